@@ -1,0 +1,101 @@
+//! Plain-old-data structs shared with the WGSL stages. Every struct here has a WGSL twin of the
+//! same name and layout (the comments name the file); `tests/shaders.rs` checks the sizes.
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::projection::{Projection, Vertical};
+
+/// A scene vertex as the stages read it (`SceneVertex` in shaders/prepare.wgsl). 64 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SceneVertex {
+    pub position: [f32; 3],
+    pub material: u32,
+    pub normal: [f32; 3],
+    pub _pad0: u32,
+    pub color: [f32; 4],
+    pub uv: [f32; 2],
+    pub _pad1: [f32; 2],
+}
+
+/// A vertex of a prepared triangle (`DrawVertex` in shaders/prepare.wgsl and raster.wgsl),
+/// in the viewer frame. `theta_ref` is the azimuth the vertex stage unwraps θ around; seam
+/// copies carry it shifted by ±2π. 64 bytes; also the vertex-buffer layout of the raster stage.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct DrawVertex {
+    pub position: [f32; 3],
+    pub theta_ref: f32,
+    pub normal: [f32; 3],
+    pub material: u32,
+    pub color: [f32; 4],
+    pub uv: [f32; 2],
+    pub _pad: [f32; 2],
+}
+
+/// `Projection` in shaders/projection.wgsl. 32 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ProjectionUniform {
+    pub screen_radius: f32,
+    pub eye_radius: f32,
+    pub width: f32,
+    pub height: f32,
+    pub acos_eye_screen: f32,
+    pub vertical_exact: u32,
+    pub pixels_per_metre: f32,
+    pub _pad: f32,
+}
+
+impl From<&Projection> for ProjectionUniform {
+    fn from(p: &Projection) -> Self {
+        ProjectionUniform {
+            screen_radius: p.screen_radius,
+            eye_radius: p.eye_radius,
+            width: p.width as f32,
+            height: p.height as f32,
+            acos_eye_screen: p.acos_eye_screen(),
+            vertical_exact: (p.vertical == Vertical::Exact) as u32,
+            pixels_per_metre: p.pixels_per_metre(),
+            _pad: 0.0,
+        }
+    }
+}
+
+/// `PrepareParams` in shaders/prepare.wgsl. 112 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct PrepareParams {
+    /// World → viewer frame (column-major, as glam stores it).
+    pub view: [[f32; 4]; 4],
+    pub projection: ProjectionUniform,
+    /// Every output point is at least this far from the vertical axis (see prepare.rs).
+    pub axis_clearance: f32,
+    pub triangle_count: u32,
+    /// Output capacity in triangles; writes beyond it are counted but not made.
+    pub capacity: u32,
+    /// Index of the first input triangle of this dispatch (for chunked runs).
+    pub first_triangle: u32,
+}
+
+/// `RasterParams` in shaders/raster.wgsl. 48 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct RasterParams {
+    pub projection: ProjectionUniform,
+    /// +1 right eye, −1 left eye.
+    pub eye_sign: f32,
+    /// Ambient term of the shading: colour × (ambient + (1 − ambient)·|n·l|).
+    pub ambient: f32,
+    pub _pad: [f32; 2],
+}
+
+/// `DrawIndirectArgs` as the GPU reads them.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct DrawIndirectArgs {
+    pub vertex_count: u32,
+    pub instance_count: u32,
+    pub first_vertex: u32,
+    pub first_instance: u32,
+}

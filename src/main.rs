@@ -1,0 +1,190 @@
+//! The `twister` command-line tool.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Args, Parser, Subcommand};
+use glam::Vec3;
+
+use twister::gpu::Gpu;
+use twister::output::{layout_images, write_images, write_text, Layout};
+use twister::{builtin, GpuScene, Projection, RenderSettings, Renderer, Scene, Vertical};
+
+#[derive(Parser)]
+#[command(
+    name = "twister",
+    version,
+    about = "Omnidirectional stereo (TWISTER concentric-mosaic) rendering on the GPU"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene into the left- and right-eye panoramas.
+    Render(RenderArgs),
+}
+
+#[derive(Args)]
+struct ViewArgs {
+    /// Image width per eye in pixels (the full 360°).
+    #[arg(long, default_value_t = 3168)]
+    width: u32,
+    /// Image height per eye in pixels.
+    #[arg(long, default_value_t = 600)]
+    height: u32,
+    /// R_T: radius of the display cylinder, metres.
+    #[arg(long, default_value_t = 1.0)]
+    screen_radius: f32,
+    /// d_e: radius of the circle the eyes move on, metres.
+    #[arg(long, default_value_t = 0.032)]
+    eye_radius: f32,
+    /// Vertical model: paper (v = R_T·y/r) or exact (pinhole on the eye circle).
+    #[arg(long, value_enum, default_value_t = Vertical::Paper)]
+    vertical: Vertical,
+    /// Viewer position x,y,z in scene units.
+    #[arg(long, value_parser = parse_vec3, default_value = "0,0,0", allow_hyphen_values = true)]
+    viewer: Vec3,
+    /// Turn of the view about the vertical axis, degrees; positive turns left.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    yaw: f32,
+}
+
+#[derive(Args)]
+struct RenderArgs {
+    /// Scene to render: builtin:demo, builtin:sphere100, builtin:sphere1024, builtin:triangle@D.
+    #[arg(default_value = "builtin:demo")]
+    scene: String,
+    /// Output folder.
+    #[arg(long, default_value = "out")]
+    out: PathBuf,
+    #[command(flatten)]
+    view: ViewArgs,
+    /// Output layout: eyes (left.png, right.png), top-bottom (stereo.png), twister (four W/2×H images).
+    #[arg(long, value_enum, default_value_t = Layout::Eyes)]
+    layout: Layout,
+    /// Background colour R,G,B, each 0–255.
+    #[arg(long, value_parser = parse_rgb, default_value = "26,26,31")]
+    background: [f32; 3],
+    /// Write render statistics as JSON to this file.
+    #[arg(long)]
+    stats: Option<PathBuf>,
+}
+
+fn parse_vec3(s: &str) -> Result<Vec3, String> {
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("'{s}': {e}"))?;
+    match v[..] {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Vec3::new(x, y, z)),
+        _ => Err(format!("'{s}': expected three finite numbers x,y,z")),
+    }
+}
+
+fn parse_rgb(s: &str) -> Result<[f32; 3], String> {
+    let v: Vec<u32> = s
+        .split(',')
+        .map(|x| x.trim().parse::<u32>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("'{s}': {e}"))?;
+    match v[..] {
+        [r, g, b] if r <= 255 && g <= 255 && b <= 255 => {
+            Ok([r as f32 / 255.0, g as f32 / 255.0, b as f32 / 255.0])
+        }
+        _ => Err(format!("'{s}': expected R,G,B with each channel 0–255")),
+    }
+}
+
+impl ViewArgs {
+    fn settings(&self) -> Result<RenderSettings, String> {
+        let projection = Projection {
+            screen_radius: self.screen_radius,
+            eye_radius: self.eye_radius,
+            width: self.width,
+            height: self.height,
+            vertical: self.vertical,
+        };
+        projection.validate()?;
+        if !self.yaw.is_finite() {
+            return Err("--yaw must be a finite number of degrees".into());
+        }
+        Ok(RenderSettings {
+            projection,
+            viewer: self.viewer,
+            yaw_deg: self.yaw,
+            ..Default::default()
+        })
+    }
+}
+
+fn load_scene(spec: &str, projection: &Projection) -> Result<Scene, String> {
+    if spec.starts_with("builtin:") {
+        return builtin::builtin_scene(spec, projection);
+    }
+    Err(format!(
+        "{spec}: loading scene files is not supported yet; use one of {}",
+        builtin::NAMES.join(", ")
+    ))
+}
+
+fn render(args: &RenderArgs) -> Result<(), String> {
+    let mut settings = args.view.settings()?;
+    settings.background = args.background;
+    let scene = load_scene(&args.scene, &settings.projection)?;
+    scene
+        .validate()
+        .map_err(|e| format!("{}: {e}", args.scene))?;
+    let gpu = Gpu::new().map_err(|e| e.to_string())?;
+    let adapter = gpu.adapter_description();
+    let renderer = Renderer::new(gpu);
+    let gpu_scene =
+        GpuScene::upload(&renderer.gpu, &scene).map_err(|e| format!("{}: {e}", args.scene))?;
+    let frame = renderer.render(&gpu_scene, &settings)?;
+    let t = std::time::Instant::now();
+    let written = write_images(&args.out, &layout_images(&frame, args.layout))?;
+    let ms_write = t.elapsed().as_secs_f64() * 1e3;
+    for p in &written {
+        println!("{}", p.display());
+    }
+    if let Some(path) = &args.stats {
+        let s = &frame.stats;
+        let json = serde_json::json!({
+            "scene": args.scene,
+            "triangles_in": s.triangles_in,
+            "triangles_drawn": s.triangles_drawn,
+            "chunks": s.chunks,
+            "width": settings.projection.width,
+            "height": settings.projection.height,
+            "screen_radius": settings.projection.screen_radius,
+            "eye_radius": settings.projection.eye_radius,
+            "vertical": settings.projection.vertical,
+            "layout": args.layout,
+            "adapter": adapter,
+            "ms_prepare": s.ms_prepare,
+            "ms_raster": s.ms_raster,
+            "ms_readback": s.ms_readback,
+            "ms_write": ms_write,
+            "ms_total": s.ms_total + ms_write,
+        });
+        write_text(path, &serde_json::to_string_pretty(&json).unwrap())?;
+    }
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::Render(args) => render(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

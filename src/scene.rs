@@ -1,0 +1,92 @@
+//! A scene: indexed triangles with per-vertex attributes, in world units (metres after
+//! `scale`), plus the named objects they belong to.
+
+use crate::gpu_types::SceneVertex;
+
+/// A named range of triangles (a glTF mesh instance, an OBJ object, a built-in shape).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Object {
+    pub name: String,
+    pub first_triangle: u32,
+    pub triangle_count: u32,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct Scene {
+    pub name: String,
+    pub vertices: Vec<SceneVertex>,
+    /// Three indices per triangle.
+    pub indices: Vec<u32>,
+    pub objects: Vec<Object>,
+}
+
+impl Scene {
+    pub fn new(name: impl Into<String>) -> Self {
+        Scene {
+            name: name.into(),
+            ..Default::default()
+        }
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+
+    /// Appends a mesh as one object; `indices` refer to `vertices`.
+    pub fn add_mesh(&mut self, name: impl Into<String>, vertices: &[SceneVertex], indices: &[u32]) {
+        let base = self.vertices.len() as u32;
+        let first = self.triangle_count() as u32;
+        self.vertices.extend_from_slice(vertices);
+        self.indices.extend(indices.iter().map(|i| i + base));
+        self.objects.push(Object {
+            name: name.into(),
+            first_triangle: first,
+            triangle_count: (indices.len() / 3) as u32,
+        });
+    }
+
+    /// Checks what the GPU stages rely on: whole triangles, indices in range, finite values.
+    /// The error names the problem; callers add the file name.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.indices.len() % 3 != 0 {
+            return Err(format!(
+                "index count {} is not a multiple of 3",
+                self.indices.len()
+            ));
+        }
+        let n = self.vertices.len();
+        if let Some((k, i)) = self
+            .indices
+            .iter()
+            .enumerate()
+            .find(|(_, &i)| i as usize >= n)
+        {
+            return Err(format!(
+                "triangle {} uses vertex index {i}, but there are only {n} vertices",
+                k / 3
+            ));
+        }
+        for (k, v) in self.vertices.iter().enumerate() {
+            if !v
+                .position
+                .iter()
+                .chain(&v.normal)
+                .chain(&v.color)
+                .chain(&v.uv)
+                .all(|x| x.is_finite())
+            {
+                return Err(format!(
+                    "vertex {k} has a NaN or infinite coordinate {:?}",
+                    v.position
+                ));
+            }
+        }
+        if self.indices.len() / 3 > u32::MAX as usize / 64 {
+            return Err(format!(
+                "{} triangles is more than twister can index",
+                self.indices.len() / 3
+            ));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,83 @@
+//! Every WGSL file in shaders/ is validated with naga: the shared projection module alone, and
+//! each stage as it is loaded (with its modules composed in front).
+
+use twister::shaders::{compose, PROJECTION, STAGES};
+
+fn validate(name: &str, source: &str) {
+    let module = match naga::front::wgsl::parse_str(source) {
+        Ok(m) => m,
+        Err(e) => panic!(
+            "{name}: parse error\n{}",
+            e.emit_to_string_with_path(source, name)
+        ),
+    };
+    let mut validator = naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::all(),
+    );
+    if let Err(e) = validator.validate(&module) {
+        panic!(
+            "{name}: validation error\n{}",
+            e.emit_to_string_with_path(source, name)
+        );
+    }
+}
+
+#[test]
+fn every_wgsl_file_validates_with_naga() {
+    validate("shaders/projection.wgsl", PROJECTION);
+    for stage in STAGES {
+        validate(stage.file, &compose(stage));
+    }
+    // Every file in shaders/ is covered: the projection module or a registered stage.
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let name = format!("shaders/{}", entry.unwrap().file_name().to_string_lossy());
+        assert!(
+            name == "shaders/projection.wgsl" || STAGES.iter().any(|s| s.file == name),
+            "{name} is not registered in twister::shaders::STAGES"
+        );
+    }
+}
+
+#[test]
+fn uniform_struct_sizes_match_wgsl() {
+    use twister::gpu_types::*;
+    // Sizes naga computes for the WGSL structs must equal the Rust twins'.
+    let size_of = |stage: &twister::shaders::Stage, name: &str| {
+        let module = naga::front::wgsl::parse_str(&compose(stage)).unwrap();
+        let mut layouter = naga::proc::Layouter::default();
+        layouter.update(module.to_ctx()).unwrap();
+        let (h, _) = module
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("{name}"));
+        layouter[h].size as usize
+    };
+    let (prepare, raster) = (&twister::shaders::PREPARE, &twister::shaders::RASTER);
+    assert_eq!(
+        size_of(prepare, "SceneVertex"),
+        std::mem::size_of::<SceneVertex>()
+    );
+    assert_eq!(
+        size_of(prepare, "DrawVertex"),
+        std::mem::size_of::<DrawVertex>()
+    );
+    assert_eq!(
+        size_of(prepare, "Projection"),
+        std::mem::size_of::<ProjectionUniform>()
+    );
+    assert_eq!(
+        size_of(prepare, "PrepareParams"),
+        std::mem::size_of::<PrepareParams>()
+    );
+    assert_eq!(
+        size_of(prepare, "DrawIndirectArgs"),
+        std::mem::size_of::<DrawIndirectArgs>()
+    );
+    assert_eq!(
+        size_of(raster, "RasterParams"),
+        std::mem::size_of::<RasterParams>()
+    );
+}
