@@ -55,10 +55,10 @@ struct DrawIndirectArgs {
 @group(0) @binding(5) var<storage, read_write> draw_args: DrawIndirectArgs;
 
 const SECTORS: u32 = 8u;
-const MAX_SPAN: f32 = 1.57079632679490;  // π/2
-const QUARTER_PI: f32 = 0.785398163397448;
-const EIGHTH_PI: f32 = 0.392699081698724;
+const MAX_SPAN: f32 = 1.6;  // rad, a little over 90°: no round angle, so meshes rarely sit on it
 const MAX_POLY: u32 = 8u;
+const SNAP: f32 = 1e-6;
+const DUPLICATE_EPS: f32 = 1e-6; // barycentric distance below which clipped vertices coincide
 
 // The input triangle in the viewer frame, shared by the helpers below.
 var<private> tri_position: array<vec3<f32>, 3>;
@@ -77,9 +77,23 @@ fn bary_position(b: vec3<f32>) -> vec3<f32> {
     return b.x * tri_position[0] + b.y * tri_position[1] + b.z * tri_position[2];
 }
 
-// Half-plane a·x + b·z ≥ c, stored as (a, b, c).
+// Signed distance to the half-plane a·x + b·z ≥ c, stored as (a, b, c). Points within a
+// relative 1e-6 of the line count as on it, so that the CPU twin and the GPU (whose rounding
+// differs in the last bits) take the same side for vertices that lie on a sector boundary.
 fn plane_distance(plane: vec3<f32>, p: vec3<f32>) -> f32 {
-    return plane.x * p.x + plane.y * p.z - plane.z;
+    let d = plane.x * p.x + plane.y * p.z - plane.z;
+    let scale = abs(plane.x * p.x) + abs(plane.y * p.z) + abs(plane.z);
+    return select(d, 0.0, abs(d) <= SNAP * scale);
+}
+
+// Appends a clipped vertex unless it repeats the previous one (a corner lying on the clip line
+// would otherwise come out twice, making a zero-area sliver).
+fn push_clipped(n: u32, b: vec3<f32>) -> u32 {
+    if (n > 0u && all(abs(b - scratch[n - 1u]) <= vec3<f32>(DUPLICATE_EPS))) {
+        return n;
+    }
+    scratch[n] = b;
+    return n + 1u;
 }
 
 // Sutherland–Hodgman clip of `poly` against one half-plane, in place.
@@ -91,13 +105,14 @@ fn clip_polygon(plane: vec3<f32>) {
         let d0 = plane_distance(plane, bary_position(cur));
         let d1 = plane_distance(plane, bary_position(next));
         if (d0 >= 0.0) {
-            scratch[n] = cur;
-            n += 1u;
+            n = push_clipped(n, cur);
         }
         if ((d0 >= 0.0) != (d1 >= 0.0)) {
-            scratch[n] = cur + (next - cur) * (d0 / (d0 - d1));
-            n += 1u;
+            n = push_clipped(n, cur + (next - cur) * (d0 / (d0 - d1)));
         }
+    }
+    if (n > 1u && all(abs(scratch[n - 1u] - scratch[0]) <= vec3<f32>(DUPLICATE_EPS))) {
+        n -= 1u;
     }
     for (var i = 0u; i < n; i++) {
         poly[i] = scratch[i];
@@ -105,10 +120,19 @@ fn clip_polygon(plane: vec3<f32>) {
     poly_count = n;
 }
 
-fn sector_boundary(k: u32) -> vec2<f32> {
-    let phi = -PI + f32(k) * QUARTER_PI;
-    return vec2<f32>(cos(phi), sin(phi));
-}
+// (cos, sin) of the sector boundaries −π + k·π/4 and of the sector middles, as exact tables
+// shared with the CPU twin (the driver's cos/sin would differ from Rust's in the last bits).
+const H: f32 = 0.707106781186548;
+const C8: f32 = 0.923879532511287;
+const S8: f32 = 0.382683432365090;
+const BOUNDARY = array<vec2<f32>, 9>(
+    vec2<f32>(-1.0, 0.0), vec2<f32>(-H, -H), vec2<f32>(0.0, -1.0), vec2<f32>(H, -H),
+    vec2<f32>(1.0, 0.0), vec2<f32>(H, H), vec2<f32>(0.0, 1.0), vec2<f32>(-H, H), vec2<f32>(-1.0, 0.0),
+);
+const MIDDLE = array<vec2<f32>, 8>(
+    vec2<f32>(-C8, -S8), vec2<f32>(-S8, -C8), vec2<f32>(S8, -C8), vec2<f32>(C8, -S8),
+    vec2<f32>(C8, S8), vec2<f32>(S8, C8), vec2<f32>(-S8, C8), vec2<f32>(-C8, S8),
+);
 
 fn segment_distance(a: vec2<f32>, b: vec2<f32>) -> f32 {
     let ab = b - a;
@@ -208,7 +232,7 @@ fn prepare(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     let e1 = vec3<f32>(0.0, 1.0, 0.0);
     let e2 = vec3<f32>(0.0, 0.0, 1.0);
     let clearance = params.axis_clearance;
-    if (!needs_axis_split(clearance / cos(EIGHTH_PI))) {
+    if (!needs_axis_split(clearance / C8)) {
         emit(e0, e1, e2);
         return;
     }
@@ -217,12 +241,12 @@ fn prepare(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         poly[1] = e1;
         poly[2] = e2;
         poly_count = 3u;
-        let d0 = sector_boundary(s);
-        let d1 = sector_boundary(s + 1u);
-        let mid = -PI + f32(s) * QUARTER_PI + EIGHTH_PI;
+        let d0 = BOUNDARY[s];
+        let d1 = BOUNDARY[s + 1u];
+        let mid = MIDDLE[s];
         clip_polygon(vec3<f32>(d0.x, d0.y, 0.0));
         clip_polygon(vec3<f32>(-d1.x, -d1.y, 0.0));
-        clip_polygon(vec3<f32>(sin(mid), -cos(mid), clearance));
+        clip_polygon(vec3<f32>(mid.y, -mid.x, clearance));
         for (var i = 1u; i + 1u < poly_count; i++) {
             emit(poly[0], poly[i], poly[i + 1u]);
         }

@@ -36,12 +36,44 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use crate::gpu_types::{DrawVertex, PrepareParams, SceneVertex};
 use crate::projection::{azimuth, horizontal_radius, wrap_angle, Projection};
-use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, FRAC_PI_8, PI, TAU};
+use std::f32::consts::{PI, TAU};
 
 /// Number of sectors an axis triangle is split into.
 pub const SECTORS: u32 = 8;
-/// Triangles spanning more azimuth than this are split into sectors too.
-pub const MAX_SPAN: f32 = FRAC_PI_2;
+/// Triangles spanning more azimuth than this (a little over 90°) are split into sectors too. Not
+/// a round angle, so that structured meshes rarely sit exactly on the threshold.
+pub const MAX_SPAN: f32 = 1.6;
+/// Signed distances within this fraction of their terms' magnitude count as on the clip line,
+/// so that the CPU and the GPU (whose rounding differs in the last bits) agree for vertices
+/// lying on a sector boundary.
+const SNAP: f32 = 1e-6;
+
+const H: f32 = std::f32::consts::FRAC_1_SQRT_2;
+const C8: f32 = 0.923_879_5; // cos(π/8)
+const S8: f32 = 0.382_683_43; // sin(π/8)
+/// (cos, sin) of the sector boundaries −π + k·π/4, an exact table shared with the WGSL.
+const BOUNDARY: [(f32, f32); 9] = [
+    (-1.0, 0.0),
+    (-H, -H),
+    (0.0, -1.0),
+    (H, -H),
+    (1.0, 0.0),
+    (H, H),
+    (0.0, 1.0),
+    (-H, H),
+    (-1.0, 0.0),
+];
+/// (cos, sin) of the sector middles −π + k·π/4 + π/8.
+const MIDDLE: [(f32, f32); 8] = [
+    (-C8, -S8),
+    (-S8, -C8),
+    (S8, -C8),
+    (C8, -S8),
+    (C8, S8),
+    (S8, C8),
+    (-S8, C8),
+    (-C8, S8),
+];
 /// Upper bound of output triangles per input triangle: 8 sectors × 4 fan triangles × 2 copies.
 pub const MAX_OUT_PER_TRIANGLE: u32 = SECTORS * 4 * 2;
 
@@ -53,7 +85,7 @@ pub fn axis_clearance(projection: &Projection) -> f32 {
 
 /// A triangle that comes nearer the axis than this is split into sectors.
 pub fn split_radius(axis_clearance: f32) -> f32 {
-    axis_clearance / FRAC_PI_8.cos()
+    axis_clearance / C8
 }
 
 pub fn prepare_params(
@@ -112,41 +144,58 @@ struct HalfPlane {
 
 impl HalfPlane {
     fn distance(&self, p: Vec3) -> f32 {
-        self.a * p.x + self.b * p.z - self.c
+        let d = self.a * p.x + self.b * p.z - self.c;
+        let scale = (self.a * p.x).abs() + (self.b * p.z).abs() + self.c.abs();
+        if d.abs() <= SNAP * scale {
+            0.0
+        } else {
+            d
+        }
     }
 }
 
+/// Barycentric distance below which two clipped vertices are the same point.
+const DUPLICATE_EPS: f32 = 1e-6;
+
+fn coincide(a: Vec3, b: Vec3) -> bool {
+    (a - b).abs().max_element() <= DUPLICATE_EPS
+}
+
 /// Sutherland–Hodgman clip of a convex polygon (barycentric corners) against one half-plane.
+/// A vertex that repeats the previous one (a corner on the clip line) is dropped, so no
+/// zero-area slivers come out.
 fn clip_polygon(tri: &Triangle, poly: &[Vec3], plane: HalfPlane) -> Vec<Vec3> {
-    let mut out = Vec::with_capacity(poly.len() + 1);
+    let mut out: Vec<Vec3> = Vec::with_capacity(poly.len() + 1);
+    let push = |b: Vec3, out: &mut Vec<Vec3>| {
+        if out.last().is_none_or(|&l| !coincide(l, b)) {
+            out.push(b);
+        }
+    };
     for i in 0..poly.len() {
         let cur = poly[i];
         let next = poly[(i + 1) % poly.len()];
         let d0 = plane.distance(tri.position(cur));
         let d1 = plane.distance(tri.position(next));
         if d0 >= 0.0 {
-            out.push(cur);
+            push(cur, &mut out);
         }
         if (d0 >= 0.0) != (d1 >= 0.0) {
-            out.push(cur + (next - cur) * (d0 / (d0 - d1)));
+            push(cur + (next - cur) * (d0 / (d0 - d1)), &mut out);
         }
     }
+    if out.len() > 1 && coincide(out[out.len() - 1], out[0]) {
+        out.pop();
+    }
     out
-}
-
-/// Boundary k of the sectors lies at azimuth −π + k·π/4; (cos, sin) of it.
-fn sector_boundary(k: u32) -> (f32, f32) {
-    let phi = -PI + k as f32 * FRAC_PI_4;
-    (phi.cos(), phi.sin())
 }
 
 /// The three half-planes of sector s: θ ≥ boundary s, θ ≤ boundary s+1, beyond the chord.
 fn sector_planes(s: u32, clearance: f32) -> [HalfPlane; 3] {
     // With P = (X, Y) = (−z, x), θ is P's polar angle. cross(d0, P) ≥ 0 ⇔ θ ≥ φ0;
     // cross(P, d1) ≥ 0 ⇔ θ ≤ φ1; dot(P, d_mid) ≥ clearance is the chord.
-    let (c0, s0) = sector_boundary(s);
-    let (c1, s1) = sector_boundary(s + 1);
-    let mid = -PI + s as f32 * FRAC_PI_4 + FRAC_PI_8;
+    let (c0, s0) = BOUNDARY[s as usize];
+    let (c1, s1) = BOUNDARY[s as usize + 1];
+    let (cm, sm) = MIDDLE[s as usize];
     [
         HalfPlane {
             a: c0,
@@ -159,8 +208,8 @@ fn sector_planes(s: u32, clearance: f32) -> [HalfPlane; 3] {
             c: 0.0,
         },
         HalfPlane {
-            a: mid.sin(),
-            b: -mid.cos(),
+            a: sm,
+            b: -cm,
             c: clearance,
         },
     ]
@@ -276,6 +325,7 @@ fn emit(projection: &Projection, tri: &Triangle, corners: [Vec3; 3], out: &mut V
 mod tests {
     use super::*;
     use crate::projection::{Eye, Projection};
+    use std::f32::consts::{FRAC_PI_4, FRAC_PI_8};
 
     fn vertex(p: [f32; 3]) -> SceneVertex {
         SceneVertex {

@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# The project's test command (README quick start, and what CI runs).
+# Installs Mesa's software Vulkan driver (lavapipe) when no Vulkan driver is present, then runs
+# the whole test suite. Extra arguments go to `cargo test`.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+have_vulkan_driver() {
+    ldconfig -p 2>/dev/null | grep -q 'libvulkan.so.1' || return 1
+    ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json /usr/local/share/vulkan/icd.d/*.json 2>/dev/null | grep -q .
+}
+
+if ! have_vulkan_driver; then
+    echo "No Vulkan driver found: installing Mesa's software Vulkan driver (lavapipe)..."
+    sudo=""
+    if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
+    export DEBIAN_FRONTEND=noninteractive
+    $sudo apt-get update -qq
+    $sudo apt-get install -y -qq --no-install-recommends mesa-vulkan-drivers libvulkan1 >/dev/null
+fi
+
+# Quiet Mesa's device-select layer, which complains when XDG_RUNTIME_DIR is unset.
+export NODEVICE_SELECT=1
+exec cargo test "$@"

@@ -1,0 +1,163 @@
+//! The `twister` binary as a user runs it.
+
+use std::path::Path;
+use std::process::Command;
+
+fn twister() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_twister"));
+    c.env("NODEVICE_SELECT", "1");
+    c
+}
+
+fn tmp(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("twister-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn png_size(p: &Path) -> (u32, u32) {
+    image::image_dimensions(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+#[test]
+fn render_writes_every_layout_and_stats() {
+    let out = tmp("layouts");
+    let size = ["--width", "320", "--height", "60"];
+    let run = |layout: &str, dir: &Path, extra: &[&str]| {
+        let o = twister()
+            .args(["render", "builtin:sphere100", "--layout", layout, "--out"])
+            .arg(dir)
+            .args(size)
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "{layout}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    };
+    let stats = out.join("stats.json");
+    run(
+        "eyes",
+        &out.join("eyes"),
+        &["--stats", stats.to_str().unwrap()],
+    );
+    assert_eq!(png_size(&out.join("eyes/left.png")), (320, 60));
+    assert_eq!(png_size(&out.join("eyes/right.png")), (320, 60));
+    run("top-bottom", &out.join("tb"), &[]);
+    assert_eq!(png_size(&out.join("tb/stereo.png")), (320, 120));
+    run("twister", &out.join("tw"), &[]);
+    for f in ["left_front", "left_back", "right_front", "right_back"] {
+        assert_eq!(png_size(&out.join(format!("tw/{f}.png"))), (160, 60), "{f}");
+    }
+    // The front image is the middle half of the eye image; the back one the outer halves.
+    let eye = image::open(out.join("eyes/left.png")).unwrap().to_rgba8();
+    let front = image::open(out.join("tw/left_front.png"))
+        .unwrap()
+        .to_rgba8();
+    let back = image::open(out.join("tw/left_back.png"))
+        .unwrap()
+        .to_rgba8();
+    for y in [0, 30, 59] {
+        for x in [0u32, 79, 159] {
+            assert_eq!(front.get_pixel(x, y), eye.get_pixel(80 + x, y));
+            assert_eq!(back.get_pixel(x, y), eye.get_pixel((240 + x) % 320, y));
+        }
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    for key in [
+        "scene",
+        "triangles_in",
+        "triangles_drawn",
+        "width",
+        "height",
+        "adapter",
+        "ms_prepare",
+        "ms_raster",
+        "ms_total",
+    ] {
+        assert!(json.get(key).is_some(), "stats lack {key}: {json}");
+    }
+    assert_eq!(json["triangles_in"], 100);
+    assert_eq!(json["width"], 320);
+    assert!(json["triangles_drawn"].as_u64().unwrap() >= 100);
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn background_and_view_flags_take_effect() {
+    let out = tmp("bg");
+    let o = twister()
+        .args([
+            "render",
+            "builtin:sphere100",
+            "--width",
+            "200",
+            "--height",
+            "40",
+            "--background",
+            "255,0,0",
+            "--yaw",
+            "180",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let img = image::open(out.join("left.png")).unwrap().to_rgba8();
+    // Turned around, the sphere is behind: the centre column is background, the edge is not.
+    assert_eq!(img.get_pixel(100, 20).0, [255, 0, 0, 255]);
+    assert_ne!(img.get_pixel(0, 20).0, [255, 0, 0, 255]);
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn no_gpu_driver_is_one_clear_error_without_panic_or_output() {
+    let out = tmp("nogpu");
+    // Only the Metal backend allowed: no adapter on Linux, as on a machine without a driver.
+    let o = twister()
+        .env("WGPU_BACKEND", "metal")
+        .args(["render", "--width", "64", "--height", "16", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("no GPU adapter found") && err.contains("mesa-vulkan-drivers"),
+        "{err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(err.lines().count(), 1, "one line: {err}");
+    assert!(
+        !out.exists(),
+        "no output folder is made when rendering fails"
+    );
+}
+
+#[test]
+fn bad_arguments_are_clear_errors() {
+    let cases: &[(&[&str], &str)] = &[
+        (&["render", "builtin:nope"], "unknown built-in scene"),
+        (&["render", "builtin:triangle@abc"], "builtin:triangle@abc"),
+        (&["render", "--eye-radius", "2"], "--eye-radius"),
+        (&["render", "--width", "0"], "image size"),
+        (&["render", "--viewer", "1,2"], "three finite numbers"),
+        (&["render", "--background", "300,0,0"], "0–255"),
+        (&["render", "scene.obj"], "scene.obj"),
+    ];
+    for (args, needle) in cases {
+        let o = twister()
+            .args(*args)
+            .args(["--out", "/nonexistent/never"])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{args:?} succeeded");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+}
