@@ -20,7 +20,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     eprintln!(
         "{} triangles in, {} drawn, {:.1} ms",
-        frame.stats.triangles_in, frame.stats.triangles_drawn, frame.stats.ms_total
+        frame.stats.triangles_in, frame.stats.triangles_out, frame.stats.ms_total
     );
     Ok(())
 }

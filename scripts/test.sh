@@ -6,8 +6,11 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 have_vulkan_driver() {
-    ldconfig -p 2>/dev/null | grep -q 'libvulkan.so.1' || return 1
-    ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json /usr/local/share/vulkan/icd.d/*.json 2>/dev/null | grep -q .
+    # Capture first: with pipefail, `grep -q` closing the pipe early would fail the pipeline.
+    local libs icds
+    libs=$(ldconfig -p 2>/dev/null || true)
+    icds=$(ls /usr/share/vulkan/icd.d/*.json /etc/vulkan/icd.d/*.json /usr/local/share/vulkan/icd.d/*.json 2>/dev/null || true)
+    [[ "$libs" == *libvulkan.so.1* && -n "$icds" ]]
 }
 
 if ! have_vulkan_driver; then

@@ -29,8 +29,10 @@ struct VertexOut {
 
 @vertex
 fn vs_main(in: VertexIn) -> VertexOut {
-    // Unwrap θ around the triangle's reference so the triangle is never split by the seam.
-    let theta = in.theta_ref + wrap_angle(azimuth(in.position) - in.theta_ref);
+    // Unwrap θ by whole turns towards the triangle's reference, so the triangle is never split
+    // by the seam; a vertex shared by neighbours gets the same bits in both.
+    let theta0 = azimuth(in.position);
+    let theta = theta0 + TAU * floor((in.theta_ref - theta0) / TAU + 0.5);
     let uvd = project_with_azimuth(params.projection, in.position, theta, params.eye_sign);
     var out: VertexOut;
     out.clip = to_clip(params.projection, uvd);

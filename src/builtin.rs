@@ -21,12 +21,7 @@ pub const SEAM_SPHERE_RADIUS: f32 = 0.8;
 /// Height of the demo's floor below the eyes.
 pub const DEMO_FLOOR_Y: f32 = -1.5;
 
-pub const NAMES: &[&str] = &[
-    "builtin:demo",
-    "builtin:sphere100",
-    "builtin:sphere1024",
-    "builtin:triangle@D",
-];
+pub const NAMES: &[&str] = &["builtin:demo", "builtin:sphere100", "builtin:sphere1024", "builtin:triangle@D"];
 
 /// Builds a built-in scene by name; `projection` sizes the screen-filling ones.
 pub fn builtin_scene(name: &str, projection: &Projection) -> Result<Scene, String> {
@@ -42,36 +37,24 @@ pub fn builtin_scene(name: &str, projection: &Projection) -> Result<Scene, Strin
                     .parse()
                     .ok()
                     .filter(|d: &f32| d.is_finite() && *d > projection.eye_radius)
-                    .ok_or_else(|| format!("{name}: the distance after '@' must be a number of metres beyond the eye circle"))?;
+                    .ok_or_else(|| {
+                        format!("{name}: the distance after '@' must be a number of metres beyond the eye circle")
+                    })?;
                 Ok(paper_triangle(distance, projection))
             } else {
-                Err(format!(
-                    "unknown built-in scene '{name}'; built-in scenes are {}",
-                    NAMES.join(", ")
-                ))
+                Err(format!("unknown built-in scene '{name}'; built-in scenes are {}", NAMES.join(", ")))
             }
         }
     }
 }
 
 fn vertex(position: Vec3, normal: Vec3, color: [f32; 4]) -> SceneVertex {
-    SceneVertex {
-        position: position.into(),
-        normal: normal.into(),
-        color,
-        ..Default::default()
-    }
+    SceneVertex { position: position.into(), normal: normal.into(), color, ..Default::default() }
 }
 
 /// A UV sphere with `slices` around and `stacks` from pole to pole: 2·slices·(stacks − 1)
 /// triangles (the pole rows are single triangles).
-pub fn uv_sphere(
-    center: Vec3,
-    radius: f32,
-    slices: u32,
-    stacks: u32,
-    color: [f32; 4],
-) -> (Vec<SceneVertex>, Vec<u32>) {
+pub fn uv_sphere(center: Vec3, radius: f32, slices: u32, stacks: u32, color: [f32; 4]) -> (Vec<SceneVertex>, Vec<u32>) {
     let mut v = Vec::new();
     let mut idx = Vec::new();
     for i in 0..=stacks {
@@ -85,12 +68,7 @@ pub fn uv_sphere(
     let row = slices + 1;
     for i in 0..stacks {
         for j in 0..slices {
-            let (a, b, c, d) = (
-                i * row + j,
-                i * row + j + 1,
-                (i + 1) * row + j,
-                (i + 1) * row + j + 1,
-            );
+            let (a, b, c, d) = (i * row + j, i * row + j + 1, (i + 1) * row + j, (i + 1) * row + j + 1);
             if i != 0 {
                 idx.extend([a, b, c]);
             }
@@ -104,12 +82,7 @@ pub fn uv_sphere(
 
 /// Sphere of `triangles` (100 or 1024) triangles, `distance` m ahead, its silhouette filling
 /// the screen height under the paper's vertical model: R_T·ρ/√(D²−ρ²) = half height.
-pub fn screen_filling_sphere(
-    triangles: u32,
-    distance: f32,
-    projection: &Projection,
-    name: &str,
-) -> Scene {
+pub fn screen_filling_sphere(triangles: u32, distance: f32, projection: &Projection, name: &str) -> Scene {
     let k = projection.half_height_m() / projection.screen_radius;
     let radius = distance * k / (1.0 + k * k).sqrt();
     sphere_scene(triangles, Vec3::new(0.0, 0.0, -distance), radius, name)
@@ -134,8 +107,7 @@ pub fn sphere_scene(triangles: u32, center: Vec3, radius: f32, name: &str) -> Sc
 /// The paper's evaluation-1 triangle: equilateral, in the plane z = −D facing the viewer,
 /// centred on the middle row; its side projects to about H pixels (R_T·s/D metres of screen).
 pub fn paper_triangle(distance: f32, projection: &Projection) -> Scene {
-    let side = projection.height as f32 / projection.pixels_per_metre() * distance
-        / projection.screen_radius;
+    let side = projection.height as f32 / projection.pixels_per_metre() * distance / projection.screen_radius;
     let h = side * 3f32.sqrt() / 2.0;
     let z = -distance;
     let n = Vec3::Z;
@@ -169,11 +141,7 @@ pub fn demo() -> Scene {
             let (x1, z1) = ((x0 + 1.0).min(half), (z0 + 1.0).min(half));
             let (x0, z0) = (x0.max(-half), z0.max(-half));
             let light = (i + j) % 2 == 0;
-            let c = if light {
-                [0.75, 0.72, 0.65, 1.0]
-            } else {
-                [0.35, 0.33, 0.3, 1.0]
-            };
+            let c = if light { [0.75, 0.72, 0.65, 1.0] } else { [0.35, 0.33, 0.3, 1.0] };
             let p = [
                 Vec3::new(x0, floor, z1),
                 Vec3::new(x1, floor, z1),
@@ -198,30 +166,10 @@ pub fn demo() -> Scene {
     );
     // Walls, each its own colour: ahead (−z) blue, right (+x) yellow, behind (+z) grey, left teal.
     let walls = [
-        (
-            [-half, -half],
-            [half, -half],
-            [0.3, 0.4, 0.8, 1.0],
-            "wall ahead",
-        ),
-        (
-            [half, -half],
-            [half, half],
-            [0.8, 0.7, 0.25, 1.0],
-            "wall right",
-        ),
-        (
-            [half, half],
-            [-half, half],
-            [0.55, 0.55, 0.55, 1.0],
-            "wall behind",
-        ),
-        (
-            [-half, half],
-            [-half, -half],
-            [0.25, 0.6, 0.55, 1.0],
-            "wall left",
-        ),
+        ([-half, -half], [half, -half], [0.3, 0.4, 0.8, 1.0], "wall ahead"),
+        ([half, -half], [half, half], [0.8, 0.7, 0.25, 1.0], "wall right"),
+        ([half, half], [-half, half], [0.55, 0.55, 0.55, 1.0], "wall behind"),
+        ([-half, half], [-half, -half], [0.25, 0.6, 0.55, 1.0], "wall left"),
     ];
     for (a, b, c, name) in walls {
         let p = [
@@ -234,24 +182,9 @@ pub fn demo() -> Scene {
     }
     // Spheres at 1 m (ahead right), 3 m (left), 5 m (straight behind, across the seam).
     let spheres = [
-        (
-            Vec3::new(0.7071, -0.2, -0.7071),
-            0.2,
-            [0.85, 0.15, 0.1, 1.0],
-            "sphere 1 m",
-        ),
-        (
-            Vec3::new(-3.0, 0.3, 0.0),
-            0.6,
-            [0.2, 0.75, 0.25, 1.0],
-            "sphere 3 m",
-        ),
-        (
-            Vec3::from(SEAM_SPHERE_CENTER),
-            SEAM_SPHERE_RADIUS,
-            SEAM_SPHERE_COLOR,
-            "sphere 5 m (seam)",
-        ),
+        (Vec3::new(0.7071, -0.2, -0.7071), 0.2, [0.85, 0.15, 0.1, 1.0], "sphere 1 m"),
+        (Vec3::new(-3.0, 0.3, 0.0), 0.6, [0.2, 0.75, 0.25, 1.0], "sphere 3 m"),
+        (Vec3::from(SEAM_SPHERE_CENTER), SEAM_SPHERE_RADIUS, SEAM_SPHERE_COLOR, "sphere 5 m (seam)"),
     ];
     for (center, radius, color, name) in spheres {
         let (v, i) = uv_sphere(center, radius, 32, 17, color);
@@ -267,18 +200,8 @@ mod tests {
     #[test]
     fn paper_spheres_have_exact_triangle_counts() {
         let p = Projection::default();
-        assert_eq!(
-            builtin_scene("builtin:sphere100", &p)
-                .unwrap()
-                .triangle_count(),
-            100
-        );
-        assert_eq!(
-            builtin_scene("builtin:sphere1024", &p)
-                .unwrap()
-                .triangle_count(),
-            1024
-        );
+        assert_eq!(builtin_scene("builtin:sphere100", &p).unwrap().triangle_count(), 100);
+        assert_eq!(builtin_scene("builtin:sphere1024", &p).unwrap().triangle_count(), 1024);
     }
 
     #[test]
@@ -295,51 +218,26 @@ mod tests {
             })
             .fold(f32::MIN, f32::max);
         let half = p.half_height_m();
-        assert!(
-            top <= half * 1.001 && top > 0.95 * half,
-            "top {top} vs half height {half}"
-        );
+        assert!(top <= half * 1.001 && top > 0.95 * half, "top {top} vs half height {half}");
     }
 
     #[test]
     fn paper_triangle_side_projects_to_image_height() {
-        let p = Projection {
-            width: 3168,
-            height: 600,
-            ..Default::default()
-        };
+        let p = Projection { width: 3168, height: 600, ..Default::default() };
         for d in [1.0, 3.0, 5.0] {
             let s = builtin_scene(&format!("builtin:triangle@{d}"), &p).unwrap();
-            let a = p
-                .project(
-                    Vec3::from(s.vertices[0].position),
-                    crate::projection::Eye::Left,
-                )
-                .unwrap();
-            let b = p
-                .project(
-                    Vec3::from(s.vertices[1].position),
-                    crate::projection::Eye::Left,
-                )
-                .unwrap();
+            let a = p.project(Vec3::from(s.vertices[0].position), crate::projection::Eye::Left).unwrap();
+            let b = p.project(Vec3::from(s.vertices[1].position), crate::projection::Eye::Left).unwrap();
             let side_px = (b.u - a.u) * p.pixels_per_radian();
-            assert!(
-                (side_px - 600.0).abs() < 0.12 * 600.0,
-                "side {side_px} px at {d} m"
-            );
+            assert!((side_px - 600.0).abs() < 0.12 * 600.0, "side {side_px} px at {d} m");
         }
     }
 
     #[test]
     fn demo_is_valid_and_unknown_names_are_errors() {
         let p = Projection::default();
-        builtin_scene("builtin:demo", &p)
-            .unwrap()
-            .validate()
-            .unwrap();
-        assert!(builtin_scene("builtin:nope", &p)
-            .unwrap_err()
-            .contains("builtin:demo"));
+        builtin_scene("builtin:demo", &p).unwrap().validate().unwrap();
+        assert!(builtin_scene("builtin:nope", &p).unwrap_err().contains("builtin:demo"));
         assert!(builtin_scene("builtin:triangle@x", &p).is_err());
         assert!(builtin_scene("builtin:triangle@0.01", &p).is_err());
     }

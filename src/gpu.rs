@@ -32,8 +32,7 @@ impl Gpu {
     }
 
     async fn new_async() -> Result<Gpu, GpuError> {
-        let instance =
-            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
         let adapter = instance
             .request_adapter(&wgpu::RequestAdapterOptions {
                 power_preference: wgpu::PowerPreference::HighPerformance,
@@ -43,8 +42,7 @@ impl Gpu {
             .map_err(|e| GpuError(format!("{NO_ADAPTER_HELP} ({e})")))?;
         let info = adapter.get_info();
         let limits = adapter.limits();
-        let wanted =
-            wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+        let wanted = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
         let features = adapter.features() & wanted;
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
@@ -54,27 +52,13 @@ impl Gpu {
                 ..Default::default()
             })
             .await
-            .map_err(|e| {
-                GpuError(format!(
-                    "the GPU adapter '{}' could not open a device: {e}",
-                    info.name
-                ))
-            })?;
-        Ok(Gpu {
-            device,
-            queue,
-            info,
-            limits,
-            features,
-        })
+            .map_err(|e| GpuError(format!("the GPU adapter '{}' could not open a device: {e}", info.name)))?;
+        Ok(Gpu { device, queue, info, limits, features })
     }
 
     /// "name (backend, device type)", for stats and logs.
     pub fn adapter_description(&self) -> String {
-        format!(
-            "{} ({:?}, {:?})",
-            self.info.name, self.info.backend, self.info.device_type
-        )
+        format!("{} ({:?}, {:?})", self.info.name, self.info.backend, self.info.device_type)
     }
 
     /// Blocks until the GPU has finished all submitted work.
@@ -84,9 +68,7 @@ impl Gpu {
 
     /// Reads a whole buffer (which must have MAP_READ usage) back to the CPU.
     pub fn read_buffer(&self, buffer: &wgpu::Buffer) -> Vec<u8> {
-        buffer.map_async(wgpu::MapMode::Read, .., |r| {
-            r.expect("mapping a readback buffer")
-        });
+        buffer.map_async(wgpu::MapMode::Read, .., |r| r.expect("mapping a readback buffer"));
         self.wait();
         let data = buffer.get_mapped_range(..).expect("mapped range").to_vec();
         buffer.unmap();

@@ -5,7 +5,7 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::projection::{Projection, Vertical};
 
-/// A scene vertex as the stages read it (`SceneVertex` in shaders/prepare.wgsl). 64 bytes.
+/// A scene vertex as the stages read it (`SceneVertex` in shaders/subdivide.wgsl). 64 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct SceneVertex {
@@ -18,7 +18,7 @@ pub struct SceneVertex {
     pub _pad1: [f32; 2],
 }
 
-/// A vertex of a prepared triangle (`DrawVertex` in shaders/prepare.wgsl and raster.wgsl),
+/// A vertex of a prepared triangle (`DrawVertex` in shaders/subdivide.wgsl and raster.wgsl),
 /// in the viewer frame. `theta_ref` is the azimuth the vertex stage unwraps θ around; seam
 /// copies carry it shifted by ±2π. 64 bytes; also the vertex-buffer layout of the raster stage.
 #[repr(C)]
@@ -62,20 +62,44 @@ impl From<&Projection> for ProjectionUniform {
     }
 }
 
-/// `PrepareParams` in shaders/prepare.wgsl. 112 bytes.
+/// `SubdivideParams` in shaders/subdivide.wgsl. 144 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct PrepareParams {
+pub struct SubdivideParams {
     /// World → viewer frame (column-major, as glam stores it).
     pub view: [[f32; 4]; 4],
     pub projection: ProjectionUniform,
-    /// Every output point is at least this far from the vertical axis (see prepare.rs).
+    /// Every output point is at least this far from the vertical axis (see subdivide.rs).
     pub axis_clearance: f32,
     pub triangle_count: u32,
-    /// Output capacity in triangles; writes beyond it are counted but not made.
-    pub capacity: u32,
-    /// Index of the first input triangle of this dispatch (for chunked runs).
+    /// Index of the first input triangle of a `plan` dispatch.
     pub first_triangle: u32,
+    /// 0 vertex, 1 fixed, 2 adaptive.
+    pub method: u32,
+    pub fixed_n: u32,
+    /// L: the longest projected edge wanted, pixels.
+    pub edge_px: f32,
+    /// N_max: the largest lattice step per piece.
+    pub max_div: u32,
+    /// Capacity of the piece buffer; `plan` counts but never writes beyond it.
+    pub piece_capacity: u32,
+    /// Capacity of the output buffer in triangles; `lattice` counts but never writes beyond it.
+    pub triangle_capacity: u32,
+    /// First piece and piece count of a `lattice` dispatch.
+    pub first_piece: u32,
+    pub piece_count: u32,
+    pub _pad: [u32; 1],
+}
+
+/// `Counters` in shaders/subdivide.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SubdivideCounters {
+    pub pieces: u32,
+    pub triangles: u32,
+    /// Bits of the largest visible output edge in pixels (an f32).
+    pub max_edge_bits: u32,
+    pub _pad: u32,
 }
 
 /// `RasterParams` in shaders/raster.wgsl. 48 bytes.

@@ -2,7 +2,8 @@
 //! panoramas (one per eye) that the TWISTER display shows around its viewer (seed 002).
 //!
 //! Stages (each a WGSL file in `shaders/` with a CPU twin of the same name here):
-//! - `prepare` ([`prepare::prepare`], `shaders/prepare.wgsl`): viewer frame, axis split, seam copies;
+//! - `subdivide` ([`subdivide::subdivide`], `shaders/subdivide.wgsl`): adaptive subdivision (eq. 5),
+//!   axis split, seam copies;
 //! - `raster` ([`raster::raster`], `shaders/raster.wgsl`): projection per vertex (eq. 1–4), shading;
 //! - `project_points` ([`projection::project_points`], `shaders/project_points.wgsl`).
 
@@ -10,12 +11,12 @@ pub mod builtin;
 pub mod gpu;
 pub mod gpu_types;
 pub mod output;
-pub mod prepare;
 pub mod projection;
 pub mod raster;
 pub mod renderer;
 pub mod scene;
 pub mod shaders;
+pub mod subdivide;
 
 pub use projection::{Eye, Projection, Vertical};
 pub use renderer::{Frame, GpuScene, RenderSettings, Renderer};

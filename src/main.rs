@@ -8,14 +8,12 @@ use glam::Vec3;
 
 use twister::gpu::Gpu;
 use twister::output::{layout_images, write_images, write_text, Layout};
+use twister::renderer::DEFAULT_MEMORY_MB;
+use twister::subdivide::{Method, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV};
 use twister::{builtin, GpuScene, Projection, RenderSettings, Renderer, Scene, Vertical};
 
 #[derive(Parser)]
-#[command(
-    name = "twister",
-    version,
-    about = "Omnidirectional stereo (TWISTER concentric-mosaic) rendering on the GPU"
-)]
+#[command(name = "twister", version, about = "Omnidirectional stereo (TWISTER concentric-mosaic) rendering on the GPU")]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -50,6 +48,18 @@ struct ViewArgs {
     /// Turn of the view about the vertical axis, degrees; positive turns left.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     yaw: f32,
+    /// Subdivision: adaptive (N = ceil(l/L) per edge), fixed:N (every edge N), vertex (none).
+    #[arg(long, value_parser = Method::parse, default_value = "adaptive")]
+    method: Method,
+    /// L: the longest projected edge `adaptive` leaves, pixels.
+    #[arg(long, default_value_t = DEFAULT_EDGE_PX)]
+    edge_px: f32,
+    /// N_max: the largest lattice step of one piece; larger polygons are pre-split.
+    #[arg(long, default_value_t = DEFAULT_MAX_DIV)]
+    max_div: u32,
+    /// Memory budget of the subdivision buffers, MiB; scenes that need more run in chunks.
+    #[arg(long, default_value_t = DEFAULT_MEMORY_MB)]
+    memory_mb: u32,
 }
 
 #[derive(Args)]
@@ -74,11 +84,8 @@ struct RenderArgs {
 }
 
 fn parse_vec3(s: &str) -> Result<Vec3, String> {
-    let v: Vec<f32> = s
-        .split(',')
-        .map(|x| x.trim().parse::<f32>())
-        .collect::<Result<_, _>>()
-        .map_err(|e| format!("'{s}': {e}"))?;
+    let v: Vec<f32> =
+        s.split(',').map(|x| x.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|e| format!("'{s}': {e}"))?;
     match v[..] {
         [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Vec3::new(x, y, z)),
         _ => Err(format!("'{s}': expected three finite numbers x,y,z")),
@@ -86,15 +93,10 @@ fn parse_vec3(s: &str) -> Result<Vec3, String> {
 }
 
 fn parse_rgb(s: &str) -> Result<[f32; 3], String> {
-    let v: Vec<u32> = s
-        .split(',')
-        .map(|x| x.trim().parse::<u32>())
-        .collect::<Result<_, _>>()
-        .map_err(|e| format!("'{s}': {e}"))?;
+    let v: Vec<u32> =
+        s.split(',').map(|x| x.trim().parse::<u32>()).collect::<Result<_, _>>().map_err(|e| format!("'{s}': {e}"))?;
     match v[..] {
-        [r, g, b] if r <= 255 && g <= 255 && b <= 255 => {
-            Ok([r as f32 / 255.0, g as f32 / 255.0, b as f32 / 255.0])
-        }
+        [r, g, b] if r <= 255 && g <= 255 && b <= 255 => Ok([r as f32 / 255.0, g as f32 / 255.0, b as f32 / 255.0]),
         _ => Err(format!("'{s}': expected R,G,B with each channel 0–255")),
     }
 }
@@ -112,12 +114,7 @@ impl ViewArgs {
         if !self.yaw.is_finite() {
             return Err("--yaw must be a finite number of degrees".into());
         }
-        Ok(RenderSettings {
-            projection,
-            viewer: self.viewer,
-            yaw_deg: self.yaw,
-            ..Default::default()
-        })
+        Ok(RenderSettings { projection, viewer: self.viewer, yaw_deg: self.yaw, ..Default::default() })
     }
 }
 
@@ -125,24 +122,18 @@ fn load_scene(spec: &str, projection: &Projection) -> Result<Scene, String> {
     if spec.starts_with("builtin:") {
         return builtin::builtin_scene(spec, projection);
     }
-    Err(format!(
-        "{spec}: loading scene files is not supported yet; use one of {}",
-        builtin::NAMES.join(", ")
-    ))
+    Err(format!("{spec}: loading scene files is not supported yet; use one of {}", builtin::NAMES.join(", ")))
 }
 
 fn render(args: &RenderArgs) -> Result<(), String> {
     let mut settings = args.view.settings()?;
     settings.background = args.background;
     let scene = load_scene(&args.scene, &settings.projection)?;
-    scene
-        .validate()
-        .map_err(|e| format!("{}: {e}", args.scene))?;
+    scene.validate().map_err(|e| format!("{}: {e}", args.scene))?;
     let gpu = Gpu::new().map_err(|e| e.to_string())?;
     let adapter = gpu.adapter_description();
     let renderer = Renderer::new(gpu);
-    let gpu_scene =
-        GpuScene::upload(&renderer.gpu, &scene).map_err(|e| format!("{}: {e}", args.scene))?;
+    let gpu_scene = GpuScene::upload(&renderer.gpu, &scene).map_err(|e| format!("{}: {e}", args.scene))?;
     let frame = renderer.render(&gpu_scene, &settings)?;
     let t = std::time::Instant::now();
     let written = write_images(&args.out, &layout_images(&frame, args.layout))?;
@@ -154,8 +145,14 @@ fn render(args: &RenderArgs) -> Result<(), String> {
         let s = &frame.stats;
         let json = serde_json::json!({
             "scene": args.scene,
+            "method": settings.method.name(),
+            "edge_px": settings.edge_px,
+            "max_div": settings.max_div,
             "triangles_in": s.triangles_in,
-            "triangles_drawn": s.triangles_drawn,
+            "triangles_out": s.triangles_out,
+            "triangles_drawn": s.triangles_out,
+            "pieces": s.pieces,
+            "max_sub_edge_px": s.max_sub_edge_px,
             "chunks": s.chunks,
             "width": settings.projection.width,
             "height": settings.projection.height,
@@ -164,7 +161,8 @@ fn render(args: &RenderArgs) -> Result<(), String> {
             "vertical": settings.projection.vertical,
             "layout": args.layout,
             "adapter": adapter,
-            "ms_prepare": s.ms_prepare,
+            "ms_subdivide": s.ms_subdivide,
+            "ms_prepare": s.ms_subdivide,
             "ms_raster": s.ms_raster,
             "ms_readback": s.ms_readback,
             "ms_write": ms_write,

@@ -31,31 +31,17 @@ pub fn columns(img: &EyeImage, start: u32, width: u32) -> EyeImage {
             rgba.extend_from_slice(&img.rgba[i..i + 4]);
         }
     }
-    EyeImage {
-        width,
-        height: img.height,
-        rgba,
-    }
+    EyeImage { width, height: img.height, rgba }
 }
 
 /// The images of a layout, with their file names.
 pub fn layout_images(frame: &Frame, layout: Layout) -> Vec<(String, EyeImage)> {
     match layout {
-        Layout::Eyes => vec![
-            ("left.png".into(), frame.left.clone()),
-            ("right.png".into(), frame.right.clone()),
-        ],
+        Layout::Eyes => vec![("left.png".into(), frame.left.clone()), ("right.png".into(), frame.right.clone())],
         Layout::TopBottom => {
             let mut rgba = frame.left.rgba.clone();
             rgba.extend_from_slice(&frame.right.rgba);
-            vec![(
-                "stereo.png".into(),
-                EyeImage {
-                    width: frame.left.width,
-                    height: 2 * frame.left.height,
-                    rgba,
-                },
-            )]
+            vec![("stereo.png".into(), EyeImage { width: frame.left.width, height: 2 * frame.left.height, rgba })]
         }
         Layout::Twister => {
             let w = frame.left.width;
@@ -63,10 +49,7 @@ pub fn layout_images(frame: &Frame, layout: Layout) -> Vec<(String, EyeImage)> {
             let mut out = Vec::new();
             for (name, img) in [("left", &frame.left), ("right", &frame.right)] {
                 out.push((format!("{name}_front.png"), columns(img, quarter, half)));
-                out.push((
-                    format!("{name}_back.png"),
-                    columns(img, quarter + half, w - half),
-                ));
+                out.push((format!("{name}_back.png"), columns(img, quarter + half, w - half)));
             }
             out
         }
@@ -75,8 +58,7 @@ pub fn layout_images(frame: &Frame, layout: Layout) -> Vec<(String, EyeImage)> {
 
 /// Writes every image into `dir` (created if missing) all-or-nothing; returns the paths.
 pub fn write_images(dir: &Path, images: &[(String, EyeImage)]) -> Result<Vec<PathBuf>, String> {
-    std::fs::create_dir_all(dir)
-        .map_err(|e| format!("{}: cannot create the output folder: {e}", dir.display()))?;
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create the output folder: {e}", dir.display()))?;
     let mut temps = Vec::new();
     let result = (|| {
         for (name, img) in images {
@@ -94,8 +76,7 @@ pub fn write_images(dir: &Path, images: &[(String, EyeImage)]) -> Result<Vec<Pat
             .map_err(|e| format!("{}: cannot write: {e}", final_path.display()))?;
         }
         for (temp, final_path) in &temps {
-            std::fs::rename(temp, final_path)
-                .map_err(|e| format!("{}: cannot write: {e}", final_path.display()))?;
+            std::fs::rename(temp, final_path).map_err(|e| format!("{}: cannot write: {e}", final_path.display()))?;
         }
         Ok(temps.iter().map(|(_, f)| f.clone()).collect())
     })();
@@ -110,14 +91,11 @@ pub fn write_images(dir: &Path, images: &[(String, EyeImage)]) -> Result<Vec<Pat
 /// Writes a text file atomically (temporary name, then rename).
 pub fn write_text(path: &Path, text: &str) -> Result<(), String> {
     if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(parent)
-            .map_err(|e| format!("{}: cannot create folder: {e}", parent.display()))?;
+        std::fs::create_dir_all(parent).map_err(|e| format!("{}: cannot create folder: {e}", parent.display()))?;
     }
     let temp = path.with_extension(format!("{}.tmp", std::process::id()));
-    std::fs::write(&temp, text)
-        .and_then(|_| std::fs::rename(&temp, path))
-        .map_err(|e| {
-            let _ = std::fs::remove_file(&temp);
-            format!("{}: cannot write: {e}", path.display())
-        })
+    std::fs::write(&temp, text).and_then(|_| std::fs::rename(&temp, path)).map_err(|e| {
+        let _ = std::fs::remove_file(&temp);
+        format!("{}: cannot write: {e}", path.display())
+    })
 }

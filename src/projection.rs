@@ -84,13 +84,7 @@ pub struct Projection {
 impl Default for Projection {
     /// The paper's TWISTER images: 3168×600 per eye, R_T = 1 m, d_e = 0.032 m.
     fn default() -> Self {
-        Projection {
-            screen_radius: 1.0,
-            eye_radius: 0.032,
-            width: 3168,
-            height: 600,
-            vertical: Vertical::Paper,
-        }
+        Projection { screen_radius: 1.0, eye_radius: 0.032, width: 3168, height: 600, vertical: Vertical::Paper }
     }
 }
 
@@ -109,9 +103,10 @@ pub fn wrap_angle(a: f32) -> f32 {
     a - tau * ((a + std::f32::consts::PI) / tau).floor()
 }
 
-/// θ = atan2(x, −z): the azimuth of a viewer-frame point.
+/// θ = atan2(x, −z): the azimuth of a viewer-frame point. x = −0 counts as +0 (θ = π straight
+/// behind), as in projection.wgsl.
 pub fn azimuth(p: Vec3) -> f32 {
-    p.x.atan2(-p.z)
+    (p.x + 0.0).atan2(-p.z)
 }
 
 /// r = √(x² + z²): the distance of a viewer-frame point from the vertical axis.
@@ -123,10 +118,7 @@ impl Projection {
     pub fn validate(&self) -> Result<(), String> {
         let finite = self.screen_radius.is_finite() && self.eye_radius.is_finite();
         if !finite || self.screen_radius <= 0.0 {
-            return Err(format!(
-                "--screen-radius must be a positive number, got {}",
-                self.screen_radius
-            ));
+            return Err(format!("--screen-radius must be a positive number, got {}", self.screen_radius));
         }
         if !(self.eye_radius >= 0.0 && self.eye_radius < self.screen_radius) {
             return Err(format!(
@@ -145,9 +137,7 @@ impl Projection {
 
     /// acos(d_e / R_T), the constant term of α.
     pub fn acos_eye_screen(&self) -> f32 {
-        (self.eye_radius / self.screen_radius)
-            .clamp(0.0, 1.0)
-            .acos()
+        (self.eye_radius / self.screen_radius).clamp(0.0, 1.0).acos()
     }
 
     /// α(r) = acos(d_e/r) − acos(d_e/R_T) (eq. 3). Points with r ≤ d_e are seen by no eye;
@@ -182,11 +172,7 @@ impl Projection {
     /// Like [`project`](Self::project) but with θ given (already unwrapped by the caller).
     pub fn project_with_azimuth(&self, p: Vec3, theta: f32, eye: Eye) -> Projected {
         let r = horizontal_radius(p);
-        Projected {
-            u: theta + eye.sign() * self.eye_shift(r),
-            v: self.screen_height(p.y, r),
-            depth: r,
-        }
+        Projected { u: theta + eye.sign() * self.eye_shift(r), v: self.screen_height(p.y, r), depth: r }
     }
 
     /// Pixels per metre of screen (square pixels): W / (2π·R_T).
@@ -264,10 +250,7 @@ mod tests {
             let e = right(phi);
             let eye_pos = [side * de * e[0], side * de * e[1]];
             let rel = [p[0] - eye_pos[0], p[2] - eye_pos[1]];
-            (
-                rel[0] * e[0] + rel[1] * e[1],
-                rel[0] * dir(phi)[0] + rel[1] * dir(phi)[1],
-            )
+            (rel[0] * e[0] + rel[1] * e[1], rel[0] * dir(phi)[0] + rel[1] * dir(phi)[1])
         };
         // The point's own azimuth; the ray direction is within ±π/2 of it.
         let theta = p[0].atan2(-p[2]);
@@ -288,10 +271,7 @@ mod tests {
         // Hit of the ray with the screen cylinder: eye_pos + t·dir with |.| = rt → t = √(rt²−de²).
         let t_screen = (rt * rt - de * de).sqrt();
         let e = right(phi);
-        let hit = [
-            side * de * e[0] + t_screen * dir(phi)[0],
-            side * de * e[1] + t_screen * dir(phi)[1],
-        ];
+        let hit = [side * de * e[0] + t_screen * dir(phi)[0], side * de * e[1] + t_screen * dir(phi)[1]];
         let u = hit[0].atan2(-hit[1]);
         let v = match vertical {
             // Pinhole on the eye circle: similar triangles along the ray.
@@ -311,36 +291,20 @@ mod tests {
     fn matches_brute_force_construction_for_both_eyes_and_vertical_models() {
         let mut rng = rand::rngs::StdRng::seed_from_u64(7);
         for vertical in [Vertical::Paper, Vertical::Exact] {
-            let proj = Projection {
-                vertical,
-                ..Projection::default()
-            };
+            let proj = Projection { vertical, ..Projection::default() };
             for _ in 0..2000 {
                 let r: f64 = rng.random_range(0.05..50.0);
                 let theta: f64 = rng.random_range(-PI..PI);
                 let y: f64 = rng.random_range(-5.0..5.0);
                 let p = [r * theta.sin(), y, -r * theta.cos()];
                 for eye in Eye::BOTH {
-                    let (u_ref, v_ref) = brute_force(
-                        p,
-                        eye,
-                        proj.eye_radius as f64,
-                        proj.screen_radius as f64,
-                        vertical,
-                    );
-                    let got = proj
-                        .project(Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32), eye)
-                        .unwrap();
+                    let (u_ref, v_ref) =
+                        brute_force(p, eye, proj.eye_radius as f64, proj.screen_radius as f64, vertical);
+                    let got = proj.project(Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32), eye).unwrap();
                     let du_px = angle_diff(got.u as f64, u_ref) * proj.pixels_per_radian() as f64;
                     let dv_px = (got.v as f64 - v_ref).abs() * proj.pixels_per_metre() as f64;
-                    assert!(
-                        du_px < 2e-3,
-                        "{vertical:?} {eye:?} p={p:?}: u off by {du_px} px"
-                    );
-                    assert!(
-                        dv_px < 2e-3 * (1.0 + v_ref.abs()),
-                        "{vertical:?} {eye:?} p={p:?}: v off by {dv_px} px"
-                    );
+                    assert!(du_px < 2e-3, "{vertical:?} {eye:?} p={p:?}: u off by {du_px} px");
+                    assert!(dv_px < 2e-3 * (1.0 + v_ref.abs()), "{vertical:?} {eye:?} p={p:?}: v off by {dv_px} px");
                     assert!((got.depth as f64 - r).abs() < 1e-4 * r);
                 }
             }
@@ -353,8 +317,7 @@ mod tests {
         let far = Vec3::new(0.0, 0.0, -5.0);
         let near = Vec3::new(0.0, 0.0, -0.5);
         let on_screen = Vec3::new(0.0, 0.0, -1.0);
-        let disparity =
-            |p| proj.project(p, Eye::Right).unwrap().u - proj.project(p, Eye::Left).unwrap().u;
+        let disparity = |p| proj.project(p, Eye::Right).unwrap().u - proj.project(p, Eye::Left).unwrap().u;
         assert!(disparity(far) > 0.0);
         assert!(disparity(near) < 0.0);
         assert!(disparity(on_screen).abs() < 1e-6);
@@ -363,29 +326,18 @@ mod tests {
     #[test]
     fn points_inside_the_eye_circle_are_not_projected() {
         let proj = Projection::default();
-        assert!(proj
-            .project(Vec3::new(0.01, 0.0, -0.01), Eye::Left)
-            .is_none());
+        assert!(proj.project(Vec3::new(0.01, 0.0, -0.01), Eye::Left).is_none());
         assert!(proj.project(Vec3::new(0.0, 3.0, 0.0), Eye::Right).is_none());
-        assert!(proj
-            .project(Vec3::new(f32::NAN, 0.0, -1.0), Eye::Right)
-            .is_none());
+        assert!(proj.project(Vec3::new(f32::NAN, 0.0, -1.0), Eye::Right).is_none());
     }
 
     #[test]
     fn pixel_mapping_round_trips() {
-        let proj = Projection {
-            width: 320,
-            height: 80,
-            ..Projection::default()
-        };
+        let proj = Projection { width: 320, height: 80, ..Projection::default() };
         for (c, r) in [(0.0, 0.0), (159.0, 39.0), (319.0, 79.0), (17.0, 60.0)] {
             let (u, v) = proj.pixel_to_screen(c, r);
             let [x, y] = proj.to_pixel(u, v);
-            assert!(
-                (x - (c + 0.5)).abs() < 1e-3 && (y - (r + 0.5)).abs() < 1e-3,
-                "{c},{r} -> {x},{y}"
-            );
+            assert!((x - (c + 0.5)).abs() < 1e-3 && (y - (r + 0.5)).abs() < 1e-3, "{c},{r} -> {x},{y}");
         }
         // θ = 0 lies on the boundary between the two centre columns; straight up is row 0.
         assert!((proj.to_pixel(0.0, 0.0)[0] - 160.0).abs() < 1e-4);

@@ -1,11 +1,13 @@
-//! The headless renderer: the `prepare` compute pre-pass, then the `raster` stage draws the
-//! prepared triangles indirectly for each eye into RGBA8 + depth, and the images are read back.
+//! The headless renderer: the `subdivide` compute pre-pass (`plan`, then `lattice`), then the
+//! `raster` stage draws the subdivided triangles indirectly for each eye into RGBA8 + depth, and
+//! the images are read back.
 //!
-//! The prepared-triangle buffer has a capacity; the pre-pass counts what it wanted to write and
-//! never writes past the end. When a chunk of the scene overflows, the buffer grows (up to the
-//! device's storage-binding limit or the caller's budget) and the chunk runs again; past the
-//! limit the chunk is halved. Chunks draw one after another into the same targets, so nothing is
-//! dropped and the number of chunks is reported.
+//! Memory: the piece and output buffers together stay within `memory_mb` (and each within the
+//! device's storage-binding limit). Both passes count what they wanted to write and never write
+//! past the end. When a `plan` over a range of triangles overflows the piece buffer, the buffer
+//! grows if the budget allows, else the range is halved; likewise a `lattice` over a range of
+//! pieces and the output buffer. Ranges are drawn one after another into the same targets
+//! (`chunks` in the stats), so nothing is dropped; a single piece that cannot fit is an error.
 
 use std::time::Instant;
 
@@ -13,15 +15,19 @@ use glam::{Mat4, Vec3};
 use wgpu::util::DeviceExt;
 
 use crate::gpu::Gpu;
-use crate::gpu_types::{DrawIndirectArgs, DrawVertex, PrepareParams, RasterParams};
-use crate::prepare::{prepare_params, MAX_OUT_PER_TRIANGLE};
+use crate::gpu_types::{DrawIndirectArgs, DrawVertex, RasterParams, SubdivideCounters, SubdivideParams};
 use crate::projection::{Eye, Projection};
 use crate::scene::Scene;
 use crate::shaders;
+use crate::subdivide::{subdivide_params, Method, SubdivideOutput, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV};
 
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 const DRAW_VERTEX_SIZE: u64 = std::mem::size_of::<DrawVertex>() as u64;
+const TRIANGLE_SIZE: u64 = 3 * DRAW_VERTEX_SIZE;
+const PIECE_SIZE: u64 = 8;
+/// Default memory budget for the subdivision buffers, MiB.
+pub const DEFAULT_MEMORY_MB: u32 = 256;
 
 /// Where the viewer stands and how the images are made.
 #[derive(Clone, Debug)]
@@ -35,8 +41,14 @@ pub struct RenderSettings {
     pub background: [f32; 3],
     /// Ambient term of the headlight shading.
     pub ambient: f32,
-    /// Most prepared triangles held at once (None: as many as the device can bind).
-    pub max_prepared_triangles: Option<u32>,
+    /// How triangles are subdivided.
+    pub method: Method,
+    /// L: the longest projected edge wanted from `adaptive`, pixels.
+    pub edge_px: f32,
+    /// N_max: the largest lattice step of one piece.
+    pub max_div: u32,
+    /// Budget for the piece and output buffers, MiB.
+    pub memory_mb: u32,
 }
 
 impl Default for RenderSettings {
@@ -47,7 +59,10 @@ impl Default for RenderSettings {
             yaw_deg: 0.0,
             background: [0.1, 0.1, 0.12],
             ambient: 0.3,
-            max_prepared_triangles: None,
+            method: Method::Adaptive,
+            edge_px: DEFAULT_EDGE_PX,
+            max_div: DEFAULT_MAX_DIV,
+            memory_mb: DEFAULT_MEMORY_MB,
         }
     }
 }
@@ -56,6 +71,35 @@ impl RenderSettings {
     /// World → viewer frame: translate the viewer to the origin, then undo the yaw.
     pub fn view(&self) -> Mat4 {
         Mat4::from_rotation_y(-self.yaw_deg.to_radians()) * Mat4::from_translation(-self.viewer)
+    }
+
+    /// Parameters of the `subdivide` stage (capacities and ranges left for the caller).
+    pub fn subdivide_params(&self, first_triangle: u32, triangle_count: u32) -> SubdivideParams {
+        subdivide_params(
+            &self.projection,
+            self.view(),
+            self.method,
+            self.edge_px,
+            self.max_div,
+            first_triangle,
+            triangle_count,
+            0,
+            0,
+        )
+    }
+
+    pub fn validate(&self) -> Result<(), String> {
+        self.projection.validate()?;
+        if !(self.edge_px.is_finite() && self.edge_px >= 0.25) {
+            return Err(format!("--edge-px must be a number of pixels ≥ 0.25, got {}", self.edge_px));
+        }
+        if !(1..=64).contains(&self.max_div) {
+            return Err(format!("--max-div must be between 1 and 64, got {}", self.max_div));
+        }
+        if self.memory_mb < 8 {
+            return Err(format!("--memory-mb must be at least 8, got {}", self.memory_mb));
+        }
+        Ok(())
     }
 
     pub fn raster_params(&self, eye: Eye) -> RasterParams {
@@ -79,12 +123,7 @@ pub struct EyeImage {
 impl EyeImage {
     pub fn pixel(&self, x: u32, y: u32) -> [u8; 4] {
         let i = 4 * (y * self.width + x) as usize;
-        [
-            self.rgba[i],
-            self.rgba[i + 1],
-            self.rgba[i + 2],
-            self.rgba[i + 3],
-        ]
+        [self.rgba[i], self.rgba[i + 1], self.rgba[i + 2], self.rgba[i + 3]]
     }
 }
 
@@ -92,9 +131,14 @@ impl EyeImage {
 #[derive(Clone, Debug, Default, serde::Serialize)]
 pub struct FrameStats {
     pub triangles_in: u64,
-    pub triangles_drawn: u64,
+    /// Triangles the subdivision produced (seam copies included), all drawn.
+    pub triangles_out: u64,
+    pub pieces: u64,
+    /// Largest projected length of an output edge with an end on the screen rows, pixels.
+    pub max_sub_edge_px: f32,
+    /// Number of `lattice` + raster rounds the scene needed to fit the memory budget.
     pub chunks: u32,
-    pub ms_prepare: f64,
+    pub ms_subdivide: f64,
     pub ms_raster: f64,
     pub ms_readback: f64,
     pub ms_total: f64,
@@ -128,10 +172,7 @@ impl GpuScene {
         scene.validate()?;
         let vbytes = std::mem::size_of_val(scene.vertices.as_slice()) as u64;
         let ibytes = std::mem::size_of_val(scene.indices.as_slice()) as u64;
-        let max = gpu
-            .limits
-            .max_storage_buffer_binding_size
-            .min(gpu.limits.max_buffer_size);
+        let max = gpu.limits.max_storage_buffer_binding_size.min(gpu.limits.max_buffer_size);
         if vbytes > max || ibytes > max {
             return Err(format!(
                 "scene too big for this GPU: {} vertices ({} MiB) and {} triangles ({} MiB); one buffer may hold at most {} MiB",
@@ -149,42 +190,37 @@ impl GpuScene {
                 b.to_vec()
             }
         };
-        let vertices = gpu
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("scene vertices"),
-                contents: &pad(bytemuck::cast_slice(&scene.vertices)),
-                usage: wgpu::BufferUsages::STORAGE,
-            });
-        let indices = gpu
-            .device
-            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("scene indices"),
-                contents: &pad(bytemuck::cast_slice(&scene.indices)),
-                usage: wgpu::BufferUsages::STORAGE,
-            });
-        Ok(GpuScene {
-            vertices,
-            indices,
-            triangle_count: scene.triangle_count() as u32,
-        })
+        let vertices = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("scene vertices"),
+            contents: &pad(bytemuck::cast_slice(&scene.vertices)),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let indices = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("scene indices"),
+            contents: &pad(bytemuck::cast_slice(&scene.indices)),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        Ok(GpuScene { vertices, indices, triangle_count: scene.triangle_count() as u32 })
     }
 }
 
-/// The output of one `prepare` dispatch.
-pub struct Prepared {
-    pub vertices: wgpu::Buffer,
-    pub draw_args: wgpu::Buffer,
-    /// Triangles the stage wanted to write; more than `capacity` means it overflowed.
-    pub requested: u32,
-    pub capacity: u32,
+/// Reusable GPU buffers of the subdivision, with their capacities.
+struct Buffers {
+    pieces: wgpu::Buffer,
+    piece_capacity: u32,
+    triangles: wgpu::Buffer,
+    triangle_capacity: u32,
+    counters: wgpu::Buffer,
+    draw_args: wgpu::Buffer,
 }
 
 pub struct Renderer {
     pub gpu: Gpu,
-    prepare: wgpu::ComputePipeline,
+    plan: wgpu::ComputePipeline,
+    lattice: wgpu::ComputePipeline,
     finalize: wgpu::ComputePipeline,
     raster: wgpu::RenderPipeline,
+    buffers: std::sync::Mutex<Option<Buffers>>,
 }
 
 struct Targets {
@@ -195,18 +231,19 @@ struct Targets {
 impl Renderer {
     pub fn new(gpu: Gpu) -> Renderer {
         let device = &gpu.device;
-        let prepare_module = shaders::load(device, &shaders::PREPARE);
+        let subdivide_module = shaders::load(device, &shaders::SUBDIVIDE);
         let compute = |entry: &str| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(entry),
                 layout: None,
-                module: &prepare_module,
+                module: &subdivide_module,
                 entry_point: Some(entry),
                 compilation_options: Default::default(),
                 cache: None,
             })
         };
-        let prepare = compute("prepare");
+        let plan = compute("plan");
+        let lattice = compute("lattice");
         let finalize = compute("finalize");
         let raster_module = shaders::load(device, &shaders::RASTER);
         let attributes = wgpu::vertex_attr_array![
@@ -251,63 +288,76 @@ impl Renderer {
             multiview_mask: None,
             cache: None,
         });
-        Renderer {
-            gpu,
-            prepare,
-            finalize,
-            raster,
+        Renderer { gpu, plan, lattice, finalize, raster, buffers: std::sync::Mutex::new(None) }
+    }
+
+    /// The largest buffer the stages can bind on this device, bytes.
+    fn max_binding(&self) -> u64 {
+        self.gpu.limits.max_storage_buffer_binding_size.min(self.gpu.limits.max_buffer_size)
+    }
+
+    /// Capacities (pieces, triangles) allowed by a memory budget: a quarter for pieces.
+    fn max_capacities(&self, memory_mb: u32) -> (u32, u32) {
+        let budget = memory_mb as u64 * (1 << 20);
+        let pieces = (budget / 4).min(self.max_binding()) / PIECE_SIZE;
+        let triangles = (budget - budget / 4).min(self.max_binding()) / TRIANGLE_SIZE;
+        (pieces.min(u32::MAX as u64) as u32, triangles.min(u32::MAX as u64) as u32)
+    }
+
+    /// Makes sure the cached buffers hold at least these capacities.
+    fn ensure_buffers(&self, cache: &mut Option<Buffers>, pieces: u32, triangles: u32) {
+        let device = &self.gpu.device;
+        let fits = cache.as_ref().is_some_and(|b| b.piece_capacity >= pieces && b.triangle_capacity >= triangles);
+        if fits {
+            return;
         }
+        let (old_p, old_t) = cache.as_ref().map_or((0, 0), |b| (b.piece_capacity, b.triangle_capacity));
+        let (pieces, triangles) = (pieces.max(old_p).max(1), triangles.max(old_t).max(1));
+        let storage = |label, size: u64, extra| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_SRC
+                    | wgpu::BufferUsages::COPY_DST
+                    | extra,
+                mapped_at_creation: false,
+            })
+        };
+        *cache = Some(Buffers {
+            pieces: storage("pieces", pieces as u64 * PIECE_SIZE, wgpu::BufferUsages::empty()),
+            piece_capacity: pieces,
+            triangles: storage("subdivided triangles", triangles as u64 * TRIANGLE_SIZE, wgpu::BufferUsages::VERTEX),
+            triangle_capacity: triangles,
+            counters: storage("counters", std::mem::size_of::<SubdivideCounters>() as u64, wgpu::BufferUsages::empty()),
+            draw_args: storage(
+                "draw args",
+                std::mem::size_of::<DrawIndirectArgs>() as u64,
+                wgpu::BufferUsages::INDIRECT,
+            ),
+        });
     }
 
-    /// The most prepared triangles one buffer can hold on this device.
-    pub fn max_capacity(&self) -> u32 {
-        let limit = self
-            .gpu
-            .limits
-            .max_storage_buffer_binding_size
-            .min(self.gpu.limits.max_buffer_size);
-        (limit / (3 * DRAW_VERTEX_SIZE)).min(u32::MAX as u64) as u32
-    }
-
-    fn prepared_buffer(&self, capacity: u32) -> wgpu::Buffer {
-        self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("prepared triangles"),
-            size: (capacity.max(1) as u64) * 3 * DRAW_VERTEX_SIZE,
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::VERTEX
-                | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        })
-    }
-
-    /// Runs `prepare` + `finalize` on one range of triangles into `out` (capacity in triangles).
-    fn run_prepare(&self, scene: &GpuScene, params: &PrepareParams, out: wgpu::Buffer) -> Prepared {
+    /// Runs one compute entry point of the subdivide stage over `count` invocations and returns
+    /// the counters afterwards.
+    fn run_subdivide(
+        &self,
+        pipeline: &wgpu::ComputePipeline,
+        scene: &GpuScene,
+        buffers: &Buffers,
+        params: &SubdivideParams,
+        count: u32,
+    ) -> SubdivideCounters {
         let device = &self.gpu.device;
         let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("prepare params"),
+            label: Some("subdivide params"),
             contents: bytemuck::bytes_of(params),
             usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let counter = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("prepare counter"),
-            contents: &[0u8; 4],
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        });
-        let draw_args = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("draw args"),
-            size: std::mem::size_of::<DrawIndirectArgs>() as u64,
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::INDIRECT
-                | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
         });
         let bind = |pipeline: &wgpu::ComputePipeline, entries: &[(u32, &wgpu::Buffer)]| {
             let entries: Vec<wgpu::BindGroupEntry> = entries
                 .iter()
-                .map(|(b, buf)| wgpu::BindGroupEntry {
-                    binding: *b,
-                    resource: buf.as_entire_binding(),
-                })
+                .map(|(b, buf)| wgpu::BindGroupEntry { binding: *b, resource: buf.as_entire_binding() })
                 .collect();
             device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: None,
@@ -315,66 +365,79 @@ impl Renderer {
                 entries: &entries,
             })
         };
-        let prepare_bg = bind(
-            &self.prepare,
-            &[
-                (0, &uniform),
-                (1, &scene.vertices),
-                (2, &scene.indices),
-                (3, &out),
-                (4, &counter),
-            ],
-        );
-        let finalize_bg = bind(
-            &self.finalize,
-            &[(0, &uniform), (4, &counter), (5, &draw_args)],
-        );
+        let main_bg = if std::ptr::eq(pipeline, &self.plan) {
+            bind(
+                pipeline,
+                &[
+                    (0, &uniform),
+                    (1, &scene.vertices),
+                    (2, &scene.indices),
+                    (3, &buffers.pieces),
+                    (5, &buffers.counters),
+                ],
+            )
+        } else {
+            bind(
+                pipeline,
+                &[
+                    (0, &uniform),
+                    (1, &scene.vertices),
+                    (2, &scene.indices),
+                    (3, &buffers.pieces),
+                    (4, &buffers.triangles),
+                    (5, &buffers.counters),
+                ],
+            )
+        };
+        let finalize_bg = bind(&self.finalize, &[(0, &uniform), (5, &buffers.counters), (6, &buffers.draw_args)]);
         let mut enc = device.create_command_encoder(&Default::default());
+        enc.clear_buffer(&buffers.counters, 0, None);
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&self.prepare);
-            pass.set_bind_group(0, &prepare_bg, &[]);
-            let groups = params.triangle_count.div_ceil(64).max(1);
-            let (x, y) = if groups <= 65535 {
-                (groups, 1)
-            } else {
-                (65535, groups.div_ceil(65535))
-            };
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &main_bg, &[]);
+            let groups = count.div_ceil(64).max(1);
+            let (x, y) = if groups <= 65535 { (groups, 1) } else { (65535, groups.div_ceil(65535)) };
             pass.dispatch_workgroups(x, y, 1);
             pass.set_pipeline(&self.finalize);
             pass.set_bind_group(0, &finalize_bg, &[]);
             pass.dispatch_workgroups(1, 1, 1);
         }
         self.gpu.queue.submit([enc.finish()]);
-        let requested = u32::from_le_bytes(self.gpu.download(&counter, 4)[..4].try_into().unwrap());
-        Prepared {
-            vertices: out,
-            draw_args,
-            requested,
-            capacity: params.capacity,
-        }
+        let bytes = self.gpu.download(&buffers.counters, std::mem::size_of::<SubdivideCounters>() as u64);
+        *bytemuck::from_bytes(&bytes)
     }
 
-    /// Runs the pre-pass alone on the whole scene (growing the buffer as needed) and reads the
-    /// prepared triangles back: the GPU side of the CPU-twin tests.
-    pub fn prepare_readback(&self, scene: &GpuScene, settings: &RenderSettings) -> Vec<DrawVertex> {
-        let mut capacity = scene.triangle_count.saturating_mul(2).max(64);
+    /// Runs the whole subdivide stage on a scene and reads its output back: the GPU side of the
+    /// CPU-twin tests. Buffers are sized to hold everything at once.
+    pub fn subdivide_readback(&self, scene: &GpuScene, settings: &RenderSettings) -> SubdivideOutput {
+        let mut cache = None;
+        let mut params = settings.subdivide_params(0, scene.triangle_count);
+        let (mut pieces_cap, mut tris_cap) =
+            (scene.triangle_count.max(64), scene.triangle_count.saturating_mul(4).max(1024));
         loop {
-            let params = prepare_params(
-                &settings.projection,
-                settings.view(),
-                scene.triangle_count,
-                0,
-                capacity,
-            );
-            let p = self.run_prepare(scene, &params, self.prepared_buffer(capacity));
-            if p.requested <= capacity {
-                let bytes = self
-                    .gpu
-                    .download(&p.vertices, p.requested as u64 * 3 * DRAW_VERTEX_SIZE);
-                return bytemuck::cast_slice(&bytes).to_vec();
+            self.ensure_buffers(&mut cache, pieces_cap, tris_cap);
+            let b = cache.as_ref().unwrap();
+            params.piece_capacity = b.piece_capacity;
+            params.triangle_capacity = b.triangle_capacity;
+            let planned = self.run_subdivide(&self.plan, scene, b, &params, scene.triangle_count);
+            if planned.pieces > b.piece_capacity {
+                pieces_cap = planned.pieces;
+                continue;
             }
-            capacity = p.requested;
+            params.first_piece = 0;
+            params.piece_count = planned.pieces;
+            let done = self.run_subdivide(&self.lattice, scene, b, &params, planned.pieces);
+            if done.triangles > b.triangle_capacity {
+                tris_cap = done.triangles;
+                continue;
+            }
+            let bytes = self.gpu.download(&b.triangles, done.triangles as u64 * TRIANGLE_SIZE);
+            return SubdivideOutput {
+                vertices: bytemuck::cast_slice(&bytes).to_vec(),
+                pieces: planned.pieces,
+                max_sub_edge_px: f32::from_bits(done.max_edge_bits),
+            };
         }
     }
 
@@ -382,11 +445,7 @@ impl Renderer {
         let make = |format, usage, label| {
             self.gpu.device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
-                size: wgpu::Extent3d {
-                    width: projection.width,
-                    height: projection.height,
-                    depth_or_array_layers: 1,
-                },
+                size: wgpu::Extent3d { width: projection.width, height: projection.height, depth_or_array_layers: 1 },
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
@@ -398,25 +457,13 @@ impl Renderer {
         let color_usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
         let depth_usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
         Targets {
-            color: [
-                make(COLOR_FORMAT, color_usage, "left colour"),
-                make(COLOR_FORMAT, color_usage, "right colour"),
-            ],
-            depth: [
-                make(DEPTH_FORMAT, depth_usage, "left depth"),
-                make(DEPTH_FORMAT, depth_usage, "right depth"),
-            ],
+            color: [make(COLOR_FORMAT, color_usage, "left colour"), make(COLOR_FORMAT, color_usage, "right colour")],
+            depth: [make(DEPTH_FORMAT, depth_usage, "left depth"), make(DEPTH_FORMAT, depth_usage, "right depth")],
         }
     }
 
-    /// Draws prepared triangles into both eyes' targets (clearing them first if `clear`).
-    fn raster_eyes(
-        &self,
-        targets: &Targets,
-        prepared: &Prepared,
-        settings: &RenderSettings,
-        clear: bool,
-    ) {
+    /// Draws the subdivided triangles into both eyes' targets (clearing them first if `clear`).
+    fn raster_eyes(&self, targets: &Targets, buffers: &Buffers, settings: &RenderSettings, clear: bool) {
         let device = &self.gpu.device;
         let mut enc = device.create_command_encoder(&Default::default());
         for (k, eye) in Eye::BOTH.into_iter().enumerate() {
@@ -428,46 +475,28 @@ impl Renderer {
             let bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: None,
                 layout: &self.raster.get_bind_group_layout(0),
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: uniform.as_entire_binding(),
-                }],
+                entries: &[wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() }],
             });
             let color_view = targets.color[k].create_view(&Default::default());
             let depth_view = targets.depth[k].create_view(&Default::default());
             let [r, g, b] = settings.background;
             let color_load = if clear {
-                wgpu::LoadOp::Clear(wgpu::Color {
-                    r: r as f64,
-                    g: g as f64,
-                    b: b as f64,
-                    a: 1.0,
-                })
+                wgpu::LoadOp::Clear(wgpu::Color { r: r as f64, g: g as f64, b: b as f64, a: 1.0 })
             } else {
                 wgpu::LoadOp::Load
             };
-            let depth_load = if clear {
-                wgpu::LoadOp::Clear(1.0)
-            } else {
-                wgpu::LoadOp::Load
-            };
+            let depth_load = if clear { wgpu::LoadOp::Clear(1.0) } else { wgpu::LoadOp::Load };
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some(eye.name()),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                     view: &color_view,
                     depth_slice: None,
                     resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: color_load,
-                        store: wgpu::StoreOp::Store,
-                    },
+                    ops: wgpu::Operations { load: color_load, store: wgpu::StoreOp::Store },
                 })],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                     view: &depth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: depth_load,
-                        store: wgpu::StoreOp::Store,
-                    }),
+                    depth_ops: Some(wgpu::Operations { load: depth_load, store: wgpu::StoreOp::Store }),
                     stencil_ops: None,
                 }),
                 timestamp_writes: None,
@@ -476,8 +505,8 @@ impl Renderer {
             });
             pass.set_pipeline(&self.raster);
             pass.set_bind_group(0, &bg, &[]);
-            pass.set_vertex_buffer(0, prepared.vertices.slice(..));
-            pass.draw_indirect(&prepared.draw_args, 0);
+            pass.set_vertex_buffer(0, buffers.triangles.slice(..));
+            pass.draw_indirect(&buffers.draw_args, 0);
         }
         self.gpu.queue.submit([enc.finish()]);
         self.gpu.wait();
@@ -486,8 +515,7 @@ impl Renderer {
     fn read_color(&self, texture: &wgpu::Texture) -> EyeImage {
         let (w, h) = (texture.width(), texture.height());
         let row = 4 * w;
-        let padded =
-            row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
         let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("colour readback"),
             size: (padded * h) as u64,
@@ -504,17 +532,9 @@ impl Renderer {
             },
             wgpu::TexelCopyBufferInfo {
                 buffer: &staging,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(padded),
-                    rows_per_image: Some(h),
-                },
+                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(padded), rows_per_image: Some(h) },
             },
-            wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
+            wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
         );
         self.gpu.queue.submit([enc.finish()]);
         let data = self.gpu.read_buffer(&staging);
@@ -522,65 +542,89 @@ impl Renderer {
         for y in 0..h as usize {
             rgba.extend_from_slice(&data[y * padded as usize..y * padded as usize + row as usize]);
         }
-        EyeImage {
-            width: w,
-            height: h,
-            rgba,
-        }
+        EyeImage { width: w, height: h, rgba }
     }
 
     /// Renders both eyes of an uploaded scene.
     pub fn render(&self, scene: &GpuScene, settings: &RenderSettings) -> Result<Frame, String> {
-        settings.projection.validate()?;
+        settings.validate()?;
         let start = Instant::now();
-        let mut stats = FrameStats {
-            triangles_in: scene.triangle_count as u64,
-            ..Default::default()
-        };
+        let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, ..Default::default() };
         let targets = self.targets(&settings.projection);
-        let max_capacity = settings
-            .max_prepared_triangles
-            .unwrap_or(u32::MAX)
-            .min(self.max_capacity())
-            .max(MAX_OUT_PER_TRIANGLE);
+        let (max_pieces, max_tris) = self.max_capacities(settings.memory_mb);
+        let mut cache = self.buffers.lock().unwrap_or_else(|e| e.into_inner());
         let n = scene.triangle_count;
-        let mut capacity = n.saturating_mul(2).saturating_add(1024).min(max_capacity);
-        let mut out = self.prepared_buffer(capacity);
-        let (mut first, mut chunk) = (0u32, n.max(1));
+        // Start from the cached buffers, or a guess; grow on overflow within the budget.
+        let (mut want_pieces, mut want_tris) = cache.as_ref().map_or(
+            (n.saturating_add(1024).min(max_pieces), n.saturating_mul(4).saturating_add(4096).min(max_tris)),
+            |b| (b.piece_capacity, b.triangle_capacity),
+        );
+        let mut max_edge = 0.0f32;
+        let (mut first_tri, mut tri_chunk) = (0u32, n.max(1));
         let mut cleared = false;
-        while first < n || !cleared {
-            let count = chunk.min(n - first);
-            let params = prepare_params(
-                &settings.projection,
-                settings.view(),
-                count,
-                first,
-                capacity,
-            );
+        while first_tri < n || !cleared {
+            let tri_count = tri_chunk.min(n - first_tri);
+            self.ensure_buffers(&mut cache, want_pieces, want_tris);
+            let b = cache.as_ref().unwrap();
+            let mut params = settings.subdivide_params(first_tri, tri_count);
+            params.piece_capacity = b.piece_capacity.min(max_pieces.max(want_pieces));
+            params.triangle_capacity = b.triangle_capacity;
             let t = Instant::now();
-            let prepared = self.run_prepare(scene, &params, out);
-            stats.ms_prepare += t.elapsed().as_secs_f64() * 1e3;
-            if prepared.requested > capacity {
-                out = prepared.vertices;
-                if prepared.requested <= max_capacity {
-                    capacity = prepared.requested;
-                    out = self.prepared_buffer(capacity);
+            let planned = self.run_subdivide(&self.plan, scene, b, &params, tri_count);
+            stats.ms_subdivide += t.elapsed().as_secs_f64() * 1e3;
+            if planned.pieces > params.piece_capacity {
+                if planned.pieces <= max_pieces {
+                    want_pieces = planned.pieces;
+                } else if tri_count > 1 {
+                    tri_chunk = tri_count / 2;
                 } else {
-                    // Cannot hold this chunk's output at once: halve the chunk. A single triangle
-                    // makes at most MAX_OUT_PER_TRIANGLE ≤ max_capacity, so this ends.
-                    chunk = (count / 2).max(1);
+                    return Err(format!(
+                        "one triangle needs {} pieces, more than --memory-mb {} allows; raise --edge-px or --memory-mb",
+                        planned.pieces, settings.memory_mb
+                    ));
                 }
                 continue;
             }
-            let t = Instant::now();
-            self.raster_eyes(&targets, &prepared, settings, !cleared);
-            stats.ms_raster += t.elapsed().as_secs_f64() * 1e3;
-            cleared = true;
-            stats.triangles_drawn += prepared.requested as u64;
-            stats.chunks += 1;
-            first += count;
-            out = prepared.vertices;
+            stats.pieces += planned.pieces as u64;
+            let (mut first_piece, mut piece_chunk) = (0u32, planned.pieces.max(1));
+            let mut piece_done = false;
+            while first_piece < planned.pieces || !piece_done {
+                let piece_count = piece_chunk.min(planned.pieces - first_piece);
+                self.ensure_buffers(&mut cache, want_pieces, want_tris);
+                let b = cache.as_ref().unwrap();
+                params.first_piece = first_piece;
+                params.piece_count = piece_count;
+                params.triangle_capacity = b.triangle_capacity.min(max_tris.max(want_tris));
+                let t = Instant::now();
+                let done = self.run_subdivide(&self.lattice, scene, b, &params, piece_count);
+                stats.ms_subdivide += t.elapsed().as_secs_f64() * 1e3;
+                if done.triangles > params.triangle_capacity {
+                    if done.triangles <= max_tris {
+                        want_tris = done.triangles;
+                    } else if piece_count > 1 {
+                        piece_chunk = piece_count / 2;
+                    } else {
+                        return Err(format!(
+                            "one piece makes {} triangles, more than --memory-mb {} allows; lower the fixed N or raise --memory-mb",
+                            done.triangles, settings.memory_mb
+                        ));
+                    }
+                    continue;
+                }
+                let t = Instant::now();
+                self.raster_eyes(&targets, b, settings, !cleared);
+                stats.ms_raster += t.elapsed().as_secs_f64() * 1e3;
+                cleared = true;
+                piece_done = true;
+                stats.triangles_out += done.triangles as u64;
+                stats.chunks += 1;
+                max_edge = max_edge.max(f32::from_bits(done.max_edge_bits));
+                first_piece += piece_count;
+            }
+            first_tri += tri_count;
         }
+        drop(cache);
+        stats.max_sub_edge_px = max_edge;
         let t = Instant::now();
         let left = self.read_color(&targets.color[0]);
         let right = self.read_color(&targets.color[1]);
@@ -592,12 +636,7 @@ impl Renderer {
 
 impl Renderer {
     /// Runs the `project_points` stage: pixel positions of viewer-frame points for one eye.
-    pub fn project_points(
-        &self,
-        projection: &Projection,
-        eye: Eye,
-        points: &[Vec3],
-    ) -> Vec<[f32; 4]> {
+    pub fn project_points(&self, projection: &Projection, eye: Eye, points: &[Vec3]) -> Vec<[f32; 4]> {
         #[repr(C)]
         #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
         struct ProjectParams {
@@ -644,18 +683,9 @@ impl Renderer {
             label: None,
             layout: &pipeline.get_bind_group_layout(0),
             entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: uniform.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: input.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: output.as_entire_binding(),
-                },
+                wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: input.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: output.as_entire_binding() },
             ],
         });
         let mut enc = device.create_command_encoder(&Default::default());

@@ -22,10 +22,7 @@ pub struct Scene {
 
 impl Scene {
     pub fn new(name: impl Into<String>) -> Self {
-        Scene {
-            name: name.into(),
-            ..Default::default()
-        }
+        Scene { name: name.into(), ..Default::default() }
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -49,43 +46,19 @@ impl Scene {
     /// The error names the problem; callers add the file name.
     pub fn validate(&self) -> Result<(), String> {
         if self.indices.len() % 3 != 0 {
-            return Err(format!(
-                "index count {} is not a multiple of 3",
-                self.indices.len()
-            ));
+            return Err(format!("index count {} is not a multiple of 3", self.indices.len()));
         }
         let n = self.vertices.len();
-        if let Some((k, i)) = self
-            .indices
-            .iter()
-            .enumerate()
-            .find(|(_, &i)| i as usize >= n)
-        {
-            return Err(format!(
-                "triangle {} uses vertex index {i}, but there are only {n} vertices",
-                k / 3
-            ));
+        if let Some((k, i)) = self.indices.iter().enumerate().find(|(_, &i)| i as usize >= n) {
+            return Err(format!("triangle {} uses vertex index {i}, but there are only {n} vertices", k / 3));
         }
         for (k, v) in self.vertices.iter().enumerate() {
-            if !v
-                .position
-                .iter()
-                .chain(&v.normal)
-                .chain(&v.color)
-                .chain(&v.uv)
-                .all(|x| x.is_finite())
-            {
-                return Err(format!(
-                    "vertex {k} has a NaN or infinite coordinate {:?}",
-                    v.position
-                ));
+            if !v.position.iter().chain(&v.normal).chain(&v.color).chain(&v.uv).all(|x| x.is_finite()) {
+                return Err(format!("vertex {k} has a NaN or infinite coordinate {:?}", v.position));
             }
         }
         if self.indices.len() / 3 > u32::MAX as usize / 64 {
-            return Err(format!(
-                "{} triangles is more than twister can index",
-                self.indices.len() / 3
-            ));
+            return Err(format!("{} triangles is more than twister can index", self.indices.len() / 3));
         }
         Ok(())
     }

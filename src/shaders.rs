@@ -14,10 +14,10 @@ pub struct Stage {
     pub needs_projection: bool,
 }
 
-pub const PREPARE: Stage = Stage {
-    name: "prepare",
-    file: "shaders/prepare.wgsl",
-    source: include_str!("../shaders/prepare.wgsl"),
+pub const SUBDIVIDE: Stage = Stage {
+    name: "subdivide",
+    file: "shaders/subdivide.wgsl",
+    source: include_str!("../shaders/subdivide.wgsl"),
     needs_projection: true,
 };
 pub const RASTER: Stage = Stage {
@@ -34,15 +34,12 @@ pub const PROJECT_POINTS: Stage = Stage {
 };
 
 /// Every stage; the naga test validates each one composed.
-pub const STAGES: &[Stage] = &[PREPARE, RASTER, PROJECT_POINTS];
+pub const STAGES: &[Stage] = &[SUBDIVIDE, RASTER, PROJECT_POINTS];
 
 /// The full WGSL source of a stage, with the modules it needs composed in front.
 pub fn compose(stage: &Stage) -> String {
     if stage.needs_projection {
-        format!(
-            "{PROJECTION}\n// ---- {} ----\n{}",
-            stage.file, stage.source
-        )
+        format!("{PROJECTION}\n// ---- {} ----\n{}", stage.file, stage.source)
     } else {
         stage.source.to_string()
     }

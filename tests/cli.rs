@@ -31,18 +31,10 @@ fn render_writes_every_layout_and_stats() {
             .args(extra)
             .output()
             .unwrap();
-        assert!(
-            o.status.success(),
-            "{layout}: {}",
-            String::from_utf8_lossy(&o.stderr)
-        );
+        assert!(o.status.success(), "{layout}: {}", String::from_utf8_lossy(&o.stderr));
     };
     let stats = out.join("stats.json");
-    run(
-        "eyes",
-        &out.join("eyes"),
-        &["--stats", stats.to_str().unwrap()],
-    );
+    run("eyes", &out.join("eyes"), &["--stats", stats.to_str().unwrap()]);
     assert_eq!(png_size(&out.join("eyes/left.png")), (320, 60));
     assert_eq!(png_size(&out.join("eyes/right.png")), (320, 60));
     run("top-bottom", &out.join("tb"), &[]);
@@ -53,20 +45,15 @@ fn render_writes_every_layout_and_stats() {
     }
     // The front image is the middle half of the eye image; the back one the outer halves.
     let eye = image::open(out.join("eyes/left.png")).unwrap().to_rgba8();
-    let front = image::open(out.join("tw/left_front.png"))
-        .unwrap()
-        .to_rgba8();
-    let back = image::open(out.join("tw/left_back.png"))
-        .unwrap()
-        .to_rgba8();
+    let front = image::open(out.join("tw/left_front.png")).unwrap().to_rgba8();
+    let back = image::open(out.join("tw/left_back.png")).unwrap().to_rgba8();
     for y in [0, 30, 59] {
         for x in [0u32, 79, 159] {
             assert_eq!(front.get_pixel(x, y), eye.get_pixel(80 + x, y));
             assert_eq!(back.get_pixel(x, y), eye.get_pixel((240 + x) % 320, y));
         }
     }
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
     for key in [
         "scene",
         "triangles_in",
@@ -126,16 +113,10 @@ fn no_gpu_driver_is_one_clear_error_without_panic_or_output() {
         .unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{err}");
-    assert!(
-        err.contains("no GPU adapter found") && err.contains("mesa-vulkan-drivers"),
-        "{err}"
-    );
+    assert!(err.contains("no GPU adapter found") && err.contains("mesa-vulkan-drivers"), "{err}");
     assert!(!err.contains("panicked"), "{err}");
     assert_eq!(err.lines().count(), 1, "one line: {err}");
-    assert!(
-        !out.exists(),
-        "no output folder is made when rendering fails"
-    );
+    assert!(!out.exists(), "no output folder is made when rendering fails");
 }
 
 #[test]
@@ -150,11 +131,7 @@ fn bad_arguments_are_clear_errors() {
         (&["render", "scene.obj"], "scene.obj"),
     ];
     for (args, needle) in cases {
-        let o = twister()
-            .args(*args)
-            .args(["--out", "/nonexistent/never"])
-            .output()
-            .unwrap();
+        let o = twister().args(*args).args(["--out", "/nonexistent/never"]).output().unwrap();
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(!o.status.success(), "{args:?} succeeded");
         assert!(err.contains(needle), "{args:?}: {err}");

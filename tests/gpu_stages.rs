@@ -5,8 +5,8 @@ mod common;
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
 use twister::gpu_types::{DrawVertex, SceneVertex};
-use twister::prepare::{prepare, prepare_params};
 use twister::raster::raster;
+use twister::subdivide::{subdivide, Method};
 use twister::{builtin, Eye, GpuScene, Projection, RenderSettings, Scene, Vertical};
 
 #[test]
@@ -17,28 +17,17 @@ fn gpu_projection_matches_cpu_within_a_thousandth_of_a_pixel() {
         .map(|_| {
             let radius: f32 = rng.random_range(0.05f32..40.0);
             let theta: f32 = rng.random_range(-3.14159f32..3.14159);
-            Vec3::new(
-                radius * theta.sin(),
-                rng.random_range(-3.0f32..3.0),
-                -radius * theta.cos(),
-            )
+            Vec3::new(radius * theta.sin(), rng.random_range(-3.0f32..3.0), -radius * theta.cos())
         })
         .collect();
     for vertical in [Vertical::Paper, Vertical::Exact] {
-        let projection = Projection {
-            vertical,
-            ..Projection::default()
-        };
+        let projection = Projection { vertical, ..Projection::default() };
         for eye in Eye::BOTH {
             let gpu = r.project_points(&projection, eye, &points);
             let cpu = twister::projection::project_points(&projection, eye, &points);
             let mut worst = 0.0f32;
             for (i, (g, c)) in gpu.iter().zip(&cpu).enumerate() {
-                assert_eq!(
-                    g[3], c[3],
-                    "point {i} {:?}: seen on one side only",
-                    points[i]
-                );
+                assert_eq!(g[3], c[3], "point {i} {:?}: seen on one side only", points[i]);
                 if c[3] == 0.0 {
                     continue;
                 }
@@ -46,17 +35,12 @@ fn gpu_projection_matches_cpu_within_a_thousandth_of_a_pixel() {
                 let dy = (g[1] - c[1]).abs();
                 // On or near the image: a thousandth of a pixel. Far off it (near the eye
                 // circle, |y| up to 10⁵ px) f32 itself resolves only ~1e-7 relative.
-                let near_image =
-                    c[1] > -(projection.height as f32) && c[1] < 2.0 * projection.height as f32;
+                let near_image = c[1] > -(projection.height as f32) && c[1] < 2.0 * projection.height as f32;
                 let tolerance = if near_image { 1e-3 } else { 1e-6 * c[1].abs() };
                 if near_image {
                     worst = worst.max(dx.max(dy));
                 }
-                assert!(
-                    dx < 1e-3 && dy < tolerance,
-                    "{vertical:?} {eye:?} point {:?}: GPU {g:?} CPU {c:?}",
-                    points[i]
-                );
+                assert!(dx < 1e-3 && dy < tolerance, "{vertical:?} {eye:?} point {:?}: GPU {g:?} CPU {c:?}", points[i]);
             }
             assert!(cpu.iter().filter(|c| c[3] == 1.0).count() > 4500);
             eprintln!("{vertical:?} {eye:?}: worst difference {worst:e} px");
@@ -64,52 +48,51 @@ fn gpu_projection_matches_cpu_within_a_thousandth_of_a_pixel() {
     }
 }
 
-/// Matches each CPU triangle to the nearest unused GPU triangle and checks they are the same.
+/// Matches each CPU triangle to the nearest unused GPU triangle (searched among those whose
+/// centroid and reference azimuth fall in neighbouring buckets) and checks they are the same.
 fn assert_same_triangle_sets(cpu: &[DrawVertex], gpu: &[DrawVertex], what: &str) {
-    if cpu.len() != gpu.len() {
-        for t in gpu.chunks(3) {
-            let c = t.iter().fold(Vec3::ZERO, |a, v| a + Vec3::from(v.position)) / 3.0;
-            let found = cpu.chunks(3).any(|u| {
-                let c2 = u.iter().fold(Vec3::ZERO, |a, v| a + Vec3::from(v.position)) / 3.0;
-                (c2 - c).length() < 1e-4 && (u[0].theta_ref - t[0].theta_ref).abs() < 1e-3
-            });
-            if !found {
-                eprintln!("GPU-only triangle {t:?}");
-            }
-        }
-    }
-    assert_eq!(
-        cpu.len(),
-        gpu.len(),
-        "{what}: CPU made {} triangles, GPU {}",
-        cpu.len() / 3,
-        gpu.len() / 3
-    );
+    use std::collections::HashMap;
+    assert_eq!(cpu.len(), gpu.len(), "{what}: CPU made {} triangles, GPU {}", cpu.len() / 3, gpu.len() / 3);
     let key = |t: &[DrawVertex]| {
         let c = t.iter().fold(Vec3::ZERO, |a, v| a + Vec3::from(v.position)) / 3.0;
         (c, t[0].theta_ref)
     };
+    let cell = |c: Vec3, th: f32| {
+        ((c.x * 1e3).floor() as i64, (c.y * 1e3).floor() as i64, (c.z * 1e3).floor() as i64, (th * 10.0).floor() as i64)
+    };
     let gpu_tris: Vec<&[DrawVertex]> = gpu.chunks(3).collect();
+    let mut buckets: HashMap<(i64, i64, i64, i64), Vec<usize>> = HashMap::new();
+    for (j, t) in gpu_tris.iter().enumerate() {
+        let (c, th) = key(t);
+        buckets.entry(cell(c, th)).or_default().push(j);
+    }
     let mut used = vec![false; gpu_tris.len()];
     for t in cpu.chunks(3) {
         let (c, th) = key(t);
-        let best = (0..gpu_tris.len())
-            .filter(|&j| !used[j])
-            .min_by(|&a, &b| {
-                let d = |j: usize| {
-                    let (c2, th2) = key(gpu_tris[j]);
-                    (c2 - c).length() + (th2 - th).abs()
-                };
-                d(a).total_cmp(&d(b))
-            })
-            .unwrap();
+        let k = cell(c, th);
+        let mut best: Option<(f32, usize)> = None;
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    for dt in -1..=1 {
+                        for &j in buckets.get(&(k.0 + dx, k.1 + dy, k.2 + dz, k.3 + dt)).into_iter().flatten() {
+                            if used[j] {
+                                continue;
+                            }
+                            let (c2, th2) = key(gpu_tris[j]);
+                            let d = (c2 - c).length() + (th2 - th).abs();
+                            if best.is_none_or(|(bd, _)| d < bd) {
+                                best = Some((d, j));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        let (_, best) = best.unwrap_or_else(|| panic!("{what}: CPU triangle {t:?} has no GPU twin"));
         used[best] = true;
         for (a, b) in t.iter().zip(gpu_tris[best]) {
-            let close = |x: &[f32], y: &[f32]| {
-                x.iter()
-                    .zip(y)
-                    .all(|(p, q)| (p - q).abs() <= 1e-4 * (1.0 + p.abs()))
-            };
+            let close = |x: &[f32], y: &[f32]| x.iter().zip(y).all(|(p, q)| (p - q).abs() <= 1e-4 * (1.0 + p.abs()));
             assert!(
                 close(&a.position, &b.position)
                     && close(&[a.theta_ref], &[b.theta_ref])
@@ -130,16 +113,8 @@ fn random_triangle_scene(seed: u64, n: usize) -> Scene {
         // Mix of small triangles anywhere, big ones around the viewer, and ones near the axis.
         let scale = [0.3f32, 6.0, 1.0][k % 3];
         let center = match k % 3 {
-            2 => Vec3::new(
-                rng.random_range(-0.05..0.05),
-                rng.random_range(-2.0..2.0),
-                rng.random_range(-0.05..0.05),
-            ),
-            _ => Vec3::new(
-                rng.random_range(-8.0..8.0),
-                rng.random_range(-3.0..3.0),
-                rng.random_range(-8.0..8.0),
-            ),
+            2 => Vec3::new(rng.random_range(-0.05..0.05), rng.random_range(-2.0..2.0), rng.random_range(-0.05..0.05)),
+            _ => Vec3::new(rng.random_range(-8.0..8.0), rng.random_range(-3.0..3.0), rng.random_range(-8.0..8.0)),
         };
         let v: Vec<SceneVertex> = (0..3)
             .map(|i| SceneVertex {
@@ -164,78 +139,45 @@ fn random_triangle_scene(seed: u64, n: usize) -> Scene {
 }
 
 #[test]
-fn gpu_prepare_matches_cpu_twin() {
+fn gpu_subdivide_matches_cpu_twin() {
     let r = common::renderer();
-    let projection = Projection {
-        width: 640,
-        height: 160,
-        ..Projection::default()
-    };
+    let projection = Projection { width: 640, height: 160, ..Projection::default() };
+    let base = RenderSettings { projection, ..Default::default() };
+    let moved = RenderSettings { viewer: Vec3::new(1.0, 0.3, -2.0), yaw_deg: 37.0, ..base.clone() };
+    let sphere = builtin::builtin_scene("builtin:sphere100", &projection).unwrap();
     let cases = [
-        (
-            random_triangle_scene(3, 600),
-            RenderSettings {
-                projection,
-                ..Default::default()
-            },
-        ),
-        (
-            builtin::demo(),
-            RenderSettings {
-                projection,
-                ..Default::default()
-            },
-        ),
-        (
-            builtin::demo(),
-            RenderSettings {
-                projection,
-                viewer: Vec3::new(1.0, 0.3, -2.0),
-                yaw_deg: 37.0,
-                ..Default::default()
-            },
-        ),
+        (random_triangle_scene(3, 600), RenderSettings { method: Method::Vertex, ..base.clone() }),
+        (random_triangle_scene(4, 300), base.clone()),
+        (random_triangle_scene(5, 200), RenderSettings { method: Method::Fixed(5), ..base.clone() }),
+        (builtin::demo(), base.clone()),
+        (builtin::demo(), RenderSettings { method: Method::Vertex, ..moved.clone() }),
+        (builtin::demo(), RenderSettings { edge_px: 12.0, max_div: 4, ..moved.clone() }),
+        (sphere, RenderSettings { edge_px: 8.0, ..base.clone() }),
     ];
-    for (scene, settings) in cases {
-        let gs = GpuScene::upload(&r.gpu, &scene).unwrap();
-        let gpu = r.prepare_readback(&gs, &settings);
-        let params = prepare_params(
-            &settings.projection,
-            settings.view(),
-            scene.triangle_count() as u32,
-            0,
-            u32::MAX,
-        );
-        let cpu = prepare(&params, &scene.vertices, &scene.indices);
+    for (k, (scene, settings)) in cases.iter().enumerate() {
+        let gs = GpuScene::upload(&r.gpu, scene).unwrap();
+        let gpu = r.subdivide_readback(&gs, settings);
+        let params = settings.subdivide_params(0, scene.triangle_count() as u32);
+        let cpu = subdivide(&params, &scene.vertices, &scene.indices);
+        let what = format!("case {k}: {} {}", scene.name, settings.method.name());
+        assert!(cpu.vertices.len() / 3 > scene.triangle_count(), "{what}: exercises splits and seam copies");
+        assert_eq!(cpu.pieces, gpu.pieces, "{what}: pieces");
         assert!(
-            cpu.len() / 3 > scene.triangle_count(),
-            "the scene exercises splits and seam copies"
+            (cpu.max_sub_edge_px - gpu.max_sub_edge_px).abs() < 1e-2 * (1.0 + cpu.max_sub_edge_px),
+            "{what}: max edge"
         );
-        assert_same_triangle_sets(&cpu, &gpu, &scene.name);
+        assert_same_triangle_sets(&cpu.vertices, &gpu.vertices, &what);
     }
 }
 
 #[test]
 fn gpu_raster_matches_cpu_twin() {
-    let projection = Projection {
-        width: 400,
-        height: 100,
-        ..Projection::default()
-    };
+    let projection = Projection { width: 400, height: 100, ..Projection::default() };
     let scene = builtin::demo();
-    let settings = RenderSettings {
-        projection,
-        ..Default::default()
-    };
+    let settings = RenderSettings { projection, ..Default::default() };
     let frame = common::render(&scene, &settings);
-    let params = prepare_params(
-        &projection,
-        settings.view(),
-        scene.triangle_count() as u32,
-        0,
-        u32::MAX,
-    );
-    let prepared = prepare(&params, &scene.vertices, &scene.indices);
+    let params = settings.subdivide_params(0, scene.triangle_count() as u32);
+    let prepared = subdivide(&params, &scene.vertices, &scene.indices).vertices;
     for eye in Eye::BOTH {
         let cpu = raster(&settings.raster_params(eye), &prepared, settings.background);
         let gpu = frame.eye(eye);
@@ -243,18 +185,11 @@ fn gpu_raster_matches_cpu_twin() {
             .rgba
             .chunks(4)
             .zip(gpu.rgba.chunks(4))
-            .filter(|(a, b)| {
-                a.iter()
-                    .zip(b.iter())
-                    .any(|(x, y)| (*x as i32 - *y as i32).abs() > 2)
-            })
+            .filter(|(a, b)| a.iter().zip(b.iter()).any(|(x, y)| (*x as i32 - *y as i32).abs() > 2))
             .count();
         let total = (projection.width * projection.height) as usize;
         // Only pixels on triangle edges may differ (tie-breaking and rounding at coverage edges).
-        assert!(
-            differing * 100 < total,
-            "{eye:?}: {differing} of {total} pixels differ"
-        );
+        assert!(differing * 100 < total, "{eye:?}: {differing} of {total} pixels differ");
         eprintln!("{eye:?}: {differing} of {total} pixels differ");
     }
 }

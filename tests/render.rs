@@ -9,11 +9,7 @@ use twister::renderer::EyeImage;
 use twister::{Eye, Projection, RenderSettings, Scene, Vertical};
 
 fn small() -> Projection {
-    Projection {
-        width: 960,
-        height: 180,
-        ..Projection::default()
-    }
+    Projection { width: 960, height: 180, ..Projection::default() }
 }
 
 /// Centroid (x, y) of the non-background pixels; x is unwrapped around `around_x`.
@@ -35,10 +31,7 @@ fn centroid(img: &EyeImage, bg: [f32; 3], around_x: f32) -> (f32, f32, usize) {
 fn sphere100_centroid_lies_where_the_oracle_projects_its_centre() {
     let projection = small();
     let scene = twister::builtin::builtin_scene("builtin:sphere100", &projection).unwrap();
-    let settings = RenderSettings {
-        projection,
-        ..Default::default()
-    };
+    let settings = RenderSettings { projection, ..Default::default() };
     let frame = common::render(&scene, &settings);
     let center = Vec3::new(0.0, 0.0, -3.0);
     for eye in Eye::BOTH {
@@ -58,15 +51,8 @@ fn disparity_has_the_right_sign_and_size() {
     // A small sphere straight ahead at several distances: the centroid difference between the
     // eyes (right − left) must be 2·α(D) in pixels: negative nearer than the screen, zero on it,
     // positive beyond.
-    let projection = Projection {
-        width: 1600,
-        height: 200,
-        ..Projection::default()
-    };
-    let settings = RenderSettings {
-        projection,
-        ..Default::default()
-    };
+    let projection = Projection { width: 1600, height: 200, ..Projection::default() };
+    let settings = RenderSettings { projection, ..Default::default() };
     for distance in [0.5f32, 1.0, 5.0] {
         // Same angular size at every distance (about 40 px across).
         let radius = distance * 0.075;
@@ -78,10 +64,7 @@ fn disparity_has_the_right_sign_and_size() {
         assert!(nl > 200 && nr > 200);
         let expected = 2.0 * projection.eye_shift(distance) * projection.pixels_per_radian();
         let got = r - l;
-        assert!(
-            (got - expected).abs() < 0.5,
-            "at {distance} m: disparity {got} px, expected {expected} px"
-        );
+        assert!((got - expected).abs() < 0.5, "at {distance} m: disparity {got} px, expected {expected} px");
         match distance {
             d if d < 1.0 => assert!(got < -5.0, "crossed disparity in front of the screen"),
             d if d > 1.0 => assert!(got > 5.0, "uncrossed disparity beyond the screen"),
@@ -99,17 +82,8 @@ fn is_seam_sphere(p: [u8; 4]) -> bool {
 #[test]
 fn seam_sphere_appears_at_both_edges_and_nowhere_between() {
     for vertical in [Vertical::Paper, Vertical::Exact] {
-        let projection = Projection {
-            vertical,
-            ..small()
-        };
-        let frame = common::render(
-            &builtin::demo(),
-            &RenderSettings {
-                projection,
-                ..Default::default()
-            },
-        );
+        let projection = Projection { vertical, ..small() };
+        let frame = common::render(&builtin::demo(), &RenderSettings { projection, ..Default::default() });
         let w = projection.width as f32;
         for eye in Eye::BOTH {
             let px = common::pixels_where(frame.eye(eye), is_seam_sphere);
@@ -125,25 +99,15 @@ fn seam_sphere_appears_at_both_edges_and_nowhere_between() {
             );
             for &(x, y) in &px {
                 let from_seam = (x as f32 + 0.5).min(w - (x as f32 + 0.5));
-                assert!(
-                    from_seam <= max_dx,
-                    "{eye:?}: seam-sphere pixel at ({x}, {y}), {from_seam} px from the seam"
-                );
+                assert!(from_seam <= max_dx, "{eye:?}: seam-sphere pixel at ({x}, {y}), {from_seam} px from the seam");
             }
         }
     }
 }
 
 fn flat_triangle(p: [[f32; 3]; 3], color: [f32; 4]) -> Scene {
-    let v: Vec<SceneVertex> = p
-        .iter()
-        .map(|&q| SceneVertex {
-            position: q,
-            normal: [0.0, 1.0, 0.0],
-            color,
-            ..Default::default()
-        })
-        .collect();
+    let v: Vec<SceneVertex> =
+        p.iter().map(|&q| SceneVertex { position: q, normal: [0.0, 1.0, 0.0], color, ..Default::default() }).collect();
     let mut s = Scene::new("probe");
     s.add_mesh("probe", &v, &[0, 1, 2]);
     s
@@ -153,24 +117,15 @@ fn flat_triangle(p: [[f32; 3]; 3], color: [f32; 4]) -> Scene {
 fn triangle_around_the_axis_covers_every_column_below_the_horizon_without_smear() {
     // A floor triangle 1.5 m below the eyes containing the vertical axis.
     let projection = small();
-    let scene = flat_triangle(
-        [[-20.0, -1.5, 15.0], [20.0, -1.5, 15.0], [0.0, -1.5, -25.0]],
-        [0.2, 0.9, 0.3, 1.0],
-    );
-    let settings = RenderSettings {
-        projection,
-        ..Default::default()
-    };
+    let scene = flat_triangle([[-20.0, -1.5, 15.0], [20.0, -1.5, 15.0], [0.0, -1.5, -25.0]], [0.2, 0.9, 0.3, 1.0]);
+    let settings = RenderSettings { projection, ..Default::default() };
     let frame = common::render(&scene, &settings);
     for eye in Eye::BOTH {
         let img = frame.eye(eye);
         let px = common::pixels_where(img, |p| !common::is_background(p, settings.background));
         let mid_row = projection.height as f32 / 2.0;
         // Nothing at or above the horizon (a smear would cross it).
-        assert!(
-            px.iter().all(|&(_, y)| y as f32 + 0.5 > mid_row),
-            "{eye:?}: floor pixels above the horizon"
-        );
+        assert!(px.iter().all(|&(_, y)| y as f32 + 0.5 > mid_row), "{eye:?}: floor pixels above the horizon");
         // Every column has floor at the bottom row (nothing dropped, no gap at the seam).
         for x in 0..projection.width {
             assert!(
@@ -184,31 +139,19 @@ fn triangle_around_the_axis_covers_every_column_below_the_horizon_without_smear(
 #[test]
 fn triangle_reaching_inside_the_eye_circle_renders_without_nan_or_smear() {
     let projection = small();
-    let settings = RenderSettings {
-        projection,
-        ..Default::default()
-    };
+    let settings = RenderSettings { projection, ..Default::default() };
     // One corner 1 cm from the axis (inside the 3.2 cm eye circle), the far edge 2 m ahead.
-    let scene = flat_triangle(
-        [[0.01, -0.5, 0.0], [2.0, -0.5, -2.0], [-2.0, -0.5, -2.0]],
-        [0.9, 0.6, 0.1, 1.0],
-    );
+    let scene = flat_triangle([[0.01, -0.5, 0.0], [2.0, -0.5, -2.0], [-2.0, -0.5, -2.0]], [0.9, 0.6, 0.1, 1.0]);
     let frame = common::render(&scene, &settings);
     for eye in Eye::BOTH {
-        let px = common::pixels_where(frame.eye(eye), |p| {
-            !common::is_background(p, settings.background)
-        });
+        let px = common::pixels_where(frame.eye(eye), |p| !common::is_background(p, settings.background));
         assert!(px.len() > 500, "{eye:?}: triangle not drawn");
         // The triangle spans azimuths of at most ±(90° + its near-axis part); it never reaches
         // straight behind (θ = ±π), so the outer quarter of columns at each edge stays empty.
         let w = projection.width;
+        assert!(px.iter().all(|&(x, _)| x > w / 8 && x < w - w / 8), "{eye:?}: pixels smeared towards the seam");
         assert!(
-            px.iter().all(|&(x, _)| x > w / 8 && x < w - w / 8),
-            "{eye:?}: pixels smeared towards the seam"
-        );
-        assert!(
-            px.iter()
-                .all(|&(_, y)| y as f32 + 0.5 > projection.height as f32 / 2.0),
+            px.iter().all(|&(_, y)| y as f32 + 0.5 > projection.height as f32 / 2.0),
             "{eye:?}: pixels above the horizon"
         );
     }

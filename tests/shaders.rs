@@ -6,20 +6,12 @@ use twister::shaders::{compose, PROJECTION, STAGES};
 fn validate(name: &str, source: &str) {
     let module = match naga::front::wgsl::parse_str(source) {
         Ok(m) => m,
-        Err(e) => panic!(
-            "{name}: parse error\n{}",
-            e.emit_to_string_with_path(source, name)
-        ),
+        Err(e) => panic!("{name}: parse error\n{}", e.emit_to_string_with_path(source, name)),
     };
-    let mut validator = naga::valid::Validator::new(
-        naga::valid::ValidationFlags::all(),
-        naga::valid::Capabilities::all(),
-    );
+    let mut validator =
+        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all());
     if let Err(e) = validator.validate(&module) {
-        panic!(
-            "{name}: validation error\n{}",
-            e.emit_to_string_with_path(source, name)
-        );
+        panic!("{name}: validation error\n{}", e.emit_to_string_with_path(source, name));
     }
 }
 
@@ -48,36 +40,16 @@ fn uniform_struct_sizes_match_wgsl() {
         let module = naga::front::wgsl::parse_str(&compose(stage)).unwrap();
         let mut layouter = naga::proc::Layouter::default();
         layouter.update(module.to_ctx()).unwrap();
-        let (h, _) = module
-            .types
-            .iter()
-            .find(|(_, t)| t.name.as_deref() == Some(name))
-            .unwrap_or_else(|| panic!("{name}"));
+        let (h, _) =
+            module.types.iter().find(|(_, t)| t.name.as_deref() == Some(name)).unwrap_or_else(|| panic!("{name}"));
         layouter[h].size as usize
     };
-    let (prepare, raster) = (&twister::shaders::PREPARE, &twister::shaders::RASTER);
-    assert_eq!(
-        size_of(prepare, "SceneVertex"),
-        std::mem::size_of::<SceneVertex>()
-    );
-    assert_eq!(
-        size_of(prepare, "DrawVertex"),
-        std::mem::size_of::<DrawVertex>()
-    );
-    assert_eq!(
-        size_of(prepare, "Projection"),
-        std::mem::size_of::<ProjectionUniform>()
-    );
-    assert_eq!(
-        size_of(prepare, "PrepareParams"),
-        std::mem::size_of::<PrepareParams>()
-    );
-    assert_eq!(
-        size_of(prepare, "DrawIndirectArgs"),
-        std::mem::size_of::<DrawIndirectArgs>()
-    );
-    assert_eq!(
-        size_of(raster, "RasterParams"),
-        std::mem::size_of::<RasterParams>()
-    );
+    let (subdivide, raster) = (&twister::shaders::SUBDIVIDE, &twister::shaders::RASTER);
+    assert_eq!(size_of(subdivide, "SceneVertex"), std::mem::size_of::<SceneVertex>());
+    assert_eq!(size_of(subdivide, "DrawVertex"), std::mem::size_of::<DrawVertex>());
+    assert_eq!(size_of(subdivide, "Projection"), std::mem::size_of::<ProjectionUniform>());
+    assert_eq!(size_of(subdivide, "SubdivideParams"), std::mem::size_of::<SubdivideParams>());
+    assert_eq!(size_of(subdivide, "Counters"), std::mem::size_of::<SubdivideCounters>());
+    assert_eq!(size_of(subdivide, "DrawIndirectArgs"), std::mem::size_of::<DrawIndirectArgs>());
+    assert_eq!(size_of(raster, "RasterParams"), std::mem::size_of::<RasterParams>());
 }

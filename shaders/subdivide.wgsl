@@ -1,0 +1,617 @@
+// The `subdivide` stage (compute): adaptive subdivision (seed 002 §2.3, eq. 5, Fig. 6), the
+// vertical-axis split and the seam copies. CPU twin and full description: src/subdivide.rs.
+// Needs projection.wgsl composed in front.
+//
+// `plan`     one invocation per input triangle: edge counts N (eq. 5), the macro-lattice level
+//            K = ceil(M / N_max) of the pre-split, and K² piece records (triangle, cell).
+// `lattice`  one invocation per piece: the regular lattice of level m = max(counts), boundary
+//            nodes snapped to each edge's nodes, each sub-triangle split around the axis if
+//            needed and appended, with a seam copy where it crosses ±π.
+// `finalize` the DrawIndirect arguments, clamped to the capacity.
+// Appends never write past a capacity: they are counted, and the host grows the buffer or
+// processes the scene in chunks.
+
+struct SceneVertex {
+    position: vec3<f32>,
+    material: u32,
+    normal: vec3<f32>,
+    _pad0: u32,
+    color: vec4<f32>,
+    uv: vec2<f32>,
+    _pad1: vec2<f32>,
+}
+
+struct DrawVertex {
+    position: vec3<f32>,
+    theta_ref: f32,
+    normal: vec3<f32>,
+    material: u32,
+    color: vec4<f32>,
+    uv: vec2<f32>,
+    _pad: vec2<f32>,
+}
+
+struct SubdivideParams {
+    view: mat4x4<f32>,
+    projection: Projection,
+    axis_clearance: f32,
+    triangle_count: u32,
+    first_triangle: u32,
+    method: u32,            // 0 vertex, 1 fixed, 2 adaptive
+    fixed_n: u32,
+    edge_px: f32,           // L
+    max_div: u32,           // N_max
+    piece_capacity: u32,
+    triangle_capacity: u32,
+    first_piece: u32,
+    piece_count: u32,
+    _pad: u32,
+}
+
+struct Counters {
+    pieces: atomic<u32>,
+    triangles: atomic<u32>,
+    max_edge_bits: atomic<u32>, // bits of the largest visible output edge, px (f32 ≥ 0 orders as u32)
+    _pad: u32,
+}
+
+struct DrawIndirectArgs {
+    vertex_count: u32,
+    instance_count: u32,
+    first_vertex: u32,
+    first_instance: u32,
+}
+
+@group(0) @binding(0) var<uniform> params: SubdivideParams;
+@group(0) @binding(1) var<storage, read> vertices: array<SceneVertex>;
+@group(0) @binding(2) var<storage, read> indices: array<u32>;
+@group(0) @binding(3) var<storage, read_write> pieces: array<vec2<u32>>;
+@group(0) @binding(4) var<storage, read_write> out_vertices: array<DrawVertex>;
+@group(0) @binding(5) var<storage, read_write> counters: Counters;
+@group(0) @binding(6) var<storage, read_write> draw_args: DrawIndirectArgs;
+
+const MAX_EDGE_DIVISIONS: u32 = 1024u;
+const EDGE_SAMPLES: u32 = 8u;
+const MAX_SPAN: f32 = 1.6;
+const SNAP: f32 = 1e-6;
+const SEAM_MARGIN: f32 = 1e-5; // rad
+
+// (cos, sin) of the sector boundaries −π + k·π/4 and of the sector middles, exact tables shared
+// with the CPU twin.
+const H: f32 = 0.70710678118654752;
+const C8: f32 = 0.923879532511287;
+const S8: f32 = 0.382683432365090;
+const BOUNDARY = array<vec2<f32>, 9>(
+    vec2<f32>(-1.0, 0.0), vec2<f32>(-H, -H), vec2<f32>(0.0, -1.0), vec2<f32>(H, -H),
+    vec2<f32>(1.0, 0.0), vec2<f32>(H, H), vec2<f32>(0.0, 1.0), vec2<f32>(-H, H), vec2<f32>(-1.0, 0.0),
+);
+const MIDDLE = array<vec2<f32>, 8>(
+    vec2<f32>(-C8, -S8), vec2<f32>(-S8, -C8), vec2<f32>(S8, -C8), vec2<f32>(C8, -S8),
+    vec2<f32>(C8, S8), vec2<f32>(S8, C8), vec2<f32>(-S8, C8), vec2<f32>(-C8, S8),
+);
+
+struct Node {
+    position: vec3<f32>,
+    bary: vec3<f32>,   // weights of the input triangle's corners, for the attributes
+}
+
+// The input triangle in the viewer frame, and its plan.
+var<private> tri_position: array<vec3<f32>, 3>;
+var<private> tri_normal: array<vec3<f32>, 3>;
+var<private> tri_color: array<vec4<f32>, 3>;
+var<private> tri_uv: array<vec2<f32>, 3>;
+var<private> tri_material: u32;
+var<private> tri_n: array<u32, 3>;    // divisions of edges P0P1, P1P2, P2P0
+var<private> tri_k: u32;              // macro-lattice level
+
+// The piece being subdivided.
+var<private> piece_q: array<Node, 3>;
+var<private> piece_counts: array<u32, 3>;
+var<private> piece_original: array<i32, 3>; // original edge under piece edge e, or −1
+var<private> piece_from: array<u32, 3>;     // fine index on that original edge at corner e
+var<private> piece_to: array<u32, 3>;
+
+// The polygon of the axis split.
+var<private> poly: array<Node, 8>;
+var<private> poly_count: u32;
+var<private> scratch: array<Node, 8>;
+
+fn corner(i: u32) -> Node {
+    var b = vec3<f32>(0.0, 0.0, 0.0);
+    b[i] = 1.0;
+    return Node(tri_position[i], b);
+}
+
+fn lex_less(a: vec3<f32>, b: vec3<f32>) -> bool {
+    return a.x < b.x || (a.x == b.x && (a.y < b.y || (a.y == b.y && a.z < b.z)));
+}
+
+fn same(a: vec3<f32>, b: vec3<f32>) -> bool {
+    return all(a == b);
+}
+
+// The point j/n of the way from a to b, from the canonically ordered pair; the ends are exact.
+fn edge_point(a: Node, b: Node, j: u32, n: u32) -> Node {
+    var lo = a;
+    var hi = b;
+    var jj = j;
+    if (lex_less(b.position, a.position)) {
+        lo = b;
+        hi = a;
+        jj = n - j;
+    }
+    if (jj == 0u) {
+        return lo;
+    }
+    if (jj == n) {
+        return hi;
+    }
+    let t = f32(jj) / f32(n);
+    return Node(lo.position + (hi.position - lo.position) * t, lo.bary + (hi.bary - lo.bary) * t);
+}
+
+// Image position in pixels (x not wrapped) of a viewer-frame point for one eye sign.
+fn pixel(p: vec3<f32>, eye_sign: f32) -> vec2<f32> {
+    let r = horizontal_radius(p);
+    let u = azimuth(p) + eye_sign * eye_shift(params.projection, r);
+    let v = screen_height(params.projection, p.y, r);
+    return vec2<f32>(u * params.projection.width / TAU, v * params.projection.pixels_per_metre);
+}
+
+// Projected length in pixels of the straight edge ab, larger of the two eyes, heights clamped.
+fn edge_length_px(a: vec3<f32>, b: vec3<f32>) -> f32 {
+    var lo = a;
+    var hi = b;
+    if (lex_less(b, a)) {
+        lo = b;
+        hi = a;
+    }
+    let clamp_v = 1.5 * params.projection.height;
+    let width = params.projection.width;
+    var longest = 0.0;
+    for (var s = 0u; s < 2u; s++) {
+        let eye_sign = select(-1.0, 1.0, s == 1u);
+        var total = 0.0;
+        var prev = vec2<f32>(0.0, 0.0);
+        for (var k = 0u; k <= EDGE_SAMPLES; k++) {
+            let t = f32(k) / f32(EDGE_SAMPLES);
+            var q = pixel(lo + (hi - lo) * t, eye_sign);
+            q.y = clamp(q.y, -clamp_v, clamp_v);
+            if (k > 0u) {
+                let dx = (q.x - prev.x) - width * round((q.x - prev.x) / width);
+                total += length(vec2<f32>(dx, q.y - prev.y));
+            }
+            prev = q;
+        }
+        longest = max(longest, total);
+    }
+    return longest;
+}
+
+fn edge_divisions(a: vec3<f32>, b: vec3<f32>) -> u32 {
+    if (params.method == 0u) {
+        return 1u;
+    }
+    if (params.method == 1u) {
+        return params.fixed_n;
+    }
+    let n = ceil(edge_length_px(a, b) / params.edge_px);
+    if (n >= f32(MAX_EDGE_DIVISIONS) || !(n == n)) {
+        return MAX_EDGE_DIVISIONS;
+    }
+    return max(u32(n), 1u);
+}
+
+fn load_triangle(t: u32) {
+    for (var k = 0u; k < 3u; k++) {
+        let v = vertices[indices[3u * t + k]];
+        tri_position[k] = (params.view * vec4<f32>(v.position, 1.0)).xyz;
+        tri_normal[k] = (params.view * vec4<f32>(v.normal, 0.0)).xyz;
+        tri_color[k] = v.color;
+        tri_uv[k] = v.uv;
+    }
+    tri_material = vertices[indices[3u * t]].material;
+    for (var e = 0u; e < 3u; e++) {
+        tri_n[e] = edge_divisions(tri_position[e], tri_position[(e + 1u) % 3u]);
+    }
+    let m = max(max(tri_n[0], tri_n[1]), tri_n[2]);
+    tri_k = 1u;
+    if (params.method == 2u) {
+        tri_k = (m + params.max_div - 1u) / params.max_div;
+    }
+}
+
+fn snap_index(idx: u32, count: u32) -> u32 {
+    return (2u * idx * count + tri_k) / (2u * tri_k);
+}
+
+// Where macro node (a, b, c)/K lies, as (kind, i, j): kind 0 = triangle corner i; kind 1 = fine
+// node j (0 < j < n_i) of original edge i; kind 2 = interior. Nodes on an original edge snap to
+// its fine nodes and may land on a corner. (`Location` in subdivide.rs.)
+const CORNER: u32 = 0u;
+const ON_EDGE: u32 = 1u;
+const INTERIOR: u32 = 2u;
+
+fn macro_location(abc: vec3<u32>) -> vec3<u32> {
+    var e = 3u;
+    var idx = 0u;
+    if (abc.z == 0u) {
+        e = 0u;
+        idx = abc.y;
+    } else if (abc.x == 0u) {
+        e = 1u;
+        idx = abc.z;
+    } else if (abc.y == 0u) {
+        e = 2u;
+        idx = abc.x;
+    }
+    if (e == 3u) {
+        return vec3<u32>(INTERIOR, 0u, 0u);
+    }
+    let j = snap_index(idx, tri_n[e]);
+    if (j == 0u) {
+        return vec3<u32>(CORNER, e, 0u);
+    }
+    if (j == tri_n[e]) {
+        return vec3<u32>(CORNER, (e + 1u) % 3u, 0u);
+    }
+    return vec3<u32>(ON_EDGE, e, j);
+}
+
+fn macro_node(abc: vec3<u32>, loc: vec3<u32>) -> Node {
+    if (loc.x == CORNER) {
+        return corner(loc.y);
+    }
+    if (loc.x == ON_EDGE) {
+        return edge_point(corner(loc.y), corner((loc.y + 1u) % 3u), loc.z, tri_n[loc.y]);
+    }
+    let w = vec3<f32>(abc) / f32(tri_k);
+    return Node(w.x * tri_position[0] + w.y * tri_position[1] + w.z * tri_position[2], w);
+}
+
+// The node's fine index along original edge oe from its start, or −1 if it is not on that edge.
+fn index_on(oe: u32, loc: vec3<u32>) -> i32 {
+    if (loc.x == CORNER && loc.y == oe) {
+        return 0;
+    }
+    if (loc.x == CORNER && loc.y == (oe + 1u) % 3u) {
+        return i32(tri_n[oe]);
+    }
+    if (loc.x == ON_EDGE && loc.y == oe) {
+        return i32(loc.z);
+    }
+    return -1;
+}
+
+struct Cell {
+    c: array<vec3<u32>, 3>,
+}
+
+// Corners of cell `cell` of a level-k lattice (row r: k − r upward cells, then k − r − 1 downward).
+fn macro_cell(k: u32, cell: u32) -> Cell {
+    var rest = cell;
+    var row = 0u;
+    while (rest >= 2u * (k - row) - 1u) {
+        rest -= 2u * (k - row) - 1u;
+        row += 1u;
+    }
+    let up = k - row;
+    var out: Cell;
+    if (rest < up) {
+        let j = rest;
+        out.c[0] = vec3<u32>(k - row - j, j, row);
+        out.c[1] = vec3<u32>(k - row - j - 1u, j + 1u, row);
+        out.c[2] = vec3<u32>(k - row - j - 1u, j, row + 1u);
+    } else {
+        let j = rest - up;
+        out.c[0] = vec3<u32>(k - row - j - 1u, j + 1u, row);
+        out.c[1] = vec3<u32>(k - row - j - 2u, j + 1u, row + 1u);
+        out.c[2] = vec3<u32>(k - row - j - 1u, j, row + 1u);
+    }
+    return out;
+}
+
+// The m-th node of piece edge e, from piece corner e towards corner e + 1.
+fn node_on_edge(e: u32, m: u32) -> Node {
+    let oe = piece_original[e];
+    var a = piece_q[e];
+    var b = piece_q[(e + 1u) % 3u];
+    var j = m;
+    var n = piece_counts[e];
+    if (oe >= 0) {
+        // On an original edge: the fine nodes of that edge, by their global index.
+        let o = u32(oe);
+        a = corner(o);
+        b = corner((o + 1u) % 3u);
+        n = tri_n[o];
+        j = select(piece_from[e] + m, piece_from[e] - m, piece_to[e] < piece_from[e]);
+    }
+    return edge_point(a, b, j, n);
+}
+
+fn interior_node(i: u32, j: u32, l: u32, m: u32) -> Node {
+    let w = vec3<f32>(f32(i), f32(j), f32(l)) / f32(m);
+    return Node(
+        w.x * piece_q[0].position + w.y * piece_q[1].position + w.z * piece_q[2].position,
+        w.x * piece_q[0].bary + w.y * piece_q[1].bary + w.z * piece_q[2].bary,
+    );
+}
+
+// ---- axis split and emission ----
+
+fn plane_distance(plane: vec3<f32>, p: vec3<f32>) -> f32 {
+    let d = plane.x * p.x + plane.y * p.z - plane.z;
+    let scale = abs(plane.x * p.x) + abs(plane.y * p.z) + abs(plane.z);
+    return select(d, 0.0, abs(d) <= SNAP * scale);
+}
+
+fn push_clipped(n: u32, v: Node) -> u32 {
+    if (n > 0u && same(v.position, scratch[n - 1u].position)) {
+        return n;
+    }
+    scratch[n] = v;
+    return n + 1u;
+}
+
+// Sutherland–Hodgman clip of `poly` against one half-plane; crossing points from the
+// canonically ordered edge.
+fn clip_polygon(plane: vec3<f32>) {
+    var n = 0u;
+    for (var i = 0u; i < poly_count; i++) {
+        let cur = poly[i];
+        let next = poly[(i + 1u) % poly_count];
+        let d0 = plane_distance(plane, cur.position);
+        let d1 = plane_distance(plane, next.position);
+        if (d0 >= 0.0) {
+            n = push_clipped(n, cur);
+        }
+        if ((d0 >= 0.0) != (d1 >= 0.0)) {
+            var lo = cur;
+            var hi = next;
+            var dl = d0;
+            var dh = d1;
+            if (lex_less(next.position, cur.position)) {
+                lo = next;
+                hi = cur;
+                dl = d1;
+                dh = d0;
+            }
+            let t = dl / (dl - dh);
+            n = push_clipped(n, Node(lo.position + (hi.position - lo.position) * t, lo.bary + (hi.bary - lo.bary) * t));
+        }
+    }
+    if (n > 1u && same(scratch[n - 1u].position, scratch[0].position)) {
+        n -= 1u;
+    }
+    for (var i = 0u; i < n; i++) {
+        poly[i] = scratch[i];
+    }
+    poly_count = n;
+}
+
+fn segment_distance(a: vec2<f32>, b: vec2<f32>) -> f32 {
+    let ab = b - a;
+    let len2 = dot(ab, ab);
+    var t = 0.0;
+    if (len2 > 0.0) {
+        t = clamp(-dot(a, ab) / len2, 0.0, 1.0);
+    }
+    return length(a + ab * t);
+}
+
+fn cross2(a: vec2<f32>, b: vec2<f32>) -> f32 {
+    return a.x * b.y - a.y * b.x;
+}
+
+fn needs_axis_split(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>, split_radius: f32) -> bool {
+    let q0 = p0.xz;
+    let q1 = p1.xz;
+    let q2 = p2.xz;
+    let e0 = cross2(q1 - q0, -q0);
+    let e1 = cross2(q2 - q1, -q1);
+    let e2 = cross2(q0 - q2, -q2);
+    let contains = (e0 >= 0.0 && e1 >= 0.0 && e2 >= 0.0) || (e0 <= 0.0 && e1 <= 0.0 && e2 <= 0.0);
+    let near = min(min(segment_distance(q0, q1), segment_distance(q1, q2)), segment_distance(q2, q0)) < split_radius;
+    let t0 = azimuth(p0);
+    let t1 = azimuth(p1);
+    let t2 = azimuth(p2);
+    let span = max(max(abs(wrap_angle(t0 - t1)), abs(wrap_angle(t1 - t2))), abs(wrap_angle(t2 - t0)));
+    return contains || near || span > MAX_SPAN;
+}
+
+fn draw_vertex(n: Node, theta_ref: f32) -> DrawVertex {
+    let b = n.bary;
+    return DrawVertex(
+        n.position,
+        theta_ref,
+        b.x * tri_normal[0] + b.y * tri_normal[1] + b.z * tri_normal[2],
+        tri_material,
+        b.x * tri_color[0] + b.y * tri_color[1] + b.z * tri_color[2],
+        b.x * tri_uv[0] + b.y * tri_uv[1] + b.z * tri_uv[2],
+        vec2<f32>(0.0, 0.0),
+    );
+}
+
+fn visible_edge_px(p: array<vec3<f32>, 3>) -> f32 {
+    let half_h = 0.5 * params.projection.height;
+    let width = params.projection.width;
+    var longest = 0.0;
+    for (var s = 0u; s < 2u; s++) {
+        let eye_sign = select(-1.0, 1.0, s == 1u);
+        let q = array<vec2<f32>, 3>(pixel(p[0], eye_sign), pixel(p[1], eye_sign), pixel(p[2], eye_sign));
+        for (var e = 0u; e < 3u; e++) {
+            let a = q[e];
+            let b = q[(e + 1u) % 3u];
+            if (abs(a.y) <= half_h || abs(b.y) <= half_h) {
+                let dx = (b.x - a.x) - width * round((b.x - a.x) / width);
+                longest = max(longest, length(vec2<f32>(dx, b.y - a.y)));
+            }
+        }
+    }
+    return longest;
+}
+
+// Appends one triangle and, where it crosses the seam, its copy on the other side.
+fn emit(a: Node, b: Node, c: Node) {
+    let ps = array<vec3<f32>, 3>(a.position, b.position, c.position);
+    let theta_c = azimuth((ps[0] + ps[1] + ps[2]) / 3.0);
+    var u_min = 1e30;
+    var u_max = -1e30;
+    for (var i = 0u; i < 3u; i++) {
+        let theta = theta_c + wrap_angle(azimuth(ps[i]) - theta_c);
+        let alpha = abs(eye_shift(params.projection, horizontal_radius(ps[i])));
+        u_min = min(u_min, theta - alpha);
+        u_max = max(u_max, theta + alpha);
+    }
+    atomicMax(&counters.max_edge_bits, bitcast<u32>(visible_edge_px(ps)));
+    // Reference azimuths: the triangle itself, then a copy past each edge it crosses.
+    var refs = array<f32, 3>(theta_c, 0.0, 0.0);
+    var count = 1u;
+    // Conservative by SEAM_MARGIN: a vertex exactly on the seam (θ = π, r = R_T) is a tie that
+    // rounding could break either way; an extra copy is clipped away by the rasterizer.
+    if (u_max > PI - SEAM_MARGIN) {
+        refs[count] = theta_c - TAU;
+        count += 1u;
+    }
+    if (u_min < -PI + SEAM_MARGIN) {
+        refs[count] = theta_c + TAU;
+        count += 1u;
+    }
+    let slot = atomicAdd(&counters.triangles, count);
+    if (slot + count > params.triangle_capacity) {
+        return; // counted, never written
+    }
+    let nodes = array<Node, 3>(a, b, c);
+    for (var k = 0u; k < 3u * count; k++) {
+        out_vertices[3u * slot + k] = draw_vertex(nodes[k % 3u], refs[k / 3u]);
+    }
+}
+
+// Axis split (if needed), then emission.
+fn finish_triangle(a: Node, b: Node, c: Node) {
+    if (same(a.position, b.position) || same(b.position, c.position) || same(c.position, a.position)) {
+        return;
+    }
+    let clearance = params.axis_clearance;
+    let split = needs_axis_split(a.position, b.position, c.position, clearance / C8);
+    let sectors = select(1u, 8u, split);
+    for (var s = 0u; s < sectors; s++) {
+        poly[0] = a;
+        poly[1] = b;
+        poly[2] = c;
+        poly_count = 3u;
+        if (split) {
+            let d0 = BOUNDARY[s];
+            let d1 = BOUNDARY[s + 1u];
+            let mid = MIDDLE[s];
+            let planes = array<vec3<f32>, 3>(vec3<f32>(d0.x, d0.y, 0.0), vec3<f32>(-d1.x, -d1.y, 0.0),
+                                             vec3<f32>(mid.y, -mid.x, clearance));
+            for (var k = 0u; k < 3u; k++) {
+                clip_polygon(planes[k]);
+            }
+        }
+        let first = poly[0];
+        for (var i = 1u; i + 1u < poly_count; i++) {
+            emit(first, poly[i], poly[i + 1u]);
+        }
+    }
+}
+
+// ---- the lattice of a piece, one triangle at a time ----
+
+// Node (i, j, l) of the piece's lattice of level m: the regular lattice, whose boundary nodes on
+// an edge with fewer divisions snap to that edge's nearest node (see subdivide.rs).
+fn lattice_node(c: vec3<u32>, m: u32) -> Node {
+    var e = 3u;
+    var idx = 0u;
+    if (c.z == 0u) {
+        e = 0u;
+        idx = c.y;
+    } else if (c.x == 0u) {
+        e = 1u;
+        idx = c.z;
+    } else if (c.y == 0u) {
+        e = 2u;
+        idx = c.x;
+    }
+    if (e < 3u) {
+        return node_on_edge(e, (2u * idx * piece_counts[e] + m) / (2u * m));
+    }
+    return interior_node(c.x, c.y, c.z, m);
+}
+
+// ---- entry points ----
+
+fn invocation_index(gid: vec3<u32>, groups: vec3<u32>) -> u32 {
+    return gid.x + gid.y * groups.x * 64u;
+}
+
+@compute @workgroup_size(64)
+fn plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let local = invocation_index(gid, groups);
+    if (local >= params.triangle_count) {
+        return;
+    }
+    let t = params.first_triangle + local;
+    load_triangle(t);
+    let count = tri_k * tri_k;
+    let base = atomicAdd(&counters.pieces, count);
+    if (base + count > params.piece_capacity) {
+        return; // counted, never written
+    }
+    for (var c = 0u; c < count; c++) {
+        pieces[base + c] = vec2<u32>(t, c);
+    }
+}
+
+@compute @workgroup_size(64)
+fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let local = invocation_index(gid, groups);
+    if (local >= params.piece_count) {
+        return;
+    }
+    let piece = pieces[params.first_piece + local];
+    load_triangle(piece.x);
+    let cell = macro_cell(tri_k, piece.y);
+    var loc: array<vec3<u32>, 3>;
+    for (var i = 0u; i < 3u; i++) {
+        loc[i] = macro_location(cell.c[i]);
+        piece_q[i] = macro_node(cell.c[i], loc[i]);
+    }
+    if (same(piece_q[0].position, piece_q[1].position) || same(piece_q[1].position, piece_q[2].position)
+        || same(piece_q[2].position, piece_q[0].position)) {
+        return; // snapped corners coincide: no area
+    }
+    // Each piece edge: on an original edge (that edge's fine nodes, by global index) or interior.
+    for (var e = 0u; e < 3u; e++) {
+        piece_original[e] = -1;
+        for (var oe = 0u; oe < 3u; oe++) {
+            let start = index_on(oe, loc[e]);
+            let end = index_on(oe, loc[(e + 1u) % 3u]);
+            if (piece_original[e] < 0 && start >= 0 && end >= 0) {
+                piece_original[e] = i32(oe);
+                piece_from[e] = u32(start);
+                piece_to[e] = u32(end);
+                piece_counts[e] = u32(abs(start - end));
+            }
+        }
+        if (piece_original[e] < 0) {
+            piece_counts[e] = min(edge_divisions(piece_q[e].position, piece_q[(e + 1u) % 3u].position), 2u * params.max_div);
+        }
+    }
+    let m = max(max(piece_counts[0], piece_counts[1]), piece_counts[2]);
+    for (var t = 0u; t < m * m; t++) {
+        let cell = macro_cell(m, t);
+        var nodes: array<Node, 3>;
+        for (var k = 0u; k < 3u; k++) {
+            nodes[k] = lattice_node(cell.c[k], m);
+        }
+        finish_triangle(nodes[0], nodes[1], nodes[2]);
+    }
+}
+
+@compute @workgroup_size(1)
+fn finalize() {
+    let written = min(atomicLoad(&counters.triangles), params.triangle_capacity);
+    draw_args = DrawIndirectArgs(3u * written, 1u, 0u, 0u);
+}
