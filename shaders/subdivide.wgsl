@@ -65,7 +65,8 @@ struct DrawIndirectArgs {
 @group(0) @binding(0) var<uniform> params: SubdivideParams;
 @group(0) @binding(1) var<storage, read> vertices: array<SceneVertex>;
 @group(0) @binding(2) var<storage, read> indices: array<u32>;
-@group(0) @binding(3) var<storage, read_write> pieces: array<vec2<u32>>;
+// Piece records: (triangle, macro cell, n0 | n1 << 16, n2 | K << 16).
+@group(0) @binding(3) var<storage, read_write> pieces: array<vec4<u32>>;
 @group(0) @binding(4) var<storage, read_write> out_vertices: array<DrawVertex>;
 @group(0) @binding(5) var<storage, read_write> counters: Counters;
 @group(0) @binding(6) var<storage, read_write> draw_args: DrawIndirectArgs;
@@ -158,8 +159,9 @@ fn pixel(p: vec3<f32>, eye_sign: f32) -> vec2<f32> {
     return vec2<f32>(u * params.projection.width / TAU, v * params.projection.pixels_per_metre);
 }
 
-// Projected length in pixels of the straight edge ab, larger of the two eyes, heights clamped.
-fn edge_length_px(a: vec3<f32>, b: vec3<f32>) -> f32 {
+// Projected length in pixels of the straight edge ab, larger of the two eyes, heights clamped,
+// as a polyline of `segments` segments.
+fn edge_length_px(a: vec3<f32>, b: vec3<f32>, segments: u32) -> f32 {
     var lo = a;
     var hi = b;
     if (lex_less(b, a)) {
@@ -173,8 +175,8 @@ fn edge_length_px(a: vec3<f32>, b: vec3<f32>) -> f32 {
         let eye_sign = select(-1.0, 1.0, s == 1u);
         var total = 0.0;
         var prev = vec2<f32>(0.0, 0.0);
-        for (var k = 0u; k <= EDGE_SAMPLES; k++) {
-            let t = f32(k) / f32(EDGE_SAMPLES);
+        for (var k = 0u; k <= segments; k++) {
+            let t = f32(k) / f32(segments);
             var q = pixel(lo + (hi - lo) * t, eye_sign);
             q.y = clamp(q.y, -clamp_v, clamp_v);
             if (k > 0u) {
@@ -195,11 +197,34 @@ fn edge_divisions(a: vec3<f32>, b: vec3<f32>) -> u32 {
     if (params.method == 1u) {
         return params.fixed_n;
     }
-    let n = ceil(edge_length_px(a, b) / params.edge_px);
+    // Quick 2-segment length first; the 8-segment polyline refines it, so it is never shorter.
+    // (One call site in a loop: lavapipe's compiler inlines every call.)
+    var length_px = 0.0;
+    for (var round = 0u; round < 2u; round++) {
+        length_px = edge_length_px(a, b, select(2u, EDGE_SAMPLES, round == 1u));
+        if (round == 0u && length_px <= 0.5 * params.edge_px) {
+            return 1u;
+        }
+    }
+    let n = ceil(length_px / params.edge_px);
     if (n >= f32(MAX_EDGE_DIVISIONS) || !(n == n)) {
         return MAX_EDGE_DIVISIONS;
     }
     return max(u32(n), 1u);
+}
+
+// Loads an input triangle into the viewer frame (edge counts and K come from `plan_triangle`
+// or from the piece record).
+// Whether a triangle lies wholly above or below the image (see `off_screen_vertically` in
+// subdivide.rs for why testing the corners suffices).
+fn off_screen_vertically(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> bool {
+    let rt = params.projection.screen_radius;
+    let de = params.projection.eye_radius;
+    let half = 0.5 * params.projection.height / params.projection.pixels_per_metre;
+    let k = half / (rt * sqrt(1.0 - (de / rt) * (de / rt)));
+    let r = vec3<f32>(horizontal_radius(p0), horizontal_radius(p1), horizontal_radius(p2));
+    let y = vec3<f32>(p0.y, p1.y, p2.y);
+    return all(y > k * r) || all(y < -k * r);
 }
 
 fn load_triangle(t: u32) {
@@ -211,6 +236,14 @@ fn load_triangle(t: u32) {
         tri_uv[k] = v.uv;
     }
     tri_material = vertices[indices[3u * t]].material;
+}
+
+fn plan_triangle() {
+    if (off_screen_vertically(tri_position[0], tri_position[1], tri_position[2])) {
+        tri_k = 0u; // no pieces
+        tri_n = array<u32, 3>(1u, 1u, 1u);
+        return;
+    }
     for (var e = 0u; e < 3u; e++) {
         tri_n[e] = edge_divisions(tri_position[e], tri_position[(e + 1u) % 3u]);
     }
@@ -489,7 +522,8 @@ fn emit(a: Node, b: Node, c: Node) {
 
 // Axis split (if needed), then emission.
 fn finish_triangle(a: Node, b: Node, c: Node) {
-    if (same(a.position, b.position) || same(b.position, c.position) || same(c.position, a.position)) {
+    if (same(a.position, b.position) || same(b.position, c.position) || same(c.position, a.position)
+        || off_screen_vertically(a.position, b.position, c.position)) {
         return;
     }
     let clearance = params.axis_clearance;
@@ -554,13 +588,15 @@ fn plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     let t = params.first_triangle + local;
     load_triangle(t);
+    plan_triangle();
     let count = tri_k * tri_k;
     let base = atomicAdd(&counters.pieces, count);
     if (base + count > params.piece_capacity) {
         return; // counted, never written
     }
+    let packed = vec2<u32>(tri_n[0] | (tri_n[1] << 16u), tri_n[2] | (tri_k << 16u));
     for (var c = 0u; c < count; c++) {
-        pieces[base + c] = vec2<u32>(t, c);
+        pieces[base + c] = vec4<u32>(t, c, packed);
     }
 }
 
@@ -572,6 +608,10 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     }
     let piece = pieces[params.first_piece + local];
     load_triangle(piece.x);
+    tri_n[0] = piece.z & 0xffffu;
+    tri_n[1] = piece.z >> 16u;
+    tri_n[2] = piece.w & 0xffffu;
+    tri_k = piece.w >> 16u;
     let cell = macro_cell(tri_k, piece.y);
     var loc: array<vec3<u32>, 3>;
     for (var i = 0u; i < 3u; i++) {

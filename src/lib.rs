@@ -7,9 +7,11 @@
 //! - `raster` ([`raster::raster`], `shaders/raster.wgsl`): projection per vertex (eq. 1–4), shading;
 //! - `project_points` ([`projection::project_points`], `shaders/project_points.wgsl`).
 
+pub mod bench;
 pub mod builtin;
 pub mod gpu;
 pub mod gpu_types;
+pub mod load;
 pub mod output;
 pub mod projection;
 pub mod raster;

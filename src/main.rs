@@ -7,10 +7,11 @@ use clap::{Args, Parser, Subcommand};
 use glam::Vec3;
 
 use twister::gpu::Gpu;
+use twister::load::load_scene;
 use twister::output::{layout_images, write_images, write_text, Layout};
 use twister::renderer::DEFAULT_MEMORY_MB;
 use twister::subdivide::{Method, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV};
-use twister::{builtin, GpuScene, Projection, RenderSettings, Renderer, Scene, Vertical};
+use twister::{GpuScene, Projection, RenderSettings, Renderer, Vertical};
 
 #[derive(Parser)]
 #[command(name = "twister", version, about = "Omnidirectional stereo (TWISTER concentric-mosaic) rendering on the GPU")]
@@ -23,6 +24,36 @@ struct Cli {
 enum Command {
     /// Render a scene into the left- and right-eye panoramas.
     Render(RenderArgs),
+    /// Benchmarks (release builds): `speed` times methods on scenes.
+    #[command(subcommand)]
+    Bench(BenchCommand),
+}
+
+#[derive(Subcommand)]
+enum BenchCommand {
+    /// Median frame time of each method on each scene, and its ratio to the first method.
+    Speed(SpeedArgs),
+}
+
+#[derive(Args)]
+struct SpeedArgs {
+    /// Scenes (.obj files or builtin:NAME).
+    #[arg(required = true)]
+    scenes: Vec<String>,
+    /// Methods, comma-separated; ratios are against the first.
+    #[arg(long, value_delimiter = ',', value_parser = Method::parse, default_value = "vertex,adaptive")]
+    methods: Vec<Method>,
+    /// Place file scenes DIST metres ahead, filling the screen height (built-in ones are placed already).
+    #[arg(long, value_name = "DIST")]
+    fit: Option<f32>,
+    /// Timed frames per point (after one warm-up); the median is reported.
+    #[arg(long, default_value_t = 5)]
+    reps: usize,
+    #[command(flatten)]
+    view: ViewArgs,
+    /// Also write the rows as JSON to this file.
+    #[arg(long)]
+    json: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -64,9 +95,12 @@ struct ViewArgs {
 
 #[derive(Args)]
 struct RenderArgs {
-    /// Scene to render: builtin:demo, builtin:sphere100, builtin:sphere1024, builtin:triangle@D.
+    /// Scene to render: a .obj file, or builtin:demo, builtin:sphere100, builtin:sphere1024, builtin:triangle@D.
     #[arg(default_value = "builtin:demo")]
     scene: String,
+    /// Move and scale the scene so that it stands DIST metres ahead, filling the screen height.
+    #[arg(long, value_name = "DIST")]
+    fit: Option<f32>,
     /// Output folder.
     #[arg(long, default_value = "out")]
     out: PathBuf,
@@ -118,18 +152,13 @@ impl ViewArgs {
     }
 }
 
-fn load_scene(spec: &str, projection: &Projection) -> Result<Scene, String> {
-    if spec.starts_with("builtin:") {
-        return builtin::builtin_scene(spec, projection);
-    }
-    Err(format!("{spec}: loading scene files is not supported yet; use one of {}", builtin::NAMES.join(", ")))
-}
-
 fn render(args: &RenderArgs) -> Result<(), String> {
     let mut settings = args.view.settings()?;
     settings.background = args.background;
-    let scene = load_scene(&args.scene, &settings.projection)?;
-    scene.validate().map_err(|e| format!("{}: {e}", args.scene))?;
+    let mut scene = load_scene(&args.scene, &settings.projection)?;
+    if let Some(d) = args.fit {
+        scene.fit(d, &settings.projection).map_err(|e| format!("{}: {e}", args.scene))?;
+    }
     let gpu = Gpu::new().map_err(|e| e.to_string())?;
     let adapter = gpu.adapter_description();
     let renderer = Renderer::new(gpu);
@@ -173,10 +202,34 @@ fn render(args: &RenderArgs) -> Result<(), String> {
     Ok(())
 }
 
+fn bench_speed(args: &SpeedArgs) -> Result<(), String> {
+    if args.reps == 0 {
+        return Err("--reps must be at least 1".into());
+    }
+    let settings = args.view.settings()?;
+    let gpu = Gpu::new().map_err(|e| e.to_string())?;
+    let adapter = gpu.adapter_description();
+    let renderer = Renderer::new(gpu);
+    let rows = twister::bench::speed(&renderer, &args.scenes, args.fit, &args.methods, &settings, args.reps, |what| {
+        eprintln!("timing {what} ...")
+    })?;
+    println!(
+        "adapter: {adapter}; {}x{} per eye, both eyes; median of {} frames after a warm-up; wall time around submit-and-wait\n",
+        settings.projection.width, settings.projection.height, args.reps
+    );
+    print!("{}", twister::bench::speed_table(&rows));
+    if let Some(path) = &args.json {
+        let json = serde_json::json!({ "adapter": adapter, "width": settings.projection.width, "height": settings.projection.height, "rows": rows });
+        write_text(path, &serde_json::to_string_pretty(&json).unwrap())?;
+    }
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Render(args) => render(args),
+        Command::Bench(BenchCommand::Speed(args)) => bench_speed(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

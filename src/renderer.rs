@@ -25,7 +25,7 @@ pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 const DRAW_VERTEX_SIZE: u64 = std::mem::size_of::<DrawVertex>() as u64;
 const TRIANGLE_SIZE: u64 = 3 * DRAW_VERTEX_SIZE;
-const PIECE_SIZE: u64 = 8;
+const PIECE_SIZE: u64 = 16;
 /// Default memory budget for the subdivision buffers, MiB.
 pub const DEFAULT_MEMORY_MB: u32 = 256;
 
@@ -304,15 +304,10 @@ impl Renderer {
         (pieces.min(u32::MAX as u64) as u32, triangles.min(u32::MAX as u64) as u32)
     }
 
-    /// Makes sure the cached buffers hold at least these capacities.
+    /// Makes sure the cached buffers hold at least these capacities. Each buffer is replaced
+    /// only if it is too small, so growing the output keeps the pieces already planned.
     fn ensure_buffers(&self, cache: &mut Option<Buffers>, pieces: u32, triangles: u32) {
         let device = &self.gpu.device;
-        let fits = cache.as_ref().is_some_and(|b| b.piece_capacity >= pieces && b.triangle_capacity >= triangles);
-        if fits {
-            return;
-        }
-        let (old_p, old_t) = cache.as_ref().map_or((0, 0), |b| (b.piece_capacity, b.triangle_capacity));
-        let (pieces, triangles) = (pieces.max(old_p).max(1), triangles.max(old_t).max(1));
         let storage = |label, size: u64, extra| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -324,18 +319,39 @@ impl Renderer {
                 mapped_at_creation: false,
             })
         };
-        *cache = Some(Buffers {
-            pieces: storage("pieces", pieces as u64 * PIECE_SIZE, wgpu::BufferUsages::empty()),
-            piece_capacity: pieces,
-            triangles: storage("subdivided triangles", triangles as u64 * TRIANGLE_SIZE, wgpu::BufferUsages::VERTEX),
-            triangle_capacity: triangles,
-            counters: storage("counters", std::mem::size_of::<SubdivideCounters>() as u64, wgpu::BufferUsages::empty()),
-            draw_args: storage(
-                "draw args",
-                std::mem::size_of::<DrawIndirectArgs>() as u64,
-                wgpu::BufferUsages::INDIRECT,
-            ),
-        });
+        let make_pieces = |n: u32| storage("pieces", n.max(1) as u64 * PIECE_SIZE, wgpu::BufferUsages::empty());
+        let make_triangles =
+            |n: u32| storage("subdivided triangles", n.max(1) as u64 * TRIANGLE_SIZE, wgpu::BufferUsages::VERTEX);
+        match cache {
+            None => {
+                *cache = Some(Buffers {
+                    pieces: make_pieces(pieces),
+                    piece_capacity: pieces.max(1),
+                    triangles: make_triangles(triangles),
+                    triangle_capacity: triangles.max(1),
+                    counters: storage(
+                        "counters",
+                        std::mem::size_of::<SubdivideCounters>() as u64,
+                        wgpu::BufferUsages::empty(),
+                    ),
+                    draw_args: storage(
+                        "draw args",
+                        std::mem::size_of::<DrawIndirectArgs>() as u64,
+                        wgpu::BufferUsages::INDIRECT,
+                    ),
+                });
+            }
+            Some(b) => {
+                if b.piece_capacity < pieces {
+                    b.pieces = make_pieces(pieces);
+                    b.piece_capacity = pieces;
+                }
+                if b.triangle_capacity < triangles {
+                    b.triangles = make_triangles(triangles);
+                    b.triangle_capacity = triangles;
+                }
+            }
+        }
     }
 
     /// Runs one compute entry point of the subdivide stage over `count` invocations and returns
@@ -555,10 +571,13 @@ impl Renderer {
         let mut cache = self.buffers.lock().unwrap_or_else(|e| e.into_inner());
         let n = scene.triangle_count;
         // Start from the cached buffers, or a guess; grow on overflow within the budget.
-        let (mut want_pieces, mut want_tris) = cache.as_ref().map_or(
-            (n.saturating_add(1024).min(max_pieces), n.saturating_mul(4).saturating_add(4096).min(max_tris)),
-            |b| (b.piece_capacity, b.triangle_capacity),
-        );
+        // Capacities in use never exceed the budget, whatever size the cached buffers have.
+        let (mut want_pieces, mut want_tris) =
+            cache.as_ref().map_or((n.saturating_add(1024), n.saturating_mul(4).saturating_add(4096)), |b| {
+                (b.piece_capacity, b.triangle_capacity)
+            });
+        want_pieces = want_pieces.min(max_pieces);
+        want_tris = want_tris.min(max_tris);
         let mut max_edge = 0.0f32;
         let (mut first_tri, mut tri_chunk) = (0u32, n.max(1));
         let mut cleared = false;
@@ -567,7 +586,7 @@ impl Renderer {
             self.ensure_buffers(&mut cache, want_pieces, want_tris);
             let b = cache.as_ref().unwrap();
             let mut params = settings.subdivide_params(first_tri, tri_count);
-            params.piece_capacity = b.piece_capacity.min(max_pieces.max(want_pieces));
+            params.piece_capacity = b.piece_capacity.min(max_pieces);
             params.triangle_capacity = b.triangle_capacity;
             let t = Instant::now();
             let planned = self.run_subdivide(&self.plan, scene, b, &params, tri_count);
@@ -594,7 +613,7 @@ impl Renderer {
                 let b = cache.as_ref().unwrap();
                 params.first_piece = first_piece;
                 params.piece_count = piece_count;
-                params.triangle_capacity = b.triangle_capacity.min(max_tris.max(want_tris));
+                params.triangle_capacity = b.triangle_capacity.min(max_tris);
                 let t = Instant::now();
                 let done = self.run_subdivide(&self.lattice, scene, b, &params, piece_count);
                 stats.ms_subdivide += t.elapsed().as_secs_f64() * 1e3;

@@ -41,6 +41,10 @@
 //! NaN is made. Only points no eye sees, or that project far above or below the image, are removed.
 //! Clip points are computed from canonically ordered edge endpoints, so neighbours agree.
 //!
+//! **Off screen.** Triangles that lie wholly above or below the image (see
+//! [`Subdivider::off_screen_vertically`]) make no pieces, and sub-triangles that do are not
+//! emitted: a floor or ceiling near the axis is not subdivided where no one can see it.
+//!
 //! **The seam.** Each output triangle carries the azimuth of its centroid, `theta_ref`; the vertex
 //! stage unwraps θ by whole turns towards it. A triangle whose u range (both eyes) crosses ±π is
 //! also emitted with `theta_ref ∓ 2π`, so it appears at both edges of the panorama.
@@ -104,7 +108,7 @@ pub const MAX_EDGE_DIVISIONS: u32 = 1024;
 pub const DEFAULT_EDGE_PX: f32 = 32.0;
 /// Default N_max, as in the paper.
 pub const DEFAULT_MAX_DIV: u32 = 7;
-/// Samples along an edge when measuring its projected length.
+/// Segments of the polyline that measures a long edge's projected length.
 pub const EDGE_SAMPLES: u32 = 8;
 
 /// Number of sectors an axis triangle is split into.
@@ -242,9 +246,10 @@ impl<'a> Subdivider<'a> {
         Vec2::new(u * self.projection.pixels_per_radian(), v * self.projection.pixels_per_metre())
     }
 
-    /// Projected length in pixels of the straight edge ab (larger of the two eyes). Heights are
-    /// clamped to ±1.5 image heights from the middle row, so off-screen parts count little.
-    pub fn edge_px(&self, a: Vec3, b: Vec3) -> f32 {
+    /// Projected length in pixels of the straight edge ab (larger of the two eyes), measured as
+    /// a polyline through `segments` + 1 points. Heights are clamped to ±1.5 image heights from
+    /// the middle row, so off-screen parts count little.
+    pub fn edge_length_px(&self, a: Vec3, b: Vec3, segments: u32) -> f32 {
         let (lo, hi) = if lex_less(b, a) { (b, a) } else { (a, b) };
         let clamp_v = 1.5 * self.projection.height as f32;
         let width = self.projection.width as f32;
@@ -252,8 +257,8 @@ impl<'a> Subdivider<'a> {
         for eye_sign in [-1.0f32, 1.0] {
             let mut total = 0.0;
             let mut prev = Vec2::ZERO;
-            for k in 0..=EDGE_SAMPLES {
-                let t = k as f32 / EDGE_SAMPLES as f32;
+            for k in 0..=segments {
+                let t = k as f32 / segments as f32;
                 let mut q = self.pixel(lo + (hi - lo) * t, eye_sign);
                 q.y = q.y.clamp(-clamp_v, clamp_v);
                 if k > 0 {
@@ -267,13 +272,18 @@ impl<'a> Subdivider<'a> {
         longest
     }
 
-    /// Divisions of an original edge (eq. 5, uncapped by N_max: pre-split handles that).
+    /// Divisions of an edge (eq. 5, not capped by N_max: the pre-split handles that). A quick
+    /// 2-segment length first: if it is at most L/2 the edge stays whole, else the 8-segment
+    /// length decides (it is never shorter, as it refines the same polyline).
     fn edge_divisions(&self, a: Vec3, b: Vec3) -> u32 {
         match self.params.method {
             0 => 1,
             1 => self.params.fixed_n,
             _ => {
-                let n = (self.edge_px(a, b) / self.params.edge_px).ceil();
+                if self.edge_length_px(a, b, 2) <= 0.5 * self.params.edge_px {
+                    return 1;
+                }
+                let n = (self.edge_length_px(a, b, EDGE_SAMPLES) / self.params.edge_px).ceil();
                 if n.is_finite() {
                     (n as u32).clamp(1, MAX_EDGE_DIVISIONS)
                 } else {
@@ -302,9 +312,26 @@ impl<'a> Subdivider<'a> {
         }
     }
 
-    /// `plan`: the macro-lattice level K of a triangle (K² pieces) and its edge counts.
+    /// Whether a triangle lies wholly above or wholly below the image. Along a segment with
+    /// y > 0, y is linear and r convex, so y/r never falls below its smaller end value: corners all
+    /// above the top mean the whole triangle is (likewise below). The exact model has
+    /// v ≥ v_paper·√(1 − d_e²/R_T²), so the test k = half height / (R_T·√(1 − d_e²/R_T²)) on y/r is
+    /// safe for both vertical models.
+    pub fn off_screen_vertically(&self, p: [Vec3; 3]) -> bool {
+        let (rt, de) = (self.projection.screen_radius, self.projection.eye_radius);
+        let k = self.projection.half_height_m() / (rt * (1.0 - (de / rt) * (de / rt)).sqrt());
+        let above = p.iter().all(|q| q.y > k * horizontal_radius(*q));
+        let below = p.iter().all(|q| q.y < -k * horizontal_radius(*q));
+        above || below
+    }
+
+    /// `plan`: the macro-lattice level K of a triangle (K² pieces, none if it is off screen
+    /// vertically) and its edge counts.
     fn plan(&self, tri: &Triangle) -> (u32, [u32; 3]) {
         let p = tri.position;
+        if self.off_screen_vertically(p) {
+            return (0, [1; 3]);
+        }
         let n = [self.edge_divisions(p[0], p[1]), self.edge_divisions(p[1], p[2]), self.edge_divisions(p[2], p[0])];
         let m = n[0].max(n[1]).max(n[2]);
         let k = if self.params.method == 2 { m.div_ceil(self.params.max_div) } else { 1 };
@@ -317,10 +344,10 @@ impl<'a> Subdivider<'a> {
         let first = self.params.first_triangle as usize;
         for t in first..first + self.params.triangle_count as usize {
             let tri = self.load(vertices, indices, t);
-            let (k, _) = self.plan(&tri);
+            let (k, n) = self.plan(&tri);
             for cell in 0..k * k {
                 out.pieces += 1;
-                self.lattice(&tri, k, cell, &mut out);
+                self.lattice(&tri, k, n, cell, &mut out);
             }
         }
         out
@@ -361,8 +388,7 @@ impl<'a> Subdivider<'a> {
     }
 
     /// `lattice`: subdivides macro cell `cell` of a triangle and emits its sub-triangles.
-    fn lattice(&self, tri: &Triangle, k: u32, cell: u32, out: &mut SubdivideOutput) {
-        let (_, n) = self.plan(tri);
+    fn lattice(&self, tri: &Triangle, k: u32, n: [u32; 3], cell: u32, out: &mut SubdivideOutput) {
         let loc = macro_cell(k, cell).map(|c| self.macro_location(n, k, c));
         let q = loc.map(|l| self.macro_node(tri, n, k, l));
         if q[0].position == q[1].position || q[1].position == q[2].position || q[2].position == q[0].position {
@@ -406,7 +432,7 @@ impl<'a> Subdivider<'a> {
     /// Axis split (if needed), then emission with seam copies.
     fn finish_triangle(&self, tri: &Triangle, nodes: [Node; 3], out: &mut SubdivideOutput) {
         let p = nodes.map(|n| n.position);
-        if p[0] == p[1] || p[1] == p[2] || p[2] == p[0] {
+        if p[0] == p[1] || p[1] == p[2] || p[2] == p[0] || self.off_screen_vertically(p) {
             return;
         }
         let clearance = self.params.axis_clearance;
@@ -837,6 +863,41 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn vertically_culled_triangles_project_wholly_off_the_image() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand::rngs::StdRng::seed_from_u64(11);
+        let mut culled = 0;
+        for vertical in [Vertical::Paper, Vertical::Exact] {
+            let projection = Projection { width: 800, height: 200, vertical, ..Projection::default() };
+            let params = params_for(&projection, Method::Adaptive, 32.0, 7, 0);
+            let sd = Subdivider::new(&params);
+            for _ in 0..3000 {
+                let p: [Vec3; 3] = std::array::from_fn(|_| {
+                    Vec3::new(rng.random_range(-2.0..2.0), rng.random_range(-1.0..3.0), rng.random_range(-2.0..2.0))
+                });
+                if !sd.off_screen_vertically(p) {
+                    continue;
+                }
+                culled += 1;
+                for _ in 0..200 {
+                    let (a, b): (f32, f32) = (rng.random(), rng.random());
+                    let (a, b) = if a + b > 1.0 { (1.0 - a, 1.0 - b) } else { (a, b) };
+                    let q = p[0] + a * (p[1] - p[0]) + b * (p[2] - p[0]);
+                    for eye in Eye::BOTH {
+                        if let Some(pr) = projection.project(q, eye) {
+                            assert!(
+                                pr.v.abs() > projection.half_height_m(),
+                                "{vertical:?}: culled triangle {p:?} shows point {q:?}"
+                            );
+                        }
+                    }
+                }
+            }
+        }
+        assert!(culled > 100, "the test exercised only {culled} culled triangles");
     }
 
     #[test]

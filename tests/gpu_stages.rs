@@ -153,6 +153,10 @@ fn gpu_subdivide_matches_cpu_twin() {
         (builtin::demo(), RenderSettings { method: Method::Vertex, ..moved.clone() }),
         (builtin::demo(), RenderSettings { edge_px: 12.0, max_div: 4, ..moved.clone() }),
         (sphere, RenderSettings { edge_px: 8.0, ..base.clone() }),
+        (
+            builtin::sphere_scene(1024, Vec3::ZERO, 2.5, "sphere around the viewer"),
+            RenderSettings { edge_px: 16.0, ..base.clone() },
+        ),
     ];
     for (k, (scene, settings)) in cases.iter().enumerate() {
         let gs = GpuScene::upload(&r.gpu, scene).unwrap();
