@@ -1,12 +1,15 @@
-// The `raster` stage (vertex + fragment): projects each prepared vertex with the TWISTER
-// projection (seed 002 eq. 1–4, projection.wgsl) for one eye and shades it.
-// CPU twin: src/raster.rs (the per-vertex part, `raster_vertex`). Needs projection.wgsl.
+// The `raster` stage (vertex + fragment): projects each subdivided vertex with the TWISTER
+// projection (seed 002 eq. 1–4, projection.wgsl) for one eye; the fragments are shaded and carry
+// their display-position error (fragment.wgsl). CPU twin: src/raster.rs.
+// Needs projection.wgsl and fragment.wgsl.
 
 struct RasterParams {
     projection: Projection,
     eye_sign: f32,   // +1 right eye, −1 left eye
     ambient: f32,
-    _pad: vec2<f32>,
+    // Test hook: draws everything shifted by this many pixels (x right, y down) while the
+    // error is still measured against the true projection.
+    shift_px: vec2<f32>,
 }
 
 @group(0) @binding(0) var<uniform> params: RasterParams;
@@ -18,6 +21,7 @@ struct VertexIn {
     @location(3) material: u32,
     @location(4) color: vec4<f32>,
     @location(5) uv: vec2<f32>,
+    @location(6) object: u32,
 }
 
 struct VertexOut {
@@ -25,6 +29,7 @@ struct VertexOut {
     @location(0) view_position: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) color: vec4<f32>,
+    @location(3) @interpolate(flat) object: u32,
 }
 
 @vertex
@@ -36,21 +41,19 @@ fn vs_main(in: VertexIn) -> VertexOut {
     let uvd = project_with_azimuth(params.projection, in.position, theta, params.eye_sign);
     var out: VertexOut;
     out.clip = to_clip(params.projection, uvd);
+    out.clip.x += 2.0 * params.shift_px.x / params.projection.width;
+    out.clip.y -= 2.0 * params.shift_px.y / params.projection.height;
     out.view_position = in.position;
     out.normal = in.normal;
     out.color = in.color;
+    out.object = in.object;
     return out;
 }
 
 @fragment
-fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
-    // Headlight from the viewer: colour × (ambient + (1 − ambient)·|n·l|), two-sided.
-    let n_len = length(in.normal);
-    let l = -normalize(in.view_position);
-    var lambert = 1.0;
-    if (n_len > 1e-6) {
-        lambert = abs(dot(in.normal / n_len, l));
-    }
-    let shade = params.ambient + (1.0 - params.ambient) * lambert;
-    return vec4<f32>(in.color.rgb * shade, 1.0);
+fn fs_main(in: VertexOut) -> FragmentOut {
+    // Clip w is 1: view_position is interpolated linearly on the screen, which is where the
+    // projection methods put a triangle's inside.
+    return fragment_out(params.projection, params.eye_sign, params.ambient, in.clip.xy, in.view_position, in.normal,
+                        in.color, in.object);
 }

@@ -15,7 +15,7 @@ struct SceneVertex {
     position: vec3<f32>,
     material: u32,
     normal: vec3<f32>,
-    _pad0: u32,
+    object: u32,
     color: vec4<f32>,
     uv: vec2<f32>,
     _pad1: vec2<f32>,
@@ -28,7 +28,8 @@ struct DrawVertex {
     material: u32,
     color: vec4<f32>,
     uv: vec2<f32>,
-    _pad: vec2<f32>,
+    object: u32,
+    _pad: f32,
 }
 
 struct SubdivideParams {
@@ -102,6 +103,7 @@ var<private> tri_normal: array<vec3<f32>, 3>;
 var<private> tri_color: array<vec4<f32>, 3>;
 var<private> tri_uv: array<vec2<f32>, 3>;
 var<private> tri_material: u32;
+var<private> tri_object: u32;
 var<private> tri_n: array<u32, 3>;    // divisions of edges P0P1, P1P2, P2P0
 var<private> tri_k: u32;              // macro-lattice level
 
@@ -236,6 +238,7 @@ fn load_triangle(t: u32) {
         tri_uv[k] = v.uv;
     }
     tri_material = vertices[indices[3u * t]].material;
+    tri_object = vertices[indices[3u * t]].object;
 }
 
 fn plan_triangle() {
@@ -461,7 +464,8 @@ fn draw_vertex(n: Node, theta_ref: f32) -> DrawVertex {
         tri_material,
         b.x * tri_color[0] + b.y * tri_color[1] + b.z * tri_color[2],
         b.x * tri_uv[0] + b.y * tri_uv[1] + b.z * tri_uv[2],
-        vec2<f32>(0.0, 0.0),
+        tri_object,
+        0.0,
     );
 }
 

@@ -23,6 +23,9 @@ pub struct Gpu {
     pub info: wgpu::AdapterInfo,
     pub limits: wgpu::Limits,
     pub features: wgpu::Features,
+    /// How the error pass writes its target: R32Float where the adapter can render to it,
+    /// else R32Uint bits. `TWISTER_ERROR_TARGET=uint` forces the latter (for tests).
+    pub error_target: crate::shaders::ErrorTarget,
 }
 
 impl Gpu {
@@ -41,6 +44,16 @@ impl Gpu {
             .await
             .map_err(|e| GpuError(format!("{NO_ADAPTER_HELP} ({e})")))?;
         let info = adapter.get_info();
+        let float_renderable = adapter
+            .get_texture_format_features(wgpu::TextureFormat::R32Float)
+            .allowed_usages
+            .contains(wgpu::TextureUsages::RENDER_ATTACHMENT);
+        let forced_uint = std::env::var("TWISTER_ERROR_TARGET").is_ok_and(|v| v == "uint");
+        let error_target = if float_renderable && !forced_uint {
+            crate::shaders::ErrorTarget::Float
+        } else {
+            crate::shaders::ErrorTarget::UintBits
+        };
         let limits = adapter.limits();
         let wanted = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
         let features = adapter.features() & wanted;
@@ -53,7 +66,7 @@ impl Gpu {
             })
             .await
             .map_err(|e| GpuError(format!("the GPU adapter '{}' could not open a device: {e}", info.name)))?;
-        Ok(Gpu { device, queue, info, limits, features })
+        Ok(Gpu { device, queue, info, limits, features, error_target })
     }
 
     /// "name (backend, device type)", for stats and logs.

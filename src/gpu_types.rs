@@ -12,7 +12,8 @@ pub struct SceneVertex {
     pub position: [f32; 3],
     pub material: u32,
     pub normal: [f32; 3],
-    pub _pad0: u32,
+    /// Index of the scene object the vertex belongs to.
+    pub object: u32,
     pub color: [f32; 4],
     pub uv: [f32; 2],
     pub _pad1: [f32; 2],
@@ -30,7 +31,8 @@ pub struct DrawVertex {
     pub material: u32,
     pub color: [f32; 4],
     pub uv: [f32; 2],
-    pub _pad: [f32; 2],
+    pub object: u32,
+    pub _pad: f32,
 }
 
 /// `Projection` in shaders/projection.wgsl. 32 bytes.
@@ -45,6 +47,18 @@ pub struct ProjectionUniform {
     pub vertical_exact: u32,
     pub pixels_per_metre: f32,
     pub _pad: f32,
+}
+
+impl From<&ProjectionUniform> for Projection {
+    fn from(p: &ProjectionUniform) -> Self {
+        Projection {
+            screen_radius: p.screen_radius,
+            eye_radius: p.eye_radius,
+            width: p.width as u32,
+            height: p.height as u32,
+            vertical: if p.vertical_exact != 0 { Vertical::Exact } else { Vertical::Paper },
+        }
+    }
 }
 
 impl From<&Projection> for ProjectionUniform {
@@ -111,7 +125,9 @@ pub struct RasterParams {
     pub eye_sign: f32,
     /// Ambient term of the shading: colour × (ambient + (1 − ambient)·|n·l|).
     pub ambient: f32,
-    pub _pad: [f32; 2],
+    /// Test hook: draw shifted by this many pixels (x right, y down); the error pass still
+    /// measures against the true projection.
+    pub shift_px: [f32; 2],
 }
 
 /// `DrawIndirectArgs` as the GPU reads them.

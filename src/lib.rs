@@ -9,12 +9,16 @@
 
 pub mod bench;
 pub mod builtin;
+pub mod compare;
+pub mod fragment;
 pub mod gpu;
 pub mod gpu_types;
+pub mod heatmap;
 pub mod load;
 pub mod output;
 pub mod projection;
 pub mod raster;
+pub mod reduce;
 pub mod renderer;
 pub mod scene;
 pub mod shaders;

@@ -24,9 +24,36 @@ struct Cli {
 enum Command {
     /// Render a scene into the left- and right-eye panoramas.
     Render(RenderArgs),
+    /// Measure the display-position error of a method (seed 002 §4.1).
+    Error(ErrorArgs),
     /// Benchmarks (release builds): `speed` times methods on scenes.
     #[command(subcommand)]
     Bench(BenchCommand),
+}
+
+#[derive(Args)]
+struct ErrorArgs {
+    /// Scene: a .obj file, or builtin:demo, builtin:sphere100, builtin:sphere1024, builtin:triangle@D.
+    #[arg(default_value = "builtin:demo")]
+    scene: String,
+    /// Move and scale the scene so that it stands DIST metres ahead, filling the screen height.
+    #[arg(long, value_name = "DIST")]
+    fit: Option<f32>,
+    #[command(flatten)]
+    view: ViewArgs,
+    /// Print one JSON object instead of a summary.
+    #[arg(long)]
+    json: bool,
+    /// Write the per-pixel error, colour-mapped with its scale, to this PNG (left eye on top).
+    #[arg(long, value_name = "FILE.png")]
+    heatmap: Option<PathBuf>,
+    /// Top of the heatmap's scale in pixels (default: a round value at or above the p99 error).
+    #[arg(long, value_name = "PX")]
+    heatmap_max: Option<f32>,
+    /// Also render with this method and report how much of the image shows a different surface,
+    /// and the colour PSNR (e.g. --against slit:1).
+    #[arg(long, value_parser = Method::parse, value_name = "METHOD")]
+    against: Option<Method>,
 }
 
 #[derive(Subcommand)]
@@ -148,21 +175,38 @@ impl ViewArgs {
         if !self.yaw.is_finite() {
             return Err("--yaw must be a finite number of degrees".into());
         }
-        Ok(RenderSettings { projection, viewer: self.viewer, yaw_deg: self.yaw, ..Default::default() })
+        let settings = RenderSettings {
+            projection,
+            viewer: self.viewer,
+            yaw_deg: self.yaw,
+            method: self.method,
+            edge_px: self.edge_px,
+            max_div: self.max_div,
+            memory_mb: self.memory_mb,
+            ..Default::default()
+        };
+        settings.validate()?;
+        Ok(settings)
     }
+}
+
+/// Loads (and places) a scene, opens the GPU and uploads the scene.
+fn setup(spec: &str, fit: Option<f32>, settings: &RenderSettings) -> Result<(Renderer, GpuScene, String), String> {
+    let mut scene = load_scene(spec, &settings.projection)?;
+    if let Some(d) = fit {
+        scene.fit(d, &settings.projection).map_err(|e| format!("{spec}: {e}"))?;
+    }
+    let gpu = Gpu::new().map_err(|e| e.to_string())?;
+    let adapter = gpu.adapter_description();
+    let renderer = Renderer::new(gpu);
+    let gpu_scene = GpuScene::upload(&renderer.gpu, &scene).map_err(|e| format!("{spec}: {e}"))?;
+    Ok((renderer, gpu_scene, adapter))
 }
 
 fn render(args: &RenderArgs) -> Result<(), String> {
     let mut settings = args.view.settings()?;
     settings.background = args.background;
-    let mut scene = load_scene(&args.scene, &settings.projection)?;
-    if let Some(d) = args.fit {
-        scene.fit(d, &settings.projection).map_err(|e| format!("{}: {e}", args.scene))?;
-    }
-    let gpu = Gpu::new().map_err(|e| e.to_string())?;
-    let adapter = gpu.adapter_description();
-    let renderer = Renderer::new(gpu);
-    let gpu_scene = GpuScene::upload(&renderer.gpu, &scene).map_err(|e| format!("{}: {e}", args.scene))?;
+    let (renderer, gpu_scene, adapter) = setup(&args.scene, args.fit, &settings)?;
     let frame = renderer.render(&gpu_scene, &settings)?;
     let t = std::time::Instant::now();
     let written = write_images(&args.out, &layout_images(&frame, args.layout))?;
@@ -202,6 +246,74 @@ fn render(args: &RenderArgs) -> Result<(), String> {
     Ok(())
 }
 
+fn error(args: &ErrorArgs) -> Result<(), String> {
+    let settings = args.view.settings()?;
+    let (renderer, gpu_scene, adapter) = setup(&args.scene, args.fit, &settings)?;
+    let frame = renderer.render(&gpu_scene, &settings)?;
+    let e = &frame.error_stats;
+    let s = &frame.stats;
+    let mut json = serde_json::json!({
+        "scene": args.scene,
+        "method": settings.method.name(),
+        "vertical": settings.projection.vertical,
+        "width": settings.projection.width,
+        "height": settings.projection.height,
+        "mean_px": e.mean,
+        "std_px": e.std_dev,
+        "p50_px": e.p50,
+        "p90_px": e.p90,
+        "p99_px": e.p99,
+        "max_px": e.max,
+        "pixels": e.count,
+        "triangles_in": s.triangles_in,
+        "triangles_out": s.triangles_out,
+        "ms_render": s.ms_subdivide + s.ms_raster,
+        "ms_total": s.ms_total,
+        "adapter": adapter,
+    });
+    if let Some(method) = args.against {
+        let reference = renderer.render(&gpu_scene, &RenderSettings { method, ..settings.clone() })?;
+        let c = twister::compare::compare(&frame, &reference);
+        json["against"] = serde_json::json!(method.name());
+        json["different_surface_fraction"] = serde_json::json!(c.different_surface_fraction);
+        json["psnr_db"] = serde_json::json!(c.psnr_db);
+    }
+    if let Some(path) = &args.heatmap {
+        let max = args.heatmap_max.unwrap_or_else(|| twister::heatmap::nice_max(e.p99));
+        let (w, h, rgba) =
+            twister::heatmap::heatmap(&frame.error, settings.projection.width, settings.projection.height, max);
+        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "heatmap.png".into());
+        let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+        write_images(dir, &[(name, twister::renderer::EyeImage { width: w, height: h, rgba })])?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string(&json).unwrap());
+    } else {
+        println!(
+            "{} {} ({}): mean {:.3} px, std {:.3}, p50 {:.3}, p90 {:.3}, p99 {:.3}, max {:.3} over {} pixels; {} triangles drawn; {:.1} ms",
+            args.scene,
+            settings.method.name(),
+            json["vertical"].as_str().unwrap_or(""),
+            e.mean,
+            e.std_dev,
+            e.p50,
+            e.p90,
+            e.p99,
+            e.max,
+            e.count,
+            s.triangles_out,
+            s.ms_subdivide + s.ms_raster
+        );
+        if let Some(f) = json.get("different_surface_fraction") {
+            println!(
+                "against {}: different surface on {:.4} of pixels, PSNR {} dB",
+                json["against"], f, json["psnr_db"]
+            );
+        }
+    }
+    Ok(())
+}
+
 fn bench_speed(args: &SpeedArgs) -> Result<(), String> {
     if args.reps == 0 {
         return Err("--reps must be at least 1".into());
@@ -229,6 +341,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Render(args) => render(args),
+        Command::Error(args) => error(args),
         Command::Bench(BenchCommand::Speed(args)) => bench_speed(args),
     };
     match result {

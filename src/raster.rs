@@ -1,95 +1,169 @@
-//! The `raster` stage, CPU twin of `shaders/raster.wgsl`: projects each prepared vertex for one
-//! eye (seed 002 eq. 1–4, via [`crate::projection`]) and rasterizes the triangles with a depth
-//! test and the same headlight shading. Clip w is 1, so attributes interpolate linearly on the
-//! screen, as on the GPU. Pixel-centre sampling; coverage on exact edges may differ from the
-//! GPU's tie-breaking rule, so tests compare images with a small tolerance on edge pixels.
+//! The `raster` stage, CPU twin of `shaders/raster.wgsl`, and the software rasterizer that the
+//! CPU twins of the drawing stages share.
+//!
+//! `raster_vertex` projects a subdivided vertex for one eye (seed 002 eq. 1–4) exactly as the
+//! vertex shader does. `rasterize` samples pixel centres with a depth test: clip-space
+//! near-plane clipping, perspective-correct attributes (with w = 1, as in the raster stage,
+//! that is linear on the screen), depth interpolated linearly on the screen as GPUs do, and an
+//! optional column scissor. Coverage on exact edges may differ from a GPU's tie-breaking rule,
+//! so tests compare images with a small tolerance on edge pixels.
 
-use glam::{Vec3, Vec4};
+use glam::{Vec2, Vec3, Vec4};
 
+use crate::fragment::{pixel_error, shade};
 use crate::gpu_types::{DrawVertex, RasterParams};
-use crate::projection::{azimuth, horizontal_radius};
+use crate::projection::{azimuth, Eye, Projection};
 
-/// Clip-space position of a prepared vertex (`vs_main` in raster.wgsl).
+/// Clip-space position of a subdivided vertex (`vs_main` in raster.wgsl).
 pub fn raster_vertex(params: &RasterParams, v: &DrawVertex) -> Vec4 {
+    let projection = Projection::from(&params.projection);
     let p = Vec3::from(v.position);
-    let pr = &params.projection;
     let theta0 = azimuth(p);
     let theta = theta0 + std::f32::consts::TAU * ((v.theta_ref - theta0) / std::f32::consts::TAU + 0.5).floor();
-    let r = horizontal_radius(p);
-    let alpha = (pr.eye_radius / r).clamp(0.0, 1.0).acos() - pr.acos_eye_screen;
-    let u = theta + params.eye_sign * alpha;
-    let v_screen = if pr.vertical_exact != 0 {
-        let de = pr.eye_radius;
-        p.y * (pr.screen_radius * pr.screen_radius - de * de).sqrt() / (r * r - de * de).max(1e-12).sqrt()
-    } else {
-        pr.screen_radius * p.y / r
-    };
-    Vec4::new(u / std::f32::consts::PI, v_screen * pr.pixels_per_metre / (0.5 * pr.height), r / (r + 1.0), 1.0)
+    let eye = if params.eye_sign > 0.0 { Eye::Right } else { Eye::Left };
+    let q = projection.project_with_azimuth(p, theta, eye);
+    let ppm = projection.pixels_per_metre();
+    Vec4::new(
+        q.u / std::f32::consts::PI + 2.0 * params.shift_px[0] / projection.width as f32,
+        q.v * ppm / (0.5 * projection.height as f32) - 2.0 * params.shift_px[1] / projection.height as f32,
+        q.depth / (q.depth + 1.0),
+        1.0,
+    )
 }
 
-/// Shading of `fs_main`: colour × (ambient + (1 − ambient)·|n·l|), light from the viewer.
-pub fn shade(params: &RasterParams, view_position: Vec3, normal: Vec3, color: Vec4) -> [u8; 4] {
-    let lambert = if normal.length() > 1e-6 { normal.normalize().dot(-view_position.normalize()).abs() } else { 1.0 };
-    let s = params.ambient + (1.0 - params.ambient) * lambert;
-    let q = |x: f32| ((x * s).clamp(0.0, 1.0) * 255.0 + 0.5).floor() as u8;
-    [q(color.x), q(color.y), q(color.z), 255]
+/// A vertex ready for rasterization.
+#[derive(Clone, Copy, Debug)]
+pub struct ClipVertex {
+    pub clip: Vec4,
+    pub view_position: Vec3,
+    pub normal: Vec3,
+    pub color: Vec4,
+    pub object: u32,
 }
 
+impl ClipVertex {
+    fn lerp(a: &ClipVertex, b: &ClipVertex, t: f32) -> ClipVertex {
+        ClipVertex {
+            clip: a.clip + (b.clip - a.clip) * t,
+            view_position: a.view_position + (b.view_position - a.view_position) * t,
+            normal: a.normal + (b.normal - a.normal) * t,
+            color: a.color + (b.color - a.color) * t,
+            object: a.object,
+        }
+    }
+}
+
+/// The outputs of a drawing stage for one eye.
 pub struct RasterImage {
     pub width: u32,
     pub height: u32,
     pub rgba: Vec<u8>,
     pub depth: Vec<f32>,
+    /// Display-position error per pixel; −1 for background and points no eye sees.
+    pub error: Vec<f32>,
+    /// Object id + 1 per pixel; 0 for background.
+    pub object: Vec<u32>,
+}
+
+impl RasterImage {
+    pub fn new(width: u32, height: u32, background: [f32; 3]) -> Self {
+        let bg = background.map(|c| (c.clamp(0.0, 1.0) * 255.0 + 0.5).floor() as u8);
+        let n = (width * height) as usize;
+        RasterImage {
+            width,
+            height,
+            rgba: (0..n).flat_map(|_| [bg[0], bg[1], bg[2], 255]).collect(),
+            depth: vec![1.0; n],
+            error: vec![-1.0; n],
+            object: vec![0; n],
+        }
+    }
+}
+
+/// What a fragment writes: colour and error, from (pixel centre, view position, normal, colour).
+pub type FragmentFn<'a> = dyn Fn(Vec2, Vec3, Vec3, Vec4) -> ([u8; 4], f32) + 'a;
+
+/// Rasterizes one triangle into `img`, within columns `scissor` (start, end).
+pub fn rasterize(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: (u32, u32), fragment: &FragmentFn) {
+    // Clip against the near plane z ≥ 0 in clip space (w = 1 triangles never need it).
+    let mut poly: Vec<ClipVertex> = Vec::with_capacity(4);
+    for i in 0..3 {
+        let (a, b) = (&tri[i], &tri[(i + 1) % 3]);
+        if a.clip.z >= 0.0 {
+            poly.push(*a);
+        }
+        if (a.clip.z >= 0.0) != (b.clip.z >= 0.0) {
+            poly.push(ClipVertex::lerp(a, b, a.clip.z / (a.clip.z - b.clip.z)));
+        }
+    }
+    for i in 1..poly.len().saturating_sub(1) {
+        rasterize_clipped(img, [poly[0], poly[i], poly[i + 1]], scissor, fragment);
+    }
+}
+
+fn rasterize_clipped(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: (u32, u32), fragment: &FragmentFn) {
+    let (w, h) = (img.width, img.height);
+    if tri.iter().any(|v| !v.clip.is_finite() || v.clip.w <= 0.0) {
+        return;
+    }
+    let s: Vec<[f32; 2]> = tri
+        .iter()
+        .map(|v| [(v.clip.x / v.clip.w + 1.0) * 0.5 * w as f32, (1.0 - v.clip.y / v.clip.w) * 0.5 * h as f32])
+        .collect();
+    let area = (s[1][0] - s[0][0]) * (s[2][1] - s[0][1]) - (s[2][0] - s[0][0]) * (s[1][1] - s[0][1]);
+    if area == 0.0 {
+        return;
+    }
+    let min_x = s.iter().map(|p| p[0]).fold(f32::MAX, f32::min).floor().max(scissor.0 as f32) as i64;
+    let max_x = s.iter().map(|p| p[0]).fold(f32::MIN, f32::max).ceil().min(scissor.1.min(w) as f32) as i64;
+    let min_y = s.iter().map(|p| p[1]).fold(f32::MAX, f32::min).floor().max(0.0) as i64;
+    let max_y = s.iter().map(|p| p[1]).fold(f32::MIN, f32::max).ceil().min(h as f32) as i64;
+    for y in min_y..max_y {
+        for x in min_x..max_x {
+            let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
+            let edge = |a: [f32; 2], b: [f32; 2]| (b[0] - a[0]) * (py - a[1]) - (b[1] - a[1]) * (px - a[0]);
+            let b = [edge(s[1], s[2]) / area, edge(s[2], s[0]) / area, edge(s[0], s[1]) / area];
+            if b.iter().any(|&x| x < 0.0) {
+                continue;
+            }
+            let z = (0..3).map(|k| b[k] * tri[k].clip.z / tri[k].clip.w).sum::<f32>();
+            let i = (y as u32 * w + x as u32) as usize;
+            if !(z < img.depth[i]) || !(z >= 0.0) {
+                continue;
+            }
+            // Perspective-correct weights.
+            let pw: Vec<f32> = (0..3).map(|k| b[k] / tri[k].clip.w).collect();
+            let sum: f32 = pw.iter().sum();
+            let mix3 = |f: &dyn Fn(&ClipVertex) -> Vec3| (0..3).map(|k| pw[k] / sum * f(&tri[k])).sum::<Vec3>();
+            let pos = mix3(&|v| v.view_position);
+            let nrm = mix3(&|v| v.normal);
+            let col = (0..3).map(|k| pw[k] / sum * tri[k].color).sum::<Vec4>();
+            let (rgba, error) = fragment(Vec2::new(px, py), pos, nrm, col);
+            img.depth[i] = z;
+            img.rgba[4 * i..4 * i + 4].copy_from_slice(&rgba);
+            img.error[i] = error;
+            img.object[i] = tri[0].object + 1;
+        }
+    }
 }
 
 /// The raster stage on the CPU for one eye.
 pub fn raster(params: &RasterParams, vertices: &[DrawVertex], background: [f32; 3]) -> RasterImage {
-    let (w, h) = (params.projection.width as u32, params.projection.height as u32);
-    let bg = background.map(|c| (c.clamp(0.0, 1.0) * 255.0 + 0.5).floor() as u8);
-    let mut img = RasterImage {
-        width: w,
-        height: h,
-        rgba: (0..w * h).flat_map(|_| [bg[0], bg[1], bg[2], 255]).collect(),
-        depth: vec![1.0; (w * h) as usize],
+    let projection = Projection::from(&params.projection);
+    let eye = if params.eye_sign > 0.0 { Eye::Right } else { Eye::Left };
+    let mut img = RasterImage::new(projection.width, projection.height, background);
+    let fragment = |xy: Vec2, pos: Vec3, nrm: Vec3, col: Vec4| {
+        (shade(params.ambient, pos, nrm, col), pixel_error(&projection, eye, pos, xy))
     };
     for tri in vertices.chunks_exact(3) {
-        let clip: Vec<Vec4> = tri.iter().map(|v| raster_vertex(params, v)).collect();
-        if clip.iter().any(|c| !c.is_finite()) {
-            continue;
-        }
-        let s: Vec<[f32; 2]> =
-            clip.iter().map(|c| [(c.x + 1.0) * 0.5 * w as f32, (1.0 - c.y) * 0.5 * h as f32]).collect();
-        let area = (s[1][0] - s[0][0]) * (s[2][1] - s[0][1]) - (s[2][0] - s[0][0]) * (s[1][1] - s[0][1]);
-        if area == 0.0 {
-            continue;
-        }
-        let min_x = s.iter().map(|p| p[0]).fold(f32::MAX, f32::min).floor().max(0.0) as i64;
-        let max_x = s.iter().map(|p| p[0]).fold(f32::MIN, f32::max).ceil().min(w as f32) as i64;
-        let min_y = s.iter().map(|p| p[1]).fold(f32::MAX, f32::min).floor().max(0.0) as i64;
-        let max_y = s.iter().map(|p| p[1]).fold(f32::MIN, f32::max).ceil().min(h as f32) as i64;
-        for y in min_y..max_y {
-            for x in min_x..max_x {
-                let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
-                let edge = |a: [f32; 2], b: [f32; 2]| (b[0] - a[0]) * (py - a[1]) - (b[1] - a[1]) * (px - a[0]);
-                let b0 = edge(s[1], s[2]) / area;
-                let b1 = edge(s[2], s[0]) / area;
-                let b2 = edge(s[0], s[1]) / area;
-                if b0 < 0.0 || b1 < 0.0 || b2 < 0.0 {
-                    continue;
-                }
-                let z = b0 * clip[0].z + b1 * clip[1].z + b2 * clip[2].z;
-                let i = (y as u32 * w + x as u32) as usize;
-                if !(z < img.depth[i]) {
-                    continue;
-                }
-                let mix3 = |f: &dyn Fn(&DrawVertex) -> Vec3| b0 * f(&tri[0]) + b1 * f(&tri[1]) + b2 * f(&tri[2]);
-                let pos = mix3(&|v| Vec3::from(v.position));
-                let nrm = mix3(&|v| Vec3::from(v.normal));
-                let col = b0 * Vec4::from(tri[0].color) + b1 * Vec4::from(tri[1].color) + b2 * Vec4::from(tri[2].color);
-                img.depth[i] = z;
-                img.rgba[4 * i..4 * i + 4].copy_from_slice(&shade(params, pos, nrm, col));
-            }
-        }
+        let cv = [0, 1, 2].map(|k| ClipVertex {
+            clip: raster_vertex(params, &tri[k]),
+            view_position: Vec3::from(tri[k].position),
+            normal: Vec3::from(tri[k].normal),
+            color: Vec4::from(tri[k].color),
+            object: tri[k].object,
+        });
+        rasterize(&mut img, cv, (0, projection.width), &fragment);
     }
     img
 }

@@ -17,11 +17,13 @@ use wgpu::util::DeviceExt;
 use crate::gpu::Gpu;
 use crate::gpu_types::{DrawIndirectArgs, DrawVertex, RasterParams, SubdivideCounters, SubdivideParams};
 use crate::projection::{Eye, Projection};
+use crate::reduce::{ErrorStats, ReduceParams};
 use crate::scene::Scene;
 use crate::shaders;
 use crate::subdivide::{subdivide_params, Method, SubdivideOutput, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV};
 
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+pub const OBJECT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 const DRAW_VERTEX_SIZE: u64 = std::mem::size_of::<DrawVertex>() as u64;
 const TRIANGLE_SIZE: u64 = 3 * DRAW_VERTEX_SIZE;
@@ -49,6 +51,10 @@ pub struct RenderSettings {
     pub max_div: u32,
     /// Budget for the piece and output buffers, MiB.
     pub memory_mb: u32,
+    /// Test hook: draws everything shifted by this many pixels (x right, y down) while the
+    /// error pass measures against the true projection.
+    #[doc(hidden)]
+    pub shift_px: [f32; 2],
 }
 
 impl Default for RenderSettings {
@@ -63,6 +69,7 @@ impl Default for RenderSettings {
             edge_px: DEFAULT_EDGE_PX,
             max_div: DEFAULT_MAX_DIV,
             memory_mb: DEFAULT_MEMORY_MB,
+            shift_px: [0.0; 2],
         }
     }
 }
@@ -107,7 +114,7 @@ impl RenderSettings {
             projection: (&self.projection).into(),
             eye_sign: eye.sign(),
             ambient: self.ambient,
-            _pad: [0.0; 2],
+            shift_px: self.shift_px,
         }
     }
 }
@@ -141,6 +148,8 @@ pub struct FrameStats {
     pub ms_subdivide: f64,
     pub ms_raster: f64,
     pub ms_readback: f64,
+    /// The error reduction (and the read-back of the per-pixel errors).
+    pub ms_error: f64,
     pub ms_total: f64,
 }
 
@@ -148,6 +157,12 @@ pub struct Frame {
     pub left: EyeImage,
     pub right: EyeImage,
     pub stats: FrameStats,
+    /// Display-position error per pixel, left and right eye (−1: background or unseen).
+    pub error: [Vec<f32>; 2],
+    /// Object id + 1 per pixel, left and right eye (0: background).
+    pub object: [Vec<u32>; 2],
+    /// The GPU reduction of `error` over both eyes.
+    pub error_stats: ErrorStats,
 }
 
 impl Frame {
@@ -220,18 +235,23 @@ pub struct Renderer {
     lattice: wgpu::ComputePipeline,
     finalize: wgpu::ComputePipeline,
     raster: wgpu::RenderPipeline,
+    accumulate: wgpu::ComputePipeline,
+    finish: wgpu::ComputePipeline,
     buffers: std::sync::Mutex<Option<Buffers>>,
 }
 
+/// Per-eye render targets: colour, display-position error, object id, depth.
 struct Targets {
     color: [wgpu::Texture; 2],
+    error: [wgpu::Texture; 2],
+    object: [wgpu::Texture; 2],
     depth: [wgpu::Texture; 2],
 }
 
 impl Renderer {
     pub fn new(gpu: Gpu) -> Renderer {
         let device = &gpu.device;
-        let subdivide_module = shaders::load(device, &shaders::SUBDIVIDE);
+        let subdivide_module = shaders::load(device, &shaders::SUBDIVIDE, gpu.error_target);
         let compute = |entry: &str| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(entry),
@@ -245,9 +265,11 @@ impl Renderer {
         let plan = compute("plan");
         let lattice = compute("lattice");
         let finalize = compute("finalize");
-        let raster_module = shaders::load(device, &shaders::RASTER);
+        let color_targets = [COLOR_FORMAT, gpu.error_target.format(), OBJECT_FORMAT]
+            .map(|format| Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL }));
+        let raster_module = shaders::load(device, &shaders::RASTER, gpu.error_target);
         let attributes = wgpu::vertex_attr_array![
-            0 => Float32x3, 1 => Float32, 2 => Float32x3, 3 => Uint32, 4 => Float32x4, 5 => Float32x2
+            0 => Float32x3, 1 => Float32, 2 => Float32x3, 3 => Uint32, 4 => Float32x4, 5 => Float32x2, 6 => Uint32
         ];
         let raster = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("raster"),
@@ -279,16 +301,24 @@ impl Renderer {
                 module: &raster_module,
                 entry_point: Some("fs_main"),
                 compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: COLOR_FORMAT,
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
+                targets: &color_targets,
             }),
             multiview_mask: None,
             cache: None,
         });
-        Renderer { gpu, plan, lattice, finalize, raster, buffers: std::sync::Mutex::new(None) }
+        let reduce_module = shaders::load(device, &shaders::REDUCE_ERROR, gpu.error_target);
+        let reduce = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: None,
+                module: &reduce_module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let (accumulate, finish) = (reduce("accumulate"), reduce("finish"));
+        Renderer { gpu, plan, lattice, finalize, raster, accumulate, finish, buffers: std::sync::Mutex::new(None) }
     }
 
     /// The largest buffer the stages can bind on this device, bytes.
@@ -472,10 +502,68 @@ impl Renderer {
         };
         let color_usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
         let depth_usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        let error_format = self.gpu.error_target.format();
         Targets {
             color: [make(COLOR_FORMAT, color_usage, "left colour"), make(COLOR_FORMAT, color_usage, "right colour")],
+            error: [make(error_format, color_usage, "left error"), make(error_format, color_usage, "right error")],
+            object: [make(OBJECT_FORMAT, color_usage, "left object"), make(OBJECT_FORMAT, color_usage, "right object")],
             depth: [make(DEPTH_FORMAT, depth_usage, "left depth"), make(DEPTH_FORMAT, depth_usage, "right depth")],
         }
+    }
+
+    /// Begins the render pass of eye `k` on its targets, clearing them first if `clear`
+    /// (background colour, error −1, object 0, depth 1).
+    fn begin_eye_pass<'e>(
+        &self,
+        enc: &'e mut wgpu::CommandEncoder,
+        targets: &Targets,
+        k: usize,
+        settings: &RenderSettings,
+        clear: bool,
+    ) -> wgpu::RenderPass<'e> {
+        let views =
+            [&targets.color[k], &targets.error[k], &targets.object[k]].map(|t| t.create_view(&Default::default()));
+        let depth_view = targets.depth[k].create_view(&Default::default());
+        let [r, g, b] = settings.background.map(|c| c as f64);
+        let no_error = match self.gpu.error_target {
+            crate::shaders::ErrorTarget::Float => -1.0,
+            crate::shaders::ErrorTarget::UintBits => (-1.0f32).to_bits() as f64,
+        };
+        let clears = [
+            wgpu::Color { r, g, b, a: 1.0 },
+            wgpu::Color { r: no_error, ..wgpu::Color::TRANSPARENT },
+            wgpu::Color::TRANSPARENT,
+        ];
+        let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = views
+            .iter()
+            .zip(clears)
+            .map(|(view, c)| {
+                Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: if clear { wgpu::LoadOp::Clear(c) } else { wgpu::LoadOp::Load },
+                        store: wgpu::StoreOp::Store,
+                    },
+                })
+            })
+            .collect();
+        enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(Eye::BOTH[k].name()),
+            color_attachments: &attachments,
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: if clear { wgpu::LoadOp::Clear(1.0) } else { wgpu::LoadOp::Load },
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        })
     }
 
     /// Draws the subdivided triangles into both eyes' targets (clearing them first if `clear`).
@@ -493,32 +581,7 @@ impl Renderer {
                 layout: &self.raster.get_bind_group_layout(0),
                 entries: &[wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() }],
             });
-            let color_view = targets.color[k].create_view(&Default::default());
-            let depth_view = targets.depth[k].create_view(&Default::default());
-            let [r, g, b] = settings.background;
-            let color_load = if clear {
-                wgpu::LoadOp::Clear(wgpu::Color { r: r as f64, g: g as f64, b: b as f64, a: 1.0 })
-            } else {
-                wgpu::LoadOp::Load
-            };
-            let depth_load = if clear { wgpu::LoadOp::Clear(1.0) } else { wgpu::LoadOp::Load };
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some(eye.name()),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &color_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations { load: color_load, store: wgpu::StoreOp::Store },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &depth_view,
-                    depth_ops: Some(wgpu::Operations { load: depth_load, store: wgpu::StoreOp::Store }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let mut pass = self.begin_eye_pass(&mut enc, targets, k, settings, clear);
             pass.set_pipeline(&self.raster);
             pass.set_bind_group(0, &bg, &[]);
             pass.set_vertex_buffer(0, buffers.triangles.slice(..));
@@ -526,6 +589,113 @@ impl Renderer {
         }
         self.gpu.queue.submit([enc.finish()]);
         self.gpu.wait();
+    }
+
+    /// Copies a 4-byte-per-texel texture of each eye into one buffer (rows padded to 256
+    /// bytes, eyes one after the other). Returns the buffer and the padded row length in texels.
+    fn copy_eyes_to_buffer(&self, textures: &[wgpu::Texture; 2], usage: wgpu::BufferUsages) -> (wgpu::Buffer, u32) {
+        let (w, h) = (textures[0].width(), textures[0].height());
+        let padded = (4 * w).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let buffer = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("eye texels"),
+            size: 2 * (padded * h) as u64,
+            usage: usage | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        for (k, texture) in textures.iter().enumerate() {
+            enc.copy_texture_to_buffer(
+                wgpu::TexelCopyTextureInfo {
+                    texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d::ZERO,
+                    aspect: wgpu::TextureAspect::All,
+                },
+                wgpu::TexelCopyBufferInfo {
+                    buffer: &buffer,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: k as u64 * (padded * h) as u64,
+                        bytes_per_row: Some(padded),
+                        rows_per_image: Some(h),
+                    },
+                },
+                wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+            );
+        }
+        self.gpu.queue.submit([enc.finish()]);
+        (buffer, padded / 4)
+    }
+
+    /// Unpads the texels of both eyes from a buffer made by `copy_eyes_to_buffer`.
+    fn unpad_eyes(data: &[u8], w: u32, h: u32, stride: u32) -> [Vec<u32>; 2] {
+        let words: &[u32] = bytemuck::cast_slice(data);
+        std::array::from_fn(|k| {
+            let base = k * (stride * h) as usize;
+            (0..h as usize).flat_map(|y| words[base + y * stride as usize..][..w as usize].iter().copied()).collect()
+        })
+    }
+
+    /// Runs the `reduce_error` stage over the error targets of both eyes; also returns the
+    /// per-pixel errors.
+    fn reduce_errors(&self, targets: &Targets) -> (ErrorStats, [Vec<f32>; 2]) {
+        let device = &self.gpu.device;
+        let (w, h) = (targets.error[0].width(), targets.error[0].height());
+        let (errors, stride) =
+            self.copy_eyes_to_buffer(&targets.error, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
+        let pixels = 2 * w * h;
+        let groups = pixels.div_ceil(256);
+        let (gx, gy) = if groups <= 65535 { (groups, 1) } else { (65535, groups.div_ceil(65535)) };
+        let params =
+            ReduceParams { width: w, height: h, row_stride: stride, images: 2, partial_count: gx * gy, _pad: [0; 3] };
+        let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("reduce params"),
+            contents: bytemuck::bytes_of(&params),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let storage = |label, size: u64| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let histogram = storage("histogram", 4 * crate::reduce::BINS as u64);
+        let partials = storage("partial sums", 8 * (gx * gy) as u64);
+        let totals = storage("totals", 8);
+        let result = storage("error stats", std::mem::size_of::<ErrorStats>() as u64);
+        let entries = [(0, &uniform), (1, &errors), (2, &histogram), (3, &partials), (4, &totals), (5, &result)];
+        let bind = |pipeline: &wgpu::ComputePipeline, used: &[u32]| {
+            let e: Vec<wgpu::BindGroupEntry> = entries
+                .iter()
+                .filter(|(b, _)| used.contains(b))
+                .map(|(b, buf)| wgpu::BindGroupEntry { binding: *b, resource: buf.as_entire_binding() })
+                .collect();
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: None,
+                layout: &pipeline.get_bind_group_layout(0),
+                entries: &e,
+            })
+        };
+        let accumulate_bg = bind(&self.accumulate, &[0, 1, 2, 3, 4]);
+        let finish_bg = bind(&self.finish, &[0, 2, 3, 4, 5]);
+        let mut enc = device.create_command_encoder(&Default::default());
+        enc.clear_buffer(&histogram, 0, None);
+        enc.clear_buffer(&totals, 0, None);
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&self.accumulate);
+            pass.set_bind_group(0, &accumulate_bg, &[]);
+            pass.dispatch_workgroups(gx, gy, 1);
+            pass.set_pipeline(&self.finish);
+            pass.set_bind_group(0, &finish_bg, &[]);
+            pass.dispatch_workgroups(1, 1, 1);
+        }
+        self.gpu.queue.submit([enc.finish()]);
+        let stats: ErrorStats =
+            *bytemuck::from_bytes(&self.gpu.download(&result, std::mem::size_of::<ErrorStats>() as u64));
+        let per_eye = Self::unpad_eyes(&self.gpu.download(&errors, errors.size()), w, h, stride);
+        (stats, per_eye.map(|v| v.into_iter().map(f32::from_bits).collect()))
     }
 
     fn read_color(&self, texture: &wgpu::Texture) -> EyeImage {
@@ -647,9 +817,14 @@ impl Renderer {
         let t = Instant::now();
         let left = self.read_color(&targets.color[0]);
         let right = self.read_color(&targets.color[1]);
+        let (objects, stride) = self.copy_eyes_to_buffer(&targets.object, wgpu::BufferUsages::COPY_SRC);
+        let object = Self::unpad_eyes(&self.gpu.download(&objects, objects.size()), left.width, left.height, stride);
         stats.ms_readback = t.elapsed().as_secs_f64() * 1e3;
+        let t = Instant::now();
+        let (error_stats, error) = self.reduce_errors(&targets);
+        stats.ms_error = t.elapsed().as_secs_f64() * 1e3;
         stats.ms_total = start.elapsed().as_secs_f64() * 1e3;
-        Ok(Frame { left, right, stats })
+        Ok(Frame { left, right, stats, error, object, error_stats })
     }
 }
 
@@ -665,7 +840,7 @@ impl Renderer {
             _pad: [f32; 2],
         }
         let device = &self.gpu.device;
-        let module = shaders::load(device, &shaders::PROJECT_POINTS);
+        let module = shaders::load(device, &shaders::PROJECT_POINTS, self.gpu.error_target);
         let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("project_points"),
             layout: None,

@@ -33,7 +33,8 @@ impl Scene {
     pub fn add_mesh(&mut self, name: impl Into<String>, vertices: &[SceneVertex], indices: &[u32]) {
         let base = self.vertices.len() as u32;
         let first = self.triangle_count() as u32;
-        self.vertices.extend_from_slice(vertices);
+        let object = self.objects.len() as u32;
+        self.vertices.extend(vertices.iter().map(|v| SceneVertex { object, ..*v }));
         self.indices.extend(indices.iter().map(|i| i + base));
         self.objects.push(Object {
             name: name.into(),

@@ -56,7 +56,7 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 use std::f32::consts::{PI, TAU};
 
 use crate::gpu_types::{DrawVertex, SceneVertex, SubdivideParams};
-use crate::projection::{azimuth, horizontal_radius, wrap_angle, Projection, Vertical};
+use crate::projection::{azimuth, horizontal_radius, wrap_angle, Projection};
 
 /// How triangles are split (`--method`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -182,6 +182,7 @@ struct Triangle {
     color: [Vec4; 3],
     uv: [Vec2; 3],
     material: u32,
+    object: u32,
 }
 
 /// A node of the subdivision: its position (computed so that neighbours agree bit for bit)
@@ -227,15 +228,7 @@ pub struct SubdivideOutput {
 
 impl<'a> Subdivider<'a> {
     pub fn new(params: &'a SubdivideParams) -> Self {
-        let p = &params.projection;
-        let projection = Projection {
-            screen_radius: p.screen_radius,
-            eye_radius: p.eye_radius,
-            width: p.width as u32,
-            height: p.height as u32,
-            vertical: if p.vertical_exact != 0 { Vertical::Exact } else { Vertical::Paper },
-        };
-        Subdivider { params, projection }
+        Subdivider { params, projection: (&params.projection).into() }
     }
 
     /// Image position (x, y) in pixels of a viewer-frame point for one eye sign, x not wrapped.
@@ -309,6 +302,7 @@ impl<'a> Subdivider<'a> {
             color: [0, 1, 2].map(|k| Vec4::from(v(k).color)),
             uv: [0, 1, 2].map(|k| Vec2::from(v(k).uv)),
             material: v(0).material,
+            object: v(0).object,
         }
     }
 
@@ -589,7 +583,8 @@ fn draw_vertex(tri: &Triangle, n: Node, theta_ref: f32) -> DrawVertex {
         material: tri.material,
         color: (b.x * tri.color[0] + b.y * tri.color[1] + b.z * tri.color[2]).into(),
         uv: (b.x * tri.uv[0] + b.y * tri.uv[1] + b.z * tri.uv[2]).into(),
-        _pad: [0.0; 2],
+        object: tri.object,
+        _pad: 0.0,
     }
 }
 
@@ -697,7 +692,7 @@ pub fn subdivide(params: &SubdivideParams, vertices: &[SceneVertex], indices: &[
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::projection::Eye;
+    use crate::projection::{Eye, Vertical};
     use std::collections::HashMap;
     use std::f32::consts::{FRAC_PI_4, FRAC_PI_8};
 

@@ -138,3 +138,33 @@ fn bad_arguments_are_clear_errors() {
         assert!(!err.contains("panicked"), "{args:?}: {err}");
     }
 }
+
+#[test]
+fn subdivision_flags_take_effect_and_are_reported() {
+    let out = tmp("flags");
+    let stats = |extra: &[&str]| -> serde_json::Value {
+        let file = out.join(format!("s{}.json", extra.join("_").replace([':', '-'], "")));
+        let o = twister()
+            .args(["render", "builtin:sphere100", "--width", "320", "--height", "60", "--out"])
+            .arg(&out)
+            .args(["--stats", file.to_str().unwrap()])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{extra:?}: {}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap()
+    };
+    let vertex = stats(&["--method", "vertex"]);
+    assert_eq!(vertex["method"], "vertex");
+    assert_eq!(vertex["triangles_out"], 100);
+    let fixed = stats(&["--method", "fixed:3"]);
+    assert_eq!(fixed["method"], "fixed:3");
+    assert_eq!(fixed["triangles_out"], 900);
+    let coarse = stats(&["--edge-px", "64"]);
+    let fine = stats(&["--edge-px", "4"]);
+    assert_eq!(fine["edge_px"], 4.0);
+    assert!(fine["triangles_out"].as_u64() > coarse["triangles_out"].as_u64());
+    let tight = stats(&["--edge-px", "0.25", "--memory-mb", "8"]);
+    assert!(tight["chunks"].as_u64().unwrap() > 1, "{tight}");
+    let _ = std::fs::remove_dir_all(&out);
+}

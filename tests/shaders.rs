@@ -1,7 +1,7 @@
 //! Every WGSL file in shaders/ is validated with naga: the shared projection module alone, and
 //! each stage as it is loaded (with its modules composed in front).
 
-use twister::shaders::{compose, PROJECTION, STAGES};
+use twister::shaders::{compose, ErrorTarget, Module, STAGES};
 
 fn validate(name: &str, source: &str) {
     let module = match naga::front::wgsl::parse_str(source) {
@@ -17,16 +17,21 @@ fn validate(name: &str, source: &str) {
 
 #[test]
 fn every_wgsl_file_validates_with_naga() {
-    validate("shaders/projection.wgsl", PROJECTION);
+    validate(Module::Projection.file(), Module::Projection.source());
+    validate(Module::Fragment.file(), &format!("{}\n{}", Module::Projection.source(), Module::Fragment.source()));
+    // Each stage with its modules, in both error-target variants.
     for stage in STAGES {
-        validate(stage.file, &compose(stage));
+        for target in [ErrorTarget::Float, ErrorTarget::UintBits] {
+            validate(&format!("{} ({target:?})", stage.file), &compose(stage, target));
+        }
     }
     // Every file in shaders/ is covered: the projection module or a registered stage.
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
     for entry in std::fs::read_dir(dir).unwrap() {
         let name = format!("shaders/{}", entry.unwrap().file_name().to_string_lossy());
         assert!(
-            name == "shaders/projection.wgsl" || STAGES.iter().any(|s| s.file == name),
+            [Module::Projection, Module::Fragment].iter().any(|m| m.file() == name)
+                || STAGES.iter().any(|s| s.file == name),
             "{name} is not registered in twister::shaders::STAGES"
         );
     }
@@ -37,7 +42,7 @@ fn uniform_struct_sizes_match_wgsl() {
     use twister::gpu_types::*;
     // Sizes naga computes for the WGSL structs must equal the Rust twins'.
     let size_of = |stage: &twister::shaders::Stage, name: &str| {
-        let module = naga::front::wgsl::parse_str(&compose(stage)).unwrap();
+        let module = naga::front::wgsl::parse_str(&compose(stage, ErrorTarget::Float)).unwrap();
         let mut layouter = naga::proc::Layouter::default();
         layouter.update(module.to_ctx()).unwrap();
         let (h, _) =
@@ -52,4 +57,7 @@ fn uniform_struct_sizes_match_wgsl() {
     assert_eq!(size_of(subdivide, "Counters"), std::mem::size_of::<SubdivideCounters>());
     assert_eq!(size_of(subdivide, "DrawIndirectArgs"), std::mem::size_of::<DrawIndirectArgs>());
     assert_eq!(size_of(raster, "RasterParams"), std::mem::size_of::<RasterParams>());
+    let reduce = &twister::shaders::REDUCE_ERROR;
+    assert_eq!(size_of(reduce, "ReduceParams"), std::mem::size_of::<twister::reduce::ReduceParams>());
+    assert_eq!(size_of(reduce, "ErrorStats"), std::mem::size_of::<twister::reduce::ErrorStats>());
 }

@@ -1,0 +1,115 @@
+//! Error heatmaps: the per-pixel display-position error of both eyes (left on top), colour-mapped
+//! from 0 to a scale maximum, with the scale drawn under the images (a colour bar with ticks
+//! labelled in pixels). Background and unseen pixels are dark grey.
+
+/// A perceptually ordered colour map (dark blue → teal → yellow → red), t in [0, 1].
+pub fn colormap(t: f32) -> [u8; 3] {
+    const STOPS: [[f32; 3]; 5] =
+        [[0.05, 0.05, 0.35], [0.1, 0.45, 0.75], [0.2, 0.75, 0.45], [0.95, 0.85, 0.2], [0.85, 0.1, 0.1]];
+    let t = t.clamp(0.0, 1.0) * (STOPS.len() - 1) as f32;
+    let i = (t.floor() as usize).min(STOPS.len() - 2);
+    let f = t - i as f32;
+    let c: Vec<u8> =
+        (0..3).map(|k| ((STOPS[i][k] + (STOPS[i + 1][k] - STOPS[i][k]) * f) * 255.0).round() as u8).collect();
+    [c[0], c[1], c[2]]
+}
+
+/// 3×5 bitmap glyphs for the scale labels.
+fn glyph(c: char) -> [u8; 5] {
+    match c {
+        '0' => [7, 5, 5, 5, 7],
+        '1' => [2, 6, 2, 2, 7],
+        '2' => [7, 1, 7, 4, 7],
+        '3' => [7, 1, 7, 1, 7],
+        '4' => [5, 5, 7, 1, 1],
+        '5' => [7, 4, 7, 1, 7],
+        '6' => [7, 4, 7, 5, 7],
+        '7' => [7, 1, 1, 1, 1],
+        '8' => [7, 5, 7, 5, 7],
+        '9' => [7, 5, 7, 1, 7],
+        '.' => [0, 0, 0, 0, 2],
+        'p' => [0, 7, 5, 7, 4],
+        'x' => [0, 5, 2, 5, 0],
+        _ => [0; 5],
+    }
+}
+
+struct Canvas {
+    width: u32,
+    height: u32,
+    rgba: Vec<u8>,
+}
+
+impl Canvas {
+    fn set(&mut self, x: u32, y: u32, c: [u8; 3]) {
+        if x < self.width && y < self.height {
+            let i = 4 * (y * self.width + x) as usize;
+            self.rgba[i..i + 4].copy_from_slice(&[c[0], c[1], c[2], 255]);
+        }
+    }
+
+    fn text(&mut self, x: u32, y: u32, s: &str, scale: u32) {
+        for (k, ch) in s.chars().enumerate() {
+            let g = glyph(ch);
+            for (row, bits) in g.iter().enumerate() {
+                for col in 0..3 {
+                    if bits & (4 >> col) != 0 {
+                        for dy in 0..scale {
+                            for dx in 0..scale {
+                                self.set(x + (k as u32 * 4 + col) * scale + dx, y + row as u32 * scale + dy, [255; 3]);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A round scale maximum at or above `max` (1, 2 or 5 × 10^k).
+pub fn nice_max(max: f32) -> f32 {
+    if !(max > 0.0) {
+        return 1.0;
+    }
+    let p = 10f32.powf(max.log10().floor());
+    [1.0, 2.0, 5.0, 10.0].iter().map(|m| m * p).find(|&v| v >= max).unwrap_or(10.0 * p)
+}
+
+/// The heatmap image (RGBA8): both eyes' errors stacked, then the scale.
+pub fn heatmap(errors: &[Vec<f32>; 2], width: u32, height: u32, scale_max: f32) -> (u32, u32, Vec<u8>) {
+    let text_scale = (width / 400).clamp(1, 4);
+    let bar_h = 12 * text_scale;
+    let total_h = 2 * height + bar_h + 10 * text_scale;
+    let mut c = Canvas { width, height: total_h, rgba: [20u8, 20, 20, 255].repeat((width * total_h) as usize) };
+    for (k, err) in errors.iter().enumerate() {
+        for y in 0..height {
+            for x in 0..width {
+                let e = err[(y * width + x) as usize];
+                let color = if e >= 0.0 { colormap(e / scale_max) } else { [40, 40, 40] };
+                c.set(x, k as u32 * height + y, color);
+            }
+        }
+    }
+    let top = 2 * height + 2 * text_scale;
+    let (x0, x1) = (width / 20, width - width / 20);
+    for x in x0..x1 {
+        let color = colormap((x - x0) as f32 / (x1 - x0) as f32);
+        for y in top..top + bar_h / 2 {
+            c.set(x, y, color);
+        }
+    }
+    for i in 0..=4 {
+        let x = x0 + (x1 - x0) * i / 4;
+        let value = scale_max * i as f32 / 4.0;
+        let label = if scale_max >= 4.0 { format!("{value:.0}") } else { format!("{value:.2}") };
+        let label = if i == 4 { format!("{label}px") } else { label };
+        for y in top..top + bar_h / 2 + text_scale {
+            c.set(x, y, [255; 3]);
+        }
+        let tx = x
+            .saturating_sub(2 * text_scale * label.len() as u32)
+            .min(width.saturating_sub(4 * text_scale * label.len() as u32));
+        c.text(tx, top + bar_h / 2 + 2 * text_scale, &label, text_scale);
+    }
+    (width, total_h, c.rgba)
+}
