@@ -51,9 +51,15 @@ fn vs_main(in: VertexIn) -> VertexOut {
 }
 
 @fragment
-fn fs_main(in: VertexOut) -> FragmentOut {
-    // Clip w is 1: view_position is interpolated linearly on the screen, which is where the
-    // projection methods put a triangle's inside.
+fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
+    return shade(params.ambient, in.view_position, in.normal, in.color);
+}
+
+// The same, plus the display-position error and the object id (when the error is measured).
+// Clip w is 1: view_position is interpolated linearly on the screen, which is where the
+// projection methods put a triangle's inside.
+@fragment
+fn fs_error(in: VertexOut) -> FragmentOut {
     return fragment_out(params.projection, params.eye_sign, params.ambient, in.clip.xy, in.view_position, in.normal,
                         in.color, in.object);
 }

@@ -106,7 +106,10 @@ fn percentile(p: f32, count: u32) -> f32 {
             if (b == BINS - 1u) {
                 return bitcast<f32>(atomicLoad(&totals.max_bits));
             }
-            return bin_low(b) + bin_width(b) * f32(rank - cumulative) / f32(n);
+            // Interpolate by rank within the bin, never beyond the largest error.
+            let low = bin_low(b);
+            let high = min(low + bin_width(b), bitcast<f32>(atomicLoad(&totals.max_bits)));
+            return low + max(high - low, 0.0) * f32(rank - cumulative) / f32(n);
         }
         cumulative += n;
     }

@@ -12,9 +12,13 @@ pub struct Comparison {
     pub psnr_db: Option<f64>,
 }
 
-pub fn compare(frame: &Frame, reference: &Frame) -> Comparison {
+/// Compares two frames rendered with `measure_error` (for their object ids).
+pub fn compare(frame: &Frame, reference: &Frame) -> Result<Comparison, String> {
+    let (Some(m), Some(r)) = (&frame.measurement, &reference.measurement) else {
+        return Err("comparing frames needs both rendered with measure_error".into());
+    };
     let (mut covered, mut different) = (0u64, 0u64);
-    for (a, b) in frame.object.iter().zip(&reference.object) {
+    for (a, b) in m.object.iter().zip(&r.object) {
         for (x, y) in a.iter().zip(b) {
             if *x != 0 || *y != 0 {
                 covered += 1;
@@ -33,8 +37,8 @@ pub fn compare(frame: &Frame, reference: &Frame) -> Comparison {
         }
     }
     let mse = sq / n.max(1) as f64;
-    Comparison {
+    Ok(Comparison {
         different_surface_fraction: if covered == 0 { 0.0 } else { different as f64 / covered as f64 },
         psnr_db: (mse > 0.0).then(|| 10.0 * (255.0 * 255.0 / mse).log10()),
-    }
+    })
 }

@@ -5,6 +5,8 @@
 //! - `subdivide` ([`subdivide::subdivide`], `shaders/subdivide.wgsl`): adaptive subdivision (eq. 5),
 //!   axis split, seam copies;
 //! - `raster` ([`raster::raster`], `shaders/raster.wgsl`): projection per vertex (eq. 1–4), shading;
+//! - `slit` ([`slit::slit`], `shaders/slit.wgsl`): the conventional slit-mosaic reference renderer;
+//! - `reduce_error` ([`reduce::reduce_error`], `shaders/reduce_error.wgsl`): error statistics;
 //! - `project_points` ([`projection::project_points`], `shaders/project_points.wgsl`).
 
 pub mod bench;
@@ -22,6 +24,7 @@ pub mod reduce;
 pub mod renderer;
 pub mod scene;
 pub mod shaders;
+pub mod slit;
 pub mod subdivide;
 
 pub use projection::{Eye, Projection, Vertical};

@@ -247,10 +247,11 @@ fn render(args: &RenderArgs) -> Result<(), String> {
 }
 
 fn error(args: &ErrorArgs) -> Result<(), String> {
-    let settings = args.view.settings()?;
+    let settings = RenderSettings { measure_error: true, ..args.view.settings()? };
     let (renderer, gpu_scene, adapter) = setup(&args.scene, args.fit, &settings)?;
     let frame = renderer.render(&gpu_scene, &settings)?;
-    let e = &frame.error_stats;
+    let measured = frame.measurement.as_ref().expect("rendered with measure_error");
+    let e = &measured.stats;
     let s = &frame.stats;
     let mut json = serde_json::json!({
         "scene": args.scene,
@@ -273,7 +274,7 @@ fn error(args: &ErrorArgs) -> Result<(), String> {
     });
     if let Some(method) = args.against {
         let reference = renderer.render(&gpu_scene, &RenderSettings { method, ..settings.clone() })?;
-        let c = twister::compare::compare(&frame, &reference);
+        let c = twister::compare::compare(&frame, &reference)?;
         json["against"] = serde_json::json!(method.name());
         json["different_surface_fraction"] = serde_json::json!(c.different_surface_fraction);
         json["psnr_db"] = serde_json::json!(c.psnr_db);
@@ -281,7 +282,7 @@ fn error(args: &ErrorArgs) -> Result<(), String> {
     if let Some(path) = &args.heatmap {
         let max = args.heatmap_max.unwrap_or_else(|| twister::heatmap::nice_max(e.p99));
         let (w, h, rgba) =
-            twister::heatmap::heatmap(&frame.error, settings.projection.width, settings.projection.height, max);
+            twister::heatmap::heatmap(&measured.error, settings.projection.width, settings.projection.height, max);
         let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "heatmap.png".into());
         let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
         write_images(dir, &[(name, twister::renderer::EyeImage { width: w, height: h, rgba })])?;

@@ -88,7 +88,10 @@ pub fn reduce_error<'a>(images: impl IntoIterator<Item = &'a [f32]>) -> ErrorSta
                 if b == BINS - 1 {
                     return max;
                 }
-                return bin_low(b) + bin_width(b) * (rank - cumulative) as f32 / n as f32;
+                // Interpolate by rank within the bin, never beyond the largest error.
+                let low = bin_low(b);
+                let high = (low + bin_width(b)).min(max);
+                return low + (high - low).max(0.0) * (rank - cumulative) as f32 / n as f32;
             }
             cumulative += n;
         }
@@ -125,6 +128,13 @@ mod tests {
         for (got, want) in [(s.p50, 5.0), (s.p90, 9.0), (s.p99, 9.9)] {
             assert!((got - want).abs() <= 1.0 / 64.0, "{got} vs {want}");
         }
+    }
+
+    #[test]
+    fn percentiles_never_exceed_the_max() {
+        let values = [0.0001f32, 0.0002, 0.0003];
+        let s = reduce_error([&values[..]]);
+        assert!(s.p50 <= s.max && s.p99 <= s.max && s.max == 0.0003, "{s:?}");
     }
 
     #[test]

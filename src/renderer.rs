@@ -20,6 +20,7 @@ use crate::projection::{Eye, Projection};
 use crate::reduce::{ErrorStats, ReduceParams};
 use crate::scene::Scene;
 use crate::shaders;
+use crate::slit::{object_spheres, slit_params, slits, sphere_in_slit, SlitCamera};
 use crate::subdivide::{subdivide_params, Method, SubdivideOutput, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV};
 
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
@@ -51,6 +52,9 @@ pub struct RenderSettings {
     pub max_div: u32,
     /// Budget for the piece and output buffers, MiB.
     pub memory_mb: u32,
+    /// Run the error pass: every fragment also writes its display-position error and object
+    /// id, reduced to statistics on the GPU (slower; off for plain rendering and speed runs).
+    pub measure_error: bool,
     /// Test hook: draws everything shifted by this many pixels (x right, y down) while the
     /// error pass measures against the true projection.
     #[doc(hidden)]
@@ -69,6 +73,7 @@ impl Default for RenderSettings {
             edge_px: DEFAULT_EDGE_PX,
             max_div: DEFAULT_MAX_DIV,
             memory_mb: DEFAULT_MEMORY_MB,
+            measure_error: false,
             shift_px: [0.0; 2],
         }
     }
@@ -102,6 +107,11 @@ impl RenderSettings {
         }
         if !(1..=64).contains(&self.max_div) {
             return Err(format!("--max-div must be between 1 and 64, got {}", self.max_div));
+        }
+        if let Method::Slit(w) = self.method {
+            if w > self.projection.width {
+                return Err(format!("slit:{w} is wider than the image ({} columns)", self.projection.width));
+            }
         }
         if self.memory_mb < 8 {
             return Err(format!("--memory-mb must be at least 8, got {}", self.memory_mb));
@@ -157,12 +167,18 @@ pub struct Frame {
     pub left: EyeImage,
     pub right: EyeImage,
     pub stats: FrameStats,
+    /// The error pass's outputs, when `RenderSettings::measure_error` was set.
+    pub measurement: Option<Measurement>,
+}
+
+/// What the error pass measured (seed 002 §4.1).
+pub struct Measurement {
     /// Display-position error per pixel, left and right eye (−1: background or unseen).
     pub error: [Vec<f32>; 2],
     /// Object id + 1 per pixel, left and right eye (0: background).
     pub object: [Vec<u32>; 2],
     /// The GPU reduction of `error` over both eyes.
-    pub error_stats: ErrorStats,
+    pub stats: ErrorStats,
 }
 
 impl Frame {
@@ -179,6 +195,8 @@ pub struct GpuScene {
     pub vertices: wgpu::Buffer,
     pub indices: wgpu::Buffer,
     pub triangle_count: u32,
+    /// Each object's triangles (first, count) and bounding sphere, for the slit renderer's culling.
+    pub objects: Vec<(u32, u32, Vec3, f32)>,
 }
 
 impl GpuScene {
@@ -208,14 +226,20 @@ impl GpuScene {
         let vertices = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("scene vertices"),
             contents: &pad(bytemuck::cast_slice(&scene.vertices)),
-            usage: wgpu::BufferUsages::STORAGE,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX,
         });
         let indices = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("scene indices"),
             contents: &pad(bytemuck::cast_slice(&scene.indices)),
-            usage: wgpu::BufferUsages::STORAGE,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDEX,
         });
-        Ok(GpuScene { vertices, indices, triangle_count: scene.triangle_count() as u32 })
+        let objects = scene
+            .objects
+            .iter()
+            .zip(object_spheres(scene))
+            .map(|(o, (c, r))| (o.first_triangle, o.triangle_count, c, r))
+            .collect();
+        Ok(GpuScene { vertices, indices, triangle_count: scene.triangle_count() as u32, objects })
     }
 }
 
@@ -234,7 +258,9 @@ pub struct Renderer {
     plan: wgpu::ComputePipeline,
     lattice: wgpu::ComputePipeline,
     finalize: wgpu::ComputePipeline,
-    raster: wgpu::RenderPipeline,
+    /// Drawing pipelines, [colour only, with the error pass].
+    raster: [wgpu::RenderPipeline; 2],
+    slit: [wgpu::RenderPipeline; 2],
     accumulate: wgpu::ComputePipeline,
     finish: wgpu::ComputePipeline,
     buffers: std::sync::Mutex<Option<Buffers>>,
@@ -265,47 +291,65 @@ impl Renderer {
         let plan = compute("plan");
         let lattice = compute("lattice");
         let finalize = compute("finalize");
-        let color_targets = [COLOR_FORMAT, gpu.error_target.format(), OBJECT_FORMAT]
+        let all_targets = [COLOR_FORMAT, gpu.error_target.format(), OBJECT_FORMAT]
             .map(|format| Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL }));
+        // A drawing pipeline, colour only (`fs_main`) or with the error pass (`fs_error`).
+        let draw = |module: &wgpu::ShaderModule, label: &str, layout: wgpu::VertexBufferLayout, measure: bool| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: None,
+                vertex: wgpu::VertexState {
+                    module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(layout)],
+                },
+                primitive: wgpu::PrimitiveState {
+                    topology: wgpu::PrimitiveTopology::TriangleList,
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module,
+                    entry_point: Some(if measure { "fs_error" } else { "fs_main" }),
+                    compilation_options: Default::default(),
+                    targets: if measure { &all_targets } else { &all_targets[..1] },
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
         let raster_module = shaders::load(device, &shaders::RASTER, gpu.error_target);
-        let attributes = wgpu::vertex_attr_array![
+        let draw_attributes = wgpu::vertex_attr_array![
             0 => Float32x3, 1 => Float32, 2 => Float32x3, 3 => Uint32, 4 => Float32x4, 5 => Float32x2, 6 => Uint32
         ];
-        let raster = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("raster"),
-            layout: None,
-            vertex: wgpu::VertexState {
-                module: &raster_module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: DRAW_VERTEX_SIZE,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &attributes,
-                })],
-            },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &raster_module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &color_targets,
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let draw_layout = || wgpu::VertexBufferLayout {
+            array_stride: DRAW_VERTEX_SIZE,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &draw_attributes,
+        };
+        let raster = [false, true].map(|m| draw(&raster_module, "raster", draw_layout(), m));
+        let slit_module = shaders::load(device, &shaders::SLIT, gpu.error_target);
+        let scene_attributes = [
+            wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 0, shader_location: 0 },
+            wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 16, shader_location: 1 },
+            wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x4, offset: 32, shader_location: 2 },
+            wgpu::VertexAttribute { format: wgpu::VertexFormat::Uint32, offset: 28, shader_location: 3 },
+        ];
+        let scene_layout = || wgpu::VertexBufferLayout {
+            array_stride: std::mem::size_of::<crate::gpu_types::SceneVertex>() as u64,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &scene_attributes,
+        };
+        let slit = [false, true].map(|m| draw(&slit_module, "slit", scene_layout(), m));
         let reduce_module = shaders::load(device, &shaders::REDUCE_ERROR, gpu.error_target);
         let reduce = |entry: &str| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -318,7 +362,18 @@ impl Renderer {
             })
         };
         let (accumulate, finish) = (reduce("accumulate"), reduce("finish"));
-        Renderer { gpu, plan, lattice, finalize, raster, accumulate, finish, buffers: std::sync::Mutex::new(None) }
+
+        Renderer {
+            gpu,
+            plan,
+            lattice,
+            finalize,
+            raster,
+            slit,
+            accumulate,
+            finish,
+            buffers: std::sync::Mutex::new(None),
+        }
     }
 
     /// The largest buffer the stages can bind on this device, bytes.
@@ -521,8 +576,11 @@ impl Renderer {
         settings: &RenderSettings,
         clear: bool,
     ) -> wgpu::RenderPass<'e> {
-        let views =
-            [&targets.color[k], &targets.error[k], &targets.object[k]].map(|t| t.create_view(&Default::default()));
+        let outputs = if settings.measure_error { 3 } else { 1 };
+        let views: Vec<wgpu::TextureView> = [&targets.color[k], &targets.error[k], &targets.object[k]][..outputs]
+            .iter()
+            .map(|t| t.create_view(&Default::default()))
+            .collect();
         let depth_view = targets.depth[k].create_view(&Default::default());
         let [r, g, b] = settings.background.map(|c| c as f64);
         let no_error = match self.gpu.error_target {
@@ -578,11 +636,11 @@ impl Renderer {
             });
             let bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: None,
-                layout: &self.raster.get_bind_group_layout(0),
+                layout: &self.raster[settings.measure_error as usize].get_bind_group_layout(0),
                 entries: &[wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() }],
             });
             let mut pass = self.begin_eye_pass(&mut enc, targets, k, settings, clear);
-            pass.set_pipeline(&self.raster);
+            pass.set_pipeline(&self.raster[settings.measure_error as usize]);
             pass.set_bind_group(0, &bg, &[]);
             pass.set_vertex_buffer(0, buffers.triangles.slice(..));
             pass.draw_indirect(&buffers.draw_args, 0);
@@ -731,9 +789,95 @@ impl Renderer {
         EyeImage { width: w, height: h, rgba }
     }
 
+    /// The slit-mosaic reference renderer: one draw per slit and visible object, per eye.
+    fn render_slit(&self, scene: &GpuScene, settings: &RenderSettings, width: u32) -> Result<Frame, String> {
+        let start = Instant::now();
+        let device = &self.gpu.device;
+        let projection = &settings.projection;
+        let targets = self.targets(projection);
+        let view = settings.view();
+        let eye_slits = Eye::BOTH.map(|eye| slits(projection, eye, width));
+        let cameras: Vec<SlitCamera> = eye_slits.iter().flatten().map(|s| s.camera).collect();
+        let camera_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("slit cameras"),
+            contents: bytemuck::cast_slice(&cameras),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let spheres: Vec<(u32, u32, Vec3, f32)> =
+            scene.objects.iter().map(|&(first, count, c, r)| (first, count, view.transform_point3(c), r)).collect();
+        let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, chunks: 1, ..Default::default() };
+        let t = Instant::now();
+        let mut enc = device.create_command_encoder(&Default::default());
+        for (k, eye) in Eye::BOTH.into_iter().enumerate() {
+            let params = slit_params(projection, view, eye, settings.ambient);
+            let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("slit params"),
+                contents: bytemuck::bytes_of(&params),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: None,
+                layout: &self.slit[settings.measure_error as usize].get_bind_group_layout(0),
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: camera_buffer.as_entire_binding() },
+                ],
+            });
+            let mut pass = self.begin_eye_pass(&mut enc, &targets, k, settings, true);
+            let pipeline = &self.slit[settings.measure_error as usize];
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &bg, &[]);
+            pass.set_vertex_buffer(0, scene.vertices.slice(..));
+            pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
+            let first_instance = (k * eye_slits[0].len()) as u32;
+            for (i, slit) in eye_slits[k].iter().enumerate() {
+                pass.set_scissor_rect(slit.first_column, 0, slit.end_column - slit.first_column, projection.height);
+                let instance = first_instance + i as u32;
+                for &(first, count, center, radius) in &spheres {
+                    if sphere_in_slit(&params, slit, center, radius) {
+                        pass.draw_indexed(3 * first..3 * (first + count), 0, instance..instance + 1);
+                        stats.triangles_out += count as u64;
+                    }
+                }
+            }
+        }
+        self.gpu.queue.submit([enc.finish()]);
+        self.gpu.wait();
+        stats.ms_raster = t.elapsed().as_secs_f64() * 1e3;
+        Ok(self.finish_frame(&targets, settings, stats, start))
+    }
+
+    /// Reads the targets back and reduces the error: the end of every render.
+    fn finish_frame(
+        &self,
+        targets: &Targets,
+        settings: &RenderSettings,
+        mut stats: FrameStats,
+        start: Instant,
+    ) -> Frame {
+        let t = Instant::now();
+        let left = self.read_color(&targets.color[0]);
+        let right = self.read_color(&targets.color[1]);
+        stats.ms_readback = t.elapsed().as_secs_f64() * 1e3;
+        let t = Instant::now();
+        let measurement = settings.measure_error.then(|| {
+            let (objects, stride) = self.copy_eyes_to_buffer(&targets.object, wgpu::BufferUsages::COPY_SRC);
+            let object =
+                Self::unpad_eyes(&self.gpu.download(&objects, objects.size()), left.width, left.height, stride);
+            let (stats, error) = self.reduce_errors(targets);
+            Measurement { error, object, stats }
+        });
+        stats.ms_error = t.elapsed().as_secs_f64() * 1e3;
+        stats.ms_total = start.elapsed().as_secs_f64() * 1e3;
+        Frame { left, right, stats, measurement }
+    }
+
     /// Renders both eyes of an uploaded scene.
     pub fn render(&self, scene: &GpuScene, settings: &RenderSettings) -> Result<Frame, String> {
         settings.validate()?;
+        if let Method::Slit(width) = settings.method {
+            return self.render_slit(scene, settings, width);
+        }
         let start = Instant::now();
         let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, ..Default::default() };
         let targets = self.targets(&settings.projection);
@@ -814,17 +958,7 @@ impl Renderer {
         }
         drop(cache);
         stats.max_sub_edge_px = max_edge;
-        let t = Instant::now();
-        let left = self.read_color(&targets.color[0]);
-        let right = self.read_color(&targets.color[1]);
-        let (objects, stride) = self.copy_eyes_to_buffer(&targets.object, wgpu::BufferUsages::COPY_SRC);
-        let object = Self::unpad_eyes(&self.gpu.download(&objects, objects.size()), left.width, left.height, stride);
-        stats.ms_readback = t.elapsed().as_secs_f64() * 1e3;
-        let t = Instant::now();
-        let (error_stats, error) = self.reduce_errors(&targets);
-        stats.ms_error = t.elapsed().as_secs_f64() * 1e3;
-        stats.ms_total = start.elapsed().as_secs_f64() * 1e3;
-        Ok(Frame { left, right, stats, error, object, error_stats })
+        Ok(self.finish_frame(&targets, settings, stats, start))
     }
 }
 

@@ -76,6 +76,12 @@ pub const PROJECT_POINTS: Stage = Stage {
     modules: &[Module::Projection],
 };
 
+pub const SLIT: Stage = Stage {
+    name: "slit",
+    file: "shaders/slit.wgsl",
+    source: include_str!("../shaders/slit.wgsl"),
+    modules: &[Module::Projection, Module::Fragment],
+};
 pub const REDUCE_ERROR: Stage = Stage {
     name: "reduce_error",
     file: "shaders/reduce_error.wgsl",
@@ -84,7 +90,7 @@ pub const REDUCE_ERROR: Stage = Stage {
 };
 
 /// Every stage; the naga test validates each one composed.
-pub const STAGES: &[Stage] = &[SUBDIVIDE, RASTER, PROJECT_POINTS, REDUCE_ERROR];
+pub const STAGES: &[Stage] = &[SUBDIVIDE, RASTER, SLIT, PROJECT_POINTS, REDUCE_ERROR];
 
 /// The full WGSL source of a stage, with the modules it needs composed in front.
 pub fn compose(stage: &Stage, error_target: ErrorTarget) -> String {

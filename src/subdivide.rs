@@ -67,6 +67,8 @@ pub enum Method {
     Fixed(u32),
     /// N = ceil(l/L) per edge (eq. 5), with pre-split beyond N_max.
     Adaptive,
+    /// The conventional slit-mosaic renderer with slits of W columns (no subdivision).
+    Slit(u32),
 }
 
 impl Method {
@@ -75,6 +77,7 @@ impl Method {
             Method::Vertex => (0, 1),
             Method::Fixed(n) => (1, n),
             Method::Adaptive => (2, 0),
+            Method::Slit(_) => (0, 1),
         }
     }
 
@@ -82,11 +85,12 @@ impl Method {
         match s {
             "vertex" => Ok(Method::Vertex),
             "adaptive" => Ok(Method::Adaptive),
-            _ => match s.strip_prefix("fixed:").map(str::parse::<u32>) {
-                Some(Ok(n)) if (1..=MAX_FIXED).contains(&n) => Ok(Method::Fixed(n)),
-                _ => {
-                    Err(format!("unknown method '{s}': expected vertex, adaptive or fixed:N with N in 1..={MAX_FIXED}"))
-                }
+            _ => match (s.strip_prefix("fixed:").map(str::parse::<u32>), s.strip_prefix("slit:").map(str::parse::<u32>)) {
+                (Some(Ok(n)), _) if (1..=MAX_FIXED).contains(&n) => Ok(Method::Fixed(n)),
+                (_, Some(Ok(w))) if w >= 1 => Ok(Method::Slit(w)),
+                _ => Err(format!(
+                    "unknown method '{s}': expected adaptive, vertex, fixed:N with N in 1..={MAX_FIXED}, or slit:W with W ≥ 1 columns"
+                )),
             },
         }
     }
@@ -96,6 +100,7 @@ impl Method {
             Method::Vertex => "vertex".into(),
             Method::Fixed(n) => format!("fixed:{n}"),
             Method::Adaptive => "adaptive".into(),
+            Method::Slit(w) => format!("slit:{w}"),
         }
     }
 }
