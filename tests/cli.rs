@@ -168,3 +168,74 @@ fn subdivision_flags_take_effect_and_are_reported() {
     assert!(tight["chunks"].as_u64().unwrap() > 1, "{tight}");
     let _ = std::fs::remove_dir_all(&out);
 }
+
+fn error_json(extra: &[&str], env: Option<(&str, &str)>) -> serde_json::Value {
+    let mut cmd = twister();
+    if let Some((k, v)) = env {
+        cmd.env(k, v);
+    }
+    let o = cmd
+        .args(["error", "builtin:sphere100", "--width", "320", "--height", "60", "--json"])
+        .args(extra)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{extra:?}: {}", String::from_utf8_lossy(&o.stderr));
+    serde_json::from_str(String::from_utf8_lossy(&o.stdout).trim()).unwrap()
+}
+
+#[test]
+fn error_command_reports_every_field_against_a_reference_and_draws_a_heatmap() {
+    let out = tmp("error");
+    let heatmap = out.join("heat.png");
+    let j = error_json(&["--method", "vertex", "--against", "slit:1", "--heatmap", heatmap.to_str().unwrap()], None);
+    for key in [
+        "method",
+        "vertical",
+        "mean_px",
+        "std_px",
+        "p50_px",
+        "p90_px",
+        "p99_px",
+        "max_px",
+        "pixels",
+        "triangles_out",
+        "ms_render",
+        "ms_total",
+        "different_surface_fraction",
+        "psnr_db",
+    ] {
+        assert!(j.get(key).is_some(), "missing {key}: {j}");
+    }
+    assert_eq!(j["method"], "vertex");
+    let f = j["different_surface_fraction"].as_f64().unwrap();
+    assert!(f > 0.0 && f < 0.2, "{j}");
+    assert!(j["psnr_db"].as_f64().unwrap() > 15.0, "{j}");
+    let (w, h) = png_size(&heatmap);
+    assert_eq!(w, 320);
+    assert!(h > 120, "two eyes and the scale");
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn uint_error_target_gives_the_same_numbers() {
+    let float = error_json(&["--method", "vertex"], None);
+    let uint = error_json(&["--method", "vertex"], Some(("TWISTER_ERROR_TARGET", "uint")));
+    for key in ["mean_px", "p50_px", "p99_px", "max_px", "pixels"] {
+        assert_eq!(float[key], uint[key], "{key}");
+    }
+}
+
+#[test]
+fn render_accepts_slit_methods() {
+    let out = tmp("slit");
+    let o = twister()
+        .args(["render", "builtin:demo", "--method", "slit:8", "--width", "256", "--height", "48", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(png_size(&out.join("left.png")), (256, 48));
+    let o = twister().args(["render", "--method", "slit:0"]).output().unwrap();
+    assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("slit:W"));
+    let _ = std::fs::remove_dir_all(&out);
+}
