@@ -46,7 +46,7 @@ struct SubdivideParams {
     triangle_capacity: u32,
     first_piece: u32,
     piece_count: u32,
-    _pad: u32,
+    measure_edges: u32,  // 1: also track the longest visible output edge
 }
 
 struct Counters {
@@ -71,6 +71,12 @@ struct DrawIndirectArgs {
 @group(0) @binding(4) var<storage, read_write> out_vertices: array<DrawVertex>;
 @group(0) @binding(5) var<storage, read_write> counters: Counters;
 @group(0) @binding(6) var<storage, read_write> draw_args: DrawIndirectArgs;
+// Workgroup counts of the `lattice` dispatch, written by `lattice_args` from the piece counter.
+@group(0) @binding(7) var<storage, read_write> lattice_dispatch: array<u32, 3>;
+
+// `piece_count` value meaning: as many pieces as `plan` made (read from the counter), so that
+// plan, lattice and drawing can run in one submission.
+const PIECES_FROM_COUNTER: u32 = 0xffffffffu;
 
 const MAX_EDGE_DIVISIONS: u32 = 1024u;
 const EDGE_SAMPLES: u32 = 8u;
@@ -500,7 +506,9 @@ fn emit(a: Node, b: Node, c: Node) {
         u_min = min(u_min, theta - alpha);
         u_max = max(u_max, theta + alpha);
     }
-    atomicMax(&counters.max_edge_bits, bitcast<u32>(visible_edge_px(ps)));
+    if (params.measure_edges != 0u) {
+        atomicMax(&counters.max_edge_bits, bitcast<u32>(visible_edge_px(ps)));
+    }
     // Reference azimuths: the triangle itself, then a copy past each edge it crosses.
     var refs = array<f32, 3>(theta_c, 0.0, 0.0);
     var count = 1u;
@@ -607,7 +615,11 @@ fn plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 @compute @workgroup_size(64)
 fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let local = invocation_index(gid, groups);
-    if (local >= params.piece_count) {
+    var piece_count = params.piece_count;
+    if (piece_count == PIECES_FROM_COUNTER) {
+        piece_count = min(atomicLoad(&counters.pieces), params.piece_capacity);
+    }
+    if (local >= piece_count) {
         return;
     }
     let piece = pieces[params.first_piece + local];
@@ -652,6 +664,14 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         }
         finish_triangle(nodes[0], nodes[1], nodes[2]);
     }
+}
+
+@compute @workgroup_size(1)
+fn lattice_args() {
+    let groups = (min(atomicLoad(&counters.pieces), params.piece_capacity) + 63u) / 64u;
+    lattice_dispatch[0] = min(groups, 65535u);
+    lattice_dispatch[1] = (groups + 65534u) / 65535u;
+    lattice_dispatch[2] = 1u;
 }
 
 @compute @workgroup_size(1)

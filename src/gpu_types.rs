@@ -102,7 +102,14 @@ pub struct SubdivideParams {
     /// First piece and piece count of a `lattice` dispatch.
     pub first_piece: u32,
     pub piece_count: u32,
-    pub _pad: [u32; 1],
+    /// 1: also measure the longest visible output edge (`max_sub_edge_px`, costs projections).
+    pub measure_edges: u32,
+}
+
+impl SubdivideParams {
+    pub fn with_measure_edges(self, on: bool) -> Self {
+        SubdivideParams { measure_edges: on as u32, ..self }
+    }
 }
 
 /// `Counters` in shaders/subdivide.wgsl.

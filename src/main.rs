@@ -206,6 +206,7 @@ fn setup(spec: &str, fit: Option<f32>, settings: &RenderSettings) -> Result<(Ren
 fn render(args: &RenderArgs) -> Result<(), String> {
     let mut settings = args.view.settings()?;
     settings.background = args.background;
+    settings.measure_edges = args.stats.is_some();
     let (renderer, gpu_scene, adapter) = setup(&args.scene, args.fit, &settings)?;
     let frame = renderer.render(&gpu_scene, &settings)?;
     let t = std::time::Instant::now();

@@ -175,7 +175,7 @@ pub fn subdivide_params(
         triangle_capacity,
         first_piece: 0,
         piece_count: 0,
-        _pad: [0; 1],
+        measure_edges: 1,
     }
 }
 
@@ -460,7 +460,9 @@ impl<'a> Subdivider<'a> {
             u_min = u_min.min(theta - alpha);
             u_max = u_max.max(theta + alpha);
         }
-        out.max_sub_edge_px = out.max_sub_edge_px.max(self.visible_edge_px(p));
+        if self.params.measure_edges != 0 {
+            out.max_sub_edge_px = out.max_sub_edge_px.max(self.visible_edge_px(p));
+        }
         let mut push = |theta_ref: f32| out.vertices.extend(nodes.map(|n| draw_vertex(tri, n, theta_ref)));
         push(theta_c);
         // Conservative by SEAM_MARGIN: a vertex exactly on the seam (θ = π, r = R_T) is a tie

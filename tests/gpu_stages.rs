@@ -142,7 +142,7 @@ fn random_triangle_scene(seed: u64, n: usize) -> Scene {
 fn gpu_subdivide_matches_cpu_twin() {
     let r = common::renderer();
     let projection = Projection { width: 640, height: 160, ..Projection::default() };
-    let base = RenderSettings { projection, ..Default::default() };
+    let base = RenderSettings { projection, measure_edges: true, ..Default::default() };
     let moved = RenderSettings { viewer: Vec3::new(1.0, 0.3, -2.0), yaw_deg: 37.0, ..base.clone() };
     let sphere = builtin::builtin_scene("builtin:sphere100", &projection).unwrap();
     let cases = [
