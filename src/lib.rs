@@ -12,12 +12,14 @@
 pub mod bench;
 pub mod builtin;
 pub mod compare;
+pub mod figures;
 pub mod fragment;
 pub mod gpu;
 pub mod gpu_types;
 pub mod heatmap;
 pub mod load;
 pub mod output;
+pub mod plot;
 pub mod projection;
 pub mod raster;
 pub mod reduce;

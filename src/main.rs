@@ -6,6 +6,7 @@ use std::process::ExitCode;
 use clap::{Args, Parser, Subcommand};
 use glam::Vec3;
 
+use twister::figures::{Figure, FigureConfig, Runner};
 use twister::gpu::Gpu;
 use twister::load::load_scene;
 use twister::output::{layout_images, write_images, write_text, Layout};
@@ -60,6 +61,30 @@ struct ErrorArgs {
 enum BenchCommand {
     /// Median frame time of each method on each scene, and its ratio to the first method.
     Speed(SpeedArgs),
+    /// Seed 002 Fig. 8: error vs edge divisions on the evaluation triangles.
+    Fig8(FigureArgs),
+    /// Seed 002 Fig. 10: error, time and triangles per method on the evaluation scenes.
+    Fig10(FigureArgs),
+    /// Seed 002 Fig. 12: slit width vs adaptive, and the matched width.
+    Fig12(FigureArgs),
+    /// All three figures.
+    All(FigureArgs),
+}
+
+#[derive(Args)]
+struct FigureArgs {
+    /// Output folder for the CSV, JSON, PNG plots and report.md.
+    #[arg(long)]
+    out: PathBuf,
+    /// A smoke run: a quarter of the resolution, 2 reps, fewer points.
+    #[arg(long)]
+    quick: bool,
+    /// Timed frames per point after a warm-up (default 5, quick 2).
+    #[arg(long)]
+    reps: Option<usize>,
+    /// Folder of the third-party assets (bunny, Sponza); absent ones are skipped.
+    #[arg(long, default_value = "../shared/assets")]
+    assets: PathBuf,
 }
 
 #[derive(Args)]
@@ -316,6 +341,24 @@ fn error(args: &ErrorArgs) -> Result<(), String> {
     Ok(())
 }
 
+fn bench_figures(args: &FigureArgs, which: Figure) -> Result<(), String> {
+    let cfg = FigureConfig::new(args.quick, args.reps, args.assets.clone(), args.out.clone());
+    let gpu = Gpu::new().map_err(|e| e.to_string())?;
+    let adapter = gpu.adapter_description();
+    let renderer = Renderer::new(gpu);
+    let progress = indicatif::ProgressBar::new(0).with_style(
+        indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {pos}/{len} {msg}")
+            .unwrap()
+            .progress_chars("=> "),
+    );
+    let runner = Runner { renderer: &renderer, cfg, progress };
+    let result = twister::figures::run(&runner, which, &adapter);
+    runner.progress.finish_and_clear();
+    result?;
+    println!("{}", args.out.join("report.md").display());
+    Ok(())
+}
+
 fn bench_speed(args: &SpeedArgs) -> Result<(), String> {
     if args.reps == 0 {
         return Err("--reps must be at least 1".into());
@@ -345,6 +388,10 @@ fn main() -> ExitCode {
         Command::Render(args) => render(args),
         Command::Error(args) => error(args),
         Command::Bench(BenchCommand::Speed(args)) => bench_speed(args),
+        Command::Bench(BenchCommand::Fig8(args)) => bench_figures(args, Figure::Fig8),
+        Command::Bench(BenchCommand::Fig10(args)) => bench_figures(args, Figure::Fig10),
+        Command::Bench(BenchCommand::Fig12(args)) => bench_figures(args, Figure::Fig12),
+        Command::Bench(BenchCommand::All(args)) => bench_figures(args, Figure::All),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

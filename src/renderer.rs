@@ -175,6 +175,9 @@ pub struct FrameStats {
     pub ms_frame: f64,
     /// Where `ms_subdivide` and `ms_raster` come from: "gpu-timestamps" or "wall".
     pub timing: &'static str,
+    /// GPU time of the frame's work from GPU timestamp queries (start of the first pass to the
+    /// end of the last), where the adapter has them and the frame ran in one submission.
+    pub ms_gpu: Option<f64>,
     pub ms_subdivide: f64,
     pub ms_raster: f64,
     pub ms_readback: f64,
@@ -548,7 +551,7 @@ impl Renderer {
         targets: &Targets,
         b: &Buffers,
         mut params: SubdivideParams,
-    ) -> Option<(SubdivideCounters, Option<(f64, f64)>)> {
+    ) -> Option<(SubdivideCounters, Option<(f64, f64, f64)>)> {
         const PIECES_FROM_COUNTER: u32 = u32::MAX;
         let device = &self.gpu.device;
         params.first_piece = 0;
@@ -558,13 +561,7 @@ impl Renderer {
         let args_bg = self.subdivide_bind_group(&self.lattice_args, &[0, 5, 7], &uniform, scene, b);
         let lattice_bg = self.subdivide_bind_group(&self.lattice, &[0, 1, 2, 3, 4, 5], &uniform, scene, b);
         let finalize_bg = self.subdivide_bind_group(&self.finalize, &[0, 5, 6], &uniform, scene, b);
-        let timestamps = self.gpu.features.contains(wgpu::Features::TIMESTAMP_QUERY).then(|| {
-            device.create_query_set(&wgpu::QuerySetDescriptor {
-                label: Some("frame times"),
-                ty: wgpu::QueryType::Timestamp,
-                count: 4,
-            })
-        });
+        let timestamps = self.timestamp_query_set();
         let mut enc = device.create_command_encoder(&Default::default());
         enc.clear_buffer(&b.counters, 0, None);
         {
@@ -618,10 +615,44 @@ impl Renderer {
         }
         let times = resolve.map(|_| {
             let t: &[u64] = bytemuck::cast_slice(&bytes[counter_size as usize..]);
-            let ms = |a: u64, b: u64| b.saturating_sub(a) as f64 * self.gpu.queue.get_timestamp_period() as f64 * 1e-6;
-            (ms(t[0], t[1]), ms(t[2], t[3]))
+            (self.ticks_to_ms(t[0], t[1]), self.ticks_to_ms(t[2], t[3]), self.ticks_to_ms(t[0], t[3]))
         });
         Some((counters, times))
+    }
+
+    /// A query set of 4 timestamps, where the adapter has timestamp queries.
+    fn timestamp_query_set(&self) -> Option<wgpu::QuerySet> {
+        self.gpu.features.contains(wgpu::Features::TIMESTAMP_QUERY).then(|| {
+            self.gpu.device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("frame times"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 4,
+            })
+        })
+    }
+
+    /// Resolves the first `count` timestamps into a mappable buffer (encoded, not submitted).
+    fn resolve_timestamps(&self, enc: &mut wgpu::CommandEncoder, q: &wgpu::QuerySet, count: u32) -> wgpu::Buffer {
+        let size = 8 * count as u64;
+        let resolve = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("timestamps"),
+            size,
+            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("timestamps readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        enc.resolve_query_set(q, 0..count, &resolve, 0);
+        enc.copy_buffer_to_buffer(&resolve, 0, &staging, 0, size);
+        staging
+    }
+
+    fn ticks_to_ms(&self, a: u64, b: u64) -> f64 {
+        b.saturating_sub(a) as f64 * self.gpu.queue.get_timestamp_period() as f64 * 1e-6
     }
 
     /// Runs the whole subdivide stage on a scene and reads its output back: the GPU side of the
@@ -938,6 +969,7 @@ impl Renderer {
             scene.objects.iter().map(|&(first, count, c, r)| (first, count, view.transform_point3(c), r)).collect();
         let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, chunks: 1, ..Default::default() };
         let t = Instant::now();
+        let timestamps = self.timestamp_query_set();
         let mut enc = device.create_command_encoder(&Default::default());
         for (k, eye) in Eye::BOTH.into_iter().enumerate() {
             let params = slit_params(projection, view, eye, settings.ambient);
@@ -954,7 +986,12 @@ impl Renderer {
                     wgpu::BindGroupEntry { binding: 1, resource: camera_buffer.as_entire_binding() },
                 ],
             });
-            let mut pass = self.begin_eye_pass(&mut enc, &targets, k, settings, true, None);
+            let writes = timestamps.as_ref().map(|q| wgpu::RenderPassTimestampWrites {
+                query_set: q,
+                beginning_of_pass_write_index: (k == 0).then_some(0),
+                end_of_pass_write_index: (k == 1).then_some(1),
+            });
+            let mut pass = self.begin_eye_pass(&mut enc, &targets, k, settings, true, writes);
             let pipeline = &self.slit[settings.measure_error as usize];
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &bg, &[]);
@@ -972,11 +1009,16 @@ impl Renderer {
                 }
             }
         }
+        let resolved = timestamps.as_ref().map(|q| self.resolve_timestamps(&mut enc, q, 2));
         self.gpu.queue.submit([enc.finish()]);
         self.gpu.wait();
         stats.ms_raster = t.elapsed().as_secs_f64() * 1e3;
         stats.ms_frame = stats.ms_raster;
         stats.timing = "wall";
+        if let Some(buffer) = resolved {
+            let ticks: Vec<u64> = bytemuck::cast_slice(&self.gpu.read_buffer(&buffer)).to_vec();
+            stats.ms_gpu = Some(self.ticks_to_ms(ticks[0], ticks[1]));
+        }
         Ok(self.finish_frame(&targets, settings, stats, start))
     }
 
@@ -1036,9 +1078,10 @@ impl Renderer {
             if let Some((counters, times)) = self.render_one_submission(scene, settings, &targets, b, params) {
                 stats.ms_frame = t.elapsed().as_secs_f64() * 1e3;
                 (stats.ms_subdivide, stats.ms_raster, stats.timing) = match times {
-                    Some((subdivide, raster)) => (subdivide, raster, "gpu-timestamps"),
+                    Some((subdivide, raster, _)) => (subdivide, raster, "gpu-timestamps"),
                     None => (0.0, stats.ms_frame, "wall"),
                 };
+                stats.ms_gpu = times.map(|t| t.2);
                 stats.pieces = counters.pieces as u64;
                 stats.triangles_out = counters.triangles as u64;
                 stats.chunks = 1;

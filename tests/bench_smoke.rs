@@ -1,0 +1,90 @@
+//! CI's smoke run of the paper's benchmarks: `twister bench all --quick` produces every output,
+//! well formed (not a speed check).
+
+use std::path::Path;
+use std::process::Command;
+
+fn run_quick(out: &Path, assets: &Path) {
+    let o = Command::new(env!("CARGO_BIN_EXE_twister"))
+        .env("NODEVICE_SELECT", "1")
+        .args(["bench", "all", "--quick", "--out"])
+        .arg(out)
+        .arg("--assets")
+        .arg(assets)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
+fn csv_rows(path: &Path, header: &[&str]) -> Vec<csv::StringRecord> {
+    let mut r = csv::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let h = r.headers().unwrap().clone();
+    for col in header {
+        assert!(h.iter().any(|x| x == *col), "{}: no column {col} in {h:?}", path.display());
+    }
+    r.records().map(|x| x.unwrap()).collect()
+}
+
+#[test]
+fn quick_benchmark_writes_every_output_well_formed() {
+    let out = std::env::temp_dir().join(format!("twister-bench-smoke-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets");
+    run_quick(&out, &assets);
+    let cols = ["scene", "method", "parameter", "mean_px", "std_px", "p99_px", "ms_frame", "triangles_out", "timing"];
+    let fig8 = csv_rows(&out.join("fig8.csv"), &cols);
+    assert_eq!(fig8.len(), 3 * 4, "three distances × the quick N values");
+    let fig10 = csv_rows(&out.join("fig10.csv"), &cols);
+    let fig12 = csv_rows(&out.join("fig12.csv"), &cols);
+    let matched = csv_rows(&out.join("fig12_matched.csv"), &["scene", "adaptive_ms", "w_star", "note"]);
+    let scenes = if assets.join("stanford-bunny/bun_zipper_res2.obj").exists() { 4 } else { 2 };
+    assert_eq!(matched.len(), scenes);
+    assert_eq!(fig10.len(), scenes * 5, "vertex, fixed:1/4/7, adaptive per scene");
+    assert_eq!(fig12.len(), scenes * 4, "adaptive and three slit widths per scene");
+    for row in fig10.iter().chain(&fig12) {
+        let ms: f64 = row[6].parse().unwrap();
+        let mean: f64 = row[3].parse().unwrap();
+        assert!(ms > 0.0 && ms.is_finite() && mean >= 0.0, "{row:?}");
+    }
+    // fig8's error falls with N at every distance (the paper's finding).
+    for d in ["triangle@1", "triangle@3", "triangle@5"] {
+        let means: Vec<f64> = fig8.iter().filter(|r| &r[0] == d).map(|r| r[3].parse().unwrap()).collect();
+        assert!(means.windows(2).all(|w| w[1] < w[0]), "{d}: {means:?}");
+    }
+    for f in ["fig8.json", "fig10.json", "fig12.json"] {
+        let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join(f)).unwrap()).unwrap();
+        assert!(v.is_array() || v.is_object(), "{f}");
+    }
+    for f in ["fig8.png", "fig10.png", "fig12.png"] {
+        let (w, h) = image::image_dimensions(out.join(f)).unwrap();
+        assert!(w >= 800 && h >= 500, "{f}: {w}x{h}");
+    }
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    for s in ["## Fig. 8", "## Fig. 10", "## Fig. 12", "31 px", "Timing source", "llvmpipe"] {
+        if s == "llvmpipe" && !report.contains("Cpu") {
+            continue; // a real GPU names itself differently
+        }
+        assert!(report.contains(s), "report.md lacks {s}");
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn absent_assets_are_skipped_with_a_clear_line() {
+    let out = std::env::temp_dir().join(format!("twister-bench-noassets-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let o = Command::new(env!("CARGO_BIN_EXE_twister"))
+        .env("NODEVICE_SELECT", "1")
+        .args(["bench", "fig10", "--quick", "--reps", "1", "--assets", "/nonexistent/assets", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        report.contains("Bunny skipped: /nonexistent/assets/stanford-bunny/bun_zipper_res2.obj is absent"),
+        "{report}"
+    );
+    assert!(report.contains("Sponza skipped"), "{report}");
+    let _ = std::fs::remove_dir_all(&out);
+}
