@@ -1,6 +1,10 @@
 // Shared fragment work of the drawing stages (raster, slit), composed in after projection.wgsl:
-// headlight shading, the display-position error of seed 002 §4.1, and the output targets.
-// CPU twin: src/fragment.rs.
+// their varyings, headlight shading, the display-position error of seed 002 §4.1, the output
+// targets and the fragment entry points. CPU twin: src/fragment.rs.
+//
+// Contract: a stage composing this module declares a uniform `params` with the fields
+// `projection: Projection`, `eye_sign: f32` (+1 right eye) and `ambient: f32`, and its vertex
+// stage returns `VertexOut`.
 
 // The error target's type. R32Float where the adapter can render to it; otherwise the loader
 // replaces the two marked lines so that the same bits go to an R32Uint target.
@@ -45,4 +49,27 @@ fn fragment_out(proj: Projection, eye_sign: f32, ambient: f32, frag_xy: vec2<f32
     out.error = encode_error(pixel_error(proj, eye_sign, view_position, frag_xy));
     out.object = object + 1u;
     return out;
+}
+
+// The varyings of the drawing stages. view_position is the surface point drawn: interpolated
+// linearly on the screen by the raster stage (clip w = 1, where the projection methods put a
+// triangle's inside), perspective-correctly by the slit stage (clip w = depth along the camera).
+struct VertexOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) view_position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) color: vec4<f32>,
+    @location(3) @interpolate(flat) object: u32,
+}
+
+@fragment
+fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
+    return shade(params.ambient, in.view_position, in.normal, in.color);
+}
+
+// The same, plus the display-position error and the object id (when the error is measured).
+@fragment
+fn fs_error(in: VertexOut) -> FragmentOut {
+    return fragment_out(params.projection, params.eye_sign, params.ambient, in.clip.xy, in.view_position, in.normal,
+                        in.color, in.object);
 }

@@ -46,6 +46,19 @@ struct ErrorStats {
 
 var<workgroup> sums: array<vec2<f32>, WG>;
 
+// Tree sum of every invocation's `value` over the workgroup (call from uniform control flow).
+fn workgroup_sum(li: u32, value: vec2<f32>) -> vec2<f32> {
+    sums[li] = value;
+    workgroupBarrier();
+    for (var stride = WG / 2u; stride > 0u; stride /= 2u) {
+        if (li < stride) {
+            sums[li] += sums[li + stride];
+        }
+        workgroupBarrier();
+    }
+    return sums[0];
+}
+
 fn bin_of(e: f32) -> u32 {
     if (e < 64.0) {
         return min(u32(floor(e * 64.0)), FINE_BINS - 1u);
@@ -84,16 +97,9 @@ fn accumulate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invo
             s = vec2<f32>(e, e * e);
         }
     }
-    sums[li] = s;
-    workgroupBarrier();
-    for (var stride = WG / 2u; stride > 0u; stride /= 2u) {
-        if (li < stride) {
-            sums[li] += sums[li + stride];
-        }
-        workgroupBarrier();
-    }
+    let total = workgroup_sum(li, s);
     if (li == 0u) {
-        partials[wid.x + wid.y * groups.x] = sums[0];
+        partials[wid.x + wid.y * groups.x] = total;
     }
 }
 
@@ -127,22 +133,15 @@ fn finish(@builtin(local_invocation_index) li: u32) {
         compensation = (t - total) - y;
         total = t;
     }
-    sums[li] = total;
-    workgroupBarrier();
-    for (var stride = WG / 2u; stride > 0u; stride /= 2u) {
-        if (li < stride) {
-            sums[li] += sums[li + stride];
-        }
-        workgroupBarrier();
-    }
+    let sum = workgroup_sum(li, total);
     if (li == 0u) {
         let count = atomicLoad(&totals.count);
         var out: ErrorStats;
         out.count = count;
         if (count > 0u) {
             let n = f32(count);
-            out.mean = sums[0].x / n;
-            out.std_dev = sqrt(max(sums[0].y / n - out.mean * out.mean, 0.0));
+            out.mean = sum.x / n;
+            out.std_dev = sqrt(max(sum.y / n - out.mean * out.mean, 0.0));
             out.p50 = percentile(0.5, count);
             out.p90 = percentile(0.9, count);
             out.p99 = percentile(0.99, count);

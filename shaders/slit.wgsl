@@ -32,13 +32,6 @@ struct VertexIn {
     @location(3) object: u32,
 }
 
-struct VertexOut {
-    @builtin(position) clip: vec4<f32>,
-    @location(0) view_position: vec3<f32>,
-    @location(1) normal: vec3<f32>,
-    @location(2) color: vec4<f32>,
-    @location(3) @interpolate(flat) object: u32,
-}
 
 @vertex
 fn vs_main(in: VertexIn) -> VertexOut {
@@ -56,17 +49,4 @@ fn vs_main(in: VertexIn) -> VertexOut {
     out.color = in.color;
     out.object = in.object;
     return out;
-}
-
-@fragment
-fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
-    return shade(params.ambient, in.view_position, in.normal, in.color);
-}
-
-// The same, plus the display-position error and the object id (when the error is measured).
-// view_position is interpolated perspective-correctly (clip w = depth along the camera).
-@fragment
-fn fs_error(in: VertexOut) -> FragmentOut {
-    return fragment_out(params.projection, params.eye_sign, params.ambient, in.clip.xy, in.view_position, in.normal,
-                        in.color, in.object);
 }

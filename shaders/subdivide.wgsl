@@ -263,10 +263,6 @@ fn plan_triangle() {
     }
 }
 
-fn snap_index(idx: u32, count: u32) -> u32 {
-    return (2u * idx * count + tri_k) / (2u * tri_k);
-}
-
 // Where macro node (a, b, c)/K lies, as (kind, i, j): kind 0 = triangle corner i; kind 1 = fine
 // node j (0 < j < n_i) of original edge i; kind 2 = interior. Nodes on an original edge snap to
 // its fine nodes and may land on a corner. (`Location` in subdivide.rs.)
@@ -274,23 +270,35 @@ const CORNER: u32 = 0u;
 const ON_EDGE: u32 = 1u;
 const INTERIOR: u32 = 2u;
 
-fn macro_location(abc: vec3<u32>) -> vec3<u32> {
-    var e = 3u;
-    var idx = 0u;
+// The boundary edge a node (a, b, c) of a level-k lattice lies on, and its index along that edge
+// from the edge's start: (0, b) for c = 0, (1, c) for a = 0, (2, a) for b = 0; edge 3 = interior.
+// Both lattice levels (the macro pre-split and each piece) place such nodes on the edge's own
+// nodes with `snap`. (`boundary_edge` and `snap` in subdivide.rs.)
+fn boundary_edge(abc: vec3<u32>) -> vec2<u32> {
     if (abc.z == 0u) {
-        e = 0u;
-        idx = abc.y;
-    } else if (abc.x == 0u) {
-        e = 1u;
-        idx = abc.z;
-    } else if (abc.y == 0u) {
-        e = 2u;
-        idx = abc.x;
+        return vec2<u32>(0u, abc.y);
     }
+    if (abc.x == 0u) {
+        return vec2<u32>(1u, abc.z);
+    }
+    if (abc.y == 0u) {
+        return vec2<u32>(2u, abc.x);
+    }
+    return vec2<u32>(3u, 0u);
+}
+
+// The edge node nearest to lattice index idx of `level` on an edge of `count` parts.
+fn snap(idx: u32, count: u32, level: u32) -> u32 {
+    return (2u * idx * count + level) / (2u * level);
+}
+
+fn macro_location(abc: vec3<u32>) -> vec3<u32> {
+    let on = boundary_edge(abc);
+    let e = on.x;
     if (e == 3u) {
         return vec3<u32>(INTERIOR, 0u, 0u);
     }
-    let j = snap_index(idx, tri_n[e]);
+    let j = snap(on.y, tri_n[e], tri_k);
     if (j == 0u) {
         return vec3<u32>(CORNER, e, 0u);
     }
@@ -568,20 +576,9 @@ fn finish_triangle(a: Node, b: Node, c: Node) {
 // Node (i, j, l) of the piece's lattice of level m: the regular lattice, whose boundary nodes on
 // an edge with fewer divisions snap to that edge's nearest node (see subdivide.rs).
 fn lattice_node(c: vec3<u32>, m: u32) -> Node {
-    var e = 3u;
-    var idx = 0u;
-    if (c.z == 0u) {
-        e = 0u;
-        idx = c.y;
-    } else if (c.x == 0u) {
-        e = 1u;
-        idx = c.z;
-    } else if (c.y == 0u) {
-        e = 2u;
-        idx = c.x;
-    }
-    if (e < 3u) {
-        return node_on_edge(e, (2u * idx * piece_counts[e] + m) / (2u * m));
+    let on = boundary_edge(c);
+    if (on.x < 3u) {
+        return node_on_edge(on.x, snap(on.y, piece_counts[on.x], m));
     }
     return interior_node(c.x, c.y, c.z, m);
 }

@@ -104,6 +104,42 @@ pub fn sphere_scene(triangles: u32, center: Vec3, radius: f32, name: &str) -> Sc
     scene
 }
 
+/// A closed, irregular mesh: an icosahedron (20 faces) with jittered radii and smooth normals.
+/// Tests use it as a closed model that is not a UV sphere.
+pub fn blob(center: Vec3, radius: f32) -> Scene {
+    let t = (1.0 + 5f32.sqrt()) / 2.0;
+    let corners = [
+        (-1.0, t, 0.0),
+        (1.0, t, 0.0),
+        (-1.0, -t, 0.0),
+        (1.0, -t, 0.0),
+        (0.0, -1.0, t),
+        (0.0, 1.0, t),
+        (0.0, -1.0, -t),
+        (0.0, 1.0, -t),
+        (t, 0.0, -1.0),
+        (t, 0.0, 1.0),
+        (-t, 0.0, -1.0),
+        (-t, 0.0, 1.0),
+    ];
+    let faces: [u32; 60] = [
+        0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4, 11, 10, 2, 10, 7, 6, 7, 1, 8, 3, 9, 4, 3,
+        4, 2, 3, 2, 6, 3, 6, 8, 3, 8, 9, 4, 9, 5, 2, 4, 11, 6, 2, 10, 8, 6, 7, 9, 8, 1,
+    ];
+    let mut v: Vec<SceneVertex> = corners
+        .iter()
+        .enumerate()
+        .map(|(i, &(x, y, z))| {
+            let d = Vec3::new(x, y, z).normalize() * (1.0 + 0.2 * (i as f32 * 2.7).sin());
+            vertex(center + radius * d, Vec3::ZERO, [0.6, 0.7, 0.5, 1.0])
+        })
+        .collect();
+    crate::load::compute_normals(&mut v, &faces);
+    let mut s = Scene::new("blob");
+    s.add_mesh("blob", &v, &faces);
+    s
+}
+
 /// The paper's evaluation-1 triangle: equilateral, in the plane z = −D facing the viewer,
 /// centred on the middle row; its side projects to about H pixels (R_T·s/D metres of screen).
 pub fn paper_triangle(distance: f32, projection: &Projection) -> Scene {

@@ -39,6 +39,20 @@ fn workgroups(count: u32) -> (u32, u32) {
     }
 }
 
+/// What to do when a pass wanted `requested` slots of a buffer: grow the buffer to it if the
+/// budget `max` allows, else halve the range of `count` items the pass ran on; Err when a single
+/// item cannot fit.
+fn on_overflow(requested: u32, max: u32, count: u32, want: &mut u32, chunk: &mut u32) -> Result<(), ()> {
+    if requested <= max {
+        *want = requested;
+    } else if count > 1 {
+        *chunk = count / 2;
+    } else {
+        return Err(());
+    }
+    Ok(())
+}
+
 /// Default memory budget for the subdivision buffers, MiB.
 pub const DEFAULT_MEMORY_MB: u32 = 256;
 
@@ -1105,16 +1119,12 @@ impl Renderer {
             let planned = self.run_subdivide(&self.plan, scene, b, &params, tri_count);
             stats.ms_subdivide += t.elapsed().as_secs_f64() * 1e3;
             if planned.pieces > params.piece_capacity {
-                if planned.pieces <= max_pieces {
-                    want_pieces = planned.pieces;
-                } else if tri_count > 1 {
-                    tri_chunk = tri_count / 2;
-                } else {
-                    return Err(format!(
+                on_overflow(planned.pieces, max_pieces, tri_count, &mut want_pieces, &mut tri_chunk).map_err(|_| {
+                    format!(
                         "one triangle needs {} pieces, more than --memory-mb {} allows; raise --edge-px or --memory-mb",
                         planned.pieces, settings.memory_mb
-                    ));
-                }
+                    )
+                })?;
                 continue;
             }
             stats.pieces += planned.pieces as u64;
@@ -1131,16 +1141,12 @@ impl Renderer {
                 let done = self.run_subdivide(&self.lattice, scene, b, &params, piece_count);
                 stats.ms_subdivide += t.elapsed().as_secs_f64() * 1e3;
                 if done.triangles > params.triangle_capacity {
-                    if done.triangles <= max_tris {
-                        want_tris = done.triangles;
-                    } else if piece_count > 1 {
-                        piece_chunk = piece_count / 2;
-                    } else {
-                        return Err(format!(
+                    on_overflow(done.triangles, max_tris, piece_count, &mut want_tris, &mut piece_chunk).map_err(|_| {
+                        format!(
                             "one piece makes {} triangles, more than --memory-mb {} allows; lower the fixed N or raise --memory-mb",
                             done.triangles, settings.memory_mb
-                        ));
-                    }
+                        )
+                    })?;
                     continue;
                 }
                 let t = Instant::now();

@@ -354,17 +354,11 @@ impl<'a> Subdivider<'a> {
 
     /// Where macro node (a, b, c)/K lies: nodes on an original edge snap to its fine nodes, and
     /// may land on a triangle corner.
-    fn macro_location(&self, n: [u32; 3], k: u32, [a, b, c]: [u32; 3]) -> Location {
-        let snap = |idx: u32, count: u32| (2 * idx * count + k) / (2 * k);
-        let (e, j) = if c == 0 {
-            (0, snap(b, n[0]))
-        } else if a == 0 {
-            (1, snap(c, n[1]))
-        } else if b == 0 {
-            (2, snap(a, n[2]))
-        } else {
-            return Location::Interior([a, b, c]);
+    fn macro_location(&self, n: [u32; 3], k: u32, abc: [u32; 3]) -> Location {
+        let Some((e, idx)) = boundary_edge(abc) else {
+            return Location::Interior(abc);
         };
+        let j = snap(idx, n[e], k);
         if j == 0 {
             Location::Corner(e)
         } else if j == n[e] {
@@ -525,6 +519,27 @@ struct PieceEdge {
     count: u32,
 }
 
+/// The boundary edge a node (a, b, c) of a lattice lies on, with its index along that edge from
+/// the edge's start: edge 0 (corner 0 → 1) where c = 0, index b; edge 1 (1 → 2) where a = 0,
+/// index c; edge 2 (2 → 0) where b = 0, index a. None inside. Both lattice levels (the macro
+/// pre-split and each piece) place such nodes on the edge's own nodes with [`snap`].
+pub fn boundary_edge([a, b, c]: [u32; 3]) -> Option<(usize, u32)> {
+    if c == 0 {
+        Some((0, b))
+    } else if a == 0 {
+        Some((1, c))
+    } else if b == 0 {
+        Some((2, a))
+    } else {
+        None
+    }
+}
+
+/// The node, of an edge in `count` parts, nearest to lattice index `idx` of `level` along it.
+pub fn snap(idx: u32, count: u32, level: u32) -> u32 {
+    (2 * idx * count + level) / (2 * level)
+}
+
 /// Corners (macro indices a, b, c with a + b + c = K) of cell `cell` of a level-K lattice.
 /// Row r (c from r to r + 1) holds K − r upward cells, then K − r − 1 downward ones.
 pub fn macro_cell(k: u32, cell: u32) -> [[u32; 3]; 3] {
@@ -556,15 +571,10 @@ pub fn lattice_triangles(
     emit: &mut dyn FnMut(Node, Node, Node),
 ) {
     let m = counts[0].max(counts[1]).max(counts[2]);
-    let snap = |idx: u32, n: u32| (2 * idx * n + m) / (2 * m);
     // A lattice node by local indices (i, j, l) with i + j + l = m (weights of q0, q1, q2).
     let node = |[i, j, l]: [u32; 3]| -> Node {
-        if l == 0 {
-            node_on_edge(0, snap(j, counts[0]))
-        } else if i == 0 {
-            node_on_edge(1, snap(l, counts[1]))
-        } else if j == 0 {
-            node_on_edge(2, snap(i, counts[2]))
+        if let Some((e, idx)) = boundary_edge([i, j, l]) {
+            node_on_edge(e, snap(idx, counts[e], m))
         } else {
             let w = Vec3::new(i as f32, j as f32, l as f32) / m as f32;
             Node {
@@ -916,59 +926,11 @@ mod tests {
         }
     }
 
-    /// An icosphere of 80·4^0 … triangles, jittered deterministically (a closed, irregular mesh).
-    fn closed_blob(center: Vec3, radius: f32) -> (Vec<SceneVertex>, Vec<u32>) {
-        let t = (1.0 + 5f32.sqrt()) / 2.0;
-        let mut pts: Vec<Vec3> = [
-            (-1.0, t, 0.0),
-            (1.0, t, 0.0),
-            (-1.0, -t, 0.0),
-            (1.0, -t, 0.0),
-            (0.0, -1.0, t),
-            (0.0, 1.0, t),
-            (0.0, -1.0, -t),
-            (0.0, 1.0, -t),
-            (t, 0.0, -1.0),
-            (t, 0.0, 1.0),
-            (-t, 0.0, -1.0),
-            (-t, 0.0, 1.0),
-        ]
-        .iter()
-        .map(|&(x, y, z)| Vec3::new(x, y, z).normalize())
-        .collect();
-        let faces: Vec<[u32; 3]> = vec![
-            [0, 11, 5],
-            [0, 5, 1],
-            [0, 1, 7],
-            [0, 7, 10],
-            [0, 10, 11],
-            [1, 5, 9],
-            [5, 11, 4],
-            [11, 10, 2],
-            [10, 7, 6],
-            [7, 1, 8],
-            [3, 9, 4],
-            [3, 4, 2],
-            [3, 2, 6],
-            [3, 6, 8],
-            [3, 8, 9],
-            [4, 9, 5],
-            [2, 4, 11],
-            [6, 2, 10],
-            [8, 6, 7],
-            [9, 8, 1],
-        ];
-        for (i, p) in pts.iter_mut().enumerate() {
-            *p *= 1.0 + 0.15 * ((i as f32 * 2.7).sin());
-        }
-        let v = pts.iter().map(|&p| vertex((center + radius * p).into())).collect();
-        (v, faces.concat())
-    }
-
     #[test]
     fn subdivided_closed_mesh_stays_closed() {
         let projection = Projection { width: 1200, height: 240, ..Projection::default() };
-        let (v, i) = closed_blob(Vec3::new(0.3, 0.1, -3.0), 1.2);
+        let blob = crate::builtin::blob(Vec3::new(0.3, 0.1, -3.0), 1.2);
+        let (v, i) = (blob.vertices, blob.indices);
         for (method, edge_px, max_div) in [
             (Method::Adaptive, 32.0f32, 7),
             (Method::Adaptive, 6.0, 3),

@@ -6,7 +6,6 @@
 mod common;
 
 use glam::Vec3;
-use twister::gpu_types::SceneVertex;
 use twister::renderer::EyeImage;
 use twister::subdivide::Method;
 use twister::{builtin, Projection, RenderSettings, Scene};
@@ -88,44 +87,9 @@ fn sphere_seen_from_inside_has_no_cracks() {
     check(&scene, "sphere100 from inside", Vec3::new(0.3, 0.2, -0.5), true);
 }
 
-/// A closed, irregular icosahedral blob (20 faces, jittered radii, smooth normals).
-fn blob(center: Vec3, radius: f32) -> Scene {
-    let t = (1.0 + 5f32.sqrt()) / 2.0;
-    let pts = [
-        (-1.0, t, 0.0),
-        (1.0, t, 0.0),
-        (-1.0, -t, 0.0),
-        (1.0, -t, 0.0),
-        (0.0, -1.0, t),
-        (0.0, 1.0, t),
-        (0.0, -1.0, -t),
-        (0.0, 1.0, -t),
-        (t, 0.0, -1.0),
-        (t, 0.0, 1.0),
-        (-t, 0.0, -1.0),
-        (-t, 0.0, 1.0),
-    ];
-    let faces: [u32; 60] = [
-        0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4, 11, 10, 2, 10, 7, 6, 7, 1, 8, 3, 9, 4, 3,
-        4, 2, 3, 2, 6, 3, 6, 8, 3, 8, 9, 4, 9, 5, 2, 4, 11, 6, 2, 10, 8, 6, 7, 9, 8, 1,
-    ];
-    let mut v: Vec<SceneVertex> = pts
-        .iter()
-        .enumerate()
-        .map(|(i, &(x, y, z))| {
-            let d = Vec3::new(x, y, z).normalize() * (1.0 + 0.2 * (i as f32 * 2.7).sin());
-            SceneVertex { position: (center + radius * d).into(), color: [0.6, 0.7, 0.5, 1.0], ..Default::default() }
-        })
-        .collect();
-    twister::load::compute_normals(&mut v, &faces);
-    let mut s = Scene::new("blob");
-    s.add_mesh("blob", &v, &faces);
-    s
-}
-
 #[test]
 fn closed_models_have_no_cracks() {
-    check(&blob(Vec3::new(0.2, 0.0, -2.5), 0.9), "blob", Vec3::ZERO, false);
+    check(&builtin::blob(Vec3::new(0.2, 0.0, -2.5), 0.9), "blob", Vec3::ZERO, false);
     let cow = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/cow/cow.obj");
     if cow.exists() {
         let p = Projection { width: 480, height: 120, ..Projection::default() };
