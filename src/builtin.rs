@@ -7,7 +7,7 @@
 //! | `builtin:triangle@D` | the paper's evaluation-1 triangle: equilateral, facing the viewer, D metres straight ahead, projected side ≈ the image height H |
 
 use glam::Vec3;
-use std::f32::consts::{PI, TAU};
+use std::f32::consts::{FRAC_1_SQRT_2, PI, TAU};
 
 use crate::gpu_types::SceneVertex;
 use crate::projection::Projection;
@@ -218,7 +218,7 @@ pub fn demo() -> Scene {
     }
     // Spheres at 1 m (ahead right), 3 m (left), 5 m (straight behind, across the seam).
     let spheres = [
-        (Vec3::new(0.7071, -0.2, -0.7071), 0.2, [0.85, 0.15, 0.1, 1.0], "sphere 1 m"),
+        (Vec3::new(FRAC_1_SQRT_2, -0.2, -FRAC_1_SQRT_2), 0.2, [0.85, 0.15, 0.1, 1.0], "sphere 1 m"),
         (Vec3::new(-3.0, 0.3, 0.0), 0.6, [0.2, 0.75, 0.25, 1.0], "sphere 3 m"),
         (Vec3::from(SEAM_SPHERE_CENTER), SEAM_SPHERE_RADIUS, SEAM_SPHERE_COLOR, "sphere 5 m (seam)"),
     ];

@@ -9,6 +9,9 @@
 //! - `reduce_error` ([`reduce::reduce_error`], `shaders/reduce_error.wgsl`): error statistics;
 //! - `project_points` ([`projection::project_points`], `shaders/project_points.wgsl`).
 
+// Comparisons written `!(x > y)` are deliberate: they put NaN on the rejecting side.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod bench;
 pub mod builtin;
 pub mod compare;

@@ -53,6 +53,9 @@ fn on_overflow(requested: u32, max: u32, count: u32, want: &mut u32, chunk: &mut
     Ok(())
 }
 
+/// GPU times of a one-submission frame, ms: (subdivision, raster, whole frame).
+type FrameTimes = (f64, f64, f64);
+
 /// Default memory budget for the subdivision buffers, MiB.
 pub const DEFAULT_MEMORY_MB: u32 = 256;
 
@@ -565,7 +568,7 @@ impl Renderer {
         targets: &Targets,
         b: &Buffers,
         mut params: SubdivideParams,
-    ) -> Option<(SubdivideCounters, Option<(f64, f64, f64)>)> {
+    ) -> Option<(SubdivideCounters, Option<FrameTimes>)> {
         const PIECES_FROM_COUNTER: u32 = u32::MAX;
         let device = &self.gpu.device;
         params.first_piece = 0;

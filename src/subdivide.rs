@@ -846,8 +846,8 @@ mod tests {
         let whole = 0.5 * (q[1].position - q[0].position).cross(q[2].position - q[0].position).length();
         assert!((total - whole).abs() < 1e-4 * whole, "{counts:?}: area {total} vs {whole}");
         let mut boundary = Vec::new();
-        for e in 0..3 {
-            for m in 0..counts[e] {
+        for (e, &count) in counts.iter().enumerate() {
+            for m in 0..count {
                 let (u, v) = (key(node_on_edge(e, m).position), key(node_on_edge(e, m + 1).position));
                 boundary.push(if u < v { (u, v) } else { (v, u) });
             }

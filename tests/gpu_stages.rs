@@ -16,7 +16,7 @@ fn gpu_projection_matches_cpu_within_a_thousandth_of_a_pixel() {
     let points: Vec<Vec3> = (0..5000)
         .map(|_| {
             let radius: f32 = rng.random_range(0.05f32..40.0);
-            let theta: f32 = rng.random_range(-3.14159f32..3.14159);
+            let theta: f32 = rng.random_range(-std::f32::consts::PI..std::f32::consts::PI);
             Vec3::new(radius * theta.sin(), rng.random_range(-3.0f32..3.0), -radius * theta.cos())
         })
         .collect();
