@@ -1,6 +1,9 @@
-//! Loading scenes: built-in names, and OBJ files (positions, normals, UVs, vertex colours;
-//! polygons triangulated; missing normals computed). Materials, textures and glTF come with the
-//! scene-import work. Every failure is one message naming the file and the problem.
+//! Loading scenes: built-in names, OBJ files (positions, normals, UVs, vertex colours; polygons
+//! triangulated; missing normals computed) and glTF 2.0 geometry (`.gltf` with external or
+//! embedded buffers, `.glb`: the default scene's node hierarchy, TRIANGLES / TRIANGLE_STRIP /
+//! TRIANGLE_FAN primitives, indexed or not, sparse accessors, base colour factor × vertex colour;
+//! textures are not sampled yet). Every failure is one message naming the file and the problem;
+//! accessors are bounds-checked before they are read.
 
 use std::path::Path;
 
@@ -23,12 +26,10 @@ pub fn load_scene(spec: &str, projection: &Projection) -> Result<Scene, String> 
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     let scene = match ext.as_deref() {
         Some("obj") => load_obj(path)?,
-        Some("gltf") | Some("glb") => {
-            return Err(format!("{spec}: glTF import is not supported yet; OBJ files and built-in scenes are"))
-        }
+        Some("gltf") | Some("glb") => load_gltf(path)?,
         _ => {
             return Err(format!(
-                "{spec}: unknown scene type (expected a .obj file or one of {})",
+                "{spec}: unknown scene type (expected a .obj, .gltf or .glb file, or one of {})",
                 builtin::NAMES.join(", ")
             ))
         }
@@ -79,6 +80,138 @@ pub fn load_obj(path: &Path) -> Result<Scene, String> {
         return Err(format!("{name}: no faces"));
     }
     Ok(scene)
+}
+
+/// Loads a glTF 2.0 file's default scene (see the module doc for what is supported).
+pub fn load_gltf(path: &Path) -> Result<Scene, String> {
+    let name = path.display().to_string();
+    if !path.is_file() {
+        return Err(format!("{name}: no such file"));
+    }
+    let (doc, buffers, _images) = gltf::import(path).map_err(|e| format!("{name}: not a readable glTF file: {e}"))?;
+    let required: Vec<&str> = doc.extensions_required().collect();
+    if !required.is_empty() {
+        return Err(format!("{name}: requires extensions twister does not support: {}", required.join(", ")));
+    }
+    let mut scene = Scene::new(name.clone());
+    let used: Vec<&str> = doc.extensions_used().collect();
+    if !used.is_empty() {
+        scene.warnings.push(format!("optional extensions ignored: {}", used.join(", ")));
+    }
+    let root =
+        doc.default_scene().or_else(|| doc.scenes().next()).ok_or_else(|| format!("{name}: the file has no scene"))?;
+    let mut stack: Vec<(gltf::Node, Mat4, usize)> = root.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
+    while let Some((node, parent, depth)) = stack.pop() {
+        if depth > 256 {
+            return Err(format!("{name}: the node hierarchy is deeper than 256 levels (a cycle?)"));
+        }
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        if !world.is_finite() {
+            return Err(format!("{name}: node {} has a NaN or infinite transform", node.index()));
+        }
+        if let Some(mesh) = node.mesh() {
+            for prim in mesh.primitives() {
+                let mesh_name = mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_string);
+                let label = format!("{mesh_name} / primitive {}", prim.index());
+                add_gltf_primitive(&mut scene, &prim, &buffers, world, &label)
+                    .map_err(|e| format!("{name}: {label}: {e}"))?;
+            }
+        }
+        stack.extend(node.children().map(|c| (c, world, depth + 1)));
+    }
+    if scene.triangle_count() == 0 {
+        return Err(format!("{name}: the default scene has no triangles"));
+    }
+    Ok(scene)
+}
+
+/// Checks that an accessor's elements lie inside its buffer view and the view inside its buffer.
+fn check_accessor(acc: &gltf::Accessor, buffers: &[gltf::buffer::Data]) -> Result<(), String> {
+    let count = acc.count();
+    if count > (1 << 28) {
+        return Err(format!("accessor {} claims {count} elements", acc.index()));
+    }
+    if let Some(view) = acc.view() {
+        let buffer_len = buffers.get(view.buffer().index()).map_or(0, |b| b.len());
+        if view.offset() + view.length() > buffer_len {
+            return Err(format!(
+                "buffer view {} overruns its buffer ({} > {buffer_len} bytes)",
+                view.index(),
+                view.offset() + view.length()
+            ));
+        }
+        let element = acc.size();
+        let stride = view.stride().unwrap_or(element);
+        if count > 0 && acc.offset() + stride * (count - 1) + element > view.length() {
+            return Err(format!("accessor {} overruns buffer view {}", acc.index(), view.index()));
+        }
+    }
+    Ok(())
+}
+
+fn add_gltf_primitive(
+    scene: &mut Scene,
+    prim: &gltf::Primitive,
+    buffers: &[gltf::buffer::Data],
+    world: Mat4,
+    label: &str,
+) -> Result<(), String> {
+    use gltf::mesh::Mode;
+    let mode = prim.mode();
+    if !matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
+        scene.warnings.push(format!("{label}: {mode:?} primitive skipped (only triangles are drawn)"));
+        return Ok(());
+    }
+    for (_, acc) in prim.attributes() {
+        check_accessor(&acc, buffers)?;
+    }
+    if let Some(acc) = prim.indices() {
+        check_accessor(&acc, buffers)?;
+    }
+    let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+    let positions: Vec<[f32; 3]> = reader.read_positions().ok_or("no POSITION attribute")?.collect();
+    let n = positions.len();
+    let normals: Option<Vec<[f32; 3]>> = reader.read_normals().map(|r| r.collect());
+    let uvs: Option<Vec<[f32; 2]>> = reader.read_tex_coords(0).map(|r| r.into_f32().collect());
+    let colors: Option<Vec<[f32; 4]>> = reader.read_colors(0).map(|r| r.into_rgba_f32().collect());
+    let factor = prim.material().pbr_metallic_roughness().base_color_factor();
+    let raw: Vec<u32> = match reader.read_indices() {
+        Some(r) => r.into_u32().collect(),
+        None => (0..n as u32).collect(),
+    };
+    if let Some(&bad) = raw.iter().find(|&&i| i as usize >= n) {
+        return Err(format!("index {bad} is out of range ({n} vertices)"));
+    }
+    let indices: Vec<u32> = match mode {
+        Mode::Triangles => raw.chunks_exact(3).flatten().copied().collect(),
+        Mode::TriangleStrip => (0..raw.len().saturating_sub(2))
+            .flat_map(|k| if k % 2 == 0 { [raw[k], raw[k + 1], raw[k + 2]] } else { [raw[k + 1], raw[k], raw[k + 2]] })
+            .collect(),
+        _ => (1..raw.len().saturating_sub(1)).flat_map(|k| [raw[0], raw[k], raw[k + 1]]).collect(),
+    };
+    let normal_matrix = world.inverse().transpose();
+    let mut vertices: Vec<SceneVertex> = (0..n)
+        .map(|i| {
+            let c = colors.as_ref().and_then(|c| c.get(i).copied()).unwrap_or([1.0; 4]);
+            SceneVertex {
+                position: world.transform_point3(Vec3::from(positions[i])).into(),
+                normal: normals
+                    .as_ref()
+                    .and_then(|v| v.get(i))
+                    .map_or(Vec3::ZERO, |&v| normal_matrix.transform_vector3(Vec3::from(v)).normalize_or_zero())
+                    .into(),
+                color: [0, 1, 2, 3].map(|k| c[k] * factor[k]),
+                uv: uvs.as_ref().and_then(|v| v.get(i)).copied().unwrap_or([0.0; 2]),
+                material: prim.material().index().map_or(0, |m| m as u32 + 1),
+                ..Default::default()
+            }
+        })
+        .collect();
+    if normals.is_none() {
+        compute_normals(&mut vertices, &indices);
+    }
+    scene.add_mesh(label, &vertices, &indices);
+    Ok(())
 }
 
 /// Area-weighted vertex normals from the faces.

@@ -34,7 +34,7 @@ enum Command {
 
 #[derive(Args)]
 struct ErrorArgs {
-    /// Scene: a .obj file, or builtin:demo, builtin:sphere100, builtin:sphere1024, builtin:triangle@D.
+    /// Scene: a .obj, .gltf or .glb file, or builtin:demo, builtin:sphere100, builtin:sphere1024, builtin:triangle@D.
     #[arg(default_value = "builtin:demo")]
     scene: String,
     /// Move and scale the scene so that it stands DIST metres ahead, filling the screen height.
@@ -89,7 +89,7 @@ struct FigureArgs {
 
 #[derive(Args)]
 struct SpeedArgs {
-    /// Scenes (.obj files or builtin:NAME).
+    /// Scenes (.obj, .gltf or .glb files, or builtin:NAME).
     #[arg(required = true)]
     scenes: Vec<String>,
     /// Methods, comma-separated; ratios are against the first.
@@ -147,7 +147,7 @@ struct ViewArgs {
 
 #[derive(Args)]
 struct RenderArgs {
-    /// Scene to render: a .obj file, or builtin:demo, builtin:sphere100, builtin:sphere1024, builtin:triangle@D.
+    /// Scene to render: a .obj, .gltf or .glb file, or builtin:demo, builtin:sphere100, builtin:sphere1024, builtin:triangle@D.
     #[arg(default_value = "builtin:demo")]
     scene: String,
     /// Move and scale the scene so that it stands DIST metres ahead, filling the screen height.

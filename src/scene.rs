@@ -18,6 +18,8 @@ pub struct Scene {
     /// Three indices per triangle.
     pub indices: Vec<u32>,
     pub objects: Vec<Object>,
+    /// Things the loader skipped or guessed, for the user to read.
+    pub warnings: Vec<String>,
 }
 
 impl Scene {
