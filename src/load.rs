@@ -45,9 +45,19 @@ pub fn load_obj(path: &Path) -> Result<Scene, String> {
         return Err(format!("{name}: no such file"));
     }
     let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
-    let (models, _materials) =
+    let (models, materials) =
         tobj::load_obj(path, &options).map_err(|e| format!("{name}: not a readable OBJ file: {e}"))?;
     let mut scene = Scene::new(name.clone());
+    // A missing or broken MTL file leaves the default material, with a warning.
+    let materials = materials.unwrap_or_else(|e| {
+        scene.warnings.push(format!("materials not loaded ({e}); using the default colour"));
+        Vec::new()
+    });
+    scene.materials = materials.len();
+    scene.textures = materials.iter().filter(|m| m.diffuse_texture.is_some()).count();
+    if scene.textures > 0 {
+        scene.warnings.push(format!("{} diffuse textures (map_Kd) are not drawn yet", scene.textures));
+    }
     for model in &models {
         let m = &model.mesh;
         let n = m.positions.len() / 3;
@@ -65,8 +75,12 @@ pub fn load_obj(path: &Path) -> Result<Scene, String> {
                 color: if m.vertex_color.len() >= 3 * n {
                     [m.vertex_color[3 * i], m.vertex_color[3 * i + 1], m.vertex_color[3 * i + 2], 1.0]
                 } else {
-                    DEFAULT_COLOR
+                    m.material_id
+                        .and_then(|k| materials.get(k))
+                        .and_then(|mat| mat.diffuse)
+                        .map_or(DEFAULT_COLOR, |d| [d[0], d[1], d[2], 1.0])
                 },
+                material: m.material_id.map_or(0, |k| k as u32 + 1),
                 uv: if m.texcoords.len() >= 2 * n { [m.texcoords[2 * i], m.texcoords[2 * i + 1]] } else { [0.0; 2] },
                 ..Default::default()
             })
@@ -98,6 +112,11 @@ pub fn load_gltf(path: &Path) -> Result<Scene, String> {
     if !used.is_empty() {
         scene.warnings.push(format!("optional extensions ignored: {}", used.join(", ")));
     }
+    scene.materials = doc.materials().count();
+    scene.textures = doc.textures().count();
+    if scene.textures > 0 {
+        scene.warnings.push(format!("{} textures are not drawn yet (base colour factors are)", scene.textures));
+    }
     let root =
         doc.default_scene().or_else(|| doc.scenes().next()).ok_or_else(|| format!("{name}: the file has no scene"))?;
     let mut stack: Vec<(gltf::Node, Mat4, usize)> = root.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
@@ -108,6 +127,18 @@ pub fn load_gltf(path: &Path) -> Result<Scene, String> {
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         if !world.is_finite() {
             return Err(format!("{name}: node {} has a NaN or infinite transform", node.index()));
+        }
+        if let Some(camera) = node.camera() {
+            // The camera looks along its local −z.
+            let forward = world.transform_vector3(-Vec3::Z);
+            scene.cameras.push(crate::scene::Camera {
+                name: camera
+                    .name()
+                    .or(node.name())
+                    .map_or_else(|| format!("camera {}", scene.cameras.len()), str::to_string),
+                position: world.transform_point3(Vec3::ZERO).into(),
+                yaw_deg: (-forward.x).atan2(-forward.z).to_degrees(),
+            });
         }
         if let Some(mesh) = node.mesh() {
             for prim in mesh.primitives() {
@@ -226,6 +257,19 @@ pub fn compute_normals(vertices: &mut [SceneVertex], indices: &[u32]) {
     }
     for (v, n) in vertices.iter_mut().zip(acc) {
         v.normal = n.normalize_or_zero().into();
+    }
+}
+
+/// A viewer position to suggest for a scene: inside it at standing height if it surrounds a
+/// person (over 4 m across on the ground), else 3 object sizes in front of it (+z side, looking
+/// along −z at it). Returns the position and "inside" or "in front".
+pub fn suggested_viewer(scene: &Scene) -> Option<([f32; 3], &'static str)> {
+    let (lo, hi) = scene.bounds()?;
+    let (size, c) = (hi - lo, (lo + hi) / 2.0);
+    if size.x > 4.0 && size.z > 4.0 {
+        Some(([c.x, lo.y + 1.7, c.z], "inside"))
+    } else {
+        Some(([c.x, c.y, hi.z + 3.0 * size.max_element()], "in front"))
     }
 }
 

@@ -12,7 +12,7 @@ use twister::load::load_scene;
 use twister::output::{layout_images, write_images, write_text, Layout};
 use twister::renderer::DEFAULT_MEMORY_MB;
 use twister::subdivide::{Method, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV};
-use twister::{GpuScene, Projection, RenderSettings, Renderer, Vertical};
+use twister::{GpuScene, Projection, RenderSettings, Renderer, Scene, Vertical};
 
 #[derive(Parser)]
 #[command(name = "twister", version, about = "Omnidirectional stereo (TWISTER concentric-mosaic) rendering on the GPU")]
@@ -27,9 +27,18 @@ enum Command {
     Render(RenderArgs),
     /// Measure the display-position error of a method (seed 002 §4.1).
     Error(ErrorArgs),
+    /// Describe a scene file as JSON: triangles, objects, materials, bounds, cameras, warnings,
+    /// and a suggested viewer position.
+    Info(InfoArgs),
     /// Benchmarks (release builds): `speed` times methods on scenes.
     #[command(subcommand)]
     Bench(BenchCommand),
+}
+
+#[derive(Args)]
+struct InfoArgs {
+    /// Scene: a .obj, .gltf or .glb file, or a built-in scene.
+    scene: String,
 }
 
 #[derive(Args)]
@@ -125,9 +134,10 @@ struct ViewArgs {
     /// Vertical model: paper (v = R_T·y/r) or exact (pinhole on the eye circle).
     #[arg(long, value_enum, default_value_t = Vertical::Paper)]
     vertical: Vertical,
-    /// Viewer position x,y,z in scene units.
-    #[arg(long, value_parser = parse_vec3, default_value = "0,0,0", allow_hyphen_values = true)]
-    viewer: Vec3,
+    /// Viewer: a position x,y,z in scene units, or camera[:N] for the file's N-th camera (default 0;
+    /// its position and yaw, plus --yaw).
+    #[arg(long, value_parser = parse_viewer, default_value = "0,0,0", allow_hyphen_values = true)]
+    viewer: Viewer,
     /// Turn of the view about the vertical axis, degrees; positive turns left.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     yaw: f32,
@@ -169,6 +179,24 @@ struct RenderArgs {
     stats: Option<PathBuf>,
 }
 
+#[derive(Clone, Copy, Debug)]
+enum Viewer {
+    At(Vec3),
+    Camera(usize),
+}
+
+fn parse_viewer(s: &str) -> Result<Viewer, String> {
+    match s.strip_prefix("camera") {
+        Some("") => Ok(Viewer::Camera(0)),
+        Some(rest) => rest
+            .strip_prefix(':')
+            .and_then(|n| n.parse().ok())
+            .map(Viewer::Camera)
+            .ok_or_else(|| format!("'{s}': expected camera or camera:N")),
+        None => parse_vec3(s).map(Viewer::At),
+    }
+}
+
 fn parse_vec3(s: &str) -> Result<Vec3, String> {
     let v: Vec<f32> =
         s.split(',').map(|x| x.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|e| format!("'{s}': {e}"))?;
@@ -202,7 +230,10 @@ impl ViewArgs {
         }
         let settings = RenderSettings {
             projection,
-            viewer: self.viewer,
+            viewer: match self.viewer {
+                Viewer::At(p) => p,
+                Viewer::Camera(_) => Vec3::ZERO, // placed by `setup` once the scene is loaded
+            },
             yaw_deg: self.yaw,
             method: self.method,
             edge_px: self.edge_px,
@@ -216,11 +247,30 @@ impl ViewArgs {
 }
 
 /// Loads (and places) a scene, opens the GPU and uploads the scene.
-fn setup(spec: &str, fit: Option<f32>, settings: &RenderSettings) -> Result<(Renderer, GpuScene, String), String> {
+/// Loads (and places) a scene; a `camera[:N]` viewer takes that camera's place and yaw.
+fn place(spec: &str, fit: Option<f32>, view: &ViewArgs, settings: &mut RenderSettings) -> Result<Scene, String> {
     let mut scene = load_scene(spec, &settings.projection)?;
     if let Some(d) = fit {
         scene.fit(d, &settings.projection).map_err(|e| format!("{spec}: {e}"))?;
     }
+    if let Viewer::Camera(n) = view.viewer {
+        let cam = scene
+            .cameras
+            .get(n)
+            .ok_or_else(|| format!("{spec}: --viewer camera:{n}, but the file has {} cameras", scene.cameras.len()))?;
+        settings.viewer = Vec3::from(cam.position);
+        settings.yaw_deg += cam.yaw_deg;
+    }
+    Ok(scene)
+}
+
+fn setup(
+    spec: &str,
+    fit: Option<f32>,
+    view: &ViewArgs,
+    settings: &mut RenderSettings,
+) -> Result<(Renderer, GpuScene, String), String> {
+    let scene = place(spec, fit, view, settings)?;
     let gpu = Gpu::new().map_err(|e| e.to_string())?;
     let adapter = gpu.adapter_description();
     let renderer = Renderer::new(gpu);
@@ -228,11 +278,31 @@ fn setup(spec: &str, fit: Option<f32>, settings: &RenderSettings) -> Result<(Ren
     Ok((renderer, gpu_scene, adapter))
 }
 
+fn info(args: &InfoArgs) -> Result<(), String> {
+    let scene = load_scene(&args.scene, &Projection::default())?;
+    let (lo, hi) = scene.bounds().ok_or_else(|| format!("{}: no triangles", args.scene))?;
+    let suggestion = twister::load::suggested_viewer(&scene);
+    let json = serde_json::json!({
+        "scene": args.scene,
+        "triangles": scene.triangle_count(),
+        "vertices": scene.vertices.len(),
+        "objects": scene.objects.len(),
+        "materials": scene.materials,
+        "textures": scene.textures,
+        "bbox": { "min": lo.to_array(), "max": hi.to_array() },
+        "cameras": scene.cameras,
+        "warnings": scene.warnings,
+        "suggested_viewer": suggestion.map(|(p, where_)| serde_json::json!({ "position": p, "where": where_ })),
+    });
+    println!("{}", serde_json::to_string_pretty(&json).unwrap());
+    Ok(())
+}
+
 fn render(args: &RenderArgs) -> Result<(), String> {
     let mut settings = args.view.settings()?;
     settings.background = args.background;
     settings.measure_edges = args.stats.is_some();
-    let (renderer, gpu_scene, adapter) = setup(&args.scene, args.fit, &settings)?;
+    let (renderer, gpu_scene, adapter) = setup(&args.scene, args.fit, &args.view, &mut settings)?;
     let frame = renderer.render(&gpu_scene, &settings)?;
     let t = std::time::Instant::now();
     let written = write_images(&args.out, &layout_images(&frame, args.layout))?;
@@ -273,8 +343,8 @@ fn render(args: &RenderArgs) -> Result<(), String> {
 }
 
 fn error(args: &ErrorArgs) -> Result<(), String> {
-    let settings = RenderSettings { measure_error: true, ..args.view.settings()? };
-    let (renderer, gpu_scene, adapter) = setup(&args.scene, args.fit, &settings)?;
+    let mut settings = RenderSettings { measure_error: true, ..args.view.settings()? };
+    let (renderer, gpu_scene, adapter) = setup(&args.scene, args.fit, &args.view, &mut settings)?;
     let frame = renderer.render(&gpu_scene, &settings)?;
     let measured = frame.measurement.as_ref().expect("rendered with measure_error");
     let e = &measured.stats;
@@ -387,6 +457,7 @@ fn main() -> ExitCode {
     let result = match &cli.command {
         Command::Render(args) => render(args),
         Command::Error(args) => error(args),
+        Command::Info(args) => info(args),
         Command::Bench(BenchCommand::Speed(args)) => bench_speed(args),
         Command::Bench(BenchCommand::Fig8(args)) => bench_figures(args, Figure::Fig8),
         Command::Bench(BenchCommand::Fig10(args)) => bench_figures(args, Figure::Fig10),

@@ -20,6 +20,21 @@ pub struct Scene {
     pub objects: Vec<Object>,
     /// Things the loader skipped or guessed, for the user to read.
     pub warnings: Vec<String>,
+    /// Materials and textures the file defines (textures are not drawn yet).
+    pub materials: usize,
+    pub textures: usize,
+    /// Cameras placed in the file (glTF camera nodes), usable as the viewer.
+    pub cameras: Vec<Camera>,
+}
+
+/// A camera placed in a scene file: where it stands and which way it looks (yaw only: the
+/// panorama is level).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Camera {
+    pub name: String,
+    pub position: [f32; 3],
+    /// Turn about +y from looking along −z, degrees, positive to the left (as `--yaw`).
+    pub yaw_deg: f32,
 }
 
 impl Scene {

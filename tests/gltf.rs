@@ -185,3 +185,67 @@ fn broken_files_are_one_clear_error_without_panic_or_output() {
         assert!(!out.exists(), "{}: output written for a broken file", file.display());
     }
 }
+
+fn twister(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_twister")).env("NODEVICE_SELECT", "1").args(args).output().unwrap()
+}
+
+#[test]
+fn info_describes_a_file_and_its_camera_is_a_viewer() {
+    let duck = assets().join("Duck/glTF-Binary/Duck.glb");
+    if !duck.exists() {
+        eprintln!("NOTE: {} is absent; the info test did not run", duck.display());
+        return;
+    }
+    let o = twister(&["info", duck.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(j["triangles"], 4212);
+    assert_eq!((j["materials"].as_u64(), j["textures"].as_u64()), (Some(1), Some(1)));
+    assert_eq!(j["cameras"].as_array().unwrap().len(), 1);
+    assert_eq!(j["suggested_viewer"]["where"], "in front");
+    assert!(j["warnings"].as_array().unwrap().iter().any(|w| w.as_str().unwrap().contains("textures")));
+    // The camera stands at (4.0, 4.6, −4.3) looking at the duck near the origin: its yaw points there.
+    let cam = &j["cameras"][0];
+    let (x, z, yaw) =
+        (cam["position"][0].as_f64().unwrap(), cam["position"][2].as_f64().unwrap(), cam["yaw_deg"].as_f64().unwrap());
+    let dir = (-(yaw.to_radians().sin()), -(yaw.to_radians().cos()));
+    let to_duck = (-x / (x * x + z * z).sqrt(), -z / (x * x + z * z).sqrt());
+    assert!(dir.0 * to_duck.0 + dir.1 * to_duck.1 > 0.99, "camera yaw {yaw} does not face the duck");
+    let out = tmp("cam");
+    let o = twister(&[
+        "render",
+        duck.to_str().unwrap(),
+        "--viewer",
+        "camera",
+        "--width",
+        "64",
+        "--height",
+        "16",
+        "--out",
+        out.join("a").to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o =
+        twister(&["render", duck.to_str().unwrap(), "--viewer", "camera:3", "--out", out.join("b").to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("camera:3") && err.contains("1 cameras"), "{err}");
+}
+
+#[test]
+fn obj_materials_give_colours_and_a_missing_mtl_is_a_warning() {
+    let dir = tmp("obj");
+    let obj = "mtllib colours.mtl\nv 0 0 -3\nv 1 0 -3\nv 0 1 -3\nv 1 1 -3\nusemtl red\nf 1 2 3\nusemtl blue\nf 2 4 3\n";
+    std::fs::write(dir.join("quad.obj"), obj).unwrap();
+    std::fs::write(dir.join("colours.mtl"), "newmtl red\nKd 1 0 0\nnewmtl blue\nKd 0 0 1\n").unwrap();
+    let p = Projection::default();
+    let s = load_scene(dir.join("quad.obj").to_str().unwrap(), &p).unwrap();
+    let colours: std::collections::BTreeSet<[u32; 3]> =
+        s.vertices.iter().map(|v| [v.color[0], v.color[1], v.color[2]].map(|c| (c * 255.0) as u32)).collect();
+    assert!(colours.contains(&[255, 0, 0]) && colours.contains(&[0, 0, 255]), "{colours:?}");
+    assert_eq!(s.materials, 2);
+    std::fs::remove_file(dir.join("colours.mtl")).unwrap();
+    let s = load_scene(dir.join("quad.obj").to_str().unwrap(), &p).unwrap();
+    assert_eq!(s.triangle_count(), 2);
+    assert!(s.warnings.iter().any(|w| w.contains("materials not loaded")), "{:?}", s.warnings);
+}
