@@ -28,7 +28,6 @@
 //! The WGSL twin of this module is `shaders/projection.wgsl`; both must stay in step.
 
 use glam::Vec3;
-use std::f64::consts::PI;
 
 /// The vertical model: how the screen height `v` of a point is computed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum, serde::Serialize)]
@@ -213,9 +212,6 @@ impl Projection {
     }
 }
 
-/// π as f32, re-exported for the stages.
-pub const PI_F32: f32 = PI as f32;
-
 /// The `project_points` stage on the CPU (twin of `shaders/project_points.wgsl`): for each
 /// viewer-frame point, `[pixel x, pixel y, depth, 1]`, or all zeros where no eye sees it.
 pub fn project_points(projection: &Projection, eye: Eye, points: &[Vec3]) -> Vec<[f32; 4]> {
@@ -235,6 +231,8 @@ pub fn project_points(projection: &Projection, eye: Eye, points: &[Vec3]) -> Vec
 mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
+    use std::f64::consts::PI;
+    const PI_F32: f32 = std::f32::consts::PI;
 
     /// The brute-force construction, in f64: for each screen azimuth φ_s, the eye of that column
     /// stands on the eye circle and looks along the tangent; find the column whose ray passes

@@ -935,37 +935,15 @@ impl Renderer {
         (stats, per_eye.map(|v| v.into_iter().map(f32::from_bits).collect()))
     }
 
-    fn read_color(&self, texture: &wgpu::Texture) -> EyeImage {
-        let (w, h) = (texture.width(), texture.height());
-        let row = 4 * w;
-        let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("colour readback"),
-            size: (padded * h) as u64,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-        enc.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo {
-                texture,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
-            },
-            wgpu::TexelCopyBufferInfo {
-                buffer: &staging,
-                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(padded), rows_per_image: Some(h) },
-            },
-            wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-        );
-        self.gpu.queue.submit([enc.finish()]);
-        let data = self.gpu.read_buffer(&staging);
-        let mut rgba = Vec::with_capacity((row * h) as usize);
-        for y in 0..h as usize {
-            rgba.extend_from_slice(&data[y * padded as usize..y * padded as usize + row as usize]);
-        }
-        EyeImage { width: w, height: h, rgba }
+    /// Reads both eyes' colour targets back.
+    fn read_colors(&self, targets: &Targets) -> [EyeImage; 2] {
+        let (w, h) = (targets.color[0].width(), targets.color[0].height());
+        let (buffer, stride) = self.copy_eyes_to_buffer(&targets.color, wgpu::BufferUsages::COPY_SRC);
+        Self::unpad_eyes(&self.gpu.download(&buffer, buffer.size()), w, h, stride).map(|texels| EyeImage {
+            width: w,
+            height: h,
+            rgba: bytemuck::cast_slice(&texels).to_vec(),
+        })
     }
 
     /// The slit-mosaic reference renderer: one draw per slit and visible object, per eye.
@@ -1048,8 +1026,7 @@ impl Renderer {
         start: Instant,
     ) -> Frame {
         let t = Instant::now();
-        let left = self.read_color(&targets.color[0]);
-        let right = self.read_color(&targets.color[1]);
+        let [left, right] = self.read_colors(targets);
         stats.ms_readback = t.elapsed().as_secs_f64() * 1e3;
         let t = Instant::now();
         let measurement = settings.measure_error.then(|| {
