@@ -40,5 +40,7 @@ fn vs_main(in: VertexIn) -> VertexOut {
     out.normal = in.normal;
     out.color = in.color;
     out.object = in.object;
+    out.uv = in.uv;
+    out.material = in.material;
     return out;
 }

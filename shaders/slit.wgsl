@@ -30,6 +30,8 @@ struct VertexIn {
     @location(1) normal: vec3<f32>,
     @location(2) color: vec4<f32>,
     @location(3) object: u32,
+    @location(4) uv: vec2<f32>,
+    @location(5) material: u32,
 }
 
 
@@ -48,5 +50,7 @@ fn vs_main(in: VertexIn) -> VertexOut {
     out.normal = (params.view * vec4<f32>(in.normal, 0.0)).xyz;
     out.color = in.color;
     out.object = in.object;
+    out.uv = in.uv;
+    out.material = in.material;
     return out;
 }

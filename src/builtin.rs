@@ -6,6 +6,7 @@
 //! | `builtin:sphere100`, `builtin:sphere1024` | spheres of exactly 100 and 1024 triangles, 3 m ahead, filling the screen height (the paper's Sphere100/Sphere1024) |
 //! | `builtin:triangle@D` | the paper's evaluation-1 triangle: equilateral, facing the viewer, D metres straight ahead, projected side ≈ the image height H |
 
+use crate::fragment::srgb_to_linear;
 use glam::Vec3;
 use std::f32::consts::{FRAC_1_SQRT_2, PI, TAU};
 
@@ -48,7 +49,10 @@ pub fn builtin_scene(name: &str, projection: &Projection) -> Result<Scene, Strin
     }
 }
 
+/// A built-in vertex; `color` is given as display (sRGB-encoded) values and stored linear.
 fn vertex(position: Vec3, normal: Vec3, color: [f32; 4]) -> SceneVertex {
+    let [r, g, b, a] = color;
+    let color = [srgb_to_linear(r), srgb_to_linear(g), srgb_to_linear(b), a];
     SceneVertex { position: position.into(), normal: normal.into(), color, ..Default::default() }
 }
 

@@ -31,6 +31,7 @@ pub mod scene;
 pub mod shaders;
 pub mod slit;
 pub mod subdivide;
+pub mod texture;
 
 pub use projection::{Eye, Projection, Vertical};
 pub use renderer::{Frame, GpuScene, RenderSettings, Renderer};

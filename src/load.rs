@@ -1,21 +1,26 @@
 //! Loading scenes: built-in names, OBJ files (positions, normals, UVs, vertex colours; polygons
-//! triangulated; missing normals computed) and glTF 2.0 geometry (`.gltf` with external or
-//! embedded buffers, `.glb`: the default scene's node hierarchy, TRIANGLES / TRIANGLE_STRIP /
-//! TRIANGLE_FAN primitives, indexed or not, sparse accessors, base colour factor × vertex colour;
-//! textures are not sampled yet). Every failure is one message naming the file and the problem;
-//! accessors are bounds-checked before they are read.
+//! triangulated; missing normals computed; MTL `Kd` colours and `map_Kd` textures) and glTF 2.0
+//! (`.gltf` with external or embedded buffers, `.glb`: the default scene's node hierarchy,
+//! TRIANGLES / TRIANGLE_STRIP / TRIANGLE_FAN primitives, indexed or not, sparse accessors;
+//! materials: base colour factor × vertex colour × base colour texture with its sampler and
+//! TEXCOORD set, `KHR_texture_transform`, alpha mode and cutoff, double-sided). Every failure is
+//! one message naming the file and the problem; accessors are bounds-checked before they are read.
+//!
+//! Texture coordinates are stored in texture space (u right, v down from the image's top row):
+//! glTF's own convention; OBJ's v (up from the bottom row) is flipped on load.
 
 use std::path::Path;
 
 use glam::{Mat4, Vec3};
 
 use crate::builtin;
-use crate::gpu_types::SceneVertex;
+use crate::gpu_types::{AlphaMode, Filter, Material, Mipmap, SceneVertex, Wrap};
 use crate::projection::Projection;
 use crate::scene::Scene;
+use crate::texture::Texture;
 
-/// Default colour of surfaces without a material.
-pub const DEFAULT_COLOR: [f32; 4] = [0.8, 0.78, 0.74, 1.0];
+/// Default colour of surfaces without a material (linear; sRGB 0.8, 0.78, 0.74).
+pub const DEFAULT_COLOR: [f32; 4] = [0.604, 0.57, 0.507, 1.0];
 
 /// Loads a scene by name (`builtin:...`) or path.
 pub fn load_scene(spec: &str, projection: &Projection) -> Result<Scene, String> {
@@ -53,10 +58,25 @@ pub fn load_obj(path: &Path) -> Result<Scene, String> {
         scene.warnings.push(format!("materials not loaded ({e}); using the default colour"));
         Vec::new()
     });
-    scene.materials = materials.len();
-    scene.textures = materials.iter().filter(|m| m.diffuse_texture.is_some()).count();
-    if scene.textures > 0 {
-        scene.warnings.push(format!("{} diffuse textures (map_Kd) are not drawn yet", scene.textures));
+    let texture_dirs = obj_texture_dirs(path);
+    let mut loaded: Vec<(String, u32)> = Vec::new(); // map_Kd as written → texture index
+    for mat in &materials {
+        let mut material = Material::default();
+        if let Some(spec) = mat.diffuse_texture.as_deref() {
+            if let Some(&(_, k)) = loaded.iter().find(|(s, _)| s == spec) {
+                material.texture = k;
+            } else {
+                match load_obj_texture(spec, &texture_dirs) {
+                    Ok(texture) => {
+                        material.texture = scene.textures.len() as u32;
+                        scene.textures.push(texture);
+                    }
+                    Err(e) => scene.warnings.push(format!("material '{}': {e}; drawn without its texture", mat.name)),
+                }
+                loaded.push((spec.to_string(), material.texture));
+            }
+        }
+        scene.materials.push(material);
     }
     for model in &models {
         let m = &model.mesh;
@@ -81,7 +101,11 @@ pub fn load_obj(path: &Path) -> Result<Scene, String> {
                         .map_or(DEFAULT_COLOR, |d| [d[0], d[1], d[2], 1.0])
                 },
                 material: m.material_id.map_or(0, |k| k as u32 + 1),
-                uv: if m.texcoords.len() >= 2 * n { [m.texcoords[2 * i], m.texcoords[2 * i + 1]] } else { [0.0; 2] },
+                uv: if m.texcoords.len() >= 2 * n {
+                    [m.texcoords[2 * i], 1.0 - m.texcoords[2 * i + 1]]
+                } else {
+                    [0.0; 2]
+                },
                 ..Default::default()
             })
             .collect();
@@ -96,26 +120,170 @@ pub fn load_obj(path: &Path) -> Result<Scene, String> {
     Ok(scene)
 }
 
+/// The folders an OBJ file's `map_Kd` paths are relative to: those of its MTL files (the
+/// `mtllib` lines, relative to the OBJ file), then the OBJ file's own folder.
+fn obj_texture_dirs(obj: &Path) -> Vec<std::path::PathBuf> {
+    let base = obj.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let text = std::fs::read(obj).unwrap_or_default();
+    let mut dirs: Vec<std::path::PathBuf> = String::from_utf8_lossy(&text)
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("mtllib "))
+        .map(|m| base.join(portable_path(m.trim())).parent().map_or(base.clone(), Path::to_path_buf))
+        .collect();
+    dirs.push(base);
+    dirs.dedup();
+    dirs
+}
+
+/// A path as written in a file made on any system: `\` separators become `/`, a leading `./`
+/// goes.
+fn portable_path(written: &str) -> String {
+    let p = written.replace('\\', "/");
+    p.strip_prefix("./").map_or(p.clone(), str::to_string)
+}
+
+/// Loads an OBJ material's `map_Kd` image. The value may carry options (`-s 1 1 1 name.png`):
+/// then the file name is its last word.
+fn load_obj_texture(spec: &str, dirs: &[std::path::PathBuf]) -> Result<Texture, String> {
+    let whole = portable_path(spec.trim());
+    let last = portable_path(spec.split_whitespace().last().unwrap_or(""));
+    let candidates: Vec<std::path::PathBuf> = dirs.iter().flat_map(|d| [d.join(&whole), d.join(&last)]).collect();
+    let file = candidates.iter().find(|p| p.is_file()).ok_or_else(|| format!("texture '{spec}' not found"))?;
+    let image = image::open(file).map_err(|e| format!("texture {}: {e}", file.display()))?;
+    Ok(Texture::from_image(file.display().to_string(), image))
+}
+
+/// An image decoded by the glTF importer, as RGBA8 (16-bit channels keep their high byte,
+/// float channels are clamped to 0..1).
+fn gltf_texture(name: String, data: &gltf::image::Data) -> Result<Texture, String> {
+    use gltf::image::Format;
+    let (channels, bytes) = match data.format {
+        Format::R8 => (1, 1),
+        Format::R8G8 => (2, 1),
+        Format::R8G8B8 => (3, 1),
+        Format::R8G8B8A8 => (4, 1),
+        Format::R16 => (1, 2),
+        Format::R16G16 => (2, 2),
+        Format::R16G16B16 => (3, 2),
+        Format::R16G16B16A16 => (4, 2),
+        Format::R32G32B32FLOAT => (3, 4),
+        Format::R32G32B32A32FLOAT => (4, 4),
+    };
+    let texels = (data.width * data.height) as usize;
+    if data.pixels.len() < texels * channels * bytes || texels == 0 {
+        return Err(format!(
+            "image '{name}' has {} bytes for {}×{} texels",
+            data.pixels.len(),
+            data.width,
+            data.height
+        ));
+    }
+    let channel = |t: usize, c: usize| -> u8 {
+        let at = (t * channels + c) * bytes;
+        match bytes {
+            1 => data.pixels[at],
+            2 => data.pixels[at + 1],
+            _ => {
+                let x = f32::from_le_bytes([0, 1, 2, 3].map(|k| data.pixels[at + k]));
+                (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
+            }
+        }
+    };
+    let rgba = (0..texels)
+        .flat_map(|t| match channels {
+            1 => [channel(t, 0); 3].into_iter().chain([255]).collect::<Vec<u8>>(),
+            2 => vec![channel(t, 0), channel(t, 0), channel(t, 0), channel(t, 1)],
+            3 => vec![channel(t, 0), channel(t, 1), channel(t, 2), 255],
+            _ => vec![channel(t, 0), channel(t, 1), channel(t, 2), channel(t, 3)],
+        })
+        .collect();
+    Ok(Texture { name, width: data.width, height: data.height, rgba })
+}
+
+/// A glTF material as twister draws it, and the TEXCOORD set and `KHR_texture_transform`
+/// (u' = offset + R(rotation)·(scale·u)) of its base colour texture.
+fn gltf_material(material: &gltf::Material) -> (Material, u32, Option<[[f32; 3]; 2]>) {
+    use gltf::texture::{MagFilter, MinFilter, WrappingMode};
+    let mut m = Material {
+        alpha_mode: match material.alpha_mode() {
+            gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+            gltf::material::AlphaMode::Mask => AlphaMode::Mask,
+            gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+        } as u32,
+        alpha_cutoff: material.alpha_cutoff().unwrap_or(0.5),
+        double_sided: material.double_sided() as u32,
+        ..Default::default()
+    };
+    let Some(info) = material.pbr_metallic_roughness().base_color_texture() else {
+        return (m, 0, None);
+    };
+    let texture = info.texture();
+    let sampler = texture.sampler();
+    let wrap = |w: WrappingMode| match w {
+        WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+        WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+        WrappingMode::Repeat => Wrap::Repeat,
+    } as u32;
+    m.texture = texture.source().index() as u32;
+    m.wrap_u = wrap(sampler.wrap_s());
+    m.wrap_v = wrap(sampler.wrap_t());
+    m.mag_filter = match sampler.mag_filter() {
+        Some(MagFilter::Nearest) => Filter::Nearest,
+        _ => Filter::Linear,
+    } as u32;
+    // No minification filter given: trilinear, the renderer's choice the spec leaves open.
+    let (min, mip) = match sampler.min_filter() {
+        Some(MinFilter::Nearest) => (Filter::Nearest, Mipmap::None),
+        Some(MinFilter::Linear) => (Filter::Linear, Mipmap::None),
+        Some(MinFilter::NearestMipmapNearest) => (Filter::Nearest, Mipmap::Nearest),
+        Some(MinFilter::LinearMipmapNearest) => (Filter::Linear, Mipmap::Nearest),
+        Some(MinFilter::NearestMipmapLinear) => (Filter::Nearest, Mipmap::Linear),
+        Some(MinFilter::LinearMipmapLinear) | None => (Filter::Linear, Mipmap::Linear),
+    };
+    (m.min_filter, m.mipmap) = (min as u32, mip as u32);
+    let transform = info.texture_transform();
+    let set = transform.as_ref().and_then(|t| t.tex_coord()).unwrap_or(info.tex_coord());
+    let matrix = transform.map(|t| {
+        let ([ox, oy], r, [sx, sy]) = (t.offset(), t.rotation(), t.scale());
+        let (s, c) = r.sin_cos();
+        [[c * sx, s * sy, ox], [-s * sx, c * sy, oy]]
+    });
+    (m, set, matrix)
+}
+
+/// glTF extensions twister draws (the others are ignored with a note, or refused when required).
+pub const GLTF_EXTENSIONS: &[&str] = &["KHR_texture_transform"];
+
 /// Loads a glTF 2.0 file's default scene (see the module doc for what is supported).
 pub fn load_gltf(path: &Path) -> Result<Scene, String> {
     let name = path.display().to_string();
     if !path.is_file() {
         return Err(format!("{name}: no such file"));
     }
-    let (doc, buffers, _images) = gltf::import(path).map_err(|e| format!("{name}: not a readable glTF file: {e}"))?;
-    let required: Vec<&str> = doc.extensions_required().collect();
+    let (doc, buffers, images) = gltf::import(path).map_err(|e| format!("{name}: not a readable glTF file: {e}"))?;
+    let required: Vec<&str> = doc.extensions_required().filter(|e| !GLTF_EXTENSIONS.contains(e)).collect();
     if !required.is_empty() {
         return Err(format!("{name}: requires extensions twister does not support: {}", required.join(", ")));
     }
     let mut scene = Scene::new(name.clone());
-    let used: Vec<&str> = doc.extensions_used().collect();
+    let used: Vec<&str> = doc.extensions_used().filter(|e| !GLTF_EXTENSIONS.contains(e)).collect();
     if !used.is_empty() {
         scene.warnings.push(format!("optional extensions ignored: {}", used.join(", ")));
     }
-    scene.materials = doc.materials().count();
-    scene.textures = doc.textures().count();
-    if scene.textures > 0 {
-        scene.warnings.push(format!("{} textures are not drawn yet (base colour factors are)", scene.textures));
+    for (image, data) in doc.images().zip(&images) {
+        let label = match (image.name(), image.source()) {
+            (Some(n), _) => n.to_string(),
+            (None, gltf::image::Source::Uri { uri, .. }) if !uri.starts_with("data:") => uri.to_string(),
+            _ => format!("image {}", image.index()),
+        };
+        scene.textures.push(gltf_texture(label, data).map_err(|e| format!("{name}: {e}"))?);
+    }
+    // glTF material k is scene material k; primitives without one share the spec's default
+    // material (single-sided, opaque), appended at the end.
+    let materials: Vec<(Material, u32, Option<[[f32; 3]; 2]>)> = doc.materials().map(|m| gltf_material(&m)).collect();
+    scene.materials = materials.iter().map(|m| m.0).collect();
+    if let Some(p) = doc.meshes().flat_map(|m| m.primitives()).find(|p| p.material().index().is_none()) {
+        scene.materials.push(gltf_material(&p.material()).0);
     }
     let root =
         doc.default_scene().or_else(|| doc.scenes().next()).ok_or_else(|| format!("{name}: the file has no scene"))?;
@@ -144,7 +312,7 @@ pub fn load_gltf(path: &Path) -> Result<Scene, String> {
             for prim in mesh.primitives() {
                 let mesh_name = mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_string);
                 let label = format!("{mesh_name} / primitive {}", prim.index());
-                add_gltf_primitive(&mut scene, &prim, &buffers, world, &label)
+                add_gltf_primitive(&mut scene, &prim, &buffers, world, &label, &materials)
                     .map_err(|e| format!("{name}: {label}: {e}"))?;
             }
         }
@@ -186,6 +354,7 @@ fn add_gltf_primitive(
     buffers: &[gltf::buffer::Data],
     world: Mat4,
     label: &str,
+    materials: &[(Material, u32, Option<[[f32; 3]; 2]>)],
 ) -> Result<(), String> {
     use gltf::mesh::Mode;
     let mode = prim.mode();
@@ -203,9 +372,22 @@ fn add_gltf_primitive(
     let positions: Vec<[f32; 3]> = reader.read_positions().ok_or("no POSITION attribute")?.collect();
     let n = positions.len();
     let normals: Option<Vec<[f32; 3]>> = reader.read_normals().map(|r| r.collect());
-    let uvs: Option<Vec<[f32; 2]>> = reader.read_tex_coords(0).map(|r| r.into_f32().collect());
+    let material = prim.material();
+    let (set, transform) = material.index().map_or((0, None), |k| (materials[k].1, materials[k].2));
+    let uvs: Option<Vec<[f32; 2]>> = reader.read_tex_coords(set).map(|r| {
+        r.into_f32()
+            .map(|[u, v]| match transform {
+                Some([a, b]) => [a[0] * u + a[1] * v + a[2], b[0] * u + b[1] * v + b[2]],
+                None => [u, v],
+            })
+            .collect()
+    });
+    if uvs.is_none() && material.pbr_metallic_roughness().base_color_texture().is_some() {
+        scene.warnings.push(format!("{label}: its material's texture uses TEXCOORD_{set}, which it lacks"));
+    }
     let colors: Option<Vec<[f32; 4]>> = reader.read_colors(0).map(|r| r.into_rgba_f32().collect());
-    let factor = prim.material().pbr_metallic_roughness().base_color_factor();
+    let factor = material.pbr_metallic_roughness().base_color_factor();
+    let material_id = material.index().map_or(materials.len() as u32, |m| m as u32) + 1;
     let raw: Vec<u32> = match reader.read_indices() {
         Some(r) => r.into_u32().collect(),
         None => (0..n as u32).collect(),
@@ -233,7 +415,7 @@ fn add_gltf_primitive(
                     .into(),
                 color: [0, 1, 2, 3].map(|k| c[k] * factor[k]),
                 uv: uvs.as_ref().and_then(|v| v.get(i)).copied().unwrap_or([0.0; 2]),
-                material: prim.material().index().map_or(0, |m| m as u32 + 1),
+                material: material_id,
                 ..Default::default()
             }
         })

@@ -10,9 +10,10 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::fragment::{pixel_error, shade};
+use crate::fragment::{pixel_error, shade, surface_color, Surface};
 use crate::gpu_types::{DrawVertex, RasterParams};
 use crate::projection::{azimuth, Eye, Projection};
+use crate::texture::MaterialTable;
 
 /// Clip-space position of a subdivided vertex (`vs_main` in raster.wgsl).
 pub fn raster_vertex(params: &RasterParams, v: &DrawVertex) -> Vec4 {
@@ -38,7 +39,9 @@ pub struct ClipVertex {
     pub view_position: Vec3,
     pub normal: Vec3,
     pub color: Vec4,
+    pub uv: Vec2,
     pub object: u32,
+    pub material: u32,
 }
 
 impl ClipVertex {
@@ -48,7 +51,9 @@ impl ClipVertex {
             view_position: a.view_position + (b.view_position - a.view_position) * t,
             normal: a.normal + (b.normal - a.normal) * t,
             color: a.color + (b.color - a.color) * t,
+            uv: a.uv + (b.uv - a.uv) * t,
             object: a.object,
+            material: a.material,
         }
     }
 }
@@ -80,8 +85,32 @@ impl RasterImage {
     }
 }
 
-/// What a fragment writes: colour and error, from (pixel centre, view position, normal, colour).
-pub type FragmentFn<'a> = dyn Fn(Vec2, Vec3, Vec3, Vec4) -> ([u8; 4], f32) + 'a;
+/// The interpolated inputs of a fragment.
+#[derive(Clone, Copy, Debug)]
+pub struct FragmentIn {
+    pub view_position: Vec3,
+    pub normal: Vec3,
+    pub surface: Surface,
+}
+
+/// What a fragment writes (colour and error), or None where it is discarded.
+pub type FragmentFn<'a> = dyn Fn(&FragmentIn) -> Option<([u8; 4], f32)> + 'a;
+
+/// The fragment entry point of the drawing stages (`fs_error` in fragment.wgsl; `fs_main`
+/// writes the same colour): surface colour, shading, display-position error.
+pub fn fragment(
+    table: &MaterialTable,
+    ambient: f32,
+    projection: &Projection,
+    eye: Eye,
+    f: &FragmentIn,
+) -> Option<([u8; 4], f32)> {
+    let color = surface_color(table, &f.surface)?;
+    Some((
+        shade(ambient, f.view_position, f.normal, color),
+        pixel_error(projection, eye, f.view_position, f.surface.frag_xy),
+    ))
+}
 
 /// Rasterizes one triangle into `img`, within columns `scissor` (start, end).
 pub fn rasterize(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: (u32, u32), fragment: &FragmentFn) {
@@ -131,14 +160,37 @@ fn rasterize_clipped(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: (u32,
             if !(z < img.depth[i]) || !(z >= 0.0) {
                 continue;
             }
-            // Perspective-correct weights.
-            let pw: Vec<f32> = (0..3).map(|k| b[k] / tri[k].clip.w).collect();
-            let sum: f32 = pw.iter().sum();
-            let mix3 = |f: &dyn Fn(&ClipVertex) -> Vec3| (0..3).map(|k| pw[k] / sum * f(&tri[k])).sum::<Vec3>();
-            let pos = mix3(&|v| v.view_position);
-            let nrm = mix3(&|v| v.normal);
-            let col = (0..3).map(|k| pw[k] / sum * tri[k].color).sum::<Vec4>();
-            let (rgba, error) = fragment(Vec2::new(px, py), pos, nrm, col);
+            // Perspective-correct weights at a point of the screen (also one pixel right and
+            // down, for the derivatives of uv).
+            let weights = |qx: f32, qy: f32| {
+                let edge = |a: [f32; 2], b: [f32; 2]| (b[0] - a[0]) * (qy - a[1]) - (b[1] - a[1]) * (qx - a[0]);
+                let b = [edge(s[1], s[2]) / area, edge(s[2], s[0]) / area, edge(s[0], s[1]) / area];
+                let pw = [0, 1, 2].map(|k| b[k] / tri[k].clip.w);
+                let sum: f32 = pw.iter().sum();
+                pw.map(|w| w / sum)
+            };
+            let pw = weights(px, py);
+            let mix3 = |f: &dyn Fn(&ClipVertex) -> Vec3| (0..3).map(|k| pw[k] * f(&tri[k])).sum::<Vec3>();
+            let uv_at = |w: [f32; 3]| (0..3).map(|k| w[k] * tri[k].uv).sum::<Vec2>();
+            let uv = uv_at(pw);
+            let input = FragmentIn {
+                view_position: mix3(&|v| v.view_position),
+                normal: mix3(&|v| v.normal),
+                surface: Surface {
+                    material: tri[0].material,
+                    color: (0..3).map(|k| pw[k] * tri[k].color).sum::<Vec4>(),
+                    uv,
+                    duv_dx: uv_at(weights(px + 1.0, py)) - uv,
+                    duv_dy: uv_at(weights(px, py + 1.0)) - uv,
+                    frag_xy: Vec2::new(px, py),
+                    // Counter-clockwise in normalized device coordinates (y up) is clockwise
+                    // on the pixel grid (y down): negative `area`.
+                    front_facing: area < 0.0,
+                },
+            };
+            let Some((rgba, error)) = fragment(&input) else {
+                continue;
+            };
             img.depth[i] = z;
             img.rgba[4 * i..4 * i + 4].copy_from_slice(&rgba);
             img.error[i] = error;
@@ -148,20 +200,25 @@ fn rasterize_clipped(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: (u32,
 }
 
 /// The raster stage on the CPU for one eye.
-pub fn raster(params: &RasterParams, vertices: &[DrawVertex], background: [f32; 3]) -> RasterImage {
+pub fn raster(
+    params: &RasterParams,
+    vertices: &[DrawVertex],
+    table: &MaterialTable,
+    background: [f32; 3],
+) -> RasterImage {
     let projection = Projection::from(&params.projection);
     let eye = if params.eye_sign > 0.0 { Eye::Right } else { Eye::Left };
     let mut img = RasterImage::new(projection.width, projection.height, background);
-    let fragment = |xy: Vec2, pos: Vec3, nrm: Vec3, col: Vec4| {
-        (shade(params.ambient, pos, nrm, col), pixel_error(&projection, eye, pos, xy))
-    };
+    let fragment = |f: &FragmentIn| fragment(table, params.ambient, &projection, eye, f);
     for tri in vertices.chunks_exact(3) {
         let cv = [0, 1, 2].map(|k| ClipVertex {
             clip: raster_vertex(params, &tri[k]),
             view_position: Vec3::from(tri[k].position),
             normal: Vec3::from(tri[k].normal),
             color: Vec4::from(tri[k].color),
+            uv: Vec2::from(tri[k].uv),
             object: tri[k].object,
+            material: tri[k].material,
         });
         rasterize(&mut img, cv, (0, projection.width), &fragment);
     }

@@ -22,6 +22,7 @@ use crate::scene::Scene;
 use crate::shaders;
 use crate::slit::{object_spheres, slit_params, slits, sphere_in_slit, SlitCamera};
 use crate::subdivide::{subdivide_params, Method, SubdivideOutput, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV};
+use crate::texture::MaterialTable;
 
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 pub const OBJECT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
@@ -237,6 +238,10 @@ pub struct GpuScene {
     pub triangle_count: u32,
     /// Each object's triangles (first, count) and bounding sphere, for the slit renderer's culling.
     pub objects: Vec<(u32, u32, Vec3, f32)>,
+    /// The material table the fragment stage reads (group 1): materials, mip levels, texels.
+    pub materials: [wgpu::Buffer; 3],
+    /// What the packing of the textures had to say (levels dropped to fit the budget).
+    pub warnings: Vec<String>,
 }
 
 impl GpuScene {
@@ -279,7 +284,29 @@ impl GpuScene {
             .zip(object_spheres(scene))
             .map(|(o, (c, r))| (o.first_triangle, o.triangle_count, c, r))
             .collect();
-        Ok(GpuScene { vertices, indices, triangle_count: scene.triangle_count() as u32, objects })
+        // Textures get at most a quarter of the device's largest binding (levels are dropped,
+        // largest first, with a warning).
+        let table = MaterialTable::of(scene, (max / 16) as usize);
+        let storage = |label: &str, bytes: &[u8]| {
+            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: &pad(bytes),
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+        };
+        let materials = [
+            storage("materials", bytemuck::cast_slice(&table.materials)),
+            storage("mip levels", bytemuck::cast_slice(&table.mips)),
+            storage("texels", bytemuck::cast_slice(&table.texels)),
+        ];
+        Ok(GpuScene {
+            vertices,
+            indices,
+            triangle_count: scene.triangle_count() as u32,
+            objects,
+            materials,
+            warnings: table.warnings,
+        })
     }
 }
 
@@ -387,6 +414,8 @@ impl Renderer {
             wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 16, shader_location: 1 },
             wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x4, offset: 32, shader_location: 2 },
             wgpu::VertexAttribute { format: wgpu::VertexFormat::Uint32, offset: 28, shader_location: 3 },
+            wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x2, offset: 48, shader_location: 4 },
+            wgpu::VertexAttribute { format: wgpu::VertexFormat::Uint32, offset: 12, shader_location: 5 },
         ];
         let scene_layout = || wgpu::VertexBufferLayout {
             array_stride: std::mem::size_of::<crate::gpu_types::SceneVertex>() as u64,
@@ -604,7 +633,7 @@ impl Renderer {
             pass.set_bind_group(0, &finalize_bg, &[]);
             pass.dispatch_workgroups(1, 1, 1);
         }
-        self.encode_raster(&mut enc, targets, b, settings, true, timestamps.as_ref().map(|q| (q, 2, 3)));
+        self.encode_raster(&mut enc, scene, targets, b, settings, true, timestamps.as_ref().map(|q| (q, 2, 3)));
         let counter_size = std::mem::size_of::<SubdivideCounters>() as u64;
         let staging = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("frame readback"),
@@ -793,6 +822,7 @@ impl Renderer {
     fn encode_raster(
         &self,
         enc: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
         targets: &Targets,
         buffers: &Buffers,
         settings: &RenderSettings,
@@ -815,15 +845,33 @@ impl Renderer {
             let mut pass = self.begin_eye_pass(enc, targets, k, settings, clear, writes);
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &bg, &[]);
+            pass.set_bind_group(1, &self.material_bind_group(pipeline, scene), &[]);
             pass.set_vertex_buffer(0, buffers.triangles.slice(..));
             pass.draw_indirect(&buffers.draw_args, 0);
         }
     }
 
+    /// The material table of a scene bound for a drawing pipeline (group 1).
+    fn material_bind_group(&self, pipeline: &wgpu::RenderPipeline, scene: &GpuScene) -> wgpu::BindGroup {
+        self.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("materials"),
+            layout: &pipeline.get_bind_group_layout(1),
+            entries: &[0, 1, 2]
+                .map(|k| wgpu::BindGroupEntry { binding: k as u32, resource: scene.materials[k].as_entire_binding() }),
+        })
+    }
+
     /// Draws the subdivided triangles into both eyes' targets and waits.
-    fn raster_eyes(&self, targets: &Targets, buffers: &Buffers, settings: &RenderSettings, clear: bool) {
+    fn raster_eyes(
+        &self,
+        scene: &GpuScene,
+        targets: &Targets,
+        buffers: &Buffers,
+        settings: &RenderSettings,
+        clear: bool,
+    ) {
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-        self.encode_raster(&mut enc, targets, buffers, settings, clear, None);
+        self.encode_raster(&mut enc, scene, targets, buffers, settings, clear, None);
         self.gpu.queue.submit([enc.finish()]);
         self.gpu.wait();
     }
@@ -990,6 +1038,7 @@ impl Renderer {
             let pipeline = &self.slit[settings.measure_error as usize];
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &bg, &[]);
+            pass.set_bind_group(1, &self.material_bind_group(pipeline, scene), &[]);
             pass.set_vertex_buffer(0, scene.vertices.slice(..));
             pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
             let first_instance = (k * eye_slits[0].len()) as u32;
@@ -1130,7 +1179,7 @@ impl Renderer {
                     continue;
                 }
                 let t = Instant::now();
-                self.raster_eyes(&targets, b, settings, !cleared);
+                self.raster_eyes(scene, &targets, b, settings, !cleared);
                 stats.ms_raster += t.elapsed().as_secs_f64() * 1e3;
                 cleared = true;
                 piece_done = true;

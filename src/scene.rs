@@ -1,7 +1,8 @@
 //! A scene: indexed triangles with per-vertex attributes, in world units (metres after
 //! `scale`), plus the named objects they belong to.
 
-use crate::gpu_types::SceneVertex;
+use crate::gpu_types::{Material, SceneVertex};
+use crate::texture::Texture;
 
 /// A named range of triangles (a glTF mesh instance, an OBJ object, a built-in shape).
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -20,9 +21,11 @@ pub struct Scene {
     pub objects: Vec<Object>,
     /// Things the loader skipped or guessed, for the user to read.
     pub warnings: Vec<String>,
-    /// Materials and textures the file defines (textures are not drawn yet).
-    pub materials: usize,
-    pub textures: usize,
+    /// The file's materials; a vertex's `material` is an index here + 1 (0: the default
+    /// material). Base colour factors are already in the vertex colours.
+    pub materials: Vec<Material>,
+    /// Decoded textures that `materials` refer to.
+    pub textures: Vec<Texture>,
     /// Cameras placed in the file (glTF camera nodes), usable as the viewer.
     pub cameras: Vec<Camera>,
 }

@@ -19,11 +19,11 @@
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
-use crate::fragment::{pixel_error, shade};
 use crate::gpu_types::{ProjectionUniform, SceneVertex};
 use crate::projection::{Eye, Projection};
-use crate::raster::{rasterize, ClipVertex, RasterImage};
+use crate::raster::{fragment, rasterize, ClipVertex, FragmentIn, RasterImage};
 use crate::scene::Scene;
+use crate::texture::MaterialTable;
 
 /// Distance of the slit cameras' near plane, metres.
 pub const NEAR: f32 = 0.01;
@@ -147,14 +147,18 @@ pub fn object_spheres(scene: &Scene) -> Vec<(Vec3, f32)> {
 }
 
 /// The slit stage on the CPU for one eye.
-pub fn slit(params: &SlitParams, slits: &[Slit], scene: &Scene, background: [f32; 3]) -> RasterImage {
+pub fn slit(
+    params: &SlitParams,
+    slits: &[Slit],
+    scene: &Scene,
+    table: &MaterialTable,
+    background: [f32; 3],
+) -> RasterImage {
     let projection = Projection::from(&params.projection);
     let eye = if params.eye_sign > 0.0 { Eye::Right } else { Eye::Left };
     let view = Mat4::from_cols_array_2d(&params.view);
     let mut img = RasterImage::new(projection.width, projection.height, background);
-    let fragment = |xy: Vec2, pos: Vec3, nrm: Vec3, col: Vec4| {
-        (shade(params.ambient, pos, nrm, col), pixel_error(&projection, eye, pos, xy))
-    };
+    let fragment = |f: &FragmentIn| fragment(table, params.ambient, &projection, eye, f);
     let spheres = object_spheres(scene);
     for slit in slits {
         for (o, &(center, radius)) in scene.objects.iter().zip(&spheres) {
@@ -170,7 +174,9 @@ pub fn slit(params: &SlitParams, slits: &[Slit], scene: &Scene, background: [f32
                         view_position: p,
                         normal: view.transform_vector3(Vec3::from(v.normal)),
                         color: Vec4::from(v.color),
+                        uv: Vec2::from(v.uv),
                         object: v.object,
+                        material: v.material,
                     }
                 });
                 rasterize(&mut img, cv, (slit.first_column, slit.end_column), &fragment);

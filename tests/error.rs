@@ -8,6 +8,7 @@ use twister::reduce::reduce_error;
 use twister::renderer::Frame;
 use twister::slit::{slit, slit_params, slits};
 use twister::subdivide::{subdivide, Method};
+use twister::texture::MaterialTable;
 use twister::{builtin, Eye, Projection, RenderSettings, Vertical};
 
 fn measured(scene: &twister::Scene, settings: &RenderSettings) -> Frame {
@@ -41,7 +42,12 @@ fn gpu_error_pass_and_reduction_match_their_cpu_twins() {
         let params = settings.subdivide_params(0, 1);
         let tris = subdivide(&params, &scene.vertices, &scene.indices).vertices;
         for (k, eye) in Eye::BOTH.into_iter().enumerate() {
-            let cpu = raster(&settings.raster_params(eye), &tris, settings.background);
+            let cpu = raster(
+                &settings.raster_params(eye),
+                &tris,
+                &MaterialTable::of(&scene, usize::MAX),
+                settings.background,
+            );
             let (mut both, mut worst) = (0, 0.0f32);
             for (g, c) in m.error[k].iter().zip(&cpu.error) {
                 if *g >= 0.0 && *c >= 0.0 {
@@ -76,7 +82,13 @@ fn gpu_slit_renderer_matches_its_cpu_twin() {
     let m = frame.measurement.as_ref().unwrap();
     for (k, eye) in Eye::BOTH.into_iter().enumerate() {
         let params = slit_params(&projection, settings.view(), eye, settings.ambient);
-        let cpu = slit(&params, &slits(&projection, eye, 4), &scene, settings.background);
+        let cpu = slit(
+            &params,
+            &slits(&projection, eye, 4),
+            &scene,
+            &MaterialTable::of(&scene, usize::MAX),
+            settings.background,
+        );
         let gpu = frame.eye(eye);
         let total = (projection.width * projection.height) as usize;
         let colour_differs = cpu

@@ -7,6 +7,7 @@ use rand::{Rng, SeedableRng};
 use twister::gpu_types::{DrawVertex, SceneVertex};
 use twister::raster::raster;
 use twister::subdivide::{subdivide, Method};
+use twister::texture::MaterialTable;
 use twister::{builtin, Eye, GpuScene, Projection, RenderSettings, Scene, Vertical};
 
 #[test]
@@ -183,7 +184,12 @@ fn gpu_raster_matches_cpu_twin() {
     let params = settings.subdivide_params(0, scene.triangle_count() as u32);
     let prepared = subdivide(&params, &scene.vertices, &scene.indices).vertices;
     for eye in Eye::BOTH {
-        let cpu = raster(&settings.raster_params(eye), &prepared, settings.background);
+        let cpu = raster(
+            &settings.raster_params(eye),
+            &prepared,
+            &MaterialTable::of(&scene, usize::MAX),
+            settings.background,
+        );
         let gpu = frame.eye(eye);
         let differing = cpu
             .rgba
