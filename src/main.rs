@@ -141,6 +141,9 @@ struct ViewArgs {
     /// Turn of the view about the vertical axis, degrees; positive turns left.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     yaw: f32,
+    /// Metres per scene unit: the scene (and --viewer, given in scene units) is scaled by it.
+    #[arg(long, default_value_t = 1.0)]
+    scale: f32,
     /// Subdivision: adaptive (N = ceil(l/L) per edge), fixed:N (every edge N), vertex (none).
     #[arg(long, value_parser = Method::parse, default_value = "adaptive")]
     method: Method,
@@ -228,10 +231,13 @@ impl ViewArgs {
         if !self.yaw.is_finite() {
             return Err("--yaw must be a finite number of degrees".into());
         }
+        if !(self.scale.is_finite() && self.scale > 0.0) {
+            return Err(format!("--scale {}: must be a positive number of metres per scene unit", self.scale));
+        }
         let settings = RenderSettings {
             projection,
             viewer: match self.viewer {
-                Viewer::At(p) => p,
+                Viewer::At(p) => p * self.scale,
                 Viewer::Camera(_) => Vec3::ZERO, // placed by `setup` once the scene is loaded
             },
             yaw_deg: self.yaw,
@@ -250,6 +256,9 @@ impl ViewArgs {
 /// Loads (and places) a scene; a `camera[:N]` viewer takes that camera's place and yaw.
 fn place(spec: &str, fit: Option<f32>, view: &ViewArgs, settings: &mut RenderSettings) -> Result<Scene, String> {
     let mut scene = load_scene(spec, &settings.projection)?;
+    if view.scale != 1.0 {
+        scene.transform(glam::Mat4::from_scale(Vec3::splat(view.scale)));
+    }
     if let Some(d) = fit {
         scene.fit(d, &settings.projection).map_err(|e| format!("{spec}: {e}"))?;
     }
@@ -258,7 +267,7 @@ fn place(spec: &str, fit: Option<f32>, view: &ViewArgs, settings: &mut RenderSet
             .cameras
             .get(n)
             .ok_or_else(|| format!("{spec}: --viewer camera:{n}, but the file has {} cameras", scene.cameras.len()))?;
-        settings.viewer = Vec3::from(cam.position);
+        settings.viewer = Vec3::from(cam.position) * view.scale;
         settings.yaw_deg += cam.yaw_deg;
     }
     Ok(scene)
