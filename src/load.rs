@@ -251,6 +251,24 @@ fn gltf_material(material: &gltf::Material) -> (Material, u32, Option<[[f32; 3];
     (m, set, matrix)
 }
 
+/// The first external buffer or image file a glTF file names that does not exist, described.
+fn missing_gltf_resource(path: &Path) -> Option<String> {
+    let gltf = gltf::Gltf::open(path).ok()?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    let exists = |uri: &str| uri.starts_with("data:") || base.join(uri.replace("%20", " ")).is_file();
+    let buffers = gltf.buffers().filter_map(|b| match b.source() {
+        gltf::buffer::Source::Uri(uri) if !exists(uri) => Some(format!("buffer {} file '{uri}' not found", b.index())),
+        _ => None,
+    });
+    let images = gltf.images().filter_map(|i| match i.source() {
+        gltf::image::Source::Uri { uri, .. } if !exists(uri) => {
+            Some(format!("image {} file '{uri}' not found", i.index()))
+        }
+        _ => None,
+    });
+    buffers.chain(images).next()
+}
+
 /// glTF extensions twister draws (the others are ignored with a note, or refused when required).
 pub const GLTF_EXTENSIONS: &[&str] = &["KHR_texture_transform"];
 
@@ -260,7 +278,10 @@ pub fn load_gltf(path: &Path) -> Result<Scene, String> {
     if !path.is_file() {
         return Err(format!("{name}: no such file"));
     }
-    let (doc, buffers, images) = gltf::import(path).map_err(|e| format!("{name}: not a readable glTF file: {e}"))?;
+    let (doc, buffers, images) = gltf::import(path).map_err(|e| match missing_gltf_resource(path) {
+        Some(missing) => format!("{name}: not a readable glTF file: {missing}"),
+        None => format!("{name}: not a readable glTF file: {e}"),
+    })?;
     let required: Vec<&str> = doc.extensions_required().filter(|e| !GLTF_EXTENSIONS.contains(e)).collect();
     if !required.is_empty() {
         return Err(format!("{name}: requires extensions twister does not support: {}", required.join(", ")));

@@ -239,3 +239,50 @@ fn render_accepts_slit_methods() {
     assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("slit:W"));
     let _ = std::fs::remove_dir_all(&out);
 }
+
+#[test]
+fn scale_turns_scene_units_into_metres_which_sets_the_disparity() {
+    // Scaling the scene and the viewer together keeps every direction; only the disparity
+    // changes, since the eye circle is in metres. Sphere100 (3 m ahead) at --scale 0.2 stands
+    // 0.6 m ahead, inside the display cylinder: its disparity changes sign.
+    use twister::projection::{Eye, Projection};
+    let (w, h) = (720u32, 120u32);
+    let projection = Projection { width: w, height: h, ..Projection::default() };
+    let disparity = |scale: &str| {
+        let out = tmp(&format!("scale{scale}"));
+        let o = twister()
+            .args(["render", "builtin:sphere100", "--width", &w.to_string(), "--height", &h.to_string()])
+            .args(["--scale", scale, "--background", "0,0,0", "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let cx = |eye: &str| {
+            let img = image::open(out.join(format!("{eye}.png"))).unwrap().to_rgba8();
+            let xs: Vec<f32> =
+                img.enumerate_pixels().filter(|(_, _, p)| p.0[..3] != [0, 0, 0]).map(|(x, _, _)| x as f32).collect();
+            assert!(xs.len() > 100);
+            xs.iter().sum::<f32>() / xs.len() as f32
+        };
+        let d = cx("right") - cx("left");
+        let _ = std::fs::remove_dir_all(&out);
+        d
+    };
+    let expected = |r: f32| {
+        let x = |eye| projection.to_pixel(projection.project(glam::Vec3::new(0.0, 0.0, -r), eye).unwrap().u, 0.0)[0];
+        x(Eye::Right) - x(Eye::Left)
+    };
+    let sphere = twister::builtin::builtin_scene("builtin:sphere100", &projection).unwrap();
+    let (lo, hi) = sphere.bounds().unwrap();
+    let (centre, front) = (-(lo.z + hi.z) / 2.0, -hi.z);
+    let (d1, d02) = (disparity("1"), disparity("0.2"));
+    // The drawn disk's disparity lies between those of its centre's and its front's distance.
+    for (d, s) in [(d1, 1.0), (d02, 0.2)] {
+        let (a, b) = (expected(s * centre), expected(s * front));
+        assert!(d >= a.min(b) - 0.5 && d <= a.max(b) + 0.5, "scale {s}: disparity {d} px, expected in {a}..{b}");
+    }
+    assert!(d1 > 0.0 && d02 < 0.0, "{d1} {d02}");
+    let o = twister().args(["render", "--scale", "0", "--out", "/nonexistent"]).output().unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--scale"));
+}

@@ -158,7 +158,13 @@ fn broken_files_are_one_clear_error_without_panic_or_output() {
     cases.push((write(&dir, "overrun.gltf", &overrun), "overruns"));
     let mut missing = gltf_json(&QUAD, None, 4);
     missing["buffers"][0]["uri"] = serde_json::json!("missing.bin");
-    cases.push((write(&dir, "missing.gltf", &missing), "not a readable glTF file"));
+    cases.push((write(&dir, "missing.gltf", &missing), "buffer 0 file 'missing.bin' not found"));
+    let mut no_image = gltf_json(&QUAD, None, 4);
+    no_image["images"] = serde_json::json!([{ "uri": "missing.png" }]);
+    cases.push((write(&dir, "no_image.gltf", &no_image), "image 0 file 'missing.png' not found"));
+    let mut bad_image = gltf_json(&QUAD, None, 4);
+    bad_image["images"] = serde_json::json!([{ "uri": "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAA" }]);
+    cases.push((write(&dir, "bad_image.gltf", &bad_image), "not a readable glTF file"));
     let mut ext = gltf_json(&QUAD, None, 4);
     ext["extensionsUsed"] = serde_json::json!(["KHR_draco_mesh_compression"]);
     ext["extensionsRequired"] = serde_json::json!(["KHR_draco_mesh_compression"]);
@@ -250,4 +256,115 @@ fn obj_materials_give_colours_and_a_missing_mtl_is_a_warning() {
     let s = load_scene(dir.join("quad.obj").to_str().unwrap(), &p).unwrap();
     assert_eq!(s.triangle_count(), 2);
     assert!(s.warnings.iter().any(|w| w.contains("materials not loaded")), "{:?}", s.warnings);
+}
+
+fn png_bytes(w: u32, h: u32, f: impl Fn(u32, u32) -> [u8; 4]) -> Vec<u8> {
+    let img = image::RgbaImage::from_fn(w, h, |x, y| image::Rgba(f(x, y)));
+    let mut bytes = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png).unwrap();
+    bytes
+}
+
+#[test]
+fn gltf_materials_keep_sampler_alpha_sides_texcoord_set_and_texture_transform() {
+    use twister::gpu_types::{AlphaMode, Filter, Mipmap, Wrap};
+    let dir = tmp("material");
+    let uv0: [[f32; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]];
+    let uv1: [[f32; 2]; 4] = [[0.1, 0.2], [0.3, 0.4], [0.5, 0.6], [0.7, 0.8]];
+    let mut json = gltf_json(&QUAD, Some(&[0, 1, 2, 2, 1, 3]), 4);
+    // Append both UV sets to the buffer.
+    let mut bytes: Vec<u8> = QUAD.iter().flatten().flat_map(|f| f.to_le_bytes()).collect();
+    bytes.extend([0u32, 1, 2, 2, 1, 3].iter().flat_map(|i| i.to_le_bytes()));
+    let at = bytes.len();
+    bytes.extend(uv0.iter().chain(&uv1).flatten().flat_map(|f| f.to_le_bytes()));
+    json["buffers"][0] = serde_json::json!({
+        "byteLength": bytes.len(),
+        "uri": format!("data:application/octet-stream;base64,{}", base64(&bytes))
+    });
+    let views = json["bufferViews"].as_array_mut().unwrap();
+    views.push(serde_json::json!({ "buffer": 0, "byteOffset": at, "byteLength": 32 }));
+    views.push(serde_json::json!({ "buffer": 0, "byteOffset": at + 32, "byteLength": 32 }));
+    let accessors = json["accessors"].as_array_mut().unwrap();
+    for view in [2, 3] {
+        accessors.push(serde_json::json!({ "bufferView": view, "componentType": 5126, "count": 4, "type": "VEC2" }));
+    }
+    json["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = serde_json::json!(2);
+    json["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_1"] = serde_json::json!(3);
+    json["meshes"][0]["primitives"][0]["material"] = serde_json::json!(0);
+    let png = png_bytes(4, 2, |x, y| [60 * x as u8, 100 * y as u8, 7, 255]);
+    json["images"] = serde_json::json!([{ "uri": format!("data:image/png;base64,{}", base64(&png)) }]);
+    // MIRRORED_REPEAT / CLAMP_TO_EDGE, NEAREST magnification, NEAREST_MIPMAP_NEAREST.
+    json["samplers"] = serde_json::json!([{ "wrapS": 33648, "wrapT": 33071, "magFilter": 9728, "minFilter": 9984 }]);
+    json["textures"] = serde_json::json!([{ "source": 0, "sampler": 0 }]);
+    let (offset, rotation, scale) = ([0.5f32, 0.25f32], std::f32::consts::FRAC_PI_2, [2.0f32, 3.0f32]);
+    json["materials"] = serde_json::json!([{
+        "pbrMetallicRoughness": {
+            "baseColorFactor": [1.0, 0.5, 1.0, 1.0],
+            "baseColorTexture": { "index": 0, "texCoord": 0, "extensions": { "KHR_texture_transform": {
+                "offset": offset, "rotation": rotation, "scale": scale, "texCoord": 1
+            } } }
+        },
+        "alphaMode": "MASK", "alphaCutoff": 0.3, "doubleSided": true
+    }]);
+    json["extensionsUsed"] = serde_json::json!(["KHR_texture_transform", "EXT_made_up"]);
+    json["extensionsRequired"] = serde_json::json!(["KHR_texture_transform"]);
+    let path = write(&dir, "material.gltf", &json);
+    let s = load_scene(path.to_str().unwrap(), &Projection::default()).unwrap();
+    assert_eq!(s.textures.len(), 1);
+    assert_eq!((s.textures[0].width, s.textures[0].height), (4, 2));
+    assert_eq!(&s.textures[0].rgba[4 * 5..4 * 6], &[60, 100, 7, 255], "texel (1, 1)");
+    let m = s.materials[0];
+    assert_eq!((m.texture, m.wrap_u, m.wrap_v), (0, Wrap::MirroredRepeat as u32, Wrap::ClampToEdge as u32));
+    assert_eq!(
+        (m.mag_filter, m.min_filter, m.mipmap),
+        (Filter::Nearest as u32, Filter::Nearest as u32, Mipmap::Nearest as u32)
+    );
+    assert_eq!((m.alpha_mode, m.alpha_cutoff, m.double_sided), (AlphaMode::Mask as u32, 0.3, 1));
+    // The transform's texCoord picks TEXCOORD_1; uv' = offset + R·(scale·uv) with
+    // R = [[cos, sin], [−sin, cos]] (the extension's rotation).
+    let (sin, cos) = rotation.sin_cos();
+    for (v, t) in s.vertices.iter().zip(uv1) {
+        let (u, w) = (scale[0] * t[0], scale[1] * t[1]);
+        let want = [offset[0] + cos * u + sin * w, offset[1] - sin * u + cos * w];
+        assert!((v.uv[0] - want[0]).abs() < 1e-5 && (v.uv[1] - want[1]).abs() < 1e-5, "{:?} vs {want:?}", v.uv);
+        assert_eq!(v.material, 1);
+        assert_eq!(v.color, [1.0, 0.5, 1.0, 1.0], "base colour factor × vertex colour");
+    }
+    let ignored: Vec<&String> = s.warnings.iter().filter(|w| w.contains("ignored")).collect();
+    assert!(
+        ignored.len() == 1 && ignored[0].contains("EXT_made_up") && !ignored[0].contains("KHR_texture_transform"),
+        "{:?}",
+        s.warnings
+    );
+    // A primitive without a material gets the spec's default one: single-sided.
+    json["meshes"][0]["primitives"][0].as_object_mut().unwrap().remove("material");
+    let s = load_scene(write(&dir, "default.gltf", &json).to_str().unwrap(), &Projection::default()).unwrap();
+    let k = s.vertices[0].material as usize - 1;
+    assert_eq!((s.materials[k].double_sided, s.materials[k].texture), (0, twister::gpu_types::NO_TEXTURE));
+}
+
+#[test]
+fn obj_map_kd_is_relative_to_the_mtl_file_and_a_missing_texture_is_a_warning() {
+    let dir = tmp("mapkd");
+    std::fs::create_dir_all(dir.join("mats/tex")).unwrap();
+    std::fs::write(dir.join("mats/tex/quadrants.png"), png_bytes(2, 2, |x, y| [200 * x as u8, 200 * y as u8, 9, 255]))
+        .unwrap();
+    // Windows-style path as exporters on Windows write it; a texture that does not exist.
+    let mtl =
+        "newmtl painted\nKd 1 1 1\nmap_Kd .\\tex\\quadrants.png\nnewmtl lost\nKd 0 1 0\nmap_Kd -s 1 1 1 missing.png\n";
+    std::fs::write(dir.join("mats/scene.mtl"), mtl).unwrap();
+    let obj = "mtllib mats/scene.mtl\nv 0 0 -3\nv 1 0 -3\nv 0 1 -3\nv 1 1 -3\nvt 0 0\nvt 1 0\nvt 0 1\nvt 1 1\n\
+               usemtl painted\nf 1/1 2/2 3/3\nusemtl lost\nf 2/2 4/4 3/3\n";
+    std::fs::write(dir.join("scene.obj"), obj).unwrap();
+    let s = load_scene(dir.join("scene.obj").to_str().unwrap(), &Projection::default()).unwrap();
+    assert_eq!(s.textures.len(), 1, "{:?}", s.warnings);
+    assert_eq!(&s.textures[0].rgba[12..16], &[200, 200, 9, 255], "texel (1, 1) of the PNG");
+    assert_eq!(s.materials[0].texture, 0);
+    assert_eq!(s.materials[1].texture, twister::gpu_types::NO_TEXTURE);
+    assert!(s.warnings.iter().any(|w| w.contains("lost") && w.contains("missing.png")), "{:?}", s.warnings);
+    // OBJ's v runs up from the bottom row; texture space runs down from the top row.
+    let top_left = s.vertices.iter().find(|v| v.position == [0.0, 1.0, -3.0]).unwrap();
+    assert_eq!(top_left.uv, [0.0, 0.0]);
+    let bottom_right = s.vertices.iter().find(|v| v.position == [1.0, 0.0, -3.0]).unwrap();
+    assert_eq!(bottom_right.uv, [1.0, 1.0]);
 }
