@@ -330,12 +330,16 @@ pub fn load_gltf(path: &Path) -> Result<Scene, String> {
             });
         }
         if let Some(mesh) = node.mesh() {
+            // One scene object per mesh instance (node), its primitives one after the other.
+            let mesh_name = mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_string);
+            let instance = node.name().map_or_else(|| format!("node {}", node.index()), str::to_string);
+            let objects_before = scene.objects.len();
             for prim in mesh.primitives() {
-                let mesh_name = mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_string);
                 let label = format!("{mesh_name} / primitive {}", prim.index());
                 add_gltf_primitive(&mut scene, &prim, &buffers, world, &label, &materials)
                     .map_err(|e| format!("{name}: {label}: {e}"))?;
             }
+            scene.merge_objects_from(objects_before, format!("{mesh_name} ({instance})"));
         }
         stack.extend(node.children().map(|c| (c, world, depth + 1)));
     }

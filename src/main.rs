@@ -296,6 +296,8 @@ fn info(args: &InfoArgs) -> Result<(), String> {
         "triangles": scene.triangle_count(),
         "vertices": scene.vertices.len(),
         "objects": scene.objects.len(),
+        "meshes": scene.meshes,
+        "primitives": scene.primitives,
         "materials": scene.materials.len(),
         "textures": scene.textures.iter().map(|t| serde_json::json!({ "name": t.name, "width": t.width, "height": t.height })).collect::<Vec<_>>(),
         "bbox": { "min": lo.to_array(), "max": hi.to_array() },

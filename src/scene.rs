@@ -28,6 +28,10 @@ pub struct Scene {
     pub textures: Vec<Texture>,
     /// Cameras placed in the file (glTF camera nodes), usable as the viewer.
     pub cameras: Vec<Camera>,
+    /// Meshes drawn (glTF mesh instances, OBJ objects/groups, built-in shapes: one per object)
+    /// and their primitives.
+    pub meshes: usize,
+    pub primitives: usize,
 }
 
 /// A camera placed in a scene file: where it stands and which way it looks (yaw only: the
@@ -61,6 +65,26 @@ impl Scene {
             first_triangle: first,
             triangle_count: (indices.len() / 3) as u32,
         });
+        self.meshes += 1;
+        self.primitives += 1;
+    }
+
+    /// Merges the objects from index `first` on (consecutive triangle ranges) into one named
+    /// object; nothing happens when there are none.
+    pub fn merge_objects_from(&mut self, first: usize, name: String) {
+        if first >= self.objects.len() {
+            return;
+        }
+        let first_triangle = self.objects[first].first_triangle;
+        let triangle_count = self.objects[first..].iter().map(|o| o.triangle_count).sum();
+        self.meshes -= self.objects.len() - first - 1;
+        self.objects.truncate(first);
+        let object = first as u32;
+        let range = 3 * first_triangle as usize..3 * (first_triangle + triangle_count) as usize;
+        for &i in &self.indices[range] {
+            self.vertices[i as usize].object = object;
+        }
+        self.objects.push(Object { name, first_triangle, triangle_count });
     }
 
     /// Checks what the GPU stages rely on: whole triangles, indices in range, finite values.

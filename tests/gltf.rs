@@ -208,6 +208,7 @@ fn info_describes_a_file_and_its_camera_is_a_viewer() {
     let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(j["triangles"], 4212);
     assert_eq!(j["materials"].as_u64(), Some(1));
+    assert_eq!((j["meshes"].as_u64(), j["primitives"].as_u64(), j["objects"].as_u64()), (Some(1), Some(1), Some(1)));
     let png = image::open(assets().join("Duck/glTF/DuckCM.png")).unwrap();
     assert_eq!(j["textures"][0]["width"].as_u64(), Some(png.width() as u64));
     assert_eq!(j["textures"][0]["height"].as_u64(), Some(png.height() as u64));
@@ -367,4 +368,24 @@ fn obj_map_kd_is_relative_to_the_mtl_file_and_a_missing_texture_is_a_warning() {
     assert_eq!(top_left.uv, [0.0, 0.0]);
     let bottom_right = s.vertices.iter().find(|v| v.position == [1.0, 0.0, -3.0]).unwrap();
     assert_eq!(bottom_right.uv, [1.0, 1.0]);
+}
+
+#[test]
+fn a_mesh_instance_is_one_object_whatever_its_primitive_count() {
+    // One mesh of two primitives drawn by two nodes: two objects (mesh instances), four primitives.
+    let mut json = gltf_json(&QUAD, Some(&[0, 1, 2, 2, 1, 3]), 4);
+    let prim = json["meshes"][0]["primitives"][0].clone();
+    json["meshes"][0]["primitives"] = serde_json::json!([prim.clone(), prim]);
+    json["nodes"] =
+        serde_json::json!([{ "children": [1, 2] }, { "mesh": 0 }, { "mesh": 0, "translation": [5.0, 0.0, 0.0] }]);
+    let s = load_scene(write(&tmp("instances"), "i.gltf", &json).to_str().unwrap(), &Projection::default()).unwrap();
+    assert_eq!((s.objects.len(), s.meshes, s.primitives, s.triangle_count()), (2, 2, 4, 8));
+    for (k, o) in s.objects.iter().enumerate() {
+        assert_eq!(o.triangle_count, 4);
+        for t in o.first_triangle..o.first_triangle + o.triangle_count {
+            for c in 0..3 {
+                assert_eq!(s.vertices[s.indices[3 * t as usize + c] as usize].object, k as u32, "{}", o.name);
+            }
+        }
+    }
 }
