@@ -73,6 +73,9 @@ struct DrawIndirectArgs {
 @group(0) @binding(6) var<storage, read_write> draw_args: DrawIndirectArgs;
 // Workgroup counts of the `lattice` dispatch, written by `lattice_args` from the piece counter.
 @group(0) @binding(7) var<storage, read_write> lattice_dispatch: array<u32, 3>;
+// Per object: the factor its L is multiplied by (the visual-field level of detail relaxes the
+// subdivision away from the gaze; 1 without it). CPU twin: `Subdivider::edge_px`.
+@group(0) @binding(8) var<storage, read> object_edge_scale: array<f32>;
 
 // `piece_count` value meaning: as many pieces as `plan` made (read from the counter), so that
 // plan, lattice and drawing can run in one submission.
@@ -207,14 +210,15 @@ fn edge_divisions(a: vec3<f32>, b: vec3<f32>) -> u32 {
     }
     // Quick 2-segment length first; the 8-segment polyline refines it, so it is never shorter.
     // (One call site in a loop: lavapipe's compiler inlines every call.)
+    let edge_px = params.edge_px * object_edge_scale[min(tri_object, arrayLength(&object_edge_scale) - 1u)];
     var length_px = 0.0;
     for (var round = 0u; round < 2u; round++) {
         length_px = edge_length_px(a, b, select(2u, EDGE_SAMPLES, round == 1u));
-        if (round == 0u && length_px <= 0.5 * params.edge_px) {
+        if (round == 0u && length_px <= 0.5 * edge_px) {
             return 1u;
         }
     }
-    let n = ceil(length_px / params.edge_px);
+    let n = ceil(length_px / edge_px);
     if (n >= f32(MAX_EDGE_DIVISIONS) || !(n == n)) {
         return MAX_EDGE_DIVISIONS;
     }

@@ -21,6 +21,7 @@ pub mod gpu;
 pub mod gpu_types;
 pub mod heatmap;
 pub mod load;
+pub mod lod;
 pub mod output;
 pub mod plot;
 pub mod projection;
@@ -32,6 +33,7 @@ pub mod shaders;
 pub mod slit;
 pub mod subdivide;
 pub mod texture;
+pub mod visual_field;
 
 pub use projection::{Eye, Projection, Vertical};
 pub use renderer::{Frame, GpuScene, RenderSettings, Renderer};

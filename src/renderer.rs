@@ -242,6 +242,8 @@ pub struct GpuScene {
     pub materials: [wgpu::Buffer; 3],
     /// What the packing of the textures had to say (levels dropped to fit the budget).
     pub warnings: Vec<String>,
+    /// Per object: the factor on L of the adaptive subdivision (1; the level of detail sets it).
+    pub object_edge_scale: wgpu::Buffer,
 }
 
 impl GpuScene {
@@ -299,6 +301,7 @@ impl GpuScene {
             storage("mip levels", bytemuck::cast_slice(&table.mips)),
             storage("texels", bytemuck::cast_slice(&table.texels)),
         ];
+        let ones = vec![1.0f32; scene.objects.len().max(1)];
         Ok(GpuScene {
             vertices,
             indices,
@@ -306,6 +309,7 @@ impl GpuScene {
             objects,
             materials,
             warnings: table.warnings,
+            object_edge_scale: storage("object edge scale", bytemuck::cast_slice(&ones)),
         })
     }
 }
@@ -516,7 +520,7 @@ impl Renderer {
 
     /// A bind group for one entry point of the subdivide stage, from the bindings it uses:
     /// 0 params, 1 vertices, 2 indices, 3 pieces, 4 triangles, 5 counters, 6 draw args,
-    /// 7 lattice dispatch.
+    /// 7 lattice dispatch, 8 per-object edge scale.
     fn subdivide_bind_group(
         &self,
         pipeline: &wgpu::ComputePipeline,
@@ -534,6 +538,7 @@ impl Renderer {
             &b.counters,
             &b.draw_args,
             &b.lattice_dispatch,
+            &scene.object_edge_scale,
         ];
         let entries: Vec<wgpu::BindGroupEntry> = used
             .iter()
@@ -565,7 +570,8 @@ impl Renderer {
         count: u32,
     ) -> SubdivideCounters {
         let uniform = self.uniform("subdivide params", params);
-        let used: &[u32] = if std::ptr::eq(pipeline, &self.plan) { &[0, 1, 2, 3, 5] } else { &[0, 1, 2, 3, 4, 5] };
+        let used: &[u32] =
+            if std::ptr::eq(pipeline, &self.plan) { &[0, 1, 2, 3, 5, 8] } else { &[0, 1, 2, 3, 4, 5, 8] };
         let main_bg = self.subdivide_bind_group(pipeline, used, &uniform, scene, buffers);
         let finalize_bg = self.subdivide_bind_group(&self.finalize, &[0, 5, 6], &uniform, scene, buffers);
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
@@ -603,9 +609,9 @@ impl Renderer {
         params.first_piece = 0;
         params.piece_count = PIECES_FROM_COUNTER;
         let uniform = self.uniform("subdivide params", &params);
-        let plan_bg = self.subdivide_bind_group(&self.plan, &[0, 1, 2, 3, 5], &uniform, scene, b);
+        let plan_bg = self.subdivide_bind_group(&self.plan, &[0, 1, 2, 3, 5, 8], &uniform, scene, b);
         let args_bg = self.subdivide_bind_group(&self.lattice_args, &[0, 5, 7], &uniform, scene, b);
-        let lattice_bg = self.subdivide_bind_group(&self.lattice, &[0, 1, 2, 3, 4, 5], &uniform, scene, b);
+        let lattice_bg = self.subdivide_bind_group(&self.lattice, &[0, 1, 2, 3, 4, 5, 8], &uniform, scene, b);
         let finalize_bg = self.subdivide_bind_group(&self.finalize, &[0, 5, 6], &uniform, scene, b);
         let timestamps = self.timestamp_query_set();
         let mut enc = device.create_command_encoder(&Default::default());

@@ -220,6 +220,9 @@ fn edge_point(a: Node, b: Node, j: u32, n: u32) -> Node {
 pub struct Subdivider<'a> {
     params: &'a SubdivideParams,
     projection: Projection,
+    /// Per object: the factor its L is multiplied by (the level of detail's relaxation; 1 where
+    /// missing). `object_edge_scale` in shaders/subdivide.wgsl.
+    edge_scale: &'a [f32],
 }
 
 /// Counters the GPU keeps too.
@@ -233,7 +236,17 @@ pub struct SubdivideOutput {
 
 impl<'a> Subdivider<'a> {
     pub fn new(params: &'a SubdivideParams) -> Self {
-        Subdivider { params, projection: (&params.projection).into() }
+        Subdivider { params, projection: (&params.projection).into(), edge_scale: &[] }
+    }
+
+    /// The same with a per-object factor on L (see `edge_scale`).
+    pub fn with_edge_scale(params: &'a SubdivideParams, edge_scale: &'a [f32]) -> Self {
+        Subdivider { edge_scale, ..Subdivider::new(params) }
+    }
+
+    /// L for a triangle of `object`.
+    fn edge_px(&self, object: u32) -> f32 {
+        self.params.edge_px * self.edge_scale.get(object as usize).copied().unwrap_or(1.0)
     }
 
     /// Image position (x, y) in pixels of a viewer-frame point for one eye sign, x not wrapped.
@@ -273,15 +286,15 @@ impl<'a> Subdivider<'a> {
     /// Divisions of an edge (eq. 5, not capped by N_max: the pre-split handles that). A quick
     /// 2-segment length first: if it is at most L/2 the edge stays whole, else the 8-segment
     /// length decides (it is never shorter, as it refines the same polyline).
-    fn edge_divisions(&self, a: Vec3, b: Vec3) -> u32 {
+    fn edge_divisions(&self, a: Vec3, b: Vec3, edge_px: f32) -> u32 {
         match self.params.method {
             0 => 1,
             1 => self.params.fixed_n,
             _ => {
-                if self.edge_length_px(a, b, 2) <= 0.5 * self.params.edge_px {
+                if self.edge_length_px(a, b, 2) <= 0.5 * edge_px {
                     return 1;
                 }
-                let n = (self.edge_length_px(a, b, EDGE_SAMPLES) / self.params.edge_px).ceil();
+                let n = (self.edge_length_px(a, b, EDGE_SAMPLES) / edge_px).ceil();
                 if n.is_finite() {
                     (n as u32).clamp(1, MAX_EDGE_DIVISIONS)
                 } else {
@@ -294,8 +307,8 @@ impl<'a> Subdivider<'a> {
     /// Divisions of an interior edge of the macro-lattice. Macro edges are about N_max·L long,
     /// but the projection stretches unevenly across a large triangle, so some need more: they may
     /// take up to 2·N_max (a piece then makes at most 4·N_max² triangles).
-    fn interior_divisions(&self, a: Vec3, b: Vec3) -> u32 {
-        self.edge_divisions(a, b).min(2 * self.params.max_div)
+    fn interior_divisions(&self, a: Vec3, b: Vec3, edge_px: f32) -> u32 {
+        self.edge_divisions(a, b, edge_px).min(2 * self.params.max_div)
     }
 
     fn load(&self, vertices: &[SceneVertex], indices: &[u32], t: usize) -> Triangle {
@@ -331,7 +344,12 @@ impl<'a> Subdivider<'a> {
         if self.off_screen_vertically(p) {
             return (0, [1; 3]);
         }
-        let n = [self.edge_divisions(p[0], p[1]), self.edge_divisions(p[1], p[2]), self.edge_divisions(p[2], p[0])];
+        let l = self.edge_px(tri.object);
+        let n = [
+            self.edge_divisions(p[0], p[1], l),
+            self.edge_divisions(p[1], p[2], l),
+            self.edge_divisions(p[2], p[0], l),
+        ];
         let m = n[0].max(n[1]).max(n[2]);
         let k = if self.params.method == 2 { m.div_ceil(self.params.max_div) } else { 1 };
         (k, n)
@@ -402,7 +420,7 @@ impl<'a> Subdivider<'a> {
                     original: None,
                     from: 0,
                     to: 0,
-                    count: self.interior_divisions(q[e].position, q[(e + 1) % 3].position),
+                    count: self.interior_divisions(q[e].position, q[(e + 1) % 3].position, self.edge_px(tri.object)),
                 });
         }
         let counts = edges.map(|e| e.count);
