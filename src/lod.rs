@@ -181,6 +181,71 @@ impl LodSelection {
     }
 }
 
+/// `--lod-overlay`: tints each object's vertex colours by its level: green in the central field,
+/// yellow (level 1) to red (level 0) across the peripheral field, dark red outside.
+pub fn tint(scene: &mut Scene, selection: &LodSelection) {
+    for v in &mut scene.vertices {
+        let Some(c) = selection.chosen.get(v.object as usize) else { continue };
+        let t = match c.field {
+            Field::Central => [0.05, 0.6, 0.05],
+            Field::Peripheral => [0.9, 0.15 + 0.65 * c.level, 0.02],
+            Field::Outside => [0.3, 0.0, 0.0],
+        };
+        for k in 0..3 {
+            v.color[k] = 0.35 * v.color[k] + 0.65 * t[k];
+        }
+    }
+}
+
+/// The visual field of a pixel of a panorama, from the viewer's centre: the pixel's direction is
+/// (sin u, v/R_T, −cos u) (the paper's vertical model; the eyes' offset is left out, this is for
+/// looking at).
+pub fn pixel_field(projection: &crate::projection::Projection, gaze: &Gaze, x: f32, y: f32) -> Field {
+    let metres_per_px = std::f32::consts::TAU * projection.screen_radius / projection.width as f32;
+    let u = (x / projection.width as f32 - 0.5) * std::f32::consts::TAU;
+    let v = (0.5 * projection.height as f32 - y) * metres_per_px;
+    gaze.position(glam::Vec3::new(u.sin(), v / projection.screen_radius, -u.cos())).field()
+}
+
+/// `--lod-overlay`: draws the central field's boundary (white) and the visual field's boundary
+/// (orange) on an eye's image: the pixels on the inner side of each boundary.
+pub fn draw_field_boundaries(
+    img: &mut crate::renderer::EyeImage,
+    projection: &crate::projection::Projection,
+    gaze: &Gaze,
+) {
+    let (w, h) = (img.width, img.height);
+    let fields: Vec<Field> = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| pixel_field(projection, gaze, x as f32 + 0.5, y as f32 + 0.5))
+        .collect();
+    let at = |x: u32, y: u32| fields[(y * w + x) as usize];
+    for y in 0..h {
+        for x in 0..w {
+            let here = at(x, y);
+            let others = [(x + 1) % w, (x + w - 1) % w]
+                .map(|nx| at(nx, y))
+                .into_iter()
+                .chain([y.checked_sub(1), (y + 1 < h).then_some(y + 1)].into_iter().flatten().map(|ny| at(x, ny)));
+            let mut colour = None;
+            for o in others {
+                if o != here {
+                    // The inner side of each boundary is painted.
+                    colour = match (here, o) {
+                        (Field::Central, _) => Some([255, 255, 255, 255]),
+                        (Field::Peripheral, Field::Outside) => Some([255, 140, 0, 255]),
+                        _ => colour,
+                    };
+                }
+            }
+            if let Some(c) = colour {
+                let i = 4 * (y * w + x) as usize;
+                img.rgba[i..i + 4].copy_from_slice(&c);
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

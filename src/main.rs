@@ -2,6 +2,8 @@
 
 use std::path::PathBuf;
 use std::process::ExitCode;
+use twister::lod::{LodChain, LodParams, LodSelection};
+use twister::visual_field::{Field, Gaze};
 
 use clap::{Args, Parser, Subcommand};
 use glam::Vec3;
@@ -156,6 +158,37 @@ struct ViewArgs {
     /// Memory budget of the subdivision buffers, MiB; scenes that need more run in chunks.
     #[arg(long, default_value_t = DEFAULT_MEMORY_MB)]
     memory_mb: u32,
+    /// Level of detail: off, or visual-field (seeds 001/000: polygon budgets and subdivision by
+    /// where each object falls in the visual field of --gaze).
+    #[arg(long, value_enum, default_value_t = LodMode::Off)]
+    lod: LodMode,
+    /// Gaze direction YAW,PITCH in degrees from straight ahead (yaw positive left, pitch up).
+    #[arg(long, value_parser = parse_gaze, default_value = "0,0", allow_hyphen_values = true)]
+    gaze: Gaze,
+    /// P2'/P1: the peripheral field's smallest share of an object's triangles.
+    #[arg(long, default_value_t = 0.3)]
+    lod_p2: f32,
+    /// P3/P1: the share of an object's triangles outside the visual field.
+    #[arg(long, default_value_t = 0.05)]
+    lod_p3: f32,
+    /// D∞, metres: the budgets fall linearly with distance to 0 at D∞ (eq. 2).
+    #[arg(long, default_value_t = 100.0)]
+    lod_dinf: f32,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum LodMode {
+    Off,
+    VisualField,
+}
+
+fn parse_gaze(s: &str) -> Result<Gaze, String> {
+    let v: Vec<f32> =
+        s.split(',').map(|x| x.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|e| format!("'{s}': {e}"))?;
+    match v[..] {
+        [yaw, pitch] if yaw.is_finite() && pitch.is_finite() && pitch.abs() <= 89.0 => Ok(Gaze::new(yaw, pitch)),
+        _ => Err(format!("'{s}': expected YAW,PITCH in degrees, pitch within ±89")),
+    }
 }
 
 #[derive(Args)]
@@ -180,6 +213,10 @@ struct RenderArgs {
     /// Write render statistics as JSON to this file.
     #[arg(long)]
     stats: Option<PathBuf>,
+    /// With --lod visual-field: tint each object by its level and draw the central-field
+    /// (white) and visual-field (orange) boundaries.
+    #[arg(long)]
+    lod_overlay: bool,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -273,18 +310,51 @@ fn place(spec: &str, fit: Option<f32>, view: &ViewArgs, settings: &mut RenderSet
     Ok(scene)
 }
 
+/// Loads and places the scene, opens the GPU and uploads it; with `--lod visual-field`, draws
+/// the gaze's selection (tinted by level for the overlay).
 fn setup(
     spec: &str,
     fit: Option<f32>,
     view: &ViewArgs,
     settings: &mut RenderSettings,
-) -> Result<(Renderer, GpuScene, String), String> {
-    let scene = place(spec, fit, view, settings)?;
+    overlay: bool,
+) -> Result<(Renderer, GpuScene, String, Option<LodSelection>), String> {
+    let mut scene = place(spec, fit, view, settings)?;
+    let selection = match view.lod {
+        LodMode::Off => None,
+        LodMode::VisualField => {
+            let params = LodParams { p2: view.lod_p2, p3: view.lod_p3, d_inf: view.lod_dinf };
+            params.validate()?;
+            let chain = LodChain::build(&scene, params.p3);
+            Some(chain.select(&scene, settings.view(), &view.gaze, &params))
+        }
+    };
+    if let (Some(sel), true) = (&selection, overlay) {
+        twister::lod::tint(&mut scene, sel);
+    }
     let gpu = Gpu::new().map_err(|e| e.to_string())?;
     let adapter = gpu.adapter_description();
     let renderer = Renderer::new(gpu);
-    let gpu_scene = GpuScene::upload(&renderer.gpu, &scene).map_err(|e| format!("{spec}: {e}"))?;
-    Ok((renderer, gpu_scene, adapter))
+    let mut gpu_scene = GpuScene::upload(&renderer.gpu, &scene).map_err(|e| format!("{spec}: {e}"))?;
+    if let Some(sel) = &selection {
+        gpu_scene = gpu_scene.with_lod(&renderer.gpu, sel);
+    }
+    Ok((renderer, gpu_scene, adapter, selection))
+}
+
+/// The LOD part of the stats: triangles selected and, per field, objects and triangles.
+fn lod_stats(selection: &Option<LodSelection>) -> serde_json::Value {
+    let Some(sel) = selection else { return serde_json::Value::Null };
+    let per = |f: Field| {
+        let c: Vec<_> = sel.chosen.iter().filter(|c| c.field == f).collect();
+        serde_json::json!({ "objects": c.len(), "triangles": c.iter().map(|c| c.triangles as u64).sum::<u64>() })
+    };
+    serde_json::json!({
+        "triangles_selected": sel.triangle_count(),
+        "central": per(Field::Central),
+        "peripheral": per(Field::Peripheral),
+        "outside": per(Field::Outside),
+    })
 }
 
 fn info(args: &InfoArgs) -> Result<(), String> {
@@ -313,8 +383,17 @@ fn render(args: &RenderArgs) -> Result<(), String> {
     let mut settings = args.view.settings()?;
     settings.background = args.background;
     settings.measure_edges = args.stats.is_some();
-    let (renderer, gpu_scene, adapter) = setup(&args.scene, args.fit, &args.view, &mut settings)?;
-    let frame = renderer.render(&gpu_scene, &settings)?;
+    if args.lod_overlay && args.view.lod == LodMode::Off {
+        return Err("--lod-overlay needs --lod visual-field".into());
+    }
+    let (renderer, gpu_scene, adapter, selection) =
+        setup(&args.scene, args.fit, &args.view, &mut settings, args.lod_overlay)?;
+    let mut frame = renderer.render(&gpu_scene, &settings)?;
+    if args.lod_overlay {
+        for img in [&mut frame.left, &mut frame.right] {
+            twister::lod::draw_field_boundaries(img, &settings.projection, &args.view.gaze);
+        }
+    }
     let t = std::time::Instant::now();
     let written = write_images(&args.out, &layout_images(&frame, args.layout))?;
     let ms_write = t.elapsed().as_secs_f64() * 1e3;
@@ -347,6 +426,7 @@ fn render(args: &RenderArgs) -> Result<(), String> {
             "ms_readback": s.ms_readback,
             "ms_write": ms_write,
             "ms_total": s.ms_total + ms_write,
+            "lod": lod_stats(&selection),
         });
         write_text(path, &serde_json::to_string_pretty(&json).unwrap())?;
     }
@@ -355,7 +435,7 @@ fn render(args: &RenderArgs) -> Result<(), String> {
 
 fn error(args: &ErrorArgs) -> Result<(), String> {
     let mut settings = RenderSettings { measure_error: true, ..args.view.settings()? };
-    let (renderer, gpu_scene, adapter) = setup(&args.scene, args.fit, &args.view, &mut settings)?;
+    let (renderer, gpu_scene, adapter, selection) = setup(&args.scene, args.fit, &args.view, &mut settings, false)?;
     let frame = renderer.render(&gpu_scene, &settings)?;
     let measured = frame.measurement.as_ref().expect("rendered with measure_error");
     let e = &measured.stats;
@@ -373,6 +453,7 @@ fn error(args: &ErrorArgs) -> Result<(), String> {
         "p99_px": e.p99,
         "max_px": e.max,
         "pixels": e.count,
+        "lod": lod_stats(&selection),
         "triangles_in": s.triangles_in,
         "triangles_out": s.triangles_out,
         "ms_render": s.ms_subdivide + s.ms_raster,

@@ -314,6 +314,40 @@ impl GpuScene {
     }
 }
 
+impl GpuScene {
+    /// The scene as a level-of-detail selection draws it: the same vertices and materials, the
+    /// selection's triangles (a new index buffer, the only upload) and per-object factors on L.
+    pub fn with_lod(&self, gpu: &Gpu, selection: &crate::lod::LodSelection) -> GpuScene {
+        let buffer = |label: &str, bytes: &[u8], usage: wgpu::BufferUsages| {
+            let padded = if bytes.is_empty() { vec![0u8; 16] } else { bytes.to_vec() };
+            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: &padded,
+                usage,
+            })
+        };
+        let scales = selection.edge_scales();
+        GpuScene {
+            vertices: self.vertices.clone(),
+            indices: buffer(
+                "lod indices",
+                bytemuck::cast_slice(&selection.indices),
+                wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDEX,
+            ),
+            triangle_count: (selection.indices.len() / 3) as u32,
+            objects: self
+                .objects
+                .iter()
+                .zip(&selection.objects)
+                .map(|(&(_, _, c, r), o)| (o.first_triangle, o.triangle_count, c, r))
+                .collect(),
+            materials: self.materials.clone(),
+            warnings: self.warnings.clone(),
+            object_edge_scale: buffer("object edge scale", bytemuck::cast_slice(&scales), wgpu::BufferUsages::STORAGE),
+        }
+    }
+}
+
 /// Reusable GPU buffers of the subdivision, with their capacities.
 struct Buffers {
     pieces: wgpu::Buffer,
