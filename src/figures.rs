@@ -35,6 +35,8 @@ pub enum Figure {
     Fig8,
     Fig10,
     Fig12,
+    /// Seed 001's level-of-detail simulation (`bench_lod`).
+    Lod,
     All,
 }
 
@@ -268,7 +270,7 @@ pub fn match_width(scene: &str, adaptive_ms: f64, slits: &[Point]) -> Matched {
     Matched { scene: scene.to_string(), adaptive_ms, w_star, note }
 }
 
-fn write_csv(path: &Path, rows: &[impl Serialize]) -> Result<(), String> {
+pub(crate) fn write_csv(path: &Path, rows: &[impl Serialize]) -> Result<(), String> {
     let mut w = csv::Writer::from_writer(Vec::new());
     for r in rows {
         w.serialize(r).map_err(|e| format!("{}: {e}", path.display()))?;
@@ -277,7 +279,7 @@ fn write_csv(path: &Path, rows: &[impl Serialize]) -> Result<(), String> {
     crate::output::write_text(path, &String::from_utf8_lossy(&bytes))
 }
 
-fn write_png(path: &Path, img: image::RgbaImage) -> Result<(), String> {
+pub(crate) fn write_png(path: &Path, img: image::RgbaImage) -> Result<(), String> {
     let name = path.file_name().unwrap().to_string_lossy().into_owned();
     let dir = path.parent().unwrap_or(Path::new("."));
     let (w, h) = img.dimensions();
@@ -445,7 +447,8 @@ pub fn run(runner: &Runner, which: Figure, adapter: &str) -> Result<String, Stri
         if want(Figure::Fig10) || want(Figure::Fig12) { cases(cfg)? } else { (Vec::new(), Vec::new()) };
     let steps = (if want(Figure::Fig8) { 3 * cfg.fig8_divisions().len() } else { 0 })
         + (if want(Figure::Fig10) { cases.len() * cfg.fig10_methods().len() } else { 0 })
-        + (if want(Figure::Fig12) { cases.len() * (1 + cfg.slit_widths().len()) } else { 0 });
+        + (if want(Figure::Fig12) { cases.len() * (1 + cfg.slit_widths().len()) } else { 0 })
+        + (if want(Figure::Lod) { runner.lod_steps() } else { 0 });
     runner.progress.set_length(steps as u64);
     let mut report = format!(
         "# twister: the paper's evaluations (seed 002 §4)\n\nAdapter: {adapter}. Image {}x{} per eye, both eyes, R_T = {} m, d_e = {} m, \
@@ -528,6 +531,21 @@ pub fn run(runner: &Runner, which: Figure, adapter: &str) -> Result<String, Stri
              Sphere100 ran at 8.5 fps.\n\n{m}\n{}\n",
             table(&points, true)
         );
+    }
+    if want(Figure::Lod) {
+        match runner.lod()? {
+            Ok(points) => {
+                timing_note = timing_note.or_else(|| points.first().map(|p| p.timing.clone()));
+                report += &crate::bench_lod::report(&cfg.out, &points)?;
+            }
+            Err(absent) => {
+                report += &format!(
+                    "- **{absent}**
+
+"
+                )
+            }
+        }
     }
     if let Some(t) = timing_note {
         report += &format!(

@@ -13,6 +13,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod bench;
+pub mod bench_lod;
 pub mod builtin;
 pub mod compare;
 pub mod figures;

@@ -78,6 +78,8 @@ enum BenchCommand {
     Fig10(FigureArgs),
     /// Seed 002 Fig. 12: slit width vs adaptive, and the matched width.
     Fig12(FigureArgs),
+    /// Seed 001: 12 bunnies, the gaze swept, with and without the visual-field level of detail.
+    Lod(FigureArgs),
     /// All three figures.
     All(FigureArgs),
 }
@@ -554,6 +556,7 @@ fn main() -> ExitCode {
         Command::Bench(BenchCommand::Fig8(args)) => bench_figures(args, Figure::Fig8),
         Command::Bench(BenchCommand::Fig10(args)) => bench_figures(args, Figure::Fig10),
         Command::Bench(BenchCommand::Fig12(args)) => bench_figures(args, Figure::Fig12),
+        Command::Bench(BenchCommand::Lod(args)) => bench_figures(args, Figure::Lod),
         Command::Bench(BenchCommand::All(args)) => bench_figures(args, Figure::All),
     };
     match result {
