@@ -66,6 +66,23 @@ fn quick_benchmark_writes_every_output_well_formed() {
         }
         assert!(report.contains(s), "report.md lacks {s}");
     }
+    // Seed 001's level-of-detail simulation: two gazes, with and without.
+    if assets.join("stanford-bunny/bun_zipper_res4.obj").exists() {
+        let lod = csv_rows(
+            &out.join("lod.csv"),
+            &["gaze_yaw", "gaze_pitch", "lod", "triangles_in", "ms_frame", "central_mean_px"],
+        );
+        assert_eq!(lod.len(), 4, "two gazes × with/without");
+        for pair in lod.chunks(2) {
+            let tri = |r: &csv::StringRecord| r[3].parse::<u64>().unwrap();
+            assert_eq!((&pair[0][2], &pair[1][2]), ("false", "true"));
+            assert_eq!(tri(&pair[0]), 12 * 948, "without: all 12 bunnies");
+            assert!(tri(&pair[1]) < tri(&pair[0]), "{pair:?}");
+        }
+        assert!(report.contains("## Visual-field level of detail") && out.join("lod.png").exists());
+    } else {
+        assert!(report.contains("level-of-detail benchmark did not run"));
+    }
     let _ = std::fs::remove_dir_all(&out);
 }
 

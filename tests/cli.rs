@@ -286,3 +286,54 @@ fn scale_turns_scene_units_into_metres_which_sets_the_disparity() {
     assert_eq!(o.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&o.stderr).contains("--scale"));
 }
+
+#[test]
+fn lod_flags_render_an_overlay_and_report_the_selection() {
+    let out = tmp("lod");
+    let stats = out.join("stats.json");
+    let o = twister()
+        .args([
+            "render",
+            "builtin:demo",
+            "--width",
+            "400",
+            "--height",
+            "80",
+            "--lod",
+            "visual-field",
+            "--gaze",
+            "90,10",
+        ])
+        .args(["--lod-overlay", "--lod-p2", "0.4", "--lod-p3", "0.1", "--lod-dinf", "50", "--out"])
+        .arg(&out)
+        .arg("--stats")
+        .arg(&stats)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    let lod = &json["lod"];
+    let by_field: u64 =
+        ["central", "peripheral", "outside"].iter().map(|f| lod[f]["triangles"].as_u64().unwrap()).sum();
+    assert_eq!(by_field, lod["triangles_selected"].as_u64().unwrap());
+    assert_eq!(json["triangles_in"], lod["triangles_selected"]);
+    // The overlay: white pixels (the central field's boundary) around 90° left of centre.
+    let img = image::open(out.join("left.png")).unwrap().to_rgba8();
+    let white: Vec<u32> =
+        img.enumerate_pixels().filter(|(_, _, p)| p.0 == [255, 255, 255, 255]).map(|(x, _, _)| x).collect();
+    assert!(!white.is_empty());
+    let (lo, hi) = (white.iter().min().unwrap(), white.iter().max().unwrap());
+    // The central field spans ±30° around 90° left: columns 400·(0.5 − 120/360) .. 400·(0.5 − 60/360).
+    assert!(*lo >= 60 && *hi <= 140, "central boundary at columns {lo}..{hi}");
+    let _ = std::fs::remove_dir_all(&out);
+    for (args, needle) in [
+        (&["render", "--lod-overlay"][..], "--lod-overlay needs --lod visual-field"),
+        (&["render", "--lod", "visual-field", "--gaze", "1,2,3"][..], "YAW,PITCH"),
+        (&["render", "--lod", "visual-field", "--lod-p3", "0.5", "--lod-p2", "0.3"][..], "P3"),
+    ] {
+        let o = twister().args(args).args(["--out", "/nonexistent/x"]).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code().map(|c| c != 0), Some(true), "{args:?}");
+        assert!(err.contains(needle) && !err.contains("panicked"), "{args:?}: {err}");
+    }
+}
