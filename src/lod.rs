@@ -14,7 +14,7 @@
 //! would otherwise get a negative count).
 //!
 //! Simplified meshes come from meshoptimizer's quadric-error simplifier (the Garland–Heckbert QEM
-//! the paper used): a chain of levels, each about half the triangles of the one before, built once
+//! the paper used): a chain of levels, each about `LEVEL_RATIO` (0.7) of the triangles of the one before, built once
 //! per object down to P3 and cached. A frame draws, for each object, the coarsest level that still
 //! has at least P_m triangles. The levels reuse the object's vertices, so UVs, normals and colours
 //! stay as they were at the vertices the simplifier keeps.
@@ -30,6 +30,9 @@ use crate::scene::{Object, Scene};
 use crate::slit::object_spheres;
 use crate::visual_field::{Field, Gaze};
 
+/// Each simplified level aims at this share of the triangles of the level before: close enough
+/// that the coarsest level meeting a budget is at most ~1.4× the budget.
+pub const LEVEL_RATIO: f32 = 0.7;
 /// The most the peripheral field relaxes L (at the field's boundary).
 pub const MAX_EDGE_RELAXATION: f32 = 4.0;
 /// The factor on L that means "do not split" (outside the visual field).
@@ -106,7 +109,7 @@ pub struct LodSelection {
 }
 
 impl LodChain {
-    /// Simplifies every object down to `min_share` of its triangles, halving at each level.
+    /// Simplifies every object down to `min_share` of its triangles, each level `LEVEL_RATIO` of the last.
     pub fn build(scene: &Scene, min_share: f32) -> LodChain {
         let bytes: &[u8] = bytemuck::cast_slice(&scene.vertices);
         let stride = std::mem::size_of::<crate::gpu_types::SceneVertex>();
@@ -125,7 +128,7 @@ impl LodChain {
                     if count <= floor {
                         break;
                     }
-                    let target = (count / 2).max(floor);
+                    let target = ((count as f32 * LEVEL_RATIO) as usize).max(floor);
                     let next =
                         meshopt::simplify(last, &adapter, 3 * target, 1.0, meshopt::SimplifyOptions::Sparse, None);
                     // Stop where the simplifier can no longer make real progress.
