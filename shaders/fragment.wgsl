@@ -23,6 +23,11 @@ struct FragmentOut {
 
 // ---- Materials and textures (layout: src/gpu_types.rs, packing: src/texture.rs) ----
 
+// false: every material of the scene is untextured, opaque and double-sided, so a fragment's
+// colour is its vertex colour and nothing is discarded; the renderer then compiles the material
+// code out (a pipeline constant), which restores early depth testing.
+override MATERIALS: bool = true;
+
 const NO_TEXTURE: u32 = 0xffffffffu;
 const WRAP_CLAMP: u32 = 1u;
 const WRAP_MIRROR: u32 = 2u;
@@ -61,10 +66,6 @@ struct MipLevel {
 
 fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
     return select(pow((c + 0.055) / 1.055, vec3<f32>(2.4)), c / 12.92, c <= vec3<f32>(0.04045));
-}
-
-fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
-    return select(1.055 * pow(c, vec3<f32>(1.0 / 2.4)) - 0.055, c * 12.92, c <= vec3<f32>(0.0031308));
 }
 
 fn euclid_mod(i: i32, n: i32) -> i32 {
@@ -154,6 +155,9 @@ fn blend_threshold(frag_xy: vec2<f32>) -> f32 {
 // face seen from behind, alpha below the MASK cutoff, a BLEND fragment the screen door leaves out).
 fn surface_color(material: u32, color: vec4<f32>, uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>,
                  frag_xy: vec2<f32>, front_facing: bool) -> vec4<f32> {
+    if (!MATERIALS) {
+        return color;
+    }
     let m = materials[min(material, arrayLength(&materials) - 1u)];
     if (m.double_sided == 0u && !front_facing) {
         return vec4<f32>(-1.0);
@@ -169,8 +173,8 @@ fn surface_color(material: u32, color: vec4<f32>, uv: vec2<f32>, duv_dx: vec2<f3
     return vec4<f32>(c.rgb, max(c.a, 0.0));
 }
 
-// Linear colour × (ambient + (1 − ambient)·|n·l|), the light at the viewer, two-sided, encoded
-// as sRGB for the colour target (which holds display values).
+// Linear colour × (ambient + (1 − ambient)·|n·l|), the light at the viewer, two-sided. The
+// colour target is sRGB: it encodes what this returns (the CPU twin encodes explicitly).
 fn shade(ambient: f32, view_position: vec3<f32>, normal: vec3<f32>, color: vec4<f32>) -> vec4<f32> {
     let n_len = length(normal);
     var lambert = 1.0;
@@ -178,7 +182,7 @@ fn shade(ambient: f32, view_position: vec3<f32>, normal: vec3<f32>, color: vec4<
         lambert = abs(dot(normal / n_len, -normalize(view_position)));
     }
     let lit = clamp(color.rgb * (ambient + (1.0 - ambient) * lambert), vec3<f32>(0.0), vec3<f32>(1.0));
-    return vec4<f32>(linear_to_srgb(lit), 1.0);
+    return vec4<f32>(lit, 1.0);
 }
 
 // Distance in pixels between the pixel centre `frag_xy` where surface point p was drawn and
@@ -222,7 +226,7 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @locatio
     let duv_dx = dpdx(in.uv);
     let duv_dy = dpdy(in.uv);
     let c = surface_color(in.material, in.color, in.uv, duv_dx, duv_dy, in.clip.xy, front_facing);
-    if (c.a < 0.0) {
+    if (MATERIALS && c.a < 0.0) {
         discard;
     }
     return shade(params.ambient, in.view_position, in.normal, c);
@@ -234,7 +238,7 @@ fn fs_error(in: VertexOut, @builtin(front_facing) front_facing: bool) -> Fragmen
     let duv_dx = dpdx(in.uv);
     let duv_dy = dpdy(in.uv);
     let c = surface_color(in.material, in.color, in.uv, duv_dx, duv_dy, in.clip.xy, front_facing);
-    if (c.a < 0.0) {
+    if (MATERIALS && c.a < 0.0) {
         discard;
     }
     return fragment_out(params.projection, params.eye_sign, params.ambient, in.clip.xy, in.view_position, in.normal,

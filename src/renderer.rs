@@ -24,7 +24,9 @@ use crate::slit::{object_spheres, slit_params, slits, sphere_in_slit, SlitCamera
 use crate::subdivide::{subdivide_params, Method, SubdivideOutput, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV};
 use crate::texture::MaterialTable;
 
-pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+/// The colour target holds display (sRGB-encoded) values; the fragment stage writes linear light
+/// and the target encodes it (cheaper than encoding in the shader on lavapipe).
+pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 pub const OBJECT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 const DRAW_VERTEX_SIZE: u64 = std::mem::size_of::<DrawVertex>() as u64;
@@ -244,6 +246,9 @@ pub struct GpuScene {
     pub warnings: Vec<String>,
     /// Per object: the factor on L of the adaptive subdivision (1; the level of detail sets it).
     pub object_edge_scale: wgpu::Buffer,
+    /// Whether some material is textured, not opaque or single-sided (else the drawing stages
+    /// use their plain pipelines).
+    pub needs_materials: bool,
 }
 
 impl GpuScene {
@@ -302,6 +307,7 @@ impl GpuScene {
             storage("texels", bytemuck::cast_slice(&table.texels)),
         ];
         let ones = vec![1.0f32; scene.objects.len().max(1)];
+        let needs_materials = table.needs_materials();
         Ok(GpuScene {
             vertices,
             indices,
@@ -310,6 +316,7 @@ impl GpuScene {
             materials,
             warnings: table.warnings,
             object_edge_scale: storage("object edge scale", bytemuck::cast_slice(&ones)),
+            needs_materials,
         })
     }
 }
@@ -344,8 +351,91 @@ impl GpuScene {
             materials: self.materials.clone(),
             warnings: self.warnings.clone(),
             object_edge_scale: buffer("object edge scale", bytemuck::cast_slice(&scales), wgpu::BufferUsages::STORAGE),
+            needs_materials: self.needs_materials,
         }
     }
+}
+
+/// The two drawing stages.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum DrawStage {
+    Raster = 0,
+    Slit = 1,
+}
+
+/// A drawing pipeline: colour only (`fs_main`) or with the error pass (`fs_error`); with the
+/// fragment stage's material code (`MATERIALS`) or without.
+fn draw_pipeline(
+    gpu: &Gpu,
+    module: &wgpu::ShaderModule,
+    stage: DrawStage,
+    measure: bool,
+    materials: bool,
+) -> wgpu::RenderPipeline {
+    // Raster: the subdivided `DrawVertex`; slit: the scene's `SceneVertex` (see gpu_types.rs).
+    let draw_attributes = wgpu::vertex_attr_array![
+        0 => Float32x3, 1 => Float32, 2 => Float32x3, 3 => Uint32, 4 => Float32x4, 5 => Float32x2, 6 => Uint32
+    ];
+    let scene_attributes = [
+        wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 0, shader_location: 0 },
+        wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 16, shader_location: 1 },
+        wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x4, offset: 32, shader_location: 2 },
+        wgpu::VertexAttribute { format: wgpu::VertexFormat::Uint32, offset: 28, shader_location: 3 },
+        wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x2, offset: 48, shader_location: 4 },
+        wgpu::VertexAttribute { format: wgpu::VertexFormat::Uint32, offset: 12, shader_location: 5 },
+    ];
+    let (label, layout) = match stage {
+        DrawStage::Raster => (
+            "raster",
+            wgpu::VertexBufferLayout {
+                array_stride: DRAW_VERTEX_SIZE,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &draw_attributes,
+            },
+        ),
+        DrawStage::Slit => (
+            "slit",
+            wgpu::VertexBufferLayout {
+                array_stride: std::mem::size_of::<crate::gpu_types::SceneVertex>() as u64,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &scene_attributes,
+            },
+        ),
+    };
+    let all_targets = [COLOR_FORMAT, gpu.error_target.format(), OBJECT_FORMAT]
+        .map(|format| Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL }));
+    let constants = [("MATERIALS", materials as u32 as f64)];
+    gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: None,
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[Some(layout)],
+        },
+        primitive: wgpu::PrimitiveState {
+            topology: wgpu::PrimitiveTopology::TriangleList,
+            cull_mode: None,
+            ..Default::default()
+        },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some(if measure { "fs_error" } else { "fs_main" }),
+            compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
+            targets: if measure { &all_targets } else { &all_targets[..1] },
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
 }
 
 /// Reusable GPU buffers of the subdivision, with their capacities.
@@ -366,9 +456,16 @@ pub struct Renderer {
     lattice: wgpu::ComputePipeline,
     lattice_args: wgpu::ComputePipeline,
     finalize: wgpu::ComputePipeline,
-    /// Drawing pipelines, [colour only, with the error pass].
+    /// Drawing pipelines, [colour only, with the error pass], for scenes whose materials are all
+    /// plain (untextured, opaque, double-sided): the fragment stage's material code is compiled
+    /// out (`MATERIALS = false`), which on lavapipe roughly halves the fragment cost.
     raster: [wgpu::RenderPipeline; 2],
     slit: [wgpu::RenderPipeline; 2],
+    raster_module: wgpu::ShaderModule,
+    slit_module: wgpu::ShaderModule,
+    /// The same with the material code ([raster, slit] × [colour only, error pass]), made when
+    /// a scene first needs them.
+    with_materials: std::sync::OnceLock<[[wgpu::RenderPipeline; 2]; 2]>,
     accumulate: wgpu::ComputePipeline,
     finish: wgpu::ComputePipeline,
     buffers: std::sync::Mutex<Option<Buffers>>,
@@ -400,67 +497,10 @@ impl Renderer {
         let lattice = compute("lattice");
         let finalize = compute("finalize");
         let lattice_args = compute("lattice_args");
-        let all_targets = [COLOR_FORMAT, gpu.error_target.format(), OBJECT_FORMAT]
-            .map(|format| Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL }));
-        // A drawing pipeline, colour only (`fs_main`) or with the error pass (`fs_error`).
-        let draw = |module: &wgpu::ShaderModule, label: &str, layout: wgpu::VertexBufferLayout, measure: bool| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: None,
-                vertex: wgpu::VertexState {
-                    module,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
-                    buffers: &[Some(layout)],
-                },
-                primitive: wgpu::PrimitiveState {
-                    topology: wgpu::PrimitiveTopology::TriangleList,
-                    cull_mode: None,
-                    ..Default::default()
-                },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::Less),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module,
-                    entry_point: Some(if measure { "fs_error" } else { "fs_main" }),
-                    compilation_options: Default::default(),
-                    targets: if measure { &all_targets } else { &all_targets[..1] },
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        };
         let raster_module = shaders::load(device, &shaders::RASTER, gpu.error_target);
-        let draw_attributes = wgpu::vertex_attr_array![
-            0 => Float32x3, 1 => Float32, 2 => Float32x3, 3 => Uint32, 4 => Float32x4, 5 => Float32x2, 6 => Uint32
-        ];
-        let draw_layout = || wgpu::VertexBufferLayout {
-            array_stride: DRAW_VERTEX_SIZE,
-            step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &draw_attributes,
-        };
-        let raster = [false, true].map(|m| draw(&raster_module, "raster", draw_layout(), m));
+        let raster = [false, true].map(|m| draw_pipeline(&gpu, &raster_module, DrawStage::Raster, m, false));
         let slit_module = shaders::load(device, &shaders::SLIT, gpu.error_target);
-        let scene_attributes = [
-            wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 0, shader_location: 0 },
-            wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x3, offset: 16, shader_location: 1 },
-            wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x4, offset: 32, shader_location: 2 },
-            wgpu::VertexAttribute { format: wgpu::VertexFormat::Uint32, offset: 28, shader_location: 3 },
-            wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32x2, offset: 48, shader_location: 4 },
-            wgpu::VertexAttribute { format: wgpu::VertexFormat::Uint32, offset: 12, shader_location: 5 },
-        ];
-        let scene_layout = || wgpu::VertexBufferLayout {
-            array_stride: std::mem::size_of::<crate::gpu_types::SceneVertex>() as u64,
-            step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &scene_attributes,
-        };
-        let slit = [false, true].map(|m| draw(&slit_module, "slit", scene_layout(), m));
+        let slit = [false, true].map(|m| draw_pipeline(&gpu, &slit_module, DrawStage::Slit, m, false));
         let reduce_module = shaders::load(device, &shaders::REDUCE_ERROR, gpu.error_target);
         let reduce = |entry: &str| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
@@ -482,6 +522,9 @@ impl Renderer {
             finalize,
             raster,
             slit,
+            raster_module,
+            slit_module,
+            with_materials: Default::default(),
             accumulate,
             finish,
             buffers: std::sync::Mutex::new(None),
@@ -815,7 +858,8 @@ impl Renderer {
             .map(|t| t.create_view(&Default::default()))
             .collect();
         let depth_view = targets.depth[k].create_view(&Default::default());
-        let [r, g, b] = settings.background.map(|c| c as f64);
+        // The background is given as display values; the sRGB target takes linear ones.
+        let [r, g, b] = settings.background.map(|c| crate::fragment::srgb_to_linear(c) as f64);
         let no_error = match self.gpu.error_target {
             crate::shaders::ErrorTarget::Float => -1.0,
             crate::shaders::ErrorTarget::UintBits => (-1.0f32).to_bits() as f64,
@@ -869,7 +913,7 @@ impl Renderer {
         clear: bool,
         timestamps: Option<(&wgpu::QuerySet, u32, u32)>,
     ) {
-        let pipeline = &self.raster[settings.measure_error as usize];
+        let pipeline = self.draw_pipeline(DrawStage::Raster, scene, settings.measure_error);
         for (k, eye) in Eye::BOTH.into_iter().enumerate() {
             let uniform = self.uniform("raster params", &settings.raster_params(eye));
             let bg = self.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -889,6 +933,22 @@ impl Renderer {
             pass.set_vertex_buffer(0, buffers.triangles.slice(..));
             pass.draw_indirect(&buffers.draw_args, 0);
         }
+    }
+
+    /// The drawing pipeline for a scene: plain where its materials allow, else with materials.
+    fn draw_pipeline(&self, stage: DrawStage, scene: &GpuScene, measure: bool) -> &wgpu::RenderPipeline {
+        let m = measure as usize;
+        if !scene.needs_materials {
+            return match stage {
+                DrawStage::Raster => &self.raster[m],
+                DrawStage::Slit => &self.slit[m],
+            };
+        }
+        let all = self.with_materials.get_or_init(|| {
+            [(DrawStage::Raster, &self.raster_module), (DrawStage::Slit, &self.slit_module)]
+                .map(|(s, module)| [false, true].map(|m| draw_pipeline(&self.gpu, module, s, m, true)))
+        });
+        &all[stage as usize][m]
     }
 
     /// The material table of a scene bound for a drawing pipeline (group 1).
@@ -1063,7 +1123,7 @@ impl Renderer {
             });
             let bg = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: None,
-                layout: &self.slit[settings.measure_error as usize].get_bind_group_layout(0),
+                layout: &self.draw_pipeline(DrawStage::Slit, scene, settings.measure_error).get_bind_group_layout(0),
                 entries: &[
                     wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 1, resource: camera_buffer.as_entire_binding() },
@@ -1075,7 +1135,7 @@ impl Renderer {
                 end_of_pass_write_index: (k == 1).then_some(1),
             });
             let mut pass = self.begin_eye_pass(&mut enc, &targets, k, settings, true, writes);
-            let pipeline = &self.slit[settings.measure_error as usize];
+            let pipeline = self.draw_pipeline(DrawStage::Slit, scene, settings.measure_error);
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &bg, &[]);
             pass.set_bind_group(1, &self.material_bind_group(pipeline, scene), &[]);

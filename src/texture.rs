@@ -80,6 +80,14 @@ impl MaterialTable {
         MaterialTable::build(&scene.materials, &scene.textures, max_texels)
     }
 
+    /// Whether any material needs the fragment stage's material code: textured, not opaque, or
+    /// single-sided. (Otherwise a fragment's colour is its vertex colour.)
+    pub fn needs_materials(&self) -> bool {
+        self.materials.iter().any(|m| {
+            m.texture != NO_TEXTURE || m.alpha_mode != crate::gpu_types::AlphaMode::Opaque as u32 || m.double_sided == 0
+        })
+    }
+
     /// Packs a scene's materials and textures, keeping at most `max_texels` texels: while over,
     /// the texture with the largest top level loses that level (with a warning).
     pub fn build(materials: &[Material], textures: &[Texture], max_texels: usize) -> MaterialTable {
