@@ -1,7 +1,7 @@
 // Shared fragment work of the drawing stages (raster, slit), composed in after projection.wgsl:
 // their varyings, the surface colour (material: base colour texture with its sampler, alpha
-// mask / screen-door blend, single-sided culling), headlight shading in linear light written
-// sRGB-encoded, the display-position error of seed 002 §4.1, the output targets and the
+// mask / screen-door blend, single-sided culling), headlight shading in linear light (the sRGB
+// colour target encodes it), the display-position error of seed 002 §4.1, the output targets and the
 // fragment entry points. CPU twins: src/fragment.rs (sampling, shading, error).
 //
 // Contract: a stage composing this module declares a uniform `params` with the fields

@@ -85,8 +85,8 @@ fn sample_level(table: &MaterialTable, m: &Material, level: u32, uv: Vec2, filte
         (p.floor(), Vec2::ZERO)
     };
     let mut sum = Vec4::ZERO;
-    for corner in 0..4 {
-        let (dx, dy) = ((corner & 1) as i32, (corner >> 1) as i32);
+    for corner in 0..4i32 {
+        let (dx, dy) = (corner & 1, corner >> 1);
         let weight = (if dx == 1 { f.x } else { 1.0 - f.x }) * (if dy == 1 { f.y } else { 1.0 - f.y });
         let x = wrap_index(base.x as i32 + dx, w, m.wrap_u);
         let y = wrap_index(base.y as i32 + dy, h, m.wrap_v);

@@ -200,9 +200,13 @@ fn gltf_texture(name: String, data: &gltf::image::Data) -> Result<Texture, Strin
     Ok(Texture { name, width: data.width, height: data.height, rgba })
 }
 
+/// A glTF material as twister draws it, its base colour texture's TEXCOORD set and texture
+/// transform (rows of a 2×3 affine matrix).
+type GltfMaterial = (Material, u32, Option<[[f32; 3]; 2]>);
+
 /// A glTF material as twister draws it, and the TEXCOORD set and `KHR_texture_transform`
 /// (u' = offset + R(rotation)·(scale·u)) of its base colour texture.
-fn gltf_material(material: &gltf::Material) -> (Material, u32, Option<[[f32; 3]; 2]>) {
+fn gltf_material(material: &gltf::Material) -> GltfMaterial {
     use gltf::texture::{MagFilter, MinFilter, WrappingMode};
     let mut m = Material {
         alpha_mode: match material.alpha_mode() {
@@ -301,7 +305,7 @@ pub fn load_gltf(path: &Path) -> Result<Scene, String> {
     }
     // glTF material k is scene material k; primitives without one share the spec's default
     // material (single-sided, opaque), appended at the end.
-    let materials: Vec<(Material, u32, Option<[[f32; 3]; 2]>)> = doc.materials().map(|m| gltf_material(&m)).collect();
+    let materials: Vec<GltfMaterial> = doc.materials().map(|m| gltf_material(&m)).collect();
     scene.materials = materials.iter().map(|m| m.0).collect();
     if let Some(p) = doc.meshes().flat_map(|m| m.primitives()).find(|p| p.material().index().is_none()) {
         scene.materials.push(gltf_material(&p.material()).0);
@@ -379,7 +383,7 @@ fn add_gltf_primitive(
     buffers: &[gltf::buffer::Data],
     world: Mat4,
     label: &str,
-    materials: &[(Material, u32, Option<[[f32; 3]; 2]>)],
+    materials: &[GltfMaterial],
 ) -> Result<(), String> {
     use gltf::mesh::Mode;
     let mode = prim.mode();

@@ -194,8 +194,8 @@ pub fn tint(scene: &mut Scene, selection: &LodSelection) {
             Field::Peripheral => [0.9, 0.15 + 0.65 * c.level, 0.02],
             Field::Outside => [0.3, 0.0, 0.0],
         };
-        for k in 0..3 {
-            v.color[k] = 0.35 * v.color[k] + 0.65 * t[k];
+        for (c, t) in v.color.iter_mut().zip(t) {
+            *c = 0.35 * *c + 0.65 * t;
         }
     }
 }

@@ -903,6 +903,7 @@ impl Renderer {
 
     /// Encodes the raster of both eyes (clearing the targets first if `clear`); with a query
     /// set, writes timestamps at the start of the first eye's pass and the end of the second's.
+    #[allow(clippy::too_many_arguments)]
     fn encode_raster(
         &self,
         enc: &mut wgpu::CommandEncoder,

@@ -20,6 +20,7 @@ const BG: [f32; 3] = [0.0, 0.0, 0.0];
 
 /// A quad facing the viewer at depth `z` (x0..x1 × y0..y1), counter-clockwise as seen from the
 /// viewer unless `reversed`; uv = `uv0` at the top-left corner to `uv1` at the bottom-right.
+#[allow(clippy::too_many_arguments)]
 fn quad(
     scene: &mut Scene,
     name: &str,
