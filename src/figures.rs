@@ -533,19 +533,9 @@ pub fn run(runner: &Runner, which: Figure, adapter: &str) -> Result<String, Stri
         );
     }
     if want(Figure::Lod) {
-        match runner.lod()? {
-            Ok(points) => {
-                timing_note = timing_note.or_else(|| points.first().map(|p| p.timing.clone()));
-                report += &crate::bench_lod::report(&cfg.out, &points)?;
-            }
-            Err(absent) => {
-                report += &format!(
-                    "- **{absent}**
-
-"
-                )
-            }
-        }
+        let (points, absent) = runner.lod()?;
+        timing_note = timing_note.or_else(|| points.first().map(|p| p.timing.clone()));
+        report += &crate::bench_lod::report(&cfg.out, &points, &absent)?;
     }
     if let Some(t) = timing_note {
         report += &format!(

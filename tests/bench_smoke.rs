@@ -66,23 +66,23 @@ fn quick_benchmark_writes_every_output_well_formed() {
         }
         assert!(report.contains(s), "report.md lacks {s}");
     }
-    // Seed 001's level-of-detail simulation: two gazes, with and without.
-    if assets.join("stanford-bunny/bun_zipper_res4.obj").exists() {
-        let lod = csv_rows(
-            &out.join("lod.csv"),
-            &["gaze_yaw", "gaze_pitch", "lod", "triangles_in", "ms_frame", "central_mean_px"],
-        );
-        assert_eq!(lod.len(), 4, "two gazes × with/without");
-        for pair in lod.chunks(2) {
-            let tri = |r: &csv::StringRecord| r[3].parse::<u64>().unwrap();
-            assert_eq!((&pair[0][2], &pair[1][2]), ("false", "true"));
-            assert_eq!(tri(&pair[0]), 12 * 948, "without: all 12 bunnies");
-            assert!(tri(&pair[1]) < tri(&pair[0]), "{pair:?}");
-        }
-        assert!(report.contains("## Visual-field level of detail") && out.join("lod.png").exists());
-    } else {
-        assert!(report.contains("level-of-detail benchmark did not run"));
+    // Seed 001's level-of-detail simulation: per ring, two gazes × off / polygons / polygons+subdivision.
+    let lod = csv_rows(
+        &out.join("lod.csv"),
+        &["scene", "gaze_yaw", "gaze_pitch", "config", "triangles_in", "triangles_out", "ms_frame", "central_mean_px"],
+    );
+    let bunnies = assets.join("stanford-bunny/bun_zipper_res4.obj").exists();
+    assert_eq!(lod.len(), if bunnies { 2 } else { 1 } * 2 * 3);
+    for run in lod.chunks(3) {
+        let tri = |r: &csv::StringRecord| r[4].parse::<u64>().unwrap();
+        let central = |r: &csv::StringRecord| r[9].parse::<f64>().unwrap();
+        assert_eq!((&run[0][3], &run[1][3], &run[2][3]), ("off", "polygons", "polygons+subdivision"));
+        assert_eq!(tri(&run[0]), 12 * if run[0][0].contains("bunny") { 948 } else { 100 }, "{run:?}");
+        assert!(tri(&run[1]) < tri(&run[0]) && tri(&run[2]) == tri(&run[1]), "{run:?}");
+        assert!(central(&run[1]) <= central(&run[0]) * 1.05 + 1e-3, "central error grew: {run:?}");
     }
+    assert!(report.contains("## Visual-field level of detail") && out.join("lod.png").exists());
+    assert_eq!(report.contains("bunny ring of the level-of-detail benchmark did not run"), !bunnies);
     let _ = std::fs::remove_dir_all(&out);
 }
 
