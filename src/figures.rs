@@ -543,7 +543,7 @@ pub fn run(runner: &Runner, which: Figure, adapter: &str) -> Result<String, Stri
             if t == "gpu-timestamps" {
                 "GPU timestamp queries (start of the first pass to the end of the last)"
             } else {
-                "wall time around submit-and-wait (the adapter has no timestamp queries)"
+                "wall time around submit-and-wait (no GPU timestamps: the adapter lacks them, or frames ran in several submissions; the `timing` column of the CSV says per point)"
             }
         );
     }
