@@ -113,6 +113,8 @@ var<private> tri_color: array<vec4<f32>, 3>;
 var<private> tri_uv: array<vec2<f32>, 3>;
 var<private> tri_material: u32;
 var<private> tri_object: u32;
+// L for this triangle: params.edge_px × its object's factor (read once in `load_triangle`).
+var<private> tri_edge_px: f32;
 var<private> tri_n: array<u32, 3>;    // divisions of edges P0P1, P1P2, P2P0
 var<private> tri_k: u32;              // macro-lattice level
 
@@ -210,15 +212,14 @@ fn edge_divisions(a: vec3<f32>, b: vec3<f32>) -> u32 {
     }
     // Quick 2-segment length first; the 8-segment polyline refines it, so it is never shorter.
     // (One call site in a loop: lavapipe's compiler inlines every call.)
-    let edge_px = params.edge_px * object_edge_scale[min(tri_object, arrayLength(&object_edge_scale) - 1u)];
     var length_px = 0.0;
     for (var round = 0u; round < 2u; round++) {
         length_px = edge_length_px(a, b, select(2u, EDGE_SAMPLES, round == 1u));
-        if (round == 0u && length_px <= 0.5 * edge_px) {
+        if (round == 0u && length_px <= 0.5 * tri_edge_px) {
             return 1u;
         }
     }
-    let n = ceil(length_px / edge_px);
+    let n = ceil(length_px / tri_edge_px);
     if (n >= f32(MAX_EDGE_DIVISIONS) || !(n == n)) {
         return MAX_EDGE_DIVISIONS;
     }
@@ -249,6 +250,7 @@ fn load_triangle(t: u32) {
     }
     tri_material = vertices[indices[3u * t]].material;
     tri_object = vertices[indices[3u * t]].object;
+    tri_edge_px = params.edge_px * object_edge_scale[min(tri_object, arrayLength(&object_edge_scale) - 1u)];
 }
 
 fn plan_triangle() {

@@ -147,11 +147,20 @@ fn rasterize_clipped(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: (u32,
     let max_x = s.iter().map(|p| p[0]).fold(f32::MIN, f32::max).ceil().min(scissor.1.min(w) as f32) as i64;
     let min_y = s.iter().map(|p| p[1]).fold(f32::MAX, f32::min).floor().max(0.0) as i64;
     let max_y = s.iter().map(|p| p[1]).fold(f32::MIN, f32::max).ceil().min(h as f32) as i64;
+    // Screen-space barycentric weights of a point, and their perspective-correct form.
+    let barycentric = |qx: f32, qy: f32| {
+        let edge = |a: [f32; 2], b: [f32; 2]| (b[0] - a[0]) * (qy - a[1]) - (b[1] - a[1]) * (qx - a[0]);
+        [edge(s[1], s[2]) / area, edge(s[2], s[0]) / area, edge(s[0], s[1]) / area]
+    };
+    let perspective = |b: [f32; 3]| {
+        let pw = [0, 1, 2].map(|k| b[k] / tri[k].clip.w);
+        let sum: f32 = pw.iter().sum();
+        pw.map(|w| w / sum)
+    };
     for y in min_y..max_y {
         for x in min_x..max_x {
             let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
-            let edge = |a: [f32; 2], b: [f32; 2]| (b[0] - a[0]) * (py - a[1]) - (b[1] - a[1]) * (px - a[0]);
-            let b = [edge(s[1], s[2]) / area, edge(s[2], s[0]) / area, edge(s[0], s[1]) / area];
+            let b = barycentric(px, py);
             if b.iter().any(|&x| x < 0.0) {
                 continue;
             }
@@ -160,16 +169,9 @@ fn rasterize_clipped(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: (u32,
             if !(z < img.depth[i]) || !(z >= 0.0) {
                 continue;
             }
-            // Perspective-correct weights at a point of the screen (also one pixel right and
-            // down, for the derivatives of uv).
-            let weights = |qx: f32, qy: f32| {
-                let edge = |a: [f32; 2], b: [f32; 2]| (b[0] - a[0]) * (qy - a[1]) - (b[1] - a[1]) * (qx - a[0]);
-                let b = [edge(s[1], s[2]) / area, edge(s[2], s[0]) / area, edge(s[0], s[1]) / area];
-                let pw = [0, 1, 2].map(|k| b[k] / tri[k].clip.w);
-                let sum: f32 = pw.iter().sum();
-                pw.map(|w| w / sum)
-            };
-            let pw = weights(px, py);
+            // Perspective-correct weights here (and one pixel right and down, for the
+            // derivatives of uv).
+            let pw = perspective(b);
             let mix3 = |f: &dyn Fn(&ClipVertex) -> Vec3| (0..3).map(|k| pw[k] * f(&tri[k])).sum::<Vec3>();
             let uv_at = |w: [f32; 3]| (0..3).map(|k| w[k] * tri[k].uv).sum::<Vec2>();
             let uv = uv_at(pw);
@@ -180,8 +182,8 @@ fn rasterize_clipped(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: (u32,
                     material: tri[0].material,
                     color: (0..3).map(|k| pw[k] * tri[k].color).sum::<Vec4>(),
                     uv,
-                    duv_dx: uv_at(weights(px + 1.0, py)) - uv,
-                    duv_dy: uv_at(weights(px, py + 1.0)) - uv,
+                    duv_dx: uv_at(perspective(barycentric(px + 1.0, py))) - uv,
+                    duv_dy: uv_at(perspective(barycentric(px, py + 1.0))) - uv,
                     frag_xy: Vec2::new(px, py),
                     // Counter-clockwise in normalized device coordinates (y up) is clockwise
                     // on the pixel grid (y down): negative `area`.

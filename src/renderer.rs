@@ -268,39 +268,28 @@ impl GpuScene {
                 max >> 20
             ));
         }
-        let pad = |b: &[u8]| {
-            if b.is_empty() {
-                vec![0u8; 16]
-            } else {
-                b.to_vec()
-            }
-        };
-        let vertices = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("scene vertices"),
-            contents: &pad(bytemuck::cast_slice(&scene.vertices)),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX,
-        });
-        let indices = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("scene indices"),
-            contents: &pad(bytemuck::cast_slice(&scene.indices)),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDEX,
-        });
+        let vertices = init_buffer(
+            gpu,
+            "scene vertices",
+            bytemuck::cast_slice(&scene.vertices),
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX,
+        );
+        let indices = init_buffer(
+            gpu,
+            "scene indices",
+            bytemuck::cast_slice(&scene.indices),
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDEX,
+        );
         let objects = scene
             .objects
             .iter()
             .zip(object_spheres(scene))
             .map(|(o, (c, r))| (o.first_triangle, o.triangle_count, c, r))
             .collect();
-        // Textures get at most a quarter of the device's largest binding (levels are dropped,
-        // largest first, with a warning).
+        // Textures get at most a quarter of the device's largest binding (max/16 texels of 4
+        // bytes; levels are dropped, largest first, with a warning).
         let table = MaterialTable::of(scene, (max / 16) as usize);
-        let storage = |label: &str, bytes: &[u8]| {
-            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents: &pad(bytes),
-                usage: wgpu::BufferUsages::STORAGE,
-            })
-        };
+        let storage = |label: &str, bytes: &[u8]| init_buffer(gpu, label, bytes, wgpu::BufferUsages::STORAGE);
         let materials = [
             storage("materials", bytemuck::cast_slice(&table.materials)),
             storage("mip levels", bytemuck::cast_slice(&table.mips)),
@@ -325,18 +314,11 @@ impl GpuScene {
     /// The scene as a level-of-detail selection draws it: the same vertices and materials, the
     /// selection's triangles (a new index buffer, the only upload) and per-object factors on L.
     pub fn with_lod(&self, gpu: &Gpu, selection: &crate::lod::LodSelection) -> GpuScene {
-        let buffer = |label: &str, bytes: &[u8], usage: wgpu::BufferUsages| {
-            let padded = if bytes.is_empty() { vec![0u8; 16] } else { bytes.to_vec() };
-            gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents: &padded,
-                usage,
-            })
-        };
         let scales = selection.edge_scales();
         GpuScene {
             vertices: self.vertices.clone(),
-            indices: buffer(
+            indices: init_buffer(
+                gpu,
                 "lod indices",
                 bytemuck::cast_slice(&selection.indices),
                 wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDEX,
@@ -350,10 +332,21 @@ impl GpuScene {
                 .collect(),
             materials: self.materials.clone(),
             warnings: self.warnings.clone(),
-            object_edge_scale: buffer("object edge scale", bytemuck::cast_slice(&scales), wgpu::BufferUsages::STORAGE),
+            object_edge_scale: init_buffer(
+                gpu,
+                "object edge scale",
+                bytemuck::cast_slice(&scales),
+                wgpu::BufferUsages::STORAGE,
+            ),
             needs_materials: self.needs_materials,
         }
     }
+}
+
+/// A buffer holding `bytes` (16 zero bytes when empty: bindings may not be empty).
+fn init_buffer(gpu: &Gpu, label: &str, bytes: &[u8], usage: wgpu::BufferUsages) -> wgpu::Buffer {
+    let contents = if bytes.is_empty() { &[0u8; 16][..] } else { bytes };
+    gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
 }
 
 /// The two drawing stages.
