@@ -6,7 +6,7 @@
 
 use glam::Vec3;
 use twister::gpu::Gpu;
-use twister::load::{load_scene, suggested_viewer};
+use twister::core::load::{load_scene, suggested_viewer};
 use twister::output::{layout_images, write_images, Layout};
 use twister::{GpuScene, RenderSettings, Renderer};
 
@@ -15,17 +15,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let file = args.next().ok_or("usage: port_gltf SCENE.gltf|.glb|.obj [OUT_DIR]")?;
     let out = args.next().unwrap_or_else(|| "out/port".into());
     let mut settings = RenderSettings::default(); // 3168×600 per eye, R_T = 1 m, d_e = 0.032 m, adaptive
-    let scene = load_scene(&file, &settings.projection)?;
+    let scene = load_scene(&file, &settings.view.projection)?;
     for w in &scene.warnings {
         eprintln!("note: {w}");
     }
     if let Some(cam) = scene.cameras.first() {
-        settings.viewer = Vec3::from(cam.position);
-        settings.yaw_deg = cam.yaw_deg;
+        settings.view.viewer = Vec3::from(cam.position);
+        settings.view.yaw_deg = cam.yaw_deg;
     } else if let Some((position, _)) = suggested_viewer(&scene) {
-        settings.viewer = Vec3::from(position);
+        settings.view.viewer = Vec3::from(position);
     }
-    let renderer = Renderer::new(Gpu::new()?);
+    let renderer = Renderer::new(Gpu::new()?)?;
     let gpu_scene = GpuScene::upload(&renderer.gpu, &scene)?;
     let frame = renderer.render(&gpu_scene, &settings)?;
     for path in write_images(out.as_ref(), &layout_images(&frame, Layout::Twister))? {

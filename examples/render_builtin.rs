@@ -4,15 +4,16 @@
 
 use twister::gpu::Gpu;
 use twister::output::{layout_images, write_images, Layout};
-use twister::{builtin, GpuScene, RenderSettings, Renderer};
+use twister::core::builtin;
+use twister::{GpuScene, RenderSettings, Renderer};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let scene_name = args.next().unwrap_or_else(|| "builtin:demo".into());
     let out = args.next().unwrap_or_else(|| "out/example".into());
     let settings = RenderSettings::default(); // 3168×600 per eye, R_T = 1 m, d_e = 0.032 m
-    let scene = builtin::builtin_scene(&scene_name, &settings.projection)?;
-    let renderer = Renderer::new(Gpu::new()?);
+    let scene = builtin::builtin_scene(&scene_name, &settings.view.projection)?;
+    let renderer = Renderer::new(Gpu::new()?)?;
     let gpu_scene = GpuScene::upload(&renderer.gpu, &scene)?;
     let frame = renderer.render(&gpu_scene, &settings)?;
     for path in write_images(out.as_ref(), &layout_images(&frame, Layout::TopBottom))? {

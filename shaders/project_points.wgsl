@@ -1,6 +1,8 @@
 // The `project_points` stage (compute): projects viewer-frame points to image pixels for one eye.
-// CPU twin: `project_points` in src/projection.rs. Used to check the GPU projection
-// against the CPU oracle. Needs projection.wgsl.
+// CPU twin: src/cpu/project_points.rs. Used to check the GPU projection against the CPU
+// oracle.
+
+#import projection
 
 struct ProjectParams {
     projection: Projection,
@@ -15,8 +17,9 @@ struct ProjectParams {
 @group(0) @binding(2) var<storage, read_write> pixels: array<vec4<f32>>;
 
 @compute @workgroup_size(64)
-fn project_points(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x;
+fn project_points(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    // A 2-D dispatch beyond 65,535 workgroups (more than 4.19 M points).
+    let i = gid.x + gid.y * groups.x * 64u;
     if (i >= params.count) {
         return;
     }

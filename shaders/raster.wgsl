@@ -1,7 +1,9 @@
 // The `raster` stage (vertex + fragment): projects each subdivided vertex with the TWISTER
 // projection (seed 002 eq. 1–4, projection.wgsl) for one eye; the fragments are shaded and carry
-// their display-position error (fragment.wgsl). CPU twin: src/raster.rs.
-// Needs projection.wgsl and fragment.wgsl.
+// their display-position error (fragment.wgsl). CPU twin: src/cpu/raster.rs.
+
+#import projection
+#import fragment
 
 struct RasterParams {
     projection: Projection,

@@ -1,13 +1,13 @@
 // The `reduce_error` stage (compute): reduces the error targets of both eyes to count, mean,
-// std, max and the p50/p90/p99 percentiles. CPU twin: src/reduce.rs, which documents the
+// std, max and the p50/p90/p99 percentiles. CPU twin: src/cpu/reduce_error.rs, which documents the
 // histogram (bins of 1/64 px below 64 px, 1 px up to 1024 px, then one overflow bin).
 //
 // `accumulate`: one invocation per pixel: histogram (atomic), count, max; per-workgroup sums.
 // `finish`: one workgroup: compensated sums of the partials, then the percentiles.
 
-const FINE_BINS: u32 = 4096u;   // [0, 64) px, 1/64 px each
-const COARSE_BINS: u32 = 960u;  // [64, 1024) px, 1 px each
-const BINS: u32 = 5057u;        // + 1 overflow bin
+// FINE_BINS ([0, 64) px, 1/64 px each), COARSE_BINS ([64, 1024) px, 1 px each), BINS (+ 1
+// overflow bin): from src/shader/constants.rs.
+#import constants
 const WG: u32 = 256u;
 
 struct ReduceParams {

@@ -4,7 +4,10 @@
 // is drawn into that slit only (scissor), one draw per slit with `first_instance` = the slit.
 // Rows follow the exact vertical model, so slit:1 converges to the projection. The fragments
 // carry the same shading and display-position error as the raster stage (fragment.wgsl).
-// CPU twin: src/slit.rs. Needs projection.wgsl and fragment.wgsl.
+// CPU twin: src/cpu/slit.rs.
+
+#import projection
+#import fragment
 
 struct SlitParams {
     view: mat4x4<f32>,

@@ -1,6 +1,8 @@
 // The `subdivide` stage (compute): adaptive subdivision (seed 002 §2.3, eq. 5, Fig. 6), the
-// vertical-axis split and the seam copies. CPU twin and full description: src/subdivide.rs.
-// Needs projection.wgsl composed in front.
+// vertical-axis split and the seam copies. CPU twin and full description: src/cpu/subdivide.rs.
+
+#import projection
+#import constants
 //
 // `plan`     one invocation per input triangle: edge counts N (eq. 5), the macro-lattice level
 //            K = ceil(M / N_max) of the pre-split, and K² piece records (triangle, cell).
@@ -38,7 +40,7 @@ struct SubdivideParams {
     axis_clearance: f32,
     triangle_count: u32,
     first_triangle: u32,
-    method: u32,            // 0 vertex, 1 fixed, 2 adaptive
+    method: u32,            // METHOD_VERTEX, METHOD_FIXED or METHOD_ADAPTIVE
     fixed_n: u32,
     edge_px: f32,           // L
     max_div: u32,           // N_max
@@ -77,15 +79,9 @@ struct DrawIndirectArgs {
 // subdivision away from the gaze; 1 without it). CPU twin: `Subdivider::edge_px`.
 @group(0) @binding(8) var<storage, read> object_edge_scale: array<f32>;
 
-// `piece_count` value meaning: as many pieces as `plan` made (read from the counter), so that
-// plan, lattice and drawing can run in one submission.
-const PIECES_FROM_COUNTER: u32 = 0xffffffffu;
-
-const MAX_EDGE_DIVISIONS: u32 = 1024u;
-const EDGE_SAMPLES: u32 = 8u;
-const MAX_SPAN: f32 = 1.6;
-const SNAP: f32 = 1e-6;
-const SEAM_MARGIN: f32 = 1e-5; // rad
+// `params.piece_count == PIECES_FROM_COUNTER` (from `constants`): as many pieces as `plan` made
+// (read from the counter), so that plan, lattice and drawing can run in one submission.
+// MAX_EDGE_DIVISIONS, EDGE_SAMPLES, MAX_SPAN, SNAP, SEAM_MARGIN: from src/shader/constants.rs.
 
 // (cos, sin) of the sector boundaries −π + k·π/4 and of the sector middles, exact tables shared
 // with the CPU twin.
@@ -204,10 +200,10 @@ fn edge_length_px(a: vec3<f32>, b: vec3<f32>, segments: u32) -> f32 {
 }
 
 fn edge_divisions(a: vec3<f32>, b: vec3<f32>) -> u32 {
-    if (params.method == 0u) {
+    if (params.method == METHOD_VERTEX) {
         return 1u;
     }
-    if (params.method == 1u) {
+    if (params.method == METHOD_FIXED) {
         return params.fixed_n;
     }
     // Quick 2-segment length first; the 8-segment polyline refines it, so it is never shorter.
@@ -264,7 +260,7 @@ fn plan_triangle() {
     }
     let m = max(max(tri_n[0], tri_n[1]), tri_n[2]);
     tri_k = 1u;
-    if (params.method == 2u) {
+    if (params.method == METHOD_ADAPTIVE) {
         tri_k = (m + params.max_div - 1u) / params.max_div;
     }
 }

@@ -10,7 +10,8 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::renderer::{EyeImage, Frame};
+use crate::core::frame::{EyeImage, Frame};
+use crate::error::{Error, Result};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -57,8 +58,8 @@ pub fn layout_images(frame: &Frame, layout: Layout) -> Vec<(String, EyeImage)> {
 }
 
 /// Writes every image into `dir` (created if missing) all-or-nothing; returns the paths.
-pub fn write_images(dir: &Path, images: &[(String, EyeImage)]) -> Result<Vec<PathBuf>, String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create the output folder: {e}", dir.display()))?;
+pub fn write_images(dir: &Path, images: &[(String, EyeImage)]) -> Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::output(dir, format!("cannot create the output folder: {e}")))?;
     let mut temps = Vec::new();
     let result = (|| {
         for (name, img) in images {
@@ -73,10 +74,10 @@ pub fn write_images(dir: &Path, images: &[(String, EyeImage)]) -> Result<Vec<Pat
                 image::ColorType::Rgba8,
                 image::ImageFormat::Png,
             )
-            .map_err(|e| format!("{}: cannot write: {e}", final_path.display()))?;
+            .map_err(|e| Error::output(&final_path, format!("cannot write: {e}")))?;
         }
         for (temp, final_path) in &temps {
-            std::fs::rename(temp, final_path).map_err(|e| format!("{}: cannot write: {e}", final_path.display()))?;
+            std::fs::rename(temp, final_path).map_err(|e| Error::output(final_path, format!("cannot write: {e}")))?;
         }
         Ok(temps.iter().map(|(_, f)| f.clone()).collect())
     })();
@@ -89,13 +90,13 @@ pub fn write_images(dir: &Path, images: &[(String, EyeImage)]) -> Result<Vec<Pat
 }
 
 /// Writes a text file atomically (temporary name, then rename).
-pub fn write_text(path: &Path, text: &str) -> Result<(), String> {
+pub fn write_text(path: &Path, text: &str) -> Result<()> {
     if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(parent).map_err(|e| format!("{}: cannot create folder: {e}", parent.display()))?;
+        std::fs::create_dir_all(parent).map_err(|e| Error::output(parent, format!("cannot create folder: {e}")))?;
     }
     let temp = path.with_extension(format!("{}.tmp", std::process::id()));
     std::fs::write(&temp, text).and_then(|_| std::fs::rename(&temp, path)).map_err(|e| {
         let _ = std::fs::remove_file(&temp);
-        format!("{}: cannot write: {e}", path.display())
+        Error::output(path, format!("cannot write: {e}"))
     })
 }

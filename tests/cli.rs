@@ -245,7 +245,7 @@ fn scale_turns_scene_units_into_metres_which_sets_the_disparity() {
     // Scaling the scene and the viewer together keeps every direction; only the disparity
     // changes, since the eye circle is in metres. Sphere100 (3 m ahead) at --scale 0.2 stands
     // 0.6 m ahead, inside the display cylinder: its disparity changes sign.
-    use twister::projection::{Eye, Projection};
+    use twister::core::projection::{Eye, Projection};
     let (w, h) = (720u32, 120u32);
     let projection = Projection { width: w, height: h, ..Projection::default() };
     let disparity = |scale: &str| {
@@ -272,7 +272,7 @@ fn scale_turns_scene_units_into_metres_which_sets_the_disparity() {
         let x = |eye| projection.to_pixel(projection.project(glam::Vec3::new(0.0, 0.0, -r), eye).unwrap().u, 0.0)[0];
         x(Eye::Right) - x(Eye::Left)
     };
-    let sphere = twister::builtin::builtin_scene("builtin:sphere100", &projection).unwrap();
+    let sphere = twister::core::builtin::builtin_scene("builtin:sphere100", &projection).unwrap();
     let (lo, hi) = sphere.bounds().unwrap();
     let (centre, front) = (-(lo.z + hi.z) / 2.0, -hi.z);
     let (d1, d02) = (disparity("1"), disparity("0.2"));
@@ -327,7 +327,7 @@ fn lod_flags_render_an_overlay_and_report_the_selection() {
     assert!(*lo >= 60 && *hi <= 140, "central boundary at columns {lo}..{hi}");
     let _ = std::fs::remove_dir_all(&out);
     for (args, needle) in [
-        (&["render", "--lod-overlay"][..], "--lod-overlay needs --lod visual-field"),
+        (&["render", "--lod-overlay"][..], "--lod-overlay: needs --lod visual-field"),
         (&["render", "--lod", "visual-field", "--gaze", "1,2,3"][..], "YAW,PITCH"),
         (&["render", "--lod", "visual-field", "--lod-p3", "0.5", "--lod-p2", "0.3"][..], "P3"),
     ] {

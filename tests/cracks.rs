@@ -6,9 +6,10 @@
 mod common;
 
 use glam::Vec3;
-use twister::renderer::EyeImage;
-use twister::subdivide::Method;
-use twister::{builtin, Projection, RenderSettings, Scene};
+use twister::EyeImage;
+use twister::core::settings::Method;
+use twister::core::builtin;
+use twister::{Projection, RenderSettings, Scene};
 
 const BG: [f32; 3] = [1.0, 0.0, 1.0];
 
@@ -49,7 +50,7 @@ fn check(scene: &Scene, what: &str, viewer: Vec3, expect_full: bool) {
     ];
     for (method, edge_px, max_div) in configs {
         let settings =
-            RenderSettings { projection, viewer, background: BG, method, edge_px, max_div, ..Default::default() };
+            RenderSettings::new(projection).with_viewer(viewer).with_background(BG).with_method(method).with_edge_px(edge_px).with_max_div(max_div);
         let frame = common::render(scene, &settings);
         for eye in twister::Eye::BOTH {
             let img = frame.eye(eye);
@@ -90,13 +91,9 @@ fn sphere_seen_from_inside_has_no_cracks() {
 #[test]
 fn closed_models_have_no_cracks() {
     check(&builtin::blob(Vec3::new(0.2, 0.0, -2.5), 0.9), "blob", Vec3::ZERO, false);
-    let cow = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/cow/cow.obj");
-    if cow.exists() {
-        let p = Projection { width: 480, height: 120, ..Projection::default() };
-        let mut scene = twister::load::load_scene(cow.to_str().unwrap(), &p).unwrap();
-        scene.fit(3.0, &p).unwrap();
-        check(&scene, "cow", Vec3::ZERO, false);
-    } else {
-        eprintln!("NOTE: {} is absent; the crack test ran on the built-in closed blob only", cow.display());
-    }
+    let cow = common::asset("cow/cow.obj");
+    let p = Projection { width: 480, height: 120, ..Projection::default() };
+    let mut scene = twister::core::load::load_scene(cow.to_str().unwrap(), &p).unwrap();
+    scene.fit(3.0, &p).unwrap();
+    check(&scene, "cow", Vec3::ZERO, false);
 }

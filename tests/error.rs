@@ -3,16 +3,20 @@
 
 mod common;
 
-use twister::raster::raster;
-use twister::reduce::reduce_error;
-use twister::renderer::Frame;
-use twister::slit::{slit, slit_params, slits};
-use twister::subdivide::{subdivide, Method};
-use twister::texture::MaterialTable;
-use twister::{builtin, Eye, Projection, RenderSettings, Vertical};
+use twister::cpu::raster::raster_params;
+use twister::cpu::subdivide::subdivide_params;
+use twister::cpu::raster::raster;
+use twister::cpu::reduce_error::reduce_error;
+use twister::Frame;
+use twister::cpu::slit::{slit, slit_params, slits};
+use twister::cpu::subdivide::subdivide;
+use twister::core::settings::Method;
+use twister::core::texture::MaterialTable;
+use twister::core::builtin;
+use twister::{Eye, Projection, RenderSettings, Vertical};
 
 fn measured(scene: &twister::Scene, settings: &RenderSettings) -> Frame {
-    common::render(scene, &RenderSettings { measure_error: true, ..settings.clone() })
+    common::render(scene, &settings.clone().with_measure_error(true))
 }
 
 #[test]
@@ -20,7 +24,7 @@ fn a_known_shift_is_measured_as_that_shift() {
     let projection = Projection { width: 960, height: 180, ..Projection::default() };
     let scene = builtin::builtin_scene("builtin:triangle@3", &projection).unwrap();
     for (shift, expected) in [([3.0f32, 4.0], 5.0f32), ([-7.0, 0.0], 7.0), ([0.0, 0.0], 0.0)] {
-        let settings = RenderSettings { projection, method: Method::Fixed(24), shift_px: shift, ..Default::default() };
+        let settings = RenderSettings::new(projection).with_method(Method::Fixed(24)).with_shift_px(shift);
         let frame = measured(&scene, &settings);
         let e = frame.measurement.unwrap().stats;
         assert!(e.count > 10_000);
@@ -36,17 +40,17 @@ fn gpu_error_pass_and_reduction_match_their_cpu_twins() {
     for vertical in [Vertical::Paper, Vertical::Exact] {
         let projection = Projection { vertical, ..projection };
         let scene = builtin::builtin_scene("builtin:triangle@3", &projection).unwrap();
-        let settings = RenderSettings { projection, method: Method::Vertex, ..Default::default() };
+        let settings = RenderSettings::new(projection).with_method(Method::Vertex);
         let frame = measured(&scene, &settings);
         let m = frame.measurement.as_ref().unwrap();
-        let params = settings.subdivide_params(0, 1);
+        let params = subdivide_params(&settings, 0, 1);
         let tris = subdivide(&params, &scene.vertices, &scene.indices).vertices;
         for (k, eye) in Eye::BOTH.into_iter().enumerate() {
             let cpu = raster(
-                &settings.raster_params(eye),
+                &raster_params(&settings, eye),
                 &tris,
                 &MaterialTable::of(&scene, usize::MAX),
-                settings.background,
+                settings.shading.background,
             );
             let (mut both, mut worst) = (0, 0.0f32);
             for (g, c) in m.error[k].iter().zip(&cpu.error) {
@@ -77,17 +81,17 @@ fn gpu_error_pass_and_reduction_match_their_cpu_twins() {
 fn gpu_slit_renderer_matches_its_cpu_twin() {
     let projection = Projection { width: 192, height: 48, vertical: Vertical::Exact, ..Projection::default() };
     let scene = builtin::demo();
-    let settings = RenderSettings { projection, method: Method::Slit(4), ..Default::default() };
+    let settings = RenderSettings::new(projection).with_method(Method::Slit(4));
     let frame = measured(&scene, &settings);
     let m = frame.measurement.as_ref().unwrap();
     for (k, eye) in Eye::BOTH.into_iter().enumerate() {
-        let params = slit_params(&projection, settings.view(), eye, settings.ambient);
+        let params = slit_params(&projection, settings.view(), eye, settings.shading.ambient);
         let cpu = slit(
             &params,
             &slits(&projection, eye, 4),
             &scene,
             &MaterialTable::of(&scene, usize::MAX),
-            settings.background,
+            settings.shading.background,
         );
         let gpu = frame.eye(eye);
         let total = (projection.width * projection.height) as usize;
@@ -116,7 +120,7 @@ fn slit_1_is_exact_and_the_slit_error_grows_with_the_width() {
     let scene = builtin::builtin_scene("builtin:sphere1024", &projection).unwrap();
     let mut previous = -1.0;
     for w in [1, 4, 16, 64] {
-        let frame = measured(&scene, &RenderSettings { projection, method: Method::Slit(w), ..Default::default() });
+        let frame = measured(&scene, &RenderSettings::new(projection).with_method(Method::Slit(w)));
         let e = frame.measurement.unwrap().stats;
         assert!(e.count > 5000);
         if w == 1 {
@@ -133,13 +137,13 @@ fn paper_evaluation_1_without_and_with_subdivision() {
     // pixels), under 1 px with every edge split in 7.
     let projection = Projection::default();
     let scene = builtin::builtin_scene("builtin:triangle@3", &projection).unwrap();
-    let vertex = measured(&scene, &RenderSettings { projection, method: Method::Vertex, ..Default::default() });
-    let fixed7 = measured(&scene, &RenderSettings { projection, method: Method::Fixed(7), ..Default::default() });
+    let vertex = measured(&scene, &RenderSettings::new(projection).with_method(Method::Vertex));
+    let fixed7 = measured(&scene, &RenderSettings::new(projection).with_method(Method::Fixed(7)));
     let (v, f) = (vertex.measurement.unwrap().stats, fixed7.measurement.unwrap().stats);
     assert!(v.mean > 10.0 && v.mean < 60.0, "vertex: mean {} px", v.mean);
     assert!(f.mean < 1.0, "fixed:7: mean {} px", f.mean);
     // The adaptive default is finer still.
-    let adaptive = measured(&scene, &RenderSettings { projection, ..Default::default() });
+    let adaptive = measured(&scene, &RenderSettings::new(projection));
     assert!(adaptive.measurement.unwrap().stats.mean < f.mean);
 }
 
@@ -147,8 +151,8 @@ fn paper_evaluation_1_without_and_with_subdivision() {
 fn error_pass_off_by_default_and_draws_the_same_image() {
     let projection = Projection { width: 320, height: 60, ..Projection::default() };
     let scene = builtin::demo();
-    let plain = common::render(&scene, &RenderSettings { projection, ..Default::default() });
-    let with = measured(&scene, &RenderSettings { projection, ..Default::default() });
+    let plain = common::render(&scene, &RenderSettings::new(projection));
+    let with = measured(&scene, &RenderSettings::new(projection));
     assert!(plain.measurement.is_none() && with.measurement.is_some());
     assert_eq!(plain.left.rgba, with.left.rgba);
     assert_eq!(plain.right.rgba, with.right.rgba);

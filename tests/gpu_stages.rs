@@ -2,13 +2,18 @@
 
 mod common;
 
+use twister::cpu::raster::raster_params;
+use twister::cpu::subdivide::subdivide_params;
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
-use twister::gpu_types::{DrawVertex, SceneVertex};
-use twister::raster::raster;
-use twister::subdivide::{subdivide, Method};
-use twister::texture::MaterialTable;
-use twister::{builtin, Eye, GpuScene, Projection, RenderSettings, Scene, Vertical};
+use twister::shader::types::DrawVertex;
+use twister::core::scene::SceneVertex;
+use twister::cpu::raster::raster;
+use twister::cpu::subdivide::subdivide;
+use twister::core::settings::Method;
+use twister::core::texture::MaterialTable;
+use twister::core::builtin;
+use twister::{Eye, GpuScene, Projection, RenderSettings, Scene, Vertical};
 
 #[test]
 fn gpu_projection_matches_cpu_within_a_thousandth_of_a_pixel() {
@@ -24,8 +29,8 @@ fn gpu_projection_matches_cpu_within_a_thousandth_of_a_pixel() {
     for vertical in [Vertical::Paper, Vertical::Exact] {
         let projection = Projection { vertical, ..Projection::default() };
         for eye in Eye::BOTH {
-            let gpu = r.project_points(&projection, eye, &points);
-            let cpu = twister::projection::project_points(&projection, eye, &points);
+            let gpu = r.project_points(&projection, eye, &points).unwrap();
+            let cpu = twister::cpu::project_points::project_points(&projection, eye, &points);
             let mut worst = 0.0f32;
             for (i, (g, c)) in gpu.iter().zip(&cpu).enumerate() {
                 assert_eq!(g[3], c[3], "point {i} {:?}: seen on one side only", points[i]);
@@ -143,28 +148,28 @@ fn random_triangle_scene(seed: u64, n: usize) -> Scene {
 fn gpu_subdivide_matches_cpu_twin() {
     let r = common::renderer();
     let projection = Projection { width: 640, height: 160, ..Projection::default() };
-    let base = RenderSettings { projection, measure_edges: true, ..Default::default() };
-    let moved = RenderSettings { viewer: Vec3::new(1.0, 0.3, -2.0), yaw_deg: 37.0, ..base.clone() };
+    let base = RenderSettings::new(projection).with_measure_edges(true);
+    let moved = base.clone().with_viewer(Vec3::new(1.0, 0.3, -2.0)).with_yaw_deg(37.0);
     let sphere = builtin::builtin_scene("builtin:sphere100", &projection).unwrap();
     let cases = [
-        (random_triangle_scene(3, 600), RenderSettings { method: Method::Vertex, ..base.clone() }),
+        (random_triangle_scene(3, 600), base.clone().with_method(Method::Vertex)),
         (random_triangle_scene(4, 300), base.clone()),
-        (random_triangle_scene(5, 200), RenderSettings { method: Method::Fixed(5), ..base.clone() }),
+        (random_triangle_scene(5, 200), base.clone().with_method(Method::Fixed(5))),
         (builtin::demo(), base.clone()),
-        (builtin::demo(), RenderSettings { method: Method::Vertex, ..moved.clone() }),
-        (builtin::demo(), RenderSettings { edge_px: 12.0, max_div: 4, ..moved.clone() }),
-        (sphere, RenderSettings { edge_px: 8.0, ..base.clone() }),
+        (builtin::demo(), moved.clone().with_method(Method::Vertex)),
+        (builtin::demo(), moved.clone().with_edge_px(12.0).with_max_div(4)),
+        (sphere, base.clone().with_edge_px(8.0)),
         (
             builtin::sphere_scene(1024, Vec3::ZERO, 2.5, "sphere around the viewer"),
-            RenderSettings { edge_px: 16.0, ..base.clone() },
+            base.clone().with_edge_px(16.0),
         ),
     ];
     for (k, (scene, settings)) in cases.iter().enumerate() {
         let gs = GpuScene::upload(&r.gpu, scene).unwrap();
-        let gpu = r.subdivide_readback(&gs, settings);
-        let params = settings.subdivide_params(0, scene.triangle_count() as u32);
+        let gpu = r.subdivide_readback(&gs, settings).unwrap();
+        let params = subdivide_params(&settings, 0, scene.triangle_count() as u32);
         let cpu = subdivide(&params, &scene.vertices, &scene.indices);
-        let what = format!("case {k}: {} {}", scene.name, settings.method.name());
+        let what = format!("case {k}: {} {}", scene.name, settings.subdivision.method.name());
         assert!(cpu.vertices.len() / 3 > scene.triangle_count(), "{what}: exercises splits and seam copies");
         assert_eq!(cpu.pieces, gpu.pieces, "{what}: pieces");
         assert!(
@@ -179,16 +184,16 @@ fn gpu_subdivide_matches_cpu_twin() {
 fn gpu_raster_matches_cpu_twin() {
     let projection = Projection { width: 400, height: 100, ..Projection::default() };
     let scene = builtin::demo();
-    let settings = RenderSettings { projection, ..Default::default() };
+    let settings = RenderSettings::new(projection);
     let frame = common::render(&scene, &settings);
-    let params = settings.subdivide_params(0, scene.triangle_count() as u32);
+    let params = subdivide_params(&settings, 0, scene.triangle_count() as u32);
     let prepared = subdivide(&params, &scene.vertices, &scene.indices).vertices;
     for eye in Eye::BOTH {
         let cpu = raster(
-            &settings.raster_params(eye),
+            &raster_params(&settings, eye),
             &prepared,
             &MaterialTable::of(&scene, usize::MAX),
-            settings.background,
+            settings.shading.background,
         );
         let gpu = frame.eye(eye);
         let differing = cpu

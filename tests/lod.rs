@@ -4,12 +4,14 @@
 
 mod common;
 
+use twister::cpu::subdivide::subdivide_params;
 use glam::Vec3;
-use twister::builtin::sphere_scene;
-use twister::lod::{LodChain, LodParams, NO_SPLIT};
-use twister::projection::Projection;
-use twister::subdivide::{Method, Subdivider};
-use twister::visual_field::{Field, Gaze};
+use twister::core::builtin::sphere_scene;
+use twister::core::lod::{LodChain, LodParams, NO_SPLIT};
+use twister::core::projection::Projection;
+use twister::cpu::subdivide::Subdivider;
+use twister::core::settings::Method;
+use twister::core::visual_field::{Field, Gaze};
 use twister::{GpuScene, RenderSettings, Scene};
 
 /// Twelve 1024-triangle spheres 3 m around the viewer every 30°.
@@ -24,7 +26,7 @@ fn ring() -> Scene {
 }
 
 fn settings() -> RenderSettings {
-    RenderSettings { projection: Projection { width: 960, height: 180, ..Projection::default() }, ..Default::default() }
+    RenderSettings::new(Projection { width: 960, height: 180, ..Projection::default() })
 }
 
 #[test]
@@ -39,19 +41,19 @@ fn the_subdivision_follows_each_objects_level_as_the_cpu_twin_does() {
     );
     let r = common::renderer();
     let base = GpuScene::upload(&r.gpu, &scene).unwrap();
-    let gpu = r.subdivide_readback(&base.with_lod(&r.gpu, &sel), &s);
+    let gpu = r.subdivide_readback(&base.with_lod(&r.gpu, &sel), &s).unwrap();
     let drawn = sel.scene(&scene);
-    let params = s.subdivide_params(0, drawn.triangle_count() as u32);
+    let params = subdivide_params(&s, 0, drawn.triangle_count() as u32);
     let scales = sel.edge_scales();
     let cpu = Subdivider::with_edge_scale(&params, &scales).run(&drawn.vertices, &drawn.indices);
     assert_eq!(gpu.vertices.len(), cpu.vertices.len(), "triangles out");
     assert_eq!(gpu.pieces, cpu.pieces);
     // Per object: outside the field nothing is split (vertex method); central objects are split
     // as without the level of detail.
-    let count = |out: &[twister::gpu_types::DrawVertex], o: u32| out.iter().filter(|v| v.object == o).count() / 3;
+    let count = |out: &[twister::shader::types::DrawVertex], o: u32| out.iter().filter(|v| v.object == o).count() / 3;
     let full = Subdivider::new(&params).run(&drawn.vertices, &drawn.indices);
     let vertex = Subdivider::new(
-        &RenderSettings { method: Method::Vertex, ..s.clone() }.subdivide_params(0, params.triangle_count),
+        &subdivide_params(&s.clone().with_method(Method::Vertex), 0, params.triangle_count),
     )
     .run(&drawn.vertices, &drawn.indices);
     for (o, c) in sel.chosen.iter().enumerate() {
@@ -71,7 +73,7 @@ fn the_subdivision_follows_each_objects_level_as_the_cpu_twin_does() {
 #[test]
 fn fewer_triangles_and_no_worse_error_in_the_central_field() {
     let scene = ring();
-    let s = RenderSettings { measure_error: true, ..settings() };
+    let s = settings().with_measure_error(true);
     let r = common::renderer();
     let base = GpuScene::upload(&r.gpu, &scene).unwrap();
     let chain = LodChain::build(&scene, 0.05);
@@ -87,16 +89,16 @@ fn fewer_triangles_and_no_worse_error_in_the_central_field() {
             full.stats.triangles_in
         );
         // Mean error over the pixels in the central field, both eyes.
-        let central_mean = |f: &twister::renderer::Frame| {
+        let central_mean = |f: &twister::Frame| {
             let m = f.measurement.as_ref().unwrap();
-            let p = &s.projection;
+            let p = &s.view.projection;
             let e: Vec<f32> = m
                 .error
                 .iter()
                 .flat_map(|eye| eye.iter().enumerate())
                 .filter(|(i, e)| {
                     let (x, y) = ((*i as u32 % p.width) as f32 + 0.5, (*i as u32 / p.width) as f32 + 0.5);
-                    **e >= 0.0 && twister::lod::pixel_field(p, &gaze, x, y) == Field::Central
+                    **e >= 0.0 && twister::core::lod::pixel_field(p, &gaze, x, y) == Field::Central
                 })
                 .map(|(_, e)| *e)
                 .collect();

@@ -3,9 +3,9 @@
 mod common;
 
 use glam::Vec3;
-use twister::builtin::{self, SEAM_SPHERE_RADIUS};
-use twister::gpu_types::SceneVertex;
-use twister::renderer::EyeImage;
+use twister::core::builtin::{self, SEAM_SPHERE_RADIUS};
+use twister::core::scene::SceneVertex;
+use twister::EyeImage;
 use twister::{Eye, Projection, RenderSettings, Scene, Vertical};
 
 fn small() -> Projection {
@@ -30,14 +30,14 @@ fn centroid(img: &EyeImage, bg: [f32; 3], around_x: f32) -> (f32, f32, usize) {
 #[test]
 fn sphere100_centroid_lies_where_the_oracle_projects_its_centre() {
     let projection = small();
-    let scene = twister::builtin::builtin_scene("builtin:sphere100", &projection).unwrap();
-    let settings = RenderSettings { projection, ..Default::default() };
+    let scene = twister::core::builtin::builtin_scene("builtin:sphere100", &projection).unwrap();
+    let settings = RenderSettings::new(projection);
     let frame = common::render(&scene, &settings);
     let center = Vec3::new(0.0, 0.0, -3.0);
     for eye in Eye::BOTH {
         let p = projection.project(center, eye).unwrap();
         let [ox, oy] = projection.to_pixel(p.u, p.v);
-        let (cx, cy, n) = centroid(frame.eye(eye), settings.background, ox);
+        let (cx, cy, n) = centroid(frame.eye(eye), settings.shading.background, ox);
         assert!(n > 1000, "{eye:?}: the sphere covers only {n} pixels");
         assert!(
             (cx - ox).abs() < 1.0 && (cy - oy).abs() < 1.0,
@@ -52,15 +52,15 @@ fn disparity_has_the_right_sign_and_size() {
     // eyes (right − left) must be 2·α(D) in pixels: negative nearer than the screen, zero on it,
     // positive beyond.
     let projection = Projection { width: 1600, height: 200, ..Projection::default() };
-    let settings = RenderSettings { projection, ..Default::default() };
+    let settings = RenderSettings::new(projection);
     for distance in [0.5f32, 1.0, 5.0] {
         // Same angular size at every distance (about 40 px across).
         let radius = distance * 0.075;
         let scene = builtin::sphere_scene(1024, Vec3::new(0.0, 0.0, -distance), radius, "probe");
         let frame = common::render(&scene, &settings);
         let mid = projection.width as f32 / 2.0;
-        let (l, _, nl) = centroid(&frame.left, settings.background, mid);
-        let (r, _, nr) = centroid(&frame.right, settings.background, mid);
+        let (l, _, nl) = centroid(&frame.left, settings.shading.background, mid);
+        let (r, _, nr) = centroid(&frame.right, settings.shading.background, mid);
         assert!(nl > 200 && nr > 200);
         let expected = 2.0 * projection.eye_shift(distance) * projection.pixels_per_radian();
         let got = r - l;
@@ -83,7 +83,7 @@ fn is_seam_sphere(p: [u8; 4]) -> bool {
 fn seam_sphere_appears_at_both_edges_and_nowhere_between() {
     for vertical in [Vertical::Paper, Vertical::Exact] {
         let projection = Projection { vertical, ..small() };
-        let frame = common::render(&builtin::demo(), &RenderSettings { projection, ..Default::default() });
+        let frame = common::render(&builtin::demo(), &RenderSettings::new(projection));
         let w = projection.width as f32;
         for eye in Eye::BOTH {
             let px = common::pixels_where(frame.eye(eye), is_seam_sphere);
@@ -118,18 +118,18 @@ fn triangle_around_the_axis_covers_every_column_below_the_horizon_without_smear(
     // A floor triangle 1.5 m below the eyes containing the vertical axis.
     let projection = small();
     let scene = flat_triangle([[-20.0, -1.5, 15.0], [20.0, -1.5, 15.0], [0.0, -1.5, -25.0]], [0.2, 0.9, 0.3, 1.0]);
-    let settings = RenderSettings { projection, ..Default::default() };
+    let settings = RenderSettings::new(projection);
     let frame = common::render(&scene, &settings);
     for eye in Eye::BOTH {
         let img = frame.eye(eye);
-        let px = common::pixels_where(img, |p| !common::is_background(p, settings.background));
+        let px = common::pixels_where(img, |p| !common::is_background(p, settings.shading.background));
         let mid_row = projection.height as f32 / 2.0;
         // Nothing at or above the horizon (a smear would cross it).
         assert!(px.iter().all(|&(_, y)| y as f32 + 0.5 > mid_row), "{eye:?}: floor pixels above the horizon");
         // Every column has floor at the bottom row (nothing dropped, no gap at the seam).
         for x in 0..projection.width {
             assert!(
-                !common::is_background(img.pixel(x, projection.height - 1), settings.background),
+                !common::is_background(img.pixel(x, projection.height - 1), settings.shading.background),
                 "{eye:?}: column {x} has no floor"
             );
         }
@@ -139,12 +139,12 @@ fn triangle_around_the_axis_covers_every_column_below_the_horizon_without_smear(
 #[test]
 fn triangle_reaching_inside_the_eye_circle_renders_without_nan_or_smear() {
     let projection = small();
-    let settings = RenderSettings { projection, ..Default::default() };
+    let settings = RenderSettings::new(projection);
     // One corner 1 cm from the axis (inside the 3.2 cm eye circle), the far edge 2 m ahead.
     let scene = flat_triangle([[0.01, -0.5, 0.0], [2.0, -0.5, -2.0], [-2.0, -0.5, -2.0]], [0.9, 0.6, 0.1, 1.0]);
     let frame = common::render(&scene, &settings);
     for eye in Eye::BOTH {
-        let px = common::pixels_where(frame.eye(eye), |p| !common::is_background(p, settings.background));
+        let px = common::pixels_where(frame.eye(eye), |p| !common::is_background(p, settings.shading.background));
         assert!(px.len() > 500, "{eye:?}: triangle not drawn");
         // The triangle spans azimuths of at most ±(90° + its near-axis part); it never reaches
         // straight behind (θ = ±π), so the outer quarter of columns at each edge stays empty.
@@ -161,8 +161,8 @@ fn triangle_reaching_inside_the_eye_circle_renders_without_nan_or_smear() {
 fn scene_too_big_for_the_memory_budget_is_drawn_in_chunks_without_loss() {
     let projection = Projection { width: 480, height: 120, ..Projection::default() };
     let scene = builtin::demo();
-    let roomy = RenderSettings { projection, edge_px: 2.0, ..Default::default() };
-    let tight = RenderSettings { memory_mb: 8, ..roomy.clone() };
+    let roomy = RenderSettings::new(projection).with_edge_px(2.0);
+    let tight = roomy.clone().with_memory_mb(8);
     let a = common::render(&scene, &roomy);
     let b = common::render(&scene, &tight);
     assert_eq!(a.stats.chunks, 1);

@@ -1,68 +1,212 @@
-//! Every WGSL file in shaders/ is validated with naga: the shared projection module alone, and
-//! each stage as it is loaded (with its modules composed in front).
+//! The WGSL side against the Rust side, with naga: every stage of the registry composes and
+//! validates (both error-target variants); every file in shaders/ is used; each stage's
+//! declared bindings are exactly its descriptor's; and every struct a stage binds is laid out
+//! exactly as its Rust twin in `shader::types::LAYOUTS`, field offset by field offset.
 
-use twister::shaders::{compose, ErrorTarget, Module, STAGES};
+use std::collections::BTreeSet;
 
-fn validate(name: &str, source: &str) {
+use naga::{AddressSpace, StorageAccess, TypeInner};
+use twister::shader::types::{StructLayout, LAYOUTS};
+use twister::shader::{compose, imports, BindingKind, ErrorTarget, Stage, SHARED, STAGES};
+
+fn parse(name: &str, source: &str) -> naga::Module {
+    parse_with_info(name, source).0
+}
+
+fn parse_with_info(name: &str, source: &str) -> (naga::Module, naga::valid::ModuleInfo) {
     let module = match naga::front::wgsl::parse_str(source) {
         Ok(m) => m,
         Err(e) => panic!("{name}: parse error\n{}", e.emit_to_string_with_path(source, name)),
     };
     let mut validator =
         naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all());
-    if let Err(e) = validator.validate(&module) {
-        panic!("{name}: validation error\n{}", e.emit_to_string_with_path(source, name));
+    match validator.validate(&module) {
+        Ok(info) => (module, info),
+        Err(e) => panic!("{name}: validation error\n{}", e.emit_to_string_with_path(source, name)),
     }
 }
 
 #[test]
-fn every_wgsl_file_validates_with_naga() {
-    validate(Module::Projection.file(), Module::Projection.source());
-    // The fragment module alone, with a stub of the `params` its contract asks stages to declare.
-    let stub = "struct StubParams { projection: Projection, eye_sign: f32, ambient: f32 }\n@group(0) @binding(0) var<uniform> params: StubParams;";
-    validate(
-        Module::Fragment.file(),
-        &format!("{}\n{stub}\n{}", Module::Projection.source(), Module::Fragment.source()),
-    );
-    // Each stage with its modules, in both error-target variants.
+fn every_stage_composes_and_validates_and_every_wgsl_file_is_used() {
+    let mut used = BTreeSet::new();
     for stage in STAGES {
         for target in [ErrorTarget::Float, ErrorTarget::UintBits] {
-            validate(&format!("{} ({target:?})", stage.file), &compose(stage, target));
+            parse(&format!("{} ({target:?})", stage.file()), &compose(stage, target));
+        }
+        used.insert(stage.file());
+        // Shared modules it reaches.
+        let mut pending: Vec<&str> = imports(stage.source);
+        while let Some(name) = pending.pop() {
+            if let Some((_, src)) = SHARED.iter().find(|(n, _)| *n == name) {
+                if used.insert(format!("shaders/shared/{name}.wgsl")) {
+                    pending.extend(imports(src));
+                }
+            }
         }
     }
-    // Every file in shaders/ is covered: the projection module or a registered stage.
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let name = format!("shaders/{}", entry.unwrap().file_name().to_string_lossy());
-        assert!(
-            [Module::Projection, Module::Fragment].iter().any(|m| m.file() == name)
-                || STAGES.iter().any(|s| s.file == name),
-            "{name} is not registered in twister::shaders::STAGES"
-        );
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    for dir in ["shaders", "shaders/shared"] {
+        for entry in std::fs::read_dir(root.join(dir)).unwrap() {
+            let entry = entry.unwrap();
+            if entry.path().extension().is_some_and(|e| e == "wgsl") {
+                let name = format!("{dir}/{}", entry.file_name().to_string_lossy());
+                assert!(used.contains(&name), "{name} is neither a registered stage nor imported by one");
+            }
+        }
+    }
+}
+
+/// The bindings a module declares: (group, binding, name, kind).
+fn declared_bindings(module: &naga::Module) -> BTreeSet<(u32, u32, String, String)> {
+    module
+        .global_variables
+        .iter()
+        .filter_map(|(_, g)| {
+            let b = g.binding.as_ref()?;
+            let kind = match g.space {
+                AddressSpace::Uniform => "Uniform",
+                AddressSpace::Storage { access } if access.contains(StorageAccess::STORE) => "StorageReadWrite",
+                AddressSpace::Storage { .. } => "Storage",
+                other => panic!("unexpected address space {other:?}"),
+            };
+            Some((b.group, b.binding, g.name.clone().unwrap_or_default(), kind.to_string()))
+        })
+        .collect()
+}
+
+fn descriptor_bindings(stage: &Stage) -> BTreeSet<(u32, u32, String, String)> {
+    stage
+        .bindings
+        .iter()
+        .map(|b| {
+            let kind = match b.kind {
+                BindingKind::Uniform => "Uniform",
+                BindingKind::Storage => "Storage",
+                BindingKind::StorageReadWrite => "StorageReadWrite",
+            };
+            (b.group, b.binding, b.name.to_string(), kind.to_string())
+        })
+        .collect()
+}
+
+#[test]
+fn each_stage_declares_exactly_the_bindings_and_entry_points_of_its_descriptor() {
+    for stage in STAGES {
+        let (module, info) = parse_with_info(stage.name, &compose(stage, ErrorTarget::Float));
+        assert_eq!(declared_bindings(&module), descriptor_bindings(stage), "{}: bindings", stage.name);
+        let entries: BTreeSet<&str> = module.entry_points.iter().map(|e| e.name.as_str()).collect();
+        let wanted: BTreeSet<&str> = stage.entry_points.iter().map(|e| e.name).collect();
+        assert_eq!(entries, wanted, "{}: entry points", stage.name);
+        // Each entry point uses exactly the bindings its descriptor lists.
+        for (k, ep) in module.entry_points.iter().enumerate() {
+            let function = info.get_entry_point(k);
+            let used: BTreeSet<String> = module
+                .global_variables
+                .iter()
+                .filter(|(h, g)| g.binding.is_some() && !function[*h].is_empty())
+                .map(|(_, g)| g.name.clone().unwrap_or_default())
+                .collect();
+            let listed: BTreeSet<String> =
+                stage.entry_point(&ep.name).unwrap().uses.iter().map(|n| n.to_string()).collect();
+            assert_eq!(used, listed, "{} {}: bindings used", stage.name, ep.name);
+        }
+        // Groups have no gaps (the pipeline layout lists them in order).
+        for g in 0..stage.group_count() {
+            assert!(stage.group(g).next().is_some(), "{}: group {g} is empty", stage.name);
+        }
+    }
+}
+
+/// Every struct type reachable from the module's bound variables.
+fn bound_structs(module: &naga::Module) -> BTreeSet<naga::Handle<naga::Type>> {
+    fn visit(module: &naga::Module, ty: naga::Handle<naga::Type>, out: &mut BTreeSet<naga::Handle<naga::Type>>) {
+        match &module.types[ty].inner {
+            TypeInner::Struct { members, .. } => {
+                if out.insert(ty) {
+                    for m in members {
+                        visit(module, m.ty, out);
+                    }
+                }
+            }
+            TypeInner::Array { base, .. } | TypeInner::BindingArray { base, .. } => visit(module, *base, out),
+            _ => {}
+        }
+    }
+    let mut out = BTreeSet::new();
+    for (_, g) in module.global_variables.iter().filter(|(_, g)| g.binding.is_some()) {
+        visit(module, g.ty, &mut out);
+    }
+    out
+}
+
+/// Differences between a WGSL struct (as naga lays it out) and a Rust layout.
+fn layout_mismatches(module: &naga::Module, ty: naga::Handle<naga::Type>, rust: &StructLayout) -> Vec<String> {
+    let TypeInner::Struct { members, span } = &module.types[ty].inner else { panic!("not a struct") };
+    let mut out = Vec::new();
+    if *span as usize != rust.size {
+        out.push(format!("{}: WGSL size {span}, Rust {} size {}", rust.wgsl_name, rust.rust_name, rust.size));
+    }
+    let wgsl: Vec<(String, usize)> =
+        members.iter().map(|m| (m.name.clone().unwrap_or_default(), m.offset as usize)).collect();
+    let rust_fields: Vec<(String, usize)> = rust.fields.iter().map(|(n, o)| (n.to_string(), *o)).collect();
+    if wgsl != rust_fields {
+        out.push(format!("{}: WGSL fields {wgsl:?} but Rust {} has {rust_fields:?}", rust.wgsl_name, rust.rust_name));
+    }
+    out
+}
+
+#[test]
+fn every_bound_struct_has_the_field_offsets_of_its_rust_twin() {
+    let mut checked = BTreeSet::new();
+    for stage in STAGES {
+        let module = parse(stage.name, &compose(stage, ErrorTarget::Float));
+        for ty in bound_structs(&module) {
+            let name = module.types[ty].name.clone().unwrap_or_default();
+            let rust = LAYOUTS
+                .iter()
+                .find(|l| l.wgsl_name == name)
+                .unwrap_or_else(|| panic!("{}: struct {name} is bound but has no Rust twin in LAYOUTS", stage.name));
+            let mismatches = layout_mismatches(&module, ty, rust);
+            assert!(mismatches.is_empty(), "{}: {}", stage.name, mismatches.join("; "));
+            checked.insert(name);
+        }
+    }
+    // Every Rust layout is used by some stage (no stale twin).
+    for l in LAYOUTS {
+        assert!(checked.contains(l.wgsl_name), "LAYOUTS lists {} but no stage binds it", l.wgsl_name);
     }
 }
 
 #[test]
-fn uniform_struct_sizes_match_wgsl() {
-    use twister::gpu_types::*;
-    // Sizes naga computes for the WGSL structs must equal the Rust twins'.
-    let size_of = |stage: &twister::shaders::Stage, name: &str| {
-        let module = naga::front::wgsl::parse_str(&compose(stage, ErrorTarget::Float)).unwrap();
-        let mut layouter = naga::proc::Layouter::default();
-        layouter.update(module.to_ctx()).unwrap();
-        let (h, _) =
-            module.types.iter().find(|(_, t)| t.name.as_deref() == Some(name)).unwrap_or_else(|| panic!("{name}"));
-        layouter[h].size as usize
-    };
-    let (subdivide, raster) = (&twister::shaders::SUBDIVIDE, &twister::shaders::RASTER);
-    assert_eq!(size_of(subdivide, "SceneVertex"), std::mem::size_of::<SceneVertex>());
-    assert_eq!(size_of(subdivide, "DrawVertex"), std::mem::size_of::<DrawVertex>());
-    assert_eq!(size_of(subdivide, "Projection"), std::mem::size_of::<ProjectionUniform>());
-    assert_eq!(size_of(subdivide, "SubdivideParams"), std::mem::size_of::<SubdivideParams>());
-    assert_eq!(size_of(subdivide, "Counters"), std::mem::size_of::<SubdivideCounters>());
-    assert_eq!(size_of(subdivide, "DrawIndirectArgs"), std::mem::size_of::<DrawIndirectArgs>());
-    assert_eq!(size_of(raster, "RasterParams"), std::mem::size_of::<RasterParams>());
-    let reduce = &twister::shaders::REDUCE_ERROR;
-    assert_eq!(size_of(reduce, "ReduceParams"), std::mem::size_of::<twister::reduce::ReduceParams>());
-    assert_eq!(size_of(reduce, "ErrorStats"), std::mem::size_of::<twister::reduce::ErrorStats>());
+fn the_layout_check_catches_a_moved_field() {
+    let module = parse("subdivide", &compose(&twister::shader::SUBDIVIDE, ErrorTarget::Float));
+    let (ty, _) = module.types.iter().find(|(_, t)| t.name.as_deref() == Some("Counters")).unwrap();
+    let good = LAYOUTS.iter().find(|l| l.wgsl_name == "Counters").unwrap();
+    assert!(layout_mismatches(&module, ty, good).is_empty());
+    let moved = StructLayout { fields: &[("pieces", 0), ("triangles", 8), ("max_edge_bits", 4), ("_pad", 12)], ..*good };
+    assert_eq!(layout_mismatches(&module, ty, &moved).len(), 1);
+    let resized = StructLayout { size: 20, ..*good };
+    assert_eq!(layout_mismatches(&module, ty, &resized).len(), 1);
+}
+
+#[test]
+fn generated_constants_are_what_the_rust_side_says() {
+    use twister::shader::constants::{all, Value};
+    let module = parse("subdivide", &compose(&twister::shader::SUBDIVIDE, ErrorTarget::Float));
+    for (name, value) in all() {
+        let (_, c) = module
+            .constants
+            .iter()
+            .find(|(_, c)| c.name.as_deref() == Some(name))
+            .unwrap_or_else(|| panic!("constant {name} missing from the composed WGSL"));
+        let literal = match module.global_expressions[c.init] {
+            naga::Expression::Literal(l) => l,
+            ref other => panic!("{name}: {other:?}"),
+        };
+        match (value, literal) {
+            (Value::U32(v), naga::Literal::U32(w)) => assert_eq!(v, w, "{name}"),
+            (Value::F32(v), naga::Literal::F32(w)) => assert_eq!(v.to_bits(), w.to_bits(), "{name}"),
+            (v, l) => panic!("{name}: Rust {v:?}, WGSL {l:?}"),
+        }
+    }
 }

@@ -4,16 +4,20 @@
 
 mod common;
 
+use twister::cpu::raster::raster_params;
+use twister::cpu::subdivide::subdivide_params;
 use std::path::Path;
 
 use glam::{Vec2, Vec3};
-use twister::gpu_types::{AlphaMode, Filter, Material, Mipmap, SceneVertex, Wrap, NO_TEXTURE};
-use twister::projection::{Eye, Projection};
-use twister::raster::raster;
-use twister::renderer::EyeImage;
-use twister::slit::{slit, slit_params, slits};
-use twister::subdivide::{subdivide, Method};
-use twister::texture::{MaterialTable, Texture};
+use twister::core::material::{AlphaMode, Filter, Material, Mipmap, Wrap, NO_TEXTURE};
+use twister::core::scene::SceneVertex;
+use twister::core::projection::{Eye, Projection};
+use twister::cpu::raster::raster;
+use twister::EyeImage;
+use twister::cpu::slit::{slit, slit_params, slits};
+use twister::cpu::subdivide::subdivide;
+use twister::core::settings::Method;
+use twister::core::texture::{MaterialTable, Texture};
 use twister::{RenderSettings, Scene};
 
 const BG: [f32; 3] = [0.0, 0.0, 0.0];
@@ -55,7 +59,7 @@ const QUADRANTS: [[u8; 4]; 4] = [[255, 0, 0, 255], [0, 0, 255, 255], [0, 255, 0,
 
 fn settings(width: u32, height: u32, method: Method) -> RenderSettings {
     let projection = Projection { width, height, ..Projection::default() };
-    RenderSettings { projection, method, background: BG, ambient: 1.0, ..Default::default() }
+    RenderSettings::new(projection).with_method(method).with_background(BG).with_ambient(1.0)
 }
 
 fn pixel_of(projection: &Projection, p: Vec3, eye: Eye) -> [f32; 2] {
@@ -76,7 +80,7 @@ fn texels_land_where_the_projection_puts_their_texture_coordinates() {
         let frame = common::render(&scene, &s);
         for eye in Eye::BOTH {
             let img = frame.eye(eye);
-            let [bx, by] = pixel_of(&s.projection, Vec3::new(0.0, 0.0, -3.0), eye);
+            let [bx, by] = pixel_of(&s.view.projection, Vec3::new(0.0, 0.0, -3.0), eye);
             let (mut checked, mut wrong) = (0, Vec::new());
             for (x, y) in common::pixels_where(img, |p| !common::is_background(p, BG)) {
                 let (cx, cy) = (x as f32 + 0.5, y as f32 + 0.5);
@@ -178,9 +182,9 @@ fn every_sampler_mode_matches_the_cpu_twin_in_both_drawing_stages() {
     let s = settings(640, 120, Method::Adaptive);
     let frame = common::render(&scene, &s);
     let prepared =
-        subdivide(&s.subdivide_params(0, scene.triangle_count() as u32), &scene.vertices, &scene.indices).vertices;
+        subdivide(&subdivide_params(&s, 0, scene.triangle_count() as u32), &scene.vertices, &scene.indices).vertices;
     for eye in Eye::BOTH {
-        let cpu = raster(&s.raster_params(eye), &prepared, &table, BG);
+        let cpu = raster(&raster_params(&s, eye), &prepared, &table, BG);
         let gpu = frame.eye(eye);
         let drawn = common::pixels_where(gpu, |p| !common::is_background(p, BG)).len();
         let bad = differing(&cpu.rgba, &gpu.rgba, 3);
@@ -193,8 +197,8 @@ fn every_sampler_mode_matches_the_cpu_twin_in_both_drawing_stages() {
     let s = settings(320, 64, Method::Slit(4));
     let frame = common::render(&scene, &s);
     for eye in Eye::BOTH {
-        let params = slit_params(&s.projection, s.view(), eye, s.ambient);
-        let cpu = slit(&params, &slits(&s.projection, eye, 4), &scene, &table, BG);
+        let params = slit_params(&s.view.projection, s.view(), eye, s.shading.ambient);
+        let cpu = slit(&params, &slits(&s.view.projection, eye, 4), &scene, &table, BG);
         let gpu = frame.eye(eye);
         let drawn = common::pixels_where(gpu, |p| !common::is_background(p, BG)).len();
         let bad = differing(&cpu.rgba, &gpu.rgba, 6);
@@ -246,7 +250,7 @@ fn single_sided_faces_seen_from_behind_and_transparent_texels_are_not_drawn() {
         for eye in Eye::BOTH {
             let img = frame.eye(eye);
             let cov = |_quad: usize, x: [f32; 2]| {
-                let (inside, drawn) = covered(img, &s.projection, eye, x, y, z);
+                let (inside, drawn) = covered(img, &s.view.projection, eye, x, y, z);
                 drawn as f32 / inside as f32
             };
             let what = format!("{method:?} {eye:?}");
@@ -264,18 +268,14 @@ fn single_sided_faces_seen_from_behind_and_transparent_texels_are_not_drawn() {
 
 #[test]
 fn box_textured_shows_its_logo_colours() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/gltf/BoxTextured/glTF");
-    if !dir.exists() {
-        eprintln!("NOTE: {} is absent; the BoxTextured test did not run", dir.display());
-        return;
-    }
+    let dir = common::asset("gltf/BoxTextured/glTF");
     let mut s = settings(1200, 300, Method::Adaptive);
-    let mut scene = twister::load::load_scene(dir.join("BoxTextured.gltf").to_str().unwrap(), &s.projection).unwrap();
+    let mut scene = twister::core::load::load_scene(dir.join("BoxTextured.gltf").to_str().unwrap(), &s.view.projection).unwrap();
     assert_eq!(scene.textures.len(), 1);
     assert!(scene.materials[0].texture != NO_TEXTURE);
-    scene.fit(1.5, &s.projection).unwrap();
+    scene.fit(1.5, &s.view.projection).unwrap();
     // Look at it from above a little, so that two faces show.
-    s.viewer = Vec3::new(0.0, 0.3, 0.0);
+    s.view.viewer = Vec3::new(0.0, 0.3, 0.0);
     let frame = common::render(&scene, &s);
     let logo = image::open(dir.join("CesiumLogoFlat.png")).unwrap().to_rgba8();
     // The logo's three most common colours (quantized to 32 levels).

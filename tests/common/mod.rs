@@ -4,17 +4,13 @@
 use std::sync::OnceLock;
 
 use twister::gpu::Gpu;
-use twister::renderer::{EyeImage, Frame};
+use twister::{EyeImage, Frame};
 use twister::{GpuScene, RenderSettings, Renderer, Scene};
 
 pub fn renderer() -> &'static Renderer {
     static R: OnceLock<Renderer> = OnceLock::new();
     R.get_or_init(|| {
-        // Quiet Mesa's device-select layer when XDG_RUNTIME_DIR is unset.
-        if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
-            unsafe { std::env::set_var("NODEVICE_SELECT", "1") };
-        }
-        Renderer::new(Gpu::new().unwrap_or_else(|e| panic!("{e}")))
+        Renderer::new(Gpu::new().unwrap_or_else(|e| panic!("{e}"))).unwrap_or_else(|e| panic!("{e}"))
     })
 }
 
@@ -39,4 +35,17 @@ pub fn pixels_where(img: &EyeImage, f: impl Fn([u8; 4]) -> bool) -> Vec<(u32, u3
 
 pub fn is_background(px: [u8; 4], bg: [f32; 3]) -> bool {
     (0..3).all(|c| (px[c] as f32 - bg[c] * 255.0).abs() <= 1.0)
+}
+
+/// A file or folder of the shared third-party assets (`../shared/assets`). CI always has them:
+/// a missing one fails the test, naming it, so that an absent asset never turns a test green.
+pub fn asset(relative: &str) -> std::path::PathBuf {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets");
+    let path = root.join(relative);
+    assert!(
+        path.exists(),
+        "test asset {} is missing: this test needs ../shared/assets (see its README) next to the project",
+        path.display()
+    );
+    path
 }

@@ -1,0 +1,128 @@
+//! Benchmarks, measured in release builds (never as timed tests).
+//!
+//! `speed`: for each scene and method, one warm-up frame, then the median of `reps` frames of
+//! both eyes. A frame's time (`ms_frame`) is wall-clock from the first submission of its GPU
+//! work (subdivision and the two-eye raster, with the counter read-back that checks the
+//! buffers) until it completed; image read-back is apart. The split into subdivision and raster
+//! comes from GPU timestamp queries where the adapter has them. Ratios are of `ms_frame`,
+//! against the first method, in the same run.
+
+use twister::error::Result;
+use twister::core::load::load_scene;
+use twister::{FrameStats, GpuScene, RenderSettings, Renderer};
+use twister::core::settings::Method;
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct SpeedRow {
+    pub scene: String,
+    pub method: String,
+    pub triangles_in: u64,
+    pub triangles_out: u64,
+    pub pieces: u64,
+    pub chunks: u32,
+    pub max_sub_edge_px: f32,
+    /// Median over the reps: wall time of the subdivision and raster of both eyes.
+    pub ms_frame: f64,
+    /// Where ms_subdivide and ms_raster come from (GPU timestamps or wall clock).
+    pub timing: String,
+    pub ms_subdivide: f64,
+    pub ms_raster: f64,
+    pub ms_readback: f64,
+    /// ms_frame / ms_frame of the first method on the same scene.
+    pub ratio: f64,
+    pub reps: usize,
+}
+
+pub fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n == 0 {
+        return f64::NAN;
+    }
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// Renders a scene `reps` times after one warm-up and returns each frame's stats.
+pub fn time_frames(
+    renderer: &Renderer,
+    scene: &GpuScene,
+    settings: &RenderSettings,
+    reps: usize,
+) -> Result<Vec<FrameStats>> {
+    renderer.render(scene, settings)?;
+    (0..reps).map(|_| renderer.render(scene, settings).map(|f| f.stats)).collect()
+}
+
+/// The `speed` benchmark: every scene with every method.
+pub fn speed(
+    renderer: &Renderer,
+    scenes: &[String],
+    fit: Option<f32>,
+    methods: &[Method],
+    base: &RenderSettings,
+    reps: usize,
+    mut progress: impl FnMut(&str),
+) -> Result<Vec<SpeedRow>> {
+    let mut rows = Vec::new();
+    for spec in scenes {
+        let mut scene = load_scene(spec, &base.view.projection)?;
+        if let (Some(d), false) = (fit, spec.starts_with("builtin:")) {
+            scene.fit(d, &base.view.projection)?;
+        }
+        let gpu_scene = GpuScene::upload(&renderer.gpu, &scene)?;
+        let mut first_ms = None;
+        for &method in methods {
+            progress(&format!("{spec} {}", method.name()));
+            let settings = base.clone().with_method(method);
+            let frames = time_frames(renderer, &gpu_scene, &settings, reps)?;
+            // The longest visible edge costs extra work: measured in one more, untimed frame.
+            let edges = renderer.render(&gpu_scene, &settings.clone().with_measure_edges(true))?.stats;
+            let ms_frame = median(frames.iter().map(|s| s.ms_frame).collect());
+            let first = *first_ms.get_or_insert(ms_frame);
+            let last = frames.last().unwrap();
+            rows.push(SpeedRow {
+                scene: spec.clone(),
+                method: method.name(),
+                triangles_in: last.triangles_in,
+                triangles_out: last.triangles_out,
+                pieces: last.pieces,
+                chunks: last.chunks,
+                max_sub_edge_px: edges.max_sub_edge_px,
+                ms_frame,
+                timing: last.timing.to_string(),
+                ms_subdivide: median(frames.iter().filter_map(|s| s.ms_subdivide).collect()),
+                ms_raster: median(frames.iter().filter_map(|s| s.ms_raster).collect()),
+                ms_readback: median(frames.iter().map(|s| s.ms_readback).collect()),
+                ratio: ms_frame / first,
+                reps,
+            });
+        }
+    }
+    Ok(rows)
+}
+
+/// A Markdown table of speed rows.
+pub fn speed_table(rows: &[SpeedRow]) -> String {
+    let mut s = String::from(
+        "| scene | method | triangles in | triangles out | ms frame (median) | ms subdivide | ms raster | ratio | max sub-edge px |\n|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in rows {
+        s += &format!(
+            "| {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.2} | {:.1} |\n",
+            r.scene,
+            r.method,
+            r.triangles_in,
+            r.triangles_out,
+            r.ms_frame,
+            r.ms_subdivide,
+            r.ms_raster,
+            r.ratio,
+            r.max_sub_edge_px
+        );
+    }
+    s
+}

@@ -1,0 +1,105 @@
+//! What a render returns: both eyes' images, what the frame cost and drew, and what the
+//! error pass measured.
+
+use crate::core::projection::Eye;
+use crate::shader::types::ErrorStats;
+
+/// One eye's image, tightly packed RGBA8 rows, top row first.
+#[derive(Clone, Debug)]
+pub struct EyeImage {
+    pub width: u32,
+    pub height: u32,
+    pub rgba: Vec<u8>,
+}
+
+impl EyeImage {
+    pub fn pixel(&self, x: u32, y: u32) -> [u8; 4] {
+        let i = 4 * (y * self.width + x) as usize;
+        [self.rgba[i], self.rgba[i + 1], self.rgba[i + 2], self.rgba[i + 3]]
+    }
+}
+
+/// Where a frame's times come from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Timing {
+    /// GPU timestamp queries: `ms_subdivide`, `ms_raster` and `ms_gpu` are GPU times.
+    GpuTimestamps,
+    /// One submission timed on the wall clock: only `ms_frame` is known (the subdivision and
+    /// raster were not timed apart: `ms_subdivide` and `ms_raster` are absent).
+    #[default]
+    WallOneSubmission,
+    /// Several submissions, each pass timed on the wall clock (submit and wait).
+    WallPerPass,
+}
+
+impl Timing {
+    pub fn name(self) -> &'static str {
+        match self {
+            Timing::GpuTimestamps => "gpu-timestamps",
+            Timing::WallOneSubmission => "wall-one-submission",
+            Timing::WallPerPass => "wall-per-pass",
+        }
+    }
+}
+
+impl std::fmt::Display for Timing {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// What a render cost and drew. Times are milliseconds; [`Timing`] says how each was measured.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct FrameStats {
+    pub triangles_in: u64,
+    /// Triangles the subdivision produced (seam copies included), all drawn.
+    pub triangles_out: u64,
+    pub pieces: u64,
+    /// Largest projected length of an output edge with an end on the screen rows, pixels.
+    pub max_sub_edge_px: f32,
+    /// Number of `lattice` + raster rounds the scene needed to fit the memory budget.
+    pub chunks: u32,
+    /// Wall time of the frame's GPU work, subdivision and raster of both eyes, from the first
+    /// submission until it completed (read-backs excluded).
+    pub ms_frame: f64,
+    pub timing: Timing,
+    /// GPU time of the frame's work from timestamp queries (start of the first pass to the end
+    /// of the last), where the adapter has them and the frame ran in one submission.
+    pub ms_gpu: Option<f64>,
+    /// The subdivision's time, where it was measured apart (see `timing`).
+    pub ms_subdivide: Option<f64>,
+    /// The two eyes' raster time, where it was measured apart (see `timing`).
+    pub ms_raster: Option<f64>,
+    /// Wall time of reading the colour targets back.
+    pub ms_readback: f64,
+    /// Wall time from the start of `render` to its end (read-backs and error reduction included).
+    pub ms_total: f64,
+}
+
+pub struct Frame {
+    pub left: EyeImage,
+    pub right: EyeImage,
+    pub stats: FrameStats,
+    /// The error pass's outputs, when `RenderSettings::measure_error` was set.
+    pub measurement: Option<Measurement>,
+}
+
+/// What the error pass measured (seed 002 §4.1).
+pub struct Measurement {
+    /// Display-position error per pixel, left and right eye (−1: background or unseen).
+    pub error: [Vec<f32>; 2],
+    /// Object id + 1 per pixel, left and right eye (0: background).
+    pub object: [Vec<u32>; 2],
+    /// The GPU reduction of `error` over both eyes.
+    pub stats: ErrorStats,
+}
+
+impl Frame {
+    pub fn eye(&self, eye: Eye) -> &EyeImage {
+        match eye {
+            Eye::Left => &self.left,
+            Eye::Right => &self.right,
+        }
+    }
+}

@@ -1,0 +1,98 @@
+//! Surface materials as the fragment stage reads them (`Material`, `MipLevel` in
+//! shaders/shared/fragment.wgsl; the layout test checks every field offset).
+
+use bytemuck::{Pod, Zeroable};
+
+/// No texture (`Material::texture`).
+pub const NO_TEXTURE: u32 = u32::MAX;
+
+/// A surface material as the fragment stage reads it (`Material` in shaders/fragment.wgsl),
+/// indexed by a vertex's `material` (0: the default material). The base colour factor is
+/// already multiplied into the vertex colours; this holds what needs the fragment. 48 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct Material {
+    /// Index of the base colour texture in the scene's textures, or `NO_TEXTURE`.
+    pub texture: u32,
+    /// Wrap modes along u and v (`Wrap as u32`).
+    pub wrap_u: u32,
+    pub wrap_v: u32,
+    /// Filters (`Filter as u32`): magnification, minification within a level, between levels.
+    pub mag_filter: u32,
+    pub min_filter: u32,
+    pub mipmap: u32,
+    /// `AlphaMode as u32`.
+    pub alpha_mode: u32,
+    pub alpha_cutoff: f32,
+    /// 1: both faces drawn; 0: faces seen from behind are culled.
+    pub double_sided: u32,
+    /// Filled in when the textures are packed: the texture's first entry in the mip table and
+    /// its level count.
+    pub first_mip: u32,
+    pub mip_count: u32,
+    pub _pad: u32,
+}
+
+impl Default for Material {
+    /// The default material: untextured, opaque, double-sided.
+    fn default() -> Self {
+        Material {
+            texture: NO_TEXTURE,
+            wrap_u: Wrap::Repeat as u32,
+            wrap_v: Wrap::Repeat as u32,
+            mag_filter: Filter::Linear as u32,
+            min_filter: Filter::Linear as u32,
+            mipmap: Mipmap::Linear as u32,
+            alpha_mode: AlphaMode::Opaque as u32,
+            alpha_cutoff: 0.5,
+            double_sided: 1,
+            first_mip: 0,
+            mip_count: 0,
+            _pad: 0,
+        }
+    }
+}
+
+/// Texture wrap mode (glTF sampler `wrapS`/`wrapT`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Wrap {
+    Repeat = 0,
+    ClampToEdge = 1,
+    MirroredRepeat = 2,
+}
+
+/// Texel filter within one mip level.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Filter {
+    Nearest = 0,
+    Linear = 1,
+}
+
+/// How the minification filter uses the mip levels: not at all (level 0), the nearest level,
+/// or a blend of the two nearest.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mipmap {
+    None = 0,
+    Nearest = 1,
+    Linear = 2,
+}
+
+/// glTF alpha mode. BLEND is drawn as order-independent screen-door transparency (see
+/// shaders/fragment.wgsl).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AlphaMode {
+    Opaque = 0,
+    Mask = 1,
+    Blend = 2,
+}
+
+/// One mip level of a packed texture (`MipLevel` in shaders/fragment.wgsl): where its texels
+/// start in the texel buffer (one RGBA8 sRGB texel per u32, rows top to bottom) and its size.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct MipLevel {
+    pub offset: u32,
+    pub width: u32,
+    pub height: u32,
+    pub _pad: u32,
+}

@@ -1,0 +1,16 @@
+//! The core: maths and data with no GPU in them. The projection (seed 002 eq. 1–4) as a
+//! [`projection::Panorama`], scenes with their loaders and materials, the visual field and level
+//! of detail (seeds 000/001), render settings and the frames a renderer returns.
+
+pub mod builtin;
+pub mod color;
+pub mod compare;
+pub mod frame;
+pub mod load;
+pub mod lod;
+pub mod material;
+pub mod projection;
+pub mod scene;
+pub mod settings;
+pub mod texture;
+pub mod visual_field;

@@ -1,0 +1,338 @@
+//! The TWISTER projection (seed 002, §2.1, eq. 1–4), CPU side.
+//!
+//! Viewer frame: the viewer stands at the origin, +y is up, straight ahead is −z. For a point
+//! `p = (x, y, z)`:
+//!
+//! ```text
+//!   r = √(x² + z²)                       (eq. 1, cylindrical radius; also the depth)
+//!   θ = atan2(x, −z)                     (azimuth, 0 straight ahead, +π/2 to the right)
+//!   α = acos(d_e / r) − acos(d_e / R_T)  (eq. 3)
+//!   u = θ ± α                            (eq. 2/4; + for the right eye, − for the left eye)
+//!   v = R_T · y / r                      (eq. 4, `Vertical::Paper`)
+//!   v = y · √(R_T² − d_e²) / √(r² − d_e²)  (`Vertical::Exact`: a pinhole on the eye circle)
+//! ```
+//!
+//! `R_T` is [`Projection::screen_radius`], `d_e` is [`Projection::eye_radius`].
+//!
+//! **Which eye gets which sign.** An eye sits on the circle of radius d_e and looks along the
+//! tangent; the right eye is on the right of its viewing direction φ, at `d_e·right(φ)`. Its ray
+//! reaches distance r from the axis after √(r² − d_e²) and is then seen from the origin at angle
+//! `φ + asin(d_e/r)`; it meets the screen at `φ + asin(d_e/R_T)`. Eliminating φ,
+//! `u = θ − asin(d_e/r) + asin(d_e/R_T) = θ + α` (using asin = π/2 − acos). So the right eye is
+//! `θ + α`: a point beyond the screen (r > R_T, α > 0) is seen further right by the right eye,
+//! the uncrossed disparity of ordinary stereo. The tests check this against a brute-force
+//! construction (eye point, tangent ray, cylinder hit) for both eyes and both vertical models.
+//!
+//! Pixels: u ∈ [−π, π) spans the image width with θ = 0 at the centre column; pixels are square,
+//! one pixel = 2π·R_T/W metres of screen; v = 0 is the middle row, +y is up in the image.
+//! The WGSL twin of this module is `shaders/projection.wgsl`; both must stay in step.
+
+use glam::Vec3;
+
+use crate::error::{Error, Result};
+
+/// The vertical model: how the screen height `v` of a point is computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Vertical {
+    /// `v = R_T·y/r`, the paper's design (seed 002 eq. 4).
+    #[default]
+    Paper,
+    /// `v = y·√(R_T²−d_e²)/√(r²−d_e²)`: what a pinhole camera on the eye circle, looking along
+    /// the tangent, sees. The slit renderer converges to this model.
+    Exact,
+}
+
+/// One of the viewer's two eyes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Eye {
+    Left,
+    Right,
+}
+
+impl Eye {
+    pub const BOTH: [Eye; 2] = [Eye::Left, Eye::Right];
+    /// The sign of α in `u = θ ± α` (see the module doc for the derivation).
+    pub fn sign(self) -> f32 {
+        match self {
+            Eye::Left => -1.0,
+            Eye::Right => 1.0,
+        }
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            Eye::Left => "left",
+            Eye::Right => "right",
+        }
+    }
+}
+
+/// The display geometry: the screen cylinder, the eye circle and the image raster.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Projection {
+    /// R_T: radius of the display cylinder, metres.
+    pub screen_radius: f32,
+    /// d_e: radius of the circle the eyes move on, metres.
+    pub eye_radius: f32,
+    /// Image width in pixels (covers the full 2π of azimuth).
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    pub vertical: Vertical,
+}
+
+impl Default for Projection {
+    /// The paper's TWISTER images: 3168×600 per eye, R_T = 1 m, d_e = 0.032 m.
+    fn default() -> Self {
+        Projection { screen_radius: 1.0, eye_radius: 0.032, width: 3168, height: 600, vertical: Vertical::Paper }
+    }
+}
+
+/// A projected point: screen azimuth `u` (radians, not wrapped), screen height `v` (metres on
+/// the screen), and depth `r` (metres from the axis).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Projected {
+    pub u: f32,
+    pub v: f32,
+    pub depth: f32,
+}
+
+/// Wraps an angle into [−π, π). Same formula as `wrap_angle` in projection.wgsl.
+pub fn wrap_angle(a: f32) -> f32 {
+    let tau = std::f32::consts::TAU;
+    a - tau * ((a + std::f32::consts::PI) / tau).floor()
+}
+
+/// θ = atan2(x, −z): the azimuth of a viewer-frame point. x = −0 counts as +0 (θ = π straight
+/// behind), as in projection.wgsl.
+pub fn azimuth(p: Vec3) -> f32 {
+    (p.x + 0.0).atan2(-p.z)
+}
+
+/// r = √(x² + z²): the distance of a viewer-frame point from the vertical axis.
+pub fn horizontal_radius(p: Vec3) -> f32 {
+    (p.x * p.x + p.z * p.z).sqrt()
+}
+
+impl Projection {
+    pub fn validate(&self) -> Result<()> {
+        if !(self.screen_radius.is_finite() && self.screen_radius > 0.0) {
+            return Err(Error::option("--screen-radius", format!("must be a positive number of metres, got {}", self.screen_radius)));
+        }
+        if !(self.eye_radius >= 0.0 && self.eye_radius < self.screen_radius) {
+            return Err(Error::option(
+                "--eye-radius",
+                format!("must be in [0, screen radius {}), got {}", self.screen_radius, self.eye_radius),
+            ));
+        }
+        if self.width < 2 || self.height < 2 || self.width > 16384 || self.height > 16384 {
+            return Err(Error::option(
+                "--width/--height",
+                format!("image size must be between 2 and 16384 pixels per side, got {}x{}", self.width, self.height),
+            ));
+        }
+        Ok(())
+    }
+
+    /// acos(d_e / R_T), the constant term of α.
+    pub fn acos_eye_screen(&self) -> f32 {
+        (self.eye_radius / self.screen_radius).clamp(0.0, 1.0).acos()
+    }
+
+    /// α(r) = acos(d_e/r) − acos(d_e/R_T) (eq. 3). Points with r ≤ d_e are seen by no eye;
+    /// the ratio is clamped so that the result stays finite (the pre-pass culls them).
+    pub fn eye_shift(&self, r: f32) -> f32 {
+        (self.eye_radius / r).clamp(0.0, 1.0).acos() - self.acos_eye_screen()
+    }
+
+    /// The screen height of a point at height `y` and distance `r` from the axis.
+    pub fn screen_height(&self, y: f32, r: f32) -> f32 {
+        match self.vertical {
+            Vertical::Paper => self.screen_radius * y / r,
+            Vertical::Exact => {
+                let (rt, de) = (self.screen_radius, self.eye_radius);
+                let t_screen = (rt * rt - de * de).sqrt();
+                let t_point = (r * r - de * de).max(1e-12).sqrt();
+                y * t_screen / t_point
+            }
+        }
+    }
+
+    /// Projects a viewer-frame point for one eye. `None` when no eye sees it (r ≤ d_e) or it is
+    /// not finite.
+    pub fn project(&self, p: Vec3, eye: Eye) -> Option<Projected> {
+        let r = horizontal_radius(p);
+        if !(r > self.eye_radius) || !p.is_finite() {
+            return None;
+        }
+        Some(self.project_with_azimuth(p, azimuth(p), eye))
+    }
+
+    /// Like [`project`](Self::project) but with θ given (already unwrapped by the caller).
+    pub fn project_with_azimuth(&self, p: Vec3, theta: f32, eye: Eye) -> Projected {
+        let r = horizontal_radius(p);
+        Projected { u: theta + eye.sign() * self.eye_shift(r), v: self.screen_height(p.y, r), depth: r }
+    }
+
+    /// Pixels per metre of screen (square pixels): W / (2π·R_T).
+    pub fn pixels_per_metre(&self) -> f32 {
+        self.width as f32 / (std::f32::consts::TAU * self.screen_radius)
+    }
+
+    /// Pixels per radian of azimuth: W / 2π.
+    pub fn pixels_per_radian(&self) -> f32 {
+        self.width as f32 / std::f32::consts::TAU
+    }
+
+    /// Continuous image coordinates (x right, y down, pixel centres at +0.5) of a screen point;
+    /// `u` is wrapped into the image.
+    pub fn to_pixel(&self, u: f32, v: f32) -> [f32; 2] {
+        let x = (wrap_angle(u) / std::f32::consts::TAU + 0.5) * self.width as f32;
+        let y = 0.5 * self.height as f32 - v * self.pixels_per_metre();
+        [x, y]
+    }
+
+    /// The screen point (u ∈ [−π, π), v) at the centre of pixel (column, row).
+    pub fn pixel_to_screen(&self, column: f32, row: f32) -> (f32, f32) {
+        let u = ((column + 0.5) / self.width as f32 - 0.5) * std::f32::consts::TAU;
+        let v = (0.5 * self.height as f32 - (row + 0.5)) / self.pixels_per_metre();
+        (u, v)
+    }
+
+    /// Half the screen height in metres.
+    pub fn half_height_m(&self) -> f32 {
+        0.5 * self.height as f32 / self.pixels_per_metre()
+    }
+
+    /// The horizontal distance in pixels between two image x coordinates, wrapping around.
+    pub fn wrapped_dx(&self, a: f32, b: f32) -> f32 {
+        let w = self.width as f32;
+        let d = (a - b).rem_euclid(w);
+        d.min(w - d)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use std::f64::consts::PI;
+    const PI_F32: f32 = std::f32::consts::PI;
+
+    /// The brute-force construction, in f64: for each screen azimuth φ_s, the eye of that column
+    /// stands on the eye circle and looks along the tangent; find the column whose ray passes
+    /// through `p` (bisection on the signed distance), then intersect that ray with the screen
+    /// cylinder. Returns (u, v) for the given eye under the `exact` vertical model, and the ray
+    /// parameters needed for the paper model.
+    fn brute_force(p: [f64; 3], eye: Eye, de: f64, rt: f64, vertical: Vertical) -> (f64, f64) {
+        let dir = |phi: f64| [phi.sin(), -phi.cos()]; // (x, z) of a viewing direction
+        let right = |phi: f64| [phi.cos(), phi.sin()]; // right-hand perpendicular of dir
+        let side = if eye == Eye::Right { 1.0 } else { -1.0 };
+        // Signed lateral offset of p from the ray of direction phi starting at the eye.
+        let offset = |phi: f64| {
+            let e = right(phi);
+            let eye_pos = [side * de * e[0], side * de * e[1]];
+            let rel = [p[0] - eye_pos[0], p[2] - eye_pos[1]];
+            (rel[0] * e[0] + rel[1] * e[1], rel[0] * dir(phi)[0] + rel[1] * dir(phi)[1])
+        };
+        // The point's own azimuth; the ray direction is within ±π/2 of it.
+        let theta = p[0].atan2(-p[2]);
+        let (mut lo, mut hi) = (theta - PI / 2.0 + 1e-9, theta + PI / 2.0 - 1e-9);
+        let f = |phi: f64| offset(phi).0;
+        assert!(f(lo) * f(hi) < 0.0, "no tangent ray brackets the point");
+        for _ in 0..200 {
+            let mid = 0.5 * (lo + hi);
+            if f(lo) * f(mid) <= 0.0 {
+                hi = mid
+            } else {
+                lo = mid
+            }
+        }
+        let phi = 0.5 * (lo + hi);
+        let forward = offset(phi).1; // distance along the ray from the eye to p
+        assert!(forward > 0.0, "the point must be in front of its eye");
+        // Hit of the ray with the screen cylinder: eye_pos + t·dir with |.| = rt → t = √(rt²−de²).
+        let t_screen = (rt * rt - de * de).sqrt();
+        let e = right(phi);
+        let hit = [side * de * e[0] + t_screen * dir(phi)[0], side * de * e[1] + t_screen * dir(phi)[1]];
+        let u = hit[0].atan2(-hit[1]);
+        let v = match vertical {
+            // Pinhole on the eye circle: similar triangles along the ray.
+            Vertical::Exact => p[1] * t_screen / forward,
+            // Paper: height scaled by the ratio of distances from the axis.
+            Vertical::Paper => rt * p[1] / (p[0] * p[0] + p[2] * p[2]).sqrt(),
+        };
+        (u, v)
+    }
+
+    fn angle_diff(a: f64, b: f64) -> f64 {
+        let d = (a - b).rem_euclid(2.0 * PI);
+        d.min(2.0 * PI - d)
+    }
+
+    #[test]
+    fn matches_brute_force_construction_for_both_eyes_and_vertical_models() {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(7);
+        for vertical in [Vertical::Paper, Vertical::Exact] {
+            let proj = Projection { vertical, ..Projection::default() };
+            for _ in 0..2000 {
+                let r: f64 = rng.random_range(0.05..50.0);
+                let theta: f64 = rng.random_range(-PI..PI);
+                let y: f64 = rng.random_range(-5.0..5.0);
+                let p = [r * theta.sin(), y, -r * theta.cos()];
+                for eye in Eye::BOTH {
+                    let (u_ref, v_ref) =
+                        brute_force(p, eye, proj.eye_radius as f64, proj.screen_radius as f64, vertical);
+                    let got = proj.project(Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32), eye).unwrap();
+                    let du_px = angle_diff(got.u as f64, u_ref) * proj.pixels_per_radian() as f64;
+                    let dv_px = (got.v as f64 - v_ref).abs() * proj.pixels_per_metre() as f64;
+                    assert!(du_px < 2e-3, "{vertical:?} {eye:?} p={p:?}: u off by {du_px} px");
+                    assert!(dv_px < 2e-3 * (1.0 + v_ref.abs()), "{vertical:?} {eye:?} p={p:?}: v off by {dv_px} px");
+                    assert!((got.depth as f64 - r).abs() < 1e-4 * r);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn right_eye_sees_far_points_to_the_right() {
+        let proj = Projection::default();
+        let far = Vec3::new(0.0, 0.0, -5.0);
+        let near = Vec3::new(0.0, 0.0, -0.5);
+        let on_screen = Vec3::new(0.0, 0.0, -1.0);
+        let disparity = |p| proj.project(p, Eye::Right).unwrap().u - proj.project(p, Eye::Left).unwrap().u;
+        assert!(disparity(far) > 0.0);
+        assert!(disparity(near) < 0.0);
+        assert!(disparity(on_screen).abs() < 1e-6);
+    }
+
+    #[test]
+    fn points_inside_the_eye_circle_are_not_projected() {
+        let proj = Projection::default();
+        assert!(proj.project(Vec3::new(0.01, 0.0, -0.01), Eye::Left).is_none());
+        assert!(proj.project(Vec3::new(0.0, 3.0, 0.0), Eye::Right).is_none());
+        assert!(proj.project(Vec3::new(f32::NAN, 0.0, -1.0), Eye::Right).is_none());
+    }
+
+    #[test]
+    fn pixel_mapping_round_trips() {
+        let proj = Projection { width: 320, height: 80, ..Projection::default() };
+        for (c, r) in [(0.0, 0.0), (159.0, 39.0), (319.0, 79.0), (17.0, 60.0)] {
+            let (u, v) = proj.pixel_to_screen(c, r);
+            let [x, y] = proj.to_pixel(u, v);
+            assert!((x - (c + 0.5)).abs() < 1e-3 && (y - (r + 0.5)).abs() < 1e-3, "{c},{r} -> {x},{y}");
+        }
+        // θ = 0 lies on the boundary between the two centre columns; straight up is row 0.
+        assert!((proj.to_pixel(0.0, 0.0)[0] - 160.0).abs() < 1e-4);
+        assert!(proj.to_pixel(0.0, proj.half_height_m())[1].abs() < 1e-4);
+    }
+
+    #[test]
+    fn wrap_angle_is_half_open() {
+        assert!((wrap_angle(PI_F32) + PI_F32).abs() < 1e-6);
+        assert!((wrap_angle(-PI_F32) + PI_F32).abs() < 1e-6);
+        assert!((wrap_angle(3.0 * PI_F32 / 2.0) + PI_F32 / 2.0).abs() < 1e-5);
+        assert!((wrap_angle(0.25) - 0.25).abs() < 1e-7);
+    }
+}

@@ -1,0 +1,239 @@
+//! A scene: indexed triangles with per-vertex attributes, in world units (metres after
+//! `scale`), plus the named objects they belong to.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec3};
+
+use crate::core::material::Material;
+use crate::core::projection::Projection;
+use crate::core::texture::Texture;
+use crate::error::{Error, Result};
+
+/// A scene vertex as the stages read it (`SceneVertex` in shaders/subdivide.wgsl). 64 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SceneVertex {
+    pub position: [f32; 3],
+    pub material: u32,
+    pub normal: [f32; 3],
+    /// Index of the scene object the vertex belongs to.
+    pub object: u32,
+    pub color: [f32; 4],
+    pub uv: [f32; 2],
+    pub _pad1: [f32; 2],
+}
+
+/// A named range of triangles (a glTF mesh instance, an OBJ object, a built-in shape).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Object {
+    pub name: String,
+    pub first_triangle: u32,
+    pub triangle_count: u32,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct Scene {
+    pub name: String,
+    pub vertices: Vec<SceneVertex>,
+    /// Three indices per triangle.
+    pub indices: Vec<u32>,
+    pub objects: Vec<Object>,
+    /// Things the loader skipped or guessed, for the user to read.
+    pub warnings: Vec<String>,
+    /// The file's materials; a vertex's `material` is an index here + 1 (0: the default
+    /// material). Base colour factors are already in the vertex colours.
+    pub materials: Vec<Material>,
+    /// Decoded textures that `materials` refer to.
+    pub textures: Vec<Texture>,
+    /// Cameras placed in the file (glTF camera nodes), usable as the viewer.
+    pub cameras: Vec<Camera>,
+    /// Meshes drawn (glTF mesh instances, OBJ objects/groups, built-in shapes: one per object)
+    /// and their primitives.
+    pub meshes: usize,
+    pub primitives: usize,
+}
+
+/// A camera placed in a scene file: where it stands and which way it looks (yaw only: the
+/// panorama is level).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Camera {
+    pub name: String,
+    pub position: [f32; 3],
+    /// Turn about +y from looking along −z, degrees, positive to the left (as `--yaw`).
+    pub yaw_deg: f32,
+}
+
+impl Scene {
+    pub fn new(name: impl Into<String>) -> Self {
+        Scene { name: name.into(), ..Default::default() }
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+
+    /// Appends a mesh as one object; `indices` refer to `vertices`.
+    pub fn add_mesh(&mut self, name: impl Into<String>, vertices: &[SceneVertex], indices: &[u32]) {
+        let base = self.vertices.len() as u32;
+        let first = self.triangle_count() as u32;
+        let object = self.objects.len() as u32;
+        self.vertices.extend(vertices.iter().map(|v| SceneVertex { object, ..*v }));
+        self.indices.extend(indices.iter().map(|i| i + base));
+        self.objects.push(Object {
+            name: name.into(),
+            first_triangle: first,
+            triangle_count: (indices.len() / 3) as u32,
+        });
+        self.meshes += 1;
+        self.primitives += 1;
+    }
+
+    /// Merges the objects from index `first` on (consecutive triangle ranges) into one named
+    /// object; nothing happens when there are none.
+    pub fn merge_objects_from(&mut self, first: usize, name: String) {
+        if first >= self.objects.len() {
+            return;
+        }
+        let first_triangle = self.objects[first].first_triangle;
+        let triangle_count = self.objects[first..].iter().map(|o| o.triangle_count).sum();
+        self.meshes -= self.objects.len() - first - 1;
+        self.objects.truncate(first);
+        let object = first as u32;
+        let range = 3 * first_triangle as usize..3 * (first_triangle + triangle_count) as usize;
+        for &i in &self.indices[range] {
+            self.vertices[i as usize].object = object;
+        }
+        self.objects.push(Object { name, first_triangle, triangle_count });
+    }
+
+    /// Checks what the GPU stages rely on: whole triangles, indices in range, finite values.
+    /// The error names the problem; callers add the file name.
+    pub fn validate(&self) -> Result<()> {
+        let err = |m: String| Error::scene(&self.name, m);
+        if self.indices.len() % 3 != 0 {
+            return Err(err(format!("index count {} is not a multiple of 3", self.indices.len())));
+        }
+        let n = self.vertices.len();
+        if let Some((k, i)) = self.indices.iter().enumerate().find(|(_, &i)| i as usize >= n) {
+            return Err(err(format!("triangle {} uses vertex index {i}, but there are only {n} vertices", k / 3)));
+        }
+        for (k, v) in self.vertices.iter().enumerate() {
+            let attributes: [(&str, &[f32]); 4] =
+                [("position", &v.position), ("normal", &v.normal), ("colour", &v.color), ("texture coordinate", &v.uv)];
+            if let Some((what, value)) = attributes.iter().find(|(_, x)| !x.iter().all(|c| c.is_finite())) {
+                return Err(err(format!("vertex {k} has a NaN or infinite {what} {value:?}")));
+            }
+        }
+        if self.indices.len() / 3 > u32::MAX as usize / 64 {
+            return Err(err(format!("{} triangles is more than twister can index", self.indices.len() / 3)));
+        }
+        Ok(())
+    }
+}
+
+/// Bounding sphere (centre, radius) of each object, in scene coordinates.
+pub fn object_spheres(scene: &Scene) -> Vec<(Vec3, f32)> {
+    scene
+        .objects
+        .iter()
+        .map(|o| {
+            let tri = &scene.indices[3 * o.first_triangle as usize..3 * (o.first_triangle + o.triangle_count) as usize];
+            let pos = |i: &u32| Vec3::from(scene.vertices[*i as usize].position);
+            let (lo, hi) =
+                tri.iter().map(pos).fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), p| (l.min(p), h.max(p)));
+            let center = (lo + hi) / 2.0;
+            (center, tri.iter().map(|i| (pos(i) - center).length()).fold(0.0, f32::max))
+        })
+        .collect()
+}
+
+/// Area-weighted vertex normals from the faces.
+pub fn compute_normals(vertices: &mut [SceneVertex], indices: &[u32]) {
+    let mut acc = vec![Vec3::ZERO; vertices.len()];
+    for t in indices.chunks_exact(3) {
+        let p = [0, 1, 2].map(|k| Vec3::from(vertices[t[k] as usize].position));
+        let n = (p[1] - p[0]).cross(p[2] - p[0]);
+        for &i in t {
+            acc[i as usize] += n;
+        }
+    }
+    for (v, n) in vertices.iter_mut().zip(acc) {
+        v.normal = n.normalize_or_zero().into();
+    }
+}
+
+impl Scene {
+    /// Axis-aligned bounds of the vertices used by triangles.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let mut it = self.indices.iter().map(|&i| Vec3::from(self.vertices[i as usize].position));
+        let first = it.next()?;
+        Some(it.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
+    }
+
+    /// Applies an affine transform to positions and normals.
+    pub fn transform(&mut self, m: Mat4) {
+        let normal_matrix = m.inverse().transpose();
+        for v in &mut self.vertices {
+            v.position = m.transform_point3(Vec3::from(v.position)).into();
+            v.normal = normal_matrix.transform_vector3(Vec3::from(v.normal)).normalize_or_zero().into();
+        }
+        // The file's cameras move with the scene (so `--viewer camera` stands where it did
+        // relative to the geometry after `--fit` or `--scale`), and turn with it.
+        for camera in &mut self.cameras {
+            camera.position = m.transform_point3(Vec3::from(camera.position)).into();
+            let yaw = camera.yaw_deg.to_radians();
+            let forward = m.transform_vector3(Vec3::new(-yaw.sin(), 0.0, -yaw.cos()));
+            if forward.x != 0.0 || forward.z != 0.0 {
+                camera.yaw_deg = (-forward.x).atan2(-forward.z).to_degrees();
+            }
+        }
+    }
+
+    /// `--fit DIST`: moves and scales the scene so that its bounding box stands `distance` m
+    /// straight ahead, centred on the eye height, its front face filling the screen height
+    /// (v = R_T·y/r at the front).
+    pub fn fit(&mut self, distance: f32, projection: &Projection) -> Result<()> {
+        let (lo, hi) = self.bounds().ok_or_else(|| Error::option("--fit", "needs a scene with triangles"))?;
+        let size = hi - lo;
+        if !(size.y > 0.0) || !(distance > projection.eye_radius) || !distance.is_finite() {
+            return Err(Error::option(
+                "--fit",
+                format!("needs a scene with height and a finite distance beyond the eye circle, got {distance}"),
+            ));
+        }
+        let half = projection.half_height_m();
+        // Front face at depth distance − s·dz/2 spans v = ±R_T·(s·h/2)/(front depth) = ±half.
+        let s = half * distance / (projection.screen_radius * size.y / 2.0 + half * size.z / 2.0);
+        let center = (lo + hi) / 2.0;
+        self.transform(
+            Mat4::from_translation(Vec3::new(0.0, 0.0, -distance))
+                * Mat4::from_scale(Vec3::splat(s))
+                * Mat4::from_translation(-center),
+        );
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn transforms_move_and_turn_the_cameras_with_the_geometry() {
+        let mut scene = Scene::new("t");
+        let v = |p: [f32; 3]| SceneVertex { position: p, ..Default::default() };
+        scene.add_mesh("tri", &[v([0.0, 0.0, -2.0]), v([1.0, 0.0, -2.0]), v([0.0, 1.0, -2.0])], &[0, 1, 2]);
+        scene.cameras.push(Camera { name: "c".into(), position: [0.0, 0.5, 0.0], yaw_deg: 30.0 });
+        let m = Mat4::from_translation(Vec3::new(1.0, 2.0, 3.0))
+            * Mat4::from_rotation_y(0.5)
+            * Mat4::from_scale(Vec3::splat(2.0));
+        scene.transform(m);
+        let c = &scene.cameras[0];
+        let expected = m.transform_point3(Vec3::new(0.0, 0.5, 0.0));
+        assert!((Vec3::from(c.position) - expected).length() < 1e-5, "{:?}", c.position);
+        assert!((c.yaw_deg - (30.0 + 0.5f32.to_degrees())).abs() < 1e-3, "{}", c.yaw_deg);
+        // The camera keeps its place relative to the first vertex.
+        let offset = Vec3::from(scene.vertices[0].position) - Vec3::from(c.position);
+        assert!((offset - m.transform_vector3(Vec3::new(0.0, -0.5, -2.0))).length() < 1e-5);
+    }
+}

@@ -1,0 +1,246 @@
+//! Render settings, in four groups: where the viewer stands and what the panorama is
+//! ([`ViewSettings`]), how triangles are subdivided ([`SubdivisionSettings`], seed 002 §2.3),
+//! how surfaces are shaded ([`ShadingSettings`]) and what is measured ([`MeasureSettings`],
+//! seed 002 §4). Builders (`with_*`) set one field of a group.
+
+use glam::{Mat4, Vec3};
+
+use crate::core::projection::Projection;
+use crate::error::{Error, Result};
+
+/// Default memory budget for the subdivision buffers, MiB.
+pub const DEFAULT_MEMORY_MB: u32 = 256;
+/// Largest N for `fixed:N` (its N² triangles are made by one GPU thread).
+pub const MAX_FIXED: u32 = 64;
+/// Default L in pixels: see the README for the error it gives.
+pub const DEFAULT_EDGE_PX: f32 = 32.0;
+/// Default N_max, as in the paper.
+pub const DEFAULT_MAX_DIV: u32 = 7;
+
+/// How triangles are drawn (`--method`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// How triangles are split (`--method`).
+pub enum Method {
+    /// No split: every vertex at its projected place, straight edges (the paper's "Vert").
+    Vertex,
+    /// Every edge split into N, regular N² lattice (the paper's fixed comparison; ignores N_max).
+    Fixed(u32),
+    /// N = ceil(l/L) per edge (eq. 5), with pre-split beyond N_max.
+    Adaptive,
+    /// The conventional slit-mosaic renderer with slits of W columns (no subdivision).
+    Slit(u32),
+}
+
+/// The subdivision rule as the `subdivide` stage reads it (`SubdivideParams::method`); the WGSL
+/// constants `METHOD_VERTEX`, `METHOD_FIXED`, `METHOD_ADAPTIVE` are generated from it.
+#[repr(u32)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SplitRule {
+    Vertex = 0,
+    Fixed = 1,
+    Adaptive = 2,
+}
+
+impl SplitRule {
+    pub const ALL: [SplitRule; 3] = [SplitRule::Vertex, SplitRule::Fixed, SplitRule::Adaptive];
+    /// The WGSL constant's name.
+    pub fn wgsl_name(self) -> &'static str {
+        match self {
+            SplitRule::Vertex => "METHOD_VERTEX",
+            SplitRule::Fixed => "METHOD_FIXED",
+            SplitRule::Adaptive => "METHOD_ADAPTIVE",
+        }
+    }
+}
+
+impl Method {
+    /// The `subdivide` stage's rule and its fixed N (the slit renderer does not subdivide).
+    pub fn split_rule(self) -> (SplitRule, u32) {
+        match self {
+            Method::Vertex | Method::Slit(_) => (SplitRule::Vertex, 1),
+            Method::Fixed(n) => (SplitRule::Fixed, n),
+            Method::Adaptive => (SplitRule::Adaptive, 0),
+        }
+    }
+
+    /// Parses `adaptive`, `vertex`, `fixed:N` or `slit:W` (the parser of `--method`).
+    pub fn parse(s: &str) -> std::result::Result<Method, String> {
+        match s {
+            "vertex" => Ok(Method::Vertex),
+            "adaptive" => Ok(Method::Adaptive),
+            _ => match (s.strip_prefix("fixed:").map(str::parse::<u32>), s.strip_prefix("slit:").map(str::parse::<u32>)) {
+                (Some(Ok(n)), _) if (1..=MAX_FIXED).contains(&n) => Ok(Method::Fixed(n)),
+                (_, Some(Ok(w))) if w >= 1 => Ok(Method::Slit(w)),
+                _ => Err(format!(
+                    "unknown method '{s}': expected adaptive, vertex, fixed:N with N in 1..={MAX_FIXED}, or slit:W with W ≥ 1 columns"
+                )),
+            },
+        }
+    }
+
+    pub fn name(self) -> String {
+        match self {
+            Method::Vertex => "vertex".into(),
+            Method::Fixed(n) => format!("fixed:{n}"),
+            Method::Adaptive => "adaptive".into(),
+            Method::Slit(w) => format!("slit:{w}"),
+        }
+    }
+}
+
+/// Where the viewer stands and what the panorama is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewSettings {
+    pub projection: Projection,
+    /// Viewer position in scene coordinates.
+    pub viewer: Vec3,
+    /// Turn of the view about +y in degrees; positive turns left (counter-clockwise from above).
+    pub yaw_deg: f32,
+}
+
+/// How triangles are subdivided, and the memory the subdivision may use.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SubdivisionSettings {
+    pub method: Method,
+    /// L: the longest projected edge wanted from `adaptive`, pixels.
+    pub edge_px: f32,
+    /// N_max: the largest lattice step of one piece.
+    pub max_div: u32,
+    /// Budget for the piece and output buffers, MiB.
+    pub memory_mb: u32,
+}
+
+/// How surfaces are shaded.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadingSettings {
+    /// Background colour, display values, each channel in [0, 1].
+    pub background: [f32; 3],
+    /// Ambient term of the headlight shading.
+    pub ambient: f32,
+}
+
+/// What a render measures besides drawing.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MeasureSettings {
+    /// Measure the longest visible output edge (`FrameStats::max_sub_edge_px`); costs a few
+    /// projections per output triangle.
+    pub edges: bool,
+    /// Run the error pass: every fragment also writes its display-position error and object
+    /// id, reduced to statistics on the GPU (slower; off for plain rendering and speed runs).
+    pub error: bool,
+    /// Test hook: draws everything shifted by this many pixels (x right, y down) while the
+    /// error pass measures against the true projection.
+    #[doc(hidden)]
+    pub shift_px: [f32; 2],
+}
+
+/// Everything a render needs besides the scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderSettings {
+    pub view: ViewSettings,
+    pub subdivision: SubdivisionSettings,
+    pub shading: ShadingSettings,
+    pub measure: MeasureSettings,
+}
+
+impl Default for ViewSettings {
+    fn default() -> Self {
+        ViewSettings { projection: Projection::default(), viewer: Vec3::ZERO, yaw_deg: 0.0 }
+    }
+}
+
+impl Default for SubdivisionSettings {
+    fn default() -> Self {
+        SubdivisionSettings {
+            method: Method::Adaptive,
+            edge_px: DEFAULT_EDGE_PX,
+            max_div: DEFAULT_MAX_DIV,
+            memory_mb: DEFAULT_MEMORY_MB,
+        }
+    }
+}
+
+impl Default for ShadingSettings {
+    fn default() -> Self {
+        ShadingSettings { background: [0.1, 0.1, 0.12], ambient: 0.3 }
+    }
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings {
+            view: ViewSettings::default(),
+            subdivision: SubdivisionSettings::default(),
+            shading: ShadingSettings::default(),
+            measure: MeasureSettings::default(),
+        }
+    }
+}
+
+macro_rules! builders {
+    ($($name:ident: $ty:ty => $group:ident.$field:ident),* $(,)?) => {
+        impl RenderSettings {
+            $(
+                #[doc = concat!("These settings with `", stringify!($group), ".", stringify!($field), "` set.")]
+                pub fn $name(mut self, value: $ty) -> Self {
+                    self.$group.$field = value;
+                    self
+                }
+            )*
+        }
+    };
+}
+
+builders! {
+    with_projection: Projection => view.projection,
+    with_viewer: Vec3 => view.viewer,
+    with_yaw_deg: f32 => view.yaw_deg,
+    with_method: Method => subdivision.method,
+    with_edge_px: f32 => subdivision.edge_px,
+    with_max_div: u32 => subdivision.max_div,
+    with_memory_mb: u32 => subdivision.memory_mb,
+    with_background: [f32; 3] => shading.background,
+    with_ambient: f32 => shading.ambient,
+    with_measure_edges: bool => measure.edges,
+    with_measure_error: bool => measure.error,
+    with_shift_px: [f32; 2] => measure.shift_px,
+}
+
+impl RenderSettings {
+    /// The default settings for a projection.
+    pub fn new(projection: Projection) -> Self {
+        RenderSettings::default().with_projection(projection)
+    }
+
+    pub fn projection(&self) -> &Projection {
+        &self.view.projection
+    }
+
+    /// World → viewer frame: translate the viewer to the origin, then undo the yaw.
+    pub fn view(&self) -> Mat4 {
+        Mat4::from_rotation_y(-self.view.yaw_deg.to_radians()) * Mat4::from_translation(-self.view.viewer)
+    }
+
+    pub fn validate(&self) -> Result<()> {
+        self.view.projection.validate()?;
+        let s = &self.subdivision;
+        if !(s.edge_px.is_finite() && s.edge_px >= 0.25) {
+            return Err(Error::option("--edge-px", format!("must be a number of pixels ≥ 0.25, got {}", s.edge_px)));
+        }
+        if !(1..=64).contains(&s.max_div) {
+            return Err(Error::option("--max-div", format!("must be between 1 and 64, got {}", s.max_div)));
+        }
+        if let Method::Slit(w) = s.method {
+            if w > self.view.projection.width {
+                return Err(Error::option(
+                    "--method",
+                    format!("slit:{w} is wider than the image ({} columns)", self.view.projection.width),
+                ));
+            }
+        }
+        if s.memory_mb < 8 {
+            return Err(Error::option("--memory-mb", format!("must be at least 8, got {}", s.memory_mb)));
+        }
+        Ok(())
+    }
+}

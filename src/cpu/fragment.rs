@@ -1,0 +1,272 @@
+//! CPU twin of `shaders/fragment.wgsl`, the fragment work shared by the drawing stages: the
+//! surface colour (material: base colour texture with its sampler, alpha mask / screen-door
+//! blend, single-sided culling), headlight shading in linear light with an sRGB-encoded output,
+//! and the display-position error (seed 002 §4.1): the distance in pixels between the pixel
+//! centre where a surface point was drawn and where the projection puts it.
+
+use glam::{Vec2, Vec3, Vec4};
+
+pub use crate::core::color::{linear_to_srgb, srgb_to_linear};
+use crate::core::material::{AlphaMode, Filter, Material, MipLevel, Mipmap, Wrap, NO_TEXTURE};
+use crate::core::projection::{Eye, Projection};
+use crate::core::texture::MaterialTable;
+
+/// Linear colour × (ambient + (1 − ambient)·|n·l|), the light at the viewer, two-sided; as
+/// sRGB-encoded RGBA8 (the colour target holds display values).
+pub fn shade(ambient: f32, view_position: Vec3, normal: Vec3, color: Vec4) -> [u8; 4] {
+    let lambert = if normal.length() > 1e-6 { normal.normalize().dot(-view_position.normalize()).abs() } else { 1.0 };
+    let s = ambient + (1.0 - ambient) * lambert;
+    let q = |x: f32| (linear_to_srgb((x * s).clamp(0.0, 1.0)) * 255.0 + 0.5).floor() as u8;
+    [q(color.x), q(color.y), q(color.z), 255]
+}
+
+/// The display-position error of surface point `p` drawn at pixel centre `frag_xy`; −1 where
+/// no eye sees the point. The horizontal distance wraps around the panorama.
+pub fn pixel_error(projection: &Projection, eye: Eye, p: Vec3, frag_xy: Vec2) -> f32 {
+    match projection.project(p, eye) {
+        None => -1.0,
+        Some(q) => {
+            let [x, y] = projection.to_pixel(q.u, q.v);
+            Vec2::new(projection.wrapped_dx(x, frag_xy.x), y - frag_xy.y).length()
+        }
+    }
+}
+
+/// Texel index `i` folded into `0..n` by a wrap mode.
+pub fn wrap_index(i: i32, n: i32, mode: u32) -> i32 {
+    if mode == Wrap::ClampToEdge as u32 {
+        i.clamp(0, n - 1)
+    } else if mode == Wrap::MirroredRepeat as u32 {
+        let m = i.rem_euclid(2 * n);
+        if m >= n {
+            2 * n - 1 - m
+        } else {
+            m
+        }
+    } else {
+        i.rem_euclid(n)
+    }
+}
+
+/// The linear-light RGBA of texel (x, y) of a level.
+fn texel(table: &MaterialTable, level: &MipLevel, x: i32, y: i32) -> Vec4 {
+    let t = table.texels[(level.offset + y as u32 * level.width + x as u32) as usize].to_le_bytes();
+    let c = t.map(|b| b as f32 / 255.0);
+    Vec4::new(srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), c[3])
+}
+
+/// Samples one mip level at `uv` (texture space: 0..1 across the image, v down) with a filter.
+fn sample_level(table: &MaterialTable, m: &Material, level: u32, uv: Vec2, filter: u32) -> Vec4 {
+    let level = &table.mips[(m.first_mip + level) as usize];
+    let (w, h) = (level.width as i32, level.height as i32);
+    let p = uv.clamp(Vec2::splat(-1e6), Vec2::splat(1e6)) * Vec2::new(w as f32, h as f32);
+    // Nearest: the texel containing p. Linear: the four texels around p, weights by distance.
+    let (base, f) = if filter == Filter::Linear as u32 {
+        let q = p - 0.5;
+        (q.floor(), q - q.floor())
+    } else {
+        (p.floor(), Vec2::ZERO)
+    };
+    let mut sum = Vec4::ZERO;
+    for corner in 0..4i32 {
+        let (dx, dy) = (corner & 1, corner >> 1);
+        let weight = (if dx == 1 { f.x } else { 1.0 - f.x }) * (if dy == 1 { f.y } else { 1.0 - f.y });
+        let x = wrap_index(base.x as i32 + dx, w, m.wrap_u);
+        let y = wrap_index(base.y as i32 + dy, h, m.wrap_v);
+        sum += weight * texel(table, level, x, y);
+    }
+    sum
+}
+
+/// Samples a material's base colour texture at `uv` with the screen-space derivatives of uv:
+/// level of detail λ = log2 of the longest footprint in level-0 texels; λ ≤ 0 magnifies
+/// (magnification filter, level 0), else the minification filter on level 0 (no mipmaps), the
+/// nearest level, or a blend of the two nearest.
+pub fn sample_texture(table: &MaterialTable, m: &Material, uv: Vec2, duv_dx: Vec2, duv_dy: Vec2) -> Vec4 {
+    let top = &table.mips[m.first_mip as usize];
+    let size = Vec2::new(top.width as f32, top.height as f32);
+    let lambda = (duv_dx * size).length().max((duv_dy * size).length()).log2();
+    let last = (m.mip_count - 1) as f32;
+    // (first level, second level, weight of the second, filter)
+    let (l0, l1, t, filter) = if !(lambda > 0.0) {
+        (0.0, 0.0, 0.0, m.mag_filter)
+    } else if m.mipmap == Mipmap::None as u32 {
+        (0.0, 0.0, 0.0, m.min_filter)
+    } else if m.mipmap == Mipmap::Nearest as u32 {
+        let l = (lambda.min(last) + 0.5).floor();
+        (l, l, 0.0, m.min_filter)
+    } else {
+        let l = lambda.min(last);
+        (l.floor(), (l.floor() + 1.0).min(last), l - l.floor(), m.min_filter)
+    };
+    let mut out = Vec4::ZERO;
+    for (k, level) in [l0, l1].into_iter().enumerate() {
+        let weight = if k == 0 { 1.0 - t } else { t };
+        if weight > 0.0 {
+            out += weight * sample_level(table, m, level as u32, uv, filter);
+        }
+    }
+    out
+}
+
+/// Screen-door threshold of a pixel for BLEND materials: a 4×4 ordered-dither (Bayer) matrix,
+/// so a surface of opacity a covers about a of the pixels, independently of drawing order.
+pub fn blend_threshold(frag_xy: Vec2) -> f32 {
+    const BAYER: [f32; 16] = [0.0, 8.0, 2.0, 10.0, 12.0, 4.0, 14.0, 6.0, 3.0, 11.0, 1.0, 9.0, 15.0, 7.0, 13.0, 5.0];
+    let (x, y) = (frag_xy.x as u32 % 4, frag_xy.y as u32 % 4);
+    (BAYER[(4 * y + x) as usize] + 0.5) / 16.0
+}
+
+/// A surface fragment before shading.
+#[derive(Clone, Copy, Debug)]
+pub struct Surface {
+    pub material: u32,
+    /// Interpolated vertex colour (base colour factor × vertex colour), linear.
+    pub color: Vec4,
+    pub uv: Vec2,
+    pub duv_dx: Vec2,
+    pub duv_dy: Vec2,
+    pub frag_xy: Vec2,
+    pub front_facing: bool,
+}
+
+/// The linear surface colour of a fragment, or None where it is discarded (a single-sided face
+/// seen from behind, alpha below the MASK cutoff, a BLEND fragment the screen door leaves out).
+pub fn surface_color(table: &MaterialTable, s: &Surface) -> Option<Vec4> {
+    let m = &table.materials[(s.material as usize).min(table.materials.len() - 1)];
+    if m.double_sided == 0 && !s.front_facing {
+        return None;
+    }
+    let mut c = s.color;
+    if m.texture != NO_TEXTURE && m.mip_count > 0 {
+        c *= sample_texture(table, m, s.uv, s.duv_dx, s.duv_dy);
+    }
+    if (m.alpha_mode == AlphaMode::Mask as u32 && c.w < m.alpha_cutoff)
+        || (m.alpha_mode == AlphaMode::Blend as u32 && c.w <= blend_threshold(s.frag_xy))
+    {
+        return None;
+    }
+    Some(c)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::core::texture::Texture;
+
+    #[test]
+    fn srgb_round_trips_every_byte() {
+        for b in 0..=255u8 {
+            let c = linear_to_srgb(srgb_to_linear(b as f32 / 255.0));
+            assert_eq!((c * 255.0 + 0.5).floor() as u8, b);
+        }
+    }
+
+    #[test]
+    fn wrap_modes_fold_indices_as_gl_does() {
+        let fold = |mode: Wrap| (-5..9).map(|i| wrap_index(i, 3, mode as u32)).collect::<Vec<_>>();
+        assert_eq!(fold(Wrap::Repeat), [1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2]);
+        assert_eq!(fold(Wrap::ClampToEdge), [0, 0, 0, 0, 0, 0, 1, 2, 2, 2, 2, 2, 2, 2]);
+        assert_eq!(fold(Wrap::MirroredRepeat), [1, 2, 2, 1, 0, 0, 1, 2, 2, 1, 0, 0, 1, 2]);
+    }
+
+    fn table(material: Material) -> MaterialTable {
+        // 4×4 texture: texel (x, y) has red 60·x, green 60·y (sRGB bytes).
+        let rgba = (0..16).flat_map(|i| [60 * (i % 4) as u8, 60 * (i / 4) as u8, 0, 255]).collect();
+        let t = Texture { name: "t".into(), width: 4, height: 4, rgba };
+        MaterialTable::build(&[Material { texture: 0, ..material }], &[t], usize::MAX)
+    }
+
+    fn encoded(c: Vec4) -> [u8; 2] {
+        [c.x, c.y].map(|x| (linear_to_srgb(x) * 255.0 + 0.5).floor() as u8)
+    }
+
+    #[test]
+    fn nearest_and_linear_sampling_hit_the_texels_they_should() {
+        let small = Vec2::splat(0.01); // magnification
+        let nearest = Material { mag_filter: Filter::Nearest as u32, ..Default::default() };
+        let t = table(nearest);
+        let m = &t.materials[1];
+        // The centre of texel (2, 1) and a point inside it.
+        for uv in [Vec2::new(2.5 / 4.0, 1.5 / 4.0), Vec2::new(2.1 / 4.0, 1.9 / 4.0)] {
+            assert_eq!(encoded(sample_texture(&t, m, uv, small, small)), [120, 60]);
+        }
+        // Repeat: u + 3 lands on the same texel.
+        assert_eq!(encoded(sample_texture(&t, m, Vec2::new(3.0 + 2.5 / 4.0, 1.5 / 4.0), small, small)), [120, 60]);
+        // Linear halfway between texel centres (1, 1) and (2, 1): the linear-light mean.
+        let t = table(Material::default());
+        let c = sample_texture(&t, &t.materials[1], Vec2::new(2.0 / 4.0, 1.5 / 4.0), small, small);
+        let mean = (srgb_to_linear(60.0 / 255.0) + srgb_to_linear(120.0 / 255.0)) / 2.0;
+        assert!((c.x - mean).abs() < 1e-6 && (c.y - srgb_to_linear(60.0 / 255.0)).abs() < 1e-6, "{c}");
+        // Clamp at the edge: far left of the texture reads column 0.
+        let clamp = Material { wrap_u: Wrap::ClampToEdge as u32, ..Default::default() };
+        let t = table(clamp);
+        assert_eq!(encoded(sample_texture(&t, &t.materials[1], Vec2::new(-7.0, 1.5 / 4.0), small, small)), [0, 60]);
+    }
+
+    #[test]
+    fn minification_picks_the_mip_level_of_the_footprint() {
+        let t = table(Material { mipmap: Mipmap::Nearest as u32, ..Default::default() });
+        let m = &t.materials[1];
+        let uv = Vec2::new(0.3, 0.6);
+        // A footprint of 4 texels: λ = 2, the 1×1 level (mean of all texels).
+        let c = sample_texture(&t, m, uv, Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0));
+        let last = t.mips[(m.first_mip + 2) as usize];
+        assert_eq!((last.width, last.height), (1, 1));
+        assert_eq!(c, texel(&t, &last, 0, 0));
+        // Without mipmaps the same footprint reads level 0.
+        let t0 =
+            table(Material { mipmap: Mipmap::None as u32, min_filter: Filter::Nearest as u32, ..Default::default() });
+        let c0 = sample_texture(&t0, &t0.materials[1], uv, Vec2::new(1.0, 0.0), Vec2::ZERO);
+        assert_eq!(encoded(c0), [60, 120]);
+    }
+
+    #[test]
+    fn alpha_modes_and_facing_decide_what_is_drawn() {
+        let surface = |material: u32, alpha: f32, front_facing: bool| Surface {
+            material,
+            color: Vec4::new(1.0, 1.0, 1.0, alpha),
+            uv: Vec2::ZERO,
+            duv_dx: Vec2::ZERO,
+            duv_dy: Vec2::ZERO,
+            frag_xy: Vec2::new(0.5, 0.5),
+            front_facing,
+        };
+        let mut t = MaterialTable::build(
+            &[
+                Material { alpha_mode: AlphaMode::Mask as u32, alpha_cutoff: 0.4, ..Default::default() },
+                Material { double_sided: 0, ..Default::default() },
+                Material { alpha_mode: AlphaMode::Blend as u32, ..Default::default() },
+            ],
+            &[],
+            0,
+        );
+        assert!(surface_color(&t, &surface(1, 0.41, true)).is_some());
+        assert!(surface_color(&t, &surface(1, 0.39, true)).is_none());
+        assert!(surface_color(&t, &surface(2, 1.0, true)).is_some());
+        assert!(surface_color(&t, &surface(2, 1.0, false)).is_none());
+        assert!(
+            surface_color(&t, &surface(0, 0.0, false)).is_some(),
+            "the default material is double-sided and opaque"
+        );
+        // Screen door: opacity a covers round(16·a) of every 4×4 block.
+        for k in 0..=16 {
+            let a = k as f32 / 16.0;
+            let covered = (0..16)
+                .filter(|i| {
+                    surface_color(
+                        &t,
+                        &Surface {
+                            frag_xy: Vec2::new((i % 4) as f32 + 0.5, (i / 4) as f32 + 0.5),
+                            ..surface(3, a, true)
+                        },
+                    )
+                    .is_some()
+                })
+                .count();
+            assert_eq!(covered, k, "opacity {a}");
+        }
+        t.materials.truncate(1);
+        assert!(surface_color(&t, &surface(9, 1.0, true)).is_some(), "an id past the table uses the last entry");
+    }
+}

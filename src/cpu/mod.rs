@@ -1,0 +1,18 @@
+//! CPU twins of the GPU stages, one module per WGSL file of the same name (as vello's
+//! `cpu/` stages): straightforward Rust versions that the tests compare the GPU against.
+//!
+//! | twin | WGSL |
+//! |---|---|
+//! | [`subdivide`] | `shaders/subdivide.wgsl` (entry points `plan`, `lattice_args`, `lattice`, `finalize`) |
+//! | [`raster`] | `shaders/raster.wgsl` |
+//! | [`slit`] | `shaders/slit.wgsl` |
+//! | [`fragment`] | `shaders/shared/fragment.wgsl` (composed into raster and slit) |
+//! | [`reduce_error`] | `shaders/reduce_error.wgsl` |
+//! | [`project_points`] | `shaders/project_points.wgsl` |
+
+pub mod fragment;
+pub mod project_points;
+pub mod raster;
+pub mod reduce_error;
+pub mod slit;
+pub mod subdivide;

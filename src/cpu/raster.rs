@@ -1,0 +1,240 @@
+//! The `raster` stage, CPU twin of `shaders/raster.wgsl`, and the software rasterizer that the
+//! CPU twins of the drawing stages share.
+//!
+//! `raster_vertex` projects a subdivided vertex for one eye (seed 002 eq. 1–4) exactly as the
+//! vertex shader does. `rasterize` samples pixel centres with a depth test: clip-space
+//! near-plane clipping, perspective-correct attributes (with w = 1, as in the raster stage,
+//! that is linear on the screen), depth interpolated linearly on the screen as GPUs do, and an
+//! optional column scissor. Coverage on exact edges may differ from a GPU's tie-breaking rule,
+//! so tests compare images with a small tolerance on edge pixels.
+
+use glam::{Vec2, Vec3, Vec4};
+
+use crate::cpu::fragment::{pixel_error, shade, surface_color, Surface};
+use crate::core::settings::RenderSettings;
+use crate::shader::types::{DrawVertex, RasterParams};
+use crate::core::projection::{azimuth, Eye, Projection};
+use crate::core::texture::MaterialTable;
+
+/// Clip-space position of a subdivided vertex (`vs_main` in raster.wgsl).
+pub fn raster_vertex(params: &RasterParams, v: &DrawVertex) -> Vec4 {
+    let projection = Projection::from(&params.projection);
+    let p = Vec3::from(v.position);
+    let theta0 = azimuth(p);
+    let theta = theta0 + std::f32::consts::TAU * ((v.theta_ref - theta0) / std::f32::consts::TAU + 0.5).floor();
+    let eye = if params.eye_sign > 0.0 { Eye::Right } else { Eye::Left };
+    let q = projection.project_with_azimuth(p, theta, eye);
+    let ppm = projection.pixels_per_metre();
+    Vec4::new(
+        q.u / std::f32::consts::PI + 2.0 * params.shift_px[0] / projection.width as f32,
+        q.v * ppm / (0.5 * projection.height as f32) - 2.0 * params.shift_px[1] / projection.height as f32,
+        q.depth / (q.depth + 1.0),
+        1.0,
+    )
+}
+
+/// A vertex ready for rasterization.
+#[derive(Clone, Copy, Debug)]
+pub struct ClipVertex {
+    pub clip: Vec4,
+    pub view_position: Vec3,
+    pub normal: Vec3,
+    pub color: Vec4,
+    pub uv: Vec2,
+    pub object: u32,
+    pub material: u32,
+}
+
+impl ClipVertex {
+    fn lerp(a: &ClipVertex, b: &ClipVertex, t: f32) -> ClipVertex {
+        ClipVertex {
+            clip: a.clip + (b.clip - a.clip) * t,
+            view_position: a.view_position + (b.view_position - a.view_position) * t,
+            normal: a.normal + (b.normal - a.normal) * t,
+            color: a.color + (b.color - a.color) * t,
+            uv: a.uv + (b.uv - a.uv) * t,
+            object: a.object,
+            material: a.material,
+        }
+    }
+}
+
+/// The outputs of a drawing stage for one eye.
+pub struct RasterImage {
+    pub width: u32,
+    pub height: u32,
+    pub rgba: Vec<u8>,
+    pub depth: Vec<f32>,
+    /// Display-position error per pixel; −1 for background and points no eye sees.
+    pub error: Vec<f32>,
+    /// Object id + 1 per pixel; 0 for background.
+    pub object: Vec<u32>,
+}
+
+impl RasterImage {
+    pub fn new(width: u32, height: u32, background: [f32; 3]) -> Self {
+        let bg = background.map(|c| (c.clamp(0.0, 1.0) * 255.0 + 0.5).floor() as u8);
+        let n = (width * height) as usize;
+        RasterImage {
+            width,
+            height,
+            rgba: (0..n).flat_map(|_| [bg[0], bg[1], bg[2], 255]).collect(),
+            depth: vec![1.0; n],
+            error: vec![-1.0; n],
+            object: vec![0; n],
+        }
+    }
+}
+
+/// The interpolated inputs of a fragment.
+#[derive(Clone, Copy, Debug)]
+pub struct FragmentIn {
+    pub view_position: Vec3,
+    pub normal: Vec3,
+    pub surface: Surface,
+}
+
+/// What a fragment writes (colour and error), or None where it is discarded.
+pub type FragmentFn<'a> = dyn Fn(&FragmentIn) -> Option<([u8; 4], f32)> + 'a;
+
+/// The fragment entry point of the drawing stages (`fs_error` in fragment.wgsl; `fs_main`
+/// writes the same colour): surface colour, shading, display-position error.
+pub fn fragment(
+    table: &MaterialTable,
+    ambient: f32,
+    projection: &Projection,
+    eye: Eye,
+    f: &FragmentIn,
+) -> Option<([u8; 4], f32)> {
+    let color = surface_color(table, &f.surface)?;
+    Some((
+        shade(ambient, f.view_position, f.normal, color),
+        pixel_error(projection, eye, f.view_position, f.surface.frag_xy),
+    ))
+}
+
+/// Rasterizes one triangle into `img`, within columns `scissor` (start, end).
+pub fn rasterize(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: (u32, u32), fragment: &FragmentFn) {
+    // Clip against the near plane z ≥ 0 in clip space (w = 1 triangles never need it).
+    let mut poly: Vec<ClipVertex> = Vec::with_capacity(4);
+    for i in 0..3 {
+        let (a, b) = (&tri[i], &tri[(i + 1) % 3]);
+        if a.clip.z >= 0.0 {
+            poly.push(*a);
+        }
+        if (a.clip.z >= 0.0) != (b.clip.z >= 0.0) {
+            poly.push(ClipVertex::lerp(a, b, a.clip.z / (a.clip.z - b.clip.z)));
+        }
+    }
+    for i in 1..poly.len().saturating_sub(1) {
+        rasterize_clipped(img, [poly[0], poly[i], poly[i + 1]], scissor, fragment);
+    }
+}
+
+fn rasterize_clipped(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: (u32, u32), fragment: &FragmentFn) {
+    let (w, h) = (img.width, img.height);
+    if tri.iter().any(|v| !v.clip.is_finite() || v.clip.w <= 0.0) {
+        return;
+    }
+    let s: Vec<[f32; 2]> = tri
+        .iter()
+        .map(|v| [(v.clip.x / v.clip.w + 1.0) * 0.5 * w as f32, (1.0 - v.clip.y / v.clip.w) * 0.5 * h as f32])
+        .collect();
+    let area = (s[1][0] - s[0][0]) * (s[2][1] - s[0][1]) - (s[2][0] - s[0][0]) * (s[1][1] - s[0][1]);
+    if area == 0.0 {
+        return;
+    }
+    let min_x = s.iter().map(|p| p[0]).fold(f32::MAX, f32::min).floor().max(scissor.0 as f32) as i64;
+    let max_x = s.iter().map(|p| p[0]).fold(f32::MIN, f32::max).ceil().min(scissor.1.min(w) as f32) as i64;
+    let min_y = s.iter().map(|p| p[1]).fold(f32::MAX, f32::min).floor().max(0.0) as i64;
+    let max_y = s.iter().map(|p| p[1]).fold(f32::MIN, f32::max).ceil().min(h as f32) as i64;
+    // Screen-space barycentric weights of a point, and their perspective-correct form.
+    let barycentric = |qx: f32, qy: f32| {
+        let edge = |a: [f32; 2], b: [f32; 2]| (b[0] - a[0]) * (qy - a[1]) - (b[1] - a[1]) * (qx - a[0]);
+        [edge(s[1], s[2]) / area, edge(s[2], s[0]) / area, edge(s[0], s[1]) / area]
+    };
+    let perspective = |b: [f32; 3]| {
+        let pw = [0, 1, 2].map(|k| b[k] / tri[k].clip.w);
+        let sum: f32 = pw.iter().sum();
+        pw.map(|w| w / sum)
+    };
+    for y in min_y..max_y {
+        for x in min_x..max_x {
+            let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
+            let b = barycentric(px, py);
+            if b.iter().any(|&x| x < 0.0) {
+                continue;
+            }
+            let z = (0..3).map(|k| b[k] * tri[k].clip.z / tri[k].clip.w).sum::<f32>();
+            let i = (y as u32 * w + x as u32) as usize;
+            if !(z < img.depth[i]) || !(z >= 0.0) {
+                continue;
+            }
+            // Perspective-correct weights here (and one pixel right and down, for the
+            // derivatives of uv).
+            let pw = perspective(b);
+            let mix3 = |f: &dyn Fn(&ClipVertex) -> Vec3| (0..3).map(|k| pw[k] * f(&tri[k])).sum::<Vec3>();
+            let uv_at = |w: [f32; 3]| (0..3).map(|k| w[k] * tri[k].uv).sum::<Vec2>();
+            let uv = uv_at(pw);
+            let input = FragmentIn {
+                view_position: mix3(&|v| v.view_position),
+                normal: mix3(&|v| v.normal),
+                surface: Surface {
+                    material: tri[0].material,
+                    color: (0..3).map(|k| pw[k] * tri[k].color).sum::<Vec4>(),
+                    uv,
+                    duv_dx: uv_at(perspective(barycentric(px + 1.0, py))) - uv,
+                    duv_dy: uv_at(perspective(barycentric(px, py + 1.0))) - uv,
+                    frag_xy: Vec2::new(px, py),
+                    // Counter-clockwise in normalized device coordinates (y up) is clockwise
+                    // on the pixel grid (y down): negative `area`.
+                    front_facing: area < 0.0,
+                },
+            };
+            let Some((rgba, error)) = fragment(&input) else {
+                continue;
+            };
+            img.depth[i] = z;
+            img.rgba[4 * i..4 * i + 4].copy_from_slice(&rgba);
+            img.error[i] = error;
+            img.object[i] = tri[0].object + 1;
+        }
+    }
+}
+
+/// The raster stage on the CPU for one eye.
+pub fn raster(
+    params: &RasterParams,
+    vertices: &[DrawVertex],
+    table: &MaterialTable,
+    background: [f32; 3],
+) -> RasterImage {
+    let projection = Projection::from(&params.projection);
+    let eye = if params.eye_sign > 0.0 { Eye::Right } else { Eye::Left };
+    let mut img = RasterImage::new(projection.width, projection.height, background);
+    let fragment = |f: &FragmentIn| fragment(table, params.ambient, &projection, eye, f);
+    for tri in vertices.chunks_exact(3) {
+        let cv = [0, 1, 2].map(|k| ClipVertex {
+            clip: raster_vertex(params, &tri[k]),
+            view_position: Vec3::from(tri[k].position),
+            normal: Vec3::from(tri[k].normal),
+            color: Vec4::from(tri[k].color),
+            uv: Vec2::from(tri[k].uv),
+            object: tri[k].object,
+            material: tri[k].material,
+        });
+        rasterize(&mut img, cv, (0, projection.width), &fragment);
+    }
+    img
+}
+
+/// The raster stage's parameters for one eye.
+pub fn raster_params(settings: &RenderSettings, eye: Eye) -> RasterParams {
+    RasterParams {
+        projection: settings.projection().into(),
+        eye_sign: eye.sign(),
+        ambient: settings.shading.ambient,
+        shift_px: settings.measure.shift_px,
+    }
+}
+

@@ -1,0 +1,206 @@
+//! The wgpu device, the one clear error when there is none, error scopes that turn a GPU
+//! validation or out-of-memory error into one [`Error::Gpu`] line, and buffer read-back.
+
+use std::sync::{Arc, Mutex};
+
+use crate::error::{Error, Result};
+use crate::shader::ErrorTarget;
+
+pub const NO_ADAPTER_HELP: &str = "no GPU adapter found: no Vulkan, Metal, DX12 or OpenGL driver is usable on this machine. \
+Install a GPU driver, or Mesa's software Vulkan driver (lavapipe): `sudo apt-get install -y mesa-vulkan-drivers libvulkan1` \
+on Debian/Ubuntu (scripts/test.sh does this for you). If WGPU_BACKEND is set, check that it names an available backend.";
+
+pub struct Gpu {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: wgpu::AdapterInfo,
+    pub limits: wgpu::Limits,
+    pub features: wgpu::Features,
+    /// How the error pass writes its target: R32Float where the adapter can render to it,
+    /// else R32Uint bits. `TWISTER_ERROR_TARGET=uint` forces the latter (for tests).
+    pub error_target: ErrorTarget,
+    /// GPU errors raised outside any error scope (kept instead of wgpu's default panic).
+    uncaptured: Arc<Mutex<Vec<String>>>,
+}
+
+/// The texture format of an error target.
+pub fn error_target_format(target: ErrorTarget) -> wgpu::TextureFormat {
+    match target {
+        ErrorTarget::Float => wgpu::TextureFormat::R32Float,
+        ErrorTarget::UintBits => wgpu::TextureFormat::R32Uint,
+    }
+}
+
+/// Mesa's device-select Vulkan layer prints `XDG_RUNTIME_DIR is invalid` twice on machines
+/// without a desktop session; `NODEVICE_SELECT=1` turns the layer off (it only reorders
+/// adapters). Set for this process before the first instance, unless the user set it.
+fn quiet_device_select_layer() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        if std::env::var_os("NODEVICE_SELECT").is_none() && std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+            // SAFETY: called once, before wgpu (or anything else in twister) starts threads
+            // that read the environment.
+            unsafe { std::env::set_var("NODEVICE_SELECT", "1") };
+        }
+    });
+}
+
+/// A wgpu error as one line.
+fn one_line(e: &wgpu::Error) -> String {
+    e.to_string().split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+impl Gpu {
+    /// Opens the default adapter (respecting `WGPU_BACKEND`) with its full limits.
+    pub fn new() -> Result<Gpu> {
+        quiet_device_select_layer();
+        pollster::block_on(Self::new_async())
+    }
+
+    async fn new_async() -> Result<Gpu> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapter = instance
+            .request_adapter(&wgpu::RequestAdapterOptions {
+                power_preference: wgpu::PowerPreference::HighPerformance,
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| Error::NoGpu(format!("{NO_ADAPTER_HELP} ({e})")))?;
+        let info = adapter.get_info();
+        let float_renderable = adapter
+            .get_texture_format_features(wgpu::TextureFormat::R32Float)
+            .allowed_usages
+            .contains(wgpu::TextureUsages::RENDER_ATTACHMENT);
+        let forced_uint = std::env::var("TWISTER_ERROR_TARGET").is_ok_and(|v| v == "uint");
+        let error_target =
+            if float_renderable && !forced_uint { ErrorTarget::Float } else { ErrorTarget::UintBits };
+        let limits = adapter.limits();
+        let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("twister"),
+                required_features: features,
+                required_limits: limits.clone(),
+                ..Default::default()
+            })
+            .await
+            .map_err(|e| Error::NoGpu(format!("the GPU adapter '{}' could not open a device: {e}", info.name)))?;
+        let uncaptured = Arc::new(Mutex::new(Vec::new()));
+        let sink = uncaptured.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            sink.lock().unwrap_or_else(|p| p.into_inner()).push(one_line(&e));
+        }));
+        Ok(Gpu { device, queue, info, limits, features, error_target, uncaptured })
+    }
+
+    /// "name (backend, device type)", for stats and logs.
+    pub fn adapter_description(&self) -> String {
+        format!("{} ({:?}, {:?})", self.info.name, self.info.backend, self.info.device_type)
+    }
+
+    /// The largest buffer a stage can bind on this device, bytes.
+    pub fn max_binding(&self) -> u64 {
+        self.limits.max_storage_buffer_binding_size.min(self.limits.max_buffer_size)
+    }
+
+    /// Runs `f` inside validation and out-of-memory error scopes: a GPU error raised by the
+    /// work becomes one `Error::Gpu` line naming `what`, instead of a panic.
+    pub fn scoped<T>(&self, what: &str, f: impl FnOnce() -> Result<T>) -> Result<T> {
+        let oom = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let result = f();
+        let invalid = pollster::block_on(validation.pop());
+        let out_of_memory = pollster::block_on(oom.pop());
+        if let Some(e) = out_of_memory.or(invalid) {
+            return Err(Error::Gpu(format!("{what}: {}", one_line(&e))));
+        }
+        if let Some(e) = self.uncaptured.lock().unwrap_or_else(|p| p.into_inner()).drain(..).next() {
+            return Err(Error::Gpu(format!("{what}: {e}")));
+        }
+        result
+    }
+
+    /// Blocks until the GPU has finished all submitted work.
+    pub fn wait(&self) {
+        let _ = self.device.poll(wgpu::PollType::wait_indefinitely());
+    }
+
+    /// Reads a whole buffer (which must have MAP_READ usage) back to the CPU.
+    pub fn read_buffer(&self, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
+        let mapped = Arc::new(Mutex::new(None));
+        let slot = mapped.clone();
+        buffer.map_async(wgpu::MapMode::Read, .., move |r| {
+            *slot.lock().unwrap_or_else(|p| p.into_inner()) = Some(r);
+        });
+        self.wait();
+        let status = mapped.lock().unwrap_or_else(|p| p.into_inner()).take();
+        match status {
+            Some(Ok(())) => {}
+            Some(Err(e)) => return Err(Error::Gpu(format!("reading back a buffer: {e}"))),
+            None => return Err(Error::Gpu("reading back a buffer: the GPU did not finish".into())),
+        }
+        let data = buffer
+            .get_mapped_range(..)
+            .map_err(|e| Error::Gpu(format!("reading back a buffer: {e}")))?
+            .to_vec();
+        buffer.unmap();
+        Ok(data)
+    }
+
+    /// Copies `size` bytes of `source` into a fresh readback buffer and returns them.
+    pub fn download(&self, source: &wgpu::Buffer, size: u64) -> Result<Vec<u8>> {
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: size.max(4),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.device.create_command_encoder(&Default::default());
+        if size > 0 {
+            enc.copy_buffer_to_buffer(source, 0, &staging, 0, size);
+        }
+        self.queue.submit([enc.finish()]);
+        let mut data = self.read_buffer(&staging)?;
+        data.truncate(size as usize);
+        Ok(data)
+    }
+
+    /// A storage buffer of `size` bytes (also a copy source and destination).
+    pub fn storage_buffer(&self, label: &str, size: u64, extra: wgpu::BufferUsages) -> wgpu::Buffer {
+        self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: size.max(4),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST | extra,
+            mapped_at_creation: false,
+        })
+    }
+
+    /// A buffer holding `bytes` (16 zero bytes when empty: bindings may not be empty).
+    pub fn init_buffer(&self, label: &str, bytes: &[u8], usage: wgpu::BufferUsages) -> wgpu::Buffer {
+        use wgpu::util::DeviceExt;
+        let contents = if bytes.is_empty() { &[0u8; 16][..] } else { bytes };
+        self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+    }
+
+    /// A uniform buffer for a `T`, written with `queue.write_buffer` before each use.
+    pub fn uniform_buffer<T: bytemuck::Pod>(&self, label: &str) -> wgpu::Buffer {
+        self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: std::mem::size_of::<T>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    }
+
+    /// Workgroups of `size` invocations for `count` items, as (x, y) within the device's
+    /// per-dimension limit (a 2-D dispatch beyond it; shaders flatten `gid.x + gid.y·x·size`).
+    pub fn workgroups(&self, count: u32, size: u32) -> (u32, u32) {
+        let max = self.limits.max_compute_workgroups_per_dimension.max(1);
+        let groups = count.div_ceil(size).max(1);
+        if groups <= max {
+            (groups, 1)
+        } else {
+            (max, groups.div_ceil(max))
+        }
+    }
+}

@@ -1,0 +1,17 @@
+//! The GPU layer (wgpu): the device, one [`stages::GpuStage`] per stage descriptor, the
+//! uploaded scene, render targets, timestamps, the frame plan, and the renderer that runs them.
+
+pub mod device;
+pub mod frame_plan;
+pub mod project_points;
+pub mod reduce_error;
+pub mod renderer;
+pub mod scene;
+pub mod slit;
+pub mod stages;
+pub mod targets;
+pub mod timestamps;
+
+pub use device::Gpu;
+pub use renderer::Renderer;
+pub use scene::GpuScene;

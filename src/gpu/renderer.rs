@@ -1,0 +1,618 @@
+//! The headless renderer: the `subdivide` compute pre-pass (`plan`, then `lattice`), then the
+//! `raster` stage draws the subdivided triangles indirectly for each eye; or the `slit` stage
+//! ([`crate::gpu::slit`]); then read-back and, with the error pass, `reduce_error`. The
+//! schedule is a [`FramePlan`]; pipelines, targets, uniforms and buffers are made once and
+//! reused across frames. Every frame runs inside GPU error scopes, so a GPU error is one
+//! [`Error::Gpu`] line.
+
+use std::mem::offset_of;
+use std::sync::{Mutex, OnceLock};
+use std::time::Instant;
+
+use crate::core::frame::{Frame, FrameStats, Measurement, Timing};
+use crate::core::projection::Eye;
+use crate::core::scene::SceneVertex;
+use crate::core::settings::{Method, RenderSettings};
+use crate::cpu::raster::raster_params;
+use crate::cpu::subdivide::{subdivide_params, SubdivideOutput};
+use crate::error::{Error, Result};
+use crate::gpu::device::{error_target_format, Gpu};
+use crate::gpu::frame_plan::{on_overflow, Capacities, FramePlan, Overflow, SubdivisionBuffers, TRIANGLE_SIZE};
+use crate::gpu::scene::GpuScene;
+use crate::gpu::stages::GpuStage;
+use crate::gpu::targets::{Targets, COLOR_FORMAT, DEPTH_FORMAT, OBJECT_FORMAT};
+use crate::gpu::timestamps::Timestamps;
+use crate::shader::constants::PIECES_FROM_COUNTER;
+use crate::shader::types::{DrawVertex, RasterParams, SlitParams, SubdivideCounters, SubdivideParams};
+use crate::shader::{RASTER, REDUCE_ERROR, SLIT, SUBDIVIDE};
+
+/// The two drawing stages.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum DrawStage {
+    Raster = 0,
+    Slit = 1,
+}
+
+/// A drawing stage's pipelines: [colour only, with the error pass], without the fragment
+/// stage's material code (`MATERIALS = false`, for scenes whose materials are all untextured,
+/// opaque and double-sided: on lavapipe it roughly halves the fragment cost) and, made when a
+/// scene first needs them, with it.
+pub(crate) struct DrawPipelines {
+    pub stage: GpuStage,
+    kind: DrawStage,
+    plain: [wgpu::RenderPipeline; 2],
+    with_materials: OnceLock<[wgpu::RenderPipeline; 2]>,
+}
+
+impl DrawPipelines {
+    fn new(gpu: &Gpu, kind: DrawStage) -> DrawPipelines {
+        let stage = GpuStage::new(gpu, if kind == DrawStage::Raster { &RASTER } else { &SLIT });
+        let plain = [false, true].map(|measure| draw_pipeline(gpu, &stage, kind, measure, false));
+        DrawPipelines { stage, kind, plain, with_materials: OnceLock::new() }
+    }
+
+    /// The pipeline for a scene: plain where its materials allow, else with materials.
+    pub fn get(&self, gpu: &Gpu, scene: &GpuScene, measure: bool) -> &wgpu::RenderPipeline {
+        let set = if scene.needs_materials {
+            self.with_materials.get_or_init(|| [false, true].map(|m| draw_pipeline(gpu, &self.stage, self.kind, m, true)))
+        } else {
+            &self.plain
+        };
+        &set[measure as usize]
+    }
+
+    /// The scene's material table (group 1).
+    pub fn material_bind_group(&self, gpu: &Gpu, scene: &GpuScene) -> wgpu::BindGroup {
+        let [a, b, c] = &scene.materials;
+        self.stage.bind_group(gpu, None, 1, &[a, b, c])
+    }
+}
+
+fn attribute(format: wgpu::VertexFormat, offset: usize, shader_location: u32) -> wgpu::VertexAttribute {
+    wgpu::VertexAttribute { format, offset: offset as u64, shader_location }
+}
+
+/// A drawing pipeline: colour only (`fs_main`) or with the error pass (`fs_error`); with the
+/// fragment stage's material code (`MATERIALS`) or without.
+fn draw_pipeline(gpu: &Gpu, stage: &GpuStage, kind: DrawStage, measure: bool, materials: bool) -> wgpu::RenderPipeline {
+    use wgpu::VertexFormat::{Float32, Float32x2, Float32x3, Float32x4, Uint32};
+    // Raster: the subdivided `DrawVertex`; slit: the scene's `SceneVertex` (`VertexIn` of each WGSL file).
+    let (stride, attributes) = match kind {
+        DrawStage::Raster => (
+            std::mem::size_of::<DrawVertex>(),
+            vec![
+                attribute(Float32x3, offset_of!(DrawVertex, position), 0),
+                attribute(Float32, offset_of!(DrawVertex, theta_ref), 1),
+                attribute(Float32x3, offset_of!(DrawVertex, normal), 2),
+                attribute(Uint32, offset_of!(DrawVertex, material), 3),
+                attribute(Float32x4, offset_of!(DrawVertex, color), 4),
+                attribute(Float32x2, offset_of!(DrawVertex, uv), 5),
+                attribute(Uint32, offset_of!(DrawVertex, object), 6),
+            ],
+        ),
+        DrawStage::Slit => (
+            std::mem::size_of::<SceneVertex>(),
+            vec![
+                attribute(Float32x3, offset_of!(SceneVertex, position), 0),
+                attribute(Float32x3, offset_of!(SceneVertex, normal), 1),
+                attribute(Float32x4, offset_of!(SceneVertex, color), 2),
+                attribute(Uint32, offset_of!(SceneVertex, object), 3),
+                attribute(Float32x2, offset_of!(SceneVertex, uv), 4),
+                attribute(Uint32, offset_of!(SceneVertex, material), 5),
+            ],
+        ),
+    };
+    let layout = wgpu::VertexBufferLayout {
+        array_stride: stride as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &attributes,
+    };
+    let all_targets = [COLOR_FORMAT, error_target_format(gpu.error_target), OBJECT_FORMAT]
+        .map(|format| Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL }));
+    let constants = [("MATERIALS", materials as u32 as f64)];
+    gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(stage.stage.name),
+        layout: Some(stage.draw_layout()),
+        vertex: wgpu::VertexState {
+            module: &stage.module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[Some(layout)],
+        },
+        primitive: wgpu::PrimitiveState {
+            topology: wgpu::PrimitiveTopology::TriangleList,
+            cull_mode: None,
+            ..Default::default()
+        },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &stage.module,
+            entry_point: Some(if measure { "fs_error" } else { "fs_main" }),
+            compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
+            targets: if measure { &all_targets } else { &all_targets[..1] },
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// The `subdivide` stage's pipelines, one per entry point.
+struct SubdividePipelines {
+    stage: GpuStage,
+    plan: wgpu::ComputePipeline,
+    lattice_args: wgpu::ComputePipeline,
+    lattice: wgpu::ComputePipeline,
+    finalize: wgpu::ComputePipeline,
+}
+
+/// What a renderer keeps between frames.
+pub(crate) struct FrameResources {
+    pub buffers: Option<SubdivisionBuffers>,
+    /// Targets of the last image size.
+    pub targets: Option<Targets>,
+    pub timestamps: Option<Timestamps>,
+    pub subdivide_params: wgpu::Buffer,
+    /// Per eye.
+    pub raster_params: [wgpu::Buffer; 2],
+    pub slit_params: [wgpu::Buffer; 2],
+    /// Counters and timestamps of a one-submission frame.
+    pub staging: wgpu::Buffer,
+}
+
+impl FrameResources {
+    /// The targets for this size, made anew only when the size changed.
+    pub fn targets(&mut self, gpu: &Gpu, width: u32, height: u32) -> &Targets {
+        if !self.targets.as_ref().is_some_and(|t| t.width == width && t.height == height) {
+            self.targets = Some(Targets::new(gpu, width, height));
+        }
+        self.targets.as_ref().expect("just made")
+    }
+}
+
+const COUNTERS_SIZE: u64 = std::mem::size_of::<SubdivideCounters>() as u64;
+const STAGING_SIZE: u64 = COUNTERS_SIZE + 8 * crate::gpu::timestamps::COUNT as u64;
+
+pub struct Renderer {
+    pub gpu: Gpu,
+    subdivide: SubdividePipelines,
+    pub(crate) raster: DrawPipelines,
+    pub(crate) slit: DrawPipelines,
+    pub(crate) reduce: GpuStage,
+    pub(crate) accumulate: wgpu::ComputePipeline,
+    pub(crate) finish: wgpu::ComputePipeline,
+    pub(crate) project_points: OnceLock<(GpuStage, wgpu::ComputePipeline)>,
+    pub(crate) resources: Mutex<FrameResources>,
+}
+
+impl Renderer {
+    /// Builds every stage's pipelines (a GPU error here is returned, not a panic).
+    pub fn new(gpu: Gpu) -> Result<Renderer> {
+        let built = gpu.scoped("building the pipelines", || {
+            let stage = GpuStage::new(&gpu, &SUBDIVIDE);
+            let subdivide = SubdividePipelines {
+                plan: stage.compute(&gpu, "plan"),
+                lattice_args: stage.compute(&gpu, "lattice_args"),
+                lattice: stage.compute(&gpu, "lattice"),
+                finalize: stage.compute(&gpu, "finalize"),
+                stage,
+            };
+            let reduce = GpuStage::new(&gpu, &REDUCE_ERROR);
+            let resources = FrameResources {
+                buffers: None,
+                targets: None,
+                timestamps: Timestamps::new(&gpu),
+                subdivide_params: gpu.uniform_buffer::<SubdivideParams>("subdivide params"),
+                raster_params: Eye::BOTH.map(|e| gpu.uniform_buffer::<RasterParams>(&format!("{} raster params", e.name()))),
+                slit_params: Eye::BOTH.map(|e| gpu.uniform_buffer::<SlitParams>(&format!("{} slit params", e.name()))),
+                staging: gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("frame readback"),
+                    size: STAGING_SIZE,
+                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                }),
+            };
+            Ok((
+                subdivide,
+                DrawPipelines::new(&gpu, DrawStage::Raster),
+                DrawPipelines::new(&gpu, DrawStage::Slit),
+                reduce.compute(&gpu, "accumulate"),
+                reduce.compute(&gpu, "finish"),
+                reduce,
+                resources,
+            ))
+        })?;
+        let (subdivide, raster, slit, accumulate, finish, reduce, resources) = built;
+        Ok(Renderer {
+            gpu,
+            subdivide,
+            raster,
+            slit,
+            reduce,
+            accumulate,
+            finish,
+            project_points: OnceLock::new(),
+            resources: Mutex::new(resources),
+        })
+    }
+
+    /// Renders both eyes of an uploaded scene.
+    pub fn render(&self, scene: &GpuScene, settings: &RenderSettings) -> Result<Frame> {
+        settings.validate()?;
+        self.check_size(settings)?;
+        let mut resources = self.resources.lock().unwrap_or_else(|e| e.into_inner());
+        self.gpu.scoped("rendering a frame", || match settings.subdivision.method {
+            Method::Slit(width) => self.render_slit(&mut resources, scene, settings, width),
+            _ => self.render_subdivided(&mut resources, scene, settings),
+        })
+    }
+
+    /// Fails with one line when the image cannot be drawn on this device.
+    fn check_size(&self, settings: &RenderSettings) -> Result<()> {
+        let p = settings.projection();
+        let max = self.gpu.limits.max_texture_dimension_2d;
+        if p.width > max || p.height > max {
+            return Err(Error::option(
+                "--width/--height",
+                format!("{}x{} is larger than this GPU's largest image, {max}x{max}", p.width, p.height),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The subdivide stage's bind group: params, vertices, indices, pieces, triangles, counters,
+    /// draw args, lattice dispatch, per-object edge scale (the order of `SUBDIVIDE.bindings`).
+    fn subdivide_bind_group(
+        &self,
+        entry: &str,
+        uniform: &wgpu::Buffer,
+        scene: &GpuScene,
+        b: &SubdivisionBuffers,
+    ) -> wgpu::BindGroup {
+        self.subdivide.stage.bind_group(
+            &self.gpu,
+            Some(entry),
+            0,
+            &[
+                uniform,
+                &scene.vertices,
+                &scene.indices,
+                &b.pieces,
+                &b.triangles,
+                &b.counters,
+                &b.draw_args,
+                &b.lattice_dispatch,
+                &scene.object_edge_scale,
+            ],
+        )
+    }
+
+    /// Runs one compute entry point of the subdivide stage (`plan` or `lattice`) over `count`
+    /// invocations, then `finalize`, and returns the counters afterwards.
+    fn run_subdivide(
+        &self,
+        entry: &str,
+        uniform: &wgpu::Buffer,
+        scene: &GpuScene,
+        buffers: &SubdivisionBuffers,
+        params: &SubdivideParams,
+        count: u32,
+    ) -> Result<SubdivideCounters> {
+        self.gpu.queue.write_buffer(uniform, 0, bytemuck::bytes_of(params));
+        let pipeline = if entry == "plan" { &self.subdivide.plan } else { &self.subdivide.lattice };
+        let bind_group = self.subdivide_bind_group(entry, uniform, scene, buffers);
+        let finalize = self.subdivide_bind_group("finalize", uniform, scene, buffers);
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        enc.clear_buffer(&buffers.counters, 0, None);
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &bind_group, &[]);
+            let (x, y) = self.gpu.workgroups(count, 64);
+            pass.dispatch_workgroups(x, y, 1);
+            pass.set_pipeline(&self.subdivide.finalize);
+            pass.set_bind_group(0, &finalize, &[]);
+            pass.dispatch_workgroups(1, 1, 1);
+        }
+        self.gpu.queue.submit([enc.finish()]);
+        let bytes = self.gpu.download(&buffers.counters, COUNTERS_SIZE)?;
+        Ok(*bytemuck::from_bytes(&bytes))
+    }
+
+    /// The usual frame, in one submission (see [`FramePlan::OneSubmission`]). Returns None if a
+    /// buffer overflowed; else the counters and, with timestamp queries, the GPU times (ms) of
+    /// the subdivision, the raster and the whole frame.
+    fn render_one_submission(
+        &self,
+        res: &FrameResources,
+        scene: &GpuScene,
+        settings: &RenderSettings,
+        targets: &Targets,
+        b: &SubdivisionBuffers,
+        mut params: SubdivideParams,
+    ) -> Result<Option<(SubdivideCounters, Option<[f64; 3]>)>> {
+        params.first_piece = 0;
+        params.piece_count = PIECES_FROM_COUNTER;
+        self.gpu.queue.write_buffer(&res.subdivide_params, 0, bytemuck::bytes_of(&params));
+        let group = |entry| self.subdivide_bind_group(entry, &res.subdivide_params, scene, b);
+        let groups = ["plan", "lattice_args", "lattice", "finalize"].map(group);
+        let timestamps = res.timestamps.as_ref();
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        enc.clear_buffer(&b.counters, 0, None);
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("subdivide"),
+                timestamp_writes: timestamps.map(|t| wgpu::ComputePassTimestampWrites {
+                    query_set: &t.set,
+                    beginning_of_pass_write_index: Some(0),
+                    end_of_pass_write_index: Some(1),
+                }),
+            });
+            pass.set_pipeline(&self.subdivide.plan);
+            pass.set_bind_group(0, &groups[0], &[]);
+            let (x, y) = self.gpu.workgroups(params.triangle_count, 64);
+            pass.dispatch_workgroups(x, y, 1);
+            pass.set_pipeline(&self.subdivide.lattice_args);
+            pass.set_bind_group(0, &groups[1], &[]);
+            pass.dispatch_workgroups(1, 1, 1);
+            pass.set_pipeline(&self.subdivide.lattice);
+            pass.set_bind_group(0, &groups[2], &[]);
+            pass.dispatch_workgroups_indirect(&b.lattice_dispatch, 0);
+            pass.set_pipeline(&self.subdivide.finalize);
+            pass.set_bind_group(0, &groups[3], &[]);
+            pass.dispatch_workgroups(1, 1, 1);
+        }
+        self.encode_raster(&mut enc, res, scene, targets, b, settings, true, timestamps.map(|t| (&t.set, 2, 3)));
+        enc.copy_buffer_to_buffer(&b.counters, 0, &res.staging, 0, COUNTERS_SIZE);
+        if let Some(t) = timestamps {
+            t.resolve(&mut enc, &res.staging, COUNTERS_SIZE);
+        }
+        self.gpu.queue.submit([enc.finish()]);
+        let bytes = self.gpu.read_buffer(&res.staging)?;
+        let counters: SubdivideCounters = *bytemuck::from_bytes(&bytes[..COUNTERS_SIZE as usize]);
+        if counters.pieces > params.piece_capacity || counters.triangles > params.triangle_capacity {
+            return Ok(None);
+        }
+        let times = timestamps.map(|t| {
+            let ticks: &[u64] = bytemuck::cast_slice(&bytes[COUNTERS_SIZE as usize..]);
+            [t.ms(ticks[0], ticks[1]), t.ms(ticks[2], ticks[3]), t.ms(ticks[0], ticks[3])]
+        });
+        Ok(Some((counters, times)))
+    }
+
+    /// Encodes the raster of both eyes (clearing the targets first if `clear`); with a query
+    /// set, writes timestamps at the start of the first eye's pass and the end of the second's.
+    #[allow(clippy::too_many_arguments)]
+    fn encode_raster(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        res: &FrameResources,
+        scene: &GpuScene,
+        targets: &Targets,
+        buffers: &SubdivisionBuffers,
+        settings: &RenderSettings,
+        clear: bool,
+        timestamps: Option<(&wgpu::QuerySet, u32, u32)>,
+    ) {
+        let pipeline = self.raster.get(&self.gpu, scene, settings.measure.error);
+        let materials = self.raster.material_bind_group(&self.gpu, scene);
+        for (k, eye) in Eye::BOTH.into_iter().enumerate() {
+            let uniform = &res.raster_params[k];
+            self.gpu.queue.write_buffer(uniform, 0, bytemuck::bytes_of(&raster_params(settings, eye)));
+            let bind_group = self.raster.stage.bind_group(&self.gpu, None, 0, &[uniform]);
+            let writes = timestamps.map(|(q, begin, end)| wgpu::RenderPassTimestampWrites {
+                query_set: q,
+                beginning_of_pass_write_index: (k == 0).then_some(begin),
+                end_of_pass_write_index: (k == 1).then_some(end),
+            });
+            let mut pass = targets.begin_eye_pass(enc, k, settings, clear, writes);
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &bind_group, &[]);
+            pass.set_bind_group(1, &materials, &[]);
+            pass.set_vertex_buffer(0, buffers.triangles.slice(..));
+            pass.draw_indirect(&buffers.draw_args, 0);
+        }
+    }
+
+    /// Runs the whole subdivide stage on a scene and reads its output back: the GPU side of the
+    /// CPU-twin tests. Buffers are sized to hold everything at once.
+    pub fn subdivide_readback(&self, scene: &GpuScene, settings: &RenderSettings) -> Result<SubdivideOutput> {
+        self.gpu.scoped("subdividing", || {
+            let mut cache = None;
+            let uniform = self.gpu.uniform_buffer::<SubdivideParams>("subdivide params");
+            let mut params = subdivide_params(settings, 0, scene.triangle_count);
+            let mut want = Capacities {
+                pieces: scene.triangle_count.max(64),
+                triangles: scene.triangle_count.saturating_mul(4).max(1024),
+            };
+            loop {
+                let b = SubdivisionBuffers::ensure(&mut cache, &self.gpu, want);
+                params.piece_capacity = b.capacity.pieces;
+                params.triangle_capacity = b.capacity.triangles;
+                let planned =
+                    self.run_subdivide("plan", &uniform, scene, b, &params, scene.triangle_count)?;
+                if planned.pieces > b.capacity.pieces {
+                    want.pieces = planned.pieces;
+                    continue;
+                }
+                params.first_piece = 0;
+                params.piece_count = planned.pieces;
+                let done = self.run_subdivide("lattice", &uniform, scene, b, &params, planned.pieces)?;
+                if done.triangles > b.capacity.triangles {
+                    want.triangles = done.triangles;
+                    continue;
+                }
+                let bytes = self.gpu.download(&b.triangles, done.triangles as u64 * TRIANGLE_SIZE)?;
+                return Ok(SubdivideOutput {
+                    vertices: bytemuck::cast_slice(&bytes).to_vec(),
+                    pieces: planned.pieces,
+                    max_sub_edge_px: f32::from_bits(done.max_edge_bits),
+                });
+            }
+        })
+    }
+
+    /// Reads the targets back and reduces the error: the end of every render.
+    pub(crate) fn finish_frame(
+        &self,
+        targets: &Targets,
+        settings: &RenderSettings,
+        mut stats: FrameStats,
+        start: Instant,
+    ) -> Result<Frame> {
+        let t = Instant::now();
+        let [left, right] = targets.read_colors(&self.gpu)?;
+        stats.ms_readback = t.elapsed().as_secs_f64() * 1e3;
+        let measurement = if settings.measure.error {
+            let object = targets.read_objects(&self.gpu)?;
+            let (stats, error) = self.reduce_errors(targets)?;
+            Some(Measurement { error, object, stats })
+        } else {
+            None
+        };
+        stats.ms_total = start.elapsed().as_secs_f64() * 1e3;
+        Ok(Frame { left, right, stats, measurement })
+    }
+
+    /// The subdivided frame: follows the [`FramePlan`].
+    fn render_subdivided(&self, res: &mut FrameResources, scene: &GpuScene, settings: &RenderSettings) -> Result<Frame> {
+        let start = Instant::now();
+        let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, ..Default::default() };
+        let p = settings.projection();
+        res.targets(&self.gpu, p.width, p.height);
+        let budget = Capacities::budget(settings.subdivision.memory_mb, self.gpu.max_binding());
+        let n = scene.triangle_count;
+        let mut plan = FramePlan::first(n, res.buffers.as_ref().map(|b| b.capacity), budget);
+        if let FramePlan::OneSubmission(want) = plan {
+            SubdivisionBuffers::ensure(&mut res.buffers, &self.gpu, want);
+            let b = res.buffers.as_ref().expect("ensured");
+            let targets = res.targets.as_ref().expect("made");
+            let mut params = subdivide_params(settings, 0, n);
+            let capacity = b.capacity.min(budget);
+            params.piece_capacity = capacity.pieces;
+            params.triangle_capacity = capacity.triangles;
+            let t = Instant::now();
+            if let Some((counters, times)) = self.render_one_submission(res, scene, settings, targets, b, params)? {
+                stats.ms_frame = t.elapsed().as_secs_f64() * 1e3;
+                match times {
+                    Some([subdivide, raster, frame]) => {
+                        stats.timing = Timing::GpuTimestamps;
+                        stats.ms_subdivide = Some(subdivide);
+                        stats.ms_raster = Some(raster);
+                        stats.ms_gpu = Some(frame);
+                    }
+                    None => stats.timing = Timing::WallOneSubmission,
+                }
+                stats.pieces = counters.pieces as u64;
+                stats.triangles_out = counters.triangles as u64;
+                stats.chunks = 1;
+                stats.max_sub_edge_px = f32::from_bits(counters.max_edge_bits);
+                return self.finish_frame(targets, settings, stats, start);
+            }
+            plan = plan.after_overflow(budget);
+        }
+        let FramePlan::Chunked { mut want, budget } = plan else { unreachable!("a one-submission frame returned") };
+        self.render_chunked(res, scene, settings, &mut want, budget, &mut stats)?;
+        stats.ms_frame = stats.ms_subdivide.unwrap_or(0.0) + stats.ms_raster.unwrap_or(0.0);
+        stats.timing = Timing::WallPerPass;
+        let targets = res.targets.as_ref().expect("made");
+        self.finish_frame(targets, settings, stats, start)
+    }
+
+    /// The chunked schedule (see [`FramePlan::Chunked`]): wall times per pass.
+    fn render_chunked(
+        &self,
+        res: &mut FrameResources,
+        scene: &GpuScene,
+        settings: &RenderSettings,
+        want: &mut Capacities,
+        budget: Capacities,
+        stats: &mut FrameStats,
+    ) -> Result<()> {
+        let n = scene.triangle_count;
+        let memory_mb = settings.subdivision.memory_mb;
+        let (mut ms_subdivide, mut ms_raster) = (0.0, 0.0);
+        let (mut first_tri, mut tri_chunk) = (0u32, n.max(1));
+        let mut cleared = false;
+        while first_tri < n || !cleared {
+            let tri_count = tri_chunk.min(n - first_tri);
+            let b = SubdivisionBuffers::ensure(&mut res.buffers, &self.gpu, *want);
+            let mut params = subdivide_params(settings, first_tri, tri_count);
+            params.piece_capacity = b.capacity.pieces.min(budget.pieces);
+            params.triangle_capacity = b.capacity.triangles;
+            let t = Instant::now();
+            let planned = self.run_subdivide("plan", &res.subdivide_params, scene, b, &params, tri_count)?;
+            ms_subdivide += t.elapsed().as_secs_f64() * 1e3;
+            if planned.pieces > params.piece_capacity {
+                match on_overflow(planned.pieces, budget.pieces, tri_count) {
+                    Overflow::Grow(p) => want.pieces = p,
+                    Overflow::Halve(c) => tri_chunk = c,
+                    Overflow::TooBig => {
+                        return Err(Error::option(
+                            "--memory-mb",
+                            format!(
+                                "{memory_mb} is too small: one triangle needs {} pieces; raise --edge-px or --memory-mb",
+                                planned.pieces
+                            ),
+                        ))
+                    }
+                }
+                continue;
+            }
+            stats.pieces += planned.pieces as u64;
+            let (mut first_piece, mut piece_chunk) = (0u32, planned.pieces.max(1));
+            let mut piece_done = false;
+            while first_piece < planned.pieces || !piece_done {
+                let piece_count = piece_chunk.min(planned.pieces - first_piece);
+                let b = SubdivisionBuffers::ensure(&mut res.buffers, &self.gpu, *want);
+                params.first_piece = first_piece;
+                params.piece_count = piece_count;
+                params.triangle_capacity = b.capacity.triangles.min(budget.triangles);
+                let t = Instant::now();
+                let done =
+                    self.run_subdivide("lattice", &res.subdivide_params, scene, b, &params, piece_count)?;
+                ms_subdivide += t.elapsed().as_secs_f64() * 1e3;
+                if done.triangles > params.triangle_capacity {
+                    match on_overflow(done.triangles, budget.triangles, piece_count) {
+                        Overflow::Grow(t) => want.triangles = t,
+                        Overflow::Halve(c) => piece_chunk = c,
+                        Overflow::TooBig => {
+                            return Err(Error::option(
+                                "--memory-mb",
+                                format!(
+                                    "{memory_mb} is too small: one piece makes {} triangles; lower the fixed N or raise --memory-mb",
+                                    done.triangles
+                                ),
+                            ))
+                        }
+                    }
+                    continue;
+                }
+                let t = Instant::now();
+                let targets = res.targets.as_ref().expect("made");
+                let b = res.buffers.as_ref().expect("ensured");
+                let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+                self.encode_raster(&mut enc, res, scene, targets, b, settings, !cleared, None);
+                self.gpu.queue.submit([enc.finish()]);
+                self.gpu.wait();
+                ms_raster += t.elapsed().as_secs_f64() * 1e3;
+                cleared = true;
+                piece_done = true;
+                stats.triangles_out += done.triangles as u64;
+                stats.chunks += 1;
+                stats.max_sub_edge_px = stats.max_sub_edge_px.max(f32::from_bits(done.max_edge_bits));
+                first_piece += piece_count;
+            }
+            first_tri += tri_count;
+        }
+        stats.ms_subdivide = Some(ms_subdivide);
+        stats.ms_raster = Some(ms_raster);
+        Ok(())
+    }
+}

@@ -1,0 +1,131 @@
+//! A scene uploaded to the GPU: vertices, indices, the material table and the per-object
+//! factor on L; a level-of-detail selection swaps only the index buffer and the factors.
+
+use glam::Vec3;
+
+use crate::core::lod::LodSelection;
+use crate::core::scene::{object_spheres, Scene};
+use crate::core::texture::MaterialTable;
+use crate::error::{Error, Result};
+use crate::gpu::device::Gpu;
+
+/// One object's triangles and bounding sphere (scene coordinates), for the slit renderer's culling.
+#[derive(Clone, Copy, Debug)]
+pub struct ObjectRange {
+    pub first_triangle: u32,
+    pub triangle_count: u32,
+    pub center: Vec3,
+    pub radius: f32,
+}
+
+pub struct GpuScene {
+    pub vertices: wgpu::Buffer,
+    pub indices: wgpu::Buffer,
+    pub triangle_count: u32,
+    pub objects: Vec<ObjectRange>,
+    /// The material table the fragment stage reads (group 1): materials, mip levels, texels.
+    pub materials: [wgpu::Buffer; 3],
+    /// What the packing of the textures had to say (levels dropped to fit the budget).
+    pub warnings: Vec<String>,
+    /// Per object: the factor on L of the adaptive subdivision (1; the level of detail sets it).
+    pub object_edge_scale: wgpu::Buffer,
+    /// Whether some material is textured, not opaque or single-sided (else the drawing stages
+    /// use their plain pipelines).
+    pub needs_materials: bool,
+}
+
+impl GpuScene {
+    /// Validates and uploads a scene; fails with a clear message if it cannot fit the device.
+    pub fn upload(gpu: &Gpu, scene: &Scene) -> Result<GpuScene> {
+        scene.validate()?;
+        let vbytes = std::mem::size_of_val(scene.vertices.as_slice()) as u64;
+        let ibytes = std::mem::size_of_val(scene.indices.as_slice()) as u64;
+        let max = gpu.max_binding();
+        if vbytes > max || ibytes > max {
+            return Err(Error::scene(
+                &scene.name,
+                format!(
+                    "too big for this GPU: {} vertices ({} MiB) and {} triangles ({} MiB); one buffer may hold at most {} MiB",
+                    scene.vertices.len(),
+                    vbytes >> 20,
+                    scene.triangle_count(),
+                    ibytes >> 20,
+                    max >> 20
+                ),
+            ));
+        }
+        gpu.scoped(&format!("uploading {}", scene.name), || {
+            let vertices = gpu.init_buffer(
+                "scene vertices",
+                bytemuck::cast_slice(&scene.vertices),
+                wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX,
+            );
+            let indices = gpu.init_buffer(
+                "scene indices",
+                bytemuck::cast_slice(&scene.indices),
+                wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDEX,
+            );
+            let objects = scene
+                .objects
+                .iter()
+                .zip(object_spheres(scene))
+                .map(|(o, (center, radius))| ObjectRange {
+                    first_triangle: o.first_triangle,
+                    triangle_count: o.triangle_count,
+                    center,
+                    radius,
+                })
+                .collect();
+            // Textures get at most a quarter of the device's largest binding (max/16 texels of 4
+            // bytes; levels are dropped, largest first, with a warning).
+            let table = MaterialTable::of(scene, (max / 16) as usize);
+            let storage = |label: &str, bytes: &[u8]| gpu.init_buffer(label, bytes, wgpu::BufferUsages::STORAGE);
+            let materials = [
+                storage("materials", bytemuck::cast_slice(&table.materials)),
+                storage("mip levels", bytemuck::cast_slice(&table.mips)),
+                storage("texels", bytemuck::cast_slice(&table.texels)),
+            ];
+            let ones = vec![1.0f32; scene.objects.len().max(1)];
+            let needs_materials = table.needs_materials();
+            Ok(GpuScene {
+                vertices,
+                indices,
+                triangle_count: scene.triangle_count() as u32,
+                objects,
+                materials,
+                warnings: table.warnings,
+                object_edge_scale: storage("object edge scale", bytemuck::cast_slice(&ones)),
+                needs_materials,
+            })
+        })
+    }
+
+    /// The scene as a level-of-detail selection draws it: the same vertices and materials, the
+    /// selection's triangles (a new index buffer, the only upload) and per-object factors on L.
+    pub fn with_lod(&self, gpu: &Gpu, selection: &LodSelection) -> GpuScene {
+        let scales = selection.edge_scales();
+        GpuScene {
+            vertices: self.vertices.clone(),
+            indices: gpu.init_buffer(
+                "lod indices",
+                bytemuck::cast_slice(&selection.indices),
+                wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDEX,
+            ),
+            triangle_count: (selection.indices.len() / 3) as u32,
+            objects: self
+                .objects
+                .iter()
+                .zip(&selection.objects)
+                .map(|(r, o)| ObjectRange { first_triangle: o.first_triangle, triangle_count: o.triangle_count, ..*r })
+                .collect(),
+            materials: self.materials.clone(),
+            warnings: self.warnings.clone(),
+            object_edge_scale: gpu.init_buffer(
+                "object edge scale",
+                bytemuck::cast_slice(&scales),
+                wgpu::BufferUsages::STORAGE,
+            ),
+            needs_materials: self.needs_materials,
+        }
+    }
+}

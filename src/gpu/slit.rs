@@ -1,0 +1,83 @@
+//! The slit-mosaic reference renderer on the GPU (`slit` stage, twin `cpu::slit`): one draw per
+//! slit and visible object, per eye, with all slit cameras in one buffer.
+
+use std::time::Instant;
+
+use crate::core::frame::{Frame, FrameStats, Timing};
+use crate::core::projection::Eye;
+use crate::core::settings::RenderSettings;
+use crate::cpu::slit::{slit_params, slits, sphere_in_slit, SlitCamera};
+use crate::error::Result;
+use crate::gpu::renderer::{FrameResources, Renderer};
+use crate::gpu::scene::GpuScene;
+
+impl Renderer {
+    pub(crate) fn render_slit(
+        &self,
+        res: &mut FrameResources,
+        scene: &GpuScene,
+        settings: &RenderSettings,
+        width: u32,
+    ) -> Result<Frame> {
+        let start = Instant::now();
+        let gpu = &self.gpu;
+        let projection = settings.projection();
+        res.targets(gpu, projection.width, projection.height);
+        let res = &*res;
+        let targets = res.targets.as_ref().expect("made");
+        let view = settings.view();
+        let eye_slits = Eye::BOTH.map(|eye| slits(projection, eye, width));
+        let cameras: Vec<SlitCamera> = eye_slits.iter().flatten().map(|s| s.camera).collect();
+        let camera_buffer = gpu.init_buffer("slit cameras", bytemuck::cast_slice(&cameras), wgpu::BufferUsages::STORAGE);
+        let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, chunks: 1, ..Default::default() };
+        let pipeline = self.slit.get(gpu, scene, settings.measure.error);
+        let materials = self.slit.material_bind_group(gpu, scene);
+        let timestamps = res.timestamps.as_ref();
+        let t = Instant::now();
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        for (k, eye) in Eye::BOTH.into_iter().enumerate() {
+            let params = slit_params(projection, view, eye, settings.shading.ambient);
+            gpu.queue.write_buffer(&res.slit_params[k], 0, bytemuck::bytes_of(&params));
+            let bind_group = self.slit.stage.bind_group(gpu, None, 0, &[&res.slit_params[k], &camera_buffer]);
+            let writes = timestamps.map(|t| wgpu::RenderPassTimestampWrites {
+                query_set: &t.set,
+                beginning_of_pass_write_index: (k == 0).then_some(0),
+                end_of_pass_write_index: (k == 1).then_some(1),
+            });
+            let mut pass = targets.begin_eye_pass(&mut enc, k, settings, true, writes);
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &bind_group, &[]);
+            pass.set_bind_group(1, &materials, &[]);
+            pass.set_vertex_buffer(0, scene.vertices.slice(..));
+            pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
+            let first_instance = (k * eye_slits[0].len()) as u32;
+            for (i, slit) in eye_slits[k].iter().enumerate() {
+                pass.set_scissor_rect(slit.first_column, 0, slit.end_column - slit.first_column, projection.height);
+                let instance = first_instance + i as u32;
+                for o in &scene.objects {
+                    if sphere_in_slit(&params, slit, view.transform_point3(o.center), o.radius) {
+                        let first = o.first_triangle;
+                        pass.draw_indexed(3 * first..3 * (first + o.triangle_count), 0, instance..instance + 1);
+                        stats.triangles_out += o.triangle_count as u64;
+                    }
+                }
+            }
+        }
+        if let Some(t) = timestamps {
+            t.resolve(&mut enc, &res.staging, 0);
+        }
+        gpu.queue.submit([enc.finish()]);
+        gpu.wait();
+        stats.ms_frame = t.elapsed().as_secs_f64() * 1e3;
+        stats.ms_raster = Some(stats.ms_frame);
+        stats.timing = Timing::WallOneSubmission;
+        if let Some(t) = timestamps {
+            let bytes = gpu.read_buffer(&res.staging)?;
+            let ticks: &[u64] = bytemuck::cast_slice(&bytes[..16]);
+            stats.ms_gpu = Some(t.ms(ticks[0], ticks[1]));
+            stats.ms_raster = stats.ms_gpu;
+            stats.timing = Timing::GpuTimestamps;
+        }
+        self.finish_frame(targets, settings, stats, start)
+    }
+}

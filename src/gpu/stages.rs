@@ -1,0 +1,122 @@
+//! A stage on the GPU, built from its descriptor ([`crate::shader::Stage`]): the composed
+//! shader module and, per pipeline, explicit bind group layouts made from the bindings the
+//! descriptor says it uses — one compute pipeline per entry point, or one drawing pipeline
+//! binding every binding. Bind groups are filled from the buffers of a whole group in binding
+//! order; each pipeline takes the ones it uses.
+
+use crate::gpu::device::Gpu;
+use crate::shader::{compose, Binding, BindingKind, Stage, StageKind};
+
+/// The layouts of one pipeline of a stage.
+pub struct PipelineLayout {
+    /// The entry point (compute), or None for the drawing pipeline.
+    pub entry: Option<&'static str>,
+    pub groups: Vec<wgpu::BindGroupLayout>,
+    pub layout: wgpu::PipelineLayout,
+}
+
+pub struct GpuStage {
+    pub stage: &'static Stage,
+    pub module: wgpu::ShaderModule,
+    pub layouts: Vec<PipelineLayout>,
+}
+
+fn layout_entry(b: &Binding, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding: b.binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: match b.kind {
+                BindingKind::Uniform => wgpu::BufferBindingType::Uniform,
+                BindingKind::Storage => wgpu::BufferBindingType::Storage { read_only: true },
+                BindingKind::StorageReadWrite => wgpu::BufferBindingType::Storage { read_only: false },
+            },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+impl GpuStage {
+    pub fn new(gpu: &Gpu, stage: &'static Stage) -> GpuStage {
+        let device = &gpu.device;
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(stage.name),
+            source: wgpu::ShaderSource::Wgsl(compose(stage, gpu.error_target).into()),
+        });
+        let (visibility, pipelines): (_, Vec<Option<&'static str>>) = match stage.kind {
+            StageKind::Compute => (wgpu::ShaderStages::COMPUTE, stage.entry_points.iter().map(|e| Some(e.name)).collect()),
+            StageKind::Draw => (wgpu::ShaderStages::VERTEX_FRAGMENT, vec![None]),
+        };
+        let layouts = pipelines
+            .into_iter()
+            .map(|entry| {
+                let groups: Vec<wgpu::BindGroupLayout> = (0..stage.group_count())
+                    .map(|g| {
+                        let entries: Vec<wgpu::BindGroupLayoutEntry> = stage
+                            .group(g)
+                            .filter(|b| stage.binds(entry, b))
+                            .map(|b| layout_entry(b, visibility))
+                            .collect();
+                        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                            label: Some(&format!("{} {} group {g}", stage.name, entry.unwrap_or("draw"))),
+                            entries: &entries,
+                        })
+                    })
+                    .collect();
+                let refs: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(Some).collect();
+                let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                    label: Some(stage.name),
+                    bind_group_layouts: &refs,
+                    immediate_size: 0,
+                });
+                PipelineLayout { entry, groups, layout }
+            })
+            .collect();
+        GpuStage { stage, module, layouts }
+    }
+
+    fn pipeline_layout(&self, entry: Option<&str>) -> &PipelineLayout {
+        self.layouts
+            .iter()
+            .find(|l| l.entry == entry)
+            .unwrap_or_else(|| panic!("{} has no pipeline {entry:?}", self.stage.name))
+    }
+
+    /// The layout of the drawing pipeline.
+    pub fn draw_layout(&self) -> &wgpu::PipelineLayout {
+        &self.pipeline_layout(None).layout
+    }
+
+    /// The compute pipeline of one entry point.
+    pub fn compute(&self, gpu: &Gpu, entry: &str) -> wgpu::ComputePipeline {
+        gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(entry),
+            layout: Some(&self.pipeline_layout(Some(entry)).layout),
+            module: &self.module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+    }
+
+    /// A bind group of `group` for a pipeline (`entry`, or None for the drawing pipeline), from
+    /// one buffer per binding of the whole group, in binding order; the pipeline's own bindings
+    /// are taken from them.
+    pub fn bind_group(&self, gpu: &Gpu, entry: Option<&str>, group: u32, buffers: &[&wgpu::Buffer]) -> wgpu::BindGroup {
+        let bindings: Vec<&Binding> = self.stage.group(group).collect();
+        assert_eq!(bindings.len(), buffers.len(), "{} group {group}: one buffer per binding", self.stage.name);
+        let entries: Vec<wgpu::BindGroupEntry> = bindings
+            .iter()
+            .zip(buffers)
+            .filter(|(b, _)| self.stage.binds(entry, b))
+            .map(|(b, buffer)| wgpu::BindGroupEntry { binding: b.binding, resource: buffer.as_entire_binding() })
+            .collect();
+        gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(self.stage.name),
+            layout: &self.pipeline_layout(entry).groups[group as usize],
+            entries: &entries,
+        })
+    }
+}

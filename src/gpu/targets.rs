@@ -1,0 +1,181 @@
+//! Per-eye render targets (colour, display-position error, object id, depth), made once per
+//! image size and reused across frames, the render pass that draws one eye into them, and
+//! their read-back.
+
+use crate::core::color::srgb_to_linear;
+use crate::core::frame::EyeImage;
+use crate::core::projection::Eye;
+use crate::core::settings::RenderSettings;
+use crate::error::Result;
+use crate::gpu::device::{error_target_format, Gpu};
+use crate::shader::ErrorTarget;
+
+/// The colour target holds display (sRGB-encoded) values; the fragment stage writes linear light
+/// and the target encodes it (cheaper than encoding in the shader on lavapipe).
+pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+pub const OBJECT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+pub struct Targets {
+    pub width: u32,
+    pub height: u32,
+    pub color: [wgpu::Texture; 2],
+    pub error: [wgpu::Texture; 2],
+    pub object: [wgpu::Texture; 2],
+    pub depth: [wgpu::Texture; 2],
+    error_target: ErrorTarget,
+}
+
+impl Targets {
+    pub fn new(gpu: &Gpu, width: u32, height: u32) -> Targets {
+        let make = |format, usage, label: &str| {
+            gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let copyable = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+        let depth = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        let error_format = error_target_format(gpu.error_target);
+        let pair = |format, usage, what: &str| {
+            Eye::BOTH.map(|eye| make(format, usage, &format!("{} {what}", eye.name())))
+        };
+        Targets {
+            width,
+            height,
+            color: pair(COLOR_FORMAT, copyable, "colour"),
+            error: pair(error_format, copyable, "error"),
+            object: pair(OBJECT_FORMAT, copyable, "object"),
+            depth: pair(DEPTH_FORMAT, depth, "depth"),
+            error_target: gpu.error_target,
+        }
+    }
+
+    /// Begins the render pass of eye `k`, clearing its targets first if `clear` (background
+    /// colour, error −1, object 0, depth 1); the error and object targets only with the error pass.
+    pub fn begin_eye_pass<'e>(
+        &self,
+        enc: &'e mut wgpu::CommandEncoder,
+        k: usize,
+        settings: &RenderSettings,
+        clear: bool,
+        timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'e>>,
+    ) -> wgpu::RenderPass<'e> {
+        let outputs = if settings.measure.error { 3 } else { 1 };
+        let views: Vec<wgpu::TextureView> = [&self.color[k], &self.error[k], &self.object[k]][..outputs]
+            .iter()
+            .map(|t| t.create_view(&Default::default()))
+            .collect();
+        let depth_view = self.depth[k].create_view(&Default::default());
+        // The background is given as display values; the sRGB target takes linear ones.
+        let [r, g, b] = settings.shading.background.map(|c| srgb_to_linear(c) as f64);
+        let no_error = match self.error_target {
+            ErrorTarget::Float => -1.0,
+            ErrorTarget::UintBits => (-1.0f32).to_bits() as f64,
+        };
+        let clears = [
+            wgpu::Color { r, g, b, a: 1.0 },
+            wgpu::Color { r: no_error, ..wgpu::Color::TRANSPARENT },
+            wgpu::Color::TRANSPARENT,
+        ];
+        let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = views
+            .iter()
+            .zip(clears)
+            .map(|(view, c)| {
+                Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: if clear { wgpu::LoadOp::Clear(c) } else { wgpu::LoadOp::Load },
+                        store: wgpu::StoreOp::Store,
+                    },
+                })
+            })
+            .collect();
+        enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(Eye::BOTH[k].name()),
+            color_attachments: &attachments,
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: if clear { wgpu::LoadOp::Clear(1.0) } else { wgpu::LoadOp::Load },
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        })
+    }
+
+    /// Reads both eyes' colour targets back.
+    pub fn read_colors(&self, gpu: &Gpu) -> Result<[EyeImage; 2]> {
+        let (w, h) = (self.width, self.height);
+        let (buffer, stride) = copy_eyes_to_buffer(gpu, &self.color, wgpu::BufferUsages::COPY_SRC);
+        let [left, right] = unpad_eyes(&gpu.download(&buffer, buffer.size())?, w, h, stride);
+        let image = |texels: Vec<u32>| EyeImage { width: w, height: h, rgba: bytemuck::cast_slice(&texels).to_vec() };
+        Ok([image(left), image(right)])
+    }
+
+    /// Reads both eyes' object ids back.
+    pub fn read_objects(&self, gpu: &Gpu) -> Result<[Vec<u32>; 2]> {
+        let (buffer, stride) = copy_eyes_to_buffer(gpu, &self.object, wgpu::BufferUsages::COPY_SRC);
+        Ok(unpad_eyes(&gpu.download(&buffer, buffer.size())?, self.width, self.height, stride))
+    }
+}
+
+/// Copies a 4-byte-per-texel texture of each eye into one buffer (rows padded to 256 bytes,
+/// eyes one after the other). Returns the buffer and the padded row length in texels.
+pub fn copy_eyes_to_buffer(
+    gpu: &Gpu,
+    textures: &[wgpu::Texture; 2],
+    usage: wgpu::BufferUsages,
+) -> (wgpu::Buffer, u32) {
+    let (w, h) = (textures[0].width(), textures[0].height());
+    let padded = (4 * w).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("eye texels"),
+        size: 2 * (padded as u64 * h as u64),
+        usage: usage | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut enc = gpu.device.create_command_encoder(&Default::default());
+    for (k, texture) in textures.iter().enumerate() {
+        enc.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: k as u64 * (padded as u64 * h as u64),
+                    bytes_per_row: Some(padded),
+                    rows_per_image: Some(h),
+                },
+            },
+            wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+        );
+    }
+    gpu.queue.submit([enc.finish()]);
+    (buffer, padded / 4)
+}
+
+/// Unpads the texels of both eyes from a buffer made by [`copy_eyes_to_buffer`].
+pub fn unpad_eyes(data: &[u8], w: u32, h: u32, stride: u32) -> [Vec<u32>; 2] {
+    let words: &[u32] = bytemuck::cast_slice(data);
+    std::array::from_fn(|k| {
+        let base = k * (stride * h) as usize;
+        (0..h as usize).flat_map(|y| words[base + y * stride as usize..][..w as usize].iter().copied()).collect()
+    })
+}

@@ -1,0 +1,78 @@
+//! Constants shared by the Rust and WGSL sides, defined once here. The WGSL module
+//! `constants` (composed by `#import constants`) is generated from this list by [`wgsl`], so
+//! the two sides cannot drift apart.
+
+use crate::core::material::{AlphaMode, Filter, Mipmap, Wrap, NO_TEXTURE};
+use crate::core::settings::SplitRule;
+
+/// Largest edge count the adaptive method asks for (edges longer than this many L are capped).
+pub const MAX_EDGE_DIVISIONS: u32 = 1024;
+/// Segments of the polyline that measures a long edge's projected length.
+pub const EDGE_SAMPLES: u32 = 8;
+/// Triangles spanning more azimuth than this (a little over 90°) are split into sectors. Not
+/// a round angle, so that structured meshes rarely sit exactly on the threshold.
+pub const MAX_SPAN: f32 = 1.6;
+/// Signed distances within this fraction of their terms' magnitude count as on the clip line,
+/// so that the CPU and the GPU (whose rounding differs in the last bits) take the same side.
+pub const SNAP: f32 = 1e-6;
+/// Seam copies are made for triangles reaching within this many radians of ±π.
+pub const SEAM_MARGIN: f32 = 1e-5;
+/// `SubdivideParams::piece_count` meaning "as many pieces as `plan` made" (read on the GPU).
+pub const PIECES_FROM_COUNTER: u32 = u32::MAX;
+
+/// Error histogram of `reduce_error`: bins of 1/64 px in [0, 64) px ...
+pub const FINE_BINS: u32 = 4096;
+/// ... bins of 1 px in [64, 1024) px ...
+pub const COARSE_BINS: u32 = 960;
+/// ... and one overflow bin.
+pub const BINS: u32 = FINE_BINS + COARSE_BINS + 1;
+
+/// A constant's value as WGSL writes it.
+#[derive(Clone, Copy, Debug)]
+pub enum Value {
+    U32(u32),
+    F32(f32),
+}
+
+/// Every shared constant: (WGSL name, value).
+pub fn all() -> Vec<(&'static str, Value)> {
+    use Value::{F32, U32};
+    let mut out = vec![
+        ("MAX_EDGE_DIVISIONS", U32(MAX_EDGE_DIVISIONS)),
+        ("EDGE_SAMPLES", U32(EDGE_SAMPLES)),
+        ("MAX_SPAN", F32(MAX_SPAN)),
+        ("SNAP", F32(SNAP)),
+        ("SEAM_MARGIN", F32(SEAM_MARGIN)),
+        ("PIECES_FROM_COUNTER", U32(PIECES_FROM_COUNTER)),
+        ("FINE_BINS", U32(FINE_BINS)),
+        ("COARSE_BINS", U32(COARSE_BINS)),
+        ("BINS", U32(BINS)),
+        ("NO_TEXTURE", U32(NO_TEXTURE)),
+        ("WRAP_REPEAT", U32(Wrap::Repeat as u32)),
+        ("WRAP_CLAMP", U32(Wrap::ClampToEdge as u32)),
+        ("WRAP_MIRROR", U32(Wrap::MirroredRepeat as u32)),
+        ("FILTER_NEAREST", U32(Filter::Nearest as u32)),
+        ("FILTER_LINEAR", U32(Filter::Linear as u32)),
+        ("MIPMAP_NONE", U32(Mipmap::None as u32)),
+        ("MIPMAP_NEAREST", U32(Mipmap::Nearest as u32)),
+        ("MIPMAP_LINEAR", U32(Mipmap::Linear as u32)),
+        ("ALPHA_OPAQUE", U32(AlphaMode::Opaque as u32)),
+        ("ALPHA_MASK", U32(AlphaMode::Mask as u32)),
+        ("ALPHA_BLEND", U32(AlphaMode::Blend as u32)),
+    ];
+    out.extend(SplitRule::ALL.map(|m| (m.wgsl_name(), U32(m as u32))));
+    out
+}
+
+/// The generated WGSL module `constants`.
+pub fn wgsl() -> String {
+    let mut s = String::from("// Generated from src/shader/constants.rs: edit the Rust side.\n");
+    for (name, value) in all() {
+        match value {
+            // `{:?}` prints the shortest decimal that reads back as the same f32 (e.g. 1e-6).
+            Value::F32(x) => s += &format!("const {name}: f32 = {x:?};\n"),
+            Value::U32(x) => s += &format!("const {name}: u32 = {x}u;\n"),
+        }
+    }
+    s
+}

@@ -1,0 +1,260 @@
+//! The WGSL side's interface, with no GPU in it: the stage registry, WGSL composition, the
+//! shared constants and the plain-old-data structs.
+//!
+//! **A stage** is one WGSL file in `shaders/` (its entry points), a CPU twin of the same name
+//! in `src/cpu/`, and one [`Stage`] descriptor here listing its bindings. The GPU layer builds
+//! the stage's explicit bind group layouts and pipelines from the descriptor
+//! (`gpu::stages`), and `tests/shaders.rs` checks every descriptor against the composed WGSL
+//! (reflected with naga): the same bindings, and every uniform/storage struct laid out exactly
+//! as its Rust twin in [`types::LAYOUTS`], field offset by field offset. Adding a stage is: the
+//! WGSL file, its twin, a `Stage` constant, a line in [`STAGES`].
+//!
+//! **Composition.** A WGSL file pulls in shared code with `#import NAME` lines (vello's
+//! convention): `shaders/shared/NAME.wgsl`, or one of the generated modules `constants`
+//! ([`constants::wgsl`]) and `error_target` (how the error pass writes its target). Each module
+//! is composed in once, after the modules it imports.
+
+pub mod constants;
+pub mod types;
+
+/// Which pipeline kind a stage makes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StageKind {
+    /// Compute entry points.
+    Compute,
+    /// A vertex + fragment pipeline (`vs_main`; `fs_main`, and `fs_error` with the error pass).
+    Draw,
+}
+
+/// How a binding is declared in WGSL.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BindingKind {
+    /// `var<uniform>`
+    Uniform,
+    /// `var<storage, read>`
+    Storage,
+    /// `var<storage, read_write>`
+    StorageReadWrite,
+}
+
+/// One resource binding of a stage.
+#[derive(Clone, Copy, Debug)]
+pub struct Binding {
+    pub group: u32,
+    pub binding: u32,
+    /// The WGSL variable's name.
+    pub name: &'static str,
+    pub kind: BindingKind,
+}
+
+const fn bind(group: u32, binding: u32, name: &'static str, kind: BindingKind) -> Binding {
+    Binding { group, binding, name, kind }
+}
+
+use BindingKind::{Storage, StorageReadWrite, Uniform};
+
+/// An entry point and the bindings it uses (by WGSL variable name). A compute entry point gets
+/// a pipeline layout of just these (a buffer used as indirect arguments by one dispatch must
+/// not be bound as storage to it); a drawing stage's pipeline binds the union of its entry
+/// points'. The naga test checks each list against what the entry point really uses.
+#[derive(Clone, Copy, Debug)]
+pub struct EntryPoint {
+    pub name: &'static str,
+    pub uses: &'static [&'static str],
+}
+
+const fn entry(name: &'static str, uses: &'static [&'static str]) -> EntryPoint {
+    EntryPoint { name, uses }
+}
+
+/// A stage: its WGSL file, entry points and bindings.
+#[derive(Clone, Copy, Debug)]
+pub struct Stage {
+    /// The stage's name: its WGSL file is `shaders/NAME.wgsl`, its CPU twin `cpu::NAME`.
+    pub name: &'static str,
+    pub source: &'static str,
+    pub kind: StageKind,
+    pub entry_points: &'static [EntryPoint],
+    /// Every binding, ordered by group then binding number.
+    pub bindings: &'static [Binding],
+}
+
+impl Stage {
+    pub fn file(&self) -> String {
+        format!("shaders/{}.wgsl", self.name)
+    }
+
+    /// The groups the stage binds (0, 1, … without gaps).
+    pub fn group_count(&self) -> u32 {
+        self.bindings.iter().map(|b| b.group + 1).max().unwrap_or(0)
+    }
+
+    /// The bindings of one group, in binding order.
+    pub fn group(&self, group: u32) -> impl Iterator<Item = &Binding> {
+        self.bindings.iter().filter(move |b| b.group == group)
+    }
+
+    pub fn entry_point(&self, name: &str) -> Option<&EntryPoint> {
+        self.entry_points.iter().find(|e| e.name == name)
+    }
+
+    /// Whether a pipeline for `entry` (None: the drawing pipeline, all entry points) binds `b`.
+    pub fn binds(&self, entry: Option<&str>, b: &Binding) -> bool {
+        match entry {
+            None => true,
+            Some(e) => self.entry_point(e).is_some_and(|e| e.uses.contains(&b.name)),
+        }
+    }
+}
+
+/// The material table the fragment module reads (group 1 of the drawing stages).
+const MATERIAL_TABLE: [Binding; 3] =
+    [bind(1, 0, "materials", Storage), bind(1, 1, "mips", Storage), bind(1, 2, "texels", Storage)];
+
+pub const SUBDIVIDE: Stage = Stage {
+    name: "subdivide",
+    source: include_str!("../../shaders/subdivide.wgsl"),
+    kind: StageKind::Compute,
+    entry_points: &[
+        entry("plan", &["params", "vertices", "indices", "pieces", "counters", "object_edge_scale"]),
+        entry("lattice_args", &["params", "counters", "lattice_dispatch"]),
+        entry("lattice", &["params", "vertices", "indices", "pieces", "out_vertices", "counters", "object_edge_scale"]),
+        entry("finalize", &["params", "counters", "draw_args"]),
+    ],
+    bindings: &[
+        bind(0, 0, "params", Uniform),
+        bind(0, 1, "vertices", Storage),
+        bind(0, 2, "indices", Storage),
+        bind(0, 3, "pieces", StorageReadWrite),
+        bind(0, 4, "out_vertices", StorageReadWrite),
+        bind(0, 5, "counters", StorageReadWrite),
+        bind(0, 6, "draw_args", StorageReadWrite),
+        bind(0, 7, "lattice_dispatch", StorageReadWrite),
+        bind(0, 8, "object_edge_scale", Storage),
+    ],
+};
+
+pub const RASTER: Stage = Stage {
+    name: "raster",
+    source: include_str!("../../shaders/raster.wgsl"),
+    kind: StageKind::Draw,
+    entry_points: &[
+        entry("vs_main", &["params"]),
+        entry("fs_main", &["params", "materials", "mips", "texels"]),
+        entry("fs_error", &["params", "materials", "mips", "texels"]),
+    ],
+    bindings: &[bind(0, 0, "params", Uniform), MATERIAL_TABLE[0], MATERIAL_TABLE[1], MATERIAL_TABLE[2]],
+};
+
+pub const SLIT: Stage = Stage {
+    name: "slit",
+    source: include_str!("../../shaders/slit.wgsl"),
+    kind: StageKind::Draw,
+    entry_points: &[
+        entry("vs_main", &["params", "cameras"]),
+        entry("fs_main", &["params", "materials", "mips", "texels"]),
+        entry("fs_error", &["params", "materials", "mips", "texels"]),
+    ],
+    bindings: &[
+        bind(0, 0, "params", Uniform),
+        bind(0, 1, "cameras", Storage),
+        MATERIAL_TABLE[0],
+        MATERIAL_TABLE[1],
+        MATERIAL_TABLE[2],
+    ],
+};
+
+pub const PROJECT_POINTS: Stage = Stage {
+    name: "project_points",
+    source: include_str!("../../shaders/project_points.wgsl"),
+    kind: StageKind::Compute,
+    entry_points: &[entry("project_points", &["params", "points", "pixels"])],
+    bindings: &[bind(0, 0, "params", Uniform), bind(0, 1, "points", Storage), bind(0, 2, "pixels", StorageReadWrite)],
+};
+
+pub const REDUCE_ERROR: Stage = Stage {
+    name: "reduce_error",
+    source: include_str!("../../shaders/reduce_error.wgsl"),
+    kind: StageKind::Compute,
+    entry_points: &[
+        entry("accumulate", &["params", "errors", "histogram", "partials", "totals"]),
+        entry("finish", &["params", "histogram", "partials", "totals", "result"]),
+    ],
+    bindings: &[
+        bind(0, 0, "params", Uniform),
+        bind(0, 1, "errors", Storage),
+        bind(0, 2, "histogram", StorageReadWrite),
+        bind(0, 3, "partials", StorageReadWrite),
+        bind(0, 4, "totals", StorageReadWrite),
+        bind(0, 5, "result", StorageReadWrite),
+    ],
+};
+
+/// The registry: every stage. The naga test validates and reflects each one composed.
+pub const STAGES: &[Stage] = &[SUBDIVIDE, RASTER, SLIT, PROJECT_POINTS, REDUCE_ERROR];
+
+/// The shared WGSL modules in `shaders/shared/`, by import name.
+pub const SHARED: &[(&str, &str)] = &[
+    ("projection", include_str!("../../shaders/shared/projection.wgsl")),
+    ("fragment", include_str!("../../shaders/shared/fragment.wgsl")),
+];
+
+/// How the error target is written: as f32 (R32Float) or as its bits (R32Uint), for adapters
+/// that cannot render to R32Float.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ErrorTarget {
+    Float,
+    UintBits,
+}
+
+impl ErrorTarget {
+    /// The generated module `error_target`: the target's WGSL type and its encoder.
+    pub fn wgsl(self) -> &'static str {
+        match self {
+            ErrorTarget::Float => "alias ErrorTarget = f32;\nfn encode_error(e: f32) -> ErrorTarget { return e; }\n",
+            ErrorTarget::UintBits => {
+                "alias ErrorTarget = u32;\nfn encode_error(e: f32) -> ErrorTarget { return bitcast<u32>(e); }\n"
+            }
+        }
+    }
+}
+
+/// The source of an importable module, or None for an unknown name.
+fn module_source(name: &str, error_target: ErrorTarget) -> Option<String> {
+    match name {
+        "constants" => Some(constants::wgsl()),
+        "error_target" => Some(error_target.wgsl().to_string()),
+        _ => SHARED.iter().find(|(n, _)| *n == name).map(|(_, s)| s.to_string()),
+    }
+}
+
+/// The names a source imports, in order.
+pub fn imports(source: &str) -> Vec<&str> {
+    source.lines().filter_map(|l| l.trim().strip_prefix("#import ")).map(str::trim).collect()
+}
+
+/// The full WGSL of a stage: its imports (recursively, each once, dependencies first), then
+/// the stage's own file with its `#import` lines commented out.
+pub fn compose(stage: &Stage, error_target: ErrorTarget) -> String {
+    fn add(name: &str, source: &str, target: ErrorTarget, done: &mut Vec<String>, out: &mut String) {
+        for dep in imports(source) {
+            if done.iter().any(|d| d == dep) {
+                continue;
+            }
+            done.push(dep.to_string());
+            let Some(dep_source) = module_source(dep, target) else {
+                panic!("{name}: `#import {dep}` names no module in shaders/shared/ or the generated ones")
+            };
+            add(dep, &dep_source, target, done, out);
+        }
+        let body: Vec<String> = source
+            .lines()
+            .map(|l| if l.trim().starts_with("#import ") { format!("// {l}") } else { l.to_string() })
+            .collect();
+        *out += &format!("// ---- {name} ----\n{}\n", body.join("\n"));
+    }
+    let mut out = String::new();
+    let mut done = Vec::new();
+    add(&stage.file(), stage.source, error_target, &mut done, &mut out);
+    out
+}

@@ -1,0 +1,259 @@
+//! Plain-old-data structs shared with the WGSL stages. Every struct here (and `SceneVertex`,
+//! `Material`, `MipLevel` in `core`) has a WGSL twin of the same layout; [`LAYOUTS`] lists
+//! their field offsets, which `tests/shaders.rs` checks against the WGSL reflected by naga.
+
+use std::mem::{offset_of, size_of};
+
+use bytemuck::{Pod, Zeroable};
+
+use crate::core::material::{Material, MipLevel};
+use crate::core::projection::{Projection, Vertical};
+use crate::core::scene::SceneVertex;
+
+/// A vertex of a prepared triangle (`DrawVertex` in shaders/subdivide.wgsl and raster.wgsl),
+/// in the viewer frame. `theta_ref` is the azimuth the vertex stage unwraps θ around; seam
+/// copies carry it shifted by ±2π. 64 bytes; also the vertex-buffer layout of the raster stage.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct DrawVertex {
+    pub position: [f32; 3],
+    pub theta_ref: f32,
+    pub normal: [f32; 3],
+    pub material: u32,
+    pub color: [f32; 4],
+    pub uv: [f32; 2],
+    pub object: u32,
+    pub _pad: f32,
+}
+
+/// `Projection` in shaders/projection.wgsl. 32 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ProjectionUniform {
+    pub screen_radius: f32,
+    pub eye_radius: f32,
+    pub width: f32,
+    pub height: f32,
+    pub acos_eye_screen: f32,
+    pub vertical_exact: u32,
+    pub pixels_per_metre: f32,
+    pub _pad: f32,
+}
+
+impl From<&ProjectionUniform> for Projection {
+    fn from(p: &ProjectionUniform) -> Self {
+        Projection {
+            screen_radius: p.screen_radius,
+            eye_radius: p.eye_radius,
+            width: p.width as u32,
+            height: p.height as u32,
+            vertical: if p.vertical_exact != 0 { Vertical::Exact } else { Vertical::Paper },
+        }
+    }
+}
+
+impl From<&Projection> for ProjectionUniform {
+    fn from(p: &Projection) -> Self {
+        ProjectionUniform {
+            screen_radius: p.screen_radius,
+            eye_radius: p.eye_radius,
+            width: p.width as f32,
+            height: p.height as f32,
+            acos_eye_screen: p.acos_eye_screen(),
+            vertical_exact: (p.vertical == Vertical::Exact) as u32,
+            pixels_per_metre: p.pixels_per_metre(),
+            _pad: 0.0,
+        }
+    }
+}
+
+/// `SubdivideParams` in shaders/subdivide.wgsl. 144 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SubdivideParams {
+    /// World → viewer frame (column-major, as glam stores it).
+    pub view: [[f32; 4]; 4],
+    pub projection: ProjectionUniform,
+    /// Every output point is at least this far from the vertical axis (see subdivide.rs).
+    pub axis_clearance: f32,
+    pub triangle_count: u32,
+    /// Index of the first input triangle of a `plan` dispatch.
+    pub first_triangle: u32,
+    /// 0 vertex, 1 fixed, 2 adaptive.
+    pub method: u32,
+    pub fixed_n: u32,
+    /// L: the longest projected edge wanted, pixels.
+    pub edge_px: f32,
+    /// N_max: the largest lattice step per piece.
+    pub max_div: u32,
+    /// Capacity of the piece buffer; `plan` counts but never writes beyond it.
+    pub piece_capacity: u32,
+    /// Capacity of the output buffer in triangles; `lattice` counts but never writes beyond it.
+    pub triangle_capacity: u32,
+    /// First piece and piece count of a `lattice` dispatch.
+    pub first_piece: u32,
+    pub piece_count: u32,
+    /// 1: also measure the longest visible output edge (`max_sub_edge_px`, costs projections).
+    pub measure_edges: u32,
+}
+
+impl SubdivideParams {
+    pub fn with_measure_edges(self, on: bool) -> Self {
+        SubdivideParams { measure_edges: on as u32, ..self }
+    }
+}
+
+/// `Counters` in shaders/subdivide.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SubdivideCounters {
+    pub pieces: u32,
+    pub triangles: u32,
+    /// Bits of the largest visible output edge in pixels (an f32).
+    pub max_edge_bits: u32,
+    pub _pad: u32,
+}
+
+/// `RasterParams` in shaders/raster.wgsl. 48 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct RasterParams {
+    pub projection: ProjectionUniform,
+    /// +1 right eye, −1 left eye.
+    pub eye_sign: f32,
+    /// Ambient term of the shading: colour × (ambient + (1 − ambient)·|n·l|).
+    pub ambient: f32,
+    /// Test hook: draw shifted by this many pixels (x right, y down); the error pass still
+    /// measures against the true projection.
+    pub shift_px: [f32; 2],
+}
+
+/// `DrawIndirectArgs` as the GPU reads them.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct DrawIndirectArgs {
+    pub vertex_count: u32,
+    pub instance_count: u32,
+    pub first_vertex: u32,
+    pub first_instance: u32,
+}
+
+/// `ErrorStats` in shaders/reduce_error.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable, serde::Serialize)]
+pub struct ErrorStats {
+    pub count: u32,
+    pub mean: f32,
+    pub std_dev: f32,
+    pub p50: f32,
+    pub p90: f32,
+    pub p99: f32,
+    pub max: f32,
+    #[serde(skip)]
+    pub _pad: f32,
+}
+
+/// `ReduceParams` in shaders/reduce_error.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ReduceParams {
+    pub width: u32,
+    pub height: u32,
+    pub row_stride: u32,
+    pub images: u32,
+    pub partial_count: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
+}
+
+/// `SlitParams` in shaders/slit.wgsl. 112 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct SlitParams {
+    pub view: [[f32; 4]; 4],
+    pub projection: ProjectionUniform,
+    pub eye_sign: f32,
+    pub ambient: f32,
+    pub near: f32,
+    pub focal_y_clip: f32,
+}
+
+/// `SlitCamera` in shaders/slit.wgsl: eye position, and (sin φ, cos φ, NDC x of the centre).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct SlitCamera {
+    pub origin: [f32; 4],
+    pub basis: [f32; 4],
+}
+
+/// `ProjectParams` in shaders/project_points.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ProjectParams {
+    pub projection: ProjectionUniform,
+    pub eye_sign: f32,
+    pub count: u32,
+    pub _pad: [f32; 2],
+}
+
+/// `Totals` in shaders/reduce_error.wgsl (GPU-internal: cleared, then read by `finish` only).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Totals {
+    pub count: u32,
+    pub max_bits: u32,
+}
+
+/// A piece record of `subdivide` (`pieces: array<vec4<u32>>`): triangle, macro cell,
+/// n0 | n1 << 16, n2 | K << 16.
+pub type Piece = [u32; 4];
+
+/// A Rust struct's layout, to be checked against its WGSL twin.
+#[derive(Clone, Copy, Debug)]
+pub struct StructLayout {
+    /// The WGSL struct's name.
+    pub wgsl_name: &'static str,
+    pub rust_name: &'static str,
+    pub size: usize,
+    /// (field name, byte offset), in declaration order.
+    pub fields: &'static [(&'static str, usize)],
+}
+
+macro_rules! layout {
+    ($wgsl:literal => $ty:ident { $($field:ident),* $(,)? }) => {
+        StructLayout {
+            wgsl_name: $wgsl,
+            rust_name: stringify!($ty),
+            size: size_of::<$ty>(),
+            fields: &[$((stringify!($field), offset_of!($ty, $field))),*],
+        }
+    };
+}
+
+/// Every struct the stages bind (as a uniform or in a storage buffer), by its WGSL name.
+pub const LAYOUTS: &[StructLayout] = &[
+    layout!("SceneVertex" => SceneVertex { position, material, normal, object, color, uv, _pad1 }),
+    layout!("DrawVertex" => DrawVertex { position, theta_ref, normal, material, color, uv, object, _pad }),
+    layout!("Projection" => ProjectionUniform {
+        screen_radius, eye_radius, width, height, acos_eye_screen, vertical_exact, pixels_per_metre, _pad
+    }),
+    layout!("SubdivideParams" => SubdivideParams {
+        view, projection, axis_clearance, triangle_count, first_triangle, method, fixed_n, edge_px, max_div,
+        piece_capacity, triangle_capacity, first_piece, piece_count, measure_edges
+    }),
+    layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, _pad }),
+    layout!("DrawIndirectArgs" => DrawIndirectArgs { vertex_count, instance_count, first_vertex, first_instance }),
+    layout!("RasterParams" => RasterParams { projection, eye_sign, ambient, shift_px }),
+    layout!("SlitParams" => SlitParams { view, projection, eye_sign, ambient, near, focal_y_clip }),
+    layout!("SlitCamera" => SlitCamera { origin, basis }),
+    layout!("ProjectParams" => ProjectParams { projection, eye_sign, count, _pad }),
+    layout!("Material" => Material {
+        texture, wrap_u, wrap_v, mag_filter, min_filter, mipmap, alpha_mode, alpha_cutoff, double_sided,
+        first_mip, mip_count, _pad
+    }),
+    layout!("MipLevel" => MipLevel { offset, width, height, _pad }),
+    layout!("ReduceParams" => ReduceParams { width, height, row_stride, images, partial_count, _pad0, _pad1, _pad2 }),
+    layout!("Totals" => Totals { count, max_bits }),
+    layout!("ErrorStats" => ErrorStats { count, mean, std_dev, p50, p90, p99, max, _pad }),
+];
