@@ -222,10 +222,8 @@ fn edge_divisions(a: vec3<f32>, b: vec3<f32>) -> u32 {
     return max(u32(n), 1u);
 }
 
-// Loads an input triangle into the viewer frame (edge counts and K come from `plan_triangle`
-// or from the piece record).
 // Whether a triangle lies wholly above or below the image (see `off_screen_vertically` in
-// subdivide.rs for why testing the corners suffices).
+// src/cpu/subdivide.rs for why testing the corners suffices).
 fn off_screen_vertically(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> bool {
     let rt = params.projection.screen_radius;
     let de = params.projection.eye_radius;
@@ -236,6 +234,8 @@ fn off_screen_vertically(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> bool {
     return all(y > k * r) || all(y < -k * r);
 }
 
+// Loads an input triangle into the viewer frame (edge counts and K come from `plan_triangle`
+// or from the piece record).
 fn load_triangle(t: u32) {
     for (var k = 0u; k < 3u; k++) {
         let v = vertices[indices[3u * t + k]];

@@ -61,11 +61,19 @@ fn render_writes_every_layout_and_stats() {
         "width",
         "height",
         "adapter",
-        "ms_prepare",
+        "timing",
+        "ms_frame",
+        "ms_subdivide",
         "ms_raster",
         "ms_total",
     ] {
         assert!(json.get(key).is_some(), "stats lack {key}: {json}");
+    }
+    // The times say how they were measured: apart only where they were.
+    match json["timing"].as_str().unwrap() {
+        "gpu-timestamps" => assert!(json["ms_subdivide"].is_number() && json["ms_raster"].is_number() && json["ms_gpu"].is_number()),
+        "wall-one-submission" => assert!(json["ms_subdivide"].is_null() && json["ms_raster"].is_null()),
+        other => panic!("a one-submission frame reported timing {other}"),
     }
     assert_eq!(json["triangles_in"], 100);
     assert_eq!(json["width"], 320);
@@ -336,4 +344,87 @@ fn lod_flags_render_an_overlay_and_report_the_selection() {
         assert_eq!(o.status.code().map(|c| c != 0), Some(true), "{args:?}");
         assert!(err.contains(needle) && !err.contains("panicked"), "{args:?}: {err}");
     }
+}
+
+#[test]
+fn a_chunked_frame_reports_wall_times_per_pass() {
+    let out = tmp("chunked");
+    let stats = out.join("s.json");
+    let o = twister()
+        .args(["render", "builtin:sphere1024", "--width", "320", "--height", "60", "--edge-px", "0.5", "--memory-mb", "8"])
+        .args(["--out", out.to_str().unwrap(), "--stats", stats.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    assert!(json["chunks"].as_u64().unwrap() > 1, "{json}");
+    assert_eq!(json["timing"], "wall-per-pass");
+    let (sub, ras, frame) =
+        (json["ms_subdivide"].as_f64().unwrap(), json["ms_raster"].as_f64().unwrap(), json["ms_frame"].as_f64().unwrap());
+    assert!(sub > 0.0 && ras > 0.0 && (sub + ras - frame).abs() < 1e-6, "{json}");
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn lod_options_without_lod_are_refused_by_every_command() {
+    for cmd in [&["render"][..], &["error"][..], &["bench", "speed", "builtin:sphere100"][..]] {
+        for (flag, value) in [("--lod-p2", "5"), ("--lod-p3", "0.1"), ("--lod-dinf", "10"), ("--gaze", "10,0")] {
+            let o = twister().args(cmd).args([flag, value]).output().unwrap();
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert!(!o.status.success(), "{cmd:?} {flag}: accepted");
+            assert!(err.contains(flag) && err.contains("needs --lod visual-field"), "{cmd:?} {flag}: {err}");
+        }
+    }
+}
+
+#[test]
+fn bench_speed_honours_scale_viewer_and_lod() {
+    let run = |extra: &[&str]| -> serde_json::Value {
+        let dir = tmp(&format!("speed{}", extra.len()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let json = dir.join("speed.json");
+        let o = twister()
+            .args(["bench", "speed", "builtin:sphere100", "--methods", "vertex", "--reps", "1"])
+            .args(["--width", "320", "--height", "60", "--json", json.to_str().unwrap()])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{extra:?}: {}", String::from_utf8_lossy(&o.stderr));
+        let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        let _ = std::fs::remove_dir_all(&dir);
+        v["rows"][0].clone()
+    };
+    let plain = run(&[]);
+    assert_eq!(plain["triangles_in"], 100);
+    // --lod visual-field with the sphere behind the gaze: fewer triangles than the full sphere.
+    let lod = run(&["--lod", "visual-field", "--gaze", "180,0"]);
+    assert!(lod["triangles_in"].as_u64().unwrap() < 100, "{lod}");
+    // A viewer at the sphere's centre sees it all around: a different subdivision (pieces) than
+    // from outside.
+    let inside = run(&["--viewer", "0,0,-3"]);
+    assert_ne!((&inside["pieces"], &inside["triangles_out"]), (&plain["pieces"], &plain["triangles_out"]), "{inside}");
+    // --scale scales the scene and the viewer (given in scene units) alike: at the centre of the
+    // doubled sphere the counts are those at the centre of the plain one (v = R_T·y/r does not
+    // change with scale); a bench that ignored --scale would stand off-centre in the big sphere.
+    let scaled = run(&["--viewer", "0,0,-3", "--scale", "2"]);
+    assert_eq!((&scaled["pieces"], &scaled["triangles_out"]), (&inside["pieces"], &inside["triangles_out"]));
+    let bad = twister().args(["bench", "speed", "builtin:sphere100", "--scale", "0"]).output().unwrap();
+    assert!(!bad.status.success() && String::from_utf8_lossy(&bad.stderr).contains("--scale"));
+}
+
+#[test]
+fn a_plain_run_without_a_desktop_session_prints_no_driver_noise() {
+    // No NODEVICE_SELECT and no XDG_RUNTIME_DIR, as on a fresh server: the program quiets
+    // Mesa's device-select layer itself.
+    let out = tmp("quiet");
+    let o = Command::new(env!("CARGO_BIN_EXE_twister"))
+        .env_remove("NODEVICE_SELECT")
+        .env_remove("XDG_RUNTIME_DIR")
+        .args(["render", "--width", "64", "--height", "16", "--out", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(err.trim().is_empty(), "a plain render printed to stderr: {err}");
+    let _ = std::fs::remove_dir_all(&out);
 }

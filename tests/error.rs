@@ -11,7 +11,6 @@ use twister::Frame;
 use twister::cpu::slit::{slit, slit_params, slits};
 use twister::cpu::subdivide::subdivide;
 use twister::core::settings::Method;
-use twister::core::texture::MaterialTable;
 use twister::core::builtin;
 use twister::{Eye, Projection, RenderSettings, Vertical};
 
@@ -49,7 +48,7 @@ fn gpu_error_pass_and_reduction_match_their_cpu_twins() {
             let cpu = raster(
                 &raster_params(&settings, eye),
                 &tris,
-                &MaterialTable::of(&scene, usize::MAX),
+                &scene.material_table(usize::MAX),
                 settings.shading.background,
             );
             let (mut both, mut worst) = (0, 0.0f32);
@@ -90,7 +89,7 @@ fn gpu_slit_renderer_matches_its_cpu_twin() {
             &params,
             &slits(&projection, eye, 4),
             &scene,
-            &MaterialTable::of(&scene, usize::MAX),
+            &scene.material_table(usize::MAX),
             settings.shading.background,
         );
         let gpu = frame.eye(eye);

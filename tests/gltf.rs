@@ -384,3 +384,52 @@ fn a_mesh_instance_is_one_object_whatever_its_primitive_count() {
         }
     }
 }
+
+/// The column span (first, last) of non-background pixels in a row band of a rendered PNG.
+fn drawn_columns(png: &Path) -> (u32, u32, u32) {
+    let img = image::open(png).unwrap().to_rgba8();
+    let bg = *img.get_pixel(0, 0);
+    let xs: Vec<u32> = img.enumerate_pixels().filter(|(_, _, p)| **p != bg).map(|(x, _, _)| x).collect();
+    assert!(!xs.is_empty(), "{}: nothing drawn", png.display());
+    (*xs.iter().min().unwrap(), *xs.iter().max().unwrap(), img.width())
+}
+
+#[test]
+fn fit_and_scale_move_the_file_camera_with_the_scene() {
+    // A camera at (2, 0, 5) looking along −z, 3 m behind a triangle centred on x = 2: the
+    // triangle is straight ahead of it. `--fit` moves the scene (centring it on x = 0); the
+    // camera must move with it, so the triangle stays straight ahead (centre columns).
+    let dir = tmp("fitcam");
+    let mut json = gltf_json(&[[1.5, -0.5, 2.0], [2.5, -0.5, 2.0], [2.0, 0.5, 2.0]], None, 4);
+    json["nodes"] = serde_json::json!([{ "mesh": 0 }, { "camera": 0, "translation": [2.0, 0.0, 5.0] }]);
+    json["scenes"] = serde_json::json!([{ "nodes": [0, 1] }]);
+    json["cameras"] = serde_json::json!([{ "type": "perspective", "perspective": { "yfov": 1.0, "znear": 0.1 } }]);
+    let file = write(&dir, "cam.gltf", &json);
+    for extra in [&["--fit", "3"][..], &["--scale", "2"][..], &["--fit", "3", "--scale", "0.5"][..]] {
+        let out = dir.join(format!("out{}", extra.join("_")));
+        let mut args = vec!["render", file.to_str().unwrap(), "--viewer", "camera", "--width", "360", "--height", "90"];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["--out", out.to_str().unwrap()]);
+        let o = twister(&args);
+        assert!(o.status.success(), "{extra:?}: {}", String::from_utf8_lossy(&o.stderr));
+        let (lo, hi, w) = drawn_columns(&out.join("left.png"));
+        let centre = (lo + hi) as f32 / 2.0;
+        assert!((centre - w as f32 / 2.0).abs() < 4.0, "{extra:?}: triangle drawn at columns {lo}..{hi} of {w}");
+    }
+}
+
+#[test]
+fn loader_warnings_are_printed_by_render_and_error() {
+    // An OBJ naming a missing MTL file: one warning line on stderr, the render still made.
+    let dir = tmp("warn");
+    let obj = dir.join("w.obj");
+    std::fs::write(&obj, "mtllib missing.mtl\nv -1 0 -3\nv 1 0 -3\nv 0 1 -3\nf 1 2 3\n").unwrap();
+    for cmd in ["render", "error"] {
+        let out = dir.join(cmd);
+        let o = twister(&[cmd, obj.to_str().unwrap(), "--width", "64", "--height", "16", "--out", out.to_str().unwrap()]
+            [..if cmd == "render" { 8 } else { 6 }]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{cmd}: {err}");
+        assert!(err.contains("warning:") && err.contains("w.obj") && err.contains("materials not loaded"), "{cmd}: {err}");
+    }
+}

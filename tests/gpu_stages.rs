@@ -11,9 +11,37 @@ use twister::core::scene::SceneVertex;
 use twister::cpu::raster::raster;
 use twister::cpu::subdivide::subdivide;
 use twister::core::settings::Method;
-use twister::core::texture::MaterialTable;
 use twister::core::builtin;
 use twister::{Eye, GpuScene, Projection, RenderSettings, Scene, Vertical};
+
+#[test]
+fn project_points_takes_no_points_and_more_than_one_dispatch_row() {
+    let r = common::renderer();
+    let projection = Projection { width: 800, height: 200, ..Projection::default() };
+    assert!(r.project_points(&projection, Eye::Left, &[]).unwrap().is_empty());
+    // 65,535 workgroups of 64 hold 4,194,240 points: beyond them the dispatch is 2-D, and
+    // every point, the last ones included, must be projected.
+    let n = 65_535 * 64 + 1000;
+    let points: Vec<Vec3> = (0..n)
+        .map(|i| {
+            let a = i as f32 * 1e-4;
+            Vec3::new(2.0 * a.sin(), (i % 7) as f32 * 0.1 - 0.3, -2.0 * a.cos())
+        })
+        .collect();
+    let gpu = r.project_points(&projection, Eye::Right, &points).unwrap();
+    assert_eq!(gpu.len(), n);
+    let sample: Vec<usize> = (0..n).step_by(9973).chain(n - 1100..n).collect();
+    let cpu = twister::cpu::project_points::project_points(
+        &projection,
+        Eye::Right,
+        &sample.iter().map(|&i| points[i]).collect::<Vec<_>>(),
+    );
+    for (&i, c) in sample.iter().zip(&cpu) {
+        let g = gpu[i];
+        assert_eq!(g[3], 1.0, "point {i} was not projected");
+        assert!(projection.wrapped_dx(g[0], c[0]) < 1e-2 && (g[1] - c[1]).abs() < 1e-2, "point {i}: {g:?} vs {c:?}");
+    }
+}
 
 #[test]
 fn gpu_projection_matches_cpu_within_a_thousandth_of_a_pixel() {
@@ -192,7 +220,7 @@ fn gpu_raster_matches_cpu_twin() {
         let cpu = raster(
             &raster_params(&settings, eye),
             &prepared,
-            &MaterialTable::of(&scene, usize::MAX),
+            &scene.material_table(usize::MAX),
             settings.shading.background,
         );
         let gpu = frame.eye(eye);

@@ -6,7 +6,6 @@ mod common;
 
 use twister::cpu::raster::raster_params;
 use twister::cpu::subdivide::subdivide_params;
-use std::path::Path;
 
 use glam::{Vec2, Vec3};
 use twister::core::material::{AlphaMode, Filter, Material, Mipmap, Wrap, NO_TEXTURE};
@@ -17,7 +16,7 @@ use twister::EyeImage;
 use twister::cpu::slit::{slit, slit_params, slits};
 use twister::cpu::subdivide::subdivide;
 use twister::core::settings::Method;
-use twister::core::texture::{MaterialTable, Texture};
+use twister::core::texture::Texture;
 use twister::{RenderSettings, Scene};
 
 const BG: [f32; 3] = [0.0, 0.0, 0.0];
@@ -177,7 +176,7 @@ fn differing(a: &[u8], b: &[u8], tol: i32) -> usize {
 #[test]
 fn every_sampler_mode_matches_the_cpu_twin_in_both_drawing_stages() {
     let scene = sampler_scene();
-    let table = MaterialTable::of(&scene, usize::MAX);
+    let table = scene.material_table(usize::MAX);
     // The raster stage (after the subdivision, here on the CPU).
     let s = settings(640, 120, Method::Adaptive);
     let frame = common::render(&scene, &s);

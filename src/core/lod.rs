@@ -45,7 +45,8 @@ pub struct LodParams {
     pub p2: f32,
     /// P3 / P1: the share outside the visual field.
     pub p3: f32,
-    /// D∞, metres: the distance at which the central and peripheral budgets reach 0.
+    /// D∞, metres: the central and peripheral budgets fall linearly with distance and would
+    /// reach 0 at D∞; they are kept at least P3 (`budget`).
     pub d_inf: f32,
 }
 

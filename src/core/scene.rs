@@ -6,7 +6,7 @@ use glam::{Mat4, Vec3};
 
 use crate::core::material::Material;
 use crate::core::projection::Projection;
-use crate::core::texture::Texture;
+use crate::core::texture::{MaterialTable, Texture};
 use crate::error::{Error, Result};
 
 /// A scene vertex as the stages read it (`SceneVertex` in shaders/subdivide.wgsl). 64 bytes.
@@ -66,6 +66,12 @@ pub struct Camera {
 impl Scene {
     pub fn new(name: impl Into<String>) -> Self {
         Scene { name: name.into(), ..Default::default() }
+    }
+
+    /// The table of the scene's materials and textures, as the fragment stage reads it, with at
+    /// most `max_texels` texels (see [`MaterialTable::build`]).
+    pub fn material_table(&self, max_texels: usize) -> MaterialTable {
+        MaterialTable::build(&self.materials, &self.textures, max_texels)
     }
 
     pub fn triangle_count(&self) -> usize {

@@ -75,11 +75,6 @@ pub struct MaterialTable {
 }
 
 impl MaterialTable {
-    /// The table of a scene's materials and textures (see `build`).
-    pub fn of(scene: &crate::core::scene::Scene, max_texels: usize) -> MaterialTable {
-        MaterialTable::build(&scene.materials, &scene.textures, max_texels)
-    }
-
     /// Whether any material needs the fragment stage's material code: textured, not opaque, or
     /// single-sided. (Otherwise a fragment's colour is its vertex colour.)
     pub fn needs_materials(&self) -> bool {

@@ -22,15 +22,20 @@
 //! On an edge with fewer divisions, the lattice's boundary nodes snap to the edge's nearest
 //! node; the triangles that collapse are dropped, the others stay in order along the edge.
 //! ```text
-//!   equal counts (3, 3, 3):          counts (3, 3, 2): the lower edge has 2 parts,
-//!            C                               C         its middle lattice node snaps
-//!           /\                              /\         to its nearest edge node (×),
-//!          /__\                            /__\        one triangle collapses and
-//!         /\  /\                          /\  /\       is dropped
-//!        /__\/__\                        /__\/__//!       /\  /\  /\                      /\  /\  \
-//!      /__\/__\/__\                    /__\/_____\
-//!     A            B                  A     ×      B
-//!   exactly n² triangles
+//!   the level-3 lattice of a piece (lattice nodes at 0, 1/3, 2/3, 1 of each edge):
+//!
+//!               C
+//!              / \
+//!             *---*
+//!            / \ / \
+//!           *---*---*
+//!          / \ / \ / \
+//!         A---1---2---B
+//!
+//!   counts (3, 3, 3): all 9 triangles are kept.
+//!   counts (3, 3, 2): edge AB has nodes at 0, 1/2 and 1 only. Lattice nodes 1 and 2 both
+//!   snap to the edge node at 1/2, so the upward triangle (1, 2, *) above them collapses to a
+//!   segment and is dropped; its two neighbours now meet at the edge node: 8 triangles.
 //! ```
 //! No cracks, no T-junctions (every edge node is a lattice corner), no zero-area triangles.
 //!

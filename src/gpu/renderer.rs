@@ -1,6 +1,6 @@
 //! The headless renderer: the `subdivide` compute pre-pass (`plan`, then `lattice`), then the
 //! `raster` stage draws the subdivided triangles indirectly for each eye; or the `slit` stage
-//! ([`crate::gpu::slit`]); then read-back and, with the error pass, `reduce_error`. The
+//! (in `gpu/slit.rs`); then read-back and, with the error pass, `reduce_error`. The
 //! schedule is a [`FramePlan`]; pipelines, targets, uniforms and buffers are made once and
 //! reused across frames. Every frame runs inside GPU error scopes, so a GPU error is one
 //! [`Error::Gpu`] line.

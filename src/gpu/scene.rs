@@ -5,7 +5,6 @@ use glam::Vec3;
 
 use crate::core::lod::LodSelection;
 use crate::core::scene::{object_spheres, Scene};
-use crate::core::texture::MaterialTable;
 use crate::error::{Error, Result};
 use crate::gpu::device::Gpu;
 
@@ -78,7 +77,7 @@ impl GpuScene {
                 .collect();
             // Textures get at most a quarter of the device's largest binding (max/16 texels of 4
             // bytes; levels are dropped, largest first, with a warning).
-            let table = MaterialTable::of(scene, (max / 16) as usize);
+            let table = scene.material_table((max / 16) as usize);
             let storage = |label: &str, bytes: &[u8]| gpu.init_buffer(label, bytes, wgpu::BufferUsages::STORAGE);
             let materials = [
                 storage("materials", bytemuck::cast_slice(&table.materials)),

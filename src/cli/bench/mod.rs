@@ -8,7 +8,11 @@ pub mod speed;
 
 use std::path::{Path, PathBuf};
 
+use clap::{Args, Subcommand};
 use serde::Serialize;
+
+use crate::args::ViewArgs;
+use crate::scene::open_renderer;
 use twister::core::projection::Projection;
 use twister::core::settings::Method;
 use twister::error::{Error, Result};
@@ -203,4 +207,101 @@ pub fn run(runner: &Runner, which: Figure, adapter: &str) -> Result<String> {
     }
     twister::output::write_text(&cfg.out.join("report.md"), &report)?;
     Ok(report)
+}
+
+#[derive(Subcommand)]
+pub enum BenchCommand {
+    /// Median frame time of each method on each scene, and its ratio to the first method.
+    Speed(SpeedArgs),
+    /// Seed 002 Fig. 8: error vs edge divisions on the evaluation triangles.
+    Fig8(FigureArgs),
+    /// Seed 002 Fig. 10: error, time and triangles per method on the evaluation scenes.
+    Fig10(FigureArgs),
+    /// Seed 002 Fig. 12: slit width vs adaptive, and the matched width.
+    Fig12(FigureArgs),
+    /// Seed 001: 12 bunnies, the gaze swept, with and without the visual-field level of detail.
+    Lod(FigureArgs),
+    /// Every benchmark figure: fig8, fig10, fig12 and lod.
+    All(FigureArgs),
+}
+
+#[derive(Args)]
+pub struct FigureArgs {
+    /// Output folder for the CSV, JSON, PNG plots and report.md.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// A smoke run: a quarter of the resolution, 2 reps, fewer points.
+    #[arg(long)]
+    pub quick: bool,
+    /// Timed frames per point after a warm-up (default 5, quick 2).
+    #[arg(long)]
+    pub reps: Option<usize>,
+    /// Folder of the third-party assets (bunny, Sponza); absent ones are skipped.
+    #[arg(long, default_value = "../shared/assets")]
+    pub assets: PathBuf,
+}
+
+#[derive(Args)]
+pub struct SpeedArgs {
+    /// Scenes (.obj, .gltf or .glb files, or builtin:NAME).
+    #[arg(required = true)]
+    pub scenes: Vec<String>,
+    /// Methods, comma-separated; ratios are against the first.
+    #[arg(long, value_delimiter = ',', value_parser = Method::parse, default_value = "vertex,adaptive")]
+    pub methods: Vec<Method>,
+    /// Place file scenes DIST metres ahead, filling the screen height (built-in ones are placed already).
+    #[arg(long, value_name = "DIST")]
+    pub fit: Option<f32>,
+    /// Timed frames per point (after one warm-up); the median is reported.
+    #[arg(long, default_value_t = 5)]
+    pub reps: usize,
+    #[command(flatten)]
+    pub view: ViewArgs,
+    /// Also write the rows as JSON to this file.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+}
+
+pub fn bench_figures(args: &FigureArgs, which: Figure) -> Result<()> {
+    let cfg = FigureConfig::new(args.quick, args.reps, args.assets.clone(), args.out.clone());
+    let (renderer, adapter) = open_renderer()?;
+    let progress = indicatif::ProgressBar::new(0).with_style(
+        indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {pos}/{len} {msg}")
+            .unwrap()
+            .progress_chars("=> "),
+    );
+    let runner = Runner { renderer: &renderer, cfg, progress };
+    let result = run(&runner, which, &adapter);
+    runner.progress.finish_and_clear();
+    result?;
+    println!("{}", args.out.join("report.md").display());
+    Ok(())
+}
+
+pub fn bench_speed(args: &SpeedArgs) -> Result<()> {
+    if !(1..=10_000).contains(&args.reps) {
+        return Err(Error::option("--reps", format!("must be between 1 and 10000, got {}", args.reps)));
+    }
+    let base = args.view.settings()?;
+    let (renderer, adapter) = open_renderer()?;
+    // Every scene as `render` would draw it: --scale, --fit (file scenes), --viewer camera:N, --lod.
+    let mut scenes = Vec::new();
+    for spec in &args.scenes {
+        let mut settings = base;
+        let fit = args.fit.filter(|_| !spec.starts_with("builtin:"));
+        let prepared = crate::scene::prepare(&renderer, spec, fit, &args.view, &mut settings, false)?;
+        scenes.push(speed::SpeedScene { spec: spec.clone(), gpu_scene: prepared.gpu_scene, settings });
+    }
+    let rows = speed::speed(&renderer, &scenes, &args.methods, args.reps, |what| eprintln!("timing {what} ..."))?;
+    let timing = rows.first().map_or("-".to_string(), |r| r.timing.clone());
+    println!(
+        "adapter: {adapter}; {}x{} per eye, both eyes; median of {} frames after a warm-up; timing: {timing}\n",
+        base.view.projection.width, base.view.projection.height, args.reps
+    );
+    print!("{}", speed::speed_table(&rows));
+    if let Some(path) = &args.json {
+        let json = serde_json::json!({ "adapter": adapter, "width": base.view.projection.width, "height": base.view.projection.height, "rows": rows });
+        twister::output::write_text(path, &serde_json::to_string_pretty(&json).unwrap())?;
+    }
+    Ok(())
 }

@@ -8,7 +8,6 @@
 //! against the first method, in the same run.
 
 use twister::error::Result;
-use twister::core::load::load_scene;
 use twister::{FrameStats, GpuScene, RenderSettings, Renderer};
 use twister::core::settings::Method;
 
@@ -23,10 +22,13 @@ pub struct SpeedRow {
     pub max_sub_edge_px: f32,
     /// Median over the reps: wall time of the subdivision and raster of both eyes.
     pub ms_frame: f64,
-    /// Where ms_subdivide and ms_raster come from (GPU timestamps or wall clock).
+    /// How the times were measured (`Timing`): GPU timestamps, or the wall clock.
     pub timing: String,
-    pub ms_subdivide: f64,
-    pub ms_raster: f64,
+    /// Median GPU time of the frame, where timestamps were available.
+    pub ms_gpu: Option<f64>,
+    /// Median times of the subdivision and the raster, where they were measured apart.
+    pub ms_subdivide: Option<f64>,
+    pub ms_raster: Option<f64>,
     pub ms_readback: f64,
     /// ms_frame / ms_frame of the first method on the same scene.
     pub ratio: f64,
@@ -57,33 +59,37 @@ pub fn time_frames(
     (0..reps).map(|_| renderer.render(scene, settings).map(|f| f.stats)).collect()
 }
 
+/// A scene of the `speed` benchmark, uploaded, with its settings (viewer, level of detail).
+pub struct SpeedScene {
+    pub spec: String,
+    pub gpu_scene: GpuScene,
+    pub settings: RenderSettings,
+}
+
 /// The `speed` benchmark: every scene with every method.
 pub fn speed(
     renderer: &Renderer,
-    scenes: &[String],
-    fit: Option<f32>,
+    scenes: &[SpeedScene],
     methods: &[Method],
-    base: &RenderSettings,
     reps: usize,
     mut progress: impl FnMut(&str),
 ) -> Result<Vec<SpeedRow>> {
     let mut rows = Vec::new();
-    for spec in scenes {
-        let mut scene = load_scene(spec, &base.view.projection)?;
-        if let (Some(d), false) = (fit, spec.starts_with("builtin:")) {
-            scene.fit(d, &base.view.projection)?;
-        }
-        let gpu_scene = GpuScene::upload(&renderer.gpu, &scene)?;
+    for SpeedScene { spec, gpu_scene, settings: base } in scenes {
         let mut first_ms = None;
         for &method in methods {
             progress(&format!("{spec} {}", method.name()));
-            let settings = base.clone().with_method(method);
-            let frames = time_frames(renderer, &gpu_scene, &settings, reps)?;
+            let settings = base.with_method(method);
+            let frames = time_frames(renderer, gpu_scene, &settings, reps)?;
             // The longest visible edge costs extra work: measured in one more, untimed frame.
-            let edges = renderer.render(&gpu_scene, &settings.clone().with_measure_edges(true))?.stats;
+            let edges = renderer.render(gpu_scene, &settings.with_measure_edges(true))?.stats;
             let ms_frame = median(frames.iter().map(|s| s.ms_frame).collect());
             let first = *first_ms.get_or_insert(ms_frame);
-            let last = frames.last().unwrap();
+            let last = frames.last().expect("reps ≥ 1");
+            let measured = |f: fn(&twister::FrameStats) -> Option<f64>| {
+                let v: Vec<f64> = frames.iter().filter_map(f).collect();
+                (v.len() == frames.len()).then(|| median(v))
+            };
             rows.push(SpeedRow {
                 scene: spec.clone(),
                 method: method.name(),
@@ -94,8 +100,9 @@ pub fn speed(
                 max_sub_edge_px: edges.max_sub_edge_px,
                 ms_frame,
                 timing: last.timing.to_string(),
-                ms_subdivide: median(frames.iter().filter_map(|s| s.ms_subdivide).collect()),
-                ms_raster: median(frames.iter().filter_map(|s| s.ms_raster).collect()),
+                ms_gpu: measured(|s| s.ms_gpu),
+                ms_subdivide: measured(|s| s.ms_subdivide),
+                ms_raster: measured(|s| s.ms_raster),
                 ms_readback: median(frames.iter().map(|s| s.ms_readback).collect()),
                 ratio: ms_frame / first,
                 reps,
@@ -112,14 +119,14 @@ pub fn speed_table(rows: &[SpeedRow]) -> String {
     );
     for r in rows {
         s += &format!(
-            "| {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.2} | {:.1} |\n",
+            "| {} | {} | {} | {} | {:.1} | {} | {} | {:.2} | {:.1} |\n",
             r.scene,
             r.method,
             r.triangles_in,
             r.triangles_out,
             r.ms_frame,
-            r.ms_subdivide,
-            r.ms_raster,
+            r.ms_subdivide.map_or("—".into(), |t| format!("{t:.1}")),
+            r.ms_raster.map_or("—".into(), |t| format!("{t:.1}")),
             r.ratio,
             r.max_sub_edge_px
         );

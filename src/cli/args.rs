@@ -1,0 +1,180 @@
+//! Options shared by the commands that render: the view (projection, viewer, method) and the
+//! level of detail, with their parsers and checks.
+
+use clap::Args;
+use glam::Vec3;
+
+use twister::core::lod::LodParams;
+use twister::core::settings::{Method, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV, DEFAULT_MEMORY_MB};
+use twister::core::visual_field::Gaze;
+use twister::error::{Error, Result};
+use twister::{Projection, RenderSettings, Vertical};
+
+#[derive(Args)]
+pub struct ViewArgs {
+    /// Image width per eye in pixels (the full 360°).
+    #[arg(long, default_value_t = 3168)]
+    pub width: u32,
+    /// Image height per eye in pixels.
+    #[arg(long, default_value_t = 600)]
+    pub height: u32,
+    /// R_T: radius of the display cylinder, metres.
+    #[arg(long, default_value_t = 1.0)]
+    pub screen_radius: f32,
+    /// d_e: radius of the circle the eyes move on, metres.
+    #[arg(long, default_value_t = 0.032)]
+    pub eye_radius: f32,
+    /// Vertical model: paper (v = R_T·y/r) or exact (pinhole on the eye circle).
+    #[arg(long, value_enum, default_value_t = Vertical::Paper)]
+    pub vertical: Vertical,
+    /// Viewer: a position x,y,z in scene units, or camera[:N] for the file's N-th camera (default 0;
+    /// its position and yaw, plus --yaw).
+    #[arg(long, value_parser = parse_viewer, default_value = "0,0,0", allow_hyphen_values = true)]
+    pub viewer: Viewer,
+    /// Turn of the view about the vertical axis, degrees; positive turns left.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub yaw: f32,
+    /// Metres per scene unit: the scene (and --viewer, given in scene units) is scaled by it.
+    #[arg(long, default_value_t = 1.0)]
+    pub scale: f32,
+    /// Subdivision: adaptive (N = ceil(l/L) per edge), fixed:N (every edge N), vertex (none).
+    #[arg(long, value_parser = Method::parse, default_value = "adaptive")]
+    pub method: Method,
+    /// L: the longest projected edge `adaptive` leaves, pixels.
+    #[arg(long, default_value_t = DEFAULT_EDGE_PX)]
+    pub edge_px: f32,
+    /// N_max: the largest lattice step of one piece; larger polygons are pre-split.
+    #[arg(long, default_value_t = DEFAULT_MAX_DIV)]
+    pub max_div: u32,
+    /// Memory budget of the subdivision buffers, MiB; scenes that need more run in chunks.
+    #[arg(long, default_value_t = DEFAULT_MEMORY_MB)]
+    pub memory_mb: u32,
+    /// Level of detail: off, or visual-field (seeds 001/000: polygon budgets and subdivision by
+    /// where each object falls in the visual field of --gaze).
+    #[arg(long, value_enum, default_value_t = LodMode::Off)]
+    pub lod: LodMode,
+    /// Gaze direction YAW,PITCH in degrees from straight ahead (yaw positive left, pitch up)
+    /// [default: 0,0] (needs --lod visual-field)
+    #[arg(long, value_parser = parse_gaze, allow_hyphen_values = true)]
+    pub gaze: Option<Gaze>,
+    /// P2'/P1: the peripheral field's smallest share of an object's triangles [default: 0.3]
+    /// (needs --lod visual-field).
+    #[arg(long)]
+    pub lod_p2: Option<f32>,
+    /// P3/P1: the share of an object's triangles outside the visual field [default: 0.05]
+    /// (needs --lod visual-field).
+    #[arg(long)]
+    pub lod_p3: Option<f32>,
+    /// D∞, metres: the budgets fall linearly with distance, kept at least P3 (eq. 2)
+    /// [default: 100] (needs --lod visual-field).
+    #[arg(long)]
+    pub lod_dinf: Option<f32>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum LodMode {
+    Off,
+    VisualField,
+}
+
+pub fn parse_gaze(s: &str) -> std::result::Result<Gaze, String> {
+    let v: Vec<f32> =
+        s.split(',').map(|x| x.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|e| format!("'{s}': {e}"))?;
+    match v[..] {
+        [yaw, pitch] if yaw.is_finite() && pitch.is_finite() && pitch.abs() <= 89.0 => Ok(Gaze::new(yaw, pitch)),
+        _ => Err(format!("'{s}': expected YAW,PITCH in degrees, pitch within ±89")),
+    }
+}
+
+
+#[derive(Clone, Copy, Debug)]
+pub enum Viewer {
+    At(Vec3),
+    Camera(usize),
+}
+
+pub fn parse_viewer(s: &str) -> std::result::Result<Viewer, String> {
+    match s.strip_prefix("camera") {
+        Some("") => Ok(Viewer::Camera(0)),
+        Some(rest) => rest
+            .strip_prefix(':')
+            .and_then(|n| n.parse().ok())
+            .map(Viewer::Camera)
+            .ok_or_else(|| format!("'{s}': expected camera or camera:N")),
+        None => parse_vec3(s).map(Viewer::At),
+    }
+}
+
+pub fn parse_vec3(s: &str) -> std::result::Result<Vec3, String> {
+    let v: Vec<f32> =
+        s.split(',').map(|x| x.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|e| format!("'{s}': {e}"))?;
+    match v[..] {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Vec3::new(x, y, z)),
+        _ => Err(format!("'{s}': expected three finite numbers x,y,z")),
+    }
+}
+
+pub fn parse_rgb(s: &str) -> std::result::Result<[f32; 3], String> {
+    let v: Vec<u32> =
+        s.split(',').map(|x| x.trim().parse::<u32>()).collect::<Result<_, _>>().map_err(|e| format!("'{s}': {e}"))?;
+    match v[..] {
+        [r, g, b] if r <= 255 && g <= 255 && b <= 255 => Ok([r as f32 / 255.0, g as f32 / 255.0, b as f32 / 255.0]),
+        _ => Err(format!("'{s}': expected R,G,B with each channel 0–255")),
+    }
+}
+
+impl ViewArgs {
+    /// The render settings these options give (the viewer of `camera[:N]` is placed with the
+    /// scene, by `cli::scene::prepare`).
+    pub fn settings(&self) -> Result<RenderSettings> {
+        let projection = Projection {
+            screen_radius: self.screen_radius,
+            eye_radius: self.eye_radius,
+            width: self.width,
+            height: self.height,
+            vertical: self.vertical,
+        };
+        projection.validate()?;
+        if !self.yaw.is_finite() {
+            return Err(Error::option("--yaw", "must be a finite number of degrees"));
+        }
+        if !(self.scale.is_finite() && self.scale > 0.0) {
+            return Err(Error::option("--scale", format!("must be a positive number of metres per scene unit, got {}", self.scale)));
+        }
+        let settings = RenderSettings::new(projection).with_viewer(match self.viewer {
+                Viewer::At(p) => p * self.scale,
+                Viewer::Camera(_) => Vec3::ZERO, // placed with the scene (`scene::prepare`)
+            }).with_yaw_deg(self.yaw).with_method(self.method).with_edge_px(self.edge_px).with_max_div(self.max_div).with_memory_mb(self.memory_mb);
+        settings.validate()?;
+        Ok(settings)
+    }
+
+    /// The level-of-detail parameters and gaze with `--lod visual-field`; the LOD options are
+    /// refused without it (they would do nothing).
+    pub fn lod(&self) -> Result<Option<(LodParams, Gaze)>> {
+        match self.lod {
+            LodMode::Off => {
+                let given = [
+                    ("--gaze", self.gaze.is_some()),
+                    ("--lod-p2", self.lod_p2.is_some()),
+                    ("--lod-p3", self.lod_p3.is_some()),
+                    ("--lod-dinf", self.lod_dinf.is_some()),
+                ];
+                match given.iter().find(|(_, g)| *g) {
+                    Some((option, _)) => Err(Error::option(option, "needs --lod visual-field")),
+                    None => Ok(None),
+                }
+            }
+            LodMode::VisualField => {
+                let d = LodParams::default();
+                let params = LodParams {
+                    p2: self.lod_p2.unwrap_or(d.p2),
+                    p3: self.lod_p3.unwrap_or(d.p3),
+                    d_inf: self.lod_dinf.unwrap_or(d.d_inf),
+                };
+                params.validate()?;
+                Ok(Some((params, self.gaze.unwrap_or(Gaze::new(0.0, 0.0)))))
+            }
+        }
+    }
+}

@@ -1,0 +1,112 @@
+//! `twister error`: the display-position error of a method (seed 002 §4.1), as a summary or
+//! JSON, with an optional heatmap and a comparison against another method.
+
+use std::path::PathBuf;
+
+use clap::Args;
+
+use crate::args::ViewArgs;
+use crate::scene::{lod_stats, open_renderer, prepare};
+use twister::core::settings::Method;
+use twister::error::Result;
+use twister::output::write_images;
+use twister::EyeImage;
+
+#[derive(Args)]
+pub struct ErrorArgs {
+    /// Scene: a .obj, .gltf or .glb file, or builtin:demo, builtin:sphere100, builtin:sphere1024, builtin:triangle@D.
+    #[arg(default_value = "builtin:demo")]
+    pub scene: String,
+    /// Move and scale the scene so that it stands DIST metres ahead, filling the screen height.
+    #[arg(long, value_name = "DIST")]
+    pub fit: Option<f32>,
+    #[command(flatten)]
+    pub view: ViewArgs,
+    /// Print one JSON object instead of a summary.
+    #[arg(long)]
+    pub json: bool,
+    /// Write the per-pixel error, colour-mapped with its scale, to this PNG (left eye on top).
+    #[arg(long, value_name = "FILE.png")]
+    pub heatmap: Option<PathBuf>,
+    /// Top of the heatmap's scale in pixels (default: a round value at or above the p99 error).
+    #[arg(long, value_name = "PX")]
+    pub heatmap_max: Option<f32>,
+    /// Also render with this method and report how much of the image shows a different surface,
+    /// and the colour PSNR (e.g. --against slit:1).
+    #[arg(long, value_parser = Method::parse, value_name = "METHOD")]
+    pub against: Option<Method>,
+}
+
+pub fn measure(args: &ErrorArgs) -> Result<()> {
+    let mut settings = args.view.settings()?.with_measure_error(true);
+    let (renderer, adapter) = open_renderer()?;
+    let prepared = prepare(&renderer, &args.scene, args.fit, &args.view, &mut settings, false)?;
+    let gpu_scene = &prepared.gpu_scene;
+    let frame = renderer.render(gpu_scene, &settings)?;
+    let measured = frame.measurement.as_ref().expect("rendered with measure_error");
+    let e = &measured.stats;
+    let s = &frame.stats;
+    let mut json = serde_json::json!({
+        "scene": args.scene,
+        "method": settings.subdivision.method.name(),
+        "vertical": settings.view.projection.vertical,
+        "width": settings.view.projection.width,
+        "height": settings.view.projection.height,
+        "mean_px": e.mean,
+        "std_px": e.std_dev,
+        "p50_px": e.p50,
+        "p90_px": e.p90,
+        "p99_px": e.p99,
+        "max_px": e.max,
+        "pixels": e.count,
+        "lod": lod_stats(&prepared.selection),
+        "triangles_in": s.triangles_in,
+        "triangles_out": s.triangles_out,
+        "ms_render": s.ms_frame,
+        "timing": s.timing,
+        "ms_total": s.ms_total,
+        "adapter": adapter,
+    });
+    if let Some(method) = args.against {
+        let reference = renderer.render(gpu_scene, &settings.clone().with_method(method))?;
+        let c = twister::core::compare::compare(&frame, &reference)?;
+        json["against"] = serde_json::json!(method.name());
+        json["different_surface_fraction"] = serde_json::json!(c.different_surface_fraction);
+        json["psnr_db"] = serde_json::json!(c.psnr_db);
+    }
+    if let Some(path) = &args.heatmap {
+        let max = args.heatmap_max.unwrap_or_else(|| crate::heatmap::nice_max(e.p99));
+        let (w, h, rgba) =
+            crate::heatmap::heatmap(&measured.error, settings.view.projection.width, settings.view.projection.height, max);
+        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "heatmap.png".into());
+        let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+        write_images(dir, &[(name, EyeImage { width: w, height: h, rgba })])?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string(&json).unwrap());
+    } else {
+        println!(
+            "{} {} ({}): mean {:.3} px, std {:.3}, p50 {:.3}, p90 {:.3}, p99 {:.3}, max {:.3} over {} pixels; {} triangles drawn; {:.1} ms",
+            args.scene,
+            settings.subdivision.method.name(),
+            json["vertical"].as_str().unwrap_or(""),
+            e.mean,
+            e.std_dev,
+            e.p50,
+            e.p90,
+            e.p99,
+            e.max,
+            e.count,
+            s.triangles_out,
+            s.ms_frame
+        );
+        if let Some(f) = json.get("different_surface_fraction") {
+            println!(
+                "against {}: different surface on {:.4} of pixels, PSNR {} dB",
+                json["against"], f, json["psnr_db"]
+            );
+        }
+    }
+    Ok(())
+}
+

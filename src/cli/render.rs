@@ -1,0 +1,96 @@
+//! `twister render`: both eyes' panoramas of a scene, written as a layout of PNGs, with
+//! optional statistics.
+
+use std::path::PathBuf;
+
+use clap::Args;
+
+use crate::args::{parse_rgb, LodMode, ViewArgs};
+use crate::scene::{lod_stats, open_renderer, prepare};
+use twister::error::{Error, Result};
+use twister::output::{layout_images, write_images, write_text, Layout};
+
+#[derive(Args)]
+pub struct RenderArgs {
+    /// Scene to render: a .obj, .gltf or .glb file, or builtin:demo, builtin:sphere100, builtin:sphere1024, builtin:triangle@D.
+    #[arg(default_value = "builtin:demo")]
+    pub scene: String,
+    /// Move and scale the scene so that it stands DIST metres ahead, filling the screen height.
+    #[arg(long, value_name = "DIST")]
+    pub fit: Option<f32>,
+    /// Output folder.
+    #[arg(long, default_value = "out")]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub view: ViewArgs,
+    /// Output layout: eyes (left.png, right.png), top-bottom (stereo.png), twister (four W/2×H images).
+    #[arg(long, value_enum, default_value_t = Layout::Eyes)]
+    pub layout: Layout,
+    /// Background colour R,G,B, each 0–255.
+    #[arg(long, value_parser = parse_rgb, default_value = "26,26,31")]
+    pub background: [f32; 3],
+    /// Write render statistics as JSON to this file.
+    #[arg(long)]
+    pub stats: Option<PathBuf>,
+    /// With --lod visual-field: tint each object by its level and draw the central-field
+    /// (white) and visual-field (orange) boundaries.
+    #[arg(long)]
+    pub lod_overlay: bool,
+}
+
+pub fn render(args: &RenderArgs) -> Result<()> {
+    let mut settings = args.view.settings()?;
+    settings.shading.background = args.background;
+    settings.measure.edges = args.stats.is_some();
+    if args.lod_overlay && args.view.lod == LodMode::Off {
+        return Err(Error::option("--lod-overlay", "needs --lod visual-field"));
+    }
+    let (renderer, adapter) = open_renderer()?;
+    let prepared = prepare(&renderer, &args.scene, args.fit, &args.view, &mut settings, args.lod_overlay)?;
+    let mut frame = renderer.render(&prepared.gpu_scene, &settings)?;
+    if let (true, Some(gaze)) = (args.lod_overlay, &prepared.gaze) {
+        for img in [&mut frame.left, &mut frame.right] {
+            twister::core::lod::draw_field_boundaries(img, settings.projection(), gaze);
+        }
+    }
+    let t = std::time::Instant::now();
+    let written = write_images(&args.out, &layout_images(&frame, args.layout))?;
+    let ms_write = t.elapsed().as_secs_f64() * 1e3;
+    for p in &written {
+        println!("{}", p.display());
+    }
+    if let Some(path) = &args.stats {
+        let s = &frame.stats;
+        let json = serde_json::json!({
+            "scene": args.scene,
+            "method": settings.subdivision.method.name(),
+            "edge_px": settings.subdivision.edge_px,
+            "max_div": settings.subdivision.max_div,
+            "triangles_in": s.triangles_in,
+            "triangles_out": s.triangles_out,
+            "triangles_drawn": s.triangles_out,
+            "pieces": s.pieces,
+            "max_sub_edge_px": s.max_sub_edge_px,
+            "chunks": s.chunks,
+            "width": settings.view.projection.width,
+            "height": settings.view.projection.height,
+            "screen_radius": settings.view.projection.screen_radius,
+            "eye_radius": settings.view.projection.eye_radius,
+            "vertical": settings.view.projection.vertical,
+            "layout": args.layout,
+            "adapter": adapter,
+            "timing": s.timing,
+            "ms_frame": s.ms_frame,
+            "ms_gpu": s.ms_gpu,
+            "ms_subdivide": s.ms_subdivide,
+            "ms_raster": s.ms_raster,
+            "ms_readback": s.ms_readback,
+            "ms_write": ms_write,
+            "ms_total": s.ms_total + ms_write,
+            "lod": lod_stats(&prepared.selection),
+        });
+        write_text(path, &serde_json::to_string_pretty(&json).unwrap())?;
+    }
+    Ok(())
+}
+

@@ -1,0 +1,108 @@
+//! From a scene option to what a command renders: load, scale, fit, place the viewer (a file
+//! camera follows the scene), select the level of detail, upload; and the warnings the user
+//! should read on the way.
+
+use glam::{Mat4, Vec3};
+
+use crate::args::{ViewArgs, Viewer};
+use twister::core::load::load_scene;
+use twister::core::lod::{LodChain, LodSelection};
+use twister::core::visual_field::{Field, Gaze};
+use twister::error::{Error, Result};
+use twister::gpu::Gpu;
+use twister::{GpuScene, RenderSettings, Renderer, Scene};
+
+/// The GPU and its renderer, with the adapter's description for reports.
+pub fn open_renderer() -> Result<(Renderer, String)> {
+    let gpu = Gpu::new()?;
+    let adapter = gpu.adapter_description();
+    Ok((Renderer::new(gpu)?, adapter))
+}
+
+/// Prints a warning line for the user (stderr).
+pub fn warn(spec: &str, warning: &str) {
+    eprintln!("warning: {spec}: {warning}");
+}
+
+/// Loads and places a scene: `--scale`, then `--fit`; a `camera[:N]` viewer takes that
+/// camera's place and yaw (the camera moved with the scene). Prints the loader's warnings.
+pub fn place(spec: &str, fit: Option<f32>, view: &ViewArgs, settings: &mut RenderSettings) -> Result<Scene> {
+    let mut scene = load_scene(spec, settings.projection())?;
+    for w in &scene.warnings {
+        warn(spec, w);
+    }
+    if view.scale != 1.0 {
+        scene.transform(Mat4::from_scale(Vec3::splat(view.scale)));
+        check_finite(&scene, spec, "--scale")?;
+    }
+    if let Some(d) = fit {
+        scene.fit(d, settings.projection())?;
+        check_finite(&scene, spec, "--fit")?;
+    }
+    if let Viewer::Camera(n) = view.viewer {
+        let cam = scene.cameras.get(n).ok_or_else(|| {
+            Error::scene(spec, format!("--viewer camera:{n}, but the file has {} cameras", scene.cameras.len()))
+        })?;
+        settings.view.viewer = Vec3::from(cam.position);
+        settings.view.yaw_deg += cam.yaw_deg;
+    }
+    Ok(scene)
+}
+
+/// After a transform: an overflow to infinity is the option's fault, not the file's.
+fn check_finite(scene: &Scene, spec: &str, option: &'static str) -> Result<()> {
+    let finite = scene.vertices.iter().all(|v| v.position.iter().all(|c| c.is_finite()));
+    if finite {
+        Ok(())
+    } else {
+        Err(Error::option(option, format!("makes the coordinates of {spec} overflow")))
+    }
+}
+
+/// A scene ready to render.
+pub struct Prepared {
+    pub gpu_scene: GpuScene,
+    pub selection: Option<LodSelection>,
+    pub gaze: Option<Gaze>,
+}
+
+/// Places the scene and uploads it; with `--lod visual-field`, draws the gaze's selection
+/// (tinted by level when `overlay`).
+pub fn prepare(
+    renderer: &Renderer,
+    spec: &str,
+    fit: Option<f32>,
+    view: &ViewArgs,
+    settings: &mut RenderSettings,
+    overlay: bool,
+) -> Result<Prepared> {
+    let lod = view.lod()?;
+    let mut scene = place(spec, fit, view, settings)?;
+    let selection = lod.map(|(params, gaze)| LodChain::build(&scene, params.p3).select(&scene, settings.view(), &gaze, &params));
+    if let (Some(sel), true) = (&selection, overlay) {
+        twister::core::lod::tint(&mut scene, sel);
+    }
+    let mut gpu_scene = GpuScene::upload(&renderer.gpu, &scene)?;
+    for w in &gpu_scene.warnings {
+        warn(spec, w);
+    }
+    if let Some(sel) = &selection {
+        gpu_scene = gpu_scene.with_lod(&renderer.gpu, sel);
+    }
+    Ok(Prepared { gpu_scene, selection, gaze: lod.map(|(_, g)| g) })
+}
+
+/// The LOD part of the stats: triangles selected and, per field, objects and triangles.
+pub fn lod_stats(selection: &Option<LodSelection>) -> serde_json::Value {
+    let Some(sel) = selection else { return serde_json::Value::Null };
+    let per = |f: Field| {
+        let c: Vec<_> = sel.chosen.iter().filter(|c| c.field == f).collect();
+        serde_json::json!({ "objects": c.len(), "triangles": c.iter().map(|c| c.triangles as u64).sum::<u64>() })
+    };
+    serde_json::json!({
+        "triangles_selected": sel.triangle_count(),
+        "central": per(Field::Central),
+        "peripheral": per(Field::Peripheral),
+        "outside": per(Field::Outside),
+    })
+}
