@@ -1,6 +1,6 @@
 //! Error heatmaps: the per-pixel display-position error of both eyes (left on top), colour-mapped
 //! from 0 to a scale maximum, with the scale drawn under the images (a colour bar with ticks
-//! labelled in pixels). Background and unseen pixels are dark grey.
+//! labelled in pixels, text by plotters). Background and unseen pixels are dark grey.
 
 /// A perceptually ordered colour map (dark blue → teal → yellow → red), t in [0, 1].
 pub fn colormap(t: f32) -> [u8; 3] {
@@ -14,54 +14,18 @@ pub fn colormap(t: f32) -> [u8; 3] {
     [c[0], c[1], c[2]]
 }
 
-/// 3×5 bitmap glyphs for the scale labels.
-fn glyph(c: char) -> [u8; 5] {
-    match c {
-        '0' => [7, 5, 5, 5, 7],
-        '1' => [2, 6, 2, 2, 7],
-        '2' => [7, 1, 7, 4, 7],
-        '3' => [7, 1, 7, 1, 7],
-        '4' => [5, 5, 7, 1, 1],
-        '5' => [7, 4, 7, 1, 7],
-        '6' => [7, 4, 7, 5, 7],
-        '7' => [7, 1, 1, 1, 1],
-        '8' => [7, 5, 7, 5, 7],
-        '9' => [7, 5, 7, 1, 7],
-        '.' => [0, 0, 0, 0, 2],
-        'p' => [0, 7, 5, 7, 4],
-        'x' => [0, 5, 2, 5, 0],
-        _ => [0; 5],
-    }
-}
-
+/// An RGB canvas.
 struct Canvas {
     width: u32,
     height: u32,
-    rgba: Vec<u8>,
+    rgb: Vec<u8>,
 }
 
 impl Canvas {
     fn set(&mut self, x: u32, y: u32, c: [u8; 3]) {
         if x < self.width && y < self.height {
-            let i = 4 * (y * self.width + x) as usize;
-            self.rgba[i..i + 4].copy_from_slice(&[c[0], c[1], c[2], 255]);
-        }
-    }
-
-    fn text(&mut self, x: u32, y: u32, s: &str, scale: u32) {
-        for (k, ch) in s.chars().enumerate() {
-            let g = glyph(ch);
-            for (row, bits) in g.iter().enumerate() {
-                for col in 0..3 {
-                    if bits & (4 >> col) != 0 {
-                        for dy in 0..scale {
-                            for dx in 0..scale {
-                                self.set(x + (k as u32 * 4 + col) * scale + dx, y + row as u32 * scale + dy, [255; 3]);
-                            }
-                        }
-                    }
-                }
-            }
+            let i = 3 * (y * self.width + x) as usize;
+            self.rgb[i..i + 3].copy_from_slice(&c);
         }
     }
 }
@@ -80,7 +44,7 @@ pub fn heatmap(errors: &[Vec<f32>; 2], width: u32, height: u32, scale_max: f32) 
     let text_scale = (width / 400).clamp(1, 4);
     let bar_h = 12 * text_scale;
     let total_h = 2 * height + bar_h + 10 * text_scale;
-    let mut c = Canvas { width, height: total_h, rgba: [20u8, 20, 20, 255].repeat((width * total_h) as usize) };
+    let mut c = Canvas { width, height: total_h, rgb: [20u8, 20, 20].repeat((width * total_h) as usize) };
     for (k, err) in errors.iter().enumerate() {
         for y in 0..height {
             for x in 0..width {
@@ -106,10 +70,11 @@ pub fn heatmap(errors: &[Vec<f32>; 2], width: u32, height: u32, scale_max: f32) 
         for y in top..top + bar_h / 2 + text_scale {
             c.set(x, y, [255; 3]);
         }
-        let tx = x
-            .saturating_sub(2 * text_scale * label.len() as u32)
-            .min(width.saturating_sub(4 * text_scale * label.len() as u32));
-        c.text(tx, top + bar_h / 2 + 2 * text_scale, &label, text_scale);
+        let size = 6 * text_scale + 2;
+        let label_w = crate::plot::label_width(size, &label);
+        let tx = x.saturating_sub(label_w / 2).min(width.saturating_sub(label_w));
+        let ty = top + bar_h / 2 + text_scale;
+        crate::plot::label(&mut c.rgb, width, total_h, tx as i32, ty as i32, size, &label);
     }
-    (width, total_h, c.rgba)
+    (width, total_h, c.rgb.chunks(3).flat_map(|p| [p[0], p[1], p[2], 255]).collect())
 }

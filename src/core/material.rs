@@ -6,7 +6,7 @@ use bytemuck::{Pod, Zeroable};
 /// No texture (`Material::texture`).
 pub const NO_TEXTURE: u32 = u32::MAX;
 
-/// A surface material as the fragment stage reads it (`Material` in shaders/fragment.wgsl),
+/// A surface material as the fragment stage reads it (`Material` in shaders/shared/fragment.wgsl),
 /// indexed by a vertex's `material` (0: the default material). The base colour factor is
 /// already multiplied into the vertex colours; this holds what needs the fragment. 48 bytes.
 #[repr(C)]
@@ -78,7 +78,7 @@ pub enum Mipmap {
 }
 
 /// glTF alpha mode. BLEND is drawn as order-independent screen-door transparency (see
-/// shaders/fragment.wgsl).
+/// shaders/shared/fragment.wgsl).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum AlphaMode {
     Opaque = 0,
@@ -86,7 +86,7 @@ pub enum AlphaMode {
     Blend = 2,
 }
 
-/// One mip level of a packed texture (`MipLevel` in shaders/fragment.wgsl): where its texels
+/// One mip level of a packed texture (`MipLevel` in shaders/shared/fragment.wgsl): where its texels
 /// start in the texel buffer (one RGBA8 sRGB texel per u32, rows top to bottom) and its size.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]

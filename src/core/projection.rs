@@ -25,7 +25,7 @@
 //!
 //! Pixels: u ∈ [−π, π) spans the image width with θ = 0 at the centre column; pixels are square,
 //! one pixel = 2π·R_T/W metres of screen; v = 0 is the middle row, +y is up in the image.
-//! The WGSL twin of this module is `shaders/projection.wgsl`; both must stay in step.
+//! The WGSL twin of this module is `shaders/shared/projection.wgsl`; both must stay in step.
 
 use glam::Vec3;
 

@@ -5,7 +5,7 @@
 //! are packed one after the other into one texel buffer, with a table of mip levels. One
 //! storage buffer instead of a texture array keeps every texture at its own size (a texture
 //! array needs equal layers, and lavapipe has no binding arrays); the fragment stage filters
-//! by hand (`sample_texture` in shaders/fragment.wgsl, twin in `src/fragment.rs`), which also
+//! by hand (`sample_texture` in shaders/shared/fragment.wgsl, twin in `src/cpu/fragment.rs`), which also
 //! makes every glTF wrap and filter mode exact per texture.
 
 use crate::core::color::{linear_to_srgb, srgb_to_linear};

@@ -1,4 +1,4 @@
-//! CPU twin of `shaders/fragment.wgsl`, the fragment work shared by the drawing stages: the
+//! CPU twin of `shaders/shared/fragment.wgsl`, the fragment work shared by the drawing stages: the
 //! surface colour (material: base colour texture with its sampler, alpha mask / screen-door
 //! blend, single-sided culling), headlight shading in linear light with an sRGB-encoded output,
 //! and the display-position error (seed 002 §4.1): the distance in pixels between the pixel

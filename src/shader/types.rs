@@ -26,7 +26,7 @@ pub struct DrawVertex {
     pub _pad: f32,
 }
 
-/// `Projection` in shaders/projection.wgsl. 32 bytes.
+/// `Projection` in shaders/shared/projection.wgsl. 32 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct ProjectionUniform {
