@@ -1,0 +1,440 @@
+//! The generic twin test: every stage of the registry (`twister::shader::STAGES`) runs on the
+//! GPU and through its CPU twin on the same cases, and the outputs must agree. A stage is added
+//! by implementing [`Twin`] for it and naming it in `twin_of`; a registered stage without one
+//! fails `every_registered_stage_matches_its_cpu_twin`.
+
+mod common;
+
+use glam::Vec3;
+use rand::{Rng, SeedableRng};
+use twister::core::builtin;
+use twister::core::settings::Method;
+use twister::cpu::raster::{raster, raster_params};
+use twister::cpu::reduce_error::reduce_error;
+use twister::cpu::slit::{slit, slit_params, slits};
+use twister::cpu::subdivide::{subdivide, subdivide_params};
+use twister::shader::types::{DrawVertex, ErrorStats};
+use twister::shader::STAGES;
+use twister::{Eye, Frame, GpuScene, Projection, RenderSettings, Renderer, Scene, Vertical};
+
+/// One stage's GPU-against-twin check.
+trait Twin {
+    type Case;
+    type Output;
+    /// Named cases.
+    fn cases() -> Vec<(String, Self::Case)>;
+    fn gpu(r: &Renderer, case: &Self::Case) -> Self::Output;
+    fn cpu(case: &Self::Case) -> Self::Output;
+    /// Err with what differs.
+    fn compare(gpu: &Self::Output, cpu: &Self::Output) -> Result<(), String>;
+}
+
+/// Runs every case of a stage's twin check; returns how many ran.
+fn check<T: Twin>(stage: &str) -> usize {
+    let r = common::renderer();
+    let cases = T::cases();
+    assert!(!cases.is_empty(), "{stage}: no twin cases");
+    for (name, case) in &cases {
+        let (gpu, cpu) = (T::gpu(r, case), T::cpu(case));
+        if let Err(e) = T::compare(&gpu, &cpu) {
+            panic!("{stage}, {name}: GPU and CPU twin differ: {e}");
+        }
+    }
+    cases.len()
+}
+
+/// The twin check of a registered stage, by name.
+fn twin_of(stage: &str) -> Option<fn(&str) -> usize> {
+    Some(match stage {
+        "project_points" => check::<ProjectPoints>,
+        "subdivide" => check::<Subdivide>,
+        "raster" => check::<Raster>,
+        "slit" => check::<Slit>,
+        "reduce_error" => check::<ReduceError>,
+        _ => return None,
+    })
+}
+
+#[test]
+fn every_registered_stage_matches_its_cpu_twin() {
+    for stage in STAGES {
+        let run = twin_of(stage.name)
+            .unwrap_or_else(|| panic!("stage {} has no twin check: implement Twin for it in tests/twins.rs", stage.name));
+        let n = run(stage.name);
+        eprintln!("{}: {n} cases agree", stage.name);
+    }
+}
+
+// ---- project_points ----
+
+struct ProjectPoints;
+
+impl Twin for ProjectPoints {
+    type Case = (Projection, Eye, Vec<Vec3>);
+    type Output = (Projection, Vec<[f32; 4]>);
+    fn cases() -> Vec<(String, Self::Case)> {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(1);
+        let points: Vec<Vec3> = (0..5000)
+            .map(|_| {
+                let radius: f32 = rng.random_range(0.05f32..40.0);
+                let theta: f32 = rng.random_range(-std::f32::consts::PI..std::f32::consts::PI);
+                Vec3::new(radius * theta.sin(), rng.random_range(-3.0f32..3.0), -radius * theta.cos())
+            })
+            .collect();
+        let mut out = Vec::new();
+        for vertical in [Vertical::Paper, Vertical::Exact] {
+            for eye in Eye::BOTH {
+                let p = Projection { vertical, ..Projection::default() };
+                out.push((format!("{vertical:?} {eye:?}"), (p, eye, points.clone())));
+            }
+        }
+        out
+    }
+    fn gpu(r: &Renderer, (p, eye, points): &Self::Case) -> Self::Output {
+        (*p, r.project_points(p, *eye, points).unwrap())
+    }
+    fn cpu((p, eye, points): &Self::Case) -> Self::Output {
+        (*p, twister::cpu::project_points::project_points(p, *eye, points))
+    }
+    /// Within a thousandth of a pixel on or near the image; far off it (near the eye circle,
+    /// |y| up to 10⁵ px) f32 itself resolves only ~1e-7 relative.
+    fn compare((p, gpu): &Self::Output, (_, cpu): &Self::Output) -> Result<(), String> {
+        if cpu.iter().filter(|c| c[3] == 1.0).count() < 4500 {
+            return Err("too few points seen to test".into());
+        }
+        for (i, (g, c)) in gpu.iter().zip(cpu).enumerate() {
+            if g[3] != c[3] {
+                return Err(format!("point {i}: seen on one side only"));
+            }
+            if c[3] == 0.0 {
+                continue;
+            }
+            let near_image = c[1] > -(p.height as f32) && c[1] < 2.0 * p.height as f32;
+            let tolerance = if near_image { 1e-3 } else { 1e-6 * c[1].abs() };
+            if !(p.wrapped_dx(g[0], c[0]) < 1e-3 && (g[1] - c[1]).abs() < tolerance) {
+                return Err(format!("point {i}: GPU {g:?}, CPU {c:?}"));
+            }
+        }
+        Ok(())
+    }
+}
+
+// ---- subdivide ----
+
+struct Subdivide;
+
+/// A mix of small triangles anywhere, big ones around the viewer, and ones near the axis.
+fn random_triangle_scene(seed: u64, n: usize) -> Scene {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    let mut scene = Scene::new("random");
+    for k in 0..n {
+        // Mix of small triangles anywhere, big ones around the viewer, and ones near the axis.
+        let scale = [0.3f32, 6.0, 1.0][k % 3];
+        let center = match k % 3 {
+            2 => Vec3::new(rng.random_range(-0.05..0.05), rng.random_range(-2.0..2.0), rng.random_range(-0.05..0.05)),
+            _ => Vec3::new(rng.random_range(-8.0..8.0), rng.random_range(-3.0..3.0), rng.random_range(-8.0..8.0)),
+        };
+        let v: Vec<twister::core::scene::SceneVertex> = (0..3)
+            .map(|i| twister::core::scene::SceneVertex {
+                position: (center
+                    + scale
+                        * Vec3::new(
+                            rng.random_range(-1.0..1.0),
+                            rng.random_range(-1.0..1.0),
+                            rng.random_range(-1.0..1.0),
+                        ))
+                .into(),
+                normal: [rng.random_range(-1.0..1.0), 1.0, 0.0],
+                color: [rng.random(), rng.random(), rng.random(), 1.0],
+                uv: [i as f32, rng.random()],
+                material: k as u32,
+                ..Default::default()
+            })
+            .collect();
+        scene.add_mesh("t", &v, &[0, 1, 2]);
+    }
+    scene
+}
+
+impl Twin for Subdivide {
+    type Case = (Scene, RenderSettings);
+    type Output = twister::cpu::subdivide::SubdivideOutput;
+    fn cases() -> Vec<(String, Self::Case)> {
+        let projection = Projection { width: 640, height: 160, ..Projection::default() };
+        let base = RenderSettings::new(projection).with_measure_edges(true);
+        let moved = base.with_viewer(Vec3::new(1.0, 0.3, -2.0)).with_yaw_deg(37.0);
+        let sphere = builtin::builtin_scene("builtin:sphere100", &projection).unwrap();
+        let around = builtin::sphere_scene(1024, Vec3::ZERO, 2.5, "sphere around the viewer");
+        let cases = [
+            (random_triangle_scene(3, 600), base.with_method(Method::Vertex)),
+            (random_triangle_scene(4, 300), base),
+            (random_triangle_scene(5, 200), base.with_method(Method::Fixed(5))),
+            (builtin::demo(), base),
+            (builtin::demo(), moved.with_method(Method::Vertex)),
+            (builtin::demo(), moved.with_edge_px(12.0).with_max_div(4)),
+            (sphere, base.with_edge_px(8.0)),
+            (around, base.with_edge_px(16.0)),
+        ];
+        cases
+            .into_iter()
+            .enumerate()
+            .map(|(k, (scene, s))| {
+                let name = format!("case {k}: {} {}", scene.name, s.subdivision.method.name());
+                let cpu = Self::cpu(&(scene.clone(), s));
+                assert!(cpu.vertices.len() / 3 > scene.triangle_count(), "{name}: exercises splits and seam copies");
+                (name, (scene, s))
+            })
+            .collect()
+    }
+    fn gpu(r: &Renderer, (scene, settings): &Self::Case) -> Self::Output {
+        let gs = GpuScene::upload(&r.gpu, scene).unwrap();
+        r.subdivide_readback(&gs, settings).unwrap()
+    }
+    fn cpu((scene, settings): &Self::Case) -> Self::Output {
+        subdivide(&subdivide_params(settings, 0, scene.triangle_count() as u32), &scene.vertices, &scene.indices)
+    }
+    fn compare(gpu: &Self::Output, cpu: &Self::Output) -> Result<(), String> {
+        if cpu.pieces != gpu.pieces {
+            return Err(format!("pieces: CPU {}, GPU {}", cpu.pieces, gpu.pieces));
+        }
+        if (cpu.max_sub_edge_px - gpu.max_sub_edge_px).abs() >= 1e-2 * (1.0 + cpu.max_sub_edge_px) {
+            return Err(format!("max edge: CPU {}, GPU {}", cpu.max_sub_edge_px, gpu.max_sub_edge_px));
+        }
+        same_triangle_sets(&cpu.vertices, &gpu.vertices)
+    }
+}
+
+/// Matches each CPU triangle to the nearest unused GPU triangle (searched among those whose
+/// centroid and reference azimuth fall in neighbouring buckets: the GPU appends in another
+/// order) and checks they are the same.
+fn same_triangle_sets(cpu: &[DrawVertex], gpu: &[DrawVertex]) -> Result<(), String> {
+    use std::collections::HashMap;
+    if cpu.len() != gpu.len() {
+        return Err(format!("CPU made {} triangles, GPU {}", cpu.len() / 3, gpu.len() / 3));
+    }
+    let key = |t: &[DrawVertex]| (t.iter().fold(Vec3::ZERO, |a, v| a + Vec3::from(v.position)) / 3.0, t[0].theta_ref);
+    let cell = |c: Vec3, th: f32| {
+        ((c.x * 1e3).floor() as i64, (c.y * 1e3).floor() as i64, (c.z * 1e3).floor() as i64, (th * 10.0).floor() as i64)
+    };
+    let gpu_tris: Vec<&[DrawVertex]> = gpu.chunks(3).collect();
+    let mut buckets: HashMap<(i64, i64, i64, i64), Vec<usize>> = HashMap::new();
+    for (j, t) in gpu_tris.iter().enumerate() {
+        let (c, th) = key(t);
+        buckets.entry(cell(c, th)).or_default().push(j);
+    }
+    let mut used = vec![false; gpu_tris.len()];
+    for t in cpu.chunks(3) {
+        let (c, th) = key(t);
+        let k = cell(c, th);
+        let mut best: Option<(f32, usize)> = None;
+        for d in 0..81i64 {
+            let (dx, dy, dz, dt) = (d % 3 - 1, d / 3 % 3 - 1, d / 9 % 3 - 1, d / 27 - 1);
+            for &j in buckets.get(&(k.0 + dx, k.1 + dy, k.2 + dz, k.3 + dt)).into_iter().flatten() {
+                if !used[j] {
+                    let (c2, th2) = key(gpu_tris[j]);
+                    let dist = (c2 - c).length() + (th2 - th).abs();
+                    if best.is_none_or(|(bd, _)| dist < bd) {
+                        best = Some((dist, j));
+                    }
+                }
+            }
+        }
+        let (_, best) = best.ok_or_else(|| format!("CPU triangle {t:?} has no GPU twin"))?;
+        used[best] = true;
+        let close = |x: &[f32], y: &[f32]| x.iter().zip(y).all(|(p, q)| (p - q).abs() <= 1e-4 * (1.0 + p.abs()));
+        for (a, b) in t.iter().zip(gpu_tris[best]) {
+            let same = close(&a.position, &b.position)
+                && close(&[a.theta_ref], &[b.theta_ref])
+                && close(&a.normal, &b.normal)
+                && close(&a.color, &b.color)
+                && close(&a.uv, &b.uv)
+                && a.material == b.material;
+            if !same {
+                return Err(format!("CPU vertex {a:?} differs from GPU vertex {b:?}"));
+            }
+        }
+    }
+    Ok(())
+}
+
+// ---- raster (with the fragment module and the error pass) ----
+
+struct Raster;
+
+/// Per eye: colour (RGBA8), display-position error (−1 where none) and object id + 1.
+type EyeOutputs = [(Vec<u8>, Vec<f32>, Vec<u32>); 2];
+
+fn measured(scene: &Scene, settings: &RenderSettings) -> Frame {
+    common::render(scene, &settings.with_measure_error(true))
+}
+
+fn frame_outputs(frame: &Frame) -> EyeOutputs {
+    let m = frame.measurement.as_ref().expect("measured");
+    [0, 1].map(|k| (frame.eye(Eye::BOTH[k]).rgba.clone(), m.error[k].clone(), m.object[k].clone()))
+}
+
+/// Only pixels on triangle edges may differ (tie-breaking and rounding at coverage edges): at
+/// most `1/share` of the pixels in colour or object; the error where both drew a surface.
+fn compare_eyes(gpu: &EyeOutputs, cpu: &EyeOutputs, share: usize, error_tolerance: Option<f32>) -> Result<(), String> {
+    let error_tolerance = error_tolerance.unwrap_or(f32::INFINITY);
+    for (k, ((gc, ge, go), (cc, ce, co))) in gpu.iter().zip(cpu).enumerate() {
+        let total = go.len();
+        let colour = gc.chunks(4).zip(cc.chunks(4)).filter(|(a, b)| a.iter().zip(*b).any(|(x, y)| x.abs_diff(*y) > 2)).count();
+        let object = go.iter().zip(co).filter(|(a, b)| a != b).count();
+        let both: Vec<f32> = ge.iter().zip(ce).filter(|(g, c)| **g >= 0.0 && **c >= 0.0).map(|(g, c)| (g - c).abs()).collect();
+        let error = both.iter().filter(|d| **d > error_tolerance).count();
+        if colour * share > total || object * share > total || error * share > total || both.len() * 4 < total / 10 {
+            return Err(format!(
+                "{:?}: {colour} colours, {object} objects and {error} errors of {total} pixels differ ({} compared, worst error difference {} px)",
+                Eye::BOTH[k],
+                both.len(),
+                both.iter().fold(0.0f32, |a, b| a.max(*b))
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// A raster case: the scene, its settings, and the tolerance of the per-pixel error (None: not
+/// compared — on the demo room, pixels where overlapping near-axis triangles tie in depth may
+/// show another sub-triangle of the same surface, whose interpolated error differs).
+type RasterCase = (Scene, RenderSettings, Option<f32>);
+
+impl Twin for Raster {
+    type Case = RasterCase;
+    type Output = (EyeOutputs, Option<f32>);
+    fn cases() -> Vec<(String, Self::Case)> {
+        let mut out = Vec::new();
+        for vertical in [Vertical::Paper, Vertical::Exact] {
+            let projection = Projection { width: 400, height: 100, vertical, ..Projection::default() };
+            out.push((format!("demo {vertical:?}"), (builtin::demo(), RenderSettings::new(projection), None)));
+            let triangle = builtin::builtin_scene("builtin:triangle@3", &projection).unwrap();
+            for method in [Method::Vertex, Method::Adaptive] {
+                let settings = RenderSettings::new(projection).with_method(method);
+                out.push((format!("triangle@3 {} {vertical:?}", method.name()), (triangle.clone(), settings, Some(0.01))));
+            }
+        }
+        out
+    }
+    fn gpu(_: &Renderer, (scene, settings, tolerance): &Self::Case) -> Self::Output {
+        (frame_outputs(&measured(scene, settings)), *tolerance)
+    }
+    fn cpu((scene, settings, tolerance): &Self::Case) -> Self::Output {
+        let params = subdivide_params(settings, 0, scene.triangle_count() as u32);
+        let tris = subdivide(&params, &scene.vertices, &scene.indices).vertices;
+        let table = scene.material_table(usize::MAX);
+        let eyes = Eye::BOTH.map(|eye| {
+            let img = raster(&raster_params(settings, eye), &tris, &table, settings.shading.background);
+            (img.rgba, img.error, img.object)
+        });
+        (eyes, *tolerance)
+    }
+    fn compare((gpu, tolerance): &Self::Output, (cpu, _): &Self::Output) -> Result<(), String> {
+        compare_eyes(gpu, cpu, 100, *tolerance)
+    }
+}
+
+// ---- slit ----
+
+struct Slit;
+
+impl Twin for Slit {
+    type Case = (Scene, RenderSettings);
+    type Output = EyeOutputs;
+    fn cases() -> Vec<(String, Self::Case)> {
+        let projection = Projection { width: 192, height: 48, vertical: Vertical::Exact, ..Projection::default() };
+        [1, 4, 16]
+            .map(|w| (format!("demo slit:{w}"), (builtin::demo(), RenderSettings::new(projection).with_method(Method::Slit(w)))))
+            .into()
+    }
+    fn gpu(_: &Renderer, (scene, settings): &Self::Case) -> Self::Output {
+        frame_outputs(&measured(scene, settings))
+    }
+    fn cpu((scene, settings): &Self::Case) -> Self::Output {
+        let Method::Slit(w) = settings.subdivision.method else { unreachable!() };
+        let p = settings.projection();
+        let table = scene.material_table(usize::MAX);
+        Eye::BOTH.map(|eye| {
+            let params = slit_params(p, settings.view(), eye, settings.shading.ambient);
+            let img = slit(&params, &slits(p, eye, w), scene, &table, settings.shading.background);
+            (img.rgba, img.error, img.object)
+        })
+    }
+    fn compare(gpu: &Self::Output, cpu: &Self::Output) -> Result<(), String> {
+        compare_eyes(gpu, cpu, 50, Some(0.01))
+    }
+}
+
+// ---- reduce_error ----
+
+struct ReduceError;
+
+impl Twin for ReduceError {
+    /// Per-pixel errors of both eyes (a real frame's), and the GPU's reduction of them.
+    type Case = ([Vec<f32>; 2], ErrorStats);
+    type Output = ErrorStats;
+    fn cases() -> Vec<(String, Self::Case)> {
+        let mut out = Vec::new();
+        for (name, scene, method) in
+            [("triangle@3 vertex", "builtin:triangle@3", Method::Vertex), ("demo adaptive", "builtin:demo", Method::Adaptive)]
+        {
+            let projection = Projection { width: 480, height: 90, ..Projection::default() };
+            let scene = builtin::builtin_scene(scene, &projection).unwrap();
+            let frame = measured(&scene, &RenderSettings::new(projection).with_method(method));
+            let m = frame.measurement.unwrap();
+            out.push((name.to_string(), (m.error, m.stats)));
+        }
+        out
+    }
+    fn gpu(_: &Renderer, (_, stats): &Self::Case) -> Self::Output {
+        *stats
+    }
+    fn cpu((errors, _): &Self::Case) -> Self::Output {
+        reduce_error(errors.iter().map(|v| v.as_slice()))
+    }
+    fn compare(gpu: &Self::Output, cpu: &Self::Output) -> Result<(), String> {
+        let close = |g: f32, c: f32, rel: f32| (g - c).abs() <= rel * c.max(1.0);
+        let ok = gpu.count == cpu.count
+            && gpu.count > 1000
+            && gpu.max == cpu.max
+            && close(gpu.mean, cpu.mean, 1e-4)
+            && close(gpu.std_dev, cpu.std_dev, 1e-3)
+            && [(gpu.p50, cpu.p50), (gpu.p90, cpu.p90), (gpu.p99, cpu.p99)].iter().all(|&(g, c)| close(g, c, 1e-4));
+        if ok {
+            Ok(())
+        } else {
+            Err(format!("GPU {gpu:?}, CPU {cpu:?}"))
+        }
+    }
+}
+
+// ---- stage-specific checks beyond the twin ----
+
+#[test]
+fn project_points_takes_no_points_and_more_than_one_dispatch_row() {
+    let r = common::renderer();
+    let projection = Projection { width: 800, height: 200, ..Projection::default() };
+    assert!(r.project_points(&projection, Eye::Left, &[]).unwrap().is_empty());
+    // 65,535 workgroups of 64 hold 4,194,240 points: beyond them the dispatch is 2-D, and
+    // every point, the last ones included, must be projected.
+    let n = 65_535 * 64 + 1000;
+    let points: Vec<Vec3> = (0..n)
+        .map(|i| {
+            let a = i as f32 * 1e-4;
+            Vec3::new(2.0 * a.sin(), (i % 7) as f32 * 0.1 - 0.3, -2.0 * a.cos())
+        })
+        .collect();
+    let gpu = r.project_points(&projection, Eye::Right, &points).unwrap();
+    assert_eq!(gpu.len(), n);
+    let sample: Vec<usize> = (0..n).step_by(9973).chain(n - 1100..n).collect();
+    let cpu = twister::cpu::project_points::project_points(
+        &projection,
+        Eye::Right,
+        &sample.iter().map(|&i| points[i]).collect::<Vec<_>>(),
+    );
+    for (&i, c) in sample.iter().zip(&cpu) {
+        let g = gpu[i];
+        assert_eq!(g[3], 1.0, "point {i} was not projected");
+        assert!(projection.wrapped_dx(g[0], c[0]) < 1e-2 && (g[1] - c[1]).abs() < 1e-2, "point {i}: {g:?} vs {c:?}");
+    }
+}
