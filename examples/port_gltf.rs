@@ -5,8 +5,8 @@
 //! `cargo run --release --example port_gltf -- ../shared/assets/gltf/Duck/glTF-Binary/Duck.glb out/duck`
 
 use glam::Vec3;
-use twister::gpu::Gpu;
 use twister::core::load::{load_scene, suggested_viewer};
+use twister::gpu::Gpu;
 use twister::output::{layout_images, write_images, Layout};
 use twister::{GpuScene, RenderSettings, Renderer};
 

@@ -2,9 +2,9 @@
 //!
 //! `cargo run --release --example render_builtin -- builtin:demo out/example`
 
+use twister::core::builtin;
 use twister::gpu::Gpu;
 use twister::output::{layout_images, write_images, Layout};
-use twister::core::builtin;
 use twister::{GpuScene, RenderSettings, Renderer};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -33,7 +33,9 @@ fn quick_benchmark_writes_every_output_well_formed() {
     let _ = std::fs::remove_dir_all(&out);
     let assets = common::asset("");
     // Every scene of the quick run is present (CI has the assets), so every row is expected.
-    for needed in ["stanford-bunny/bun_zipper_res2.obj", "stanford-bunny/bun_zipper_res4.obj", "sponza-dabrovic/sponza.obj"] {
+    for needed in
+        ["stanford-bunny/bun_zipper_res2.obj", "stanford-bunny/bun_zipper_res4.obj", "sponza-dabrovic/sponza.obj"]
+    {
         common::asset(needed);
     }
     run_quick(&out, &assets);

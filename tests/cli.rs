@@ -71,7 +71,9 @@ fn render_writes_every_layout_and_stats() {
     }
     // The times say how they were measured: apart only where they were.
     match json["timing"].as_str().unwrap() {
-        "gpu-timestamps" => assert!(json["ms_subdivide"].is_number() && json["ms_raster"].is_number() && json["ms_gpu"].is_number()),
+        "gpu-timestamps" => {
+            assert!(json["ms_subdivide"].is_number() && json["ms_raster"].is_number() && json["ms_gpu"].is_number())
+        }
         "wall-one-submission" => assert!(json["ms_subdivide"].is_null() && json["ms_raster"].is_null()),
         other => panic!("a one-submission frame reported timing {other}"),
     }
@@ -351,7 +353,18 @@ fn a_chunked_frame_reports_wall_times_per_pass() {
     let out = tmp("chunked");
     let stats = out.join("s.json");
     let o = twister()
-        .args(["render", "builtin:sphere1024", "--width", "320", "--height", "60", "--edge-px", "0.5", "--memory-mb", "8"])
+        .args([
+            "render",
+            "builtin:sphere1024",
+            "--width",
+            "320",
+            "--height",
+            "60",
+            "--edge-px",
+            "0.5",
+            "--memory-mb",
+            "8",
+        ])
         .args(["--out", out.to_str().unwrap(), "--stats", stats.to_str().unwrap()])
         .output()
         .unwrap();
@@ -359,10 +372,27 @@ fn a_chunked_frame_reports_wall_times_per_pass() {
     let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
     assert!(json["chunks"].as_u64().unwrap() > 1, "{json}");
     assert_eq!(json["timing"], "wall-per-pass");
-    let (sub, ras, frame) =
-        (json["ms_subdivide"].as_f64().unwrap(), json["ms_raster"].as_f64().unwrap(), json["ms_frame"].as_f64().unwrap());
+    let (sub, ras, frame) = (
+        json["ms_subdivide"].as_f64().unwrap(),
+        json["ms_raster"].as_f64().unwrap(),
+        json["ms_frame"].as_f64().unwrap(),
+    );
     assert!(sub > 0.0 && ras > 0.0 && (sub + ras - frame).abs() < 1e-6, "{json}");
     let _ = std::fs::remove_dir_all(&out);
+}
+
+#[test]
+fn benchmark_reps_out_of_range_are_refused() {
+    for args in [
+        &["bench", "speed", "builtin:sphere100", "--reps", "0"][..],
+        &["bench", "speed", "builtin:sphere100", "--reps", "18446744073709551615"][..],
+        &["bench", "fig8", "--out", "/nonexistent/x", "--reps", "0"][..],
+        &["bench", "fig8", "--out", "/nonexistent/x", "--reps", "10001"][..],
+    ] {
+        let o = twister().args(args).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && err.contains("--reps") && err.lines().count() == 1, "{args:?}: {err}");
+    }
 }
 
 #[test]

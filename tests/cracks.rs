@@ -6,9 +6,9 @@
 mod common;
 
 use glam::Vec3;
-use twister::EyeImage;
-use twister::core::settings::Method;
 use twister::core::builtin;
+use twister::core::settings::Method;
+use twister::EyeImage;
 use twister::{Projection, RenderSettings, Scene};
 
 const BG: [f32; 3] = [1.0, 0.0, 1.0];
@@ -49,8 +49,12 @@ fn check(scene: &Scene, what: &str, viewer: Vec3, expect_full: bool) {
         (Method::Vertex, 32.0, 7),
     ];
     for (method, edge_px, max_div) in configs {
-        let settings =
-            RenderSettings::new(projection).with_viewer(viewer).with_background(BG).with_method(method).with_edge_px(edge_px).with_max_div(max_div);
+        let settings = RenderSettings::new(projection)
+            .with_viewer(viewer)
+            .with_background(BG)
+            .with_method(method)
+            .with_edge_px(edge_px)
+            .with_max_div(max_div);
         let frame = common::render(scene, &settings);
         for eye in twister::Eye::BOTH {
             let img = frame.eye(eye);

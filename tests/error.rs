@@ -3,13 +3,13 @@
 
 mod common;
 
-use twister::Frame;
-use twister::core::settings::Method;
 use twister::core::builtin;
+use twister::core::settings::Method;
+use twister::Frame;
 use twister::{Projection, RenderSettings, Vertical};
 
 fn measured(scene: &twister::Scene, settings: &RenderSettings) -> Frame {
-    common::render(scene, &settings.clone().with_measure_error(true))
+    common::render(scene, &(*settings).with_measure_error(true))
 }
 
 #[test]

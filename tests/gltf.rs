@@ -426,10 +426,15 @@ fn loader_warnings_are_printed_by_render_and_error() {
     std::fs::write(&obj, "mtllib missing.mtl\nv -1 0 -3\nv 1 0 -3\nv 0 1 -3\nf 1 2 3\n").unwrap();
     for cmd in ["render", "error"] {
         let out = dir.join(cmd);
-        let o = twister(&[cmd, obj.to_str().unwrap(), "--width", "64", "--height", "16", "--out", out.to_str().unwrap()]
-            [..if cmd == "render" { 8 } else { 6 }]);
+        let o = twister(
+            &[cmd, obj.to_str().unwrap(), "--width", "64", "--height", "16", "--out", out.to_str().unwrap()]
+                [..if cmd == "render" { 8 } else { 6 }],
+        );
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(o.status.success(), "{cmd}: {err}");
-        assert!(err.contains("warning:") && err.contains("w.obj") && err.contains("materials not loaded"), "{cmd}: {err}");
+        assert!(
+            err.contains("warning:") && err.contains("w.obj") && err.contains("materials not loaded"),
+            "{cmd}: {err}"
+        );
     }
 }

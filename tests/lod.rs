@@ -4,14 +4,14 @@
 
 mod common;
 
-use twister::cpu::subdivide::subdivide_params;
 use glam::Vec3;
 use twister::core::builtin::sphere_scene;
 use twister::core::lod::{LodChain, LodParams, NO_SPLIT};
 use twister::core::projection::Projection;
-use twister::cpu::subdivide::Subdivider;
 use twister::core::settings::Method;
 use twister::core::visual_field::{Field, Gaze};
+use twister::cpu::subdivide::subdivide_params;
+use twister::cpu::subdivide::Subdivider;
 use twister::{GpuScene, RenderSettings, Scene};
 
 /// Twelve 1024-triangle spheres 3 m around the viewer every 30°.
@@ -52,10 +52,8 @@ fn the_subdivision_follows_each_objects_level_as_the_cpu_twin_does() {
     // as without the level of detail.
     let count = |out: &[twister::shader::types::DrawVertex], o: u32| out.iter().filter(|v| v.object == o).count() / 3;
     let full = Subdivider::new(&params).run(&drawn.vertices, &drawn.indices);
-    let vertex = Subdivider::new(
-        &subdivide_params(&s.clone().with_method(Method::Vertex), 0, params.triangle_count),
-    )
-    .run(&drawn.vertices, &drawn.indices);
+    let vertex = Subdivider::new(&subdivide_params(&s.with_method(Method::Vertex), 0, params.triangle_count))
+        .run(&drawn.vertices, &drawn.indices);
     for (o, c) in sel.chosen.iter().enumerate() {
         let o = o as u32;
         assert_eq!(count(&gpu.vertices, o), count(&cpu.vertices, o), "object {o}");

@@ -162,7 +162,7 @@ fn scene_too_big_for_the_memory_budget_is_drawn_in_chunks_without_loss() {
     let projection = Projection { width: 480, height: 120, ..Projection::default() };
     let scene = builtin::demo();
     let roomy = RenderSettings::new(projection).with_edge_px(2.0);
-    let tight = roomy.clone().with_memory_mb(8);
+    let tight = roomy.with_memory_mb(8);
     let a = common::render(&scene, &roomy);
     let b = common::render(&scene, &tight);
     assert_eq!(a.stats.chunks, 1);

@@ -121,11 +121,9 @@ fn each_stage_declares_exactly_the_bindings_and_entry_points_of_its_descriptor()
 fn bound_structs(module: &naga::Module) -> BTreeSet<naga::Handle<naga::Type>> {
     fn visit(module: &naga::Module, ty: naga::Handle<naga::Type>, out: &mut BTreeSet<naga::Handle<naga::Type>>) {
         match &module.types[ty].inner {
-            TypeInner::Struct { members, .. } => {
-                if out.insert(ty) {
-                    for m in members {
-                        visit(module, m.ty, out);
-                    }
+            TypeInner::Struct { members, .. } if out.insert(ty) => {
+                for m in members {
+                    visit(module, m.ty, out);
                 }
             }
             TypeInner::Array { base, .. } | TypeInner::BindingArray { base, .. } => visit(module, *base, out),
@@ -183,7 +181,8 @@ fn the_layout_check_catches_a_moved_field() {
     let (ty, _) = module.types.iter().find(|(_, t)| t.name.as_deref() == Some("Counters")).unwrap();
     let good = LAYOUTS.iter().find(|l| l.wgsl_name == "Counters").unwrap();
     assert!(layout_mismatches(&module, ty, good).is_empty());
-    let moved = StructLayout { fields: &[("pieces", 0), ("triangles", 8), ("max_edge_bits", 4), ("_pad", 12)], ..*good };
+    let moved =
+        StructLayout { fields: &[("pieces", 0), ("triangles", 8), ("max_edge_bits", 4), ("_pad", 12)], ..*good };
     assert_eq!(layout_mismatches(&module, ty, &moved).len(), 1);
     let resized = StructLayout { size: 20, ..*good };
     assert_eq!(layout_mismatches(&module, ty, &resized).len(), 1);

@@ -9,14 +9,14 @@ use twister::cpu::subdivide::subdivide_params;
 
 use glam::{Vec2, Vec3};
 use twister::core::material::{AlphaMode, Filter, Material, Mipmap, Wrap, NO_TEXTURE};
-use twister::core::scene::SceneVertex;
 use twister::core::projection::{Eye, Projection};
-use twister::cpu::raster::raster;
-use twister::EyeImage;
-use twister::cpu::slit::{slit, slit_params, slits};
-use twister::cpu::subdivide::subdivide;
+use twister::core::scene::SceneVertex;
 use twister::core::settings::Method;
 use twister::core::texture::Texture;
+use twister::cpu::raster::raster;
+use twister::cpu::slit::{slit, slit_params, slits};
+use twister::cpu::subdivide::subdivide;
+use twister::EyeImage;
 use twister::{RenderSettings, Scene};
 
 const BG: [f32; 3] = [0.0, 0.0, 0.0];
@@ -269,7 +269,8 @@ fn single_sided_faces_seen_from_behind_and_transparent_texels_are_not_drawn() {
 fn box_textured_shows_its_logo_colours() {
     let dir = common::asset("gltf/BoxTextured/glTF");
     let mut s = settings(1200, 300, Method::Adaptive);
-    let mut scene = twister::core::load::load_scene(dir.join("BoxTextured.gltf").to_str().unwrap(), &s.view.projection).unwrap();
+    let mut scene =
+        twister::core::load::load_scene(dir.join("BoxTextured.gltf").to_str().unwrap(), &s.view.projection).unwrap();
     assert_eq!(scene.textures.len(), 1);
     assert!(scene.materials[0].texture != NO_TEXTURE);
     scene.fit(1.5, &s.view.projection).unwrap();

@@ -58,8 +58,9 @@ fn twin_of(stage: &str) -> Option<fn(&str) -> usize> {
 #[test]
 fn every_registered_stage_matches_its_cpu_twin() {
     for stage in STAGES {
-        let run = twin_of(stage.name)
-            .unwrap_or_else(|| panic!("stage {} has no twin check: implement Twin for it in tests/twins.rs", stage.name));
+        let run = twin_of(stage.name).unwrap_or_else(|| {
+            panic!("stage {} has no twin check: implement Twin for it in tests/twins.rs", stage.name)
+        });
         let n = run(stage.name);
         eprintln!("{}: {n} cases agree", stage.name);
     }
@@ -279,9 +280,11 @@ fn compare_eyes(gpu: &EyeOutputs, cpu: &EyeOutputs, share: usize, error_toleranc
     let error_tolerance = error_tolerance.unwrap_or(f32::INFINITY);
     for (k, ((gc, ge, go), (cc, ce, co))) in gpu.iter().zip(cpu).enumerate() {
         let total = go.len();
-        let colour = gc.chunks(4).zip(cc.chunks(4)).filter(|(a, b)| a.iter().zip(*b).any(|(x, y)| x.abs_diff(*y) > 2)).count();
+        let colour =
+            gc.chunks(4).zip(cc.chunks(4)).filter(|(a, b)| a.iter().zip(*b).any(|(x, y)| x.abs_diff(*y) > 2)).count();
         let object = go.iter().zip(co).filter(|(a, b)| a != b).count();
-        let both: Vec<f32> = ge.iter().zip(ce).filter(|(g, c)| **g >= 0.0 && **c >= 0.0).map(|(g, c)| (g - c).abs()).collect();
+        let both: Vec<f32> =
+            ge.iter().zip(ce).filter(|(g, c)| **g >= 0.0 && **c >= 0.0).map(|(g, c)| (g - c).abs()).collect();
         let error = both.iter().filter(|d| **d > error_tolerance).count();
         if colour * share > total || object * share > total || error * share > total || both.len() * 4 < total / 10 {
             return Err(format!(
@@ -311,7 +314,10 @@ impl Twin for Raster {
             let triangle = builtin::builtin_scene("builtin:triangle@3", &projection).unwrap();
             for method in [Method::Vertex, Method::Adaptive] {
                 let settings = RenderSettings::new(projection).with_method(method);
-                out.push((format!("triangle@3 {} {vertical:?}", method.name()), (triangle.clone(), settings, Some(0.01))));
+                out.push((
+                    format!("triangle@3 {} {vertical:?}", method.name()),
+                    (triangle.clone(), settings, Some(0.01)),
+                ));
             }
         }
         out
@@ -344,7 +350,12 @@ impl Twin for Slit {
     fn cases() -> Vec<(String, Self::Case)> {
         let projection = Projection { width: 192, height: 48, vertical: Vertical::Exact, ..Projection::default() };
         [1, 4, 16]
-            .map(|w| (format!("demo slit:{w}"), (builtin::demo(), RenderSettings::new(projection).with_method(Method::Slit(w)))))
+            .map(|w| {
+                (
+                    format!("demo slit:{w}"),
+                    (builtin::demo(), RenderSettings::new(projection).with_method(Method::Slit(w))),
+                )
+            })
             .into()
     }
     fn gpu(_: &Renderer, (scene, settings): &Self::Case) -> Self::Output {
@@ -375,9 +386,10 @@ impl Twin for ReduceError {
     type Output = ErrorStats;
     fn cases() -> Vec<(String, Self::Case)> {
         let mut out = Vec::new();
-        for (name, scene, method) in
-            [("triangle@3 vertex", "builtin:triangle@3", Method::Vertex), ("demo adaptive", "builtin:demo", Method::Adaptive)]
-        {
+        for (name, scene, method) in [
+            ("triangle@3 vertex", "builtin:triangle@3", Method::Vertex),
+            ("demo adaptive", "builtin:demo", Method::Adaptive),
+        ] {
             let projection = Projection { width: 480, height: 90, ..Projection::default() };
             let scene = builtin::builtin_scene(scene, &projection).unwrap();
             let frame = measured(&scene, &RenderSettings::new(projection).with_method(method));

@@ -86,7 +86,6 @@ pub fn parse_gaze(s: &str) -> std::result::Result<Gaze, String> {
     }
 }
 
-
 #[derive(Clone, Copy, Debug)]
 pub enum Viewer {
     At(Vec3),
@@ -139,12 +138,21 @@ impl ViewArgs {
             return Err(Error::option("--yaw", "must be a finite number of degrees"));
         }
         if !(self.scale.is_finite() && self.scale > 0.0) {
-            return Err(Error::option("--scale", format!("must be a positive number of metres per scene unit, got {}", self.scale)));
+            return Err(Error::option(
+                "--scale",
+                format!("must be a positive number of metres per scene unit, got {}", self.scale),
+            ));
         }
-        let settings = RenderSettings::new(projection).with_viewer(match self.viewer {
+        let settings = RenderSettings::new(projection)
+            .with_viewer(match self.viewer {
                 Viewer::At(p) => p * self.scale,
                 Viewer::Camera(_) => Vec3::ZERO, // placed with the scene (`scene::prepare`)
-            }).with_yaw_deg(self.yaw).with_method(self.method).with_edge_px(self.edge_px).with_max_div(self.max_div).with_memory_mb(self.memory_mb);
+            })
+            .with_yaw_deg(self.yaw)
+            .with_method(self.method)
+            .with_edge_px(self.edge_px)
+            .with_max_div(self.max_div)
+            .with_memory_mb(self.memory_mb);
         settings.validate()?;
         Ok(settings)
     }

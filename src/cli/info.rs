@@ -33,4 +33,3 @@ pub fn info(args: &InfoArgs) -> Result<()> {
     println!("{}", serde_json::to_string_pretty(&json).unwrap());
     Ok(())
 }
-

@@ -1,5 +1,8 @@
 //! The `twister` command-line tool: `render`, `error`, `info` and `bench`.
 
+// Comparisons written `!(x > y)` are deliberate: they put NaN on the rejecting side.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 mod args;
 mod bench;
 mod heatmap;

@@ -68,7 +68,7 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
         "adapter": adapter,
     });
     if let Some(method) = args.against {
-        let reference = renderer.render(gpu_scene, &settings.clone().with_method(method))?;
+        let reference = renderer.render(gpu_scene, &settings.with_method(method))?;
         let c = twister::core::compare::compare(&frame, &reference)?;
         json["against"] = serde_json::json!(method.name());
         json["different_surface_fraction"] = serde_json::json!(c.different_surface_fraction);
@@ -76,8 +76,12 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
     }
     if let Some(path) = &args.heatmap {
         let max = args.heatmap_max.unwrap_or_else(|| crate::heatmap::nice_max(e.p99));
-        let (w, h, rgba) =
-            crate::heatmap::heatmap(&measured.error, settings.view.projection.width, settings.view.projection.height, max);
+        let (w, h, rgba) = crate::heatmap::heatmap(
+            &measured.error,
+            settings.view.projection.width,
+            settings.view.projection.height,
+            max,
+        );
         let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "heatmap.png".into());
         let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
         write_images(dir, &[(name, EyeImage { width: w, height: h, rgba })])?;
@@ -109,4 +113,3 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
     }
     Ok(())
 }
-

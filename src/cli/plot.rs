@@ -205,10 +205,16 @@ pub fn draw_panels(charts: &[Chart], columns: usize, w: u32, h: u32) -> RgbaImag
         let root = BitMapBackend::with_buffer(&mut rgb, (width, height)).into_drawing_area();
         let panels = root.split_evenly((rows, columns));
         for (chart, area) in charts.iter().zip(&panels) {
-            let xs: Vec<f64> =
-                chart.series.iter().flat_map(|s| s.points.iter().map(|p| p.0)).chain(chart.x_ticks.iter().map(|t| t.0)).collect();
+            let xs: Vec<f64> = chart
+                .series
+                .iter()
+                .flat_map(|s| s.points.iter().map(|p| p.0))
+                .chain(chart.x_ticks.iter().map(|t| t.0))
+                .collect();
             let ys = chart.series.iter().flat_map(|s| {
-                s.points.iter().flat_map(|&(_, y, e)| [y, y + e.unwrap_or(0.0), if chart.y_log { y } else { y - e.unwrap_or(0.0) }])
+                s.points.iter().flat_map(|&(_, y, e)| {
+                    [y, y + e.unwrap_or(0.0), if chart.y_log { y } else { y - e.unwrap_or(0.0) }]
+                })
             });
             let mut xr = axis_range(xs.iter().copied(), chart.x_log);
             if !chart.x_ticks.is_empty() && !chart.x_log {

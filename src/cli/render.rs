@@ -93,4 +93,3 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     }
     Ok(())
 }
-

@@ -78,7 +78,8 @@ pub fn prepare(
 ) -> Result<Prepared> {
     let lod = view.lod()?;
     let mut scene = place(spec, fit, view, settings)?;
-    let selection = lod.map(|(params, gaze)| LodChain::build(&scene, params.p3).select(&scene, settings.view(), &gaze, &params));
+    let selection =
+        lod.map(|(params, gaze)| LodChain::build(&scene, params.p3).select(&scene, settings.view(), &gaze, &params));
     if let (Some(sel), true) = (&selection, overlay) {
         twister::core::lod::tint(&mut scene, sel);
     }

@@ -10,10 +10,10 @@ use crate::core::color::srgb_to_linear;
 use glam::Vec3;
 use std::f32::consts::{FRAC_1_SQRT_2, PI, TAU};
 
-use crate::core::scene::SceneVertex;
-use crate::error::{Error, Result};
 use crate::core::projection::Projection;
 use crate::core::scene::Scene;
+use crate::core::scene::SceneVertex;
+use crate::error::{Error, Result};
 
 /// Colour of the seam sphere in `builtin:demo` (tests find it by this hue).
 pub const SEAM_SPHERE_COLOR: [f32; 4] = [0.9, 0.1, 0.9, 1.0];

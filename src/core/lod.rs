@@ -26,8 +26,8 @@
 
 use glam::Mat4;
 
-use crate::core::scene::{Object, Scene};
 use crate::core::scene::object_spheres;
+use crate::core::scene::{Object, Scene};
 use crate::core::visual_field::{Field, Gaze};
 
 /// Each simplified level aims at this share of the triangles of the level before: close enough
@@ -60,10 +60,16 @@ impl LodParams {
     pub fn validate(&self) -> crate::error::Result<()> {
         use crate::error::Error;
         if !(self.p3 > 0.0 && self.p3 <= self.p2 && self.p2 <= 1.0) {
-            return Err(Error::option("--lod-p2/--lod-p3", format!("need 0 < P3 ≤ P2' ≤ 1, got P2' = {} and P3 = {}", self.p2, self.p3)));
+            return Err(Error::option(
+                "--lod-p2/--lod-p3",
+                format!("need 0 < P3 ≤ P2' ≤ 1, got P2' = {} and P3 = {}", self.p2, self.p3),
+            ));
         }
         if !(self.d_inf > 0.0 && self.d_inf.is_finite()) {
-            return Err(Error::option("--lod-dinf", format!("must be a positive distance in metres, got {}", self.d_inf)));
+            return Err(Error::option(
+                "--lod-dinf",
+                format!("must be a positive distance in metres, got {}", self.d_inf),
+            ));
         }
         Ok(())
     }

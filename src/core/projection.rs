@@ -118,7 +118,10 @@ pub fn horizontal_radius(p: Vec3) -> f32 {
 impl Projection {
     pub fn validate(&self) -> Result<()> {
         if !(self.screen_radius.is_finite() && self.screen_radius > 0.0) {
-            return Err(Error::option("--screen-radius", format!("must be a positive number of metres, got {}", self.screen_radius)));
+            return Err(Error::option(
+                "--screen-radius",
+                format!("must be a positive number of metres, got {}", self.screen_radius),
+            ));
         }
         if !(self.eye_radius >= 0.0 && self.eye_radius < self.screen_radius) {
             return Err(Error::option(
@@ -210,6 +213,62 @@ impl Projection {
         let w = self.width as f32;
         let d = (a - b).rem_euclid(w);
         d.min(w - d)
+    }
+}
+
+/// The panoramas twister renders. Only the TWISTER display's cylinder today; the full-sphere
+/// equirectangular ODS panorama is the next (it implements [`Panorama`] too).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PanoramaKind {
+    /// The TWISTER display's cylinder: concentric mosaics, eq. 1–4 (this module).
+    #[default]
+    Cylinder,
+}
+
+/// A panorama as a camera model (pbrt's `Camera`, for two eyes): where an eye's image shows a
+/// viewer-frame point, and its inverse, the point at a given depth that a pixel shows. The
+/// rasterizer's stages and their twins use the forward map; the inverse places points from
+/// pixels (tests, ray generation).
+pub trait Panorama {
+    fn kind(&self) -> PanoramaKind;
+    /// Image size per eye, pixels.
+    fn size(&self) -> [u32; 2];
+    /// Continuous image coordinates (x right, y down; pixel centres at +0.5, x wrapped into the
+    /// image) and the depth of a viewer-frame point for one eye; None where no eye sees it.
+    fn project_pixel(&self, p: Vec3, eye: Eye) -> Option<([f32; 2], f32)>;
+    /// The viewer-frame point at `depth` that `eye` sees at image coordinates `pixel`:
+    /// `project_pixel(unproject_pixel(q, d, e), e) == (q, d)` for every depth an eye sees.
+    fn unproject_pixel(&self, pixel: [f32; 2], depth: f32, eye: Eye) -> Vec3;
+}
+
+impl Panorama for Projection {
+    fn kind(&self) -> PanoramaKind {
+        PanoramaKind::Cylinder
+    }
+
+    fn size(&self) -> [u32; 2] {
+        [self.width, self.height]
+    }
+
+    fn project_pixel(&self, p: Vec3, eye: Eye) -> Option<([f32; 2], f32)> {
+        self.project(p, eye).map(|q| (self.to_pixel(q.u, q.v), q.depth))
+    }
+
+    /// Inverts eq. 1–4 at depth r (the distance from the axis): u and v from the pixel, then
+    /// θ = u ∓ α(r) and y = v·r/R_T (paper) or y = v·√(r² − d_e²)/√(R_T² − d_e²) (exact).
+    fn unproject_pixel(&self, [x, y]: [f32; 2], r: f32, eye: Eye) -> Vec3 {
+        let u = (x / self.width as f32 - 0.5) * std::f32::consts::TAU;
+        let v = (0.5 * self.height as f32 - y) / self.pixels_per_metre();
+        let theta = u - eye.sign() * self.eye_shift(r);
+        let height = match self.vertical {
+            Vertical::Paper => v * r / self.screen_radius,
+            Vertical::Exact => {
+                let (rt, de) = (self.screen_radius, self.eye_radius);
+                v * (r * r - de * de).max(0.0).sqrt() / (rt * rt - de * de).sqrt()
+            }
+        };
+        Vec3::new(r * theta.sin(), height, -r * theta.cos())
     }
 }
 
@@ -326,6 +385,33 @@ mod tests {
         // θ = 0 lies on the boundary between the two centre columns; straight up is row 0.
         assert!((proj.to_pixel(0.0, 0.0)[0] - 160.0).abs() < 1e-4);
         assert!(proj.to_pixel(0.0, proj.half_height_m())[1].abs() < 1e-4);
+    }
+
+    #[test]
+    fn the_inverse_takes_pixels_back_to_points_for_both_eyes_and_models() {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(11);
+        for vertical in [Vertical::Paper, Vertical::Exact] {
+            let proj = Projection { width: 1600, height: 400, vertical, ..Projection::default() };
+            assert_eq!((proj.kind(), proj.size()), (PanoramaKind::Cylinder, [1600, 400]));
+            for _ in 0..2000 {
+                let r: f32 = rng.random_range(0.05..30.0);
+                let theta: f32 = rng.random_range(-3.1..3.1);
+                let p = Vec3::new(r * theta.sin(), rng.random_range(-3.0..3.0), -r * theta.cos());
+                for eye in Eye::BOTH {
+                    let (pixel, depth) = proj.project_pixel(p, eye).unwrap();
+                    let back = proj.unproject_pixel(pixel, depth, eye);
+                    assert!(
+                        (back - p).length() < 1e-4 * (1.0 + p.length()),
+                        "{vertical:?} {eye:?}: {p} → {pixel:?} → {back}"
+                    );
+                    // And pixel → point → the same pixel, at another depth.
+                    let q = proj.unproject_pixel([pixel[0], 200.0], 2.5, eye);
+                    let (again, d) = proj.project_pixel(q, eye).unwrap();
+                    assert!(proj.wrapped_dx(again[0], pixel[0]) < 1e-2 && (again[1] - 200.0).abs() < 1e-2, "{again:?}");
+                    assert!((d - 2.5).abs() < 1e-5);
+                }
+            }
+        }
     }
 
     #[test]

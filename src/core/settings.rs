@@ -135,7 +135,7 @@ pub struct MeasureSettings {
 }
 
 /// Everything a render needs besides the scene.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct RenderSettings {
     pub view: ViewSettings,
     pub subdivision: SubdivisionSettings,
@@ -163,17 +163,6 @@ impl Default for SubdivisionSettings {
 impl Default for ShadingSettings {
     fn default() -> Self {
         ShadingSettings { background: [0.1, 0.1, 0.12], ambient: 0.3 }
-    }
-}
-
-impl Default for RenderSettings {
-    fn default() -> Self {
-        RenderSettings {
-            view: ViewSettings::default(),
-            subdivision: SubdivisionSettings::default(),
-            shading: ShadingSettings::default(),
-            measure: MeasureSettings::default(),
-        }
     }
 }
 

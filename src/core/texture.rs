@@ -78,9 +78,9 @@ impl MaterialTable {
     /// Whether any material needs the fragment stage's material code: textured, not opaque, or
     /// single-sided. (Otherwise a fragment's colour is its vertex colour.)
     pub fn needs_materials(&self) -> bool {
-        self.materials.iter().any(|m| {
-            m.texture != NO_TEXTURE || m.alpha_mode != AlphaMode::Opaque as u32 || m.double_sided == 0
-        })
+        self.materials
+            .iter()
+            .any(|m| m.texture != NO_TEXTURE || m.alpha_mode != AlphaMode::Opaque as u32 || m.double_sided == 0)
     }
 
     /// Packs a scene's materials and textures, keeping at most `max_texels` texels: while over,

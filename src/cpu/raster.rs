@@ -10,11 +10,11 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::cpu::fragment::{pixel_error, shade, surface_color, Surface};
-use crate::core::settings::RenderSettings;
-use crate::shader::types::{DrawVertex, RasterParams};
 use crate::core::projection::{azimuth, Eye, Projection};
+use crate::core::settings::RenderSettings;
 use crate::core::texture::MaterialTable;
+use crate::cpu::fragment::{pixel_error, shade, surface_color, Surface};
+use crate::shader::types::{DrawVertex, RasterParams};
 
 /// Clip-space position of a subdivided vertex (`vs_main` in raster.wgsl).
 pub fn raster_vertex(params: &RasterParams, v: &DrawVertex) -> Vec4 {
@@ -237,4 +237,3 @@ pub fn raster_params(settings: &RenderSettings, eye: Eye) -> RasterParams {
         shift_px: settings.measure.shift_px,
     }
 }
-

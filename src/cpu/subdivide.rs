@@ -671,7 +671,13 @@ mod tests {
         SceneVertex { position: p, normal: [0.0, 1.0, 0.0], color: [1.0; 4], ..Default::default() }
     }
 
-    pub(super) fn params_for(projection: &Projection, method: Method, edge_px: f32, max_div: u32, n: u32) -> SubdivideParams {
+    pub(super) fn params_for(
+        projection: &Projection,
+        method: Method,
+        edge_px: f32,
+        max_div: u32,
+        n: u32,
+    ) -> SubdivideParams {
         let settings = RenderSettings::new(*projection)
             .with_method(method)
             .with_edge_px(edge_px)

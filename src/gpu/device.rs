@@ -72,8 +72,7 @@ impl Gpu {
             .allowed_usages
             .contains(wgpu::TextureUsages::RENDER_ATTACHMENT);
         let forced_uint = std::env::var("TWISTER_ERROR_TARGET").is_ok_and(|v| v == "uint");
-        let error_target =
-            if float_renderable && !forced_uint { ErrorTarget::Float } else { ErrorTarget::UintBits };
+        let error_target = if float_renderable && !forced_uint { ErrorTarget::Float } else { ErrorTarget::UintBits };
         let limits = adapter.limits();
         let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
         let (device, queue) = adapter
@@ -139,10 +138,7 @@ impl Gpu {
             Some(Err(e)) => return Err(Error::Gpu(format!("reading back a buffer: {e}"))),
             None => return Err(Error::Gpu("reading back a buffer: the GPU did not finish".into())),
         }
-        let data = buffer
-            .get_mapped_range(..)
-            .map_err(|e| Error::Gpu(format!("reading back a buffer: {e}")))?
-            .to_vec();
+        let data = buffer.get_mapped_range(..).map_err(|e| Error::Gpu(format!("reading back a buffer: {e}")))?.to_vec();
         buffer.unmap();
         Ok(data)
     }

@@ -39,7 +39,10 @@ impl Capacities {
 
     /// A first guess for a scene of `triangles` input triangles.
     pub fn guess(triangles: u32) -> Capacities {
-        Capacities { pieces: triangles.saturating_add(1024), triangles: triangles.saturating_mul(4).saturating_add(4096) }
+        Capacities {
+            pieces: triangles.saturating_add(1024),
+            triangles: triangles.saturating_mul(4).saturating_add(4096),
+        }
     }
 }
 
@@ -175,9 +178,6 @@ mod tests {
         }
         let small = Capacities { pieces: 10, triangles: 20 };
         assert_eq!(FramePlan::first(5, Some(small), budget), FramePlan::OneSubmission(small));
-        assert_eq!(
-            FramePlan::OneSubmission(small).after_overflow(budget),
-            FramePlan::Chunked { want: small, budget }
-        );
+        assert_eq!(FramePlan::OneSubmission(small).after_overflow(budget), FramePlan::Chunked { want: small, budget });
     }
 }

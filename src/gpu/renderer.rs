@@ -54,7 +54,8 @@ impl DrawPipelines {
     /// The pipeline for a scene: plain where its materials allow, else with materials.
     pub fn get(&self, gpu: &Gpu, scene: &GpuScene, measure: bool) -> &wgpu::RenderPipeline {
         let set = if scene.needs_materials {
-            self.with_materials.get_or_init(|| [false, true].map(|m| draw_pipeline(gpu, &self.stage, self.kind, m, true)))
+            self.with_materials
+                .get_or_init(|| [false, true].map(|m| draw_pipeline(gpu, &self.stage, self.kind, m, true)))
         } else {
             &self.plain
         };
@@ -209,7 +210,8 @@ impl Renderer {
                 targets: None,
                 timestamps: Timestamps::new(&gpu),
                 subdivide_params: gpu.uniform_buffer::<SubdivideParams>("subdivide params"),
-                raster_params: Eye::BOTH.map(|e| gpu.uniform_buffer::<RasterParams>(&format!("{} raster params", e.name()))),
+                raster_params: Eye::BOTH
+                    .map(|e| gpu.uniform_buffer::<RasterParams>(&format!("{} raster params", e.name()))),
                 slit_params: Eye::BOTH.map(|e| gpu.uniform_buffer::<SlitParams>(&format!("{} slit params", e.name()))),
                 staging: gpu.device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("frame readback"),
@@ -435,8 +437,7 @@ impl Renderer {
                 let b = SubdivisionBuffers::ensure(&mut cache, &self.gpu, want);
                 params.piece_capacity = b.capacity.pieces;
                 params.triangle_capacity = b.capacity.triangles;
-                let planned =
-                    self.run_subdivide("plan", &uniform, scene, b, &params, scene.triangle_count)?;
+                let planned = self.run_subdivide("plan", &uniform, scene, b, &params, scene.triangle_count)?;
                 if planned.pieces > b.capacity.pieces {
                     want.pieces = planned.pieces;
                     continue;
@@ -481,7 +482,12 @@ impl Renderer {
     }
 
     /// The subdivided frame: follows the [`FramePlan`].
-    fn render_subdivided(&self, res: &mut FrameResources, scene: &GpuScene, settings: &RenderSettings) -> Result<Frame> {
+    fn render_subdivided(
+        &self,
+        res: &mut FrameResources,
+        scene: &GpuScene,
+        settings: &RenderSettings,
+    ) -> Result<Frame> {
         let start = Instant::now();
         let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, ..Default::default() };
         let p = settings.projection();
@@ -553,15 +559,13 @@ impl Renderer {
                 match on_overflow(planned.pieces, budget.pieces, tri_count) {
                     Overflow::Grow(p) => want.pieces = p,
                     Overflow::Halve(c) => tri_chunk = c,
-                    Overflow::TooBig => {
-                        return Err(Error::option(
-                            "--memory-mb",
-                            format!(
-                                "{memory_mb} is too small: one triangle needs {} pieces; raise --edge-px or --memory-mb",
-                                planned.pieces
-                            ),
-                        ))
-                    }
+                    Overflow::TooBig => return Err(Error::option(
+                        "--memory-mb",
+                        format!(
+                            "{memory_mb} is too small: one triangle needs {} pieces; raise --edge-px or --memory-mb",
+                            planned.pieces
+                        ),
+                    )),
                 }
                 continue;
             }
@@ -575,8 +579,7 @@ impl Renderer {
                 params.piece_count = piece_count;
                 params.triangle_capacity = b.capacity.triangles.min(budget.triangles);
                 let t = Instant::now();
-                let done =
-                    self.run_subdivide("lattice", &res.subdivide_params, scene, b, &params, piece_count)?;
+                let done = self.run_subdivide("lattice", &res.subdivide_params, scene, b, &params, piece_count)?;
                 ms_subdivide += t.elapsed().as_secs_f64() * 1e3;
                 if done.triangles > params.triangle_capacity {
                     match on_overflow(done.triangles, budget.triangles, piece_count) {

@@ -28,7 +28,8 @@ impl Renderer {
         let view = settings.view();
         let eye_slits = Eye::BOTH.map(|eye| slits(projection, eye, width));
         let cameras: Vec<SlitCamera> = eye_slits.iter().flatten().map(|s| s.camera).collect();
-        let camera_buffer = gpu.init_buffer("slit cameras", bytemuck::cast_slice(&cameras), wgpu::BufferUsages::STORAGE);
+        let camera_buffer =
+            gpu.init_buffer("slit cameras", bytemuck::cast_slice(&cameras), wgpu::BufferUsages::STORAGE);
         let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, chunks: 1, ..Default::default() };
         let pipeline = self.slit.get(gpu, scene, settings.measure.error);
         let materials = self.slit.material_bind_group(gpu, scene);

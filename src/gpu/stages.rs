@@ -46,7 +46,9 @@ impl GpuStage {
             source: wgpu::ShaderSource::Wgsl(compose(stage, gpu.error_target).into()),
         });
         let (visibility, pipelines): (_, Vec<Option<&'static str>>) = match stage.kind {
-            StageKind::Compute => (wgpu::ShaderStages::COMPUTE, stage.entry_points.iter().map(|e| Some(e.name)).collect()),
+            StageKind::Compute => {
+                (wgpu::ShaderStages::COMPUTE, stage.entry_points.iter().map(|e| Some(e.name)).collect())
+            }
             StageKind::Draw => (wgpu::ShaderStages::VERTEX_FRAGMENT, vec![None]),
         };
         let layouts = pipelines

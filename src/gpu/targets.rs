@@ -43,9 +43,8 @@ impl Targets {
         let copyable = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
         let depth = wgpu::TextureUsages::RENDER_ATTACHMENT;
         let error_format = error_target_format(gpu.error_target);
-        let pair = |format, usage, what: &str| {
-            Eye::BOTH.map(|eye| make(format, usage, &format!("{} {what}", eye.name())))
-        };
+        let pair =
+            |format, usage, what: &str| Eye::BOTH.map(|eye| make(format, usage, &format!("{} {what}", eye.name())));
         Targets {
             width,
             height,
@@ -134,11 +133,7 @@ impl Targets {
 
 /// Copies a 4-byte-per-texel texture of each eye into one buffer (rows padded to 256 bytes,
 /// eyes one after the other). Returns the buffer and the padded row length in texels.
-pub fn copy_eyes_to_buffer(
-    gpu: &Gpu,
-    textures: &[wgpu::Texture; 2],
-    usage: wgpu::BufferUsages,
-) -> (wgpu::Buffer, u32) {
+pub fn copy_eyes_to_buffer(gpu: &Gpu, textures: &[wgpu::Texture; 2], usage: wgpu::BufferUsages) -> (wgpu::Buffer, u32) {
     let (w, h) = (textures[0].width(), textures[0].height());
     let padded = (4 * w).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {

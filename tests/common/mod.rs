@@ -9,9 +9,7 @@ use twister::{GpuScene, RenderSettings, Renderer, Scene};
 
 pub fn renderer() -> &'static Renderer {
     static R: OnceLock<Renderer> = OnceLock::new();
-    R.get_or_init(|| {
-        Renderer::new(Gpu::new().unwrap_or_else(|e| panic!("{e}"))).unwrap_or_else(|e| panic!("{e}"))
-    })
+    R.get_or_init(|| Renderer::new(Gpu::new().unwrap_or_else(|e| panic!("{e}"))).unwrap_or_else(|e| panic!("{e}")))
 }
 
 pub fn render(scene: &Scene, settings: &RenderSettings) -> Frame {

@@ -19,18 +19,17 @@
 
 use twister::error::Result;
 
-
 use glam::Vec3;
 use serde::Serialize;
 
 use crate::bench::speed::median;
 use crate::bench::{FigureConfig, Runner};
-use twister::core::load::load_scene;
 use crate::plot::{draw_panels, Chart, Series, PALETTE};
+use twister::core::load::load_scene;
 use twister::core::projection::{Projection, Vertical};
-use twister::{GpuScene, RenderSettings};
 use twister::core::scene::Scene;
 use twister::core::settings::Method;
+use twister::{GpuScene, RenderSettings};
 
 /// A scene of the fig10/fig12 evaluations, placed.
 pub struct Case {

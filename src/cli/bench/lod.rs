@@ -12,22 +12,22 @@
 //! several times, shows what relaxing it saves. `--quick` uses the 948-triangle bunny, a quarter of
 //! the resolution and two gazes.
 
-use twister::error::{Error, Result};
 use std::path::Path;
 use std::time::Instant;
+use twister::error::{Error, Result};
 
 use glam::{Mat4, Vec3};
 use serde::Serialize;
 
 use crate::bench::speed::median;
-use twister::core::builtin::sphere_scene;
 use crate::bench::{write_csv, write_png, Runner};
+use crate::plot::{draw_panels, Chart, Series, PALETTE};
+use twister::core::builtin::sphere_scene;
 use twister::core::load::load_obj;
 use twister::core::lod::{LodChain, LodParams};
-use crate::plot::{draw_panels, Chart, Series, PALETTE};
-use twister::{Frame, GpuScene, RenderSettings};
 use twister::core::scene::Scene;
 use twister::core::visual_field::{Field, Gaze};
+use twister::{Frame, GpuScene, RenderSettings};
 
 /// Twelve copies of a model, `height` m tall, `radius` m around the viewer every 30°, at eye
 /// height, each turned to face the viewer.
@@ -168,7 +168,7 @@ impl Runner<'_> {
                             base.with_lod(&self.renderer.gpu, &sel)
                         });
                         let ms_select = t.elapsed().as_secs_f64() * 1e3;
-                        let s = settings.clone().with_measure_error(measure);
+                        let s = settings.with_measure_error(measure);
                         let frame = self.renderer.render(selected.as_ref().unwrap_or(&base), &s)?;
                         Ok((frame, ms_select, t.elapsed().as_secs_f64() * 1e3))
                     };

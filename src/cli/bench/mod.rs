@@ -20,6 +20,9 @@ use twister::gpu::Renderer;
 
 use figures::{cases, plot_fig10, plot_fig12, plot_fig8, table};
 
+/// The most timed frames per point a benchmark takes (a typo of a huge number would run forever).
+pub const MAX_REPS: usize = 10_000;
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Figure {
     Fig8,
@@ -89,10 +92,7 @@ pub fn write_png(path: &Path, img: image::RgbaImage) -> Result<()> {
     let name = path.file_name().unwrap().to_string_lossy().into_owned();
     let dir = path.parent().unwrap_or(Path::new("."));
     let (w, h) = img.dimensions();
-    twister::output::write_images(
-        dir,
-        &[(name, twister::EyeImage { width: w, height: h, rgba: img.into_raw() })],
-    )?;
+    twister::output::write_images(dir, &[(name, twister::EyeImage { width: w, height: h, rgba: img.into_raw() })])?;
     Ok(())
 }
 
@@ -127,73 +127,24 @@ pub fn run(runner: &Runner, which: Figure, adapter: &str) -> Result<String> {
     report += "\n";
     let mut timing_note = None;
     if want(Figure::Fig8) {
-        let points = runner.fig8()?;
-        write_csv(&cfg.out.join("fig8.csv"), &points)?;
-        twister::output::write_text(&cfg.out.join("fig8.json"), &serde_json::to_string_pretty(&points).unwrap())?;
-        write_png(&cfg.out.join("fig8.png"), plot_fig8(&points))?;
-        let at = |n: u32| {
-            let v: Vec<String> =
-                points.iter().filter(|p| p.parameter == n).map(|p| format!("{:.2}", p.mean_px)).collect();
-            v.join(" / ")
-        };
-        report += &format!(
-            "## Fig. 8: error vs division count\n\n![fig8](fig8.png)\n\nPaper: about 31 px mean at N = 1, under 1 px by N = 7, nearly the same at 1, 3 and 5 m. \
-             Here (mean px at 1 / 3 / 5 m): N = 1: {}; N = 7: {}.\n\n{}\n",
-            at(1),
-            at(7),
-            table(&points, false)
-        );
+        let (section, timing) = fig8_section(runner)?;
+        report += &section;
+        timing_note = timing_note.or(timing);
     }
     if want(Figure::Fig10) {
-        let points = runner.fig10(&cases)?;
-        timing_note = points.first().map(|p| p.timing.clone());
-        write_csv(&cfg.out.join("fig10.csv"), &points)?;
-        twister::output::write_text(&cfg.out.join("fig10.json"), &serde_json::to_string_pretty(&points).unwrap())?;
-        write_png(&cfg.out.join("fig10.png"), plot_fig10(&points))?;
-        let overhead: Vec<String> = cases
-            .iter()
-            .filter_map(|c| {
-                let t = |m: &str| points.iter().find(|p| p.scene == c.label && p.method == m).map(|p| p.ms_frame);
-                Some(format!("{}: {:+.1} ms", c.label, t("adaptive")? - t("vertex")?))
-            })
-            .collect();
-        report += &format!(
-            "## Fig. 10: error and time per method\n\n![fig10](fig10.png)\n\nPaper: the proposed method's mean error under 1 px on every object; \
-             its cost over drawing the vertices only (Prop − Vert): Sphere100 2 ms, Sphere1024 8 ms, Bunny 67 ms, Cube 30 ms; Bunny 14 fps \
-             adaptive vs 134 fps undivided. Here (adaptive − vertex): {}.\n\n{}\n",
-            overhead.join(", "),
-            table(&points, true)
-        );
+        let (section, timing) = fig10_section(runner, &cases)?;
+        report += &section;
+        timing_note = timing_note.or(timing);
     }
     if want(Figure::Fig12) {
-        let (points, matched) = runner.fig12(&cases)?;
-        timing_note = timing_note.or_else(|| points.first().map(|p| p.timing.clone()));
-        write_csv(&cfg.out.join("fig12.csv"), &points)?;
-        write_csv(&cfg.out.join("fig12_matched.csv"), &matched)?;
-        let json = serde_json::json!({ "points": points, "matched": matched });
-        twister::output::write_text(&cfg.out.join("fig12.json"), &serde_json::to_string_pretty(&json).unwrap())?;
-        write_png(&cfg.out.join("fig12.png"), plot_fig12(&points))?;
-        let mut m = String::from("| scene | adaptive ms | matched slit width w* | |\n|---|---|---|---|\n");
-        for x in &matched {
-            m += &format!(
-                "| {} | {:.1} | {} | {} |\n",
-                x.scene,
-                x.adaptive_ms,
-                x.w_star.map_or("—".into(), |w| format!("{w:.1} px")),
-                x.note
-            );
-        }
-        report += &format!(
-            "## Fig. 12: slit width vs adaptive\n\n![fig12](fig12.png)\n\nErrors here use the exact vertical model, the one slits converge to \
-             (fig8 and fig10 use the paper's). Paper: w* ≈ 18 px (Sphere100), ≈ 10 px (Sphere1024), no advantage on its Bunny; slit:1 on \
-             Sphere100 ran at 8.5 fps.\n\n{m}\n{}\n",
-            table(&points, true)
-        );
+        let (section, timing) = fig12_section(runner, &cases)?;
+        report += &section;
+        timing_note = timing_note.or(timing);
     }
     if want(Figure::Lod) {
-        let (points, absent) = runner.lod()?;
-        timing_note = timing_note.or_else(|| points.first().map(|p| p.timing.clone()));
-        report += &crate::bench::lod::report(&cfg.out, &points, &absent)?;
+        let (section, timing) = lod_section(runner)?;
+        report += &section;
+        timing_note = timing_note.or(timing);
     }
     if let Some(t) = timing_note {
         report += &format!(
@@ -207,6 +158,98 @@ pub fn run(runner: &Runner, which: Figure, adapter: &str) -> Result<String> {
     }
     twister::output::write_text(&cfg.out.join("report.md"), &report)?;
     Ok(report)
+}
+
+/// The report section of fig8, its outputs written to the output folder; and the
+/// timing source of its points.
+fn fig8_section(runner: &Runner) -> Result<(String, Option<String>)> {
+    let cfg = &runner.cfg;
+    let mut report = String::new();
+    let points = runner.fig8()?;
+    write_csv(&cfg.out.join("fig8.csv"), &points)?;
+    twister::output::write_text(&cfg.out.join("fig8.json"), &serde_json::to_string_pretty(&points).unwrap())?;
+    write_png(&cfg.out.join("fig8.png"), plot_fig8(&points))?;
+    let at = |n: u32| {
+        let v: Vec<String> = points.iter().filter(|p| p.parameter == n).map(|p| format!("{:.2}", p.mean_px)).collect();
+        v.join(" / ")
+    };
+    report += &format!(
+        "## Fig. 8: error vs division count\n\n![fig8](fig8.png)\n\nPaper: about 31 px mean at N = 1, under 1 px by N = 7, nearly the same at 1, 3 and 5 m. \
+         Here (mean px at 1 / 3 / 5 m): N = 1: {}; N = 7: {}.\n\n{}\n",
+        at(1),
+        at(7),
+        table(&points, false)
+    );
+    Ok((report, None))
+}
+
+/// The report section of fig10, its outputs written to the output folder; and the
+/// timing source of its points.
+fn fig10_section(runner: &Runner, cases: &[figures::Case]) -> Result<(String, Option<String>)> {
+    let cfg = &runner.cfg;
+    let mut report = String::new();
+    let points = runner.fig10(cases)?;
+    let timing_note = points.first().map(|p| p.timing.clone());
+    write_csv(&cfg.out.join("fig10.csv"), &points)?;
+    twister::output::write_text(&cfg.out.join("fig10.json"), &serde_json::to_string_pretty(&points).unwrap())?;
+    write_png(&cfg.out.join("fig10.png"), plot_fig10(&points))?;
+    let overhead: Vec<String> = cases
+        .iter()
+        .filter_map(|c| {
+            let t = |m: &str| points.iter().find(|p| p.scene == c.label && p.method == m).map(|p| p.ms_frame);
+            Some(format!("{}: {:+.1} ms", c.label, t("adaptive")? - t("vertex")?))
+        })
+        .collect();
+    report += &format!(
+        "## Fig. 10: error and time per method\n\n![fig10](fig10.png)\n\nPaper: the proposed method's mean error under 1 px on every object; \
+         its cost over drawing the vertices only (Prop − Vert): Sphere100 2 ms, Sphere1024 8 ms, Bunny 67 ms, Cube 30 ms; Bunny 14 fps \
+         adaptive vs 134 fps undivided. Here (adaptive − vertex): {}.\n\n{}\n",
+        overhead.join(", "),
+        table(&points, true)
+    );
+    Ok((report, timing_note))
+}
+
+/// The report section of fig12, its outputs written to the output folder; and the
+/// timing source of its points.
+fn fig12_section(runner: &Runner, cases: &[figures::Case]) -> Result<(String, Option<String>)> {
+    let cfg = &runner.cfg;
+    let mut report = String::new();
+    let (points, matched) = runner.fig12(cases)?;
+    let timing_note = points.first().map(|p| p.timing.clone());
+    write_csv(&cfg.out.join("fig12.csv"), &points)?;
+    write_csv(&cfg.out.join("fig12_matched.csv"), &matched)?;
+    let json = serde_json::json!({ "points": points, "matched": matched });
+    twister::output::write_text(&cfg.out.join("fig12.json"), &serde_json::to_string_pretty(&json).unwrap())?;
+    write_png(&cfg.out.join("fig12.png"), plot_fig12(&points))?;
+    let mut m = String::from("| scene | adaptive ms | matched slit width w* | |\n|---|---|---|---|\n");
+    for x in &matched {
+        m += &format!(
+            "| {} | {:.1} | {} | {} |\n",
+            x.scene,
+            x.adaptive_ms,
+            x.w_star.map_or("—".into(), |w| format!("{w:.1} px")),
+            x.note
+        );
+    }
+    report += &format!(
+        "## Fig. 12: slit width vs adaptive\n\n![fig12](fig12.png)\n\nErrors here use the exact vertical model, the one slits converge to \
+         (fig8 and fig10 use the paper's). Paper: w* ≈ 18 px (Sphere100), ≈ 10 px (Sphere1024), no advantage on its Bunny; slit:1 on \
+         Sphere100 ran at 8.5 fps.\n\n{m}\n{}\n",
+        table(&points, true)
+    );
+    Ok((report, timing_note))
+}
+
+/// The report section of lod, its outputs written to the output folder; and the
+/// timing source of its points.
+fn lod_section(runner: &Runner) -> Result<(String, Option<String>)> {
+    let cfg = &runner.cfg;
+    let mut report = String::new();
+    let (points, absent) = runner.lod()?;
+    let timing_note = points.first().map(|p| p.timing.clone());
+    report += &crate::bench::lod::report(&cfg.out, &points, &absent)?;
+    Ok((report, timing_note))
 }
 
 #[derive(Subcommand)]
@@ -263,6 +306,9 @@ pub struct SpeedArgs {
 }
 
 pub fn bench_figures(args: &FigureArgs, which: Figure) -> Result<()> {
+    if let Some(reps) = args.reps.filter(|r| !(1..=MAX_REPS).contains(r)) {
+        return Err(Error::option("--reps", format!("must be between 1 and {MAX_REPS}, got {reps}")));
+    }
     let cfg = FigureConfig::new(args.quick, args.reps, args.assets.clone(), args.out.clone());
     let (renderer, adapter) = open_renderer()?;
     let progress = indicatif::ProgressBar::new(0).with_style(
@@ -279,8 +325,8 @@ pub fn bench_figures(args: &FigureArgs, which: Figure) -> Result<()> {
 }
 
 pub fn bench_speed(args: &SpeedArgs) -> Result<()> {
-    if !(1..=10_000).contains(&args.reps) {
-        return Err(Error::option("--reps", format!("must be between 1 and 10000, got {}", args.reps)));
+    if !(1..=MAX_REPS).contains(&args.reps) {
+        return Err(Error::option("--reps", format!("must be between 1 and {MAX_REPS}, got {}", args.reps)));
     }
     let base = args.view.settings()?;
     let (renderer, adapter) = open_renderer()?;

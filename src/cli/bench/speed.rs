@@ -7,9 +7,9 @@
 //! comes from GPU timestamp queries where the adapter has them. Ratios are of `ms_frame`,
 //! against the first method, in the same run.
 
+use twister::core::settings::Method;
 use twister::error::Result;
 use twister::{FrameStats, GpuScene, RenderSettings, Renderer};
-use twister::core::settings::Method;
 
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct SpeedRow {

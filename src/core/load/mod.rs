@@ -15,9 +15,9 @@ use glam::{Mat4, Vec3};
 
 use crate::core::builtin;
 use crate::core::material::{AlphaMode, Filter, Material, Mipmap, Wrap};
-use crate::core::scene::{compute_normals, SceneVertex};
 use crate::core::projection::Projection;
 use crate::core::scene::Scene;
+use crate::core::scene::{compute_normals, SceneVertex};
 use crate::core::texture::Texture;
 use crate::error::{Error, Result};
 
