@@ -450,3 +450,22 @@ fn project_points_takes_no_points_and_more_than_one_dispatch_row() {
         assert!(projection.wrapped_dx(g[0], c[0]) < 1e-2 && (g[1] - c[1]).abs() < 1e-2, "point {i}: {g:?} vs {c:?}");
     }
 }
+
+#[test]
+fn a_gpu_error_inside_a_frame_scope_is_one_error_line_not_a_panic() {
+    let gpu = &common::renderer().gpu;
+    let too_big = gpu.limits.max_buffer_size.saturating_add(4);
+    let result = gpu.scoped("making a buffer", || {
+        let _ = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("too big"),
+            size: too_big,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        Ok(())
+    });
+    let err = result.expect_err("a buffer beyond the device limit must be refused").to_string();
+    assert!(err.starts_with("GPU error: making a buffer:") && !err.contains('\n'), "{err}");
+    // The device still works afterwards.
+    assert!(gpu.scoped("nothing", || Ok(())).is_ok());
+}

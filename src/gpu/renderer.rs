@@ -559,13 +559,15 @@ impl Renderer {
                 match on_overflow(planned.pieces, budget.pieces, tri_count) {
                     Overflow::Grow(p) => want.pieces = p,
                     Overflow::Halve(c) => tri_chunk = c,
-                    Overflow::TooBig => return Err(Error::option(
-                        "--memory-mb",
-                        format!(
+                    Overflow::TooBig => {
+                        return Err(Error::option(
+                            "--memory-mb",
+                            format!(
                             "{memory_mb} is too small: one triangle needs {} pieces; raise --edge-px or --memory-mb",
                             planned.pieces
                         ),
-                    )),
+                        ))
+                    }
                 }
                 continue;
             }
