@@ -1,0 +1,313 @@
+//! glTF 2.0 files (the gltf crate): `.gltf` with external or embedded buffers and `.glb`; the
+//! default scene's node hierarchy, triangle primitives, sparse accessors, materials and cameras.
+
+use std::path::Path;
+
+use glam::{Mat4, Vec3};
+
+use crate::core::material::{AlphaMode, Filter, Material, Mipmap, Wrap};
+use crate::core::scene::{compute_normals, Scene, SceneVertex};
+use crate::core::texture::Texture;
+
+/// float channels are clamped to 0..1).
+/// An image decoded by the glTF importer, as RGBA8 (16-bit channels keep their high byte,
+fn gltf_texture(name: String, data: &gltf::image::Data) -> std::result::Result<Texture, String> {
+    use gltf::image::Format;
+    let (channels, bytes) = match data.format {
+        Format::R8 => (1, 1),
+        Format::R8G8 => (2, 1),
+        Format::R8G8B8 => (3, 1),
+        Format::R8G8B8A8 => (4, 1),
+        Format::R16 => (1, 2),
+        Format::R16G16 => (2, 2),
+        Format::R16G16B16 => (3, 2),
+        Format::R16G16B16A16 => (4, 2),
+        Format::R32G32B32FLOAT => (3, 4),
+        Format::R32G32B32A32FLOAT => (4, 4),
+    };
+    let texels = (data.width * data.height) as usize;
+    if data.pixels.len() < texels * channels * bytes || texels == 0 {
+        return Err(format!(
+            "image '{name}' has {} bytes for {}×{} texels",
+            data.pixels.len(),
+            data.width,
+            data.height
+        ));
+    }
+    let channel = |t: usize, c: usize| -> u8 {
+        let at = (t * channels + c) * bytes;
+        match bytes {
+            1 => data.pixels[at],
+            2 => data.pixels[at + 1],
+            _ => {
+                let x = f32::from_le_bytes([0, 1, 2, 3].map(|k| data.pixels[at + k]));
+                (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
+            }
+        }
+    };
+    let rgba = (0..texels)
+        .flat_map(|t| match channels {
+            1 => [channel(t, 0); 3].into_iter().chain([255]).collect::<Vec<u8>>(),
+            2 => vec![channel(t, 0), channel(t, 0), channel(t, 0), channel(t, 1)],
+            3 => vec![channel(t, 0), channel(t, 1), channel(t, 2), 255],
+            _ => vec![channel(t, 0), channel(t, 1), channel(t, 2), channel(t, 3)],
+        })
+        .collect();
+    Ok(Texture { name, width: data.width, height: data.height, rgba })
+}
+
+/// A glTF material as twister draws it, its base colour texture's TEXCOORD set and texture
+/// transform (rows of a 2×3 affine matrix).
+type GltfMaterial = (Material, u32, Option<[[f32; 3]; 2]>);
+
+/// A glTF material as twister draws it, and the TEXCOORD set and `KHR_texture_transform`
+/// (u' = offset + R(rotation)·(scale·u)) of its base colour texture.
+fn gltf_material(material: &gltf::Material) -> GltfMaterial {
+    use gltf::texture::{MagFilter, MinFilter, WrappingMode};
+    let mut m = Material {
+        alpha_mode: match material.alpha_mode() {
+            gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+            gltf::material::AlphaMode::Mask => AlphaMode::Mask,
+            gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+        } as u32,
+        alpha_cutoff: material.alpha_cutoff().unwrap_or(0.5),
+        double_sided: material.double_sided() as u32,
+        ..Default::default()
+    };
+    let Some(info) = material.pbr_metallic_roughness().base_color_texture() else {
+        return (m, 0, None);
+    };
+    let texture = info.texture();
+    let sampler = texture.sampler();
+    let wrap = |w: WrappingMode| match w {
+        WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+        WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+        WrappingMode::Repeat => Wrap::Repeat,
+    } as u32;
+    m.texture = texture.source().index() as u32;
+    m.wrap_u = wrap(sampler.wrap_s());
+    m.wrap_v = wrap(sampler.wrap_t());
+    m.mag_filter = match sampler.mag_filter() {
+        Some(MagFilter::Nearest) => Filter::Nearest,
+        _ => Filter::Linear,
+    } as u32;
+    // No minification filter given: trilinear, the renderer's choice the spec leaves open.
+    let (min, mip) = match sampler.min_filter() {
+        Some(MinFilter::Nearest) => (Filter::Nearest, Mipmap::None),
+        Some(MinFilter::Linear) => (Filter::Linear, Mipmap::None),
+        Some(MinFilter::NearestMipmapNearest) => (Filter::Nearest, Mipmap::Nearest),
+        Some(MinFilter::LinearMipmapNearest) => (Filter::Linear, Mipmap::Nearest),
+        Some(MinFilter::NearestMipmapLinear) => (Filter::Nearest, Mipmap::Linear),
+        Some(MinFilter::LinearMipmapLinear) | None => (Filter::Linear, Mipmap::Linear),
+    };
+    (m.min_filter, m.mipmap) = (min as u32, mip as u32);
+    let transform = info.texture_transform();
+    let set = transform.as_ref().and_then(|t| t.tex_coord()).unwrap_or(info.tex_coord());
+    let matrix = transform.map(|t| {
+        let ([ox, oy], r, [sx, sy]) = (t.offset(), t.rotation(), t.scale());
+        let (s, c) = r.sin_cos();
+        [[c * sx, s * sy, ox], [-s * sx, c * sy, oy]]
+    });
+    (m, set, matrix)
+}
+
+/// The first external buffer or image file a glTF file names that does not exist, described.
+fn missing_gltf_resource(path: &Path) -> Option<String> {
+    let gltf = gltf::Gltf::open(path).ok()?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    let exists = |uri: &str| uri.starts_with("data:") || base.join(uri.replace("%20", " ")).is_file();
+    let buffers = gltf.buffers().filter_map(|b| match b.source() {
+        gltf::buffer::Source::Uri(uri) if !exists(uri) => Some(format!("buffer {} file '{uri}' not found", b.index())),
+        _ => None,
+    });
+    let images = gltf.images().filter_map(|i| match i.source() {
+        gltf::image::Source::Uri { uri, .. } if !exists(uri) => {
+            Some(format!("image {} file '{uri}' not found", i.index()))
+        }
+        _ => None,
+    });
+    buffers.chain(images).next()
+}
+
+/// glTF extensions twister draws (the others are ignored with a note, or refused when required).
+pub const GLTF_EXTENSIONS: &[&str] = &["KHR_texture_transform"];
+
+pub(super) fn read_gltf(path: &Path) -> std::result::Result<Scene, String> {
+    let name = path.display().to_string();
+    if !path.is_file() {
+        return Err(format!("{name}: no such file"));
+    }
+    let (doc, buffers, images) = gltf::import(path).map_err(|e| match missing_gltf_resource(path) {
+        Some(missing) => format!("{name}: not a readable glTF file: {missing}"),
+        None => format!("{name}: not a readable glTF file: {e}"),
+    })?;
+    let required: Vec<&str> = doc.extensions_required().filter(|e| !GLTF_EXTENSIONS.contains(e)).collect();
+    if !required.is_empty() {
+        return Err(format!("{name}: requires extensions twister does not support: {}", required.join(", ")));
+    }
+    let mut scene = Scene::new(name.clone());
+    let used: Vec<&str> = doc.extensions_used().filter(|e| !GLTF_EXTENSIONS.contains(e)).collect();
+    if !used.is_empty() {
+        scene.warnings.push(format!("optional extensions ignored: {}", used.join(", ")));
+    }
+    for (image, data) in doc.images().zip(&images) {
+        let label = match (image.name(), image.source()) {
+            (Some(n), _) => n.to_string(),
+            (None, gltf::image::Source::Uri { uri, .. }) if !uri.starts_with("data:") => uri.to_string(),
+            _ => format!("image {}", image.index()),
+        };
+        scene.textures.push(gltf_texture(label, data).map_err(|e| format!("{name}: {e}"))?);
+    }
+    // glTF material k is scene material k; primitives without one share the spec's default
+    // material (single-sided, opaque), appended at the end.
+    let materials: Vec<GltfMaterial> = doc.materials().map(|m| gltf_material(&m)).collect();
+    scene.materials = materials.iter().map(|m| m.0).collect();
+    if let Some(p) = doc.meshes().flat_map(|m| m.primitives()).find(|p| p.material().index().is_none()) {
+        scene.materials.push(gltf_material(&p.material()).0);
+    }
+    let root =
+        doc.default_scene().or_else(|| doc.scenes().next()).ok_or_else(|| format!("{name}: the file has no scene"))?;
+    let mut stack: Vec<(gltf::Node, Mat4, usize)> = root.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
+    while let Some((node, parent, depth)) = stack.pop() {
+        if depth > 256 {
+            return Err(format!("{name}: the node hierarchy is deeper than 256 levels (a cycle?)"));
+        }
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        if !world.is_finite() {
+            return Err(format!("{name}: node {} has a NaN or infinite transform", node.index()));
+        }
+        if let Some(camera) = node.camera() {
+            // The camera looks along its local −z.
+            let forward = world.transform_vector3(-Vec3::Z);
+            scene.cameras.push(crate::core::scene::Camera {
+                name: camera
+                    .name()
+                    .or(node.name())
+                    .map_or_else(|| format!("camera {}", scene.cameras.len()), str::to_string),
+                position: world.transform_point3(Vec3::ZERO).into(),
+                yaw_deg: (-forward.x).atan2(-forward.z).to_degrees(),
+            });
+        }
+        if let Some(mesh) = node.mesh() {
+            // One scene object per mesh instance (node), its primitives one after the other.
+            let mesh_name = mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_string);
+            let instance = node.name().map_or_else(|| format!("node {}", node.index()), str::to_string);
+            let objects_before = scene.objects.len();
+            for prim in mesh.primitives() {
+                let label = format!("{mesh_name} / primitive {}", prim.index());
+                add_gltf_primitive(&mut scene, &prim, &buffers, world, &label, &materials)
+                    .map_err(|e| format!("{name}: {label}: {e}"))?;
+            }
+            scene.merge_objects_from(objects_before, format!("{mesh_name} ({instance})"));
+        }
+        stack.extend(node.children().map(|c| (c, world, depth + 1)));
+    }
+    if scene.triangle_count() == 0 {
+        return Err(format!("{name}: the default scene has no triangles"));
+    }
+    Ok(scene)
+}
+
+/// Checks that an accessor's elements lie inside its buffer view and the view inside its buffer.
+fn check_accessor(acc: &gltf::Accessor, buffers: &[gltf::buffer::Data]) -> std::result::Result<(), String> {
+    let count = acc.count();
+    if count > (1 << 28) {
+        return Err(format!("accessor {} claims {count} elements", acc.index()));
+    }
+    if let Some(view) = acc.view() {
+        let buffer_len = buffers.get(view.buffer().index()).map_or(0, |b| b.len());
+        if view.offset() + view.length() > buffer_len {
+            return Err(format!(
+                "buffer view {} overruns its buffer ({} > {buffer_len} bytes)",
+                view.index(),
+                view.offset() + view.length()
+            ));
+        }
+        let element = acc.size();
+        let stride = view.stride().unwrap_or(element);
+        if count > 0 && acc.offset() + stride * (count - 1) + element > view.length() {
+            return Err(format!("accessor {} overruns buffer view {}", acc.index(), view.index()));
+        }
+    }
+    Ok(())
+}
+
+fn add_gltf_primitive(
+    scene: &mut Scene,
+    prim: &gltf::Primitive,
+    buffers: &[gltf::buffer::Data],
+    world: Mat4,
+    label: &str,
+    materials: &[GltfMaterial],
+) -> std::result::Result<(), String> {
+    use gltf::mesh::Mode;
+    let mode = prim.mode();
+    if !matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
+        scene.warnings.push(format!("{label}: {mode:?} primitive skipped (only triangles are drawn)"));
+        return Ok(());
+    }
+    for (_, acc) in prim.attributes() {
+        check_accessor(&acc, buffers)?;
+    }
+    if let Some(acc) = prim.indices() {
+        check_accessor(&acc, buffers)?;
+    }
+    let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+    let positions: Vec<[f32; 3]> = reader.read_positions().ok_or("no POSITION attribute")?.collect();
+    let n = positions.len();
+    let normals: Option<Vec<[f32; 3]>> = reader.read_normals().map(|r| r.collect());
+    let material = prim.material();
+    let (set, transform) = material.index().map_or((0, None), |k| (materials[k].1, materials[k].2));
+    let uvs: Option<Vec<[f32; 2]>> = reader.read_tex_coords(set).map(|r| {
+        r.into_f32()
+            .map(|[u, v]| match transform {
+                Some([a, b]) => [a[0] * u + a[1] * v + a[2], b[0] * u + b[1] * v + b[2]],
+                None => [u, v],
+            })
+            .collect()
+    });
+    if uvs.is_none() && material.pbr_metallic_roughness().base_color_texture().is_some() {
+        scene.warnings.push(format!("{label}: its material's texture uses TEXCOORD_{set}, which it lacks"));
+    }
+    let colors: Option<Vec<[f32; 4]>> = reader.read_colors(0).map(|r| r.into_rgba_f32().collect());
+    let factor = material.pbr_metallic_roughness().base_color_factor();
+    let material_id = material.index().map_or(materials.len() as u32, |m| m as u32) + 1;
+    let raw: Vec<u32> = match reader.read_indices() {
+        Some(r) => r.into_u32().collect(),
+        None => (0..n as u32).collect(),
+    };
+    if let Some(&bad) = raw.iter().find(|&&i| i as usize >= n) {
+        return Err(format!("index {bad} is out of range ({n} vertices)"));
+    }
+    let indices: Vec<u32> = match mode {
+        Mode::Triangles => raw.chunks_exact(3).flatten().copied().collect(),
+        Mode::TriangleStrip => (0..raw.len().saturating_sub(2))
+            .flat_map(|k| if k % 2 == 0 { [raw[k], raw[k + 1], raw[k + 2]] } else { [raw[k + 1], raw[k], raw[k + 2]] })
+            .collect(),
+        _ => (1..raw.len().saturating_sub(1)).flat_map(|k| [raw[0], raw[k], raw[k + 1]]).collect(),
+    };
+    let normal_matrix = world.inverse().transpose();
+    let mut vertices: Vec<SceneVertex> = (0..n)
+        .map(|i| {
+            let c = colors.as_ref().and_then(|c| c.get(i).copied()).unwrap_or([1.0; 4]);
+            SceneVertex {
+                position: world.transform_point3(Vec3::from(positions[i])).into(),
+                normal: normals
+                    .as_ref()
+                    .and_then(|v| v.get(i))
+                    .map_or(Vec3::ZERO, |&v| normal_matrix.transform_vector3(Vec3::from(v)).normalize_or_zero())
+                    .into(),
+                color: [0, 1, 2, 3].map(|k| c[k] * factor[k]),
+                uv: uvs.as_ref().and_then(|v| v.get(i)).copied().unwrap_or([0.0; 2]),
+                material: material_id,
+                ..Default::default()
+            }
+        })
+        .collect();
+    if normals.is_none() {
+        compute_normals(&mut vertices, &indices);
+    }
+    scene.add_mesh(label, &vertices, &indices);
+    Ok(())
+}
+

@@ -1,0 +1,120 @@
+//! OBJ files (tobj): objects and groups, positions, normals (computed when missing), texture
+//! coordinates (v flipped to texture space), vertex colours, MTL `Kd` colours and `map_Kd` textures.
+
+use std::path::Path;
+
+use super::DEFAULT_COLOR;
+use crate::core::material::Material;
+use crate::core::scene::{compute_normals, Scene, SceneVertex};
+use crate::core::texture::Texture;
+
+
+pub(super) fn read_obj(path: &Path) -> std::result::Result<Scene, String> {
+    let name = path.display().to_string();
+    if !path.is_file() {
+        return Err(format!("{name}: no such file"));
+    }
+    let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
+    let (models, materials) =
+        tobj::load_obj(path, &options).map_err(|e| format!("{name}: not a readable OBJ file: {e}"))?;
+    let mut scene = Scene::new(name.clone());
+    // A missing or broken MTL file leaves the default material, with a warning.
+    let materials = materials.unwrap_or_else(|e| {
+        scene.warnings.push(format!("materials not loaded ({e}); using the default colour"));
+        Vec::new()
+    });
+    let texture_dirs = obj_texture_dirs(path);
+    let mut loaded: Vec<(String, u32)> = Vec::new(); // map_Kd as written → texture index
+    for mat in &materials {
+        let mut material = Material::default();
+        if let Some(spec) = mat.diffuse_texture.as_deref() {
+            if let Some(&(_, k)) = loaded.iter().find(|(s, _)| s == spec) {
+                material.texture = k;
+            } else {
+                match load_obj_texture(spec, &texture_dirs) {
+                    Ok(texture) => {
+                        material.texture = scene.textures.len() as u32;
+                        scene.textures.push(texture);
+                    }
+                    Err(e) => scene.warnings.push(format!("material '{}': {e}; drawn without its texture", mat.name)),
+                }
+                loaded.push((spec.to_string(), material.texture));
+            }
+        }
+        scene.materials.push(material);
+    }
+    for model in &models {
+        let m = &model.mesh;
+        let n = m.positions.len() / 3;
+        if m.indices.iter().any(|&i| i as usize >= n) {
+            return Err(format!("{name}: object '{}' has a face index beyond its {n} vertices", model.name));
+        }
+        let mut vertices: Vec<SceneVertex> = (0..n)
+            .map(|i| SceneVertex {
+                position: [m.positions[3 * i], m.positions[3 * i + 1], m.positions[3 * i + 2]],
+                normal: if m.normals.len() >= 3 * n {
+                    [m.normals[3 * i], m.normals[3 * i + 1], m.normals[3 * i + 2]]
+                } else {
+                    [0.0; 3]
+                },
+                color: if m.vertex_color.len() >= 3 * n {
+                    [m.vertex_color[3 * i], m.vertex_color[3 * i + 1], m.vertex_color[3 * i + 2], 1.0]
+                } else {
+                    m.material_id
+                        .and_then(|k| materials.get(k))
+                        .and_then(|mat| mat.diffuse)
+                        .map_or(DEFAULT_COLOR, |d| [d[0], d[1], d[2], 1.0])
+                },
+                material: m.material_id.map_or(0, |k| k as u32 + 1),
+                uv: if m.texcoords.len() >= 2 * n {
+                    [m.texcoords[2 * i], 1.0 - m.texcoords[2 * i + 1]]
+                } else {
+                    [0.0; 2]
+                },
+                ..Default::default()
+            })
+            .collect();
+        if m.normals.len() < 3 * n {
+            compute_normals(&mut vertices, &m.indices);
+        }
+        scene.add_mesh(model.name.clone(), &vertices, &m.indices);
+    }
+    if scene.triangle_count() == 0 {
+        return Err(format!("{name}: no faces"));
+    }
+    Ok(scene)
+}
+
+/// The folders an OBJ file's `map_Kd` paths are relative to: those of its MTL files (the
+/// `mtllib` lines, relative to the OBJ file), then the OBJ file's own folder.
+fn obj_texture_dirs(obj: &Path) -> Vec<std::path::PathBuf> {
+    let base = obj.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let text = std::fs::read(obj).unwrap_or_default();
+    let mut dirs: Vec<std::path::PathBuf> = String::from_utf8_lossy(&text)
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("mtllib "))
+        .map(|m| base.join(portable_path(m.trim())).parent().map_or(base.clone(), Path::to_path_buf))
+        .collect();
+    dirs.push(base);
+    dirs.dedup();
+    dirs
+}
+
+/// A path as written in a file made on any system: `\` separators become `/`, a leading `./`
+/// goes.
+fn portable_path(written: &str) -> String {
+    let p = written.replace('\\', "/");
+    p.strip_prefix("./").map_or(p.clone(), str::to_string)
+}
+
+/// Loads an OBJ material's `map_Kd` image. The value may carry options (`-s 1 1 1 name.png`):
+/// then the file name is its last word.
+fn load_obj_texture(spec: &str, dirs: &[std::path::PathBuf]) -> std::result::Result<Texture, String> {
+    let whole = portable_path(spec.trim());
+    let last = portable_path(spec.split_whitespace().last().unwrap_or(""));
+    let candidates: Vec<std::path::PathBuf> = dirs.iter().flat_map(|d| [d.join(&whole), d.join(&last)]).collect();
+    let file = candidates.iter().find(|p| p.is_file()).ok_or_else(|| format!("texture '{spec}' not found"))?;
+    let image = image::open(file).map_err(|e| format!("texture {}: {e}", file.display()))?;
+    Ok(Texture::from_image(file.display().to_string(), image))
+}
+
