@@ -141,11 +141,11 @@ fn broken_files_are_one_clear_error_without_panic_or_output() {
     let mut cases: Vec<(PathBuf, &str)> = Vec::new();
     let garbage = dir.join("garbage.gltf");
     std::fs::write(&garbage, "{ this is not json").unwrap();
-    cases.push((garbage, "not a readable glTF file"));
+    cases.push((garbage, "not a glTF file (invalid JSON"));
     let good = serde_json::to_string(&gltf_json(&QUAD, Some(&[0, 1, 2]), 4)).unwrap();
     let truncated = dir.join("truncated.gltf");
     std::fs::write(&truncated, &good[..good.len() / 2]).unwrap();
-    cases.push((truncated, "not a readable glTF file"));
+    cases.push((truncated, "not a glTF file (invalid JSON"));
     cases.push((write(&dir, "index.gltf", &gltf_json(&QUAD, Some(&[0, 1, 9]), 4)), "index 9 is out of range"));
     cases.push((
         write(&dir, "nan.gltf", &gltf_json(&[[0.0, f32::NAN, -3.0], [1.0, 0.0, -3.0], [0.0, 1.0, -3.0]], None, 4)),
@@ -156,13 +156,13 @@ fn broken_files_are_one_clear_error_without_panic_or_output() {
     cases.push((write(&dir, "overrun.gltf", &overrun), "overruns"));
     let mut missing = gltf_json(&QUAD, None, 4);
     missing["buffers"][0]["uri"] = serde_json::json!("missing.bin");
-    cases.push((write(&dir, "missing.gltf", &missing), "buffer 0 file 'missing.bin' not found"));
+    cases.push((write(&dir, "missing.gltf", &missing), "buffer 0 file 'missing.bin': no such file"));
     let mut no_image = gltf_json(&QUAD, None, 4);
     no_image["images"] = serde_json::json!([{ "uri": "missing.png" }]);
-    cases.push((write(&dir, "no_image.gltf", &no_image), "image 0 file 'missing.png' not found"));
+    cases.push((write(&dir, "no_image.gltf", &no_image), "image 0 file 'missing.png': no such file"));
     let mut bad_image = gltf_json(&QUAD, None, 4);
     bad_image["images"] = serde_json::json!([{ "uri": "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAA" }]);
-    cases.push((write(&dir, "bad_image.gltf", &bad_image), "not a readable glTF file"));
+    cases.push((write(&dir, "bad_image.gltf", &bad_image), "image 0: cannot be decoded"));
     let mut ext = gltf_json(&QUAD, None, 4);
     ext["extensionsUsed"] = serde_json::json!(["KHR_draco_mesh_compression"]);
     ext["extensionsRequired"] = serde_json::json!(["KHR_draco_mesh_compression"]);
@@ -173,7 +173,60 @@ fn broken_files_are_one_clear_error_without_panic_or_output() {
     bytes.extend(4000u32.to_le_bytes()); // claims 4000 bytes, has 20
     bytes.extend([0u8; 8]);
     std::fs::write(&glb, bytes).unwrap();
-    cases.push((glb, "not a readable glTF file"));
+    cases.push((glb, "not a readable GLB file"));
+    // Invalid documents the gltf crate would panic on, or accept.
+    let doc = || gltf_json(&QUAD, None, 4);
+    let mut edit = |name: &str, f: &dyn Fn(&mut serde_json::Value), needle: &'static str| {
+        let mut d = doc();
+        f(&mut d);
+        cases.push((write(&dir, name, &d), needle));
+    };
+    edit(
+        "acc99.gltf",
+        &|d| d["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = 99.into(),
+        "names accessors[99]",
+    );
+    edit("stride4.gltf", &|d| d["bufferViews"][0]["byteStride"] = 4.into(), "byteStride is only 4");
+    edit("version.gltf", &|d| d["asset"]["version"] = "1.0".into(), "asset.version is \"1.0\"");
+    edit("scalar.gltf", &|d| d["accessors"][0]["type"] = "SCALAR".into(), "of type SCALAR");
+    edit("ubyte.gltf", &|d| d["accessors"][0]["componentType"] = 5121.into(), "componentType 5121");
+    edit("bytelength.gltf", &|d| d["buffers"][0]["byteLength"] = 10.into(), "overruns buffers[0]");
+    edit(
+        "shared.gltf",
+        &|d| {
+            d["nodes"] = serde_json::json!([{ "children": [1] }, { "mesh": 0 }, { "children": [1] }]);
+            d["scenes"][0]["nodes"] = serde_json::json!([0, 2]);
+        },
+        "a glTF node has at most one parent",
+    );
+    edit(
+        "cycle.gltf",
+        &|d| d["nodes"] = serde_json::json!([{ "children": [1], "mesh": 0 }, { "children": [0] }]),
+        "cycle",
+    );
+    edit(
+        "base64.gltf",
+        &|d| d["buffers"][0]["uri"] = "data:application/octet-stream;base64,AAA!AAAA".into(),
+        "buffer 0:",
+    );
+    for (name, text, needle) in [
+        ("empty.gltf", "", "is empty"),
+        ("brace.gltf", "{", "invalid JSON"),
+        ("object.gltf", "{}", "asset.version is missing"),
+    ] {
+        std::fs::write(dir.join(name), text).unwrap();
+        cases.push((dir.join(name), needle));
+    }
+    std::fs::create_dir_all(dir.join("folder.gltf")).unwrap();
+    cases.push((dir.join("folder.gltf"), "is a folder, not a file"));
+    #[cfg(unix)]
+    {
+        let _ = std::os::unix::fs::symlink("/dev/zero", dir.join("zero.gltf"));
+        cases.push((dir.join("zero.gltf"), "not a regular file"));
+        let mut dev = doc();
+        dev["buffers"][0]["uri"] = "/dev/zero".into();
+        cases.push((write(&dir, "devzero.gltf", &dev), "buffer 0 file '/dev/zero': is not a regular file"));
+    }
     for (file, needle) in cases {
         let out = dir.join("out");
         let o = Command::new(env!("CARGO_BIN_EXE_twister"))
@@ -437,4 +490,47 @@ fn loader_warnings_are_printed_by_render_and_error() {
             "{cmd}: {err}"
         );
     }
+}
+
+#[test]
+fn obj_files_are_read_safely_and_faults_name_their_line() {
+    let dir = tmp("objsafe");
+    let tri = "v 0 0 -3\nv 1 0 -3\nv 0 1 -3\n";
+    let cases: [(&str, String, Option<&str>); 5] = [
+        ("two.obj", format!("{tri}f 1 2\nf 1 2 3\n"), Some("line 4: a face needs at least 3 vertices, got 2")),
+        ("one.obj", format!("{tri}f 1\n"), Some("line 4: a face needs at least 3 vertices, got 1")),
+        ("vt.obj", format!("{tri}f 1/5 2/5 3/5\n"), Some("face names texture coordinate 5")),
+        ("vn.obj", format!("{tri}vn 0 0 1\nf 1//1 2//2 3//1\n"), Some("face names normal 2")),
+        ("zero.obj", format!("mtllib /dev/zero\n{tri}f 1 2 3\n"), None),
+    ];
+    for (name, text, needle) in cases {
+        let file = dir.join(name);
+        std::fs::write(&file, text).unwrap();
+        let o = twister(&["info", file.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        match needle {
+            Some(needle) => {
+                assert_eq!(o.status.code(), Some(1), "{name}: {err}");
+                assert!(err.contains(name) && err.contains(needle) && err.lines().count() == 1, "{name}: {err}");
+            }
+            None => {
+                // An MTL that is a device is not read (it never ends): a warning, the default colour.
+                assert!(o.status.success(), "{name}: {err}");
+                let j: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+                let w = j["warnings"][0].as_str().unwrap();
+                assert!(w.contains("/dev/zero") && w.contains("not a regular file"), "{w}");
+            }
+        }
+    }
+    // An object name in Latin-1 is a label: read, not refused.
+    let latin1 = dir.join("latin1.obj");
+    let mut bytes = b"o caf\xe9\n".to_vec();
+    bytes.extend_from_slice(format!("{tri}f 1 2 3\n").as_bytes());
+    std::fs::write(&latin1, bytes).unwrap();
+    let o = twister(&["info", latin1.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // A folder named like a scene.
+    std::fs::create_dir_all(dir.join("folder.obj")).unwrap();
+    let o = twister(&["info", dir.join("folder.obj").to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("is a folder, not a file"));
 }

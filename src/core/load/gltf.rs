@@ -9,8 +9,8 @@ use crate::core::material::{AlphaMode, Filter, Material, Mipmap, Wrap};
 use crate::core::scene::{compute_normals, Scene, SceneVertex};
 use crate::core::texture::Texture;
 
-/// float channels are clamped to 0..1).
 /// An image decoded by the glTF importer, as RGBA8 (16-bit channels keep their high byte,
+/// float channels are clamped to 0..1).
 fn gltf_texture(name: String, data: &gltf::image::Data) -> std::result::Result<Texture, String> {
     use gltf::image::Format;
     let (channels, bytes) = match data.format {
@@ -111,36 +111,55 @@ fn gltf_material(material: &gltf::Material) -> GltfMaterial {
     (m, set, matrix)
 }
 
-/// The first external buffer or image file a glTF file names that does not exist, described.
-fn missing_gltf_resource(path: &Path) -> Option<String> {
-    let gltf = gltf::Gltf::open(path).ok()?;
-    let base = path.parent().unwrap_or(Path::new("."));
-    let exists = |uri: &str| uri.starts_with("data:") || base.join(uri.replace("%20", " ")).is_file();
-    let buffers = gltf.buffers().filter_map(|b| match b.source() {
-        gltf::buffer::Source::Uri(uri) if !exists(uri) => Some(format!("buffer {} file '{uri}' not found", b.index())),
-        _ => None,
-    });
-    let images = gltf.images().filter_map(|i| match i.source() {
-        gltf::image::Source::Uri { uri, .. } if !exists(uri) => {
-            Some(format!("image {} file '{uri}' not found", i.index()))
-        }
-        _ => None,
-    });
-    buffers.chain(images).next()
-}
-
 /// glTF extensions twister draws (the others are ignored with a note, or refused when required).
 pub const GLTF_EXTENSIONS: &[&str] = &["KHR_texture_transform"];
 
 pub(super) fn read_gltf(path: &Path) -> std::result::Result<Scene, String> {
     let name = path.display().to_string();
-    if !path.is_file() {
-        return Err(format!("{name}: no such file"));
+    let bytes = super::read_file(path)?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    // The JSON (of a .gltf, or the JSON chunk of a .glb) is checked before the gltf crate reads
+    // it: the crate panics on some invalid files.
+    let is_glb = bytes.starts_with(b"glTF");
+    let json_bytes: std::borrow::Cow<[u8]> = if is_glb {
+        gltf::Glb::from_slice(&bytes).map_err(|e| format!("not a readable GLB file: {e}"))?.json
+    } else {
+        std::borrow::Cow::Borrowed(&bytes[..])
+    };
+    if json_bytes.iter().all(u8::is_ascii_whitespace) {
+        return Err("is empty: not a glTF file".into());
     }
-    let (doc, buffers, images) = gltf::import(path).map_err(|e| match missing_gltf_resource(path) {
-        Some(missing) => format!("{name}: not a readable glTF file: {missing}"),
-        None => format!("{name}: not a readable glTF file: {e}"),
+    let json: serde_json::Value = serde_json::from_slice(&json_bytes).map_err(|e| {
+        if is_glb {
+            format!("the GLB's JSON chunk is not valid JSON: {e}")
+        } else {
+            format!("not a glTF file (invalid JSON: {e})")
+        }
     })?;
+    super::gltf_check::check(&json)?;
+    check_external_files(&json, base)?;
+    let gltf::Gltf { document: doc, mut blob } =
+        gltf::Gltf::from_slice(&bytes).map_err(|e| format!("not a readable glTF file: {e}"))?;
+    let mut buffers = Vec::new();
+    for buffer in doc.buffers() {
+        let data = gltf::buffer::Data::from_source_and_blob(buffer.source(), Some(base), &mut blob)
+            .map_err(|e| format!("buffer {}: {e}", buffer.index()))?;
+        if data.len() < buffer.length() {
+            return Err(format!(
+                "buffer {} holds {} bytes, fewer than its byteLength {}",
+                buffer.index(),
+                data.len(),
+                buffer.length()
+            ));
+        }
+        buffers.push(data);
+    }
+    let mut images = Vec::new();
+    for image in doc.images() {
+        let data = gltf::image::Data::from_source(image.source(), Some(base), &buffers)
+            .map_err(|e| format!("image {}: cannot be decoded: {e}", image.index()))?;
+        images.push(data);
+    }
     let required: Vec<&str> = doc.extensions_required().filter(|e| !GLTF_EXTENSIONS.contains(e)).collect();
     if !required.is_empty() {
         return Err(format!("{name}: requires extensions twister does not support: {}", required.join(", ")));
@@ -206,6 +225,44 @@ pub(super) fn read_gltf(path: &Path) -> std::result::Result<Scene, String> {
         return Err(format!("{name}: the default scene has no triangles"));
     }
     Ok(scene)
+}
+
+/// Checks every external file a glTF document names (buffers, images) before anything reads
+/// it: a regular file of bounded size, named in the error when it is not.
+fn check_external_files(json: &serde_json::Value, base: &Path) -> std::result::Result<(), String> {
+    for array in ["buffers", "images"] {
+        for (i, item) in json.get(array).and_then(|a| a.as_array()).into_iter().flatten().enumerate() {
+            let Some(uri) = item.get("uri").and_then(|u| u.as_str()) else { continue };
+            if uri.starts_with("data:") {
+                continue;
+            }
+            let what = if array == "buffers" { "buffer" } else { "image" };
+            let decoded = percent_decode(uri);
+            super::check_file(&base.join(&decoded)).map_err(|e| format!("{what} {i} file '{decoded}': {e}"))?;
+        }
+    }
+    Ok(())
+}
+
+/// A URI's %XX escapes decoded (glTF URIs are relative references).
+fn percent_decode(uri: &str) -> String {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let hex = |k: usize| bytes.get(k).and_then(|b| (*b as char).to_digit(16));
+        match (bytes[i], hex(i + 1), hex(i + 2)) {
+            (b'%', Some(h), Some(l)) => {
+                out.push((h * 16 + l) as u8);
+                i += 3;
+            }
+            (b, _, _) => {
+                out.push(b);
+                i += 1;
+            }
+        }
+    }
+    String::from_utf8_lossy(&out).into_owned()
 }
 
 /// Checks that an accessor's elements lie inside its buffer view and the view inside its buffer.
@@ -310,4 +367,3 @@ fn add_gltf_primitive(
     scene.add_mesh(label, &vertices, &indices);
     Ok(())
 }
-

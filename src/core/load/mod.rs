@@ -10,11 +10,10 @@
 //! glTF's own convention; OBJ's v (up from the bottom row) is flipped on load.
 
 mod gltf;
+mod gltf_check;
 mod obj;
 
 use std::path::Path;
-
-use glam::Vec3;
 
 use crate::core::builtin;
 use crate::core::projection::Projection;
@@ -48,6 +47,43 @@ pub fn load_scene(spec: &str, projection: &Projection) -> Result<Scene> {
     Ok(scene)
 }
 
+/// The largest file a scene may be or name (scene, MTL, buffer, image), bytes: memory stays
+/// bounded whatever a file claims.
+pub const MAX_FILE_BYTES: u64 = 1 << 30;
+
+/// Checks that `path` is a regular file (links followed) of at most [`MAX_FILE_BYTES`]: not a
+/// folder, device, pipe or socket, which could be endless.
+pub(crate) fn check_file(path: &Path) -> std::result::Result<u64, String> {
+    let meta = std::fs::metadata(path).map_err(|e| match e.kind() {
+        std::io::ErrorKind::NotFound => "no such file".to_string(),
+        _ => format!("cannot be read: {e}"),
+    })?;
+    if meta.is_dir() {
+        return Err("is a folder, not a file".into());
+    }
+    if !meta.is_file() {
+        return Err("is not a regular file (a device, pipe or socket?)".into());
+    }
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(format!("is {} MiB, more than the {} MiB twister reads", meta.len() >> 20, MAX_FILE_BYTES >> 20));
+    }
+    Ok(meta.len())
+}
+
+/// Reads a whole file after [`check_file`], never more than [`MAX_FILE_BYTES`].
+pub(crate) fn read_file(path: &Path) -> std::result::Result<Vec<u8>, String> {
+    use std::io::Read;
+    check_file(path)?;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes))
+        .map_err(|e| format!("cannot be read: {e}"))?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(format!("is more than the {} MiB twister reads", MAX_FILE_BYTES >> 20));
+    }
+    Ok(bytes)
+}
+
 /// A loader's message as a scene error naming the file (once).
 pub(crate) fn scene_error(name: &str, message: String) -> Error {
     let message = message.strip_prefix(&format!("{name}: ")).map(str::to_string).unwrap_or(message);
@@ -63,9 +99,10 @@ pub fn load_obj(path: &Path) -> Result<Scene> {
 pub fn load_gltf(path: &Path) -> Result<Scene> {
     gltf::read_gltf(path).map_err(|m| scene_error(&path.display().to_string(), m))
 }
-/// along −z at it). Returns the position and "inside" or "in front".
+
 /// A viewer position to suggest for a scene: inside it at standing height if it surrounds a
 /// person (over 4 m across on the ground), else 3 object sizes in front of it (+z side, looking
+/// along −z at it). Returns the position and "inside" or "in front".
 pub fn suggested_viewer(scene: &Scene) -> Option<([f32; 3], &'static str)> {
     let (lo, hi) = scene.bounds()?;
     let (size, c) = (hi - lo, (lo + hi) / 2.0);

@@ -8,19 +8,29 @@ use crate::core::material::Material;
 use crate::core::scene::{compute_normals, Scene, SceneVertex};
 use crate::core::texture::Texture;
 
-
 pub(super) fn read_obj(path: &Path) -> std::result::Result<Scene, String> {
     let name = path.display().to_string();
-    if !path.is_file() {
-        return Err(format!("{name}: no such file"));
-    }
+    // Names and comments are labels: bytes that are not UTF-8 (Latin-1 names) are replaced,
+    // not refused.
+    let text = String::from_utf8_lossy(&super::read_file(path)?).into_owned();
+    check_faces(&text)?;
     let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
-    let (models, materials) =
-        tobj::load_obj(path, &options).map_err(|e| format!("{name}: not a readable OBJ file: {e}"))?;
+    let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let (models, materials) = tobj::load_obj_buf(&mut text.as_bytes(), &options, |mtl| {
+        // MTL files are read like every other file a scene names: regular, bounded.
+        let mtl_path = base.join(mtl);
+        let bytes = super::read_file(&mtl_path).map_err(|e| {
+            log_mtl_problem(&mtl_path, &e);
+            tobj::LoadError::OpenFileFailed
+        })?;
+        tobj::load_mtl_buf(&mut String::from_utf8_lossy(&bytes).as_bytes())
+    })
+    .map_err(|e| format!("{name}: not a readable OBJ file: {e}"))?;
     let mut scene = Scene::new(name.clone());
     // A missing or broken MTL file leaves the default material, with a warning.
     let materials = materials.unwrap_or_else(|e| {
-        scene.warnings.push(format!("materials not loaded ({e}); using the default colour"));
+        let why = MTL_PROBLEM.with(|p| p.borrow_mut().take()).unwrap_or_else(|| e.to_string());
+        scene.warnings.push(format!("materials not loaded ({why}); using the default colour"));
         Vec::new()
     });
     let texture_dirs = obj_texture_dirs(path);
@@ -85,11 +95,60 @@ pub(super) fn read_obj(path: &Path) -> std::result::Result<Scene, String> {
     Ok(scene)
 }
 
+thread_local! {
+    /// Why the last MTL file could not be read (tobj's error type cannot carry it).
+    static MTL_PROBLEM: std::cell::RefCell<Option<String>> = const { std::cell::RefCell::new(None) };
+}
+
+fn log_mtl_problem(path: &Path, problem: &str) {
+    MTL_PROBLEM.with(|p| *p.borrow_mut() = Some(format!("{} {problem}", path.display())));
+}
+
+/// Checks every face line before tobj reads the file: at least 3 vertices, and each position,
+/// texture-coordinate and normal index naming one defined before it (1-based, or negative:
+/// relative to the end). The error names the line.
+fn check_faces(text: &str) -> std::result::Result<(), String> {
+    let (mut v, mut vt, mut vn) = (0i64, 0i64, 0i64);
+    for (k, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => v += 1,
+            Some("vt") => vt += 1,
+            Some("vn") => vn += 1,
+            Some("f") => {
+                let corners: Vec<&str> = words.collect();
+                if corners.len() < 3 {
+                    return Err(format!("line {}: a face needs at least 3 vertices, got {}", k + 1, corners.len()));
+                }
+                for corner in corners {
+                    for ((part, count), what) in
+                        corner.split('/').zip([v, vt, vn]).zip(["vertex", "texture coordinate", "normal"])
+                    {
+                        if part.is_empty() {
+                            continue;
+                        }
+                        let i: i64 =
+                            part.parse().map_err(|_| format!("line {}: '{corner}' is not a face corner", k + 1))?;
+                        if i == 0 || i > count || i < -count {
+                            return Err(format!(
+                                "line {}: face names {what} {i}, but {count} are defined before it",
+                                k + 1
+                            ));
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
 /// The folders an OBJ file's `map_Kd` paths are relative to: those of its MTL files (the
 /// `mtllib` lines, relative to the OBJ file), then the OBJ file's own folder.
 fn obj_texture_dirs(obj: &Path) -> Vec<std::path::PathBuf> {
     let base = obj.parent().unwrap_or(Path::new(".")).to_path_buf();
-    let text = std::fs::read(obj).unwrap_or_default();
+    let text = super::read_file(obj).unwrap_or_default();
     let mut dirs: Vec<std::path::PathBuf> = String::from_utf8_lossy(&text)
         .lines()
         .filter_map(|l| l.trim().strip_prefix("mtllib "))
@@ -113,8 +172,9 @@ fn load_obj_texture(spec: &str, dirs: &[std::path::PathBuf]) -> std::result::Res
     let whole = portable_path(spec.trim());
     let last = portable_path(spec.split_whitespace().last().unwrap_or(""));
     let candidates: Vec<std::path::PathBuf> = dirs.iter().flat_map(|d| [d.join(&whole), d.join(&last)]).collect();
-    let file = candidates.iter().find(|p| p.is_file()).ok_or_else(|| format!("texture '{spec}' not found"))?;
-    let image = image::open(file).map_err(|e| format!("texture {}: {e}", file.display()))?;
+    let file = candidates.iter().find(|p| p.exists()).ok_or_else(|| format!("texture '{spec}' not found"))?;
+    let bytes = super::read_file(file).map_err(|e| format!("texture {} {e}", file.display()))?;
+    let image =
+        image::load_from_memory(&bytes).map_err(|e| format!("texture {} cannot be decoded: {e}", file.display()))?;
     Ok(Texture::from_image(file.display().to_string(), image))
 }
-
