@@ -297,6 +297,8 @@ mod tests {
         assert!(check(&d).unwrap_err().contains("byteStride is only 4"));
         let mut d = doc();
         d["nodes"] = json!([{ "children": [1, 1] }, { "mesh": 0 }]);
+        assert!(check(&d).unwrap_err().contains("lists nodes[1] twice"));
+        d["nodes"] = json!([{ "children": [1] }, { "mesh": 0 }, { "children": [1] }]);
         assert!(check(&d).unwrap_err().contains("child of both"));
         let mut d = doc();
         d["nodes"] = json!([{ "children": [1], "mesh": 0 }, { "children": [0] }]);
