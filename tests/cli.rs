@@ -458,3 +458,59 @@ fn a_plain_run_without_a_desktop_session_prints_no_driver_noise() {
     assert!(err.trim().is_empty(), "a plain render printed to stderr: {err}");
     let _ = std::fs::remove_dir_all(&out);
 }
+
+#[test]
+fn outputs_are_all_or_nothing_and_checked_before_rendering() {
+    let out = tmp("atomic");
+    std::fs::create_dir_all(out.join("right.png")).unwrap();
+    std::fs::write(out.join("left.png"), b"older render").unwrap();
+    let o =
+        twister().args(["render", "--width", "64", "--height", "16", "--out", out.to_str().unwrap()]).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("right.png") && err.lines().count() == 1, "{err}");
+    assert_eq!(std::fs::read(out.join("left.png")).unwrap(), b"older render", "left.png was replaced");
+    // A stats path that cannot be written: nothing at all is written.
+    let fresh = tmp("atomic-stats");
+    std::fs::create_dir_all(fresh.join("stats.json")).unwrap();
+    let o = twister()
+        .args(["render", "--width", "64", "--height", "16", "--out", fresh.join("imgs").to_str().unwrap()])
+        .args(["--stats", fresh.join("stats.json").to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("stats.json"));
+    assert!(!fresh.join("imgs").exists(), "images written although the stats could not be");
+    // --out naming a file.
+    let file = fresh.join("a-file");
+    std::fs::write(&file, b"x").unwrap();
+    let o = twister()
+        .args(["render", "--width", "64", "--height", "16", "--out", file.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("is a file, not a folder"), "{err}");
+    // Temporaries of a killed run are cleaned up by the next one in that folder.
+    std::fs::remove_dir_all(out.join("right.png")).unwrap();
+    let stale = out.join(".left.png.4194303.tmp");
+    std::fs::write(&stale, b"half").unwrap();
+    let o =
+        twister().args(["render", "--width", "64", "--height", "16", "--out", out.to_str().unwrap()]).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(!stale.exists(), "stale temporary kept");
+    let _ = (std::fs::remove_dir_all(&out), std::fs::remove_dir_all(&fresh));
+}
+
+#[test]
+fn identical_runs_give_identical_bytes() {
+    let run = |dir: &Path| {
+        let o = twister()
+            .args(["render", "builtin:demo", "--width", "320", "--height", "80", "--layout", "top-bottom", "--out"])
+            .arg(dir)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        std::fs::read(dir.join("stereo.png")).unwrap()
+    };
+    let (a, b) = (tmp("same-a"), tmp("same-b"));
+    assert!(run(&a) == run(&b), "two identical renders differ");
+    let _ = (std::fs::remove_dir_all(&a), std::fs::remove_dir_all(&b));
+}

@@ -8,11 +8,12 @@ use clap::Args;
 use crate::args::ViewArgs;
 use crate::scene::{lod_stats, open_renderer, prepare};
 use twister::core::settings::Method;
-use twister::error::Result;
+use twister::error::{Error, Result};
 use twister::output::write_images;
 use twister::EyeImage;
 
 #[derive(Args)]
+#[command(allow_negative_numbers = true)]
 pub struct ErrorArgs {
     /// Scene: a .obj, .gltf or .glb file, or builtin:demo, builtin:sphere100, builtin:sphere1024, builtin:triangle@D.
     #[arg(default_value = "builtin:demo")]
@@ -38,6 +39,12 @@ pub struct ErrorArgs {
 }
 
 pub fn measure(args: &ErrorArgs) -> Result<()> {
+    if let Some(max) = args.heatmap_max.filter(|m| !(m.is_finite() && *m > 0.0)) {
+        return Err(Error::option("--heatmap-max", format!("must be a positive number of pixels, got {max}")));
+    }
+    if let Some(path) = &args.heatmap {
+        twister::output::check_outputs(&[path.as_path()])?;
+    }
     let mut settings = args.view.settings()?.with_measure_error(true);
     let (renderer, adapter) = open_renderer()?;
     let prepared = prepare(&renderer, &args.scene, args.fit, &args.view, &mut settings, false)?;

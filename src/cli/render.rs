@@ -8,9 +8,10 @@ use clap::Args;
 use crate::args::{parse_rgb, LodMode, ViewArgs};
 use crate::scene::{lod_stats, open_renderer, prepare};
 use twister::error::{Error, Result};
-use twister::output::{layout_images, write_images, write_text, Layout};
+use twister::output::{check_outputs, layout_images, layout_names, png_file, write_all, Layout, OutputFile};
 
 #[derive(Args)]
+#[command(allow_negative_numbers = true)]
 pub struct RenderArgs {
     /// Scene to render: a .obj, .gltf or .glb file, or builtin:demo, builtin:sphere100, builtin:sphere1024, builtin:triangle@D.
     #[arg(default_value = "builtin:demo")]
@@ -45,6 +46,11 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     if args.lod_overlay && args.view.lod == LodMode::Off {
         return Err(Error::option("--lod-overlay", "needs --lod visual-field"));
     }
+    // Every output is checked before anything is rendered, and all are written together.
+    let image_paths: Vec<PathBuf> = layout_names(args.layout).iter().map(|name| args.out.join(name)).collect();
+    let mut all_paths: Vec<&std::path::Path> = image_paths.iter().map(PathBuf::as_path).collect();
+    all_paths.extend(args.stats.as_deref());
+    check_outputs(&all_paths)?;
     let (renderer, adapter) = open_renderer()?;
     let prepared = prepare(&renderer, &args.scene, args.fit, &args.view, &mut settings, args.lod_overlay)?;
     let mut frame = renderer.render(&prepared.gpu_scene, &settings)?;
@@ -54,11 +60,12 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         }
     }
     let t = std::time::Instant::now();
-    let written = write_images(&args.out, &layout_images(&frame, args.layout))?;
+    let mut files = layout_images(&frame, args.layout)
+        .iter()
+        .map(|(name, img)| png_file(args.out.join(name), img))
+        .collect::<Result<Vec<_>>>()?;
+    // PNG encoding: the writing itself is a rename.
     let ms_write = t.elapsed().as_secs_f64() * 1e3;
-    for p in &written {
-        println!("{}", p.display());
-    }
     if let Some(path) = &args.stats {
         let s = &frame.stats;
         let json = serde_json::json!({
@@ -89,7 +96,12 @@ pub fn render(args: &RenderArgs) -> Result<()> {
             "ms_total": s.ms_total + ms_write,
             "lod": lod_stats(&prepared.selection),
         });
-        write_text(path, &serde_json::to_string_pretty(&json).unwrap())?;
+        let text = serde_json::to_string_pretty(&json).expect("JSON of plain values");
+        files.push(OutputFile { path: path.clone(), bytes: text.into_bytes() });
+    }
+    write_all(&files)?;
+    for f in files.iter().take(image_paths.len()) {
+        println!("{}", f.path.display());
     }
     Ok(())
 }

@@ -7,6 +7,7 @@ use glam::{Mat4, Vec3};
 use crate::args::{ViewArgs, Viewer};
 use twister::core::load::load_scene;
 use twister::core::lod::{LodChain, LodSelection};
+use twister::core::scene::MAX_COORDINATE;
 use twister::core::visual_field::{Field, Gaze};
 use twister::error::{Error, Result};
 use twister::gpu::Gpu;
@@ -49,13 +50,16 @@ pub fn place(spec: &str, fit: Option<f32>, view: &ViewArgs, settings: &mut Rende
     Ok(scene)
 }
 
-/// After a transform: an overflow to infinity is the option's fault, not the file's.
+/// After a transform: coordinates beyond what the projection computes in f32 (or an overflow
+/// to infinity) are the option's fault, not the file's.
 fn check_finite(scene: &Scene, spec: &str, option: &'static str) -> Result<()> {
-    let finite = scene.vertices.iter().all(|v| v.position.iter().all(|c| c.is_finite()));
-    if finite {
+    let fits = |c: &f32| c.abs() <= MAX_COORDINATE;
+    if scene.vertices.iter().all(|v| v.position.iter().all(fits))
+        && scene.cameras.iter().all(|c| c.position.iter().all(fits))
+    {
         Ok(())
     } else {
-        Err(Error::option(option, format!("makes the coordinates of {spec} overflow")))
+        Err(Error::option(option, format!("puts {spec} beyond ±{MAX_COORDINATE:e} m, more than twister draws")))
     }
 }
 

@@ -23,6 +23,13 @@ pub struct SceneVertex {
     pub _pad1: [f32; 2],
 }
 
+/// The most triangles a scene may hold (the subdivision indexes pieces in 32 bits).
+pub const MAX_TRIANGLES: usize = u32::MAX as usize / 64;
+
+/// The largest coordinate a scene may have, in its units: squares and sums of squares stay finite
+/// in f32 (the projection computes x² + z²), with room for the view transform.
+pub const MAX_COORDINATE: f32 = 1e15;
+
 /// A named range of triangles (a glTF mesh instance, an OBJ object, a built-in shape).
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Object {
@@ -124,14 +131,22 @@ impl Scene {
             return Err(err(format!("triangle {} uses vertex index {i}, but there are only {n} vertices", k / 3)));
         }
         for (k, v) in self.vertices.iter().enumerate() {
+            if let Some(c) = v.position.iter().find(|c| c.abs() > MAX_COORDINATE) {
+                return Err(err(format!(
+                    "vertex {k} lies {c:e} from the origin; twister draws coordinates within ±{MAX_COORDINATE:e} (a wrong unit or --scale?)"
+                )));
+            }
             let attributes: [(&str, &[f32]); 4] =
                 [("position", &v.position), ("normal", &v.normal), ("colour", &v.color), ("texture coordinate", &v.uv)];
             if let Some((what, value)) = attributes.iter().find(|(_, x)| !x.iter().all(|c| c.is_finite())) {
                 return Err(err(format!("vertex {k} has a NaN or infinite {what} {value:?}")));
             }
         }
-        if self.indices.len() / 3 > u32::MAX as usize / 64 {
-            return Err(err(format!("{} triangles is more than twister can index", self.indices.len() / 3)));
+        if self.indices.len() / 3 > MAX_TRIANGLES {
+            return Err(err(format!(
+                "{} triangles is more than twister draws ({MAX_TRIANGLES})",
+                self.indices.len() / 3
+            )));
         }
         Ok(())
     }

@@ -212,6 +212,13 @@ impl RenderSettings {
 
     pub fn validate(&self) -> Result<()> {
         self.view.projection.validate()?;
+        let max = crate::core::scene::MAX_COORDINATE;
+        if !self.view.viewer.is_finite() || self.view.viewer.abs().max_element() > max {
+            return Err(Error::option("--viewer", format!("must lie within ±{max:e}, got {}", self.view.viewer)));
+        }
+        if !self.view.yaw_deg.is_finite() {
+            return Err(Error::option("--yaw", "must be a finite number of degrees"));
+        }
         let s = &self.subdivision;
         if !(s.edge_px.is_finite() && s.edge_px >= 0.25) {
             return Err(Error::option("--edge-px", format!("must be a number of pixels ≥ 0.25, got {}", s.edge_px)));

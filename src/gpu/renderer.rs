@@ -265,6 +265,27 @@ impl Renderer {
                 format!("{}x{} is larger than this GPU's largest image, {max}x{max}", p.width, p.height),
             ));
         }
+        // Both eyes' colour targets are read back through one buffer (rows padded to 256
+        // bytes); with the error pass, both error targets are bound as one storage buffer.
+        let padded_row = (4 * p.width as u64).div_ceil(256) * 256;
+        let eyes_bytes = 2 * padded_row * p.height as u64;
+        let (limit, what) = if settings.measure.error {
+            (self.gpu.max_binding(), "the error pass's buffer")
+        } else {
+            (self.gpu.limits.max_buffer_size, "the read-back buffer")
+        };
+        if eyes_bytes > limit {
+            return Err(Error::option(
+                "--width/--height",
+                format!(
+                    "{}x{} needs {} MiB for {what}, more than this GPU's {} MiB: use a smaller image",
+                    p.width,
+                    p.height,
+                    eyes_bytes >> 20,
+                    limit >> 20
+                ),
+            ));
+        }
         Ok(())
     }
 

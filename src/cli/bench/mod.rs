@@ -269,6 +269,7 @@ pub enum BenchCommand {
 }
 
 #[derive(Args)]
+#[command(allow_negative_numbers = true)]
 pub struct FigureArgs {
     /// Output folder for the CSV, JSON, PNG plots and report.md.
     #[arg(long)]
@@ -285,6 +286,7 @@ pub struct FigureArgs {
 }
 
 #[derive(Args)]
+#[command(allow_negative_numbers = true)]
 pub struct SpeedArgs {
     /// Scenes (.obj, .gltf or .glb files, or builtin:NAME).
     #[arg(required = true)]

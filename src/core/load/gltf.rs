@@ -114,6 +114,10 @@ fn gltf_material(material: &gltf::Material) -> GltfMaterial {
 /// glTF extensions twister draws (the others are ignored with a note, or refused when required).
 pub const GLTF_EXTENSIONS: &[&str] = &["KHR_texture_transform"];
 
+/// The most triangles a scene may hold (`Scene::validate`'s limit, checked while mesh instances
+/// are added so that a file cannot make memory grow past it).
+const MAX_TRIANGLES: usize = crate::core::scene::MAX_TRIANGLES;
+
 pub(super) fn read_gltf(path: &Path) -> std::result::Result<Scene, String> {
     let name = path.display().to_string();
     let bytes = super::read_file(path)?;
@@ -218,6 +222,11 @@ pub(super) fn read_gltf(path: &Path) -> std::result::Result<Scene, String> {
                     .map_err(|e| format!("{name}: {label}: {e}"))?;
             }
             scene.merge_objects_from(objects_before, format!("{mesh_name} ({instance})"));
+        }
+        if scene.triangle_count() > MAX_TRIANGLES {
+            return Err(format!(
+                "{name}: its mesh instances hold more than {MAX_TRIANGLES} triangles, more than twister draws"
+            ));
         }
         stack.extend(node.children().map(|c| (c, world, depth + 1)));
     }
