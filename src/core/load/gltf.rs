@@ -125,6 +125,19 @@ pub(super) fn read_gltf(path: &Path) -> std::result::Result<Scene, String> {
     // The JSON (of a .gltf, or the JSON chunk of a .glb) is checked before the gltf crate reads
     // it: the crate panics on some invalid files.
     let is_glb = bytes.starts_with(b"glTF");
+    let named_glb = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    if named_glb && !is_glb {
+        return Err("not a GLB file: it does not start with 'glTF'".into());
+    }
+    if is_glb && bytes.len() >= 12 {
+        let claimed = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize;
+        if claimed != bytes.len() {
+            return Err(format!(
+                "not a readable GLB file: its header says {claimed} bytes, the file has {}",
+                bytes.len()
+            ));
+        }
+    }
     let json_bytes: std::borrow::Cow<[u8]> = if is_glb {
         gltf::Glb::from_slice(&bytes).map_err(|e| format!("not a readable GLB file: {e}"))?.json
     } else {
@@ -193,7 +206,7 @@ pub(super) fn read_gltf(path: &Path) -> std::result::Result<Scene, String> {
     let mut stack: Vec<(gltf::Node, Mat4, usize)> = root.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
     while let Some((node, parent, depth)) = stack.pop() {
         if depth > 256 {
-            return Err(format!("{name}: the node hierarchy is deeper than 256 levels (a cycle?)"));
+            return Err(format!("{name}: the node hierarchy is deeper than 256 levels"));
         }
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         if !world.is_finite() {

@@ -133,6 +133,12 @@ pub fn check(root: &Value) -> Result<(), String> {
         let n = components(ty).ok_or(format!("{at}.type \"{ty}\" is not a glTF accessor type"))?;
         let ct = acc.get("componentType").and_then(Value::as_u64).unwrap_or(0);
         let bytes = component_bytes(ct).ok_or(format!("{at}.componentType {ct} is not a glTF component type"))?;
+        match acc.get("count").and_then(Value::as_u64) {
+            Some(c) if c >= 1 => {}
+            _ => {
+                return Err(format!("{at}.count must be at least 1, got {}", acc.get("count").unwrap_or(&Value::Null)))
+            }
+        }
         if let Some(v) = field(root, acc, &at, "bufferView", "bufferViews")? {
             if let Some(stride) = root["bufferViews"][v].get("byteStride").and_then(Value::as_u64) {
                 if (stride as usize) < n * bytes {

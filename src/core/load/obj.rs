@@ -111,7 +111,18 @@ fn check_faces(text: &str) -> std::result::Result<(), String> {
     let (mut v, mut vt, mut vn) = (0i64, 0i64, 0i64);
     for (k, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
-        match words.next() {
+        let keyword = words.next();
+        if let Some(kind @ ("v" | "vt" | "vn")) = keyword {
+            let numbers: Vec<&str> = words.clone().collect();
+            let needed = if kind == "vt" { 1 } else { 3 };
+            if numbers.len() < needed {
+                return Err(format!("line {}: '{kind}' needs {needed} numbers, got {}", k + 1, numbers.len()));
+            }
+            if let Some(bad) = numbers.iter().find(|w| w.parse::<f32>().is_err()) {
+                return Err(format!("line {}: '{bad}' is not a number", k + 1));
+            }
+        }
+        match keyword {
             Some("v") => v += 1,
             Some("vt") => vt += 1,
             Some("vn") => vn += 1,
