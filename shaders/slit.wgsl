@@ -48,7 +48,8 @@ fn vs_main(in: VertexIn) -> VertexOut {
     let x_c = rel.x * c + rel.z * s;    // along right(φ) = (cos φ, 0, sin φ)
     let z_c = rel.x * s - rel.z * c;    // along forward(φ) = (sin φ, 0, −cos φ)
     var out: VertexOut;
-    out.clip = vec4<f32>(cam.basis.z * z_c + x_c / PI, rel.y * params.focal_y_clip, z_c - params.near, z_c);
+    // Depth 1 − near/z_c, kept below 1 however far (MAX_DEPTH).
+    out.clip = vec4<f32>(cam.basis.z * z_c + x_c / PI, rel.y * params.focal_y_clip, min(z_c - params.near, z_c * MAX_DEPTH), z_c);
     out.view_position = p;
     out.normal = (params.view * vec4<f32>(in.normal, 0.0)).xyz;
     out.color = in.color;

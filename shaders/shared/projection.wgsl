@@ -7,6 +7,8 @@
 //   v = R_T·y/r (paper)   or   v = y·√(R_T²−d_e²)/√(r²−d_e²) (exact)
 //   depth = r
 
+#import constants
+
 const PI: f32 = 3.14159265358979;
 const TAU: f32 = 6.28318530717959;
 
@@ -110,6 +112,6 @@ fn to_pixel(proj: Projection, u: f32, v: f32) -> vec2<f32> {
 fn to_clip(proj: Projection, uvd: vec3<f32>) -> vec4<f32> {
     let x = uvd.x / PI;
     let y = uvd.y * proj.pixels_per_metre / (0.5 * proj.height);
-    let z = uvd.z / (uvd.z + 1.0);
+    let z = min(uvd.z / (uvd.z + 1.0), MAX_DEPTH);
     return vec4<f32>(x, y, z, 1.0);
 }

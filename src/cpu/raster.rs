@@ -28,7 +28,7 @@ pub fn raster_vertex(params: &RasterParams, v: &DrawVertex) -> Vec4 {
     Vec4::new(
         q.u / std::f32::consts::PI + 2.0 * params.shift_px[0] / projection.width as f32,
         q.v * ppm / (0.5 * projection.height as f32) - 2.0 * params.shift_px[1] / projection.height as f32,
-        q.depth / (q.depth + 1.0),
+        (q.depth / (q.depth + 1.0)).min(crate::shader::constants::MAX_DEPTH),
         1.0,
     )
 }

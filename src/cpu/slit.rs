@@ -79,7 +79,9 @@ pub fn slit_vertex(params: &SlitParams, camera: &SlitCamera, p: Vec3) -> Vec4 {
     let (s, c) = (camera.basis[0], camera.basis[1]);
     let x_c = rel.x * c + rel.z * s;
     let z_c = rel.x * s - rel.z * c;
-    Vec4::new(camera.basis[2] * z_c + x_c / std::f32::consts::PI, rel.y * params.focal_y_clip, z_c - params.near, z_c)
+    // Depth 1 − near/z_c, kept below 1 however far (MAX_DEPTH).
+    let z = (z_c - params.near).min(z_c * crate::shader::constants::MAX_DEPTH);
+    Vec4::new(camera.basis[2] * z_c + x_c / std::f32::consts::PI, rel.y * params.focal_y_clip, z, z_c)
 }
 
 /// Whether a sphere (viewer frame) can be seen through a slit: in front of the near plane and

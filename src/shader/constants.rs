@@ -20,6 +20,12 @@ pub const SEAM_MARGIN: f32 = 1e-5;
 /// `SubdivideParams::piece_count` meaning "as many pieces as `plan` made" (read on the GPU).
 pub const PIECES_FROM_COUNTER: u32 = u32::MAX;
 
+/// The farthest depth a drawing stage writes, 1 − 2⁻²¹: a surface however far (its depth would
+/// round to 1, or reach it when interpolated across the triangle) still passes the `Less` test
+/// against the cleared 1. Depths tie beyond it: beyond ~2,000 km for the projection methods
+/// (r/(r+1)), beyond ~20 km for the slit cameras (1 − near/z).
+pub const MAX_DEPTH: f32 = 1.0 - 1.0 / (1 << 21) as f32;
+
 /// Error histogram of `reduce_error`: bins of 1/64 px in [0, 64) px ...
 pub const FINE_BINS: u32 = 4096;
 /// ... bins of 1 px in [64, 1024) px ...
@@ -44,6 +50,7 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("SNAP", F32(SNAP)),
         ("SEAM_MARGIN", F32(SEAM_MARGIN)),
         ("PIECES_FROM_COUNTER", U32(PIECES_FROM_COUNTER)),
+        ("MAX_DEPTH", F32(MAX_DEPTH)),
         ("FINE_BINS", U32(FINE_BINS)),
         ("COARSE_BINS", U32(COARSE_BINS)),
         ("BINS", U32(BINS)),
