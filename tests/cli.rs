@@ -514,3 +514,21 @@ fn identical_runs_give_identical_bytes() {
     assert!(run(&a) == run(&b), "two identical renders differ");
     let _ = (std::fs::remove_dir_all(&a), std::fs::remove_dir_all(&b));
 }
+
+#[test]
+fn an_image_too_large_for_the_device_is_refused_up_front() {
+    let out = tmp("huge");
+    let start = std::time::Instant::now();
+    let o = twister()
+        .args(["render", "--width", "16384", "--height", "16384", "--out", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    // lavapipe: a 2 GiB read-back exceeds its buffer limit; a real GPU may take it.
+    if !o.status.success() {
+        assert!(err.contains("--width/--height") && err.lines().count() == 1, "{err}");
+        assert!(start.elapsed().as_secs() < 20, "refused only after {:?}", start.elapsed());
+        assert!(!out.exists());
+    }
+    let _ = std::fs::remove_dir_all(&out);
+}

@@ -147,6 +147,37 @@ fn corpus() -> Vec<(String, Vec<u8>)> {
         ("mode_points", "/meshes/0/primitives/0/mode", json!(0)),
         ("mode_bad", "/meshes/0/primitives/0/mode", json!(99)),
         ("material_9", "/meshes/0/primitives/0/material", json!(9)),
+        // Sparse accessors: a valid one is below; beyond the accessor, float indices, too many.
+        (
+            "sparse_beyond",
+            "/accessors/0/sparse",
+            json!({ "count": 1, "indices": { "bufferView": 1, "componentType": 5125, "byteOffset": 2 }, "values": { "bufferView": 0 } }),
+        ),
+        (
+            "sparse_float",
+            "/accessors/0/sparse",
+            json!({ "count": 1, "indices": { "bufferView": 1, "componentType": 5126 }, "values": { "bufferView": 0 } }),
+        ),
+        (
+            "sparse_count",
+            "/accessors/0/sparse",
+            json!({ "count": 9, "indices": { "bufferView": 1, "componentType": 5123 }, "values": { "bufferView": 0 } }),
+        ),
+        (
+            "sparse_overrun",
+            "/accessors/0/sparse",
+            json!({ "count": 4, "indices": { "bufferView": 1, "componentType": 5125 }, "values": { "bufferView": 0 } }),
+        ),
+        (
+            "sparse_no_values",
+            "/accessors/0/sparse",
+            json!({ "count": 1, "indices": { "bufferView": 1, "componentType": 5123 } }),
+        ),
+        (
+            "sparse_ok",
+            "/accessors/0/sparse",
+            json!({ "count": 1, "indices": { "bufferView": 1, "componentType": 5123 }, "values": { "bufferView": 0, "byteOffset": 12 } }),
+        ),
     ];
     for (name, pointer, value) in edits {
         let mut d = doc.clone();
@@ -253,7 +284,7 @@ fn malformed_files_are_one_clear_error_or_a_scene_never_a_panic() {
         check_file(&path, &mut loaded);
     }
     // The valid files load; the corpus is mostly refused.
-    for valid in ["valid.gltf", "valid.glb", "valid.obj"] {
+    for valid in ["valid.gltf", "valid.glb", "valid.obj", "sparse_ok.gltf", "sparse_ok.glb"] {
         assert!(loaded.contains(&d.join(valid)), "{valid} did not load");
     }
     assert!(loaded.len() * 3 < files.len(), "{} of {} malformed files loaded", loaded.len(), files.len());

@@ -274,7 +274,7 @@ impl Renderer {
         } else {
             (self.gpu.limits.max_buffer_size, "the read-back buffer")
         };
-        if eyes_bytes > limit {
+        if eyes_bytes >= limit {
             return Err(Error::option(
                 "--width/--height",
                 format!(

@@ -293,22 +293,68 @@ fn check_accessor(acc: &gltf::Accessor, buffers: &[gltf::buffer::Data]) -> std::
     if count > (1 << 28) {
         return Err(format!("accessor {} claims {count} elements", acc.index()));
     }
+    let element = acc.size();
     if let Some(view) = acc.view() {
-        let buffer_len = buffers.get(view.buffer().index()).map_or(0, |b| b.len());
-        if view.offset() + view.length() > buffer_len {
-            return Err(format!(
-                "buffer view {} overruns its buffer ({} > {buffer_len} bytes)",
-                view.index(),
-                view.offset() + view.length()
-            ));
-        }
-        let element = acc.size();
+        let bytes = view_bytes(&view, buffers)?;
         let stride = view.stride().unwrap_or(element);
-        if count > 0 && acc.offset() + stride * (count - 1) + element > view.length() {
+        let end = stride
+            .checked_mul(count.saturating_sub(1))
+            .and_then(|n| n.checked_add(element))
+            .and_then(|n| n.checked_add(acc.offset()));
+        if end.is_none_or(|end| end > bytes.len()) {
             return Err(format!("accessor {} overruns buffer view {}", acc.index(), view.index()));
         }
     }
+    if let Some(sparse) = acc.sparse() {
+        // Sparse indices must lie in the accessor, values in their view.
+        let n = sparse.count();
+        let indices = sparse.indices();
+        let size = match indices.index_type() {
+            gltf::accessor::sparse::IndexType::U8 => 1,
+            gltf::accessor::sparse::IndexType::U16 => 2,
+            gltf::accessor::sparse::IndexType::U32 => 4,
+        };
+        let ib = view_bytes(&indices.view(), buffers)?;
+        let ib = ib.get(indices.offset()..).and_then(|b| b.get(..n.checked_mul(size)?));
+        let ib = ib.ok_or(format!(
+            "accessor {}: its sparse indices overrun buffer view {}",
+            acc.index(),
+            sparse.indices().view().index()
+        ))?;
+        for k in 0..n {
+            let i = match size {
+                1 => ib[k] as usize,
+                2 => u16::from_le_bytes([ib[2 * k], ib[2 * k + 1]]) as usize,
+                _ => u32::from_le_bytes([ib[4 * k], ib[4 * k + 1], ib[4 * k + 2], ib[4 * k + 3]]) as usize,
+            };
+            if i >= count {
+                return Err(format!("accessor {}: sparse index {i} is beyond its {count} elements", acc.index()));
+            }
+        }
+        let values = sparse.values();
+        let vb = view_bytes(&values.view(), buffers)?;
+        if values.offset().checked_add(n.saturating_mul(element)).is_none_or(|end| end > vb.len()) {
+            return Err(format!(
+                "accessor {}: its sparse values overrun buffer view {}",
+                acc.index(),
+                values.view().index()
+            ));
+        }
+    }
     Ok(())
+}
+
+/// The bytes of a buffer view, checked to lie in its buffer's data.
+fn view_bytes<'a>(
+    view: &gltf::buffer::View,
+    buffers: &'a [gltf::buffer::Data],
+) -> std::result::Result<&'a [u8], String> {
+    let data = buffers.get(view.buffer().index()).map_or(&[][..], |b| &b.0[..]);
+    view.offset().checked_add(view.length()).and_then(|end| data.get(view.offset()..end)).ok_or(format!(
+        "buffer view {} overruns its buffer ({} bytes)",
+        view.index(),
+        data.len()
+    ))
 }
 
 fn add_gltf_primitive(

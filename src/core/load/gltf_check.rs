@@ -150,8 +150,23 @@ pub fn check(root: &Value) -> Result<(), String> {
             }
         }
         if let Some(sparse) = acc.get("sparse") {
-            field(root, &sparse["indices"], &format!("{at}.sparse.indices"), "bufferView", "bufferViews")?;
-            field(root, &sparse["values"], &format!("{at}.sparse.values"), "bufferView", "bufferViews")?;
+            let count = acc.get("count").and_then(Value::as_u64).unwrap_or(0);
+            match sparse.get("count").and_then(Value::as_u64) {
+                Some(c) if c >= 1 && c <= count => {}
+                other => {
+                    let got = other.map_or("none".to_string(), |c| c.to_string());
+                    return Err(format!("{at}.sparse.count must be 1..={count}, got {got}"));
+                }
+            }
+            for part in ["indices", "values"] {
+                let p = sparse.get(part).ok_or(format!("{at}.sparse.{part} is missing"))?;
+                field(root, p, &format!("{at}.sparse.{part}"), "bufferView", "bufferViews")?
+                    .ok_or(format!("{at}.sparse.{part}.bufferView is missing"))?;
+            }
+            let ct = sparse["indices"].get("componentType").and_then(Value::as_u64).unwrap_or(0);
+            if ![5121, 5123, 5125].contains(&ct) {
+                return Err(format!("{at}.sparse.indices.componentType {ct} is not 5121, 5123 or 5125"));
+            }
         }
     }
     for (at, image) in items(root, "images") {
@@ -248,7 +263,10 @@ pub fn check(root: &Value) -> Result<(), String> {
             let cat = format!("{at}.channels[{k}]");
             match c.get("sampler").and_then(Value::as_u64) {
                 Some(s) if (s as usize) < samplers => {}
-                other => return Err(format!("{cat}.sampler is {other:?}, but the animation has {samplers} samplers")),
+                other => {
+                    let got = other.map_or("missing".to_string(), |s| s.to_string());
+                    return Err(format!("{cat}.sampler is {got}, but the animation has {samplers} samplers"));
+                }
             }
             if let Some(target) = c.get("target") {
                 field(root, target, &format!("{cat}.target"), "node", "nodes")?;
