@@ -382,6 +382,25 @@ fn a_chunked_frame_reports_wall_times_per_pass() {
 }
 
 #[test]
+fn negative_and_malformed_numbers_are_one_line_naming_the_option() {
+    for (args, needle) in [
+        (&["render", "--width", "-5"][..], "--width"),
+        (&["render", "--fit", "-1"][..], "--fit"),
+        (&["render", "--edge-px", "-1"][..], "--edge-px"),
+        (&["render", "--max-div", "-1"][..], "--max-div"),
+        (&["render", "--eye-radius", "NaN"][..], "--eye-radius"),
+        (&["render", "--yaw", "abc"][..], "--yaw"),
+        (&["error", "--heatmap-max", "0"][..], "--heatmap-max"),
+        (&["error", "--heatmap-max", "-5"][..], "--heatmap-max"),
+    ] {
+        let o = twister().args(args).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{args:?} accepted");
+        assert!(err.contains(needle) && err.trim().lines().count() == 1 && !err.contains("'-- -"), "{args:?}: {err}");
+    }
+}
+
+#[test]
 fn benchmark_reps_out_of_range_are_refused() {
     for args in [
         &["bench", "speed", "builtin:sphere100", "--reps", "0"][..],
@@ -502,16 +521,23 @@ fn outputs_are_all_or_nothing_and_checked_before_rendering() {
 #[test]
 fn identical_runs_give_identical_bytes() {
     let run = |dir: &Path| {
+        let stats = dir.join("stats.json");
         let o = twister()
             .args(["render", "builtin:demo", "--width", "320", "--height", "80", "--layout", "top-bottom", "--out"])
             .arg(dir)
+            .args(["--stats", stats.to_str().unwrap()])
             .output()
             .unwrap();
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-        std::fs::read(dir.join("stereo.png")).unwrap()
+        let mut json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+        // Times differ between runs; everything else must not.
+        json.as_object_mut().unwrap().retain(|k, _| !k.starts_with("ms_"));
+        (std::fs::read(dir.join("stereo.png")).unwrap(), json)
     };
     let (a, b) = (tmp("same-a"), tmp("same-b"));
-    assert!(run(&a) == run(&b), "two identical renders differ");
+    let (ra, rb) = (run(&a), run(&b));
+    assert!(ra.0 == rb.0, "two identical renders differ");
+    assert_eq!(ra.1, rb.1, "their stats differ");
     let _ = (std::fs::remove_dir_all(&a), std::fs::remove_dir_all(&b));
 }
 
