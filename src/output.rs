@@ -113,11 +113,18 @@ pub fn check_outputs(paths: &[&Path]) -> Result<()> {
             }
         }
         let mut parent = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-        // The nearest existing ancestor must be a folder (the rest is made when writing).
+        // The nearest existing ancestor must be a folder we can write in (the rest is made when
+        // writing): a probe file is made and removed.
         loop {
             match std::fs::metadata(parent) {
-                Ok(meta) if meta.is_dir() => break,
-                Ok(_) => return Err(Error::output(parent, "is a file, not a folder: cannot write outputs in it")),
+                Ok(meta) if meta.is_dir() => {
+                    let probe = parent.join(format!(".twister-probe.{}.tmp", std::process::id()));
+                    std::fs::write(&probe, b"")
+                        .map_err(|e| Error::output(*path, format!("cannot be written in {}: {e}", parent.display())))?;
+                    let _ = std::fs::remove_file(&probe);
+                    break;
+                }
+                Ok(_) => return Err(Error::output(parent, "is not a folder: cannot write outputs in it")),
                 Err(_) => match parent.parent() {
                     Some(p) if !p.as_os_str().is_empty() => parent = p,
                     _ => break,

@@ -498,6 +498,17 @@ fn outputs_are_all_or_nothing_and_checked_before_rendering() {
         .unwrap();
     assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("stats.json"));
     assert!(!fresh.join("imgs").exists(), "images written although the stats could not be");
+    // A stats file where nothing can be written (/proc): refused before rendering, no images.
+    if Path::new("/proc/self").exists() {
+        let o = twister()
+            .args(["render", "--width", "64", "--height", "16", "--out", fresh.join("imgs").to_str().unwrap()])
+            .args(["--stats", "/proc/stats.json"])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && err.contains("/proc/stats.json") && err.lines().count() == 1, "{err}");
+        assert!(!fresh.join("imgs").exists(), "images written although the stats could not be");
+    }
     // --out naming a file.
     let file = fresh.join("a-file");
     std::fs::write(&file, b"x").unwrap();
@@ -506,7 +517,7 @@ fn outputs_are_all_or_nothing_and_checked_before_rendering() {
         .output()
         .unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(!o.status.success() && err.contains("is a file, not a folder"), "{err}");
+    assert!(!o.status.success() && err.contains("is not a folder"), "{err}");
     // Temporaries of a killed run are cleaned up by the next one in that folder.
     std::fs::remove_dir_all(out.join("right.png")).unwrap();
     let stale = out.join(".left.png.4194303.tmp");

@@ -173,8 +173,13 @@ pub(super) fn read_gltf(path: &Path) -> std::result::Result<Scene, String> {
     }
     let mut images = Vec::new();
     for image in doc.images() {
-        let data = gltf::image::Data::from_source(image.source(), Some(base), &buffers)
-            .map_err(|e| format!("image {}: cannot be decoded: {e}", image.index()))?;
+        let data = gltf::image::Data::from_source(image.source(), Some(base), &buffers).map_err(|e| {
+            let named = match image.source() {
+                gltf::image::Source::Uri { uri, .. } if !uri.starts_with("data:") => format!(" ('{uri}')"),
+                _ => String::new(),
+            };
+            format!("image {}{named}: cannot be decoded: {e}", image.index())
+        })?;
         images.push(data);
     }
     let required: Vec<&str> = doc.extensions_required().filter(|e| !GLTF_EXTENSIONS.contains(e)).collect();
