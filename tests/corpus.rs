@@ -20,17 +20,6 @@ fn dir() -> PathBuf {
     d
 }
 
-fn base64(bytes: &[u8]) -> String {
-    const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut s = String::new();
-    for c in bytes.chunks(3) {
-        let n = (c[0] as u32) << 16 | (*c.get(1).unwrap_or(&0) as u32) << 8 | *c.get(2).unwrap_or(&0) as u32;
-        for k in 0..4 {
-            s.push(if k <= c.len() { T[(n >> (18 - 6 * k) & 63) as usize] as char } else { '=' });
-        }
-    }
-    s
-}
 
 /// A valid two-triangle glTF document (positions, normals, indices) and its binary buffer.
 fn valid_gltf() -> (serde_json::Value, Vec<u8>) {
@@ -55,7 +44,7 @@ fn valid_gltf() -> (serde_json::Value, Vec<u8>) {
 
 fn gltf_text(doc: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
     let mut d = doc.clone();
-    d["buffers"][0]["uri"] = json!(format!("data:application/octet-stream;base64,{}", base64(bin)));
+    d["buffers"][0]["uri"] = json!(format!("data:application/octet-stream;base64,{}", common::base64(bin)));
     serde_json::to_vec(&d).unwrap()
 }
 

@@ -20,17 +20,6 @@ fn tmp(name: &str) -> PathBuf {
     d
 }
 
-fn base64(bytes: &[u8]) -> String {
-    const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut s = String::new();
-    for c in bytes.chunks(3) {
-        let n = (c[0] as u32) << 16 | (*c.get(1).unwrap_or(&0) as u32) << 8 | *c.get(2).unwrap_or(&0) as u32;
-        for k in 0..4 {
-            s.push(if k <= c.len() { T[(n >> (18 - 6 * k) & 63) as usize] as char } else { '=' });
-        }
-    }
-    s
-}
 
 /// A one-primitive glTF with an embedded buffer: positions, optional u32 indices, a mode.
 fn gltf_json(positions: &[[f32; 3]], indices: Option<&[u32]>, mode: u32) -> serde_json::Value {
@@ -59,7 +48,7 @@ fn gltf_json(positions: &[[f32; 3]], indices: Option<&[u32]>, mode: u32) -> serd
         "meshes": [{ "primitives": [prim] }],
         "accessors": accessors,
         "bufferViews": views,
-        "buffers": [{ "byteLength": bytes.len(), "uri": format!("data:application/octet-stream;base64,{}", base64(&bytes)) }]
+        "buffers": [{ "byteLength": bytes.len(), "uri": format!("data:application/octet-stream;base64,{}", common::base64(&bytes)) }]
     })
 }
 
@@ -328,7 +317,7 @@ fn gltf_materials_keep_sampler_alpha_sides_texcoord_set_and_texture_transform() 
     bytes.extend(uv0.iter().chain(&uv1).flatten().flat_map(|f| f.to_le_bytes()));
     json["buffers"][0] = serde_json::json!({
         "byteLength": bytes.len(),
-        "uri": format!("data:application/octet-stream;base64,{}", base64(&bytes))
+        "uri": format!("data:application/octet-stream;base64,{}", common::base64(&bytes))
     });
     let views = json["bufferViews"].as_array_mut().unwrap();
     views.push(serde_json::json!({ "buffer": 0, "byteOffset": at, "byteLength": 32 }));
@@ -341,7 +330,7 @@ fn gltf_materials_keep_sampler_alpha_sides_texcoord_set_and_texture_transform() 
     json["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_1"] = serde_json::json!(3);
     json["meshes"][0]["primitives"][0]["material"] = serde_json::json!(0);
     let png = png_bytes(4, 2, |x, y| [60 * x as u8, 100 * y as u8, 7, 255]);
-    json["images"] = serde_json::json!([{ "uri": format!("data:image/png;base64,{}", base64(&png)) }]);
+    json["images"] = serde_json::json!([{ "uri": format!("data:image/png;base64,{}", common::base64(&png)) }]);
     // MIRRORED_REPEAT / CLAMP_TO_EDGE, NEAREST magnification, NEAREST_MIPMAP_NEAREST.
     json["samplers"] = serde_json::json!([{ "wrapS": 33648, "wrapT": 33071, "magFilter": 9728, "minFilter": 9984 }]);
     json["textures"] = serde_json::json!([{ "source": 0, "sampler": 0 }]);
