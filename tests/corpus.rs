@@ -20,7 +20,6 @@ fn dir() -> PathBuf {
     d
 }
 
-
 /// A valid two-triangle glTF document (positions, normals, indices) and its binary buffer.
 fn valid_gltf() -> (serde_json::Value, Vec<u8>) {
     let positions: [[f32; 3]; 4] = [[0.0, 0.0, -3.0], [1.0, 0.0, -3.0], [0.0, 1.0, -3.0], [1.0, 1.0, -3.0]];

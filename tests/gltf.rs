@@ -20,7 +20,6 @@ fn tmp(name: &str) -> PathBuf {
     d
 }
 
-
 /// A one-primitive glTF with an embedded buffer: positions, optional u32 indices, a mode.
 fn gltf_json(positions: &[[f32; 3]], indices: Option<&[u32]>, mode: u32) -> serde_json::Value {
     let mut bytes: Vec<u8> = positions.iter().flatten().flat_map(|f| f.to_le_bytes()).collect();

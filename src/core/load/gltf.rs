@@ -118,8 +118,12 @@ pub const GLTF_EXTENSIONS: &[&str] = &["KHR_texture_transform"];
 /// are added so that a file cannot make memory grow past it).
 const MAX_TRIANGLES: usize = crate::core::scene::MAX_TRIANGLES;
 
-pub(super) fn read_gltf(path: &Path) -> std::result::Result<Scene, String> {
-    let name = path.display().to_string();
+/// A glTF document with its buffers and decoded images.
+type Document = (gltf::Document, Vec<gltf::buffer::Data>, Vec<gltf::image::Data>);
+
+/// Reads a glTF file's document, buffers and images: every file checked before it is read,
+/// the JSON checked before the gltf crate parses it (the crate panics on some invalid files).
+fn read_document(path: &Path) -> std::result::Result<Document, String> {
     let bytes = super::read_file(path)?;
     let base = path.parent().unwrap_or(Path::new("."));
     // The JSON (of a .gltf, or the JSON chunk of a .glb) is checked before the gltf crate reads
@@ -182,6 +186,12 @@ pub(super) fn read_gltf(path: &Path) -> std::result::Result<Scene, String> {
         })?;
         images.push(data);
     }
+    Ok((doc, buffers, images))
+}
+
+pub(super) fn read_gltf(path: &Path) -> std::result::Result<Scene, String> {
+    let name = path.display().to_string();
+    let (doc, buffers, images) = read_document(path)?;
     let required: Vec<&str> = doc.extensions_required().filter(|e| !GLTF_EXTENSIONS.contains(e)).collect();
     if !required.is_empty() {
         return Err(format!("{name}: requires extensions twister does not support: {}", required.join(", ")));

@@ -96,6 +96,16 @@ fn accessor_use(root: &Value, k: usize, what: &str, types: &[&str], cts: &[u64])
 
 /// All the checks; the first problem found.
 pub fn check(root: &Value) -> Result<(), String> {
+    check_asset_and_scenes(root)?;
+    check_buffers_and_accessors(root)?;
+    check_textures_and_materials(root)?;
+    check_meshes(root)?;
+    check_nodes(root)?;
+    check_skins_and_animations(root)
+}
+
+/// The document is glTF 2.x; the scene indices.
+fn check_asset_and_scenes(root: &Value) -> Result<(), String> {
     if !root.is_object() {
         return Err("not a glTF document (the JSON is not an object)".into());
     }
@@ -111,7 +121,11 @@ pub fn check(root: &Value) -> Result<(), String> {
             index(root, n, &format!("{at}.nodes[{k}]"), "nodes")?;
         }
     }
-    // Buffers, views, accessors.
+    Ok(())
+}
+
+/// Buffer views within their buffers; accessors' types, counts, strides and sparse parts.
+fn check_buffers_and_accessors(root: &Value) -> Result<(), String> {
     for (at, view) in items(root, "bufferViews") {
         let b = field(root, view, &at, "buffer", "buffers")?.ok_or(format!("{at} has no buffer"))?;
         let start = view.get("byteOffset").and_then(Value::as_u64).unwrap_or(0);
@@ -169,6 +183,11 @@ pub fn check(root: &Value) -> Result<(), String> {
             }
         }
     }
+    Ok(())
+}
+
+/// Image, texture and material references.
+fn check_textures_and_materials(root: &Value) -> Result<(), String> {
     for (at, image) in items(root, "images") {
         field(root, image, &at, "bufferView", "bufferViews")?;
     }
@@ -193,7 +212,11 @@ pub fn check(root: &Value) -> Result<(), String> {
             }
         }
     }
-    // Meshes.
+    Ok(())
+}
+
+/// Primitive attributes, indices, materials and morph targets: indices in range, accessor types fit.
+fn check_meshes(root: &Value) -> Result<(), String> {
     for (at, mesh) in items(root, "meshes") {
         for (p, prim) in mesh.get("primitives").and_then(Value::as_array).into_iter().flatten().enumerate() {
             let pat = format!("{at}.primitives[{p}]");
@@ -215,7 +238,11 @@ pub fn check(root: &Value) -> Result<(), String> {
             }
         }
     }
-    // Nodes: indices, then the hierarchy must be a forest (one parent at most, no cycle).
+    Ok(())
+}
+
+/// Node references; the hierarchy must be a forest (one parent at most, no cycle).
+fn check_nodes(root: &Value) -> Result<(), String> {
     let node_count = len(root, "nodes");
     let mut parent: Vec<Option<usize>> = vec![None; node_count];
     for (at, node) in items(root, "nodes") {
@@ -246,6 +273,11 @@ pub fn check(root: &Value) -> Result<(), String> {
             }
         }
     }
+    Ok(())
+}
+
+/// Skin and animation references.
+fn check_skins_and_animations(root: &Value) -> Result<(), String> {
     for (at, skin) in items(root, "skins") {
         field(root, skin, &at, "inverseBindMatrices", "accessors")?;
         field(root, skin, &at, "skeleton", "nodes")?;
