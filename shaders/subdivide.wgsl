@@ -262,6 +262,8 @@ fn plan_triangle() {
     tri_k = 1u;
     if (params.method == METHOD_ADAPTIVE) {
         tri_k = (m + params.max_div - 1u) / params.max_div;
+    } else if (params.method == METHOD_FIXED) {
+        tri_k = (m + FIXED_PIECE_DIVISIONS - 1u) / FIXED_PIECE_DIVISIONS;
     }
 }
 
@@ -651,7 +653,12 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
             }
         }
         if (piece_original[e] < 0) {
-            piece_counts[e] = min(edge_divisions(piece_q[e].position, piece_q[(e + 1u) % 3u].position), 2u * params.max_div);
+            if (params.method == METHOD_FIXED) {
+                // fixed:N pieces take N/K on interior edges (the regular N-lattice when K | N).
+                piece_counts[e] = (params.fixed_n + tri_k - 1u) / tri_k;
+            } else {
+                piece_counts[e] = min(edge_divisions(piece_q[e].position, piece_q[(e + 1u) % 3u].position), 2u * params.max_div);
+            }
         }
     }
     let m = max(max(piece_counts[0], piece_counts[1]), piece_counts[2]);

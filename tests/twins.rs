@@ -175,6 +175,9 @@ impl Twin for Subdivide {
             (builtin::demo(), moved.with_edge_px(12.0).with_max_div(4)),
             (sphere, base.with_edge_px(8.0)),
             (around, base.with_edge_px(16.0)),
+            // fixed:N beyond 32 divisions: pre-split into pieces (one invocation used to stop short).
+            (builtin::builtin_scene("builtin:triangle@3", &projection).unwrap(), base.with_method(Method::Fixed(64))),
+            (random_triangle_scene(6, 12), base.with_method(Method::Fixed(45))),
         ];
         cases
             .into_iter()

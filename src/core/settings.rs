@@ -24,6 +24,7 @@ pub enum Method {
     /// No split: every vertex at its projected place, straight edges (the paper's "Vert").
     Vertex,
     /// Every edge split into N, regular N² lattice (the paper's fixed comparison; ignores N_max).
+    /// Beyond 32 divisions the triangle is first cut into K² pieces of N/K (K = ceil(N/32)).
     Fixed(u32),
     /// N = ceil(l/L) per edge (eq. 5), with pre-split beyond N_max.
     Adaptive,

@@ -63,7 +63,7 @@ use std::f32::consts::{PI, TAU};
 use crate::core::projection::{azimuth, horizontal_radius, wrap_angle, Projection};
 use crate::core::scene::SceneVertex;
 use crate::core::settings::{RenderSettings, SplitRule};
-use crate::shader::constants::{EDGE_SAMPLES, MAX_EDGE_DIVISIONS, MAX_SPAN, SEAM_MARGIN, SNAP};
+use crate::shader::constants::{EDGE_SAMPLES, FIXED_PIECE_DIVISIONS, MAX_EDGE_DIVISIONS, MAX_SPAN, SEAM_MARGIN, SNAP};
 use crate::shader::types::{DrawVertex, SubdivideParams};
 
 /// Number of sectors an axis triangle is split into.
@@ -242,7 +242,12 @@ impl<'a> Subdivider<'a> {
     /// Divisions of an interior edge of the macro-lattice. Macro edges are about N_max·L long,
     /// but the projection stretches unevenly across a large triangle, so some need more: they may
     /// take up to 2·N_max (a piece then makes at most 4·N_max² triangles).
-    fn interior_divisions(&self, a: Vec3, b: Vec3, edge_px: f32) -> u32 {
+    /// `fixed:N` pieces (K per edge) take N/K (rounded up) on their interior edges: the union is the
+    /// regular N-lattice when K divides N.
+    fn interior_divisions(&self, a: Vec3, b: Vec3, edge_px: f32, k: u32) -> u32 {
+        if self.params.method == SplitRule::Fixed as u32 {
+            return self.params.fixed_n.div_ceil(k.max(1));
+        }
         self.edge_divisions(a, b, edge_px).min(2 * self.params.max_div)
     }
 
@@ -286,7 +291,13 @@ impl<'a> Subdivider<'a> {
             self.edge_divisions(p[2], p[0], l),
         ];
         let m = n[0].max(n[1]).max(n[2]);
-        let k = if self.params.method == SplitRule::Adaptive as u32 { m.div_ceil(self.params.max_div) } else { 1 };
+        let k = if self.params.method == SplitRule::Adaptive as u32 {
+            m.div_ceil(self.params.max_div)
+        } else if self.params.method == SplitRule::Fixed as u32 {
+            m.div_ceil(FIXED_PIECE_DIVISIONS)
+        } else {
+            1
+        };
         (k, n)
     }
 
@@ -355,7 +366,7 @@ impl<'a> Subdivider<'a> {
                     original: None,
                     from: 0,
                     to: 0,
-                    count: self.interior_divisions(q[e].position, q[(e + 1) % 3].position, self.edge_px(tri.object)),
+                    count: self.interior_divisions(q[e].position, q[(e + 1) % 3].position, self.edge_px(tri.object), k),
                 });
         }
         let counts = edges.map(|e| e.count);

@@ -17,6 +17,10 @@ pub const MAX_SPAN: f32 = 1.6;
 pub const SNAP: f32 = 1e-6;
 /// Seam copies are made for triangles reaching within this many radians of ±π.
 pub const SEAM_MARGIN: f32 = 1e-5;
+/// `fixed:N` above this many divisions is pre-split into a macro-lattice of K = ceil(N / this)
+/// pieces (N = 64: 4 pieces of 32²), so that one `lattice` invocation never makes more than
+/// this² triangles (lavapipe cut invocations short beyond about 1,900).
+pub const FIXED_PIECE_DIVISIONS: u32 = 32;
 /// `SubdivideParams::piece_count` meaning "as many pieces as `plan` made" (read on the GPU).
 pub const PIECES_FROM_COUNTER: u32 = u32::MAX;
 
@@ -46,6 +50,7 @@ pub fn all() -> Vec<(&'static str, Value)> {
     let mut out = vec![
         ("MAX_EDGE_DIVISIONS", U32(MAX_EDGE_DIVISIONS)),
         ("EDGE_SAMPLES", U32(EDGE_SAMPLES)),
+        ("FIXED_PIECE_DIVISIONS", U32(FIXED_PIECE_DIVISIONS)),
         ("MAX_SPAN", F32(MAX_SPAN)),
         ("SNAP", F32(SNAP)),
         ("SEAM_MARGIN", F32(SEAM_MARGIN)),
