@@ -50,7 +50,7 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
     let prepared = prepare(&renderer, &args.scene, args.fit, &args.view, &mut settings, false)?;
     let gpu_scene = &prepared.gpu_scene;
     let frame = renderer.render(gpu_scene, &settings)?;
-    let measured = frame.measurement.as_ref().expect("rendered with measure_error");
+    let measured = frame.measurement.as_ref().expect("rendered with the error pass");
     let e = &measured.stats;
     let s = &frame.stats;
     let mut json = serde_json::json!({

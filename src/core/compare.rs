@@ -13,7 +13,7 @@ pub struct Comparison {
     pub psnr_db: Option<f64>,
 }
 
-/// Compares two frames rendered with `measure_error` (for their object ids).
+/// Compares two frames rendered with the error pass (`measure.error`, for their object ids).
 pub fn compare(frame: &Frame, reference: &Frame) -> Result<Comparison> {
     let (Some(m), Some(r)) = (&frame.measurement, &reference.measurement) else {
         return Err(Error::Compare("both frames must be rendered with the error pass (measure.error)".into()));

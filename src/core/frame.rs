@@ -81,7 +81,7 @@ pub struct Frame {
     pub left: EyeImage,
     pub right: EyeImage,
     pub stats: FrameStats,
-    /// The error pass's outputs, when `RenderSettings::measure_error` was set.
+    /// The error pass's outputs, when `RenderSettings::measure.error` was set.
     pub measurement: Option<Measurement>,
 }
 

@@ -97,12 +97,6 @@ pub struct SubdivideParams {
     pub measure_edges: u32,
 }
 
-impl SubdivideParams {
-    pub fn with_measure_edges(self, on: bool) -> Self {
-        SubdivideParams { measure_edges: on as u32, ..self }
-    }
-}
-
 /// `Counters` in shaders/subdivide.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
