@@ -34,11 +34,11 @@ pub fn place(spec: &str, fit: Option<f32>, view: &ViewArgs, settings: &mut Rende
     }
     if view.scale != 1.0 {
         scene.transform(Mat4::from_scale(Vec3::splat(view.scale)));
-        check_finite(&scene, spec, "--scale")?;
+        check_in_range(&scene, spec, "--scale")?;
     }
     if let Some(d) = fit {
         scene.fit(d, settings.projection())?;
-        check_finite(&scene, spec, "--fit")?;
+        check_in_range(&scene, spec, "--fit")?;
     }
     if let Viewer::Camera(n) = view.viewer {
         let cam = scene.cameras.get(n).ok_or_else(|| {
@@ -52,7 +52,7 @@ pub fn place(spec: &str, fit: Option<f32>, view: &ViewArgs, settings: &mut Rende
 
 /// After a transform: coordinates beyond what the projection computes in f32 (or an overflow
 /// to infinity) are the option's fault, not the file's.
-fn check_finite(scene: &Scene, spec: &str, option: &'static str) -> Result<()> {
+fn check_in_range(scene: &Scene, spec: &str, option: &'static str) -> Result<()> {
     let fits = |c: &f32| c.abs() <= MAX_COORDINATE;
     if scene.vertices.iter().all(|v| v.position.iter().all(fits))
         && scene.cameras.iter().all(|c| c.position.iter().all(fits))

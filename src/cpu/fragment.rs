@@ -6,7 +6,7 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-pub use crate::core::color::{linear_to_srgb, srgb_to_linear};
+use crate::core::color::{linear_to_srgb, srgb_to_linear};
 use crate::core::material::{AlphaMode, Filter, Material, MipLevel, Mipmap, Wrap, NO_TEXTURE};
 use crate::core::projection::{Eye, Projection};
 use crate::core::texture::MaterialTable;

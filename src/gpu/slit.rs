@@ -27,6 +27,8 @@ impl Renderer {
         let targets = res.targets.as_ref().expect("made");
         let view = settings.view();
         let eye_slits = Eye::BOTH.map(|eye| slits(projection, eye, width));
+        // Object centres in the viewer frame, once (the culling below runs per slit and object).
+        let centers: Vec<_> = scene.objects.iter().map(|o| view.transform_point3(o.center)).collect();
         let cameras: Vec<SlitCamera> = eye_slits.iter().flatten().map(|s| s.camera).collect();
         let camera_buffer =
             gpu.init_buffer("slit cameras", bytemuck::cast_slice(&cameras), wgpu::BufferUsages::STORAGE);
@@ -55,8 +57,8 @@ impl Renderer {
             for (i, slit) in eye_slits[k].iter().enumerate() {
                 pass.set_scissor_rect(slit.first_column, 0, slit.end_column - slit.first_column, projection.height);
                 let instance = first_instance + i as u32;
-                for o in &scene.objects {
-                    if sphere_in_slit(&params, slit, view.transform_point3(o.center), o.radius) {
+                for (o, &center) in scene.objects.iter().zip(&centers) {
+                    if sphere_in_slit(&params, slit, center, o.radius) {
                         let first = o.first_triangle;
                         pass.draw_indexed(3 * first..3 * (first + o.triangle_count), 0, instance..instance + 1);
                         stats.triangles_out += o.triangle_count as u64;
