@@ -1,5 +1,5 @@
 // The `subdivide` stage (compute): adaptive subdivision (seed 002 §2.3, eq. 5, Fig. 6), the
-// vertical-axis split and the seam copies. CPU twin and full description: src/cpu/subdivide.rs.
+// vertical-axis split and the seam copies. CPU twin and full description: src/cpu/subdivide/.
 
 #import projection
 #import constants
@@ -223,7 +223,7 @@ fn edge_divisions(a: vec3<f32>, b: vec3<f32>) -> u32 {
 }
 
 // Whether a triangle lies wholly above or below the image (see `off_screen_vertically` in
-// src/cpu/subdivide.rs for why testing the corners suffices).
+// src/cpu/subdivide/ for why testing the corners suffices).
 fn off_screen_vertically(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> bool {
     let rt = params.projection.screen_radius;
     let de = params.projection.eye_radius;
