@@ -4,11 +4,13 @@
 #import projection
 #import constants
 //
-// `plan`     one invocation per input triangle: edge counts N (eq. 5), the macro-lattice level
-//            K = ceil(M / N_max) of the pre-split, and K² piece records (triangle, cell).
-// `lattice`  one invocation per piece: the regular lattice of level m = max(counts), boundary
-//            nodes snapped to each edge's nodes, each sub-triangle split around the axis if
-//            needed and appended, with a seam copy where it crosses ±π.
+// `plan`     one invocation per input triangle: its parts around the vertical axis (quadrants
+//            minus a small square around the axis, fan-triangulated), and for each part the edge
+//            counts N (eq. 5), the macro-lattice level K = ceil(M / N_max) of the pre-split, and
+//            K² piece records (triangle, part, cell).
+// `lattice`  one invocation per piece: the part again (recomputed, the same bits), the regular
+//            lattice of level m = max(counts), boundary nodes snapped to each edge's nodes, each
+//            sub-triangle appended, with a seam copy where it crosses ±π.
 // `finalize` the DrawIndirect arguments, clamped to the capacity.
 // Appends never write past a capacity: they are counted, and the host grows the buffer or
 // processes the scene in chunks.
@@ -68,7 +70,7 @@ struct DrawIndirectArgs {
 @group(0) @binding(0) var<uniform> params: SubdivideParams;
 @group(0) @binding(1) var<storage, read> vertices: array<SceneVertex>;
 @group(0) @binding(2) var<storage, read> indices: array<u32>;
-// Piece records: (triangle, macro cell, n0 | n1 << 16, n2 | K << 16).
+// Piece records: (triangle, part | macro cell << 4, n0 | n1 << 16, n2 | K << 16).
 @group(0) @binding(3) var<storage, read_write> pieces: array<vec4<u32>>;
 @group(0) @binding(4) var<storage, read_write> out_vertices: array<DrawVertex>;
 @group(0) @binding(5) var<storage, read_write> counters: Counters;
@@ -81,21 +83,7 @@ struct DrawIndirectArgs {
 
 // `params.piece_count == PIECES_FROM_COUNTER` (from `constants`): as many pieces as `plan` made
 // (read from the counter), so that plan, lattice and drawing can run in one submission.
-// MAX_EDGE_DIVISIONS, EDGE_SAMPLES, MAX_SPAN, SNAP, SEAM_MARGIN: from src/shader/constants.rs.
-
-// (cos, sin) of the sector boundaries −π + k·π/4 and of the sector middles, exact tables shared
-// with the CPU twin.
-const H: f32 = 0.70710678118654752;
-const C8: f32 = 0.923879532511287;
-const S8: f32 = 0.382683432365090;
-const BOUNDARY = array<vec2<f32>, 9>(
-    vec2<f32>(-1.0, 0.0), vec2<f32>(-H, -H), vec2<f32>(0.0, -1.0), vec2<f32>(H, -H),
-    vec2<f32>(1.0, 0.0), vec2<f32>(H, H), vec2<f32>(0.0, 1.0), vec2<f32>(-H, H), vec2<f32>(-1.0, 0.0),
-);
-const MIDDLE = array<vec2<f32>, 8>(
-    vec2<f32>(-C8, -S8), vec2<f32>(-S8, -C8), vec2<f32>(S8, -C8), vec2<f32>(C8, -S8),
-    vec2<f32>(C8, S8), vec2<f32>(S8, C8), vec2<f32>(-S8, C8), vec2<f32>(-C8, S8),
-);
+// MAX_EDGE_DIVISIONS, EDGE_SAMPLES, MAX_PARTS, SNAP, SEAM_MARGIN: from src/shader/constants.rs.
 
 struct Node {
     position: vec3<f32>,
@@ -111,7 +99,9 @@ var<private> tri_material: u32;
 var<private> tri_object: u32;
 // L for this triangle: params.edge_px × its object's factor (read once in `load_triangle`).
 var<private> tri_edge_px: f32;
-var<private> tri_n: array<u32, 3>;    // divisions of edges P0P1, P1P2, P2P0
+// The part being split (see `triangle_part`), and its plan.
+var<private> part: array<Node, 3>;
+var<private> tri_n: array<u32, 3>;    // divisions of the part's edges Q0Q1, Q1Q2, Q2Q0
 var<private> tri_k: u32;              // macro-lattice level
 
 // The piece being subdivided.
@@ -121,15 +111,13 @@ var<private> piece_original: array<i32, 3>; // original edge under piece edge e,
 var<private> piece_from: array<u32, 3>;     // fine index on that original edge at corner e
 var<private> piece_to: array<u32, 3>;
 
-// The polygon of the axis split.
-var<private> poly: array<Node, 8>;
+// A quadrant's polygon while it is clipped (at most 6 corners).
+var<private> poly: array<Node, 6>;
 var<private> poly_count: u32;
-var<private> scratch: array<Node, 8>;
+var<private> scratch: array<Node, 6>;
 
 fn corner(i: u32) -> Node {
-    var b = vec3<f32>(0.0, 0.0, 0.0);
-    b[i] = 1.0;
-    return Node(tri_position[i], b);
+    return part[i];
 }
 
 fn lex_less(a: vec3<f32>, b: vec3<f32>) -> bool {
@@ -168,8 +156,8 @@ fn pixel(p: vec3<f32>, eye_sign: f32) -> vec2<f32> {
     return vec2<f32>(u * params.projection.width / TAU, v * params.projection.pixels_per_metre);
 }
 
-// Projected length in pixels of the straight edge ab, larger of the two eyes, heights clamped,
-// as a polyline of `segments` segments.
+// Projected length in pixels of the straight edge ab, larger of the two eyes, heights clamped
+// (segments beyond the clamp at both ends count 0), as a polyline of `segments` segments.
 fn edge_length_px(a: vec3<f32>, b: vec3<f32>, segments: u32) -> f32 {
     var lo = a;
     var hi = b;
@@ -188,7 +176,7 @@ fn edge_length_px(a: vec3<f32>, b: vec3<f32>, segments: u32) -> f32 {
             let t = f32(k) / f32(segments);
             var q = pixel(lo + (hi - lo) * t, eye_sign);
             q.y = clamp(q.y, -clamp_v, clamp_v);
-            if (k > 0u) {
+            if (k > 0u && !(q.y == prev.y && abs(q.y) == clamp_v)) {
                 let dx = (q.x - prev.x) - width * round((q.x - prev.x) / width);
                 total += length(vec2<f32>(dx, q.y - prev.y));
             }
@@ -234,12 +222,12 @@ fn off_screen_vertically(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> bool {
     return all(y > k * r) || all(y < -k * r);
 }
 
-// Loads an input triangle into the viewer frame (edge counts and K come from `plan_triangle`
-// or from the piece record).
+// Loads an input triangle into the viewer frame, its vertices snapped to the cut planes
+// (its parts, their edge counts and K come from `visit_parts` or from the piece record).
 fn load_triangle(t: u32) {
     for (var k = 0u; k < 3u; k++) {
         let v = vertices[indices[3u * t + k]];
-        tri_position[k] = (params.view * vec4<f32>(v.position, 1.0)).xyz;
+        tri_position[k] = snap_to_cut_planes((params.view * vec4<f32>(v.position, 1.0)).xyz);
         tri_normal[k] = (params.view * vec4<f32>(v.normal, 0.0)).xyz;
         tri_color[k] = v.color;
         tri_uv[k] = v.uv;
@@ -249,14 +237,10 @@ fn load_triangle(t: u32) {
     tri_edge_px = params.edge_px * object_edge_scale[min(tri_object, arrayLength(&object_edge_scale) - 1u)];
 }
 
-fn plan_triangle() {
-    if (off_screen_vertically(tri_position[0], tri_position[1], tri_position[2])) {
-        tri_k = 0u; // no pieces
-        tri_n = array<u32, 3>(1u, 1u, 1u);
-        return;
-    }
+// Edge counts and macro-lattice level of the current part.
+fn plan_part() {
     for (var e = 0u; e < 3u; e++) {
-        tri_n[e] = edge_divisions(tri_position[e], tri_position[(e + 1u) % 3u]);
+        tri_n[e] = edge_divisions(part[e].position, part[(e + 1u) % 3u].position);
     }
     let m = max(max(tri_n[0], tri_n[1]), tri_n[2]);
     tri_k = 1u;
@@ -319,8 +303,7 @@ fn macro_node(abc: vec3<u32>, loc: vec3<u32>) -> Node {
     if (loc.x == ON_EDGE) {
         return edge_point(corner(loc.y), corner((loc.y + 1u) % 3u), loc.z, tri_n[loc.y]);
     }
-    let w = vec3<f32>(abc) / f32(tri_k);
-    return Node(w.x * tri_position[0] + w.y * tri_position[1] + w.z * tri_position[2], w);
+    return weighted(part, vec3<f32>(abc) / f32(tri_k));
 }
 
 // The node's fine index along original edge oe from its start, or −1 if it is not on that edge.
@@ -383,20 +366,56 @@ fn node_on_edge(e: u32, m: u32) -> Node {
     return edge_point(a, b, j, n);
 }
 
-fn interior_node(i: u32, j: u32, l: u32, m: u32) -> Node {
-    let w = vec3<f32>(f32(i), f32(j), f32(l)) / f32(m);
+// The point with weights w of a triangle of nodes (positions and barycentric weights alike).
+fn weighted(q: array<Node, 3>, w: vec3<f32>) -> Node {
     return Node(
-        w.x * piece_q[0].position + w.y * piece_q[1].position + w.z * piece_q[2].position,
-        w.x * piece_q[0].bary + w.y * piece_q[1].bary + w.z * piece_q[2].bary,
+        w.x * q[0].position + w.y * q[1].position + w.z * q[2].position,
+        w.x * q[0].bary + w.y * q[1].bary + w.z * q[2].bary,
     );
 }
 
-// ---- axis split and emission ----
+fn interior_node(i: u32, j: u32, l: u32, m: u32) -> Node {
+    return weighted(piece_q, vec3<f32>(f32(i), f32(j), f32(l)) / f32(m));
+}
 
-fn plane_distance(plane: vec3<f32>, p: vec3<f32>) -> f32 {
-    let d = plane.x * p.x + plane.y * p.z - plane.z;
-    let scale = abs(plane.x * p.x) + abs(plane.y * p.z) + abs(plane.z);
-    return select(d, 0.0, abs(d) <= SNAP * scale);
+// ---- the parts around the vertical axis (src/cpu/subdivide/axis.rs) ----
+
+// Moves a vertex within SNAP (relative to |x| + |z|) of the plane x = 0 or z = 0 onto it.
+fn snap_to_cut_planes(p: vec3<f32>) -> vec3<f32> {
+    let scale = SNAP * (abs(p.x) + abs(p.z));
+    return vec3<f32>(select(p.x, 0.0, abs(p.x) <= scale), p.y, select(p.z, 0.0, abs(p.z) <= scale));
+}
+
+// The half-planes: CUT_X s·x ≥ 0, CUT_Z s·z ≥ 0, CUT_CHORD sx·x + sz·z ≥ ρ.
+const CUT_X: u32 = 0u;
+const CUT_Z: u32 = 1u;
+const CUT_CHORD: u32 = 2u;
+
+fn cut_distance(kind: u32, s: vec2<f32>, p: vec3<f32>) -> f32 {
+    if (kind == CUT_X) {
+        return s.x * p.x;
+    }
+    if (kind == CUT_Z) {
+        return s.y * p.z;
+    }
+    let rho = params.axis_clearance;
+    let d = s.x * p.x + s.y * p.z - rho;
+    return select(d, 0.0, abs(d) <= SNAP * (abs(p.x) + abs(p.z) + rho));
+}
+
+// The crossing of lo→hi (canonically ordered); on x = 0 or z = 0 that coordinate is set to 0.
+fn cut_crossing(kind: u32, lo: Node, hi: Node, dl: f32, dh: f32) -> Node {
+    let t = dl / (dl - dh);
+    var n = Node(lo.position + (hi.position - lo.position) * t, lo.bary + (hi.bary - lo.bary) * t);
+    let scale = SNAP * (abs(lo.position.x) + abs(lo.position.z) + abs(hi.position.x) + abs(hi.position.z));
+    if (kind == CUT_X) {
+        n.position.x = 0.0;
+        n.position.z = select(n.position.z, 0.0, abs(n.position.z) <= scale);
+    } else if (kind == CUT_Z) {
+        n.position.z = 0.0;
+        n.position.x = select(n.position.x, 0.0, abs(n.position.x) <= scale);
+    }
+    return n;
 }
 
 fn push_clipped(n: u32, v: Node) -> u32 {
@@ -409,33 +428,29 @@ fn push_clipped(n: u32, v: Node) -> u32 {
 
 // Sutherland–Hodgman clip of `poly` against one half-plane; crossing points from the
 // canonically ordered edge.
-fn clip_polygon(plane: vec3<f32>) {
+fn clip_polygon(kind: u32, s: vec2<f32>) {
     var n = 0u;
     for (var i = 0u; i < poly_count; i++) {
         let cur = poly[i];
         let next = poly[(i + 1u) % poly_count];
-        let d0 = plane_distance(plane, cur.position);
-        let d1 = plane_distance(plane, next.position);
+        let d0 = cut_distance(kind, s, cur.position);
+        let d1 = cut_distance(kind, s, next.position);
         if (d0 >= 0.0) {
             n = push_clipped(n, cur);
         }
-        if ((d0 >= 0.0) != (d1 >= 0.0)) {
-            var lo = cur;
-            var hi = next;
-            var dl = d0;
-            var dh = d1;
+        if ((d0 >= 0.0) != (d1 >= 0.0) && d0 != 0.0 && d1 != 0.0) {
             if (lex_less(next.position, cur.position)) {
-                lo = next;
-                hi = cur;
-                dl = d1;
-                dh = d0;
+                n = push_clipped(n, cut_crossing(kind, next, cur, d1, d0));
+            } else {
+                n = push_clipped(n, cut_crossing(kind, cur, next, d0, d1));
             }
-            let t = dl / (dl - dh);
-            n = push_clipped(n, Node(lo.position + (hi.position - lo.position) * t, lo.bary + (hi.bary - lo.bary) * t));
         }
     }
     if (n > 1u && same(scratch[n - 1u].position, scratch[0].position)) {
         n -= 1u;
+    }
+    if (n < 3u) {
+        n = 0u;
     }
     for (var i = 0u; i < n; i++) {
         poly[i] = scratch[i];
@@ -443,35 +458,70 @@ fn clip_polygon(plane: vec3<f32>) {
     poly_count = n;
 }
 
-fn segment_distance(a: vec2<f32>, b: vec2<f32>) -> f32 {
-    let ab = b - a;
-    let len2 = dot(ab, ab);
-    var t = 0.0;
-    if (len2 > 0.0) {
-        t = clamp(-dot(a, ab) / len2, 0.0, 1.0);
+// Clips the input triangle to quadrant q (signs of x and z as in `QUADRANTS` of axis.rs).
+fn quadrant_polygon(q: u32) {
+    let signs = array<vec2<f32>, 4>(vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0), vec2<f32>(-1.0, 1.0), vec2<f32>(-1.0, -1.0));
+    let s = signs[q];
+    poly[0] = Node(tri_position[0], vec3<f32>(1.0, 0.0, 0.0));
+    poly[1] = Node(tri_position[1], vec3<f32>(0.0, 1.0, 0.0));
+    poly[2] = Node(tri_position[2], vec3<f32>(0.0, 0.0, 1.0));
+    poly_count = 3u;
+    // Quick tests (the clips would give the same): wholly on the far side of x = 0 or z = 0, or
+    // two corners the same (no polygon); wholly inside the quadrant and beyond the chord.
+    let p = tri_position;
+    let dx = vec3<f32>(s.x * p[0].x, s.x * p[1].x, s.x * p[2].x);
+    let dz = vec3<f32>(s.y * p[0].z, s.y * p[1].z, s.y * p[2].z);
+    if (all(dx < vec3<f32>(0.0)) || all(dz < vec3<f32>(0.0)) || same(p[0], p[1]) || same(p[1], p[2])
+        || same(p[2], p[0])) {
+        poly_count = 0u;
+        return;
     }
-    return length(a + ab * t);
+    if (all(dx > vec3<f32>(0.0)) && all(dz > vec3<f32>(0.0)) && cut_distance(CUT_CHORD, s, p[0]) > 0.0
+        && cut_distance(CUT_CHORD, s, p[1]) > 0.0 && cut_distance(CUT_CHORD, s, p[2]) > 0.0) {
+        return;
+    }
+    clip_polygon(CUT_X, s);
+    clip_polygon(CUT_Z, s);
+    clip_polygon(CUT_CHORD, s);
 }
 
-fn cross2(a: vec2<f32>, b: vec2<f32>) -> f32 {
-    return a.x * b.y - a.y * b.x;
+// Visits the parts of the current triangle in the twin's order (`parts` in axis.rs): with
+// `wanted` < MAX_PARTS, loads part `wanted` into `part` and returns true if it exists; with
+// wanted = MAX_PARTS, plans every part and appends its pieces (the `plan` entry point).
+fn visit_parts(t: u32, wanted: u32) -> bool {
+    var index = 0u;
+    for (var q = 0u; q < 4u; q++) {
+        quadrant_polygon(q);
+        for (var i = 1u; i + 1u < poly_count; i++) {
+            if (wanted == MAX_PARTS || index == wanted) {
+                part[0] = poly[0];
+                part[1] = poly[i];
+                part[2] = poly[i + 1u];
+                if (wanted != MAX_PARTS) {
+                    return true;
+                }
+                plan_part();
+                append_pieces(t, index);
+            }
+            index += 1u;
+        }
+    }
+    return false;
 }
 
-fn needs_axis_split(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>, split_radius: f32) -> bool {
-    let q0 = p0.xz;
-    let q1 = p1.xz;
-    let q2 = p2.xz;
-    let e0 = cross2(q1 - q0, -q0);
-    let e1 = cross2(q2 - q1, -q1);
-    let e2 = cross2(q0 - q2, -q2);
-    let contains = (e0 >= 0.0 && e1 >= 0.0 && e2 >= 0.0) || (e0 <= 0.0 && e1 <= 0.0 && e2 <= 0.0);
-    let near = min(min(segment_distance(q0, q1), segment_distance(q1, q2)), segment_distance(q2, q0)) < split_radius;
-    let t0 = azimuth(p0);
-    let t1 = azimuth(p1);
-    let t2 = azimuth(p2);
-    let span = max(max(abs(wrap_angle(t0 - t1)), abs(wrap_angle(t1 - t2))), abs(wrap_angle(t2 - t0)));
-    return contains || near || span > MAX_SPAN;
+fn append_pieces(t: u32, index: u32) {
+    let count = tri_k * tri_k;
+    let base = atomicAdd(&counters.pieces, count);
+    if (base + count > params.piece_capacity) {
+        return; // counted, never written
+    }
+    let packed = vec2<u32>(tri_n[0] | (tri_n[1] << 16u), tri_n[2] | (tri_k << 16u));
+    for (var c = 0u; c < count; c++) {
+        pieces[base + c] = vec4<u32>(t, index | (c << 4u), packed);
+    }
 }
+
+// ---- emission ----
 
 fn draw_vertex(n: Node, theta_ref: f32) -> DrawVertex {
     let b = n.bary;
@@ -544,35 +594,13 @@ fn emit(a: Node, b: Node, c: Node) {
     }
 }
 
-// Axis split (if needed), then emission.
+// Emission of a sub-triangle, unless it is degenerate or off screen.
 fn finish_triangle(a: Node, b: Node, c: Node) {
     if (same(a.position, b.position) || same(b.position, c.position) || same(c.position, a.position)
         || off_screen_vertically(a.position, b.position, c.position)) {
         return;
     }
-    let clearance = params.axis_clearance;
-    let split = needs_axis_split(a.position, b.position, c.position, clearance / C8);
-    let sectors = select(1u, 8u, split);
-    for (var s = 0u; s < sectors; s++) {
-        poly[0] = a;
-        poly[1] = b;
-        poly[2] = c;
-        poly_count = 3u;
-        if (split) {
-            let d0 = BOUNDARY[s];
-            let d1 = BOUNDARY[s + 1u];
-            let mid = MIDDLE[s];
-            let planes = array<vec3<f32>, 3>(vec3<f32>(d0.x, d0.y, 0.0), vec3<f32>(-d1.x, -d1.y, 0.0),
-                                             vec3<f32>(mid.y, -mid.x, clearance));
-            for (var k = 0u; k < 3u; k++) {
-                clip_polygon(planes[k]);
-            }
-        }
-        let first = poly[0];
-        for (var i = 1u; i + 1u < poly_count; i++) {
-            emit(first, poly[i], poly[i + 1u]);
-        }
-    }
+    emit(a, b, c);
 }
 
 // ---- the lattice of a piece, one triangle at a time ----
@@ -601,16 +629,10 @@ fn plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     let t = params.first_triangle + local;
     load_triangle(t);
-    plan_triangle();
-    let count = tri_k * tri_k;
-    let base = atomicAdd(&counters.pieces, count);
-    if (base + count > params.piece_capacity) {
-        return; // counted, never written
+    if (off_screen_vertically(tri_position[0], tri_position[1], tri_position[2])) {
+        return; // no pieces
     }
-    let packed = vec2<u32>(tri_n[0] | (tri_n[1] << 16u), tri_n[2] | (tri_k << 16u));
-    for (var c = 0u; c < count; c++) {
-        pieces[base + c] = vec4<u32>(t, c, packed);
-    }
+    visit_parts(t, MAX_PARTS);
 }
 
 @compute @workgroup_size(64)
@@ -625,11 +647,14 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     }
     let piece = pieces[params.first_piece + local];
     load_triangle(piece.x);
+    if (!visit_parts(piece.x, piece.y & 15u)) {
+        return;
+    }
     tri_n[0] = piece.z & 0xffffu;
     tri_n[1] = piece.z >> 16u;
     tri_n[2] = piece.w & 0xffffu;
     tri_k = piece.w >> 16u;
-    let cell = macro_cell(tri_k, piece.y);
+    let cell = macro_cell(tri_k, piece.y >> 4u);
     var loc: array<vec3<u32>, 3>;
     for (var i = 0u; i < 3u; i++) {
         loc[i] = macro_location(cell.c[i]);

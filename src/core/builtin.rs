@@ -2,7 +2,9 @@
 //!
 //! | name | what |
 //! |---|---|
-//! | `builtin:demo` | a 12 m room around the viewer: tiled floor (one tile under the viewer, around the axis), four walls, a ceiling of two triangles whose shared diagonal passes through the axis, and spheres at 1 m (ahead right, red), 3 m (left, green), 5 m (straight behind, magenta, straddling the ±π seam) |
+//! | `builtin:demo` | a 12 m room around the viewer, one closed mesh: tiled floor (one tile under the viewer, around the axis), four walls, a tiled ceiling whose middle tile's diagonal passes over the viewer, and spheres at 1 m (ahead right, red), 3 m (left, green), 5 m (straight behind, magenta, straddling the ±π seam) |
+//! | `builtin:box-room` | a closed 40×10×40 m box of 12 triangles around the viewer, the floor 1.7 m below the eyes, each face its own colour |
+//! | `builtin:cube` | the closed 2 m cube [−1, 1]³ of 12 triangles, each face its own colour (place the viewer inside it with `--viewer`) |
 //! | `builtin:sphere100`, `builtin:sphere1024` | spheres of exactly 100 and 1024 triangles, 3 m ahead, filling the screen height (the paper's Sphere100/Sphere1024) |
 //! | `builtin:triangle@D` | the paper's evaluation-1 triangle: equilateral, facing the viewer, D metres straight ahead, projected side ≈ the image height H |
 
@@ -23,13 +25,22 @@ pub const SEAM_SPHERE_RADIUS: f32 = 0.8;
 /// Height of the demo's floor below the eyes.
 pub const DEMO_FLOOR_Y: f32 = -1.5;
 
-pub const NAMES: &[&str] = &["builtin:demo", "builtin:sphere100", "builtin:sphere1024", "builtin:triangle@D"];
+pub const NAMES: &[&str] = &[
+    "builtin:demo",
+    "builtin:box-room",
+    "builtin:cube",
+    "builtin:sphere100",
+    "builtin:sphere1024",
+    "builtin:triangle@D",
+];
 
 /// Builds a built-in scene by name; `projection` sizes the screen-filling ones.
 pub fn builtin_scene(name: &str, projection: &Projection) -> Result<Scene> {
     let spec = name.strip_prefix("builtin:").unwrap_or(name);
     match spec {
         "demo" => Ok(demo()),
+        "box-room" => Ok(closed_box(name, Vec3::new(-20.0, -1.7, -20.0), Vec3::new(20.0, 8.3, 20.0))),
+        "cube" => Ok(closed_box(name, Vec3::splat(-1.0), Vec3::splat(1.0))),
         "sphere100" => Ok(screen_filling_sphere(100, 3.0, projection, name)),
         "sphere1024" => Ok(screen_filling_sphere(1024, 3.0, projection, name)),
         _ => {
@@ -65,7 +76,8 @@ pub fn uv_sphere(center: Vec3, radius: f32, slices: u32, stacks: u32, color: [f3
     for i in 0..=stacks {
         let polar = PI * i as f32 / stacks as f32;
         for j in 0..=slices {
-            let az = TAU * j as f32 / slices as f32;
+            // The last column repeats the first's positions bit for bit (a closed mesh).
+            let az = TAU * (j % slices) as f32 / slices as f32;
             let n = Vec3::new(polar.sin() * az.cos(), polar.cos(), polar.sin() * az.sin());
             v.push(vertex(center + radius * n, n, color));
         }
@@ -163,11 +175,37 @@ pub fn paper_triangle(distance: f32, projection: &Projection) -> Scene {
     scene
 }
 
-/// A quad a, b, c, d (counter-clockwise seen from the front) as two triangles.
-fn quad(scene: &mut Scene, name: &str, p: [Vec3; 4], color: [f32; 4]) {
-    let n = (p[1] - p[0]).cross(p[3] - p[0]).normalize();
-    let v: Vec<SceneVertex> = p.iter().map(|&q| vertex(q, n, color)).collect();
-    scene.add_mesh(name, &v, &[0, 1, 2, 0, 2, 3]);
+/// A closed box from `lo` to `hi` seen from inside (one object, 12 triangles on 8 shared corner
+/// positions), each face its own colour: −z, +x, +z, −x, floor, ceiling.
+pub fn closed_box(name: &str, lo: Vec3, hi: Vec3) -> Scene {
+    let colours = [
+        [0.3, 0.4, 0.8, 1.0],
+        [0.8, 0.7, 0.25, 1.0],
+        [0.55, 0.55, 0.55, 1.0],
+        [0.25, 0.6, 0.55, 1.0],
+        [0.6, 0.45, 0.35, 1.0],
+        [0.6, 0.65, 0.75, 1.0],
+    ];
+    let c = |x: usize, y: usize, z: usize| Vec3::new([lo.x, hi.x][x], [lo.y, hi.y][y], [lo.z, hi.z][z]);
+    // Each face's corners counter-clockwise seen from inside the box.
+    let faces = [
+        [c(0, 0, 0), c(1, 0, 0), c(1, 1, 0), c(0, 1, 0)],
+        [c(1, 0, 0), c(1, 0, 1), c(1, 1, 1), c(1, 1, 0)],
+        [c(1, 0, 1), c(0, 0, 1), c(0, 1, 1), c(1, 1, 1)],
+        [c(0, 0, 1), c(0, 0, 0), c(0, 1, 0), c(0, 1, 1)],
+        [c(0, 0, 1), c(1, 0, 1), c(1, 0, 0), c(0, 0, 0)],
+        [c(0, 1, 0), c(1, 1, 0), c(1, 1, 1), c(0, 1, 1)],
+    ];
+    let (mut v, mut idx) = (Vec::new(), Vec::new());
+    for (p, colour) in faces.iter().zip(colours) {
+        let n = (p[1] - p[0]).cross(p[3] - p[0]).normalize();
+        let base = v.len() as u32;
+        v.extend(p.iter().map(|&q| vertex(q, n, colour)));
+        idx.extend([0, 1, 2, 0, 2, 3].map(|i| base + i));
+    }
+    let mut scene = Scene::new(name);
+    scene.add_mesh("box", &v, &idx);
+    scene
 }
 
 /// `builtin:demo`: a room around the viewer (see the module doc).
@@ -175,52 +213,51 @@ pub fn demo() -> Scene {
     let mut s = Scene::new("builtin:demo");
     let half = 6.0f32; // room half-size, metres
     let (floor, ceiling) = (DEMO_FLOOR_Y, 2.5f32);
-    // Floor: 12×12 tiles of 1 m, offset by half a tile so that one tile holds the axis.
-    for i in 0..12 {
-        for j in 0..12 {
-            let (x0, z0) = (-half + i as f32 - 0.5, -half + j as f32 - 0.5);
-            let (x1, z1) = ((x0 + 1.0).min(half), (z0 + 1.0).min(half));
-            let (x0, z0) = (x0.max(-half), z0.max(-half));
-            let light = (i + j) % 2 == 0;
+    // Tile lines every metre, offset by half a tile so that one tile holds the axis: −6, −5.5,
+    // −4.5, …, 5.5, 6. Floor, walls and ceiling share them, so the room is one closed mesh
+    // (every edge shared by exactly two triangles, no T-junctions).
+    let mut lines = vec![-half];
+    lines.extend((0..12).map(|i| -half + 0.5 + i as f32));
+    lines.push(half);
+    let (mut v, mut idx) = (Vec::new(), Vec::new());
+    let mut quad = |p: [Vec3; 4], color: [f32; 4]| {
+        let n = (p[1] - p[0]).cross(p[3] - p[0]).normalize();
+        let base = v.len() as u32;
+        v.extend(p.iter().map(|&q| vertex(q, n, color)));
+        idx.extend([0, 1, 2, 0, 2, 3].map(|i| base + i));
+    };
+    for (i, x) in lines.windows(2).enumerate() {
+        for (j, z) in lines.windows(2).enumerate() {
+            let light = (i + j) % 2 == 1;
             let c = if light { [0.75, 0.72, 0.65, 1.0] } else { [0.35, 0.33, 0.3, 1.0] };
-            let p = [
-                Vec3::new(x0, floor, z1),
-                Vec3::new(x1, floor, z1),
-                Vec3::new(x1, floor, z0),
-                Vec3::new(x0, floor, z0),
-            ];
-            quad(&mut s, "floor", p, c);
+            let at = |a: f32, b: f32, y: f32| Vec3::new(a, y, b);
+            quad([at(x[0], z[1], floor), at(x[1], z[1], floor), at(x[1], z[0], floor), at(x[0], z[0], floor)], c);
+            // Ceiling tiles, each two triangles; the middle tile's diagonal passes over the viewer.
+            let c = [0.6, 0.65, 0.75, 1.0];
+            quad(
+                [at(x[0], z[0], ceiling), at(x[1], z[0], ceiling), at(x[1], z[1], ceiling), at(x[0], z[1], ceiling)],
+                c,
+            );
         }
     }
-    // Ceiling: two triangles; their shared diagonal passes straight over the viewer.
-    let c = [0.6, 0.65, 0.75, 1.0];
-    quad(
-        &mut s,
-        "ceiling",
-        [
-            Vec3::new(-half, ceiling, -half),
-            Vec3::new(half, ceiling, -half),
-            Vec3::new(half, ceiling, half),
-            Vec3::new(-half, ceiling, half),
-        ],
-        c,
-    );
-    // Walls, each its own colour: ahead (−z) blue, right (+x) yellow, behind (+z) grey, left teal.
-    let walls = [
-        ([-half, -half], [half, -half], [0.3, 0.4, 0.8, 1.0], "wall ahead"),
-        ([half, -half], [half, half], [0.8, 0.7, 0.25, 1.0], "wall right"),
-        ([half, half], [-half, half], [0.55, 0.55, 0.55, 1.0], "wall behind"),
-        ([-half, half], [-half, -half], [0.25, 0.6, 0.55, 1.0], "wall left"),
-    ];
-    for (a, b, c, name) in walls {
-        let p = [
-            Vec3::new(a[0], floor, a[1]),
-            Vec3::new(b[0], floor, b[1]),
-            Vec3::new(b[0], ceiling, b[1]),
-            Vec3::new(a[0], ceiling, a[1]),
-        ];
-        quad(&mut s, name, p, c);
+    // Walls, each its own colour: ahead (−z) blue, right (+x) yellow, behind (+z) grey, left teal;
+    // one column per tile line, so their bottom and top edges are the floor's and the ceiling's.
+    let colours = [[0.3, 0.4, 0.8, 1.0], [0.8, 0.7, 0.25, 1.0], [0.55, 0.55, 0.55, 1.0], [0.25, 0.6, 0.55, 1.0]];
+    for (w, colour) in colours.into_iter().enumerate() {
+        for t in lines.windows(2) {
+            // Along the wall, counter-clockwise seen from inside.
+            let at = |a: f32| match w {
+                0 => Vec3::new(a, 0.0, -half),
+                1 => Vec3::new(half, 0.0, a),
+                2 => Vec3::new(-a, 0.0, half),
+                _ => Vec3::new(-half, 0.0, -a),
+            };
+            let (a, b) = (at(t[0]), at(t[1]));
+            let y = |p: Vec3, y: f32| Vec3::new(p.x, y, p.z);
+            quad([y(a, floor), y(b, floor), y(b, ceiling), y(a, ceiling)], colour);
+        }
     }
+    s.add_mesh("room", &v, &idx);
     // Spheres at 1 m (ahead right), 3 m (left), 5 m (straight behind, across the seam).
     let spheres = [
         (Vec3::new(FRAC_1_SQRT_2, -0.2, -FRAC_1_SQRT_2), 0.2, [0.85, 0.15, 0.1, 1.0], "sphere 1 m"),

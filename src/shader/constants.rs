@@ -9,9 +9,13 @@ use crate::core::settings::SplitRule;
 pub const MAX_EDGE_DIVISIONS: u32 = 1024;
 /// Segments of the polyline that measures a long edge's projected length.
 pub const EDGE_SAMPLES: u32 = 8;
-/// Triangles spanning more azimuth than this (a little over 90°) are split into sectors. Not
-/// a round angle, so that structured meshes rarely sit exactly on the threshold.
-pub const MAX_SPAN: f32 = 1.6;
+/// The square cut around the vertical axis has half-diagonal ρ = d_e clamped to
+/// [`AXIS_CLEARANCE_MIN`, `AXIS_CLEARANCE_MAX`]·R_T (see `cpu::subdivide::axis`).
+pub const AXIS_CLEARANCE_MIN: f32 = 1e-5;
+pub const AXIS_CLEARANCE_MAX: f32 = 1e-3;
+/// The most parts an input triangle is cut into around the axis: 4 quadrants × a fan of at
+/// most 4 triangles (a triangle clipped by three half-planes has at most 6 corners).
+pub const MAX_PARTS: u32 = 16;
 /// Signed distances within this fraction of their terms' magnitude count as on the clip line,
 /// so that the CPU and the GPU (whose rounding differs in the last bits) take the same side.
 pub const SNAP: f32 = 1e-6;
@@ -51,7 +55,9 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("MAX_EDGE_DIVISIONS", U32(MAX_EDGE_DIVISIONS)),
         ("EDGE_SAMPLES", U32(EDGE_SAMPLES)),
         ("FIXED_PIECE_DIVISIONS", U32(FIXED_PIECE_DIVISIONS)),
-        ("MAX_SPAN", F32(MAX_SPAN)),
+        ("AXIS_CLEARANCE_MIN", F32(AXIS_CLEARANCE_MIN)),
+        ("AXIS_CLEARANCE_MAX", F32(AXIS_CLEARANCE_MAX)),
+        ("MAX_PARTS", U32(MAX_PARTS)),
         ("SNAP", F32(SNAP)),
         ("SEAM_MARGIN", F32(SEAM_MARGIN)),
         ("PIECES_FROM_COUNTER", U32(PIECES_FROM_COUNTER)),

@@ -1,129 +1,166 @@
-//! The vertical axis (see the module doc of `cpu::subdivide`): sub-triangles that contain or
-//! near the axis, or span too much azimuth, are cut into the 8 sectors of 45° around it and by a
-//! chord just outside the eye circle. The exact sector tables are shared with the WGSL.
+//! The vertical axis (see the module doc of `cpu::subdivide`). Every input triangle is cut into
+//! its **parts**: its polygon in each of the four quadrants around the axis (cut by the planes
+//! x = 0 and z = 0), minus a small square around the axis (the chord `sx·x + sz·z ≥ ρ` of each
+//! quadrant, ρ = [`axis_clearance`]), fan-triangulated. The parts are what the pre-split and the
+//! lattice subdivide.
+//!
+//! **Why this is watertight.** Every point where a part's boundary meets another part's is
+//! computed from one edge alone, the same way in every triangle that has that edge:
+//! - where an input edge crosses x = 0 or z = 0: from its canonically ordered endpoints, and
+//!   the crossed coordinate is then set to exactly 0;
+//! - where a sub-segment of an input edge (between such crossings) meets the chord: likewise;
+//! - where a cut line (inside a triangle, on x = 0 or z = 0) meets the chord: both quadrants
+//!   beside it see the same segment, whose crossed coordinate is exactly 0, so the chord's
+//!   distance `sx·x + sz·z − ρ` is the same number in both.
+//!
+//! Vertices within `SNAP` (relative) of a cutting plane are moved onto it first, so that the
+//! CPU and the GPU, whose matrix products differ in the last bits, take the same side.
+//!
+//! **What is removed.** Only the square |x| + |z| < ρ around the axis, whose points have
+//! r < ρ ≤ d_e: no eye sees them. Points between the square and the eye circle (r < d_e) stay
+//! and are drawn with the eye offset of the eye circle (`Projection::eye_shift` clamps), far
+//! above or below the image in the exact vertical model and just beyond the circle's image in
+//! the paper model, so that a ceiling close above the viewer has no hole in either.
+//!
+//! **Cost.** Only triangles that straddle x = 0 or z = 0 (or come within ρ of the axis) are cut;
+//! all others are their own single part.
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
-use super::{lex_less, Node};
-use crate::core::projection::{azimuth, wrap_angle, Projection};
-use crate::shader::constants::{MAX_SPAN, SNAP};
+use super::Node;
+use crate::core::projection::Projection;
+use crate::shader::constants::{AXIS_CLEARANCE_MAX, AXIS_CLEARANCE_MIN, MAX_PARTS, SNAP};
 
-/// Number of sectors an axis triangle is split into.
-pub const SECTORS: usize = 8;
+/// The quadrants (sign of x, sign of z), in the order the twin and the WGSL number parts.
+pub const QUADRANTS: [(f32, f32); 4] = [(1.0, -1.0), (1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0)];
 
-const H: f32 = std::f32::consts::FRAC_1_SQRT_2;
-const C8: f32 = 0.923_879_5; // cos(π/8)
-const S8: f32 = 0.382_683_43; // sin(π/8)
-/// (cos, sin) of the sector boundaries −π + k·π/4, an exact table shared with the WGSL.
-const BOUNDARY: [(f32, f32); 9] =
-    [(-1.0, 0.0), (-H, -H), (0.0, -1.0), (H, -H), (1.0, 0.0), (H, H), (0.0, 1.0), (-H, H), (-1.0, 0.0)];
-/// (cos, sin) of the sector middles −π + k·π/4 + π/8.
-const MIDDLE: [(f32, f32); 8] =
-    [(-C8, -S8), (-S8, -C8), (S8, -C8), (C8, -S8), (C8, S8), (S8, C8), (-S8, C8), (-C8, S8)];
-
-/// The clearance kept around the vertical axis: just outside the eye circle (and never zero,
-/// so that a mono camera with d_e = 0 still avoids the singular axis).
+/// ρ, the half-diagonal of the square cut around the axis: the eye radius clamped to
+/// `[AXIS_CLEARANCE_MIN, AXIS_CLEARANCE_MAX]`·R_T = [10⁻⁵, 10⁻³]·R_T. At most d_e, so only points no
+/// eye sees are removed, unless d_e < 10⁻⁵·R_T (a mono camera): then the removed points within
+/// 10⁻⁵·R_T of the axis could show only if they were as close to the eyes' height. Small, so that
+/// the paper model's image of a ceiling just above the eyes reaches past the top of the image;
+/// not smaller, so that the thin parts beside the square keep distinct lattice nodes in f32.
 pub fn axis_clearance(projection: &Projection) -> f32 {
-    projection.eye_radius.max(1e-3 * projection.screen_radius) * (1.0 + 1e-3)
+    let rt = projection.screen_radius;
+    projection.eye_radius.clamp(AXIS_CLEARANCE_MIN * rt, AXIS_CLEARANCE_MAX * rt)
 }
 
-/// A triangle that comes nearer the axis than this is split into sectors.
-pub fn split_radius(axis_clearance: f32) -> f32 {
-    axis_clearance / C8
+/// Moves a vertex within `SNAP` (relative to |x| + |z|) of the plane x = 0 or z = 0 onto it.
+pub fn snap_to_cut_planes(p: Vec3) -> Vec3 {
+    let scale = SNAP * (p.x.abs() + p.z.abs());
+    Vec3::new(if p.x.abs() <= scale { 0.0 } else { p.x }, p.y, if p.z.abs() <= scale { 0.0 } else { p.z })
 }
 
-/// Half-plane `a·x + b·z ≥ c` in the viewer frame's xz plane.
-#[derive(Clone, Copy)]
-pub(super) struct HalfPlane {
-    a: f32,
-    b: f32,
-    c: f32,
+/// A half-plane a part is clipped by.
+#[derive(Clone, Copy, Debug)]
+enum Cut {
+    /// s·x ≥ 0 (the crossed coordinate of a crossing point is set to 0).
+    X(f32),
+    /// s·z ≥ 0.
+    Z(f32),
+    /// sx·x + sz·z ≥ ρ: outside the square around the axis.
+    Chord(f32, f32, f32),
 }
 
-impl HalfPlane {
-    fn distance(&self, p: Vec3) -> f32 {
-        let d = self.a * p.x + self.b * p.z - self.c;
-        let scale = (self.a * p.x).abs() + (self.b * p.z).abs() + self.c.abs();
-        if d.abs() <= SNAP * scale {
-            0.0
-        } else {
-            d
+impl Cut {
+    fn distance(self, p: Vec3) -> f32 {
+        match self {
+            Cut::X(s) => s * p.x,
+            Cut::Z(s) => s * p.z,
+            Cut::Chord(sx, sz, rho) => {
+                let d = sx * p.x + sz * p.z - rho;
+                if d.abs() <= SNAP * (p.x.abs() + p.z.abs() + rho) {
+                    0.0
+                } else {
+                    d
+                }
+            }
         }
+    }
+
+    /// The crossing of segment lo→hi (canonically ordered) with distances dl, dh of opposite signs.
+    fn crossing(self, lo: Node, hi: Node, dl: f32, dh: f32) -> Node {
+        let t = dl / (dl - dh);
+        let mut n =
+            Node { position: lo.position + (hi.position - lo.position) * t, bary: lo.bary + (hi.bary - lo.bary) * t };
+        let scale = SNAP * (lo.position.x.abs() + lo.position.z.abs() + hi.position.x.abs() + hi.position.z.abs());
+        match self {
+            Cut::X(_) => {
+                n.position.x = 0.0;
+                if n.position.z.abs() <= scale {
+                    n.position.z = 0.0;
+                }
+            }
+            Cut::Z(_) => {
+                n.position.z = 0.0;
+                if n.position.x.abs() <= scale {
+                    n.position.x = 0.0;
+                }
+            }
+            Cut::Chord(..) => {}
+        }
+        n
     }
 }
 
-/// Sutherland–Hodgman clip of a convex polygon against one half-plane. Crossing points are
-/// computed from the canonically ordered edge, so neighbours get the same point; a vertex that
-/// repeats the previous one (a corner on the clip line) is dropped.
-pub(super) fn clip_polygon(poly: &[Node], plane: HalfPlane) -> Vec<Node> {
-    let mut out: Vec<Node> = Vec::with_capacity(poly.len() + 1);
-    let push = |n: Node, out: &mut Vec<Node>| {
-        if out.last().is_none_or(|l| l.position != n.position) {
-            out.push(n);
-        }
-    };
-    for i in 0..poly.len() {
-        let cur = poly[i];
-        let next = poly[(i + 1) % poly.len()];
-        let d0 = plane.distance(cur.position);
-        let d1 = plane.distance(next.position);
-        if d0 >= 0.0 {
-            push(cur, &mut out);
-        }
-        if (d0 >= 0.0) != (d1 >= 0.0) {
-            let (lo, hi, dl, dh) =
-                if lex_less(next.position, cur.position) { (next, cur, d1, d0) } else { (cur, next, d0, d1) };
-            let t = dl / (dl - dh);
-            push(
-                Node {
-                    position: lo.position + (hi.position - lo.position) * t,
-                    bary: lo.bary + (hi.bary - lo.bary) * t,
-                },
-                &mut out,
-            );
+/// A convex polygon of at most 6 vertices (a triangle clipped by three half-planes).
+#[derive(Clone, Copy, Debug)]
+struct Polygon {
+    nodes: [Node; 6],
+    count: usize,
+}
+
+impl Polygon {
+    fn push(&mut self, n: Node) {
+        if self.count == 0 || self.nodes[self.count - 1].position != n.position {
+            self.nodes[self.count] = n;
+            self.count += 1;
         }
     }
-    if out.len() > 1 && out[out.len() - 1].position == out[0].position {
-        out.pop();
+
+    /// Sutherland–Hodgman clip against one half-plane; crossing points come from the
+    /// canonically ordered edge, so a neighbour that clips the same edge gets the same point.
+    fn clip(&self, cut: Cut) -> Polygon {
+        let mut out = Polygon { nodes: [self.nodes[0]; 6], count: 0 };
+        for i in 0..self.count {
+            let cur = self.nodes[i];
+            let next = self.nodes[(i + 1) % self.count];
+            let (d0, d1) = (cut.distance(cur.position), cut.distance(next.position));
+            if d0 >= 0.0 {
+                out.push(cur);
+            }
+            if (d0 >= 0.0) != (d1 >= 0.0) && d0 != 0.0 && d1 != 0.0 {
+                let (lo, hi, dl, dh) = if super::lex_less(next.position, cur.position) {
+                    (next, cur, d1, d0)
+                } else {
+                    (cur, next, d0, d1)
+                };
+                out.push(cut.crossing(lo, hi, dl, dh));
+            }
+        }
+        if out.count > 1 && out.nodes[out.count - 1].position == out.nodes[0].position {
+            out.count -= 1;
+        }
+        if out.count < 3 {
+            out.count = 0;
+        }
+        out
     }
+}
+
+/// The parts of a triangle (corners in the viewer frame, already snapped), at most
+/// `MAX_PARTS`; part corners carry barycentric weights in the triangle. Numbered quadrant by
+/// quadrant ([`QUADRANTS`]), then along each quadrant's fan.
+pub fn parts(p: [Vec3; 3], rho: f32) -> Vec<[Node; 3]> {
+    let mut out = Vec::with_capacity(4);
+    let bary = [Vec3::X, Vec3::Y, Vec3::Z];
+    let triangle = Polygon { nodes: [0, 1, 2, 0, 0, 0].map(|i| Node { position: p[i], bary: bary[i] }), count: 3 };
+    for (sx, sz) in QUADRANTS {
+        let poly = triangle.clip(Cut::X(sx)).clip(Cut::Z(sz)).clip(Cut::Chord(sx, sz, rho));
+        for i in 1..poly.count.saturating_sub(1) {
+            out.push([poly.nodes[0], poly.nodes[i], poly.nodes[i + 1]]);
+        }
+    }
+    debug_assert!(out.len() <= MAX_PARTS as usize);
     out
-}
-
-/// The three half-planes of sector s: θ ≥ boundary s, θ ≤ boundary s+1, beyond the chord.
-pub(super) fn sector_planes(s: usize, clearance: f32) -> [HalfPlane; 3] {
-    // With P = (X, Y) = (−z, x), θ is P's polar angle. cross(d0, P) ≥ 0 ⇔ θ ≥ φ0;
-    // cross(P, d1) ≥ 0 ⇔ θ ≤ φ1; dot(P, d_mid) ≥ clearance is the chord.
-    let (c0, s0) = BOUNDARY[s];
-    let (c1, s1) = BOUNDARY[s + 1];
-    let (cm, sm) = MIDDLE[s];
-    [
-        HalfPlane { a: c0, b: s0, c: 0.0 },
-        HalfPlane { a: -c1, b: -s1, c: 0.0 },
-        HalfPlane { a: sm, b: -cm, c: clearance },
-    ]
-}
-
-fn segment_distance(a: Vec2, b: Vec2) -> f32 {
-    let ab = b - a;
-    let len2 = ab.dot(ab);
-    let t = if len2 > 0.0 { (-a.dot(ab) / len2).clamp(0.0, 1.0) } else { 0.0 };
-    (a + ab * t).length()
-}
-
-pub(super) fn cross2(a: Vec2, b: Vec2) -> f32 {
-    a.x * b.y - a.y * b.x
-}
-
-/// Whether a triangle must be split into sectors (see the module doc).
-pub fn needs_axis_split(p: [Vec3; 3], split_radius: f32) -> bool {
-    let q = p.map(|v| Vec2::new(v.x, v.z));
-    let e0 = cross2(q[1] - q[0], -q[0]);
-    let e1 = cross2(q[2] - q[1], -q[1]);
-    let e2 = cross2(q[0] - q[2], -q[2]);
-    let contains = (e0 >= 0.0 && e1 >= 0.0 && e2 >= 0.0) || (e0 <= 0.0 && e1 <= 0.0 && e2 <= 0.0);
-    let near =
-        segment_distance(q[0], q[1]).min(segment_distance(q[1], q[2])).min(segment_distance(q[2], q[0])) < split_radius;
-    let t = p.map(azimuth);
-    let span = wrap_angle(t[0] - t[1]).abs().max(wrap_angle(t[1] - t[2]).abs()).max(wrap_angle(t[2] - t[0]).abs());
-    contains || near || span > MAX_SPAN
 }

@@ -40,11 +40,11 @@
 //! No cracks, no T-junctions (every edge node is a lattice corner), no zero-area triangles.
 //!
 //! **The vertical axis.** No eye sees a point with r ≤ d_e, and a triangle around the axis covers
-//! every azimuth. A sub-triangle whose footprint contains or nears the axis, or spans more than
-//! `MAX_SPAN` of azimuth, is split into the 8 sectors of 45° around the axis and cut by a chord
-//! just outside the eye circle (`axis_clearance`): nothing is smeared across the panorama and no
-//! NaN is made. Only points no eye sees, or that project far above or below the image, are removed.
-//! Clip points are computed from canonically ordered edge endpoints, so neighbours agree.
+//! every azimuth. Every input triangle is therefore first cut into its parts in the four
+//! quadrants around the axis (planes x = 0 and z = 0; the seam θ = ±π is one of the cuts, so no
+//! part crosses it in θ), minus a small square around the axis whose points no eye sees (see
+//! `axis.rs`). The cut points on an edge depend on that edge alone, so neighbours agree; the
+//! parts are then split as above, each part's edges counting as its "original" edges.
 //!
 //! **Off screen.** Triangles that lie wholly above or below the image (see
 //! [`Subdivider::off_screen_vertically`]) make no pieces, and sub-triangles that do are not
@@ -68,8 +68,7 @@ use crate::shader::types::{DrawVertex, SubdivideParams};
 
 mod axis;
 
-pub use axis::{axis_clearance, needs_axis_split, split_radius, SECTORS};
-use axis::{clip_polygon, sector_planes};
+pub use axis::{axis_clearance, parts, snap_to_cut_planes, QUADRANTS};
 
 /// The `subdivide` stage's parameters for a range of input triangles (capacities and piece
 /// ranges are left for the caller, 0).
@@ -175,7 +174,8 @@ impl<'a> Subdivider<'a> {
 
     /// Projected length in pixels of the straight edge ab (larger of the two eyes), measured as
     /// a polyline through `segments` + 1 points. Heights are clamped to ±1.5 image heights from
-    /// the middle row, so off-screen parts count little.
+    /// the middle row, so off-screen parts count little, and segments beyond the clamp at both
+    /// ends (on one side) count nothing.
     pub fn edge_length_px(&self, a: Vec3, b: Vec3, segments: u32) -> f32 {
         let (lo, hi) = if lex_less(b, a) { (b, a) } else { (a, b) };
         let clamp_v = 1.5 * self.projection.height as f32;
@@ -188,7 +188,7 @@ impl<'a> Subdivider<'a> {
                 let t = k as f32 / segments as f32;
                 let mut q = self.pixel(lo + (hi - lo) * t, eye_sign);
                 q.y = q.y.clamp(-clamp_v, clamp_v);
-                if k > 0 {
+                if k > 0 && !(q.y == prev.y && q.y.abs() == clamp_v) {
                     let dx = (q.x - prev.x) - width * ((q.x - prev.x) / width).round();
                     total += Vec2::new(dx, q.y - prev.y).length();
                 }
@@ -236,7 +236,7 @@ impl<'a> Subdivider<'a> {
         let view = Mat4::from_cols_array_2d(&self.params.view);
         let v = |k: usize| &vertices[indices[3 * t + k] as usize];
         Triangle {
-            position: [0, 1, 2].map(|k| view.transform_point3(Vec3::from(v(k).position))),
+            position: [0, 1, 2].map(|k| snap_to_cut_planes(view.transform_point3(Vec3::from(v(k).position)))),
             normal: [0, 1, 2].map(|k| view.transform_vector3(Vec3::from(v(k).normal))),
             color: [0, 1, 2].map(|k| Vec4::from(v(k).color)),
             uv: [0, 1, 2].map(|k| Vec2::from(v(k).uv)),
@@ -258,13 +258,9 @@ impl<'a> Subdivider<'a> {
         above || below
     }
 
-    /// `plan`: the macro-lattice level K of a triangle (K² pieces, none if it is off screen
-    /// vertically) and its edge counts.
-    fn plan(&self, tri: &Triangle) -> (u32, [u32; 3]) {
-        let p = tri.position;
-        if self.off_screen_vertically(p) {
-            return (0, [1; 3]);
-        }
+    /// `plan`: the macro-lattice level K of a part (K² pieces) and its edge counts.
+    fn plan(&self, tri: &Triangle, part: &[Node; 3]) -> (u32, [u32; 3]) {
+        let p = part.map(|n| n.position);
         let l = self.edge_px(tri.object);
         let n = [
             self.edge_divisions(p[0], p[1], l),
@@ -282,16 +278,26 @@ impl<'a> Subdivider<'a> {
         (k, n)
     }
 
+    /// The parts of an input triangle (none if it lies wholly above or below the image).
+    fn triangle_parts(&self, tri: &Triangle) -> Vec<[Node; 3]> {
+        if self.off_screen_vertically(tri.position) {
+            return Vec::new();
+        }
+        parts(tri.position, self.params.axis_clearance)
+    }
+
     /// The whole stage for the dispatch's triangles.
     pub fn run(&self, vertices: &[SceneVertex], indices: &[u32]) -> SubdivideOutput {
         let mut out = SubdivideOutput::default();
         let first = self.params.first_triangle as usize;
         for t in first..first + self.params.triangle_count as usize {
             let tri = self.load(vertices, indices, t);
-            let (k, n) = self.plan(&tri);
-            for cell in 0..k * k {
-                out.pieces += 1;
-                self.lattice(&tri, k, n, cell, &mut out);
+            for part in self.triangle_parts(&tri) {
+                let (k, n) = self.plan(&tri, &part);
+                for cell in 0..k * k {
+                    out.pieces += 1;
+                    self.lattice(&tri, &part, k, n, cell, &mut out);
+                }
             }
         }
         out
@@ -313,22 +319,21 @@ impl<'a> Subdivider<'a> {
         }
     }
 
-    fn macro_node(&self, tri: &Triangle, n: [u32; 3], k: u32, loc: Location) -> Node {
-        let corner = |i: usize| Node { position: tri.position[i], bary: Vec3::from(BARY[i]) };
+    fn macro_node(&self, part: &[Node; 3], n: [u32; 3], k: u32, loc: Location) -> Node {
         match loc {
-            Location::Corner(i) => corner(i),
-            Location::OnEdge(e, j) => edge_point(corner(e), corner((e + 1) % 3), j, n[e]),
+            Location::Corner(i) => part[i],
+            Location::OnEdge(e, j) => edge_point(part[e], part[(e + 1) % 3], j, n[e]),
             Location::Interior([a, b, c]) => {
                 let w = Vec3::new(a as f32, b as f32, c as f32) / k as f32;
-                Node { position: w.x * tri.position[0] + w.y * tri.position[1] + w.z * tri.position[2], bary: w }
+                weighted(part, w)
             }
         }
     }
 
-    /// `lattice`: subdivides macro cell `cell` of a triangle and emits its sub-triangles.
-    fn lattice(&self, tri: &Triangle, k: u32, n: [u32; 3], cell: u32, out: &mut SubdivideOutput) {
+    /// `lattice`: subdivides macro cell `cell` of a part and emits its sub-triangles.
+    fn lattice(&self, tri: &Triangle, part: &[Node; 3], k: u32, n: [u32; 3], cell: u32, out: &mut SubdivideOutput) {
         let loc = macro_cell(k, cell).map(|c| self.macro_location(n, k, c));
-        let q = loc.map(|l| self.macro_node(tri, n, k, l));
+        let q = loc.map(|l| self.macro_node(part, n, k, l));
         if q[0].position == q[1].position || q[1].position == q[2].position || q[2].position == q[0].position {
             return; // snapped corners coincide: no area
         }
@@ -356,9 +361,8 @@ impl<'a> Subdivider<'a> {
             let pe = edges[e];
             match pe.original {
                 Some(oe) => {
-                    let corner = |i: usize| Node { position: tri.position[i], bary: Vec3::from(BARY[i]) };
                     let j = if pe.to >= pe.from { pe.from + m } else { pe.from - m };
-                    edge_point(corner(oe), corner((oe + 1) % 3), j, n[oe])
+                    edge_point(part[oe], part[(oe + 1) % 3], j, n[oe])
                 }
                 None => edge_point(q[e], q[(e + 1) % 3], m, pe.count),
             }
@@ -367,26 +371,13 @@ impl<'a> Subdivider<'a> {
         lattice_triangles(counts, &q, &node_on_edge, &mut emit);
     }
 
-    /// Axis split (if needed), then emission with seam copies.
+    /// Emission of a sub-triangle with its seam copies, unless it is degenerate or off screen.
     fn finish_triangle(&self, tri: &Triangle, nodes: [Node; 3], out: &mut SubdivideOutput) {
         let p = nodes.map(|n| n.position);
         if p[0] == p[1] || p[1] == p[2] || p[2] == p[0] || self.off_screen_vertically(p) {
             return;
         }
-        let clearance = self.params.axis_clearance;
-        if !needs_axis_split(p, split_radius(clearance)) {
-            self.emit(tri, nodes, out);
-            return;
-        }
-        for s in 0..SECTORS {
-            let mut poly = nodes.to_vec();
-            for plane in sector_planes(s, clearance) {
-                poly = clip_polygon(&poly, plane);
-            }
-            for i in 1..poly.len().saturating_sub(1) {
-                self.emit(tri, [poly[0], poly[i], poly[i + 1]], out);
-            }
-        }
+        self.emit(tri, nodes, out);
     }
 
     fn emit(&self, tri: &Triangle, nodes: [Node; 3], out: &mut SubdivideOutput) {
@@ -433,7 +424,13 @@ impl<'a> Subdivider<'a> {
     }
 }
 
-const BARY: [[f32; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+/// The point with weights `w` of a triangle of nodes (position and barycentric weights alike).
+fn weighted(q: &[Node; 3], w: Vec3) -> Node {
+    Node {
+        position: w.x * q[0].position + w.y * q[1].position + w.z * q[2].position,
+        bary: w.x * q[0].bary + w.y * q[1].bary + w.z * q[2].bary,
+    }
+}
 
 /// Where a macro node lies. Original edge e runs from corner e to corner e + 1.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -521,11 +518,7 @@ pub fn lattice_triangles(
         if let Some((e, idx)) = boundary_edge([i, j, l]) {
             node_on_edge(e, snap(idx, counts[e], m))
         } else {
-            let w = Vec3::new(i as f32, j as f32, l as f32) / m as f32;
-            Node {
-                position: w.x * q[0].position + w.y * q[1].position + w.z * q[2].position,
-                bary: w.x * q[0].bary + w.y * q[1].bary + w.z * q[2].bary,
-            }
+            weighted(q, Vec3::new(i as f32, j as f32, l as f32) / m as f32)
         }
     };
     for t in 0..m * m {
@@ -557,3 +550,5 @@ pub fn subdivide(params: &SubdivideParams, vertices: &[SceneVertex], indices: &[
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod watertight_tests;

@@ -1,11 +1,10 @@
 //! Tests of the `subdivide` twin: lattice conformity, closed meshes, pre-split, seam, axis.
 
-use super::axis::cross2;
 use super::*;
 use crate::core::projection::{Eye, Vertical};
 use crate::core::settings::{Method, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV};
 use std::collections::HashMap;
-use std::f32::consts::{FRAC_PI_4, FRAC_PI_8};
+use std::f32::consts::FRAC_PI_2;
 
 fn vertex(p: [f32; 3]) -> SceneVertex {
     SceneVertex { position: p, normal: [0.0, 1.0, 0.0], color: [1.0; 4], ..Default::default() }
@@ -43,38 +42,52 @@ fn footprint_area(v: &[DrawVertex]) -> f32 {
     v.chunks(3)
         .map(|t| {
             let q: Vec<Vec2> = t.iter().map(|d| Vec2::new(d.position[0], d.position[2])).collect();
-            0.5 * cross2(q[1] - q[0], q[2] - q[0]).abs()
+            0.5 * (q[1] - q[0]).perp_dot(q[2] - q[0]).abs()
         })
         .sum()
 }
 
 #[test]
 fn ordinary_triangle_passes_through_the_vertex_method_unchanged() {
-    let (_, out) = run_method([[-0.5, 0.0, -3.0], [0.5, 0.0, -3.0], [0.0, 0.5, -3.0]], Method::Vertex);
+    let (_, out) = run_method([[0.5, 0.0, -3.0], [1.5, 0.0, -3.0], [1.0, 0.5, -3.0]], Method::Vertex);
     assert_eq!(out.len(), 3);
-    assert!(out[0].theta_ref.abs() < 1e-6);
+    assert!((out[0].theta_ref - (1.0f32).atan2(3.0)).abs() < 1e-6);
 }
 
 #[test]
-fn floor_around_the_axis_is_split_and_keeps_its_area_outside_the_clearance() {
+fn triangle_straddling_a_cut_plane_becomes_a_part_on_each_side() {
+    // Straight ahead, across x = 0: a triangle on one side, a quad (two parts) on the other.
+    let (_, out) = run_method([[-0.5, 0.0, -3.0], [0.7, 0.0, -3.0], [0.2, 0.5, -3.0]], Method::Vertex);
+    assert_eq!(out.len(), 9);
+    for t in out.chunks(3) {
+        let side: Vec<f32> = t.iter().map(|d| d.position[0]).collect();
+        assert!(side.iter().all(|&x| x >= 0.0) || side.iter().all(|&x| x <= 0.0), "part {side:?} crosses x = 0");
+    }
+    let area: f32 = out.chunks(3).map(area3).sum();
+    assert!((area - 0.5 * 1.2 * 0.5).abs() < 1e-5, "area {area}");
+}
+
+#[test]
+fn floor_around_the_axis_is_cut_into_quadrants_minus_the_square_around_the_axis() {
     let tri = [[-4.0, -1.5, 3.0], [4.0, -1.5, 3.0], [0.0, -1.5, -5.0]];
     let (projection, out) = run_method(tri, Method::Vertex);
-    assert!(out.len() >= 3 * 8, "expected sector pieces, got {} vertices", out.len());
-    let clearance = axis_clearance(&projection);
+    assert!(out.len() >= 3 * 4, "expected a part per quadrant, got {} vertices", out.len());
+    let rho = axis_clearance(&projection);
     for d in &out {
-        let r = horizontal_radius(Vec3::from(d.position));
-        assert!(r >= clearance * (1.0 - 1e-4), "point at r={r} inside the clearance");
+        let p = Vec3::from(d.position);
+        // Cut points near the axis are computed from far corners: absolute precision ~1e-6·8 m.
+        assert!(p.x.abs() + p.z.abs() >= rho - 1e-5, "point {p} inside the square around the axis");
         for eye in Eye::BOTH {
-            let p = projection.project(Vec3::from(d.position), eye).expect("projectable");
-            assert!(p.u.is_finite() && p.v.is_finite());
+            let pr = projection.project_with_azimuth(p, azimuth(p), eye);
+            assert!(pr.u.is_finite() && pr.v.is_finite());
         }
     }
-    // The pieces tile the triangle minus the octagon around the axis (area 8·c²·tan(π/8)).
+    // The parts tile the triangle minus the square |x| + |z| < ρ (area 2ρ²).
     let full = 0.5 * 8.0 * 8.0;
-    let octagon = 8.0 * clearance * clearance * FRAC_PI_8.tan();
+    let square = 2.0 * rho * rho;
     let originals: Vec<DrawVertex> = out.chunks(3).filter(|t| t[0].theta_ref.abs() <= PI).flatten().copied().collect();
     let got = footprint_area(&originals);
-    assert!((got - (full - octagon)).abs() < 1e-3 * full, "area {got} vs {}", full - octagon);
+    assert!((got - (full - square)).abs() < 1e-4 * full, "area {got} vs {}", full - square);
     for t in out.chunks(3) {
         let th: Vec<f32> = t
             .iter()
@@ -82,34 +95,42 @@ fn floor_around_the_axis_is_split_and_keeps_its_area_outside_the_clearance() {
             .map(|a| t[0].theta_ref + wrap_angle(a - t[0].theta_ref))
             .collect();
         let span = th.iter().cloned().fold(f32::MIN, f32::max) - th.iter().cloned().fold(f32::MAX, f32::min);
-        assert!(span <= FRAC_PI_4 + 1e-4, "piece spans {span}");
+        assert!(span <= FRAC_PI_2 + 1e-4, "part spans {span}");
     }
 }
 
 #[test]
-fn triangle_with_a_vertex_inside_the_eye_circle_is_clipped_without_nan() {
+fn triangle_with_a_vertex_inside_the_eye_circle_is_cut_without_nan() {
     for method in [Method::Vertex, Method::Adaptive, Method::Fixed(4)] {
-        let (projection, out) = run_method([[0.01, -0.5, 0.0], [2.0, -0.5, -2.0], [-2.0, -0.5, -2.0]], method);
-        assert!(!out.is_empty());
-        for d in &out {
-            assert!(horizontal_radius(Vec3::from(d.position)) > projection.eye_radius);
-            assert!(d.position.iter().chain(d.normal.iter()).all(|x| x.is_finite()));
+        for near in [[0.01, -0.5, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.5]] {
+            let (projection, out) = run_method([near, [2.0, -0.5, -2.0], [-2.0, -0.5, -2.0]], method);
+            assert!(!out.is_empty());
+            let rho = axis_clearance(&projection);
+            for d in &out {
+                let p = Vec3::from(d.position);
+                assert!(p.x.abs() + p.z.abs() >= rho - 1e-5, "{p} inside the square");
+                assert!(d.position.iter().chain(d.normal.iter()).all(|x| x.is_finite()));
+            }
         }
     }
 }
 
 #[test]
 fn seam_triangle_gets_a_copy_on_the_other_side() {
+    // Cut at the seam (x = 0 behind the viewer) into a part on each side; each part's u range
+    // reaches past ±π in one eye, so each also gets a copy a turn away.
     let (_, out) = run_method([[-0.5, 0.0, 3.0], [0.5, 0.0, 3.0], [0.0, 0.5, 3.0]], Method::Vertex);
-    assert_eq!(out.len(), 6, "one triangle and its seam copy");
+    assert_eq!(out.len(), 12, "two parts and their seam copies");
     let refs: Vec<f32> = out.chunks(3).map(|t| t[0].theta_ref).collect();
-    assert!((refs[0].abs() - PI).abs() < 1e-3 && (refs[1].abs() - PI).abs() < 1e-3);
-    assert!((refs[0] - refs[1]).abs() > 6.0);
+    let inside: Vec<f32> = refs.iter().copied().filter(|r| r.abs() <= PI).collect();
+    assert_eq!(inside.len(), 2);
+    assert!(inside.iter().all(|r| (r.abs() - PI).abs() < 0.2) && inside[0] * inside[1] < 0.0, "{refs:?}");
+    assert!(refs.iter().filter(|r| r.abs() > PI).all(|r| (r.abs() - PI).abs() < 0.2 + TAU - PI), "{refs:?}");
 }
 
 #[test]
 fn fixed_n_makes_exactly_n_squared_triangles_of_positive_area_tiling_the_triangle() {
-    let tri = [[-0.6, -0.3, -3.0], [0.7, -0.2, -3.2], [0.1, 0.6, -2.8]];
+    let tri = [[0.4, -0.3, -3.0], [1.7, -0.2, -3.2], [1.1, 0.6, -2.8]];
     let whole = {
         let p = tri.map(Vec3::from);
         0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length()
