@@ -70,7 +70,7 @@ struct DrawIndirectArgs {
 @group(0) @binding(0) var<uniform> params: SubdivideParams;
 @group(0) @binding(1) var<storage, read> vertices: array<SceneVertex>;
 @group(0) @binding(2) var<storage, read> indices: array<u32>;
-// Piece records: (triangle, part | macro cell << 4, n0 | n1 << 16, n2 | K << 16).
+// Piece records: (triangle, part | macro cell << PART_BITS, n0 | n1 << 16, n2 | K << 16).
 @group(0) @binding(3) var<storage, read_write> pieces: array<vec4<u32>>;
 @group(0) @binding(4) var<storage, read_write> out_vertices: array<DrawVertex>;
 @group(0) @binding(5) var<storage, read_write> counters: Counters;
@@ -111,10 +111,13 @@ var<private> piece_original: array<i32, 3>; // original edge under piece edge e,
 var<private> piece_from: array<u32, 3>;     // fine index on that original edge at corner e
 var<private> piece_to: array<u32, 3>;
 
-// A quadrant's polygon while it is clipped (at most 6 corners).
-var<private> poly: array<Node, 6>;
+// A polygon while it is clipped (at most 7 corners), and a quadrant's polygon kept while its
+// bands are cut from it.
+var<private> poly: array<Node, 7>;
 var<private> poly_count: u32;
-var<private> scratch: array<Node, 6>;
+var<private> scratch: array<Node, 7>;
+var<private> quadrant: array<Node, 7>;
+var<private> quadrant_count: u32;
 
 fn corner(i: u32) -> Node {
     return part[i];
@@ -167,24 +170,32 @@ fn edge_length_px(a: vec3<f32>, b: vec3<f32>, segments: u32) -> f32 {
     }
     let clamp_v = 1.5 * params.projection.height;
     let width = params.projection.width;
+    var length_px = 0.0;
     var longest = 0.0;
+    var nearest = 1e30;
     for (var s = 0u; s < 2u; s++) {
         let eye_sign = select(-1.0, 1.0, s == 1u);
         var total = 0.0;
         var prev = vec2<f32>(0.0, 0.0);
         for (var k = 0u; k <= segments; k++) {
             let t = f32(k) / f32(segments);
-            var q = pixel(lo + (hi - lo) * t, eye_sign);
+            let p = lo + (hi - lo) * t;
+            nearest = min(nearest, horizontal_radius(p));
+            var q = pixel(p, eye_sign);
             q.y = clamp(q.y, -clamp_v, clamp_v);
             if (k > 0u && !(q.y == prev.y && abs(q.y) == clamp_v)) {
                 let dx = (q.x - prev.x) - width * round((q.x - prev.x) / width);
-                total += length(vec2<f32>(dx, q.y - prev.y));
+                let segment = length(vec2<f32>(dx, q.y - prev.y));
+                longest = max(longest, segment);
+                total += segment;
             }
             prev = q;
         }
-        longest = max(longest, total);
+        length_px = max(length_px, total);
     }
-    return longest;
+    // Near the eye circle (the paper model shows it: α ∝ √(r − d_e)) no stretch is allowed.
+    let stretch = select(MAX_STRETCH, 1.0, nearest < 2.0 * params.projection.eye_radius);
+    return max(length_px, f32(segments) * longest / stretch);
 }
 
 fn edge_divisions(a: vec3<f32>, b: vec3<f32>) -> u32 {
@@ -386,21 +397,28 @@ fn snap_to_cut_planes(p: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(select(p.x, 0.0, abs(p.x) <= scale), p.y, select(p.z, 0.0, abs(p.z) <= scale));
 }
 
-// The half-planes: CUT_X s·x ≥ 0, CUT_Z s·z ≥ 0, CUT_CHORD sx·x + sz·z ≥ ρ.
+// The half-planes: CUT_X s·x ≥ 0, CUT_Z s·z ≥ 0, CUT_CHORD side·(sx·x + sz·z − c) ≥ 0 (beyond
+// or within the diamond |x| + |z| = c of the quadrant).
 const CUT_X: u32 = 0u;
 const CUT_Z: u32 = 1u;
 const CUT_CHORD: u32 = 2u;
 
-fn cut_distance(kind: u32, s: vec2<f32>, p: vec3<f32>) -> f32 {
-    if (kind == CUT_X) {
-        return s.x * p.x;
+struct Cut {
+    kind: u32,
+    s: vec2<f32>,
+    c: f32,
+    side: f32,
+}
+
+fn cut_distance(cut: Cut, p: vec3<f32>) -> f32 {
+    if (cut.kind == CUT_X) {
+        return cut.s.x * p.x;
     }
-    if (kind == CUT_Z) {
-        return s.y * p.z;
+    if (cut.kind == CUT_Z) {
+        return cut.s.y * p.z;
     }
-    let rho = params.axis_clearance;
-    let d = s.x * p.x + s.y * p.z - rho;
-    return select(d, 0.0, abs(d) <= SNAP * (abs(p.x) + abs(p.z) + rho));
+    let d = cut.s.x * p.x + cut.s.y * p.z - cut.c;
+    return select(cut.side * d, 0.0, abs(d) <= SNAP * (abs(p.x) + abs(p.z) + cut.c));
 }
 
 // The crossing of lo→hi (canonically ordered); on x = 0 or z = 0 that coordinate is set to 0.
@@ -428,21 +446,21 @@ fn push_clipped(n: u32, v: Node) -> u32 {
 
 // Sutherland–Hodgman clip of `poly` against one half-plane; crossing points from the
 // canonically ordered edge.
-fn clip_polygon(kind: u32, s: vec2<f32>) {
+fn clip_polygon(cut: Cut) {
     var n = 0u;
     for (var i = 0u; i < poly_count; i++) {
         let cur = poly[i];
         let next = poly[(i + 1u) % poly_count];
-        let d0 = cut_distance(kind, s, cur.position);
-        let d1 = cut_distance(kind, s, next.position);
+        let d0 = cut_distance(cut, cur.position);
+        let d1 = cut_distance(cut, next.position);
         if (d0 >= 0.0) {
             n = push_clipped(n, cur);
         }
         if ((d0 >= 0.0) != (d1 >= 0.0) && d0 != 0.0 && d1 != 0.0) {
             if (lex_less(next.position, cur.position)) {
-                n = push_clipped(n, cut_crossing(kind, next, cur, d1, d0));
+                n = push_clipped(n, cut_crossing(cut.kind, next, cur, d1, d0));
             } else {
-                n = push_clipped(n, cut_crossing(kind, cur, next, d0, d1));
+                n = push_clipped(n, cut_crossing(cut.kind, cur, next, d0, d1));
             }
         }
     }
@@ -458,16 +476,27 @@ fn clip_polygon(kind: u32, s: vec2<f32>) {
     poly_count = n;
 }
 
+// Whether every corner of `poly` is on the far side of the cut (x: the clip would be empty),
+// or none is (y: the clip would change nothing). `Polygon::all_beyond` in axis.rs.
+fn all_beyond(cut: Cut) -> vec2<bool> {
+    var beyond = true;
+    var within = true;
+    for (var i = 0u; i < poly_count; i++) {
+        let d = cut_distance(cut, poly[i].position);
+        beyond = beyond && d < 0.0;
+        within = within && d >= 0.0;
+    }
+    return vec2<bool>(beyond, within);
+}
+
 // Clips the input triangle to quadrant q (signs of x and z as in `QUADRANTS` of axis.rs).
-fn quadrant_polygon(q: u32) {
-    let signs = array<vec2<f32>, 4>(vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0), vec2<f32>(-1.0, 1.0), vec2<f32>(-1.0, -1.0));
-    let s = signs[q];
+fn quadrant_polygon(s: vec2<f32>) {
     poly[0] = Node(tri_position[0], vec3<f32>(1.0, 0.0, 0.0));
     poly[1] = Node(tri_position[1], vec3<f32>(0.0, 1.0, 0.0));
     poly[2] = Node(tri_position[2], vec3<f32>(0.0, 0.0, 1.0));
     poly_count = 3u;
     // Quick tests (the clips would give the same): wholly on the far side of x = 0 or z = 0, or
-    // two corners the same (no polygon); wholly inside the quadrant and beyond the chord.
+    // two corners the same (no polygon); wholly inside the quadrant.
     let p = tri_position;
     let dx = vec3<f32>(s.x * p[0].x, s.x * p[1].x, s.x * p[2].x);
     let dz = vec3<f32>(s.y * p[0].z, s.y * p[1].z, s.y * p[2].z);
@@ -476,34 +505,77 @@ fn quadrant_polygon(q: u32) {
         poly_count = 0u;
         return;
     }
-    if (all(dx > vec3<f32>(0.0)) && all(dz > vec3<f32>(0.0)) && cut_distance(CUT_CHORD, s, p[0]) > 0.0
-        && cut_distance(CUT_CHORD, s, p[1]) > 0.0 && cut_distance(CUT_CHORD, s, p[2]) > 0.0) {
+    if (all(dx >= vec3<f32>(0.0)) && all(dz >= vec3<f32>(0.0))) {
         return;
     }
-    clip_polygon(CUT_X, s);
-    clip_polygon(CUT_Z, s);
-    clip_polygon(CUT_CHORD, s);
+    clip_polygon(Cut(CUT_X, s, 0.0, 1.0));
+    clip_polygon(Cut(CUT_Z, s, 0.0, 1.0));
 }
 
-// Visits the parts of the current triangle in the twin's order (`parts` in axis.rs): with
-// `wanted` < MAX_PARTS, loads part `wanted` into `part` and returns true if it exists; with
-// wanted = MAX_PARTS, plans every part and appends its pieces (the `plan` entry point).
+// Visits the parts of the current triangle in the twin's order (`parts` in axis.rs: quadrant by
+// quadrant, band by band outwards, along each fan): with `wanted` < MAX_PARTS, loads part
+// `wanted` into `part` and returns true if it exists; with wanted = MAX_PARTS, plans every
+// part and appends its pieces (the `plan` entry point).
 fn visit_parts(t: u32, wanted: u32) -> bool {
+    let signs = array<vec2<f32>, 4>(vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0), vec2<f32>(-1.0, 1.0), vec2<f32>(-1.0, -1.0));
+    // Bands for the adaptive method only (`band_limit` in axis.rs).
+    let limit = select(0.0, BAND_LIMIT * params.projection.screen_radius, params.method == METHOD_ADAPTIVE);
     var index = 0u;
     for (var q = 0u; q < 4u; q++) {
-        quadrant_polygon(q);
-        for (var i = 1u; i + 1u < poly_count; i++) {
-            if (wanted == MAX_PARTS || index == wanted) {
-                part[0] = poly[0];
-                part[1] = poly[i];
-                part[2] = poly[i + 1u];
-                if (wanted != MAX_PARTS) {
-                    return true;
-                }
-                plan_part();
-                append_pieces(t, index);
+        let s = signs[q];
+        quadrant_polygon(s);
+        if (poly_count == 0u) {
+            continue;
+        }
+        // What lies beyond the current diamond (`rest` in axis.rs); each band is cut from it,
+        // and the rest beyond the next diamond from the same polygon.
+        clip_polygon(Cut(CUT_CHORD, s, params.axis_clearance, 1.0));
+        quadrant = poly;
+        quadrant_count = poly_count;
+        var c = params.axis_clearance;
+        loop {
+            if (quadrant_count == 0u) {
+                break;
             }
-            index += 1u;
+            c *= BAND_RATIO;
+            poly = quadrant;
+            poly_count = quadrant_count;
+            if (c >= limit) {
+                quadrant_count = 0u; // the last band: all the rest
+            } else {
+                let within = Cut(CUT_CHORD, s, c, -1.0);
+                let test = all_beyond(within);
+                if (test.x) {
+                    continue; // all of it lies beyond this band
+                }
+                if (test.y) {
+                    quadrant_count = 0u;
+                } else {
+                    clip_polygon(within);
+                    let band = poly;
+                    let band_count = poly_count;
+                    poly = quadrant;
+                    poly_count = quadrant_count;
+                    clip_polygon(Cut(CUT_CHORD, s, c, 1.0));
+                    quadrant = poly;
+                    quadrant_count = poly_count;
+                    poly = band;
+                    poly_count = band_count;
+                }
+            }
+            for (var i = 1u; i + 1u < poly_count; i++) {
+                if (wanted == MAX_PARTS || index == wanted) {
+                    part[0] = poly[0];
+                    part[1] = poly[i];
+                    part[2] = poly[i + 1u];
+                    if (wanted != MAX_PARTS) {
+                        return true;
+                    }
+                    plan_part();
+                    append_pieces(t, index);
+                }
+                index += 1u;
+            }
         }
     }
     return false;
@@ -517,7 +589,7 @@ fn append_pieces(t: u32, index: u32) {
     }
     let packed = vec2<u32>(tri_n[0] | (tri_n[1] << 16u), tri_n[2] | (tri_k << 16u));
     for (var c = 0u; c < count; c++) {
-        pieces[base + c] = vec4<u32>(t, index | (c << 4u), packed);
+        pieces[base + c] = vec4<u32>(t, index | (c << PART_BITS), packed);
     }
 }
 
@@ -647,14 +719,14 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     }
     let piece = pieces[params.first_piece + local];
     load_triangle(piece.x);
-    if (!visit_parts(piece.x, piece.y & 15u)) {
+    if (!visit_parts(piece.x, piece.y & (MAX_PARTS - 1u))) {
         return;
     }
     tri_n[0] = piece.z & 0xffffu;
     tri_n[1] = piece.z >> 16u;
     tri_n[2] = piece.w & 0xffffu;
     tri_k = piece.w >> 16u;
-    let cell = macro_cell(tri_k, piece.y >> 4u);
+    let cell = macro_cell(tri_k, piece.y >> PART_BITS);
     var loc: array<vec3<u32>, 3>;
     for (var i = 0u; i < 3u; i++) {
         loc[i] = macro_location(cell.c[i]);

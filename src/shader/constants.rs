@@ -13,12 +13,24 @@ pub const EDGE_SAMPLES: u32 = 8;
 /// [`AXIS_CLEARANCE_MIN`, `AXIS_CLEARANCE_MAX`]·R_T (see `cpu::subdivide::axis`).
 pub const AXIS_CLEARANCE_MIN: f32 = 1e-5;
 pub const AXIS_CLEARANCE_MAX: f32 = 1e-3;
-/// The most parts an input triangle is cut into around the axis: 4 quadrants × a fan of at
-/// most 4 triangles (a triangle clipped by three half-planes has at most 6 corners).
-pub const MAX_PARTS: u32 = 16;
+/// For the adaptive method, parts are also cut into bands by the diamonds |x| + |z| = ρ·√2^k
+/// below this many R_T (see `cpu::subdivide::axis::band_bounds`).
+pub const BAND_LIMIT: f32 = 1000.0;
+/// The ratio of consecutive band diamonds.
+pub const BAND_RATIO: f32 = std::f32::consts::SQRT_2;
+/// The most parts an input triangle is cut into: 4 quadrants × at most 55 bands
+/// (log_√2(BAND_LIMIT / AXIS_CLEARANCE_MIN) + 1) × a fan of at most 5 triangles (a triangle
+/// clipped by four half-planes has at most 7 corners) = 1,100, within the `PART_BITS` bits that
+/// piece records give the part index (the macro cell has the other 21: K² < 2²¹ as K ≤ 1,024).
+pub const PART_BITS: u32 = 11;
+pub const MAX_PARTS: u32 = 1 << PART_BITS;
 /// Signed distances within this fraction of their terms' magnitude count as on the clip line,
 /// so that the CPU and the GPU (whose rounding differs in the last bits) take the same side.
 pub const SNAP: f32 = 1e-6;
+/// An edge is split by the larger of its projected length and `EDGE_SAMPLES` × its longest
+/// sampled segment / this (1 within 2·d_e of the axis): equal parts stay short enough where the
+/// projection stretches an edge unevenly, e.g. v ∝ 1/r (see `Subdivider::edge_length_px`).
+pub const MAX_STRETCH: f32 = 2.0;
 /// Seam copies are made for triangles reaching within this many radians of ±π.
 pub const SEAM_MARGIN: f32 = 1e-5;
 /// `fixed:N` above this many divisions is pre-split into a macro-lattice of K = ceil(N / this)
@@ -57,8 +69,12 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("FIXED_PIECE_DIVISIONS", U32(FIXED_PIECE_DIVISIONS)),
         ("AXIS_CLEARANCE_MIN", F32(AXIS_CLEARANCE_MIN)),
         ("AXIS_CLEARANCE_MAX", F32(AXIS_CLEARANCE_MAX)),
+        ("BAND_LIMIT", F32(BAND_LIMIT)),
+        ("BAND_RATIO", F32(BAND_RATIO)),
+        ("PART_BITS", U32(PART_BITS)),
         ("MAX_PARTS", U32(MAX_PARTS)),
         ("SNAP", F32(SNAP)),
+        ("MAX_STRETCH", F32(MAX_STRETCH)),
         ("SEAM_MARGIN", F32(SEAM_MARGIN)),
         ("PIECES_FROM_COUNTER", U32(PIECES_FROM_COUNTER)),
         ("MAX_DEPTH", F32(MAX_DEPTH)),

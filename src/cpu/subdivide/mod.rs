@@ -63,12 +63,12 @@ use std::f32::consts::{PI, TAU};
 use crate::core::projection::{azimuth, horizontal_radius, wrap_angle, Projection};
 use crate::core::scene::SceneVertex;
 use crate::core::settings::{RenderSettings, SplitRule};
-use crate::shader::constants::{EDGE_SAMPLES, FIXED_PIECE_DIVISIONS, MAX_EDGE_DIVISIONS, SEAM_MARGIN};
+use crate::shader::constants::{EDGE_SAMPLES, FIXED_PIECE_DIVISIONS, MAX_EDGE_DIVISIONS, MAX_STRETCH, SEAM_MARGIN};
 use crate::shader::types::{DrawVertex, SubdivideParams};
 
 mod axis;
 
-pub use axis::{axis_clearance, parts, snap_to_cut_planes, QUADRANTS};
+pub use axis::{axis_clearance, band_bounds, band_limit, parts, snap_to_cut_planes, QUADRANTS};
 
 /// The `subdivide` stage's parameters for a range of input triangles (capacities and piece
 /// ranges are left for the caller, 0).
@@ -172,31 +172,40 @@ impl<'a> Subdivider<'a> {
         Vec2::new(u * self.projection.pixels_per_radian(), v * self.projection.pixels_per_metre())
     }
 
-    /// Projected length in pixels of the straight edge ab (larger of the two eyes), measured as
-    /// a polyline through `segments` + 1 points. Heights are clamped to ±1.5 image heights from
-    /// the middle row, so off-screen parts count little, and segments beyond the clamp at both
-    /// ends (on one side) count nothing.
+    /// The projected length in pixels by which the straight edge ab is split: measured as a
+    /// polyline through `segments` + 1 points (the larger of the two eyes), its length l (eq. 5)
+    /// or, if larger, `segments` × its longest segment / `MAX_STRETCH` (/ 1 where the edge comes
+    /// within 2·d_e of the axis, where the paper model's α ∝ √(r − d_e) bends it sharply): an edge
+    /// the projection stretches unevenly gets equal parts short enough where it is stretched
+    /// most. Heights are clamped to ±1.5 image heights from the middle row, so off-screen parts
+    /// count little, and segments beyond the clamp at both ends (on one side) count nothing.
     pub fn edge_length_px(&self, a: Vec3, b: Vec3, segments: u32) -> f32 {
         let (lo, hi) = if lex_less(b, a) { (b, a) } else { (a, b) };
         let clamp_v = 1.5 * self.projection.height as f32;
         let width = self.projection.width as f32;
-        let mut longest = 0.0f32;
+        let (mut length, mut longest, mut nearest) = (0.0f32, 0.0f32, f32::INFINITY);
         for eye_sign in [-1.0f32, 1.0] {
             let mut total = 0.0;
             let mut prev = Vec2::ZERO;
             for k in 0..=segments {
                 let t = k as f32 / segments as f32;
-                let mut q = self.pixel(lo + (hi - lo) * t, eye_sign);
+                let p = lo + (hi - lo) * t;
+                nearest = nearest.min(horizontal_radius(p));
+                let mut q = self.pixel(p, eye_sign);
                 q.y = q.y.clamp(-clamp_v, clamp_v);
                 if k > 0 && !(q.y == prev.y && q.y.abs() == clamp_v) {
                     let dx = (q.x - prev.x) - width * ((q.x - prev.x) / width).round();
-                    total += Vec2::new(dx, q.y - prev.y).length();
+                    let segment = Vec2::new(dx, q.y - prev.y).length();
+                    longest = longest.max(segment);
+                    total += segment;
                 }
                 prev = q;
             }
-            longest = longest.max(total);
+            length = length.max(total);
         }
-        longest
+        // Near the eye circle (the paper model shows it: α ∝ √(r − d_e)) no stretch is allowed.
+        let stretch = if nearest < 2.0 * self.projection.eye_radius { 1.0 } else { MAX_STRETCH };
+        length.max(segments as f32 * longest / stretch)
     }
 
     /// Divisions of an edge (eq. 5, not capped by N_max: the pre-split handles that). A quick
@@ -283,7 +292,7 @@ impl<'a> Subdivider<'a> {
         if self.off_screen_vertically(tri.position) {
             return Vec::new();
         }
-        parts(tri.position, self.params.axis_clearance)
+        parts(tri.position, self.params.axis_clearance, band_limit(self.params.method, self.projection.screen_radius))
     }
 
     /// The whole stage for the dispatch's triangles.

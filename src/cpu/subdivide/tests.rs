@@ -69,7 +69,8 @@ fn triangle_straddling_a_cut_plane_becomes_a_part_on_each_side() {
 
 #[test]
 fn floor_around_the_axis_is_cut_into_quadrants_minus_the_square_around_the_axis() {
-    let tri = [[-4.0, -1.5, 3.0], [4.0, -1.5, 3.0], [0.0, -1.5, -5.0]];
+    // Just below the eyes, so that every part shows (none is culled above or below the image).
+    let tri = [[-4.0, -1e-4, 3.0], [4.0, -1e-4, 3.0], [0.0, -1e-4, -5.0]];
     let (projection, out) = run_method(tri, Method::Vertex);
     assert!(out.len() >= 3 * 4, "expected a part per quadrant, got {} vertices", out.len());
     let rho = axis_clearance(&projection);
