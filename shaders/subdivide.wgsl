@@ -193,8 +193,10 @@ fn edge_length_px(a: vec3<f32>, b: vec3<f32>, segments: u32) -> f32 {
         }
         length_px = max(length_px, total);
     }
-    // Near the eye circle (the paper model shows it: α ∝ √(r − d_e)) no stretch is allowed.
-    let stretch = select(MAX_STRETCH, 1.0, nearest < 2.0 * params.projection.eye_radius);
+    // Near the eye circle, which the paper model shows on screen (α ∝ √(r − d_e)), no stretch
+    // is allowed (the exact model puts it at v = ±∞).
+    let ring = params.projection.vertical_exact == 0u && nearest < 2.0 * params.projection.eye_radius;
+    let stretch = select(MAX_STRETCH, 1.0, ring);
     return max(length_px, f32(segments) * longest / stretch);
 }
 
@@ -256,9 +258,10 @@ fn plan_part() {
     let m = max(max(tri_n[0], tri_n[1]), tri_n[2]);
     tri_k = 1u;
     if (params.method == METHOD_ADAPTIVE) {
-        tri_k = (m + params.max_div - 1u) / params.max_div;
+        let step = min(params.max_div, PIECE_DIVISIONS);
+        tri_k = min((m + step - 1u) / step, MAX_MACRO_LEVEL);
     } else if (params.method == METHOD_FIXED) {
-        tri_k = (m + FIXED_PIECE_DIVISIONS - 1u) / FIXED_PIECE_DIVISIONS;
+        tri_k = (m + PIECE_DIVISIONS - 1u) / PIECE_DIVISIONS;
     }
 }
 
@@ -754,7 +757,7 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
                 // fixed:N pieces take N/K on interior edges (the regular N-lattice when K | N).
                 piece_counts[e] = (params.fixed_n + tri_k - 1u) / tri_k;
             } else {
-                piece_counts[e] = min(edge_divisions(piece_q[e].position, piece_q[(e + 1u) % 3u].position), 2u * params.max_div);
+                piece_counts[e] = min(min(edge_divisions(piece_q[e].position, piece_q[(e + 1u) % 3u].position), 2u * params.max_div), PIECE_DIVISIONS);
             }
         }
     }

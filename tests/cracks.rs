@@ -101,3 +101,84 @@ fn closed_models_have_no_cracks() {
     scene.fit(3.0, &p).unwrap();
     check(&scene, "cow", Vec3::ZERO, false);
 }
+
+/// Surround scenes (issue: watertight around the axis): closed surfaces around the viewer —
+/// the 40×10×40 m box room, the 2 m cube with the eyes 5 cm under its ceiling and 5 cm above its
+/// floor, a sphere enclosing the viewer, the demo room — show no background pixel at all, for
+/// every method (vertex, fixed:N below and above the pre-split, adaptive for small and large L),
+/// at wide, square and tall image sizes, in both vertical models.
+#[test]
+fn surround_scenes_show_no_background_for_any_method_size_or_vertical_model() {
+    use twister::core::projection::Vertical;
+    let cube = builtin::closed_box("cube", Vec3::splat(-1.0), Vec3::splat(1.0));
+    let scenes: Vec<(&str, Scene, Vec3)> = vec![
+        ("box room", builtin::builtin_scene("builtin:box-room", &Projection::default()).unwrap(), Vec3::ZERO),
+        ("cube, eyes under the ceiling", cube.clone(), Vec3::new(0.0, 0.95, 0.0)),
+        ("cube, eyes above the floor", cube, Vec3::new(0.1, -0.95, -0.2)),
+        ("sphere around", builtin::sphere_scene(1024, Vec3::new(0.2, 0.3, 0.0), 2.5, "sphere"), Vec3::ZERO),
+    ];
+    let methods = [
+        (Method::Vertex, 32.0, 7),
+        (Method::Fixed(1), 32.0, 7),
+        (Method::Fixed(2), 32.0, 7),
+        (Method::Fixed(7), 32.0, 7),
+        (Method::Fixed(8), 32.0, 7),
+        (Method::Fixed(45), 32.0, 7),
+        (Method::Adaptive, 4.0, 3),
+        (Method::Adaptive, 32.0, 7),
+        (Method::Adaptive, 128.0, 7),
+    ];
+    let r = common::renderer();
+    let mut renders = 0;
+    for (what, scene, viewer) in &scenes {
+        let gs = twister::GpuScene::upload(&r.gpu, scene).unwrap();
+        for (width, height) in [(320, 80), (192, 192), (96, 256)] {
+            for vertical in [Vertical::Paper, Vertical::Exact] {
+                for (method, edge_px, max_div) in methods {
+                    if matches!(method, Method::Fixed(45)) && scene.triangle_count() > 100 {
+                        continue; // 2,025 triangles per part: the small meshes only
+                    }
+                    let projection = Projection { width, height, vertical, ..Projection::default() };
+                    let settings = RenderSettings::new(projection)
+                        .with_viewer(*viewer)
+                        .with_background(BG)
+                        .with_method(method)
+                        .with_edge_px(edge_px)
+                        .with_max_div(max_div);
+                    let frame = r.render(&gs, &settings).unwrap();
+                    renders += 1;
+                    for eye in twister::Eye::BOTH {
+                        let bg = common::pixels_where(frame.eye(eye), |p| p[..3] == [255, 0, 255]);
+                        assert!(
+                            bg.is_empty(),
+                            "{what}, {width}x{height} {vertical:?} {} L={edge_px} N_max={max_div} {eye:?}: {} background pixels, e.g. {:?}",
+                            method.name(),
+                            bg.len(),
+                            &bg[..bg.len().min(5)]
+                        );
+                    }
+                }
+            }
+        }
+    }
+    assert!(renders > 200);
+}
+
+/// The demo room at 1024×1024 (its ceiling and floor reach far towards the axis on screen).
+#[test]
+fn the_demo_room_is_closed_at_1024_square() {
+    use twister::core::projection::Vertical;
+    let r = common::renderer();
+    let gs = twister::GpuScene::upload(&r.gpu, &builtin::demo()).unwrap();
+    for vertical in [Vertical::Paper, Vertical::Exact] {
+        for method in [Method::Vertex, Method::Fixed(7), Method::Adaptive] {
+            let projection = Projection { width: 1024, height: 1024, vertical, ..Projection::default() };
+            let settings = RenderSettings::new(projection).with_background(BG).with_method(method);
+            let frame = r.render(&gs, &settings).unwrap();
+            for eye in twister::Eye::BOTH {
+                let bg = common::pixels_where(frame.eye(eye), |p| p[..3] == [255, 0, 255]).len();
+                assert_eq!(bg, 0, "demo room 1024x1024 {vertical:?} {} {eye:?}: background pixels", method.name());
+            }
+        }
+    }
+}

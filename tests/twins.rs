@@ -166,6 +166,12 @@ impl Twin for Subdivide {
         let moved = base.with_viewer(Vec3::new(1.0, 0.3, -2.0)).with_yaw_deg(37.0);
         let sphere = builtin::builtin_scene("builtin:sphere100", &projection).unwrap();
         let around = builtin::sphere_scene(1024, Vec3::ZERO, 2.5, "sphere around the viewer");
+        let box_room = builtin::builtin_scene("builtin:box-room", &projection).unwrap();
+        let cube = builtin::builtin_scene("builtin:cube", &projection).unwrap();
+        let tall_projection = Projection { width: 192, height: 256, ..Projection::default() };
+        let tall = RenderSettings::new(tall_projection);
+        let small = RenderSettings::new(Projection { width: 64, height: 96, ..tall_projection });
+        let tall_exact = RenderSettings::new(Projection { vertical: Vertical::Exact, ..tall_projection });
         let cases = [
             (random_triangle_scene(3, 600), base.with_method(Method::Vertex)),
             (random_triangle_scene(4, 300), base),
@@ -178,6 +184,14 @@ impl Twin for Subdivide {
             // fixed:N beyond 32 divisions: pre-split into pieces (one invocation used to stop short).
             (builtin::builtin_scene("builtin:triangle@3", &projection).unwrap(), base.with_method(Method::Fixed(64))),
             (random_triangle_scene(6, 12), base.with_method(Method::Fixed(45))),
+            // Surround scenes: quadrant and band cuts, the square around the axis, tall images,
+            // both vertical models, a part beyond 32 × N_max divisions (K capped).
+            (box_room.clone(), base),
+            (box_room.clone(), tall.with_method(Method::Vertex)),
+            (box_room, tall_exact.with_method(Method::Fixed(7))),
+            (cube.clone(), tall.with_viewer(Vec3::new(0.0, 0.95, 0.0))),
+            (cube.clone(), small.with_viewer(Vec3::new(0.0, 0.95, 0.0)).with_edge_px(4.0).with_max_div(3)),
+            (cube, tall_exact.with_viewer(Vec3::new(0.1, -0.8, 0.2)).with_edge_px(12.0)),
         ];
         cases
             .into_iter()

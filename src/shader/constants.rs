@@ -28,15 +28,21 @@ pub const MAX_PARTS: u32 = 1 << PART_BITS;
 /// so that the CPU and the GPU (whose rounding differs in the last bits) take the same side.
 pub const SNAP: f32 = 1e-6;
 /// An edge is split by the larger of its projected length and `EDGE_SAMPLES` × its longest
-/// sampled segment / this (1 within 2·d_e of the axis): equal parts stay short enough where the
+/// sampled segment / this (1 within 2·d_e of the axis in the paper model): equal parts stay short enough where the
 /// projection stretches an edge unevenly, e.g. v ∝ 1/r (see `Subdivider::edge_length_px`).
 pub const MAX_STRETCH: f32 = 2.0;
 /// Seam copies are made for triangles reaching within this many radians of ±π.
 pub const SEAM_MARGIN: f32 = 1e-5;
-/// `fixed:N` above this many divisions is pre-split into a macro-lattice of K = ceil(N / this)
-/// pieces (N = 64: 4 pieces of 32²), so that one `lattice` invocation never makes more than
-/// this² triangles (lavapipe cut invocations short beyond about 1,900).
-pub const FIXED_PIECE_DIVISIONS: u32 = 32;
+/// The most divisions of a piece's edge: `fixed:N` above it is pre-split into a macro-lattice of
+/// K = ceil(N / this) pieces (N = 64: 4 pieces of 32²), and `adaptive` takes N_max as at most
+/// this, so that one `lattice` invocation never makes more than this² triangles (lavapipe cut
+/// invocations short beyond about 1,900).
+pub const PIECE_DIVISIONS: u32 = 32;
+/// The largest macro-lattice level K: a part makes at most this² pieces, so that one `plan`
+/// invocation's loop stays short (lavapipe lost pieces with K = 342, 117k pieces per part). An
+/// adaptive part whose longest edge needs more than this × N_max divisions (an edge over
+/// 224·L long at N_max = 7) gets pieces of up to `PIECE_DIVISIONS` per edge instead of N_max.
+pub const MAX_MACRO_LEVEL: u32 = MAX_EDGE_DIVISIONS / PIECE_DIVISIONS;
 /// `SubdivideParams::piece_count` meaning "as many pieces as `plan` made" (read on the GPU).
 pub const PIECES_FROM_COUNTER: u32 = u32::MAX;
 
@@ -66,7 +72,8 @@ pub fn all() -> Vec<(&'static str, Value)> {
     let mut out = vec![
         ("MAX_EDGE_DIVISIONS", U32(MAX_EDGE_DIVISIONS)),
         ("EDGE_SAMPLES", U32(EDGE_SAMPLES)),
-        ("FIXED_PIECE_DIVISIONS", U32(FIXED_PIECE_DIVISIONS)),
+        ("PIECE_DIVISIONS", U32(PIECE_DIVISIONS)),
+        ("MAX_MACRO_LEVEL", U32(MAX_MACRO_LEVEL)),
         ("AXIS_CLEARANCE_MIN", F32(AXIS_CLEARANCE_MIN)),
         ("AXIS_CLEARANCE_MAX", F32(AXIS_CLEARANCE_MAX)),
         ("BAND_LIMIT", F32(BAND_LIMIT)),

@@ -15,7 +15,9 @@
 //! cut into a macro-lattice of level K = ceil(M / N_max) (K² pieces); macro nodes on an original
 //! edge snap to that edge's fine nodes j/N_e, so a neighbour sees the same nodes whatever its own K.
 //! Each piece then needs at most about N_max per edge: N_max caps only the lattice step. Pieces
-//! whose snapped corners coincide have no area and are skipped.
+//! whose snapped corners coincide have no area and are skipped. K is at most `MAX_MACRO_LEVEL`
+//! (32) and a piece's edges at most `PIECE_DIVISIONS` (32), so that no invocation's loop runs
+//! long (lavapipe cuts long invocations short).
 //!
 //! **Lattice (`lattice`).** With counts (n0, n1, n2) on a piece's edges, the piece is cut by the
 //! regular triangular lattice of level m = max(n0, n1, n2) (the paper's Fig. 6): m² triangles.
@@ -60,10 +62,12 @@
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use std::f32::consts::{PI, TAU};
 
-use crate::core::projection::{azimuth, horizontal_radius, wrap_angle, Projection};
+use crate::core::projection::{azimuth, horizontal_radius, wrap_angle, Projection, Vertical};
 use crate::core::scene::SceneVertex;
 use crate::core::settings::{RenderSettings, SplitRule};
-use crate::shader::constants::{EDGE_SAMPLES, FIXED_PIECE_DIVISIONS, MAX_EDGE_DIVISIONS, MAX_STRETCH, SEAM_MARGIN};
+use crate::shader::constants::{
+    EDGE_SAMPLES, MAX_EDGE_DIVISIONS, MAX_MACRO_LEVEL, MAX_STRETCH, PIECE_DIVISIONS, SEAM_MARGIN,
+};
 use crate::shader::types::{DrawVertex, SubdivideParams};
 
 mod axis;
@@ -174,8 +178,8 @@ impl<'a> Subdivider<'a> {
 
     /// The projected length in pixels by which the straight edge ab is split: measured as a
     /// polyline through `segments` + 1 points (the larger of the two eyes), its length l (eq. 5)
-    /// or, if larger, `segments` × its longest segment / `MAX_STRETCH` (/ 1 where the edge comes
-    /// within 2·d_e of the axis, where the paper model's α ∝ √(r − d_e) bends it sharply): an edge
+    /// or, if larger, `segments` × its longest segment / `MAX_STRETCH` (/ 1 in the paper model
+    /// where the edge comes within 2·d_e of the axis: α ∝ √(r − d_e) bends it sharply): an edge
     /// the projection stretches unevenly gets equal parts short enough where it is stretched
     /// most. Heights are clamped to ±1.5 image heights from the middle row, so off-screen parts
     /// count little, and segments beyond the clamp at both ends (on one side) count nothing.
@@ -203,8 +207,10 @@ impl<'a> Subdivider<'a> {
             }
             length = length.max(total);
         }
-        // Near the eye circle (the paper model shows it: α ∝ √(r − d_e)) no stretch is allowed.
-        let stretch = if nearest < 2.0 * self.projection.eye_radius { 1.0 } else { MAX_STRETCH };
+        // Near the eye circle, which the paper model shows on screen (α ∝ √(r − d_e)), no stretch
+        // is allowed (the exact model puts it at v = ±∞).
+        let ring = self.projection.vertical == Vertical::Paper && nearest < 2.0 * self.projection.eye_radius;
+        let stretch = if ring { 1.0 } else { MAX_STRETCH };
         length.max(segments as f32 * longest / stretch)
     }
 
@@ -231,14 +237,14 @@ impl<'a> Subdivider<'a> {
 
     /// Divisions of an interior edge of the macro-lattice. Macro edges are about N_max·L long,
     /// but the projection stretches unevenly across a large triangle, so some need more: they may
-    /// take up to 2·N_max (a piece then makes at most 4·N_max² triangles).
+    /// take up to 2·N_max, and at most `PIECE_DIVISIONS` (a piece then makes at most 32² triangles).
     /// `fixed:N` pieces (K per edge) take N/K (rounded up) on their interior edges: the union is the
     /// regular N-lattice when K divides N.
     fn interior_divisions(&self, a: Vec3, b: Vec3, edge_px: f32, k: u32) -> u32 {
         if self.params.method == SplitRule::Fixed as u32 {
             return self.params.fixed_n.div_ceil(k.max(1));
         }
-        self.edge_divisions(a, b, edge_px).min(2 * self.params.max_div)
+        self.edge_divisions(a, b, edge_px).min(2 * self.params.max_div).min(PIECE_DIVISIONS)
     }
 
     fn load(&self, vertices: &[SceneVertex], indices: &[u32], t: usize) -> Triangle {
@@ -278,9 +284,9 @@ impl<'a> Subdivider<'a> {
         ];
         let m = n[0].max(n[1]).max(n[2]);
         let k = if self.params.method == SplitRule::Adaptive as u32 {
-            m.div_ceil(self.params.max_div)
+            m.div_ceil(self.params.max_div.min(PIECE_DIVISIONS)).min(MAX_MACRO_LEVEL)
         } else if self.params.method == SplitRule::Fixed as u32 {
-            m.div_ceil(FIXED_PIECE_DIVISIONS)
+            m.div_ceil(PIECE_DIVISIONS)
         } else {
             1
         };
