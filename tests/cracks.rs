@@ -182,3 +182,72 @@ fn the_demo_room_is_closed_at_1024_square() {
         }
     }
 }
+
+/// A triangle with a corner at or near the viewer (inside the eye circle) and two corners 3 m
+/// ahead is drawn whole: every point of it that an eye sees (r > d_e), projected by the CPU
+/// projection, lands on a pixel the render covered, unless it is within a margin of the
+/// projected outline (the chords' own error). The oracle is the projection of the surface, not
+/// the rasterizer.
+#[test]
+fn triangles_reaching_into_the_eye_circle_are_drawn_whole() {
+    use rand::{Rng, SeedableRng};
+    use twister::core::projection::{Panorama, Vertical};
+    let r = common::renderer();
+    let mut rng = rand::rngs::StdRng::seed_from_u64(5);
+    let mut checked = 0;
+    // At the viewer (seen edge-on, a sliver), behind it, and inside the eye circle below it.
+    for near in [Vec3::ZERO, Vec3::new(0.0, 0.0, 0.5), Vec3::new(0.01, -0.3, -0.01)] {
+        let corners = [near, Vec3::new(-1.0, -1.0, -3.0), Vec3::new(1.2, 0.5, -3.0)];
+        let v: Vec<twister::core::scene::SceneVertex> = corners
+            .iter()
+            .map(|p| twister::core::scene::SceneVertex {
+                position: p.to_array(),
+                normal: [0.0, 0.0, 1.0],
+                color: [0.8, 0.8, 0.8, 1.0],
+                ..Default::default()
+            })
+            .collect();
+        let mut scene = Scene::new("near triangle");
+        scene.add_mesh("t", &v, &[0, 1, 2]);
+        let gs = twister::GpuScene::upload(&r.gpu, &scene).unwrap();
+        for vertical in [Vertical::Paper, Vertical::Exact] {
+            let projection = Projection { width: 640, height: 160, vertical, ..Projection::default() };
+            for (method, margin) in [(Method::Adaptive, 1.5f32), (Method::Fixed(7), 6.0)] {
+                let settings = RenderSettings::new(projection).with_background(BG).with_method(method);
+                let frame = r.render(&gs, &settings).unwrap();
+                for eye in twister::Eye::BOTH {
+                    // The outline, densely sampled, projected.
+                    let outline: Vec<[f32; 2]> = (0..3)
+                        .flat_map(|e| {
+                            let (a, b) = (corners[e], corners[(e + 1) % 3]);
+                            (0..=4000).map(move |k| a + (b - a) * (k as f32 / 4000.0))
+                        })
+                        .filter_map(|p| projection.project_pixel(p, eye).map(|q| q.0))
+                        .collect();
+                    let img = frame.eye(eye);
+                    for _ in 0..3000 {
+                        let (a, b): (f32, f32) = (rng.random(), rng.random());
+                        let (a, b) = if a + b > 1.0 { (1.0 - a, 1.0 - b) } else { (a, b) };
+                        let p = corners[0] + a * (corners[1] - corners[0]) + b * (corners[2] - corners[0]);
+                        let Some(([x, y], _)) = projection.project_pixel(p, eye) else { continue };
+                        let near_outline = outline.iter().any(|q| {
+                            let dx = projection.wrapped_dx(q[0], x);
+                            dx * dx + (q[1] - y) * (q[1] - y) < margin * margin
+                        });
+                        if near_outline || y < margin || y > projection.height as f32 - margin {
+                            continue;
+                        }
+                        checked += 1;
+                        let px = img.pixel((x as u32).min(projection.width - 1), y as u32);
+                        assert!(
+                            px[..3] != [255, 0, 255],
+                            "corner at {near}, {vertical:?} {} {eye:?}: point {p} (pixel {x:.1}, {y:.1}) not drawn",
+                            method.name()
+                        );
+                    }
+                }
+            }
+        }
+    }
+    assert!(checked > 10_000, "only {checked} points checked");
+}
