@@ -1,6 +1,7 @@
 //! Property tests of the `subdivide` twin on closed meshes around the viewer (issue: surround
 //! scenes): random closed meshes (icospheres, boxes, tori, the cow) at random positions and
-//! sizes — around, above, below and enclosing the viewer — with random settings. The oracle is
+//! sizes — around, above, below and enclosing the viewer — with random settings, with and without
+//! the level of detail's relaxed L. The oracle is
 //! the mesh itself:
 //! - **watertight**: every output edge (by the exact bits of its two end points) is used by
 //!   exactly two output triangles, except edges on the square cut around the axis (which no eye
@@ -166,6 +167,7 @@ fn edge_key(a: Vec3, b: Vec3) -> (Key, Key) {
 }
 
 /// Runs one case and checks the properties; returns the number of output triangles.
+#[allow(clippy::too_many_arguments)]
 fn check_case(
     mesh: &Mesh,
     centre: Vec3,
@@ -174,9 +176,10 @@ fn check_case(
     method: Method,
     edge_px: f32,
     max_div: u32,
+    lod_scale: f32,
 ) -> usize {
     let what = format!(
-        "{} ×{scale:.2} at {centre:.2}, {}x{} {:?} d_e={} R_T={}, {} L={edge_px:.1} N_max={max_div}",
+        "{} ×{scale:.2} at {centre:.2}, {}x{} {:?} d_e={} R_T={}, {} L={edge_px:.1} N_max={max_div} LOD×{lod_scale}",
         mesh.name,
         projection.width,
         projection.height,
@@ -192,7 +195,9 @@ fn check_case(
         .collect();
     let triangles = mesh.indices.len() / 3;
     let params = params_for(projection, method, edge_px, max_div, triangles as u32);
-    let sd = Subdivider::new(&params);
+    // The visual-field level of detail scales one object's L (uniform over a closed mesh).
+    let lod = [lod_scale];
+    let sd = Subdivider::with_edge_scale(&params, &lod);
     let rho = params.axis_clearance;
     // Absolute precision of points computed from the mesh's corners.
     let tol = 4e-6 * (centre.abs().max_element() + scale);
@@ -220,7 +225,7 @@ fn check_case(
     };
     let on_square = |p: Vec3| (p.x.abs() + p.z.abs() - rho).abs() <= tol + 1e-3 * rho;
 
-    let out = subdivide(&params, &vertices, &mesh.indices);
+    let out = sd.run(&vertices, &mesh.indices);
     let originals: Vec<&[DrawVertex]> = out.vertices.chunks(3).filter(|t| t[0].theta_ref.abs() <= PI).collect();
     let mut edges: HashMap<(Key, Key), u32> = HashMap::new();
     for t in &originals {
@@ -259,7 +264,7 @@ fn check_case(
     for _ in 0..12 {
         let t = rng.random_range(0..triangles);
         let one = SubdivideParams { first_triangle: t as u32, triangle_count: 1, ..params };
-        let out = subdivide(&one, &vertices, &mesh.indices);
+        let out = Subdivider::with_edge_scale(&one, &lod).run(&vertices, &mesh.indices);
         let corner = [0, 1, 2].map(|k| snap_to_cut_planes(placed[mesh.indices[3 * t + k] as usize]));
         let normal = (corner[1] - corner[0]).cross(corner[2] - corner[0]);
         if normal.length() == 0.0 {
@@ -351,7 +356,9 @@ fn random_closed_meshes_around_the_viewer_subdivide_watertight_and_whole() {
             ),
             _ => (Method::Adaptive, rng.random_range(4.0..64.0), rng.random_range(1..16)),
         };
-        total += check_case(mesh, centre, scale, &projection, method, edge_px, max_div);
+        // With the level of detail: L relaxed (peripheral field) or no split (outside).
+        let lod_scale = [1.0, 1.0, 2.5, crate::core::lod::NO_SPLIT][rng.random_range(0..4)];
+        total += check_case(mesh, centre, scale, &projection, method, edge_px, max_div, lod_scale);
     }
     assert!(total > 10_000, "the cases made only {total} triangles");
 }
