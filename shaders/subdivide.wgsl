@@ -515,6 +515,71 @@ fn quadrant_polygon(s: vec2<f32>) {
     clip_polygon(Cut(CUT_Z, s, 0.0, 1.0));
 }
 
+// The part index of a triangle that is its own single part (the piece record needs no search).
+const WHOLE_TRIANGLE: u32 = MAX_PARTS - 1u;
+
+// c_k = ρ·√2^k, exactly as the twin (`band_bound` in axis.rs): ρ or ρ·√2, times 2^(k/2).
+fn band_bound(k: u32) -> f32 {
+    let base = select(params.axis_clearance, params.axis_clearance * BAND_RATIO, (k & 1u) == 1u);
+    return ldexp(base, i32(k / 2u));
+}
+
+// The band of distance d (|x| + |z|): the largest k with c_k ≤ d among the bounds below
+// `limit` (k = 0 always counts); an estimate from the logarithm, then exact steps.
+fn band_of(d: f32, limit: f32) -> u32 {
+    var k = u32(min(2.0 * log2(max(d / params.axis_clearance, 1.0)), 200.0));
+    loop {
+        let c = band_bound(k);
+        if (k == 0u || !(c > d || c >= limit)) {
+            break;
+        }
+        k -= 1u;
+    }
+    loop {
+        let c = band_bound(k + 1u);
+        if (!(c <= d && c < limit)) {
+            break;
+        }
+        k += 1u;
+    }
+    return k;
+}
+
+// Whether every corner of the quadrant polygon is on the far side of the cut, or none is
+// (`all_beyond` on the polygon kept in `quadrant`, without copying it).
+fn quadrant_beyond(cut: Cut) -> vec2<bool> {
+    var beyond = true;
+    var within = true;
+    for (var i = 0u; i < quadrant_count; i++) {
+        let d = cut_distance(cut, quadrant[i].position);
+        beyond = beyond && d < 0.0;
+        within = within && d >= 0.0;
+    }
+    return vec2<bool>(beyond, within);
+}
+
+// Whether the input triangle lies strictly inside quadrant s and one band (below `limit`):
+// then it is its own single part. `single_band` in axis.rs.
+fn single_band(s: vec2<f32>, limit: f32) -> bool {
+    let p = tri_position;
+    let dx = vec3<f32>(s.x * p[0].x, s.x * p[1].x, s.x * p[2].x);
+    let dz = vec3<f32>(s.y * p[0].z, s.y * p[1].z, s.y * p[2].z);
+    if (!(all(dx > vec3<f32>(0.0)) && all(dz > vec3<f32>(0.0)))) {
+        return false;
+    }
+    let d = dx + dz;
+    let k = band_of(min(min(d.x, d.y), d.z), limit);
+    let lower = Cut(CUT_CHORD, s, band_bound(k), 1.0);
+    let next = band_bound(k + 1u);
+    let upper = Cut(CUT_CHORD, s, next, -1.0);
+    for (var i = 0u; i < 3u; i++) {
+        if (cut_distance(lower, p[i]) <= 0.0 || (next < limit && cut_distance(upper, p[i]) <= 0.0)) {
+            return false;
+        }
+    }
+    return true;
+}
+
 // Visits the parts of the current triangle in the twin's order (`parts` in axis.rs: quadrant by
 // quadrant, band by band outwards, along each fan): with `wanted` < MAX_PARTS, loads part
 // `wanted` into `part` and returns true if it exists; with wanted = MAX_PARTS, plans every
@@ -523,6 +588,19 @@ fn visit_parts(t: u32, wanted: u32) -> bool {
     let signs = array<vec2<f32>, 4>(vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0), vec2<f32>(-1.0, 1.0), vec2<f32>(-1.0, -1.0));
     // Bands for the adaptive method only (`band_limit` in axis.rs).
     let limit = select(0.0, BAND_LIMIT * params.projection.screen_radius, params.method == METHOD_ADAPTIVE);
+    // Most triangles: one quadrant, one band, one part (what the loop below would give, faster).
+    for (var q = 0u; q < 4u; q++) {
+        if (single_band(signs[q], limit)) {
+            part[0] = Node(tri_position[0], vec3<f32>(1.0, 0.0, 0.0));
+            part[1] = Node(tri_position[1], vec3<f32>(0.0, 1.0, 0.0));
+            part[2] = Node(tri_position[2], vec3<f32>(0.0, 0.0, 1.0));
+            if (wanted == MAX_PARTS) {
+                plan_part();
+                append_pieces(t, WHOLE_TRIANGLE);
+            }
+            return wanted == 0u || wanted == WHOLE_TRIANGLE;
+        }
+    }
     var index = 0u;
     for (var q = 0u; q < 4u; q++) {
         let s = signs[q];
@@ -535,22 +613,31 @@ fn visit_parts(t: u32, wanted: u32) -> bool {
         clip_polygon(Cut(CUT_CHORD, s, params.axis_clearance, 1.0));
         quadrant = poly;
         quadrant_count = poly_count;
-        var c = params.axis_clearance;
+        // Start at the band of the nearest corner: the bands below are empty, and cutting them
+        // away would leave the polygon as it is (the twin runs them; the parts are the same).
+        var d_min = 1e30;
+        for (var i = 0u; i < quadrant_count; i++) {
+            d_min = min(d_min, s.x * quadrant[i].position.x + s.y * quadrant[i].position.z);
+        }
+        var k = band_of(d_min, limit);
         loop {
             if (quadrant_count == 0u) {
                 break;
             }
-            c *= BAND_RATIO;
-            poly = quadrant;
-            poly_count = quadrant_count;
+            k += 1u;
+            let c = band_bound(k);
             if (c >= limit) {
+                poly = quadrant;
+                poly_count = quadrant_count;
                 quadrant_count = 0u; // the last band: all the rest
             } else {
                 let within = Cut(CUT_CHORD, s, c, -1.0);
-                let test = all_beyond(within);
+                let test = quadrant_beyond(within);
                 if (test.x) {
                     continue; // all of it lies beyond this band
                 }
+                poly = quadrant;
+                poly_count = quadrant_count;
                 if (test.y) {
                     quadrant_count = 0u;
                 } else {
@@ -722,7 +809,12 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     }
     let piece = pieces[params.first_piece + local];
     load_triangle(piece.x);
-    if (!visit_parts(piece.x, piece.y & (MAX_PARTS - 1u))) {
+    let part_index = piece.y & (MAX_PARTS - 1u);
+    if (part_index == WHOLE_TRIANGLE) {
+        part[0] = Node(tri_position[0], vec3<f32>(1.0, 0.0, 0.0));
+        part[1] = Node(tri_position[1], vec3<f32>(0.0, 1.0, 0.0));
+        part[2] = Node(tri_position[2], vec3<f32>(0.0, 0.0, 1.0));
+    } else if (!visit_parts(piece.x, part_index)) {
         return;
     }
     tri_n[0] = piece.z & 0xffffu;

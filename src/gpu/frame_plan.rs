@@ -37,10 +37,11 @@ impl Capacities {
         Capacities { pieces: self.pieces.min(other.pieces), triangles: self.triangles.min(other.triangles) }
     }
 
-    /// A first guess for a scene of `triangles` input triangles.
+    /// A first guess for a scene of `triangles` input triangles (a triangle is a piece or more:
+    /// the cuts around the axis make a few parts of some, the pre-split pieces of large ones).
     pub fn guess(triangles: u32) -> Capacities {
         Capacities {
-            pieces: triangles.saturating_add(1024),
+            pieces: triangles.saturating_mul(2).saturating_add(4096),
             triangles: triangles.saturating_mul(4).saturating_add(4096),
         }
     }

@@ -183,7 +183,36 @@ impl Polygon {
 /// 2, so equal parts of an edge stay about equally long on screen (the projection stretches
 /// ∝ 1/r). Beyond the last, no cut. `limit` is [`band_limit`].
 pub fn band_bounds(rho: f32, limit: f32) -> impl Iterator<Item = f32> {
-    std::iter::successors(Some(rho), |c| Some(BAND_RATIO * c)).take_while(move |&c| c < limit)
+    (0..).map(move |k| band_bound(rho, k)).take_while(move |&c| c < limit)
+}
+
+/// c_k = ρ·√2^k, exactly as the WGSL computes it: ρ or ρ·√2 (one rounding) times 2^(k/2).
+pub fn band_bound(rho: f32, k: u32) -> f32 {
+    let base = if k % 2 == 0 { rho } else { rho * BAND_RATIO };
+    base * 2f32.powi((k / 2) as i32)
+}
+
+/// Whether a triangle lies strictly inside quadrant (sx, sz) and one band: then it is its own
+/// single part (the clips would change nothing, see [`parts`]). `single_band` in the WGSL.
+fn single_band(p: [Vec3; 3], (sx, sz): (f32, f32), rho: f32, limit: f32) -> bool {
+    if !p.iter().all(|q| sx * q.x > 0.0 && sz * q.z > 0.0) {
+        return false;
+    }
+    let d_min = p.iter().map(|q| sx * q.x + sz * q.z).fold(f32::INFINITY, f32::min);
+    // The band holding d_min: the largest k with c_k ≤ d_min among the bounds below `limit`
+    // (k = 0, the square around the axis, always counts); an estimate from the logarithm,
+    // then exact steps.
+    let mut k = (2.0 * (d_min / rho).max(1.0).log2()).min(200.0) as u32;
+    while k > 0 && (band_bound(rho, k) > d_min || band_bound(rho, k) >= limit) {
+        k -= 1;
+    }
+    while band_bound(rho, k + 1) <= d_min && band_bound(rho, k + 1) < limit {
+        k += 1;
+    }
+    let lower = Cut::Chord(sx, sz, band_bound(rho, k), 1.0);
+    let next = band_bound(rho, k + 1);
+    let upper = (next < limit).then_some(Cut::Chord(sx, sz, next, -1.0));
+    p.iter().all(|&q| lower.distance(q) > 0.0 && upper.is_none_or(|u| u.distance(q) > 0.0))
 }
 
 /// Where bands stop: `BAND_LIMIT`·R_T for the adaptive method, none (0) for `vertex` and
@@ -204,6 +233,10 @@ pub fn parts(p: [Vec3; 3], rho: f32, band_limit: f32) -> Vec<[Node; 3]> {
     let bary = [Vec3::X, Vec3::Y, Vec3::Z];
     let triangle = Polygon { nodes: [0, 1, 2, 0, 0, 0, 0].map(|i| Node { position: p[i], bary: bary[i] }), count: 3 };
     let bounds: Vec<f32> = band_bounds(rho, band_limit).collect();
+    // Most triangles: one quadrant, one band, one part (what the loop below would give, faster).
+    if QUADRANTS.iter().any(|&q| single_band(p, q, rho, band_limit)) {
+        return vec![[0, 1, 2].map(|i| triangle.nodes[i])];
+    }
     for (sx, sz) in QUADRANTS {
         // What lies beyond the current diamond; each band is cut from it, and the rest beyond
         // the next diamond is cut from the same polygon, so both sides of a diamond get the
