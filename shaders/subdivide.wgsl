@@ -7,8 +7,8 @@
 // `plan`     one invocation per input triangle: its parts around the vertical axis (quadrants
 //            minus a small square around the axis, fan-triangulated), and for each part the edge
 //            counts N (eq. 5), the macro-lattice level K = ceil(M / N_max) of the pre-split, and
-//            K² piece records (triangle, part, cell).
-// `lattice`  one invocation per piece: the part again (recomputed, the same bits), the regular
+//            K² piece records (triangle, cell, counts, the part's corners).
+// `lattice`  one invocation per piece: the part's corners from the piece record, the regular
 //            lattice of level m = max(counts), boundary nodes snapped to each edge's nodes, each
 //            sub-triangle appended, with a seam copy where it crosses ±π.
 // `finalize` the DrawIndirect arguments, clamped to the capacity.
@@ -70,8 +70,19 @@ struct DrawIndirectArgs {
 @group(0) @binding(0) var<uniform> params: SubdivideParams;
 @group(0) @binding(1) var<storage, read> vertices: array<SceneVertex>;
 @group(0) @binding(2) var<storage, read> indices: array<u32>;
-// Piece records: (triangle, part | macro cell << PART_BITS, n0 | n1 << 16, n2 | K << 16).
-@group(0) @binding(3) var<storage, read_write> pieces: array<vec4<u32>>;
+// A piece: its triangle, macro cell, the part's edge counts and K, and the part's corners
+// (position and barycentric weights), so that `lattice` need not cut the triangle again.
+struct Piece {
+    triangle: u32,
+    cell: u32,
+    counts01: u32,      // n0 | n1 << 16
+    count2_level: u32,  // n2 | K << 16
+    corner: array<vec4<f32>, 3>, // position, barycentric weight of the triangle's corner 0
+    bary1: vec4<f32>,   // weights of corners 1 and 2 at the part's corners 0, 1, 2
+    bary2: vec4<f32>,
+}
+
+@group(0) @binding(3) var<storage, read_write> pieces: array<Piece>;
 @group(0) @binding(4) var<storage, read_write> out_vertices: array<DrawVertex>;
 @group(0) @binding(5) var<storage, read_write> counters: Counters;
 @group(0) @binding(6) var<storage, read_write> draw_args: DrawIndirectArgs;
@@ -83,7 +94,7 @@ struct DrawIndirectArgs {
 
 // `params.piece_count == PIECES_FROM_COUNTER` (from `constants`): as many pieces as `plan` made
 // (read from the counter), so that plan, lattice and drawing can run in one submission.
-// MAX_EDGE_DIVISIONS, EDGE_SAMPLES, MAX_PARTS, SNAP, SEAM_MARGIN: from src/shader/constants.rs.
+// MAX_EDGE_DIVISIONS, EDGE_SAMPLES, BAND_LIMIT, BAND_RATIO, SNAP, SEAM_MARGIN: from src/shader/constants.rs.
 
 struct Node {
     position: vec3<f32>,
@@ -515,9 +526,6 @@ fn quadrant_polygon(s: vec2<f32>) {
     clip_polygon(Cut(CUT_Z, s, 0.0, 1.0));
 }
 
-// The part index of a triangle that is its own single part (the piece record needs no search).
-const WHOLE_TRIANGLE: u32 = MAX_PARTS - 1u;
-
 // c_k = ρ·√2^k, exactly as the twin (`band_bound` in axis.rs): ρ or ρ·√2, times 2^(k/2).
 fn band_bound(k: u32) -> f32 {
     let base = select(params.axis_clearance, params.axis_clearance * BAND_RATIO, (k & 1u) == 1u);
@@ -580,11 +588,9 @@ fn single_band(s: vec2<f32>, limit: f32) -> bool {
     return true;
 }
 
-// Visits the parts of the current triangle in the twin's order (`parts` in axis.rs: quadrant by
-// quadrant, band by band outwards, along each fan): with `wanted` < MAX_PARTS, loads part
-// `wanted` into `part` and returns true if it exists; with wanted = MAX_PARTS, plans every
-// part and appends its pieces (the `plan` entry point).
-fn visit_parts(t: u32, wanted: u32) -> bool {
+// Plans every part of the current triangle (`parts` in axis.rs: quadrant by quadrant, band by
+// band outwards, along each fan) and appends its pieces.
+fn plan_parts(t: u32) {
     let signs = array<vec2<f32>, 4>(vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0), vec2<f32>(-1.0, 1.0), vec2<f32>(-1.0, -1.0));
     // Bands for the adaptive method only (`band_limit` in axis.rs).
     let limit = select(0.0, BAND_LIMIT * params.projection.screen_radius, params.method == METHOD_ADAPTIVE);
@@ -594,14 +600,11 @@ fn visit_parts(t: u32, wanted: u32) -> bool {
             part[0] = Node(tri_position[0], vec3<f32>(1.0, 0.0, 0.0));
             part[1] = Node(tri_position[1], vec3<f32>(0.0, 1.0, 0.0));
             part[2] = Node(tri_position[2], vec3<f32>(0.0, 0.0, 1.0));
-            if (wanted == MAX_PARTS) {
-                plan_part();
-                append_pieces(t, WHOLE_TRIANGLE);
-            }
-            return wanted == 0u || wanted == WHOLE_TRIANGLE;
+            plan_part();
+            append_pieces(t);
+            return;
         }
     }
-    var index = 0u;
     for (var q = 0u; q < 4u; q++) {
         let s = signs[q];
         quadrant_polygon(s);
@@ -654,32 +657,34 @@ fn visit_parts(t: u32, wanted: u32) -> bool {
                 }
             }
             for (var i = 1u; i + 1u < poly_count; i++) {
-                if (wanted == MAX_PARTS || index == wanted) {
-                    part[0] = poly[0];
-                    part[1] = poly[i];
-                    part[2] = poly[i + 1u];
-                    if (wanted != MAX_PARTS) {
-                        return true;
-                    }
-                    plan_part();
-                    append_pieces(t, index);
-                }
-                index += 1u;
+                part[0] = poly[0];
+                part[1] = poly[i];
+                part[2] = poly[i + 1u];
+                plan_part();
+                append_pieces(t);
             }
         }
     }
-    return false;
 }
 
-fn append_pieces(t: u32, index: u32) {
+fn append_pieces(t: u32) {
     let count = tri_k * tri_k;
     let base = atomicAdd(&counters.pieces, count);
     if (base + count > params.piece_capacity) {
         return; // counted, never written
     }
-    let packed = vec2<u32>(tri_n[0] | (tri_n[1] << 16u), tri_n[2] | (tri_k << 16u));
+    var record: Piece;
+    record.triangle = t;
+    record.counts01 = tri_n[0] | (tri_n[1] << 16u);
+    record.count2_level = tri_n[2] | (tri_k << 16u);
+    for (var i = 0u; i < 3u; i++) {
+        record.corner[i] = vec4<f32>(part[i].position, part[i].bary.x);
+        record.bary1[i] = part[i].bary.y;
+        record.bary2[i] = part[i].bary.z;
+    }
     for (var c = 0u; c < count; c++) {
-        pieces[base + c] = vec4<u32>(t, index | (c << PART_BITS), packed);
+        record.cell = c;
+        pieces[base + c] = record;
     }
 }
 
@@ -794,7 +799,7 @@ fn plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if (off_screen_vertically(tri_position[0], tri_position[1], tri_position[2])) {
         return; // no pieces
     }
-    visit_parts(t, MAX_PARTS);
+    plan_parts(t);
 }
 
 @compute @workgroup_size(64)
@@ -808,20 +813,15 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         return;
     }
     let piece = pieces[params.first_piece + local];
-    load_triangle(piece.x);
-    let part_index = piece.y & (MAX_PARTS - 1u);
-    if (part_index == WHOLE_TRIANGLE) {
-        part[0] = Node(tri_position[0], vec3<f32>(1.0, 0.0, 0.0));
-        part[1] = Node(tri_position[1], vec3<f32>(0.0, 1.0, 0.0));
-        part[2] = Node(tri_position[2], vec3<f32>(0.0, 0.0, 1.0));
-    } else if (!visit_parts(piece.x, part_index)) {
-        return;
+    load_triangle(piece.triangle);
+    for (var i = 0u; i < 3u; i++) {
+        part[i] = Node(piece.corner[i].xyz, vec3<f32>(piece.corner[i].w, piece.bary1[i], piece.bary2[i]));
     }
-    tri_n[0] = piece.z & 0xffffu;
-    tri_n[1] = piece.z >> 16u;
-    tri_n[2] = piece.w & 0xffffu;
-    tri_k = piece.w >> 16u;
-    let cell = macro_cell(tri_k, piece.y >> PART_BITS);
+    tri_n[0] = piece.counts01 & 0xffffu;
+    tri_n[1] = piece.counts01 >> 16u;
+    tri_n[2] = piece.count2_level & 0xffffu;
+    tri_k = piece.count2_level >> 16u;
+    let cell = macro_cell(tri_k, piece.cell);
     var loc: array<vec3<u32>, 3>;
     for (var i = 0u; i < 3u; i++) {
         loc[i] = macro_location(cell.c[i]);

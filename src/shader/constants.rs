@@ -18,12 +18,6 @@ pub const AXIS_CLEARANCE_MAX: f32 = 1e-3;
 pub const BAND_LIMIT: f32 = 1000.0;
 /// The ratio of consecutive band diamonds.
 pub const BAND_RATIO: f32 = std::f32::consts::SQRT_2;
-/// The most parts an input triangle is cut into: 4 quadrants × at most 55 bands
-/// (log_√2(BAND_LIMIT / AXIS_CLEARANCE_MIN) + 1) × a fan of at most 5 triangles (a triangle
-/// clipped by four half-planes has at most 7 corners) = 1,100, within the `PART_BITS` bits that
-/// piece records give the part index (the macro cell has the other 21: K² < 2²¹ as K ≤ 1,024).
-pub const PART_BITS: u32 = 11;
-pub const MAX_PARTS: u32 = 1 << PART_BITS;
 /// Signed distances within this fraction of their terms' magnitude count as on the clip line,
 /// so that the CPU and the GPU (whose rounding differs in the last bits) take the same side.
 pub const SNAP: f32 = 1e-6;
@@ -78,8 +72,6 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("AXIS_CLEARANCE_MAX", F32(AXIS_CLEARANCE_MAX)),
         ("BAND_LIMIT", F32(BAND_LIMIT)),
         ("BAND_RATIO", F32(BAND_RATIO)),
-        ("PART_BITS", U32(PART_BITS)),
-        ("MAX_PARTS", U32(MAX_PARTS)),
         ("SNAP", F32(SNAP)),
         ("MAX_STRETCH", F32(MAX_STRETCH)),
         ("SEAM_MARGIN", F32(SEAM_MARGIN)),

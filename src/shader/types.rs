@@ -199,9 +199,25 @@ pub struct Totals {
     pub max_bits: u32,
 }
 
-/// A piece record of `subdivide` (`pieces: array<vec4<u32>>`): triangle, macro cell,
-/// n0 | n1 << 16, n2 | K << 16.
-pub type Piece = [u32; 4];
+/// A piece record of `subdivide`: the input triangle, the macro cell (its part's edge counts and
+/// K packed), and the part's corners (viewer-frame positions and barycentric weights in the
+/// triangle), so that `lattice` need not cut the triangle again.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Piece {
+    pub triangle: u32,
+    pub cell: u32,
+    /// n0 | n1 << 16
+    pub counts01: u32,
+    /// n2 | K << 16
+    pub count2_level: u32,
+    /// Corner i: position xyz, barycentric weight of the triangle's corner 0.
+    pub corner: [[f32; 4]; 3],
+    /// Barycentric weights of the triangle's corners 1 and 2 at each part corner (x, y, z: the
+    /// part's corners 0, 1, 2).
+    pub bary1: [f32; 4],
+    pub bary2: [f32; 4],
+}
 
 /// A Rust struct's layout, to be checked against its WGSL twin.
 #[derive(Clone, Copy, Debug)]
@@ -237,6 +253,7 @@ pub const LAYOUTS: &[StructLayout] = &[
         piece_capacity, triangle_capacity, first_piece, piece_count, measure_edges
     }),
     layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, _pad }),
+    layout!("Piece" => Piece { triangle, cell, counts01, count2_level, corner, bary1, bary2 }),
     layout!("DrawIndirectArgs" => DrawIndirectArgs { vertex_count, instance_count, first_vertex, first_instance }),
     layout!("RasterParams" => RasterParams { projection, eye_sign, ambient, shift_px }),
     layout!("SlitParams" => SlitParams { view, projection, eye_sign, ambient, near, focal_y_clip }),

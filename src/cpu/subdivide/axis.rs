@@ -39,7 +39,7 @@ use glam::Vec3;
 
 use super::Node;
 use crate::core::projection::Projection;
-use crate::shader::constants::{AXIS_CLEARANCE_MAX, AXIS_CLEARANCE_MIN, BAND_LIMIT, BAND_RATIO, MAX_PARTS, SNAP};
+use crate::shader::constants::{AXIS_CLEARANCE_MAX, AXIS_CLEARANCE_MIN, BAND_LIMIT, BAND_RATIO, SNAP};
 
 /// The quadrants (sign of x, sign of z), in the order the twin and the WGSL number parts.
 pub const QUADRANTS: [(f32, f32); 4] = [(1.0, -1.0), (1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0)];
@@ -225,8 +225,8 @@ pub fn band_limit(method: u32, screen_radius: f32) -> f32 {
     }
 }
 
-/// The parts of a triangle (corners in the viewer frame, already snapped), at most
-/// `MAX_PARTS`; part corners carry barycentric weights in the triangle. Numbered quadrant by
+/// The parts of a triangle (corners in the viewer frame, already snapped); part corners carry
+/// barycentric weights in the triangle. Numbered quadrant by
 /// quadrant ([`QUADRANTS`]), band by band outwards ([`band_bounds`]), then along each fan.
 pub fn parts(p: [Vec3; 3], rho: f32, band_limit: f32) -> Vec<[Node; 3]> {
     let mut out = Vec::with_capacity(4);
@@ -268,6 +268,5 @@ pub fn parts(p: [Vec3; 3], rho: f32, band_limit: f32) -> Vec<[Node; 3]> {
             }
         }
     }
-    debug_assert!(out.len() <= MAX_PARTS as usize);
     out
 }
