@@ -13,7 +13,7 @@ use twister::output::{check_outputs, layout_images, layout_names, png_file, writ
 #[derive(Args)]
 #[command(allow_negative_numbers = true)]
 pub struct RenderArgs {
-    /// Scene to render: a .obj, .gltf or .glb file, or builtin:demo, builtin:sphere100, builtin:sphere1024, builtin:triangle@D.
+    /// Scene to render: a .obj, .gltf or .glb file, or builtin:demo, builtin:box-room, builtin:cube, builtin:sphere100, builtin:sphere1024, builtin:triangle@D.
     #[arg(default_value = "builtin:demo")]
     pub scene: String,
     /// Move and scale the scene so that it stands DIST metres ahead, filling the screen height.
