@@ -490,19 +490,6 @@ fn clip_polygon(cut: Cut) {
     poly_count = n;
 }
 
-// Whether every corner of `poly` is on the far side of the cut (x: the clip would be empty),
-// or none is (y: the clip would change nothing). `Polygon::all_beyond` in axis.rs.
-fn all_beyond(cut: Cut) -> vec2<bool> {
-    var beyond = true;
-    var within = true;
-    for (var i = 0u; i < poly_count; i++) {
-        let d = cut_distance(cut, poly[i].position);
-        beyond = beyond && d < 0.0;
-        within = within && d >= 0.0;
-    }
-    return vec2<bool>(beyond, within);
-}
-
 // Clips the input triangle to quadrant q (signs of x and z as in `QUADRANTS` of axis.rs).
 fn quadrant_polygon(s: vec2<f32>) {
     poly[0] = Node(tri_position[0], vec3<f32>(1.0, 0.0, 0.0));
@@ -553,8 +540,9 @@ fn band_of(d: f32, limit: f32) -> u32 {
     return k;
 }
 
-// Whether every corner of the quadrant polygon is on the far side of the cut, or none is
-// (`all_beyond` on the polygon kept in `quadrant`, without copying it).
+// Whether every corner of the polygon kept in `quadrant` is on the far side of the cut (x: the
+// clip would be empty), or none is (y: the clip would change nothing). `Polygon::all_beyond`
+// in axis.rs.
 fn quadrant_beyond(cut: Cut) -> vec2<bool> {
     var beyond = true;
     var within = true;

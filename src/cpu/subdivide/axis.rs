@@ -232,11 +232,11 @@ pub fn parts(p: [Vec3; 3], rho: f32, band_limit: f32) -> Vec<[Node; 3]> {
     let mut out = Vec::with_capacity(4);
     let bary = [Vec3::X, Vec3::Y, Vec3::Z];
     let triangle = Polygon { nodes: [0, 1, 2, 0, 0, 0, 0].map(|i| Node { position: p[i], bary: bary[i] }), count: 3 };
-    let bounds: Vec<f32> = band_bounds(rho, band_limit).collect();
     // Most triangles: one quadrant, one band, one part (what the loop below would give, faster).
     if QUADRANTS.iter().any(|&q| single_band(p, q, rho, band_limit)) {
         return vec![[0, 1, 2].map(|i| triangle.nodes[i])];
     }
+    let bounds: Vec<f32> = band_bounds(rho, band_limit).collect();
     for (sx, sz) in QUADRANTS {
         // What lies beyond the current diamond; each band is cut from it, and the rest beyond
         // the next diamond is cut from the same polygon, so both sides of a diamond get the

@@ -72,7 +72,7 @@ use crate::shader::types::{DrawVertex, SubdivideParams};
 
 mod axis;
 
-pub use axis::{axis_clearance, band_bounds, band_limit, parts, snap_to_cut_planes, QUADRANTS};
+pub use axis::{axis_clearance, band_limit, parts, snap_to_cut_planes};
 
 /// The `subdivide` stage's parameters for a range of input triangles (capacities and piece
 /// ranges are left for the caller, 0).
