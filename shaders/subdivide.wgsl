@@ -4,8 +4,16 @@
 #import projection
 #import constants
 //
-// `plan`     one invocation per input triangle: its parts around the vertical axis (quadrants
-//            minus a small square around the axis, fan-triangulated), and for each part the edge
+// `active_cuts` one invocation per input triangle of the whole scene: the cuts around the axis
+//            the frame makes (quadrant cuts and the square, the diamonds), OR-ed into `counters`.
+// `plan`     one invocation per input triangle. A triangle that is its own single part (no cuts
+//            this frame, or inside one quadrant and one band) is planned here; the others are
+//            listed in `cut_list` for `plan_cuts` (the clipping code, kept out of this entry
+//            point: lavapipe runs a shader that merely contains it markedly slower).
+// `plan_cuts_args`, `plan_cuts`  one invocation per listed triangle: its parts around the
+//            vertical axis under the frame's cuts (quadrants minus a small square around the axis,
+//            bands between the active diamonds, fan-triangulated).
+//            For every part, `plan` and `plan_cuts` find the edge
 //            counts N (eq. 5), the macro-lattice level K = ceil(M / N_max) of the pre-split, and
 //            K² piece records (triangle, cell, counts, the part's corners).
 // `lattice`  one invocation per piece: the part's corners from the piece record, the regular
@@ -57,7 +65,13 @@ struct Counters {
     pieces: atomic<u32>,
     triangles: atomic<u32>,
     max_edge_bits: atomic<u32>, // bits of the largest visible output edge, px (f32 ≥ 0 orders as u32)
-    _pad: u32,
+    cut_count: atomic<u32>,     // triangles `plan` listed for `plan_cuts`
+    // The frame's cuts around the axis (`AxisCuts` in axis.rs): bit 0 the quadrant cuts and the
+    // square, bit k the diamond c_k; bits 0–31 and 32–63. Kept across the chunks of a frame.
+    cuts_low: atomic<u32>,
+    cuts_high: atomic<u32>,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 struct DrawIndirectArgs {
@@ -86,11 +100,14 @@ struct Piece {
 @group(0) @binding(4) var<storage, read_write> out_vertices: array<DrawVertex>;
 @group(0) @binding(5) var<storage, read_write> counters: Counters;
 @group(0) @binding(6) var<storage, read_write> draw_args: DrawIndirectArgs;
-// Workgroup counts of the `lattice` dispatch, written by `lattice_args` from the piece counter.
-@group(0) @binding(7) var<storage, read_write> lattice_dispatch: array<u32, 3>;
+// Workgroup counts of the `lattice` dispatch (0–2), written by `lattice_args` from the piece
+// counter, and of the `plan_cuts` dispatch (3–5), written by `plan_cuts_args`.
+@group(0) @binding(7) var<storage, read_write> lattice_dispatch: array<u32, 6>;
 // Per object: the factor its L is multiplied by (the visual-field level of detail relaxes the
 // subdivision away from the gaze; 1 without it). CPU twin: `Subdivider::edge_px`.
 @group(0) @binding(8) var<storage, read> object_edge_scale: array<f32>;
+// The triangles `plan` left for `plan_cuts` (room for every triangle of a dispatch).
+@group(0) @binding(9) var<storage, read_write> cut_list: array<u32>;
 
 // `params.piece_count == PIECES_FROM_COUNTER` (from `constants`): as many pieces as `plan` made
 // (read from the counter), so that plan, lattice and drawing can run in one submission.
@@ -129,6 +146,8 @@ var<private> poly_count: u32;
 var<private> scratch: array<Node, 7>;
 var<private> quadrant: array<Node, 7>;
 var<private> quadrant_count: u32;
+// The frame's cuts (bits 0–31, 32–63), read by `plan` from the counters.
+var<private> cuts: vec2<u32>;
 
 fn corner(i: u32) -> Node {
     return part[i];
@@ -246,12 +265,20 @@ fn off_screen_vertically(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> bool {
     return all(y > k * r) || all(y < -k * r);
 }
 
-// Loads an input triangle into the viewer frame, its vertices snapped to the cut planes
-// (its parts, their edge counts and K come from `visit_parts` or from the piece record).
-fn load_triangle(t: u32) {
+// The corners of input triangle t in the viewer frame, snapped to the cut planes.
+fn load_positions(t: u32) {
     for (var k = 0u; k < 3u; k++) {
         let v = vertices[indices[3u * t + k]];
         tri_position[k] = snap_to_cut_planes((params.view * vec4<f32>(v.position, 1.0)).xyz);
+    }
+}
+
+// Loads an input triangle into the viewer frame, its vertices snapped to the cut planes
+// (its parts, their edge counts and K come from `visit_parts` or from the piece record).
+fn load_triangle(t: u32) {
+    load_positions(t);
+    for (var k = 0u; k < 3u; k++) {
+        let v = vertices[indices[3u * t + k]];
         tri_normal[k] = (params.view * vec4<f32>(v.normal, 0.0)).xyz;
         tri_color[k] = v.color;
         tri_uv[k] = v.uv;
@@ -519,25 +546,112 @@ fn band_bound(k: u32) -> f32 {
     return ldexp(base, i32(k / 2u));
 }
 
-// The band of distance d (|x| + |z|): the largest k with c_k ≤ d among the bounds below
-// `limit` (k = 0 always counts); an estimate from the logarithm, then exact steps.
-fn band_of(d: f32, limit: f32) -> u32 {
-    var k = u32(min(2.0 * log2(max(d / params.axis_clearance, 1.0)), 200.0));
+// The largest k < MAX_DIAMONDS with c_k ≤ d (0 if none): an estimate from the logarithm, then
+// exact steps. `band_of` in axis.rs.
+fn band_of(d: f32) -> u32 {
+    var k = u32(min(2.0 * log2(max(d / params.axis_clearance, 1.0)), f32(MAX_DIAMONDS - 1u)));
     loop {
-        let c = band_bound(k);
-        if (k == 0u || !(c > d || c >= limit)) {
+        if (k == 0u || !(band_bound(k) > d)) {
             break;
         }
         k -= 1u;
     }
     loop {
-        let c = band_bound(k + 1u);
-        if (!(c <= d && c < limit)) {
+        if (!(k + 1u < MAX_DIAMONDS && band_bound(k + 1u) <= d)) {
             break;
         }
         k += 1u;
     }
     return k;
+}
+
+fn cut_active(k: u32) -> bool {
+    if (k < 32u) {
+        return ((cuts.x >> k) & 1u) != 0u;
+    }
+    return k < 64u && ((cuts.y >> (k - 32u)) & 1u) != 0u;
+}
+
+// The next active diamond after k, or MAX_DIAMONDS. `next_cut` in axis.rs.
+fn next_cut(k: u32) -> u32 {
+    let j = k + 1u;
+    if (j < 32u) {
+        let low = cuts.x & (0xffffffffu << j);
+        if (low != 0u) {
+            return firstTrailingBit(low);
+        }
+    }
+    if (j < 64u) {
+        let high = cuts.y & (0xffffffffu << (max(j, 32u) - 32u));
+        if (high != 0u) {
+            return 32u + firstTrailingBit(high);
+        }
+    }
+    return MAX_DIAMONDS;
+}
+
+// The largest active k with c_k ≤ d (k = 0, the square, always counts). `zone_of` in axis.rs.
+fn zone_of(d: f32) -> u32 {
+    var k = band_of(d);
+    loop {
+        if (k == 0u || cut_active(k)) {
+            break;
+        }
+        k -= 1u;
+    }
+    return k;
+}
+
+// The smallest and largest |x| + |z| of the triangle's points (`diamond_range` in axis.rs).
+fn diamond_range(p: array<vec3<f32>, 3>) -> vec2<f32> {
+    let d = vec3<f32>(abs(p[0].x) + abs(p[0].z), abs(p[1].x) + abs(p[1].z), abs(p[2].x) + abs(p[2].z));
+    let hi = max(max(d.x, d.y), d.z);
+    var s: vec3<f32>;
+    for (var e = 0u; e < 3u; e++) {
+        let a = p[e];
+        let b = p[(e + 1u) % 3u];
+        s[e] = (b.z - a.z) * a.x - (b.x - a.x) * a.z;
+    }
+    if (all(s >= vec3<f32>(0.0)) || all(s <= vec3<f32>(0.0))) {
+        return vec2<f32>(0.0, hi);
+    }
+    var lo = min(min(d.x, d.y), d.z);
+    for (var e = 0u; e < 3u; e++) {
+        let a = p[e];
+        let b = p[(e + 1u) % 3u];
+        if ((a.x < 0.0) != (b.x < 0.0) && a.x != 0.0 && b.x != 0.0) {
+            lo = min(lo, abs(a.z + (b.z - a.z) * (a.x / (a.x - b.x))));
+        }
+        if ((a.z < 0.0) != (b.z < 0.0) && a.z != 0.0 && b.z != 0.0) {
+            lo = min(lo, abs(a.x + (b.x - a.x) * (a.z / (a.z - b.z))));
+        }
+    }
+    return vec2<f32>(lo, hi);
+}
+
+// The cuts the current triangle asks for (`triangle_cuts` in axis.rs), as bits 0–31, 32–63.
+fn triangle_cuts(limit: f32) -> vec2<u32> {
+    let range = diamond_range(tri_position);
+    let lo = range.x;
+    let hi = range.y;
+    if (!(lo < band_bound(1u) || hi > WIDE_RATIO * lo)) {
+        return vec2<u32>(0u);
+    }
+    var bits = vec2<u32>(1u, 0u);
+    for (var k = 1u; k < MAX_DIAMONDS; k++) {
+        let c = band_bound(k);
+        if (c >= limit || c >= hi) {
+            break;
+        }
+        if (lo < c) {
+            if (k < 32u) {
+                bits.x |= 1u << k;
+            } else {
+                bits.y |= 1u << (k - 32u);
+            }
+        }
+    }
+    return bits;
 }
 
 // Whether every corner of the polygon kept in `quadrant` is on the far side of the cut (x: the
@@ -554,9 +668,9 @@ fn quadrant_beyond(cut: Cut) -> vec2<bool> {
     return vec2<bool>(beyond, within);
 }
 
-// Whether the input triangle lies strictly inside quadrant s and one band (below `limit`):
-// then it is its own single part. `single_band` in axis.rs.
-fn single_band(s: vec2<f32>, limit: f32) -> bool {
+// Whether the input triangle lies strictly inside quadrant s and between two consecutive active
+// diamonds: then it is its own single part. `single_band` in axis.rs.
+fn single_band(s: vec2<f32>) -> bool {
     let p = tri_position;
     let dx = vec3<f32>(s.x * p[0].x, s.x * p[1].x, s.x * p[2].x);
     let dz = vec3<f32>(s.y * p[0].z, s.y * p[1].z, s.y * p[2].z);
@@ -564,35 +678,38 @@ fn single_band(s: vec2<f32>, limit: f32) -> bool {
         return false;
     }
     let d = dx + dz;
-    let k = band_of(min(min(d.x, d.y), d.z), limit);
+    let k = zone_of(min(min(d.x, d.y), d.z));
     let lower = Cut(CUT_CHORD, s, band_bound(k), 1.0);
-    let next = band_bound(k + 1u);
-    let upper = Cut(CUT_CHORD, s, next, -1.0);
+    let next = next_cut(k);
+    let upper = Cut(CUT_CHORD, s, band_bound(min(next, MAX_DIAMONDS - 1u)), -1.0);
     for (var i = 0u; i < 3u; i++) {
-        if (cut_distance(lower, p[i]) <= 0.0 || (next < limit && cut_distance(upper, p[i]) <= 0.0)) {
+        if (cut_distance(lower, p[i]) <= 0.0 || (next < MAX_DIAMONDS && cut_distance(upper, p[i]) <= 0.0)) {
             return false;
         }
     }
     return true;
 }
 
+const QUADRANT_SIGNS = array<vec2<f32>, 4>(vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0), vec2<f32>(-1.0, 1.0), vec2<f32>(-1.0, -1.0));
+
+// Whether the current triangle is its own single part: no cuts this frame, or one quadrant and
+// one band (the loop of `plan_parts` would give that part).
+fn single_part() -> bool {
+    if (all(cuts == vec2<u32>(0u))) {
+        return true;
+    }
+    for (var q = 0u; q < 4u; q++) {
+        if (single_band(QUADRANT_SIGNS[q])) {
+            return true;
+        }
+    }
+    return false;
+}
+
 // Plans every part of the current triangle (`parts` in axis.rs: quadrant by quadrant, band by
 // band outwards, along each fan) and appends its pieces.
 fn plan_parts(t: u32) {
-    let signs = array<vec2<f32>, 4>(vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0), vec2<f32>(-1.0, 1.0), vec2<f32>(-1.0, -1.0));
-    // Bands for the adaptive method only (`band_limit` in axis.rs).
-    let limit = select(0.0, BAND_LIMIT * params.projection.screen_radius, params.method == METHOD_ADAPTIVE);
-    // Most triangles: one quadrant, one band, one part (what the loop below would give, faster).
-    for (var q = 0u; q < 4u; q++) {
-        if (single_band(signs[q], limit)) {
-            part[0] = Node(tri_position[0], vec3<f32>(1.0, 0.0, 0.0));
-            part[1] = Node(tri_position[1], vec3<f32>(0.0, 1.0, 0.0));
-            part[2] = Node(tri_position[2], vec3<f32>(0.0, 0.0, 1.0));
-            plan_part();
-            append_pieces(t);
-            return;
-        }
-    }
+    let signs = QUADRANT_SIGNS;
     for (var q = 0u; q < 4u; q++) {
         let s = signs[q];
         quadrant_polygon(s);
@@ -610,14 +727,14 @@ fn plan_parts(t: u32) {
         for (var i = 0u; i < quadrant_count; i++) {
             d_min = min(d_min, s.x * quadrant[i].position.x + s.y * quadrant[i].position.z);
         }
-        var k = band_of(d_min, limit);
+        var k = zone_of(d_min);
         loop {
             if (quadrant_count == 0u) {
                 break;
             }
-            k += 1u;
-            let c = band_bound(k);
-            if (c >= limit) {
+            k = next_cut(k);
+            let c = band_bound(min(k, MAX_DIAMONDS - 1u));
+            if (k >= MAX_DIAMONDS) {
                 poly = quadrant;
                 poly_count = quadrant_count;
                 quadrant_count = 0u; // the last band: all the rest
@@ -776,6 +893,28 @@ fn invocation_index(gid: vec3<u32>, groups: vec3<u32>) -> u32 {
     return gid.x + gid.y * groups.x * 64u;
 }
 
+// Over every triangle of the scene, before `plan` (and before every chunk of a chunked frame).
+@compute @workgroup_size(64)
+fn active_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let local = invocation_index(gid, groups);
+    if (local >= params.triangle_count) {
+        return;
+    }
+    load_positions(params.first_triangle + local);
+    if (off_screen_vertically(tri_position[0], tri_position[1], tri_position[2])) {
+        return;
+    }
+    // Diamonds for the adaptive method only (`band_limit` in axis.rs).
+    let limit = select(0.0, BAND_LIMIT * params.projection.screen_radius, params.method == METHOD_ADAPTIVE);
+    let bits = triangle_cuts(limit);
+    if (bits.x != 0u) {
+        atomicOr(&counters.cuts_low, bits.x);
+    }
+    if (bits.y != 0u) {
+        atomicOr(&counters.cuts_high, bits.y);
+    }
+}
+
 @compute @workgroup_size(64)
 fn plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let local = invocation_index(gid, groups);
@@ -783,10 +922,42 @@ fn plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         return;
     }
     let t = params.first_triangle + local;
+    cuts = vec2<u32>(atomicLoad(&counters.cuts_low), atomicLoad(&counters.cuts_high));
     load_triangle(t);
     if (off_screen_vertically(tri_position[0], tri_position[1], tri_position[2])) {
         return; // no pieces
     }
+    if (single_part()) {
+        part[0] = Node(tri_position[0], vec3<f32>(1.0, 0.0, 0.0));
+        part[1] = Node(tri_position[1], vec3<f32>(0.0, 1.0, 0.0));
+        part[2] = Node(tri_position[2], vec3<f32>(0.0, 0.0, 1.0));
+        plan_part();
+        append_pieces(t);
+        return;
+    }
+    let slot = atomicAdd(&counters.cut_count, 1u);
+    if (slot < arrayLength(&cut_list)) {
+        cut_list[slot] = t;
+    }
+}
+
+@compute @workgroup_size(1)
+fn plan_cuts_args() {
+    let groups = (min(atomicLoad(&counters.cut_count), arrayLength(&cut_list)) + 63u) / 64u;
+    lattice_dispatch[3] = min(groups, 65535u);
+    lattice_dispatch[4] = (groups + 65534u) / 65535u;
+    lattice_dispatch[5] = 1u;
+}
+
+@compute @workgroup_size(64)
+fn plan_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let local = invocation_index(gid, groups);
+    if (local >= min(atomicLoad(&counters.cut_count), arrayLength(&cut_list))) {
+        return;
+    }
+    let t = cut_list[local];
+    cuts = vec2<u32>(atomicLoad(&counters.cuts_low), atomicLoad(&counters.cuts_high));
+    load_triangle(t);
     plan_parts(t);
 }
 

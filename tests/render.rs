@@ -160,22 +160,31 @@ fn triangle_reaching_inside_the_eye_circle_renders_without_nan_or_smear() {
 
 #[test]
 fn scene_too_big_for_the_memory_budget_is_drawn_in_chunks_without_loss() {
-    let projection = Projection { width: 480, height: 120, ..Projection::default() };
     let scene = builtin::demo();
-    let roomy = RenderSettings::new(projection).with_edge_px(2.0);
-    let tight = roomy.with_memory_mb(8);
-    let a = common::render(&scene, &roomy);
-    let b = common::render(&scene, &tight);
-    assert_eq!(a.stats.chunks, 1);
-    assert!(b.stats.chunks > 1, "8 MiB should not hold {} triangles at once", b.stats.triangles_out);
-    assert_eq!(a.stats.triangles_out, b.stats.triangles_out, "chunking lost or added triangles");
-    for eye in Eye::BOTH {
-        let differ = a.eye(eye).rgba.chunks(4).zip(b.eye(eye).rgba.chunks(4)).filter(|(p, q)| p != q).count();
-        // Equal-depth fragments (seam copies, shared edges) may resolve in another order.
-        assert!(
-            differ * 1000 < a.eye(eye).rgba.len() / 4,
-            "{eye:?}: {differ} pixels differ between one chunk and many"
-        );
+    // Wide: no triangle asks for cuts around the axis. Square: the floor and the ceiling near the
+    // axis show, and the cuts they ask for hold in every chunk.
+    for (projection, edge_px, cut) in [
+        (Projection { width: 960, height: 180, ..Projection::default() }, 3.0, false),
+        (Projection { width: 256, height: 256, ..Projection::default() }, 4.0, true),
+    ] {
+        let roomy = RenderSettings::new(projection).with_edge_px(edge_px);
+        let params = twister::cpu::subdivide::subdivide_params(&roomy, 0, scene.triangle_count() as u32);
+        let cuts = twister::cpu::subdivide::Subdivider::new(&params).active_cuts(&scene.vertices, &scene.indices);
+        assert_eq!(cuts != 0, cut, "{projection:?}: cuts {cuts:#x}");
+        let tight = roomy.with_memory_mb(8);
+        let a = common::render(&scene, &roomy);
+        let b = common::render(&scene, &tight);
+        assert_eq!(a.stats.chunks, 1);
+        assert!(b.stats.chunks > 1, "8 MiB should not hold {} triangles at once", b.stats.triangles_out);
+        assert_eq!(a.stats.triangles_out, b.stats.triangles_out, "chunking lost or added triangles");
+        for eye in Eye::BOTH {
+            let differ = a.eye(eye).rgba.chunks(4).zip(b.eye(eye).rgba.chunks(4)).filter(|(p, q)| p != q).count();
+            // Equal-depth fragments (seam copies, shared edges) may resolve in another order.
+            assert!(
+                differ * 1000 < a.eye(eye).rgba.len() / 4,
+                "{eye:?}: {differ} pixels differ between one chunk and many"
+            );
+        }
     }
 }
 

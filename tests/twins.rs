@@ -177,7 +177,7 @@ impl Twin for Subdivide {
             (random_triangle_scene(4, 300), base),
             (random_triangle_scene(5, 200), base.with_method(Method::Fixed(5))),
             (builtin::demo(), base),
-            (builtin::demo(), moved.with_method(Method::Vertex)),
+            (builtin::demo(), moved.with_projection(tall_projection).with_method(Method::Vertex)),
             (builtin::demo(), moved.with_edge_px(12.0).with_max_div(4)),
             (sphere, base.with_edge_px(8.0)),
             (around, base.with_edge_px(16.0)),
@@ -193,16 +193,21 @@ impl Twin for Subdivide {
             (cube.clone(), small.with_viewer(Vec3::new(0.0, 0.95, 0.0)).with_edge_px(4.0).with_max_div(3)),
             (cube, tall_exact.with_viewer(Vec3::new(0.1, -0.8, 0.2)).with_edge_px(12.0)),
         ];
-        cases
+        let mut cut_frames = 0;
+        let cases: Vec<_> = cases
             .into_iter()
             .enumerate()
             .map(|(k, (scene, s))| {
                 let name = format!("case {k}: {} {}", scene.name, s.subdivision.method.name());
                 let cpu = Self::cpu(&(scene.clone(), s));
                 assert!(cpu.vertices.len() / 3 > scene.triangle_count(), "{name}: exercises splits and seam copies");
+                cut_frames += (cpu.cuts != 0) as usize;
                 (name, (scene, s))
             })
-            .collect()
+            .collect();
+        // Frames with and without cuts around the axis.
+        assert!(cut_frames >= 8 && cut_frames < cases.len(), "{cut_frames} of {} cases cut", cases.len());
+        cases
     }
     fn gpu(r: &Renderer, (scene, settings): &Self::Case) -> Self::Output {
         let gs = GpuScene::upload(&r.gpu, scene).unwrap();
@@ -212,6 +217,9 @@ impl Twin for Subdivide {
         subdivide(&subdivide_params(settings, 0, scene.triangle_count() as u32), &scene.vertices, &scene.indices)
     }
     fn compare(gpu: &Self::Output, cpu: &Self::Output) -> Result<(), String> {
+        if cpu.cuts != gpu.cuts {
+            return Err(format!("cuts around the axis: CPU {:#x}, GPU {:#x}", cpu.cuts, gpu.cuts));
+        }
         if cpu.pieces != gpu.pieces {
             return Err(format!("pieces: CPU {}, GPU {}", cpu.pieces, gpu.pieces));
         }

@@ -100,8 +100,11 @@ pub struct SubdivisionBuffers {
     pub triangles: wgpu::Buffer,
     pub counters: wgpu::Buffer,
     pub draw_args: wgpu::Buffer,
-    /// Indirect dispatch arguments of `lattice` in the one-submission frame.
+    /// Indirect dispatch arguments of `lattice` (in the one-submission frame) and `plan_cuts`.
     pub lattice_dispatch: wgpu::Buffer,
+    /// The triangles `plan` leaves to `plan_cuts`: room for every triangle of the scene.
+    pub cut_list: wgpu::Buffer,
+    pub cut_list_capacity: u32,
     pub capacity: Capacities,
 }
 
@@ -129,20 +132,37 @@ impl SubdivisionBuffers {
                 std::mem::size_of::<DrawIndirectArgs>() as u64,
                 wgpu::BufferUsages::INDIRECT,
             ),
-            lattice_dispatch: gpu.storage_buffer("lattice dispatch", 16, wgpu::BufferUsages::INDIRECT),
+            lattice_dispatch: gpu.storage_buffer("lattice dispatch", 24, wgpu::BufferUsages::INDIRECT),
+            cut_list: gpu.storage_buffer("cut list", 4, wgpu::BufferUsages::empty()),
+            cut_list_capacity: 1,
             capacity,
         }
     }
 
     /// Makes sure the cached buffers hold at least `want`. Each buffer is replaced only if it is
     /// too small, so growing the output keeps the pieces already planned.
+    /// The cut list gets room for `triangles` (the scene's triangle count, at most what one
+    /// binding holds: [`SubdivisionBuffers::cut_list_capacity`] bounds a dispatch's triangles).
     pub fn ensure<'c>(
         cache: &'c mut Option<SubdivisionBuffers>,
         gpu: &Gpu,
         want: Capacities,
+        triangles: u32,
     ) -> &'c SubdivisionBuffers {
+        let cut_list = (triangles as u64).min(gpu.max_binding() / 4).max(1) as u32;
+        if let Some(b) = cache.as_mut() {
+            if b.cut_list_capacity < cut_list {
+                b.cut_list = gpu.storage_buffer("cut list", 4 * cut_list as u64, wgpu::BufferUsages::empty());
+                b.cut_list_capacity = cut_list;
+            }
+        }
         match cache {
-            None => *cache = Some(SubdivisionBuffers::new(gpu, want)),
+            None => {
+                let mut b = SubdivisionBuffers::new(gpu, want);
+                b.cut_list = gpu.storage_buffer("cut list", 4 * cut_list as u64, wgpu::BufferUsages::empty());
+                b.cut_list_capacity = cut_list;
+                *cache = Some(b);
+            }
             Some(b) => {
                 if b.capacity.pieces < want.pieces {
                     b.pieces = pieces_buffer(gpu, want.pieces);

@@ -147,7 +147,10 @@ fn draw_pipeline(gpu: &Gpu, stage: &GpuStage, kind: DrawStage, measure: bool, ma
 /// The `subdivide` stage's pipelines, one per entry point.
 struct SubdividePipelines {
     stage: GpuStage,
+    active_cuts: wgpu::ComputePipeline,
     plan: wgpu::ComputePipeline,
+    plan_cuts_args: wgpu::ComputePipeline,
+    plan_cuts: wgpu::ComputePipeline,
     lattice_args: wgpu::ComputePipeline,
     lattice: wgpu::ComputePipeline,
     finalize: wgpu::ComputePipeline,
@@ -198,7 +201,10 @@ impl Renderer {
         let built = gpu.scoped("building the pipelines", || {
             let stage = GpuStage::new(&gpu, &SUBDIVIDE);
             let subdivide = SubdividePipelines {
+                active_cuts: stage.compute(&gpu, "active_cuts"),
                 plan: stage.compute(&gpu, "plan"),
+                plan_cuts_args: stage.compute(&gpu, "plan_cuts_args"),
+                plan_cuts: stage.compute(&gpu, "plan_cuts"),
                 lattice_args: stage.compute(&gpu, "lattice_args"),
                 lattice: stage.compute(&gpu, "lattice"),
                 finalize: stage.compute(&gpu, "finalize"),
@@ -290,7 +296,8 @@ impl Renderer {
     }
 
     /// The subdivide stage's bind group: params, vertices, indices, pieces, triangles, counters,
-    /// draw args, lattice dispatch, per-object edge scale (the order of `SUBDIVIDE.bindings`).
+    /// draw args, lattice dispatch, per-object edge scale, cut list (the order of
+    /// `SUBDIVIDE.bindings`).
     fn subdivide_bind_group(
         &self,
         entry: &str,
@@ -312,12 +319,38 @@ impl Renderer {
                 &b.draw_args,
                 &b.lattice_dispatch,
                 &scene.object_edge_scale,
+                &b.cut_list,
             ],
         )
     }
 
+    /// Clears the counters and runs `active_cuts` over every triangle of the scene: the start of
+    /// a frame that runs `plan` and `lattice` apart (chunks, read-back).
+    fn run_active_cuts(
+        &self,
+        uniform: &wgpu::Buffer,
+        scene: &GpuScene,
+        buffers: &SubdivisionBuffers,
+        params: &SubdivideParams,
+    ) {
+        let params = SubdivideParams { first_triangle: 0, triangle_count: scene.triangle_count, ..*params };
+        self.gpu.queue.write_buffer(uniform, 0, bytemuck::bytes_of(&params));
+        let bind_group = self.subdivide_bind_group("active_cuts", uniform, scene, buffers);
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        enc.clear_buffer(&buffers.counters, 0, None);
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_pipeline(&self.subdivide.active_cuts);
+            pass.set_bind_group(0, &bind_group, &[]);
+            let (x, y) = self.gpu.workgroups(scene.triangle_count, 64);
+            pass.dispatch_workgroups(x, y, 1);
+        }
+        self.gpu.queue.submit([enc.finish()]);
+    }
+
     /// Runs one compute entry point of the subdivide stage (`plan` or `lattice`) over `count`
-    /// invocations, then `finalize`, and returns the counters afterwards.
+    /// invocations, then `finalize`, and returns the counters afterwards (the frame's cuts,
+    /// from `run_active_cuts`, are kept).
     fn run_subdivide(
         &self,
         entry: &str,
@@ -330,15 +363,19 @@ impl Renderer {
         self.gpu.queue.write_buffer(uniform, 0, bytemuck::bytes_of(params));
         let pipeline = if entry == "plan" { &self.subdivide.plan } else { &self.subdivide.lattice };
         let bind_group = self.subdivide_bind_group(entry, uniform, scene, buffers);
+        let cut_groups = ["plan_cuts_args", "plan_cuts"].map(|e| self.subdivide_bind_group(e, uniform, scene, buffers));
         let finalize = self.subdivide_bind_group("finalize", uniform, scene, buffers);
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-        enc.clear_buffer(&buffers.counters, 0, None);
+        enc.clear_buffer(&buffers.counters, 0, Some(SubdivideCounters::RUN_BYTES));
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &bind_group, &[]);
             let (x, y) = self.gpu.workgroups(count, 64);
             pass.dispatch_workgroups(x, y, 1);
+            if entry == "plan" {
+                self.encode_plan_cuts(&mut pass, buffers, &cut_groups);
+            }
             pass.set_pipeline(&self.subdivide.finalize);
             pass.set_bind_group(0, &finalize, &[]);
             pass.dispatch_workgroups(1, 1, 1);
@@ -346,6 +383,16 @@ impl Renderer {
         self.gpu.queue.submit([enc.finish()]);
         let bytes = self.gpu.download(&buffers.counters, COUNTERS_SIZE)?;
         Ok(*bytemuck::from_bytes(&bytes))
+    }
+
+    /// `plan_cuts_args` and `plan_cuts` (the triangles `plan` listed), after `plan`.
+    fn encode_plan_cuts(&self, pass: &mut wgpu::ComputePass, b: &SubdivisionBuffers, groups: &[wgpu::BindGroup; 2]) {
+        pass.set_pipeline(&self.subdivide.plan_cuts_args);
+        pass.set_bind_group(0, &groups[0], &[]);
+        pass.dispatch_workgroups(1, 1, 1);
+        pass.set_pipeline(&self.subdivide.plan_cuts);
+        pass.set_bind_group(0, &groups[1], &[]);
+        pass.dispatch_workgroups_indirect(&b.lattice_dispatch, 12);
     }
 
     /// The usual frame, in one submission (see [`FramePlan::OneSubmission`]). Returns None if a
@@ -364,7 +411,8 @@ impl Renderer {
         params.piece_count = PIECES_FROM_COUNTER;
         self.gpu.queue.write_buffer(&res.subdivide_params, 0, bytemuck::bytes_of(&params));
         let group = |entry| self.subdivide_bind_group(entry, &res.subdivide_params, scene, b);
-        let groups = ["plan", "lattice_args", "lattice", "finalize"].map(group);
+        let groups = ["active_cuts", "plan", "lattice_args", "lattice", "finalize"].map(group);
+        let cut_groups = ["plan_cuts_args", "plan_cuts"].map(group);
         let timestamps = res.timestamps.as_ref();
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         enc.clear_buffer(&b.counters, 0, None);
@@ -377,18 +425,22 @@ impl Renderer {
                     end_of_pass_write_index: Some(1),
                 }),
             });
-            pass.set_pipeline(&self.subdivide.plan);
-            pass.set_bind_group(0, &groups[0], &[]);
             let (x, y) = self.gpu.workgroups(params.triangle_count, 64);
+            pass.set_pipeline(&self.subdivide.active_cuts);
+            pass.set_bind_group(0, &groups[0], &[]);
             pass.dispatch_workgroups(x, y, 1);
-            pass.set_pipeline(&self.subdivide.lattice_args);
+            pass.set_pipeline(&self.subdivide.plan);
             pass.set_bind_group(0, &groups[1], &[]);
+            pass.dispatch_workgroups(x, y, 1);
+            self.encode_plan_cuts(&mut pass, b, &cut_groups);
+            pass.set_pipeline(&self.subdivide.lattice_args);
+            pass.set_bind_group(0, &groups[2], &[]);
             pass.dispatch_workgroups(1, 1, 1);
             pass.set_pipeline(&self.subdivide.lattice);
-            pass.set_bind_group(0, &groups[2], &[]);
+            pass.set_bind_group(0, &groups[3], &[]);
             pass.dispatch_workgroups_indirect(&b.lattice_dispatch, 0);
             pass.set_pipeline(&self.subdivide.finalize);
-            pass.set_bind_group(0, &groups[3], &[]);
+            pass.set_bind_group(0, &groups[4], &[]);
             pass.dispatch_workgroups(1, 1, 1);
         }
         self.encode_raster(&mut enc, res, scene, targets, b, settings, true, timestamps.map(|t| (&t.set, 2, 3)));
@@ -455,9 +507,10 @@ impl Renderer {
                 triangles: scene.triangle_count.saturating_mul(4).max(1024),
             };
             loop {
-                let b = SubdivisionBuffers::ensure(&mut cache, &self.gpu, want);
+                let b = SubdivisionBuffers::ensure(&mut cache, &self.gpu, want, scene.triangle_count);
                 params.piece_capacity = b.capacity.pieces;
                 params.triangle_capacity = b.capacity.triangles;
+                self.run_active_cuts(&uniform, scene, b, &params);
                 let planned = self.run_subdivide("plan", &uniform, scene, b, &params, scene.triangle_count)?;
                 if planned.pieces > b.capacity.pieces {
                     want.pieces = planned.pieces;
@@ -475,6 +528,7 @@ impl Renderer {
                     vertices: bytemuck::cast_slice(&bytes).to_vec(),
                     pieces: planned.pieces,
                     max_sub_edge_px: f32::from_bits(done.max_edge_bits),
+                    cuts: done.cuts(),
                 });
             }
         })
@@ -517,7 +571,14 @@ impl Renderer {
         let n = scene.triangle_count;
         let mut plan = FramePlan::first(n, res.buffers.as_ref().map(|b| b.capacity), budget);
         if let FramePlan::OneSubmission(want) = plan {
-            SubdivisionBuffers::ensure(&mut res.buffers, &self.gpu, want);
+            SubdivisionBuffers::ensure(&mut res.buffers, &self.gpu, want, n);
+            let b = res.buffers.as_ref().expect("ensured");
+            if b.cut_list_capacity < n {
+                // More triangles than one binding lists for `plan_cuts`: chunks.
+                plan = plan.after_overflow(budget);
+            }
+        }
+        if let FramePlan::OneSubmission(_) = plan {
             let b = res.buffers.as_ref().expect("ensured");
             let targets = res.targets.as_ref().expect("made");
             let mut params = subdivide_params(settings, 0, n);
@@ -567,9 +628,14 @@ impl Renderer {
         let (mut ms_subdivide, mut ms_raster) = (0.0, 0.0);
         let (mut first_tri, mut tri_chunk) = (0u32, n.max(1));
         let mut cleared = false;
+        let b = SubdivisionBuffers::ensure(&mut res.buffers, &self.gpu, *want, n);
+        tri_chunk = tri_chunk.min(b.cut_list_capacity);
+        let t = Instant::now();
+        self.run_active_cuts(&res.subdivide_params, scene, b, &subdivide_params(settings, 0, n));
+        ms_subdivide += t.elapsed().as_secs_f64() * 1e3;
         while first_tri < n || !cleared {
             let tri_count = tri_chunk.min(n - first_tri);
-            let b = SubdivisionBuffers::ensure(&mut res.buffers, &self.gpu, *want);
+            let b = SubdivisionBuffers::ensure(&mut res.buffers, &self.gpu, *want, n);
             let mut params = subdivide_params(settings, first_tri, tri_count);
             params.piece_capacity = b.capacity.pieces.min(budget.pieces);
             params.triangle_capacity = b.capacity.triangles;
@@ -597,7 +663,7 @@ impl Renderer {
             let mut piece_done = false;
             while first_piece < planned.pieces || !piece_done {
                 let piece_count = piece_chunk.min(planned.pieces - first_piece);
-                let b = SubdivisionBuffers::ensure(&mut res.buffers, &self.gpu, *want);
+                let b = SubdivisionBuffers::ensure(&mut res.buffers, &self.gpu, *want, n);
                 params.first_piece = first_piece;
                 params.piece_count = piece_count;
                 params.triangle_capacity = b.capacity.triangles.min(budget.triangles);

@@ -14,8 +14,13 @@ pub const EDGE_SAMPLES: u32 = 8;
 pub const AXIS_CLEARANCE_MIN: f32 = 1e-5;
 pub const AXIS_CLEARANCE_MAX: f32 = 1e-3;
 /// For the adaptive method, parts are also cut into bands by the diamonds |x| + |z| = ρ·√2^k
-/// below this many R_T (see `cpu::subdivide::axis::band_bounds`).
+/// below this many R_T (see `cpu::subdivide::axis::band_bound`).
 pub const BAND_LIMIT: f32 = 1000.0;
+/// A triangle whose diamond distances |x| + |z| span more than this ratio switches on the cuts
+/// around the axis for the frame (see `cpu::subdivide::axis::triangle_cuts`).
+pub const WIDE_RATIO: f32 = 2.0;
+/// Diamonds are numbered below this: the frame's active cuts are a 64-bit mask.
+pub const MAX_DIAMONDS: u32 = 64;
 /// The ratio of consecutive band diamonds.
 pub const BAND_RATIO: f32 = std::f32::consts::SQRT_2;
 /// Signed distances within this fraction of their terms' magnitude count as on the clip line,
@@ -71,6 +76,8 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("AXIS_CLEARANCE_MIN", F32(AXIS_CLEARANCE_MIN)),
         ("AXIS_CLEARANCE_MAX", F32(AXIS_CLEARANCE_MAX)),
         ("BAND_LIMIT", F32(BAND_LIMIT)),
+        ("WIDE_RATIO", F32(WIDE_RATIO)),
+        ("MAX_DIAMONDS", U32(MAX_DIAMONDS)),
         ("BAND_RATIO", F32(BAND_RATIO)),
         ("SNAP", F32(SNAP)),
         ("MAX_STRETCH", F32(MAX_STRETCH)),

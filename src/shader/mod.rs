@@ -116,7 +116,10 @@ pub const SUBDIVIDE: Stage = Stage {
     source: include_str!("../../shaders/subdivide.wgsl"),
     kind: StageKind::Compute,
     entry_points: &[
-        entry("plan", &["params", "vertices", "indices", "pieces", "counters", "object_edge_scale"]),
+        entry("active_cuts", &["params", "vertices", "indices", "counters"]),
+        entry("plan", &["params", "vertices", "indices", "pieces", "counters", "object_edge_scale", "cut_list"]),
+        entry("plan_cuts_args", &["counters", "lattice_dispatch", "cut_list"]),
+        entry("plan_cuts", &["params", "vertices", "indices", "pieces", "counters", "object_edge_scale", "cut_list"]),
         entry("lattice_args", &["params", "counters", "lattice_dispatch"]),
         entry("lattice", &["params", "vertices", "indices", "pieces", "out_vertices", "counters", "object_edge_scale"]),
         entry("finalize", &["params", "counters", "draw_args"]),
@@ -131,6 +134,7 @@ pub const SUBDIVIDE: Stage = Stage {
         bind(0, 6, "draw_args", StorageReadWrite),
         bind(0, 7, "lattice_dispatch", StorageReadWrite),
         bind(0, 8, "object_edge_scale", Storage),
+        bind(0, 9, "cut_list", StorageReadWrite),
     ],
 };
 

@@ -105,7 +105,24 @@ pub struct SubdivideCounters {
     pub triangles: u32,
     /// Bits of the largest visible output edge in pixels (an f32).
     pub max_edge_bits: u32,
-    pub _pad: u32,
+    /// Triangles `plan` listed for `plan_cuts`.
+    pub cut_count: u32,
+    /// The frame's cuts around the axis (`AxisCuts`), bits 0–31 and 32–63.
+    pub cuts_low: u32,
+    pub cuts_high: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
+}
+
+impl SubdivideCounters {
+    /// Bytes of the counters that each `plan` or `lattice` run starts from zero; the cuts after
+    /// them are set once per frame by `active_cuts`.
+    pub const RUN_BYTES: u64 = 16;
+
+    /// The frame's cuts as one mask.
+    pub fn cuts(&self) -> u64 {
+        self.cuts_low as u64 | (self.cuts_high as u64) << 32
+    }
 }
 
 /// `RasterParams` in shaders/raster.wgsl. 48 bytes.
@@ -252,7 +269,7 @@ pub const LAYOUTS: &[StructLayout] = &[
         view, projection, axis_clearance, triangle_count, first_triangle, method, fixed_n, edge_px, max_div,
         piece_capacity, triangle_capacity, first_piece, piece_count, measure_edges
     }),
-    layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, _pad }),
+    layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, cuts_low, cuts_high, _pad1, _pad2 }),
     layout!("Piece" => Piece { triangle, cell, counts01, count2_level, corner, bary1, bary2 }),
     layout!("DrawIndirectArgs" => DrawIndirectArgs { vertex_count, instance_count, first_vertex, first_instance }),
     layout!("RasterParams" => RasterParams { projection, eye_sign, ambient, shift_px }),

@@ -1,9 +1,19 @@
-//! The vertical axis (see the module doc of `cpu::subdivide`). Every input triangle is cut into
-//! its **parts**: its polygon in each of the four quadrants around the axis (cut by the planes
-//! x = 0 and z = 0), for the adaptive method cut further into **bands** by the diamonds
-//! |x| + |z| = c_k, c_k = ρ·√2^k ([`band_bounds`]), minus the innermost diamond (half-diagonal
-//! ρ = [`axis_clearance`]), each fan-triangulated. The parts are what the pre-split and the
-//! lattice subdivide.
+//! The vertical axis (see the module doc of `cpu::subdivide`). Triangles near the axis, or
+//! large next to their distance from it, are cut into **parts**: their polygon in each of the
+//! four quadrants around the axis (cut by the planes x = 0 and z = 0), for the adaptive method
+//! cut further into **bands** by the diamonds |x| + |z| = c_k, c_k = ρ·√2^k ([`band_bound`]),
+//! minus the innermost diamond (half-diagonal ρ = [`axis_clearance`]), each fan-triangulated.
+//! The parts are what the pre-split and the lattice subdivide.
+//!
+//! **Which cuts a frame makes.** A first pass over every on-screen triangle of the scene
+//! (`active_cuts`, before `plan`) collects the cuts the frame makes ([`AxisCuts`]): a triangle
+//! that reaches the first diamond, or whose diamond distances span more than `WIDE_RATIO`,
+//! switches on the quadrant cuts and the square, and (adaptive) every diamond that crosses it
+//! ([`triangle_cuts`]). Every triangle is then cut at the quadrant planes and the active diamonds
+//! it crosses, and no others. A scene with no such triangle (an object in front of the viewer)
+//! is not cut at all; in a room, the floor and ceiling near the axis switch on the diamonds
+//! there, and small triangles far out are cut only where a large one needs the same diamond.
+//! The cuts are one set for the whole frame, so both triangles that share an edge cut it alike.
 //!
 //! **Why bands.** The projection stretches ∝ 1/r (v = R_T·y/r, and θ turns fast near the axis),
 //! so eq. 5's equal parts of an edge that runs from near the axis outwards would be far longer on
@@ -31,15 +41,16 @@
 //! below the image in the exact vertical model and just beyond the circle's image in the paper
 //! model, so that a ceiling close above the viewer has no hole in either.
 //!
-//! **Cost.** Only triangles that straddle x = 0 or z = 0, or a diamond, are cut; all others are
-//! their own single part (about +4 % parts on the bunny at 3 m with `vertex`, +10 % with
-//! `adaptive`).
+//! **Cost.** Only triangles that straddle x = 0 or z = 0, or an active diamond, are cut, and
+//! only when the frame has active cuts at all; all others are their own single part.
 
 use glam::Vec3;
 
 use super::Node;
 use crate::core::projection::Projection;
-use crate::shader::constants::{AXIS_CLEARANCE_MAX, AXIS_CLEARANCE_MIN, BAND_LIMIT, BAND_RATIO, SNAP};
+use crate::shader::constants::{
+    AXIS_CLEARANCE_MAX, AXIS_CLEARANCE_MIN, BAND_LIMIT, BAND_RATIO, MAX_DIAMONDS, SNAP, WIDE_RATIO,
+};
 
 /// The quadrants (sign of x, sign of z), in the order the twin and the WGSL number parts.
 pub const QUADRANTS: [(f32, f32); 4] = [(1.0, -1.0), (1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0)];
@@ -178,45 +189,119 @@ impl Polygon {
     }
 }
 
-/// The diamonds |x| + |z| = c_k that cut the plane into bands, c_k = ρ·√2^k while c_k < `limit`:
-/// the first cuts away the square around the axis, and within each band r varies by at most
-/// 2, so equal parts of an edge stay about equally long on screen (the projection stretches
-/// ∝ 1/r). Beyond the last, no cut. `limit` is [`band_limit`].
-pub fn band_bounds(rho: f32, limit: f32) -> impl Iterator<Item = f32> {
-    (0..).map(move |k| band_bound(rho, k)).take_while(move |&c| c < limit)
-}
-
-/// c_k = ρ·√2^k, exactly as the WGSL computes it: ρ or ρ·√2 (one rounding) times 2^(k/2).
+/// The diamond |x| + |z| = c_k, c_k = ρ·√2^k (k ≥ 0; c_0 = ρ bounds the square around the
+/// axis): within the band between two consecutive diamonds r varies by at most 2, so equal parts
+/// of an edge stay about equally long on screen (the projection stretches ∝ 1/r). Computed
+/// exactly as the WGSL does: ρ or ρ·√2 (one rounding) times 2^(k/2).
 pub fn band_bound(rho: f32, k: u32) -> f32 {
     let base = if k % 2 == 0 { rho } else { rho * BAND_RATIO };
     base * 2f32.powi((k / 2) as i32)
 }
 
-/// Whether a triangle lies strictly inside quadrant (sx, sz) and one band: then it is its own
-/// single part (the clips would change nothing, see [`parts`]). `single_band` in the WGSL.
-fn single_band(p: [Vec3; 3], (sx, sz): (f32, f32), rho: f32, limit: f32) -> bool {
+/// The cuts around the axis that a frame makes (see [`triangle_cuts`]): bit 0 the quadrant cuts
+/// (planes x = 0 and z = 0) and the square around the axis, bit k ≥ 1 the diamond c_k
+/// ([`band_bound`]). With no bit set, no triangle is cut.
+pub type AxisCuts = u64;
+
+/// The smallest and largest diamond distance |x| + |z| of a triangle's points: the largest at
+/// a corner; the smallest 0 where the triangle's footprint (its projection along y) holds the
+/// axis, else on an edge, at an end or where the edge crosses x = 0 or z = 0 (|x| + |z| is
+/// linear between those). `diamond_range` in the WGSL.
+pub fn diamond_range(p: [Vec3; 3]) -> (f32, f32) {
+    let d = p.map(|q| q.x.abs() + q.z.abs());
+    let hi = d[0].max(d[1]).max(d[2]);
+    // Which side of each footprint edge the axis lies on.
+    let side = |a: Vec3, b: Vec3| (b.z - a.z) * a.x - (b.x - a.x) * a.z;
+    let s = [side(p[0], p[1]), side(p[1], p[2]), side(p[2], p[0])];
+    if s.iter().all(|&x| x >= 0.0) || s.iter().all(|&x| x <= 0.0) {
+        return (0.0, hi);
+    }
+    let mut lo = d[0].min(d[1]).min(d[2]);
+    for e in 0..3 {
+        let (a, b) = (p[e], p[(e + 1) % 3]);
+        if (a.x < 0.0) != (b.x < 0.0) && a.x != 0.0 && b.x != 0.0 {
+            lo = lo.min((a.z + (b.z - a.z) * (a.x / (a.x - b.x))).abs());
+        }
+        if (a.z < 0.0) != (b.z < 0.0) && a.z != 0.0 && b.z != 0.0 {
+            lo = lo.min((a.x + (b.x - a.x) * (a.z / (a.z - b.z))).abs());
+        }
+    }
+    (lo, hi)
+}
+
+/// The cuts one on-screen triangle asks for. A triangle that reaches the first diamond c_1, or
+/// whose diamond distances span more than `WIDE_RATIO` (d_max > `WIDE_RATIO`·d_min), asks for
+/// the quadrant cuts and the square (bit 0) and, below `limit` ([`band_limit`]), for every
+/// diamond that crosses it. Others ask for nothing: r changes little across them, and eq. 5
+/// with the stretch rule splits them well (see the module doc).
+pub fn triangle_cuts(p: [Vec3; 3], rho: f32, limit: f32) -> AxisCuts {
+    let (lo, hi) = diamond_range(p);
+    if !(lo < band_bound(rho, 1) || hi > WIDE_RATIO * lo) {
+        return 0;
+    }
+    let mut cuts = 1;
+    for k in 1..MAX_DIAMONDS {
+        let c = band_bound(rho, k);
+        if c >= limit || c >= hi {
+            break;
+        }
+        if lo < c {
+            cuts |= 1 << k;
+        }
+    }
+    cuts
+}
+
+/// The largest k < `MAX_DIAMONDS` with c_k ≤ d (0 if none): an estimate from the logarithm,
+/// then exact steps. `band_of` in the WGSL.
+pub fn band_of(rho: f32, d: f32) -> u32 {
+    let mut k = (2.0 * (d / rho).max(1.0).log2()).min((MAX_DIAMONDS - 1) as f32) as u32;
+    while k > 0 && band_bound(rho, k) > d {
+        k -= 1;
+    }
+    while k + 1 < MAX_DIAMONDS && band_bound(rho, k + 1) <= d {
+        k += 1;
+    }
+    k
+}
+
+/// The next active diamond after k, or `MAX_DIAMONDS` if none. `next_cut` in the WGSL.
+pub fn next_cut(cuts: AxisCuts, k: u32) -> u32 {
+    let above = if k + 1 >= MAX_DIAMONDS { 0 } else { cuts & (u64::MAX << (k + 1)) };
+    if above == 0 {
+        MAX_DIAMONDS
+    } else {
+        above.trailing_zeros()
+    }
+}
+
+/// The active diamond at or below distance d: the largest active k with c_k ≤ d (k = 0, the
+/// square, always counts). `zone_of` in the WGSL.
+pub fn zone_of(cuts: AxisCuts, rho: f32, d: f32) -> u32 {
+    let mut k = band_of(rho, d);
+    while k > 0 && cuts & (1 << k) == 0 {
+        k -= 1;
+    }
+    k
+}
+
+/// Whether a triangle lies strictly inside quadrant (sx, sz) and between two consecutive active
+/// diamonds: then it is its own single part (the clips would change nothing, see [`parts`]).
+/// `single_band` in the WGSL.
+fn single_band(p: [Vec3; 3], (sx, sz): (f32, f32), rho: f32, cuts: AxisCuts) -> bool {
     if !p.iter().all(|q| sx * q.x > 0.0 && sz * q.z > 0.0) {
         return false;
     }
     let d_min = p.iter().map(|q| sx * q.x + sz * q.z).fold(f32::INFINITY, f32::min);
-    // The band holding d_min: the largest k with c_k ≤ d_min among the bounds below `limit`
-    // (k = 0, the square around the axis, always counts); an estimate from the logarithm,
-    // then exact steps.
-    let mut k = (2.0 * (d_min / rho).max(1.0).log2()).min(200.0) as u32;
-    while k > 0 && (band_bound(rho, k) > d_min || band_bound(rho, k) >= limit) {
-        k -= 1;
-    }
-    while band_bound(rho, k + 1) <= d_min && band_bound(rho, k + 1) < limit {
-        k += 1;
-    }
+    let k = zone_of(cuts, rho, d_min);
     let lower = Cut::Chord(sx, sz, band_bound(rho, k), 1.0);
-    let next = band_bound(rho, k + 1);
-    let upper = (next < limit).then_some(Cut::Chord(sx, sz, next, -1.0));
+    let next = next_cut(cuts, k);
+    let upper = (next < MAX_DIAMONDS).then(|| Cut::Chord(sx, sz, band_bound(rho, next), -1.0));
     p.iter().all(|&q| lower.distance(q) > 0.0 && upper.is_none_or(|u| u.distance(q) > 0.0))
 }
 
-/// Where bands stop: `BAND_LIMIT`·R_T for the adaptive method, none (0) for `vertex` and
-/// `fixed:N`, whose splits do not follow projected lengths.
+/// Where diamonds stop: `BAND_LIMIT`·R_T for the adaptive method; for `vertex` and `fixed:N`,
+/// whose splits do not follow projected lengths, only the square is cut (0).
 pub fn band_limit(method: u32, screen_radius: f32) -> f32 {
     if method == crate::core::settings::SplitRule::Adaptive as u32 {
         BAND_LIMIT * screen_radius
@@ -225,24 +310,25 @@ pub fn band_limit(method: u32, screen_radius: f32) -> f32 {
     }
 }
 
-/// The parts of a triangle (corners in the viewer frame, already snapped); part corners carry
-/// barycentric weights in the triangle. Numbered quadrant by
-/// quadrant ([`QUADRANTS`]), band by band outwards ([`band_bounds`]), then along each fan.
-pub fn parts(p: [Vec3; 3], rho: f32, band_limit: f32) -> Vec<[Node; 3]> {
+/// The parts of a triangle (corners in the viewer frame, already snapped) under the frame's
+/// `cuts`; part corners carry barycentric weights in the triangle. Numbered quadrant by quadrant
+/// ([`QUADRANTS`]), band by band outwards (the active diamonds), then along each fan. With no
+/// cut active, the triangle is its own part.
+pub fn parts(p: [Vec3; 3], rho: f32, cuts: AxisCuts) -> Vec<[Node; 3]> {
     let mut out = Vec::with_capacity(4);
     let bary = [Vec3::X, Vec3::Y, Vec3::Z];
     let triangle = Polygon { nodes: [0, 1, 2, 0, 0, 0, 0].map(|i| Node { position: p[i], bary: bary[i] }), count: 3 };
     // Most triangles: one quadrant, one band, one part (what the loop below would give, faster).
-    if QUADRANTS.iter().any(|&q| single_band(p, q, rho, band_limit)) {
+    if cuts == 0 || QUADRANTS.iter().any(|&q| single_band(p, q, rho, cuts)) {
         return vec![[0, 1, 2].map(|i| triangle.nodes[i])];
     }
-    let bounds: Vec<f32> = band_bounds(rho, band_limit).collect();
+    let bounds: Vec<f32> = (1..MAX_DIAMONDS).filter(|k| cuts & (1 << k) != 0).map(|k| band_bound(rho, k)).collect();
     for (sx, sz) in QUADRANTS {
         // What lies beyond the current diamond; each band is cut from it, and the rest beyond
         // the next diamond is cut from the same polygon, so both sides of a diamond get the
         // same points (from the same edges).
         let mut rest = triangle.clip(Cut::X(sx)).clip(Cut::Z(sz)).clip(Cut::Chord(sx, sz, rho, 1.0));
-        for next in bounds.iter().skip(1).map(Some).chain([None]) {
+        for next in bounds.iter().map(Some).chain([None]) {
             if rest.count == 0 {
                 break;
             }

@@ -42,11 +42,15 @@
 //! No cracks, no T-junctions (every edge node is a lattice corner), no zero-area triangles.
 //!
 //! **The vertical axis.** No eye sees a point with r ≤ d_e, and a triangle around the axis covers
-//! every azimuth. Every input triangle is therefore first cut into its parts in the four
-//! quadrants around the axis (planes x = 0 and z = 0; the seam θ = ±π is one of the cuts, so no
-//! part crosses it in θ), minus a small square around the axis whose points no eye sees (see
-//! `axis.rs`). The cut points on an edge depend on that edge alone, so neighbours agree; the
-//! parts are then split as above, each part's edges counting as its "original" edges.
+//! every azimuth. Triangles that reach near the axis, or are large next to their distance from it,
+//! switch on cuts for the whole frame (`active_cuts`, a pass over the scene before `plan`): every
+//! triangle is then cut into its parts in the four quadrants around the axis (planes x = 0 and
+//! z = 0; the seam θ = ±π is one of the cuts, so no part crosses it in θ), minus a small square
+//! around the axis whose points no eye sees, and (adaptive) into bands between the diamonds those
+//! triangles need (see `axis.rs`). The cut points on an edge depend on that edge and the frame's
+//! cuts alone, so neighbours agree; the parts are then split as above, each part's edges counting
+//! as its "original" edges. On the GPU, `plan` plans the triangles that are their own single part
+//! and lists the others for `plan_cuts`, which clips them.
 //!
 //! **Off screen.** Triangles that lie wholly above or below the image (see
 //! [`Subdivider::off_screen_vertically`]) make no pieces, and sub-triangles that do are not
@@ -72,7 +76,7 @@ use crate::shader::types::{DrawVertex, SubdivideParams};
 
 mod axis;
 
-pub use axis::{axis_clearance, band_limit, parts, snap_to_cut_planes};
+pub use axis::{axis_clearance, band_limit, diamond_range, parts, snap_to_cut_planes, triangle_cuts, AxisCuts};
 
 /// The `subdivide` stage's parameters for a range of input triangles (capacities and piece
 /// ranges are left for the caller, 0).
@@ -151,6 +155,8 @@ pub struct SubdivideOutput {
     pub pieces: u32,
     /// Largest projected length, in pixels, of an output edge with an end on the screen rows.
     pub max_sub_edge_px: f32,
+    /// The cuts around the axis the frame made (`active_cuts`).
+    pub cuts: AxisCuts,
 }
 
 impl<'a> Subdivider<'a> {
@@ -247,11 +253,19 @@ impl<'a> Subdivider<'a> {
         self.edge_divisions(a, b, edge_px).min(2 * self.params.max_div).min(PIECE_DIVISIONS)
     }
 
+    /// The corners of input triangle t in the viewer frame, snapped to the cut planes.
+    fn positions(&self, vertices: &[SceneVertex], indices: &[u32], t: usize) -> [Vec3; 3] {
+        let view = Mat4::from_cols_array_2d(&self.params.view);
+        [0, 1, 2].map(|k| {
+            snap_to_cut_planes(view.transform_point3(Vec3::from(vertices[indices[3 * t + k] as usize].position)))
+        })
+    }
+
     fn load(&self, vertices: &[SceneVertex], indices: &[u32], t: usize) -> Triangle {
         let view = Mat4::from_cols_array_2d(&self.params.view);
         let v = |k: usize| &vertices[indices[3 * t + k] as usize];
         Triangle {
-            position: [0, 1, 2].map(|k| snap_to_cut_planes(view.transform_point3(Vec3::from(v(k).position)))),
+            position: self.positions(vertices, indices, t),
             normal: [0, 1, 2].map(|k| view.transform_vector3(Vec3::from(v(k).normal))),
             color: [0, 1, 2].map(|k| Vec4::from(v(k).color)),
             uv: [0, 1, 2].map(|k| Vec2::from(v(k).uv)),
@@ -294,20 +308,36 @@ impl<'a> Subdivider<'a> {
     }
 
     /// The parts of an input triangle (none if it lies wholly above or below the image).
-    fn triangle_parts(&self, tri: &Triangle) -> Vec<[Node; 3]> {
+    fn triangle_parts(&self, tri: &Triangle, cuts: AxisCuts) -> Vec<[Node; 3]> {
         if self.off_screen_vertically(tri.position) {
             return Vec::new();
         }
-        parts(tri.position, self.params.axis_clearance, band_limit(self.params.method, self.projection.screen_radius))
+        parts(tri.position, self.params.axis_clearance, cuts)
     }
 
-    /// The whole stage for the dispatch's triangles.
+    /// `active_cuts`: the cuts around the axis the frame makes (see `axis.rs`), from every
+    /// on-screen triangle of the scene: all of `indices`, whatever range the dispatch plans.
+    pub fn active_cuts(&self, vertices: &[SceneVertex], indices: &[u32]) -> AxisCuts {
+        let limit = band_limit(self.params.method, self.projection.screen_radius);
+        (0..indices.len() / 3)
+            .map(|t| self.positions(vertices, indices, t))
+            .filter(|&p| !self.off_screen_vertically(p))
+            .fold(0, |cuts, p| cuts | triangle_cuts(p, self.params.axis_clearance, limit))
+    }
+
+    /// The whole stage for the dispatch's triangles: `active_cuts` over the scene, then `plan`
+    /// and `lattice`.
     pub fn run(&self, vertices: &[SceneVertex], indices: &[u32]) -> SubdivideOutput {
-        let mut out = SubdivideOutput::default();
+        self.run_with_cuts(vertices, indices, self.active_cuts(vertices, indices))
+    }
+
+    /// The same with the frame's cuts already known (tests that subdivide one triangle at a time).
+    pub fn run_with_cuts(&self, vertices: &[SceneVertex], indices: &[u32], cuts: AxisCuts) -> SubdivideOutput {
+        let mut out = SubdivideOutput { cuts, ..Default::default() };
         let first = self.params.first_triangle as usize;
         for t in first..first + self.params.triangle_count as usize {
             let tri = self.load(vertices, indices, t);
-            for part in self.triangle_parts(&tri) {
+            for part in self.triangle_parts(&tri, cuts) {
                 let (k, n) = self.plan(&tri, &part);
                 for cell in 0..k * k {
                     out.pieces += 1;

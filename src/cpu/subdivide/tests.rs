@@ -32,6 +32,14 @@ fn run_method(tri: [[f32; 3]; 3], method: Method) -> (Projection, Vec<DrawVertex
     (projection, subdivide(&params, &v, &[0, 1, 2]).vertices)
 }
 
+/// The same in a frame where another triangle switched the cuts around the axis on (bit 0: the
+/// quadrant cuts and the square).
+fn run_method_with_cuts(tri: [[f32; 3]; 3], method: Method, cuts: AxisCuts) -> Vec<DrawVertex> {
+    let params = params_for(&Projection::default(), method, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV, 1);
+    let v: Vec<SceneVertex> = tri.iter().map(|&p| vertex(p)).collect();
+    Subdivider::new(&params).run_with_cuts(&v, &[0, 1, 2], cuts).vertices
+}
+
 fn area3(t: &[DrawVertex]) -> f32 {
     let p: Vec<Vec3> = t.iter().map(|d| Vec3::from(d.position)).collect();
     0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length()
@@ -55,9 +63,14 @@ fn ordinary_triangle_passes_through_the_vertex_method_unchanged() {
 }
 
 #[test]
-fn triangle_straddling_a_cut_plane_becomes_a_part_on_each_side() {
-    // Straight ahead, across x = 0: a triangle on one side, a quad (two parts) on the other.
-    let (_, out) = run_method([[-0.5, 0.0, -3.0], [0.7, 0.0, -3.0], [0.2, 0.5, -3.0]], Method::Vertex);
+fn triangle_straddling_a_cut_plane_becomes_a_part_on_each_side_when_the_frame_cuts() {
+    // Straight ahead, across x = 0. Alone, it is small next to its distance from the axis: no
+    // cuts. In a frame with the quadrant cuts on: a triangle on one side, a quad (two parts) on
+    // the other.
+    let tri = [[-0.5, 0.0, -3.0], [0.7, 0.0, -3.0], [0.2, 0.5, -3.0]];
+    let (_, alone) = run_method(tri, Method::Vertex);
+    assert_eq!(alone.len(), 3);
+    let out = run_method_with_cuts(tri, Method::Vertex, 1);
     assert_eq!(out.len(), 9);
     for t in out.chunks(3) {
         let side: Vec<f32> = t.iter().map(|d| d.position[0]).collect();
@@ -120,7 +133,12 @@ fn triangle_with_a_vertex_inside_the_eye_circle_is_cut_without_nan() {
 fn seam_triangle_gets_a_copy_on_the_other_side() {
     // Cut at the seam (x = 0 behind the viewer) into a part on each side; each part's u range
     // reaches past ±π in one eye, so each also gets a copy a turn away.
-    let (_, out) = run_method([[-0.5, 0.0, 3.0], [0.5, 0.0, 3.0], [0.0, 0.5, 3.0]], Method::Vertex);
+    let tri = [[-0.5, 0.0, 3.0], [0.5, 0.0, 3.0], [0.0, 0.5, 3.0]];
+    // Alone (no cuts in the frame): the triangle and its copy a turn away.
+    let (_, alone) = run_method(tri, Method::Vertex);
+    assert_eq!(alone.len(), 6, "the triangle and its seam copy");
+    assert!((alone[0].theta_ref - alone[3].theta_ref).abs() > 6.0);
+    let out = run_method_with_cuts(tri, Method::Vertex, 1);
     assert_eq!(out.len(), 12, "two parts and their seam copies");
     let refs: Vec<f32> = out.chunks(3).map(|t| t[0].theta_ref).collect();
     let inside: Vec<f32> = refs.iter().copied().filter(|r| r.abs() <= PI).collect();
@@ -318,10 +336,11 @@ mod real_mesh_tests {
             }
         }
         let params = params_for(&projection, Method::Adaptive, 6.0, 4, 1);
+        let cuts = Subdivider::new(&params).active_cuts(&scene.vertices, &scene.indices);
         let outputs: Vec<Vec<DrawVertex>> = (0..scene.triangle_count())
             .map(|t| {
-                subdivide(&SubdivideParams { first_triangle: t as u32, ..params }, &scene.vertices, &scene.indices)
-                    .vertices
+                let one = SubdivideParams { first_triangle: t as u32, ..params };
+                Subdivider::new(&one).run_with_cuts(&scene.vertices, &scene.indices, cuts).vertices
             })
             .collect();
         let (mut compared, mut split) = (0, 0);

@@ -200,7 +200,7 @@ fn check_case(
     let sd = Subdivider::with_edge_scale(&params, &lod);
     let rho = params.axis_clearance;
     // Absolute precision of points computed from the mesh's corners.
-    let tol = 4e-6 * (centre.abs().max_element() + scale);
+    let tol = 4e-6 * placed.iter().fold(0.0f32, |m, p| m.max(p.abs().max_element()));
 
     // Input edges used other than twice (an open or non-manifold input) may stay open.
     let mut input_edges: HashMap<(Key, Key), u32> = HashMap::new();
@@ -226,6 +226,7 @@ fn check_case(
     let on_square = |p: Vec3| (p.x.abs() + p.z.abs() - rho).abs() <= tol + 1e-3 * rho;
 
     let out = sd.run(&vertices, &mesh.indices);
+    let cuts = out.cuts;
     let originals: Vec<&[DrawVertex]> = out.vertices.chunks(3).filter(|t| t[0].theta_ref.abs() <= PI).collect();
     let mut edges: HashMap<(Key, Key), u32> = HashMap::new();
     for t in &originals {
@@ -264,7 +265,7 @@ fn check_case(
     for _ in 0..12 {
         let t = rng.random_range(0..triangles);
         let one = SubdivideParams { first_triangle: t as u32, triangle_count: 1, ..params };
-        let out = Subdivider::with_edge_scale(&one, &lod).run(&vertices, &mesh.indices);
+        let out = Subdivider::with_edge_scale(&one, &lod).run_with_cuts(&vertices, &mesh.indices, cuts);
         let corner = [0, 1, 2].map(|k| snap_to_cut_planes(placed[mesh.indices[3 * t + k] as usize]));
         let normal = (corner[1] - corner[0]).cross(corner[2] - corner[0]);
         if normal.length() == 0.0 {
@@ -313,15 +314,26 @@ fn check_case(
     originals.len()
 }
 
+/// Two meshes as one (the second's indices shifted), each moved and scaled.
+fn together(a: &Mesh, (ca, sa): (Vec3, f32), b: &Mesh, (cb, sb): (Vec3, f32)) -> Mesh {
+    let mut positions: Vec<Vec3> = a.positions.iter().map(|&p| p * sa + ca).collect();
+    let base = positions.len() as u32;
+    positions.extend(b.positions.iter().map(|&p| p * sb + cb));
+    let indices = a.indices.iter().copied().chain(b.indices.iter().map(|i| i + base)).collect();
+    Mesh { name: format!("{} beside, {} around", a.name, b.name), positions, indices }
+}
+
 #[test]
 fn random_closed_meshes_around_the_viewer_subdivide_watertight_and_whole() {
     let meshes = [icosphere(1), icosphere(2), grid_box(1), grid_box(3), torus(12, 8), cow()];
     let mut rng = StdRng::seed_from_u64(2026);
     let mut total = 0;
-    for case in 0..48 {
+    for case in 0..60 {
         let mesh = &meshes[case % meshes.len()];
-        // Around (enclosing), above, below, beside the viewer; large and small.
-        let (centre, scale) = match case % 4 {
+        // Around (enclosing), above, below, beside the viewer; large and small; and beside the
+        // viewer inside a room that switches the cuts around the axis on (the mesh is then cut
+        // only at the diamonds the room needs, and where it straddles x = 0 or z = 0).
+        let (centre, scale) = match case % 5 {
             0 => (
                 Vec3::new(rng.random_range(-0.3..0.3), rng.random_range(-0.5..0.5), rng.random_range(-0.3..0.3)),
                 rng.random_range(1.5..20.0),
@@ -338,6 +350,14 @@ fn random_closed_meshes_around_the_viewer_subdivide_watertight_and_whole() {
                 Vec3::new(rng.random_range(-4.0..4.0), rng.random_range(-1.0..1.0), rng.random_range(-4.0..4.0)),
                 rng.random_range(0.2..2.0),
             ),
+        };
+        let in_room;
+        let (mesh, centre, scale) = if case % 5 == 4 {
+            let room = (Vec3::new(rng.random_range(-0.3..0.3), 0.0, rng.random_range(-0.3..0.3)), 6.0);
+            in_room = together(mesh, (centre, scale), &grid_box(3), room);
+            (&in_room, Vec3::ZERO, 1.0)
+        } else {
+            (mesh, centre, scale)
         };
         let projection = Projection {
             screen_radius: rng.random_range(0.5..3.0),
