@@ -24,8 +24,7 @@ fn project_points(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wo
         return;
     }
     let p = points[i].xyz;
-    let r = horizontal_radius(p);
-    if (!(r > params.projection.eye_radius)) {
+    if (!sees(params.projection, p)) {
         pixels[i] = vec4<f32>(0.0, 0.0, 0.0, 0.0);
         return;
     }

@@ -10,7 +10,7 @@
 //            this frame, or inside one quadrant and one band) is planned here; the others are
 //            listed in `cut_list` for `plan_cuts` (the clipping code, kept out of this entry
 //            point: lavapipe runs a shader that merely contains it markedly slower).
-// `plan_cuts_args`, `plan_cuts`  one invocation per listed triangle: its parts around the
+// `plan_cuts_args`, `plan_cuts`  one invocation per listed triangle and quadrant: its parts around the
 //            vertical axis under the frame's cuts (quadrants minus a small square around the axis,
 //            bands between the active diamonds, fan-triangulated).
 //            For every part, `plan` and `plan_cuts` find the edge
@@ -183,10 +183,8 @@ fn edge_point(a: Node, b: Node, j: u32, n: u32) -> Node {
 
 // Image position in pixels (x not wrapped) of a viewer-frame point for one eye sign.
 fn pixel(p: vec3<f32>, eye_sign: f32) -> vec2<f32> {
-    let r = horizontal_radius(p);
-    let u = azimuth(p) + eye_sign * eye_shift(params.projection, r);
-    let v = screen_height(params.projection, p.y, r);
-    return vec2<f32>(u * params.projection.width / TAU, v * params.projection.pixels_per_metre);
+    let q = project_with_azimuth(params.projection, p, azimuth(p), eye_sign);
+    return vec2<f32>(q.x * params.projection.width / TAU, q.y * params.projection.pixels_per_v);
 }
 
 // Projected length in pixels of the straight edge ab, larger of the two eyes, heights clamped
@@ -223,9 +221,10 @@ fn edge_length_px(a: vec3<f32>, b: vec3<f32>, segments: u32) -> f32 {
         }
         length_px = max(length_px, total);
     }
-    // Near the eye circle, which the paper model shows on screen (α ∝ √(r − d_e)), no stretch
-    // is allowed (the exact model puts it at v = ±∞).
-    let ring = params.projection.vertical_exact == 0u && nearest < 2.0 * params.projection.eye_radius;
+    // Near the eye circle, which the paper model and the sphere show on screen (α and the
+    // longitude ∝ √(r − d_e)), no stretch is allowed (the exact model puts it at v = ±∞).
+    let shows_ring = params.projection.vertical_exact == 0u || params.projection.panorama == PANORAMA_SPHERE;
+    let ring = shows_ring && nearest < 2.0 * params.projection.eye_radius;
     let stretch = select(MAX_STRETCH, 1.0, ring);
     return max(length_px, f32(segments) * longest / stretch);
 }
@@ -256,9 +255,12 @@ fn edge_divisions(a: vec3<f32>, b: vec3<f32>) -> u32 {
 // Whether a triangle lies wholly above or below the image (see `off_screen_vertically` in
 // src/cpu/subdivide/ for why testing the corners suffices).
 fn off_screen_vertically(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> bool {
+    if (params.projection.panorama == PANORAMA_SPHERE) {
+        return false; // the sphere shows every direction
+    }
     let rt = params.projection.screen_radius;
     let de = params.projection.eye_radius;
-    let half = 0.5 * params.projection.height / params.projection.pixels_per_metre;
+    let half = 0.5 * params.projection.height / params.projection.pixels_per_v;
     let k = half / (rt * sqrt(1.0 - (de / rt) * (de / rt)));
     let r = vec3<f32>(horizontal_radius(p0), horizontal_radius(p1), horizontal_radius(p2));
     let y = vec3<f32>(p0.y, p1.y, p2.y);
@@ -706,15 +708,15 @@ fn single_part() -> bool {
     return false;
 }
 
-// Plans every part of the current triangle (`parts` in axis.rs: quadrant by quadrant, band by
-// band outwards, along each fan) and appends its pieces.
-fn plan_parts(t: u32) {
+// Plans every part of the current triangle in quadrant q (`parts` in axis.rs: band by band
+// outwards, along each fan) and appends its pieces.
+fn plan_quadrant(t: u32, q: u32) {
     let signs = QUADRANT_SIGNS;
-    for (var q = 0u; q < 4u; q++) {
+    {
         let s = signs[q];
         quadrant_polygon(s);
         if (poly_count == 0u) {
-            continue;
+            return;
         }
         // What lies beyond the current diamond (`rest` in axis.rs); each band is cut from it,
         // and the rest beyond the next diamond from the same polygon.
@@ -836,9 +838,17 @@ fn emit(a: Node, b: Node, c: Node) {
     var u_max = -1e30;
     for (var i = 0u; i < 3u; i++) {
         let theta = theta_c + wrap_angle(azimuth(ps[i]) - theta_c);
-        let alpha = abs(eye_shift(params.projection, horizontal_radius(ps[i])));
-        u_min = min(u_min, theta - alpha);
-        u_max = max(u_max, theta + alpha);
+        if (params.projection.panorama == PANORAMA_SPHERE) {
+            for (var s = 0u; s < 2u; s++) {
+                let u = project_with_azimuth(params.projection, ps[i], theta, select(-1.0, 1.0, s == 1u)).x;
+                u_min = min(u_min, u);
+                u_max = max(u_max, u);
+            }
+        } else {
+            let alpha = abs(eye_shift(params.projection, horizontal_radius(ps[i])));
+            u_min = min(u_min, theta - alpha);
+            u_max = max(u_max, theta + alpha);
+        }
     }
     if (params.measure_edges != 0u) {
         atomicMax(&counters.max_edge_bits, bitcast<u32>(visible_edge_px(ps)));
@@ -943,22 +953,24 @@ fn plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
 
 @compute @workgroup_size(1)
 fn plan_cuts_args() {
-    let groups = (min(atomicLoad(&counters.cut_count), arrayLength(&cut_list)) + 63u) / 64u;
+    let groups = (4u * min(atomicLoad(&counters.cut_count), arrayLength(&cut_list)) + 63u) / 64u;
     lattice_dispatch[3] = min(groups, 65535u);
     lattice_dispatch[4] = (groups + 65534u) / 65535u;
     lattice_dispatch[5] = 1u;
 }
 
+// One invocation per listed triangle and quadrant (the bands of one quadrant keep an invocation
+// within lavapipe's loop budget: it stops any invocation after 65,535 loop iterations).
 @compute @workgroup_size(64)
 fn plan_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let local = invocation_index(gid, groups);
-    if (local >= min(atomicLoad(&counters.cut_count), arrayLength(&cut_list))) {
+    if (local / 4u >= min(atomicLoad(&counters.cut_count), arrayLength(&cut_list))) {
         return;
     }
-    let t = cut_list[local];
+    let t = cut_list[local / 4u];
     cuts = vec2<u32>(atomicLoad(&counters.cuts_low), atomicLoad(&counters.cuts_high));
     load_triangle(t);
-    plan_parts(t);
+    plan_quadrant(t, local % 4u);
 }
 
 @compute @workgroup_size(64)

@@ -89,6 +89,22 @@ impl Twin for ProjectPoints {
                 out.push((format!("{vertical:?} {eye:?}"), (p, eye, points.clone())));
             }
         }
+        // The full sphere: points in every direction (the poles and the pole merge's fade).
+        let sphere_points: Vec<Vec3> = (0..5000)
+            .map(|_| {
+                let (a, b): (f32, f32) =
+                    (rng.random_range(-1.0..1.0), rng.random_range(-std::f32::consts::PI..std::f32::consts::PI));
+                let d = 10f32.powf(rng.random_range(-1.0..1.6));
+                let h = (1.0 - a * a).sqrt();
+                Vec3::new(d * h * b.sin(), d * a, -d * h * b.cos())
+            })
+            .collect();
+        for (convergence, pole_merge) in [(None, Some((60.0, 75.0))), (Some(1.5), Some((45.0, 80.0))), (None, None)] {
+            for eye in Eye::BOTH {
+                let p = Projection { convergence, pole_merge, ..Projection::equirect(4096) };
+                out.push((format!("sphere {convergence:?} {pole_merge:?} {eye:?}"), (p, eye, sphere_points.clone())));
+            }
+        }
         out
     }
     fn gpu(r: &Renderer, (p, eye, points): &Self::Case) -> Self::Output {
@@ -112,7 +128,10 @@ impl Twin for ProjectPoints {
             }
             let near_image = c[1] > -(p.height as f32) && c[1] < 2.0 * p.height as f32;
             let tolerance = if near_image { 1e-3 } else { 1e-6 * c[1].abs() };
-            if !(p.wrapped_dx(g[0], c[0]) < 1e-3 && (g[1] - c[1]).abs() < tolerance) {
+            // On the sphere, columns near the poles are short: compare the distance they make.
+            let (_, lat) = p.pixel_to_screen(c[0], c[1]);
+            let squeeze = if p.panorama == twister::core::projection::PanoramaKind::Equirect { lat.cos() } else { 1.0 };
+            if !(p.wrapped_dx(g[0], c[0]) * squeeze < 1e-3 && (g[1] - c[1]).abs() < tolerance) {
                 return Err(format!("point {i}: GPU {g:?}, CPU {c:?}"));
             }
         }
@@ -192,6 +211,21 @@ impl Twin for Subdivide {
             (cube.clone(), tall.with_viewer(Vec3::new(0.0, 0.95, 0.0))),
             (cube.clone(), small.with_viewer(Vec3::new(0.0, 0.95, 0.0)).with_edge_px(4.0).with_max_div(3)),
             (cube, tall_exact.with_viewer(Vec3::new(0.1, -0.8, 0.2)).with_edge_px(12.0)),
+            // The full sphere: the poles (pole merge on and off), converging rays, the seam.
+            (builtin::demo(), RenderSettings::new(Projection::equirect(256))),
+            (
+                builtin::demo(),
+                RenderSettings::new(Projection {
+                    convergence: Some(2.0),
+                    pole_merge: None,
+                    ..Projection::equirect(192)
+                })
+                .with_method(Method::Vertex),
+            ),
+            (
+                random_triangle_scene(7, 200),
+                RenderSettings::new(Projection::equirect(256)).with_method(Method::Fixed(3)),
+            ),
         ];
         let mut cut_frames = 0;
         let cases: Vec<_> = cases

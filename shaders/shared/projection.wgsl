@@ -1,18 +1,22 @@
-// The TWISTER projection (seed 002, §2.1, eq. 1–4), GPU side.
-// Imported by every stage that projects (`#import projection`); the CPU twin is
-// src/core/projection.rs, which documents the derivation of the eye sign.
+// The panoramas' projections, GPU side. Imported by every stage that projects
+// (`#import projection`); the CPU twin is src/core/projection.rs, which derives both.
 //
+// The TWISTER cylinder (seed 002, §2.1, eq. 1–4):
 //   r = √(x² + z²), θ = atan2(x, −z), α = acos(d_e/r) − acos(d_e/R_T)
 //   u = θ + eye_sign·α   (eye_sign = +1 right eye, −1 left eye)
 //   v = R_T·y/r (paper)   or   v = y·√(R_T²−d_e²)/√(r²−d_e²) (exact)
 //   depth = r
+// The full sphere (equirectangular ODS, Cycles' spherical stereo), at eye offset d:
+//   e = d (parallel) or (1 − t)·d, (c² + d²)t² − 2d²t − (|P|² − d²) = 0 (converging on radius c)
+//   u = λ = θ − eye_sign·asin(e/r), v = φ = atan2(y, √(r² − e²)), depth = √(r² + y² + d² − 2de)
+//   with d = f(|φ|)·d_e (pole merge), solved by Newton steps.
 
 #import constants
 
 const PI: f32 = 3.14159265358979;
 const TAU: f32 = 6.28318530717959;
 
-// Mirrors `ProjectionUniform` in src/shader/types.rs (32 bytes).
+// Mirrors `ProjectionUniform` in src/shader/types.rs (48 bytes).
 struct Projection {
     screen_radius: f32,    // R_T, metres
     eye_radius: f32,       // d_e, metres
@@ -20,9 +24,16 @@ struct Projection {
     height: f32,           // image height in pixels
     acos_eye_screen: f32,  // acos(d_e / R_T)
     vertical_exact: u32,   // 0: paper model, 1: exact model
-    pixels_per_metre: f32, // W / (2π·R_T)
+    pixels_per_v: f32,     // W / (2π·R_T) (cylinder: v in metres), H/π (sphere: v in radians)
+    panorama: u32,         // PANORAMA_CYLINDER or PANORAMA_SPHERE
+    convergence: f32,      // sphere: rays converge on this radius, metres; 0: parallel
+    pole_from: f32,        // sphere: pole merge, radians of altitude; pole_to 0: off
+    pole_to: f32,
     _pad: f32,
 }
+
+const PANORAMA_CYLINDER: u32 = 0u;
+const PANORAMA_SPHERE: u32 = 1u;
 
 // atan2 and acos accurate to about 1e-7 rad. Drivers' built-ins may be far less precise (lavapipe's
 // are off by ~4e-6 rad, 2e-3 px at 3168 px): reduce to |t| ≤ tan(π/12) and sum the odd series
@@ -65,6 +76,11 @@ fn precise_acos(c: f32) -> f32 {
     return precise_atan2(sqrt(max((1.0 - c) * (1.0 + c), 0.0)), c);
 }
 
+// asin(q) for q in [−1, 1].
+fn precise_asin(q: f32) -> f32 {
+    return precise_atan2(q, sqrt(max((1.0 - q) * (1.0 + q), 0.0)));
+}
+
 // Wraps an angle into [−π, π).
 fn wrap_angle(a: f32) -> f32 {
     return a - TAU * floor((a + PI) / TAU);
@@ -93,16 +109,114 @@ fn screen_height(proj: Projection, y: f32, r: f32) -> f32 {
     return proj.screen_radius * y / r;
 }
 
-// (u, v, depth) of a viewer-frame point whose azimuth θ the caller has already unwrapped.
+// ---- the full sphere (`Projection::sphere_*` in projection.rs) ----
+
+// The pole merge's factor on the eye offset for a ray of altitude a ≥ 0.
+fn pole_fade(proj: Projection, a: f32) -> f32 {
+    if (proj.pole_to <= 0.0 || a <= proj.pole_from) {
+        return 1.0;
+    }
+    if (a >= proj.pole_to) {
+        return 0.0;
+    }
+    return cos(0.5 * PI * (a - proj.pole_from) / (proj.pole_to - proj.pole_from));
+}
+
+// e and de/dd: the eye ray's distance from P's vertical line along `side`, for eye offset d ≥ 0.
+fn sphere_e_slope(proj: Projection, r: f32, y: f32, d: f32) -> vec2<f32> {
+    if (proj.convergence <= 0.0) {
+        return vec2<f32>(d, 1.0);
+    }
+    let d2 = d * d;
+    let c2 = proj.convergence * proj.convergence;
+    let p2 = r * r + y * y;
+    let s = sqrt(max(d2 * d2 + (d2 + c2) * (p2 - d2), 0.0));
+    let t = (d2 + s) / (d2 + c2);
+    var ds = 0.0;
+    if (s > 0.0) {
+        ds = d * (p2 - c2) / s;
+    }
+    let dt = ((2.0 * d + ds) * (d2 + c2) - 2.0 * d * (d2 + s)) / ((d2 + c2) * (d2 + c2));
+    return vec2<f32>((1.0 - t) * d, 1.0 - t - d * dt);
+}
+
+fn sphere_e(proj: Projection, r: f32, y: f32, d: f32) -> f32 {
+    return sphere_e_slope(proj, r, y, d).x;
+}
+
+// Longitude, latitude and depth |P − E| at a fixed eye offset d.
+fn sphere_at_offset(proj: Projection, r: f32, y: f32, theta: f32, eye_sign: f32, d: f32) -> vec3<f32> {
+    let e = sphere_e(proj, r, y, d);
+    var q = 0.0;
+    if (r > 0.0) {
+        q = clamp(e / r, -1.0, 1.0);
+    }
+    let lon = theta - eye_sign * precise_asin(q);
+    let lat = precise_atan2(y, sqrt(max(r * r - e * e, 0.0)));
+    let depth = sqrt(max(r * r + y * y + d * d - 2.0 * d * e, 0.0));
+    return vec3<f32>(lon, lat, depth);
+}
+
+// The altitude at which a point is seen at eye offset d, and its slope d(altitude)/dd.
+fn sphere_altitude(proj: Projection, r: f32, y: f32, d: f32) -> vec2<f32> {
+    let e = sphere_e_slope(proj, r, y, d);
+    let h = sqrt(max(r * r - e.x * e.x, 1e-30));
+    return vec2<f32>(precise_atan2(abs(y), h), abs(y) * e.x * e.y / (h * (h * h + y * y)));
+}
+
+// One Newton step on g(a) = altitude(f(a)·d_e) − a (`sphere_eye_offset` in projection.rs).
+fn sphere_newton_step(proj: Projection, r: f32, y: f32, a: f32) -> f32 {
+    let k = 0.5 * PI / (proj.pole_to - proj.pole_from);
+    let altitude = sphere_altitude(proj, r, y, pole_fade(proj, a) * proj.eye_radius);
+    let g = altitude.x - a;
+    let dg = altitude.y * proj.eye_radius * (-k * sin(k * (a - proj.pole_from))) - 1.0;
+    return clamp(a - g / dg, proj.pole_from, proj.pole_to);
+}
+
+// The eye offset f(|φ|)·d_e at which a point is seen: the root of φ = φ(f(φ)·d_e), by four Newton
+// steps written out (no loop: lavapipe limits the loop iterations of an invocation).
+fn sphere_eye_offset(proj: Projection, r: f32, y: f32) -> f32 {
+    let de = proj.eye_radius;
+    if (proj.pole_to <= 0.0 || sphere_altitude(proj, r, y, de).x <= proj.pole_from) {
+        return de;
+    }
+    let centre = sphere_altitude(proj, r, y, 0.0).x;
+    if (centre >= proj.pole_to) {
+        return 0.0;
+    }
+    var a = clamp(centre, proj.pole_from, proj.pole_to);
+    a = sphere_newton_step(proj, r, y, a);
+    a = sphere_newton_step(proj, r, y, a);
+    a = sphere_newton_step(proj, r, y, a);
+    a = sphere_newton_step(proj, r, y, a);
+    return pole_fade(proj, a) * de;
+}
+
+// Whether an eye sees the point (`Projection::project` is Some): the cylinder r > d_e; the sphere
+// r > |e| at the point's offset (a point on the axis only where the offset has faded to 0).
+fn sees(proj: Projection, p: vec3<f32>) -> bool {
+    let r = horizontal_radius(p);
+    if (proj.panorama != PANORAMA_SPHERE) {
+        return r > proj.eye_radius;
+    }
+    let e = sphere_e(proj, r, p.y, sphere_eye_offset(proj, r, p.y));
+    return r > abs(e) || (r == 0.0 && e == 0.0 && p.y != 0.0);
+}
+
+// (u, v, depth) of a viewer-frame point whose azimuth θ the caller has already unwrapped:
+// (u, v) are (θ ± α, screen height) on the cylinder, (longitude, latitude) on the sphere.
 fn project_with_azimuth(proj: Projection, p: vec3<f32>, theta: f32, eye_sign: f32) -> vec3<f32> {
     let r = horizontal_radius(p);
+    if (proj.panorama == PANORAMA_SPHERE) {
+        return sphere_at_offset(proj, r, p.y, theta, eye_sign, sphere_eye_offset(proj, r, p.y));
+    }
     return vec3<f32>(theta + eye_sign * eye_shift(proj, r), screen_height(proj, p.y, r), r);
 }
 
 // Continuous image coordinates (x right, y down) of a screen point, u wrapped into the image.
 fn to_pixel(proj: Projection, u: f32, v: f32) -> vec2<f32> {
     let x = (wrap_angle(u) / TAU + 0.5) * proj.width;
-    let y = 0.5 * proj.height - v * proj.pixels_per_metre;
+    let y = 0.5 * proj.height - v * proj.pixels_per_v;
     return vec2<f32>(x, y);
 }
 
@@ -111,7 +225,7 @@ fn to_pixel(proj: Projection, u: f32, v: f32) -> vec2<f32> {
 // screen as in the paper; depth r maps monotonically into (0, 1) as r / (r + 1).
 fn to_clip(proj: Projection, uvd: vec3<f32>) -> vec4<f32> {
     let x = uvd.x / PI;
-    let y = uvd.y * proj.pixels_per_metre / (0.5 * proj.height);
+    let y = uvd.y * proj.pixels_per_v / (0.5 * proj.height);
     let z = min(uvd.z / (uvd.z + 1.0), MAX_DEPTH);
     return vec4<f32>(x, y, z, 1.0);
 }

@@ -5,6 +5,7 @@ use clap::Args;
 use glam::Vec3;
 
 use twister::core::lod::LodParams;
+use twister::core::projection::{PanoramaKind, DEFAULT_POLE_MERGE};
 use twister::core::settings::{Method, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV, DEFAULT_MEMORY_MB};
 use twister::core::visual_field::Gaze;
 use twister::error::{Error, Result};
@@ -12,12 +13,30 @@ use twister::{Projection, RenderSettings, Vertical};
 
 #[derive(Args)]
 pub struct ViewArgs {
-    /// Image width per eye in pixels (the full 360°).
-    #[arg(long, default_value_t = 3168)]
-    pub width: u32,
-    /// Image height per eye in pixels.
-    #[arg(long, default_value_t = 600)]
-    pub height: u32,
+    /// The panorama: cylinder (the TWISTER display) or equirect (the full sphere, 360° × 180°
+    /// per eye: omni-directional stereo as VR players, 360° video and Blender use).
+    /// [default: cylinder; equirect with --preset]
+    #[arg(long, value_enum)]
+    pub panorama: Option<PanoramaKind>,
+    /// Image width per eye in pixels (the full 360°) [default: 3168; equirect 4096].
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height per eye in pixels [default: 600; equirect: width/2].
+    #[arg(long)]
+    pub height: Option<u32>,
+    /// Size preset of the full sphere (implies --panorama equirect): vr4k (4096×4096 top-bottom:
+    /// 4096×2048 per eye), vr6k (6144×6144), vr8k (8192×8192).
+    #[arg(long, value_enum, conflicts_with_all = ["width", "height"])]
+    pub preset: Option<Preset>,
+    /// equirect: parallel (every eye ray tangent to the eye circle, Google ODS, Cycles
+    /// "parallel"), or DIST: the rays converge on the sphere of DIST metres (Cycles "off-axis")
+    /// [default: parallel].
+    #[arg(long, value_parser = parse_convergence)]
+    pub convergence: Option<Convergence>,
+    /// equirect: FROM,TO degrees of altitude over which the eye offset fades to 0 towards the
+    /// poles (Blender's pole merge), or off [default: 60,75].
+    #[arg(long, value_parser = parse_pole_merge)]
+    pub pole_merge: Option<PoleMerge>,
     /// R_T: radius of the display cylinder, metres.
     #[arg(long, default_value_t = 1.0)]
     pub screen_radius: f32,
@@ -69,6 +88,54 @@ pub struct ViewArgs {
     /// [default: 100] (needs --lod visual-field).
     #[arg(long)]
     pub lod_dinf: Option<f32>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Preset {
+    Vr4k,
+    Vr6k,
+    Vr8k,
+}
+
+impl Preset {
+    /// Width per eye (the height is half: 360° × 180°).
+    pub fn width(self) -> u32 {
+        match self {
+            Preset::Vr4k => 4096,
+            Preset::Vr6k => 6144,
+            Preset::Vr8k => 8192,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Convergence(pub Option<f32>);
+
+pub fn parse_convergence(s: &str) -> std::result::Result<Convergence, String> {
+    if s == "parallel" {
+        return Ok(Convergence(None));
+    }
+    match s.parse::<f32>() {
+        Ok(d) if d.is_finite() && d > 0.0 => Ok(Convergence(Some(d))),
+        _ => Err(format!("'{s}': expected parallel or a distance in metres")),
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PoleMerge(pub Option<(f32, f32)>);
+
+pub fn parse_pole_merge(s: &str) -> std::result::Result<PoleMerge, String> {
+    if s == "off" {
+        return Ok(PoleMerge(None));
+    }
+    let v: Vec<f32> =
+        s.split(',').map(|x| x.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|e| format!("'{s}': {e}"))?;
+    match v[..] {
+        [from, to] if from.is_finite() && to.is_finite() && 0.0 <= from && from < to && to <= 90.0 => {
+            Ok(PoleMerge(Some((from, to))))
+        }
+        _ => Err(format!("'{s}': expected off or FROM,TO degrees with 0 ≤ FROM < TO ≤ 90")),
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -126,12 +193,39 @@ impl ViewArgs {
     /// The render settings these options give (the viewer of `camera[:N]` is placed with the
     /// scene, by `cli::scene::prepare`).
     pub fn settings(&self) -> Result<RenderSettings> {
+        let panorama = match (self.panorama, self.preset) {
+            (Some(PanoramaKind::Cylinder), Some(_)) => {
+                return Err(Error::option("--preset", "sizes the full sphere: use it with --panorama equirect"))
+            }
+            (Some(p), _) => p,
+            (None, Some(_)) => PanoramaKind::Equirect,
+            (None, None) => PanoramaKind::Cylinder,
+        };
+        if panorama == PanoramaKind::Cylinder {
+            if self.convergence.is_some() {
+                return Err(Error::option("--convergence", "needs --panorama equirect"));
+            }
+            if self.pole_merge.is_some() {
+                return Err(Error::option("--pole-merge", "needs --panorama equirect"));
+            }
+        }
+        let (width, height) = match (panorama, self.preset) {
+            (_, Some(preset)) => (preset.width(), preset.width() / 2),
+            (PanoramaKind::Cylinder, None) => (self.width.unwrap_or(3168), self.height.unwrap_or(600)),
+            (PanoramaKind::Equirect, None) => {
+                let width = self.width.unwrap_or(4096);
+                (width, self.height.unwrap_or(width / 2))
+            }
+        };
         let projection = Projection {
             screen_radius: self.screen_radius,
             eye_radius: self.eye_radius,
-            width: self.width,
-            height: self.height,
+            width,
+            height,
             vertical: self.vertical,
+            panorama,
+            convergence: self.convergence.and_then(|c| c.0),
+            pole_merge: self.pole_merge.map_or(Some(DEFAULT_POLE_MERGE), |p| p.0),
         };
         projection.validate()?;
         if !self.yaw.is_finite() {

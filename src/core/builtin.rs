@@ -100,7 +100,7 @@ pub fn uv_sphere(center: Vec3, radius: f32, slices: u32, stacks: u32, color: [f3
 /// Sphere of `triangles` (100 or 1024) triangles, `distance` m ahead, its silhouette filling
 /// the screen height under the paper's vertical model: R_T·ρ/√(D²−ρ²) = half height.
 pub fn screen_filling_sphere(triangles: u32, distance: f32, projection: &Projection, name: &str) -> Scene {
-    let k = projection.half_height_m() / projection.screen_radius;
+    let k = projection.fill_tan();
     let radius = distance * k / (1.0 + k * k).sqrt();
     sphere_scene(triangles, Vec3::new(0.0, 0.0, -distance), radius, name)
 }
@@ -160,7 +160,7 @@ pub fn blob(center: Vec3, radius: f32) -> Scene {
 /// The paper's evaluation-1 triangle: equilateral, in the plane z = −D facing the viewer,
 /// centred on the middle row; its side projects to about H pixels (R_T·s/D metres of screen).
 pub fn paper_triangle(distance: f32, projection: &Projection) -> Scene {
-    let side = projection.height as f32 / projection.pixels_per_metre() * distance / projection.screen_radius;
+    let side = 2.0 * projection.fill_tan() * distance;
     let h = side * 3f32.sqrt() / 2.0;
     let z = -distance;
     let n = Vec3::Z;

@@ -222,9 +222,10 @@ impl Scene {
                 format!("needs a scene with height and a finite distance beyond the eye circle, got {distance}"),
             ));
         }
-        let half = projection.half_height_m();
-        // Front face at depth distance − s·dz/2 spans v = ±R_T·(s·h/2)/(front depth) = ±half.
-        let s = half * distance / (projection.screen_radius * size.y / 2.0 + half * size.z / 2.0);
+        // Front face at depth distance − s·dz/2 spans ±k = (s·h/2)/(front depth): the screen's
+        // height (v = R_T·y/r), or ±30° on the sphere.
+        let k = projection.fill_tan();
+        let s = k * distance / (size.y / 2.0 + k * size.z / 2.0);
         let center = (lo + hi) / 2.0;
         self.transform(
             Mat4::from_translation(Vec3::new(0.0, 0.0, -distance))

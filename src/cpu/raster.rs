@@ -24,10 +24,10 @@ pub fn raster_vertex(params: &RasterParams, v: &DrawVertex) -> Vec4 {
     let theta = theta0 + std::f32::consts::TAU * ((v.theta_ref - theta0) / std::f32::consts::TAU + 0.5).floor();
     let eye = if params.eye_sign > 0.0 { Eye::Right } else { Eye::Left };
     let q = projection.project_with_azimuth(p, theta, eye);
-    let ppm = projection.pixels_per_metre();
     Vec4::new(
         q.u / std::f32::consts::PI + 2.0 * params.shift_px[0] / projection.width as f32,
-        q.v * ppm / (0.5 * projection.height as f32) - 2.0 * params.shift_px[1] / projection.height as f32,
+        q.v * projection.pixels_per_v() / (0.5 * projection.height as f32)
+            - 2.0 * params.shift_px[1] / projection.height as f32,
         (q.depth / (q.depth + 1.0)).min(crate::shader::constants::MAX_DEPTH),
         1.0,
     )

@@ -7,7 +7,7 @@ use std::mem::{offset_of, size_of};
 use bytemuck::{Pod, Zeroable};
 
 use crate::core::material::{Material, MipLevel};
-use crate::core::projection::{Projection, Vertical};
+use crate::core::projection::{PanoramaKind, Projection, Vertical};
 use crate::core::scene::SceneVertex;
 
 /// A vertex of a prepared triangle (`DrawVertex` in shaders/subdivide.wgsl and raster.wgsl),
@@ -26,7 +26,7 @@ pub struct DrawVertex {
     pub _pad: f32,
 }
 
-/// `Projection` in shaders/shared/projection.wgsl. 32 bytes.
+/// `Projection` in shaders/shared/projection.wgsl. 48 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct ProjectionUniform {
@@ -36,7 +36,15 @@ pub struct ProjectionUniform {
     pub height: f32,
     pub acos_eye_screen: f32,
     pub vertical_exact: u32,
-    pub pixels_per_metre: f32,
+    /// Pixels per unit of v (metres of screen, or radians of latitude).
+    pub pixels_per_v: f32,
+    /// 0 the cylinder, 1 the sphere (`PanoramaKind`).
+    pub panorama: u32,
+    /// The sphere's convergence distance, metres; 0: parallel rays.
+    pub convergence: f32,
+    /// The sphere's pole merge, radians of altitude; `pole_to` 0: off (as in Cycles).
+    pub pole_from: f32,
+    pub pole_to: f32,
     pub _pad: f32,
 }
 
@@ -48,12 +56,16 @@ impl From<&ProjectionUniform> for Projection {
             width: p.width as u32,
             height: p.height as u32,
             vertical: if p.vertical_exact != 0 { Vertical::Exact } else { Vertical::Paper },
+            panorama: if p.panorama == 1 { PanoramaKind::Equirect } else { PanoramaKind::Cylinder },
+            convergence: (p.convergence > 0.0).then_some(p.convergence),
+            pole_merge: (p.pole_to > 0.0).then(|| (p.pole_from.to_degrees(), p.pole_to.to_degrees())),
         }
     }
 }
 
 impl From<&Projection> for ProjectionUniform {
     fn from(p: &Projection) -> Self {
+        let (pole_from, pole_to) = p.pole_merge.map_or((0.0, 0.0), |(a, b)| (a.to_radians(), b.to_radians()));
         ProjectionUniform {
             screen_radius: p.screen_radius,
             eye_radius: p.eye_radius,
@@ -61,7 +73,11 @@ impl From<&Projection> for ProjectionUniform {
             height: p.height as f32,
             acos_eye_screen: p.acos_eye_screen(),
             vertical_exact: (p.vertical == Vertical::Exact) as u32,
-            pixels_per_metre: p.pixels_per_metre(),
+            pixels_per_v: p.pixels_per_v(),
+            panorama: (p.panorama == PanoramaKind::Equirect) as u32,
+            convergence: p.convergence.unwrap_or(0.0),
+            pole_from,
+            pole_to,
             _pad: 0.0,
         }
     }
@@ -263,7 +279,8 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("SceneVertex" => SceneVertex { position, material, normal, object, color, uv, _pad1 }),
     layout!("DrawVertex" => DrawVertex { position, theta_ref, normal, material, color, uv, object, _pad }),
     layout!("Projection" => ProjectionUniform {
-        screen_radius, eye_radius, width, height, acos_eye_screen, vertical_exact, pixels_per_metre, _pad
+        screen_radius, eye_radius, width, height, acos_eye_screen, vertical_exact, pixels_per_v, panorama,
+        convergence, pole_from, pole_to, _pad
     }),
     layout!("SubdivideParams" => SubdivideParams {
         view, projection, axis_clearance, triangle_count, first_triangle, method, fixed_n, edge_px, max_div,

@@ -47,7 +47,7 @@
 use glam::Vec3;
 
 use super::Node;
-use crate::core::projection::Projection;
+use crate::core::projection::{PanoramaKind, Projection};
 use crate::shader::constants::{
     AXIS_CLEARANCE_MAX, AXIS_CLEARANCE_MIN, BAND_LIMIT, BAND_RATIO, MAX_DIAMONDS, SNAP, WIDE_RATIO,
 };
@@ -61,7 +61,15 @@ pub const QUADRANTS: [(f32, f32); 4] = [(1.0, -1.0), (1.0, 1.0), (-1.0, 1.0), (-
 /// 10⁻⁵·R_T of the axis could show only if they were as close to the eyes' height. Small, so that
 /// the paper model's image of a ceiling just above the eyes reaches past the top of the image;
 /// not smaller, so that the thin parts beside the square keep distinct lattice nodes in f32.
+///
+/// The sphere with pole merge sees every point near the axis (at the poles the eyes meet at the
+/// centre): there ρ is `AXIS_CLEARANCE_MIN` metres, so the hole the square leaves at a pole (the
+/// colatitudes below ρ/h for a surface h above or below the eyes) is smaller than half a pixel
+/// row unless h < 2ρ·H/π (1.3 cm at 4096×2048).
 pub fn axis_clearance(projection: &Projection) -> f32 {
+    if projection.panorama == PanoramaKind::Equirect && projection.pole_merge.is_some() {
+        return AXIS_CLEARANCE_MIN;
+    }
     let rt = projection.screen_radius;
     projection.eye_radius.clamp(AXIS_CLEARANCE_MIN * rt, AXIS_CLEARANCE_MAX * rt)
 }

@@ -66,7 +66,7 @@
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use std::f32::consts::{PI, TAU};
 
-use crate::core::projection::{azimuth, horizontal_radius, wrap_angle, Projection, Vertical};
+use crate::core::projection::{azimuth, horizontal_radius, wrap_angle, Eye, PanoramaKind, Projection, Vertical};
 use crate::core::scene::SceneVertex;
 use crate::core::settings::{RenderSettings, SplitRule};
 use crate::shader::constants::{
@@ -176,10 +176,9 @@ impl<'a> Subdivider<'a> {
 
     /// Image position (x, y) in pixels of a viewer-frame point for one eye sign, x not wrapped.
     fn pixel(&self, p: Vec3, eye_sign: f32) -> Vec2 {
-        let r = horizontal_radius(p);
-        let u = azimuth(p) + eye_sign * self.projection.eye_shift(r);
-        let v = self.projection.screen_height(p.y, r);
-        Vec2::new(u * self.projection.pixels_per_radian(), v * self.projection.pixels_per_metre())
+        let eye = if eye_sign > 0.0 { Eye::Right } else { Eye::Left };
+        let q = self.projection.project_with_azimuth(p, azimuth(p), eye);
+        Vec2::new(q.u * self.projection.pixels_per_radian(), q.v * self.projection.pixels_per_v())
     }
 
     /// The projected length in pixels by which the straight edge ab is split: measured as a
@@ -213,9 +212,11 @@ impl<'a> Subdivider<'a> {
             }
             length = length.max(total);
         }
-        // Near the eye circle, which the paper model shows on screen (α ∝ √(r − d_e)), no stretch
-        // is allowed (the exact model puts it at v = ±∞).
-        let ring = self.projection.vertical == Vertical::Paper && nearest < 2.0 * self.projection.eye_radius;
+        // Near the eye circle, which the paper model and the sphere show on screen (α and the
+        // longitude ∝ √(r − d_e)), no stretch is allowed (the exact model puts it at v = ±∞).
+        let shows_ring =
+            self.projection.vertical == Vertical::Paper || self.projection.panorama == PanoramaKind::Equirect;
+        let ring = shows_ring && nearest < 2.0 * self.projection.eye_radius;
         let stretch = if ring { 1.0 } else { MAX_STRETCH };
         length.max(segments as f32 * longest / stretch)
     }
@@ -280,6 +281,9 @@ impl<'a> Subdivider<'a> {
     /// v ≥ v_paper·√(1 − d_e²/R_T²), so the test k = half height / (R_T·√(1 − d_e²/R_T²)) on y/r is
     /// safe for both vertical models.
     pub fn off_screen_vertically(&self, p: [Vec3; 3]) -> bool {
+        if self.projection.panorama == PanoramaKind::Equirect {
+            return false; // the sphere shows every direction
+        }
         let (rt, de) = (self.projection.screen_radius, self.projection.eye_radius);
         let k = self.projection.half_height_m() / (rt * (1.0 - (de / rt) * (de / rt)).sqrt());
         let above = p.iter().all(|q| q.y > k * horizontal_radius(*q));
@@ -431,9 +435,17 @@ impl<'a> Subdivider<'a> {
         let (mut u_min, mut u_max) = (f32::INFINITY, f32::NEG_INFINITY);
         for q in p {
             let theta = theta_c + wrap_angle(azimuth(q) - theta_c);
-            let alpha = self.projection.eye_shift(horizontal_radius(q)).abs();
-            u_min = u_min.min(theta - alpha);
-            u_max = u_max.max(theta + alpha);
+            if self.projection.panorama == PanoramaKind::Equirect {
+                for eye in Eye::BOTH {
+                    let u = self.projection.project_with_azimuth(q, theta, eye).u;
+                    u_min = u_min.min(u);
+                    u_max = u_max.max(u);
+                }
+            } else {
+                let alpha = self.projection.eye_shift(horizontal_radius(q)).abs();
+                u_min = u_min.min(theta - alpha);
+                u_max = u_max.max(theta + alpha);
+            }
         }
         if self.params.measure_edges != 0 {
             out.max_sub_edge_px = out.max_sub_edge_px.max(self.visible_edge_px(p));

@@ -19,7 +19,7 @@ use rand::{Rng, SeedableRng};
 
 use super::tests::params_for;
 use super::*;
-use crate::core::projection::Vertical;
+use crate::core::projection::{PanoramaKind, Vertical};
 use crate::core::settings::Method;
 
 /// A mesh as positions and triangle indices; shared vertices are shared indices, so shared
@@ -294,7 +294,8 @@ fn check_case(
             let r = horizontal_radius(p);
             // Clearly outside the square and clearly on screen (a margin for the sub-triangles
             // culled whole: those lie wholly beyond the image, and so does this point then).
-            if p.x.abs() + p.z.abs() < rho * 1.01 + 2.0 * tol || p.y.abs() > 0.99 * k * r {
+            let off_screen = projection.panorama == PanoramaKind::Cylinder && p.y.abs() > 0.99 * k * r;
+            if p.x.abs() + p.z.abs() < rho * 1.01 + 2.0 * tol || off_screen {
                 continue;
             }
             let w = bary_of(p);
@@ -365,6 +366,19 @@ fn random_closed_meshes_around_the_viewer_subdivide_watertight_and_whole() {
             width: rng.random_range(64..512),
             height: rng.random_range(32..512),
             vertical: if rng.random() { Vertical::Paper } else { Vertical::Exact },
+            ..Projection::default()
+        };
+        // A third of the cases on the full sphere (any convergence, pole merge on or off).
+        let projection = if case % 3 == 2 {
+            Projection {
+                panorama: PanoramaKind::Equirect,
+                height: projection.width / 2,
+                convergence: [None, Some(2.0)][rng.random_range(0..2)],
+                pole_merge: [None, Some(crate::core::projection::DEFAULT_POLE_MERGE)][rng.random_range(0..2)],
+                ..projection
+            }
+        } else {
+            projection
         };
         let (method, edge_px, max_div) = match rng.random_range(0..4) {
             0 => (Method::Vertex, 8.0, 7),
