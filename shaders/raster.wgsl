@@ -12,6 +12,10 @@ struct RasterParams {
     // Test hook: draws everything shifted by this many pixels (x right, y down) while the
     // error is still measured against the true projection.
     shift_px: vec2<f32>,
+    error_angle: u32,  // 1: the error target holds arcminutes (fragment.wgsl)
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: RasterParams;

@@ -16,6 +16,10 @@ struct SlitParams {
     ambient: f32,
     near: f32,          // near plane distance along the camera's forward axis
     focal_y_clip: f32,  // t_S · pixels_per_metre / (H/2), t_S = √(R_T² − d_e²)
+    error_angle: u32,   // 1: the error target holds arcminutes (fragment.wgsl)
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // One slit's camera: eye position (viewer frame), and (sin φ, cos φ, NDC x of the slit centre).

@@ -1,19 +1,26 @@
-//! Output layouts and file writing. All outputs of one command are written together or not at
-//! all: each under a temporary name beside its place, then moved in; on a failure the earlier
-//! outputs are restored. Temporaries left by a killed process are cleaned up by the next run
-//! that writes in that folder.
+//! Output layouts, image formats, metadata and file writing. All outputs of one command are
+//! written together or not at all: each under a temporary name beside its place, then moved
+//! in; on a failure the earlier outputs are restored. Temporaries left by a killed process are
+//! cleaned up by the next run that writes in that folder.
 //!
-//! | layout | files |
+//! | layout | files (`.png` or `.jpg`) |
 //! |---|---|
 //! | `eyes` | `left.png`, `right.png`: W×H each |
-//! | `top-bottom` | `stereo.png`: W×2H, left eye on top (the VR players' top-bottom format) |
+//! | `top-bottom` | `stereo_TB.png`: W×2H, left eye on top (the VR players' top-bottom format; `_TB` is the suffix players look for) |
+//! | `side-by-side` | `stereo_LR.png`: 2W×H, left eye on the left (`_LR`) |
 //! | `twister` | `left_front.png`, `left_back.png`, `right_front.png`, `right_back.png`: W/2×H each, as the paper fed the display. Front is the half centred straight ahead (θ ∈ [−π/2, π/2)); back is the half centred behind, continuous across the seam |
+//!
+//! Depth (`--depth`, [`depth_images`]) follows the layout: `left_depth.exr` and
+//! `right_depth.exr` (eyes, twister), `depth_TB.exr`, `depth_LR.exr`: one 32-bit float channel
+//! `Z`, the distance in metres from each pixel's eye point along its ray, +∞ where no surface is.
+//!
+//! Full-sphere images carry Google's photo-sphere XMP ([`gpano_xmp`]): in PNG as an iTXt chunk
+//! `XML:com.adobe.xmp`, in JPEG as an APP1 segment.
 
 use std::path::{Path, PathBuf};
 
-use image::ImageEncoder;
-
 use crate::core::frame::{EyeImage, Frame};
+use crate::core::projection::PanoramaKind;
 use crate::error::{Error, Result};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum, serde::Serialize)]
@@ -22,7 +29,52 @@ pub enum Layout {
     #[default]
     Eyes,
     TopBottom,
+    SideBySide,
     Twister,
+}
+
+impl Layout {
+    /// The layout a panorama is written in by default: the eyes apart for the cylinder (the
+    /// TWISTER display's inputs), top-bottom for the sphere (what VR players take).
+    pub fn default_for(panorama: PanoramaKind) -> Layout {
+        match panorama {
+            PanoramaKind::Cylinder => Layout::Eyes,
+            PanoramaKind::Equirect => Layout::TopBottom,
+        }
+    }
+}
+
+/// The image file format (`--format`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ImageFormat {
+    #[default]
+    Png,
+    Jpg,
+}
+
+impl ImageFormat {
+    pub fn extension(self) -> &'static str {
+        match self {
+            ImageFormat::Png => "png",
+            ImageFormat::Jpg => "jpg",
+        }
+    }
+}
+
+/// How images are encoded: the format, the JPEG quality (1–100) and the XMP packet each file
+/// carries (the sphere's GPano metadata).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Encoding {
+    pub format: ImageFormat,
+    pub quality: u8,
+    pub xmp: Option<String>,
+}
+
+impl Default for Encoding {
+    fn default() -> Self {
+        Encoding { format: ImageFormat::Png, quality: 90, xmp: None }
+    }
 }
 
 /// Columns [start, start + width) of an image, wrapping around the panorama.
@@ -38,38 +90,126 @@ pub fn columns(img: &EyeImage, start: u32, width: u32) -> EyeImage {
     EyeImage { width, height: img.height, rgba }
 }
 
+/// The two eyes side by side, left on the left (4-byte texels, rows of `width`).
+fn side_by_side<T: Copy>(left: &[T], right: &[T], width: usize, per_texel: usize) -> Vec<T> {
+    left.chunks(width * per_texel)
+        .zip(right.chunks(width * per_texel))
+        .flat_map(|(l, r)| l.iter().chain(r))
+        .copied()
+        .collect()
+}
+
 /// The file names of a layout, in the order of [`layout_images`].
-pub fn layout_names(layout: Layout) -> Vec<String> {
+pub fn layout_names(layout: Layout, format: ImageFormat) -> Vec<String> {
+    let ext = format.extension();
     match layout {
-        Layout::Eyes => vec!["left.png".into(), "right.png".into()],
-        Layout::TopBottom => vec!["stereo.png".into()],
-        Layout::Twister => {
-            ["left", "right"].iter().flat_map(|eye| [format!("{eye}_front.png"), format!("{eye}_back.png")]).collect()
-        }
+        Layout::Eyes => vec![format!("left.{ext}"), format!("right.{ext}")],
+        Layout::TopBottom => vec![format!("stereo_TB.{ext}")],
+        Layout::SideBySide => vec![format!("stereo_LR.{ext}")],
+        Layout::Twister => ["left", "right"]
+            .iter()
+            .flat_map(|eye| [format!("{eye}_front.{ext}"), format!("{eye}_back.{ext}")])
+            .collect(),
     }
 }
 
 /// The images of a layout, with their file names.
-pub fn layout_images(frame: &Frame, layout: Layout) -> Vec<(String, EyeImage)> {
-    match layout {
-        Layout::Eyes => vec![("left.png".into(), frame.left.clone()), ("right.png".into(), frame.right.clone())],
+pub fn layout_images(frame: &Frame, layout: Layout, format: ImageFormat) -> Vec<(String, EyeImage)> {
+    let names = layout_names(layout, format);
+    let (w, h) = (frame.left.width, frame.left.height);
+    let images = match layout {
+        Layout::Eyes => vec![frame.left.clone(), frame.right.clone()],
         Layout::TopBottom => {
             let mut rgba = frame.left.rgba.clone();
             rgba.extend_from_slice(&frame.right.rgba);
-            vec![("stereo.png".into(), EyeImage { width: frame.left.width, height: 2 * frame.left.height, rgba })]
+            vec![EyeImage { width: w, height: 2 * h, rgba }]
+        }
+        Layout::SideBySide => {
+            vec![EyeImage {
+                width: 2 * w,
+                height: h,
+                rgba: side_by_side(&frame.left.rgba, &frame.right.rgba, w as usize, 4),
+            }]
         }
         Layout::Twister => {
-            let w = frame.left.width;
             let (quarter, half) = (w / 4, w / 2);
-            let mut out = Vec::new();
-            for (name, img) in [("left", &frame.left), ("right", &frame.right)] {
-                out.push((format!("{name}_front.png"), columns(img, quarter, half)));
-                out.push((format!("{name}_back.png"), columns(img, quarter + half, w - half)));
-            }
-            out
+            [&frame.left, &frame.right]
+                .iter()
+                .flat_map(|img| [columns(img, quarter, half), columns(img, quarter + half, w - half)])
+                .collect()
         }
+    };
+    names.into_iter().zip(images).collect()
+}
+
+/// A single-channel float image (depth).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DepthImage {
+    pub width: u32,
+    pub height: u32,
+    pub values: Vec<f32>,
+}
+
+/// The depth files of a layout (see the module doc), from a frame rendered with
+/// `measure.depth`; None without depth.
+pub fn depth_images(frame: &Frame, layout: Layout) -> Option<Vec<(String, DepthImage)>> {
+    let [left, right] = frame.depth.as_ref()?;
+    let (w, h) = (frame.left.width, frame.left.height);
+    Some(match layout {
+        Layout::Eyes | Layout::Twister => vec![
+            ("left_depth.exr".into(), DepthImage { width: w, height: h, values: left.clone() }),
+            ("right_depth.exr".into(), DepthImage { width: w, height: h, values: right.clone() }),
+        ],
+        Layout::TopBottom => {
+            let values = left.iter().chain(right).copied().collect();
+            vec![("depth_TB.exr".into(), DepthImage { width: w, height: 2 * h, values })]
+        }
+        Layout::SideBySide => {
+            let values = side_by_side(left, right, w as usize, 1);
+            vec![("depth_LR.exr".into(), DepthImage { width: 2 * w, height: h, values })]
+        }
+    })
+}
+
+/// The names [`depth_images`] gives a layout.
+pub fn depth_names(layout: Layout) -> Vec<String> {
+    match layout {
+        Layout::Eyes | Layout::Twister => vec!["left_depth.exr".into(), "right_depth.exr".into()],
+        Layout::TopBottom => vec!["depth_TB.exr".into()],
+        Layout::SideBySide => vec!["depth_LR.exr".into()],
     }
 }
+
+/// Google's photo-sphere XMP (GPano) for an equirectangular panorama of `width` × `height`
+/// pixels per eye, the whole sphere (no crop): what Google Photos, Facebook, Kuula and most VR
+/// photo viewers read to show an image as a sphere.
+pub fn gpano_xmp(width: u32, height: u32) -> String {
+    format!(
+        concat!(
+            "<?xpacket begin=\"\u{feff}\" id=\"W5M0MpCehiHzreSzNTczkc9d\"?>\n",
+            "<x:xmpmeta xmlns:x=\"adobe:ns:meta/\" x:xmptk=\"twister\">\n",
+            " <rdf:RDF xmlns:rdf=\"http://www.w3.org/1999/02/22-rdf-syntax-ns#\">\n",
+            "  <rdf:Description rdf:about=\"\" xmlns:GPano=\"http://ns.google.com/photos/1.0/panorama/\">\n",
+            "   <GPano:ProjectionType>equirectangular</GPano:ProjectionType>\n",
+            "   <GPano:UsePanoramaViewer>True</GPano:UsePanoramaViewer>\n",
+            "   <GPano:CroppedAreaImageWidthPixels>{w}</GPano:CroppedAreaImageWidthPixels>\n",
+            "   <GPano:CroppedAreaImageHeightPixels>{h}</GPano:CroppedAreaImageHeightPixels>\n",
+            "   <GPano:FullPanoWidthPixels>{w}</GPano:FullPanoWidthPixels>\n",
+            "   <GPano:FullPanoHeightPixels>{h}</GPano:FullPanoHeightPixels>\n",
+            "   <GPano:CroppedAreaLeftPixels>0</GPano:CroppedAreaLeftPixels>\n",
+            "   <GPano:CroppedAreaTopPixels>0</GPano:CroppedAreaTopPixels>\n",
+            "  </rdf:Description>\n",
+            " </rdf:RDF>\n",
+            "</x:xmpmeta>\n",
+            "<?xpacket end=\"w\"?>"
+        ),
+        w = width,
+        h = height
+    )
+}
+
+/// The namespace line that opens an XMP APP1 segment of a JPEG.
+pub const JPEG_XMP_NAMESPACE: &[u8] = b"http://ns.adobe.com/xap/1.0/\0";
 
 /// One output file: where it goes and its bytes.
 #[derive(Clone, Debug)]
@@ -78,13 +218,77 @@ pub struct OutputFile {
     pub bytes: Vec<u8>,
 }
 
-/// An image encoded as PNG.
+/// An image encoded as PNG (no metadata).
 pub fn png_file(path: PathBuf, img: &EyeImage) -> Result<OutputFile> {
+    image_file(path, img, &Encoding::default())
+}
+
+/// An image encoded as `encoding` says: PNG (RGBA, the XMP as an iTXt chunk
+/// `XML:com.adobe.xmp`) or JPEG (RGB at the quality, the XMP as an APP1 segment after the JFIF
+/// header).
+pub fn image_file(path: PathBuf, img: &EyeImage, encoding: &Encoding) -> Result<OutputFile> {
+    let fail = |e: &dyn std::fmt::Display| Error::output(&path, format!("cannot encode: {e}"));
     let mut bytes = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut bytes)
-        .write_image(&img.rgba, img.width, img.height, image::ExtendedColorType::Rgba8)
-        .map_err(|e| Error::output(&path, format!("cannot encode: {e}")))?;
+    match encoding.format {
+        ImageFormat::Png => {
+            let mut encoder = png::Encoder::new(&mut bytes, img.width, img.height);
+            encoder.set_color(png::ColorType::Rgba);
+            encoder.set_depth(png::BitDepth::Eight);
+            if let Some(xmp) = &encoding.xmp {
+                encoder.add_itxt_chunk("XML:com.adobe.xmp".into(), xmp.clone()).map_err(|e| fail(&e))?;
+            }
+            let mut writer = encoder.write_header().map_err(|e| fail(&e))?;
+            writer.write_image_data(&img.rgba).map_err(|e| fail(&e))?;
+            writer.finish().map_err(|e| fail(&e))?;
+        }
+        ImageFormat::Jpg => {
+            use image::ImageEncoder;
+            let rgb: Vec<u8> = img.rgba.chunks(4).flat_map(|p| [p[0], p[1], p[2]]).collect();
+            let mut jpeg = Vec::new();
+            image::codecs::jpeg::JpegEncoder::new_with_quality(&mut jpeg, encoding.quality.clamp(1, 100))
+                .write_image(&rgb, img.width, img.height, image::ExtendedColorType::Rgb8)
+                .map_err(|e| fail(&e))?;
+            bytes = match &encoding.xmp {
+                Some(xmp) => with_jpeg_xmp(&jpeg, xmp).ok_or_else(|| fail(&"the XMP packet is too long for JPEG"))?,
+                None => jpeg,
+            };
+        }
+    }
     Ok(OutputFile { path, bytes })
+}
+
+/// A JPEG with an XMP APP1 segment inserted after SOI and the APP0 (JFIF) segment, if any.
+/// None if the packet does not fit one segment (64 KiB).
+fn with_jpeg_xmp(jpeg: &[u8], xmp: &str) -> Option<Vec<u8>> {
+    let payload = [JPEG_XMP_NAMESPACE, xmp.as_bytes()].concat();
+    let length = u16::try_from(payload.len() + 2).ok()?;
+    // After SOI (2 bytes) and an APP0 segment (FF E0, length) when present.
+    let mut at = 2;
+    if jpeg.len() >= 6 && jpeg[2] == 0xFF && jpeg[3] == 0xE0 {
+        at = 4 + u16::from_be_bytes([jpeg[4], jpeg[5]]) as usize;
+    }
+    let mut out = Vec::with_capacity(jpeg.len() + payload.len() + 4);
+    out.extend_from_slice(&jpeg[..at]);
+    out.extend_from_slice(&[0xFF, 0xE1]);
+    out.extend_from_slice(&length.to_be_bytes());
+    out.extend_from_slice(&payload);
+    out.extend_from_slice(&jpeg[at..]);
+    Some(out)
+}
+
+/// A depth image as OpenEXR: one 32-bit float channel `Z`, uncompressed scan lines.
+pub fn exr_file(path: PathBuf, depth: &DepthImage) -> Result<OutputFile> {
+    use exr::prelude::*;
+    let (w, h) = (depth.width as usize, depth.height as usize);
+    let channel =
+        SpecificChannels::build().with_channel("Z").with_pixel_fn(|p: Vec2<usize>| (depth.values[p.y() * w + p.x()],));
+    let image = Image::from_channels((w, h), channel);
+    let mut cursor = std::io::Cursor::new(Vec::new());
+    image
+        .write()
+        .to_buffered(&mut cursor)
+        .map_err(|e| crate::error::Error::output(&path, format!("cannot encode OpenEXR: {e}")))?;
+    Ok(OutputFile { path, bytes: cursor.into_inner() })
 }
 
 /// The temporary name of an output while it is written: `.NAME.PID.tmp` beside it (and
@@ -248,10 +452,12 @@ mod tests {
     #[test]
     fn layout_names_are_the_names_of_the_layout_images() {
         let eye = EyeImage { width: 8, height: 2, rgba: vec![0; 64] };
-        let frame = Frame { left: eye.clone(), right: eye, stats: Default::default(), measurement: None };
-        for layout in [Layout::Eyes, Layout::TopBottom, Layout::Twister] {
-            let names: Vec<String> = layout_images(&frame, layout).into_iter().map(|(n, _)| n).collect();
-            assert_eq!(names, layout_names(layout));
+        let frame = Frame { left: eye.clone(), right: eye, stats: Default::default(), measurement: None, depth: None };
+        for layout in [Layout::Eyes, Layout::TopBottom, Layout::SideBySide, Layout::Twister] {
+            for format in [ImageFormat::Png, ImageFormat::Jpg] {
+                let names: Vec<String> = layout_images(&frame, layout, format).into_iter().map(|(n, _)| n).collect();
+                assert_eq!(names, layout_names(layout, format));
+            }
         }
     }
 

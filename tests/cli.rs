@@ -38,7 +38,19 @@ fn render_writes_every_layout_and_stats() {
     assert_eq!(png_size(&out.join("eyes/left.png")), (320, 60));
     assert_eq!(png_size(&out.join("eyes/right.png")), (320, 60));
     run("top-bottom", &out.join("tb"), &[]);
-    assert_eq!(png_size(&out.join("tb/stereo.png")), (320, 120));
+    assert_eq!(png_size(&out.join("tb/stereo_TB.png")), (320, 120));
+    run("side-by-side", &out.join("lr"), &[]);
+    assert_eq!(png_size(&out.join("lr/stereo_LR.png")), (640, 60));
+    // Top-bottom: left on top; side-by-side: left on the left.
+    let eyes = ["left", "right"].map(|e| image::open(out.join(format!("eyes/{e}.png"))).unwrap().to_rgba8());
+    let tb = image::open(out.join("tb/stereo_TB.png")).unwrap().to_rgba8();
+    let lr = image::open(out.join("lr/stereo_LR.png")).unwrap().to_rgba8();
+    for (k, eye) in eyes.iter().enumerate() {
+        for (x, y) in [(0, 0), (100, 30), (319, 59)] {
+            assert_eq!(tb.get_pixel(x, y + 60 * k as u32), eye.get_pixel(x, y));
+            assert_eq!(lr.get_pixel(x + 320 * k as u32, y), eye.get_pixel(x, y));
+        }
+    }
     run("twister", &out.join("tw"), &[]);
     for f in ["left_front", "left_back", "right_front", "right_back"] {
         assert_eq!(png_size(&out.join(format!("tw/{f}.png"))), (160, 60), "{f}");
@@ -546,7 +558,7 @@ fn identical_runs_give_identical_bytes() {
         let mut json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
         // Times differ between runs; everything else must not.
         json.as_object_mut().unwrap().retain(|k, _| !k.starts_with("ms_"));
-        (std::fs::read(dir.join("stereo.png")).unwrap(), json)
+        (std::fs::read(dir.join("stereo_TB.png")).unwrap(), json)
     };
     let (a, b) = (tmp("same-a"), tmp("same-b"));
     let (ra, rb) = (run(&a), run(&b));

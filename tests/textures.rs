@@ -196,7 +196,7 @@ fn every_sampler_mode_matches_the_cpu_twin_in_both_drawing_stages() {
     let s = settings(320, 64, Method::Slit(4));
     let frame = common::render(&scene, &s);
     for eye in Eye::BOTH {
-        let params = slit_params(&s.view.projection, s.view(), eye, s.shading.ambient);
+        let params = slit_params(&s.view.projection, s.view(), eye, s.shading.ambient, false);
         let cpu = slit(&params, &slits(&s.view.projection, eye, 4), &scene, &table, BG);
         let gpu = frame.eye(eye);
         let drawn = common::pixels_where(gpu, |p| !common::is_background(p, BG)).len();

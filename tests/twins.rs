@@ -321,24 +321,37 @@ fn same_triangle_sets(cpu: &[DrawVertex], gpu: &[DrawVertex]) -> Result<(), Stri
 
 struct Raster;
 
-/// Per eye: colour (RGBA8), display-position error (−1 where none) and object id + 1.
-type EyeOutputs = [(Vec<u8>, Vec<f32>, Vec<u32>); 2];
+/// Per eye: colour (RGBA8), display-position error (−1 where none), object id + 1 and the
+/// distance from the pixel's eye point (+∞ where none).
+type EyeOutputs = [(Vec<u8>, Vec<f32>, Vec<u32>, Vec<f32>); 2];
 
 fn measured(scene: &Scene, settings: &RenderSettings) -> Frame {
-    common::render(scene, &settings.with_measure_error(true))
+    common::render(scene, &settings.with_measure_error(true).with_depth(true))
 }
 
 fn frame_outputs(frame: &Frame) -> EyeOutputs {
     let m = frame.measurement.as_ref().expect("measured");
-    [0, 1].map(|k| (frame.eye(Eye::BOTH[k]).rgba.clone(), m.error[k].clone(), m.object[k].clone()))
+    let depth = frame.depth.as_ref().expect("depth measured");
+    [0, 1].map(|k| (frame.eye(Eye::BOTH[k]).rgba.clone(), m.error[k].clone(), m.object[k].clone(), depth[k].clone()))
 }
 
 /// Only pixels on triangle edges may differ (tie-breaking and rounding at coverage edges): at
 /// most `1/share` of the pixels in colour or object; the error where both drew a surface.
 fn compare_eyes(gpu: &EyeOutputs, cpu: &EyeOutputs, share: usize, error_tolerance: Option<f32>) -> Result<(), String> {
     let error_tolerance = error_tolerance.unwrap_or(f32::INFINITY);
-    for (k, ((gc, ge, go), (cc, ce, co))) in gpu.iter().zip(cpu).enumerate() {
+    for (k, ((gc, ge, go, gd), (cc, ce, co, cd))) in gpu.iter().zip(cpu).enumerate() {
         let total = go.len();
+        let distance = gd
+            .iter()
+            .zip(cd)
+            .filter(|(g, c)| {
+                let same = (g.is_infinite() && c.is_infinite()) || (*g - *c).abs() <= 1e-3 * c.abs();
+                !same
+            })
+            .count();
+        if distance * share > total {
+            return Err(format!("{:?}: {distance} of {total} distances differ", Eye::BOTH[k]));
+        }
         let colour =
             gc.chunks(4).zip(cc.chunks(4)).filter(|(a, b)| a.iter().zip(*b).any(|(x, y)| x.abs_diff(*y) > 2)).count();
         let object = go.iter().zip(co).filter(|(a, b)| a != b).count();
@@ -379,6 +392,26 @@ impl Twin for Raster {
                 ));
             }
         }
+        // The full sphere, with the error in pixels and as an angle (arcminutes).
+        let sphere = Projection::equirect(320);
+        out.push(("demo on the sphere".into(), (builtin::demo(), RenderSettings::new(sphere), None)));
+        // A triangle 2 m ahead reaching ±60° across and 50° up and down.
+        let mut triangle = Scene::new("big triangle");
+        let corner = |p: [f32; 3]| twister::core::scene::SceneVertex {
+            position: p,
+            normal: [0.0, 0.0, 1.0],
+            color: [0.8, 0.7, 0.6, 1.0],
+            ..Default::default()
+        };
+        triangle.add_mesh(
+            "t",
+            &[corner([-3.5, -2.4, -2.0]), corner([3.5, -2.4, -2.0]), corner([0.0, 2.4, -2.0])],
+            &[0, 1, 2],
+        );
+        for angle in [false, true] {
+            let settings = RenderSettings::new(sphere).with_method(Method::Vertex).with_error_angle(angle);
+            out.push((format!("triangle@3 on the sphere, angle {angle}"), (triangle.clone(), settings, Some(0.02))));
+        }
         out
     }
     fn gpu(_: &Renderer, (scene, settings, tolerance): &Self::Case) -> Self::Output {
@@ -390,7 +423,7 @@ impl Twin for Raster {
         let table = scene.material_table(usize::MAX);
         let eyes = Eye::BOTH.map(|eye| {
             let img = raster(&raster_params(settings, eye), &tris, &table, settings.shading.background);
-            (img.rgba, img.error, img.object)
+            (img.rgba, img.error, img.object, img.distance)
         });
         (eyes, *tolerance)
     }
@@ -425,9 +458,9 @@ impl Twin for Slit {
         let p = settings.projection();
         let table = scene.material_table(usize::MAX);
         Eye::BOTH.map(|eye| {
-            let params = slit_params(p, settings.view(), eye, settings.shading.ambient);
+            let params = slit_params(p, settings.view(), eye, settings.shading.ambient, settings.measure.error_angle);
             let img = slit(&params, &slits(p, eye, w), scene, &table, settings.shading.background);
-            (img.rgba, img.error, img.object)
+            (img.rgba, img.error, img.object, img.distance)
         })
     }
     fn compare(gpu: &Self::Output, cpu: &Self::Output) -> Result<(), String> {

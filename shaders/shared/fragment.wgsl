@@ -5,8 +5,9 @@
 // fragment entry points. CPU twins: src/cpu/fragment.rs (sampling, shading, error).
 //
 // Contract: a stage composing this module declares a uniform `params` with the fields
-// `projection: Projection`, `eye_sign: f32` (+1 right eye) and `ambient: f32`, its vertex
-// stage returns `VertexOut`, and its pipelines bind the material table as group 1.
+// `projection: Projection`, `eye_sign: f32` (+1 right eye), `ambient: f32` and
+// `error_angle: u32`, its vertex stage returns `VertexOut`, and its pipelines bind the material
+// table as group 1.
 
 #import projection
 #import constants
@@ -16,10 +17,13 @@
 
 struct FragmentOut {
     @location(0) color: vec4<f32>,
-    // Display-position error in pixels; −1 where no eye sees the point (r ≤ d_e).
+    // Display-position error in pixels (or arcminutes with `error_angle`); −1 where no eye
+    // sees the point.
     @location(1) error: ErrorTarget,
     // Object id + 1 (0 is the background).
     @location(2) object: u32,
+    // Distance in metres from the pixel's eye point to the surface point (cleared to +∞).
+    @location(3) distance: ErrorTarget,
 }
 
 // ---- Materials and textures (layout: src/core/material.rs, packing: src/core/texture.rs) ----
@@ -179,25 +183,86 @@ fn shade(ambient: f32, view_position: vec3<f32>, normal: vec3<f32>, color: vec4<
     return vec4<f32>(lit, 1.0);
 }
 
-// Distance in pixels between the pixel centre `frag_xy` where surface point p was drawn and
-// where the projection puts p for this eye (horizontal distance wrapping around the panorama).
-fn pixel_error(proj: Projection, eye_sign: f32, p: vec3<f32>, frag_xy: vec2<f32>) -> f32 {
-    if (!(horizontal_radius(p) > proj.eye_radius)) {
+// The screen point (u, v) at image position (x, y) (`Projection::pixel_to_screen`).
+fn from_pixel(proj: Projection, xy: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>((xy.x / proj.width - 0.5) * TAU, (0.5 * proj.height - xy.y) / proj.pixels_per_v);
+}
+
+// The unit direction, seen from the centre, of screen point (u, v): on the cylinder the screen
+// point (R_T sin u, v, −R_T cos u), on the sphere longitude u, latitude v.
+fn screen_direction(proj: Projection, uv: vec2<f32>) -> vec3<f32> {
+    if (proj.panorama == PANORAMA_SPHERE) {
+        return vec3<f32>(cos(uv.y) * sin(uv.x), sin(uv.y), -cos(uv.y) * cos(uv.x));
+    }
+    return normalize(vec3<f32>(proj.screen_radius * sin(uv.x), uv.y, -proj.screen_radius * cos(uv.x)));
+}
+
+// The display-position error of surface point p drawn at pixel centre `frag_xy` for this eye: the
+// distance in pixels to where the projection puts p (horizontal distance wrapping around the
+// panorama), or with `angle` the angle between the two directions in arcminutes; −1 where no eye
+// sees p.
+fn pixel_error(proj: Projection, eye_sign: f32, p: vec3<f32>, frag_xy: vec2<f32>, angle: bool) -> f32 {
+    if (!sees(proj, p)) {
         return -1.0;
     }
     let uvd = project_with_azimuth(proj, p, azimuth(p), eye_sign);
+    if (angle) {
+        let a = screen_direction(proj, uvd.xy);
+        let b = screen_direction(proj, from_pixel(proj, frag_xy));
+        return precise_atan2(length(cross(a, b)), dot(a, b)) * (180.0 * 60.0 / PI);
+    }
     let ideal = to_pixel(proj, uvd.x, uvd.y);
     var dx = abs(ideal.x - frag_xy.x);
     dx = min(dx, proj.width - dx);
     return length(vec2<f32>(dx, ideal.y - frag_xy.y));
 }
 
-fn fragment_out(proj: Projection, eye_sign: f32, ambient: f32, frag_xy: vec2<f32>, view_position: vec3<f32>,
-                normal: vec3<f32>, color: vec4<f32>, object: u32) -> FragmentOut {
+struct Ray {
+    origin: vec3<f32>,
+    dir: vec3<f32>,
+}
+
+// The ray of the pixel at `frag_xy` (`pixel_ray` in fragment.rs): on the sphere the pixel's ray
+// (`Projection::sphere_ray`); on the cylinder from the eye whose tangent ray meets the screen at
+// the pixel's column (viewing direction φ = u − s·asin(d_e/R_T)) through the pixel's screen point.
+fn pixel_ray(proj: Projection, eye_sign: f32, frag_xy: vec2<f32>) -> Ray {
+    let uv = from_pixel(proj, frag_xy);
+    if (proj.panorama == PANORAMA_SPHERE) {
+        let d = vec3<f32>(cos(uv.y) * sin(uv.x), sin(uv.y), -cos(uv.y) * cos(uv.x));
+        let origin = eye_sign * pole_fade(proj, abs(uv.y)) * proj.eye_radius * vec3<f32>(cos(uv.x), 0.0, sin(uv.x));
+        if (proj.convergence > 0.0) {
+            return Ray(origin, normalize(proj.convergence * d - origin));
+        }
+        return Ray(origin, d);
+    }
+    let phi = uv.x - eye_sign * precise_asin(proj.eye_radius / proj.screen_radius);
+    let origin = eye_sign * proj.eye_radius * vec3<f32>(cos(phi), 0.0, sin(phi));
+    let screen = vec3<f32>(proj.screen_radius * sin(uv.x), uv.y, -proj.screen_radius * cos(uv.x));
+    return Ray(origin, normalize(screen - origin));
+}
+
+// The distance along the pixel's ray to the plane through p with normal n (the drawn triangle's
+// plane), or |p − eye point| where the ray runs nearly within the plane (`pixel_distance`).
+fn pixel_distance(proj: Projection, eye_sign: f32, p: vec3<f32>, n: vec3<f32>, frag_xy: vec2<f32>) -> f32 {
+    let ray = pixel_ray(proj, eye_sign, frag_xy);
+    let denom = dot(ray.dir, n);
+    if (abs(denom) > 1e-3 * length(n)) {
+        let t = dot(p - ray.origin, n) / denom;
+        if (t > 0.0) {
+            return t;
+        }
+    }
+    return length(p - ray.origin);
+}
+
+fn fragment_out(frag_xy: vec2<f32>, view_position: vec3<f32>, plane_normal: vec3<f32>, normal: vec3<f32>,
+                color: vec4<f32>, object: u32) -> FragmentOut {
     var out: FragmentOut;
-    out.color = shade(ambient, view_position, normal, color);
-    out.error = encode_error(pixel_error(proj, eye_sign, view_position, frag_xy));
+    out.color = shade(params.ambient, view_position, normal, color);
+    out.error = encode_error(pixel_error(params.projection, params.eye_sign, view_position, frag_xy,
+                                         params.error_angle != 0u));
     out.object = object + 1u;
+    out.distance = encode_error(pixel_distance(params.projection, params.eye_sign, view_position, plane_normal, frag_xy));
     return out;
 }
 
@@ -226,15 +291,17 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @locatio
     return shade(params.ambient, in.view_position, in.normal, c);
 }
 
-// The same, plus the display-position error and the object id (when the error is measured).
+// The same, plus the display-position error, the object id and the distance (when the error or
+// the depth is measured).
 @fragment
 fn fs_error(in: VertexOut, @builtin(front_facing) front_facing: bool) -> FragmentOut {
     let duv_dx = dpdx(in.uv);
     let duv_dy = dpdy(in.uv);
+    // Two vectors in the drawn triangle's plane (for the exact distance along the pixel's ray).
+    let plane_normal = cross(dpdxFine(in.view_position), dpdyFine(in.view_position));
     let c = surface_color(in.material, in.color, in.uv, duv_dx, duv_dy, in.clip.xy, front_facing);
     if (MATERIALS && c.a < 0.0) {
         discard;
     }
-    return fragment_out(params.projection, params.eye_sign, params.ambient, in.clip.xy, in.view_position, in.normal,
-                        c, in.object);
+    return fragment_out(in.clip.xy, in.view_position, plane_normal, in.normal, c, in.object);
 }

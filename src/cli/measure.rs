@@ -74,6 +74,18 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
         "ms_total": s.ms_total,
         "adapter": adapter,
     });
+    // On the sphere, pixels shrink towards the poles: the error is also measured as an angle
+    // (seen from the centre), by a second render whose error pass writes arcminutes.
+    if settings.view.projection.panorama == twister::core::projection::PanoramaKind::Equirect {
+        let angular = renderer.render(gpu_scene, &settings.with_error_angle(true))?;
+        let a = angular.measurement.as_ref().expect("rendered with the error pass").stats;
+        json["panorama"] = serde_json::json!("equirect");
+        json["mean_arcmin"] = serde_json::json!(a.mean);
+        json["p50_arcmin"] = serde_json::json!(a.p50);
+        json["p90_arcmin"] = serde_json::json!(a.p90);
+        json["p99_arcmin"] = serde_json::json!(a.p99);
+        json["max_arcmin"] = serde_json::json!(a.max);
+    }
     if let Some(method) = args.against {
         let reference = renderer.render(gpu_scene, &settings.with_method(method))?;
         let c = twister::core::compare::compare(&frame, &reference)?;
@@ -111,6 +123,16 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
             s.triangles_out,
             s.ms_frame
         );
+        if let Some(m) = json.get("mean_arcmin") {
+            println!(
+                "as an angle: mean {:.3}′, p50 {:.3}′, p90 {:.3}′, p99 {:.3}′, max {:.3}′ (arcminutes)",
+                m.as_f64().unwrap_or(f64::NAN),
+                json["p50_arcmin"].as_f64().unwrap_or(f64::NAN),
+                json["p90_arcmin"].as_f64().unwrap_or(f64::NAN),
+                json["p99_arcmin"].as_f64().unwrap_or(f64::NAN),
+                json["max_arcmin"].as_f64().unwrap_or(f64::NAN)
+            );
+        }
         if let Some(f) = json.get("different_surface_fraction") {
             println!(
                 "against {}: different surface on {:.4} of pixels, PSNR {} dB",

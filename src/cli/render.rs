@@ -7,8 +7,12 @@ use clap::Args;
 
 use crate::args::{parse_rgb, LodMode, ViewArgs};
 use crate::scene::{lod_stats, open_renderer, prepare};
+use twister::core::projection::PanoramaKind;
 use twister::error::{Error, Result};
-use twister::output::{check_outputs, layout_images, layout_names, png_file, write_all, Layout, OutputFile};
+use twister::output::{
+    check_outputs, depth_images, depth_names, exr_file, gpano_xmp, image_file, layout_images, layout_names, write_all,
+    Encoding, ImageFormat, Layout, OutputFile,
+};
 
 #[derive(Args)]
 #[command(allow_negative_numbers = true)]
@@ -24,9 +28,22 @@ pub struct RenderArgs {
     pub out: PathBuf,
     #[command(flatten)]
     pub view: ViewArgs,
-    /// Output layout: eyes (left.png, right.png), top-bottom (stereo.png), twister (four W/2×H images).
-    #[arg(long, value_enum, default_value_t = Layout::Eyes)]
-    pub layout: Layout,
+    /// Output layout: eyes (left.png, right.png), top-bottom (stereo_TB.png, left eye on top),
+    /// side-by-side (stereo_LR.png, left eye on the left), twister (four W/2×H images)
+    /// [default: eyes; top-bottom for --panorama equirect].
+    #[arg(long, value_enum)]
+    pub layout: Option<Layout>,
+    /// Image format: png or jpg (full-sphere images carry GPano XMP metadata in both).
+    #[arg(long, value_enum, default_value_t = ImageFormat::Png)]
+    pub format: ImageFormat,
+    /// JPEG quality, 1–100 (with --format jpg).
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=100))]
+    pub quality: Option<u8>,
+    /// Also write each eye's distance from its eye point along the ray, metres, as 32-bit float
+    /// OpenEXR (channel Z, +inf where no surface): left_depth.exr/right_depth.exr, depth_TB.exr
+    /// or depth_LR.exr, following the layout.
+    #[arg(long)]
+    pub depth: bool,
     /// Background colour R,G,B, each 0–255.
     #[arg(long, value_parser = parse_rgb, default_value = "26,26,31")]
     pub background: [f32; 3],
@@ -43,11 +60,27 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     let mut settings = args.view.settings()?;
     settings.shading.background = args.background;
     settings.measure.edges = args.stats.is_some();
+    settings.measure.depth = args.depth;
+    let panorama = settings.projection().panorama;
+    let layout = args.layout.unwrap_or(Layout::default_for(panorama));
+    if args.quality.is_some() && args.format != ImageFormat::Jpg {
+        return Err(Error::option("--quality", "needs --format jpg"));
+    }
+    let (w, h) = (settings.projection().width, settings.projection().height);
+    let encoding = Encoding {
+        format: args.format,
+        quality: args.quality.unwrap_or(90),
+        xmp: (panorama == PanoramaKind::Equirect).then(|| gpano_xmp(w, h)),
+    };
     if args.lod_overlay && args.view.lod == LodMode::Off {
         return Err(Error::option("--lod-overlay", "needs --lod visual-field"));
     }
     // Every output is checked before anything is rendered, and all are written together.
-    let image_paths: Vec<PathBuf> = layout_names(args.layout).iter().map(|name| args.out.join(name)).collect();
+    let mut image_paths: Vec<PathBuf> =
+        layout_names(layout, args.format).iter().map(|name| args.out.join(name)).collect();
+    if args.depth {
+        image_paths.extend(depth_names(layout).iter().map(|name| args.out.join(name)));
+    }
     let mut all_paths: Vec<&std::path::Path> = image_paths.iter().map(PathBuf::as_path).collect();
     all_paths.extend(args.stats.as_deref());
     check_outputs(&all_paths)?;
@@ -60,11 +93,14 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         }
     }
     let t = std::time::Instant::now();
-    let mut files = layout_images(&frame, args.layout)
+    let mut files = layout_images(&frame, layout, args.format)
         .iter()
-        .map(|(name, img)| png_file(args.out.join(name), img))
+        .map(|(name, img)| image_file(args.out.join(name), img, &encoding))
         .collect::<Result<Vec<_>>>()?;
-    // PNG encoding: the writing itself is a rename.
+    for (name, depth) in depth_images(&frame, layout).unwrap_or_default() {
+        files.push(exr_file(args.out.join(name), &depth)?);
+    }
+    // Encoding: the writing itself is a rename.
     let ms_write = t.elapsed().as_secs_f64() * 1e3;
     if let Some(path) = &args.stats {
         let s = &frame.stats;
@@ -84,7 +120,11 @@ pub fn render(args: &RenderArgs) -> Result<()> {
             "screen_radius": settings.view.projection.screen_radius,
             "eye_radius": settings.view.projection.eye_radius,
             "vertical": settings.view.projection.vertical,
-            "layout": args.layout,
+            "panorama": panorama,
+            "convergence": settings.view.projection.convergence.map_or(serde_json::json!("parallel"), |c| serde_json::json!(c)),
+            "pole_merge": settings.view.projection.pole_merge,
+            "layout": layout,
+            "format": args.format,
             "adapter": adapter,
             "timing": s.timing,
             "ms_frame": s.ms_frame,

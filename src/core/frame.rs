@@ -83,6 +83,9 @@ pub struct Frame {
     pub stats: FrameStats,
     /// The error pass's outputs, when `RenderSettings::measure.error` was set.
     pub measurement: Option<Measurement>,
+    /// Per pixel, left and right eye: the distance in metres from the pixel's eye point to the
+    /// surface it shows (+∞: background), when `RenderSettings::measure.depth` was set.
+    pub depth: Option<[Vec<f32>; 2]>,
 }
 
 /// What the error pass measured (seed 002 §4.1).

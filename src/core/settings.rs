@@ -129,10 +129,23 @@ pub struct MeasureSettings {
     /// Run the error pass: every fragment also writes its display-position error and object
     /// id, reduced to statistics on the GPU (slower; off for plain rendering and speed runs).
     pub error: bool,
+    /// The error pass measures the display-position error as the angle between where a point
+    /// was drawn and where it belongs (arcminutes, seen from the centre) instead of in pixels:
+    /// on the sphere, pixels shrink towards the poles.
+    pub error_angle: bool,
+    /// Also read back each pixel's distance from its eye point along its ray (`Frame::depth`).
+    pub depth: bool,
     /// Test hook: draws everything shifted by this many pixels (x right, y down) while the
     /// error pass measures against the true projection.
     #[doc(hidden)]
     pub shift_px: [f32; 2],
+}
+
+impl MeasureSettings {
+    /// Whether the drawing stages write the measuring targets (error, object id, distance).
+    pub fn targets(&self) -> bool {
+        self.error || self.depth
+    }
 }
 
 /// Everything a render needs besides the scene.
@@ -193,6 +206,8 @@ builders! {
     with_ambient: f32 => shading.ambient,
     with_measure_edges: bool => measure.edges,
     with_measure_error: bool => measure.error,
+    with_error_angle: bool => measure.error_angle,
+    with_depth: bool => measure.depth,
     with_shift_px: [f32; 2] => measure.shift_px,
 }
 

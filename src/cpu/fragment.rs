@@ -8,7 +8,7 @@ use glam::{Vec2, Vec3, Vec4};
 
 use crate::core::color::{linear_to_srgb, srgb_to_linear};
 use crate::core::material::{AlphaMode, Filter, Material, MipLevel, Mipmap, Wrap, NO_TEXTURE};
-use crate::core::projection::{Eye, Projection};
+use crate::core::projection::{Eye, PanoramaKind, Projection};
 use crate::core::texture::MaterialTable;
 
 /// Linear colour × (ambient + (1 − ambient)·|n·l|), the light at the viewer, two-sided; as
@@ -20,16 +20,71 @@ pub fn shade(ambient: f32, view_position: Vec3, normal: Vec3, color: Vec4) -> [u
     [q(color.x), q(color.y), q(color.z), 255]
 }
 
-/// The display-position error of surface point `p` drawn at pixel centre `frag_xy`; −1 where
-/// no eye sees the point. The horizontal distance wraps around the panorama.
-pub fn pixel_error(projection: &Projection, eye: Eye, p: Vec3, frag_xy: Vec2) -> f32 {
+/// The display-position error of surface point `p` drawn at pixel centre `frag_xy`: the
+/// distance in pixels to where the projection puts it (wrapping around the panorama), or with
+/// `angle` the angle between the two directions seen from the centre, in arcminutes; −1 where
+/// no eye sees the point.
+pub fn pixel_error(projection: &Projection, eye: Eye, p: Vec3, frag_xy: Vec2, angle: bool) -> f32 {
     match projection.project(p, eye) {
         None => -1.0,
+        Some(q) if angle => {
+            let a = screen_direction(projection, q.u, q.v);
+            let (u, v) = projection.pixel_to_screen(frag_xy.x - 0.5, frag_xy.y - 0.5);
+            let b = screen_direction(projection, u, v);
+            a.cross(b).length().atan2(a.dot(b)).to_degrees() * 60.0
+        }
         Some(q) => {
             let [x, y] = projection.to_pixel(q.u, q.v);
             Vec2::new(projection.wrapped_dx(x, frag_xy.x), y - frag_xy.y).length()
         }
     }
+}
+
+/// The unit direction, seen from the centre, of screen point (u, v): on the cylinder the screen
+/// point (R_T sin u, v, −R_T cos u), on the sphere longitude u, latitude v.
+pub fn screen_direction(projection: &Projection, u: f32, v: f32) -> Vec3 {
+    match projection.panorama {
+        PanoramaKind::Equirect => Vec3::new(v.cos() * u.sin(), v.sin(), -v.cos() * u.cos()),
+        PanoramaKind::Cylinder => {
+            let rt = projection.screen_radius;
+            Vec3::new(rt * u.sin(), v, -rt * u.cos()).normalize()
+        }
+    }
+}
+
+/// The ray of the pixel at `frag_xy`: its eye point and unit direction. The sphere: the
+/// pixel's ray ([`Projection::sphere_ray`]). The cylinder: from the eye whose tangent ray meets
+/// the screen at the pixel's column (viewing direction φ = u − s·asin(d_e/R_T), as the slit
+/// cameras) through the pixel's screen point (R_T sin u, v, −R_T cos u) — the exact vertical
+/// model's ray; the paper model has no single ray per pixel and uses the same.
+pub fn pixel_ray(projection: &Projection, eye: Eye, frag_xy: Vec2) -> (Vec3, Vec3) {
+    let (u, v) = projection.pixel_to_screen(frag_xy.x - 0.5, frag_xy.y - 0.5);
+    match projection.panorama {
+        PanoramaKind::Equirect => projection.sphere_ray(u, v, eye),
+        PanoramaKind::Cylinder => {
+            let (rt, de) = (projection.screen_radius, projection.eye_radius);
+            let phi = u - eye.sign() * (de / rt).asin();
+            let origin = eye.sign() * de * Vec3::new(phi.cos(), 0.0, phi.sin());
+            let screen = Vec3::new(rt * u.sin(), v, -rt * u.cos());
+            (origin, (screen - origin).normalize())
+        }
+    }
+}
+
+/// What `--depth` writes: the distance in metres along the ray of the pixel at `frag_xy` to the
+/// plane through surface point `p` with normal `n` (the drawn triangle's plane: exact for flat
+/// input triangles, however coarse the subdivision), or |p − eye point| where the ray runs
+/// nearly within the plane.
+pub fn pixel_distance(projection: &Projection, eye: Eye, p: Vec3, n: Vec3, frag_xy: Vec2) -> f32 {
+    let (origin, dir) = pixel_ray(projection, eye, frag_xy);
+    let denom = dir.dot(n);
+    if denom.abs() > 1e-3 * n.length() {
+        let t = (p - origin).dot(n) / denom;
+        if t > 0.0 {
+            return t;
+        }
+    }
+    (p - origin).length()
 }
 
 /// Texel index `i` folded into `0..n` by a wrap mode.

@@ -13,7 +13,7 @@ use glam::{Vec2, Vec3, Vec4};
 use crate::core::projection::{azimuth, Eye, Projection};
 use crate::core::settings::RenderSettings;
 use crate::core::texture::MaterialTable;
-use crate::cpu::fragment::{pixel_error, shade, surface_color, Surface};
+use crate::cpu::fragment::{pixel_distance, pixel_error, shade, surface_color, Surface};
 use crate::shader::types::{DrawVertex, RasterParams};
 
 /// Clip-space position of a subdivided vertex (`vs_main` in raster.wgsl).
@@ -69,6 +69,8 @@ pub struct RasterImage {
     pub error: Vec<f32>,
     /// Object id + 1 per pixel; 0 for background.
     pub object: Vec<u32>,
+    /// Distance from the pixel's eye point, metres; +∞ for background.
+    pub distance: Vec<f32>,
 }
 
 impl RasterImage {
@@ -82,6 +84,7 @@ impl RasterImage {
             depth: vec![1.0; n],
             error: vec![-1.0; n],
             object: vec![0; n],
+            distance: vec![f32::INFINITY; n],
         }
     }
 }
@@ -90,27 +93,42 @@ impl RasterImage {
 #[derive(Clone, Copy, Debug)]
 pub struct FragmentIn {
     pub view_position: Vec3,
+    /// The change of `view_position` one pixel right and one down (both in the surface's plane).
+    pub dp_dx: Vec3,
+    pub dp_dy: Vec3,
     pub normal: Vec3,
     pub surface: Surface,
 }
 
-/// What a fragment writes (colour and error), or None where it is discarded.
-pub type FragmentFn<'a> = dyn Fn(&FragmentIn) -> Option<([u8; 4], f32)> + 'a;
+/// What a fragment writes: colour, display-position error, distance from its eye point.
+#[derive(Clone, Copy, Debug)]
+pub struct FragmentOut {
+    pub rgba: [u8; 4],
+    pub error: f32,
+    pub distance: f32,
+}
+
+/// What a fragment writes, or None where it is discarded.
+pub type FragmentFn<'a> = dyn Fn(&FragmentIn) -> Option<FragmentOut> + 'a;
 
 /// The fragment entry point of the drawing stages (`fs_error` in fragment.wgsl; `fs_main`
-/// writes the same colour): surface colour, shading, display-position error.
+/// writes the same colour): surface colour, shading, display-position error (in pixels, or in
+/// arcminutes with `error_angle`), distance.
 pub fn fragment(
     table: &MaterialTable,
     ambient: f32,
     projection: &Projection,
     eye: Eye,
+    error_angle: bool,
     f: &FragmentIn,
-) -> Option<([u8; 4], f32)> {
+) -> Option<FragmentOut> {
     let color = surface_color(table, &f.surface)?;
-    Some((
-        shade(ambient, f.view_position, f.normal, color),
-        pixel_error(projection, eye, f.view_position, f.surface.frag_xy),
-    ))
+    let frag_xy = f.surface.frag_xy;
+    Some(FragmentOut {
+        rgba: shade(ambient, f.view_position, f.normal, color),
+        error: pixel_error(projection, eye, f.view_position, frag_xy, error_angle),
+        distance: pixel_distance(projection, eye, f.view_position, f.dp_dx.cross(f.dp_dy), frag_xy),
+    })
 }
 
 /// Rasterizes one triangle into `img`, within columns `scissor` (start, end).
@@ -176,8 +194,12 @@ fn rasterize_clipped(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: (u32,
             let mix3 = |f: &dyn Fn(&ClipVertex) -> Vec3| (0..3).map(|k| pw[k] * f(&tri[k])).sum::<Vec3>();
             let uv_at = |w: [f32; 3]| (0..3).map(|k| w[k] * tri[k].uv).sum::<Vec2>();
             let uv = uv_at(pw);
+            let position_at = |w: [f32; 3]| (0..3).map(|k| w[k] * tri[k].view_position).sum::<Vec3>();
+            let view_position = mix3(&|v| v.view_position);
             let input = FragmentIn {
-                view_position: mix3(&|v| v.view_position),
+                view_position,
+                dp_dx: position_at(perspective(barycentric(px + 1.0, py))) - view_position,
+                dp_dy: position_at(perspective(barycentric(px, py + 1.0))) - view_position,
                 normal: mix3(&|v| v.normal),
                 surface: Surface {
                     material: tri[0].material,
@@ -191,12 +213,13 @@ fn rasterize_clipped(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: (u32,
                     front_facing: area < 0.0,
                 },
             };
-            let Some((rgba, error)) = fragment(&input) else {
+            let Some(out) = fragment(&input) else {
                 continue;
             };
             img.depth[i] = z;
-            img.rgba[4 * i..4 * i + 4].copy_from_slice(&rgba);
-            img.error[i] = error;
+            img.rgba[4 * i..4 * i + 4].copy_from_slice(&out.rgba);
+            img.error[i] = out.error;
+            img.distance[i] = out.distance;
             img.object[i] = tri[0].object + 1;
         }
     }
@@ -212,7 +235,7 @@ pub fn raster(
     let projection = Projection::from(&params.projection);
     let eye = if params.eye_sign > 0.0 { Eye::Right } else { Eye::Left };
     let mut img = RasterImage::new(projection.width, projection.height, background);
-    let fragment = |f: &FragmentIn| fragment(table, params.ambient, &projection, eye, f);
+    let fragment = |f: &FragmentIn| fragment(table, params.ambient, &projection, eye, params.error_angle != 0, f);
     for tri in vertices.chunks_exact(3) {
         let cv = [0, 1, 2].map(|k| ClipVertex {
             clip: raster_vertex(params, &tri[k]),
@@ -235,5 +258,7 @@ pub fn raster_params(settings: &RenderSettings, eye: Eye) -> RasterParams {
         eye_sign: eye.sign(),
         ambient: settings.shading.ambient,
         shift_px: settings.measure.shift_px,
+        error_angle: settings.measure.error_angle as u32,
+        ..Default::default()
     }
 }

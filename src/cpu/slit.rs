@@ -36,7 +36,7 @@ pub struct Slit {
     pub camera: SlitCamera,
 }
 
-pub fn slit_params(projection: &Projection, view: Mat4, eye: Eye, ambient: f32) -> SlitParams {
+pub fn slit_params(projection: &Projection, view: Mat4, eye: Eye, ambient: f32, error_angle: bool) -> SlitParams {
     let (rt, de) = (projection.screen_radius, projection.eye_radius);
     let t_screen = (rt * rt - de * de).sqrt();
     SlitParams {
@@ -46,6 +46,8 @@ pub fn slit_params(projection: &Projection, view: Mat4, eye: Eye, ambient: f32) 
         ambient,
         near: NEAR,
         focal_y_clip: t_screen * projection.pixels_per_metre() / (0.5 * projection.height as f32),
+        error_angle: error_angle as u32,
+        ..Default::default()
     }
 }
 
@@ -124,7 +126,7 @@ pub fn slit(
     let eye = if params.eye_sign > 0.0 { Eye::Right } else { Eye::Left };
     let view = Mat4::from_cols_array_2d(&params.view);
     let mut img = RasterImage::new(projection.width, projection.height, background);
-    let fragment = |f: &FragmentIn| fragment(table, params.ambient, &projection, eye, f);
+    let fragment = |f: &FragmentIn| fragment(table, params.ambient, &projection, eye, params.error_angle != 0, f);
     let spheres = object_spheres(scene);
     for slit in slits {
         for (o, &(center, radius)) in scene.objects.iter().zip(&spheres) {

@@ -108,8 +108,9 @@ fn draw_pipeline(gpu: &Gpu, stage: &GpuStage, kind: DrawStage, measure: bool, ma
         step_mode: wgpu::VertexStepMode::Vertex,
         attributes: &attributes,
     };
-    let all_targets = [COLOR_FORMAT, error_target_format(gpu.error_target), OBJECT_FORMAT]
-        .map(|format| Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL }));
+    let all_targets =
+        [COLOR_FORMAT, error_target_format(gpu.error_target), OBJECT_FORMAT, error_target_format(gpu.error_target)]
+            .map(|format| Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL }));
     let constants = [("MATERIALS", materials as u32 as f64)];
     gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(stage.stage.name),
@@ -475,7 +476,7 @@ impl Renderer {
         clear: bool,
         timestamps: Option<(&wgpu::QuerySet, u32, u32)>,
     ) {
-        let pipeline = self.raster.get(&self.gpu, scene, settings.measure.error);
+        let pipeline = self.raster.get(&self.gpu, scene, settings.measure.targets());
         let materials = self.raster.material_bind_group(&self.gpu, scene);
         for (k, eye) in Eye::BOTH.into_iter().enumerate() {
             let uniform = &res.raster_params[k];
@@ -545,6 +546,7 @@ impl Renderer {
         let t = Instant::now();
         let [left, right] = targets.read_colors(&self.gpu)?;
         stats.ms_readback = t.elapsed().as_secs_f64() * 1e3;
+        let depth = if settings.measure.depth { Some(targets.read_distances(&self.gpu)?) } else { None };
         let measurement = if settings.measure.error {
             let object = targets.read_objects(&self.gpu)?;
             let (stats, error) = self.reduce_errors(targets)?;
@@ -553,7 +555,7 @@ impl Renderer {
             None
         };
         stats.ms_total = start.elapsed().as_secs_f64() * 1e3;
-        Ok(Frame { left, right, stats, measurement })
+        Ok(Frame { left, right, stats, measurement, depth })
     }
 
     /// The subdivided frame: follows the [`FramePlan`].

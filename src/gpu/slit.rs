@@ -33,13 +33,13 @@ impl Renderer {
         let camera_buffer =
             gpu.init_buffer("slit cameras", bytemuck::cast_slice(&cameras), wgpu::BufferUsages::STORAGE);
         let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, chunks: 1, ..Default::default() };
-        let pipeline = self.slit.get(gpu, scene, settings.measure.error);
+        let pipeline = self.slit.get(gpu, scene, settings.measure.targets());
         let materials = self.slit.material_bind_group(gpu, scene);
         let timestamps = res.timestamps.as_ref();
         let t = Instant::now();
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         for (k, eye) in Eye::BOTH.into_iter().enumerate() {
-            let params = slit_params(projection, view, eye, settings.shading.ambient);
+            let params = slit_params(projection, view, eye, settings.shading.ambient, settings.measure.error_angle);
             gpu.queue.write_buffer(&res.slit_params[k], 0, bytemuck::bytes_of(&params));
             let bind_group = self.slit.stage.bind_group(gpu, None, 0, &[&res.slit_params[k], &camera_buffer]);
             let writes = timestamps.map(|t| wgpu::RenderPassTimestampWrites {

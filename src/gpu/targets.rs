@@ -22,6 +22,8 @@ pub struct Targets {
     pub color: [wgpu::Texture; 2],
     pub error: [wgpu::Texture; 2],
     pub object: [wgpu::Texture; 2],
+    /// Distance from each pixel's eye point (the error target's format).
+    pub distance: [wgpu::Texture; 2],
     pub depth: [wgpu::Texture; 2],
     error_target: ErrorTarget,
 }
@@ -51,13 +53,15 @@ impl Targets {
             color: pair(COLOR_FORMAT, copyable, "colour"),
             error: pair(error_format, copyable, "error"),
             object: pair(OBJECT_FORMAT, copyable, "object"),
+            distance: pair(error_format, copyable, "distance"),
             depth: pair(DEPTH_FORMAT, depth, "depth"),
             error_target: gpu.error_target,
         }
     }
 
     /// Begins the render pass of eye `k`, clearing its targets first if `clear` (background
-    /// colour, error −1, object 0, depth 1); the error and object targets only with the error pass.
+    /// colour, error −1, object 0, distance +∞, depth 1); the error, object and distance targets
+    /// only when measuring (`MeasureSettings::targets`).
     pub fn begin_eye_pass<'e>(
         &self,
         enc: &'e mut wgpu::CommandEncoder,
@@ -66,22 +70,24 @@ impl Targets {
         clear: bool,
         timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'e>>,
     ) -> wgpu::RenderPass<'e> {
-        let outputs = if settings.measure.error { 3 } else { 1 };
-        let views: Vec<wgpu::TextureView> = [&self.color[k], &self.error[k], &self.object[k]][..outputs]
+        let outputs = if settings.measure.targets() { 4 } else { 1 };
+        let views: Vec<wgpu::TextureView> = [&self.color[k], &self.error[k], &self.object[k], &self.distance[k]]
+            [..outputs]
             .iter()
             .map(|t| t.create_view(&Default::default()))
             .collect();
         let depth_view = self.depth[k].create_view(&Default::default());
         // The background is given as display values; the sRGB target takes linear ones.
         let [r, g, b] = settings.shading.background.map(|c| srgb_to_linear(c) as f64);
-        let no_error = match self.error_target {
-            ErrorTarget::Float => -1.0,
-            ErrorTarget::UintBits => (-1.0f32).to_bits() as f64,
+        let value = |x: f32| match self.error_target {
+            ErrorTarget::Float => x as f64,
+            ErrorTarget::UintBits => x.to_bits() as f64,
         };
         let clears = [
             wgpu::Color { r, g, b, a: 1.0 },
-            wgpu::Color { r: no_error, ..wgpu::Color::TRANSPARENT },
+            wgpu::Color { r: value(-1.0), ..wgpu::Color::TRANSPARENT },
             wgpu::Color::TRANSPARENT,
+            wgpu::Color { r: value(f32::INFINITY), ..wgpu::Color::TRANSPARENT },
         ];
         let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = views
             .iter()
@@ -122,6 +128,13 @@ impl Targets {
         let [left, right] = unpad_eyes(&gpu.download(&buffer, buffer.size())?, w, h, stride);
         let image = |texels: Vec<u32>| EyeImage { width: w, height: h, rgba: bytemuck::cast_slice(&texels).to_vec() };
         Ok([image(left), image(right)])
+    }
+
+    /// Reads both eyes' distances back (metres; +∞ where no surface is drawn).
+    pub fn read_distances(&self, gpu: &Gpu) -> Result<[Vec<f32>; 2]> {
+        let (buffer, stride) = copy_eyes_to_buffer(gpu, &self.distance, wgpu::BufferUsages::COPY_SRC);
+        let words = unpad_eyes(&gpu.download(&buffer, buffer.size())?, self.width, self.height, stride);
+        Ok(words.map(|v| v.into_iter().map(f32::from_bits).collect()))
     }
 
     /// Reads both eyes' object ids back.

@@ -141,7 +141,7 @@ impl SubdivideCounters {
     }
 }
 
-/// `RasterParams` in shaders/raster.wgsl. 48 bytes.
+/// `RasterParams` in shaders/raster.wgsl. 80 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct RasterParams {
@@ -153,6 +153,12 @@ pub struct RasterParams {
     /// Test hook: draw shifted by this many pixels (x right, y down); the error pass still
     /// measures against the true projection.
     pub shift_px: [f32; 2],
+    /// 1: the error target holds the display-position error as an angle (arcminutes) rather
+    /// than in pixels.
+    pub error_angle: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
 }
 
 /// `DrawIndirectArgs` as the GPU reads them.
@@ -194,7 +200,7 @@ pub struct ReduceParams {
     pub _pad2: u32,
 }
 
-/// `SlitParams` in shaders/slit.wgsl. 112 bytes.
+/// `SlitParams` in shaders/slit.wgsl. 144 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct SlitParams {
@@ -204,6 +210,11 @@ pub struct SlitParams {
     pub ambient: f32,
     pub near: f32,
     pub focal_y_clip: f32,
+    /// As in [`RasterParams`].
+    pub error_angle: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
 }
 
 /// `SlitCamera` in shaders/slit.wgsl: eye position, and (sin φ, cos φ, NDC x of the centre).
@@ -289,8 +300,10 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, cuts_low, cuts_high, _pad1, _pad2 }),
     layout!("Piece" => Piece { triangle, cell, counts01, count2_level, corner, bary1, bary2 }),
     layout!("DrawIndirectArgs" => DrawIndirectArgs { vertex_count, instance_count, first_vertex, first_instance }),
-    layout!("RasterParams" => RasterParams { projection, eye_sign, ambient, shift_px }),
-    layout!("SlitParams" => SlitParams { view, projection, eye_sign, ambient, near, focal_y_clip }),
+    layout!("RasterParams" => RasterParams { projection, eye_sign, ambient, shift_px, error_angle, _pad0, _pad1, _pad2 }),
+    layout!("SlitParams" => SlitParams {
+        view, projection, eye_sign, ambient, near, focal_y_clip, error_angle, _pad0, _pad1, _pad2
+    }),
     layout!("SlitCamera" => SlitCamera { origin, basis }),
     layout!("ProjectParams" => ProjectParams { projection, eye_sign, count, _pad }),
     layout!("Material" => Material {

@@ -1,0 +1,298 @@
+//! The full-sphere panorama (equirectangular omni-directional stereo) as a user gets it: closed
+//! rooms without holes at the poles, points where the formulas put them, the depth files and
+//! the metadata players read.
+
+mod common;
+
+use glam::Vec3;
+use twister::core::builtin;
+use twister::core::projection::PanoramaKind;
+use twister::core::settings::Method;
+use twister::{Eye, Projection, RenderSettings, Scene};
+
+fn twister() -> std::process::Command {
+    let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_twister"));
+    c.env("NODEVICE_SELECT", "1");
+    c
+}
+
+fn tmp(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("twister-sphere-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+#[test]
+fn the_demo_room_on_the_sphere_shows_floor_and_ceiling_whole() {
+    let black = [0.0; 3];
+    for (width, method) in
+        [(256, Method::Adaptive), (512, Method::Adaptive), (256, Method::Vertex), (192, Method::Fixed(3))]
+    {
+        for pole_merge in [Some((60.0, 75.0)), None] {
+            let projection = Projection { pole_merge, ..Projection::equirect(width) };
+            let settings = RenderSettings::new(projection).with_method(method).with_background(black);
+            let frame = common::render(&builtin::demo(), &settings);
+            for eye in Eye::BOTH {
+                let holes = common::pixels_where(frame.eye(eye), |p| common::is_background(p, black));
+                assert!(
+                    holes.is_empty(),
+                    "{width} px {} pole merge {pole_merge:?} {eye:?}: {} background pixels, e.g. {:?}",
+                    method.name(),
+                    holes.len(),
+                    &holes[..holes.len().min(5)]
+                );
+            }
+        }
+    }
+}
+
+/// Small spheres at known places: the centroid of each one's pixels lies where the sphere's
+/// formulas put its centre. Computed here from the geometry alone: with parallel rays and the
+/// full eye offset (latitudes within ±60°) the eye on the circle of radius d_e sees a point at
+/// horizontal radius r, height y, azimuth θ at longitude θ − s·asin(d_e/r), latitude
+/// atan2(y, √(r² − d_e²)); beyond ±75° the pole merge has removed the offset: longitude θ,
+/// latitude atan2(y, r).
+#[test]
+fn spheres_land_where_the_formulas_put_them_at_every_latitude_and_across_the_seam() {
+    let de = 0.032f32;
+    let width = 1024u32;
+    let projection = Projection::equirect(width);
+    let mut cases = Vec::new();
+    for (k, &distance) in [0.3f32, 1.0, 3.0, 10.0].iter().enumerate() {
+        for (j, &lat) in [0.0f32, 45.0, -45.0, 80.0, -80.0].iter().enumerate() {
+            // Longitudes spread out, one straight behind (across the seam).
+            let lon = if (k + j) % 5 == 0 { 180.0f32 } else { -150.0 + 67.0 * ((k * 5 + j) % 5) as f32 };
+            let (lat_r, lon_r) = (lat.to_radians(), lon.to_radians());
+            let centre = distance * Vec3::new(lat_r.cos() * lon_r.sin(), lat_r.sin(), -lat_r.cos() * lon_r.cos());
+            cases.push((centre, 0.012 * distance));
+        }
+    }
+    for (centre, radius) in cases {
+        let mut scene = Scene::new("probe");
+        let (v, i) = builtin::uv_sphere(centre, radius, 24, 13, [0.9, 0.2, 0.2, 1.0]);
+        scene.add_mesh("probe", &v, &i);
+        let frame = common::render(&scene, &RenderSettings::new(projection).with_measure_error(true));
+        let m = frame.measurement.as_ref().unwrap();
+        let r = (centre.x * centre.x + centre.z * centre.z).sqrt();
+        let theta = centre.x.atan2(-centre.z);
+        let altitude = centre.y.atan2(r).abs().to_degrees();
+        for (k, eye) in Eye::BOTH.into_iter().enumerate() {
+            let (lon, lat) = if altitude < 59.0 {
+                (theta - eye.sign() * (de / r).asin(), centre.y.atan2((r * r - de * de).sqrt()))
+            } else {
+                (theta, centre.y.atan2(r))
+            };
+            let want_x = (lon / std::f32::consts::TAU + 0.5) * width as f32;
+            let want_y = (0.5 - lat / std::f32::consts::PI) * (width / 2) as f32;
+            // Centroid of the sphere's pixels, x unwrapped around the expected column.
+            let (mut sx, mut sy, mut n) = (0.0f64, 0.0f64, 0u32);
+            for (p, &id) in m.object[k].iter().enumerate() {
+                if id == 0 {
+                    continue;
+                }
+                let (x, y) = ((p as u32 % width) as f32 + 0.5, (p as u32 / width) as f32 + 0.5);
+                let dx = (x - want_x) - width as f32 * ((x - want_x) / width as f32).round();
+                sx += dx as f64;
+                sy += y as f64;
+                n += 1;
+            }
+            assert!(n >= 4, "{centre} {eye:?}: only {n} pixels");
+            let (dx, dy) = (sx / n as f64, sy / n as f64 - want_y as f64);
+            // Columns shrink towards the poles: compare the distance on the sphere.
+            let squeeze = lat.cos() as f64;
+            assert!(
+                (dx * squeeze).abs() < 0.35 && dy.abs() < 0.35,
+                "{centre} (altitude {altitude:.0}°) {eye:?}: centroid off by {:.3}, {dy:.3} px ({n} pixels)",
+                dx * squeeze
+            );
+        }
+    }
+}
+
+/// Reads a PNG's iTXt chunk `XML:com.adobe.xmp`, or a JPEG's XMP APP1 segment.
+fn xmp_of(path: &std::path::Path) -> String {
+    let bytes = std::fs::read(path).unwrap();
+    if path.extension().is_some_and(|e| e == "png") {
+        let decoder = png::Decoder::new(std::io::Cursor::new(bytes));
+        let reader = decoder.read_info().unwrap();
+        let chunk =
+            reader.info().utf8_text.iter().find(|c| c.keyword == "XML:com.adobe.xmp").expect("an XMP iTXt chunk");
+        return chunk.get_text().unwrap();
+    }
+    // JPEG: walk the segments from SOI.
+    assert_eq!(&bytes[..2], &[0xFF, 0xD8]);
+    let mut at = 2;
+    while at + 4 <= bytes.len() && bytes[at] == 0xFF {
+        let marker = bytes[at + 1];
+        let len = u16::from_be_bytes([bytes[at + 2], bytes[at + 3]]) as usize;
+        let body = &bytes[at + 4..at + 2 + len];
+        if marker == 0xE1 && body.starts_with(twister::output::JPEG_XMP_NAMESPACE) {
+            return String::from_utf8(body[twister::output::JPEG_XMP_NAMESPACE.len()..].to_vec()).unwrap();
+        }
+        if marker == 0xDA {
+            break;
+        }
+        at += 2 + len;
+    }
+    panic!("{}: no XMP segment", path.display())
+}
+
+/// The GPano properties of an XMP packet, parsed as XML.
+fn gpano(xmp: &str) -> std::collections::HashMap<String, String> {
+    let doc = roxmltree::Document::parse(xmp).expect("well-formed XMP");
+    doc.descendants()
+        .filter(|n| n.tag_name().namespace() == Some("http://ns.google.com/photos/1.0/panorama/"))
+        .map(|n| (n.tag_name().name().to_string(), n.text().unwrap_or("").to_string()))
+        .collect()
+}
+
+#[test]
+fn sphere_images_carry_photo_sphere_metadata_in_png_and_jpeg_and_players_names() {
+    let out = tmp("metadata");
+    for (format, layout, file, size) in [
+        ("png", None, "stereo_TB.png", (256, 256)),
+        ("jpg", Some("side-by-side"), "stereo_LR.jpg", (512, 128)),
+        ("png", Some("eyes"), "left.png", (256, 128)),
+    ] {
+        let mut cmd = twister();
+        cmd.args(["render", "builtin:demo", "--panorama", "equirect", "--width", "256", "--method", "vertex"]);
+        cmd.args(["--format", format, "--out"]).arg(&out);
+        if let Some(l) = layout {
+            cmd.args(["--layout", l]);
+        }
+        let o = cmd.output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let path = out.join(file);
+        assert_eq!(image::image_dimensions(&path).unwrap(), size, "{file}");
+        let g = gpano(&xmp_of(&path));
+        assert_eq!(g["ProjectionType"], "equirectangular", "{file}: {g:?}");
+        assert_eq!(g["UsePanoramaViewer"], "True");
+        assert_eq!((g["FullPanoWidthPixels"].as_str(), g["FullPanoHeightPixels"].as_str()), ("256", "128"));
+        assert_eq!(
+            (g["CroppedAreaImageWidthPixels"].as_str(), g["CroppedAreaImageHeightPixels"].as_str()),
+            ("256", "128")
+        );
+        assert_eq!((g["CroppedAreaLeftPixels"].as_str(), g["CroppedAreaTopPixels"].as_str()), ("0", "0"));
+    }
+    // The cylinder is no photo sphere: no GPano.
+    let o = twister()
+        .args(["render", "builtin:demo", "--width", "320", "--height", "80", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let decoder = png::Decoder::new(std::io::Cursor::new(std::fs::read(out.join("left.png")).unwrap()));
+    assert!(decoder.read_info().unwrap().info().utf8_text.is_empty());
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// Reads the channel Z of an OpenEXR file: (width, height, values).
+fn read_exr(path: &std::path::Path) -> (usize, usize, Vec<f32>) {
+    use exr::prelude::*;
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .specific_channels()
+        .required("Z")
+        .collect_pixels(
+            |size, _| (size.width(), size.height(), vec![0.0f32; size.width() * size.height()]),
+            |(w, _, v), pos, (z,): (f32,)| v[pos.y() * *w + pos.x()] = z,
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .unwrap();
+    image.layer_data.channel_data.pixels
+}
+
+/// The depth files hold the distance from each pixel's eye point along its ray: checked against
+/// the ray (built here from the pixel: Cycles' construction) meeting the box room's walls, for
+/// both panoramas' eyes, and +∞ where no surface is.
+#[test]
+fn depth_files_hold_the_distance_along_each_pixels_ray() {
+    let out = tmp("depth");
+    let (lo, hi) = (Vec3::new(-20.0, -1.7, -20.0), Vec3::new(20.0, 8.3, 20.0));
+    // Distance along a ray from inside the box to its walls.
+    let to_wall = |o: Vec3, d: Vec3| {
+        (0..3)
+            .map(|k| {
+                let t1 = (lo[k] - o[k]) / d[k];
+                let t2 = (hi[k] - o[k]) / d[k];
+                t1.max(t2)
+            })
+            .fold(f32::INFINITY, f32::min)
+    };
+    for panorama in ["equirect", "cylinder"] {
+        let size: &[&str] =
+            if panorama == "equirect" { &["--width", "256"] } else { &["--width", "256", "--height", "64"] };
+        let o = twister()
+            .args([
+                "render",
+                "builtin:box-room",
+                "--panorama",
+                panorama,
+                "--vertical",
+                "exact",
+                "--depth",
+                "--layout",
+                "eyes",
+            ])
+            .args(size)
+            .args(["--edge-px", "8", "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let projection = if panorama == "equirect" {
+            Projection::equirect(256)
+        } else {
+            Projection { width: 256, height: 64, vertical: twister::Vertical::Exact, ..Projection::default() }
+        };
+        assert_eq!(projection.panorama == PanoramaKind::Equirect, panorama == "equirect");
+        for eye in Eye::BOTH {
+            let (w, h, z) = read_exr(&out.join(format!("{}_depth.exr", eye.name())));
+            assert_eq!((w, h), (256, projection.height as usize));
+            let mut checked = 0;
+            for y in (2..h - 2).step_by(5) {
+                for x in (0..w).step_by(7) {
+                    // The pixel's ray: the sphere's from Cycles' construction; the cylinder's
+                    // the tangent ray of the eye whose view meets the screen at this column,
+                    // through the screen point (exact model).
+                    let (u, v) = projection.pixel_to_screen(x as f32, y as f32);
+                    let s = eye.sign();
+                    let (origin, dir) = if panorama == "equirect" {
+                        let d = Vec3::new(v.cos() * u.sin(), v.sin(), -v.cos() * u.cos());
+                        let side = d.cross(Vec3::Y).normalize();
+                        let fade = projection.pole_fade(v.abs());
+                        (s * 0.032 * fade * side, d)
+                    } else {
+                        let phi = u - s * (0.032f32).asin();
+                        let origin = s * 0.032 * Vec3::new(phi.cos(), 0.0, phi.sin());
+                        let screen = Vec3::new(u.sin(), v, -u.cos());
+                        (origin, (screen - origin).normalize())
+                    };
+                    let want = to_wall(origin, dir);
+                    let got = z[y * w + x];
+                    assert!(
+                        (got - want).abs() <= 1e-3 * want,
+                        "{panorama} {eye:?} pixel ({x}, {y}): depth {got} m, the ray meets the wall at {want} m"
+                    );
+                    checked += 1;
+                }
+            }
+            assert!(checked > 300);
+        }
+    }
+    // Background: +∞.
+    let o = twister()
+        .args(["render", "builtin:sphere100", "--panorama", "equirect", "--width", "128", "--depth", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success());
+    let (w, h, z) = read_exr(&out.join("depth_TB.exr"));
+    assert_eq!((w, h), (128, 128));
+    assert!(z[0].is_infinite() && z[0] > 0.0, "the top-left corner shows no surface: {}", z[0]);
+    assert!(z.iter().any(|d| d.is_finite() && *d > 1.0), "the sphere is in the depth");
+    let _ = std::fs::remove_dir_all(&out);
+}
