@@ -1,10 +1,12 @@
 // The `slit` stage (vertex + fragment): the conventional slit-mosaic renderer (seed 002 §1,
-// §4.3). For each slit of columns and each eye, a pinhole camera on the eye circle looks along
-// the tangent, aimed so its central ray meets the screen at the slit's centre column; the scene
-// is drawn into that slit only (scissor), one draw per slit with `first_instance` = the slit.
-// Rows follow the exact vertical model, so slit:1 converges to the projection. The fragments
-// carry the same shading and display-position error as the raster stage (fragment.wgsl).
-// CPU twin: src/cpu/slit.rs.
+// §4.3). The cylinder: for each slit of columns and each eye, a pinhole camera on the eye circle
+// looks along the tangent, aimed so its central ray meets the screen at the slit's centre
+// column; rows follow the exact vertical model, so slit:1 converges to the projection. The
+// sphere: each slit is cut into W × W tiles, each a pinhole camera at its centre pixel's eye
+// point looking along that pixel's ray. The scene is drawn into each slit or tile only
+// (scissor), one draw per slit with `first_instance` = the slit. The fragments carry the same
+// shading and display-position error as the raster stage (fragment.wgsl).
+// CPU twin: src/cpu/slit.rs, which derives the camera form.
 
 #import projection
 #import fragment
@@ -15,17 +17,16 @@ struct SlitParams {
     eye_sign: f32,
     ambient: f32,
     near: f32,          // near plane distance along the camera's forward axis
-    focal_y_clip: f32,  // t_S · pixels_per_metre / (H/2), t_S = √(R_T² − d_e²)
     error_angle: u32,   // 1: the error target holds arcminutes (fragment.wgsl)
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
 }
 
-// One slit's camera: eye position (viewer frame), and (sin φ, cos φ, NDC x of the slit centre).
+// One slit's (or tile's) camera: position and axes (viewer frame); the slit centre in NDC in
+// right_cx.w and up_cy.w; NDC per unit of x_c/z_c in origin_sx.w, of y_c/z_c in forward_sy.w.
 struct SlitCamera {
-    origin: vec4<f32>,
-    basis: vec4<f32>,
+    origin_sx: vec4<f32>,
+    right_cx: vec4<f32>,
+    up_cy: vec4<f32>,
+    forward_sy: vec4<f32>,
 }
 
 @group(0) @binding(0) var<uniform> params: SlitParams;
@@ -46,14 +47,14 @@ struct VertexIn {
 fn vs_main(in: VertexIn) -> VertexOut {
     let cam = cameras[in.slit];
     let p = (params.view * vec4<f32>(in.position, 1.0)).xyz;
-    let rel = p - cam.origin.xyz;
-    let s = cam.basis.x;
-    let c = cam.basis.y;
-    let x_c = rel.x * c + rel.z * s;    // along right(φ) = (cos φ, 0, sin φ)
-    let z_c = rel.x * s - rel.z * c;    // along forward(φ) = (sin φ, 0, −cos φ)
+    let rel = p - cam.origin_sx.xyz;
+    let x_c = dot(rel, cam.right_cx.xyz);
+    let y_c = dot(rel, cam.up_cy.xyz);
+    let z_c = dot(rel, cam.forward_sy.xyz);
     var out: VertexOut;
     // Depth 1 − near/z_c, kept below 1 however far (MAX_DEPTH).
-    out.clip = vec4<f32>(cam.basis.z * z_c + x_c / PI, rel.y * params.focal_y_clip, min(z_c - params.near, z_c * MAX_DEPTH), z_c);
+    out.clip = vec4<f32>(cam.right_cx.w * z_c + x_c * cam.origin_sx.w, cam.up_cy.w * z_c + y_c * cam.forward_sy.w,
+                         min(z_c - params.near, z_c * MAX_DEPTH), z_c);
     out.view_position = p;
     out.normal = (params.view * vec4<f32>(in.normal, 0.0)).xyz;
     out.color = in.color;

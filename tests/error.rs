@@ -45,6 +45,33 @@ fn slit_1_is_exact_and_the_slit_error_grows_with_the_width() {
 }
 
 #[test]
+fn on_the_sphere_the_tiles_converge_to_the_projection_as_they_shrink() {
+    // Spheres all over the sphere (ahead, above, below, behind), converging rays too.
+    let mut scene = twister::Scene::new("spheres");
+    for (k, (lon, lat)) in
+        [(0.0f32, 0.0f32), (90.0, 50.0), (-120.0, -65.0), (180.0, 20.0), (30.0, 80.0)].iter().enumerate()
+    {
+        let (lon, lat) = (lon.to_radians(), lat.to_radians());
+        let d = 2.0 + k as f32;
+        let centre = glam::Vec3::new(d * lat.cos() * lon.sin(), d * lat.sin(), -d * lat.cos() * lon.cos());
+        let (v, i) = builtin::uv_sphere(centre, 0.3 * d, 24, 13, [0.8, 0.8, 0.8, 1.0]);
+        scene.add_mesh("s", &v, &i);
+    }
+    for convergence in [None, Some(3.0)] {
+        let projection = Projection { convergence, ..Projection::equirect(256) };
+        let mut previous = f32::INFINITY;
+        for w in [32, 8, 2] {
+            let frame = measured(&scene, &RenderSettings::new(projection).with_method(Method::Slit(w)));
+            let e = frame.measurement.unwrap().stats;
+            assert!(e.count > 2000);
+            assert!(e.mean < previous, "slit:{w}: mean {} px not below the wider tiles' {previous}", e.mean);
+            previous = e.mean;
+        }
+        assert!(previous < 0.1, "{convergence:?}: 2-pixel tiles still {previous} px off");
+    }
+}
+
+#[test]
 fn paper_evaluation_1_without_and_with_subdivision() {
     // Seed 002 §4.1 at the paper's resolution: about 31 px mean without subdivision (tens of
     // pixels), under 1 px with every edge split in 7.

@@ -441,14 +441,23 @@ impl Twin for Slit {
     type Output = EyeOutputs;
     fn cases() -> Vec<(String, Self::Case)> {
         let projection = Projection { width: 192, height: 48, vertical: Vertical::Exact, ..Projection::default() };
-        [1, 4, 16]
+        let mut cases: Vec<_> = [1, 4, 16]
             .map(|w| {
                 (
                     format!("demo slit:{w}"),
                     (builtin::demo(), RenderSettings::new(projection).with_method(Method::Slit(w))),
                 )
             })
-            .into()
+            .into();
+        // The sphere's tiles, parallel and converging rays.
+        for (w, convergence) in [(4, None), (16, Some(2.0))] {
+            let sphere = Projection { convergence, ..Projection::equirect(128) };
+            cases.push((
+                format!("demo on the sphere slit:{w} convergence {convergence:?}"),
+                (builtin::demo(), RenderSettings::new(sphere).with_method(Method::Slit(w))),
+            ));
+        }
+        cases
     }
     fn gpu(_: &Renderer, (scene, settings): &Self::Case) -> Self::Output {
         frame_outputs(&measured(scene, settings))

@@ -131,8 +131,9 @@ pub fn fragment(
     })
 }
 
-/// Rasterizes one triangle into `img`, within columns `scissor` (start, end).
-pub fn rasterize(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: (u32, u32), fragment: &FragmentFn) {
+/// Rasterizes one triangle into `img`, within the scissor rectangle [columns start, end, rows
+/// start, end).
+pub fn rasterize(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: [u32; 4], fragment: &FragmentFn) {
     // Clip against the near plane z ≥ 0 in clip space (w = 1 triangles never need it).
     let mut poly: Vec<ClipVertex> = Vec::with_capacity(4);
     for i in 0..3 {
@@ -149,7 +150,7 @@ pub fn rasterize(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: (u32, u32
     }
 }
 
-fn rasterize_clipped(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: (u32, u32), fragment: &FragmentFn) {
+fn rasterize_clipped(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: [u32; 4], fragment: &FragmentFn) {
     let (w, h) = (img.width, img.height);
     if tri.iter().any(|v| !v.clip.is_finite() || v.clip.w <= 0.0) {
         return;
@@ -162,10 +163,10 @@ fn rasterize_clipped(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: (u32,
     if area == 0.0 {
         return;
     }
-    let min_x = s.iter().map(|p| p[0]).fold(f32::MAX, f32::min).floor().max(scissor.0 as f32) as i64;
-    let max_x = s.iter().map(|p| p[0]).fold(f32::MIN, f32::max).ceil().min(scissor.1.min(w) as f32) as i64;
-    let min_y = s.iter().map(|p| p[1]).fold(f32::MAX, f32::min).floor().max(0.0) as i64;
-    let max_y = s.iter().map(|p| p[1]).fold(f32::MIN, f32::max).ceil().min(h as f32) as i64;
+    let min_x = s.iter().map(|p| p[0]).fold(f32::MAX, f32::min).floor().max(scissor[0] as f32) as i64;
+    let max_x = s.iter().map(|p| p[0]).fold(f32::MIN, f32::max).ceil().min(scissor[1].min(w) as f32) as i64;
+    let min_y = s.iter().map(|p| p[1]).fold(f32::MAX, f32::min).floor().max(scissor[2] as f32) as i64;
+    let max_y = s.iter().map(|p| p[1]).fold(f32::MIN, f32::max).ceil().min(scissor[3].min(h) as f32) as i64;
     // Screen-space barycentric weights of a point, and their perspective-correct form.
     let barycentric = |qx: f32, qy: f32| {
         let edge = |a: [f32; 2], b: [f32; 2]| (b[0] - a[0]) * (qy - a[1]) - (b[1] - a[1]) * (qx - a[0]);
@@ -246,7 +247,7 @@ pub fn raster(
             object: tri[k].object,
             material: tri[k].material,
         });
-        rasterize(&mut img, cv, (0, projection.width), &fragment);
+        rasterize(&mut img, cv, [0, projection.width, 0, projection.height], &fragment);
     }
     img
 }

@@ -55,7 +55,12 @@ impl Renderer {
             pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
             let first_instance = (k * eye_slits[0].len()) as u32;
             for (i, slit) in eye_slits[k].iter().enumerate() {
-                pass.set_scissor_rect(slit.first_column, 0, slit.end_column - slit.first_column, projection.height);
+                pass.set_scissor_rect(
+                    slit.first_column,
+                    slit.first_row,
+                    slit.end_column - slit.first_column,
+                    slit.end_row - slit.first_row,
+                );
                 let instance = first_instance + i as u32;
                 for (o, &center) in scene.objects.iter().zip(&centers) {
                     if sphere_in_slit(&params, slit, center, o.radius) {

@@ -200,29 +200,29 @@ pub struct ReduceParams {
     pub _pad2: u32,
 }
 
-/// `SlitParams` in shaders/slit.wgsl. 144 bytes.
+/// `SlitParams` in shaders/slit.wgsl. 128 bytes.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct SlitParams {
     pub view: [[f32; 4]; 4],
     pub projection: ProjectionUniform,
     pub eye_sign: f32,
     pub ambient: f32,
     pub near: f32,
-    pub focal_y_clip: f32,
     /// As in [`RasterParams`].
     pub error_angle: u32,
-    pub _pad0: u32,
-    pub _pad1: u32,
-    pub _pad2: u32,
 }
 
-/// `SlitCamera` in shaders/slit.wgsl: eye position, and (sin φ, cos φ, NDC x of the centre).
+/// `SlitCamera` in shaders/slit.wgsl: the camera's position and axes (viewer frame), the tile
+/// centre in NDC (x in `right_cx.w`, y in `up_cy.w`) and the NDC per unit of x_c/z_c
+/// (`origin_sx.w`) and y_c/z_c (`forward_sy.w`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct SlitCamera {
-    pub origin: [f32; 4],
-    pub basis: [f32; 4],
+    pub origin_sx: [f32; 4],
+    pub right_cx: [f32; 4],
+    pub up_cy: [f32; 4],
+    pub forward_sy: [f32; 4],
 }
 
 /// `ProjectParams` in shaders/project_points.wgsl.
@@ -301,10 +301,8 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("Piece" => Piece { triangle, cell, counts01, count2_level, corner, bary1, bary2 }),
     layout!("DrawIndirectArgs" => DrawIndirectArgs { vertex_count, instance_count, first_vertex, first_instance }),
     layout!("RasterParams" => RasterParams { projection, eye_sign, ambient, shift_px, error_angle, _pad0, _pad1, _pad2 }),
-    layout!("SlitParams" => SlitParams {
-        view, projection, eye_sign, ambient, near, focal_y_clip, error_angle, _pad0, _pad1, _pad2
-    }),
-    layout!("SlitCamera" => SlitCamera { origin, basis }),
+    layout!("SlitParams" => SlitParams { view, projection, eye_sign, ambient, near, error_angle }),
+    layout!("SlitCamera" => SlitCamera { origin_sx, right_cx, up_cy, forward_sy }),
     layout!("ProjectParams" => ProjectParams { projection, eye_sign, count, _pad }),
     layout!("Material" => Material {
         texture, wrap_u, wrap_v, mag_filter, min_filter, mipmap, alpha_mode, alpha_cutoff, double_sided,
