@@ -16,7 +16,7 @@ struct ReduceParams {
     row_stride: u32,   // u32s per padded row
     images: u32,
     partial_count: u32,
-    _pad0: u32,
+    partial_offset: u32, // where this dispatch's per-workgroup sums go (one dispatch per eye)
     _pad1: u32,
     _pad2: u32,
 }
@@ -99,7 +99,7 @@ fn accumulate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invo
     }
     let total = workgroup_sum(li, s);
     if (li == 0u) {
-        partials[wid.x + wid.y * groups.x] = total;
+        partials[params.partial_offset + wid.x + wid.y * groups.x] = total;
     }
 }
 

@@ -487,13 +487,16 @@ impl Twin for ReduceError {
     type Output = ErrorStats;
     fn cases() -> Vec<(String, Self::Case)> {
         let mut out = Vec::new();
-        for (name, scene, method) in [
-            ("triangle@3 vertex", "builtin:triangle@3", Method::Vertex),
-            ("demo adaptive", "builtin:demo", Method::Adaptive),
+        for (name, scene, method, per_eye) in [
+            ("triangle@3 vertex", "builtin:triangle@3", Method::Vertex, false),
+            ("demo adaptive", "builtin:demo", Method::Adaptive, false),
+            // One dispatch per eye, as for images beyond one storage binding.
+            ("demo adaptive, one eye at a time", "builtin:demo", Method::Adaptive, true),
         ] {
             let projection = Projection { width: 480, height: 90, ..Projection::default() };
             let scene = builtin::builtin_scene(scene, &projection).unwrap();
-            let frame = measured(&scene, &RenderSettings::new(projection).with_method(method));
+            let settings = RenderSettings::new(projection).with_method(method).with_reduce_per_eye(per_eye);
+            let frame = measured(&scene, &settings);
             let m = frame.measurement.unwrap();
             out.push((name.to_string(), (m.error, m.stats)));
         }

@@ -139,6 +139,10 @@ pub struct MeasureSettings {
     /// error pass measures against the true projection.
     #[doc(hidden)]
     pub shift_px: [f32; 2],
+    /// Test hook: the error reduction binds one eye at a time even where both would fit (as it
+    /// must for images beyond one storage binding, e.g. 8192×4096 per eye on lavapipe).
+    #[doc(hidden)]
+    pub reduce_per_eye: bool,
 }
 
 impl MeasureSettings {
@@ -209,6 +213,7 @@ builders! {
     with_error_angle: bool => measure.error_angle,
     with_depth: bool => measure.depth,
     with_shift_px: [f32; 2] => measure.shift_px,
+    with_reduce_per_eye: bool => measure.reduce_per_eye,
 }
 
 impl RenderSettings {

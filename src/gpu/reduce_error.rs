@@ -12,40 +12,62 @@ const WORKGROUP: u32 = 256;
 
 impl Renderer {
     /// Runs `reduce_error` over the error targets of both eyes; also returns the per-pixel errors.
-    pub(crate) fn reduce_errors(&self, targets: &Targets) -> Result<(ErrorStats, [Vec<f32>; 2])> {
+    /// Both eyes in one dispatch where they fit one storage binding, else one dispatch per eye
+    /// (each eye's rows bound as a range; their sums and histogram add up).
+    pub(crate) fn reduce_errors(&self, targets: &Targets, per_eye: bool) -> Result<(ErrorStats, [Vec<f32>; 2])> {
         let gpu = &self.gpu;
         let (w, h) = (targets.width, targets.height);
         let (errors, stride) =
             copy_eyes_to_buffer(gpu, &targets.error, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
-        let (gx, gy) = gpu.workgroups(2 * w * h, WORKGROUP);
-        let params = ReduceParams {
-            width: w,
-            height: h,
-            row_stride: stride,
-            images: 2,
-            partial_count: gx * gy,
-            ..Default::default()
-        };
-        let uniform = gpu.init_buffer("reduce params", bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
+        let eye_bytes = errors.size() / 2;
+        let together = errors.size() <= gpu.max_binding() && !per_eye;
+        let dispatches: Vec<(u64, u64, u32)> =
+            if together { vec![(0, errors.size(), 2)] } else { vec![(0, eye_bytes, 1), (eye_bytes, eye_bytes, 1)] };
+        let (gx, gy) = gpu.workgroups(if together { 2 * w * h } else { w * h }, WORKGROUP);
+        let partial_count = gx * gy * dispatches.len() as u32;
         let storage = |label, size: u64| gpu.storage_buffer(label, size, wgpu::BufferUsages::empty());
         let histogram = storage("histogram", 4 * BINS as u64);
-        let partials = storage("partial sums", 8 * (gx * gy) as u64);
+        let partials = storage("partial sums", 8 * partial_count as u64);
         let totals = storage("totals", std::mem::size_of::<Totals>() as u64);
         let result = storage("error stats", std::mem::size_of::<ErrorStats>() as u64);
-        let buffers = [&uniform, &errors, &histogram, &partials, &totals, &result];
-        let accumulate = self.reduce.bind_group(gpu, Some("accumulate"), 0, &buffers);
-        let finish = self.reduce.bind_group(gpu, Some("finish"), 0, &buffers);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         enc.clear_buffer(&histogram, 0, None);
         enc.clear_buffer(&totals, 0, None);
-        {
-            let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&self.accumulate);
-            pass.set_bind_group(0, &accumulate, &[]);
-            pass.dispatch_workgroups(gx, gy, 1);
-            pass.set_pipeline(&self.finish);
-            pass.set_bind_group(0, &finish, &[]);
-            pass.dispatch_workgroups(1, 1, 1);
+        let mut uniforms = Vec::new();
+        for (k, &(offset, size, images)) in dispatches.iter().enumerate() {
+            let params = ReduceParams {
+                width: w,
+                height: h,
+                row_stride: stride,
+                images,
+                partial_count,
+                partial_offset: k as u32 * gx * gy,
+                ..Default::default()
+            };
+            let uniform = gpu.init_buffer("reduce params", bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
+            let range = wgpu::BufferBinding { buffer: &errors, offset, size: std::num::NonZeroU64::new(size) };
+            let buffers = [
+                uniform.as_entire_buffer_binding(),
+                range,
+                histogram.as_entire_buffer_binding(),
+                partials.as_entire_buffer_binding(),
+                totals.as_entire_buffer_binding(),
+                result.as_entire_buffer_binding(),
+            ];
+            let accumulate = self.reduce.bind_group_ranges(gpu, Some("accumulate"), 0, &buffers);
+            {
+                let mut pass = enc.begin_compute_pass(&Default::default());
+                pass.set_pipeline(&self.accumulate);
+                pass.set_bind_group(0, &accumulate, &[]);
+                pass.dispatch_workgroups(gx, gy, 1);
+                if k + 1 == dispatches.len() {
+                    let finish = self.reduce.bind_group_ranges(gpu, Some("finish"), 0, &buffers);
+                    pass.set_pipeline(&self.finish);
+                    pass.set_bind_group(0, &finish, &[]);
+                    pass.dispatch_workgroups(1, 1, 1);
+                }
+            }
+            uniforms.push(uniform);
         }
         gpu.queue.submit([enc.finish()]);
         let stats: ErrorStats =

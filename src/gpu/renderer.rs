@@ -273,15 +273,17 @@ impl Renderer {
             ));
         }
         // Both eyes' colour targets are read back through one buffer (rows padded to 256
-        // bytes); with the error pass, both error targets are bound as one storage buffer.
+        // bytes); with the error pass, each eye's error target is bound as storage (both at once
+        // when they fit one binding).
         let padded_row = (4 * p.width as u64).div_ceil(256) * 256;
         let eyes_bytes = 2 * padded_row * p.height as u64;
+        let max_buffer = self.gpu.limits.max_buffer_size;
         let (limit, what) = if settings.measure.error {
-            (self.gpu.max_binding(), "the error pass's buffer")
+            (max_buffer.min(2 * self.gpu.max_binding()), "the error pass's buffers")
         } else {
-            (self.gpu.limits.max_buffer_size, "the read-back buffer")
+            (max_buffer, "the read-back buffer")
         };
-        if eyes_bytes >= limit {
+        if eyes_bytes > limit {
             return Err(Error::option(
                 "--width/--height",
                 format!(
@@ -549,7 +551,7 @@ impl Renderer {
         let depth = if settings.measure.depth { Some(targets.read_distances(&self.gpu)?) } else { None };
         let measurement = if settings.measure.error {
             let object = targets.read_objects(&self.gpu)?;
-            let (stats, error) = self.reduce_errors(targets)?;
+            let (stats, error) = self.reduce_errors(targets, settings.measure.reduce_per_eye)?;
             Some(Measurement { error, object, stats })
         } else {
             None

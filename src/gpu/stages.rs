@@ -107,13 +107,28 @@ impl GpuStage {
     /// one buffer per binding of the whole group, in binding order; the pipeline's own bindings
     /// are taken from them.
     pub fn bind_group(&self, gpu: &Gpu, entry: Option<&str>, group: u32, buffers: &[&wgpu::Buffer]) -> wgpu::BindGroup {
+        let whole: Vec<wgpu::BufferBinding> = buffers.iter().map(|b| b.as_entire_buffer_binding()).collect();
+        self.bind_group_ranges(gpu, entry, group, &whole)
+    }
+
+    /// The same with buffer ranges (a binding of part of a buffer larger than one binding holds).
+    pub fn bind_group_ranges(
+        &self,
+        gpu: &Gpu,
+        entry: Option<&str>,
+        group: u32,
+        buffers: &[wgpu::BufferBinding],
+    ) -> wgpu::BindGroup {
         let bindings: Vec<&Binding> = self.stage.group(group).collect();
         assert_eq!(bindings.len(), buffers.len(), "{} group {group}: one buffer per binding", self.stage.name);
         let entries: Vec<wgpu::BindGroupEntry> = bindings
             .iter()
             .zip(buffers)
             .filter(|(b, _)| self.stage.binds(entry, b))
-            .map(|(b, buffer)| wgpu::BindGroupEntry { binding: b.binding, resource: buffer.as_entire_binding() })
+            .map(|(b, buffer)| wgpu::BindGroupEntry {
+                binding: b.binding,
+                resource: wgpu::BindingResource::Buffer(buffer.clone()),
+            })
             .collect();
         gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some(self.stage.name),

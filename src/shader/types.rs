@@ -195,7 +195,8 @@ pub struct ReduceParams {
     pub row_stride: u32,
     pub images: u32,
     pub partial_count: u32,
-    pub _pad0: u32,
+    /// Index of this dispatch's first per-workgroup sum (one dispatch per eye for large images).
+    pub partial_offset: u32,
     pub _pad1: u32,
     pub _pad2: u32,
 }
@@ -309,7 +310,7 @@ pub const LAYOUTS: &[StructLayout] = &[
         first_mip, mip_count, _pad
     }),
     layout!("MipLevel" => MipLevel { offset, width, height, _pad }),
-    layout!("ReduceParams" => ReduceParams { width, height, row_stride, images, partial_count, _pad0, _pad1, _pad2 }),
+    layout!("ReduceParams" => ReduceParams { width, height, row_stride, images, partial_count, partial_offset, _pad1, _pad2 }),
     layout!("Totals" => Totals { count, max_bits }),
     layout!("ErrorStats" => ErrorStats { count, mean, std_dev, p50, p90, p99, max, _pad }),
 ];
