@@ -209,13 +209,11 @@ pub fn tint(scene: &mut Scene, selection: &LodSelection) {
 }
 
 /// The visual field of a pixel of a panorama, from the viewer's centre: the pixel's direction is
-/// (sin u, v/R_T, −cos u) (the paper's vertical model; the eyes' offset is left out, this is for
-/// looking at).
+/// `Projection::screen_direction` (on the cylinder (sin u, v/R_T, −cos u), the paper's vertical
+/// model; the eyes' offset is left out, this is for looking at).
 pub fn pixel_field(projection: &crate::core::projection::Projection, gaze: &Gaze, x: f32, y: f32) -> Field {
-    let metres_per_px = std::f32::consts::TAU * projection.screen_radius / projection.width as f32;
-    let u = (x / projection.width as f32 - 0.5) * std::f32::consts::TAU;
-    let v = (0.5 * projection.height as f32 - y) * metres_per_px;
-    gaze.position(glam::Vec3::new(u.sin(), v / projection.screen_radius, -u.cos())).field()
+    let (u, v) = projection.pixel_to_screen(x - 0.5, y - 0.5);
+    gaze.position(projection.screen_direction(u, v)).field()
 }
 
 /// `--lod-overlay`: draws the central field's boundary (white) and the visual field's boundary

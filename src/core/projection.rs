@@ -418,6 +418,19 @@ impl Projection {
         }
     }
 
+    /// The unit direction, seen from the centre, of screen point (u, v): on the cylinder the
+    /// screen point (R_T sin u, v, −R_T cos u), on the sphere longitude u, latitude v.
+    /// `screen_direction` in fragment.wgsl.
+    pub fn screen_direction(&self, u: f32, v: f32) -> Vec3 {
+        match self.panorama {
+            PanoramaKind::Equirect => Vec3::new(v.cos() * u.sin(), v.sin(), -v.cos() * u.cos()),
+            PanoramaKind::Cylinder => {
+                let rt = self.screen_radius;
+                Vec3::new(rt * u.sin(), v, -rt * u.cos()).normalize()
+            }
+        }
+    }
+
     /// Half the screen height in metres (the cylinder).
     pub fn half_height_m(&self) -> f32 {
         0.5 * self.height as f32 / self.pixels_per_metre()

@@ -28,26 +28,14 @@ pub fn pixel_error(projection: &Projection, eye: Eye, p: Vec3, frag_xy: Vec2, an
     match projection.project(p, eye) {
         None => -1.0,
         Some(q) if angle => {
-            let a = screen_direction(projection, q.u, q.v);
+            let a = projection.screen_direction(q.u, q.v);
             let (u, v) = projection.pixel_to_screen(frag_xy.x - 0.5, frag_xy.y - 0.5);
-            let b = screen_direction(projection, u, v);
+            let b = projection.screen_direction(u, v);
             a.cross(b).length().atan2(a.dot(b)).to_degrees() * 60.0
         }
         Some(q) => {
             let [x, y] = projection.to_pixel(q.u, q.v);
             Vec2::new(projection.wrapped_dx(x, frag_xy.x), y - frag_xy.y).length()
-        }
-    }
-}
-
-/// The unit direction, seen from the centre, of screen point (u, v): on the cylinder the screen
-/// point (R_T sin u, v, −R_T cos u), on the sphere longitude u, latitude v.
-pub fn screen_direction(projection: &Projection, u: f32, v: f32) -> Vec3 {
-    match projection.panorama {
-        PanoramaKind::Equirect => Vec3::new(v.cos() * u.sin(), v.sin(), -v.cos() * u.cos()),
-        PanoramaKind::Cylinder => {
-            let rt = projection.screen_radius;
-            Vec3::new(rt * u.sin(), v, -rt * u.cos()).normalize()
         }
     }
 }
