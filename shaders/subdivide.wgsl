@@ -254,14 +254,19 @@ fn edge_divisions(a: vec3<f32>, b: vec3<f32>) -> u32 {
 
 // Whether a triangle lies wholly above or below the image (see `off_screen_vertically` in
 // src/cpu/subdivide/ for why testing the corners suffices).
-fn off_screen_vertically(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> bool {
+// The slope beyond which |y|/r shows in no pixel row (`Subdivider::vertical_limit`).
+fn vertical_limit() -> f32 {
     if (params.projection.panorama == PANORAMA_SPHERE) {
-        return false; // the sphere shows every direction
+        return 1.0 / tan(0.5 * PI / params.projection.height);
     }
     let rt = params.projection.screen_radius;
     let de = params.projection.eye_radius;
     let half = 0.5 * params.projection.height / params.projection.pixels_per_v;
-    let k = half / (rt * sqrt(1.0 - (de / rt) * (de / rt)));
+    return half / (rt * sqrt(1.0 - (de / rt) * (de / rt)));
+}
+
+fn off_screen_vertically(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> bool {
+    let k = vertical_limit();
     let r = vec3<f32>(horizontal_radius(p0), horizontal_radius(p1), horizontal_radius(p2));
     let y = vec3<f32>(p0.y, p1.y, p2.y);
     return all(y > k * r) || all(y < -k * r);

@@ -448,7 +448,7 @@ impl Projection {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
 pub enum PanoramaKind {
-    /// The TWISTER display's cylinder: concentric mosaics, eq. 1–4 (this module).
+    /// The TWISTER display's cylinder: concentric mosaics, seed 002 eq. 1–4.
     #[default]
     Cylinder,
     /// The full sphere, equirectangular omni-directional stereo (Google ODS, Cycles' spherical

@@ -275,17 +275,26 @@ impl<'a> Subdivider<'a> {
         }
     }
 
-    /// Whether a triangle lies wholly above or wholly below the image. Along a segment with
-    /// y > 0, y is linear and r convex, so y/r never falls below its smaller end value: corners all
-    /// above the top mean the whole triangle is (likewise below). The exact model has
-    /// v ≥ v_paper·√(1 − d_e²/R_T²), so the test k = half height / (R_T·√(1 − d_e²/R_T²)) on y/r is
-    /// safe for both vertical models.
-    pub fn off_screen_vertically(&self, p: [Vec3; 3]) -> bool {
+    /// The slope k such that a point with |y| > k·r shows in no pixel: above the top of the
+    /// cylinder's image, or on the sphere beyond the centre of its first (or last) pixel row
+    /// (latitude π/2 − π/2H), which no rasterized sample reaches. The exact model has
+    /// v ≥ v_paper·√(1 − d_e²/R_T²), so k = half height / (R_T·√(1 − d_e²/R_T²)) is safe for both
+    /// vertical models; on the sphere the latitude atan2(y, √(r² − e²)) ≥ atan(y/r), so
+    /// k = 1/tan(π/2H) is safe for every eye offset. `vertical_limit` in subdivide.wgsl.
+    pub fn vertical_limit(&self) -> f32 {
         if self.projection.panorama == PanoramaKind::Equirect {
-            return false; // the sphere shows every direction
+            return 1.0 / (0.5 * PI / self.projection.height as f32).tan();
         }
         let (rt, de) = (self.projection.screen_radius, self.projection.eye_radius);
-        let k = self.projection.half_height_m() / (rt * (1.0 - (de / rt) * (de / rt)).sqrt());
+        self.projection.half_height_m() / (rt * (1.0 - (de / rt) * (de / rt)).sqrt())
+    }
+
+    /// Whether a triangle shows in no pixel row: wholly above or wholly below the image's rows
+    /// ([`Subdivider::vertical_limit`]). Along a segment with y > 0, y is linear and r convex, so
+    /// y/r never falls below its smaller end value (the set y ≥ k·r is convex): corners all
+    /// beyond mean the whole triangle is.
+    pub fn off_screen_vertically(&self, p: [Vec3; 3]) -> bool {
+        let k = self.vertical_limit();
         let above = p.iter().all(|q| q.y > k * horizontal_radius(*q));
         let below = p.iter().all(|q| q.y < -k * horizontal_radius(*q));
         above || below

@@ -283,10 +283,7 @@ fn check_case(
             assert!(bary_of(p).min_element() >= -1e-4, "{what}: output point {p} outside its triangle");
             assert!(p.x.abs() + p.z.abs() >= rho - tol, "{what}: output point {p} inside the square around the axis");
         }
-        let k = {
-            let (rt, de) = (projection.screen_radius, projection.eye_radius);
-            projection.half_height_m() / (rt * (1.0 - (de / rt) * (de / rt)).sqrt())
-        };
+        let k = sd.vertical_limit();
         for _ in 0..40 {
             let (a, b): (f32, f32) = (rng.random(), rng.random());
             let (a, b) = if a + b > 1.0 { (1.0 - a, 1.0 - b) } else { (a, b) };
@@ -294,7 +291,7 @@ fn check_case(
             let r = horizontal_radius(p);
             // Clearly outside the square and clearly on screen (a margin for the sub-triangles
             // culled whole: those lie wholly beyond the image, and so does this point then).
-            let off_screen = projection.panorama == PanoramaKind::Cylinder && p.y.abs() > 0.99 * k * r;
+            let off_screen = p.y.abs() > 0.99 * k * r;
             if p.x.abs() + p.z.abs() < rho * 1.01 + 2.0 * tol || off_screen {
                 continue;
             }

@@ -1,0 +1,89 @@
+"""Renders an OBJ scene exported by `cargo run --example cycles_reference` with Blender Cycles'
+spherical stereo (equirectangular, both eyes) as flat, unlit colours, so that twister's
+full-sphere panorama can be checked against Cycles pixel for pixel.
+
+blender -b -P scripts/cycles/render_cycles.py -- SCENE.obj OUT_PREFIX WIDTH CONVERGENCE POLE_FROM POLE_TO
+    CONVERGENCE: `parallel` or a distance in metres; POLE_FROM/POLE_TO in degrees (`off` for no merge)
+
+Writes OUT_PREFIX_L.png and OUT_PREFIX_R.png (WIDTH × WIDTH/2 each).
+
+The scene is in twister's frame (+y up, −z ahead); the importer turns it into Blender's (+z up,
++y ahead): forward −Z, up Y. The camera stands at the origin looking along +y (rotation 90°
+about x), so the panorama's centre column looks where twister's does.
+"""
+import math
+import sys
+
+import bpy
+
+argv = sys.argv[sys.argv.index("--") + 1:]
+obj_path, out_prefix, width, convergence, pole_from, pole_to = argv[:6]
+width = int(width)
+
+bpy.ops.wm.read_factory_settings(use_empty=True)
+scene = bpy.context.scene
+if hasattr(bpy.ops.wm, "obj_import"):
+    bpy.ops.wm.obj_import(filepath=obj_path, forward_axis="NEGATIVE_Z", up_axis="Y")
+else:
+    bpy.ops.import_scene.obj(filepath=obj_path, axis_forward="-Z", axis_up="Y")
+
+# Flat colours: every material emits its diffuse colour (linear), nothing else lights.
+for mat in bpy.data.materials:
+    colour = tuple(mat.diffuse_color)
+    mat.use_nodes = True
+    nodes = mat.node_tree.nodes
+    nodes.clear()
+    emission = nodes.new("ShaderNodeEmission")
+    emission.inputs["Color"].default_value = colour
+    emission.inputs["Strength"].default_value = 1.0
+    output = nodes.new("ShaderNodeOutputMaterial")
+    mat.node_tree.links.new(emission.outputs["Emission"], output.inputs["Surface"])
+world = bpy.data.worlds.new("black")
+world.use_nodes = True
+world.node_tree.nodes["Background"].inputs["Color"].default_value = (0, 0, 0, 1)
+scene.world = world
+
+cam_data = bpy.data.cameras.new("ods")
+cam_data.type = "PANO"
+if hasattr(cam_data, "panorama_type"):
+    cam_data.panorama_type = "EQUIRECTANGULAR"
+else:
+    cam_data.cycles.panorama_type = "EQUIRECTANGULAR"
+stereo = cam_data.stereo
+stereo.interocular_distance = 0.064
+if convergence == "parallel":
+    stereo.convergence_mode = "PARALLEL"
+else:
+    stereo.convergence_mode = "OFFAXIS"
+    stereo.convergence_distance = float(convergence)
+stereo.use_spherical_stereo = True
+if pole_from == "off":
+    stereo.use_pole_merge = False
+else:
+    stereo.use_pole_merge = True
+    stereo.pole_merge_angle_from = math.radians(float(pole_from))
+    stereo.pole_merge_angle_to = math.radians(float(pole_to))
+cam = bpy.data.objects.new("ods", cam_data)
+scene.collection.objects.link(cam)
+cam.location = (0, 0, 0)
+cam.rotation_euler = (math.pi / 2, 0, 0)
+scene.camera = cam
+
+scene.render.engine = "CYCLES"
+scene.cycles.device = "CPU"
+scene.cycles.samples = 64
+scene.cycles.use_denoising = False
+scene.cycles.filter_width = 0.01  # no reconstruction blur: each pixel averages its own area
+scene.cycles.max_bounces = 0
+scene.render.resolution_x = width
+scene.render.resolution_y = width // 2
+scene.render.resolution_percentage = 100
+scene.view_settings.view_transform = "Standard"
+scene.view_settings.look = "None"
+scene.render.image_settings.file_format = "PNG"
+scene.render.image_settings.color_mode = "RGB"
+scene.render.use_multiview = True
+scene.render.views_format = "STEREO_3D"
+scene.render.image_settings.views_format = "INDIVIDUAL"
+scene.render.filepath = out_prefix
+bpy.ops.render.render(write_still=True)
