@@ -60,7 +60,6 @@ pub fn slit_params(projection: &Projection, view: Mat4, eye: Eye, ambient: f32, 
         ambient,
         near: NEAR,
         error_angle: error_angle as u32,
-        ..Default::default()
     }
 }
 

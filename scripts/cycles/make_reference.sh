@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Renders the Cycles references of tests/cycles.rs with Blender (3.4 or later: `apt-get install
+# blender`) and checks twister against them. Not part of the test suite (CI has no Blender): the
+# snapped renders are committed in tests/data/cycles/.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+work=$(mktemp -d)
+cargo run -q --release --example cycles_reference -- export "$work"
+render() { blender -b -P scripts/cycles/render_cycles.py -- "$work/demo.obj" "$work/$1" 512 "$2" "$3" "$4" >/dev/null; }
+render parallel parallel 60 75
+render converge2m 2.0 60 75
+render no_pole_merge parallel off off
+for case in "parallel parallel" "converge2m 2.0" "no_pole_merge parallel off"; do
+    set -- $case
+    cargo run -q --release --example cycles_reference -- snap "$work/$1" "tests/data/cycles/demo_$1"
+    echo "$1:"
+    cargo run -q --release --example cycles_reference -- compare "tests/data/cycles/demo_$1" 512 "${@:2}"
+done
+rm -rf "$work"
