@@ -151,6 +151,17 @@ fn bad_arguments_are_clear_errors() {
         (&["render", "--viewer", "1,2"], "three finite numbers"),
         (&["render", "--background", "300,0,0"], "0–255"),
         (&["render", "scene.obj"], "scene.obj"),
+        // Options of the full sphere, and of the image format.
+        (&["render", "--convergence", "2"], "--convergence: needs --panorama equirect"),
+        (&["render", "--pole-merge", "60,75"], "--pole-merge: needs --panorama equirect"),
+        (&["render", "--panorama", "equirect", "--pole-merge", "80,70"], "FROM < TO"),
+        (&["render", "--panorama", "equirect", "--convergence", "close"], "parallel or a distance"),
+        (&["render", "--panorama", "equirect", "--convergence", "0.01"], "--convergence"),
+        (&["render", "--preset", "vr4k", "--panorama", "cylinder"], "--preset"),
+        (&["render", "--preset", "vr4k", "--width", "100"], "--width"),
+        (&["render", "--quality", "50"], "--quality: needs --format jpg"),
+        (&["render", "--format", "jpg", "--quality", "0"], "--quality"),
+        (&["render", "--format", "gif"], "--format"),
     ];
     for (args, needle) in cases {
         let o = twister().args(*args).args(["--out", "/nonexistent/never"]).output().unwrap();
@@ -178,8 +189,8 @@ fn subdivision_flags_take_effect_and_are_reported() {
     };
     let vertex = stats(&["--method", "vertex"]);
     assert_eq!(vertex["method"], "vertex");
-    // vertex: one triangle per part (the 100 triangles, those across x = 0 or z = 0 cut in
-    // parts); fixed:3: nine per part.
+    // vertex: one triangle per part (the 100 triangles: nothing near the axis asks for cuts, so
+    // none is cut); fixed:3: nine per part.
     let parts = vertex["triangles_out"].as_u64().unwrap();
     assert!((100..200).contains(&parts), "{parts} parts");
     let fixed = stats(&["--method", "fixed:3"]);
