@@ -10,7 +10,8 @@
 //            this frame, or inside one quadrant and one band) is planned here; the others are
 //            listed in `cut_list` for `plan_cuts` (the clipping code, kept out of this entry
 //            point: lavapipe runs a shader that merely contains it markedly slower).
-// `plan_cuts_args`, `plan_cuts`  one invocation per listed triangle and quadrant: its parts around the
+// `plan_cuts_args`, `plan_cuts`  one invocation per listed triangle (on the sphere per triangle
+//            and quadrant): its parts around the
 //            vertical axis under the frame's cuts (quadrants minus a small square around the axis,
 //            bands between the active diamonds, fan-triangulated).
 //            For every part, `plan` and `plan_cuts` find the edge
@@ -223,7 +224,7 @@ fn edge_length_px(a: vec3<f32>, b: vec3<f32>, segments: u32) -> f32 {
     }
     // Near the eye circle, which the paper model and the sphere show on screen (α and the
     // longitude ∝ √(r − d_e)), no stretch is allowed (the exact model puts it at v = ±∞).
-    let shows_ring = params.projection.vertical_exact == 0u || params.projection.panorama == PANORAMA_SPHERE;
+    let shows_ring = params.projection.vertical_exact == 0u || is_sphere(params.projection);
     let ring = shows_ring && nearest < 2.0 * params.projection.eye_radius;
     let stretch = select(MAX_STRETCH, 1.0, ring);
     return max(length_px, f32(segments) * longest / stretch);
@@ -256,7 +257,7 @@ fn edge_divisions(a: vec3<f32>, b: vec3<f32>) -> u32 {
 // src/cpu/subdivide/ for why testing the corners suffices).
 // The slope beyond which |y|/r shows in no pixel row (`Subdivider::vertical_limit`).
 fn vertical_limit() -> f32 {
-    if (params.projection.panorama == PANORAMA_SPHERE) {
+    if (is_sphere(params.projection)) {
         return 1.0 / tan(0.5 * PI / params.projection.height);
     }
     let rt = params.projection.screen_radius;
@@ -843,7 +844,7 @@ fn emit(a: Node, b: Node, c: Node) {
     var u_max = -1e30;
     for (var i = 0u; i < 3u; i++) {
         let theta = theta_c + wrap_angle(azimuth(ps[i]) - theta_c);
-        if (params.projection.panorama == PANORAMA_SPHERE) {
+        if (is_sphere(params.projection)) {
             for (var s = 0u; s < 2u; s++) {
                 let u = project_with_azimuth(params.projection, ps[i], theta, select(-1.0, 1.0, s == 1u)).x;
                 u_min = min(u_min, u);
@@ -956,26 +957,39 @@ fn plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
 }
 
+// Invocations of `plan_cuts` per listed triangle: one per quadrant on the sphere, whose bands reach
+// 10⁻⁵ m from the axis (many more bands: one quadrant's keep an invocation within lavapipe's loop
+// budget, which stops any invocation after 65,535 loop iterations); one per triangle on the
+// cylinder (its few bands fit, and lanes of a triangle's empty quadrants would idle).
+fn plan_cuts_split() -> u32 {
+    return select(1u, 4u, (PANORAMAS & 2u) != 0u);
+}
+
 @compute @workgroup_size(1)
 fn plan_cuts_args() {
-    let groups = (4u * min(atomicLoad(&counters.cut_count), arrayLength(&cut_list)) + 63u) / 64u;
+    let groups = (plan_cuts_split() * min(atomicLoad(&counters.cut_count), arrayLength(&cut_list)) + 63u) / 64u;
     lattice_dispatch[3] = min(groups, 65535u);
     lattice_dispatch[4] = (groups + 65534u) / 65535u;
     lattice_dispatch[5] = 1u;
 }
 
-// One invocation per listed triangle and quadrant (the bands of one quadrant keep an invocation
-// within lavapipe's loop budget: it stops any invocation after 65,535 loop iterations).
 @compute @workgroup_size(64)
 fn plan_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let local = invocation_index(gid, groups);
-    if (local / 4u >= min(atomicLoad(&counters.cut_count), arrayLength(&cut_list))) {
+    let split = plan_cuts_split();
+    if (local / split >= min(atomicLoad(&counters.cut_count), arrayLength(&cut_list))) {
         return;
     }
-    let t = cut_list[local / 4u];
+    let t = cut_list[local / split];
     cuts = vec2<u32>(atomicLoad(&counters.cuts_low), atomicLoad(&counters.cuts_high));
     load_triangle(t);
-    plan_quadrant(t, local % 4u);
+    if (split == 4u) {
+        plan_quadrant(t, local % 4u);
+    } else {
+        for (var q = 0u; q < 4u; q++) {
+            plan_quadrant(t, q);
+        }
+    }
 }
 
 @compute @workgroup_size(64)

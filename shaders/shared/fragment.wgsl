@@ -191,7 +191,7 @@ fn from_pixel(proj: Projection, xy: vec2<f32>) -> vec2<f32> {
 // The unit direction, seen from the centre, of screen point (u, v): on the cylinder the screen
 // point (R_T sin u, v, −R_T cos u), on the sphere longitude u, latitude v.
 fn screen_direction(proj: Projection, uv: vec2<f32>) -> vec3<f32> {
-    if (proj.panorama == PANORAMA_SPHERE) {
+    if (is_sphere(proj)) {
         return vec3<f32>(cos(uv.y) * sin(uv.x), sin(uv.y), -cos(uv.y) * cos(uv.x));
     }
     return normalize(vec3<f32>(proj.screen_radius * sin(uv.x), uv.y, -proj.screen_radius * cos(uv.x)));
@@ -227,7 +227,7 @@ struct Ray {
 // the pixel's column (viewing direction φ = u − s·asin(d_e/R_T)) through the pixel's screen point.
 fn pixel_ray(proj: Projection, eye_sign: f32, frag_xy: vec2<f32>) -> Ray {
     let uv = from_pixel(proj, frag_xy);
-    if (proj.panorama == PANORAMA_SPHERE) {
+    if (is_sphere(proj)) {
         let d = vec3<f32>(cos(uv.y) * sin(uv.x), sin(uv.y), -cos(uv.y) * cos(uv.x));
         let origin = eye_sign * pole_fade(proj, abs(uv.y)) * proj.eye_radius * vec3<f32>(cos(uv.x), 0.0, sin(uv.x));
         if (proj.convergence > 0.0) {

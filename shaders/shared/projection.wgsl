@@ -35,6 +35,16 @@ struct Projection {
 const PANORAMA_CYLINDER: u32 = 0u;
 const PANORAMA_SPHERE: u32 = 1u;
 
+// The panoramas a pipeline can draw (bit 0 the cylinder, bit 1 the sphere). The subdivide stage's
+// pipelines are built for one panorama each, so the other's code is compiled out: on lavapipe a
+// shader that merely contains the sphere's projection (inlined at every sample of an edge) ran
+// the cylinder's subdivision three times slower.
+override PANORAMAS: u32 = 3u;
+
+fn is_sphere(proj: Projection) -> bool {
+    return (PANORAMAS & 2u) != 0u && ((PANORAMAS & 1u) == 0u || proj.panorama == PANORAMA_SPHERE);
+}
+
 // atan2 and acos accurate to about 1e-7 rad. Drivers' built-ins may be far less precise (lavapipe's
 // are off by ~4e-6 rad, 2e-3 px at 3168 px): reduce to |t| ≤ tan(π/12) and sum the odd series
 // (truncation error < 0.268¹³/13 ≈ 3e-9).
@@ -196,7 +206,7 @@ fn sphere_eye_offset(proj: Projection, r: f32, y: f32) -> f32 {
 // r > |e| at the point's offset (a point on the axis only where the offset has faded to 0).
 fn sees(proj: Projection, p: vec3<f32>) -> bool {
     let r = horizontal_radius(p);
-    if (proj.panorama != PANORAMA_SPHERE) {
+    if (!is_sphere(proj)) {
         return r > proj.eye_radius;
     }
     let e = sphere_e(proj, r, p.y, sphere_eye_offset(proj, r, p.y));
@@ -207,7 +217,7 @@ fn sees(proj: Projection, p: vec3<f32>) -> bool {
 // (u, v) are (θ ± α, screen height) on the cylinder, (longitude, latitude) on the sphere.
 fn project_with_azimuth(proj: Projection, p: vec3<f32>, theta: f32, eye_sign: f32) -> vec3<f32> {
     let r = horizontal_radius(p);
-    if (proj.panorama == PANORAMA_SPHERE) {
+    if (is_sphere(proj)) {
         return sphere_at_offset(proj, r, p.y, theta, eye_sign, sphere_eye_offset(proj, r, p.y));
     }
     return vec3<f32>(theta + eye_sign * eye_shift(proj, r), screen_height(proj, p.y, r), r);

@@ -10,7 +10,7 @@ use std::sync::{Mutex, OnceLock};
 use std::time::Instant;
 
 use crate::core::frame::{Frame, FrameStats, Measurement, Timing};
-use crate::core::projection::Eye;
+use crate::core::projection::{Eye, PanoramaKind};
 use crate::core::scene::SceneVertex;
 use crate::core::settings::{Method, RenderSettings};
 use crate::cpu::raster::raster_params;
@@ -146,8 +146,8 @@ fn draw_pipeline(gpu: &Gpu, stage: &GpuStage, kind: DrawStage, measure: bool, ma
 }
 
 /// The `subdivide` stage's pipelines, one per entry point.
-struct SubdividePipelines {
-    stage: GpuStage,
+/// The `subdivide` stage's pipelines for one panorama, one per entry point.
+struct SubdivideVariant {
     active_cuts: wgpu::ComputePipeline,
     plan: wgpu::ComputePipeline,
     plan_cuts_args: wgpu::ComputePipeline,
@@ -155,6 +155,35 @@ struct SubdividePipelines {
     lattice_args: wgpu::ComputePipeline,
     lattice: wgpu::ComputePipeline,
     finalize: wgpu::ComputePipeline,
+}
+
+/// The `subdivide` stage: its layouts, and its pipelines built for each panorama when first
+/// needed (the WGSL `override PANORAMAS` compiles the other panorama's projection out).
+struct SubdividePipelines {
+    stage: GpuStage,
+    variants: [OnceLock<SubdivideVariant>; 2],
+}
+
+impl SubdividePipelines {
+    fn variant(&self, gpu: &Gpu, panorama: PanoramaKind) -> &SubdivideVariant {
+        let (k, bits) = match panorama {
+            PanoramaKind::Cylinder => (0, 1.0),
+            PanoramaKind::Equirect => (1, 2.0),
+        };
+        self.variants[k].get_or_init(|| {
+            let constants = [("PANORAMAS", bits)];
+            let make = |entry| self.stage.compute_with(gpu, entry, &constants);
+            SubdivideVariant {
+                active_cuts: make("active_cuts"),
+                plan: make("plan"),
+                plan_cuts_args: make("plan_cuts_args"),
+                plan_cuts: make("plan_cuts"),
+                lattice_args: make("lattice_args"),
+                lattice: make("lattice"),
+                finalize: make("finalize"),
+            }
+        })
+    }
 }
 
 /// What a renderer keeps between frames.
@@ -201,16 +230,9 @@ impl Renderer {
     pub fn new(gpu: Gpu) -> Result<Renderer> {
         let built = gpu.scoped("building the pipelines", || {
             let stage = GpuStage::new(&gpu, &SUBDIVIDE);
-            let subdivide = SubdividePipelines {
-                active_cuts: stage.compute(&gpu, "active_cuts"),
-                plan: stage.compute(&gpu, "plan"),
-                plan_cuts_args: stage.compute(&gpu, "plan_cuts_args"),
-                plan_cuts: stage.compute(&gpu, "plan_cuts"),
-                lattice_args: stage.compute(&gpu, "lattice_args"),
-                lattice: stage.compute(&gpu, "lattice"),
-                finalize: stage.compute(&gpu, "finalize"),
-                stage,
-            };
+            let subdivide = SubdividePipelines { stage, variants: [OnceLock::new(), OnceLock::new()] };
+            // The cylinder's pipelines now: a GPU error building them shows here, not mid-frame.
+            subdivide.variant(&gpu, PanoramaKind::Cylinder);
             let reduce = GpuStage::new(&gpu, &REDUCE_ERROR);
             let resources = FrameResources {
                 buffers: None,
@@ -327,6 +349,12 @@ impl Renderer {
         )
     }
 
+    /// The subdivide pipelines for the panorama of `params`.
+    fn subdivide_for(&self, params: &SubdivideParams) -> &SubdivideVariant {
+        let panorama = if params.projection.panorama == 1 { PanoramaKind::Equirect } else { PanoramaKind::Cylinder };
+        self.subdivide.variant(&self.gpu, panorama)
+    }
+
     /// Clears the counters and runs `active_cuts` over every triangle of the scene: the start of
     /// a frame that runs `plan` and `lattice` apart (chunks, read-back).
     fn run_active_cuts(
@@ -343,7 +371,7 @@ impl Renderer {
         enc.clear_buffer(&buffers.counters, 0, None);
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&self.subdivide.active_cuts);
+            pass.set_pipeline(&self.subdivide_for(&params).active_cuts);
             pass.set_bind_group(0, &bind_group, &[]);
             let (x, y) = self.gpu.workgroups(scene.triangle_count, 64);
             pass.dispatch_workgroups(x, y, 1);
@@ -364,7 +392,8 @@ impl Renderer {
         count: u32,
     ) -> Result<SubdivideCounters> {
         self.gpu.queue.write_buffer(uniform, 0, bytemuck::bytes_of(params));
-        let pipeline = if entry == "plan" { &self.subdivide.plan } else { &self.subdivide.lattice };
+        let variant = self.subdivide_for(params);
+        let pipeline = if entry == "plan" { &variant.plan } else { &variant.lattice };
         let bind_group = self.subdivide_bind_group(entry, uniform, scene, buffers);
         let cut_groups = ["plan_cuts_args", "plan_cuts"].map(|e| self.subdivide_bind_group(e, uniform, scene, buffers));
         let finalize = self.subdivide_bind_group("finalize", uniform, scene, buffers);
@@ -377,9 +406,9 @@ impl Renderer {
             let (x, y) = self.gpu.workgroups(count, 64);
             pass.dispatch_workgroups(x, y, 1);
             if entry == "plan" {
-                self.encode_plan_cuts(&mut pass, buffers, &cut_groups);
+                Self::encode_plan_cuts(variant, &mut pass, buffers, &cut_groups);
             }
-            pass.set_pipeline(&self.subdivide.finalize);
+            pass.set_pipeline(&variant.finalize);
             pass.set_bind_group(0, &finalize, &[]);
             pass.dispatch_workgroups(1, 1, 1);
         }
@@ -389,11 +418,16 @@ impl Renderer {
     }
 
     /// `plan_cuts_args` and `plan_cuts` (the triangles `plan` listed), after `plan`.
-    fn encode_plan_cuts(&self, pass: &mut wgpu::ComputePass, b: &SubdivisionBuffers, groups: &[wgpu::BindGroup; 2]) {
-        pass.set_pipeline(&self.subdivide.plan_cuts_args);
+    fn encode_plan_cuts(
+        variant: &SubdivideVariant,
+        pass: &mut wgpu::ComputePass,
+        b: &SubdivisionBuffers,
+        groups: &[wgpu::BindGroup; 2],
+    ) {
+        pass.set_pipeline(&variant.plan_cuts_args);
         pass.set_bind_group(0, &groups[0], &[]);
         pass.dispatch_workgroups(1, 1, 1);
-        pass.set_pipeline(&self.subdivide.plan_cuts);
+        pass.set_pipeline(&variant.plan_cuts);
         pass.set_bind_group(0, &groups[1], &[]);
         pass.dispatch_workgroups_indirect(&b.lattice_dispatch, 12);
     }
@@ -429,20 +463,21 @@ impl Renderer {
                 }),
             });
             let (x, y) = self.gpu.workgroups(params.triangle_count, 64);
-            pass.set_pipeline(&self.subdivide.active_cuts);
+            let variant = self.subdivide_for(&params);
+            pass.set_pipeline(&variant.active_cuts);
             pass.set_bind_group(0, &groups[0], &[]);
             pass.dispatch_workgroups(x, y, 1);
-            pass.set_pipeline(&self.subdivide.plan);
+            pass.set_pipeline(&variant.plan);
             pass.set_bind_group(0, &groups[1], &[]);
             pass.dispatch_workgroups(x, y, 1);
-            self.encode_plan_cuts(&mut pass, b, &cut_groups);
-            pass.set_pipeline(&self.subdivide.lattice_args);
+            Self::encode_plan_cuts(variant, &mut pass, b, &cut_groups);
+            pass.set_pipeline(&variant.lattice_args);
             pass.set_bind_group(0, &groups[2], &[]);
             pass.dispatch_workgroups(1, 1, 1);
-            pass.set_pipeline(&self.subdivide.lattice);
+            pass.set_pipeline(&variant.lattice);
             pass.set_bind_group(0, &groups[3], &[]);
             pass.dispatch_workgroups_indirect(&b.lattice_dispatch, 0);
-            pass.set_pipeline(&self.subdivide.finalize);
+            pass.set_pipeline(&variant.finalize);
             pass.set_bind_group(0, &groups[4], &[]);
             pass.dispatch_workgroups(1, 1, 1);
         }

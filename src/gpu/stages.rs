@@ -93,12 +93,17 @@ impl GpuStage {
 
     /// The compute pipeline of one entry point.
     pub fn compute(&self, gpu: &Gpu, entry: &str) -> wgpu::ComputePipeline {
+        self.compute_with(gpu, entry, &[])
+    }
+
+    /// The same with pipeline-overridable constants set (WGSL `override`).
+    pub fn compute_with(&self, gpu: &Gpu, entry: &str, constants: &[(&str, f64)]) -> wgpu::ComputePipeline {
         gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some(entry),
             layout: Some(&self.pipeline_layout(Some(entry)).layout),
             module: &self.module,
             entry_point: Some(entry),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
             cache: None,
         })
     }
