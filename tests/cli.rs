@@ -471,6 +471,10 @@ fn bench_speed_honours_scale_viewer_and_lod() {
     };
     let plain = run(&[]);
     assert_eq!(plain["triangles_in"], 100);
+    // The columns that show what the subdivision multiplies.
+    let out = plain["triangles_out"].as_u64().unwrap();
+    assert_eq!(plain["vertices_out"].as_u64().unwrap(), 3 * out);
+    assert!((plain["out_per_in"].as_f64().unwrap() - out as f64 / 100.0).abs() < 1e-9, "{plain}");
     // --lod visual-field with the sphere behind the gaze: fewer triangles than the full sphere.
     let lod = run(&["--lod", "visual-field", "--gaze", "180,0"]);
     assert!(lod["triangles_in"].as_u64().unwrap() < 100, "{lod}");

@@ -17,6 +17,11 @@ pub struct SpeedRow {
     pub method: String,
     pub triangles_in: u64,
     pub triangles_out: u64,
+    /// triangles_out / triangles_in: how much the subdivision multiplies the input.
+    pub out_per_in: f64,
+    /// Vertex-stage invocations per eye: three per output triangle (the subdivided output is not
+    /// indexed; the slit renderer runs them per slit it draws an object in).
+    pub vertices_out: u64,
     pub pieces: u64,
     pub chunks: u32,
     pub max_sub_edge_px: f32,
@@ -95,6 +100,8 @@ pub fn speed(
                 method: method.name(),
                 triangles_in: last.triangles_in,
                 triangles_out: last.triangles_out,
+                out_per_in: last.triangles_out as f64 / last.triangles_in.max(1) as f64,
+                vertices_out: 3 * last.triangles_out,
                 pieces: last.pieces,
                 chunks: last.chunks,
                 max_sub_edge_px: edges.max_sub_edge_px,
@@ -115,15 +122,17 @@ pub fn speed(
 /// A Markdown table of speed rows.
 pub fn speed_table(rows: &[SpeedRow]) -> String {
     let mut s = String::from(
-        "| scene | method | triangles in | triangles out | ms frame (median) | ms subdivide | ms raster | ratio | max sub-edge px |\n|---|---|---|---|---|---|---|---|---|\n",
+        "| scene | method | triangles in | triangles out | out / in | vertices per eye | ms frame (median) | ms subdivide | ms raster | ratio | max sub-edge px |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         s += &format!(
-            "| {} | {} | {} | {} | {:.1} | {} | {} | {:.2} | {:.1} |\n",
+            "| {} | {} | {} | {} | {:.2} | {} | {:.1} | {} | {} | {:.2} | {:.1} |\n",
             r.scene,
             r.method,
             r.triangles_in,
             r.triangles_out,
+            r.out_per_in,
+            r.vertices_out,
             r.ms_frame,
             r.ms_subdivide.map_or("—".into(), |t| format!("{t:.1}")),
             r.ms_raster.map_or("—".into(), |t| format!("{t:.1}")),
