@@ -773,8 +773,11 @@ fn plan_quadrant(t: u32, q: u32) {
                 part[0] = poly[0];
                 part[1] = poly[i];
                 part[2] = poly[i + 1u];
-                plan_part();
-                append_pieces(t);
+                // A part wholly beyond the image's rows makes no pieces (`run` in subdivide.rs).
+                if (!off_screen_vertically(part[0].position, part[1].position, part[2].position)) {
+                    plan_part();
+                    append_pieces(t);
+                }
             }
         }
     }
@@ -1020,6 +1023,9 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     if (same(piece_q[0].position, piece_q[1].position) || same(piece_q[1].position, piece_q[2].position)
         || same(piece_q[2].position, piece_q[0].position)) {
         return; // snapped corners coincide: no area
+    }
+    if (off_screen_vertically(piece_q[0].position, piece_q[1].position, piece_q[2].position)) {
+        return; // every sub-triangle would be culled
     }
     // Each piece edge: on an original edge (that edge's fine nodes, by global index) or interior.
     for (var e = 0u; e < 3u; e++) {

@@ -52,9 +52,10 @@
 //! as its "original" edges. On the GPU, `plan` plans the triangles that are their own single part
 //! and lists the others for `plan_cuts`, which clips them.
 //!
-//! **Off screen.** Triangles that lie wholly above or below the image (see
-//! [`Subdivider::off_screen_vertically`]) make no pieces, and sub-triangles that do are not
-//! emitted: a floor or ceiling near the axis is not subdivided where no one can see it.
+//! **Off screen.** Triangles, parts and pieces that lie wholly above or below the image's rows
+//! (see [`Subdivider::off_screen_vertically`]) make no pieces or no lattice, and sub-triangles
+//! that do are not emitted: a floor or ceiling near the axis is not subdivided where no one can
+//! see it (the box room at 1024×1024: 750 pieces instead of 1,956, the same image).
 //!
 //! **The seam.** Each output triangle carries the azimuth of its centroid, `theta_ref`; the vertex
 //! stage unwraps θ by whole turns towards it. A triangle whose u range (both eyes) crosses ±π is
@@ -351,6 +352,11 @@ impl<'a> Subdivider<'a> {
         for t in first..first + self.params.triangle_count as usize {
             let tri = self.load(vertices, indices, t);
             for part in self.triangle_parts(&tri, cuts) {
+                // A part (a band of a floor under the viewer) wholly beyond the image's rows
+                // makes no pieces; likewise a piece in `lattice`.
+                if self.off_screen_vertically(part.map(|n| n.position)) {
+                    continue;
+                }
                 let (k, n) = self.plan(&tri, &part);
                 for cell in 0..k * k {
                     out.pieces += 1;
@@ -394,6 +400,9 @@ impl<'a> Subdivider<'a> {
         let q = loc.map(|l| self.macro_node(part, n, k, l));
         if q[0].position == q[1].position || q[1].position == q[2].position || q[2].position == q[0].position {
             return; // snapped corners coincide: no area
+        }
+        if self.off_screen_vertically(q.map(|n| n.position)) {
+            return; // every sub-triangle would be culled
         }
         // Each piece edge: on an original edge (that edge's fine nodes, by global index) or interior.
         let mut edges = [PieceEdge::default(); 3];
