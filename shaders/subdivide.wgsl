@@ -60,6 +60,10 @@ struct SubdivideParams {
     first_piece: u32,
     piece_count: u32,
     measure_edges: u32,  // 1: also track the longest visible output edge
+    vertical_limit: f32, // |y| > this·r: no pixel row shows the point (`Projection::vertical_limit`)
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 struct Counters {
@@ -255,19 +259,8 @@ fn edge_divisions(a: vec3<f32>, b: vec3<f32>) -> u32 {
 
 // Whether a triangle lies wholly above or below the image (see `off_screen_vertically` in
 // src/cpu/subdivide/ for why testing the corners suffices).
-// The slope beyond which |y|/r shows in no pixel row (`Subdivider::vertical_limit`).
-fn vertical_limit() -> f32 {
-    if (is_sphere(params.projection)) {
-        return 1.0 / tan(0.5 * PI / params.projection.height);
-    }
-    let rt = params.projection.screen_radius;
-    let de = params.projection.eye_radius;
-    let half = 0.5 * params.projection.height / params.projection.pixels_per_v;
-    return half / (rt * sqrt(1.0 - (de / rt) * (de / rt)));
-}
-
 fn off_screen_vertically(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> bool {
-    let k = vertical_limit();
+    let k = params.vertical_limit;
     let r = vec3<f32>(horizontal_radius(p0), horizontal_radius(p1), horizontal_radius(p2));
     let y = vec3<f32>(p0.y, p1.y, p2.y);
     return all(y > k * r) || all(y < -k * r);

@@ -155,20 +155,19 @@ pub struct DepthImage {
 pub fn depth_images(frame: &Frame, layout: Layout) -> Option<Vec<(String, DepthImage)>> {
     let [left, right] = frame.depth.as_ref()?;
     let (w, h) = (frame.left.width, frame.left.height);
-    Some(match layout {
+    let images = match layout {
         Layout::Eyes | Layout::Twister => vec![
-            ("left_depth.exr".into(), DepthImage { width: w, height: h, values: left.clone() }),
-            ("right_depth.exr".into(), DepthImage { width: w, height: h, values: right.clone() }),
+            DepthImage { width: w, height: h, values: left.clone() },
+            DepthImage { width: w, height: h, values: right.clone() },
         ],
         Layout::TopBottom => {
-            let values = left.iter().chain(right).copied().collect();
-            vec![("depth_TB.exr".into(), DepthImage { width: w, height: 2 * h, values })]
+            vec![DepthImage { width: w, height: 2 * h, values: left.iter().chain(right).copied().collect() }]
         }
         Layout::SideBySide => {
-            let values = side_by_side(left, right, w as usize, 1);
-            vec![("depth_LR.exr".into(), DepthImage { width: 2 * w, height: h, values })]
+            vec![DepthImage { width: 2 * w, height: h, values: side_by_side(left, right, w as usize, 1) }]
         }
-    })
+    };
+    Some(depth_names(layout).into_iter().zip(images).collect())
 }
 
 /// The names [`depth_images`] gives a layout.

@@ -12,5 +12,6 @@ pub mod material;
 pub mod projection;
 pub mod scene;
 pub mod settings;
+pub mod sphere;
 pub mod texture;
 pub mod visual_field;

@@ -83,7 +83,7 @@ impl From<&Projection> for ProjectionUniform {
     }
 }
 
-/// `SubdivideParams` in shaders/subdivide.wgsl. 144 bytes.
+/// `SubdivideParams` in shaders/subdivide.wgsl. 176 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct SubdivideParams {
@@ -111,6 +111,11 @@ pub struct SubdivideParams {
     pub piece_count: u32,
     /// 1: also measure the longest visible output edge (`max_sub_edge_px`, costs projections).
     pub measure_edges: u32,
+    /// `Projection::vertical_limit`: beyond |y| > this·r no pixel row shows a point.
+    pub vertical_limit: f32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
 }
 
 /// `Counters` in shaders/subdivide.wgsl.
@@ -296,7 +301,7 @@ pub const LAYOUTS: &[StructLayout] = &[
     }),
     layout!("SubdivideParams" => SubdivideParams {
         view, projection, axis_clearance, triangle_count, first_triangle, method, fixed_n, edge_px, max_div,
-        piece_capacity, triangle_capacity, first_piece, piece_count, measure_edges
+        piece_capacity, triangle_capacity, first_piece, piece_count, measure_edges, vertical_limit, _pad0, _pad1, _pad2
     }),
     layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, cuts_low, cuts_high, _pad1, _pad2 }),
     layout!("Piece" => Piece { triangle, cell, counts01, count2_level, corner, bary1, bary2 }),

@@ -262,7 +262,7 @@ pub fn triangle_cuts(p: [Vec3; 3], rho: f32, limit: f32) -> AxisCuts {
 
 /// The largest k < `MAX_DIAMONDS` with c_k ≤ d (0 if none): an estimate from the logarithm,
 /// then exact steps. `band_of` in the WGSL.
-pub fn band_of(rho: f32, d: f32) -> u32 {
+fn band_of(rho: f32, d: f32) -> u32 {
     let mut k = (2.0 * (d / rho).max(1.0).log2()).min((MAX_DIAMONDS - 1) as f32) as u32;
     while k > 0 && band_bound(rho, k) > d {
         k -= 1;
@@ -274,7 +274,7 @@ pub fn band_of(rho: f32, d: f32) -> u32 {
 }
 
 /// The next active diamond after k, or `MAX_DIAMONDS` if none. `next_cut` in the WGSL.
-pub fn next_cut(cuts: AxisCuts, k: u32) -> u32 {
+fn next_cut(cuts: AxisCuts, k: u32) -> u32 {
     let above = if k + 1 >= MAX_DIAMONDS { 0 } else { cuts & (u64::MAX << (k + 1)) };
     if above == 0 {
         MAX_DIAMONDS
@@ -285,7 +285,7 @@ pub fn next_cut(cuts: AxisCuts, k: u32) -> u32 {
 
 /// The active diamond at or below distance d: the largest active k with c_k ≤ d (k = 0, the
 /// square, always counts). `zone_of` in the WGSL.
-pub fn zone_of(cuts: AxisCuts, rho: f32, d: f32) -> u32 {
+fn zone_of(cuts: AxisCuts, rho: f32, d: f32) -> u32 {
     let mut k = band_of(rho, d);
     while k > 0 && cuts & (1 << k) == 0 {
         k -= 1;

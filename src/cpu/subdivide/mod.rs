@@ -77,7 +77,7 @@ use crate::shader::types::{DrawVertex, SubdivideParams};
 
 mod axis;
 
-pub use axis::{axis_clearance, band_limit, diamond_range, parts, snap_to_cut_planes, triangle_cuts, AxisCuts};
+pub use axis::{axis_clearance, band_limit, parts, snap_to_cut_planes, triangle_cuts, AxisCuts};
 
 /// The `subdivide` stage's parameters for a range of input triangles (capacities and piece
 /// ranges are left for the caller, 0).
@@ -100,6 +100,8 @@ pub fn subdivide_params(settings: &RenderSettings, first_triangle: u32, triangle
         first_piece: 0,
         piece_count: 0,
         measure_edges: (settings.measure.edges || settings.measure.error) as u32,
+        vertical_limit: projection.vertical_limit(),
+        ..Default::default()
     }
 }
 
@@ -276,18 +278,10 @@ impl<'a> Subdivider<'a> {
         }
     }
 
-    /// The slope k such that a point with |y| > k·r shows in no pixel: above the top of the
-    /// cylinder's image, or on the sphere beyond the centre of its first (or last) pixel row
-    /// (latitude π/2 − π/2H), which no rasterized sample reaches. The exact model has
-    /// v ≥ v_paper·√(1 − d_e²/R_T²), so k = half height / (R_T·√(1 − d_e²/R_T²)) is safe for both
-    /// vertical models; on the sphere the latitude atan2(y, √(r² − e²)) ≥ atan(y/r), so
-    /// k = 1/tan(π/2H) is safe for every eye offset. `vertical_limit` in subdivide.wgsl.
+    /// The slope k such that a point with |y| > k·r shows in no pixel row
+    /// ([`Projection::vertical_limit`], passed to the GPU in `SubdivideParams`).
     pub fn vertical_limit(&self) -> f32 {
-        if self.projection.panorama == PanoramaKind::Equirect {
-            return 1.0 / (0.5 * PI / self.projection.height as f32).tan();
-        }
-        let (rt, de) = (self.projection.screen_radius, self.projection.eye_radius);
-        self.projection.half_height_m() / (rt * (1.0 - (de / rt) * (de / rt)).sqrt())
+        self.params.vertical_limit
     }
 
     /// Whether a triangle shows in no pixel row: wholly above or wholly below the image's rows
