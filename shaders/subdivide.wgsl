@@ -51,7 +51,7 @@ struct SubdivideParams {
     axis_clearance: f32,
     triangle_count: u32,
     first_triangle: u32,
-    method: u32,            // METHOD_VERTEX, METHOD_FIXED or METHOD_ADAPTIVE
+    method: u32,            // METHOD_VERTEX, METHOD_FIXED, METHOD_ADAPTIVE (length) or METHOD_ERROR
     fixed_n: u32,
     edge_px: f32,           // L
     max_div: u32,           // N_max
@@ -61,7 +61,7 @@ struct SubdivideParams {
     piece_count: u32,
     measure_edges: u32,  // 1: also track the longest visible output edge
     vertical_limit: f32, // |y| > this·r: no pixel row shows the point (`Projection::vertical_limit`)
-    _pad0: u32,
+    max_error_px: f32,   // τ of the error split
     _pad1: u32,
     _pad2: u32,
 }
@@ -132,6 +132,7 @@ var<private> tri_material: u32;
 var<private> tri_object: u32;
 // L for this triangle: params.edge_px × its object's factor (read once in `load_triangle`).
 var<private> tri_edge_px: f32;
+var<private> tri_max_error_px: f32;
 // The part being split (see `triangle_part`), and its plan.
 var<private> part: array<Node, 3>;
 var<private> tri_n: array<u32, 3>;    // divisions of the part's edges Q0Q1, Q1Q2, Q2Q0
@@ -192,9 +193,18 @@ fn pixel(p: vec3<f32>, eye_sign: f32) -> vec2<f32> {
     return vec2<f32>(q.x * params.projection.width / TAU, q.y * params.projection.pixels_per_v);
 }
 
-// Projected length in pixels of the straight edge ab, larger of the two eyes, heights clamped
-// (segments beyond the clamp at both ends count 0), as a polyline of `segments` segments.
-fn edge_length_px(a: vec3<f32>, b: vec3<f32>, segments: u32) -> f32 {
+// What the split rules read of the straight edge ab (`Subdivider::edge_profile`): sampled at
+// `segments` segments, both eyes, in canonical order: the projected length by which eq. 5 splits
+// it (heights clamped, segments beyond the clamp at both ends counting 0, stretch-adjusted), the
+// largest second difference of the sampled points (x unwrapped, triples beyond the clamp
+// skipped) by which the error split splits it, and whether it comes near the eye circle.
+struct EdgeProfile {
+    length_px: f32,
+    bend_px: f32,
+    ring: bool,
+}
+
+fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
     var lo = a;
     var hi = b;
     if (lex_less(b, a)) {
@@ -206,22 +216,32 @@ fn edge_length_px(a: vec3<f32>, b: vec3<f32>, segments: u32) -> f32 {
     var length_px = 0.0;
     var longest = 0.0;
     var nearest = 1e30;
+    var bend = 0.0;
     for (var s = 0u; s < 2u; s++) {
         let eye_sign = select(-1.0, 1.0, s == 1u);
         var total = 0.0;
         var prev = vec2<f32>(0.0, 0.0);
+        var q0 = vec2<f32>(0.0, 0.0);
+        var q1 = vec2<f32>(0.0, 0.0);
         for (var k = 0u; k <= segments; k++) {
             let t = f32(k) / f32(segments);
             let p = lo + (hi - lo) * t;
             nearest = min(nearest, horizontal_radius(p));
-            var q = pixel(p, eye_sign);
+            let raw = pixel(p, eye_sign);
+            var q = raw;
             q.y = clamp(q.y, -clamp_v, clamp_v);
+            let dx = (q.x - prev.x) - width * round((q.x - prev.x) / width);
             if (k > 0u && !(q.y == prev.y && abs(q.y) == clamp_v)) {
-                let dx = (q.x - prev.x) - width * round((q.x - prev.x) / width);
                 let segment = length(vec2<f32>(dx, q.y - prev.y));
                 longest = max(longest, segment);
                 total += segment;
             }
+            let unwrapped = vec2<f32>(select(raw.x, q1.x + dx, k > 0u), raw.y);
+            if (k >= 2u && abs(unwrapped.y) < clamp_v && abs(q1.y) < clamp_v && abs(q0.y) < clamp_v) {
+                bend = max(bend, length(unwrapped - 2.0 * q1 + q0));
+            }
+            q0 = q1;
+            q1 = unwrapped;
             prev = q;
         }
         length_px = max(length_px, total);
@@ -231,9 +251,16 @@ fn edge_length_px(a: vec3<f32>, b: vec3<f32>, segments: u32) -> f32 {
     let shows_ring = params.projection.vertical_exact == 0u || is_sphere(params.projection);
     let ring = shows_ring && nearest < 2.0 * params.projection.eye_radius;
     let stretch = select(MAX_STRETCH, 1.0, ring);
-    return max(length_px, f32(segments) * longest / stretch);
+    return EdgeProfile(max(length_px, f32(segments) * longest / stretch), bend, ring);
 }
 
+// Parts for a chord error of at most τ (`parts_for_bend`).
+fn parts_for_bend(bend_px: f32, segments: u32, max_error_px: f32) -> f32 {
+    return ceil(f32(segments) * sqrt(bend_px / (8.0 * max_error_px)));
+}
+
+// Divisions of an edge (`Subdivider::edge_divisions`): eq. 5 for METHOD_ADAPTIVE, the error
+// split for METHOD_ERROR. (One call site per rule in a loop: lavapipe's compiler inlines every call.)
 fn edge_divisions(a: vec3<f32>, b: vec3<f32>) -> u32 {
     if (params.method == METHOD_VERTEX) {
         return 1u;
@@ -241,16 +268,21 @@ fn edge_divisions(a: vec3<f32>, b: vec3<f32>) -> u32 {
     if (params.method == METHOD_FIXED) {
         return params.fixed_n;
     }
-    // Quick 2-segment length first; the 8-segment polyline refines it, so it is never shorter.
-    // (One call site in a loop: lavapipe's compiler inlines every call.)
-    var length_px = 0.0;
-    for (var round = 0u; round < 2u; round++) {
-        length_px = edge_length_px(a, b, select(2u, EDGE_SAMPLES, round == 1u));
-        if (round == 0u && length_px <= 0.5 * tri_edge_px) {
+    var n = 0.0;
+    let quick = edge_profile(a, b, 2u);
+    if (params.method == METHOD_ADAPTIVE) {
+        if (quick.length_px <= 0.5 * tri_edge_px) {
             return 1u;
         }
+        n = ceil(edge_profile(a, b, EDGE_SAMPLES).length_px / tri_edge_px);
+    } else {
+        if (quick.length_px <= tri_edge_px && !quick.ring && parts_for_bend(quick.bend_px, 2u, tri_max_error_px) <= 1.0) {
+            return 1u;
+        }
+        let p = edge_profile(a, b, EDGE_SAMPLES);
+        let longest = select(ERROR_SPLIT_LENGTH * tri_edge_px, tri_edge_px, p.ring);
+        n = max(parts_for_bend(p.bend_px, EDGE_SAMPLES, tri_max_error_px), ceil(p.length_px / longest));
     }
-    let n = ceil(length_px / tri_edge_px);
     if (n >= f32(MAX_EDGE_DIVISIONS) || !(n == n)) {
         return MAX_EDGE_DIVISIONS;
     }
@@ -286,7 +318,14 @@ fn load_triangle(t: u32) {
     }
     tri_material = vertices[indices[3u * t]].material;
     tri_object = vertices[indices[3u * t]].object;
-    tri_edge_px = params.edge_px * object_edge_scale[min(tri_object, arrayLength(&object_edge_scale) - 1u)];
+    let scale = object_edge_scale[min(tri_object, arrayLength(&object_edge_scale) - 1u)];
+    tri_edge_px = params.edge_px * scale;
+    tri_max_error_px = params.max_error_px * (scale * scale);
+}
+
+// Whether the method is one of the adaptive rules (eq. 5 or the error split).
+fn is_adaptive() -> bool {
+    return params.method == METHOD_ADAPTIVE || params.method == METHOD_ERROR;
 }
 
 // Edge counts and macro-lattice level of the current part.
@@ -296,7 +335,7 @@ fn plan_part() {
     }
     let m = max(max(tri_n[0], tri_n[1]), tri_n[2]);
     tri_k = 1u;
-    if (params.method == METHOD_ADAPTIVE) {
+    if (is_adaptive()) {
         let step = min(params.max_div, PIECE_DIVISIONS);
         tri_k = min((m + step - 1u) / step, MAX_MACRO_LEVEL);
     } else if (params.method == METHOD_FIXED) {
@@ -917,7 +956,7 @@ fn active_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
         return;
     }
     // Diamonds for the adaptive method only (`band_limit` in axis.rs).
-    let limit = select(0.0, BAND_LIMIT * params.projection.screen_radius, params.method == METHOD_ADAPTIVE);
+    let limit = select(0.0, BAND_LIMIT * params.projection.screen_radius, is_adaptive());
     let bits = triangle_cuts(limit);
     if (bits.x != 0u) {
         atomicOr(&counters.cuts_low, bits.x);

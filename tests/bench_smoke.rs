@@ -44,11 +44,11 @@ fn quick_benchmark_writes_every_output_well_formed() {
     assert_eq!(fig8.len(), 3 * 4, "three distances × the quick N values");
     let fig10 = csv_rows(&out.join("fig10.csv"), &cols);
     let fig12 = csv_rows(&out.join("fig12.csv"), &cols);
-    let matched = csv_rows(&out.join("fig12_matched.csv"), &["scene", "adaptive_ms", "w_star", "note"]);
+    let matched = csv_rows(&out.join("fig12_matched.csv"), &["scene", "method", "adaptive_ms", "w_star", "note"]);
     let scenes = 4;
-    assert_eq!(matched.len(), scenes);
-    assert_eq!(fig10.len(), scenes * 5, "vertex, fixed:1/4/7, adaptive per scene");
-    assert_eq!(fig12.len(), scenes * 4, "adaptive and three slit widths per scene");
+    assert_eq!(matched.len(), scenes * 2, "adaptive:length and adaptive per scene");
+    assert_eq!(fig10.len(), scenes * 6, "vertex, fixed:1/4/7, adaptive:length, adaptive per scene");
+    assert_eq!(fig12.len(), scenes * 5, "adaptive:length, adaptive and three slit widths per scene");
     for row in fig10.iter().chain(&fig12) {
         let ms: f64 = row[6].parse().unwrap();
         let mean: f64 = row[3].parse().unwrap();

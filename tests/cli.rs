@@ -196,11 +196,21 @@ fn subdivision_flags_take_effect_and_are_reported() {
     let fixed = stats(&["--method", "fixed:3"]);
     assert_eq!(fixed["method"], "fixed:3");
     assert_eq!(fixed["triangles_out"].as_u64().unwrap(), 9 * parts);
-    let coarse = stats(&["--edge-px", "64"]);
-    let fine = stats(&["--edge-px", "4"]);
+    // The paper's eq. 5 (`--split length` or `--method adaptive:length`) follows L ...
+    let coarse = stats(&["--split", "length", "--edge-px", "64"]);
+    let fine = stats(&["--method", "adaptive:length", "--edge-px", "4"]);
     assert_eq!(fine["edge_px"], 4.0);
+    assert_eq!(fine["method"], "adaptive:length");
+    assert_eq!(coarse["method"], "adaptive:length");
     assert!(fine["triangles_out"].as_u64() > coarse["triangles_out"].as_u64());
-    let tight = stats(&["--edge-px", "0.25", "--memory-mb", "8"]);
+    // ... the error split (the default) follows τ.
+    let loose = stats(&["--max-error-px", "2"]);
+    let strict = stats(&["--max-error-px", "0.0625"]);
+    assert_eq!(strict["method"], "adaptive");
+    assert_eq!(strict["max_error_px"], 0.0625);
+    assert!(strict["triangles_out"].as_u64() > loose["triangles_out"].as_u64());
+    assert!(strict["max_sub_edge_px"].as_f64() < loose["max_sub_edge_px"].as_f64());
+    let tight = stats(&["--split", "length", "--edge-px", "0.25", "--memory-mb", "8"]);
     assert!(tight["chunks"].as_u64().unwrap() > 1, "{tight}");
     let _ = std::fs::remove_dir_all(&out);
 }
@@ -386,6 +396,8 @@ fn a_chunked_frame_reports_wall_times_per_pass() {
             "320",
             "--height",
             "60",
+            "--method",
+            "adaptive:length",
             "--edge-px",
             "0.5",
             "--memory-mb",
@@ -414,6 +426,9 @@ fn negative_and_malformed_numbers_are_one_line_naming_the_option() {
         (&["render", "--fit", "-1"][..], "--fit"),
         (&["render", "--edge-px", "-1"][..], "--edge-px"),
         (&["render", "--max-div", "-1"][..], "--max-div"),
+        (&["render", "--max-error-px", "0"][..], "--max-error-px"),
+        (&["render", "--max-error-px", "NaN"][..], "--max-error-px"),
+        (&["render", "--split", "curvature"][..], "--split"),
         (&["render", "--eye-radius", "NaN"][..], "--eye-radius"),
         (&["render", "--yaw", "abc"][..], "--yaw"),
         (&["error", "--heatmap-max", "0"][..], "--heatmap-max"),

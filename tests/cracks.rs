@@ -7,7 +7,7 @@ mod common;
 
 use glam::Vec3;
 use twister::core::builtin;
-use twister::core::settings::Method;
+use twister::core::settings::{Method, Split};
 use twister::EyeImage;
 use twister::{Projection, RenderSettings, Scene};
 
@@ -42,9 +42,10 @@ fn holes(img: &EyeImage) -> Vec<(u32, u32)> {
 fn check(scene: &Scene, what: &str, viewer: Vec3, expect_full: bool) {
     let projection = Projection { width: 480, height: 120, ..Projection::default() };
     let configs = [
-        (Method::Adaptive, 32.0, 7),
-        (Method::Adaptive, 8.0, 7),
-        (Method::Adaptive, 4.0, 3),
+        (Method::Adaptive(Split::Length), 32.0, 7),
+        (Method::Adaptive(Split::Length), 8.0, 7),
+        (Method::Adaptive(Split::Length), 4.0, 3),
+        (Method::Adaptive(Split::Error), 32.0, 7),
         (Method::Fixed(3), 32.0, 7),
         (Method::Vertex, 32.0, 7),
     ];
@@ -124,9 +125,10 @@ fn surround_scenes_show_no_background_for_any_method_size_or_vertical_model() {
         (Method::Fixed(7), 32.0, 7),
         (Method::Fixed(8), 32.0, 7),
         (Method::Fixed(45), 32.0, 7),
-        (Method::Adaptive, 4.0, 3),
-        (Method::Adaptive, 32.0, 7),
-        (Method::Adaptive, 128.0, 7),
+        (Method::Adaptive(Split::Length), 4.0, 3),
+        (Method::Adaptive(Split::Length), 32.0, 7),
+        (Method::Adaptive(Split::Length), 128.0, 7),
+        (Method::Adaptive(Split::Error), 32.0, 7),
     ];
     let r = common::renderer();
     let mut renders = 0;
@@ -171,7 +173,9 @@ fn the_demo_room_is_closed_at_1024_square() {
     let r = common::renderer();
     let gs = twister::GpuScene::upload(&r.gpu, &builtin::demo()).unwrap();
     for vertical in [Vertical::Paper, Vertical::Exact] {
-        for method in [Method::Vertex, Method::Fixed(7), Method::Adaptive] {
+        for method in
+            [Method::Vertex, Method::Fixed(7), Method::Adaptive(Split::Length), Method::Adaptive(Split::Error)]
+        {
             let projection = Projection { width: 1024, height: 1024, vertical, ..Projection::default() };
             let settings = RenderSettings::new(projection).with_background(BG).with_method(method);
             let frame = r.render(&gs, &settings).unwrap();
@@ -212,7 +216,11 @@ fn triangles_reaching_into_the_eye_circle_are_drawn_whole() {
         let gs = twister::GpuScene::upload(&r.gpu, &scene).unwrap();
         for vertical in [Vertical::Paper, Vertical::Exact] {
             let projection = Projection { width: 640, height: 160, vertical, ..Projection::default() };
-            for (method, margin) in [(Method::Adaptive, 1.5f32), (Method::Fixed(7), 6.0)] {
+            for (method, margin) in [
+                (Method::Adaptive(Split::Length), 1.5f32),
+                (Method::Adaptive(Split::Error), 1.5),
+                (Method::Fixed(7), 6.0),
+            ] {
                 let settings = RenderSettings::new(projection).with_background(BG).with_method(method);
                 let frame = r.render(&gs, &settings).unwrap();
                 for eye in twister::Eye::BOTH {

@@ -5,7 +5,7 @@ mod common;
 use glam::Vec3;
 use twister::core::builtin::{self, SEAM_SPHERE_RADIUS};
 use twister::core::scene::SceneVertex;
-use twister::core::settings::Method;
+use twister::core::settings::{Method, Split};
 use twister::EyeImage;
 use twister::{Eye, Projection, RenderSettings, Scene, Vertical};
 
@@ -167,7 +167,7 @@ fn scene_too_big_for_the_memory_budget_is_drawn_in_chunks_without_loss() {
         (Projection { width: 960, height: 180, ..Projection::default() }, 3.0, false),
         (Projection { width: 256, height: 256, ..Projection::default() }, 4.0, true),
     ] {
-        let roomy = RenderSettings::new(projection).with_edge_px(edge_px);
+        let roomy = RenderSettings::new(projection).with_method(Method::Adaptive(Split::Length)).with_edge_px(edge_px);
         let params = twister::cpu::subdivide::subdivide_params(&roomy, 0, scene.triangle_count() as u32);
         let cuts = twister::cpu::subdivide::Subdivider::new(&params).active_cuts(&scene.vertices, &scene.indices);
         assert_eq!(cuts != 0, cut, "{projection:?}: cuts {cuts:#x}");
@@ -202,7 +202,7 @@ fn a_triangle_far_away_is_drawn_by_every_method() {
             common::pixels_where(&frame.left, |p| !common::is_background(p, settings.shading.background)).len()
         };
         let (vertex, adaptive, slit) =
-            (coverage(Method::Vertex), coverage(Method::Adaptive), coverage(Method::Slit(1)));
+            (coverage(Method::Vertex), coverage(Method::Adaptive(Split::Length)), coverage(Method::Slit(1)));
         eprintln!("{d} m: vertex {vertex}, adaptive {adaptive}, slit:1 {slit} pixels");
         // The exact shape has curved edges: adaptive and slit:1 agree; vertex (straight edges)
         // differs, but draws too.

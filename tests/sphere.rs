@@ -7,7 +7,7 @@ mod common;
 use glam::Vec3;
 use twister::core::builtin;
 use twister::core::projection::PanoramaKind;
-use twister::core::settings::Method;
+use twister::core::settings::{Method, Split};
 use twister::{Eye, Projection, RenderSettings, Scene};
 
 fn twister() -> std::process::Command {
@@ -25,9 +25,12 @@ fn tmp(name: &str) -> std::path::PathBuf {
 #[test]
 fn the_demo_room_on_the_sphere_shows_floor_and_ceiling_whole() {
     let black = [0.0; 3];
-    for (width, method) in
-        [(256, Method::Adaptive), (512, Method::Adaptive), (256, Method::Vertex), (192, Method::Fixed(3))]
-    {
+    for (width, method) in [
+        (256, Method::Adaptive(Split::Length)),
+        (512, Method::Adaptive(Split::Error)),
+        (256, Method::Vertex),
+        (192, Method::Fixed(3)),
+    ] {
         for pole_merge in [Some((60.0, 75.0)), None] {
             let projection = Projection { pole_merge, ..Projection::equirect(width) };
             let settings = RenderSettings::new(projection).with_method(method).with_background(black);

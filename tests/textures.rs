@@ -11,7 +11,7 @@ use glam::{Vec2, Vec3};
 use twister::core::material::{AlphaMode, Filter, Material, Mipmap, Wrap, NO_TEXTURE};
 use twister::core::projection::{Eye, Projection};
 use twister::core::scene::SceneVertex;
-use twister::core::settings::Method;
+use twister::core::settings::{Method, Split};
 use twister::core::texture::Texture;
 use twister::cpu::raster::raster;
 use twister::cpu::slit::{slit, slit_params, slits};
@@ -74,7 +74,7 @@ fn texels_land_where_the_projection_puts_their_texture_coordinates() {
     scene.textures.push(texture(2, 2, |x, y| QUADRANTS[(2 * y + x) as usize]));
     scene.materials.push(Material { texture: 0, mag_filter: Filter::Nearest as u32, ..Default::default() });
     quad(&mut scene, "quad", [-1.0, 1.0], [-1.0, 1.0], -3.0, [Vec2::ZERO, Vec2::ONE], 1, [1.0; 4], false);
-    for method in [Method::Adaptive, Method::Slit(1)] {
+    for method in [Method::Adaptive(Split::Length), Method::Slit(1)] {
         let s = settings(720, 180, method);
         let frame = common::render(&scene, &s);
         for eye in Eye::BOTH {
@@ -178,7 +178,7 @@ fn every_sampler_mode_matches_the_cpu_twin_in_both_drawing_stages() {
     let scene = sampler_scene();
     let table = scene.material_table(usize::MAX);
     // The raster stage (after the subdivision, here on the CPU).
-    let s = settings(640, 120, Method::Adaptive);
+    let s = settings(640, 120, Method::Adaptive(Split::Length));
     let frame = common::render(&scene, &s);
     let prepared =
         subdivide(&subdivide_params(&s, 0, scene.triangle_count() as u32), &scene.vertices, &scene.indices).vertices;
@@ -243,7 +243,7 @@ fn single_sided_faces_seen_from_behind_and_transparent_texels_are_not_drawn() {
     quad(&mut scene, "double-sided, from behind", [xs[2][0], xs[2][1]], y, z, uv, 0, white, true);
     quad(&mut scene, "mask", [xs[3][0], xs[3][1]], y, z, uv, 2, white, false);
     quad(&mut scene, "blend 0.5", [xs[4][0], xs[4][1]], y, z, uv, 3, [1.0, 1.0, 1.0, 0.5], false);
-    for method in [Method::Adaptive, Method::Vertex, Method::Slit(2)] {
+    for method in [Method::Adaptive(Split::Length), Method::Vertex, Method::Slit(2)] {
         let s = settings(900, 150, method);
         let frame = common::render(&scene, &s);
         for eye in Eye::BOTH {
@@ -268,7 +268,7 @@ fn single_sided_faces_seen_from_behind_and_transparent_texels_are_not_drawn() {
 #[test]
 fn box_textured_shows_its_logo_colours() {
     let dir = common::asset("gltf/BoxTextured/glTF");
-    let mut s = settings(1200, 300, Method::Adaptive);
+    let mut s = settings(1200, 300, Method::Adaptive(Split::Length));
     let mut scene =
         twister::core::load::load_scene(dir.join("BoxTextured.gltf").to_str().unwrap(), &s.view.projection).unwrap();
     assert_eq!(scene.textures.len(), 1);

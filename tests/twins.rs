@@ -8,7 +8,7 @@ mod common;
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
 use twister::core::builtin;
-use twister::core::settings::Method;
+use twister::core::settings::{Method, Split};
 use twister::cpu::raster::{raster, raster_params};
 use twister::cpu::reduce_error::reduce_error;
 use twister::cpu::slit::{slit, slit_params, slits};
@@ -197,9 +197,12 @@ impl Twin for Subdivide {
             (random_triangle_scene(5, 200), base.with_method(Method::Fixed(5))),
             (builtin::demo(), base),
             (builtin::demo(), moved.with_projection(tall_projection).with_method(Method::Vertex)),
-            (builtin::demo(), moved.with_edge_px(12.0).with_max_div(4)),
-            (sphere, base.with_edge_px(8.0)),
-            (around, base.with_edge_px(16.0)),
+            (builtin::demo(), moved.with_method(Method::Adaptive(Split::Length)).with_edge_px(12.0).with_max_div(4)),
+            (sphere.clone(), base.with_method(Method::Adaptive(Split::Length)).with_edge_px(8.0)),
+            // The error split (the default method) with a fine tolerance.
+            (sphere, base.with_max_error_px(0.05)),
+            (around, base.with_method(Method::Adaptive(Split::Length)).with_edge_px(16.0)),
+            (builtin::sphere_scene(1024, Vec3::ZERO, 2.5, "sphere around the viewer"), base.with_max_error_px(0.2)),
             // fixed:N beyond 32 divisions: pre-split into pieces (one invocation used to stop short).
             (builtin::builtin_scene("builtin:triangle@3", &projection).unwrap(), base.with_method(Method::Fixed(64))),
             (random_triangle_scene(6, 12), base.with_method(Method::Fixed(45))),
@@ -209,7 +212,14 @@ impl Twin for Subdivide {
             (box_room.clone(), tall.with_method(Method::Vertex)),
             (box_room, tall_exact.with_method(Method::Fixed(7))),
             (cube.clone(), tall.with_viewer(Vec3::new(0.0, 0.95, 0.0))),
-            (cube.clone(), small.with_viewer(Vec3::new(0.0, 0.95, 0.0)).with_edge_px(4.0).with_max_div(3)),
+            (
+                cube.clone(),
+                small
+                    .with_viewer(Vec3::new(0.0, 0.95, 0.0))
+                    .with_method(Method::Adaptive(Split::Length))
+                    .with_edge_px(4.0)
+                    .with_max_div(3),
+            ),
             (cube, tall_exact.with_viewer(Vec3::new(0.1, -0.8, 0.2)).with_edge_px(12.0)),
             // The full sphere: the poles (pole merge on and off), converging rays, the seam.
             (builtin::demo(), RenderSettings::new(Projection::equirect(256))),
@@ -384,7 +394,7 @@ impl Twin for Raster {
             let projection = Projection { width: 400, height: 100, vertical, ..Projection::default() };
             out.push((format!("demo {vertical:?}"), (builtin::demo(), RenderSettings::new(projection), None)));
             let triangle = builtin::builtin_scene("builtin:triangle@3", &projection).unwrap();
-            for method in [Method::Vertex, Method::Adaptive] {
+            for method in [Method::Vertex, Method::Adaptive(Split::Length), Method::Adaptive(Split::Error)] {
                 let settings = RenderSettings::new(projection).with_method(method);
                 out.push((
                     format!("triangle@3 {} {vertical:?}", method.name()),
@@ -489,9 +499,9 @@ impl Twin for ReduceError {
         let mut out = Vec::new();
         for (name, scene, method, per_eye) in [
             ("triangle@3 vertex", "builtin:triangle@3", Method::Vertex, false),
-            ("demo adaptive", "builtin:demo", Method::Adaptive, false),
+            ("demo adaptive", "builtin:demo", Method::Adaptive(Split::Length), false),
             // One dispatch per eye, as for images beyond one storage binding.
-            ("demo adaptive, one eye at a time", "builtin:demo", Method::Adaptive, true),
+            ("demo adaptive, one eye at a time", "builtin:demo", Method::Adaptive(Split::Length), true),
         ] {
             let projection = Projection { width: 480, height: 90, ..Projection::default() };
             let scene = builtin::builtin_scene(scene, &projection).unwrap();

@@ -6,7 +6,9 @@ use glam::Vec3;
 
 use twister::core::lod::LodParams;
 use twister::core::projection::{PanoramaKind, DEFAULT_POLE_MERGE};
-use twister::core::settings::{Method, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV, DEFAULT_MEMORY_MB};
+use twister::core::settings::{
+    Method, Split, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV, DEFAULT_MAX_ERROR_PX, DEFAULT_MEMORY_MB,
+};
 use twister::core::visual_field::Gaze;
 use twister::error::{Error, Result};
 use twister::{Projection, RenderSettings, Vertical};
@@ -56,10 +58,19 @@ pub struct ViewArgs {
     /// Metres per scene unit: the scene (and --viewer, given in scene units) is scaled by it.
     #[arg(long, default_value_t = 1.0)]
     pub scale: f32,
-    /// Subdivision: adaptive (N = ceil(l/L) per edge), fixed:N (every edge N), vertex (none).
+    /// Subdivision: adaptive (each edge split as --split says), adaptive:length (the paper's
+    /// eq. 5, N = ceil(l/L) per edge), fixed:N (every edge N), vertex (none).
     #[arg(long, value_parser = Method::parse, default_value = "adaptive")]
     pub method: Method,
-    /// L: the longest projected edge `adaptive` leaves, pixels.
+    /// What splits an adaptive edge: error (its projected error, --max-error-px) or length (its
+    /// projected length, --edge-px: the paper's eq. 5) [default: error].
+    #[arg(long, value_enum)]
+    pub split: Option<SplitArg>,
+    /// τ: the display-position error the error split allows an edge, pixels.
+    #[arg(long, default_value_t = DEFAULT_MAX_ERROR_PX)]
+    pub max_error_px: f32,
+    /// L: the longest projected edge `adaptive:length` leaves, pixels (the error split keeps
+    /// edges under 8·L, and under L near the eye circle).
     #[arg(long, default_value_t = DEFAULT_EDGE_PX)]
     pub edge_px: f32,
     /// N_max: the largest lattice step of one piece; larger polygons are pre-split.
@@ -88,6 +99,15 @@ pub struct ViewArgs {
     /// [default: 100] (needs --lod visual-field).
     #[arg(long)]
     pub lod_dinf: Option<f32>,
+}
+
+/// `--split`: what splits an adaptive edge.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SplitArg {
+    /// Its projected error (τ = --max-error-px).
+    Error,
+    /// Its projected length (L = --edge-px): the paper's eq. 5.
+    Length,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -243,8 +263,13 @@ impl ViewArgs {
                 Viewer::Camera(_) => Vec3::ZERO, // placed with the scene (`scene::prepare`)
             })
             .with_yaw_deg(self.yaw)
-            .with_method(self.method)
+            .with_method(match (self.method, self.split) {
+                (Method::Adaptive(_), Some(SplitArg::Error)) => Method::Adaptive(Split::Error),
+                (Method::Adaptive(_), Some(SplitArg::Length)) => Method::Adaptive(Split::Length),
+                (method, _) => method,
+            })
             .with_edge_px(self.edge_px)
+            .with_max_error_px(self.max_error_px)
             .with_max_div(self.max_div)
             .with_memory_mb(self.memory_mb);
         settings.validate()?;

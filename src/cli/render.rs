@@ -108,6 +108,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
             "scene": args.scene,
             "method": settings.subdivision.method.name(),
             "edge_px": settings.subdivision.edge_px,
+            "max_error_px": settings.subdivision.max_error_px,
             "max_div": settings.subdivision.max_div,
             "triangles_in": s.triangles_in,
             "triangles_out": s.triangles_out,

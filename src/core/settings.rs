@@ -16,6 +16,8 @@ pub const MAX_FIXED: u32 = 64;
 pub const DEFAULT_EDGE_PX: f32 = 32.0;
 /// Default N_max, as in the paper.
 pub const DEFAULT_MAX_DIV: u32 = 7;
+/// Default τ of the error split, pixels: see the README for the error it gives.
+pub const DEFAULT_MAX_ERROR_PX: f32 = 0.5;
 
 /// How triangles are drawn (`--method`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -26,10 +28,23 @@ pub enum Method {
     /// Every edge split into N, regular N² lattice (the paper's fixed comparison; ignores N_max).
     /// Beyond 32 divisions the triangle is first cut into K² pieces of N/K (K = ceil(N/32)).
     Fixed(u32),
-    /// N = ceil(l/L) per edge (eq. 5), with pre-split beyond N_max.
-    Adaptive,
+    /// Each edge split into as many equal parts as its rule asks (see [`Split`]), with pre-split
+    /// beyond N_max.
+    Adaptive(Split),
     /// The conventional slit-mosaic renderer with slits of W columns (no subdivision).
     Slit(u32),
+}
+
+/// What decides an adaptive edge's divisions (`--split`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Split {
+    /// The projected error: N = ceil(S·√(b / 8τ)), b the largest second difference of the
+    /// projected edge sampled at S = 8 segments (`Subdivider::edge_profile`), τ `max_error_px`;
+    /// edges stay under 8·L long, and the length rule holds near the eye circle.
+    #[default]
+    Error,
+    /// The projected length, N = ceil(l/L): the paper's eq. 5.
+    Length,
 }
 
 /// The subdivision rule as the `subdivide` stage reads it (`SubdivideParams::method`); the WGSL
@@ -40,16 +55,23 @@ pub enum SplitRule {
     Vertex = 0,
     Fixed = 1,
     Adaptive = 2,
+    AdaptiveError = 3,
 }
 
 impl SplitRule {
-    pub const ALL: [SplitRule; 3] = [SplitRule::Vertex, SplitRule::Fixed, SplitRule::Adaptive];
+    pub const ALL: [SplitRule; 4] =
+        [SplitRule::Vertex, SplitRule::Fixed, SplitRule::Adaptive, SplitRule::AdaptiveError];
+    /// Whether `SubdivideParams::method` is one of the adaptive rules (pre-split, diamonds).
+    pub fn is_adaptive(method: u32) -> bool {
+        method == SplitRule::Adaptive as u32 || method == SplitRule::AdaptiveError as u32
+    }
     /// The WGSL constant's name.
     pub fn wgsl_name(self) -> &'static str {
         match self {
             SplitRule::Vertex => "METHOD_VERTEX",
             SplitRule::Fixed => "METHOD_FIXED",
             SplitRule::Adaptive => "METHOD_ADAPTIVE",
+            SplitRule::AdaptiveError => "METHOD_ERROR",
         }
     }
 }
@@ -60,20 +82,23 @@ impl Method {
         match self {
             Method::Vertex | Method::Slit(_) => (SplitRule::Vertex, 1),
             Method::Fixed(n) => (SplitRule::Fixed, n),
-            Method::Adaptive => (SplitRule::Adaptive, 0),
+            Method::Adaptive(Split::Length) => (SplitRule::Adaptive, 0),
+            Method::Adaptive(Split::Error) => (SplitRule::AdaptiveError, 0),
         }
     }
 
-    /// Parses `adaptive`, `vertex`, `fixed:N` or `slit:W` (the parser of `--method`).
+    /// Parses `adaptive` (the error split), `adaptive:length` (eq. 5), `adaptive:error`,
+    /// `vertex`, `fixed:N` or `slit:W` (the parser of `--method`).
     pub fn parse(s: &str) -> std::result::Result<Method, String> {
         match s {
             "vertex" => Ok(Method::Vertex),
-            "adaptive" => Ok(Method::Adaptive),
+            "adaptive" | "adaptive:error" => Ok(Method::Adaptive(Split::Error)),
+            "adaptive:length" => Ok(Method::Adaptive(Split::Length)),
             _ => match (s.strip_prefix("fixed:").map(str::parse::<u32>), s.strip_prefix("slit:").map(str::parse::<u32>)) {
                 (Some(Ok(n)), _) if (1..=MAX_FIXED).contains(&n) => Ok(Method::Fixed(n)),
                 (_, Some(Ok(w))) if w >= 1 => Ok(Method::Slit(w)),
                 _ => Err(format!(
-                    "unknown method '{s}': expected adaptive, vertex, fixed:N with N in 1..={MAX_FIXED}, or slit:W with W ≥ 1 columns"
+                    "unknown method '{s}': expected adaptive, adaptive:length, vertex, fixed:N with N in 1..={MAX_FIXED}, or slit:W with W ≥ 1 columns"
                 )),
             },
         }
@@ -83,7 +108,8 @@ impl Method {
         match self {
             Method::Vertex => "vertex".into(),
             Method::Fixed(n) => format!("fixed:{n}"),
-            Method::Adaptive => "adaptive".into(),
+            Method::Adaptive(Split::Error) => "adaptive".into(),
+            Method::Adaptive(Split::Length) => "adaptive:length".into(),
             Method::Slit(w) => format!("slit:{w}"),
         }
     }
@@ -103,8 +129,11 @@ pub struct ViewSettings {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SubdivisionSettings {
     pub method: Method,
-    /// L: the longest projected edge wanted from `adaptive`, pixels.
+    /// L: the longest projected edge wanted from `adaptive:length`, pixels (the error split
+    /// keeps edges under 8·L, and L near the eye circle).
     pub edge_px: f32,
+    /// τ: the display-position error the error split allows an edge, pixels.
+    pub max_error_px: f32,
     /// N_max: the largest lattice step of one piece.
     pub max_div: u32,
     /// Budget for the piece and output buffers, MiB.
@@ -170,8 +199,9 @@ impl Default for ViewSettings {
 impl Default for SubdivisionSettings {
     fn default() -> Self {
         SubdivisionSettings {
-            method: Method::Adaptive,
+            method: Method::Adaptive(Split::Error),
             edge_px: DEFAULT_EDGE_PX,
+            max_error_px: DEFAULT_MAX_ERROR_PX,
             max_div: DEFAULT_MAX_DIV,
             memory_mb: DEFAULT_MEMORY_MB,
         }
@@ -204,6 +234,7 @@ builders! {
     with_yaw_deg: f32 => view.yaw_deg,
     with_method: Method => subdivision.method,
     with_edge_px: f32 => subdivision.edge_px,
+    with_max_error_px: f32 => subdivision.max_error_px,
     with_max_div: u32 => subdivision.max_div,
     with_memory_mb: u32 => subdivision.memory_mb,
     with_background: [f32; 3] => shading.background,
@@ -243,6 +274,12 @@ impl RenderSettings {
         let s = &self.subdivision;
         if !(s.edge_px.is_finite() && s.edge_px >= 0.25) {
             return Err(Error::option("--edge-px", format!("must be a number of pixels ≥ 0.25, got {}", s.edge_px)));
+        }
+        if !(s.max_error_px.is_finite() && s.max_error_px >= 0.01) {
+            return Err(Error::option(
+                "--max-error-px",
+                format!("must be a number of pixels ≥ 0.01, got {}", s.max_error_px),
+            ));
         }
         if !(1..=64).contains(&s.max_div) {
             return Err(Error::option("--max-div", format!("must be between 1 and 64, got {}", s.max_div)));

@@ -28,8 +28,11 @@ pub const BAND_RATIO: f32 = std::f32::consts::SQRT_2;
 pub const SNAP: f32 = 1e-6;
 /// An edge is split by the larger of its projected length and `EDGE_SAMPLES` × its longest
 /// sampled segment / this (1 within 2·d_e of the axis in the paper model): equal parts stay short enough where the
-/// projection stretches an edge unevenly, e.g. v ∝ 1/r (see `Subdivider::edge_length_px`).
+/// projection stretches an edge unevenly, e.g. v ∝ 1/r (see `Subdivider::edge_profile`).
 pub const MAX_STRETCH: f32 = 2.0;
+/// The error split leaves no edge longer than this many L (so that depth and attributes, which
+/// interpolate linearly on the screen, do so over bounded spans).
+pub const ERROR_SPLIT_LENGTH: f32 = 8.0;
 /// Seam copies are made for triangles reaching within this many radians of ±π.
 pub const SEAM_MARGIN: f32 = 1e-5;
 /// The most divisions of a piece's edge: `fixed:N` above it is pre-split into a macro-lattice of
@@ -81,6 +84,7 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("BAND_RATIO", F32(BAND_RATIO)),
         ("SNAP", F32(SNAP)),
         ("MAX_STRETCH", F32(MAX_STRETCH)),
+        ("ERROR_SPLIT_LENGTH", F32(ERROR_SPLIT_LENGTH)),
         ("SEAM_MARGIN", F32(SEAM_MARGIN)),
         ("PIECES_FROM_COUNTER", U32(PIECES_FROM_COUNTER)),
         ("MAX_DEPTH", F32(MAX_DEPTH)),

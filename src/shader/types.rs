@@ -113,7 +113,8 @@ pub struct SubdivideParams {
     pub measure_edges: u32,
     /// `Projection::vertical_limit`: beyond |y| > this·r no pixel row shows a point.
     pub vertical_limit: f32,
-    pub _pad0: u32,
+    /// τ: the error split's tolerance per edge, pixels.
+    pub max_error_px: f32,
     pub _pad1: u32,
     pub _pad2: u32,
 }
@@ -301,7 +302,7 @@ pub const LAYOUTS: &[StructLayout] = &[
     }),
     layout!("SubdivideParams" => SubdivideParams {
         view, projection, axis_clearance, triangle_count, first_triangle, method, fixed_n, edge_px, max_div,
-        piece_capacity, triangle_capacity, first_piece, piece_count, measure_edges, vertical_limit, _pad0, _pad1, _pad2
+        piece_capacity, triangle_capacity, first_piece, piece_count, measure_edges, vertical_limit, max_error_px, _pad1, _pad2
     }),
     layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, cuts_low, cuts_high, _pad1, _pad2 }),
     layout!("Piece" => Piece { triangle, cell, counts01, count2_level, corner, bary1, bary2 }),

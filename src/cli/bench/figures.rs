@@ -5,10 +5,11 @@
 //! - **fig8** (Fig. 8): `builtin:triangle@1`, `@3`, `@5` with `fixed:N`, N = 1..10: mean and std
 //!   of the display-position error.
 //! - **fig10** (Fig. 10): Sphere100, Sphere1024, the 16,301-triangle bunny (3 m ahead, filling the
-//!   screen height) and the Sponza atrium (viewer inside at standing height) with `adaptive`,
+//!   screen height) and the Sponza atrium (viewer inside at standing height) with `adaptive:length`, `adaptive`,
 //!   `fixed:1..7` and `vertex`: error (mean, std, p99), frame time for both eyes, output triangles.
-//! - **fig12** (Fig. 12): `slit:W`, W = 1, 2, 4, …, 128 against `adaptive` on the fig10 scenes:
-//!   time and error, and the matched width w* at which slits take as long as `adaptive`
+//! - **fig12** (Fig. 12): `slit:W`, W = 1, 2, 4, …, 128 against `adaptive:length` (the paper's
+//!   eq. 5) and `adaptive` (the error split) on the fig10 scenes: time and error, and the matched
+//!   width w* at which slits take as long as each
 //!   (interpolated between the measured widths with log W linear in log time).
 //!
 //! Times: median of `reps` frames after a warm-up. The frame time is the GPU time from timestamp
@@ -28,7 +29,7 @@ use crate::plot::{draw_panels, Chart, Series, PALETTE};
 use twister::core::load::load_scene;
 use twister::core::projection::{Projection, Vertical};
 use twister::core::scene::Scene;
-use twister::core::settings::Method;
+use twister::core::settings::{Method, Split};
 use twister::{GpuScene, RenderSettings};
 
 /// A scene of the fig10/fig12 evaluations, placed.
@@ -86,6 +87,8 @@ pub struct Point {
 #[derive(Clone, Debug, Serialize)]
 pub struct Matched {
     pub scene: String,
+    /// The adaptive method matched (`adaptive:length`, the paper's, or `adaptive`).
+    pub method: String,
     pub adaptive_ms: f64,
     pub w_star: Option<f64>,
     pub note: String,
@@ -171,8 +174,11 @@ impl Runner<'_> {
         for case in cases {
             let gpu_scene = GpuScene::upload(&self.renderer.gpu, &case.scene)?;
             // Slits converge to the exact vertical model: every fig12 error is measured in it.
-            let adaptive =
-                self.point(&case.label, &gpu_scene, case.viewer, Method::Adaptive, 0, true, Vertical::Exact)?;
+            let mut adaptive = Vec::new();
+            for split in [Split::Length, Split::Error] {
+                let method = Method::Adaptive(split);
+                adaptive.push(self.point(&case.label, &gpu_scene, case.viewer, method, 0, true, Vertical::Exact)?);
+            }
             let mut slits = Vec::new();
             for w in self.cfg.slit_widths() {
                 slits.push(self.point(
@@ -185,8 +191,10 @@ impl Runner<'_> {
                     Vertical::Exact,
                 )?);
             }
-            matched.push(match_width(&case.label, adaptive.ms_frame, &slits));
-            out.push(adaptive);
+            for a in &adaptive {
+                matched.push(match_width(&case.label, &a.method, a.ms_frame, &slits));
+            }
+            out.extend(adaptive);
             out.extend(slits);
         }
         Ok((out, matched))
@@ -195,7 +203,7 @@ impl Runner<'_> {
 
 /// The slit width at which slits take as long as adaptive, log W interpolated linearly in log
 /// time between the two measured widths around it.
-pub fn match_width(scene: &str, adaptive_ms: f64, slits: &[Point]) -> Matched {
+pub fn match_width(scene: &str, method: &str, adaptive_ms: f64, slits: &[Point]) -> Matched {
     let pts: Vec<(f64, f64)> = slits.iter().map(|p| (p.parameter as f64, p.ms_frame)).collect();
     let mut w_star = None;
     for w in pts.windows(2) {
@@ -212,7 +220,7 @@ pub fn match_width(scene: &str, adaptive_ms: f64, slits: &[Point]) -> Matched {
         (None, _, Some(&(w, _))) => format!("adaptive is faster than every slit width up to {w} px"),
         _ => "no slit widths measured".into(),
     };
-    Matched { scene: scene.to_string(), adaptive_ms, w_star, note }
+    Matched { scene: scene.to_string(), method: method.to_string(), adaptive_ms, w_star, note }
 }
 
 fn series_by_scene(
@@ -246,11 +254,12 @@ fn series_by_scene(
         .collect()
 }
 
-/// Position of a fig10 method on the x axis: vertex, fixed:1..7, adaptive.
+/// Position of a fig10 method on the x axis: vertex, fixed:1..7, adaptive:length, adaptive.
 fn method_x(p: &Point) -> Option<f64> {
     match p.method.as_str() {
         "vertex" => Some(0.0),
-        "adaptive" => Some(8.0),
+        "adaptive:length" => Some(8.0),
+        "adaptive" => Some(9.0),
         m if m.starts_with("fixed:") => Some(p.parameter as f64),
         _ => None,
     }
@@ -271,7 +280,7 @@ pub fn plot_fig8(points: &[Point]) -> image::RgbaImage {
 pub fn plot_fig10(points: &[Point]) -> image::RgbaImage {
     let ticks: Vec<(f64, String)> = std::iter::once((0.0, "vertex".to_string()))
         .chain((1..=7).map(|n| (n as f64, format!("fixed:{n}"))))
-        .chain([(8.0, "adaptive".into())])
+        .chain([(8.0, "adaptive:length".into()), (9.0, "adaptive (error)".into())])
         .collect();
     let error = Chart {
         title: "Fig. 10 (left): display-position error".into(),
@@ -303,11 +312,12 @@ pub fn plot_fig12(points: &[Point]) -> image::RgbaImage {
     for (series, value) in [(&mut time, 0usize), (&mut error, 1)] {
         let extra: Vec<Series> = series
             .iter()
-            .filter_map(|s| {
-                let a = points.iter().find(|p| p.scene == s.label && p.method == "adaptive")?;
+            .flat_map(|s| ["adaptive:length", "adaptive"].map(|m| (s, m)))
+            .filter_map(|(s, method)| {
+                let a = points.iter().find(|p| p.scene == s.label && p.method == method)?;
                 let y = if value == 0 { a.ms_frame } else { a.mean_px as f64 };
                 Some(Series {
-                    label: format!("{} adaptive", s.label),
+                    label: format!("{} {method}", s.label),
                     points: vec![(lo, y, None), (hi, y, None)],
                     color: s.color,
                     dashed: true,

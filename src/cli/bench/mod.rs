@@ -14,7 +14,7 @@ use serde::Serialize;
 use crate::args::ViewArgs;
 use crate::scene::open_renderer;
 use twister::core::projection::Projection;
-use twister::core::settings::Method;
+use twister::core::settings::{Method, Split};
 use twister::error::{Error, Result};
 use twister::gpu::Renderer;
 
@@ -61,7 +61,10 @@ impl FigureConfig {
 
     pub fn fig10_methods(&self) -> Vec<Method> {
         let fixed: Vec<u32> = if self.quick { vec![1, 4, 7] } else { (1..=7).collect() };
-        std::iter::once(Method::Vertex).chain(fixed.into_iter().map(Method::Fixed)).chain([Method::Adaptive]).collect()
+        std::iter::once(Method::Vertex)
+            .chain(fixed.into_iter().map(Method::Fixed))
+            .chain([Method::Adaptive(Split::Length), Method::Adaptive(Split::Error)])
+            .collect()
     }
 
     pub fn slit_widths(&self) -> Vec<u32> {
@@ -197,7 +200,12 @@ fn fig10_section(runner: &Runner, cases: &[figures::Case]) -> Result<(String, Op
         .iter()
         .filter_map(|c| {
             let t = |m: &str| points.iter().find(|p| p.scene == c.label && p.method == m).map(|p| p.ms_frame);
-            Some(format!("{}: {:+.1} ms", c.label, t("adaptive")? - t("vertex")?))
+            Some(format!(
+                "{}: {:+.1} ms (adaptive:length), {:+.1} ms (adaptive, the error split)",
+                c.label,
+                t("adaptive:length")? - t("vertex")?,
+                t("adaptive")? - t("vertex")?
+            ))
         })
         .collect();
     report += &format!(
@@ -222,11 +230,12 @@ fn fig12_section(runner: &Runner, cases: &[figures::Case]) -> Result<(String, Op
     let json = serde_json::json!({ "points": points, "matched": matched });
     twister::output::write_text(&cfg.out.join("fig12.json"), &serde_json::to_string_pretty(&json).unwrap())?;
     write_png(&cfg.out.join("fig12.png"), plot_fig12(&points))?;
-    let mut m = String::from("| scene | adaptive ms | matched slit width w* | |\n|---|---|---|---|\n");
+    let mut m = String::from("| scene | method | ms | matched slit width w* | |\n|---|---|---|---|---|\n");
     for x in &matched {
         m += &format!(
-            "| {} | {:.1} | {} | {} |\n",
+            "| {} | {} | {:.1} | {} | {} |\n",
             x.scene,
+            x.method,
             x.adaptive_ms,
             x.w_star.map_or("—".into(), |w| format!("{w:.1} px")),
             x.note

@@ -311,7 +311,7 @@ fn single_band(p: [Vec3; 3], (sx, sz): (f32, f32), rho: f32, cuts: AxisCuts) -> 
 /// Where diamonds stop: `BAND_LIMIT`·R_T for the adaptive method; for `vertex` and `fixed:N`,
 /// whose splits do not follow projected lengths, only the square is cut (0).
 pub fn band_limit(method: u32, screen_radius: f32) -> f32 {
-    if method == crate::core::settings::SplitRule::Adaptive as u32 {
+    if crate::core::settings::SplitRule::is_adaptive(method) {
         BAND_LIMIT * screen_radius
     } else {
         0.0

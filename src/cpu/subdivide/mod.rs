@@ -71,7 +71,7 @@ use crate::core::projection::{azimuth, horizontal_radius, wrap_angle, Eye, Panor
 use crate::core::scene::SceneVertex;
 use crate::core::settings::{RenderSettings, SplitRule};
 use crate::shader::constants::{
-    EDGE_SAMPLES, MAX_EDGE_DIVISIONS, MAX_MACRO_LEVEL, MAX_STRETCH, PIECE_DIVISIONS, SEAM_MARGIN,
+    EDGE_SAMPLES, ERROR_SPLIT_LENGTH, MAX_EDGE_DIVISIONS, MAX_MACRO_LEVEL, MAX_STRETCH, PIECE_DIVISIONS, SEAM_MARGIN,
 };
 use crate::shader::types::{DrawVertex, SubdivideParams};
 
@@ -94,6 +94,7 @@ pub fn subdivide_params(settings: &RenderSettings, first_triangle: u32, triangle
         method: rule as u32,
         fixed_n,
         edge_px: sub.edge_px,
+        max_error_px: sub.max_error_px,
         max_div: sub.max_div.max(1),
         piece_capacity: 0,
         triangle_capacity: 0,
@@ -142,6 +143,28 @@ fn edge_point(a: Node, b: Node, j: u32, n: u32) -> Node {
     Node { position: lo.position + (hi.position - lo.position) * t, bary: lo.bary + (hi.bary - lo.bary) * t }
 }
 
+/// What [`Subdivider::edge_profile`] measures of an edge.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EdgeProfile {
+    pub length_px: f32,
+    pub bend_px: f32,
+    pub ring: bool,
+}
+
+/// A triangle's L and τ (see [`Subdivider::limits`]).
+#[derive(Clone, Copy, Debug)]
+struct Limits {
+    edge_px: f32,
+    max_error_px: f32,
+}
+
+/// Parts an edge needs so that its chord error, about bend·S²/(8n²) for n parts (see
+/// [`Subdivider::edge_profile`]), is at most τ: ceil(S·√(bend / 8τ)) (not rounded to an integer
+/// count yet; NaN stays NaN).
+fn parts_for_bend(bend_px: f32, segments: u32, max_error_px: f32) -> f32 {
+    (segments as f32 * (bend_px / (8.0 * max_error_px)).sqrt()).ceil()
+}
+
 /// The stage's state for one dispatch: parameters and the derived projection.
 pub struct Subdivider<'a> {
     params: &'a SubdivideParams,
@@ -172,9 +195,11 @@ impl<'a> Subdivider<'a> {
         Subdivider { edge_scale, ..Subdivider::new(params) }
     }
 
-    /// L for a triangle of `object`.
-    fn edge_px(&self, object: u32) -> f32 {
-        self.params.edge_px * self.edge_scale.get(object as usize).copied().unwrap_or(1.0)
+    /// L and τ for a triangle of `object`: the level of detail scales L by its factor s, and τ by
+    /// s² (an edge's error grows as the square of its parts' length).
+    fn limits(&self, object: u32) -> Limits {
+        let s = self.edge_scale.get(object as usize).copied().unwrap_or(1.0);
+        Limits { edge_px: self.params.edge_px * s, max_error_px: self.params.max_error_px * (s * s) }
     }
 
     /// Image position (x, y) in pixels of a viewer-frame point for one eye sign, x not wrapped.
@@ -184,33 +209,53 @@ impl<'a> Subdivider<'a> {
         Vec2::new(q.u * self.projection.pixels_per_radian(), q.v * self.projection.pixels_per_v())
     }
 
-    /// The projected length in pixels by which the straight edge ab is split: measured as a
-    /// polyline through `segments` + 1 points (the larger of the two eyes), its length l (eq. 5)
-    /// or, if larger, `segments` × its longest segment / `MAX_STRETCH` (/ 1 in the paper model
-    /// where the edge comes within 2·d_e of the axis: α ∝ √(r − d_e) bends it sharply): an edge
-    /// the projection stretches unevenly gets equal parts short enough where it is stretched
-    /// most. Heights are clamped to ±1.5 image heights from the middle row, so off-screen parts
-    /// count little, and segments beyond the clamp at both ends (on one side) count nothing.
-    pub fn edge_length_px(&self, a: Vec3, b: Vec3, segments: u32) -> f32 {
+    /// What the split rules read of the straight edge ab, projected and sampled as a polyline
+    /// through `segments` + 1 points (both eyes, x unwrapped across the seam), in the edge's
+    /// canonical order:
+    /// - `length_px`, by which eq. 5 splits it: the polyline's length l (the larger of the two
+    ///   eyes) or, if larger, `segments` × its longest segment / `MAX_STRETCH` (/ 1 in the paper
+    ///   model where the edge comes within 2·d_e of the axis: α ∝ √(r − d_e) bends it sharply):
+    ///   an edge the projection stretches unevenly gets equal parts short enough where it is
+    ///   stretched most. Heights are clamped to ±1.5 image heights from the middle row, so
+    ///   off-screen parts count little, and segments beyond the clamp at both ends (on one side)
+    ///   count nothing.
+    /// - `bend_px`, by which the error split splits it: the largest second difference
+    ///   |q(k+1) − 2 q(k) + q(k−1)| of the sampled points (both eyes; triples with a point beyond the
+    ///   height clamp are skipped). A straight edge drawn with its nodes at the projected places
+    ///   is wrong between the nodes by about |q''|·(t/n)²/8 for n parts (q'' the second derivative
+    ///   along the edge's parameter t, whose sampled estimate is bend·S²): the chord's error,
+    ///   across and along the curve (the drawn point j/n of the way is not where the point j/n
+    ///   of the way along the 3-D edge projects).
+    /// - `ring`: the edge comes within 2·d_e of the axis where the panorama shows the eye circle.
+    pub fn edge_profile(&self, a: Vec3, b: Vec3, segments: u32) -> EdgeProfile {
         let (lo, hi) = if lex_less(b, a) { (b, a) } else { (a, b) };
         let clamp_v = 1.5 * self.projection.height as f32;
         let width = self.projection.width as f32;
-        let (mut length, mut longest, mut nearest) = (0.0f32, 0.0f32, f32::INFINITY);
+        let (mut length, mut longest, mut nearest, mut bend) = (0.0f32, 0.0f32, f32::INFINITY, 0.0f32);
         for eye_sign in [-1.0f32, 1.0] {
             let mut total = 0.0;
             let mut prev = Vec2::ZERO;
+            // The last two points, x unwrapped, y unclamped.
+            let (mut q0, mut q1) = (Vec2::ZERO, Vec2::ZERO);
             for k in 0..=segments {
                 let t = k as f32 / segments as f32;
                 let p = lo + (hi - lo) * t;
                 nearest = nearest.min(horizontal_radius(p));
-                let mut q = self.pixel(p, eye_sign);
+                let raw = self.pixel(p, eye_sign);
+                let mut q = raw;
                 q.y = q.y.clamp(-clamp_v, clamp_v);
+                let dx = (q.x - prev.x) - width * ((q.x - prev.x) / width).round();
                 if k > 0 && !(q.y == prev.y && q.y.abs() == clamp_v) {
-                    let dx = (q.x - prev.x) - width * ((q.x - prev.x) / width).round();
                     let segment = Vec2::new(dx, q.y - prev.y).length();
                     longest = longest.max(segment);
                     total += segment;
                 }
+                let unwrapped = Vec2::new(if k > 0 { q1.x + dx } else { raw.x }, raw.y);
+                if k >= 2 && unwrapped.y.abs() < clamp_v && q1.y.abs() < clamp_v && q0.y.abs() < clamp_v {
+                    bend = bend.max((unwrapped - 2.0 * q1 + q0).length());
+                }
+                q0 = q1;
+                q1 = unwrapped;
                 prev = q;
             }
             length = length.max(total);
@@ -221,27 +266,43 @@ impl<'a> Subdivider<'a> {
             self.projection.vertical == Vertical::Paper || self.projection.panorama == PanoramaKind::Equirect;
         let ring = shows_ring && nearest < 2.0 * self.projection.eye_radius;
         let stretch = if ring { 1.0 } else { MAX_STRETCH };
-        length.max(segments as f32 * longest / stretch)
+        EdgeProfile { length_px: length.max(segments as f32 * longest / stretch), bend_px: bend, ring }
     }
 
-    /// Divisions of an edge (eq. 5, not capped by N_max: the pre-split handles that). A quick
-    /// 2-segment length first: if it is at most L/2 the edge stays whole, else the 8-segment
-    /// length decides (it is never shorter, as it refines the same polyline).
-    fn edge_divisions(&self, a: Vec3, b: Vec3, edge_px: f32) -> u32 {
-        match self.params.method {
-            0 => 1,
-            1 => self.params.fixed_n,
-            _ => {
-                if self.edge_length_px(a, b, 2) <= 0.5 * edge_px {
+    /// Divisions of an edge (not capped by N_max: the pre-split handles that), `edge_px` L and
+    /// `max_error_px` τ being the triangle's (scaled by its object's level of detail).
+    /// `adaptive:length` (eq. 5): a quick 2-segment length first: if it is at most L/2 the edge
+    /// stays whole, else N = ceil(l/L) from the 8-segment length (never shorter, as it refines
+    /// the same polyline). `adaptive` (the error split): an edge whose 2-segment polyline is at
+    /// most L long, away from the eye circle, and whose midpoint bend asks for one part stays
+    /// whole; else N = ceil(S·√(bend / 8τ)) from the 8-segment profile, at least l / (8·L)
+    /// (no edge longer than 8·L: depth and attributes interpolate over bounded spans), and near
+    /// the eye circle at least l / L, as eq. 5 (the second differences miss the ring's √ bend).
+    fn edge_divisions(&self, a: Vec3, b: Vec3, limits: Limits) -> u32 {
+        let Limits { edge_px, max_error_px } = limits;
+        let n = match self.params.method {
+            0 => return 1,
+            1 => return self.params.fixed_n,
+            2 => {
+                if self.edge_profile(a, b, 2).length_px <= 0.5 * edge_px {
                     return 1;
                 }
-                let n = (self.edge_length_px(a, b, EDGE_SAMPLES) / edge_px).ceil();
-                if n.is_finite() {
-                    (n as u32).clamp(1, MAX_EDGE_DIVISIONS)
-                } else {
-                    MAX_EDGE_DIVISIONS
-                }
+                (self.edge_profile(a, b, EDGE_SAMPLES).length_px / edge_px).ceil()
             }
+            _ => {
+                let quick = self.edge_profile(a, b, 2);
+                if quick.length_px <= edge_px && !quick.ring && parts_for_bend(quick.bend_px, 2, max_error_px) <= 1.0 {
+                    return 1;
+                }
+                let p = self.edge_profile(a, b, EDGE_SAMPLES);
+                let longest = if p.ring { edge_px } else { ERROR_SPLIT_LENGTH * edge_px };
+                parts_for_bend(p.bend_px, EDGE_SAMPLES, max_error_px).max((p.length_px / longest).ceil())
+            }
+        };
+        if n.is_finite() {
+            (n as u32).clamp(1, MAX_EDGE_DIVISIONS)
+        } else {
+            MAX_EDGE_DIVISIONS
         }
     }
 
@@ -250,11 +311,11 @@ impl<'a> Subdivider<'a> {
     /// take up to 2·N_max, and at most `PIECE_DIVISIONS` (a piece then makes at most 32² triangles).
     /// `fixed:N` pieces (K per edge) take N/K (rounded up) on their interior edges: the union is the
     /// regular N-lattice when K divides N.
-    fn interior_divisions(&self, a: Vec3, b: Vec3, edge_px: f32, k: u32) -> u32 {
+    fn interior_divisions(&self, a: Vec3, b: Vec3, limits: Limits, k: u32) -> u32 {
         if self.params.method == SplitRule::Fixed as u32 {
             return self.params.fixed_n.div_ceil(k.max(1));
         }
-        self.edge_divisions(a, b, edge_px).min(2 * self.params.max_div).min(PIECE_DIVISIONS)
+        self.edge_divisions(a, b, limits).min(2 * self.params.max_div).min(PIECE_DIVISIONS)
     }
 
     /// The corners of input triangle t in the viewer frame, snapped to the cut planes.
@@ -298,14 +359,14 @@ impl<'a> Subdivider<'a> {
     /// `plan`: the macro-lattice level K of a part (K² pieces) and its edge counts.
     fn plan(&self, tri: &Triangle, part: &[Node; 3]) -> (u32, [u32; 3]) {
         let p = part.map(|n| n.position);
-        let l = self.edge_px(tri.object);
+        let l = self.limits(tri.object);
         let n = [
             self.edge_divisions(p[0], p[1], l),
             self.edge_divisions(p[1], p[2], l),
             self.edge_divisions(p[2], p[0], l),
         ];
         let m = n[0].max(n[1]).max(n[2]);
-        let k = if self.params.method == SplitRule::Adaptive as u32 {
+        let k = if SplitRule::is_adaptive(self.params.method) {
             m.div_ceil(self.params.max_div.min(PIECE_DIVISIONS)).min(MAX_MACRO_LEVEL)
         } else if self.params.method == SplitRule::Fixed as u32 {
             m.div_ceil(PIECE_DIVISIONS)
@@ -413,7 +474,7 @@ impl<'a> Subdivider<'a> {
                     original: None,
                     from: 0,
                     to: 0,
-                    count: self.interior_divisions(q[e].position, q[(e + 1) % 3].position, self.edge_px(tri.object), k),
+                    count: self.interior_divisions(q[e].position, q[(e + 1) % 3].position, self.limits(tri.object), k),
                 });
         }
         let counts = edges.map(|e| e.count);

@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::core::projection::{Eye, Vertical};
-use crate::core::settings::{Method, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV};
+use crate::core::settings::{Method, Split, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV};
 use std::collections::HashMap;
 use std::f32::consts::FRAC_PI_2;
 
@@ -17,9 +17,12 @@ pub(super) fn params_for(
     max_div: u32,
     n: u32,
 ) -> SubdivideParams {
+    // The error split's τ follows L (τ = L/64: 0.5 px at the default L), so that cases that
+    // vary L vary τ too.
     let settings = RenderSettings::new(*projection)
         .with_method(method)
         .with_edge_px(edge_px)
+        .with_max_error_px(edge_px / 64.0)
         .with_max_div(max_div)
         .with_measure_edges(true);
     subdivide_params(&settings, 0, n)
@@ -115,7 +118,7 @@ fn floor_around_the_axis_is_cut_into_quadrants_minus_the_square_around_the_axis(
 
 #[test]
 fn triangle_with_a_vertex_inside_the_eye_circle_is_cut_without_nan() {
-    for method in [Method::Vertex, Method::Adaptive, Method::Fixed(4)] {
+    for method in [Method::Vertex, Method::Adaptive(Split::Length), Method::Adaptive(Split::Error), Method::Fixed(4)] {
         for near in [[0.01, -0.5, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.5]] {
             let (projection, out) = run_method([near, [2.0, -0.5, -2.0], [-2.0, -0.5, -2.0]], method);
             assert!(!out.is_empty());
@@ -225,7 +228,7 @@ fn vertically_culled_triangles_project_wholly_off_the_image() {
     let mut culled = 0;
     for vertical in [Vertical::Paper, Vertical::Exact] {
         let projection = Projection { width: 800, height: 200, vertical, ..Projection::default() };
-        let params = params_for(&projection, Method::Adaptive, 32.0, 7, 0);
+        let params = params_for(&projection, Method::Adaptive(Split::Length), 32.0, 7, 0);
         let sd = Subdivider::new(&params);
         for _ in 0..3000 {
             let p: [Vec3; 3] = std::array::from_fn(|_| {
@@ -273,15 +276,15 @@ fn subdivided_closed_mesh_stays_closed() {
     let blob = crate::core::builtin::blob(Vec3::new(0.3, 0.1, -3.0), 1.2);
     let (v, i) = (blob.vertices, blob.indices);
     for (method, edge_px, max_div) in [
-        (Method::Adaptive, 32.0f32, 7),
-        (Method::Adaptive, 6.0, 3),
-        (Method::Adaptive, 3.0, 7),
+        (Method::Adaptive(Split::Length), 32.0f32, 7),
+        (Method::Adaptive(Split::Length), 6.0, 3),
+        (Method::Adaptive(Split::Length), 3.0, 7),
         (Method::Fixed(5), 0.0, 7),
     ] {
         let params = params_for(&projection, method, edge_px.max(1.0), max_div, (i.len() / 3) as u32);
         let out = subdivide(&params, &v, &i);
         assert!(out.vertices.len() / 3 > i.len() / 3);
-        if method == Method::Adaptive && edge_px <= 6.0 {
+        if method == Method::Adaptive(Split::Length) && edge_px <= 6.0 {
             assert!(out.pieces > (i.len() / 3) as u32, "L = {edge_px}: pre-split expected");
         }
         let key = |p: [f32; 3]| p.map(f32::to_bits);
@@ -299,7 +302,7 @@ fn subdivided_closed_mesh_stays_closed() {
             "{} L={edge_px} N_max={max_div}: {open} edges not shared by exactly two triangles",
             method.name()
         );
-        if method == Method::Adaptive {
+        if method == Method::Adaptive(Split::Length) {
             // Eq. 5 bounds each original edge's parts by L; lattice lines inside a large face
             // nearer the viewer than its edges project longer, by up to the depth ratio
             // across the face (here ~1.7).
@@ -311,7 +314,7 @@ fn subdivided_closed_mesh_stays_closed() {
 mod real_mesh_tests {
     use super::super::*;
     use super::params_for;
-    use crate::core::settings::Method;
+    use crate::core::settings::{Method, Split};
     use std::collections::{BTreeSet, HashMap};
 
     /// Seed 002 §2.3's crack-freeness, literally: on a real mesh, the two triangles sharing an
@@ -335,7 +338,7 @@ mod real_mesh_tests {
                 edges.entry(if ka < kb { (ka, kb) } else { (kb, ka) }).or_default().push(t);
             }
         }
-        let params = params_for(&projection, Method::Adaptive, 6.0, 4, 1);
+        let params = params_for(&projection, Method::Adaptive(Split::Length), 6.0, 4, 1);
         let cuts = Subdivider::new(&params).active_cuts(&scene.vertices, &scene.indices);
         let outputs: Vec<Vec<DrawVertex>> = (0..scene.triangle_count())
             .map(|t| {

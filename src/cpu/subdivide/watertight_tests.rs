@@ -20,7 +20,7 @@ use rand::{Rng, SeedableRng};
 use super::tests::params_for;
 use super::*;
 use crate::core::projection::{PanoramaKind, Vertical};
-use crate::core::settings::Method;
+use crate::core::settings::{Method, Split};
 
 /// A mesh as positions and triangle indices; shared vertices are shared indices, so shared
 /// edges have bit-identical end points.
@@ -377,7 +377,7 @@ fn random_closed_meshes_around_the_viewer_subdivide_watertight_and_whole() {
         } else {
             projection
         };
-        let (method, edge_px, max_div) = match rng.random_range(0..4) {
+        let (method, edge_px, max_div) = match rng.random_range(0..5) {
             0 => (Method::Vertex, 8.0, 7),
             // At most ~300k output triangles: the test runs in debug builds.
             1 => (
@@ -385,7 +385,9 @@ fn random_closed_meshes_around_the_viewer_subdivide_watertight_and_whole() {
                 8.0,
                 7,
             ),
-            _ => (Method::Adaptive, rng.random_range(4.0..64.0), rng.random_range(1..16)),
+            // The error split: τ = L/64 (see `params_for`), 0.06 to 1 px.
+            2 => (Method::Adaptive(Split::Error), rng.random_range(4.0..64.0), rng.random_range(1..16)),
+            _ => (Method::Adaptive(Split::Length), rng.random_range(4.0..64.0), rng.random_range(1..16)),
         };
         // With the level of detail: L relaxed (peripheral field) or no split (outside).
         let lod_scale = [1.0, 1.0, 2.5, crate::core::lod::NO_SPLIT][rng.random_range(0..4)];
