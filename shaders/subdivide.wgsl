@@ -260,7 +260,9 @@ fn parts_for_bend(bend_px: f32, segments: u32, max_error_px: f32) -> f32 {
 }
 
 // Divisions of an edge (`Subdivider::edge_divisions`): eq. 5 for METHOD_ADAPTIVE, the error
-// split for METHOD_ERROR. (One call site per rule in a loop: lavapipe's compiler inlines every call.)
+// split for METHOD_ERROR. The quick 2-segment profile, then the 8-segment one, from one call site
+// in a loop (lavapipe's compiler inlines every call, and a shader that merely contains more code
+// runs slower).
 fn edge_divisions(a: vec3<f32>, b: vec3<f32>) -> u32 {
     if (params.method == METHOD_VERTEX) {
         return 1u;
@@ -268,20 +270,24 @@ fn edge_divisions(a: vec3<f32>, b: vec3<f32>) -> u32 {
     if (params.method == METHOD_FIXED) {
         return params.fixed_n;
     }
+    let by_length = params.method == METHOD_ADAPTIVE;
     var n = 0.0;
-    let quick = edge_profile(a, b, 2u);
-    if (params.method == METHOD_ADAPTIVE) {
-        if (quick.length_px <= 0.5 * tri_edge_px) {
-            return 1u;
+    for (var round = 0u; round < 2u; round++) {
+        let segments = select(2u, EDGE_SAMPLES, round == 1u);
+        let p = edge_profile(a, b, segments);
+        let by_bend = parts_for_bend(p.bend_px, segments, tri_max_error_px);
+        if (round == 0u) {
+            let whole = select(p.length_px <= tri_edge_px && !p.ring && by_bend <= 1.0,
+                               p.length_px <= 0.5 * tri_edge_px, by_length);
+            if (whole) {
+                return 1u;
+            }
+        } else if (by_length) {
+            n = ceil(p.length_px / tri_edge_px);
+        } else {
+            let longest = select(ERROR_SPLIT_LENGTH * tri_edge_px, tri_edge_px, p.ring);
+            n = max(by_bend, ceil(p.length_px / longest));
         }
-        n = ceil(edge_profile(a, b, EDGE_SAMPLES).length_px / tri_edge_px);
-    } else {
-        if (quick.length_px <= tri_edge_px && !quick.ring && parts_for_bend(quick.bend_px, 2u, tri_max_error_px) <= 1.0) {
-            return 1u;
-        }
-        let p = edge_profile(a, b, EDGE_SAMPLES);
-        let longest = select(ERROR_SPLIT_LENGTH * tri_edge_px, tri_edge_px, p.ring);
-        n = max(parts_for_bend(p.bend_px, EDGE_SAMPLES, tri_max_error_px), ceil(p.length_px / longest));
     }
     if (n >= f32(MAX_EDGE_DIVISIONS) || !(n == n)) {
         return MAX_EDGE_DIVISIONS;
