@@ -15,12 +15,13 @@
 //            vertical axis under the frame's cuts (quadrants minus a small square around the axis,
 //            bands between the active diamonds, fan-triangulated).
 //            For every part, `plan` and `plan_cuts` find the edge
-//            counts N (eq. 5), the macro-lattice level K = ceil(M / N_max) of the pre-split, and
+//            counts N (eq. 5 or the error split), the macro-lattice level K = ceil(M / N_max) of the pre-split, and
 //            K² piece records (triangle, cell, counts, the part's corners).
 // `lattice`  one invocation per piece: the part's corners from the piece record, the regular
-//            lattice of level m = max(counts), boundary nodes snapped to each edge's nodes, each
-//            sub-triangle appended, with a seam copy where it crosses ±π.
-// `finalize` the DrawIndirect arguments, clamped to the capacity.
+//            lattice of level m = max(counts), boundary nodes snapped to each edge's nodes; its
+//            nodes appended once and its drawn sub-triangles as indices into them, the whole
+//            piece again a turn away where its nodes' u range crosses ±π.
+// `finalize` the DrawIndexedIndirect arguments (none drawn if a buffer overflowed).
 // Appends never write past a capacity: they are counted, and the host grows the buffer or
 // processes the scene in chunks.
 
@@ -71,18 +72,19 @@ struct Counters {
     triangles: atomic<u32>,
     max_edge_bits: atomic<u32>, // bits of the largest visible output edge, px (f32 ≥ 0 orders as u32)
     cut_count: atomic<u32>,     // triangles `plan` listed for `plan_cuts`
+    nodes: atomic<u32>,         // output nodes (`lattice`)
+    _pad0: u32,
     // The frame's cuts around the axis (`AxisCuts` in axis.rs): bit 0 the quadrant cuts and the
     // square, bit k the diamond c_k; bits 0–31 and 32–63. Kept across the chunks of a frame.
     cuts_low: atomic<u32>,
     cuts_high: atomic<u32>,
-    _pad1: u32,
-    _pad2: u32,
 }
 
-struct DrawIndirectArgs {
-    vertex_count: u32,
+struct DrawIndexedIndirectArgs {
+    index_count: u32,
     instance_count: u32,
-    first_vertex: u32,
+    first_index: u32,
+    base_vertex: i32,
     first_instance: u32,
 }
 
@@ -102,9 +104,11 @@ struct Piece {
 }
 
 @group(0) @binding(3) var<storage, read_write> pieces: array<Piece>;
-@group(0) @binding(4) var<storage, read_write> out_vertices: array<DrawVertex>;
+// The output: each piece's lattice nodes once (per seam copy), and its triangles as indices
+// into them (`SubdivideOutput` in src/cpu/subdivide/).
+@group(0) @binding(4) var<storage, read_write> out_nodes: array<DrawVertex>;
 @group(0) @binding(5) var<storage, read_write> counters: Counters;
-@group(0) @binding(6) var<storage, read_write> draw_args: DrawIndirectArgs;
+@group(0) @binding(6) var<storage, read_write> draw_args: DrawIndexedIndirectArgs;
 // Workgroup counts of the `lattice` dispatch (0–2), written by `lattice_args` from the piece
 // counter, and of the `plan_cuts` dispatch (3–5), written by `plan_cuts_args`.
 @group(0) @binding(7) var<storage, read_write> lattice_dispatch: array<u32, 6>;
@@ -113,6 +117,7 @@ struct Piece {
 @group(0) @binding(8) var<storage, read> object_edge_scale: array<f32>;
 // The triangles `plan` left for `plan_cuts` (room for every triangle of a dispatch).
 @group(0) @binding(9) var<storage, read_write> cut_list: array<u32>;
+@group(0) @binding(10) var<storage, read_write> out_indices: array<u32>;
 
 // `params.piece_count == PIECES_FROM_COUNTER` (from `constants`): as many pieces as `plan` made
 // (read from the counter), so that plan, lattice and drawing can run in one submission.
@@ -877,62 +882,7 @@ fn visible_edge_px(p: array<vec3<f32>, 3>) -> f32 {
     return longest;
 }
 
-// Appends one triangle and, where it crosses the seam, its copy on the other side.
-fn emit(a: Node, b: Node, c: Node) {
-    let ps = array<vec3<f32>, 3>(a.position, b.position, c.position);
-    let theta_c = azimuth((ps[0] + ps[1] + ps[2]) / 3.0);
-    var u_min = 1e30;
-    var u_max = -1e30;
-    for (var i = 0u; i < 3u; i++) {
-        let theta = theta_c + wrap_angle(azimuth(ps[i]) - theta_c);
-        if (is_sphere(params.projection)) {
-            for (var s = 0u; s < 2u; s++) {
-                let u = project_with_azimuth(params.projection, ps[i], theta, select(-1.0, 1.0, s == 1u)).x;
-                u_min = min(u_min, u);
-                u_max = max(u_max, u);
-            }
-        } else {
-            let alpha = abs(eye_shift(params.projection, horizontal_radius(ps[i])));
-            u_min = min(u_min, theta - alpha);
-            u_max = max(u_max, theta + alpha);
-        }
-    }
-    if (params.measure_edges != 0u) {
-        atomicMax(&counters.max_edge_bits, bitcast<u32>(visible_edge_px(ps)));
-    }
-    // Reference azimuths: the triangle itself, then a copy past each edge it crosses.
-    var refs = array<f32, 3>(theta_c, 0.0, 0.0);
-    var count = 1u;
-    // Conservative by SEAM_MARGIN: a vertex exactly on the seam (θ = π, r = R_T) is a tie that
-    // rounding could break either way; an extra copy is clipped away by the rasterizer.
-    if (u_max > PI - SEAM_MARGIN) {
-        refs[count] = theta_c - TAU;
-        count += 1u;
-    }
-    if (u_min < -PI + SEAM_MARGIN) {
-        refs[count] = theta_c + TAU;
-        count += 1u;
-    }
-    let slot = atomicAdd(&counters.triangles, count);
-    if (slot + count > params.triangle_capacity) {
-        return; // counted, never written
-    }
-    let nodes = array<Node, 3>(a, b, c);
-    for (var k = 0u; k < 3u * count; k++) {
-        out_vertices[3u * slot + k] = draw_vertex(nodes[k % 3u], refs[k / 3u]);
-    }
-}
-
-// Emission of a sub-triangle, unless it is degenerate or off screen.
-fn finish_triangle(a: Node, b: Node, c: Node) {
-    if (same(a.position, b.position) || same(b.position, c.position) || same(c.position, a.position)
-        || off_screen_vertically(a.position, b.position, c.position)) {
-        return;
-    }
-    emit(a, b, c);
-}
-
-// ---- the lattice of a piece, one triangle at a time ----
+// ---- the lattice of a piece: its nodes once, its triangles as indices ----
 
 // Node (i, j, l) of the piece's lattice of level m: the regular lattice, whose boundary nodes on
 // an edge with fewer divisions snap to that edge's nearest node (see subdivide.rs).
@@ -942,6 +892,32 @@ fn lattice_node(c: vec3<u32>, m: u32) -> Node {
         return node_on_edge(on.x, snap(on.y, piece_counts[on.x], m));
     }
     return interior_node(c.x, c.y, c.z, m);
+}
+
+// Slot of lattice node (i, j, l) among the piece's (m + 1)(m + 2)/2: rows l = 0..m of m + 1 − l
+// nodes, by j (`node_slot` in subdivide.rs).
+fn node_slot(c: vec3<u32>, m: u32) -> u32 {
+    return c.z * (2u * m + 3u - c.z) / 2u + c.y;
+}
+
+// Lattice node `slot` of level m as (i, j, l).
+fn slot_node(slot: u32, m: u32) -> vec3<u32> {
+    var l = 0u;
+    var rest = slot;
+    while (rest > m - l) {
+        rest -= m + 1u - l;
+        l += 1u;
+    }
+    return vec3<u32>(m - l - rest, rest, l);
+}
+
+// Whether lattice triangle t of level m is drawn: not collapsed by snapping, not off screen.
+fn lattice_triangle_drawn(t: u32, m: u32) -> bool {
+    let cell = macro_cell(m, t);
+    let a = lattice_node(cell.c[0], m).position;
+    let b = lattice_node(cell.c[1], m).position;
+    let c = lattice_node(cell.c[2], m).position;
+    return !(same(a, b) || same(b, c) || same(c, a) || off_screen_vertically(a, b, c));
 }
 
 // ---- entry points ----
@@ -1088,13 +1064,82 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         }
     }
     let m = max(max(piece_counts[0], piece_counts[1]), piece_counts[2]);
+    // Which of the m² lattice triangles are drawn (one bit each; m ≤ PIECE_DIVISIONS = 32).
+    var drawn: array<u32, 32>;
+    var count = 0u;
     for (var t = 0u; t < m * m; t++) {
-        let cell = macro_cell(m, t);
-        var nodes: array<Node, 3>;
-        for (var k = 0u; k < 3u; k++) {
-            nodes[k] = lattice_node(cell.c[k], m);
+        if (lattice_triangle_drawn(t, m)) {
+            drawn[t / 32u] |= 1u << (t % 32u);
+            count += 1u;
         }
-        finish_triangle(nodes[0], nodes[1], nodes[2]);
+    }
+    if (count == 0u) {
+        return;
+    }
+    // The seam: every node is unwrapped towards the piece's reference azimuth; where the nodes'
+    // u range (both eyes) reaches ±π, the piece is drawn again a turn away. Conservative by
+    // SEAM_MARGIN: an extra copy is clipped by the rasterizer.
+    let node_count = (m + 1u) * (m + 2u) / 2u;
+    let theta_c = azimuth((piece_q[0].position + piece_q[1].position + piece_q[2].position) / 3.0);
+    var u_min = 1e30;
+    var u_max = -1e30;
+    for (var k = 0u; k < node_count; k++) {
+        let p = lattice_node(slot_node(k, m), m).position;
+        let theta = theta_c + wrap_angle(azimuth(p) - theta_c);
+        if (is_sphere(params.projection)) {
+            for (var s = 0u; s < 2u; s++) {
+                let u = project_with_azimuth(params.projection, p, theta, select(-1.0, 1.0, s == 1u)).x;
+                u_min = min(u_min, u);
+                u_max = max(u_max, u);
+            }
+        } else {
+            let alpha = abs(eye_shift(params.projection, horizontal_radius(p)));
+            u_min = min(u_min, theta - alpha);
+            u_max = max(u_max, theta + alpha);
+        }
+    }
+    var refs = array<f32, 3>(theta_c, 0.0, 0.0);
+    var copies = 1u;
+    if (u_max > PI - SEAM_MARGIN) {
+        refs[copies] = theta_c - TAU;
+        copies += 1u;
+    }
+    if (u_min < -PI + SEAM_MARGIN) {
+        refs[copies] = theta_c + TAU;
+        copies += 1u;
+    }
+    let first_node = atomicAdd(&counters.nodes, copies * node_count);
+    let first_triangle = atomicAdd(&counters.triangles, copies * count);
+    if (first_node + copies * node_count > params.triangle_capacity
+        || first_triangle + copies * count > params.triangle_capacity) {
+        return; // counted, never written
+    }
+    for (var k = 0u; k < node_count; k++) {
+        let node = lattice_node(slot_node(k, m), m);
+        for (var c = 0u; c < copies; c++) {
+            out_nodes[first_node + c * node_count + k] = draw_vertex(node, refs[c]);
+        }
+    }
+    var slot = 3u * first_triangle;
+    for (var t = 0u; t < m * m; t++) {
+        if ((drawn[t / 32u] & (1u << (t % 32u))) == 0u) {
+            continue;
+        }
+        let cell = macro_cell(m, t);
+        let local = vec3<u32>(node_slot(cell.c[0], m), node_slot(cell.c[1], m), node_slot(cell.c[2], m));
+        if (params.measure_edges != 0u) {
+            let ps = array<vec3<f32>, 3>(out_nodes[first_node + local.x].position,
+                                         out_nodes[first_node + local.y].position,
+                                         out_nodes[first_node + local.z].position);
+            atomicMax(&counters.max_edge_bits, bitcast<u32>(visible_edge_px(ps)));
+        }
+        for (var c = 0u; c < copies; c++) {
+            let base = first_node + c * node_count;
+            out_indices[slot] = base + local.x;
+            out_indices[slot + 1u] = base + local.y;
+            out_indices[slot + 2u] = base + local.z;
+            slot += 3u;
+        }
     }
 }
 
@@ -1108,6 +1153,9 @@ fn lattice_args() {
 
 @compute @workgroup_size(1)
 fn finalize() {
-    let written = min(atomicLoad(&counters.triangles), params.triangle_capacity);
-    draw_args = DrawIndirectArgs(3u * written, 1u, 0u, 0u);
+    var written = atomicLoad(&counters.triangles);
+    if (written > params.triangle_capacity || atomicLoad(&counters.nodes) > params.triangle_capacity) {
+        written = 0u; // an overflowed run draws nothing; the renderer grows the buffers and reruns
+    }
+    draw_args = DrawIndexedIndirectArgs(3u * written, 1u, 0u, 0, 0u);
 }

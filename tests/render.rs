@@ -164,8 +164,8 @@ fn scene_too_big_for_the_memory_budget_is_drawn_in_chunks_without_loss() {
     // Wide: no triangle asks for cuts around the axis. Square: the floor and the ceiling near the
     // axis show, and the cuts they ask for hold in every chunk.
     for (projection, edge_px, cut) in [
-        (Projection { width: 960, height: 180, ..Projection::default() }, 3.0, false),
-        (Projection { width: 256, height: 256, ..Projection::default() }, 4.0, true),
+        (Projection { width: 960, height: 180, ..Projection::default() }, 2.0, false),
+        (Projection { width: 256, height: 256, ..Projection::default() }, 2.5, true),
     ] {
         let roomy = RenderSettings::new(projection).with_method(Method::Adaptive(Split::Length)).with_edge_px(edge_px);
         let params = twister::cpu::subdivide::subdivide_params(&roomy, 0, scene.triangle_count() as u32);

@@ -270,6 +270,13 @@ impl Twin for Subdivide {
         if (cpu.max_sub_edge_px - gpu.max_sub_edge_px).abs() >= 1e-2 * (1.0 + cpu.max_sub_edge_px) {
             return Err(format!("max edge: CPU {}, GPU {}", cpu.max_sub_edge_px, gpu.max_sub_edge_px));
         }
+        // The indexed output: as many shared nodes, every index within them.
+        if cpu.nodes.len() != gpu.nodes.len() {
+            return Err(format!("nodes: CPU {}, GPU {}", cpu.nodes.len(), gpu.nodes.len()));
+        }
+        if let Some(i) = gpu.indices.iter().find(|&&i| i as usize >= gpu.nodes.len()) {
+            return Err(format!("GPU index {i} beyond its {} nodes", gpu.nodes.len()));
+        }
         same_triangle_sets(&cpu.vertices, &gpu.vertices)
     }
 }

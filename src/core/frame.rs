@@ -55,6 +55,9 @@ pub struct FrameStats {
     pub triangles_in: u64,
     /// Triangles the subdivision produced (seam copies included), all drawn.
     pub triangles_out: u64,
+    /// Nodes the subdivision produced (each piece's lattice nodes once per seam copy): the
+    /// vertices the triangles index, shaded once per eye.
+    pub nodes_out: u64,
     pub pieces: u64,
     /// Largest projected length of an output edge with an end on the screen rows, pixels.
     pub max_sub_edge_px: f32,

@@ -1,6 +1,6 @@
 //! How one frame's subdivision and raster are scheduled, and the subdivision buffers they use.
 //!
-//! Memory: the piece and output buffers together stay within `memory_mb` (and each within the
+//! Memory: the piece and output buffers (nodes and triangle indices) together stay within `memory_mb` (and each within the
 //! device's storage-binding limit). Both passes count what they wanted to write and never
 //! write past the end. The usual frame is [`FramePlan::OneSubmission`]: `plan` → `lattice`
 //! (sized on the GPU from the piece counter) → `finalize` → both eyes, then one read of the
@@ -11,12 +11,19 @@
 //! stats), so nothing is dropped; a single piece that cannot fit is an error.
 
 use crate::gpu::device::Gpu;
-use crate::shader::types::{DrawIndirectArgs, DrawVertex, Piece, SubdivideCounters};
+use crate::shader::types::{DrawIndexedIndirectArgs, DrawVertex, Piece, SubdivideCounters};
 
 pub const PIECE_SIZE: u64 = std::mem::size_of::<Piece>() as u64;
-pub const TRIANGLE_SIZE: u64 = 3 * std::mem::size_of::<DrawVertex>() as u64;
+/// Bytes of one output node.
+pub const NODE_SIZE: u64 = std::mem::size_of::<DrawVertex>() as u64;
+/// Bytes of one output triangle's indices.
+pub const INDICES_SIZE: u64 = 3 * 4;
+/// Bytes of one unit of output capacity: room for a node and for a triangle's indices (the
+/// lattices make about one node per output triangle or fewer: (m + 1)(m + 2)/2 for m²).
+pub const OUTPUT_UNIT_SIZE: u64 = NODE_SIZE + INDICES_SIZE;
 
-/// Capacities of the piece and output buffers, in pieces and triangles.
+/// Capacities of the piece and output buffers: pieces, and output units (each a node and a
+/// triangle's indices; `triangles` also caps the nodes).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Capacities {
     pub pieces: u32,
@@ -24,12 +31,12 @@ pub struct Capacities {
 }
 
 impl Capacities {
-    /// What a memory budget allows: a quarter for pieces, the rest for triangles, each within
-    /// the largest binding.
+    /// What a memory budget allows: a quarter for pieces, the rest for the output (nodes and
+    /// indices), each buffer within the largest binding.
     pub fn budget(memory_mb: u32, max_binding: u64) -> Capacities {
         let budget = memory_mb as u64 * (1 << 20);
         let pieces = (budget / 4).min(max_binding) / PIECE_SIZE;
-        let triangles = (budget - budget / 4).min(max_binding) / TRIANGLE_SIZE;
+        let triangles = ((budget - budget / 4) / OUTPUT_UNIT_SIZE).min(max_binding / NODE_SIZE);
         Capacities { pieces: pieces.min(u32::MAX as u64) as u32, triangles: triangles.min(u32::MAX as u64) as u32 }
     }
 
@@ -97,7 +104,9 @@ pub fn on_overflow(requested: u32, max: u32, count: u32) -> Overflow {
 /// The subdivision's GPU buffers, with their capacities; kept by the renderer across frames.
 pub struct SubdivisionBuffers {
     pub pieces: wgpu::Buffer,
-    pub triangles: wgpu::Buffer,
+    /// The output: lattice nodes (the raster's vertex buffer) and triangles' indices into them.
+    pub nodes: wgpu::Buffer,
+    pub indices: wgpu::Buffer,
     pub counters: wgpu::Buffer,
     pub draw_args: wgpu::Buffer,
     /// Indirect dispatch arguments of `lattice` (in the one-submission frame) and `plan_cuts`.
@@ -112,16 +121,21 @@ fn pieces_buffer(gpu: &Gpu, n: u32) -> wgpu::Buffer {
     gpu.storage_buffer("pieces", n.max(1) as u64 * PIECE_SIZE, wgpu::BufferUsages::empty())
 }
 
-fn triangles_buffer(gpu: &Gpu, n: u32) -> wgpu::Buffer {
-    gpu.storage_buffer("subdivided triangles", n.max(1) as u64 * TRIANGLE_SIZE, wgpu::BufferUsages::VERTEX)
+fn output_buffers(gpu: &Gpu, n: u32) -> (wgpu::Buffer, wgpu::Buffer) {
+    (
+        gpu.storage_buffer("subdivided nodes", n.max(1) as u64 * NODE_SIZE, wgpu::BufferUsages::VERTEX),
+        gpu.storage_buffer("subdivided triangles", n.max(1) as u64 * INDICES_SIZE, wgpu::BufferUsages::INDEX),
+    )
 }
 
 impl SubdivisionBuffers {
     pub fn new(gpu: &Gpu, capacity: Capacities) -> SubdivisionBuffers {
         let capacity = Capacities { pieces: capacity.pieces.max(1), triangles: capacity.triangles.max(1) };
+        let (nodes, indices) = output_buffers(gpu, capacity.triangles);
         SubdivisionBuffers {
             pieces: pieces_buffer(gpu, capacity.pieces),
-            triangles: triangles_buffer(gpu, capacity.triangles),
+            nodes,
+            indices,
             counters: gpu.storage_buffer(
                 "counters",
                 std::mem::size_of::<SubdivideCounters>() as u64,
@@ -129,7 +143,7 @@ impl SubdivisionBuffers {
             ),
             draw_args: gpu.storage_buffer(
                 "draw args",
-                std::mem::size_of::<DrawIndirectArgs>() as u64,
+                std::mem::size_of::<DrawIndexedIndirectArgs>() as u64,
                 wgpu::BufferUsages::INDIRECT,
             ),
             lattice_dispatch: gpu.storage_buffer("lattice dispatch", 24, wgpu::BufferUsages::INDIRECT),
@@ -169,7 +183,7 @@ impl SubdivisionBuffers {
                     b.capacity.pieces = want.pieces;
                 }
                 if b.capacity.triangles < want.triangles {
-                    b.triangles = triangles_buffer(gpu, want.triangles);
+                    (b.nodes, b.indices) = output_buffers(gpu, want.triangles);
                     b.capacity.triangles = want.triangles;
                 }
             }

@@ -17,7 +17,9 @@ use crate::cpu::raster::raster_params;
 use crate::cpu::subdivide::{subdivide_params, SubdivideOutput};
 use crate::error::{Error, Result};
 use crate::gpu::device::{error_target_format, Gpu};
-use crate::gpu::frame_plan::{on_overflow, Capacities, FramePlan, Overflow, SubdivisionBuffers, TRIANGLE_SIZE};
+use crate::gpu::frame_plan::{
+    on_overflow, Capacities, FramePlan, Overflow, SubdivisionBuffers, INDICES_SIZE, NODE_SIZE,
+};
 use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
 use crate::gpu::targets::{Targets, COLOR_FORMAT, DEPTH_FORMAT, OBJECT_FORMAT};
@@ -320,8 +322,8 @@ impl Renderer {
         Ok(())
     }
 
-    /// The subdivide stage's bind group: params, vertices, indices, pieces, triangles, counters,
-    /// draw args, lattice dispatch, per-object edge scale, cut list (the order of
+    /// The subdivide stage's bind group: params, vertices, indices, pieces, output nodes,
+    /// counters, draw args, lattice dispatch, per-object edge scale, cut list, output indices (the order of
     /// `SUBDIVIDE.bindings`).
     fn subdivide_bind_group(
         &self,
@@ -339,12 +341,13 @@ impl Renderer {
                 &scene.vertices,
                 &scene.indices,
                 &b.pieces,
-                &b.triangles,
+                &b.nodes,
                 &b.counters,
                 &b.draw_args,
                 &b.lattice_dispatch,
                 &scene.object_edge_scale,
                 &b.cut_list,
+                &b.indices,
             ],
         )
     }
@@ -489,7 +492,7 @@ impl Renderer {
         self.gpu.queue.submit([enc.finish()]);
         let bytes = self.gpu.read_buffer(&res.staging)?;
         let counters: SubdivideCounters = *bytemuck::from_bytes(&bytes[..COUNTERS_SIZE as usize]);
-        if counters.pieces > params.piece_capacity || counters.triangles > params.triangle_capacity {
+        if counters.pieces > params.piece_capacity || counters.output_units() > params.triangle_capacity {
             return Ok(None);
         }
         let times = timestamps.map(|t| {
@@ -528,8 +531,9 @@ impl Renderer {
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &bind_group, &[]);
             pass.set_bind_group(1, &materials, &[]);
-            pass.set_vertex_buffer(0, buffers.triangles.slice(..));
-            pass.draw_indirect(&buffers.draw_args, 0);
+            pass.set_vertex_buffer(0, buffers.nodes.slice(..));
+            pass.set_index_buffer(buffers.indices.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed_indirect(&buffers.draw_args, 0);
         }
     }
 
@@ -557,17 +561,19 @@ impl Renderer {
                 params.first_piece = 0;
                 params.piece_count = planned.pieces;
                 let done = self.run_subdivide("lattice", &uniform, scene, b, &params, planned.pieces)?;
-                if done.triangles > b.capacity.triangles {
-                    want.triangles = done.triangles;
+                if done.output_units() > b.capacity.triangles {
+                    want.triangles = done.output_units();
                     continue;
                 }
-                let bytes = self.gpu.download(&b.triangles, done.triangles as u64 * TRIANGLE_SIZE)?;
-                return Ok(SubdivideOutput {
-                    vertices: bytemuck::cast_slice(&bytes).to_vec(),
-                    pieces: planned.pieces,
-                    max_sub_edge_px: f32::from_bits(done.max_edge_bits),
-                    cuts: done.cuts(),
-                });
+                let nodes = self.gpu.download(&b.nodes, done.nodes as u64 * NODE_SIZE)?;
+                let indices = self.gpu.download(&b.indices, done.triangles as u64 * INDICES_SIZE)?;
+                return Ok(SubdivideOutput::indexed(
+                    bytemuck::cast_slice(&nodes).to_vec(),
+                    bytemuck::cast_slice(&indices).to_vec(),
+                    planned.pieces,
+                    f32::from_bits(done.max_edge_bits),
+                    done.cuts(),
+                ));
             }
         })
     }
@@ -638,6 +644,7 @@ impl Renderer {
                 }
                 stats.pieces = counters.pieces as u64;
                 stats.triangles_out = counters.triangles as u64;
+                stats.nodes_out = counters.nodes as u64;
                 stats.chunks = 1;
                 stats.max_sub_edge_px = f32::from_bits(counters.max_edge_bits);
                 return self.finish_frame(targets, settings, stats, start);
@@ -709,16 +716,16 @@ impl Renderer {
                 let t = Instant::now();
                 let done = self.run_subdivide("lattice", &res.subdivide_params, scene, b, &params, piece_count)?;
                 ms_subdivide += t.elapsed().as_secs_f64() * 1e3;
-                if done.triangles > params.triangle_capacity {
-                    match on_overflow(done.triangles, budget.triangles, piece_count) {
+                if done.output_units() > params.triangle_capacity {
+                    match on_overflow(done.output_units(), budget.triangles, piece_count) {
                         Overflow::Grow(t) => want.triangles = t,
                         Overflow::Halve(c) => piece_chunk = c,
                         Overflow::TooBig => {
                             return Err(Error::option(
                                 "--memory-mb",
                                 format!(
-                                    "{memory_mb} is too small: one piece makes {} triangles; lower the fixed N or raise --memory-mb",
-                                    done.triangles
+                                    "{memory_mb} is too small: one piece makes {} triangles and nodes; lower the fixed N or raise --memory-mb",
+                                    done.output_units()
                                 ),
                             ))
                         }
@@ -736,6 +743,7 @@ impl Renderer {
                 cleared = true;
                 piece_done = true;
                 stats.triangles_out += done.triangles as u64;
+                stats.nodes_out += done.nodes as u64;
                 stats.chunks += 1;
                 stats.max_sub_edge_px = stats.max_sub_edge_px.max(f32::from_bits(done.max_edge_bits));
                 first_piece += piece_count;

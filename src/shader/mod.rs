@@ -121,7 +121,10 @@ pub const SUBDIVIDE: Stage = Stage {
         entry("plan_cuts_args", &["counters", "lattice_dispatch", "cut_list"]),
         entry("plan_cuts", &["params", "vertices", "indices", "pieces", "counters", "object_edge_scale", "cut_list"]),
         entry("lattice_args", &["params", "counters", "lattice_dispatch"]),
-        entry("lattice", &["params", "vertices", "indices", "pieces", "out_vertices", "counters", "object_edge_scale"]),
+        entry(
+            "lattice",
+            &["params", "vertices", "indices", "pieces", "out_nodes", "counters", "object_edge_scale", "out_indices"],
+        ),
         entry("finalize", &["params", "counters", "draw_args"]),
     ],
     bindings: &[
@@ -129,12 +132,13 @@ pub const SUBDIVIDE: Stage = Stage {
         bind(0, 1, "vertices", Storage),
         bind(0, 2, "indices", Storage),
         bind(0, 3, "pieces", StorageReadWrite),
-        bind(0, 4, "out_vertices", StorageReadWrite),
+        bind(0, 4, "out_nodes", StorageReadWrite),
         bind(0, 5, "counters", StorageReadWrite),
         bind(0, 6, "draw_args", StorageReadWrite),
         bind(0, 7, "lattice_dispatch", StorageReadWrite),
         bind(0, 8, "object_edge_scale", Storage),
         bind(0, 9, "cut_list", StorageReadWrite),
+        bind(0, 10, "out_indices", StorageReadWrite),
     ],
 };
 

@@ -129,17 +129,24 @@ pub struct SubdivideCounters {
     pub max_edge_bits: u32,
     /// Triangles `plan` listed for `plan_cuts`.
     pub cut_count: u32,
+    /// Output nodes (`lattice`).
+    pub nodes: u32,
+    pub _pad0: u32,
     /// The frame's cuts around the axis (`AxisCuts`), bits 0–31 and 32–63.
     pub cuts_low: u32,
     pub cuts_high: u32,
-    pub _pad1: u32,
-    pub _pad2: u32,
 }
 
 impl SubdivideCounters {
     /// Bytes of the counters that each `plan` or `lattice` run starts from zero; the cuts after
     /// them are set once per frame by `active_cuts`.
-    pub const RUN_BYTES: u64 = 16;
+    pub const RUN_BYTES: u64 = 24;
+
+    /// What the output buffers must hold, in their unit (a triangle's indices and a node each):
+    /// the larger of the triangle and node counts.
+    pub fn output_units(&self) -> u32 {
+        self.triangles.max(self.nodes)
+    }
 
     /// The frame's cuts as one mask.
     pub fn cuts(&self) -> u64 {
@@ -167,13 +174,14 @@ pub struct RasterParams {
     pub _pad2: u32,
 }
 
-/// `DrawIndirectArgs` as the GPU reads them.
+/// `DrawIndexedIndirectArgs` as the GPU reads them.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
-pub struct DrawIndirectArgs {
-    pub vertex_count: u32,
+pub struct DrawIndexedIndirectArgs {
+    pub index_count: u32,
     pub instance_count: u32,
-    pub first_vertex: u32,
+    pub first_index: u32,
+    pub base_vertex: i32,
     pub first_instance: u32,
 }
 
@@ -304,9 +312,9 @@ pub const LAYOUTS: &[StructLayout] = &[
         view, projection, axis_clearance, triangle_count, first_triangle, method, fixed_n, edge_px, max_div,
         piece_capacity, triangle_capacity, first_piece, piece_count, measure_edges, vertical_limit, max_error_px, _pad1, _pad2
     }),
-    layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, cuts_low, cuts_high, _pad1, _pad2 }),
+    layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, nodes, _pad0, cuts_low, cuts_high }),
     layout!("Piece" => Piece { triangle, cell, counts01, count2_level, corner, bary1, bary2 }),
-    layout!("DrawIndirectArgs" => DrawIndirectArgs { vertex_count, instance_count, first_vertex, first_instance }),
+    layout!("DrawIndexedIndirectArgs" => DrawIndexedIndirectArgs { index_count, instance_count, first_index, base_vertex, first_instance }),
     layout!("RasterParams" => RasterParams { projection, eye_sign, ambient, shift_px, error_angle, _pad0, _pad1, _pad2 }),
     layout!("SlitParams" => SlitParams { view, projection, eye_sign, ambient, near, error_angle }),
     layout!("SlitCamera" => SlitCamera { origin_sx, right_cx, up_cy, forward_sy }),

@@ -19,8 +19,8 @@ pub struct SpeedRow {
     pub triangles_out: u64,
     /// triangles_out / triangles_in: how much the subdivision multiplies the input.
     pub out_per_in: f64,
-    /// Vertex-stage invocations per eye: three per output triangle (the subdivided output is not
-    /// indexed; the slit renderer runs them per slit it draws an object in).
+    /// Vertices the vertex stage shades per eye: the subdivision's output nodes (its triangles
+    /// index them); three per triangle drawn for the slit renderer (per slit it draws an object in).
     pub vertices_out: u64,
     pub pieces: u64,
     pub chunks: u32,
@@ -101,7 +101,7 @@ pub fn speed(
                 triangles_in: last.triangles_in,
                 triangles_out: last.triangles_out,
                 out_per_in: last.triangles_out as f64 / last.triangles_in.max(1) as f64,
-                vertices_out: 3 * last.triangles_out,
+                vertices_out: if last.nodes_out > 0 { last.nodes_out } else { 3 * last.triangles_out },
                 pieces: last.pieces,
                 chunks: last.chunks,
                 max_sub_edge_px: edges.max_sub_edge_px,

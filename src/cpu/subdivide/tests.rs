@@ -166,6 +166,34 @@ fn fixed_n_makes_exactly_n_squared_triangles_of_positive_area_tiling_the_triangl
     }
 }
 
+#[test]
+fn the_lattice_stores_each_node_once_and_its_triangles_index_them() {
+    for m in 1..=PIECE_DIVISIONS {
+        let slots: Vec<[u32; 3]> = (0..(m + 1) * (m + 2) / 2).map(|k| slot_node(k, m)).collect();
+        for (k, c) in slots.iter().enumerate() {
+            assert_eq!(c[0] + c[1] + c[2], m);
+            assert_eq!(node_slot(*c, m), k as u32, "level {m}: slot {k} is {c:?}");
+        }
+    }
+    let tri = [[0.4, -0.3, -3.0], [1.7, -0.2, -3.2], [1.1, 0.6, -2.8]];
+    for n in [1, 3, 7] {
+        let params = params_for(&Projection::default(), Method::Fixed(n), DEFAULT_EDGE_PX, DEFAULT_MAX_DIV, 1);
+        let v: Vec<SceneVertex> = tri.iter().map(|&p| vertex(p)).collect();
+        let out = subdivide(&params, &v, &[0, 1, 2]);
+        // One piece: its (n + 1)(n + 2)/2 lattice nodes, each shared by the triangles around it.
+        assert_eq!(out.nodes.len() as u32, (n + 1) * (n + 2) / 2, "fixed:{n}");
+        assert_eq!(out.indices.len() as u32, 3 * n * n);
+        let distinct: std::collections::BTreeSet<[u32; 3]> =
+            out.nodes.iter().map(|d| d.position.map(f32::to_bits)).collect();
+        assert_eq!(distinct.len(), out.nodes.len(), "fixed:{n}: a node stored twice");
+        assert!(out
+            .indices
+            .chunks(3)
+            .zip(out.vertices.chunks(3))
+            .all(|(i, t)| i.iter().zip(t).all(|(&i, v)| out.nodes[i as usize] == *v)));
+    }
+}
+
 /// Checks a triangulation of the triangle q with `counts` nodes per edge is conforming:
 /// every edge is shared by two triangles or lies on the boundary, the boundary edges are
 /// exactly the consecutive edge nodes, and the areas add up.
