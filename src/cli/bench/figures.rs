@@ -280,11 +280,11 @@ pub fn plot_fig8(points: &[Point]) -> image::RgbaImage {
 pub fn plot_fig10(points: &[Point]) -> image::RgbaImage {
     let ticks: Vec<(f64, String)> = std::iter::once((0.0, "vertex".to_string()))
         .chain((1..=7).map(|n| (n as f64, format!("fixed:{n}"))))
-        .chain([(8.0, "adaptive:length".into()), (9.0, "adaptive (error)".into())])
+        .chain([(8.0, "eq. 5".into()), (9.0, "error".into())])
         .collect();
     let error = Chart {
         title: "Fig. 10 (left): display-position error".into(),
-        x_label: "method".into(),
+        x_label: "method (eq. 5: adaptive:length; error: adaptive, the error split)".into(),
         y_label: "error [px] (mean ± std)".into(),
         y_log: true,
         x_ticks: ticks.clone(),
@@ -293,7 +293,7 @@ pub fn plot_fig10(points: &[Point]) -> image::RgbaImage {
     };
     let time = Chart {
         title: "Fig. 10 (right): time per frame, both eyes".into(),
-        x_label: "method".into(),
+        x_label: "method (eq. 5: adaptive:length; error: adaptive, the error split)".into(),
         y_label: "ms per frame".into(),
         y_log: true,
         x_ticks: ticks,
