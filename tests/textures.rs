@@ -220,6 +220,44 @@ fn covered(img: &EyeImage, projection: &Projection, eye: Eye, x: [f32; 2], y: [f
 }
 
 #[test]
+fn a_scene_of_single_sided_materials_culls_back_faces_in_the_rasterizer_as_the_fragments_would() {
+    // Every material single-sided: the pipelines cull back faces (GpuScene::cull_back_faces); the
+    // image is the one the fragment stage's discard gives, per eye (and with the CPU twin).
+    let mut scene = Scene::new("single-sided");
+    scene.materials = vec![Material { double_sided: 0, ..Default::default() }];
+    let (y, z) = ([-0.4, 0.4], -3.0);
+    let xs = [[-1.6, -0.8], [-0.6, 0.2], [0.4, 1.2]];
+    let uv = [Vec2::ZERO, Vec2::ONE];
+    // Material 1: the scene's first (0 is the table's default, double-sided).
+    quad(&mut scene, "facing", xs[0], y, z, uv, 1, [1.0; 4], false);
+    quad(&mut scene, "from behind", xs[1], y, z, uv, 1, [1.0; 4], true);
+    quad(&mut scene, "facing again", xs[2], y, z, uv, 1, [1.0; 4], false);
+    let r = common::renderer();
+    let gs = twister::GpuScene::upload(&r.gpu, &scene).unwrap();
+    assert!(gs.cull_back_faces);
+    let mut mixed = scene.clone();
+    quad(&mut mixed, "default material", [2.0, 2.5], y, z, uv, 0, [1.0; 4], false);
+    assert!(
+        !twister::GpuScene::upload(&r.gpu, &mixed).unwrap().cull_back_faces,
+        "the default material is double-sided"
+    );
+    for method in [Method::Adaptive(Split::Error), Method::Vertex, Method::Slit(2)] {
+        let s = settings(900, 150, method);
+        let frame = r.render(&gs, &s).unwrap();
+        for eye in Eye::BOTH {
+            let img = frame.eye(eye);
+            let cov = |x: [f32; 2]| {
+                let (inside, drawn) = covered(img, &s.view.projection, eye, x, y, z);
+                drawn as f32 / inside as f32
+            };
+            assert_eq!(cov(xs[0]), 1.0, "{method:?} {eye:?}: the facing quad");
+            assert_eq!(cov(xs[1]), 0.0, "{method:?} {eye:?}: the quad seen from behind");
+            assert_eq!(cov(xs[2]), 1.0, "{method:?} {eye:?}: the other facing quad");
+        }
+    }
+}
+
+#[test]
 fn single_sided_faces_seen_from_behind_and_transparent_texels_are_not_drawn() {
     let mut scene = Scene::new("coverage");
     scene.textures.push(texture(2, 1, |x, _| [255, 255, 255, if x == 0 { 0 } else { 255 }]));

@@ -38,26 +38,30 @@ pub(crate) enum DrawStage {
 /// A drawing stage's pipelines: [colour only, with the error pass], without the fragment
 /// stage's material code (`MATERIALS = false`, for scenes whose materials are all untextured,
 /// opaque and double-sided: on lavapipe it roughly halves the fragment cost) and, made when a
-/// scene first needs them, with it.
+/// scene first needs them, with it, and with it and back faces culled (every material
+/// single-sided).
 pub(crate) struct DrawPipelines {
     pub stage: GpuStage,
     kind: DrawStage,
     plain: [wgpu::RenderPipeline; 2],
     with_materials: OnceLock<[wgpu::RenderPipeline; 2]>,
+    culled: OnceLock<[wgpu::RenderPipeline; 2]>,
 }
 
 impl DrawPipelines {
     fn new(gpu: &Gpu, kind: DrawStage) -> DrawPipelines {
         let stage = GpuStage::new(gpu, if kind == DrawStage::Raster { &RASTER } else { &SLIT });
-        let plain = [false, true].map(|measure| draw_pipeline(gpu, &stage, kind, measure, false));
-        DrawPipelines { stage, kind, plain, with_materials: OnceLock::new() }
+        let plain = [false, true].map(|measure| draw_pipeline(gpu, &stage, kind, measure, false, false));
+        DrawPipelines { stage, kind, plain, with_materials: OnceLock::new(), culled: OnceLock::new() }
     }
 
     /// The pipeline for a scene: plain where its materials allow, else with materials.
     pub fn get(&self, gpu: &Gpu, scene: &GpuScene, measure: bool) -> &wgpu::RenderPipeline {
-        let set = if scene.needs_materials {
+        let set = if scene.cull_back_faces {
+            self.culled.get_or_init(|| [false, true].map(|m| draw_pipeline(gpu, &self.stage, self.kind, m, true, true)))
+        } else if scene.needs_materials {
             self.with_materials
-                .get_or_init(|| [false, true].map(|m| draw_pipeline(gpu, &self.stage, self.kind, m, true)))
+                .get_or_init(|| [false, true].map(|m| draw_pipeline(gpu, &self.stage, self.kind, m, true, false)))
         } else {
             &self.plain
         };
@@ -76,8 +80,16 @@ fn attribute(format: wgpu::VertexFormat, offset: usize, shader_location: u32) ->
 }
 
 /// A drawing pipeline: colour only (`fs_main`) or with the error pass (`fs_error`); with the
-/// fragment stage's material code (`MATERIALS`) or without.
-fn draw_pipeline(gpu: &Gpu, stage: &GpuStage, kind: DrawStage, measure: bool, materials: bool) -> wgpu::RenderPipeline {
+/// fragment stage's material code (`MATERIALS`) or without; culling back faces (counter-clockwise
+/// on screen is the front, as `front_facing` in the fragment stage) or not.
+fn draw_pipeline(
+    gpu: &Gpu,
+    stage: &GpuStage,
+    kind: DrawStage,
+    measure: bool,
+    materials: bool,
+    cull: bool,
+) -> wgpu::RenderPipeline {
     use wgpu::VertexFormat::{Float32, Float32x2, Float32x3, Float32x4, Uint32};
     // Raster: the subdivided `DrawVertex`; slit: the scene's `SceneVertex` (`VertexIn` of each WGSL file).
     let (stride, attributes) = match kind {
@@ -125,7 +137,8 @@ fn draw_pipeline(gpu: &Gpu, stage: &GpuStage, kind: DrawStage, measure: bool, ma
         },
         primitive: wgpu::PrimitiveState {
             topology: wgpu::PrimitiveTopology::TriangleList,
-            cull_mode: None,
+            front_face: wgpu::FrontFace::Ccw,
+            cull_mode: cull.then_some(wgpu::Face::Back),
             ..Default::default()
         },
         depth_stencil: Some(wgpu::DepthStencilState {

@@ -31,6 +31,8 @@ pub struct GpuScene {
     /// Whether some material is textured, not opaque or single-sided (else the drawing stages
     /// use their plain pipelines).
     pub needs_materials: bool,
+    /// Every material is single-sided: the drawing pipelines cull back faces.
+    pub cull_back_faces: bool,
 }
 
 impl GpuScene {
@@ -86,6 +88,7 @@ impl GpuScene {
             ];
             let ones = vec![1.0f32; scene.objects.len().max(1)];
             let needs_materials = table.needs_materials();
+            let cull_back_faces = table.all_single_sided(&scene.vertices);
             Ok(GpuScene {
                 vertices,
                 indices,
@@ -95,6 +98,7 @@ impl GpuScene {
                 warnings: table.warnings,
                 object_edge_scale: storage("object edge scale", bytemuck::cast_slice(&ones)),
                 needs_materials,
+                cull_back_faces,
             })
         })
     }
@@ -125,6 +129,7 @@ impl GpuScene {
                 wgpu::BufferUsages::STORAGE,
             ),
             needs_materials: self.needs_materials,
+            cull_back_faces: self.cull_back_faces,
         }
     }
 }
