@@ -83,16 +83,20 @@ impl MaterialTable {
             .any(|m| m.texture != NO_TEXTURE || m.alpha_mode != AlphaMode::Opaque as u32 || m.double_sided == 0)
     }
 
-    /// Whether every material the vertices use (by index into this table, clamped as the
-    /// fragment stage clamps it) is single-sided: the drawing stages then cull back faces in the
-    /// rasterizer, per eye, before any fragment work (the same triangles the fragment stage would
-    /// discard: both go by the triangle's winding on screen).
-    pub fn all_single_sided(&self, vertices: &[crate::core::scene::SceneVertex]) -> bool {
+    /// Whether every material in `used` (indices into this table, as the vertices carry them,
+    /// clamped as the fragment stage clamps them) is single-sided, and there is one: the drawing
+    /// stages then cull back faces in the rasterizer, per eye, before any fragment work (the same
+    /// triangles the fragment stage would discard: both go by the triangle's winding on screen).
+    pub fn all_single_sided(&self, used: impl IntoIterator<Item = u32>) -> bool {
         let last = self.materials.len().saturating_sub(1);
-        !vertices.is_empty()
-            && vertices
-                .iter()
-                .all(|v| self.materials.get((v.material as usize).min(last)).is_some_and(|m| m.double_sided == 0))
+        let mut any = false;
+        for m in used {
+            any = true;
+            if self.materials.get((m as usize).min(last)).is_none_or(|m| m.double_sided != 0) {
+                return false;
+            }
+        }
+        any
     }
 
     /// Packs a scene's materials and textures, keeping at most `max_texels` texels: while over,

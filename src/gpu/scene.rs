@@ -88,7 +88,7 @@ impl GpuScene {
             ];
             let ones = vec![1.0f32; scene.objects.len().max(1)];
             let needs_materials = table.needs_materials();
-            let cull_back_faces = table.all_single_sided(&scene.vertices);
+            let cull_back_faces = table.all_single_sided(scene.vertices.iter().map(|v| v.material));
             Ok(GpuScene {
                 vertices,
                 indices,
