@@ -900,17 +900,6 @@ fn node_slot(c: vec3<u32>, m: u32) -> u32 {
     return c.z * (2u * m + 3u - c.z) / 2u + c.y;
 }
 
-// Lattice node `slot` of level m as (i, j, l).
-fn slot_node(slot: u32, m: u32) -> vec3<u32> {
-    var l = 0u;
-    var rest = slot;
-    while (rest > m - l) {
-        rest -= m + 1u - l;
-        l += 1u;
-    }
-    return vec3<u32>(m - l - rest, rest, l);
-}
-
 // Whether lattice triangle t of level m is drawn: not collapsed by snapping, not off screen.
 fn lattice_triangle_drawn(t: u32, m: u32) -> bool {
     let cell = macro_cell(m, t);
@@ -1083,8 +1072,17 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     let theta_c = azimuth((piece_q[0].position + piece_q[1].position + piece_q[2].position) / 3.0);
     var u_min = 1e30;
     var u_max = -1e30;
+    // Nodes in slot order: (i, j, l) row by row, kept by a running (j, l) rather than searched
+    // for each slot (lavapipe stops an invocation after 65,535 loop iterations in all).
+    var j = 0u;
+    var l = 0u;
     for (var k = 0u; k < node_count; k++) {
-        let p = lattice_node(slot_node(k, m), m).position;
+        let p = lattice_node(vec3<u32>(m - j - l, j, l), m).position;
+        j += 1u;
+        if (j > m - l) {
+            j = 0u;
+            l += 1u;
+        }
         let theta = theta_c + wrap_angle(azimuth(p) - theta_c);
         if (is_sphere(params.projection)) {
             for (var s = 0u; s < 2u; s++) {
@@ -1114,10 +1112,17 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         || first_triangle + copies * count > params.triangle_capacity) {
         return; // counted, never written
     }
+    j = 0u;
+    l = 0u;
     for (var k = 0u; k < node_count; k++) {
-        let node = lattice_node(slot_node(k, m), m);
+        let node = lattice_node(vec3<u32>(m - j - l, j, l), m);
         for (var c = 0u; c < copies; c++) {
             out_nodes[first_node + c * node_count + k] = draw_vertex(node, refs[c]);
+        }
+        j += 1u;
+        if (j > m - l) {
+            j = 0u;
+            l += 1u;
         }
     }
     var slot = 3u * first_triangle;
