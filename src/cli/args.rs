@@ -65,7 +65,7 @@ pub struct ViewArgs {
     /// What splits an adaptive edge: error (its projected error, --max-error-px) or length (its
     /// projected length, --edge-px: the paper's eq. 5) [default: error].
     #[arg(long, value_enum)]
-    pub split: Option<SplitArg>,
+    pub split: Option<Split>,
     /// τ: the display-position error the error split allows an edge, pixels.
     #[arg(long, default_value_t = DEFAULT_MAX_ERROR_PX)]
     pub max_error_px: f32,
@@ -99,15 +99,6 @@ pub struct ViewArgs {
     /// [default: 100] (needs --lod visual-field).
     #[arg(long)]
     pub lod_dinf: Option<f32>,
-}
-
-/// `--split`: what splits an adaptive edge.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum SplitArg {
-    /// Its projected error (τ = --max-error-px).
-    Error,
-    /// Its projected length (L = --edge-px): the paper's eq. 5.
-    Length,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -264,8 +255,7 @@ impl ViewArgs {
             })
             .with_yaw_deg(self.yaw)
             .with_method(match (self.method, self.split) {
-                (Method::Adaptive(_), Some(SplitArg::Error)) => Method::Adaptive(Split::Error),
-                (Method::Adaptive(_), Some(SplitArg::Length)) => Method::Adaptive(Split::Length),
+                (Method::Adaptive(_), Some(split)) => Method::Adaptive(split),
                 (method, _) => method,
             })
             .with_edge_px(self.edge_px)

@@ -36,14 +36,14 @@ pub enum Method {
 }
 
 /// What decides an adaptive edge's divisions (`--split`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum Split {
-    /// The projected error: N = ceil(S·√(b / 8τ)), b the largest second difference of the
-    /// projected edge sampled at S = 8 segments (`Subdivider::edge_profile`), τ `max_error_px`;
+    /// Its projected error (τ = --max-error-px): N = ceil(S·√(b / 8τ)), b the largest second
+    /// difference of the projected edge sampled at S = 8 segments (`Subdivider::edge_profile`);
     /// edges stay under 8·L long, and the length rule holds near the eye circle.
     #[default]
     Error,
-    /// The projected length, N = ceil(l/L): the paper's eq. 5.
+    /// Its projected length (L = --edge-px), N = ceil(l/L): the paper's eq. 5.
     Length,
 }
 

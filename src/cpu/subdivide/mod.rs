@@ -197,6 +197,11 @@ pub struct SubdivideOutput {
     pub cuts: AxisCuts,
 }
 
+/// Indexed triangles as three vertices each.
+fn expand(nodes: &[DrawVertex], indices: &[u32]) -> Vec<DrawVertex> {
+    indices.iter().map(|&i| nodes[i as usize]).collect()
+}
+
 impl SubdivideOutput {
     /// An output from its nodes and indices (the GPU's read-back), with `vertices` expanded.
     pub fn indexed(
@@ -206,7 +211,7 @@ impl SubdivideOutput {
         max_sub_edge_px: f32,
         cuts: AxisCuts,
     ) -> Self {
-        let vertices = indices.iter().map(|&i| nodes[i as usize]).collect();
+        let vertices = expand(&nodes, &indices);
         SubdivideOutput { nodes, indices, vertices, pieces, max_sub_edge_px, cuts }
     }
 }
@@ -445,7 +450,7 @@ impl<'a> Subdivider<'a> {
                 }
             }
         }
-        out.vertices = out.indices.iter().map(|&i| out.nodes[i as usize]).collect();
+        out.vertices = expand(&out.nodes, &out.indices);
         out
     }
 
@@ -519,17 +524,16 @@ impl<'a> Subdivider<'a> {
         // The lattice of level m: which of its m² triangles are drawn (not collapsed by snapping,
         // not off screen), then its nodes once, then the drawn triangles as indices into them.
         let m = counts[0].max(counts[1]).max(counts[2]);
-        let node = |c: [u32; 3]| lattice_node(counts, &q, &node_on_edge, m, c);
-        let drawn: Vec<u32> = (0..m * m)
-            .filter(|&t| {
-                let p = macro_cell(m, t).map(|c| node(c).position);
-                !(p[0] == p[1] || p[1] == p[2] || p[2] == p[0] || self.off_screen_vertically(p))
-            })
+        let drawn: Vec<[u32; 3]> = lattice_triangles(counts, &q, &node_on_edge)
+            .into_iter()
+            .filter(|(_, t)| !self.off_screen_vertically(t.map(|n| n.position)))
+            .map(|(slots, _)| slots)
             .collect();
         if drawn.is_empty() {
             return;
         }
-        let nodes: Vec<Node> = (0..(m + 1) * (m + 2) / 2).map(|k| node(slot_node(k, m))).collect();
+        let nodes: Vec<Node> =
+            (0..(m + 1) * (m + 2) / 2).map(|k| lattice_node(counts, &q, &node_on_edge, m, slot_node(k, m))).collect();
         // The seam: every node is unwrapped towards the piece's reference azimuth; where the
         // nodes' u range (both eyes) reaches ±π, the piece is drawn again a turn away.
         let theta_c = azimuth((q[0].position + q[1].position + q[2].position) / 3.0);
@@ -562,9 +566,7 @@ impl<'a> Subdivider<'a> {
         for &theta_ref in &refs {
             out.nodes.extend(nodes.iter().map(|&n| draw_vertex(tri, n, theta_ref)));
         }
-        for t in drawn {
-            let cell = macro_cell(m, t);
-            let local = cell.map(|c| node_slot(c, m));
+        for local in drawn {
             if self.params.measure_edges != 0 {
                 out.max_sub_edge_px =
                     out.max_sub_edge_px.max(self.visible_edge_px(local.map(|i| nodes[i as usize].position)));
@@ -671,24 +673,26 @@ pub fn macro_cell(k: u32, cell: u32) -> [[u32; 3]; 3] {
     }
 }
 
-/// Generates the lattice of a piece with corners `q` and edge counts `counts` (edge e runs from
-/// corner e to corner e+1; `node_on_edge(e, m)` gives its m-th node from corner e): the regular
-/// lattice of level m = max(counts), whose boundary nodes on an edge with fewer divisions snap
-/// to that edge's nearest node. Snapping is monotone along the edge, so no triangle folds over;
-/// triangles whose snapped corners coincide have no area and are skipped.
+/// The lattice of a piece with corners `q` and edge counts `counts` (edge e runs from corner e to
+/// corner e+1; `node_on_edge(e, m)` gives its m-th node from corner e): the regular lattice of
+/// level m = max(counts), whose boundary nodes on an edge with fewer divisions snap to that edge's
+/// nearest node. Snapping is monotone along the edge, so no triangle folds over; triangles whose
+/// snapped corners coincide have no area and are skipped. Each triangle as its corners' slots
+/// ([`node_slot`]) and nodes.
 pub fn lattice_triangles(
     counts: [u32; 3],
     q: &[Node; 3],
     node_on_edge: &dyn Fn(usize, u32) -> Node,
-    emit: &mut dyn FnMut(Node, Node, Node),
-) {
+) -> Vec<([u32; 3], [Node; 3])> {
     let m = counts[0].max(counts[1]).max(counts[2]);
-    for t in 0..m * m {
-        let [a, b, c] = macro_cell(m, t).map(|c| lattice_node(counts, q, node_on_edge, m, c));
-        if a.position != b.position && b.position != c.position && c.position != a.position {
-            emit(a, b, c);
-        }
-    }
+    (0..m * m)
+        .filter_map(|t| {
+            let cell = macro_cell(m, t);
+            let [a, b, c] = cell.map(|c| lattice_node(counts, q, node_on_edge, m, c));
+            (a.position != b.position && b.position != c.position && c.position != a.position)
+                .then(|| (cell.map(|c| node_slot(c, m)), [a, b, c]))
+        })
+        .collect()
 }
 
 /// Lattice node (i, j, l), i + j + l = m (weights of q0, q1, q2), of a piece with corners `q`

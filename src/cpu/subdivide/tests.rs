@@ -204,8 +204,8 @@ fn check_conforming(counts: [u32; 3]) {
         Node { position: Vec3::new(0.4, 1.1, -3.2), bary: Vec3::Z },
     ];
     let node_on_edge = |e: usize, m: u32| edge_point(q[e], q[(e + 1) % 3], m, counts[e]);
-    let mut tris = Vec::new();
-    lattice_triangles(counts, &q, &node_on_edge, &mut |a, b, c| tris.push([a.position, b.position, c.position]));
+    let tris: Vec<[Vec3; 3]> =
+        lattice_triangles(counts, &q, &node_on_edge).into_iter().map(|(_, t)| t.map(|n| n.position)).collect();
     let key = |p: Vec3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
     let mut edges: HashMap<([u32; 3], [u32; 3]), u32> = HashMap::new();
     let mut total = 0.0;
