@@ -1,9 +1,12 @@
 // The `raster` stage (vertex + fragment): projects each subdivided vertex with the TWISTER
-// projection (seed 002 eq. 1–4, projection.wgsl) for one eye; the fragments are shaded and carry
-// their display-position error (fragment.wgsl). CPU twin: src/cpu/raster.rs.
+// projection (seed 002 eq. 1–4, projection.wgsl) for the eye drawn; the fragments are shaded and
+// carry their display-position error (fragment.wgsl). Both eyes come from one draw where the
+// adapter has multiview (the eye is the view index, each eye a layer of the targets), else from
+// one pass per eye (the `eyes` module, src/shader/mod.rs). CPU twin: src/cpu/raster.rs.
 
 #import projection
 #import fragment
+#import eyes
 
 struct RasterParams {
     projection: Projection,
@@ -18,7 +21,12 @@ struct RasterParams {
     _pad2: u32,
 }
 
-@group(0) @binding(0) var<uniform> params: RasterParams;
+// Left eye, right eye.
+@group(0) @binding(0) var<uniform> params: array<RasterParams, 2>;
+
+fn stage_params(eye: u32) -> RasterParams {
+    return params[eye];
+}
 
 struct VertexIn {
     @location(0) position: vec3<f32>,
@@ -32,7 +40,9 @@ struct VertexIn {
 
 
 @vertex
-fn vs_main(in: VertexIn) -> VertexOut {
+fn vs_main(in: VertexIn, eye_in: EyeIn) -> VertexOut {
+    let eye = eye_index(eye_in);
+    let params = stage_params(eye);
     // Unwrap θ by whole turns towards the triangle's reference, so the triangle is never split
     // by the seam; a vertex shared by neighbours gets the same bits in both.
     let theta0 = azimuth(in.position);
@@ -48,5 +58,6 @@ fn vs_main(in: VertexIn) -> VertexOut {
     out.object = in.object;
     out.uv = in.uv;
     out.material = in.material;
+    out.eye = eye;
     return out;
 }

@@ -30,6 +30,11 @@ struct SlitCamera {
 }
 
 @group(0) @binding(0) var<uniform> params: SlitParams;
+
+// The slit stage draws one eye per pass, with that eye's `params`.
+fn stage_params(eye: u32) -> SlitParams {
+    return params;
+}
 @group(0) @binding(1) var<storage, read> cameras: array<SlitCamera>;
 
 struct VertexIn {
@@ -61,5 +66,6 @@ fn vs_main(in: VertexIn) -> VertexOut {
     out.object = in.object;
     out.uv = in.uv;
     out.material = in.material;
+    out.eye = 0u;
     return out;
 }

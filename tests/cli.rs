@@ -614,3 +614,77 @@ fn an_image_too_large_for_the_device_is_refused_up_front() {
     }
     let _ = std::fs::remove_dir_all(&out);
 }
+
+#[test]
+fn both_eyes_in_one_multiview_draw_match_a_pass_per_eye() {
+    // The raster stage can draw both eyes from one multiview draw (`TWISTER_MULTIVIEW=on`; the
+    // default on hardware GPUs) or a pass per eye (`off`; the default on software adapters).
+    // Both must draw the same: colours and distances (the error pass's fragment path, which
+    // reads the eye's parameters). Lavapipe's multiview has a race (a few pixels near triangle
+    // edges differ from run to run when the machine is busy, measured up to 0.6 %), so up to
+    // 2 % of the pixels may differ here; mixing the eyes' parameters up would change nearly
+    // every pixel (the eyes are apart by the disparity, and every distance changes).
+    #[path = "common/mod.rs"]
+    #[allow(unused)]
+    mod common;
+    let duck = common::asset("gltf/Duck/glTF-Binary/Duck.glb");
+    let alpha = common::asset("gltf/AlphaBlendModeTest/glTF-Binary/AlphaBlendModeTest.glb");
+    let cases: Vec<(String, Vec<&str>)> = vec![
+        ("builtin:demo".into(), vec!["--height", "90"]),
+        (
+            "builtin:demo".into(),
+            vec!["--method", "vertex", "--panorama", "equirect", "--height", "240", "--layout", "eyes"],
+        ),
+        ("builtin:sphere1024".into(), vec!["--method", "adaptive:length", "--height", "90"]),
+        // Single-sided materials: culled by the rasterizer per eye.
+        (duck.to_string_lossy().into(), vec!["--fit", "2", "--height", "90"]),
+        // Textures, alpha mask and blend, double-sided: the material code.
+        (alpha.to_string_lossy().into(), vec!["--fit", "2", "--height", "90"]),
+    ];
+    for (k, (scene, extra)) in cases.iter().enumerate() {
+        let run = |env: Option<&str>| {
+            let out = tmp(&format!("multiview{k}{}", env.is_some()));
+            let mut cmd = twister();
+            if let Some(v) = env {
+                cmd.env("TWISTER_MULTIVIEW", v);
+            }
+            let o = cmd
+                .args(["render", scene, "--width", "480", "--depth", "--out"])
+                .arg(&out)
+                .arg("--stats")
+                .arg(out.join("stats.json"))
+                .args(extra)
+                .output()
+                .unwrap();
+            assert!(o.status.success(), "{scene} {extra:?}: {}", String::from_utf8_lossy(&o.stderr));
+            let stats: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(out.join("stats.json")).unwrap()).unwrap();
+            let files = ["left.png", "right.png", "left_depth.exr", "right_depth.exr"].map(|f| {
+                if f.ends_with(".exr") {
+                    common::read_exr(&out.join(f)).2.into_iter().map(|z| [z; 4]).collect()
+                } else {
+                    let img = image::open(out.join(f)).unwrap_or_else(|e| panic!("{f}: {e}")).to_rgba32f();
+                    img.pixels().map(|p| p.0).collect::<Vec<[f32; 4]>>()
+                }
+            });
+            let _ = std::fs::remove_dir_all(&out);
+            (stats["adapter"].as_str().unwrap().to_string(), files)
+        };
+        let (adapter, both) = run(Some("on"));
+        let (per_eye_adapter, per_eye) = run(Some("off"));
+        assert!(per_eye_adapter.contains("a pass per eye"), "{per_eye_adapter}");
+        if !adapter.contains("multiview") {
+            eprintln!("{adapter}: no multiview on this adapter; both runs drew a pass per eye");
+        }
+        let differing = |a: &[[f32; 4]], b: &[[f32; 4]]| a.iter().zip(b).filter(|(p, q)| p != q).count();
+        let names = ["left.png", "right.png", "left_depth.exr", "right_depth.exr"];
+        for (f, (a, b)) in names.iter().zip(both.iter().zip(&per_eye)) {
+            let bad = differing(a, b);
+            assert!(bad * 50 <= a.len(), "{scene} {extra:?}: {f}: {bad} of {} pixels differ", a.len());
+        }
+        // The two eyes differ (each view drew its own eye) by far more than that.
+        let apart = differing(&both[2], &both[3]);
+        let covered = both[2].iter().zip(&both[3]).filter(|(p, q)| p[0].is_finite() || q[0].is_finite()).count();
+        assert!(apart * 2 > covered, "{scene} {extra:?}: left and right differ on only {apart} of {covered} distances");
+    }
+}

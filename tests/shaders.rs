@@ -7,7 +7,7 @@ use std::collections::BTreeSet;
 
 use naga::{AddressSpace, StorageAccess, TypeInner};
 use twister::shader::types::{StructLayout, LAYOUTS};
-use twister::shader::{compose, imports, BindingKind, ErrorTarget, Stage, SHARED, STAGES};
+use twister::shader::{compose, imports, BindingKind, ShaderOptions, Stage, SHARED, STAGES};
 
 fn parse(name: &str, source: &str) -> naga::Module {
     parse_with_info(name, source).0
@@ -30,8 +30,8 @@ fn parse_with_info(name: &str, source: &str) -> (naga::Module, naga::valid::Modu
 fn every_stage_composes_and_validates_and_every_wgsl_file_is_used() {
     let mut used = BTreeSet::new();
     for stage in STAGES {
-        for target in [ErrorTarget::Float, ErrorTarget::UintBits] {
-            parse(&format!("{} ({target:?})", stage.file()), &compose(stage, target));
+        for options in ShaderOptions::ALL {
+            parse(&format!("{} ({options:?})", stage.file()), &compose(stage, options));
         }
         used.insert(stage.file());
         // Shared modules it reaches.
@@ -92,7 +92,7 @@ fn descriptor_bindings(stage: &Stage) -> BTreeSet<(u32, u32, String, String)> {
 #[test]
 fn each_stage_declares_exactly_the_bindings_and_entry_points_of_its_descriptor() {
     for stage in STAGES {
-        let (module, info) = parse_with_info(stage.name, &compose(stage, ErrorTarget::Float));
+        let (module, info) = parse_with_info(stage.name, &compose(stage, ShaderOptions::ALL[0]));
         assert_eq!(declared_bindings(&module), descriptor_bindings(stage), "{}: bindings", stage.name);
         let entries: BTreeSet<&str> = module.entry_points.iter().map(|e| e.name.as_str()).collect();
         let wanted: BTreeSet<&str> = stage.entry_points.iter().map(|e| e.name).collect();
@@ -157,7 +157,7 @@ fn layout_mismatches(module: &naga::Module, ty: naga::Handle<naga::Type>, rust: 
 fn every_bound_struct_has_the_field_offsets_of_its_rust_twin() {
     let mut checked = BTreeSet::new();
     for stage in STAGES {
-        let module = parse(stage.name, &compose(stage, ErrorTarget::Float));
+        let module = parse(stage.name, &compose(stage, ShaderOptions::ALL[0]));
         for ty in bound_structs(&module) {
             let name = module.types[ty].name.clone().unwrap_or_default();
             let rust = LAYOUTS
@@ -177,7 +177,7 @@ fn every_bound_struct_has_the_field_offsets_of_its_rust_twin() {
 
 #[test]
 fn the_layout_check_catches_a_moved_field() {
-    let module = parse("subdivide", &compose(&twister::shader::SUBDIVIDE, ErrorTarget::Float));
+    let module = parse("subdivide", &compose(&twister::shader::SUBDIVIDE, ShaderOptions::ALL[0]));
     let (ty, _) = module.types.iter().find(|(_, t)| t.name.as_deref() == Some("Counters")).unwrap();
     let good = LAYOUTS.iter().find(|l| l.wgsl_name == "Counters").unwrap();
     assert!(layout_mismatches(&module, ty, good).is_empty());
@@ -191,7 +191,7 @@ fn the_layout_check_catches_a_moved_field() {
 #[test]
 fn generated_constants_are_what_the_rust_side_says() {
     use twister::shader::constants::{all, Value};
-    let module = parse("subdivide", &compose(&twister::shader::SUBDIVIDE, ErrorTarget::Float));
+    let module = parse("subdivide", &compose(&twister::shader::SUBDIVIDE, ShaderOptions::ALL[0]));
     for (name, value) in all() {
         let (_, c) = module
             .constants

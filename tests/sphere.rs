@@ -189,25 +189,6 @@ fn sphere_images_carry_photo_sphere_metadata_in_png_and_jpeg_and_players_names()
     let _ = std::fs::remove_dir_all(&out);
 }
 
-/// Reads the channel Z of an OpenEXR file: (width, height, values).
-fn read_exr(path: &std::path::Path) -> (usize, usize, Vec<f32>) {
-    use exr::prelude::*;
-    let image = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .specific_channels()
-        .required("Z")
-        .collect_pixels(
-            |size, _| (size.width(), size.height(), vec![0.0f32; size.width() * size.height()]),
-            |(w, _, v), pos, (z,): (f32,)| v[pos.y() * *w + pos.x()] = z,
-        )
-        .first_valid_layer()
-        .all_attributes()
-        .from_file(path)
-        .unwrap();
-    image.layer_data.channel_data.pixels
-}
-
 /// The depth files hold the distance from each pixel's eye point along its ray: checked against
 /// the ray (built here from the pixel: Cycles' construction) meeting the box room's walls, for
 /// both panoramas' eyes, and +∞ where no surface is.
@@ -253,7 +234,7 @@ fn depth_files_hold_the_distance_along_each_pixels_ray() {
         };
         assert_eq!(projection.panorama == PanoramaKind::Equirect, panorama == "equirect");
         for eye in Eye::BOTH {
-            let (w, h, z) = read_exr(&out.join(format!("{}_depth.exr", eye.name())));
+            let (w, h, z) = common::read_exr(&out.join(format!("{}_depth.exr", eye.name())));
             assert_eq!((w, h), (256, projection.height as usize));
             let mut checked = 0;
             for y in (2..h - 2).step_by(5) {
@@ -293,7 +274,7 @@ fn depth_files_hold_the_distance_along_each_pixels_ray() {
         .output()
         .unwrap();
     assert!(o.status.success());
-    let (w, h, z) = read_exr(&out.join("depth_TB.exr"));
+    let (w, h, z) = common::read_exr(&out.join("depth_TB.exr"));
     assert_eq!((w, h), (128, 128));
     assert!(z[0].is_infinite() && z[0] > 0.0, "the top-left corner shows no surface: {}", z[0]);
     assert!(z.iter().any(|d| d.is_finite() && *d > 1.0), "the sphere is in the depth");

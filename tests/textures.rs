@@ -182,8 +182,8 @@ fn every_sampler_mode_matches_the_cpu_twin_in_both_drawing_stages() {
     let frame = common::render(&scene, &s);
     let prepared =
         subdivide(&subdivide_params(&s, 0, scene.triangle_count() as u32), &scene.vertices, &scene.indices).vertices;
-    for eye in Eye::BOTH {
-        let cpu = raster(&raster_params(&s, eye), &prepared, &table, BG);
+    let cpu_eyes = raster(&raster_params(&s), &prepared, &table, BG);
+    for (eye, cpu) in Eye::BOTH.into_iter().zip(cpu_eyes) {
         let gpu = frame.eye(eye);
         let drawn = common::pixels_where(gpu, |p| !common::is_background(p, BG)).len();
         let bad = differing(&cpu.rgba, &gpu.rgba, 3);

@@ -438,10 +438,8 @@ impl Twin for Raster {
         let params = subdivide_params(settings, 0, scene.triangle_count() as u32);
         let tris = subdivide(&params, &scene.vertices, &scene.indices).vertices;
         let table = scene.material_table(usize::MAX);
-        let eyes = Eye::BOTH.map(|eye| {
-            let img = raster(&raster_params(settings, eye), &tris, &table, settings.shading.background);
-            (img.rgba, img.error, img.object, img.distance)
-        });
+        let eyes = raster(&raster_params(settings), &tris, &table, settings.shading.background)
+            .map(|img| (img.rgba, img.error, img.object, img.distance));
         (eyes, *tolerance)
     }
     fn compare((gpu, tolerance): &Self::Output, (cpu, _): &Self::Output) -> Result<(), String> {

@@ -4,10 +4,11 @@
 // colour target encodes it), the display-position error of seed 002 §4.1, the output targets and the
 // fragment entry points. CPU twins: src/cpu/fragment.rs (sampling, shading, error).
 //
-// Contract: a stage composing this module declares a uniform `params` with the fields
-// `projection: Projection`, `eye_sign: f32` (+1 right eye), `ambient: f32` and
-// `error_angle: u32`, its vertex stage returns `VertexOut`, and its pipelines bind the material
-// table as group 1.
+// Contract: a stage composing this module defines `fn stage_params(eye: u32)` returning the
+// drawn eye's parameters, a struct with the fields `projection: Projection`, `eye_sign: f32`
+// (+1 right eye), `ambient: f32` and `error_angle: u32`; its vertex stage returns `VertexOut`
+// with `eye` set (0 left, 1 right: the raster stage draws both eyes in one draw where it can);
+// its pipelines bind the material table as group 1.
 
 #import projection
 #import constants
@@ -255,8 +256,9 @@ fn pixel_distance(proj: Projection, eye_sign: f32, p: vec3<f32>, n: vec3<f32>, f
     return length(p - ray.origin);
 }
 
-fn fragment_out(frag_xy: vec2<f32>, view_position: vec3<f32>, plane_normal: vec3<f32>, normal: vec3<f32>,
-                color: vec4<f32>, object: u32) -> FragmentOut {
+fn fragment_out(eye: u32, frag_xy: vec2<f32>, view_position: vec3<f32>, plane_normal: vec3<f32>,
+                normal: vec3<f32>, color: vec4<f32>, object: u32) -> FragmentOut {
+    let params = stage_params(eye);
     var out: FragmentOut;
     out.color = shade(params.ambient, view_position, normal, color);
     out.error = encode_error(pixel_error(params.projection, params.eye_sign, view_position, frag_xy,
@@ -277,6 +279,8 @@ struct VertexOut {
     @location(3) @interpolate(flat) object: u32,
     @location(4) uv: vec2<f32>,
     @location(5) @interpolate(flat) material: u32,
+    // The eye drawn: 0 left, 1 right.
+    @location(6) @interpolate(flat) eye: u32,
 }
 
 @fragment
@@ -288,7 +292,7 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @locatio
     if (MATERIALS && c.a < 0.0) {
         discard;
     }
-    return shade(params.ambient, in.view_position, in.normal, c);
+    return shade(stage_params(in.eye).ambient, in.view_position, in.normal, c);
 }
 
 // The same, plus the display-position error, the object id and the distance (when the error or
@@ -303,5 +307,5 @@ fn fs_error(in: VertexOut, @builtin(front_facing) front_facing: bool) -> Fragmen
     if (MATERIALS && c.a < 0.0) {
         discard;
     }
-    return fragment_out(in.clip.xy, in.view_position, plane_normal, in.normal, c, in.object);
+    return fragment_out(in.eye, in.clip.xy, in.view_position, plane_normal, in.normal, c, in.object);
 }

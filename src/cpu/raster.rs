@@ -226,40 +226,43 @@ fn rasterize_clipped(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: [u32;
     }
 }
 
-/// The raster stage on the CPU for one eye.
+/// The raster stage on the CPU: both eyes (left, right) from one walk over the triangles, as
+/// the GPU's multiview draw does (each vertex projected for each eye with that eye's parameters).
 pub fn raster(
-    params: &RasterParams,
+    params: &[RasterParams; 2],
     vertices: &[DrawVertex],
     table: &MaterialTable,
     background: [f32; 3],
-) -> RasterImage {
-    let projection = Projection::from(&params.projection);
-    let eye = if params.eye_sign > 0.0 { Eye::Right } else { Eye::Left };
-    let mut img = RasterImage::new(projection.width, projection.height, background);
-    let fragment = |f: &FragmentIn| fragment(table, params.ambient, &projection, eye, params.error_angle != 0, f);
+) -> [RasterImage; 2] {
+    let projection = Projection::from(&params[0].projection);
+    let mut images = params.map(|_| RasterImage::new(projection.width, projection.height, background));
     for tri in vertices.chunks_exact(3) {
-        let cv = [0, 1, 2].map(|k| ClipVertex {
-            clip: raster_vertex(params, &tri[k]),
-            view_position: Vec3::from(tri[k].position),
-            normal: Vec3::from(tri[k].normal),
-            color: Vec4::from(tri[k].color),
-            uv: Vec2::from(tri[k].uv),
-            object: tri[k].object,
-            material: tri[k].material,
-        });
-        rasterize(&mut img, cv, [0, projection.width, 0, projection.height], &fragment);
+        for ((eye_params, eye), img) in params.iter().zip(Eye::BOTH).zip(images.iter_mut()) {
+            let cv = [0, 1, 2].map(|k| ClipVertex {
+                clip: raster_vertex(eye_params, &tri[k]),
+                view_position: Vec3::from(tri[k].position),
+                normal: Vec3::from(tri[k].normal),
+                color: Vec4::from(tri[k].color),
+                uv: Vec2::from(tri[k].uv),
+                object: tri[k].object,
+                material: tri[k].material,
+            });
+            let fragment =
+                |f: &FragmentIn| fragment(table, eye_params.ambient, &projection, eye, eye_params.error_angle != 0, f);
+            rasterize(img, cv, [0, projection.width, 0, projection.height], &fragment);
+        }
     }
-    img
+    images
 }
 
-/// The raster stage's parameters for one eye.
-pub fn raster_params(settings: &RenderSettings, eye: Eye) -> RasterParams {
-    RasterParams {
+/// The raster stage's parameters: the left eye's, then the right's (its `array<RasterParams, 2>`).
+pub fn raster_params(settings: &RenderSettings) -> [RasterParams; 2] {
+    Eye::BOTH.map(|eye| RasterParams {
         projection: settings.projection().into(),
         eye_sign: eye.sign(),
         ambient: settings.shading.ambient,
         shift_px: settings.measure.shift_px,
         error_angle: settings.measure.error_angle as u32,
         ..Default::default()
-    }
+    })
 }

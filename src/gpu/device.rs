@@ -4,11 +4,14 @@
 use std::sync::{Arc, Mutex};
 
 use crate::error::{Error, Result};
-use crate::shader::ErrorTarget;
+use crate::shader::{ErrorTarget, EyesPerDraw, ShaderOptions};
 
 pub const NO_ADAPTER_HELP: &str = "no GPU adapter found: no Vulkan, Metal, DX12 or OpenGL driver is usable on this machine. \
 Install a GPU driver, or Mesa's software Vulkan driver (lavapipe): `sudo apt-get install -y mesa-vulkan-drivers libvulkan1` \
 on Debian/Ubuntu (scripts/test.sh does this for you). If WGPU_BACKEND is set, check that it names an available backend.";
+
+/// How long a read-back waits for the GPU before it gives up with an error.
+const READBACK_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(600);
 
 pub struct Gpu {
     pub device: wgpu::Device,
@@ -19,6 +22,10 @@ pub struct Gpu {
     /// How the error pass writes its target: R32Float where the adapter can render to it,
     /// else R32Uint bits. `TWISTER_ERROR_TARGET=uint` forces the latter (for tests).
     pub error_target: ErrorTarget,
+    /// How the raster stage draws the two eyes: both in one multiview draw where the adapter
+    /// has multiview (2 views or more) and is a hardware GPU, else a pass per eye.
+    /// `TWISTER_MULTIVIEW=on|off` overrides the choice (where the adapter has multiview).
+    pub eyes_per_draw: EyesPerDraw,
     /// GPU errors raised outside any error scope (kept instead of wgpu's default panic).
     uncaptured: Arc<Mutex<Vec<String>>>,
 }
@@ -74,7 +81,18 @@ impl Gpu {
         let forced_uint = std::env::var("TWISTER_ERROR_TARGET").is_ok_and(|v| v == "uint");
         let error_target = if float_renderable && !forced_uint { ErrorTarget::Float } else { ErrorTarget::UintBits };
         let limits = adapter.limits();
-        let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
+        let multiview = adapter.features().contains(wgpu::Features::MULTIVIEW)
+            && limits.max_multiview_view_count >= 2
+            && match std::env::var("TWISTER_MULTIVIEW").as_deref() {
+                Ok("off") => false,
+                Ok("on") => true,
+                // Lavapipe (Mesa 22.3, measured) drops or mixes a few pixels near triangle
+                // edges in multiview draws when the machine is busy: a race in the driver that
+                // makes frames differ from run to run. Software adapters draw a pass per eye.
+                _ => info.device_type != wgpu::DeviceType::Cpu,
+            };
+        let eyes_per_draw = if multiview { EyesPerDraw::Both } else { EyesPerDraw::One };
+        let features = adapter.features() & (wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::MULTIVIEW);
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("twister"),
@@ -89,12 +107,21 @@ impl Gpu {
         device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
             sink.lock().unwrap_or_else(|p| p.into_inner()).push(one_line(&e));
         }));
-        Ok(Gpu { device, queue, info, limits, features, error_target, uncaptured })
+        Ok(Gpu { device, queue, info, limits, features, error_target, eyes_per_draw, uncaptured })
     }
 
-    /// "name (backend, device type)", for stats and logs.
+    /// What the generated shader modules depend on.
+    pub fn shader_options(&self) -> ShaderOptions {
+        ShaderOptions { error_target: self.error_target, eyes: self.eyes_per_draw }
+    }
+
+    /// "name (backend, device type; how the eyes are drawn)", for stats and logs.
     pub fn adapter_description(&self) -> String {
-        format!("{} ({:?}, {:?})", self.info.name, self.info.backend, self.info.device_type)
+        let eyes = match self.eyes_per_draw {
+            EyesPerDraw::Both => "both eyes per draw (multiview)",
+            EyesPerDraw::One => "a pass per eye",
+        };
+        format!("{} ({:?}, {:?}; {eyes})", self.info.name, self.info.backend, self.info.device_type)
     }
 
     /// The largest buffer a stage can bind on this device, bytes.
@@ -131,12 +158,24 @@ impl Gpu {
         buffer.map_async(wgpu::MapMode::Read, .., move |r| {
             *slot.lock().unwrap_or_else(|p| p.into_inner()) = Some(r);
         });
-        self.wait();
-        let status = mapped.lock().unwrap_or_else(|p| p.into_inner()).take();
-        match status {
-            Some(Ok(())) => {}
-            Some(Err(e)) => return Err(Error::Gpu(format!("reading back a buffer: {e}"))),
-            None => return Err(Error::Gpu("reading back a buffer: the GPU did not finish".into())),
+        // A wait can return before the work is done (lavapipe, rarely, on a busy machine: its
+        // fence wait returns early): poll again until the mapping is done, within a bound.
+        let deadline = std::time::Instant::now() + READBACK_TIMEOUT;
+        let status = loop {
+            self.wait();
+            if let Some(status) = mapped.lock().unwrap_or_else(|p| p.into_inner()).take() {
+                break status;
+            }
+            if std::time::Instant::now() > deadline {
+                return Err(Error::Gpu(format!(
+                    "reading back a buffer: the GPU did not finish within {} s",
+                    READBACK_TIMEOUT.as_secs()
+                )));
+            }
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        };
+        if let Err(e) = status {
+            return Err(Error::Gpu(format!("reading back a buffer: {e}")));
         }
         let data = buffer.get_mapped_range(..).map_err(|e| Error::Gpu(format!("reading back a buffer: {e}")))?.to_vec();
         buffer.unmap();

@@ -22,7 +22,7 @@ use crate::gpu::frame_plan::{
 };
 use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
-use crate::gpu::targets::{Targets, COLOR_FORMAT, DEPTH_FORMAT, OBJECT_FORMAT};
+use crate::gpu::targets::{Layers, Targets, COLOR_FORMAT, DEPTH_FORMAT, OBJECT_FORMAT};
 use crate::gpu::timestamps::Timestamps;
 use crate::shader::constants::PIECES_FROM_COUNTER;
 use crate::shader::types::{DrawVertex, RasterParams, SlitParams, SubdivideCounters, SubdivideParams};
@@ -35,37 +35,65 @@ pub(crate) enum DrawStage {
     Slit = 1,
 }
 
-/// A drawing stage's pipelines: [colour only, with the error pass], without the fragment
-/// stage's material code (`MATERIALS = false`, for scenes whose materials are all untextured,
-/// opaque and double-sided: on lavapipe it roughly halves the fragment cost) and, made when a
-/// scene first needs them, with it, and with it and back faces culled (every material
-/// single-sided).
+/// A drawing stage's pipelines, each made when a frame first needs it, for: a scene's look
+/// ([`Look`]); colour only or with the error pass; and the eyes drawn ([`Layers`]: both in one
+/// multiview draw, or one eye, a pipeline per eye with the WGSL `override EYE`; the slit stage
+/// draws one eye per pass with per-eye parameters and needs no per-eye pipeline).
 pub(crate) struct DrawPipelines {
     pub stage: GpuStage,
     kind: DrawStage,
-    plain: [wgpu::RenderPipeline; 2],
-    with_materials: OnceLock<[wgpu::RenderPipeline; 2]>,
-    culled: OnceLock<[wgpu::RenderPipeline; 2]>,
+    /// By `Self::index`.
+    pipelines: [OnceLock<wgpu::RenderPipeline>; 18],
+}
+
+/// What a scene's materials need of a drawing pipeline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Look {
+    /// Without the fragment stage's material code (`MATERIALS = false`), for scenes whose
+    /// materials are all untextured, opaque and double-sided: on lavapipe it roughly halves
+    /// the fragment cost.
+    Plain = 0,
+    /// With it.
+    Materials = 1,
+    /// With it, back faces culled by the rasterizer (every used material single-sided).
+    Culled = 2,
+}
+
+impl Look {
+    pub fn of(scene: &GpuScene) -> Look {
+        if scene.cull_back_faces {
+            Look::Culled
+        } else if scene.needs_materials {
+            Look::Materials
+        } else {
+            Look::Plain
+        }
+    }
 }
 
 impl DrawPipelines {
     fn new(gpu: &Gpu, kind: DrawStage) -> DrawPipelines {
         let stage = GpuStage::new(gpu, if kind == DrawStage::Raster { &RASTER } else { &SLIT });
-        let plain = [false, true].map(|measure| draw_pipeline(gpu, &stage, kind, measure, false, false));
-        DrawPipelines { stage, kind, plain, with_materials: OnceLock::new(), culled: OnceLock::new() }
+        DrawPipelines { stage, kind, pipelines: std::array::from_fn(|_| OnceLock::new()) }
     }
 
-    /// The pipeline for a scene: plain where its materials allow, else with materials.
-    pub fn get(&self, gpu: &Gpu, scene: &GpuScene, measure: bool) -> &wgpu::RenderPipeline {
-        let set = if scene.cull_back_faces {
-            self.culled.get_or_init(|| [false, true].map(|m| draw_pipeline(gpu, &self.stage, self.kind, m, true, true)))
-        } else if scene.needs_materials {
-            self.with_materials
-                .get_or_init(|| [false, true].map(|m| draw_pipeline(gpu, &self.stage, self.kind, m, true, false)))
-        } else {
-            &self.plain
+    fn index(&self, look: Look, measure: bool, layers: Layers) -> usize {
+        let eyes = match (self.kind, layers) {
+            (_, Layers::Both) => 0,
+            (DrawStage::Slit, Layers::Eye(_)) => 1,
+            (DrawStage::Raster, Layers::Eye(k)) => 1 + k.min(1),
         };
-        &set[measure as usize]
+        (look as usize * 2 + measure as usize) * 3 + eyes
+    }
+
+    /// The pipeline for a scene's look, with the error pass or not, drawing `layers`.
+    pub fn get(&self, gpu: &Gpu, scene: &GpuScene, measure: bool, layers: Layers) -> &wgpu::RenderPipeline {
+        self.get_look(gpu, Look::of(scene), measure, layers)
+    }
+
+    fn get_look(&self, gpu: &Gpu, look: Look, measure: bool, layers: Layers) -> &wgpu::RenderPipeline {
+        self.pipelines[self.index(look, measure, layers)]
+            .get_or_init(|| draw_pipeline(gpu, &self.stage, self.kind, look, measure, layers))
     }
 
     /// The scene's material table (group 1).
@@ -81,14 +109,15 @@ fn attribute(format: wgpu::VertexFormat, offset: usize, shader_location: u32) ->
 
 /// A drawing pipeline: colour only (`fs_main`) or with the error pass (`fs_error`); with the
 /// fragment stage's material code (`MATERIALS`) or without; culling back faces (counter-clockwise
-/// on screen is the front, as `front_facing` in the fragment stage) or not.
+/// on screen is the front, as `front_facing` in the fragment stage) or not; both eyes as a
+/// multiview pipeline, or one (the raster stage's `EYE`).
 fn draw_pipeline(
     gpu: &Gpu,
     stage: &GpuStage,
     kind: DrawStage,
+    look: Look,
     measure: bool,
-    materials: bool,
-    cull: bool,
+    layers: Layers,
 ) -> wgpu::RenderPipeline {
     use wgpu::VertexFormat::{Float32, Float32x2, Float32x3, Float32x4, Uint32};
     // Raster: the subdivided `DrawVertex`; slit: the scene's `SceneVertex` (`VertexIn` of each WGSL file).
@@ -125,20 +154,29 @@ fn draw_pipeline(
     let all_targets =
         [COLOR_FORMAT, error_target_format(gpu.error_target), OBJECT_FORMAT, error_target_format(gpu.error_target)]
             .map(|format| Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL }));
-    let constants = [("MATERIALS", materials as u32 as f64)];
+    let mut constants = vec![("MATERIALS", (look != Look::Plain) as u32 as f64)];
+    let multiview_mask = match layers {
+        Layers::Both => std::num::NonZeroU32::new(0b11),
+        Layers::Eye(k) => {
+            if kind == DrawStage::Raster {
+                constants.push(("EYE", k as f64));
+            }
+            None
+        }
+    };
     gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(stage.stage.name),
         layout: Some(stage.draw_layout()),
         vertex: wgpu::VertexState {
             module: &stage.module,
             entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
             buffers: &[Some(layout)],
         },
         primitive: wgpu::PrimitiveState {
             topology: wgpu::PrimitiveTopology::TriangleList,
             front_face: wgpu::FrontFace::Ccw,
-            cull_mode: cull.then_some(wgpu::Face::Back),
+            cull_mode: (look == Look::Culled).then_some(wgpu::Face::Back),
             ..Default::default()
         },
         depth_stencil: Some(wgpu::DepthStencilState {
@@ -155,7 +193,7 @@ fn draw_pipeline(
             compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
             targets: if measure { &all_targets } else { &all_targets[..1] },
         }),
-        multiview_mask: None,
+        multiview_mask,
         cache: None,
     })
 }
@@ -208,8 +246,8 @@ pub(crate) struct FrameResources {
     pub targets: Option<Targets>,
     pub timestamps: Option<Timestamps>,
     pub subdivide_params: wgpu::Buffer,
-    /// Per eye.
-    pub raster_params: [wgpu::Buffer; 2],
+    /// Both eyes' (left, right), as the raster stage's `array<RasterParams, 2>`.
+    pub raster_params: wgpu::Buffer,
     pub slit_params: [wgpu::Buffer; 2],
     /// Counters and timestamps of a one-submission frame.
     pub staging: wgpu::Buffer,
@@ -254,8 +292,7 @@ impl Renderer {
                 targets: None,
                 timestamps: Timestamps::new(&gpu),
                 subdivide_params: gpu.uniform_buffer::<SubdivideParams>("subdivide params"),
-                raster_params: Eye::BOTH
-                    .map(|e| gpu.uniform_buffer::<RasterParams>(&format!("{} raster params", e.name()))),
+                raster_params: gpu.uniform_buffer::<[RasterParams; 2]>("raster params"),
                 slit_params: Eye::BOTH.map(|e| gpu.uniform_buffer::<SlitParams>(&format!("{} slit params", e.name()))),
                 staging: gpu.device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("frame readback"),
@@ -264,9 +301,12 @@ impl Renderer {
                     mapped_at_creation: false,
                 }),
             };
+            let raster = DrawPipelines::new(&gpu, DrawStage::Raster);
+            // The usual pipeline now, for the same reason.
+            raster.get_look(&gpu, Look::Plain, false, Layers::passes(gpu.eyes_per_draw)[0]);
             Ok((
                 subdivide,
-                DrawPipelines::new(&gpu, DrawStage::Raster),
+                raster,
                 DrawPipelines::new(&gpu, DrawStage::Slit),
                 reduce.compute(&gpu, "accumulate"),
                 reduce.compute(&gpu, "finish"),
@@ -515,8 +555,9 @@ impl Renderer {
         Ok(Some((counters, times)))
     }
 
-    /// Encodes the raster of both eyes (clearing the targets first if `clear`); with a query
-    /// set, writes timestamps at the start of the first eye's pass and the end of the second's.
+    /// Encodes the raster of both eyes (clearing the targets first if `clear`): one multiview
+    /// pass, or a pass per eye ([`Layers::passes`]); with a query set, writes timestamps at the
+    /// start of the first pass and the end of the last.
     #[allow(clippy::too_many_arguments)]
     fn encode_raster(
         &self,
@@ -529,18 +570,19 @@ impl Renderer {
         clear: bool,
         timestamps: Option<(&wgpu::QuerySet, u32, u32)>,
     ) {
-        let pipeline = self.raster.get(&self.gpu, scene, settings.measure.targets());
         let materials = self.raster.material_bind_group(&self.gpu, scene);
-        for (k, eye) in Eye::BOTH.into_iter().enumerate() {
-            let uniform = &res.raster_params[k];
-            self.gpu.queue.write_buffer(uniform, 0, bytemuck::bytes_of(&raster_params(settings, eye)));
-            let bind_group = self.raster.stage.bind_group(&self.gpu, None, 0, &[uniform]);
+        let uniform = &res.raster_params;
+        self.gpu.queue.write_buffer(uniform, 0, bytemuck::cast_slice(&raster_params(settings)));
+        let bind_group = self.raster.stage.bind_group(&self.gpu, None, 0, &[uniform]);
+        let passes = Layers::passes(self.gpu.eyes_per_draw);
+        for (k, &layers) in passes.iter().enumerate() {
+            let pipeline = self.raster.get(&self.gpu, scene, settings.measure.targets(), layers);
             let writes = timestamps.map(|(q, begin, end)| wgpu::RenderPassTimestampWrites {
                 query_set: q,
                 beginning_of_pass_write_index: (k == 0).then_some(begin),
-                end_of_pass_write_index: (k == 1).then_some(end),
+                end_of_pass_write_index: (k + 1 == passes.len()).then_some(end),
             });
-            let mut pass = targets.begin_eye_pass(enc, k, settings, clear, writes);
+            let mut pass = targets.begin_pass(enc, layers, settings, clear, writes);
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &bind_group, &[]);
             pass.set_bind_group(1, &materials, &[]);

@@ -10,6 +10,7 @@ use crate::cpu::slit::{slit_params, slits, sphere_in_slit, SlitCamera};
 use crate::error::Result;
 use crate::gpu::renderer::{FrameResources, Renderer};
 use crate::gpu::scene::GpuScene;
+use crate::gpu::targets::Layers;
 
 impl Renderer {
     pub(crate) fn render_slit(
@@ -33,7 +34,7 @@ impl Renderer {
         let camera_buffer =
             gpu.init_buffer("slit cameras", bytemuck::cast_slice(&cameras), wgpu::BufferUsages::STORAGE);
         let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, chunks: 1, ..Default::default() };
-        let pipeline = self.slit.get(gpu, scene, settings.measure.targets());
+        let pipeline = self.slit.get(gpu, scene, settings.measure.targets(), Layers::Eye(0));
         let materials = self.slit.material_bind_group(gpu, scene);
         let timestamps = res.timestamps.as_ref();
         let t = Instant::now();
@@ -47,7 +48,7 @@ impl Renderer {
                 beginning_of_pass_write_index: (k == 0).then_some(0),
                 end_of_pass_write_index: (k == 1).then_some(1),
             });
-            let mut pass = targets.begin_eye_pass(&mut enc, k, settings, true, writes);
+            let mut pass = targets.begin_pass(&mut enc, Layers::Eye(k), settings, true, writes);
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &bind_group, &[]);
             pass.set_bind_group(1, &materials, &[]);

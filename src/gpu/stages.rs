@@ -43,7 +43,7 @@ impl GpuStage {
         let device = &gpu.device;
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(stage.name),
-            source: wgpu::ShaderSource::Wgsl(compose(stage, gpu.error_target).into()),
+            source: wgpu::ShaderSource::Wgsl(compose(stage, gpu.shader_options()).into()),
         });
         let (visibility, pipelines): (_, Vec<Option<&'static str>>) = match stage.kind {
             StageKind::Compute => {

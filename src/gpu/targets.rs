@@ -1,6 +1,7 @@
-//! Per-eye render targets (colour, display-position error, object id, depth), made once per
-//! image size and reused across frames, the render pass that draws one eye into them, and
-//! their read-back.
+//! The render targets (colour, display-position error, object id, distance, depth), made once
+//! per image size and reused across frames: each a 2-layer texture, layer 0 the left eye and
+//! layer 1 the right; the render pass that draws one eye into its layer, or both eyes at once
+//! (multiview); and their read-back.
 
 use crate::core::color::srgb_to_linear;
 use crate::core::frame::EyeImage;
@@ -8,7 +9,7 @@ use crate::core::projection::Eye;
 use crate::core::settings::RenderSettings;
 use crate::error::Result;
 use crate::gpu::device::{error_target_format, Gpu};
-use crate::shader::ErrorTarget;
+use crate::shader::{ErrorTarget, EyesPerDraw};
 
 /// The colour target holds display (sRGB-encoded) values; the fragment stage writes linear light
 /// and the target encodes it (cheaper than encoding in the shader on lavapipe).
@@ -16,15 +17,34 @@ pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrg
 pub const OBJECT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
+/// Which layers a render pass draws.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Layers {
+    /// One eye (0 left, 1 right).
+    Eye(usize),
+    /// Both eyes, as the two views of a multiview pass.
+    Both,
+}
+
+impl Layers {
+    /// The raster stage's passes: one multiview pass drawing both eyes, or one per eye.
+    pub fn passes(eyes: EyesPerDraw) -> &'static [Layers] {
+        match eyes {
+            EyesPerDraw::Both => &[Layers::Both],
+            EyesPerDraw::One => &[Layers::Eye(0), Layers::Eye(1)],
+        }
+    }
+}
+
 pub struct Targets {
     pub width: u32,
     pub height: u32,
-    pub color: [wgpu::Texture; 2],
-    pub error: [wgpu::Texture; 2],
-    pub object: [wgpu::Texture; 2],
+    pub color: wgpu::Texture,
+    pub error: wgpu::Texture,
+    pub object: wgpu::Texture,
     /// Distance from each pixel's eye point (the error target's format).
-    pub distance: [wgpu::Texture; 2],
-    pub depth: [wgpu::Texture; 2],
+    pub distance: wgpu::Texture,
+    pub depth: wgpu::Texture,
     error_target: ErrorTarget,
 }
 
@@ -33,7 +53,7 @@ impl Targets {
         let make = |format, usage, label: &str| {
             gpu.device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
-                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                size: wgpu::Extent3d { width, height, depth_or_array_layers: 2 },
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
@@ -45,38 +65,45 @@ impl Targets {
         let copyable = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
         let depth = wgpu::TextureUsages::RENDER_ATTACHMENT;
         let error_format = error_target_format(gpu.error_target);
-        let pair =
-            |format, usage, what: &str| Eye::BOTH.map(|eye| make(format, usage, &format!("{} {what}", eye.name())));
         Targets {
             width,
             height,
-            color: pair(COLOR_FORMAT, copyable, "colour"),
-            error: pair(error_format, copyable, "error"),
-            object: pair(OBJECT_FORMAT, copyable, "object"),
-            distance: pair(error_format, copyable, "distance"),
-            depth: pair(DEPTH_FORMAT, depth, "depth"),
+            color: make(COLOR_FORMAT, copyable, "colour"),
+            error: make(error_format, copyable, "error"),
+            object: make(OBJECT_FORMAT, copyable, "object"),
+            distance: make(error_format, copyable, "distance"),
+            depth: make(DEPTH_FORMAT, depth, "depth"),
             error_target: gpu.error_target,
         }
     }
 
-    /// Begins the render pass of eye `k`, clearing its targets first if `clear` (background
-    /// colour, error −1, object 0, distance +∞, depth 1); the error, object and distance targets
-    /// only when measuring (`MeasureSettings::targets`).
-    pub fn begin_eye_pass<'e>(
+    /// Begins a render pass drawing `layers`, clearing their targets first if `clear`
+    /// (background colour, error −1, object 0, distance +∞, depth 1); the error, object and
+    /// distance targets only when measuring (`MeasureSettings::targets`).
+    pub fn begin_pass<'e>(
         &self,
         enc: &'e mut wgpu::CommandEncoder,
-        k: usize,
+        layers: Layers,
         settings: &RenderSettings,
         clear: bool,
         timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'e>>,
     ) -> wgpu::RenderPass<'e> {
         let outputs = if settings.measure.targets() { 4 } else { 1 };
-        let views: Vec<wgpu::TextureView> = [&self.color[k], &self.error[k], &self.object[k], &self.distance[k]]
-            [..outputs]
-            .iter()
-            .map(|t| t.create_view(&Default::default()))
-            .collect();
-        let depth_view = self.depth[k].create_view(&Default::default());
+        let (dimension, base_array_layer, array_layer_count, multiview_mask) = match layers {
+            Layers::Eye(k) => (wgpu::TextureViewDimension::D2, k as u32, 1, None),
+            Layers::Both => (wgpu::TextureViewDimension::D2Array, 0, 2, std::num::NonZeroU32::new(0b11)),
+        };
+        let view = |t: &wgpu::Texture| {
+            t.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(dimension),
+                base_array_layer,
+                array_layer_count: Some(array_layer_count),
+                ..Default::default()
+            })
+        };
+        let views: Vec<wgpu::TextureView> =
+            [&self.color, &self.error, &self.object, &self.distance][..outputs].iter().map(|t| view(t)).collect();
+        let depth_view = view(&self.depth);
         // The background is given as display values; the sRGB target takes linear ones.
         let [r, g, b] = settings.shading.background.map(|c| srgb_to_linear(c) as f64);
         let value = |x: f32| match self.error_target {
@@ -105,7 +132,10 @@ impl Targets {
             })
             .collect();
         enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some(Eye::BOTH[k].name()),
+            label: Some(match layers {
+                Layers::Eye(k) => Eye::BOTH[k].name(),
+                Layers::Both => "both eyes",
+            }),
             color_attachments: &attachments,
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &depth_view,
@@ -117,7 +147,7 @@ impl Targets {
             }),
             timestamp_writes,
             occlusion_query_set: None,
-            multiview_mask: None,
+            multiview_mask,
         })
     }
 
@@ -144,10 +174,10 @@ impl Targets {
     }
 }
 
-/// Copies a 4-byte-per-texel texture of each eye into one buffer (rows padded to 256 bytes,
-/// eyes one after the other). Returns the buffer and the padded row length in texels.
-pub fn copy_eyes_to_buffer(gpu: &Gpu, textures: &[wgpu::Texture; 2], usage: wgpu::BufferUsages) -> (wgpu::Buffer, u32) {
-    let (w, h) = (textures[0].width(), textures[0].height());
+/// Copies both layers (eyes) of a 4-byte-per-texel target into one buffer (rows padded to 256
+/// bytes, eyes one after the other). Returns the buffer and the padded row length in texels.
+pub fn copy_eyes_to_buffer(gpu: &Gpu, texture: &wgpu::Texture, usage: wgpu::BufferUsages) -> (wgpu::Buffer, u32) {
+    let (w, h) = (texture.width(), texture.height());
     let padded = (4 * w).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("eye texels"),
@@ -156,12 +186,12 @@ pub fn copy_eyes_to_buffer(gpu: &Gpu, textures: &[wgpu::Texture; 2], usage: wgpu
         mapped_at_creation: false,
     });
     let mut enc = gpu.device.create_command_encoder(&Default::default());
-    for (k, texture) in textures.iter().enumerate() {
+    for k in 0..2u32 {
         enc.copy_texture_to_buffer(
             wgpu::TexelCopyTextureInfo {
                 texture,
                 mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
+                origin: wgpu::Origin3d { x: 0, y: 0, z: k },
                 aspect: wgpu::TextureAspect::All,
             },
             wgpu::TexelCopyBufferInfo {

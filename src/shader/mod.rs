@@ -11,8 +11,9 @@
 //!
 //! **Composition.** A WGSL file pulls in shared code with `#import NAME` lines (vello's
 //! convention): `shaders/shared/NAME.wgsl`, or one of the generated modules `constants`
-//! ([`constants::wgsl`]) and `error_target` (how the error pass writes its target). Each module
-//! is composed in once, after the modules it imports.
+//! ([`constants::wgsl`]), `error_target` (how the error pass writes its target) and `eyes` (how
+//! a drawing stage learns which eye it draws, [`EyesPerDraw`]). Each module is composed in once,
+//! after the modules it imports.
 
 pub mod constants;
 pub mod types;
@@ -227,11 +228,55 @@ impl ErrorTarget {
     }
 }
 
+/// How the raster stage draws the two eyes: both in one draw (multiview: each eye is a view,
+/// a layer of the 2-layer targets, and `@builtin(view_index)` tells the shader which), or one
+/// render pass per eye with a pipeline built for that eye (the WGSL `override EYE`), on adapters
+/// without multiview.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EyesPerDraw {
+    Both,
+    One,
+}
+
+impl EyesPerDraw {
+    /// The generated module `eyes`: `EyeIn`, a vertex-stage input, and `eye_index(EyeIn)`, the
+    /// eye drawn (0 left, 1 right).
+    pub fn wgsl(self) -> &'static str {
+        match self {
+            EyesPerDraw::Both => {
+                "struct EyeIn { @builtin(view_index) view: u32, }\nfn eye_index(e: EyeIn) -> u32 { return e.view; }\n"
+            }
+            EyesPerDraw::One => {
+                "override EYE: u32 = 0u;\nstruct EyeIn { @builtin(instance_index) instance: u32, }\n\
+                 fn eye_index(e: EyeIn) -> u32 { return EYE; }\n"
+            }
+        }
+    }
+}
+
+/// What the generated modules depend on: the adapter's capabilities.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ShaderOptions {
+    pub error_target: ErrorTarget,
+    pub eyes: EyesPerDraw,
+}
+
+impl ShaderOptions {
+    /// Every combination (the naga test validates each stage under all of them).
+    pub const ALL: [ShaderOptions; 4] = [
+        ShaderOptions { error_target: ErrorTarget::Float, eyes: EyesPerDraw::Both },
+        ShaderOptions { error_target: ErrorTarget::Float, eyes: EyesPerDraw::One },
+        ShaderOptions { error_target: ErrorTarget::UintBits, eyes: EyesPerDraw::Both },
+        ShaderOptions { error_target: ErrorTarget::UintBits, eyes: EyesPerDraw::One },
+    ];
+}
+
 /// The source of an importable module, or None for an unknown name.
-fn module_source(name: &str, error_target: ErrorTarget) -> Option<String> {
+fn module_source(name: &str, options: ShaderOptions) -> Option<String> {
     match name {
         "constants" => Some(constants::wgsl()),
-        "error_target" => Some(error_target.wgsl().to_string()),
+        "error_target" => Some(options.error_target.wgsl().to_string()),
+        "eyes" => Some(options.eyes.wgsl().to_string()),
         _ => SHARED.iter().find(|(n, _)| *n == name).map(|(_, s)| s.to_string()),
     }
 }
@@ -243,17 +288,17 @@ pub fn imports(source: &str) -> Vec<&str> {
 
 /// The full WGSL of a stage: its imports (recursively, each once, dependencies first), then
 /// the stage's own file with its `#import` lines commented out.
-pub fn compose(stage: &Stage, error_target: ErrorTarget) -> String {
-    fn add(name: &str, source: &str, target: ErrorTarget, done: &mut Vec<String>, out: &mut String) {
+pub fn compose(stage: &Stage, options: ShaderOptions) -> String {
+    fn add(name: &str, source: &str, options: ShaderOptions, done: &mut Vec<String>, out: &mut String) {
         for dep in imports(source) {
             if done.iter().any(|d| d == dep) {
                 continue;
             }
             done.push(dep.to_string());
-            let Some(dep_source) = module_source(dep, target) else {
+            let Some(dep_source) = module_source(dep, options) else {
                 panic!("{name}: `#import {dep}` names no module in shaders/shared/ or the generated ones")
             };
-            add(dep, &dep_source, target, done, out);
+            add(dep, &dep_source, options, done, out);
         }
         let body: Vec<String> = source
             .lines()
@@ -263,6 +308,6 @@ pub fn compose(stage: &Stage, error_target: ErrorTarget) -> String {
     }
     let mut out = String::new();
     let mut done = Vec::new();
-    add(&stage.file(), stage.source, error_target, &mut done, &mut out);
+    add(&stage.file(), stage.source, options, &mut done, &mut out);
     out
 }

@@ -60,3 +60,22 @@ pub fn base64(bytes: &[u8]) -> String {
     }
     s
 }
+
+/// Reads the channel Z of an OpenEXR file: (width, height, values).
+pub fn read_exr(path: &std::path::Path) -> (usize, usize, Vec<f32>) {
+    use exr::prelude::*;
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .specific_channels()
+        .required("Z")
+        .collect_pixels(
+            |size, _| (size.width(), size.height(), vec![0.0f32; size.width() * size.height()]),
+            |(w, _, v), pos, (z,): (f32,)| v[pos.y() * *w + pos.x()] = z,
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .unwrap();
+    image.layer_data.channel_data.pixels
+}
