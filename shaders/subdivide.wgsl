@@ -3,6 +3,7 @@
 
 #import projection
 #import constants
+#import scene
 //
 // `active_cuts` one invocation per input triangle of the whole scene: the cuts around the axis
 //            the frame makes (quadrant cuts and the square, the diamonds), OR-ed into `counters`.
@@ -25,15 +26,6 @@
 // Appends never write past a capacity: they are counted, and the host grows the buffer or
 // processes the scene in chunks.
 
-struct SceneVertex {
-    position: vec3<f32>,
-    material: u32,
-    normal: vec3<f32>,
-    object: u32,
-    color: vec4<f32>,
-    uv: vec2<f32>,
-    _pad1: vec2<f32>,
-}
 
 struct DrawVertex {
     position: vec3<f32>,

@@ -50,6 +50,7 @@ fn twin_of(stage: &str) -> Option<fn(&str) -> usize> {
         "subdivide" => check::<Subdivide>,
         "raster" => check::<Raster>,
         "slit" => check::<Slit>,
+        "trace" => check::<Trace>,
         "reduce_error" => check::<ReduceError>,
         _ => return None,
     })
@@ -489,6 +490,54 @@ impl Twin for Slit {
     }
     fn compare(gpu: &Self::Output, cpu: &Self::Output) -> Result<(), String> {
         compare_eyes(gpu, cpu, 50, Some(0.01))
+    }
+}
+
+// ---- trace ----
+
+struct Trace;
+
+impl Twin for Trace {
+    type Case = (Scene, RenderSettings);
+    type Output = EyeOutputs;
+    fn cases() -> Vec<(String, Self::Case)> {
+        let cylinder = Projection { width: 192, height: 48, vertical: Vertical::Exact, ..Projection::default() };
+        let sphere = Projection { convergence: Some(2.0), ..Projection::equirect(128) };
+        let moved = RenderSettings::new(cylinder)
+            .with_method(Method::Trace)
+            .with_viewer(Vec3::new(0.3, 0.2, -0.4))
+            .with_yaw_deg(35.0);
+        vec![
+            ("demo".into(), (builtin::demo(), RenderSettings::new(cylinder).with_method(Method::Trace))),
+            ("demo, viewer moved and turned".into(), (builtin::demo(), moved)),
+            (
+                "demo on the sphere, converging".into(),
+                (builtin::demo(), RenderSettings::new(sphere).with_method(Method::Trace)),
+            ),
+            (
+                "box room".into(),
+                (
+                    builtin::builtin_scene("builtin:box-room", &cylinder).unwrap(),
+                    RenderSettings::new(cylinder).with_method(Method::Trace),
+                ),
+            ),
+        ]
+    }
+    fn gpu(r: &Renderer, (scene, settings): &Self::Case) -> Self::Output {
+        let gs = GpuScene::upload(&r.gpu, scene).and_then(|g| g.with_bvh(&r.gpu, scene)).expect("upload");
+        frame_outputs(&r.render(&gs, &settings.with_measure_error(true).with_depth(true)).expect("render"))
+    }
+    fn cpu((scene, settings): &Self::Case) -> Self::Output {
+        let positions: Vec<Vec3> = scene.vertices.iter().map(|v| Vec3::from(v.position)).collect();
+        let bvh = twister::core::bvh::SceneBvh::build(&positions, &scene.indices);
+        let p = settings.projection();
+        let params = twister::cpu::trace::trace_params(settings, p.width);
+        let table = scene.material_table(usize::MAX);
+        twister::cpu::trace::trace(&params, &scene.vertices, &scene.indices, &bvh, &table)
+            .map(|img| (img.rgba, img.error, img.object, img.distance))
+    }
+    fn compare(gpu: &Self::Output, cpu: &Self::Output) -> Result<(), String> {
+        compare_eyes(gpu, cpu, 200, Some(0.01))
     }
 }
 

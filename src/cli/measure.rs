@@ -47,7 +47,8 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
     }
     let mut settings = args.view.settings()?.with_measure_error(true);
     let (renderer, adapter) = open_renderer()?;
-    let prepared = prepare(&renderer, &args.scene, args.fit, &args.view, &mut settings, false)?;
+    let methods: Vec<Method> = std::iter::once(settings.subdivision.method).chain(args.against).collect();
+    let prepared = prepare(&renderer, &args.scene, args.fit, &args.view, &mut settings, false, &methods)?;
     let gpu_scene = &prepared.gpu_scene;
     let frame = renderer.render(gpu_scene, &settings)?;
     let measured = frame.measurement.as_ref().expect("rendered with the error pass");

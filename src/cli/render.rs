@@ -85,7 +85,8 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     all_paths.extend(args.stats.as_deref());
     check_outputs(&all_paths)?;
     let (renderer, adapter) = open_renderer()?;
-    let prepared = prepare(&renderer, &args.scene, args.fit, &args.view, &mut settings, args.lod_overlay)?;
+    let method = [settings.subdivision.method];
+    let prepared = prepare(&renderer, &args.scene, args.fit, &args.view, &mut settings, args.lod_overlay, &method)?;
     let mut frame = renderer.render(&prepared.gpu_scene, &settings)?;
     if let (true, Some(gaze)) = (args.lod_overlay, &prepared.gaze) {
         for img in [&mut frame.left, &mut frame.right] {

@@ -8,6 +8,7 @@ use crate::args::{ViewArgs, Viewer};
 use twister::core::load::load_scene;
 use twister::core::lod::{LodChain, LodSelection};
 use twister::core::scene::MAX_COORDINATE;
+use twister::core::settings::Method;
 use twister::core::visual_field::{Field, Gaze};
 use twister::error::{Error, Result};
 use twister::gpu::Gpu;
@@ -70,8 +71,8 @@ pub struct Prepared {
     pub gaze: Option<Gaze>,
 }
 
-/// Places the scene and uploads it; with `--lod visual-field`, draws the gaze's selection
-/// (tinted by level when `overlay`).
+/// Places the scene and uploads it, with its BVH when one of `methods` traces rays; with
+/// `--lod visual-field`, draws the gaze's selection (tinted by level when `overlay`).
 pub fn prepare(
     renderer: &Renderer,
     spec: &str,
@@ -79,6 +80,7 @@ pub fn prepare(
     view: &ViewArgs,
     settings: &mut RenderSettings,
     overlay: bool,
+    methods: &[Method],
 ) -> Result<Prepared> {
     let lod = view.lod()?;
     let mut scene = place(spec, fit, view, settings)?;
@@ -88,6 +90,9 @@ pub fn prepare(
         twister::core::lod::tint(&mut scene, sel);
     }
     let mut gpu_scene = GpuScene::upload(&renderer.gpu, &scene)?;
+    if methods.contains(&Method::Trace) {
+        gpu_scene = gpu_scene.with_bvh(&renderer.gpu, &scene)?;
+    }
     for w in &gpu_scene.warnings {
         warn(spec, w);
     }

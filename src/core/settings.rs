@@ -5,7 +5,7 @@
 
 use glam::{Mat4, Vec3};
 
-use crate::core::projection::Projection;
+use crate::core::projection::{PanoramaKind, Projection, Vertical};
 use crate::error::{Error, Result};
 
 /// Default memory budget for the subdivision buffers, MiB.
@@ -33,6 +33,9 @@ pub enum Method {
     Adaptive(Split),
     /// The conventional slit-mosaic renderer with slits of W columns (no subdivision).
     Slit(u32),
+    /// Ray tracing (seed 000): one primary ray per pixel from its eye point, the closest hit
+    /// through a BVH; exact per pixel (the cylinder's `exact` vertical model, or the sphere).
+    Trace,
 }
 
 /// What decides an adaptive edge's divisions (`--split`).
@@ -80,7 +83,7 @@ impl Method {
     /// The `subdivide` stage's rule and its fixed N (the slit renderer does not subdivide).
     pub fn split_rule(self) -> (SplitRule, u32) {
         match self {
-            Method::Vertex | Method::Slit(_) => (SplitRule::Vertex, 1),
+            Method::Vertex | Method::Slit(_) | Method::Trace => (SplitRule::Vertex, 1),
             Method::Fixed(n) => (SplitRule::Fixed, n),
             Method::Adaptive(Split::Length) => (SplitRule::Adaptive, 0),
             Method::Adaptive(Split::Error) => (SplitRule::AdaptiveError, 0),
@@ -88,17 +91,18 @@ impl Method {
     }
 
     /// Parses `adaptive` (the error split), `adaptive:length` (eq. 5), `adaptive:error`,
-    /// `vertex`, `fixed:N` or `slit:W` (the parser of `--method`).
+    /// `vertex`, `fixed:N`, `slit:W` or `trace` (the parser of `--method`).
     pub fn parse(s: &str) -> std::result::Result<Method, String> {
         match s {
             "vertex" => Ok(Method::Vertex),
+            "trace" => Ok(Method::Trace),
             "adaptive" | "adaptive:error" => Ok(Method::Adaptive(Split::Error)),
             "adaptive:length" => Ok(Method::Adaptive(Split::Length)),
             _ => match (s.strip_prefix("fixed:").map(str::parse::<u32>), s.strip_prefix("slit:").map(str::parse::<u32>)) {
                 (Some(Ok(n)), _) if (1..=MAX_FIXED).contains(&n) => Ok(Method::Fixed(n)),
                 (_, Some(Ok(w))) if w >= 1 => Ok(Method::Slit(w)),
                 _ => Err(format!(
-                    "unknown method '{s}': expected adaptive, adaptive:length, vertex, fixed:N with N in 1..={MAX_FIXED}, or slit:W with W ≥ 1 columns"
+                    "unknown method '{s}': expected adaptive, adaptive:length, vertex, fixed:N with N in 1..={MAX_FIXED}, slit:W with W ≥ 1 columns, or trace"
                 )),
             },
         }
@@ -111,6 +115,7 @@ impl Method {
             Method::Adaptive(Split::Error) => "adaptive".into(),
             Method::Adaptive(Split::Length) => "adaptive:length".into(),
             Method::Slit(w) => format!("slit:{w}"),
+            Method::Trace => "trace".into(),
         }
     }
 }
@@ -291,6 +296,16 @@ impl RenderSettings {
                     format!("slit:{w} is wider than the image ({} columns)", self.view.projection.width),
                 ));
             }
+        }
+        if s.method == Method::Trace
+            && self.view.projection.panorama == PanoramaKind::Cylinder
+            && self.view.projection.vertical == Vertical::Paper
+        {
+            return Err(Error::option(
+                "--method",
+                "trace follows each pixel's ray, and the paper's vertical model (v = R_T·y/r) has none \
+                 (the points it shows at a pixel lie on a curve): use --vertical exact",
+            ));
         }
         if s.memory_mb < 8 {
             return Err(Error::option("--memory-mb", format!("must be at least 8, got {}", s.memory_mb)));

@@ -6,7 +6,8 @@
 //! | [`subdivide`] | `shaders/subdivide.wgsl` (entry points `plan`, `lattice_args`, `lattice`, `finalize`) |
 //! | [`raster`] | `shaders/raster.wgsl` |
 //! | [`slit`] | `shaders/slit.wgsl` |
-//! | [`fragment`] | `shaders/shared/fragment.wgsl` (composed into raster and slit) |
+//! | [`trace`] | `shaders/trace.wgsl` |
+//! | [`fragment`] | `shaders/shared/fragment.wgsl` and `surface.wgsl` (composed into raster, slit and trace) |
 //! | [`reduce_error`] | `shaders/reduce_error.wgsl` |
 //! | [`project_points`] | `shaders/project_points.wgsl` |
 
@@ -16,3 +17,4 @@ pub mod raster;
 pub mod reduce_error;
 pub mod slit;
 pub mod subdivide;
+pub mod trace;

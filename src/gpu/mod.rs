@@ -11,6 +11,7 @@ pub mod slit;
 pub mod stages;
 pub mod targets;
 pub mod timestamps;
+pub mod trace;
 
 pub use device::Gpu;
 pub use renderer::Renderer;

@@ -24,6 +24,7 @@ use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
 use crate::gpu::targets::{Layers, Targets, COLOR_FORMAT, DEPTH_FORMAT, OBJECT_FORMAT};
 use crate::gpu::timestamps::Timestamps;
+use crate::gpu::trace::{trace_params_buffer, TraceOutputs, TracePipelines};
 use crate::shader::constants::PIECES_FROM_COUNTER;
 use crate::shader::types::{DrawVertex, RasterParams, SlitParams, SubdivideCounters, SubdivideParams};
 use crate::shader::{RASTER, REDUCE_ERROR, SLIT, SUBDIVIDE};
@@ -251,6 +252,9 @@ pub(crate) struct FrameResources {
     pub slit_params: [wgpu::Buffer; 2],
     /// Counters and timestamps of a one-submission frame.
     pub staging: wgpu::Buffer,
+    pub trace_params: wgpu::Buffer,
+    /// The ray tracer's outputs of the last image size.
+    pub trace_outputs: Option<TraceOutputs>,
 }
 
 impl FrameResources {
@@ -275,6 +279,7 @@ pub struct Renderer {
     pub(crate) accumulate: wgpu::ComputePipeline,
     pub(crate) finish: wgpu::ComputePipeline,
     pub(crate) project_points: OnceLock<(GpuStage, wgpu::ComputePipeline)>,
+    pub(crate) trace: OnceLock<TracePipelines>,
     pub(crate) resources: Mutex<FrameResources>,
 }
 
@@ -300,6 +305,8 @@ impl Renderer {
                     usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
                     mapped_at_creation: false,
                 }),
+                trace_params: trace_params_buffer(&gpu),
+                trace_outputs: None,
             };
             let raster = DrawPipelines::new(&gpu, DrawStage::Raster);
             // The usual pipeline now, for the same reason.
@@ -324,6 +331,7 @@ impl Renderer {
             accumulate,
             finish,
             project_points: OnceLock::new(),
+            trace: OnceLock::new(),
             resources: Mutex::new(resources),
         })
     }
@@ -335,6 +343,7 @@ impl Renderer {
         let mut resources = self.resources.lock().unwrap_or_else(|e| e.into_inner());
         self.gpu.scoped("rendering a frame", || match settings.subdivision.method {
             Method::Slit(width) => self.render_slit(&mut resources, scene, settings, width),
+            Method::Trace => self.render_trace(&mut resources, scene, settings),
             _ => self.render_subdivided(&mut resources, scene, settings),
         })
     }

@@ -3,10 +3,12 @@
 
 use glam::Vec3;
 
+use crate::core::bvh::SceneBvh;
 use crate::core::lod::LodSelection;
 use crate::core::scene::{object_spheres, Scene};
 use crate::error::{Error, Result};
 use crate::gpu::device::Gpu;
+use crate::shader::constants::TRACE_STACK;
 
 /// One object's triangles and bounding sphere (scene coordinates), for the slit renderer's culling.
 #[derive(Clone, Copy, Debug)]
@@ -33,6 +35,15 @@ pub struct GpuScene {
     pub needs_materials: bool,
     /// Every material is single-sided: the drawing pipelines cull back faces.
     pub cull_back_faces: bool,
+    /// The BVH the ray tracer walks (`--method trace`), once built ([`GpuScene::with_bvh`]).
+    pub bvh: Option<GpuBvh>,
+}
+
+/// A scene's BVH on the GPU ([`SceneBvh`]): nodes and leaf triangle indices.
+pub struct GpuBvh {
+    pub nodes: wgpu::Buffer,
+    pub primitives: wgpu::Buffer,
+    pub node_count: usize,
 }
 
 impl GpuScene {
@@ -99,8 +110,43 @@ impl GpuScene {
                 object_edge_scale: storage("object edge scale", bytemuck::cast_slice(&ones)),
                 needs_materials,
                 cull_back_faces,
+                bvh: None,
             })
         })
+    }
+
+    /// The same scene with its BVH built (on the CPU) and uploaded, for the ray tracer. Fails
+    /// with one line if the tree is deeper than the traversal's stack or too big for the device.
+    pub fn with_bvh(mut self, gpu: &Gpu, scene: &Scene) -> Result<GpuScene> {
+        let positions: Vec<Vec3> = scene.vertices.iter().map(|v| Vec3::from(v.position)).collect();
+        let bvh = SceneBvh::build(&positions, &scene.indices);
+        let depth = bvh.depth();
+        if depth > TRACE_STACK {
+            return Err(Error::scene(
+                &scene.name,
+                format!("its BVH is {depth} levels deep, more than the ray tracer's stack of {TRACE_STACK}"),
+            ));
+        }
+        let bytes = std::mem::size_of_val(bvh.nodes.as_slice()) as u64;
+        if bytes > gpu.max_binding() {
+            return Err(Error::scene(
+                &scene.name,
+                format!(
+                    "its BVH ({} MiB) is larger than this GPU binds ({} MiB)",
+                    bytes >> 20,
+                    gpu.max_binding() >> 20
+                ),
+            ));
+        }
+        self.bvh = Some(gpu.scoped(&format!("uploading the BVH of {}", scene.name), || {
+            let storage = |label: &str, bytes: &[u8]| gpu.init_buffer(label, bytes, wgpu::BufferUsages::STORAGE);
+            Ok(GpuBvh {
+                nodes: storage("bvh nodes", bytemuck::cast_slice(&bvh.nodes)),
+                primitives: storage("bvh primitives", bytemuck::cast_slice(&bvh.primitives)),
+                node_count: bvh.nodes.len(),
+            })
+        })?);
+        Ok(self)
     }
 
     /// The scene as a level-of-detail selection draws it: the same vertices and materials, the
@@ -130,6 +176,8 @@ impl GpuScene {
             ),
             needs_materials: self.needs_materials,
             cull_back_faces: self.cull_back_faces,
+            // The BVH indexes the full scene's triangles: a selection has none (yet).
+            bvh: None,
         }
     }
 }

@@ -62,7 +62,9 @@ impl Targets {
                 view_formats: &[],
             })
         };
-        let copyable = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+        // COPY_DST: the ray tracer copies its outputs in.
+        let copyable =
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::COPY_DST;
         let depth = wgpu::TextureUsages::RENDER_ATTACHMENT;
         let error_format = error_target_format(gpu.error_target);
         Targets {

@@ -173,6 +173,43 @@ pub const SLIT: Stage = Stage {
     ],
 };
 
+pub const TRACE: Stage = Stage {
+    name: "trace",
+    source: include_str!("../../shaders/trace.wgsl"),
+    kind: StageKind::Compute,
+    entry_points: &[entry(
+        "trace",
+        &[
+            "params",
+            "vertices",
+            "indices",
+            "bvh_nodes",
+            "bvh_primitives",
+            "out_color",
+            "out_error",
+            "out_object",
+            "out_distance",
+            "materials",
+            "mips",
+            "texels",
+        ],
+    )],
+    bindings: &[
+        bind(0, 0, "params", Uniform),
+        bind(0, 1, "vertices", Storage),
+        bind(0, 2, "indices", Storage),
+        bind(0, 3, "bvh_nodes", Storage),
+        bind(0, 4, "bvh_primitives", Storage),
+        bind(0, 5, "out_color", StorageReadWrite),
+        bind(0, 6, "out_error", StorageReadWrite),
+        bind(0, 7, "out_object", StorageReadWrite),
+        bind(0, 8, "out_distance", StorageReadWrite),
+        MATERIAL_TABLE[0],
+        MATERIAL_TABLE[1],
+        MATERIAL_TABLE[2],
+    ],
+};
+
 pub const PROJECT_POINTS: Stage = Stage {
     name: "project_points",
     source: include_str!("../../shaders/project_points.wgsl"),
@@ -200,11 +237,13 @@ pub const REDUCE_ERROR: Stage = Stage {
 };
 
 /// The registry: every stage. The naga test validates and reflects each one composed.
-pub const STAGES: &[Stage] = &[SUBDIVIDE, RASTER, SLIT, PROJECT_POINTS, REDUCE_ERROR];
+pub const STAGES: &[Stage] = &[SUBDIVIDE, RASTER, SLIT, TRACE, PROJECT_POINTS, REDUCE_ERROR];
 
 /// The shared WGSL modules in `shaders/shared/`, by import name.
 pub const SHARED: &[(&str, &str)] = &[
     ("projection", include_str!("../../shaders/shared/projection.wgsl")),
+    ("scene", include_str!("../../shaders/shared/scene.wgsl")),
+    ("surface", include_str!("../../shaders/shared/surface.wgsl")),
     ("fragment", include_str!("../../shaders/shared/fragment.wgsl")),
 ];
 

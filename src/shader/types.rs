@@ -6,6 +6,7 @@ use std::mem::{offset_of, size_of};
 
 use bytemuck::{Pod, Zeroable};
 
+pub use crate::core::bvh::BvhNode;
 use crate::core::material::{Material, MipLevel};
 use crate::core::projection::{PanoramaKind, Projection, Vertical};
 use crate::core::scene::SceneVertex;
@@ -300,6 +301,23 @@ macro_rules! layout {
     };
 }
 
+/// `TraceParams` in shaders/trace.wgsl. 144 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct TraceParams {
+    /// Viewer frame → scene frame, columns (the inverse of `RenderSettings::view`).
+    pub to_scene: [[f32; 4]; 4],
+    pub projection: ProjectionUniform,
+    /// Background colour, display (sRGB) values, alpha 1.
+    pub background: [f32; 4],
+    pub ambient: f32,
+    /// As in [`RasterParams`].
+    pub error_angle: u32,
+    /// Padded row length of the outputs, texels (rows of 256 bytes, as texture copies need).
+    pub row_texels: u32,
+    pub _pad0: u32,
+}
+
 /// Every struct the stages bind (as a uniform or in a storage buffer), by its WGSL name.
 pub const LAYOUTS: &[StructLayout] = &[
     layout!("SceneVertex" => SceneVertex { position, material, normal, object, color, uv, _pad1 }),
@@ -318,6 +336,8 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("RasterParams" => RasterParams { projection, eye_sign, ambient, shift_px, error_angle, _pad0, _pad1, _pad2 }),
     layout!("SlitParams" => SlitParams { view, projection, eye_sign, ambient, near, error_angle }),
     layout!("SlitCamera" => SlitCamera { origin_sx, right_cx, up_cy, forward_sy }),
+    layout!("TraceParams" => TraceParams { to_scene, projection, background, ambient, error_angle, row_texels, _pad0 }),
+    layout!("BvhNode" => BvhNode { min, first, max, count }),
     layout!("ProjectParams" => ProjectParams { projection, eye_sign, count, _pad }),
     layout!("Material" => Material {
         texture, wrap_u, wrap_v, mag_filter, min_filter, mipmap, alpha_mode, alpha_cutoff, double_sided,

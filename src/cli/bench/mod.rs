@@ -346,7 +346,7 @@ pub fn bench_speed(args: &SpeedArgs) -> Result<()> {
     for spec in &args.scenes {
         let mut settings = base;
         let fit = args.fit.filter(|_| !spec.starts_with("builtin:"));
-        let prepared = crate::scene::prepare(&renderer, spec, fit, &args.view, &mut settings, false)?;
+        let prepared = crate::scene::prepare(&renderer, spec, fit, &args.view, &mut settings, false, &args.methods)?;
         scenes.push(speed::SpeedScene { spec: spec.clone(), gpu_scene: prepared.gpu_scene, settings });
     }
     let rows = speed::speed(&renderer, &scenes, &args.methods, args.reps, |what| eprintln!("timing {what} ..."))?;

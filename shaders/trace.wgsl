@@ -1,0 +1,203 @@
+// The `trace` stage (compute): ray tracing (seed 000), one primary ray per pixel and eye from
+// the pixel's eye point (`pixel_ray` of surface.wgsl: the cylinder's exact vertical model, or the
+// sphere with its convergence and pole merge), the closest hit through the scene's BVH
+// (src/core/bvh.rs), shaded with the rasterizer's materials and headlight (surface.wgsl).
+// Writes the same four outputs as the drawing stages, per eye, into buffers the host copies into
+// the targets: colour (sRGB-encoded RGBA8), display-position error, object id + 1, distance.
+// CPU twin: src/cpu/trace.rs.
+//
+// Traversal: a binary BVH, nearer child first, the farther on a stack of TRACE_STACK entries
+// (the host refuses deeper trees). A candidate hit closer than the best is accepted only if its
+// material keeps it (a single-sided face seen from behind, alpha below a MASK cutoff or a
+// BLEND screen door are passed through, as the fragment stage discards them). Textures are sampled
+// at level 0 (no ray differentials yet).
+
+#import projection
+#import constants
+#import scene
+#import surface
+
+struct TraceParams {
+    // Viewer frame → scene frame (the inverse of the view: the viewer's position and yaw).
+    to_scene: mat4x4<f32>,
+    projection: Projection,
+    // Background colour, display (sRGB) values.
+    background: vec4<f32>,
+    ambient: f32,
+    error_angle: u32,   // 1: the error output holds arcminutes
+    row_texels: u32,    // padded row length of the outputs; an eye's rows follow the other's
+    _pad0: u32,
+}
+
+struct BvhNode {
+    min: vec3<f32>,
+    first: u32,
+    max: vec3<f32>,
+    count: u32,
+}
+
+@group(0) @binding(0) var<uniform> params: TraceParams;
+@group(0) @binding(1) var<storage, read> vertices: array<SceneVertex>;
+@group(0) @binding(2) var<storage, read> indices: array<u32>;
+@group(0) @binding(3) var<storage, read> bvh_nodes: array<BvhNode>;
+@group(0) @binding(4) var<storage, read> bvh_primitives: array<u32>;
+@group(0) @binding(5) var<storage, read_write> out_color: array<u32>;
+@group(0) @binding(6) var<storage, read_write> out_error: array<u32>;
+@group(0) @binding(7) var<storage, read_write> out_object: array<u32>;
+@group(0) @binding(8) var<storage, read_write> out_distance: array<u32>;
+
+const NO_HIT: u32 = 0xffffffffu;
+const FAR: f32 = 3.0e38;
+
+struct Hit {
+    t: f32,
+    triangle: u32,
+    b1: f32,
+    b2: f32,
+    front: bool,
+}
+
+// The entry distance of the ray into a node's box (clamped at 0), or FAR if it misses the box
+// or enters it beyond `limit`. `inv` is 1/dir with no zero component.
+fn enter_box(n: BvhNode, origin: vec3<f32>, inv: vec3<f32>, limit: f32) -> f32 {
+    let t1 = (n.min - origin) * inv;
+    let t2 = (n.max - origin) * inv;
+    let near = max(max(min(t1.x, t2.x), min(t1.y, t2.y)), max(min(t1.z, t2.z), 0.0));
+    let far = min(min(max(t1.x, t2.x), max(t1.y, t2.y)), min(max(t1.z, t2.z), limit));
+    return select(FAR, near, near <= far);
+}
+
+// Whether a candidate hit's material keeps it (the fragment stage's discard, with no derivatives).
+fn keeps(triangle: u32, b1: f32, b2: f32, front: bool, frag_xy: vec2<f32>) -> bool {
+    if (!MATERIALS) {
+        return true;
+    }
+    let a = vertices[indices[3u * triangle]];
+    let m = materials[min(a.material, arrayLength(&materials) - 1u)];
+    if (m.alpha_mode == ALPHA_OPAQUE) {
+        return front || m.double_sided != 0u;
+    }
+    let b = vertices[indices[3u * triangle + 1u]];
+    let c = vertices[indices[3u * triangle + 2u]];
+    let b0 = 1.0 - b1 - b2;
+    let color = b0 * a.color + b1 * b.color + b2 * c.color;
+    let uv = b0 * a.uv + b1 * b.uv + b2 * c.uv;
+    return surface_color(a.material, color, uv, vec2<f32>(0.0), vec2<f32>(0.0), frag_xy, front).a >= 0.0;
+}
+
+// The closest kept hit along the ray (scene frame), Möller–Trumbore per triangle.
+fn closest_hit(origin: vec3<f32>, dir: vec3<f32>, frag_xy: vec2<f32>) -> Hit {
+    var best = Hit(FAR, NO_HIT, 0.0, 0.0, true);
+    let tiny = vec3<f32>(1e-20);
+    let safe = select(dir, select(tiny, -tiny, dir < vec3<f32>(0.0)), abs(dir) < tiny);
+    let inv = 1.0 / safe;
+    if (enter_box(bvh_nodes[0], origin, inv, FAR) == FAR) {
+        return best;
+    }
+    var stack: array<u32, TRACE_STACK>;
+    var depth = 0u;
+    var node = 0u;
+    loop {
+        let n = bvh_nodes[node];
+        if (n.count > 0u) {
+            for (var k = 0u; k < n.count; k++) {
+                let tri = bvh_primitives[n.first + k];
+                let v0 = vertices[indices[3u * tri]].position;
+                let e1 = vertices[indices[3u * tri + 1u]].position - v0;
+                let e2 = vertices[indices[3u * tri + 2u]].position - v0;
+                let p = cross(dir, e2);
+                let det = dot(e1, p);
+                if (abs(det) < 1e-12) {
+                    continue;
+                }
+                let inv_det = 1.0 / det;
+                let s = origin - v0;
+                let b1 = dot(s, p) * inv_det;
+                let q = cross(s, e1);
+                let b2 = dot(dir, q) * inv_det;
+                let t = dot(e2, q) * inv_det;
+                if (b1 < 0.0 || b2 < 0.0 || b1 + b2 > 1.0 || !(t > 0.0) || t >= best.t) {
+                    continue;
+                }
+                if (keeps(tri, b1, b2, det > 0.0, frag_xy)) {
+                    best = Hit(t, tri, b1, b2, det > 0.0);
+                }
+            }
+            if (depth == 0u) {
+                break;
+            }
+            depth -= 1u;
+            node = stack[depth];
+            continue;
+        }
+        let ta = enter_box(bvh_nodes[n.first], origin, inv, best.t);
+        let tb = enter_box(bvh_nodes[n.first + 1u], origin, inv, best.t);
+        if (ta == FAR && tb == FAR) {
+            if (depth == 0u) {
+                break;
+            }
+            depth -= 1u;
+            node = stack[depth];
+        } else if (ta != FAR && tb != FAR) {
+            let a_first = ta <= tb;
+            node = select(n.first + 1u, n.first, a_first);
+            if (depth < TRACE_STACK) {
+                stack[depth] = select(n.first, n.first + 1u, a_first);
+                depth += 1u;
+            }
+        } else {
+            node = select(n.first + 1u, n.first, ta != FAR);
+        }
+    }
+    return best;
+}
+
+fn linear_to_srgb(c: vec3<f32>) -> vec3<f32> {
+    return select(1.055 * pow(c, vec3<f32>(1.0 / 2.4)) - 0.055, 12.92 * c, c <= vec3<f32>(0.0031308));
+}
+
+// sRGB bytes as the colour target holds them: round(x·255), like `cpu::fragment::shade`.
+fn pack_display(c: vec3<f32>) -> u32 {
+    let q = floor(clamp(c, vec3<f32>(0.0), vec3<f32>(1.0)) * 255.0 + 0.5);
+    return u32(q.x) | (u32(q.y) << 8u) | (u32(q.z) << 16u) | (255u << 24u);
+}
+
+@compute @workgroup_size(8, 8, 1)
+fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let proj = params.projection;
+    if (gid.x >= u32(proj.width) || gid.y >= u32(proj.height)) {
+        return;
+    }
+    let eye_sign = select(-1.0, 1.0, gid.z == 1u);
+    let slot = (gid.z * u32(proj.height) + gid.y) * params.row_texels + gid.x;
+    let frag_xy = vec2<f32>(gid.xy) + 0.5;
+    let ray = pixel_ray(proj, eye_sign, frag_xy);
+    let origin = (params.to_scene * vec4<f32>(ray.origin, 1.0)).xyz;
+    let dir = (params.to_scene * vec4<f32>(ray.dir, 0.0)).xyz;
+    let hit = closest_hit(origin, dir, frag_xy);
+    if (hit.triangle == NO_HIT) {
+        out_color[slot] = pack_display(params.background.rgb);
+        out_error[slot] = bitcast<u32>(-1.0);
+        out_object[slot] = 0u;
+        out_distance[slot] = 0x7f800000u;  // +∞
+        return;
+    }
+    let a = vertices[indices[3u * hit.triangle]];
+    let b = vertices[indices[3u * hit.triangle + 1u]];
+    let c = vertices[indices[3u * hit.triangle + 2u]];
+    let b0 = 1.0 - hit.b1 - hit.b2;
+    let color = b0 * a.color + hit.b1 * b.color + hit.b2 * c.color;
+    let uv = b0 * a.uv + hit.b1 * b.uv + hit.b2 * c.uv;
+    // The normal in the viewer frame (to_scene is a rotation and a translation: its transpose
+    // rotates back).
+    let n_scene = b0 * a.normal + hit.b1 * b.normal + hit.b2 * c.normal;
+    let rotation = mat3x3<f32>(params.to_scene[0].xyz, params.to_scene[1].xyz, params.to_scene[2].xyz);
+    let normal = transpose(rotation) * n_scene;
+    let view_position = ray.origin + hit.t * ray.dir;
+    let surface = surface_color(a.material, color, uv, vec2<f32>(0.0), vec2<f32>(0.0), frag_xy, hit.front);
+    let lit = shade(params.ambient, view_position, normal, surface);
+    out_color[slot] = pack_display(linear_to_srgb(lit.rgb));
+    out_error[slot] = bitcast<u32>(pixel_error(proj, eye_sign, view_position, frag_xy, params.error_angle != 0u));
+    out_object[slot] = a.object + 1u;
+    out_distance[slot] = bitcast<u32>(hit.t);
+}

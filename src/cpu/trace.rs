@@ -1,0 +1,190 @@
+//! The `trace` stage, CPU twin of `shaders/trace.wgsl`: ray tracing (seed 000), one primary ray
+//! per pixel and eye from the pixel's eye point ([`pixel_ray`]: the cylinder's exact vertical
+//! model, or the sphere), the closest hit through the scene's BVH ([`SceneBvh`]), shaded with
+//! the rasterizer's materials and headlight. The same traversal as the WGSL (nearer child
+//! first, farther on a stack), so that ties resolve alike.
+
+use glam::{Mat4, Vec2, Vec3, Vec4};
+
+use crate::core::bvh::{BvhNode, SceneBvh};
+use crate::core::material::AlphaMode;
+use crate::core::projection::{Eye, Projection};
+use crate::core::scene::SceneVertex;
+use crate::core::settings::RenderSettings;
+use crate::core::texture::MaterialTable;
+use crate::cpu::fragment::{pixel_error, pixel_ray, shade, surface_color, Surface};
+use crate::cpu::raster::RasterImage;
+use crate::shader::constants::TRACE_STACK;
+use crate::shader::types::TraceParams;
+
+/// The trace stage's parameters (`row_texels`: the outputs' padded row length).
+pub fn trace_params(settings: &RenderSettings, row_texels: u32) -> TraceParams {
+    let [r, g, b] = settings.shading.background;
+    TraceParams {
+        to_scene: settings.view().inverse().to_cols_array_2d(),
+        projection: settings.projection().into(),
+        background: [r, g, b, 1.0],
+        ambient: settings.shading.ambient,
+        error_angle: settings.measure.error_angle as u32,
+        row_texels,
+        _pad0: 0,
+    }
+}
+
+/// The closest hit kept along a ray: distance, triangle, barycentrics of corners 1 and 2, and
+/// whether the ray meets the triangle's front (counter-clockwise) face.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    pub t: f32,
+    pub triangle: u32,
+    pub b1: f32,
+    pub b2: f32,
+    pub front: bool,
+}
+
+/// The entry distance of the ray into a node's box (clamped at 0), or None if it misses it or
+/// enters beyond `limit` (`enter_box`).
+fn enter_box(n: &BvhNode, origin: Vec3, inv: Vec3, limit: f32) -> Option<f32> {
+    let t1 = (Vec3::from(n.min) - origin) * inv;
+    let t2 = (Vec3::from(n.max) - origin) * inv;
+    let near = t1.min(t2).max_element().max(0.0);
+    let far = t1.max(t2).min_element().min(limit);
+    (near <= far).then_some(near)
+}
+
+/// The closest hit along the ray (scene frame) that `keeps` accepts (`closest_hit`): binary BVH,
+/// nearer child first, Möller–Trumbore per triangle.
+pub fn closest_hit(
+    bvh: &SceneBvh,
+    vertices: &[SceneVertex],
+    indices: &[u32],
+    origin: Vec3,
+    dir: Vec3,
+    keeps: &dyn Fn(u32, f32, f32, bool) -> bool,
+) -> Option<Hit> {
+    let mut best: Option<Hit> = None;
+    let best_t = |b: &Option<Hit>| b.map_or(f32::MAX, |h| h.t);
+    let tiny = 1e-20;
+    let safe = Vec3::select(dir.abs().cmplt(Vec3::splat(tiny)), Vec3::splat(tiny).copysign(dir), dir);
+    let inv = Vec3::ONE / safe;
+    enter_box(&bvh.nodes[0], origin, inv, f32::MAX)?;
+    let position = |tri: u32, k: u32| Vec3::from(vertices[indices[(3 * tri + k) as usize] as usize].position);
+    let mut stack = Vec::with_capacity(TRACE_STACK as usize);
+    let mut node = 0usize;
+    loop {
+        let n = &bvh.nodes[node];
+        if n.count > 0 {
+            for k in 0..n.count {
+                let tri = bvh.primitives[(n.first + k) as usize];
+                let v0 = position(tri, 0);
+                let (e1, e2) = (position(tri, 1) - v0, position(tri, 2) - v0);
+                let p = dir.cross(e2);
+                let det = e1.dot(p);
+                if det.abs() < 1e-12 {
+                    continue;
+                }
+                let inv_det = 1.0 / det;
+                let s = origin - v0;
+                let b1 = s.dot(p) * inv_det;
+                let q = s.cross(e1);
+                let b2 = dir.dot(q) * inv_det;
+                let t = e2.dot(q) * inv_det;
+                if b1 < 0.0 || b2 < 0.0 || b1 + b2 > 1.0 || !(t > 0.0) || t >= best_t(&best) {
+                    continue;
+                }
+                if keeps(tri, b1, b2, det > 0.0) {
+                    best = Some(Hit { t, triangle: tri, b1, b2, front: det > 0.0 });
+                }
+            }
+            match stack.pop() {
+                Some(next) => node = next,
+                None => break,
+            }
+            continue;
+        }
+        let (a, b) = (n.first as usize, n.first as usize + 1);
+        let limit = best_t(&best);
+        match (enter_box(&bvh.nodes[a], origin, inv, limit), enter_box(&bvh.nodes[b], origin, inv, limit)) {
+            (None, None) => match stack.pop() {
+                Some(next) => node = next,
+                None => break,
+            },
+            (Some(ta), Some(tb)) => {
+                let (near, far) = if ta <= tb { (a, b) } else { (b, a) };
+                if stack.len() < TRACE_STACK as usize {
+                    stack.push(far);
+                }
+                node = near;
+            }
+            (Some(_), None) => node = a,
+            (None, Some(_)) => node = b,
+        }
+    }
+    best
+}
+
+/// The trace stage on the CPU: both eyes (left, right).
+pub fn trace(
+    params: &TraceParams,
+    vertices: &[SceneVertex],
+    indices: &[u32],
+    bvh: &SceneBvh,
+    table: &MaterialTable,
+) -> [RasterImage; 2] {
+    let projection = Projection::from(&params.projection);
+    let to_scene = Mat4::from_cols_array_2d(&params.to_scene);
+    let rotation_back = glam::Mat3::from_mat4(to_scene).transpose();
+    let [r, g, b, _] = params.background;
+    let corners = |tri: u32| [0, 1, 2].map(|k| &vertices[indices[(3 * tri + k) as usize] as usize]);
+    let surface = |tri: u32, b1: f32, b2: f32, front: bool, frag_xy: Vec2| {
+        let [a, b, c] = corners(tri);
+        let b0 = 1.0 - b1 - b2;
+        let mix4 = |x: [f32; 4], y: [f32; 4], z: [f32; 4]| b0 * Vec4::from(x) + b1 * Vec4::from(y) + b2 * Vec4::from(z);
+        let mix2 = |x: [f32; 2], y: [f32; 2], z: [f32; 2]| b0 * Vec2::from(x) + b1 * Vec2::from(y) + b2 * Vec2::from(z);
+        Surface {
+            material: a.material,
+            color: mix4(a.color, b.color, c.color),
+            uv: mix2(a.uv, b.uv, c.uv),
+            duv_dx: Vec2::ZERO,
+            duv_dy: Vec2::ZERO,
+            frag_xy,
+            front_facing: front,
+        }
+    };
+    Eye::BOTH.map(|eye| {
+        // The image's background is given in display values, as `RasterImage::new` takes it.
+        let mut img = RasterImage::new(projection.width, projection.height, [r, g, b]);
+        for y in 0..projection.height {
+            for x in 0..projection.width {
+                let frag_xy = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                let (origin_v, dir_v) = pixel_ray(&projection, eye, frag_xy);
+                let origin = to_scene.transform_point3(origin_v);
+                let dir = to_scene.transform_vector3(dir_v);
+                let keeps = |tri: u32, b1: f32, b2: f32, front: bool| {
+                    let m = &table.materials[(corners(tri)[0].material as usize).min(table.materials.len() - 1)];
+                    if m.alpha_mode == AlphaMode::Opaque as u32 {
+                        return front || m.double_sided != 0;
+                    }
+                    surface_color(table, &surface(tri, b1, b2, front, frag_xy)).is_some()
+                };
+                let Some(hit) = closest_hit(bvh, vertices, indices, origin, dir, &keeps) else { continue };
+                let [a, b, c] = corners(hit.triangle);
+                let b0 = 1.0 - hit.b1 - hit.b2;
+                let normal = rotation_back
+                    * (b0 * Vec3::from(a.normal) + hit.b1 * Vec3::from(b.normal) + hit.b2 * Vec3::from(c.normal));
+                let view_position = origin_v + hit.t * dir_v;
+                let Some(color) = surface_color(table, &surface(hit.triangle, hit.b1, hit.b2, hit.front, frag_xy))
+                else {
+                    continue;
+                };
+                let i = (y * projection.width + x) as usize;
+                img.rgba[4 * i..4 * i + 4].copy_from_slice(&shade(params.ambient, view_position, normal, color));
+                img.error[i] = pixel_error(&projection, eye, view_position, frag_xy, params.error_angle != 0);
+                img.object[i] = a.object + 1;
+                img.distance[i] = hit.t;
+                img.depth[i] = hit.t;
+            }
+        }
+        img
+    })
+}

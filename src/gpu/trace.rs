@@ -1,0 +1,160 @@
+//! The ray tracer on the GPU (`trace` stage, twin `cpu::trace`): one compute dispatch over
+//! every pixel of both eyes, writing colour, error, object id and distance into buffers that
+//! are copied into the render targets' layers, so read-back, error statistics and outputs are
+//! those of the other methods.
+
+use std::time::Instant;
+
+use crate::core::frame::{Frame, FrameStats, Timing};
+use crate::core::settings::RenderSettings;
+use crate::cpu::trace::trace_params;
+use crate::error::{Error, Result};
+use crate::gpu::device::Gpu;
+use crate::gpu::renderer::{FrameResources, Renderer};
+use crate::gpu::scene::GpuScene;
+use crate::gpu::stages::GpuStage;
+use crate::shader::types::TraceParams;
+
+/// The trace stage's pipelines: without and with the material code (`MATERIALS`).
+pub(crate) struct TracePipelines {
+    stage: GpuStage,
+    pipelines: [wgpu::ComputePipeline; 2],
+}
+
+impl TracePipelines {
+    pub fn new(gpu: &Gpu) -> TracePipelines {
+        let stage = GpuStage::new(gpu, &crate::shader::TRACE);
+        let pipelines = [0.0, 1.0].map(|m| stage.compute_with(gpu, "trace", &[("MATERIALS", m)]));
+        TracePipelines { stage, pipelines }
+    }
+}
+
+/// The outputs of the last image size: colour, error, object, distance, both eyes.
+pub(crate) struct TraceOutputs {
+    row_texels: u32,
+    height: u32,
+    buffers: [wgpu::Buffer; 4],
+}
+
+impl Renderer {
+    pub(crate) fn render_trace(
+        &self,
+        res: &mut FrameResources,
+        scene: &GpuScene,
+        settings: &RenderSettings,
+    ) -> Result<Frame> {
+        let start = Instant::now();
+        let gpu = &self.gpu;
+        let Some(bvh) = &scene.bvh else {
+            return Err(Error::option(
+                "--method",
+                "trace needs the scene's BVH, and this scene was uploaded without one (GpuScene::with_bvh; a level-of-detail selection has none yet)",
+            ));
+        };
+        let p = settings.projection();
+        // Rows padded to 256 bytes, as buffer-to-texture copies need.
+        let row_texels = p.width.div_ceil(64) * 64;
+        let bytes = 4 * row_texels as u64 * p.height as u64 * 2;
+        if bytes > gpu.max_binding() {
+            return Err(Error::option(
+                "--width/--height",
+                format!(
+                    "{}x{} needs {} MiB per output of the ray tracer, more than this GPU binds ({} MiB): use a smaller image",
+                    p.width,
+                    p.height,
+                    bytes >> 20,
+                    gpu.max_binding() >> 20
+                ),
+            ));
+        }
+        res.targets(gpu, p.width, p.height);
+        if !res.trace_outputs.as_ref().is_some_and(|o| o.row_texels == row_texels && o.height == p.height) {
+            let make = |what: &str| gpu.storage_buffer(&format!("trace {what}"), bytes, wgpu::BufferUsages::empty());
+            res.trace_outputs = Some(TraceOutputs {
+                row_texels,
+                height: p.height,
+                buffers: ["colour", "error", "object", "distance"].map(make),
+            });
+        }
+        let res = &*res;
+        let targets = res.targets.as_ref().expect("made");
+        let outputs = res.trace_outputs.as_ref().expect("made");
+        let trace = self.trace.get_or_init(|| TracePipelines::new(gpu));
+        let params = trace_params(settings, row_texels);
+        gpu.queue.write_buffer(&res.trace_params, 0, bytemuck::bytes_of(&params));
+        let [a, b, c] = &scene.materials;
+        let [color, error, object, distance] = &outputs.buffers;
+        let bind_group = trace.stage.bind_group(
+            gpu,
+            Some("trace"),
+            0,
+            &[
+                &res.trace_params,
+                &scene.vertices,
+                &scene.indices,
+                &bvh.nodes,
+                &bvh.primitives,
+                color,
+                error,
+                object,
+                distance,
+            ],
+        );
+        let materials = trace.stage.bind_group(gpu, Some("trace"), 1, &[a, b, c]);
+        let timestamps = res.timestamps.as_ref();
+        let t = Instant::now();
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("trace"),
+                timestamp_writes: timestamps.map(|t| wgpu::ComputePassTimestampWrites {
+                    query_set: &t.set,
+                    beginning_of_pass_write_index: Some(0),
+                    end_of_pass_write_index: Some(1),
+                }),
+            });
+            pass.set_pipeline(&trace.pipelines[scene.needs_materials as usize]);
+            pass.set_bind_group(0, &bind_group, &[]);
+            pass.set_bind_group(1, &materials, &[]);
+            pass.dispatch_workgroups(p.width.div_ceil(8), p.height.div_ceil(8), 2);
+        }
+        for (buffer, texture) in
+            outputs.buffers.iter().zip([&targets.color, &targets.error, &targets.object, &targets.distance])
+        {
+            enc.copy_buffer_to_texture(
+                wgpu::TexelCopyBufferInfo {
+                    buffer,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(4 * row_texels),
+                        rows_per_image: Some(p.height),
+                    },
+                },
+                texture.as_image_copy(),
+                wgpu::Extent3d { width: p.width, height: p.height, depth_or_array_layers: 2 },
+            );
+        }
+        if let Some(t) = timestamps {
+            t.resolve(&mut enc, &res.staging, 0);
+        }
+        gpu.queue.submit([enc.finish()]);
+        gpu.wait();
+        let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, chunks: 1, ..Default::default() };
+        stats.ms_frame = t.elapsed().as_secs_f64() * 1e3;
+        stats.ms_raster = Some(stats.ms_frame);
+        stats.timing = Timing::WallOneSubmission;
+        if let Some(t) = timestamps {
+            let bytes = gpu.read_buffer(&res.staging)?;
+            let ticks: &[u64] = bytemuck::cast_slice(&bytes[..16]);
+            stats.ms_gpu = Some(t.ms(ticks[0], ticks[1]));
+            stats.ms_raster = stats.ms_gpu;
+            stats.timing = Timing::GpuTimestamps;
+        }
+        self.finish_frame(targets, settings, stats, start)
+    }
+}
+
+/// The trace stage's uniform buffer.
+pub(crate) fn trace_params_buffer(gpu: &Gpu) -> wgpu::Buffer {
+    gpu.uniform_buffer::<TraceParams>("trace params")
+}
