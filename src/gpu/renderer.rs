@@ -24,9 +24,8 @@ use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
 use crate::gpu::targets::{Layers, Targets, COLOR_FORMAT, DEPTH_FORMAT, OBJECT_FORMAT};
 use crate::gpu::timestamps::Timestamps;
-use crate::gpu::trace::{trace_params_buffer, TraceOutputs, TracePipelines};
 use crate::shader::constants::PIECES_FROM_COUNTER;
-use crate::shader::types::{DrawVertex, RasterParams, SlitParams, SubdivideCounters, SubdivideParams};
+use crate::shader::types::{DrawVertex, RasterParams, SlitParams, SubdivideCounters, SubdivideParams, TraceParams};
 use crate::shader::{RASTER, REDUCE_ERROR, SLIT, SUBDIVIDE};
 
 /// The two drawing stages.
@@ -253,8 +252,9 @@ pub(crate) struct FrameResources {
     /// Counters and timestamps of a one-submission frame.
     pub staging: wgpu::Buffer,
     pub trace_params: wgpu::Buffer,
-    /// The ray tracer's outputs of the last image size.
-    pub trace_outputs: Option<TraceOutputs>,
+    /// The ray tracer's outputs of the last image size: (padded row texels, height, colour,
+    /// error, object and distance buffers).
+    pub trace_outputs: Option<(u32, u32, [wgpu::Buffer; 4])>,
 }
 
 impl FrameResources {
@@ -279,7 +279,8 @@ pub struct Renderer {
     pub(crate) accumulate: wgpu::ComputePipeline,
     pub(crate) finish: wgpu::ComputePipeline,
     pub(crate) project_points: OnceLock<(GpuStage, wgpu::ComputePipeline)>,
-    pub(crate) trace: OnceLock<TracePipelines>,
+    /// The trace stage and its pipelines without and with the material code.
+    pub(crate) trace: OnceLock<(GpuStage, [wgpu::ComputePipeline; 2])>,
     pub(crate) resources: Mutex<FrameResources>,
 }
 
@@ -305,7 +306,7 @@ impl Renderer {
                     usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
                     mapped_at_creation: false,
                 }),
-                trace_params: trace_params_buffer(&gpu),
+                trace_params: gpu.uniform_buffer::<TraceParams>("trace params"),
                 trace_outputs: None,
             };
             let raster = DrawPipelines::new(&gpu, DrawStage::Raster);

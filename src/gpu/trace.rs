@@ -9,32 +9,9 @@ use crate::core::frame::{Frame, FrameStats, Timing};
 use crate::core::settings::RenderSettings;
 use crate::cpu::trace::trace_params;
 use crate::error::{Error, Result};
-use crate::gpu::device::Gpu;
 use crate::gpu::renderer::{FrameResources, Renderer};
 use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
-use crate::shader::types::TraceParams;
-
-/// The trace stage's pipelines: without and with the material code (`MATERIALS`).
-pub(crate) struct TracePipelines {
-    stage: GpuStage,
-    pipelines: [wgpu::ComputePipeline; 2],
-}
-
-impl TracePipelines {
-    pub fn new(gpu: &Gpu) -> TracePipelines {
-        let stage = GpuStage::new(gpu, &crate::shader::TRACE);
-        let pipelines = [0.0, 1.0].map(|m| stage.compute_with(gpu, "trace", &[("MATERIALS", m)]));
-        TracePipelines { stage, pipelines }
-    }
-}
-
-/// The outputs of the last image size: colour, error, object, distance, both eyes.
-pub(crate) struct TraceOutputs {
-    row_texels: u32,
-    height: u32,
-    buffers: [wgpu::Buffer; 4],
-}
 
 impl Renderer {
     pub(crate) fn render_trace(
@@ -68,23 +45,23 @@ impl Renderer {
             ));
         }
         res.targets(gpu, p.width, p.height);
-        if !res.trace_outputs.as_ref().is_some_and(|o| o.row_texels == row_texels && o.height == p.height) {
+        if !res.trace_outputs.as_ref().is_some_and(|(r, h, _)| *r == row_texels && *h == p.height) {
             let make = |what: &str| gpu.storage_buffer(&format!("trace {what}"), bytes, wgpu::BufferUsages::empty());
-            res.trace_outputs = Some(TraceOutputs {
-                row_texels,
-                height: p.height,
-                buffers: ["colour", "error", "object", "distance"].map(make),
-            });
+            res.trace_outputs = Some((row_texels, p.height, ["colour", "error", "object", "distance"].map(make)));
         }
         let res = &*res;
         let targets = res.targets.as_ref().expect("made");
-        let outputs = res.trace_outputs.as_ref().expect("made");
-        let trace = self.trace.get_or_init(|| TracePipelines::new(gpu));
+        let (_, _, outputs) = res.trace_outputs.as_ref().expect("made");
+        let (stage, pipelines) = self.trace.get_or_init(|| {
+            let stage = GpuStage::new(gpu, &crate::shader::TRACE);
+            let pipelines = [0.0, 1.0].map(|m| stage.compute_with(gpu, "trace", &[("MATERIALS", m)]));
+            (stage, pipelines)
+        });
         let params = trace_params(settings, row_texels);
         gpu.queue.write_buffer(&res.trace_params, 0, bytemuck::bytes_of(&params));
         let [a, b, c] = &scene.materials;
-        let [color, error, object, distance] = &outputs.buffers;
-        let bind_group = trace.stage.bind_group(
+        let [color, error, object, distance] = outputs;
+        let bind_group = stage.bind_group(
             gpu,
             Some("trace"),
             0,
@@ -100,7 +77,7 @@ impl Renderer {
                 distance,
             ],
         );
-        let materials = trace.stage.bind_group(gpu, Some("trace"), 1, &[a, b, c]);
+        let materials = stage.bind_group(gpu, Some("trace"), 1, &[a, b, c]);
         let timestamps = res.timestamps.as_ref();
         let t = Instant::now();
         let mut enc = gpu.device.create_command_encoder(&Default::default());
@@ -113,13 +90,13 @@ impl Renderer {
                     end_of_pass_write_index: Some(1),
                 }),
             });
-            pass.set_pipeline(&trace.pipelines[scene.needs_materials as usize]);
+            pass.set_pipeline(&pipelines[scene.needs_materials as usize]);
             pass.set_bind_group(0, &bind_group, &[]);
             pass.set_bind_group(1, &materials, &[]);
             pass.dispatch_workgroups(p.width.div_ceil(8), p.height.div_ceil(8), 2);
         }
         for (buffer, texture) in
-            outputs.buffers.iter().zip([&targets.color, &targets.error, &targets.object, &targets.distance])
+            outputs.iter().zip([&targets.color, &targets.error, &targets.object, &targets.distance])
         {
             enc.copy_buffer_to_texture(
                 wgpu::TexelCopyBufferInfo {
@@ -152,9 +129,4 @@ impl Renderer {
         }
         self.finish_frame(targets, settings, stats, start)
     }
-}
-
-/// The trace stage's uniform buffer.
-pub(crate) fn trace_params_buffer(gpu: &Gpu) -> wgpu::Buffer {
-    gpu.uniform_buffer::<TraceParams>("trace params")
 }
