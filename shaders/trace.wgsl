@@ -7,7 +7,8 @@
 // CPU twin: src/cpu/trace.rs.
 //
 // Traversal: a binary BVH, nearer child first, the farther on a stack of TRACE_STACK entries
-// (the host refuses deeper trees). A candidate hit closer than the best is accepted only if its
+// with its entry distance (skipped when popped if the best hit is nearer; the host refuses
+// deeper trees). A candidate hit closer than the best is accepted only if its
 // material keeps it (a single-sided face seen from behind, alpha below a MASK cutoff or a
 // BLEND screen door are passed through, as the fragment stage discards them). Textures are sampled
 // at level 0 (no ray differentials yet).
@@ -94,11 +95,14 @@ fn closest_hit(origin: vec3<f32>, dir: vec3<f32>, frag_xy: vec2<f32>) -> Hit {
     if (enter_box(bvh_nodes[0], origin, inv, FAR) == FAR) {
         return best;
     }
-    var stack: array<u32, TRACE_STACK>;
+    // Nodes still to visit, with the distance where the ray enters their box.
+    var stack_node: array<u32, TRACE_STACK>;
+    var stack_t: array<f32, TRACE_STACK>;
     var depth = 0u;
     var node = 0u;
     loop {
         let n = bvh_nodes[node];
+        var descend = false;
         if (n.count > 0u) {
             for (var k = 0u; k < n.count; k++) {
                 let tri = bvh_primitives[n.first + k];
@@ -123,30 +127,41 @@ fn closest_hit(origin: vec3<f32>, dir: vec3<f32>, frag_xy: vec2<f32>) -> Hit {
                     best = Hit(t, tri, b1, b2, det > 0.0);
                 }
             }
-            if (depth == 0u) {
-                break;
+        } else {
+            let ta = enter_box(bvh_nodes[n.first], origin, inv, best.t);
+            let tb = enter_box(bvh_nodes[n.first + 1u], origin, inv, best.t);
+            if (ta != FAR && tb != FAR) {
+                let a_first = ta <= tb;
+                node = select(n.first + 1u, n.first, a_first);
+                if (depth < TRACE_STACK) {
+                    stack_node[depth] = select(n.first, n.first + 1u, a_first);
+                    stack_t[depth] = max(ta, tb);
+                    depth += 1u;
+                }
+                descend = true;
+            } else if (ta != FAR || tb != FAR) {
+                node = select(n.first + 1u, n.first, ta != FAR);
+                descend = true;
             }
-            depth -= 1u;
-            node = stack[depth];
+        }
+        if (descend) {
             continue;
         }
-        let ta = enter_box(bvh_nodes[n.first], origin, inv, best.t);
-        let tb = enter_box(bvh_nodes[n.first + 1u], origin, inv, best.t);
-        if (ta == FAR && tb == FAR) {
+        // The latest pending node the ray enters before the best hit so far.
+        var found = false;
+        loop {
             if (depth == 0u) {
                 break;
             }
             depth -= 1u;
-            node = stack[depth];
-        } else if (ta != FAR && tb != FAR) {
-            let a_first = ta <= tb;
-            node = select(n.first + 1u, n.first, a_first);
-            if (depth < TRACE_STACK) {
-                stack[depth] = select(n.first, n.first + 1u, a_first);
-                depth += 1u;
+            if (stack_t[depth] < best.t) {
+                node = stack_node[depth];
+                found = true;
+                break;
             }
-        } else {
-            node = select(n.first + 1u, n.first, ta != FAR);
+        }
+        if (!found) {
+            break;
         }
     }
     return best;

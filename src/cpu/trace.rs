@@ -53,7 +53,8 @@ fn enter_box(n: &BvhNode, origin: Vec3, inv: Vec3, limit: f32) -> Option<f32> {
 }
 
 /// The closest hit along the ray (scene frame) that `keeps` accepts (`closest_hit`): binary BVH,
-/// nearer child first, Möller–Trumbore per triangle.
+/// nearer child first (the farther kept with its entry distance, and skipped when popped if the
+/// best hit is nearer), Möller–Trumbore per triangle.
 pub fn closest_hit(
     bvh: &SceneBvh,
     vertices: &[SceneVertex],
@@ -69,10 +70,12 @@ pub fn closest_hit(
     let inv = Vec3::ONE / safe;
     enter_box(&bvh.nodes[0], origin, inv, f32::MAX)?;
     let position = |tri: u32, k: u32| Vec3::from(vertices[indices[(3 * tri + k) as usize] as usize].position);
-    let mut stack = Vec::with_capacity(TRACE_STACK as usize);
+    // Nodes still to visit, with the distance where the ray enters their box.
+    let mut stack: Vec<(usize, f32)> = Vec::with_capacity(TRACE_STACK as usize);
     let mut node = 0usize;
     loop {
         let n = &bvh.nodes[node];
+        let mut descend = false;
         if n.count > 0 {
             for k in 0..n.count {
                 let tri = bvh.primitives[(n.first + k) as usize];
@@ -96,28 +99,30 @@ pub fn closest_hit(
                     best = Some(Hit { t, triangle: tri, b1, b2, front: det > 0.0 });
                 }
             }
-            match stack.pop() {
-                Some(next) => node = next,
-                None => break,
+        } else {
+            let (a, b) = (n.first as usize, n.first as usize + 1);
+            let limit = best_t(&best);
+            match (enter_box(&bvh.nodes[a], origin, inv, limit), enter_box(&bvh.nodes[b], origin, inv, limit)) {
+                (Some(ta), Some(tb)) => {
+                    let (near, far) = if ta <= tb { (a, b) } else { (b, a) };
+                    if stack.len() < TRACE_STACK as usize {
+                        stack.push((far, ta.max(tb)));
+                    }
+                    node = near;
+                    descend = true;
+                }
+                (Some(_), None) => (node, descend) = (a, true),
+                (None, Some(_)) => (node, descend) = (b, true),
+                (None, None) => {}
             }
+        }
+        if descend {
             continue;
         }
-        let (a, b) = (n.first as usize, n.first as usize + 1);
-        let limit = best_t(&best);
-        match (enter_box(&bvh.nodes[a], origin, inv, limit), enter_box(&bvh.nodes[b], origin, inv, limit)) {
-            (None, None) => match stack.pop() {
-                Some(next) => node = next,
-                None => break,
-            },
-            (Some(ta), Some(tb)) => {
-                let (near, far) = if ta <= tb { (a, b) } else { (b, a) };
-                if stack.len() < TRACE_STACK as usize {
-                    stack.push(far);
-                }
-                node = near;
-            }
-            (Some(_), None) => node = a,
-            (None, Some(_)) => node = b,
+        // The latest pending node the ray enters before the best hit so far.
+        match std::iter::from_fn(|| stack.pop()).find(|&(_, t)| t < best_t(&best)) {
+            Some((next, _)) => node = next,
+            None => break,
         }
     }
     best
