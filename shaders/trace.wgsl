@@ -24,10 +24,12 @@ struct TraceParams {
     projection: Projection,
     // Background colour, display (sRGB) values.
     background: vec4<f32>,
+    // The point light (scene frame) in xyz, w = 1; w = 0: the headlight at the viewer.
+    light: vec4<f32>,
     ambient: f32,
     error_angle: u32,   // 1: the error output holds arcminutes
     row_texels: u32,    // padded row length of the outputs; an eye's rows follow the other's
-    _pad0: u32,
+    reflect_max: u32,   // bounces of mirror and refraction rays (seed 000's Reflect_max)
 }
 
 struct BvhNode {
@@ -86,13 +88,14 @@ fn keeps(triangle: u32, b1: f32, b2: f32, front: bool, frag_xy: vec2<f32>) -> bo
     return surface_color(a.material, color, uv, vec2<f32>(0.0), vec2<f32>(0.0), frag_xy, front).a >= 0.0;
 }
 
-// The closest kept hit along the ray (scene frame), Möller–Trumbore per triangle.
-fn closest_hit(origin: vec3<f32>, dir: vec3<f32>, frag_xy: vec2<f32>) -> Hit {
-    var best = Hit(FAR, NO_HIT, 0.0, 0.0, true);
+// The closest kept hit along the ray (scene frame) nearer than `limit`, Möller–Trumbore per
+// triangle.
+fn closest_hit(origin: vec3<f32>, dir: vec3<f32>, frag_xy: vec2<f32>, limit: f32) -> Hit {
+    var best = Hit(limit, NO_HIT, 0.0, 0.0, true);
     let tiny = vec3<f32>(1e-20);
     let safe = select(dir, select(tiny, -tiny, dir < vec3<f32>(0.0)), abs(dir) < tiny);
     let inv = 1.0 / safe;
-    if (enter_box(bvh_nodes[0], origin, inv, FAR) == FAR) {
+    if (enter_box(bvh_nodes[0], origin, inv, limit) == FAR) {
         return best;
     }
     // Nodes still to visit, with the distance where the ray enters their box.
@@ -177,6 +180,82 @@ fn pack_display(c: vec3<f32>) -> u32 {
     return u32(q.x) | (u32(q.y) << 8u) | (u32(q.z) << 16u) | (255u << 24u);
 }
 
+// A ray waiting to be traced (scene frame), with the weight of its light in the pixel.
+struct Pending {
+    origin: vec3<f32>,
+    bounces: u32,
+    dir: vec3<f32>,
+    weight: vec3<f32>,
+}
+
+// What a hit shows: the shaded colour and the rays it spawns (`shade_hit`).
+struct Shaded {
+    color: vec3<f32>,      // its own light, weighted (1 − mirror − transmission)
+    mirror: f32,
+    transmission: f32,
+    tint: vec3<f32>,       // the surface colour, which tints the mirrored light
+    normal: vec3<f32>,     // scene frame, facing the ray
+    ior: f32,
+    front: bool,
+}
+
+// The surface at a hit `p` (scene frame), shaded with the headlight at the viewer
+// (`view_position` in the viewer frame), or with the point light and its shadow ray, and its
+// optics.
+fn shade_hit(hit: Hit, dir: vec3<f32>, p: vec3<f32>, view_position: vec3<f32>, frag_xy: vec2<f32>) -> Shaded {
+    let a = vertices[indices[3u * hit.triangle]];
+    let b = vertices[indices[3u * hit.triangle + 1u]];
+    let c = vertices[indices[3u * hit.triangle + 2u]];
+    let b0 = 1.0 - hit.b1 - hit.b2;
+    let color = b0 * a.color + hit.b1 * b.color + hit.b2 * c.color;
+    let uv = b0 * a.uv + hit.b1 * b.uv + hit.b2 * c.uv;
+    var n = b0 * a.normal + hit.b1 * b.normal + hit.b2 * c.normal;
+    if (dot(n, n) < 1e-12) {
+        n = cross(b.position - a.position, c.position - a.position);
+    }
+    n = normalize(n);
+    // The normal in the viewer frame (to_scene is a rotation and a translation: its
+    // transpose rotates back).
+    let rotation = mat3x3<f32>(params.to_scene[0].xyz, params.to_scene[1].xyz, params.to_scene[2].xyz);
+    let surface = surface_color(a.material, color, uv, vec2<f32>(0.0), vec2<f32>(0.0), frag_xy, hit.front);
+    var lit = shade(params.ambient, view_position, transpose(rotation) * n, surface).rgb;
+    let facing = select(n, -n, dot(n, dir) > 0.0);
+    if (params.light.w > 0.0) {
+        // Lambert towards the light, one-sided (the side the ray sees), zero in shadow.
+        let to_light = params.light.xyz - p;
+        let dist = length(to_light);
+        let l = to_light / max(dist, 1e-20);
+        var lambert = max(dot(facing, l), 0.0);
+        if (lambert > 0.0) {
+            let offset = 1e-4 * max(1.0, length(p));
+            if (closest_hit(p + offset * facing, l, frag_xy, dist - offset).triangle != NO_HIT) {
+                lambert = 0.0;
+            }
+        }
+        lit = clamp(surface.rgb * (params.ambient + (1.0 - params.ambient) * lambert), vec3<f32>(0.0), vec3<f32>(1.0));
+    }
+    var out = Shaded(lit, 0.0, 0.0, surface.rgb, facing, 1.5, hit.front);
+    if (MATERIALS) {
+        let m = materials[min(a.material, arrayLength(&materials) - 1u)];
+        out.mirror = m.mirror;
+        out.transmission = m.transmission;
+        out.ior = m.ior;
+        out.color *= max(1.0 - m.mirror - m.transmission, 0.0);
+    }
+    return out;
+}
+
+// The refracted direction (Snell's law, unit vectors, `n` facing the incoming ray, eta = n₁/n₂),
+// or the mirrored one under total internal reflection.
+fn refract_or_reflect(d: vec3<f32>, n: vec3<f32>, eta: f32) -> vec3<f32> {
+    let cos_i = -dot(d, n);
+    let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+    if (k < 0.0) {
+        return reflect(d, n);
+    }
+    return normalize(eta * d + (eta * cos_i - sqrt(k)) * n);
+}
+
 @compute @workgroup_size(8, 8, 1)
 fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     let proj = params.projection;
@@ -189,7 +268,7 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     let ray = pixel_ray(proj, eye_sign, frag_xy);
     let origin = (params.to_scene * vec4<f32>(ray.origin, 1.0)).xyz;
     let dir = (params.to_scene * vec4<f32>(ray.dir, 0.0)).xyz;
-    let hit = closest_hit(origin, dir, frag_xy);
+    let hit = closest_hit(origin, dir, frag_xy, FAR);
     if (hit.triangle == NO_HIT) {
         out_color[slot] = pack_display(params.background.rgb);
         out_error[slot] = bitcast<u32>(-1.0);
@@ -197,22 +276,51 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
         out_distance[slot] = 0x7f800000u;  // +∞
         return;
     }
-    let a = vertices[indices[3u * hit.triangle]];
-    let b = vertices[indices[3u * hit.triangle + 1u]];
-    let c = vertices[indices[3u * hit.triangle + 2u]];
-    let b0 = 1.0 - hit.b1 - hit.b2;
-    let color = b0 * a.color + hit.b1 * b.color + hit.b2 * c.color;
-    let uv = b0 * a.uv + hit.b1 * b.uv + hit.b2 * c.uv;
-    // The normal in the viewer frame (to_scene is a rotation and a translation: its transpose
-    // rotates back).
-    let n_scene = b0 * a.normal + hit.b1 * b.normal + hit.b2 * c.normal;
-    let rotation = mat3x3<f32>(params.to_scene[0].xyz, params.to_scene[1].xyz, params.to_scene[2].xyz);
-    let normal = transpose(rotation) * n_scene;
+    // The primary hit gives the error, object and distance outputs; its colour gathers the
+    // light of the mirror and refraction rays it spawns, depth first.
     let view_position = ray.origin + hit.t * ray.dir;
-    let surface = surface_color(a.material, color, uv, vec2<f32>(0.0), vec2<f32>(0.0), frag_xy, hit.front);
-    let lit = shade(params.ambient, view_position, normal, surface);
-    out_color[slot] = pack_display(linear_to_srgb(lit.rgb));
     out_error[slot] = bitcast<u32>(pixel_error(proj, eye_sign, view_position, frag_xy, params.error_angle != 0u));
-    out_object[slot] = a.object + 1u;
+    out_object[slot] = vertices[indices[3u * hit.triangle]].object + 1u;
     out_distance[slot] = bitcast<u32>(hit.t);
+    let background = srgb_to_linear(params.background.rgb);
+    // The scene frame's origin of the viewer frame, for the headlight of secondary hits.
+    let to_view = transpose(mat3x3<f32>(params.to_scene[0].xyz, params.to_scene[1].xyz, params.to_scene[2].xyz));
+    let viewer = params.to_scene[3].xyz;
+    var pending: array<Pending, TRACE_PENDING>;
+    var count = 0u;
+    var color = vec3<f32>(0.0);
+    var current = Pending(origin, 0u, dir, vec3<f32>(1.0));
+    var current_hit = hit;
+    loop {
+        if (current_hit.triangle == NO_HIT) {
+            color += current.weight * background;
+        } else {
+            let p = current.origin + current_hit.t * current.dir;
+            let s = shade_hit(current_hit, current.dir, p, to_view * (p - viewer), frag_xy);
+            color += current.weight * s.color;
+            let offset = 1e-4 * max(1.0, length(p));
+            if (current.bounces < params.reflect_max) {
+                if (s.mirror > 0.0 && count < TRACE_PENDING) {
+                    let d = reflect(current.dir, s.normal);
+                    pending[count] = Pending(p + offset * s.normal, current.bounces + 1u, d, current.weight * s.mirror * s.tint);
+                    count += 1u;
+                }
+                if (s.transmission > 0.0 && count < TRACE_PENDING) {
+                    // Entering through the front face: n₁/n₂ = 1/ior; leaving: ior.
+                    let eta = select(s.ior, 1.0 / s.ior, s.front);
+                    let d = refract_or_reflect(current.dir, s.normal, eta);
+                    let side = select(s.normal, -s.normal, dot(d, s.normal) < 0.0);
+                    pending[count] = Pending(p + offset * side, current.bounces + 1u, d, current.weight * s.transmission);
+                    count += 1u;
+                }
+            }
+        }
+        if (count == 0u) {
+            break;
+        }
+        count -= 1u;
+        current = pending[count];
+        current_hit = closest_hit(current.origin, current.dir, frag_xy, FAR);
+    }
+    out_color[slot] = pack_display(linear_to_srgb(color));
 }

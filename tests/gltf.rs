@@ -522,3 +522,52 @@ fn obj_files_are_read_safely_and_faults_name_their_line() {
     let o = twister(&["info", dir.join("folder.obj").to_str().unwrap()]);
     assert!(String::from_utf8_lossy(&o.stderr).contains("is a folder, not a file"));
 }
+
+#[test]
+fn optics_are_read_from_gltf_and_mtl_for_the_ray_tracer() {
+    // glTF: a smooth metal is a mirror; a rough one and a plain dielectric are not; transmission
+    // and ior come from their extensions (ior 1.5 when absent).
+    let dir = tmp("optics");
+    let mut json = gltf_json(&QUAD[..3], None, 4);
+    json["materials"] = serde_json::json!([
+        { "pbrMetallicRoughness": { "metallicFactor": 1.0, "roughnessFactor": 0.0 } },
+        { "pbrMetallicRoughness": { "metallicFactor": 1.0, "roughnessFactor": 0.4 } },
+        { "extensions": { "KHR_materials_transmission": { "transmissionFactor": 0.8 }, "KHR_materials_ior": { "ior": 1.33 } } },
+        { "extensions": { "KHR_materials_transmission": { "transmissionFactor": 1.0 } } }
+    ]);
+    json["extensionsUsed"] = serde_json::json!(["KHR_materials_transmission", "KHR_materials_ior"]);
+    json["meshes"][0]["primitives"][0]["material"] = serde_json::json!(0);
+    let path = write(&dir, "optics.gltf", &json);
+    let scene = load_scene(path.to_str().unwrap(), &Projection::default()).unwrap();
+    let m = &scene.materials;
+    assert_eq!(m.len(), 4, "{m:?}");
+    assert_eq!((m[0].mirror, m[1].mirror, m[2].mirror), (1.0, 0.0, 0.0));
+    assert_eq!((m[2].transmission, m[2].ior), (0.8, 1.33));
+    assert_eq!((m[3].transmission, m[3].ior, m[0].transmission), (1.0, 1.5, 0.0));
+    // MTL: illum 3 mirrors Ks; illum 7 also transmits 1 − d with index Ni; illum 6 reads Tr;
+    // illum 2 has no optics.
+    std::fs::write(
+        dir.join("optics.mtl"),
+        "newmtl chrome\nillum 3\nKs 0.8 0.9 0.7\nnewmtl glass\nillum 7\nKs 0.1 0.1 0.1\nd 0.3\nNi 1.33\n\
+         newmtl tinted\nillum 6\nTr 0.6\nnewmtl matte\nillum 2\nKs 1 1 1\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("optics.obj"),
+        "mtllib optics.mtl\nv 0 0 -3\nv 1 0 -3\nv 0 1 -3\nusemtl chrome\nf 1 2 3\nusemtl glass\nf 1 2 3\n\
+         usemtl tinted\nf 1 2 3\nusemtl matte\nf 1 2 3\n",
+    )
+    .unwrap();
+    let scene = load_scene(dir.join("optics.obj").to_str().unwrap(), &Projection::default()).unwrap();
+    let m = &scene.materials;
+    assert_eq!(m.len(), 4, "{m:?}");
+    assert_eq!((m[0].mirror, m[0].transmission), (0.9, 0.0));
+    assert!(
+        (m[1].mirror - 0.1).abs() < 1e-6 && (m[1].transmission - 0.7).abs() < 1e-6 && m[1].ior == 1.33,
+        "{:?}",
+        m[1]
+    );
+    assert!((m[2].transmission - 0.6).abs() < 1e-6 && m[2].ior == 1.5, "{:?}", m[2]);
+    assert_eq!((m[3].mirror, m[3].transmission), (0.0, 0.0));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -121,3 +121,230 @@ fn trace_refuses_the_paper_model_and_a_scene_without_its_bvh() {
     let gs = gs.with_bvh(&r.gpu, &scene).unwrap();
     assert!(r.render(&gs, &sphere).is_ok());
 }
+
+// ---- optics: a mirror sphere and a glass sphere against analytic rays ----
+
+use glam::{Vec2, Vec3};
+use twister::core::color::linear_to_srgb;
+use twister::core::material::Material;
+use twister::cpu::fragment::pixel_ray;
+
+/// The room (each wall its colour), a checkerboard of 0.25 m tiles just before the −z wall, and
+/// a smooth sphere of `material` ahead, unlit (ambient 1: every surface shows its colour).
+const ROOM_LO: Vec3 = Vec3::new(-3.0, -2.0, -4.0);
+const ROOM_HI: Vec3 = Vec3::new(3.0, 2.5, 3.0);
+const BOARD_Z: f32 = -3.9;
+const TILE: f32 = 0.25;
+const CENTER: Vec3 = Vec3::new(0.0, 0.0, -2.0);
+const RADIUS: f32 = 0.6;
+const TILE_COLOURS: [[f32; 4]; 2] = [[0.9, 0.1, 0.1, 1.0], [0.1, 0.2, 0.9, 1.0]];
+
+fn optics_scene(material: Material) -> Scene {
+    let mut scene = builtin::closed_box("optics room", ROOM_LO, ROOM_HI);
+    let (mut v, mut idx) = (Vec::new(), Vec::new());
+    let (nx, ny) = (((ROOM_HI.x - ROOM_LO.x) / TILE) as i32, ((ROOM_HI.y - ROOM_LO.y) / TILE) as i32);
+    for j in 0..ny {
+        for i in 0..nx {
+            let (x0, y0) = (ROOM_LO.x + i as f32 * TILE, ROOM_LO.y + j as f32 * TILE);
+            let color = TILE_COLOURS[((i + j) % 2) as usize];
+            let base = v.len() as u32;
+            for (x, y) in [(x0, y0), (x0 + TILE, y0), (x0 + TILE, y0 + TILE), (x0, y0 + TILE)] {
+                v.push(twister::core::scene::SceneVertex {
+                    position: [x, y, BOARD_Z],
+                    normal: [0.0, 0.0, 1.0],
+                    color,
+                    ..Default::default()
+                });
+            }
+            idx.extend([0, 1, 2, 0, 2, 3].map(|k| base + k));
+        }
+    }
+    scene.add_mesh("checkerboard", &v, &idx);
+    let (v, idx) = builtin::uv_sphere(CENTER, RADIUS, 128, 64, [1.0; 4]);
+    scene.materials.push(material);
+    let first = scene.vertices.len();
+    scene.add_mesh("sphere", &v, &idx);
+    for vertex in &mut scene.vertices[first..] {
+        vertex.material = 1;
+    }
+    scene
+}
+
+/// Where a ray inside the room first meets the checkerboard or a wall: the expected display
+/// colour, or None within `margin` of a colour boundary.
+fn room_colour(p: Vec3, d: Vec3, margin: f32) -> Option<[u8; 3]> {
+    let display = |c: [f32; 4]| [0, 1, 2].map(|k| (linear_to_srgb(c[k]) * 255.0 + 0.5).floor() as u8);
+    if d.z < 0.0 {
+        let t = (BOARD_Z - p.z) / d.z;
+        let q = p + t * d;
+        if t > 0.0 && q.x > ROOM_LO.x && q.x < ROOM_HI.x && q.y > ROOM_LO.y && q.y < ROOM_HI.y {
+            let (u, v) = ((q.x - ROOM_LO.x) / TILE, (q.y - ROOM_LO.y) / TILE);
+            let near_edge = |w: f32| (w - w.round()).abs() * TILE < margin;
+            if near_edge(u) || near_edge(v) {
+                return None;
+            }
+            return Some(display(TILE_COLOURS[((u.floor() + v.floor()) as i32 % 2) as usize]));
+        }
+    }
+    // The walls: −z, +x, +z, −x, floor, ceiling (closed_box's colours, in that order).
+    let room = builtin::closed_box("walls", ROOM_LO, ROOM_HI);
+    let exits = [(2, false), (0, true), (2, true), (0, false), (1, false), (1, true)];
+    let (mut best, mut face) = (f32::INFINITY, 0);
+    for (k, &(axis, high)) in exits.iter().enumerate() {
+        let bound = if high { ROOM_HI[axis] } else { ROOM_LO[axis] };
+        let t = (bound - p[axis]) / d[axis];
+        if t > 0.0 && t < best {
+            (best, face) = (t, k);
+        }
+    }
+    let q = p + best * d;
+    let (axis, _) = exits[face];
+    let inside = (0..3).filter(|&a| a != axis).all(|a| q[a] - ROOM_LO[a] > margin && ROOM_HI[a] - q[a] > margin);
+    let colour = room.vertices[4 * face].color;
+    inside.then(|| display(colour))
+}
+
+/// Traces the sphere scene and checks every pixel whose analytic path `expected` can tell.
+fn check_optics(name: &str, material: Material, expected: &dyn Fn(Vec3, Vec3) -> Option<[u8; 3]>) {
+    let projection = exact(480, 160);
+    let scene = optics_scene(material);
+    let settings = RenderSettings::new(projection).with_method(Method::Trace).with_ambient(1.0);
+    let frame = render(&scene, &settings);
+    let (mut checked, mut wrong) = (0, Vec::new());
+    for eye in Eye::BOTH {
+        let img = frame.eye(eye);
+        for y in 0..projection.height {
+            for x in 0..projection.width {
+                let frag_xy = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                let (o, d) = pixel_ray(&projection, eye, frag_xy);
+                let Some(want) = expected(o, d) else { continue };
+                checked += 1;
+                let i = 4 * (y * projection.width + x) as usize;
+                let got = &img.rgba[i..i + 3];
+                if got.iter().zip(want).any(|(g, w)| g.abs_diff(w) > 3) {
+                    wrong.push((eye, x, y, got.to_vec(), want));
+                }
+            }
+        }
+    }
+    eprintln!("{name}: {checked} pixels checked, {} differ", wrong.len());
+    assert!(checked > 500, "{name}: only {checked} pixels could be checked");
+    assert!(
+        wrong.len() * 200 <= checked,
+        "{name}: {} of {checked} differ, e.g. {:?}",
+        wrong.len(),
+        &wrong[..wrong.len().min(5)]
+    );
+}
+
+/// The ray's entry into the sphere (distance, point, outward normal), if it meets it at an angle
+/// steeper than `min_cos`.
+fn sphere_entry(o: Vec3, d: Vec3, min_cos: f32) -> Option<(Vec3, Vec3)> {
+    let oc = o - CENTER;
+    let b = oc.dot(d);
+    let disc = b * b - (oc.length_squared() - RADIUS * RADIUS);
+    if disc <= 0.0 {
+        return None;
+    }
+    let t = -b - disc.sqrt();
+    let p = o + t * d;
+    let n = (p - CENTER) / RADIUS;
+    (t > 0.0 && -d.dot(n) > min_cos).then_some((p, n))
+}
+
+#[test]
+fn a_mirror_sphere_reflects_the_walls_and_board_where_reflection_puts_them() {
+    let mirror = Material { mirror: 1.0, ..Default::default() };
+    check_optics("mirror", mirror, &|o, d| {
+        let (p, n) = sphere_entry(o, d, 0.3)?;
+        room_colour(p, d - 2.0 * d.dot(n) * n, 0.08)
+    });
+}
+
+#[test]
+fn a_glass_sphere_refracts_the_board_as_snells_law_says() {
+    let ior = 1.5f32;
+    let glass = Material { transmission: 1.0, ior, ..Default::default() };
+    let snell = |d: Vec3, n: Vec3, eta: f32| -> Option<Vec3> {
+        let cos_i = -d.dot(n);
+        let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+        (k >= 0.0).then(|| (eta * d + (eta * cos_i - k.sqrt()) * n).normalize())
+    };
+    check_optics("glass", glass, &|o, d| {
+        let (p, n) = sphere_entry(o, d, 0.3)?;
+        let inside = snell(d, n, 1.0 / ior)?;
+        // The exit: the chord through the sphere, then out (no total internal reflection here).
+        let t = -2.0 * (p - CENTER).dot(inside);
+        let q = p + t * inside;
+        let out = snell(inside, -(q - CENTER) / RADIUS, ior)?;
+        room_colour(q, out, 0.05)
+    });
+}
+
+/// The ray's entry distance into the box [lo, hi] within (0, limit), if any (slab test).
+fn enters_box(o: Vec3, d: Vec3, lo: Vec3, hi: Vec3, limit: f32) -> bool {
+    let inv = d.recip();
+    let (t1, t2) = ((lo - o) * inv, (hi - o) * inv);
+    let near = t1.min(t2).max_element().max(0.0);
+    let far = t1.max(t2).min_element().min(limit);
+    near <= far
+}
+
+#[test]
+fn a_point_light_casts_the_blockers_hard_shadow_where_geometry_puts_it() {
+    let light = Vec3::new(0.3, 2.0, -2.2);
+    let (block_lo, block_hi) = (Vec3::new(-0.35, -0.2, -2.6), Vec3::new(0.25, 0.4, -1.9));
+    let mut scene = builtin::closed_box("shadow room", ROOM_LO, ROOM_HI);
+    let blocker = builtin::closed_box("blocker", block_lo, block_hi);
+    scene.add_mesh("blocker", &blocker.vertices, &blocker.indices);
+    let projection = exact(480, 160);
+    let ambient = 0.3;
+    let settings =
+        RenderSettings::new(projection).with_method(Method::Trace).with_ambient(ambient).with_light(Some(light));
+    let frame = render(&scene, &settings);
+    let floor = scene.vertices[16].color; // closed_box's face 4, the floor
+    let display =
+        |s: f32| [0, 1, 2].map(|k| (linear_to_srgb((floor[k] * s).clamp(0.0, 1.0)) * 255.0 + 0.5).floor() as u8);
+    let grow = Vec3::splat(0.05);
+    let (mut lit, mut shadowed, mut wrong) = (0, 0, Vec::new());
+    for eye in Eye::BOTH {
+        let img = frame.eye(eye);
+        for y in 0..projection.height {
+            for x in 0..projection.width {
+                let (o, d) = pixel_ray(&projection, eye, Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                if d.y >= -1e-3 {
+                    continue;
+                }
+                let t = (ROOM_LO.y - o.y) / d.y;
+                let q = o + t * d;
+                let inside = q.x > ROOM_LO.x + 0.05
+                    && q.x < ROOM_HI.x - 0.05
+                    && q.z > ROOM_LO.z + 0.05
+                    && q.z < ROOM_HI.z - 0.05;
+                if !inside || enters_box(o, d, block_lo - grow, block_hi + grow, t) {
+                    continue; // off the floor, or the blocker is in the way
+                }
+                let to_light = light - q;
+                let (dist, l) = (to_light.length(), to_light.normalize());
+                let surely_in = enters_box(q, l, block_lo + grow, block_hi - grow, dist);
+                let surely_out = !enters_box(q, l, block_lo - grow, block_hi + grow, dist);
+                let want = if surely_in {
+                    shadowed += 1;
+                    display(ambient)
+                } else if surely_out {
+                    lit += 1;
+                    display(ambient + (1.0 - ambient) * l.y.max(0.0))
+                } else {
+                    continue; // the penumbra-free edge itself
+                };
+                let i = 4 * (y * projection.width + x) as usize;
+                if img.rgba[i..i + 3].iter().zip(want).any(|(g, w)| g.abs_diff(w) > 3) {
+                    wrong.push((eye, x, y, img.rgba[i..i + 3].to_vec(), want));
+                }
+            }
+        }
+    }
+    eprintln!("shadow: {lit} lit and {shadowed} shadowed floor pixels checked, {} differ", wrong.len());
+    assert!(lit > 500 && shadowed > 100, "{lit} lit, {shadowed} shadowed");
+    assert!(wrong.len() * 200 <= lit + shadowed, "{} differ, e.g. {:?}", wrong.len(), &wrong[..wrong.len().min(5)]);
+}

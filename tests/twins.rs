@@ -497,6 +497,21 @@ impl Twin for Slit {
 
 struct Trace;
 
+/// The demo room with its objects 1 and 2 made a tinted half mirror and a glass (transmission 0.8,
+/// index 1.3): the ray tracer's mirror and refraction rays.
+fn optics_demo() -> Scene {
+    let mut scene = builtin::demo();
+    scene.materials.push(twister::core::material::Material { mirror: 0.6, ..Default::default() });
+    scene.materials.push(twister::core::material::Material { transmission: 0.8, ior: 1.3, ..Default::default() });
+    let base = scene.materials.len() as u32 - 1;
+    for v in &mut scene.vertices {
+        if v.object == 1 || v.object == 2 {
+            v.material = base + v.object - 1;
+        }
+    }
+    scene
+}
+
 impl Twin for Trace {
     type Case = (Scene, RenderSettings);
     type Output = EyeOutputs;
@@ -513,6 +528,19 @@ impl Twin for Trace {
             (
                 "demo on the sphere, converging".into(),
                 (builtin::demo(), RenderSettings::new(sphere).with_method(Method::Trace)),
+            ),
+            (
+                "demo with a mirror and a glass object".into(),
+                (optics_demo(), RenderSettings::new(cylinder).with_method(Method::Trace)),
+            ),
+            (
+                "demo with a mirror, a glass and a point light".into(),
+                (
+                    optics_demo(),
+                    RenderSettings::new(cylinder)
+                        .with_method(Method::Trace)
+                        .with_light(Some(Vec3::new(0.4, 1.2, -0.8))),
+                ),
             ),
             (
                 "box room".into(),

@@ -28,7 +28,9 @@ struct Material {
     double_sided: u32,
     first_mip: u32,
     mip_count: u32,
-    _pad: u32,
+    mirror: f32,        // the ray tracer's optics (src/core/material.rs)
+    transmission: f32,
+    ior: f32,
 }
 
 struct MipLevel {

@@ -7,7 +7,7 @@ use glam::Vec3;
 use twister::core::lod::LodParams;
 use twister::core::projection::{PanoramaKind, DEFAULT_POLE_MERGE};
 use twister::core::settings::{
-    Method, Split, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV, DEFAULT_MAX_ERROR_PX, DEFAULT_MEMORY_MB,
+    Method, Split, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV, DEFAULT_MAX_ERROR_PX, DEFAULT_MEMORY_MB, DEFAULT_REFLECT_MAX,
 };
 use twister::core::visual_field::Gaze;
 use twister::error::{Error, Result};
@@ -73,6 +73,13 @@ pub struct ViewArgs {
     /// edges under 8·L, and under L near the eye circle).
     #[arg(long, default_value_t = DEFAULT_EDGE_PX)]
     pub edge_px: f32,
+    /// `--method trace`: bounces of mirror and refraction rays (seed 000's Reflect_max), 0 to 8.
+    #[arg(long, default_value_t = DEFAULT_REFLECT_MAX)]
+    pub reflect_max: u32,
+    /// `--method trace`: a point light at X,Y,Z (scene coordinates) casting hard shadows, instead
+    /// of the headlight at the viewer.
+    #[arg(long, value_parser = parse_vec3, value_name = "X,Y,Z")]
+    pub light: Option<Vec3>,
     /// N_max: the largest lattice step of one piece; larger polygons are pre-split.
     #[arg(long, default_value_t = DEFAULT_MAX_DIV)]
     pub max_div: u32,
@@ -261,7 +268,12 @@ impl ViewArgs {
             .with_edge_px(self.edge_px)
             .with_max_error_px(self.max_error_px)
             .with_max_div(self.max_div)
-            .with_memory_mb(self.memory_mb);
+            .with_memory_mb(self.memory_mb)
+            .with_reflect_max(self.reflect_max)
+            .with_light(self.light);
+        if self.light.is_some() && settings.subdivision.method != Method::Trace {
+            return Err(Error::option("--light", "lights the ray tracer: use it with --method trace"));
+        }
         settings.validate()?;
         Ok(settings)
     }

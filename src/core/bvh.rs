@@ -1,11 +1,11 @@
 //! A bounding volume hierarchy over a scene's triangles, for the ray tracer (`--method trace`,
-//! seed 000): built on the CPU by obvhs (PLOC clustering with spatial pre-splits and
-//! reinsertion, then leaves collapsed by the SAH cost), stored as a flat array of 32-byte binary
+//! seed 000): built on the CPU by obvhs (its medium preset: PLOC clustering and reinsertion, then
+//! leaves of up to 8 triangles collapsed by the SAH cost), stored as a flat array of 32-byte binary
 //! nodes that the WGSL traversal (`shaders/trace.wgsl`) and its CPU twin (`cpu::trace`) walk.
 //!
 //! A node with `count` = 0 is inner: its children are `nodes[first]` and `nodes[first + 1]`.
 //! Else it is a leaf of `count` triangles, `primitives[first .. first + count]` (triangle
-//! indices; a triangle split by the pre-split may appear in several leaves). The root is node 0.
+//! indices). The root is node 0.
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec3, Vec3A};

@@ -30,7 +30,13 @@ pub struct Material {
     /// its level count.
     pub first_mip: u32,
     pub mip_count: u32,
-    pub _pad: u32,
+    /// The ray tracer's optics (the rasterizer ignores them): the share of light mirrored
+    /// (tinted by the surface colour), the share transmitted and refracted, and the index of
+    /// refraction (glTF metallic 1 / roughness 0 → mirror 1; `KHR_materials_transmission`,
+    /// `KHR_materials_ior`; OBJ `illum` 3–7 with `Ks`, `d`/`Tr`, `Ni`).
+    pub mirror: f32,
+    pub transmission: f32,
+    pub ior: f32,
 }
 
 impl Default for Material {
@@ -48,7 +54,9 @@ impl Default for Material {
             double_sided: 1,
             first_mip: 0,
             mip_count: 0,
-            _pad: 0,
+            mirror: 0.0,
+            transmission: 0.0,
+            ior: 1.5,
         }
     }
 }

@@ -18,6 +18,10 @@ pub const DEFAULT_EDGE_PX: f32 = 32.0;
 pub const DEFAULT_MAX_DIV: u32 = 7;
 /// Default τ of the error split, pixels: see the README for the error it gives.
 pub const DEFAULT_MAX_ERROR_PX: f32 = 0.5;
+/// `--reflect-max`: seed 000's Reflect_max.
+pub const DEFAULT_REFLECT_MAX: u32 = 3;
+/// The deepest `--reflect-max` (the ray tracer's stack of pending rays is this deep + 1).
+pub const MAX_REFLECT: u32 = 8;
 
 /// How triangles are drawn (`--method`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -152,6 +156,13 @@ pub struct ShadingSettings {
     pub background: [f32; 3],
     /// Ambient term of the headlight shading.
     pub ambient: f32,
+    /// The ray tracer's depth of mirror and refraction rays (`--reflect-max`, seed 000's
+    /// Reflect_max): each hit on a mirroring or transmitting surface spawns up to two rays, at
+    /// most this many bounces deep (up to 2^(n+1) − 2 secondary rays per pixel).
+    pub reflect_max: u32,
+    /// The ray tracer's point light (`--light`, scene coordinates), with hard shadows; None:
+    /// the headlight at the viewer, as the rasterizer.
+    pub light: Option<Vec3>,
 }
 
 /// What a render measures besides drawing.
@@ -215,7 +226,7 @@ impl Default for SubdivisionSettings {
 
 impl Default for ShadingSettings {
     fn default() -> Self {
-        ShadingSettings { background: [0.1, 0.1, 0.12], ambient: 0.3 }
+        ShadingSettings { background: [0.1, 0.1, 0.12], ambient: 0.3, reflect_max: DEFAULT_REFLECT_MAX, light: None }
     }
 }
 
@@ -244,6 +255,8 @@ builders! {
     with_memory_mb: u32 => subdivision.memory_mb,
     with_background: [f32; 3] => shading.background,
     with_ambient: f32 => shading.ambient,
+    with_reflect_max: u32 => shading.reflect_max,
+    with_light: Option<Vec3> => shading.light,
     with_measure_edges: bool => measure.edges,
     with_measure_error: bool => measure.error,
     with_error_angle: bool => measure.error_angle,
@@ -306,6 +319,18 @@ impl RenderSettings {
                 "trace follows each pixel's ray, and the paper's vertical model (v = R_T·y/r) has none \
                  (the points it shows at a pixel lie on a curve): use --vertical exact",
             ));
+        }
+        if self.shading.reflect_max > MAX_REFLECT {
+            return Err(Error::option(
+                "--reflect-max",
+                format!("must be between 0 and {MAX_REFLECT}, got {}", self.shading.reflect_max),
+            ));
+        }
+        if let Some(light) = self.shading.light {
+            let max = crate::core::scene::MAX_COORDINATE;
+            if !light.is_finite() || light.abs().max_element() > max {
+                return Err(Error::option("--light", format!("must lie within ±{max:e}, got {light}")));
+            }
         }
         if s.memory_mb < 8 {
             return Err(Error::option("--memory-mb", format!("must be at least 8, got {}", s.memory_mb)));

@@ -83,6 +83,12 @@ impl MaterialTable {
             .any(|m| m.texture != NO_TEXTURE || m.alpha_mode != AlphaMode::Opaque as u32 || m.double_sided == 0)
     }
 
+    /// Whether any material mirrors or transmits light (the ray tracer's optics, which need its
+    /// material code).
+    pub fn has_optics(&self) -> bool {
+        self.materials.iter().any(|m| m.mirror > 0.0 || m.transmission > 0.0)
+    }
+
     /// Whether every material in `used` (indices into this table, as the vertices carry them,
     /// clamped as the fragment stage clamps them) is single-sided, and there is one: the drawing
     /// stages then cull back faces in the rasterizer, per eye, before any fragment work (the same

@@ -14,10 +14,16 @@ use crate::core::texture::MaterialTable;
 /// Linear colour × (ambient + (1 − ambient)·|n·l|), the light at the viewer, two-sided; as
 /// sRGB-encoded RGBA8 (the colour target holds display values).
 pub fn shade(ambient: f32, view_position: Vec3, normal: Vec3, color: Vec4) -> [u8; 4] {
+    let lit = shade_linear(ambient, view_position, normal, color);
+    let q = |x: f32| (linear_to_srgb(x) * 255.0 + 0.5).floor() as u8;
+    [q(lit.x), q(lit.y), q(lit.z), 255]
+}
+
+/// The same in linear light, each channel clamped to [0, 1] (`shade` in surface.wgsl).
+pub fn shade_linear(ambient: f32, view_position: Vec3, normal: Vec3, color: Vec4) -> Vec3 {
     let lambert = if normal.length() > 1e-6 { normal.normalize().dot(-view_position.normalize()).abs() } else { 1.0 };
     let s = ambient + (1.0 - ambient) * lambert;
-    let q = |x: f32| (linear_to_srgb((x * s).clamp(0.0, 1.0)) * 255.0 + 0.5).floor() as u8;
-    [q(color.x), q(color.y), q(color.z), 255]
+    (color.truncate() * s).clamp(Vec3::ZERO, Vec3::ONE)
 }
 
 /// The display-position error of surface point `p` drawn at pixel centre `frag_xy`: the

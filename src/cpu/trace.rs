@@ -7,14 +7,15 @@
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use crate::core::bvh::{BvhNode, SceneBvh};
+use crate::core::color::{linear_to_srgb, srgb_to_linear};
 use crate::core::material::AlphaMode;
 use crate::core::projection::{Eye, Projection};
 use crate::core::scene::SceneVertex;
 use crate::core::settings::RenderSettings;
 use crate::core::texture::MaterialTable;
-use crate::cpu::fragment::{pixel_error, pixel_ray, shade, surface_color, Surface};
+use crate::cpu::fragment::{pixel_error, pixel_ray, shade_linear, surface_color, Surface};
 use crate::cpu::raster::RasterImage;
-use crate::shader::constants::TRACE_STACK;
+use crate::shader::constants::{TRACE_PENDING, TRACE_STACK};
 use crate::shader::types::TraceParams;
 
 /// The trace stage's parameters (`row_texels`: the outputs' padded row length).
@@ -24,10 +25,11 @@ pub fn trace_params(settings: &RenderSettings, row_texels: u32) -> TraceParams {
         to_scene: settings.view().inverse().to_cols_array_2d(),
         projection: settings.projection().into(),
         background: [r, g, b, 1.0],
+        light: settings.shading.light.map_or([0.0; 4], |l| [l.x, l.y, l.z, 1.0]),
         ambient: settings.shading.ambient,
         error_angle: settings.measure.error_angle as u32,
         row_texels,
-        _pad0: 0,
+        reflect_max: settings.shading.reflect_max,
     }
 }
 
@@ -52,7 +54,8 @@ fn enter_box(n: &BvhNode, origin: Vec3, inv: Vec3, limit: f32) -> Option<f32> {
     (near <= far).then_some(near)
 }
 
-/// The closest hit along the ray (scene frame) that `keeps` accepts (`closest_hit`): binary BVH,
+/// The closest hit along the ray (scene frame), nearer than `limit`, that `keeps` accepts
+/// (`closest_hit`): binary BVH,
 /// nearer child first (the farther kept with its entry distance, and skipped when popped if the
 /// best hit is nearer), Möller–Trumbore per triangle.
 pub fn closest_hit(
@@ -61,14 +64,15 @@ pub fn closest_hit(
     indices: &[u32],
     origin: Vec3,
     dir: Vec3,
+    limit: f32,
     keeps: &dyn Fn(u32, f32, f32, bool) -> bool,
 ) -> Option<Hit> {
     let mut best: Option<Hit> = None;
-    let best_t = |b: &Option<Hit>| b.map_or(f32::MAX, |h| h.t);
+    let best_t = |b: &Option<Hit>| b.map_or(limit, |h| h.t);
     let tiny = 1e-20;
     let safe = Vec3::select(dir.abs().cmplt(Vec3::splat(tiny)), Vec3::splat(tiny).copysign(dir), dir);
     let inv = Vec3::ONE / safe;
-    enter_box(&bvh.nodes[0], origin, inv, f32::MAX)?;
+    enter_box(&bvh.nodes[0], origin, inv, limit)?;
     let position = |tri: u32, k: u32| Vec3::from(vertices[indices[(3 * tri + k) as usize] as usize].position);
     // Nodes still to visit, with the distance where the ray enters their box.
     let mut stack: Vec<(usize, f32)> = Vec::with_capacity(TRACE_STACK as usize);
@@ -128,6 +132,29 @@ pub fn closest_hit(
     best
 }
 
+/// What a hit shows (`shade_hit`): its own light (weighted 1 − mirror − transmission, sRGB-free
+/// linear), its optics, the tint of mirrored light, the normal facing the ray (scene frame).
+struct Shaded {
+    color: Vec3,
+    mirror: f32,
+    transmission: f32,
+    tint: Vec3,
+    normal: Vec3,
+    ior: f32,
+    front: bool,
+}
+
+/// The refracted direction (Snell's law; `n` facing the incoming ray, eta = n₁/n₂), or the
+/// mirrored one under total internal reflection (`refract_or_reflect`).
+pub fn refract_or_reflect(d: Vec3, n: Vec3, eta: f32) -> Vec3 {
+    let cos_i = -d.dot(n);
+    let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+    if k < 0.0 {
+        return d - 2.0 * d.dot(n) * n;
+    }
+    (eta * d + (eta * cos_i - k.sqrt()) * n).normalize()
+}
+
 /// The trace stage on the CPU: both eyes (left, right).
 pub fn trace(
     params: &TraceParams,
@@ -138,9 +165,12 @@ pub fn trace(
 ) -> [RasterImage; 2] {
     let projection = Projection::from(&params.projection);
     let to_scene = Mat4::from_cols_array_2d(&params.to_scene);
-    let rotation_back = glam::Mat3::from_mat4(to_scene).transpose();
+    let to_view = glam::Mat3::from_mat4(to_scene).transpose();
+    let viewer = to_scene.w_axis.truncate();
     let [r, g, b, _] = params.background;
+    let background = Vec3::new(r, g, b).map(srgb_to_linear);
     let corners = |tri: u32| [0, 1, 2].map(|k| &vertices[indices[(3 * tri + k) as usize] as usize]);
+    let material = |tri: u32| &table.materials[(corners(tri)[0].material as usize).min(table.materials.len() - 1)];
     let surface = |tri: u32, b1: f32, b2: f32, front: bool, frag_xy: Vec2| {
         let [a, b, c] = corners(tri);
         let b0 = 1.0 - b1 - b2;
@@ -156,40 +186,119 @@ pub fn trace(
             front_facing: front,
         }
     };
+    let light = (params.light[3] > 0.0).then(|| Vec3::new(params.light[0], params.light[1], params.light[2]));
+    let shade_hit = |hit: &Hit,
+                     dir: Vec3,
+                     p: Vec3,
+                     view_position: Vec3,
+                     frag_xy: Vec2,
+                     keeps: &dyn Fn(u32, f32, f32, bool) -> bool| {
+        let [a, b, c] = corners(hit.triangle);
+        let b0 = 1.0 - hit.b1 - hit.b2;
+        let mut n = b0 * Vec3::from(a.normal) + hit.b1 * Vec3::from(b.normal) + hit.b2 * Vec3::from(c.normal);
+        if n.length_squared() < 1e-12 {
+            let p = |v: &SceneVertex| Vec3::from(v.position);
+            n = (p(b) - p(a)).cross(p(c) - p(a));
+        }
+        let n = n.normalize();
+        let color = surface_color(table, &surface(hit.triangle, hit.b1, hit.b2, hit.front, frag_xy))
+            .expect("a kept hit has a colour");
+        let m = material(hit.triangle);
+        let own = 1.0 - m.mirror - m.transmission;
+        let facing = if n.dot(dir) > 0.0 { -n } else { n };
+        let lit = match light {
+            None => shade_linear(params.ambient, view_position, to_view * n, color),
+            Some(light) => {
+                // Lambert towards the light, one-sided, zero in shadow.
+                let to_light = light - p;
+                let dist = to_light.length();
+                let l = to_light / dist.max(1e-20);
+                let mut lambert = facing.dot(l).max(0.0);
+                let offset = 1e-4 * p.length().max(1.0);
+                if lambert > 0.0
+                    && closest_hit(bvh, vertices, indices, p + offset * facing, l, dist - offset, keeps).is_some()
+                {
+                    lambert = 0.0;
+                }
+                (color.truncate() * (params.ambient + (1.0 - params.ambient) * lambert)).clamp(Vec3::ZERO, Vec3::ONE)
+            }
+        };
+        Shaded {
+            color: lit * own.max(0.0),
+            mirror: m.mirror,
+            transmission: m.transmission,
+            tint: color.truncate(),
+            normal: facing,
+            ior: m.ior,
+            front: hit.front,
+        }
+    };
     Eye::BOTH.map(|eye| {
         // The image's background is given in display values, as `RasterImage::new` takes it.
         let mut img = RasterImage::new(projection.width, projection.height, [r, g, b]);
         for y in 0..projection.height {
             for x in 0..projection.width {
                 let frag_xy = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-                let (origin_v, dir_v) = pixel_ray(&projection, eye, frag_xy);
-                let origin = to_scene.transform_point3(origin_v);
-                let dir = to_scene.transform_vector3(dir_v);
                 let keeps = |tri: u32, b1: f32, b2: f32, front: bool| {
-                    let m = &table.materials[(corners(tri)[0].material as usize).min(table.materials.len() - 1)];
+                    let m = material(tri);
                     if m.alpha_mode == AlphaMode::Opaque as u32 {
                         return front || m.double_sided != 0;
                     }
                     surface_color(table, &surface(tri, b1, b2, front, frag_xy)).is_some()
                 };
-                let Some(hit) = closest_hit(bvh, vertices, indices, origin, dir, &keeps) else { continue };
-                let [a, b, c] = corners(hit.triangle);
-                let b0 = 1.0 - hit.b1 - hit.b2;
-                let normal = rotation_back
-                    * (b0 * Vec3::from(a.normal) + hit.b1 * Vec3::from(b.normal) + hit.b2 * Vec3::from(c.normal));
-                let view_position = origin_v + hit.t * dir_v;
-                let Some(color) = surface_color(table, &surface(hit.triangle, hit.b1, hit.b2, hit.front, frag_xy))
-                else {
-                    continue;
-                };
+                let (origin_v, dir_v) = pixel_ray(&projection, eye, frag_xy);
+                let origin = to_scene.transform_point3(origin_v);
+                let dir = to_scene.transform_vector3(dir_v);
+                let Some(hit) = closest_hit(bvh, vertices, indices, origin, dir, FAR, &keeps) else { continue };
                 let i = (y * projection.width + x) as usize;
-                img.rgba[4 * i..4 * i + 4].copy_from_slice(&shade(params.ambient, view_position, normal, color));
+                let view_position = origin_v + hit.t * dir_v;
                 img.error[i] = pixel_error(&projection, eye, view_position, frag_xy, params.error_angle != 0);
-                img.object[i] = a.object + 1;
+                img.object[i] = corners(hit.triangle)[0].object + 1;
                 img.distance[i] = hit.t;
                 img.depth[i] = hit.t;
+                // The colour gathers the mirror and refraction rays, depth first (as the WGSL).
+                let mut pending: Vec<(Vec3, u32, Vec3, Vec3)> = Vec::with_capacity(TRACE_PENDING as usize);
+                let mut color = Vec3::ZERO;
+                let (mut current, mut current_hit) = ((origin, 0u32, dir, Vec3::ONE), Some(hit));
+                loop {
+                    let (o, bounces, d, weight) = current;
+                    match current_hit {
+                        None => color += weight * background,
+                        Some(h) => {
+                            let p = o + h.t * d;
+                            let s = shade_hit(&h, d, p, to_view * (p - viewer), frag_xy, &keeps);
+                            color += weight * s.color;
+                            let offset = 1e-4 * p.length().max(1.0);
+                            if bounces < params.reflect_max {
+                                if s.mirror > 0.0 && pending.len() < TRACE_PENDING as usize {
+                                    let r = d - 2.0 * d.dot(s.normal) * s.normal;
+                                    pending.push((p + offset * s.normal, bounces + 1, r, weight * s.mirror * s.tint));
+                                }
+                                if s.transmission > 0.0 && pending.len() < TRACE_PENDING as usize {
+                                    let eta = if s.front { 1.0 / s.ior } else { s.ior };
+                                    let t = refract_or_reflect(d, s.normal, eta);
+                                    let side = if t.dot(s.normal) < 0.0 { -s.normal } else { s.normal };
+                                    pending.push((p + offset * side, bounces + 1, t, weight * s.transmission));
+                                }
+                            }
+                        }
+                    }
+                    let Some(next) = pending.pop() else { break };
+                    current = next;
+                    current_hit = closest_hit(bvh, vertices, indices, next.0, next.2, FAR, &keeps);
+                }
+                img.rgba[4 * i..4 * i + 4].copy_from_slice(&display_bytes(color));
             }
         }
         img
     })
 }
+
+/// Linear colour → sRGB bytes as the colour target holds them (`pack_display(linear_to_srgb(c))`).
+fn display_bytes(c: Vec3) -> [u8; 4] {
+    let q = |x: f32| (linear_to_srgb(x.clamp(0.0, 1.0)) * 255.0 + 0.5).floor() as u8;
+    [q(c.x), q(c.y), q(c.z), 255]
+}
+
+/// "No hit" distance of a ray (`FAR` in trace.wgsl).
+const FAR: f32 = 3.0e38;

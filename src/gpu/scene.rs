@@ -35,6 +35,8 @@ pub struct GpuScene {
     pub needs_materials: bool,
     /// Every material is single-sided: the drawing pipelines cull back faces.
     pub cull_back_faces: bool,
+    /// Some material mirrors or transmits light (the ray tracer then runs its material code).
+    pub has_optics: bool,
     /// The BVH the ray tracer walks (`--method trace`), once built ([`GpuScene::with_bvh`]).
     pub bvh: Option<GpuBvh>,
 }
@@ -99,6 +101,7 @@ impl GpuScene {
             ];
             let ones = vec![1.0f32; scene.objects.len().max(1)];
             let needs_materials = table.needs_materials();
+            let has_optics = table.has_optics();
             let cull_back_faces = table.all_single_sided(scene.vertices.iter().map(|v| v.material));
             Ok(GpuScene {
                 vertices,
@@ -110,6 +113,7 @@ impl GpuScene {
                 object_edge_scale: storage("object edge scale", bytemuck::cast_slice(&ones)),
                 needs_materials,
                 cull_back_faces,
+                has_optics,
                 bvh: None,
             })
         })
@@ -176,6 +180,7 @@ impl GpuScene {
             ),
             needs_materials: self.needs_materials,
             cull_back_faces: self.cull_back_faces,
+            has_optics: self.has_optics,
             // The BVH indexes the full scene's triangles: a selection has none (yet).
             bvh: None,
         }

@@ -35,6 +35,9 @@ pub const MAX_STRETCH: f32 = 2.0;
 pub const ERROR_SPLIT_LENGTH: f32 = 8.0;
 /// The ray tracer's traversal stack (entries): the host refuses a BVH deeper than this.
 pub const TRACE_STACK: u32 = 64;
+/// The ray tracer's pending mirror and refraction rays per pixel (depth first: one per bounce
+/// level, + 1).
+pub const TRACE_PENDING: u32 = crate::core::settings::MAX_REFLECT + 1;
 /// Seam copies are made for triangles reaching within this many radians of ±π.
 pub const SEAM_MARGIN: f32 = 1e-5;
 /// The most divisions of a piece's edge: `fixed:N` above it is pre-split into a macro-lattice of
@@ -89,6 +92,7 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("ERROR_SPLIT_LENGTH", F32(ERROR_SPLIT_LENGTH)),
         ("SEAM_MARGIN", F32(SEAM_MARGIN)),
         ("TRACE_STACK", U32(TRACE_STACK)),
+        ("TRACE_PENDING", U32(TRACE_PENDING)),
         ("PIECES_FROM_COUNTER", U32(PIECES_FROM_COUNTER)),
         ("MAX_DEPTH", F32(MAX_DEPTH)),
         ("FINE_BINS", U32(FINE_BINS)),

@@ -301,7 +301,7 @@ macro_rules! layout {
     };
 }
 
-/// `TraceParams` in shaders/trace.wgsl. 144 bytes.
+/// `TraceParams` in shaders/trace.wgsl. 160 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct TraceParams {
@@ -310,12 +310,15 @@ pub struct TraceParams {
     pub projection: ProjectionUniform,
     /// Background colour, display (sRGB) values, alpha 1.
     pub background: [f32; 4],
+    /// The point light (scene frame) in xyz, w = 1; w = 0: the headlight at the viewer.
+    pub light: [f32; 4],
     pub ambient: f32,
     /// As in [`RasterParams`].
     pub error_angle: u32,
     /// Padded row length of the outputs, texels (rows of 256 bytes, as texture copies need).
     pub row_texels: u32,
-    pub _pad0: u32,
+    /// Bounces of mirror and refraction rays (`ShadingSettings::reflect_max`).
+    pub reflect_max: u32,
 }
 
 /// Every struct the stages bind (as a uniform or in a storage buffer), by its WGSL name.
@@ -336,12 +339,12 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("RasterParams" => RasterParams { projection, eye_sign, ambient, shift_px, error_angle, _pad0, _pad1, _pad2 }),
     layout!("SlitParams" => SlitParams { view, projection, eye_sign, ambient, near, error_angle }),
     layout!("SlitCamera" => SlitCamera { origin_sx, right_cx, up_cy, forward_sy }),
-    layout!("TraceParams" => TraceParams { to_scene, projection, background, ambient, error_angle, row_texels, _pad0 }),
+    layout!("TraceParams" => TraceParams { to_scene, projection, background, light, ambient, error_angle, row_texels, reflect_max }),
     layout!("BvhNode" => BvhNode { min, first, max, count }),
     layout!("ProjectParams" => ProjectParams { projection, eye_sign, count, _pad }),
     layout!("Material" => Material {
         texture, wrap_u, wrap_v, mag_filter, min_filter, mipmap, alpha_mode, alpha_cutoff, double_sided,
-        first_mip, mip_count, _pad
+        first_mip, mip_count, mirror, transmission, ior
     }),
     layout!("MipLevel" => MipLevel { offset, width, height, _pad }),
     layout!("ReduceParams" => ReduceParams { width, height, row_stride, images, partial_count, partial_offset, _pad1, _pad2 }),

@@ -72,6 +72,19 @@ fn gltf_material(material: &gltf::Material) -> GltfMaterial {
         } as u32,
         alpha_cutoff: material.alpha_cutoff().unwrap_or(0.5),
         double_sided: material.double_sided() as u32,
+        // The ray tracer's optics: a smooth metal is a mirror tinted by its base colour;
+        // KHR_materials_transmission's factor refracts with KHR_materials_ior's index (1.5 by
+        // default, as the extension says).
+        mirror: {
+            let pbr = material.pbr_metallic_roughness();
+            if pbr.metallic_factor() >= 1.0 && pbr.roughness_factor() <= 0.0 {
+                1.0
+            } else {
+                0.0
+            }
+        },
+        transmission: material.transmission().map_or(0.0, |t| t.transmission_factor().clamp(0.0, 1.0)),
+        ior: material.ior().filter(|i| i.is_finite() && *i >= 1.0).unwrap_or(1.5),
         ..Default::default()
     };
     let Some(info) = material.pbr_metallic_roughness().base_color_texture() else {

@@ -36,7 +36,7 @@ pub(super) fn read_obj(path: &Path) -> std::result::Result<Scene, String> {
     let texture_dirs = obj_texture_dirs(path);
     let mut loaded: Vec<(String, u32)> = Vec::new(); // map_Kd as written → texture index
     for mat in &materials {
-        let mut material = Material::default();
+        let mut material = obj_optics(mat);
         if let Some(spec) = mat.diffuse_texture.as_deref() {
             if let Some(&(_, k)) = loaded.iter().find(|(s, _)| s == spec) {
                 material.texture = k;
@@ -188,4 +188,26 @@ fn load_obj_texture(spec: &str, dirs: &[std::path::PathBuf]) -> std::result::Res
     let image =
         image::load_from_memory(&bytes).map_err(|e| format!("texture {} cannot be decoded: {e}", file.display()))?;
     Ok(Texture::from_image(file.display().to_string(), image))
+}
+
+/// The ray tracer's optics of an MTL material, by its illumination model: `illum` 3 and 5
+/// (ray-traced reflection) mirror the share `Ks` (its largest channel; the reflection is tinted by
+/// the surface colour); 4, 6 and 7 (ray-traced refraction) also transmit 1 − `d` (or `Tr`) with
+/// index `Ni` (1.5 when absent or below 1). Other models: no optics.
+pub fn obj_optics(mat: &tobj::Material) -> Material {
+    let illum = mat.illumination_model.unwrap_or(2);
+    let ks = mat.specular.map_or(0.0, |s| s.iter().fold(0.0f32, |a, b| a.max(*b))).clamp(0.0, 1.0);
+    let opacity = mat
+        .dissolve
+        .or_else(|| mat.unknown_param.get("Tr").and_then(|t| t.trim().parse::<f32>().ok()).map(|t| 1.0 - t))
+        .unwrap_or(1.0);
+    let mut m = Material::default();
+    if (3..=7).contains(&illum) {
+        m.mirror = ks;
+    }
+    if matches!(illum, 4 | 6 | 7) {
+        m.transmission = (1.0 - opacity).clamp(0.0, 1.0 - m.mirror);
+        m.ior = mat.optical_density.filter(|n| n.is_finite() && *n >= 1.0).unwrap_or(1.5);
+    }
+    m
 }
