@@ -693,3 +693,28 @@ fn both_eyes_in_one_multiview_draw_match_a_pass_per_eye() {
         assert!(apart * 2 > covered, "{scene} {extra:?}: left and right differ on only {apart} of {covered} distances");
     }
 }
+
+#[test]
+fn error_against_trace_reports_surfaces_and_distances_against_the_traced_hits() {
+    let run = |extra: &[&str]| {
+        let o = twister()
+            .args(["error", "builtin:demo", "--vertical", "exact", "--width", "320", "--height", "60", "--json"])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{extra:?}: {}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_str::<serde_json::Value>(String::from_utf8_lossy(&o.stdout).trim()).unwrap()
+    };
+    // The traced image puts every surface point exactly where the projection says.
+    let traced = run(&["--method", "trace"]);
+    assert!(traced["p99_px"].as_f64().unwrap() < 1e-3, "{traced}");
+    // The projection methods draw the same surfaces as the traced hits; their distances (along each
+    // pixel's ray to the drawn triangle's plane) equal the hits' where the same triangle is drawn.
+    let f = |j: &serde_json::Value, k: &str| j[k].as_f64().unwrap_or_else(|| panic!("{k}: {j}"));
+    for method in ["adaptive", "vertex"] {
+        let j = run(&["--method", method, "--against", "trace"]);
+        assert_eq!(j["against"], "trace");
+        assert!(f(&j, "different_surface_fraction") < 0.005, "{j}");
+        assert!(f(&j, "depth_rel_p99") < 1e-3, "{j}");
+    }
+}

@@ -45,7 +45,8 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
     if let Some(path) = &args.heatmap {
         twister::output::check_outputs(&[path.as_path()])?;
     }
-    let mut settings = args.view.settings()?.with_measure_error(true);
+    // With --against, both frames also measure depth (the distance differences).
+    let mut settings = args.view.settings()?.with_measure_error(true).with_depth(args.against.is_some());
     let (renderer, adapter) = open_renderer()?;
     let methods: Vec<Method> = std::iter::once(settings.subdivision.method).chain(args.against).collect();
     let prepared = prepare(&renderer, &args.scene, args.fit, &args.view, &mut settings, false, &methods)?;
@@ -93,6 +94,8 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
         json["against"] = serde_json::json!(method.name());
         json["different_surface_fraction"] = serde_json::json!(c.different_surface_fraction);
         json["psnr_db"] = serde_json::json!(c.psnr_db);
+        json["depth_rel_mean"] = serde_json::json!(c.depth_rel_mean);
+        json["depth_rel_p99"] = serde_json::json!(c.depth_rel_p99);
     }
     if let Some(path) = &args.heatmap {
         let max = args.heatmap_max.unwrap_or_else(|| crate::heatmap::nice_max(e.p99));
@@ -136,8 +139,8 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
         }
         if let Some(f) = json.get("different_surface_fraction") {
             println!(
-                "against {}: different surface on {:.4} of pixels, PSNR {} dB",
-                json["against"], f, json["psnr_db"]
+                "against {}: different surface on {:.4} of pixels, PSNR {} dB, distance off by {} (mean) / {} (p99) of the reference's",
+                json["against"], f, json["psnr_db"], json["depth_rel_mean"], json["depth_rel_p99"]
             );
         }
     }

@@ -15,6 +15,12 @@ pub struct Comparison {
     pub different_surface_fraction: f64,
     /// Colour PSNR over all pixels of both eyes, dB (None when the images are identical).
     pub psnr_db: Option<f64>,
+    /// Where both frames measured depth: over the pixels showing the same object in both, the
+    /// mean and 99th percentile of the relative difference of the distances along the pixels'
+    /// rays, |d − d_ref| / d_ref (against `trace`: how far the drawn surface lies from the true
+    /// hit).
+    pub depth_rel_mean: Option<f64>,
+    pub depth_rel_p99: Option<f64>,
 }
 
 /// Compares two frames rendered with the error pass (`measure.error`, for their object ids).
@@ -42,9 +48,28 @@ pub fn compare(frame: &Frame, reference: &Frame) -> Result<Comparison> {
         }
     }
     let mse = sq / n.max(1) as f64;
+    let mut depth: Vec<f64> = Vec::new();
+    if let (Some(da), Some(db)) = (&frame.depth, &reference.depth) {
+        for k in 0..2 {
+            for (((x, y), p), q) in m.object[k].iter().zip(&r.object[k]).zip(&da[k]).zip(&db[k]) {
+                if *x != 0 && x == y && p.is_finite() && q.is_finite() && *q > 0.0 {
+                    depth.push(((p - q) / q).abs() as f64);
+                }
+            }
+        }
+    }
+    depth.sort_by(f64::total_cmp);
+    let (depth_rel_mean, depth_rel_p99) = if depth.is_empty() {
+        (None, None)
+    } else {
+        let p99 = depth[((depth.len() - 1) as f64 * 0.99).round() as usize];
+        (Some(depth.iter().sum::<f64>() / depth.len() as f64), Some(p99))
+    };
     Ok(Comparison {
         different_surface_fraction: if covered == 0 { 0.0 } else { different as f64 / covered as f64 },
         psnr_db: (mse > 0.0).then(|| 10.0 * (255.0 * 255.0 / mse).log10()),
+        depth_rel_mean,
+        depth_rel_p99,
     })
 }
 
