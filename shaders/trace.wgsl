@@ -180,28 +180,40 @@ fn pack_display(c: vec3<f32>) -> u32 {
     return u32(q.x) | (u32(q.y) << 8u) | (u32(q.z) << 16u) | (255u << 24u);
 }
 
-// A ray waiting to be traced (scene frame), with the weight of its light in the pixel.
-struct Pending {
+// A ray waiting to be traced (scene frame): the primary ray, a mirror or refraction ray (its
+// light weighted by `weight`), or a shadow ray (`weight`: the light it brings if nothing is hit
+// before `limit`). One loop traces them all through the one call of `closest_hit` (lavapipe runs
+// a shader with several inlined copies of the traversal markedly slower).
+struct Task {
     origin: vec3<f32>,
-    bounces: u32,
+    kind: u32,
     dir: vec3<f32>,
+    limit: f32,
     weight: vec3<f32>,
+    bounces: u32,
 }
 
-// What a hit shows: the shaded colour and the rays it spawns (`shade_hit`).
+const PRIMARY: u32 = 0u;
+const SECONDARY: u32 = 1u;
+const SHADOW: u32 = 2u;
+
+// What a hit shows (`shade_hit`).
 struct Shaded {
-    color: vec3<f32>,      // its own light, weighted (1 − mirror − transmission)
+    color: vec3<f32>,      // its own light now (all of it, or the ambient part with a point light)
+    direct: vec3<f32>,     // with a point light: the light it adds unless shadowed
+    to_light: vec4<f32>,   // the unit direction to the light and its distance (w)
     mirror: f32,
     transmission: f32,
-    tint: vec3<f32>,       // the surface colour, which tints the mirrored light
-    normal: vec3<f32>,     // scene frame, facing the ray
     ior: f32,
     front: bool,
+    tint: vec3<f32>,       // the surface colour, which tints the mirrored light
+    normal: vec3<f32>,     // scene frame, facing the ray
 }
 
-// The surface at a hit `p` (scene frame), shaded with the headlight at the viewer
-// (`view_position` in the viewer frame), or with the point light and its shadow ray, and its
-// optics.
+// The surface at a hit `p` (scene frame) with its optics; shaded with the headlight at the
+// viewer (`view_position` in the viewer frame), or with the point light (Lambert on the side the
+// ray sees; the shadow ray decides the direct part). Its own light is weighted by
+// 1 − mirror − transmission.
 fn shade_hit(hit: Hit, dir: vec3<f32>, p: vec3<f32>, view_position: vec3<f32>, frag_xy: vec2<f32>) -> Shaded {
     let a = vertices[indices[3u * hit.triangle]];
     let b = vertices[indices[3u * hit.triangle + 1u]];
@@ -218,29 +230,27 @@ fn shade_hit(hit: Hit, dir: vec3<f32>, p: vec3<f32>, view_position: vec3<f32>, f
     // transpose rotates back).
     let rotation = mat3x3<f32>(params.to_scene[0].xyz, params.to_scene[1].xyz, params.to_scene[2].xyz);
     let surface = surface_color(a.material, color, uv, vec2<f32>(0.0), vec2<f32>(0.0), frag_xy, hit.front);
-    var lit = shade(params.ambient, view_position, transpose(rotation) * n, surface).rgb;
     let facing = select(n, -n, dot(n, dir) > 0.0);
-    if (params.light.w > 0.0) {
-        // Lambert towards the light, one-sided (the side the ray sees), zero in shadow.
-        let to_light = params.light.xyz - p;
-        let dist = length(to_light);
-        let l = to_light / max(dist, 1e-20);
-        var lambert = max(dot(facing, l), 0.0);
-        if (lambert > 0.0) {
-            let offset = 1e-4 * max(1.0, length(p));
-            if (closest_hit(p + offset * facing, l, frag_xy, dist - offset).triangle != NO_HIT) {
-                lambert = 0.0;
-            }
-        }
-        lit = clamp(surface.rgb * (params.ambient + (1.0 - params.ambient) * lambert), vec3<f32>(0.0), vec3<f32>(1.0));
-    }
-    var out = Shaded(lit, 0.0, 0.0, surface.rgb, facing, 1.5, hit.front);
+    var own = 1.0;
+    var out = Shaded(vec3<f32>(0.0), vec3<f32>(0.0), vec4<f32>(0.0), 0.0, 0.0, 1.5, hit.front, surface.rgb, facing);
     if (MATERIALS) {
         let m = materials[min(a.material, arrayLength(&materials) - 1u)];
         out.mirror = m.mirror;
         out.transmission = m.transmission;
         out.ior = m.ior;
-        out.color *= max(1.0 - m.mirror - m.transmission, 0.0);
+        own = max(1.0 - m.mirror - m.transmission, 0.0);
+    }
+    if (params.light.w > 0.0) {
+        let to_light = params.light.xyz - p;
+        let dist = length(to_light);
+        let l = to_light / max(dist, 1e-20);
+        let lambert = max(dot(facing, l), 0.0);
+        let base = clamp(surface.rgb, vec3<f32>(0.0), vec3<f32>(1.0)) * own;
+        out.color = base * params.ambient;
+        out.direct = base * (1.0 - params.ambient) * lambert;
+        out.to_light = vec4<f32>(l, dist);
+    } else {
+        out.color = shade(params.ambient, view_position, transpose(rotation) * n, surface).rgb * own;
     }
     return out;
 }
@@ -266,61 +276,70 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     let slot = (gid.z * u32(proj.height) + gid.y) * params.row_texels + gid.x;
     let frag_xy = vec2<f32>(gid.xy) + 0.5;
     let ray = pixel_ray(proj, eye_sign, frag_xy);
-    let origin = (params.to_scene * vec4<f32>(ray.origin, 1.0)).xyz;
-    let dir = (params.to_scene * vec4<f32>(ray.dir, 0.0)).xyz;
-    let hit = closest_hit(origin, dir, frag_xy, FAR);
-    if (hit.triangle == NO_HIT) {
-        out_color[slot] = pack_display(params.background.rgb);
-        out_error[slot] = bitcast<u32>(-1.0);
-        out_object[slot] = 0u;
-        out_distance[slot] = 0x7f800000u;  // +∞
-        return;
-    }
-    // The primary hit gives the error, object and distance outputs; its colour gathers the
-    // light of the mirror and refraction rays it spawns, depth first.
-    let view_position = ray.origin + hit.t * ray.dir;
-    out_error[slot] = bitcast<u32>(pixel_error(proj, eye_sign, view_position, frag_xy, params.error_angle != 0u));
-    out_object[slot] = vertices[indices[3u * hit.triangle]].object + 1u;
-    out_distance[slot] = bitcast<u32>(hit.t);
     let background = srgb_to_linear(params.background.rgb);
-    // The scene frame's origin of the viewer frame, for the headlight of secondary hits.
+    // The scene frame's origin of the viewer frame and the rotation back, for the headlight.
     let to_view = transpose(mat3x3<f32>(params.to_scene[0].xyz, params.to_scene[1].xyz, params.to_scene[2].xyz));
     let viewer = params.to_scene[3].xyz;
-    var pending: array<Pending, TRACE_PENDING>;
+    var pending: array<Task, TRACE_PENDING>;
     var count = 0u;
     var color = vec3<f32>(0.0);
-    var current = Pending(origin, 0u, dir, vec3<f32>(1.0));
-    var current_hit = hit;
+    var task = Task((params.to_scene * vec4<f32>(ray.origin, 1.0)).xyz, PRIMARY,
+                    (params.to_scene * vec4<f32>(ray.dir, 0.0)).xyz, FAR, vec3<f32>(1.0), 0u);
     loop {
-        if (current_hit.triangle == NO_HIT) {
-            color += current.weight * background;
+        let hit = closest_hit(task.origin, task.dir, frag_xy, task.limit);
+        if (task.kind == SHADOW) {
+            if (hit.triangle == NO_HIT) {
+                color += task.weight;
+            }
+        } else if (hit.triangle == NO_HIT) {
+            if (task.kind == PRIMARY) {
+                out_color[slot] = pack_display(params.background.rgb);
+                out_error[slot] = bitcast<u32>(-1.0);
+                out_object[slot] = 0u;
+                out_distance[slot] = 0x7f800000u;  // +∞
+                return;
+            }
+            color += task.weight * background;
         } else {
-            let p = current.origin + current_hit.t * current.dir;
-            let s = shade_hit(current_hit, current.dir, p, to_view * (p - viewer), frag_xy);
-            color += current.weight * s.color;
+            let p = task.origin + hit.t * task.dir;
+            if (task.kind == PRIMARY) {
+                // The primary hit gives the error, object and distance outputs.
+                let view_position = ray.origin + hit.t * ray.dir;
+                out_error[slot] = bitcast<u32>(pixel_error(proj, eye_sign, view_position, frag_xy, params.error_angle != 0u));
+                out_object[slot] = vertices[indices[3u * hit.triangle]].object + 1u;
+                out_distance[slot] = bitcast<u32>(hit.t);
+            }
+            let s = shade_hit(hit, task.dir, p, to_view * (p - viewer), frag_xy);
+            color += task.weight * s.color;
             let offset = 1e-4 * max(1.0, length(p));
-            if (current.bounces < params.reflect_max) {
+            if (task.bounces < params.reflect_max) {
                 if (s.mirror > 0.0 && count < TRACE_PENDING) {
-                    let d = reflect(current.dir, s.normal);
-                    pending[count] = Pending(p + offset * s.normal, current.bounces + 1u, d, current.weight * s.mirror * s.tint);
+                    let d = reflect(task.dir, s.normal);
+                    pending[count] = Task(p + offset * s.normal, SECONDARY, d, FAR,
+                                          task.weight * s.mirror * s.tint, task.bounces + 1u);
                     count += 1u;
                 }
                 if (s.transmission > 0.0 && count < TRACE_PENDING) {
                     // Entering through the front face: n₁/n₂ = 1/ior; leaving: ior.
                     let eta = select(s.ior, 1.0 / s.ior, s.front);
-                    let d = refract_or_reflect(current.dir, s.normal, eta);
+                    let d = refract_or_reflect(task.dir, s.normal, eta);
                     let side = select(s.normal, -s.normal, dot(d, s.normal) < 0.0);
-                    pending[count] = Pending(p + offset * side, current.bounces + 1u, d, current.weight * s.transmission);
+                    pending[count] = Task(p + offset * side, SECONDARY, d, FAR, task.weight * s.transmission,
+                                          task.bounces + 1u);
                     count += 1u;
                 }
+            }
+            if (any(s.direct > vec3<f32>(0.0)) && count < TRACE_PENDING) {
+                pending[count] = Task(p + offset * s.normal, SHADOW, s.to_light.xyz, s.to_light.w - offset,
+                                      task.weight * s.direct, 0u);
+                count += 1u;
             }
         }
         if (count == 0u) {
             break;
         }
         count -= 1u;
-        current = pending[count];
-        current_hit = closest_hit(current.origin, current.dir, frag_xy, FAR);
+        task = pending[count];
     }
     out_color[slot] = pack_display(linear_to_srgb(color));
 }

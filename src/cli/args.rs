@@ -271,11 +271,16 @@ impl ViewArgs {
             .with_memory_mb(self.memory_mb)
             .with_reflect_max(self.reflect_max)
             .with_light(self.light);
-        if self.light.is_some() && settings.subdivision.method != Method::Trace {
-            return Err(Error::option("--light", "lights the ray tracer: use it with --method trace"));
-        }
         settings.validate()?;
         Ok(settings)
+    }
+
+    /// `--light` is refused unless one of `methods` traces rays (it would do nothing).
+    pub fn check_light(&self, methods: &[Method]) -> Result<()> {
+        if self.light.is_some() && !methods.contains(&Method::Trace) {
+            return Err(Error::option("--light", "lights the ray tracer: use it with --method trace"));
+        }
+        Ok(())
     }
 
     /// The level-of-detail parameters and gaze with `--lod visual-field`; the LOD options are

@@ -82,6 +82,7 @@ pub fn prepare(
     overlay: bool,
     methods: &[Method],
 ) -> Result<Prepared> {
+    view.check_light(methods)?;
     let lod = view.lod()?;
     let mut scene = place(spec, fit, view, settings)?;
     let selection =

@@ -35,9 +35,9 @@ pub const MAX_STRETCH: f32 = 2.0;
 pub const ERROR_SPLIT_LENGTH: f32 = 8.0;
 /// The ray tracer's traversal stack (entries): the host refuses a BVH deeper than this.
 pub const TRACE_STACK: u32 = 64;
-/// The ray tracer's pending mirror and refraction rays per pixel (depth first: one per bounce
-/// level, + 1).
-pub const TRACE_PENDING: u32 = crate::core::settings::MAX_REFLECT + 1;
+/// The ray tracer's pending rays per pixel, traced depth first: per bounce level one mirror or
+/// refraction ray waiting, plus the two a hit spawns and its shadow ray.
+pub const TRACE_PENDING: u32 = crate::core::settings::MAX_REFLECT + 3;
 /// Seam copies are made for triangles reaching within this many radians of ±π.
 pub const SEAM_MARGIN: f32 = 1e-5;
 /// The most divisions of a piece's edge: `fixed:N` above it is pre-split into a macro-lattice of
