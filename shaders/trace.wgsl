@@ -1,7 +1,9 @@
 // The `trace` stage (compute): ray tracing (seed 000), one primary ray per pixel and eye from
 // the pixel's eye point (`pixel_ray` of surface.wgsl: the cylinder's exact vertical model, or the
 // sphere with its convergence and pole merge), the closest hit through the scene's BVH
-// (src/core/bvh.rs), shaded with the rasterizer's materials and headlight (surface.wgsl).
+// (src/core/bvh.rs), shaded with the rasterizer's materials and headlight (surface.wgsl), or a
+// point light with shadow rays; mirror and refraction rays (the material's optics) to
+// `reflect_max` bounces, depth first.
 // Writes the same four outputs as the drawing stages, per eye, into buffers the host copies into
 // the targets: colour (sRGB-encoded RGBA8), display-position error, object id + 1, distance.
 // CPU twin: src/cpu/trace.rs.

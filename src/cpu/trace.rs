@@ -1,8 +1,10 @@
 //! The `trace` stage, CPU twin of `shaders/trace.wgsl`: ray tracing (seed 000), one primary ray
 //! per pixel and eye from the pixel's eye point ([`pixel_ray`]: the cylinder's exact vertical
 //! model, or the sphere), the closest hit through the scene's BVH ([`SceneBvh`]), shaded with
-//! the rasterizer's materials and headlight. The same traversal as the WGSL (nearer child
-//! first, farther on a stack), so that ties resolve alike.
+//! the rasterizer's materials and headlight, or a point light with shadow rays; mirror and
+//! refraction rays to `reflect_max` bounces, depth first. The same traversal as the WGSL (nearer
+//! child first, farther on a stack), so that ties resolve alike; the WGSL queues a hit's shadow
+//! ray with the light it brings, the twin traces it at once (the same sum).
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
