@@ -28,6 +28,10 @@ struct TraceParams {
     background: vec4<f32>,
     // The point light (scene frame) in xyz, w = 1; w = 0: the headlight at the viewer.
     light: vec4<f32>,
+    // The visual-field LOD's gaze (viewer frame): forward (w = 1: LOD on), right, up.
+    gaze_forward: vec4<f32>,
+    gaze_right: vec4<f32>,
+    gaze_up: vec4<f32>,
     ambient: f32,
     error_angle: u32,   // 1: the error output holds arcminutes
     row_texels: u32,    // padded row length of the outputs; an eye's rows follow the other's
@@ -268,6 +272,35 @@ fn refract_or_reflect(d: vec3<f32>, n: vec3<f32>, eta: f32) -> vec3<f32> {
     return normalize(eta * d + (eta * cos_i - sqrt(k)) * n);
 }
 
+// The level of detail of a direction (viewer frame) for the gaze (seed 000 eq. 1–8,
+// `visual_field::Gaze::position` and `FieldPosition::level`): 1 in the central field, falling
+// linearly to 0 at the visual field's elliptic boundary, 0 outside.
+fn visual_level(d_in: vec3<f32>) -> f32 {
+    let d = normalize(d_in);
+    let df = dot(params.gaze_forward.xyz, d);
+    let dr = dot(params.gaze_right.xyz, d);
+    let du = dot(params.gaze_up.xyz, d);
+    let horizontal = sqrt(df * df + dr * dr);
+    let m_alpha = select(0.0, precise_acos(clamp(df / horizontal, -1.0, 1.0)), horizontal > 1e-9);
+    let vertical = sqrt(df * df + du * du);
+    var m_beta = select(0.0, precise_acos(clamp(abs(df) / vertical, -1.0, 1.0)), vertical > 1e-9);
+    if (du < 0.0) {
+        m_beta = -m_beta;
+    }
+    let l = sqrt(m_alpha * m_alpha + m_beta * m_beta);
+    if (l <= CENTRAL_RADIUS) {
+        return 1.0;
+    }
+    let b = select(FIELD_DOWN, FIELD_UP, m_beta >= 0.0);
+    let c = m_alpha / l;
+    let s = m_beta / l;
+    let boundary = 1.0 / sqrt((c / FIELD_SIDEWAYS) * (c / FIELD_SIDEWAYS) + (s / b) * (s / b));
+    if (l > boundary) {
+        return 0.0;
+    }
+    return (boundary - l) / (boundary - CENTRAL_RADIUS);
+}
+
 @compute @workgroup_size(8, 8, 1)
 fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     let proj = params.projection;
@@ -285,6 +318,20 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     var pending: array<Task, TRACE_PENDING>;
     var count = 0u;
     var color = vec3<f32>(0.0);
+    // Seed 000's level of detail: rays outside the visual field are not traced (background), and
+    // a ray's bounces are level × Reflect_max (eq. 9, rounded).
+    var reflect_max = params.reflect_max;
+    if (params.gaze_forward.w > 0.0) {
+        let level = visual_level(ray.dir);
+        if (level <= 0.0) {
+            out_color[slot] = pack_display(params.background.rgb);
+            out_error[slot] = bitcast<u32>(-1.0);
+            out_object[slot] = 0u;
+            out_distance[slot] = 0x7f800000u;  // +∞
+            return;
+        }
+        reflect_max = u32(floor(level * f32(params.reflect_max) + 0.5));
+    }
     var task = Task((params.to_scene * vec4<f32>(ray.origin, 1.0)).xyz, PRIMARY,
                     (params.to_scene * vec4<f32>(ray.dir, 0.0)).xyz, FAR, vec3<f32>(1.0), 0u);
     loop {
@@ -314,7 +361,7 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
             let s = shade_hit(hit, task.dir, p, to_view * (p - viewer), frag_xy);
             color += task.weight * s.color;
             let offset = 1e-4 * max(1.0, length(p));
-            if (task.bounces < params.reflect_max) {
+            if (task.bounces < reflect_max) {
                 if (s.mirror > 0.0 && count < TRACE_PENDING) {
                     let d = reflect(task.dir, s.normal);
                     pending[count] = Task(p + offset * s.normal, SECONDARY, d, FAR,

@@ -433,6 +433,7 @@ fn negative_and_malformed_numbers_are_one_line_naming_the_option() {
         (&["render", "--reflect-max", "-1"][..], "--reflect-max"),
         (&["render", "--method", "trace"][..], "--vertical exact"),
         (&["render", "--light", "0,2,0"][..], "--light"),
+        (&["bench", "speed", "builtin:demo", "--methods", "vertex,trace", "--vertical", "exact", "--lod", "visual-field"][..], "--lod"),
         (&["render", "--method", "trace", "--vertical", "exact", "--light", "0,nan,0"][..], "--light"),
         (&["render", "--eye-radius", "NaN"][..], "--eye-radius"),
         (&["render", "--yaw", "abc"][..], "--yaw"),

@@ -348,3 +348,39 @@ fn a_point_light_casts_the_blockers_hard_shadow_where_geometry_puts_it() {
     assert!(lit > 500 && shadowed > 100, "{lit} lit, {shadowed} shadowed");
     assert!(wrong.len() * 200 <= lit + shadowed, "{} differ, e.g. {:?}", wrong.len(), &wrong[..wrong.len().min(5)]);
 }
+
+#[test]
+fn visual_field_lod_leaves_rays_outside_the_field_untraced_and_the_rest_as_without() {
+    use twister::core::visual_field::Gaze;
+    let projection = exact(480, 120);
+    let scene = builtin::demo();
+    let gaze = Gaze::new(40.0, -10.0);
+    let plain = render(&scene, &RenderSettings::new(projection).with_method(Method::Trace));
+    let lod = render(&scene, &RenderSettings::new(projection).with_method(Method::Trace).with_trace_gaze(Some(gaze)));
+    let (mut outside, mut inside) = (0, 0);
+    for (k, eye) in Eye::BOTH.into_iter().enumerate() {
+        let (a, b) = (plain.eye(eye), lod.eye(eye));
+        let objects = &lod.measurement.as_ref().unwrap().object[k];
+        for y in 0..projection.height {
+            for x in 0..projection.width {
+                let (_, d) = pixel_ray(&projection, eye, Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                let position = gaze.position(d);
+                let level = position.level();
+                // Skip the boundary itself (where rounding decides).
+                if (position.l - position.boundary).abs() < 1e-3 {
+                    continue;
+                }
+                let i = (y * projection.width + x) as usize;
+                if level <= 0.0 {
+                    outside += 1;
+                    assert_eq!(objects[i], 0, "{eye:?} ({x}, {y}): traced outside the visual field");
+                } else {
+                    inside += 1;
+                    assert_eq!(a.rgba[4 * i..4 * i + 4], b.rgba[4 * i..4 * i + 4], "{eye:?} ({x}, {y}): level {level}");
+                }
+            }
+        }
+    }
+    eprintln!("visual-field LOD: {outside} pixels untraced, {inside} as without LOD");
+    assert!(outside > 10_000 && inside > 10_000, "{outside} outside, {inside} inside");
+}

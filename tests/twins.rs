@@ -543,6 +543,15 @@ impl Twin for Trace {
                 ),
             ),
             (
+                "demo with a mirror and a glass object, visual-field level of detail".into(),
+                (
+                    optics_demo(),
+                    RenderSettings::new(cylinder)
+                        .with_method(Method::Trace)
+                        .with_trace_gaze(Some(twister::core::visual_field::Gaze::new(30.0, 5.0))),
+                ),
+            ),
+            (
                 "box room".into(),
                 (
                     builtin::builtin_scene("builtin:box-room", &cylinder).unwrap(),

@@ -83,7 +83,18 @@ pub fn prepare(
     methods: &[Method],
 ) -> Result<Prepared> {
     view.check_light(methods)?;
-    let lod = view.lod()?;
+    let mut lod = view.lod()?;
+    if let (Some((_, gaze)), true) = (&lod, methods.contains(&Method::Trace)) {
+        // The ray tracer's level of detail is per ray (seed 000), not a selection of objects.
+        if methods.len() > 1 {
+            return Err(Error::option(
+                "--lod",
+                "with --method trace, the level of detail is per ray: run trace apart from the other methods",
+            ));
+        }
+        *settings = settings.with_trace_gaze(Some(*gaze));
+        lod = None;
+    }
     let mut scene = place(spec, fit, view, settings)?;
     let selection =
         lod.map(|(params, gaze)| LodChain::build(&scene, params.p3).select(&scene, settings.view(), &gaze, &params));

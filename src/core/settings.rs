@@ -163,6 +163,10 @@ pub struct ShadingSettings {
     /// The ray tracer's point light (`--light`, scene coordinates), with hard shadows; None:
     /// the headlight at the viewer, as the rasterizer.
     pub light: Option<Vec3>,
+    /// The ray tracer's visual-field level of detail (seed 000, `--lod visual-field` with
+    /// `--method trace`): the gaze; each primary ray's level (eq. 8) sets its bounces (eq. 9),
+    /// and rays outside the visual field are not traced.
+    pub trace_gaze: Option<crate::core::visual_field::Gaze>,
 }
 
 /// What a render measures besides drawing.
@@ -226,7 +230,13 @@ impl Default for SubdivisionSettings {
 
 impl Default for ShadingSettings {
     fn default() -> Self {
-        ShadingSettings { background: [0.1, 0.1, 0.12], ambient: 0.3, reflect_max: DEFAULT_REFLECT_MAX, light: None }
+        ShadingSettings {
+            background: [0.1, 0.1, 0.12],
+            ambient: 0.3,
+            reflect_max: DEFAULT_REFLECT_MAX,
+            light: None,
+            trace_gaze: None,
+        }
     }
 }
 
@@ -257,6 +267,7 @@ builders! {
     with_ambient: f32 => shading.ambient,
     with_reflect_max: u32 => shading.reflect_max,
     with_light: Option<Vec3> => shading.light,
+    with_trace_gaze: Option<crate::core::visual_field::Gaze> => shading.trace_gaze,
     with_measure_edges: bool => measure.edges,
     with_measure_error: bool => measure.error,
     with_error_angle: bool => measure.error_angle,

@@ -15,6 +15,7 @@ use crate::core::projection::{Eye, Projection};
 use crate::core::scene::SceneVertex;
 use crate::core::settings::RenderSettings;
 use crate::core::texture::MaterialTable;
+use crate::core::visual_field::Gaze;
 use crate::cpu::fragment::{pixel_error, pixel_ray, shade_linear, surface_color, Surface};
 use crate::cpu::raster::RasterImage;
 use crate::shader::constants::{TRACE_PENDING, TRACE_STACK};
@@ -28,6 +29,9 @@ pub fn trace_params(settings: &RenderSettings, row_texels: u32) -> TraceParams {
         projection: settings.projection().into(),
         background: [r, g, b, 1.0],
         light: settings.shading.light.map_or([0.0; 4], |l| [l.x, l.y, l.z, 1.0]),
+        gaze_forward: settings.shading.trace_gaze.map_or([0.0; 4], |g| g.forward.extend(1.0).to_array()),
+        gaze_right: settings.shading.trace_gaze.map_or([0.0; 4], |g| g.right.extend(0.0).to_array()),
+        gaze_up: settings.shading.trace_gaze.map_or([0.0; 4], |g| g.up.extend(0.0).to_array()),
         ambient: settings.shading.ambient,
         error_angle: settings.measure.error_angle as u32,
         row_texels,
@@ -189,6 +193,11 @@ pub fn trace(
         }
     };
     let light = (params.light[3] > 0.0).then(|| Vec3::new(params.light[0], params.light[1], params.light[2]));
+    let gaze = (params.gaze_forward[3] > 0.0).then(|| Gaze {
+        forward: Vec4::from(params.gaze_forward).truncate(),
+        right: Vec4::from(params.gaze_right).truncate(),
+        up: Vec4::from(params.gaze_up).truncate(),
+    });
     let shade_hit = |hit: &Hit,
                      dir: Vec3,
                      p: Vec3,
@@ -249,6 +258,18 @@ pub fn trace(
                     surface_color(table, &surface(tri, b1, b2, front, frag_xy)).is_some()
                 };
                 let (origin_v, dir_v) = pixel_ray(&projection, eye, frag_xy);
+                // Seed 000's level of detail: untraced outside the visual field, level ×
+                // Reflect_max bounces (eq. 9, rounded).
+                let reflect_max = match gaze {
+                    None => params.reflect_max,
+                    Some(g) => {
+                        let level = g.position(dir_v).level();
+                        if level <= 0.0 {
+                            continue;
+                        }
+                        (level * params.reflect_max as f32 + 0.5).floor() as u32
+                    }
+                };
                 let origin = to_scene.transform_point3(origin_v);
                 let dir = to_scene.transform_vector3(dir_v);
                 let Some(hit) = closest_hit(bvh, vertices, indices, origin, dir, FAR, &keeps) else { continue };
@@ -271,7 +292,7 @@ pub fn trace(
                             let s = shade_hit(&h, d, p, to_view * (p - viewer), frag_xy, &keeps);
                             color += weight * s.color;
                             let offset = 1e-4 * p.length().max(1.0);
-                            if bounces < params.reflect_max {
+                            if bounces < reflect_max {
                                 if s.mirror > 0.0 && pending.len() < TRACE_PENDING as usize {
                                     let r = d - 2.0 * d.dot(s.normal) * s.normal;
                                     pending.push((p + offset * s.normal, bounces + 1, r, weight * s.mirror * s.tint));

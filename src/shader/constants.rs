@@ -4,6 +4,7 @@
 
 use crate::core::material::{AlphaMode, Filter, Mipmap, Wrap, NO_TEXTURE};
 use crate::core::settings::SplitRule;
+use crate::core::visual_field::{CENTRAL_RADIUS, FIELD_DOWN, FIELD_SIDEWAYS, FIELD_UP};
 
 /// Largest edge count the adaptive method asks for (edges longer than this many L are capped).
 pub const MAX_EDGE_DIVISIONS: u32 = 1024;
@@ -93,6 +94,10 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("SEAM_MARGIN", F32(SEAM_MARGIN)),
         ("TRACE_STACK", U32(TRACE_STACK)),
         ("TRACE_PENDING", U32(TRACE_PENDING)),
+        ("CENTRAL_RADIUS", F32(CENTRAL_RADIUS)),
+        ("FIELD_SIDEWAYS", F32(FIELD_SIDEWAYS)),
+        ("FIELD_UP", F32(FIELD_UP)),
+        ("FIELD_DOWN", F32(FIELD_DOWN)),
         ("PIECES_FROM_COUNTER", U32(PIECES_FROM_COUNTER)),
         ("MAX_DEPTH", F32(MAX_DEPTH)),
         ("FINE_BINS", U32(FINE_BINS)),

@@ -301,7 +301,7 @@ macro_rules! layout {
     };
 }
 
-/// `TraceParams` in shaders/trace.wgsl. 160 bytes.
+/// `TraceParams` in shaders/trace.wgsl. 208 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct TraceParams {
@@ -312,6 +312,10 @@ pub struct TraceParams {
     pub background: [f32; 4],
     /// The point light (scene frame) in xyz, w = 1; w = 0: the headlight at the viewer.
     pub light: [f32; 4],
+    /// The visual-field LOD's gaze (viewer frame): forward (w = 1: LOD on), right, up.
+    pub gaze_forward: [f32; 4],
+    pub gaze_right: [f32; 4],
+    pub gaze_up: [f32; 4],
     pub ambient: f32,
     /// As in [`RasterParams`].
     pub error_angle: u32,
@@ -339,7 +343,7 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("RasterParams" => RasterParams { projection, eye_sign, ambient, shift_px, error_angle, _pad0, _pad1, _pad2 }),
     layout!("SlitParams" => SlitParams { view, projection, eye_sign, ambient, near, error_angle }),
     layout!("SlitCamera" => SlitCamera { origin_sx, right_cx, up_cy, forward_sy }),
-    layout!("TraceParams" => TraceParams { to_scene, projection, background, light, ambient, error_angle, row_texels, reflect_max }),
+    layout!("TraceParams" => TraceParams { to_scene, projection, background, light, gaze_forward, gaze_right, gaze_up, ambient, error_angle, row_texels, reflect_max }),
     layout!("BvhNode" => BvhNode { min, first, max, count }),
     layout!("ProjectParams" => ProjectParams { projection, eye_sign, count, _pad }),
     layout!("Material" => Material {
