@@ -54,6 +54,8 @@ struct BvhNode {
 @group(0) @binding(6) var<storage, read_write> out_error: array<u32>;
 @group(0) @binding(7) var<storage, read_write> out_object: array<u32>;
 @group(0) @binding(8) var<storage, read_write> out_distance: array<u32>;
+// Per workgroup slot (wrapping): rays traced, ray–triangle tests.
+@group(0) @binding(9) var<storage, read_write> counts: array<atomic<u32>>;
 
 const NO_HIT: u32 = 0xffffffffu;
 const FAR: f32 = 3.0e38;
@@ -64,6 +66,7 @@ struct Hit {
     b1: f32,
     b2: f32,
     front: bool,
+    tests: u32,   // ray–triangle tests made
 }
 
 // The entry distance of the ray into a node's box (clamped at 0), or FAR if it misses the box
@@ -97,7 +100,8 @@ fn keeps(triangle: u32, b1: f32, b2: f32, front: bool, frag_xy: vec2<f32>) -> bo
 // The closest kept hit along the ray (scene frame) nearer than `limit`, Möller–Trumbore per
 // triangle.
 fn closest_hit(origin: vec3<f32>, dir: vec3<f32>, frag_xy: vec2<f32>, limit: f32) -> Hit {
-    var best = Hit(limit, NO_HIT, 0.0, 0.0, true);
+    var best = Hit(limit, NO_HIT, 0.0, 0.0, true, 0u);
+    var tests = 0u;
     let tiny = vec3<f32>(1e-20);
     let safe = select(dir, select(tiny, -tiny, dir < vec3<f32>(0.0)), abs(dir) < tiny);
     let inv = 1.0 / safe;
@@ -113,6 +117,7 @@ fn closest_hit(origin: vec3<f32>, dir: vec3<f32>, frag_xy: vec2<f32>, limit: f32
         let n = bvh_nodes[node];
         var descend = false;
         if (n.count > 0u) {
+            tests += n.count;
             for (var k = 0u; k < n.count; k++) {
                 let tri = bvh_primitives[n.first + k];
                 let v0 = vertices[indices[3u * tri]].position;
@@ -133,7 +138,7 @@ fn closest_hit(origin: vec3<f32>, dir: vec3<f32>, frag_xy: vec2<f32>, limit: f32
                     continue;
                 }
                 if (keeps(tri, b1, b2, det > 0.0, frag_xy)) {
-                    best = Hit(t, tri, b1, b2, det > 0.0);
+                    best = Hit(t, tri, b1, b2, det > 0.0, 0u);
                 }
             }
         } else {
@@ -173,6 +178,7 @@ fn closest_hit(origin: vec3<f32>, dir: vec3<f32>, frag_xy: vec2<f32>, limit: f32
             break;
         }
     }
+    best.tests = tests;
     return best;
 }
 
@@ -334,19 +340,21 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     var task = Task((params.to_scene * vec4<f32>(ray.origin, 1.0)).xyz, PRIMARY,
                     (params.to_scene * vec4<f32>(ray.dir, 0.0)).xyz, FAR, vec3<f32>(1.0), 0u);
+    var rays = 0u;
+    var tests = 0u;
+    var missed = false;
     loop {
         let hit = closest_hit(task.origin, task.dir, frag_xy, task.limit);
+        rays += 1u;
+        tests += hit.tests;
         if (task.kind == SHADOW) {
             if (hit.triangle == NO_HIT) {
                 color += task.weight;
             }
         } else if (hit.triangle == NO_HIT) {
             if (task.kind == PRIMARY) {
-                out_color[slot] = pack_display(params.background.rgb);
-                out_error[slot] = bitcast<u32>(-1.0);
-                out_object[slot] = 0u;
-                out_distance[slot] = 0x7f800000u;  // +∞
-                return;
+                missed = true;
+                break;
             }
             color += task.weight * background;
         } else {
@@ -389,6 +397,17 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         count -= 1u;
         task = pending[count];
+    }
+    // Counted per group of 64 pixels (a wrapping slot), so that no 32-bit counter overflows.
+    let count_slot = (((gid.z * u32(proj.height) + gid.y) * u32(proj.width) + gid.x) / 64u) % TRACE_COUNT_SLOTS;
+    atomicAdd(&counts[2u * count_slot], rays);
+    atomicAdd(&counts[2u * count_slot + 1u], tests);
+    if (missed) {
+        out_color[slot] = pack_display(params.background.rgb);
+        out_error[slot] = bitcast<u32>(-1.0);
+        out_object[slot] = 0u;
+        out_distance[slot] = 0x7f800000u;  // +∞
+        return;
     }
     out_color[slot] = pack_display(linear_to_srgb(color));
 }

@@ -381,6 +381,14 @@ fn visual_field_lod_leaves_rays_outside_the_field_untraced_and_the_rest_as_witho
             }
         }
     }
-    eprintln!("visual-field LOD: {outside} pixels untraced, {inside} as without LOD");
+    let counts = |f: &Frame| (f.stats.rays_traced.unwrap(), f.stats.triangle_tests.unwrap());
+    let ((rays, tests), (lod_rays, lod_tests)) = (counts(&plain), counts(&lod));
+    eprintln!(
+        "visual-field LOD: {outside} pixels untraced, {inside} as without LOD; rays {rays} → {lod_rays}, \
+         triangle tests {tests} → {lod_tests}"
+    );
     assert!(outside > 10_000 && inside > 10_000, "{outside} outside, {inside} inside");
+    // Every covered pixel traces one primary ray (the demo room surrounds the viewer).
+    assert_eq!(rays, 2 * (projection.width * projection.height) as u64);
+    assert!(lod_rays < rays && lod_tests < tests, "rays {rays} → {lod_rays}, tests {tests} → {lod_tests}");
 }

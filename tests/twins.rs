@@ -514,7 +514,8 @@ fn optics_demo() -> Scene {
 
 impl Twin for Trace {
     type Case = (Scene, RenderSettings);
-    type Output = EyeOutputs;
+    /// The images, and the rays traced and triangle tests made.
+    type Output = (EyeOutputs, u64, u64);
     fn cases() -> Vec<(String, Self::Case)> {
         let cylinder = Projection { width: 192, height: 48, vertical: Vertical::Exact, ..Projection::default() };
         let sphere = Projection { convergence: Some(2.0), ..Projection::equirect(128) };
@@ -562,7 +563,9 @@ impl Twin for Trace {
     }
     fn gpu(r: &Renderer, (scene, settings): &Self::Case) -> Self::Output {
         let gs = GpuScene::upload(&r.gpu, scene).and_then(|g| g.with_bvh(&r.gpu, scene)).expect("upload");
-        frame_outputs(&r.render(&gs, &settings.with_measure_error(true).with_depth(true)).expect("render"))
+        let frame = r.render(&gs, &settings.with_measure_error(true).with_depth(true)).expect("render");
+        let (rays, tests) = (frame.stats.rays_traced.expect("counted"), frame.stats.triangle_tests.expect("counted"));
+        (frame_outputs(&frame), rays, tests)
     }
     fn cpu((scene, settings): &Self::Case) -> Self::Output {
         let positions: Vec<Vec3> = scene.vertices.iter().map(|v| Vec3::from(v.position)).collect();
@@ -570,10 +573,15 @@ impl Twin for Trace {
         let p = settings.projection();
         let params = twister::cpu::trace::trace_params(settings, p.width);
         let table = scene.material_table(usize::MAX);
-        twister::cpu::trace::trace(&params, &scene.vertices, &scene.indices, &bvh, &table)
-            .map(|img| (img.rgba, img.error, img.object, img.distance))
+        let out = twister::cpu::trace::trace(&params, &scene.vertices, &scene.indices, &bvh, &table);
+        (out.images.map(|img| (img.rgba, img.error, img.object, img.distance)), out.rays, out.triangle_tests)
     }
-    fn compare(gpu: &Self::Output, cpu: &Self::Output) -> Result<(), String> {
+    fn compare((gpu, g_rays, g_tests): &Self::Output, (cpu, c_rays, c_tests): &Self::Output) -> Result<(), String> {
+        // The same traversal: the same counts, but for rays where rounding decides a tie.
+        let near = |a: u64, b: u64, share: f64| (a as f64 - b as f64).abs() <= share * b as f64;
+        if !near(*g_rays, *c_rays, 0.002) || !near(*g_tests, *c_tests, 0.01) || *c_rays == 0 {
+            return Err(format!("rays {g_rays} vs {c_rays}, triangle tests {g_tests} vs {c_tests}"));
+        }
         compare_eyes(gpu, cpu, 200, Some(0.01))
     }
 }

@@ -115,6 +115,8 @@ pub fn render(args: &RenderArgs) -> Result<()> {
             "triangles_out": s.triangles_out,
             "triangles_drawn": s.triangles_out,
             "pieces": s.pieces,
+            "rays_traced": s.rays_traced,
+            "triangle_tests": s.triangle_tests,
             "max_sub_edge_px": s.max_sub_edge_px,
             "chunks": s.chunks,
             "width": settings.view.projection.width,

@@ -59,6 +59,9 @@ pub struct FrameStats {
     /// vertices the triangles index, shaded once per eye.
     pub nodes_out: u64,
     pub pieces: u64,
+    /// The ray tracer: rays traced (primary, mirror, refraction, shadow) and ray–triangle tests.
+    pub rays_traced: Option<u64>,
+    pub triangle_tests: Option<u64>,
     /// Largest projected length of an output edge with an end on the screen rows, pixels.
     pub max_sub_edge_px: f32,
     /// Number of `lattice` + raster rounds the scene needed to fit the memory budget.

@@ -6,6 +6,8 @@
 //! child first, farther on a stack), so that ties resolve alike; the WGSL queues a hit's shadow
 //! ray with the light it brings, the twin traces it at once (the same sum).
 
+use std::cell::Cell;
+
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use crate::core::bvh::{BvhNode, SceneBvh};
@@ -60,19 +62,27 @@ fn enter_box(n: &BvhNode, origin: Vec3, inv: Vec3, limit: f32) -> Option<f32> {
     (near <= far).then_some(near)
 }
 
+/// What rays are traced against: the scene's BVH, vertices and indices.
+#[derive(Clone, Copy)]
+pub struct TracedScene<'a> {
+    pub bvh: &'a SceneBvh,
+    pub vertices: &'a [SceneVertex],
+    pub indices: &'a [u32],
+}
+
 /// The closest hit along the ray (scene frame), nearer than `limit`, that `keeps` accepts
 /// (`closest_hit`): binary BVH,
 /// nearer child first (the farther kept with its entry distance, and skipped when popped if the
 /// best hit is nearer), Möller–Trumbore per triangle.
 pub fn closest_hit(
-    bvh: &SceneBvh,
-    vertices: &[SceneVertex],
-    indices: &[u32],
+    scene: &TracedScene,
     origin: Vec3,
     dir: Vec3,
     limit: f32,
     keeps: &dyn Fn(u32, f32, f32, bool) -> bool,
+    tests: &Cell<u64>,
 ) -> Option<Hit> {
+    let TracedScene { bvh, vertices, indices } = *scene;
     let mut best: Option<Hit> = None;
     let best_t = |b: &Option<Hit>| b.map_or(limit, |h| h.t);
     let tiny = 1e-20;
@@ -87,6 +97,7 @@ pub fn closest_hit(
         let n = &bvh.nodes[node];
         let mut descend = false;
         if n.count > 0 {
+            tests.set(tests.get() + n.count as u64);
             for k in 0..n.count {
                 let tri = bvh.primitives[(n.first + k) as usize];
                 let v0 = position(tri, 0);
@@ -161,14 +172,24 @@ pub fn refract_or_reflect(d: Vec3, n: Vec3, eta: f32) -> Vec3 {
     (eta * d + (eta * cos_i - k.sqrt()) * n).normalize()
 }
 
-/// The trace stage on the CPU: both eyes (left, right).
+/// What the trace stage makes: both eyes' images (left, right), and the rays traced (primary,
+/// mirror, refraction, shadow) and ray–triangle tests made.
+pub struct TraceOutput {
+    pub images: [RasterImage; 2],
+    pub rays: u64,
+    pub triangle_tests: u64,
+}
+
+/// The trace stage on the CPU.
 pub fn trace(
     params: &TraceParams,
     vertices: &[SceneVertex],
     indices: &[u32],
     bvh: &SceneBvh,
     table: &MaterialTable,
-) -> [RasterImage; 2] {
+) -> TraceOutput {
+    let (rays, tests) = (Cell::new(0u64), Cell::new(0u64));
+    let traced = TracedScene { bvh, vertices, indices };
     let projection = Projection::from(&params.projection);
     let to_scene = Mat4::from_cols_array_2d(&params.to_scene);
     let to_view = glam::Mat3::from_mat4(to_scene).transpose();
@@ -215,27 +236,32 @@ pub fn trace(
         let color = surface_color(table, &surface(hit.triangle, hit.b1, hit.b2, hit.front, frag_xy))
             .expect("a kept hit has a colour");
         let m = material(hit.triangle);
-        let own = 1.0 - m.mirror - m.transmission;
+        let own = (1.0 - m.mirror - m.transmission).max(0.0);
         let facing = if n.dot(dir) > 0.0 { -n } else { n };
         let lit = match light {
-            None => shade_linear(params.ambient, view_position, to_view * n, color),
+            None => shade_linear(params.ambient, view_position, to_view * n, color) * own,
             Some(light) => {
-                // Lambert towards the light, one-sided, zero in shadow.
+                // Lambert towards the light, one-sided; the direct part only if the shadow ray
+                // (traced where there is direct light to lose) meets nothing.
                 let to_light = light - p;
                 let dist = to_light.length();
                 let l = to_light / dist.max(1e-20);
-                let mut lambert = facing.dot(l).max(0.0);
+                let base = color.truncate().clamp(Vec3::ZERO, Vec3::ONE) * own;
+                let direct = base * (1.0 - params.ambient) * facing.dot(l).max(0.0);
+                let mut lit = base * params.ambient;
                 let offset = 1e-4 * p.length().max(1.0);
-                if lambert > 0.0
-                    && closest_hit(bvh, vertices, indices, p + offset * facing, l, dist - offset, keeps).is_some()
-                {
-                    lambert = 0.0;
+                if direct.max_element() > 0.0 {
+                    rays.set(rays.get() + 1);
+                    let shadow = closest_hit(&traced, p + offset * facing, l, dist - offset, keeps, &tests);
+                    if shadow.is_none() {
+                        lit += direct;
+                    }
                 }
-                (color.truncate() * (params.ambient + (1.0 - params.ambient) * lambert)).clamp(Vec3::ZERO, Vec3::ONE)
+                lit
             }
         };
         Shaded {
-            color: lit * own.max(0.0),
+            color: lit,
             mirror: m.mirror,
             transmission: m.transmission,
             tint: color.truncate(),
@@ -244,7 +270,7 @@ pub fn trace(
             front: hit.front,
         }
     };
-    Eye::BOTH.map(|eye| {
+    let images = Eye::BOTH.map(|eye| {
         // The image's background is given in display values, as `RasterImage::new` takes it.
         let mut img = RasterImage::new(projection.width, projection.height, [r, g, b]);
         for y in 0..projection.height {
@@ -272,7 +298,8 @@ pub fn trace(
                 };
                 let origin = to_scene.transform_point3(origin_v);
                 let dir = to_scene.transform_vector3(dir_v);
-                let Some(hit) = closest_hit(bvh, vertices, indices, origin, dir, FAR, &keeps) else { continue };
+                rays.set(rays.get() + 1);
+                let Some(hit) = closest_hit(&traced, origin, dir, FAR, &keeps, &tests) else { continue };
                 let i = (y * projection.width + x) as usize;
                 let view_position = origin_v + hit.t * dir_v;
                 img.error[i] = pixel_error(&projection, eye, view_position, frag_xy, params.error_angle != 0);
@@ -308,13 +335,15 @@ pub fn trace(
                     }
                     let Some(next) = pending.pop() else { break };
                     current = next;
-                    current_hit = closest_hit(bvh, vertices, indices, next.0, next.2, FAR, &keeps);
+                    rays.set(rays.get() + 1);
+                    current_hit = closest_hit(&traced, next.0, next.2, FAR, &keeps, &tests);
                 }
                 img.rgba[4 * i..4 * i + 4].copy_from_slice(&display_bytes(color));
             }
         }
         img
-    })
+    });
+    TraceOutput { images, rays: rays.get(), triangle_tests: tests.get() }
 }
 
 /// Linear colour → sRGB bytes as the colour target holds them (`pack_display(linear_to_srgb(c))`).

@@ -253,8 +253,9 @@ pub(crate) struct FrameResources {
     pub staging: wgpu::Buffer,
     pub trace_params: wgpu::Buffer,
     /// The ray tracer's outputs of the last image size: (padded row texels, height, colour,
-    /// error, object and distance buffers).
+    /// error, object and distance buffers), and its counters of rays and triangle tests.
     pub trace_outputs: Option<(u32, u32, [wgpu::Buffer; 4])>,
+    pub trace_counts: Option<wgpu::Buffer>,
 }
 
 impl FrameResources {
@@ -308,6 +309,7 @@ impl Renderer {
                 }),
                 trace_params: gpu.uniform_buffer::<TraceParams>("trace params"),
                 trace_outputs: None,
+                trace_counts: None,
             };
             let raster = DrawPipelines::new(&gpu, DrawStage::Raster);
             // The usual pipeline now, for the same reason.

@@ -12,6 +12,7 @@ use crate::error::{Error, Result};
 use crate::gpu::renderer::{FrameResources, Renderer};
 use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
+use crate::shader::constants::TRACE_COUNT_SLOTS;
 
 impl Renderer {
     pub(crate) fn render_trace(
@@ -49,6 +50,11 @@ impl Renderer {
             let make = |what: &str| gpu.storage_buffer(&format!("trace {what}"), bytes, wgpu::BufferUsages::empty());
             res.trace_outputs = Some((row_texels, p.height, ["colour", "error", "object", "distance"].map(make)));
         }
+        let counts_bytes = 8 * TRACE_COUNT_SLOTS as u64;
+        let counts = res
+            .trace_counts
+            .get_or_insert_with(|| gpu.storage_buffer("trace counts", counts_bytes, wgpu::BufferUsages::empty()));
+        let counts = counts.clone();
         let res = &*res;
         let targets = res.targets.as_ref().expect("made");
         let (_, _, outputs) = res.trace_outputs.as_ref().expect("made");
@@ -75,12 +81,14 @@ impl Renderer {
                 error,
                 object,
                 distance,
+                &counts,
             ],
         );
         let materials = stage.bind_group(gpu, Some("trace"), 1, &[a, b, c]);
         let timestamps = res.timestamps.as_ref();
         let t = Instant::now();
         let mut enc = gpu.device.create_command_encoder(&Default::default());
+        enc.clear_buffer(&counts, 0, None);
         {
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("trace"),
@@ -117,6 +125,10 @@ impl Renderer {
         gpu.queue.submit([enc.finish()]);
         gpu.wait();
         let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, chunks: 1, ..Default::default() };
+        let words = gpu.download(&counts, counts_bytes)?;
+        let words: &[u32] = bytemuck::cast_slice(&words);
+        stats.rays_traced = Some(words.iter().step_by(2).map(|&w| w as u64).sum());
+        stats.triangle_tests = Some(words.iter().skip(1).step_by(2).map(|&w| w as u64).sum());
         stats.ms_frame = t.elapsed().as_secs_f64() * 1e3;
         stats.ms_raster = Some(stats.ms_frame);
         stats.timing = Timing::WallOneSubmission;

@@ -39,6 +39,9 @@ pub const TRACE_STACK: u32 = 64;
 /// The ray tracer's pending rays per pixel, traced depth first: per bounce level one mirror or
 /// refraction ray waiting, plus the two a hit spawns and its shadow ray.
 pub const TRACE_PENDING: u32 = crate::core::settings::MAX_REFLECT + 3;
+/// The ray tracer counts rays and triangle tests per workgroup into this many slots (two 32-bit
+/// counters each, summed on the host in 64 bits, so that no slot overflows).
+pub const TRACE_COUNT_SLOTS: u32 = 4096;
 /// Seam copies are made for triangles reaching within this many radians of ±π.
 pub const SEAM_MARGIN: f32 = 1e-5;
 /// The most divisions of a piece's edge: `fixed:N` above it is pre-split into a macro-lattice of
@@ -94,6 +97,7 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("SEAM_MARGIN", F32(SEAM_MARGIN)),
         ("TRACE_STACK", U32(TRACE_STACK)),
         ("TRACE_PENDING", U32(TRACE_PENDING)),
+        ("TRACE_COUNT_SLOTS", U32(TRACE_COUNT_SLOTS)),
         ("CENTRAL_RADIUS", F32(CENTRAL_RADIUS)),
         ("FIELD_SIDEWAYS", F32(FIELD_SIDEWAYS)),
         ("FIELD_UP", F32(FIELD_UP)),
