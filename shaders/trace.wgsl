@@ -307,6 +307,14 @@ fn visual_level(d_in: vec3<f32>) -> f32 {
     return (boundary - l) / (boundary - CENTRAL_RADIUS);
 }
 
+// A pixel that shows no surface: the background colour, error −1, object 0, distance +∞.
+fn write_background(slot: u32) {
+    out_color[slot] = pack_display(params.background.rgb);
+    out_error[slot] = bitcast<u32>(-1.0);
+    out_object[slot] = 0u;
+    out_distance[slot] = 0x7f800000u;
+}
+
 @compute @workgroup_size(8, 8, 1)
 fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     let proj = params.projection;
@@ -330,10 +338,7 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (params.gaze_forward.w > 0.0) {
         let level = visual_level(ray.dir);
         if (level <= 0.0) {
-            out_color[slot] = pack_display(params.background.rgb);
-            out_error[slot] = bitcast<u32>(-1.0);
-            out_object[slot] = 0u;
-            out_distance[slot] = 0x7f800000u;  // +∞
+            write_background(slot);
             return;
         }
         reflect_max = u32(floor(level * f32(params.reflect_max) + 0.5));
@@ -403,10 +408,7 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     atomicAdd(&counts[2u * count_slot], rays);
     atomicAdd(&counts[2u * count_slot + 1u], tests);
     if (missed) {
-        out_color[slot] = pack_display(params.background.rgb);
-        out_error[slot] = bitcast<u32>(-1.0);
-        out_object[slot] = 0u;
-        out_distance[slot] = 0x7f800000u;  // +∞
+        write_background(slot);
         return;
     }
     out_color[slot] = pack_display(linear_to_srgb(color));

@@ -568,8 +568,7 @@ impl Twin for Trace {
         (frame_outputs(&frame), rays, tests)
     }
     fn cpu((scene, settings): &Self::Case) -> Self::Output {
-        let positions: Vec<Vec3> = scene.vertices.iter().map(|v| Vec3::from(v.position)).collect();
-        let bvh = twister::core::bvh::SceneBvh::build(&positions, &scene.indices);
+        let bvh = twister::core::bvh::SceneBvh::build(&scene.vertices, &scene.indices);
         let p = settings.projection();
         let params = twister::cpu::trace::trace_params(settings, p.width);
         let table = scene.material_table(usize::MAX);

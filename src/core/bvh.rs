@@ -8,7 +8,9 @@
 //! indices). The root is node 0.
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Vec3, Vec3A};
+use glam::Vec3A;
+
+use crate::core::scene::SceneVertex;
 
 /// `BvhNode` in shaders/trace.wgsl. 32 bytes.
 #[repr(C)]
@@ -31,13 +33,13 @@ pub struct SceneBvh {
 }
 
 impl SceneBvh {
-    /// Builds the BVH of the triangles `indices` (three per triangle) over `positions`. An empty
+    /// Builds the BVH of the triangles `indices` (three per triangle) over `vertices`. An empty
     /// scene gets one leaf with an empty box, which no ray enters.
-    pub fn build(positions: &[Vec3], indices: &[u32]) -> SceneBvh {
+    pub fn build(vertices: &[SceneVertex], indices: &[u32]) -> SceneBvh {
         let triangles: Vec<obvhs::triangle::Triangle> = indices
             .chunks_exact(3)
             .map(|t| {
-                let p = |k: usize| Vec3A::from(positions[t[k] as usize]);
+                let p = |k: usize| Vec3A::from_array(vertices[t[k] as usize].position);
                 obvhs::triangle::Triangle { v0: p(0), v1: p(1), v2: p(2) }
             })
             .collect();

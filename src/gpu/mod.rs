@@ -2,6 +2,7 @@
 //! uploaded scene, render targets, timestamps, the frame plan, and the renderer that runs them.
 
 pub mod device;
+pub mod draw;
 pub mod frame_plan;
 pub mod project_points;
 pub mod reduce_error;

@@ -122,8 +122,7 @@ impl GpuScene {
     /// The same scene with its BVH built (on the CPU) and uploaded, for the ray tracer. Fails
     /// with one line if the tree is deeper than the traversal's stack or too big for the device.
     pub fn with_bvh(mut self, gpu: &Gpu, scene: &Scene) -> Result<GpuScene> {
-        let positions: Vec<Vec3> = scene.vertices.iter().map(|v| Vec3::from(v.position)).collect();
-        let bvh = SceneBvh::build(&positions, &scene.indices);
+        let bvh = SceneBvh::build(&scene.vertices, &scene.indices);
         let depth = bvh.depth();
         if depth > TRACE_STACK {
             return Err(Error::scene(

@@ -3,7 +3,7 @@
 
 use std::time::Instant;
 
-use crate::core::frame::{Frame, FrameStats, Timing};
+use crate::core::frame::{Frame, FrameStats};
 use crate::core::projection::Eye;
 use crate::core::settings::RenderSettings;
 use crate::cpu::slit::{slit_params, slits, sphere_in_slit, SlitCamera};
@@ -11,6 +11,7 @@ use crate::error::Result;
 use crate::gpu::renderer::{FrameResources, Renderer};
 use crate::gpu::scene::GpuScene;
 use crate::gpu::targets::Layers;
+use crate::gpu::timestamps::submit_timed_pass;
 
 impl Renderer {
     pub(crate) fn render_slit(
@@ -72,21 +73,7 @@ impl Renderer {
                 }
             }
         }
-        if let Some(t) = timestamps {
-            t.resolve(&mut enc, &res.staging, 0);
-        }
-        gpu.queue.submit([enc.finish()]);
-        gpu.wait();
-        stats.ms_frame = t.elapsed().as_secs_f64() * 1e3;
-        stats.ms_raster = Some(stats.ms_frame);
-        stats.timing = Timing::WallOneSubmission;
-        if let Some(t) = timestamps {
-            let bytes = gpu.read_buffer(&res.staging)?;
-            let ticks: &[u64] = bytemuck::cast_slice(&bytes[..16]);
-            stats.ms_gpu = Some(t.ms(ticks[0], ticks[1]));
-            stats.ms_raster = stats.ms_gpu;
-            stats.timing = Timing::GpuTimestamps;
-        }
+        submit_timed_pass(gpu, enc, timestamps, &res.staging, t, &mut stats)?;
         self.finish_frame(targets, settings, stats, start)
     }
 }

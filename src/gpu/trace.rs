@@ -5,13 +5,14 @@
 
 use std::time::Instant;
 
-use crate::core::frame::{Frame, FrameStats, Timing};
+use crate::core::frame::{Frame, FrameStats};
 use crate::core::settings::RenderSettings;
 use crate::cpu::trace::trace_params;
 use crate::error::{Error, Result};
 use crate::gpu::renderer::{FrameResources, Renderer};
 use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
+use crate::gpu::timestamps::submit_timed_pass;
 use crate::shader::constants::TRACE_COUNT_SLOTS;
 
 impl Renderer {
@@ -119,26 +120,13 @@ impl Renderer {
                 wgpu::Extent3d { width: p.width, height: p.height, depth_or_array_layers: 2 },
             );
         }
-        if let Some(t) = timestamps {
-            t.resolve(&mut enc, &res.staging, 0);
-        }
-        gpu.queue.submit([enc.finish()]);
-        gpu.wait();
         let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, chunks: 1, ..Default::default() };
+        submit_timed_pass(gpu, enc, timestamps, &res.staging, t, &mut stats)?;
+        // The counters are read after the frame's time is taken.
         let words = gpu.download(&counts, counts_bytes)?;
         let words: &[u32] = bytemuck::cast_slice(&words);
         stats.rays_traced = Some(words.iter().step_by(2).map(|&w| w as u64).sum());
         stats.triangle_tests = Some(words.iter().skip(1).step_by(2).map(|&w| w as u64).sum());
-        stats.ms_frame = t.elapsed().as_secs_f64() * 1e3;
-        stats.ms_raster = Some(stats.ms_frame);
-        stats.timing = Timing::WallOneSubmission;
-        if let Some(t) = timestamps {
-            let bytes = gpu.read_buffer(&res.staging)?;
-            let ticks: &[u64] = bytemuck::cast_slice(&bytes[..16]);
-            stats.ms_gpu = Some(t.ms(ticks[0], ticks[1]));
-            stats.ms_raster = stats.ms_gpu;
-            stats.timing = Timing::GpuTimestamps;
-        }
         self.finish_frame(targets, settings, stats, start)
     }
 }

@@ -1,0 +1,184 @@
+//! The drawing stages' pipelines (`raster`, `slit`): per scene look (material code or not, back
+//! faces culled or not), with or without the error pass, and per way of drawing the eyes (one
+//! multiview draw, or a pass per eye), each built when a frame first needs it.
+
+use std::mem::offset_of;
+use std::sync::OnceLock;
+
+use crate::core::scene::SceneVertex;
+use crate::gpu::device::{error_target_format, Gpu};
+use crate::gpu::scene::GpuScene;
+use crate::gpu::stages::GpuStage;
+use crate::gpu::targets::{Layers, COLOR_FORMAT, DEPTH_FORMAT, OBJECT_FORMAT};
+use crate::shader::types::DrawVertex;
+use crate::shader::{RASTER, SLIT};
+
+/// The two drawing stages.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum DrawStage {
+    Raster = 0,
+    Slit = 1,
+}
+
+/// A drawing stage's pipelines, each made when a frame first needs it, for: a scene's look
+/// ([`Look`]); colour only or with the error pass; and the eyes drawn ([`Layers`]: both in one
+/// multiview draw, or one eye, a pipeline per eye with the WGSL `override EYE`; the slit stage
+/// draws one eye per pass with per-eye parameters and needs no per-eye pipeline).
+pub(crate) struct DrawPipelines {
+    pub stage: GpuStage,
+    kind: DrawStage,
+    /// By `Self::index`.
+    pipelines: [OnceLock<wgpu::RenderPipeline>; 18],
+}
+
+/// What a scene's materials need of a drawing pipeline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Look {
+    /// Without the fragment stage's material code (`MATERIALS = false`), for scenes whose
+    /// materials are all untextured, opaque and double-sided: on lavapipe it roughly halves
+    /// the fragment cost.
+    Plain = 0,
+    /// With it.
+    Materials = 1,
+    /// With it, back faces culled by the rasterizer (every used material single-sided).
+    Culled = 2,
+}
+
+impl Look {
+    pub fn of(scene: &GpuScene) -> Look {
+        if scene.cull_back_faces {
+            Look::Culled
+        } else if scene.needs_materials {
+            Look::Materials
+        } else {
+            Look::Plain
+        }
+    }
+}
+
+impl DrawPipelines {
+    pub fn new(gpu: &Gpu, kind: DrawStage) -> DrawPipelines {
+        let stage = GpuStage::new(gpu, if kind == DrawStage::Raster { &RASTER } else { &SLIT });
+        DrawPipelines { stage, kind, pipelines: std::array::from_fn(|_| OnceLock::new()) }
+    }
+
+    fn index(&self, look: Look, measure: bool, layers: Layers) -> usize {
+        let eyes = match (self.kind, layers) {
+            (_, Layers::Both) => 0,
+            (DrawStage::Slit, Layers::Eye(_)) => 1,
+            (DrawStage::Raster, Layers::Eye(k)) => 1 + k.min(1),
+        };
+        (look as usize * 2 + measure as usize) * 3 + eyes
+    }
+
+    /// The pipeline for a scene's look, with the error pass or not, drawing `layers`.
+    pub fn get(&self, gpu: &Gpu, scene: &GpuScene, measure: bool, layers: Layers) -> &wgpu::RenderPipeline {
+        self.get_look(gpu, Look::of(scene), measure, layers)
+    }
+
+    pub fn get_look(&self, gpu: &Gpu, look: Look, measure: bool, layers: Layers) -> &wgpu::RenderPipeline {
+        self.pipelines[self.index(look, measure, layers)]
+            .get_or_init(|| draw_pipeline(gpu, &self.stage, self.kind, look, measure, layers))
+    }
+
+    /// The scene's material table (group 1).
+    pub fn material_bind_group(&self, gpu: &Gpu, scene: &GpuScene) -> wgpu::BindGroup {
+        let [a, b, c] = &scene.materials;
+        self.stage.bind_group(gpu, None, 1, &[a, b, c])
+    }
+}
+
+fn attribute(format: wgpu::VertexFormat, offset: usize, shader_location: u32) -> wgpu::VertexAttribute {
+    wgpu::VertexAttribute { format, offset: offset as u64, shader_location }
+}
+
+/// A drawing pipeline: colour only (`fs_main`) or with the error pass (`fs_error`); with the
+/// fragment stage's material code (`MATERIALS`) or without; culling back faces (counter-clockwise
+/// on screen is the front, as `front_facing` in the fragment stage) or not; both eyes as a
+/// multiview pipeline, or one (the raster stage's `EYE`).
+fn draw_pipeline(
+    gpu: &Gpu,
+    stage: &GpuStage,
+    kind: DrawStage,
+    look: Look,
+    measure: bool,
+    layers: Layers,
+) -> wgpu::RenderPipeline {
+    use wgpu::VertexFormat::{Float32, Float32x2, Float32x3, Float32x4, Uint32};
+    // Raster: the subdivided `DrawVertex`; slit: the scene's `SceneVertex` (`VertexIn` of each WGSL file).
+    let (stride, attributes) = match kind {
+        DrawStage::Raster => (
+            std::mem::size_of::<DrawVertex>(),
+            vec![
+                attribute(Float32x3, offset_of!(DrawVertex, position), 0),
+                attribute(Float32, offset_of!(DrawVertex, theta_ref), 1),
+                attribute(Float32x3, offset_of!(DrawVertex, normal), 2),
+                attribute(Uint32, offset_of!(DrawVertex, material), 3),
+                attribute(Float32x4, offset_of!(DrawVertex, color), 4),
+                attribute(Float32x2, offset_of!(DrawVertex, uv), 5),
+                attribute(Uint32, offset_of!(DrawVertex, object), 6),
+            ],
+        ),
+        DrawStage::Slit => (
+            std::mem::size_of::<SceneVertex>(),
+            vec![
+                attribute(Float32x3, offset_of!(SceneVertex, position), 0),
+                attribute(Float32x3, offset_of!(SceneVertex, normal), 1),
+                attribute(Float32x4, offset_of!(SceneVertex, color), 2),
+                attribute(Uint32, offset_of!(SceneVertex, object), 3),
+                attribute(Float32x2, offset_of!(SceneVertex, uv), 4),
+                attribute(Uint32, offset_of!(SceneVertex, material), 5),
+            ],
+        ),
+    };
+    let layout = wgpu::VertexBufferLayout {
+        array_stride: stride as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &attributes,
+    };
+    let all_targets =
+        [COLOR_FORMAT, error_target_format(gpu.error_target), OBJECT_FORMAT, error_target_format(gpu.error_target)]
+            .map(|format| Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL }));
+    let mut constants = vec![("MATERIALS", (look != Look::Plain) as u32 as f64)];
+    let multiview_mask = match layers {
+        Layers::Both => std::num::NonZeroU32::new(0b11),
+        Layers::Eye(k) => {
+            if kind == DrawStage::Raster {
+                constants.push(("EYE", k as f64));
+            }
+            None
+        }
+    };
+    gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(stage.stage.name),
+        layout: Some(stage.draw_layout()),
+        vertex: wgpu::VertexState {
+            module: &stage.module,
+            entry_point: Some("vs_main"),
+            compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
+            buffers: &[Some(layout)],
+        },
+        primitive: wgpu::PrimitiveState {
+            topology: wgpu::PrimitiveTopology::TriangleList,
+            front_face: wgpu::FrontFace::Ccw,
+            cull_mode: (look == Look::Culled).then_some(wgpu::Face::Back),
+            ..Default::default()
+        },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &stage.module,
+            entry_point: Some(if measure { "fs_error" } else { "fs_main" }),
+            compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
+            targets: if measure { &all_targets } else { &all_targets[..1] },
+        }),
+        multiview_mask,
+        cache: None,
+    })
+}
