@@ -8,9 +8,11 @@
 // the targets: colour (sRGB-encoded RGBA8), display-position error, object id + 1, distance.
 // CPU twin: src/cpu/trace.rs.
 //
-// Traversal: a binary BVH, nearer child first, the farther on a stack of TRACE_STACK entries
+// Traversal: the two-level BVH of src/core/bvh.rs (a top level over the objects, a tree per
+// level of each object's chain) walked as one binary tree, nearer child first, the farther on a stack of TRACE_STACK entries
 // with its entry distance (skipped when popped if the best hit is nearer; the host refuses
-// deeper trees). A candidate hit closer than the best is accepted only if its
+// deeper trees); at an object leaf the walk goes on at the root of the level the ray's visual
+// level picks (seed 000 eq. 10, `pick_level`). A candidate hit closer than the best is accepted only if its
 // material keeps it (a single-sided face seen from behind, alpha below a MASK cutoff or a
 // BLEND screen door are passed through, as the fragment stage discards them). Textures are sampled
 // at level 0 (no ray differentials yet).
@@ -36,8 +38,14 @@ struct TraceParams {
     error_angle: u32,   // 1: the error output holds arcminutes
     row_texels: u32,    // padded row length of the outputs; an eye's rows follow the other's
     reflect_max: u32,   // bounces of mirror and refraction rays (seed 000's Reflect_max)
+    lod_min_share: f32, // N_min / N_max of eq. 10
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
+// count = 0: inner (children first, first + 1); count & OBJECT_LEAF: an object, its chain's
+// levels first .. first + (count & ~OBJECT_LEAF); else a leaf of triangles first .. first + count.
 struct BvhNode {
     min: vec3<f32>,
     first: u32,
@@ -45,11 +53,20 @@ struct BvhNode {
     count: u32,
 }
 
+// One level of an object's chain: the root of its tree and its triangles.
+struct BvhLevel {
+    root: u32,
+    triangles: u32,
+}
+
+const OBJECT_LEAF: u32 = 0x80000000u;
+
 @group(0) @binding(0) var<uniform> params: TraceParams;
 @group(0) @binding(1) var<storage, read> vertices: array<SceneVertex>;
+// The BVH's triangles (every level's, leaf by leaf), three vertex indices each.
 @group(0) @binding(2) var<storage, read> indices: array<u32>;
 @group(0) @binding(3) var<storage, read> bvh_nodes: array<BvhNode>;
-@group(0) @binding(4) var<storage, read> bvh_primitives: array<u32>;
+@group(0) @binding(4) var<storage, read> bvh_levels: array<BvhLevel>;
 @group(0) @binding(5) var<storage, read_write> out_color: array<u32>;
 @group(0) @binding(6) var<storage, read_write> out_error: array<u32>;
 @group(0) @binding(7) var<storage, read_write> out_object: array<u32>;
@@ -97,9 +114,23 @@ fn keeps(triangle: u32, b1: f32, b2: f32, front: bool, frag_xy: vec2<f32>) -> bo
     return surface_color(a.material, color, uv, vec2<f32>(0.0), vec2<f32>(0.0), frag_xy, front).a >= 0.0;
 }
 
-// The closest kept hit along the ray (scene frame) nearer than `limit`, Möller–Trumbore per
-// triangle.
-fn closest_hit(origin: vec3<f32>, dir: vec3<f32>, frag_xy: vec2<f32>, limit: f32) -> Hit {
+// The level of an object's chain (levels first .. first + count, the original first) that a ray
+// of visual level `level` meets (eq. 10, `SceneBvh::pick_level`): N_j = level·(N_max − N_min) +
+// N_min, and the coarsest level with at least N_j triangles.
+fn pick_level(first: u32, count: u32, level: f32) -> u32 {
+    let max = f32(bvh_levels[first].triangles);
+    let wanted = level * (max - params.lod_min_share * max) + params.lod_min_share * max;
+    for (var k = count - 1u; k > 0u; k--) {
+        if (f32(bvh_levels[first + k].triangles) >= wanted) {
+            return first + k;
+        }
+    }
+    return first;
+}
+
+// The closest kept hit along the ray (scene frame) nearer than `limit` for a ray of visual
+// level `level`, Möller–Trumbore per triangle.
+fn closest_hit(origin: vec3<f32>, dir: vec3<f32>, frag_xy: vec2<f32>, limit: f32, level: f32) -> Hit {
     var best = Hit(limit, NO_HIT, 0.0, 0.0, true, 0u);
     var tests = 0u;
     let tiny = vec3<f32>(1e-20);
@@ -116,10 +147,14 @@ fn closest_hit(origin: vec3<f32>, dir: vec3<f32>, frag_xy: vec2<f32>, limit: f32
     loop {
         let n = bvh_nodes[node];
         var descend = false;
+        if ((n.count & OBJECT_LEAF) != 0u) {
+            node = bvh_levels[pick_level(n.first, n.count & ~OBJECT_LEAF, level)].root;
+            continue;
+        }
         if (n.count > 0u) {
             tests += n.count;
             for (var k = 0u; k < n.count; k++) {
-                let tri = bvh_primitives[n.first + k];
+                let tri = n.first + k;
                 let v0 = vertices[indices[3u * tri]].position;
                 let e1 = vertices[indices[3u * tri + 1u]].position - v0;
                 let e2 = vertices[indices[3u * tri + 2u]].position - v0;
@@ -334,9 +369,11 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     var color = vec3<f32>(0.0);
     // Seed 000's level of detail: rays outside the visual field are not traced (background), and
     // a ray's bounces are level × Reflect_max (eq. 9, rounded).
+    // Its rays meet each object at the level of detail eq. 10 gives (level 1: the original).
     var reflect_max = params.reflect_max;
+    var level = 1.0;
     if (params.gaze_forward.w > 0.0) {
-        let level = visual_level(ray.dir);
+        level = visual_level(ray.dir);
         if (level <= 0.0) {
             write_background(slot);
             return;
@@ -349,7 +386,7 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     var tests = 0u;
     var missed = false;
     loop {
-        let hit = closest_hit(task.origin, task.dir, frag_xy, task.limit);
+        let hit = closest_hit(task.origin, task.dir, frag_xy, task.limit, level);
         rays += 1u;
         tests += hit.tests;
         if (task.kind == SHADOW) {

@@ -451,7 +451,14 @@ mod tests {
     #[test]
     fn layout_names_are_the_names_of_the_layout_images() {
         let eye = EyeImage { width: 8, height: 2, rgba: vec![0; 64] };
-        let frame = Frame { left: eye.clone(), right: eye, stats: Default::default(), measurement: None, depth: None };
+        let frame = Frame {
+            left: eye.clone(),
+            right: eye,
+            stats: Default::default(),
+            measurement: None,
+            depth: None,
+            positions: None,
+        };
         for layout in [Layout::Eyes, Layout::TopBottom, Layout::SideBySide, Layout::Twister] {
             for format in [ImageFormat::Png, ImageFormat::Jpg] {
                 let names: Vec<String> = layout_images(&frame, layout, format).into_iter().map(|(n, _)| n).collect();

@@ -33,9 +33,12 @@ fn quick_benchmark_writes_every_output_well_formed() {
     let _ = std::fs::remove_dir_all(&out);
     let assets = common::asset("");
     // Every scene of the quick run is present (CI has the assets), so every row is expected.
-    for needed in
-        ["stanford-bunny/bun_zipper_res2.obj", "stanford-bunny/bun_zipper_res4.obj", "sponza-dabrovic/sponza.obj"]
-    {
+    for needed in [
+        "stanford-bunny/bun_zipper_res2.obj",
+        "stanford-bunny/bun_zipper_res4.obj",
+        "sponza-dabrovic/sponza.obj",
+        "cow/cow.obj",
+    ] {
         common::asset(needed);
     }
     run_quick(&out, &assets);
@@ -90,6 +93,38 @@ fn quick_benchmark_writes_every_output_well_formed() {
     }
     assert!(report.contains("## Visual-field level of detail") && out.join("lod.png").exists());
     assert!(!report.contains("bunny ring of the level-of-detail benchmark did not run"));
+    // Seed 000's Table 2: per scene A–D, plain, then LOD and LOD without eq. 10 for states 1 and 2.
+    let trace = csv_rows(
+        &out.join("trace_lod.csv"),
+        &["scene", "state", "config", "s_frame", "rays_traced", "triangle_tests", "covered_pixels"],
+    );
+    assert_eq!(trace.len(), 4 * 5, "four scenes × (plain + two states × two LOD configurations)");
+    let num = |r: &csv::StringRecord, k: usize| r[k].parse::<f64>().unwrap();
+    for run in trace.chunks(5) {
+        assert_eq!(
+            run.iter().map(|r| (r[1].to_string(), r[2].to_string())).collect::<Vec<_>>(),
+            [
+                ("-", "plain"),
+                ("state 1", "lod"),
+                ("state 1", "lod without eq. 10"),
+                ("state 2", "lod"),
+                ("state 2", "lod without eq. 10")
+            ]
+            .map(|(a, b)| (a.to_string(), b.to_string()))
+        );
+        for r in run {
+            assert!(num(r, 3) > 0.0 && num(r, 4) > 0.0 && num(r, 5) > 0.0, "{r:?}");
+        }
+        // LOD traces fewer rays than plain; eq. 10 changes the triangles met, not the rays.
+        assert!(num(&run[1], 4) < num(&run[0], 4) && num(&run[3], 4) < num(&run[0], 4), "{run:?}");
+        assert!((num(&run[1], 4) - num(&run[2], 4)).abs() <= 0.01 * num(&run[2], 4), "{run:?}");
+    }
+    // Mirror cows (A, C) spawn rays that diffuse ones (B, D) do not.
+    assert!(num(&trace[0], 4) > num(&trace[5], 4) && num(&trace[10], 4) > num(&trace[15], 4));
+    assert!(report.contains("## Visual-field level of detail in ray tracing") && report.contains("2.078"));
+    for f in ["trace_lod.png", "trace_lod_A_state1.png", "trace_lod_A_state2.png", "trace_lod.json"] {
+        assert!(out.join(f).exists(), "{f}");
+    }
     let _ = std::fs::remove_dir_all(&out);
 }
 

@@ -512,6 +512,33 @@ fn optics_demo() -> Scene {
     scene
 }
 
+/// The demo room with two dense mirror spheres (3,200 triangles each), one ahead and one to the
+/// right: objects with long level-of-detail chains.
+fn lod_spheres() -> Scene {
+    let mut scene = optics_demo();
+    // Vertex material k is `materials[k − 1]`: optics_demo's mirror.
+    let mirror = scene.materials.len() as u32 - 1;
+    for (name, centre) in [("ahead", Vec3::new(0.0, 0.0, -1.6)), ("right", Vec3::new(1.5, -0.2, -0.3))] {
+        let s = builtin::sphere_scene(3200, centre, 0.45, name);
+        let first = scene.vertices.len();
+        scene.add_mesh(name, &s.vertices, &s.indices);
+        scene.vertices[first..].iter_mut().for_each(|v| v.material = mirror);
+    }
+    scene
+}
+
+/// The BVH the command line builds: with a visual-field gaze, each object's level-of-detail
+/// chain down to the settings' N_min share.
+fn traced_bvh(scene: &Scene, settings: &RenderSettings) -> twister::core::bvh::SceneBvh {
+    match settings.shading.trace_gaze {
+        None => twister::core::bvh::SceneBvh::of_scene(scene),
+        Some(_) => {
+            let chain = twister::core::lod::LodChain::build(scene, settings.shading.trace_min_share);
+            twister::core::bvh::SceneBvh::build(&scene.vertices, &chain.levels)
+        }
+    }
+}
+
 impl Twin for Trace {
     type Case = (Scene, RenderSettings);
     /// The images, and the rays traced and triangle tests made.
@@ -553,6 +580,17 @@ impl Twin for Trace {
                 ),
             ),
             (
+                "two dense spheres among the demo's objects, per-ray polygon level (eq. 10)".into(),
+                (
+                    lod_spheres(),
+                    RenderSettings::new(cylinder)
+                        .with_method(Method::Trace)
+                        .with_light(Some(Vec3::new(0.0, 1.5, 0.0)))
+                        .with_trace_gaze(Some(twister::core::visual_field::Gaze::new(-20.0, 0.0)))
+                        .with_trace_min_share(0.1),
+                ),
+            ),
+            (
                 "box room".into(),
                 (
                     builtin::builtin_scene("builtin:box-room", &cylinder).unwrap(),
@@ -562,17 +600,19 @@ impl Twin for Trace {
         ]
     }
     fn gpu(r: &Renderer, (scene, settings): &Self::Case) -> Self::Output {
-        let gs = GpuScene::upload(&r.gpu, scene).and_then(|g| g.with_bvh(&r.gpu, scene)).expect("upload");
+        let gs = GpuScene::upload(&r.gpu, scene)
+            .and_then(|g| g.with_built_bvh(&r.gpu, &scene.name, &traced_bvh(scene, settings)))
+            .expect("upload");
         let frame = r.render(&gs, &settings.with_measure_error(true).with_depth(true)).expect("render");
         let (rays, tests) = (frame.stats.rays_traced.expect("counted"), frame.stats.triangle_tests.expect("counted"));
         (frame_outputs(&frame), rays, tests)
     }
     fn cpu((scene, settings): &Self::Case) -> Self::Output {
-        let bvh = twister::core::bvh::SceneBvh::build(&scene.vertices, &scene.indices);
+        let bvh = traced_bvh(scene, settings);
         let p = settings.projection();
         let params = twister::cpu::trace::trace_params(settings, p.width);
         let table = scene.material_table(usize::MAX);
-        let out = twister::cpu::trace::trace(&params, &scene.vertices, &scene.indices, &bvh, &table);
+        let out = twister::cpu::trace::trace(&params, &scene.vertices, &bvh, &table);
         (out.images.map(|img| (img.rgba, img.error, img.object, img.distance)), out.rays, out.triangle_tests)
     }
     fn compare((gpu, g_rays, g_tests): &Self::Output, (cpu, c_rays, c_tests): &Self::Output) -> Result<(), String> {

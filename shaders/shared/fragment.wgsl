@@ -70,6 +70,27 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @locatio
 // the depth is measured).
 @fragment
 fn fs_error(in: VertexOut, @builtin(front_facing) front_facing: bool) -> FragmentOut {
+    return measured(in, front_facing);
+}
+
+struct FragmentOutPosition {
+    @location(0) color: vec4<f32>,
+    @location(1) error: ErrorTarget,
+    @location(2) object: u32,
+    @location(3) distance: ErrorTarget,
+    // The surface point drawn (viewer frame), w = 1 (cleared to 0: background).
+    @location(4) position: vec4<f32>,
+}
+
+// The same, plus the surface point drawn (for the display-position error against the ray tracer).
+@fragment
+fn fs_position(in: VertexOut, @builtin(front_facing) front_facing: bool) -> FragmentOutPosition {
+    let m = measured(in, front_facing);
+    return FragmentOutPosition(m.color, m.error, m.object, m.distance, vec4<f32>(in.view_position, 1.0));
+}
+
+// What fs_error writes (a discarded fragment writes nothing).
+fn measured(in: VertexOut, front_facing: bool) -> FragmentOut {
     let duv_dx = dpdx(in.uv);
     let duv_dy = dpdy(in.uv);
     // Two vectors in the drawn triangle's plane (for the exact distance along the pixel's ray).

@@ -62,6 +62,7 @@ fn main() -> ExitCode {
         Command::Bench(BenchCommand::Fig10(args)) => bench::bench_figures(args, Figure::Fig10),
         Command::Bench(BenchCommand::Fig12(args)) => bench::bench_figures(args, Figure::Fig12),
         Command::Bench(BenchCommand::Lod(args)) => bench::bench_figures(args, Figure::Lod),
+        Command::Bench(BenchCommand::TraceLod(args)) => bench::bench_figures(args, Figure::TraceLod),
         Command::Bench(BenchCommand::All(args)) => bench::bench_figures(args, Figure::All),
     };
     match result {

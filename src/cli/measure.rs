@@ -45,8 +45,14 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
     if let Some(path) = &args.heatmap {
         twister::output::check_outputs(&[path.as_path()])?;
     }
-    // With --against, both frames also measure depth (the distance differences).
-    let mut settings = args.view.settings()?.with_measure_error(true).with_depth(args.against.is_some());
+    // With --against, both frames also measure depth (the distance differences); against the ray
+    // tracer, also the surface points (where the traced image shows what was drawn).
+    let mut settings = args
+        .view
+        .settings()?
+        .with_measure_error(true)
+        .with_depth(args.against.is_some())
+        .with_positions(args.against == Some(Method::Trace));
     let (renderer, adapter) = open_renderer()?;
     let methods: Vec<Method> = std::iter::once(settings.subdivision.method).chain(args.against).collect();
     let prepared = prepare(&renderer, &args.scene, args.fit, &args.view, &mut settings, false, &methods)?;
@@ -96,6 +102,13 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
         json["psnr_db"] = serde_json::json!(c.psnr_db);
         json["depth_rel_mean"] = serde_json::json!(c.depth_rel_mean);
         json["depth_rel_p99"] = serde_json::json!(c.depth_rel_p99);
+        if let Some(t) = c.traced_error {
+            json["traced_mean_px"] = serde_json::json!(t.mean_px);
+            json["traced_p99_px"] = serde_json::json!(t.p99_px);
+            json["traced_max_px"] = serde_json::json!(t.max_px);
+            json["traced_pixels"] = serde_json::json!(t.pixels);
+            json["traced_unmatched"] = serde_json::json!(t.unmatched);
+        }
     }
     if let Some(path) = &args.heatmap {
         let max = args.heatmap_max.unwrap_or_else(|| crate::heatmap::nice_max(e.p99));
@@ -141,6 +154,16 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
             println!(
                 "against {}: different surface on {:.4} of pixels, PSNR {} dB, distance off by {} (mean) / {} (p99) of the reference's",
                 json["against"], f, json["psnr_db"], json["depth_rel_mean"], json["depth_rel_p99"]
+            );
+        }
+        if let Some(m) = json.get("traced_mean_px") {
+            println!(
+                "display-position error measured on the traced image: mean {:.3} px, p99 {:.3}, max {:.3} over {} pixels ({} not found there)",
+                m.as_f64().unwrap_or(f64::NAN),
+                json["traced_p99_px"].as_f64().unwrap_or(f64::NAN),
+                json["traced_max_px"].as_f64().unwrap_or(f64::NAN),
+                json["traced_pixels"],
+                json["traced_unmatched"]
             );
         }
     }

@@ -5,6 +5,7 @@
 use glam::{Mat4, Vec3};
 
 use crate::args::{ViewArgs, Viewer};
+use twister::core::bvh::SceneBvh;
 use twister::core::load::load_scene;
 use twister::core::lod::{LodChain, LodSelection};
 use twister::core::scene::MAX_COORDINATE;
@@ -84,7 +85,9 @@ pub fn prepare(
 ) -> Result<Prepared> {
     view.check_light(methods)?;
     let mut lod = view.lod()?;
-    if let (Some((_, gaze)), true) = (&lod, methods.contains(&Method::Trace)) {
+    // The ray tracer's level of detail: each object's chain down to P3 of its triangles.
+    let mut trace_min_share = None;
+    if let (Some((params, gaze)), true) = (&lod, methods.contains(&Method::Trace)) {
         // The ray tracer's level of detail is per ray (seed 000), not a selection of objects.
         if methods.len() > 1 {
             return Err(Error::option(
@@ -92,7 +95,8 @@ pub fn prepare(
                 "with --method trace, the level of detail is per ray: run trace apart from the other methods",
             ));
         }
-        *settings = settings.with_trace_gaze(Some(*gaze));
+        *settings = settings.with_trace_gaze(Some(*gaze)).with_trace_min_share(params.p3);
+        trace_min_share = Some(params.p3);
         lod = None;
     }
     let mut scene = place(spec, fit, view, settings)?;
@@ -103,7 +107,17 @@ pub fn prepare(
     }
     let mut gpu_scene = GpuScene::upload(&renderer.gpu, &scene)?;
     if methods.contains(&Method::Trace) {
-        gpu_scene = gpu_scene.with_bvh(&renderer.gpu, &scene)?;
+        gpu_scene = match trace_min_share {
+            None => gpu_scene.with_bvh(&renderer.gpu, &scene)?,
+            Some(share) => {
+                let chain = LodChain::build(&scene, share);
+                gpu_scene.with_built_bvh(
+                    &renderer.gpu,
+                    &scene.name,
+                    &SceneBvh::build(&scene.vertices, &chain.levels),
+                )?
+            }
+        };
     }
     for w in &gpu_scene.warnings {
         warn(spec, w);

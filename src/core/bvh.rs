@@ -1,72 +1,172 @@
-//! A bounding volume hierarchy over a scene's triangles, for the ray tracer (`--method trace`,
-//! seed 000): built on the CPU by obvhs (its medium preset: PLOC clustering and reinsertion, then
-//! leaves of up to 8 triangles collapsed by the SAH cost), stored as a flat array of 32-byte binary
-//! nodes that the WGSL traversal (`shaders/trace.wgsl`) and its CPU twin (`cpu::trace`) walk.
+//! The ray tracer's acceleration structure (`--method trace`, seed 000 §3.4): **one BVH per
+//! object and per level of its level-of-detail chain, and a top level over the objects**, as the
+//! seed builds per object so that eq. 10 can pick, per ray, the level of each object it meets.
+//! Every tree is built on the CPU by obvhs (its medium preset: PLOC clustering and reinsertion,
+//! then leaves of up to 8 triangles collapsed by the SAH cost; the top level keeps one object per
+//! leaf) and all of them are stored in one flat array of 32-byte binary nodes that the WGSL
+//! traversal (`shaders/trace.wgsl`) and its CPU twin (`cpu::trace`) walk as one tree:
 //!
-//! A node with `count` = 0 is inner: its children are `nodes[first]` and `nodes[first + 1]`.
-//! Else it is a leaf of `count` triangles, `primitives[first .. first + count]` (triangle
-//! indices). The root is node 0.
+//! - `count` = 0: an inner node, children `nodes[first]` and `nodes[first + 1]`;
+//! - `count` & [`OBJECT_LEAF`]: a top-level leaf, one object whose chain is
+//!   `levels[first .. first + (count & !OBJECT_LEAF)]`, level 0 (the original) first, each
+//!   level giving the root of its tree; the walk goes on at the root of the level the ray picks;
+//! - otherwise a leaf of `count` triangles, `first .. first + count`, triangles of [`SceneBvh::indices`]
+//!   (the triangles of every level, laid out leaf by leaf, so no second indirection is needed).
+//!
+//! The root is node 0. Objects with a single level (every object, without a level-of-detail
+//! chain) share one tree: one top-level leaf over all their triangles.
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3A;
 
-use crate::core::scene::SceneVertex;
+use crate::core::scene::{Scene, SceneVertex};
+
+/// The flag of a top-level leaf's `count` (the rest of `count` is the object's level count).
+pub const OBJECT_LEAF: u32 = 0x8000_0000;
 
 /// `BvhNode` in shaders/trace.wgsl. 32 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct BvhNode {
     pub min: [f32; 3],
-    /// First child (inner node) or first entry of `primitives` (leaf).
+    /// First child (inner node), first level (object leaf) or first triangle (leaf).
     pub first: u32,
     pub max: [f32; 3],
-    /// Triangles in the leaf; 0 for an inner node.
+    /// 0 for an inner node; [`OBJECT_LEAF`] | levels for an object; else the leaf's triangles.
     pub count: u32,
 }
 
-/// A scene's BVH, in scene coordinates.
+/// `BvhLevel` in shaders/trace.wgsl: one level of an object's chain. 8 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct BvhLevel {
+    /// The node at the root of this level's tree.
+    pub root: u32,
+    /// Its triangles (eq. 10 picks the coarsest level with at least N_j).
+    pub triangles: u32,
+}
+
+/// A scene's two-level BVH, in scene coordinates.
 #[derive(Clone, Debug, Default)]
 pub struct SceneBvh {
     pub nodes: Vec<BvhNode>,
-    /// Triangle indices, leaf by leaf.
-    pub primitives: Vec<u32>,
+    pub levels: Vec<BvhLevel>,
+    /// Three vertex indices per triangle, every level's triangles, leaf by leaf.
+    pub indices: Vec<u32>,
+}
+
+/// The obvhs build of `triangles` (three indices each, over `vertices`), or None if there are none.
+fn build_tree(vertices: &[SceneVertex], indices: &[u32]) -> Option<obvhs::bvh2::Bvh2> {
+    let triangles: Vec<obvhs::triangle::Triangle> = indices
+        .chunks_exact(3)
+        .map(|t| {
+            let p = |k: usize| Vec3A::from_array(vertices[t[k] as usize].position);
+            obvhs::triangle::Triangle { v0: p(0), v1: p(1), v2: p(2) }
+        })
+        .collect();
+    if triangles.is_empty() {
+        return None;
+    }
+    let mut build_time = std::time::Duration::ZERO;
+    Some(obvhs::bvh2::builder::build_bvh2_from_tris(&triangles, obvhs::BvhBuildParams::medium_build(), &mut build_time))
+}
+
+fn node(n: &obvhs::bvh2::node::Bvh2Node, first: u32, count: u32) -> BvhNode {
+    BvhNode { min: n.aabb.min.to_array(), first, max: n.aabb.max.to_array(), count }
 }
 
 impl SceneBvh {
-    /// Builds the BVH of the triangles `indices` (three per triangle) over `vertices`. An empty
-    /// scene gets one leaf with an empty box, which no ray enters.
-    pub fn build(vertices: &[SceneVertex], indices: &[u32]) -> SceneBvh {
-        let triangles: Vec<obvhs::triangle::Triangle> = indices
-            .chunks_exact(3)
-            .map(|t| {
-                let p = |k: usize| Vec3A::from_array(vertices[t[k] as usize].position);
-                obvhs::triangle::Triangle { v0: p(0), v1: p(1), v2: p(2) }
-            })
-            .collect();
-        if triangles.is_empty() {
-            let empty = BvhNode { min: [1.0; 3], max: [-1.0; 3], first: 0, count: 1 };
-            return SceneBvh { nodes: vec![empty], primitives: vec![0] };
-        }
-        let mut build_time = std::time::Duration::ZERO;
-        let bvh = obvhs::bvh2::builder::build_bvh2_from_tris(
-            &triangles,
-            obvhs::BvhBuildParams::medium_build(),
-            &mut build_time,
-        );
-        let nodes = bvh
-            .nodes
+    /// The BVH of a scene drawn as it is: one level per object.
+    pub fn of_scene(scene: &Scene) -> SceneBvh {
+        let chains: Vec<Vec<Vec<u32>>> = scene
+            .objects
             .iter()
-            .map(|n| BvhNode {
-                min: n.aabb.min.to_array(),
-                first: n.first_index,
-                max: n.aabb.max.to_array(),
-                count: n.prim_count,
+            .map(|o| {
+                let first = 3 * o.first_triangle as usize;
+                vec![scene.indices[first..first + 3 * o.triangle_count as usize].to_vec()]
             })
             .collect();
-        SceneBvh { nodes, primitives: bvh.primitive_indices }
+        SceneBvh::build(&scene.vertices, &chains)
     }
 
-    /// The deepest path from the root (the traversal's stack needs at most this many entries).
+    /// Builds the BVH of objects given as chains of levels (`chains[object][level]`: three
+    /// indices into `vertices` per triangle, level 0 the original, each level coarser than the
+    /// one before, as `LodChain::levels`). The objects with one level only share one tree (a
+    /// top level over objects whose boxes overlap, as in an atrium, costs rays up to twice the
+    /// time of one tree over all their triangles: measured on Sponza); each object with a chain
+    /// gets a tree per level. Objects without triangles are left out; an empty scene gets one
+    /// leaf with an empty box, which no ray enters.
+    pub fn build(vertices: &[SceneVertex], chains: &[Vec<Vec<u32>>]) -> SceneBvh {
+        let mut out = SceneBvh::default();
+        let pooled: Vec<u32> = chains.iter().filter(|c| c.len() == 1).flat_map(|c| c[0].iter().copied()).collect();
+        let groups: Vec<Vec<&[u32]>> = chains
+            .iter()
+            .filter(|c| c.len() > 1)
+            .map(|c| c.iter().map(|l| l.as_slice()).collect())
+            .chain((!pooled.is_empty()).then(|| vec![pooled.as_slice()]))
+            .collect();
+        // The top level over the groups' boxes (their level 0's root box), one group per leaf.
+        let mut boxes = Vec::new();
+        let mut object_levels = Vec::new();
+        let mut subtrees: Vec<BvhNode> = Vec::new();
+        for chain in &groups {
+            let first_level = out.levels.len() as u32;
+            let mut object_box = None;
+            for level in chain {
+                let Some(tree) = build_tree(vertices, level) else { continue };
+                object_box.get_or_insert(tree.nodes[0].aabb);
+                let (base, triangle_base) = (subtrees.len() as u32, (out.indices.len() / 3) as u32);
+                for n in &tree.nodes {
+                    subtrees.push(if n.prim_count == 0 {
+                        node(n, base + n.first_index, 0)
+                    } else {
+                        node(n, triangle_base + n.first_index, n.prim_count)
+                    });
+                }
+                for &p in &tree.primitive_indices {
+                    out.indices.extend_from_slice(&level[3 * p as usize..3 * p as usize + 3]);
+                }
+                out.levels.push(BvhLevel { root: base, triangles: (level.len() / 3) as u32 });
+            }
+            if let Some(b) = object_box {
+                boxes.push(b);
+                object_levels.push((first_level, out.levels.len() as u32 - first_level));
+            }
+        }
+        if boxes.is_empty() {
+            out.nodes = vec![BvhNode { min: [1.0; 3], max: [-1.0; 3], first: 0, count: 1 }];
+            out.indices = vec![0; 3];
+            return out;
+        }
+        let params = obvhs::BvhBuildParams { max_prims_per_leaf: 1, ..obvhs::BvhBuildParams::medium_build() };
+        let mut build_time = std::time::Duration::ZERO;
+        let top = obvhs::bvh2::builder::build_bvh2(&boxes, params, &mut build_time);
+        let top_len = top.nodes.len() as u32;
+        for n in &top.nodes {
+            out.nodes.push(if n.prim_count == 0 {
+                node(n, n.first_index, 0)
+            } else {
+                assert_eq!(n.prim_count, 1, "one object per top-level leaf");
+                let (first_level, count) = object_levels[top.primitive_indices[n.first_index as usize] as usize];
+                node(n, first_level, OBJECT_LEAF | count)
+            });
+        }
+        // The subtrees follow the top level: shift their inner nodes' child indices and roots.
+        out.nodes.extend(subtrees.into_iter().map(|n| {
+            if n.count == 0 {
+                BvhNode { first: n.first + top_len, ..n }
+            } else {
+                n
+            }
+        }));
+        for l in &mut out.levels {
+            l.root += top_len;
+        }
+        out
+    }
+
+    /// The deepest path from the root through any level's tree (the traversal's stack needs at
+    /// most this many entries).
     pub fn depth(&self) -> u32 {
         let mut deepest = 0;
         let mut stack = vec![(0usize, 1u32)];
@@ -76,8 +176,121 @@ impl SceneBvh {
             if n.count == 0 {
                 stack.push((n.first as usize, d + 1));
                 stack.push((n.first as usize + 1, d + 1));
+            } else if n.count & OBJECT_LEAF != 0 {
+                let levels = n.first as usize..(n.first + (n.count & !OBJECT_LEAF)) as usize;
+                stack.extend(self.levels[levels].iter().map(|l| (l.root as usize, d)));
             }
         }
         deepest
+    }
+
+    /// The level of an object's chain (`levels`, level 0 first) that a ray of visual level
+    /// `level` meets (seed 000 eq. 10): N_j = level·(N_max − N_min) + N_min with N_max the
+    /// original's triangles and N_min = `min_share`·N_max, and the coarsest level with at least
+    /// N_j triangles (`pick_level` in trace.wgsl).
+    pub fn pick_level(levels: &[BvhLevel], level: f32, min_share: f32) -> usize {
+        let max = levels[0].triangles as f32;
+        let wanted = level * (max - min_share * max) + min_share * max;
+        (1..levels.len()).rev().find(|&k| levels[k].triangles as f32 >= wanted).unwrap_or(0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::core::builtin::sphere_scene;
+    use crate::core::lod::LodChain;
+    use glam::Vec3;
+
+    fn levels(counts: &[u32]) -> Vec<BvhLevel> {
+        counts.iter().map(|&triangles| BvhLevel { root: 0, triangles }).collect()
+    }
+
+    #[test]
+    fn eq_10_picks_the_coarsest_level_with_enough_triangles() {
+        let chain = levels(&[1000, 700, 490, 343, 240, 168, 118, 100]);
+        // N_min = 0.1 · 1000 = 100: level 1 wants all 1000, level 0 wants 100.
+        assert_eq!(SceneBvh::pick_level(&chain, 1.0, 0.1), 0);
+        assert_eq!(SceneBvh::pick_level(&chain, 0.0, 0.1), 7);
+        // Level 0.5: N_j = 0.5 · 900 + 100 = 550 → 700 is the coarsest with ≥ 550.
+        assert_eq!(SceneBvh::pick_level(&chain, 0.5, 0.1), 1);
+        // Level 0.2: N_j = 280 → 343.
+        assert_eq!(SceneBvh::pick_level(&chain, 0.2, 0.1), 3);
+        // N_j exactly a level's count takes that level.
+        assert_eq!(SceneBvh::pick_level(&levels(&[1000, 550, 300]), 0.5, 0.1), 1);
+        // A chain that stops above N_min: its coarsest level serves every ray below it.
+        assert_eq!(SceneBvh::pick_level(&levels(&[1000, 700]), 0.0, 0.05), 1);
+        assert_eq!(SceneBvh::pick_level(&levels(&[50]), 0.0, 0.05), 0);
+    }
+
+    /// Every level's triangles lie exactly once in the leaves under its root, inside every box
+    /// on their way; each object is one top-level leaf listing its chain.
+    #[test]
+    fn each_level_tree_holds_its_triangles_once_inside_its_boxes() {
+        let mut scene = Scene::new("three");
+        for (k, x) in [-2.0f32, 0.0, 2.0].into_iter().enumerate() {
+            let s = sphere_scene(1500 + 500 * k as u32, Vec3::new(x, 0.0, -3.0), 0.5, "s");
+            scene.add_mesh(format!("s{k}"), &s.vertices, &s.indices);
+        }
+        let chain = LodChain::build(&scene, 0.1);
+        let bvh = SceneBvh::build(&scene.vertices, &chain.levels);
+        let mut objects = Vec::new();
+        let mut stack = vec![0usize];
+        while let Some(i) = stack.pop() {
+            let n = bvh.nodes[i];
+            if n.count == 0 {
+                stack.extend([n.first as usize, n.first as usize + 1]);
+            } else {
+                assert!(n.count & OBJECT_LEAF != 0, "the top level holds objects only");
+                objects.push((n.first, n.count & !OBJECT_LEAF));
+            }
+        }
+        objects.sort();
+        assert_eq!(objects.len(), 3);
+        let mut seen = vec![0u32; bvh.indices.len() / 3];
+        for ((first, count), levels) in objects.iter().zip(&chain.levels) {
+            assert_eq!(*count as usize, levels.len());
+            for (level, expected) in bvh.levels[*first as usize..(*first + *count) as usize].iter().zip(levels) {
+                assert_eq!(level.triangles as usize, expected.len() / 3);
+                let mut found: Vec<[u32; 3]> = Vec::new();
+                let mut stack = vec![level.root as usize];
+                while let Some(i) = stack.pop() {
+                    let n = bvh.nodes[i];
+                    let inside = |p: [f32; 3]| (0..3).all(|a| n.min[a] <= p[a] && p[a] <= n.max[a]);
+                    if n.count == 0 {
+                        stack.extend([n.first as usize, n.first as usize + 1]);
+                        for c in [bvh.nodes[n.first as usize], bvh.nodes[n.first as usize + 1]] {
+                            assert!(inside(c.min) && inside(c.max), "child box outside its parent");
+                        }
+                    } else {
+                        assert!(n.count & OBJECT_LEAF == 0);
+                        for t in n.first..n.first + n.count {
+                            seen[t as usize] += 1;
+                            let tri = [0, 1, 2].map(|k| bvh.indices[3 * t as usize + k]);
+                            assert!(tri.iter().all(|&v| inside(scene.vertices[v as usize].position)));
+                            found.push(tri);
+                        }
+                    }
+                }
+                let mut want: Vec<[u32; 3]> = expected.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+                found.sort();
+                want.sort();
+                assert_eq!(found, want);
+            }
+        }
+        assert!(seen.iter().all(|&s| s == 1), "every triangle in exactly one leaf");
+        assert!(bvh.depth() > 3);
+        // Without chains, the objects share one tree under one top-level leaf.
+        let flat = SceneBvh::of_scene(&scene);
+        assert_eq!((flat.nodes[0].first, flat.nodes[0].count), (0, OBJECT_LEAF | 1));
+        assert_eq!(flat.levels, [BvhLevel { root: 1, triangles: scene.triangle_count() as u32 }]);
+        assert_eq!(flat.indices.len(), scene.indices.len());
+    }
+
+    #[test]
+    fn an_empty_scene_has_one_empty_leaf() {
+        let bvh = SceneBvh::of_scene(&Scene::new("empty"));
+        assert_eq!(bvh.nodes.len(), 1);
+        assert!(bvh.nodes[0].min[0] > bvh.nodes[0].max[0]);
     }
 }

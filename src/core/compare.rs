@@ -1,5 +1,7 @@
 //! Comparing a frame against a reference frame (`twister error --against`): how much of the
-//! image shows a different surface, and how close the colours are; and comparing flat-coloured
+//! image shows a different surface, and how close the colours are; against the ray tracer, where
+//! the traced image shows each drawn surface point (the display-position error measured without
+//! the analytic projection); and comparing flat-coloured
 //! images from two renderers by where their colour boundaries lie (twister against Blender
 //! Cycles: `examples/cycles_reference.rs`, `tests/cycles.rs`).
 
@@ -21,6 +23,134 @@ pub struct Comparison {
     /// hit).
     pub depth_rel_mean: Option<f64>,
     pub depth_rel_p99: Option<f64>,
+    /// Where both frames have their surface points (`Frame::positions`), the reference a traced
+    /// one: [`traced_display_error`].
+    pub traced_error: Option<TracedError>,
+}
+
+/// The display-position error of a frame measured against a traced frame: for each pixel p
+/// showing a surface point X, the place q* in the traced image whose ray meets X, and |q* − p|
+/// in pixels (x wraps). It shares no code with the analytic error (seed 002 §4.1): only the
+/// traced rays say where a point belongs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct TracedError {
+    pub mean_px: f64,
+    pub p99_px: f64,
+    pub max_px: f64,
+    /// Pixels measured (both eyes).
+    pub pixels: u64,
+    /// Pixels whose point the traced image does not show nearby (occluded there, or beyond the
+    /// search), left out of the statistics.
+    pub unmatched: u64,
+}
+
+/// How far the traced image may be searched from a pixel for the point it shows, pixels.
+pub const TRACED_SEARCH_STEPS: usize = 24;
+
+/// [`TracedError`] of the surface points `drawn` (per eye, NaN: none) against the traced
+/// points `traced` with their object ids (`drawn_object`, `traced_object`; 0: background), on
+/// images `width` × `height`.
+///
+/// Per pixel p with point X: from p, step to the 8-neighbour (same object in the traced image)
+/// whose traced point is nearest X until none is nearer (at most [`TRACED_SEARCH_STEPS`]); at
+/// that pixel q, the traced points of q's horizontal and vertical neighbours give the local map
+/// Y(q + δ) ≈ Y(q) + J·δ, and δ solves it for X in least squares (|δ| ≤ 1.5 per axis). X is
+/// matched if it lies within one pixel footprint of Y(q) + J·δ.
+pub fn traced_display_error(
+    drawn: &[Vec<[f32; 3]>; 2],
+    drawn_object: &[Vec<u32>; 2],
+    traced: &[Vec<[f32; 3]>; 2],
+    traced_object: &[Vec<u32>; 2],
+    width: usize,
+    height: usize,
+) -> TracedError {
+    use glam::Vec3;
+    let mut errors: Vec<f64> = Vec::new();
+    let mut unmatched = 0u64;
+    for k in 0..2 {
+        let (pos, obj, tpos, tobj) = (&drawn[k], &drawn_object[k], &traced[k], &traced_object[k]);
+        let at = |x: i64, y: i64| -> Option<usize> {
+            (0..height as i64).contains(&y).then(|| y as usize * width + x.rem_euclid(width as i64) as usize)
+        };
+        for i in 0..width * height {
+            let (o, x) = (obj[i], Vec3::from(pos[i]));
+            if o == 0 || !x.is_finite() {
+                continue;
+            }
+            let usable = |j: usize| tobj[j] == o && Vec3::from(tpos[j]).is_finite();
+            let dist = |j: usize| (Vec3::from(tpos[j]) - x).length_squared();
+            let (px, py) = ((i % width) as i64, (i / width) as i64);
+            // The start: p itself, or the nearest usable pixel around it.
+            let mut best = (usable(i)).then_some((px, py, dist(i)));
+            if best.is_none() {
+                for (dx, dy) in [(-1, 0), (1, 0), (0, -1), (0, 1), (-1, -1), (1, -1), (-1, 1), (1, 1)] {
+                    if let Some(j) = at(px + dx, py + dy).filter(|&j| usable(j)) {
+                        if best.is_none_or(|b| dist(j) < b.2) {
+                            best = Some((px + dx, py + dy, dist(j)));
+                        }
+                    }
+                }
+            }
+            let Some(mut q) = best else {
+                unmatched += 1;
+                continue;
+            };
+            for _ in 0..TRACED_SEARCH_STEPS {
+                let mut next = q;
+                for (dx, dy) in [(-1, 0), (1, 0), (0, -1), (0, 1), (-1, -1), (1, -1), (-1, 1), (1, 1)] {
+                    if let Some(j) = at(q.0 + dx, q.1 + dy).filter(|&j| usable(j)) {
+                        if dist(j) < next.2 {
+                            next = (q.0 + dx, q.1 + dy, dist(j));
+                        }
+                    }
+                }
+                if next == q {
+                    break;
+                }
+                q = next;
+            }
+            let y = Vec3::from(tpos[at(q.0, q.1).expect("inside")]);
+            // The local map from the neighbours (one side or the other, same object).
+            let axis = |dx: i64, dy: i64| {
+                [1i64, -1].into_iter().find_map(|s| {
+                    at(q.0 + s * dx, q.1 + s * dy).filter(|&j| usable(j)).map(|j| (Vec3::from(tpos[j]) - y) * s as f32)
+                })
+            };
+            let (Some(a), Some(b)) = (axis(1, 0), axis(0, 1)) else {
+                unmatched += 1;
+                continue;
+            };
+            let r = x - y;
+            let (aa, ab, bb) = (a.dot(a), a.dot(b), b.dot(b));
+            let det = aa * bb - ab * ab;
+            let (dx, dy) = if det > 1e-12 * aa * bb {
+                (
+                    ((bb * a.dot(r) - ab * b.dot(r)) / det).clamp(-1.5, 1.5),
+                    ((aa * b.dot(r) - ab * a.dot(r)) / det).clamp(-1.5, 1.5),
+                )
+            } else {
+                (0.0, 0.0)
+            };
+            let footprint = aa.max(bb).sqrt();
+            if (y + dx * a + dy * b - x).length() > footprint {
+                unmatched += 1;
+                continue;
+            }
+            let mut ex = (q.0 as f32 + dx - px as f32).abs();
+            ex = ex.min(width as f32 - ex);
+            let ey = q.1 as f32 + dy - py as f32;
+            errors.push((ex * ex + ey * ey).sqrt() as f64);
+        }
+    }
+    errors.sort_by(f64::total_cmp);
+    let n = errors.len();
+    TracedError {
+        mean_px: if n == 0 { 0.0 } else { errors.iter().sum::<f64>() / n as f64 },
+        p99_px: if n == 0 { 0.0 } else { errors[((n - 1) as f64 * 0.99).round() as usize] },
+        max_px: errors.last().copied().unwrap_or(0.0),
+        pixels: n as u64,
+        unmatched,
+    }
 }
 
 /// Compares two frames rendered with the error pass (`measure.error`, for their object ids).
@@ -65,11 +195,23 @@ pub fn compare(frame: &Frame, reference: &Frame) -> Result<Comparison> {
         let p99 = depth[((depth.len() - 1) as f64 * 0.99).round() as usize];
         (Some(depth.iter().sum::<f64>() / depth.len() as f64), Some(p99))
     };
+    let traced_error = match (&frame.positions, &reference.positions) {
+        (Some(drawn), Some(traced)) => Some(traced_display_error(
+            drawn,
+            &m.object,
+            traced,
+            &r.object,
+            frame.left.width as usize,
+            frame.left.height as usize,
+        )),
+        _ => None,
+    };
     Ok(Comparison {
         different_surface_fraction: if covered == 0 { 0.0 } else { different as f64 / covered as f64 },
         psnr_db: (mse > 0.0).then(|| 10.0 * (255.0 * 255.0 / mse).log10()),
         depth_rel_mean,
         depth_rel_p99,
+        traced_error,
     })
 }
 

@@ -92,6 +92,10 @@ pub struct Frame {
     /// Per pixel, left and right eye: the distance in metres from the pixel's eye point to the
     /// surface it shows (+∞: background), when `RenderSettings::measure.depth` was set.
     pub depth: Option<[Vec<f32>; 2]>,
+    /// Per pixel, left and right eye: the surface point it shows, viewer frame (the drawing
+    /// stages' interpolated `view_position`; NaN: background), when
+    /// `RenderSettings::measure.positions` was set.
+    pub positions: Option<[Vec<[f32; 3]>; 2]>,
 }
 
 /// What the error pass measured (seed 002 §4.1).

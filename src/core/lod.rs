@@ -35,6 +35,10 @@ use crate::core::visual_field::{Field, Gaze};
 pub const LEVEL_RATIO: f32 = 0.7;
 /// The most the peripheral field relaxes L (at the field's boundary).
 pub const MAX_EDGE_RELAXATION: f32 = 4.0;
+/// Objects with fewer triangles keep only their original: there is little to save, and the
+/// simplifier would break their shape (a quad collapsed to one triangle loses half its area, a
+/// box its faces).
+pub const MIN_CHAIN_TRIANGLES: u32 = 64;
 /// The factor on L that means "do not split" (outside the visual field).
 pub const NO_SPLIT: f32 = 1e30;
 
@@ -52,11 +56,13 @@ pub struct LodParams {
 
 impl Default for LodParams {
     fn default() -> Self {
-        LodParams { p2: 0.3, p3: 0.05, d_inf: 100.0 }
+        LodParams::DEFAULT
     }
 }
 
 impl LodParams {
+    pub const DEFAULT: LodParams = LodParams { p2: 0.3, p3: 0.05, d_inf: 100.0 };
+
     pub fn validate(&self) -> crate::error::Result<()> {
         use crate::error::Error;
         if !(self.p3 > 0.0 && self.p3 <= self.p2 && self.p2 <= 1.0) {
@@ -93,6 +99,10 @@ impl LodParams {
 /// (three per triangle, into the scene's vertices) of level k; level 0 is the original.
 pub struct LodChain {
     pub levels: Vec<Vec<Vec<u32>>>,
+    /// `errors[object][k]`: how far level k may lie from the original, as a share of the
+    /// object's extent (meshoptimizer's error of each simplification step, summed along the
+    /// chain: an upper bound; 0 for level 0).
+    pub errors: Vec<Vec<f32>>,
 }
 
 /// What a frame's selection chose for one object.
@@ -122,14 +132,19 @@ impl LodChain {
         let bytes: &[u8] = bytemuck::cast_slice(&scene.vertices);
         let stride = std::mem::size_of::<crate::core::scene::SceneVertex>();
         let adapter = meshopt::VertexDataAdapter::new(bytes, stride, 0).expect("vertex layout");
-        let levels = scene
+        let (levels, errors) = scene
             .objects
             .iter()
             .map(|o| {
                 let first = 3 * o.first_triangle as usize;
                 let original = scene.indices[first..first + 3 * o.triangle_count as usize].to_vec();
-                let floor = ((o.triangle_count as f32 * min_share).ceil() as usize).max(1);
+                let floor = if o.triangle_count < MIN_CHAIN_TRIANGLES {
+                    o.triangle_count as usize
+                } else {
+                    ((o.triangle_count as f32 * min_share).ceil() as usize).max(1)
+                };
                 let mut chain = vec![original];
+                let mut errors = vec![0.0f32];
                 loop {
                     let last = chain.last().unwrap();
                     let count = last.len() / 3;
@@ -137,18 +152,26 @@ impl LodChain {
                         break;
                     }
                     let target = ((count as f32 * LEVEL_RATIO) as usize).max(floor);
-                    let next =
-                        meshopt::simplify(last, &adapter, 3 * target, 1.0, meshopt::SimplifyOptions::Sparse, None);
+                    let mut error = 0.0f32;
+                    let next = meshopt::simplify(
+                        last,
+                        &adapter,
+                        3 * target,
+                        1.0,
+                        meshopt::SimplifyOptions::Sparse,
+                        Some(&mut error),
+                    );
                     // Stop where the simplifier can no longer make real progress.
                     if next.is_empty() || next.len() / 3 > count * 9 / 10 {
                         break;
                     }
                     chain.push(next);
+                    errors.push(errors.last().unwrap() + error);
                 }
-                chain
+                (chain, errors)
             })
-            .collect();
-        LodChain { levels }
+            .unzip();
+        LodChain { levels, errors }
     }
 
     /// Chooses each object's level for a gaze (in the viewer frame of `view`) and builds the
@@ -284,6 +307,15 @@ mod tests {
             scene.add_mesh(format!("sphere {k}"), &one.vertices, &one.indices);
         }
         let chain = LodChain::build(&scene, 0.05);
+        // A small object, such as a flat quad, has no coarser level.
+        let mut quad = Scene::new("quad");
+        let corner = |x: f32, z: f32| crate::core::scene::SceneVertex { position: [x, 0.0, z], ..Default::default() };
+        quad.add_mesh(
+            "quad",
+            &[corner(0.0, 0.0), corner(0.0, 1.0), corner(1.0, 1.0), corner(1.0, 0.0)],
+            &[0, 1, 2, 0, 2, 3],
+        );
+        assert_eq!(LodChain::build(&quad, 0.05).levels[0].len(), 1);
         for levels in &chain.levels {
             assert!(levels.len() >= 4, "{} levels", levels.len());
             for w in levels.windows(2) {

@@ -167,6 +167,9 @@ pub struct ShadingSettings {
     /// `--method trace`): the gaze; each primary ray's level (eq. 8) sets its bounces (eq. 9),
     /// and rays outside the visual field are not traced.
     pub trace_gaze: Option<crate::core::visual_field::Gaze>,
+    /// With `trace_gaze`: N_min / N_max of eq. 10, the share of an object's triangles that a ray
+    /// at level 0 meets (`--lod-p3`); the scene's BVH holds each object's chain down to it.
+    pub trace_min_share: f32,
 }
 
 /// What a render measures besides drawing.
@@ -184,6 +187,9 @@ pub struct MeasureSettings {
     pub error_angle: bool,
     /// Also read back each pixel's distance from its eye point along its ray (`Frame::depth`).
     pub depth: bool,
+    /// Also read back the surface point each pixel shows (`Frame::positions`), for the
+    /// display-position error against the ray tracer (`error --against trace`).
+    pub positions: bool,
     /// Test hook: draws everything shifted by this many pixels (x right, y down) while the
     /// error pass measures against the true projection.
     #[doc(hidden)]
@@ -197,7 +203,19 @@ pub struct MeasureSettings {
 impl MeasureSettings {
     /// Whether the drawing stages write the measuring targets (error, object id, distance).
     pub fn targets(&self) -> bool {
-        self.error || self.depth
+        self.error || self.depth || self.positions
+    }
+
+    /// The colour attachments the drawing stages write: colour; + error, object, distance when
+    /// measuring; + positions.
+    pub fn outputs(&self) -> usize {
+        if self.positions {
+            5
+        } else if self.targets() {
+            4
+        } else {
+            1
+        }
     }
 }
 
@@ -236,6 +254,7 @@ impl Default for ShadingSettings {
             reflect_max: DEFAULT_REFLECT_MAX,
             light: None,
             trace_gaze: None,
+            trace_min_share: crate::core::lod::LodParams::DEFAULT.p3,
         }
     }
 }
@@ -268,10 +287,12 @@ builders! {
     with_reflect_max: u32 => shading.reflect_max,
     with_light: Option<Vec3> => shading.light,
     with_trace_gaze: Option<crate::core::visual_field::Gaze> => shading.trace_gaze,
+    with_trace_min_share: f32 => shading.trace_min_share,
     with_measure_edges: bool => measure.edges,
     with_measure_error: bool => measure.error,
     with_error_angle: bool => measure.error_angle,
     with_depth: bool => measure.depth,
+    with_positions: bool => measure.positions,
     with_shift_px: [f32; 2] => measure.shift_px,
     with_reduce_per_eye: bool => measure.reduce_per_eye,
 }

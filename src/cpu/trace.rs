@@ -10,7 +10,7 @@ use std::cell::Cell;
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
-use crate::core::bvh::{BvhNode, SceneBvh};
+use crate::core::bvh::{BvhNode, SceneBvh, OBJECT_LEAF};
 use crate::core::color::{linear_to_srgb, srgb_to_linear};
 use crate::core::material::AlphaMode;
 use crate::core::projection::{Eye, Projection};
@@ -38,6 +38,10 @@ pub fn trace_params(settings: &RenderSettings, row_texels: u32) -> TraceParams {
         error_angle: settings.measure.error_angle as u32,
         row_texels,
         reflect_max: settings.shading.reflect_max,
+        lod_min_share: settings.shading.trace_min_share,
+        _pad0: 0,
+        _pad1: 0,
+        _pad2: 0,
     }
 }
 
@@ -62,27 +66,32 @@ fn enter_box(n: &BvhNode, origin: Vec3, inv: Vec3, limit: f32) -> Option<f32> {
     (near <= far).then_some(near)
 }
 
-/// What rays are traced against: the scene's BVH, vertices and indices.
+/// What rays are traced against: the scene's BVH (with its triangles) and vertices, and the
+/// share of an object's triangles that eq. 10 gives a ray of level 0 (N_min / N_max).
 #[derive(Clone, Copy)]
 pub struct TracedScene<'a> {
     pub bvh: &'a SceneBvh,
     pub vertices: &'a [SceneVertex],
-    pub indices: &'a [u32],
+    pub min_share: f32,
 }
 
 /// The closest hit along the ray (scene frame), nearer than `limit`, that `keeps` accepts
 /// (`closest_hit`): binary BVH,
 /// nearer child first (the farther kept with its entry distance, and skipped when popped if the
-/// best hit is nearer), Möller–Trumbore per triangle.
+/// best hit is nearer), Möller–Trumbore per triangle; at an object, the walk goes on in the
+/// level of its chain that the ray's visual `level` picks (eq. 10, [`SceneBvh::pick_level`]).
+/// Triangles are numbered in `bvh.indices`.
 pub fn closest_hit(
     scene: &TracedScene,
     origin: Vec3,
     dir: Vec3,
     limit: f32,
+    level: f32,
     keeps: &dyn Fn(u32, f32, f32, bool) -> bool,
     tests: &Cell<u64>,
 ) -> Option<Hit> {
-    let TracedScene { bvh, vertices, indices } = *scene;
+    let TracedScene { bvh, vertices, min_share } = *scene;
+    let indices = &bvh.indices;
     let mut best: Option<Hit> = None;
     let best_t = |b: &Option<Hit>| b.map_or(limit, |h| h.t);
     let tiny = 1e-20;
@@ -96,10 +105,15 @@ pub fn closest_hit(
     loop {
         let n = &bvh.nodes[node];
         let mut descend = false;
+        if n.count & OBJECT_LEAF != 0 {
+            let levels = &bvh.levels[n.first as usize..(n.first + (n.count & !OBJECT_LEAF)) as usize];
+            node = levels[SceneBvh::pick_level(levels, level, min_share)].root as usize;
+            continue;
+        }
         if n.count > 0 {
             tests.set(tests.get() + n.count as u64);
             for k in 0..n.count {
-                let tri = bvh.primitives[(n.first + k) as usize];
+                let tri = n.first + k;
                 let v0 = position(tri, 0);
                 let (e1, e2) = (position(tri, 1) - v0, position(tri, 2) - v0);
                 let p = dir.cross(e2);
@@ -181,15 +195,10 @@ pub struct TraceOutput {
 }
 
 /// The trace stage on the CPU.
-pub fn trace(
-    params: &TraceParams,
-    vertices: &[SceneVertex],
-    indices: &[u32],
-    bvh: &SceneBvh,
-    table: &MaterialTable,
-) -> TraceOutput {
+pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, table: &MaterialTable) -> TraceOutput {
     let (rays, tests) = (Cell::new(0u64), Cell::new(0u64));
-    let traced = TracedScene { bvh, vertices, indices };
+    let traced = TracedScene { bvh, vertices, min_share: params.lod_min_share };
+    let indices = &bvh.indices;
     let projection = Projection::from(&params.projection);
     let to_scene = Mat4::from_cols_array_2d(&params.to_scene);
     let to_view = glam::Mat3::from_mat4(to_scene).transpose();
@@ -224,6 +233,7 @@ pub fn trace(
                      p: Vec3,
                      view_position: Vec3,
                      frag_xy: Vec2,
+                     level: f32,
                      keeps: &dyn Fn(u32, f32, f32, bool) -> bool| {
         let [a, b, c] = corners(hit.triangle);
         let b0 = 1.0 - hit.b1 - hit.b2;
@@ -252,7 +262,7 @@ pub fn trace(
                 let offset = 1e-4 * p.length().max(1.0);
                 if direct.max_element() > 0.0 {
                     rays.set(rays.get() + 1);
-                    let shadow = closest_hit(&traced, p + offset * facing, l, dist - offset, keeps, &tests);
+                    let shadow = closest_hit(&traced, p + offset * facing, l, dist - offset, level, keeps, &tests);
                     if shadow.is_none() {
                         lit += direct;
                     }
@@ -286,20 +296,22 @@ pub fn trace(
                 let (origin_v, dir_v) = pixel_ray(&projection, eye, frag_xy);
                 // Seed 000's level of detail: untraced outside the visual field, level ×
                 // Reflect_max bounces (eq. 9, rounded).
-                let reflect_max = match gaze {
-                    None => params.reflect_max,
+                // Its rays meet each object at the level of detail eq. 10 gives (level 1: the
+                // original).
+                let (level, reflect_max) = match gaze {
+                    None => (1.0, params.reflect_max),
                     Some(g) => {
                         let level = g.position(dir_v).level();
                         if level <= 0.0 {
                             continue;
                         }
-                        (level * params.reflect_max as f32 + 0.5).floor() as u32
+                        (level, (level * params.reflect_max as f32 + 0.5).floor() as u32)
                     }
                 };
                 let origin = to_scene.transform_point3(origin_v);
                 let dir = to_scene.transform_vector3(dir_v);
                 rays.set(rays.get() + 1);
-                let Some(hit) = closest_hit(&traced, origin, dir, FAR, &keeps, &tests) else { continue };
+                let Some(hit) = closest_hit(&traced, origin, dir, FAR, level, &keeps, &tests) else { continue };
                 let i = (y * projection.width + x) as usize;
                 let view_position = origin_v + hit.t * dir_v;
                 img.error[i] = pixel_error(&projection, eye, view_position, frag_xy, params.error_angle != 0);
@@ -316,7 +328,7 @@ pub fn trace(
                         None => color += weight * background,
                         Some(h) => {
                             let p = o + h.t * d;
-                            let s = shade_hit(&h, d, p, to_view * (p - viewer), frag_xy, &keeps);
+                            let s = shade_hit(&h, d, p, to_view * (p - viewer), frag_xy, level, &keeps);
                             color += weight * s.color;
                             let offset = 1e-4 * p.length().max(1.0);
                             if bounces < reflect_max {
@@ -336,7 +348,7 @@ pub fn trace(
                     let Some(next) = pending.pop() else { break };
                     current = next;
                     rays.set(rays.get() + 1);
-                    current_hit = closest_hit(&traced, next.0, next.2, FAR, &keeps, &tests);
+                    current_hit = closest_hit(&traced, next.0, next.2, FAR, level, &keeps, &tests);
                 }
                 img.rgba[4 * i..4 * i + 4].copy_from_slice(&display_bytes(color));
             }
@@ -344,6 +356,26 @@ pub fn trace(
         img
     });
     TraceOutput { images, rays: rays.get(), triangle_tests: tests.get() }
+}
+
+/// The points the pixels' rays meet at `distances` (per eye, +∞: none → NaN), viewer frame:
+/// a traced frame's surface points (`Frame::positions`).
+pub fn ray_hit_points(projection: &Projection, distances: &[Vec<f32>; 2]) -> [Vec<[f32; 3]>; 2] {
+    std::array::from_fn(|k| {
+        let eye = Eye::BOTH[k];
+        distances[k]
+            .iter()
+            .enumerate()
+            .map(|(i, &t)| {
+                if !t.is_finite() {
+                    return [f32::NAN; 3];
+                }
+                let (x, y) = ((i as u32 % projection.width) as f32 + 0.5, (i as u32 / projection.width) as f32 + 0.5);
+                let (o, d) = pixel_ray(projection, eye, Vec2::new(x, y));
+                (o + t * d).to_array()
+            })
+            .collect()
+    })
 }
 
 /// Linear colour → sRGB bytes as the colour target holds them (`pack_display(linear_to_srgb(c))`).
@@ -354,3 +386,89 @@ fn display_bytes(c: Vec3) -> [u8; 4] {
 
 /// "No hit" distance of a ray (`FAR` in trace.wgsl).
 const FAR: f32 = 3.0e38;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::core::builtin::sphere_scene;
+    use crate::core::bvh::BvhLevel;
+    use crate::core::lod::LodChain;
+    use crate::core::scene::Scene;
+
+    /// The nearest hit of a ray among `triangles` by testing every one (Möller–Trumbore).
+    fn brute_force(vertices: &[SceneVertex], triangles: &[u32], origin: Vec3, dir: Vec3) -> Option<f32> {
+        let mut best: Option<f32> = None;
+        for t in triangles.chunks_exact(3) {
+            let p = |k: usize| Vec3::from(vertices[t[k] as usize].position);
+            let (e1, e2) = (p(1) - p(0), p(2) - p(0));
+            let q = dir.cross(e2);
+            let det = e1.dot(q);
+            if det.abs() < 1e-12 {
+                continue;
+            }
+            let s = origin - p(0);
+            let b1 = s.dot(q) / det;
+            let r = s.cross(e1);
+            let b2 = dir.dot(r) / det;
+            let d = e2.dot(r) / det;
+            if b1 >= 0.0 && b2 >= 0.0 && b1 + b2 <= 1.0 && d > 0.0 && best.is_none_or(|b| d < b) {
+                best = Some(d);
+            }
+        }
+        best
+    }
+
+    /// Through the two-level BVH, a ray of visual level λ meets each object at the chain level
+    /// eq. 10 picks: its hit is the brute-force nearest hit among those levels' triangles.
+    #[test]
+    fn closest_hit_meets_each_object_at_the_level_eq_10_picks() {
+        let mut scene = Scene::new("spheres");
+        for (k, z) in [-2.0f32, -3.0, -4.0].into_iter().enumerate() {
+            let s = sphere_scene(2400, Vec3::new(0.3 * k as f32, 0.1 * k as f32, z), 0.6, "s");
+            scene.add_mesh(format!("s{k}"), &s.vertices, &s.indices);
+        }
+        let chain = LodChain::build(&scene, 0.08);
+        let bvh = SceneBvh::build(&scene.vertices, &chain.levels);
+        let traced = TracedScene { bvh: &bvh, vertices: &scene.vertices, min_share: 0.08 };
+        let tests = Cell::new(0);
+        let mut checked = [0usize; 2];
+        for i in 0..600 {
+            let level = (i % 11) as f32 / 10.0;
+            let a = i as f32 * 0.618;
+            let dir = Vec3::new(0.25 * a.sin(), 0.25 * (1.7 * a).cos(), -1.0).normalize();
+            let origin = Vec3::new(0.05 * (i % 3) as f32, 0.0, 0.0);
+            let picked: Vec<u32> = chain
+                .levels
+                .iter()
+                .map(|object| {
+                    let counts: Vec<BvhLevel> =
+                        object.iter().map(|l| BvhLevel { root: 0, triangles: (l.len() / 3) as u32 }).collect();
+                    object[SceneBvh::pick_level(&counts, level, 0.08)].clone()
+                })
+                .collect::<Vec<_>>()
+                .concat();
+            let want = brute_force(&scene.vertices, &picked, origin, dir);
+            let got = closest_hit(&traced, origin, dir, FAR, level, &|_, _, _, _| true, &tests).map(|h| h.t);
+            match (want, got) {
+                (Some(w), Some(g)) => assert!((w - g).abs() < 1e-4 * w, "ray {i}, level {level}: {g} vs {w}"),
+                (None, None) => {}
+                _ => panic!("ray {i}, level {level}: {got:?} vs brute force {want:?}"),
+            }
+            checked[want.is_some() as usize] += 1;
+        }
+        assert!(checked[1] > 300 && checked[0] > 20, "{checked:?}");
+        // A coarse level is a different surface: the same ray may hit at another distance.
+        let ray = |level| {
+            closest_hit(
+                &traced,
+                Vec3::ZERO,
+                Vec3::new(0.1, 0.05, -1.0).normalize(),
+                FAR,
+                level,
+                &|_, _, _, _| true,
+                &tests,
+            )
+        };
+        assert_ne!(ray(1.0).map(|h| h.triangle), ray(0.0).map(|h| h.triangle));
+    }
+}

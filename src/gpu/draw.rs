@@ -1,5 +1,5 @@
 //! The drawing stages' pipelines (`raster`, `slit`): per scene look (material code or not, back
-//! faces culled or not), with or without the error pass, and per way of drawing the eyes (one
+//! faces culled or not), with or without the error pass (and the positions), and per way of drawing the eyes (one
 //! multiview draw, or a pass per eye), each built when a frame first needs it.
 
 use std::mem::offset_of;
@@ -9,7 +9,7 @@ use crate::core::scene::SceneVertex;
 use crate::gpu::device::{error_target_format, Gpu};
 use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
-use crate::gpu::targets::{Layers, COLOR_FORMAT, DEPTH_FORMAT, OBJECT_FORMAT};
+use crate::gpu::targets::{Layers, COLOR_FORMAT, DEPTH_FORMAT, OBJECT_FORMAT, POSITION_FORMAT};
 use crate::shader::types::DrawVertex;
 use crate::shader::{RASTER, SLIT};
 
@@ -28,7 +28,7 @@ pub(crate) struct DrawPipelines {
     pub stage: GpuStage,
     kind: DrawStage,
     /// By `Self::index`.
-    pipelines: [OnceLock<wgpu::RenderPipeline>; 18],
+    pipelines: [OnceLock<wgpu::RenderPipeline>; 27],
 }
 
 /// What a scene's materials need of a drawing pipeline.
@@ -62,23 +62,29 @@ impl DrawPipelines {
         DrawPipelines { stage, kind, pipelines: std::array::from_fn(|_| OnceLock::new()) }
     }
 
-    fn index(&self, look: Look, measure: bool, layers: Layers) -> usize {
+    fn index(&self, look: Look, outputs: usize, layers: Layers) -> usize {
         let eyes = match (self.kind, layers) {
             (_, Layers::Both) => 0,
             (DrawStage::Slit, Layers::Eye(_)) => 1,
             (DrawStage::Raster, Layers::Eye(k)) => 1 + k.min(1),
         };
-        (look as usize * 2 + measure as usize) * 3 + eyes
+        let outputs = match outputs {
+            1 => 0,
+            4 => 1,
+            _ => 2,
+        };
+        (look as usize * 3 + outputs) * 3 + eyes
     }
 
-    /// The pipeline for a scene's look, with the error pass or not, drawing `layers`.
-    pub fn get(&self, gpu: &Gpu, scene: &GpuScene, measure: bool, layers: Layers) -> &wgpu::RenderPipeline {
-        self.get_look(gpu, Look::of(scene), measure, layers)
+    /// The pipeline for a scene's look, writing `outputs` targets (`MeasureSettings::outputs`),
+    /// drawing `layers`.
+    pub fn get(&self, gpu: &Gpu, scene: &GpuScene, outputs: usize, layers: Layers) -> &wgpu::RenderPipeline {
+        self.get_look(gpu, Look::of(scene), outputs, layers)
     }
 
-    pub fn get_look(&self, gpu: &Gpu, look: Look, measure: bool, layers: Layers) -> &wgpu::RenderPipeline {
-        self.pipelines[self.index(look, measure, layers)]
-            .get_or_init(|| draw_pipeline(gpu, &self.stage, self.kind, look, measure, layers))
+    pub fn get_look(&self, gpu: &Gpu, look: Look, outputs: usize, layers: Layers) -> &wgpu::RenderPipeline {
+        self.pipelines[self.index(look, outputs, layers)]
+            .get_or_init(|| draw_pipeline(gpu, &self.stage, self.kind, look, outputs, layers))
     }
 
     /// The scene's material table (group 1).
@@ -92,7 +98,8 @@ fn attribute(format: wgpu::VertexFormat, offset: usize, shader_location: u32) ->
     wgpu::VertexAttribute { format, offset: offset as u64, shader_location }
 }
 
-/// A drawing pipeline: colour only (`fs_main`) or with the error pass (`fs_error`); with the
+/// A drawing pipeline: colour only (`fs_main`, 1 output), with the error pass (`fs_error`, 4) or
+/// also the surface points (`fs_position`, 5); with the
 /// fragment stage's material code (`MATERIALS`) or without; culling back faces (counter-clockwise
 /// on screen is the front, as `front_facing` in the fragment stage) or not; both eyes as a
 /// multiview pipeline, or one (the raster stage's `EYE`).
@@ -101,7 +108,7 @@ fn draw_pipeline(
     stage: &GpuStage,
     kind: DrawStage,
     look: Look,
-    measure: bool,
+    outputs: usize,
     layers: Layers,
 ) -> wgpu::RenderPipeline {
     use wgpu::VertexFormat::{Float32, Float32x2, Float32x3, Float32x4, Uint32};
@@ -136,9 +143,9 @@ fn draw_pipeline(
         step_mode: wgpu::VertexStepMode::Vertex,
         attributes: &attributes,
     };
-    let all_targets =
-        [COLOR_FORMAT, error_target_format(gpu.error_target), OBJECT_FORMAT, error_target_format(gpu.error_target)]
-            .map(|format| Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL }));
+    let error = error_target_format(gpu.error_target);
+    let all_targets = [COLOR_FORMAT, error, OBJECT_FORMAT, error, POSITION_FORMAT]
+        .map(|format| Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL }));
     let mut constants = vec![("MATERIALS", (look != Look::Plain) as u32 as f64)];
     let multiview_mask = match layers {
         Layers::Both => std::num::NonZeroU32::new(0b11),
@@ -174,9 +181,13 @@ fn draw_pipeline(
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
             module: &stage.module,
-            entry_point: Some(if measure { "fs_error" } else { "fs_main" }),
+            entry_point: Some(match outputs {
+                1 => "fs_main",
+                4 => "fs_error",
+                _ => "fs_position",
+            }),
             compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
-            targets: if measure { &all_targets } else { &all_targets[..1] },
+            targets: &all_targets[..outputs],
         }),
         multiview_mask,
         cache: None,

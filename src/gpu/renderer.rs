@@ -89,9 +89,15 @@ pub(crate) struct FrameResources {
 
 impl FrameResources {
     /// The targets for this size, made anew only when the size changed.
-    pub fn targets(&mut self, gpu: &Gpu, width: u32, height: u32) -> &Targets {
-        if !self.targets.as_ref().is_some_and(|t| t.width == width && t.height == height) {
-            self.targets = Some(Targets::new(gpu, width, height));
+    /// The targets for this size (with the positions target if `positions`), made anew only
+    /// when the size changed or the positions target is wanted and missing.
+    pub fn targets(&mut self, gpu: &Gpu, width: u32, height: u32, positions: bool) -> &Targets {
+        if !self
+            .targets
+            .as_ref()
+            .is_some_and(|t| t.width == width && t.height == height && (t.position.is_some() || !positions))
+        {
+            self.targets = Some(Targets::new(gpu, width, height, positions));
         }
         self.targets.as_ref().expect("just made")
     }
@@ -142,7 +148,7 @@ impl Renderer {
             };
             let raster = DrawPipelines::new(&gpu, DrawStage::Raster);
             // The usual pipeline now, for the same reason.
-            raster.get_look(&gpu, Look::Plain, false, Layers::passes(gpu.eyes_per_draw)[0]);
+            raster.get_look(&gpu, Look::Plain, 1, Layers::passes(gpu.eyes_per_draw)[0]);
             Ok((
                 subdivide,
                 raster,
@@ -417,7 +423,7 @@ impl Renderer {
         let bind_group = self.raster.stage.bind_group(&self.gpu, None, 0, &[uniform]);
         let passes = Layers::passes(self.gpu.eyes_per_draw);
         for (k, &layers) in passes.iter().enumerate() {
-            let pipeline = self.raster.get(&self.gpu, scene, settings.measure.targets(), layers);
+            let pipeline = self.raster.get(&self.gpu, scene, settings.measure.outputs(), layers);
             let writes = timestamps.map(|(q, begin, end)| wgpu::RenderPassTimestampWrites {
                 query_set: q,
                 beginning_of_pass_write_index: (k == 0).then_some(begin),
@@ -486,6 +492,7 @@ impl Renderer {
         let [left, right] = targets.read_colors(&self.gpu)?;
         stats.ms_readback = t.elapsed().as_secs_f64() * 1e3;
         let depth = if settings.measure.depth { Some(targets.read_distances(&self.gpu)?) } else { None };
+        let positions = if settings.measure.positions { Some(targets.read_positions(&self.gpu)?) } else { None };
         let measurement = if settings.measure.error {
             let object = targets.read_objects(&self.gpu)?;
             let (stats, error) = self.reduce_errors(targets, settings.measure.reduce_per_eye)?;
@@ -494,7 +501,7 @@ impl Renderer {
             None
         };
         stats.ms_total = start.elapsed().as_secs_f64() * 1e3;
-        Ok(Frame { left, right, stats, measurement, depth })
+        Ok(Frame { left, right, stats, measurement, depth, positions })
     }
 
     /// The subdivided frame: follows the [`FramePlan`].
@@ -507,7 +514,7 @@ impl Renderer {
         let start = Instant::now();
         let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, ..Default::default() };
         let p = settings.projection();
-        res.targets(&self.gpu, p.width, p.height);
+        res.targets(&self.gpu, p.width, p.height, settings.measure.positions);
         let budget = Capacities::budget(settings.subdivision.memory_mb, self.gpu.max_binding());
         let n = scene.triangle_count;
         let mut plan = FramePlan::first(n, res.buffers.as_ref().map(|b| b.capacity), budget);

@@ -41,10 +41,12 @@ pub struct GpuScene {
     pub bvh: Option<GpuBvh>,
 }
 
-/// A scene's BVH on the GPU ([`SceneBvh`]): nodes and leaf triangle indices.
+/// A scene's BVH on the GPU ([`SceneBvh`]): nodes, the objects' chains of levels, and the
+/// triangles (every level's, leaf by leaf).
 pub struct GpuBvh {
     pub nodes: wgpu::Buffer,
-    pub primitives: wgpu::Buffer,
+    pub levels: wgpu::Buffer,
+    pub indices: wgpu::Buffer,
     pub node_count: usize,
 }
 
@@ -119,21 +121,27 @@ impl GpuScene {
         })
     }
 
-    /// The same scene with its BVH built (on the CPU) and uploaded, for the ray tracer. Fails
-    /// with one line if the tree is deeper than the traversal's stack or too big for the device.
-    pub fn with_bvh(mut self, gpu: &Gpu, scene: &Scene) -> Result<GpuScene> {
-        let bvh = SceneBvh::build(&scene.vertices, &scene.indices);
+    /// The same scene with its BVH built (on the CPU, one level per object) and uploaded, for
+    /// the ray tracer. Fails with one line if the tree is deeper than the traversal's stack or
+    /// too big for the device.
+    pub fn with_bvh(self, gpu: &Gpu, scene: &Scene) -> Result<GpuScene> {
+        self.with_built_bvh(gpu, &scene.name, &SceneBvh::of_scene(scene))
+    }
+
+    /// The same scene with `bvh` (built over its vertices, e.g. with a level-of-detail chain
+    /// per object) uploaded; `name` names the scene in errors.
+    pub fn with_built_bvh(mut self, gpu: &Gpu, name: &str, bvh: &SceneBvh) -> Result<GpuScene> {
         let depth = bvh.depth();
         if depth > TRACE_STACK {
             return Err(Error::scene(
-                &scene.name,
+                name,
                 format!("its BVH is {depth} levels deep, more than the ray tracer's stack of {TRACE_STACK}"),
             ));
         }
-        let bytes = std::mem::size_of_val(bvh.nodes.as_slice()) as u64;
+        let bytes = std::mem::size_of_val(bvh.nodes.as_slice()).max(4 * bvh.indices.len()) as u64;
         if bytes > gpu.max_binding() {
             return Err(Error::scene(
-                &scene.name,
+                name,
                 format!(
                     "its BVH ({} MiB) is larger than this GPU binds ({} MiB)",
                     bytes >> 20,
@@ -141,11 +149,14 @@ impl GpuScene {
                 ),
             ));
         }
-        self.bvh = Some(gpu.scoped(&format!("uploading the BVH of {}", scene.name), || {
+        self.bvh = Some(gpu.scoped(&format!("uploading the BVH of {name}"), || {
             let storage = |label: &str, bytes: &[u8]| gpu.init_buffer(label, bytes, wgpu::BufferUsages::STORAGE);
+            // An empty chain table still needs a binding.
+            let levels: &[u8] = if bvh.levels.is_empty() { &[0; 8] } else { bytemuck::cast_slice(&bvh.levels) };
             Ok(GpuBvh {
                 nodes: storage("bvh nodes", bytemuck::cast_slice(&bvh.nodes)),
-                primitives: storage("bvh primitives", bytemuck::cast_slice(&bvh.primitives)),
+                levels: storage("bvh levels", levels),
+                indices: storage("bvh triangles", bytemuck::cast_slice(&bvh.indices)),
                 node_count: bvh.nodes.len(),
             })
         })?);

@@ -16,6 +16,8 @@ use crate::shader::{ErrorTarget, EyesPerDraw};
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 pub const OBJECT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// The surface point each pixel shows (viewer frame) in xyz, w = 1 (0: background).
+pub const POSITION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 /// Which layers a render pass draws.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -44,12 +46,14 @@ pub struct Targets {
     pub object: wgpu::Texture,
     /// Distance from each pixel's eye point (the error target's format).
     pub distance: wgpu::Texture,
+    /// The surface points (`POSITION_FORMAT`), made only when asked for (16 bytes a pixel).
+    pub position: Option<wgpu::Texture>,
     pub depth: wgpu::Texture,
     error_target: ErrorTarget,
 }
 
 impl Targets {
-    pub fn new(gpu: &Gpu, width: u32, height: u32) -> Targets {
+    pub fn new(gpu: &Gpu, width: u32, height: u32, positions: bool) -> Targets {
         let make = |format, usage, label: &str| {
             gpu.device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
@@ -74,6 +78,7 @@ impl Targets {
             error: make(error_format, copyable, "error"),
             object: make(OBJECT_FORMAT, copyable, "object"),
             distance: make(error_format, copyable, "distance"),
+            position: positions.then(|| make(POSITION_FORMAT, copyable, "position")),
             depth: make(DEPTH_FORMAT, depth, "depth"),
             error_target: gpu.error_target,
         }
@@ -81,7 +86,8 @@ impl Targets {
 
     /// Begins a render pass drawing `layers`, clearing their targets first if `clear`
     /// (background colour, error −1, object 0, distance +∞, depth 1); the error, object and
-    /// distance targets only when measuring (`MeasureSettings::targets`).
+    /// distance targets only when measuring (`MeasureSettings::targets`), and the positions
+    /// target when it is measured too.
     pub fn begin_pass<'e>(
         &self,
         enc: &'e mut wgpu::CommandEncoder,
@@ -90,7 +96,7 @@ impl Targets {
         clear: bool,
         timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'e>>,
     ) -> wgpu::RenderPass<'e> {
-        let outputs = if settings.measure.targets() { 4 } else { 1 };
+        let outputs = settings.measure.outputs();
         let (dimension, base_array_layer, array_layer_count, multiview_mask) = match layers {
             Layers::Eye(k) => (wgpu::TextureViewDimension::D2, k as u32, 1, None),
             Layers::Both => (wgpu::TextureViewDimension::D2Array, 0, 2, std::num::NonZeroU32::new(0b11)),
@@ -103,8 +109,10 @@ impl Targets {
                 ..Default::default()
             })
         };
-        let views: Vec<wgpu::TextureView> =
-            [&self.color, &self.error, &self.object, &self.distance][..outputs].iter().map(|t| view(t)).collect();
+        let position = (outputs > 4)
+            .then(|| self.position.as_ref().expect("the targets were made with positions where they are measured"));
+        let all = [&self.color, &self.error, &self.object, &self.distance];
+        let views: Vec<wgpu::TextureView> = all.into_iter().chain(position).take(outputs).map(view).collect();
         let depth_view = view(&self.depth);
         // The background is given as display values; the sRGB target takes linear ones.
         let [r, g, b] = settings.shading.background.map(|c| srgb_to_linear(c) as f64);
@@ -117,6 +125,7 @@ impl Targets {
             wgpu::Color { r: value(-1.0), ..wgpu::Color::TRANSPARENT },
             wgpu::Color::TRANSPARENT,
             wgpu::Color { r: value(f32::INFINITY), ..wgpu::Color::TRANSPARENT },
+            wgpu::Color::TRANSPARENT,
         ];
         let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = views
             .iter()
@@ -169,6 +178,26 @@ impl Targets {
         Ok(words.map(|v| v.into_iter().map(f32::from_bits).collect()))
     }
 
+    /// Reads both eyes' surface points back (NaN where no surface is drawn).
+    pub fn read_positions(&self, gpu: &Gpu) -> Result<[Vec<[f32; 3]>; 2]> {
+        let texture = self.position.as_ref().expect("made with positions");
+        let (buffer, stride) = copy_eyes_to_buffer(gpu, texture, wgpu::BufferUsages::COPY_SRC);
+        let words = unpad_eyes(&gpu.download(&buffer, buffer.size())?, 4 * self.width, self.height, stride);
+        Ok(words.map(|v| {
+            v.chunks_exact(4)
+                .map(
+                    |p| {
+                        if f32::from_bits(p[3]) > 0.0 {
+                            [0, 1, 2].map(|k| f32::from_bits(p[k]))
+                        } else {
+                            [f32::NAN; 3]
+                        }
+                    },
+                )
+                .collect()
+        }))
+    }
+
     /// Reads both eyes' object ids back.
     pub fn read_objects(&self, gpu: &Gpu) -> Result<[Vec<u32>; 2]> {
         let (buffer, stride) = copy_eyes_to_buffer(gpu, &self.object, wgpu::BufferUsages::COPY_SRC);
@@ -176,11 +205,12 @@ impl Targets {
     }
 }
 
-/// Copies both layers (eyes) of a 4-byte-per-texel target into one buffer (rows padded to 256
-/// bytes, eyes one after the other). Returns the buffer and the padded row length in texels.
+/// Copies both layers (eyes) of a target into one buffer (rows padded to 256 bytes, eyes one
+/// after the other). Returns the buffer and the padded row length in 4-byte words.
 pub fn copy_eyes_to_buffer(gpu: &Gpu, texture: &wgpu::Texture, usage: wgpu::BufferUsages) -> (wgpu::Buffer, u32) {
     let (w, h) = (texture.width(), texture.height());
-    let padded = (4 * w).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let texel = texture.format().block_copy_size(None).expect("a colour format");
+    let padded = (texel * w).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("eye texels"),
         size: 2 * (padded as u64 * h as u64),
@@ -211,7 +241,7 @@ pub fn copy_eyes_to_buffer(gpu: &Gpu, texture: &wgpu::Texture, usage: wgpu::Buff
     (buffer, padded / 4)
 }
 
-/// Unpads the texels of both eyes from a buffer made by [`copy_eyes_to_buffer`].
+/// Unpads the texels of both eyes from a buffer made by [`copy_eyes_to_buffer`] (`w`: words per row).
 pub fn unpad_eyes(data: &[u8], w: u32, h: u32, stride: u32) -> [Vec<u32>; 2] {
     let words: &[u32] = bytemuck::cast_slice(data);
     std::array::from_fn(|k| {

@@ -7,7 +7,7 @@ use std::time::Instant;
 
 use crate::core::frame::{Frame, FrameStats};
 use crate::core::settings::RenderSettings;
-use crate::cpu::trace::trace_params;
+use crate::cpu::trace::{ray_hit_points, trace_params};
 use crate::error::{Error, Result};
 use crate::gpu::renderer::{FrameResources, Renderer};
 use crate::gpu::scene::GpuScene;
@@ -46,7 +46,7 @@ impl Renderer {
                 ),
             ));
         }
-        res.targets(gpu, p.width, p.height);
+        res.targets(gpu, p.width, p.height, false);
         if !res.trace_outputs.as_ref().is_some_and(|(r, h, _)| *r == row_texels && *h == p.height) {
             let make = |what: &str| gpu.storage_buffer(&format!("trace {what}"), bytes, wgpu::BufferUsages::empty());
             res.trace_outputs = Some((row_texels, p.height, ["colour", "error", "object", "distance"].map(make)));
@@ -75,9 +75,9 @@ impl Renderer {
             &[
                 &res.trace_params,
                 &scene.vertices,
-                &scene.indices,
+                &bvh.indices,
                 &bvh.nodes,
-                &bvh.primitives,
+                &bvh.levels,
                 color,
                 error,
                 object,
@@ -127,6 +127,16 @@ impl Renderer {
         let words: &[u32] = bytemuck::cast_slice(&words);
         stats.rays_traced = Some(words.iter().step_by(2).map(|&w| w as u64).sum());
         stats.triangle_tests = Some(words.iter().skip(1).step_by(2).map(|&w| w as u64).sum());
-        self.finish_frame(targets, settings, stats, start)
+        // The surface points are where the pixels' rays meet their hits.
+        let wanted = settings.measure.positions;
+        let inner = settings.with_positions(false).with_depth(settings.measure.depth || wanted);
+        let mut frame = self.finish_frame(targets, &inner, stats, start)?;
+        if wanted {
+            frame.positions = Some(ray_hit_points(p, frame.depth.as_ref().expect("read with the positions")));
+            if !settings.measure.depth {
+                frame.depth = None;
+            }
+        }
+        Ok(frame)
     }
 }

@@ -23,7 +23,8 @@ pub mod types;
 pub enum StageKind {
     /// Compute entry points.
     Compute,
-    /// A vertex + fragment pipeline (`vs_main`; `fs_main`, and `fs_error` with the error pass).
+    /// A vertex + fragment pipeline (`vs_main`; `fs_main`, and `fs_error` with the error pass,
+    /// `fs_position` also writing the surface points).
     Draw,
 }
 
@@ -151,6 +152,7 @@ pub const RASTER: Stage = Stage {
         entry("vs_main", &["params"]),
         entry("fs_main", &["params", "materials", "mips", "texels"]),
         entry("fs_error", &["params", "materials", "mips", "texels"]),
+        entry("fs_position", &["params", "materials", "mips", "texels"]),
     ],
     bindings: &[bind(0, 0, "params", Uniform), MATERIAL_TABLE[0], MATERIAL_TABLE[1], MATERIAL_TABLE[2]],
 };
@@ -163,6 +165,7 @@ pub const SLIT: Stage = Stage {
         entry("vs_main", &["params", "cameras"]),
         entry("fs_main", &["params", "materials", "mips", "texels"]),
         entry("fs_error", &["params", "materials", "mips", "texels"]),
+        entry("fs_position", &["params", "materials", "mips", "texels"]),
     ],
     bindings: &[
         bind(0, 0, "params", Uniform),
@@ -184,7 +187,7 @@ pub const TRACE: Stage = Stage {
             "vertices",
             "indices",
             "bvh_nodes",
-            "bvh_primitives",
+            "bvh_levels",
             "out_color",
             "out_error",
             "out_object",
@@ -200,7 +203,7 @@ pub const TRACE: Stage = Stage {
         bind(0, 1, "vertices", Storage),
         bind(0, 2, "indices", Storage),
         bind(0, 3, "bvh_nodes", Storage),
-        bind(0, 4, "bvh_primitives", Storage),
+        bind(0, 4, "bvh_levels", Storage),
         bind(0, 5, "out_color", StorageReadWrite),
         bind(0, 6, "out_error", StorageReadWrite),
         bind(0, 7, "out_object", StorageReadWrite),

@@ -6,7 +6,7 @@ use std::mem::{offset_of, size_of};
 
 use bytemuck::{Pod, Zeroable};
 
-pub use crate::core::bvh::BvhNode;
+pub use crate::core::bvh::{BvhLevel, BvhNode};
 use crate::core::material::{Material, MipLevel};
 use crate::core::projection::{PanoramaKind, Projection, Vertical};
 use crate::core::scene::SceneVertex;
@@ -301,7 +301,7 @@ macro_rules! layout {
     };
 }
 
-/// `TraceParams` in shaders/trace.wgsl. 208 bytes.
+/// `TraceParams` in shaders/trace.wgsl. 224 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct TraceParams {
@@ -323,6 +323,11 @@ pub struct TraceParams {
     pub row_texels: u32,
     /// Bounces of mirror and refraction rays (`ShadingSettings::reflect_max`).
     pub reflect_max: u32,
+    /// N_min / N_max of eq. 10 (`ShadingSettings::trace_min_share`).
+    pub lod_min_share: f32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
 }
 
 /// Every struct the stages bind (as a uniform or in a storage buffer), by its WGSL name.
@@ -343,8 +348,9 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("RasterParams" => RasterParams { projection, eye_sign, ambient, shift_px, error_angle, _pad0, _pad1, _pad2 }),
     layout!("SlitParams" => SlitParams { view, projection, eye_sign, ambient, near, error_angle }),
     layout!("SlitCamera" => SlitCamera { origin_sx, right_cx, up_cy, forward_sy }),
-    layout!("TraceParams" => TraceParams { to_scene, projection, background, light, gaze_forward, gaze_right, gaze_up, ambient, error_angle, row_texels, reflect_max }),
+    layout!("TraceParams" => TraceParams { to_scene, projection, background, light, gaze_forward, gaze_right, gaze_up, ambient, error_angle, row_texels, reflect_max, lod_min_share, _pad0, _pad1, _pad2 }),
     layout!("BvhNode" => BvhNode { min, first, max, count }),
+    layout!("BvhLevel" => BvhLevel { root, triangles }),
     layout!("ProjectParams" => ProjectParams { projection, eye_sign, count, _pad }),
     layout!("Material" => Material {
         texture, wrap_u, wrap_v, mag_filter, min_filter, mipmap, alpha_mode, alpha_cutoff, double_sided,

@@ -5,6 +5,7 @@
 pub mod figures;
 pub mod lod;
 pub mod speed;
+pub mod trace_lod;
 
 use std::path::{Path, PathBuf};
 
@@ -30,6 +31,8 @@ pub enum Figure {
     Fig12,
     /// Seed 001's level-of-detail simulation (`bench_lod`).
     Lod,
+    /// Seed 000's ray-tracing level-of-detail experiment (Table 2).
+    TraceLod,
     All,
 }
 
@@ -109,9 +112,17 @@ pub fn run(runner: &Runner, which: Figure, adapter: &str) -> Result<String> {
     let steps = (if want(Figure::Fig8) { 3 * cfg.fig8_divisions().len() } else { 0 })
         + (if want(Figure::Fig10) { cases.len() * cfg.fig10_methods().len() } else { 0 })
         + (if want(Figure::Fig12) { cases.len() * (1 + cfg.slit_widths().len()) } else { 0 })
-        + (if want(Figure::Lod) { runner.lod_steps() } else { 0 });
+        + (if want(Figure::Lod) { runner.lod_steps() } else { 0 })
+        + (if want(Figure::TraceLod) { runner.trace_lod_steps() } else { 0 });
     runner.progress.set_length(steps as u64);
-    let mut report = format!(
+    let mut report = if which == Figure::TraceLod {
+        format!(
+            "# twister: seed 000's ray-tracing experiment\n\nAdapter: {adapter}. Times: median of {} frames after a warm-up{}.\n\n",
+            cfg.reps,
+            if cfg.quick { " (quick run: lower resolution)" } else { "" },
+        )
+    } else {
+        format!(
         "# twister: the paper's evaluations (seed 002 §4)\n\nAdapter: {adapter}. Image {}x{} per eye, both eyes, R_T = {} m, d_e = {} m, \
          paper vertical model. Times: median of {} frames after a warm-up{}. Errors: one more frame with the error pass.\n\n",
         cfg.projection.width,
@@ -120,7 +131,8 @@ pub fn run(runner: &Runner, which: Figure, adapter: &str) -> Result<String> {
         cfg.projection.eye_radius,
         cfg.reps,
         if cfg.quick { " (quick run: lower resolution, fewer points)" } else { "" },
-    );
+        )
+    };
     for line in &skipped {
         report += &format!("- **{line}**\n");
     }
@@ -148,6 +160,11 @@ pub fn run(runner: &Runner, which: Figure, adapter: &str) -> Result<String> {
         let (section, timing) = lod_section(runner)?;
         report += &section;
         timing_note = timing_note.or(timing);
+    }
+    if want(Figure::TraceLod) {
+        let (points, chain, absent) = runner.trace_lod()?;
+        timing_note = timing_note.or(points.first().map(|p| p.timing.clone()));
+        report += &trace_lod::report(&cfg.out, &points, &chain, absent, &runner.trace_lod_projection())?;
     }
     if let Some(t) = timing_note {
         report += &format!(
@@ -273,7 +290,9 @@ pub enum BenchCommand {
     Fig12(FigureArgs),
     /// Seed 001: 12 bunnies, the gaze swept, with and without the visual-field level of detail.
     Lod(FigureArgs),
-    /// Every benchmark figure: fig8, fig10, fig12 and lod.
+    /// Seed 000 Table 2: 8 cows, ray traced with and without the visual-field level of detail.
+    TraceLod(FigureArgs),
+    /// Every benchmark figure: fig8, fig10, fig12, lod and trace-lod.
     All(FigureArgs),
 }
 
