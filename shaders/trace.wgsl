@@ -39,8 +39,8 @@ struct TraceParams {
     row_texels: u32,    // padded row length of the outputs; an eye's rows follow the other's
     reflect_max: u32,   // bounces of mirror and refraction rays (seed 000's Reflect_max)
     lod_min_share: f32, // N_min / N_max of eq. 10
-    _pad0: u32,
-    _pad1: u32,
+    original_root: u32, // where rays that meet every original start (SceneBvh::original_root)
+    original_level: f32, // rays above this visual level do (SceneBvh::original_level)
     _pad2: u32,
 }
 
@@ -120,12 +120,15 @@ fn keeps(triangle: u32, b1: f32, b2: f32, front: bool, frag_xy: vec2<f32>) -> bo
 fn pick_level(first: u32, count: u32, level: f32) -> u32 {
     let max = f32(bvh_levels[first].triangles);
     let wanted = level * (max - params.lod_min_share * max) + params.lod_min_share * max;
-    for (var k = count - 1u; k > 0u; k--) {
-        if (f32(bvh_levels[first + k].triangles) >= wanted) {
-            return first + k;
+    // The counts fall along the chain: the last level still ≥ N_j.
+    var k = 0u;
+    loop {
+        if (k + 1u >= count || f32(bvh_levels[first + k + 1u].triangles) < wanted) {
+            break;
         }
+        k += 1u;
     }
-    return first;
+    return first + k;
 }
 
 // The closest kept hit along the ray (scene frame) nearer than `limit` for a ray of visual
@@ -136,14 +139,15 @@ fn closest_hit(origin: vec3<f32>, dir: vec3<f32>, frag_xy: vec2<f32>, limit: f32
     let tiny = vec3<f32>(1e-20);
     let safe = select(dir, select(tiny, -tiny, dir < vec3<f32>(0.0)), abs(dir) < tiny);
     let inv = 1.0 / safe;
-    if (enter_box(bvh_nodes[0], origin, inv, limit) == FAR) {
+    // Rays that meet every object's original start at the tree over all of them.
+    var node = select(0u, params.original_root, level > params.original_level);
+    if (enter_box(bvh_nodes[node], origin, inv, limit) == FAR) {
         return best;
     }
     // Nodes still to visit, with the distance where the ray enters their box.
     var stack_node: array<u32, TRACE_STACK>;
     var stack_t: array<f32, TRACE_STACK>;
     var depth = 0u;
-    var node = 0u;
     loop {
         let n = bvh_nodes[node];
         var descend = false;

@@ -730,6 +730,7 @@ fn error_against_trace_reports_surfaces_and_distances_against_the_traced_hits() 
         assert_eq!(j["against"], "trace");
         assert!(f(&j, "different_surface_fraction") < 0.005, "{j}");
         assert!(f(&j, "depth_rel_p99") < 1e-3, "{j}");
+        assert!(f(&j, "different_triangle_fraction") < 0.01, "{j}");
         // The display-position error found on the traced image is the analytic one's.
         assert!((f(&j, "traced_mean_px") - f(&j, "mean_px")).abs() <= 0.03 * f(&j, "mean_px") + 0.01, "{j}");
         assert!(f(&j, "traced_pixels") > 0.95 * f(&j, "pixels") && f(&j, "traced_unmatched") < 0.01 * f(&j, "pixels"));

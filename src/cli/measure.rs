@@ -102,6 +102,7 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
         json["psnr_db"] = serde_json::json!(c.psnr_db);
         json["depth_rel_mean"] = serde_json::json!(c.depth_rel_mean);
         json["depth_rel_p99"] = serde_json::json!(c.depth_rel_p99);
+        json["different_triangle_fraction"] = serde_json::json!(c.different_triangle_fraction);
         if let Some(t) = c.traced_error {
             json["traced_mean_px"] = serde_json::json!(t.mean_px);
             json["traced_p99_px"] = serde_json::json!(t.p99_px);
@@ -150,10 +151,16 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
                 json["max_arcmin"].as_f64().unwrap_or(f64::NAN)
             );
         }
-        if let Some(f) = json.get("different_surface_fraction") {
+        if json.get("different_surface_fraction").is_some() {
+            let num = |k: &str| json[k].as_f64().map_or("—".to_string(), |v| format!("{v:.3e}"));
             println!(
-                "against {}: different surface on {:.4} of pixels, PSNR {} dB, distance off by {} (mean) / {} (p99) of the reference's",
-                json["against"], f, json["psnr_db"], json["depth_rel_mean"], json["depth_rel_p99"]
+                "against {}: different surface on {} of pixels (another triangle of the same object on {}), PSNR {} dB, distance off by {} (mean) / {} (p99) of the reference's",
+                json["against"].as_str().unwrap_or(""),
+                num("different_surface_fraction"),
+                num("different_triangle_fraction"),
+                json["psnr_db"].as_f64().map_or("∞".to_string(), |v| format!("{v:.2}")),
+                num("depth_rel_mean"),
+                num("depth_rel_p99")
             );
         }
         if let Some(m) = json.get("traced_mean_px") {

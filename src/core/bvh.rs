@@ -14,7 +14,9 @@
 //!   (the triangles of every level, laid out leaf by leaf, so no second indirection is needed).
 //!
 //! The root is node 0. Objects with a single level (every object, without a level-of-detail
-//! chain) share one tree: one top-level leaf over all their triangles.
+//! chain) share one tree: one top-level leaf over all their triangles. With chains, one more tree
+//! over every object's original, not under the top level, is where rays of level 1 start
+//! ([`SceneBvh::original_root`]).
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3A;
@@ -53,6 +55,13 @@ pub struct SceneBvh {
     pub levels: Vec<BvhLevel>,
     /// Three vertex indices per triangle, every level's triangles, leaf by leaf.
     pub indices: Vec<u32>,
+    /// Where rays that meet every object's original start (see [`SceneBvh::original_level`]):
+    /// the root of a tree over every object's original (its level 0) when some object has a
+    /// chain, else the root (node 0). The same hits as through the top level, faster.
+    pub original_root: u32,
+    /// The largest share of its original that an object's first simplified level keeps
+    /// (0 without chains).
+    pub first_step: f32,
 }
 
 /// The obvhs build of `triangles` (three indices each, over `vertices`), or None if there are none.
@@ -94,8 +103,10 @@ impl SceneBvh {
     /// one before, as `LodChain::levels`). The objects with one level only share one tree (a
     /// top level over objects whose boxes overlap, as in an atrium, costs rays up to twice the
     /// time of one tree over all their triangles: measured on Sponza); each object with a chain
-    /// gets a tree per level. Objects without triangles are left out; an empty scene gets one
-    /// leaf with an empty box, which no ray enters.
+    /// gets a tree per level, and then one more tree over every object's original serves the
+    /// rays that meet the originals everywhere (level 1: the central field), at plain tracing's
+    /// speed ([`SceneBvh::original_root`]). Objects without triangles are left out; an empty
+    /// scene gets one leaf with an empty box, which no ray enters.
     pub fn build(vertices: &[SceneVertex], chains: &[Vec<Vec<u32>>]) -> SceneBvh {
         let mut out = SceneBvh::default();
         let pooled: Vec<u32> = chains.iter().filter(|c| c.len() == 1).flat_map(|c| c[0].iter().copied()).collect();
@@ -105,28 +116,34 @@ impl SceneBvh {
             .map(|c| c.iter().map(|l| l.as_slice()).collect())
             .chain((!pooled.is_empty()).then(|| vec![pooled.as_slice()]))
             .collect();
+        let mut subtrees: Vec<BvhNode> = Vec::new();
+        // Appends the tree of `level`'s triangles to the subtrees and its triangles (leaf by
+        // leaf) to the indices; its root (in the subtrees) and box.
+        let mut add_tree = |level: &[u32], out: &mut SceneBvh| {
+            let tree = build_tree(vertices, level)?;
+            let (base, triangle_base) = (subtrees.len() as u32, (out.indices.len() / 3) as u32);
+            for n in &tree.nodes {
+                subtrees.push(if n.prim_count == 0 {
+                    node(n, base + n.first_index, 0)
+                } else {
+                    node(n, triangle_base + n.first_index, n.prim_count)
+                });
+            }
+            for &p in &tree.primitive_indices {
+                out.indices.extend_from_slice(&level[3 * p as usize..3 * p as usize + 3]);
+            }
+            Some((base, tree.nodes[0].aabb))
+        };
         // The top level over the groups' boxes (their level 0's root box), one group per leaf.
         let mut boxes = Vec::new();
         let mut object_levels = Vec::new();
-        let mut subtrees: Vec<BvhNode> = Vec::new();
         for chain in &groups {
             let first_level = out.levels.len() as u32;
             let mut object_box = None;
             for level in chain {
-                let Some(tree) = build_tree(vertices, level) else { continue };
-                object_box.get_or_insert(tree.nodes[0].aabb);
-                let (base, triangle_base) = (subtrees.len() as u32, (out.indices.len() / 3) as u32);
-                for n in &tree.nodes {
-                    subtrees.push(if n.prim_count == 0 {
-                        node(n, base + n.first_index, 0)
-                    } else {
-                        node(n, triangle_base + n.first_index, n.prim_count)
-                    });
-                }
-                for &p in &tree.primitive_indices {
-                    out.indices.extend_from_slice(&level[3 * p as usize..3 * p as usize + 3]);
-                }
-                out.levels.push(BvhLevel { root: base, triangles: (level.len() / 3) as u32 });
+                let Some((root, b)) = add_tree(level, &mut out) else { continue };
+                object_box.get_or_insert(b);
+                out.levels.push(BvhLevel { root, triangles: (level.len() / 3) as u32 });
             }
             if let Some(b) = object_box {
                 boxes.push(b);
@@ -138,6 +155,12 @@ impl SceneBvh {
             out.indices = vec![0; 3];
             return out;
         }
+        let original = if chains.iter().any(|c| c.len() > 1) {
+            let all: Vec<u32> = chains.iter().filter_map(|c| c.first()).flat_map(|l| l.iter().copied()).collect();
+            add_tree(&all, &mut out).map(|(root, _)| root)
+        } else {
+            None
+        };
         let params = obvhs::BvhBuildParams { max_prims_per_leaf: 1, ..obvhs::BvhBuildParams::medium_build() };
         let mut build_time = std::time::Duration::ZERO;
         let top = obvhs::bvh2::builder::build_bvh2(&boxes, params, &mut build_time);
@@ -162,14 +185,33 @@ impl SceneBvh {
         for l in &mut out.levels {
             l.root += top_len;
         }
+        out.original_root = original.map_or(0, |r| r + top_len);
+        out.first_step =
+            chains.iter().filter(|c| c.len() > 1).map(|c| c[1].len() as f32 / c[0].len() as f32).fold(0.0, f32::max);
         out
+    }
+
+    /// The visual level above which eq. 10 picks every object's original (N_j above each
+    /// object's first simplified level), so that rays start at [`SceneBvh::original_root`]
+    /// (`original_level` in trace.wgsl's parameters); −1 without chains (every ray does).
+    pub fn original_level(&self, min_share: f32) -> f32 {
+        SceneBvh::original_level_of(self.first_step, min_share)
+    }
+
+    /// [`SceneBvh::original_level`] from [`SceneBvh::first_step`].
+    pub fn original_level_of(first_step: f32, min_share: f32) -> f32 {
+        if first_step <= 0.0 {
+            -1.0
+        } else {
+            ((first_step - min_share) / (1.0 - min_share)).min(1.0)
+        }
     }
 
     /// The deepest path from the root through any level's tree (the traversal's stack needs at
     /// most this many entries).
     pub fn depth(&self) -> u32 {
         let mut deepest = 0;
-        let mut stack = vec![(0usize, 1u32)];
+        let mut stack = vec![(0usize, 1u32), (self.original_root as usize, 1u32)];
         while let Some((i, d)) = stack.pop() {
             deepest = deepest.max(d);
             let n = &self.nodes[i];
@@ -191,7 +233,9 @@ impl SceneBvh {
     pub fn pick_level(levels: &[BvhLevel], level: f32, min_share: f32) -> usize {
         let max = levels[0].triangles as f32;
         let wanted = level * (max - min_share * max) + min_share * max;
-        (1..levels.len()).rev().find(|&k| levels[k].triangles as f32 >= wanted).unwrap_or(0)
+        // The levels' counts fall along the chain: the last one still ≥ N_j (rays near the
+        // central field stop at the first step).
+        (1..levels.len()).take_while(|&k| levels[k].triangles as f32 >= wanted).last().unwrap_or(0)
     }
 }
 
@@ -248,36 +292,47 @@ mod tests {
         objects.sort();
         assert_eq!(objects.len(), 3);
         let mut seen = vec![0u32; bvh.indices.len() / 3];
+        // The triangles under a root, every box holding its children and triangles.
+        let walk = |root: u32, seen: &mut Vec<u32>| {
+            let mut found: Vec<[u32; 3]> = Vec::new();
+            let mut stack = vec![root as usize];
+            while let Some(i) = stack.pop() {
+                let n = bvh.nodes[i];
+                let inside = |p: [f32; 3]| (0..3).all(|a| n.min[a] <= p[a] && p[a] <= n.max[a]);
+                if n.count == 0 {
+                    stack.extend([n.first as usize, n.first as usize + 1]);
+                    for c in [bvh.nodes[n.first as usize], bvh.nodes[n.first as usize + 1]] {
+                        assert!(inside(c.min) && inside(c.max), "child box outside its parent");
+                    }
+                } else {
+                    assert!(n.count & OBJECT_LEAF == 0);
+                    for t in n.first..n.first + n.count {
+                        seen[t as usize] += 1;
+                        let tri = [0, 1, 2].map(|k| bvh.indices[3 * t as usize + k]);
+                        assert!(tri.iter().all(|&v| inside(scene.vertices[v as usize].position)));
+                        found.push(tri);
+                    }
+                }
+            }
+            found.sort();
+            found
+        };
+        let sorted = |l: &[u32]| {
+            let mut v: Vec<[u32; 3]> = l.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+            v.sort();
+            v
+        };
         for ((first, count), levels) in objects.iter().zip(&chain.levels) {
             assert_eq!(*count as usize, levels.len());
             for (level, expected) in bvh.levels[*first as usize..(*first + *count) as usize].iter().zip(levels) {
                 assert_eq!(level.triangles as usize, expected.len() / 3);
-                let mut found: Vec<[u32; 3]> = Vec::new();
-                let mut stack = vec![level.root as usize];
-                while let Some(i) = stack.pop() {
-                    let n = bvh.nodes[i];
-                    let inside = |p: [f32; 3]| (0..3).all(|a| n.min[a] <= p[a] && p[a] <= n.max[a]);
-                    if n.count == 0 {
-                        stack.extend([n.first as usize, n.first as usize + 1]);
-                        for c in [bvh.nodes[n.first as usize], bvh.nodes[n.first as usize + 1]] {
-                            assert!(inside(c.min) && inside(c.max), "child box outside its parent");
-                        }
-                    } else {
-                        assert!(n.count & OBJECT_LEAF == 0);
-                        for t in n.first..n.first + n.count {
-                            seen[t as usize] += 1;
-                            let tri = [0, 1, 2].map(|k| bvh.indices[3 * t as usize + k]);
-                            assert!(tri.iter().all(|&v| inside(scene.vertices[v as usize].position)));
-                            found.push(tri);
-                        }
-                    }
-                }
-                let mut want: Vec<[u32; 3]> = expected.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
-                found.sort();
-                want.sort();
-                assert_eq!(found, want);
+                assert_eq!(walk(level.root, &mut seen), sorted(expected));
             }
         }
+        // Rays of level 1 start at one tree over every original.
+        assert_ne!(bvh.original_root, 0);
+        let originals: Vec<u32> = chain.levels.iter().flat_map(|l| l[0].iter().copied()).collect();
+        assert_eq!(walk(bvh.original_root, &mut seen), sorted(&originals));
         assert!(seen.iter().all(|&s| s == 1), "every triangle in exactly one leaf");
         assert!(bvh.depth() > 3);
         // Without chains, the objects share one tree under one top-level leaf.
@@ -285,6 +340,7 @@ mod tests {
         assert_eq!((flat.nodes[0].first, flat.nodes[0].count), (0, OBJECT_LEAF | 1));
         assert_eq!(flat.levels, [BvhLevel { root: 1, triangles: scene.triangle_count() as u32 }]);
         assert_eq!(flat.indices.len(), scene.indices.len());
+        assert_eq!(flat.original_root, 0);
     }
 
     #[test]

@@ -23,6 +23,12 @@ pub struct Comparison {
     /// hit).
     pub depth_rel_mean: Option<f64>,
     pub depth_rel_p99: Option<f64>,
+    /// Where both frames measured depth: of the pixels showing the same object in both, the
+    /// fraction whose distances differ by more than [`SAME_PLANE`] (relative): another triangle
+    /// of that object (a different plane) is shown. The drawing stages' distance is the pixel's
+    /// ray to the drawn triangle's plane, so the same triangle gives the same distance; adjacent
+    /// coplanar triangles count as one surface.
+    pub different_triangle_fraction: Option<f64>,
     /// Where both frames have their surface points (`Frame::positions`), the reference a traced
     /// one: [`traced_display_error`].
     pub traced_error: Option<TracedError>,
@@ -43,6 +49,9 @@ pub struct TracedError {
     /// search), left out of the statistics.
     pub unmatched: u64,
 }
+
+/// The relative distance difference under which two pixels show the same plane.
+pub const SAME_PLANE: f64 = 1e-4;
 
 /// How far the traced image may be searched from a pixel for the point it shows, pixels.
 pub const TRACED_SEARCH_STEPS: usize = 24;
@@ -188,6 +197,8 @@ pub fn compare(frame: &Frame, reference: &Frame) -> Result<Comparison> {
             }
         }
     }
+    let different_triangle_fraction =
+        (!depth.is_empty()).then(|| depth.iter().filter(|&&d| d > SAME_PLANE).count() as f64 / depth.len() as f64);
     depth.sort_by(f64::total_cmp);
     let (depth_rel_mean, depth_rel_p99) = if depth.is_empty() {
         (None, None)
@@ -211,6 +222,7 @@ pub fn compare(frame: &Frame, reference: &Frame) -> Result<Comparison> {
         psnr_db: (mse > 0.0).then(|| 10.0 * (255.0 * 255.0 / mse).log10()),
         depth_rel_mean,
         depth_rel_p99,
+        different_triangle_fraction,
         traced_error,
     })
 }

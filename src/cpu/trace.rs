@@ -39,8 +39,9 @@ pub fn trace_params(settings: &RenderSettings, row_texels: u32) -> TraceParams {
         row_texels,
         reflect_max: settings.shading.reflect_max,
         lod_min_share: settings.shading.trace_min_share,
-        _pad0: 0,
-        _pad1: 0,
+        // Set from the scene's BVH where it is bound (`SceneBvh::original_root`, `original_level`).
+        original_root: 0,
+        original_level: -1.0,
         _pad2: 0,
     }
 }
@@ -97,11 +98,12 @@ pub fn closest_hit(
     let tiny = 1e-20;
     let safe = Vec3::select(dir.abs().cmplt(Vec3::splat(tiny)), Vec3::splat(tiny).copysign(dir), dir);
     let inv = Vec3::ONE / safe;
-    enter_box(&bvh.nodes[0], origin, inv, limit)?;
+    // Rays that meet every object's original start at the tree over all of them.
+    let mut node = if level > bvh.original_level(min_share) { bvh.original_root as usize } else { 0 };
+    enter_box(&bvh.nodes[node], origin, inv, limit)?;
     let position = |tri: u32, k: u32| Vec3::from(vertices[indices[(3 * tri + k) as usize] as usize].position);
     // Nodes still to visit, with the distance where the ray enters their box.
     let mut stack: Vec<(usize, f32)> = Vec::with_capacity(TRACE_STACK as usize);
-    let mut node = 0usize;
     loop {
         let n = &bvh.nodes[node];
         let mut descend = false;

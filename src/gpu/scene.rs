@@ -48,6 +48,9 @@ pub struct GpuBvh {
     pub levels: wgpu::Buffer,
     pub indices: wgpu::Buffer,
     pub node_count: usize,
+    /// [`SceneBvh::original_root`], and the chains' first step ([`SceneBvh::first_step`]).
+    pub original_root: u32,
+    pub first_step: f32,
 }
 
 impl GpuScene {
@@ -158,6 +161,8 @@ impl GpuScene {
                 levels: storage("bvh levels", levels),
                 indices: storage("bvh triangles", bytemuck::cast_slice(&bvh.indices)),
                 node_count: bvh.nodes.len(),
+                original_root: bvh.original_root,
+                first_step: bvh.first_step,
             })
         })?);
         Ok(self)

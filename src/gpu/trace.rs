@@ -5,6 +5,7 @@
 
 use std::time::Instant;
 
+use crate::core::bvh::SceneBvh;
 use crate::core::frame::{Frame, FrameStats};
 use crate::core::settings::RenderSettings;
 use crate::cpu::trace::{ray_hit_points, trace_params};
@@ -14,6 +15,7 @@ use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
 use crate::gpu::timestamps::submit_timed_pass;
 use crate::shader::constants::TRACE_COUNT_SLOTS;
+use crate::shader::types::TraceParams;
 
 impl Renderer {
     pub(crate) fn render_trace(
@@ -65,6 +67,11 @@ impl Renderer {
             (stage, pipelines)
         });
         let params = trace_params(settings, row_texels);
+        let params = TraceParams {
+            original_root: bvh.original_root,
+            original_level: SceneBvh::original_level_of(bvh.first_step, params.lod_min_share),
+            ..params
+        };
         gpu.queue.write_buffer(&res.trace_params, 0, bytemuck::bytes_of(&params));
         let [a, b, c] = &scene.materials;
         let [color, error, object, distance] = outputs;

@@ -325,8 +325,10 @@ pub struct TraceParams {
     pub reflect_max: u32,
     /// N_min / N_max of eq. 10 (`ShadingSettings::trace_min_share`).
     pub lod_min_share: f32,
-    pub _pad0: u32,
-    pub _pad1: u32,
+    /// Where rays that meet every object's original start (`SceneBvh::original_root`), and
+    /// the visual level above which they do (`SceneBvh::original_level`).
+    pub original_root: u32,
+    pub original_level: f32,
     pub _pad2: u32,
 }
 
@@ -348,7 +350,7 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("RasterParams" => RasterParams { projection, eye_sign, ambient, shift_px, error_angle, _pad0, _pad1, _pad2 }),
     layout!("SlitParams" => SlitParams { view, projection, eye_sign, ambient, near, error_angle }),
     layout!("SlitCamera" => SlitCamera { origin_sx, right_cx, up_cy, forward_sy }),
-    layout!("TraceParams" => TraceParams { to_scene, projection, background, light, gaze_forward, gaze_right, gaze_up, ambient, error_angle, row_texels, reflect_max, lod_min_share, _pad0, _pad1, _pad2 }),
+    layout!("TraceParams" => TraceParams { to_scene, projection, background, light, gaze_forward, gaze_right, gaze_up, ambient, error_angle, row_texels, reflect_max, lod_min_share, original_root, original_level, _pad2 }),
     layout!("BvhNode" => BvhNode { min, first, max, count }),
     layout!("BvhLevel" => BvhLevel { root, triangles }),
     layout!("ProjectParams" => ProjectParams { projection, eye_sign, count, _pad }),

@@ -1,17 +1,19 @@
 //! `twister bench trace-lod`: seed 000's experiment (§4, Table 2) on this ray tracer. Eight cows
-//! (`cow/cow.obj`, 5,804 triangles: N_max; N_min = 500) stand on a floor, one point light above
-//! the viewer, Reflect_max = 3, in four scenes: A mirror cows all around, B diffuse cows all
-//! around, C mirror cows ahead only, D diffuse cows ahead only. Each is traced plainly and with
-//! the visual-field level of detail for two gazes: state 1 straight ahead, state 2 down at the
-//! floor; with LOD both with eq. 10 (each cow's chain down to 500 triangles, the level per ray)
-//! and without it (eq. 8–9 only: untraced outside the field, fewer bounces), so that what the
-//! polygon control adds shows apart.
+//! (`cow/cow.obj`, 5,804 triangles: N_max; N_min = 500), one point light above the viewer,
+//! Reflect_max = 3, in four scenes: A mirror cows all around, B diffuse cows all around, C mirror
+//! cows ahead only, D diffuse cows ahead only. Each is traced plainly and with the visual-field
+//! level of detail for two gazes: state 1 straight ahead, state 2 down (the seed's floor screen);
+//! with LOD both with eq. 10 (each cow's chain down to 500 triangles, the level per ray) and
+//! without it (eq. 8–9 only: untraced outside the field, fewer bounces), so that what the polygon
+//! control adds shows apart.
 //!
 //! Choices where the seed is silent or its display differs: the panorama is the full-sphere ODS
-//! (the seed's CAVE had a floor screen; 640×320 per eye, both eyes: 409,600 rays, about the seed's
-//! 256×256×6); the cows are 1.2 m tall, 3 m away (all around: every 45°; ahead: within ±35°, at
-//! 3 and 4.5 m); the eyes are 1.5 m above the floor; the light 2.5 m above the eyes; state 2
-//! gazes 60° down (the floor screen's centre seen from a standing viewer).
+//! (640×320 per eye, both eyes: 409,600 rays, about the seed's 256×256×6). The seed's CAVE had a
+//! front, a right and a floor screen, and "all around" put cows evenly on all three: here four
+//! cows stand around the viewer at eye level (every 90°, 2.5 m away) and four below it (45° down,
+//! between them), as on a floor screen; "ahead only" puts all eight within ±35° of straight ahead
+//! (two rows, at eye level 3 m away and 20° down 3.5 m away). The cows are 1.5 m tall, nothing else is in the scene
+//! (no floor: the seed names none), the light 2.5 m above the eyes; state 2 gazes 60° down.
 
 use std::path::Path;
 
@@ -25,7 +27,7 @@ use twister::core::bvh::SceneBvh;
 use twister::core::load::load_obj;
 use twister::core::lod::LodChain;
 use twister::core::material::Material;
-use twister::core::scene::{Scene, SceneVertex};
+use twister::core::scene::Scene;
 use twister::core::settings::Method;
 use twister::core::visual_field::Gaze;
 use twister::error::{Error, Result};
@@ -67,16 +69,15 @@ pub struct TraceLodPoint {
     pub timing: String,
 }
 
-/// The eyes' height above the floor, the light's height above the eyes, the cows' height, metres.
-const EYE_HEIGHT: f32 = 1.5;
+/// The light's height above the eyes and the cows' height, metres.
 const LIGHT_HEIGHT: f32 = 2.5;
-const COW_HEIGHT: f32 = 1.2;
+const COW_HEIGHT: f32 = 1.5;
 
-/// One of the four scenes: eight cows (mirrors or diffuse, around or ahead) on a floor.
+/// One of the four scenes: eight cows, mirrors or diffuse, around or ahead.
 pub fn scene(cow: &Scene, mirror: bool, around: bool) -> Result<Scene> {
     let (lo, hi) = cow.bounds().ok_or_else(|| Error::scene("cow", "the model has no triangles"))?;
     let s = COW_HEIGHT / (hi.y - lo.y);
-    let foot = Vec3::new((lo.x + hi.x) / 2.0, lo.y, (lo.z + hi.z) / 2.0);
+    let centre = (lo + hi) / 2.0;
     let mut out = Scene::new(format!(
         "{} cows {}",
         if mirror { "mirror" } else { "diffuse" },
@@ -84,19 +85,27 @@ pub fn scene(cow: &Scene, mirror: bool, around: bool) -> Result<Scene> {
     ));
     // Vertex material 1 is `materials[0]` (0: the default material).
     out.materials = vec![Material { mirror: if mirror { 0.85 } else { 0.0 }, ..Material::default() }];
-    let places: Vec<(f32, f32)> = if around {
-        (0..8).map(|k| (45.0 * k as f32, 3.0)).collect()
+    // (azimuth left of ahead, elevation, distance) of each cow's centre.
+    let places: Vec<(f32, f32, f32)> = if around {
+        (0..4)
+            .map(|k| (90.0 * k as f32, 0.0, 2.5))
+            .chain((0..4).map(|k| (45.0 + 90.0 * k as f32, -45.0, 2.5)))
+            .collect()
     } else {
-        (0..8).map(|k| (-35.0 + 10.0 * k as f32, if k % 2 == 0 { 3.0 } else { 4.5 })).collect()
+        (0..4)
+            .map(|k| (-30.0 + 20.0 * k as f32, 0.0, 3.0))
+            .chain((0..4).map(|k| (-20.0 + 20.0 * k as f32, -20.0, 3.5)))
+            .collect()
     };
     let colour = if mirror { [0.92, 0.92, 0.95, 1.0] } else { [0.75, 0.58, 0.42, 1.0] };
-    for (k, (azimuth, distance)) in places.into_iter().enumerate() {
-        let a = azimuth.to_radians();
-        // Side-on to the viewer, feet on the floor.
-        let m = Mat4::from_translation(Vec3::new(-distance * a.sin(), -EYE_HEIGHT, -distance * a.cos()))
+    for (k, (azimuth, elevation, distance)) in places.into_iter().enumerate() {
+        let (a, e) = (azimuth.to_radians(), elevation.to_radians());
+        let at = distance * Vec3::new(-a.sin() * e.cos(), e.sin(), -a.cos() * e.cos());
+        // Side-on to the viewer, upright.
+        let m = Mat4::from_translation(at)
             * Mat4::from_rotation_y(a)
             * Mat4::from_scale(Vec3::splat(s))
-            * Mat4::from_translation(-foot);
+            * Mat4::from_translation(-centre);
         let mut one = cow.clone();
         one.transform(m);
         for v in &mut one.vertices {
@@ -105,15 +114,6 @@ pub fn scene(cow: &Scene, mirror: bool, around: bool) -> Result<Scene> {
         }
         out.add_mesh(format!("cow {k}"), &one.vertices, &one.indices);
     }
-    // The floor: 40 m square, grey, facing up.
-    let corner = |x: f32, z: f32| SceneVertex {
-        position: [x, -EYE_HEIGHT, z],
-        normal: [0.0, 1.0, 0.0],
-        color: [0.55, 0.55, 0.55, 1.0],
-        ..SceneVertex::default()
-    };
-    let floor = [corner(-20.0, -20.0), corner(-20.0, 20.0), corner(20.0, 20.0), corner(20.0, -20.0)];
-    out.add_mesh("floor", &floor, &[0, 1, 2, 0, 2, 3]);
     Ok(out)
 }
 
@@ -275,9 +275,10 @@ pub fn report(
     write_png(&out.join("trace_lod.png"), plot(points))?;
     let mut text = format!(
         "## Visual-field level of detail in ray tracing (seed 000, Table 2)\n\n![trace-lod](trace_lod.png)\n\n\
-         Eight cows ({COW_TRIANGLES} triangles, N_min = {MIN_TRIANGLES}) on a floor, a point light {LIGHT_HEIGHT} m above the eyes, \
-         Reflect_max = 3; full-sphere ODS panorama {}×{} per eye, both eyes. A: mirror cows all around, B: diffuse all around, \
-         C: mirror ahead only, D: diffuse ahead only. State 1 gazes ahead, state 2 60° down. `lod` is `--lod visual-field` \
+         Eight cows ({COW_TRIANGLES} triangles, N_min = {MIN_TRIANGLES}), a point light {LIGHT_HEIGHT} m above the eyes, \
+         Reflect_max = 3; full-sphere ODS panorama {}×{} per eye, both eyes. A: mirror cows all around (four at eye level \
+         every 90°, four 45° below between them, as on the seed's floor screen), B: diffuse all around, C: mirror ahead only \
+         (within ±35°), D: diffuse ahead only. State 1 gazes ahead, state 2 60° down. `lod` is `--lod visual-field` \
          with `--method trace` (eq. 8–10); `lod without eq. 10` keeps every cow whole (untraced outside the field, fewer bounces only).\n\n\
          Seconds per frame, this renderer (seed 000 in parentheses, its 2007 CAVE cluster):\n\n| | A | B | C | D |\n|---|---|---|---|---|\n",
         projection.width, projection.height
