@@ -14,8 +14,11 @@
 // deeper trees); at an object leaf the walk goes on at the root of the level the ray's visual
 // level picks (seed 000 eq. 10, `pick_level`). A candidate hit closer than the best is accepted only if its
 // material keeps it (a single-sided face seen from behind, alpha below a MASK cutoff or a
-// BLEND screen door are passed through, as the fragment stage discards them). Textures are sampled
-// at level 0 (no ray differentials yet).
+// BLEND screen door are passed through, as the fragment stage discards them). Textures are
+// filtered by ray cones (`texture_footprint`): a ray carries the width of its pixel's cone, which
+// grows by the pixel's angular size per metre; at a hit the footprint is that width over the
+// incidence, in the triangle's texture units, and the sampler picks its mip level from it as the
+// rasterizer does from screen derivatives.
 
 #import projection
 #import constants
@@ -96,8 +99,24 @@ fn enter_box(n: BvhNode, origin: vec3<f32>, inv: vec3<f32>, limit: f32) -> f32 {
     return select(FAR, near, near <= far);
 }
 
-// Whether a candidate hit's material keeps it (the fragment stage's discard, with no derivatives).
-fn keeps(triangle: u32, b1: f32, b2: f32, front: bool, frag_xy: vec2<f32>) -> bool {
+// The footprint in texture units of a ray cone `width` metres wide meeting `triangle` along the
+// unit direction `dir`: width / |cos incidence| (at most 20×) × √(uv area / world area).
+fn texture_footprint(triangle: u32, dir: vec3<f32>, width: f32) -> f32 {
+    let a = vertices[indices[3u * triangle]];
+    let b = vertices[indices[3u * triangle + 1u]];
+    let c = vertices[indices[3u * triangle + 2u]];
+    let n = cross(b.position - a.position, c.position - a.position);
+    let world = max(length(n), 1e-30);
+    let d1 = b.uv - a.uv;
+    let d2 = c.uv - a.uv;
+    let uv = abs(d1.x * d2.y - d1.y * d2.x);
+    let cos_i = max(abs(dot(n, dir)) / world, 0.05);
+    return width / cos_i * sqrt(uv / world);
+}
+
+// Whether a candidate hit's material keeps it (the fragment stage's discard), its texture
+// filtered over `footprint` (texture units).
+fn keeps(triangle: u32, b1: f32, b2: f32, front: bool, frag_xy: vec2<f32>, dir: vec3<f32>, width: f32) -> bool {
     if (!MATERIALS) {
         return true;
     }
@@ -111,7 +130,8 @@ fn keeps(triangle: u32, b1: f32, b2: f32, front: bool, frag_xy: vec2<f32>) -> bo
     let b0 = 1.0 - b1 - b2;
     let color = b0 * a.color + b1 * b.color + b2 * c.color;
     let uv = b0 * a.uv + b1 * b.uv + b2 * c.uv;
-    return surface_color(a.material, color, uv, vec2<f32>(0.0), vec2<f32>(0.0), frag_xy, front).a >= 0.0;
+    let f = texture_footprint(triangle, dir, width);
+    return surface_color(a.material, color, uv, vec2<f32>(f, 0.0), vec2<f32>(0.0, f), frag_xy, front).a >= 0.0;
 }
 
 // The level of an object's chain (levels first .. first + count, the original first) that a ray
@@ -132,8 +152,9 @@ fn pick_level(first: u32, count: u32, level: f32) -> u32 {
 }
 
 // The closest kept hit along the ray (scene frame) nearer than `limit` for a ray of visual
-// level `level`, Möller–Trumbore per triangle.
-fn closest_hit(origin: vec3<f32>, dir: vec3<f32>, frag_xy: vec2<f32>, limit: f32, level: f32) -> Hit {
+// level `level` and cone `cone` (width at the origin, growth per metre), Möller–Trumbore per
+// triangle.
+fn closest_hit(origin: vec3<f32>, dir: vec3<f32>, frag_xy: vec2<f32>, limit: f32, level: f32, cone: vec2<f32>) -> Hit {
     var best = Hit(limit, NO_HIT, 0.0, 0.0, true, 0u);
     var tests = 0u;
     let tiny = vec3<f32>(1e-20);
@@ -176,7 +197,7 @@ fn closest_hit(origin: vec3<f32>, dir: vec3<f32>, frag_xy: vec2<f32>, limit: f32
                 if (b1 < 0.0 || b2 < 0.0 || b1 + b2 > 1.0 || !(t > 0.0) || t >= best.t) {
                     continue;
                 }
-                if (keeps(tri, b1, b2, det > 0.0, frag_xy)) {
+                if (keeps(tri, b1, b2, det > 0.0, frag_xy, dir, cone.x + cone.y * t)) {
                     best = Hit(t, tri, b1, b2, det > 0.0, 0u);
                 }
             }
@@ -242,6 +263,7 @@ struct Task {
     limit: f32,
     weight: vec3<f32>,
     bounces: u32,
+    cone: vec2<f32>,   // the ray cone: width at the origin (m), growth per metre
 }
 
 const PRIMARY: u32 = 0u;
@@ -265,7 +287,8 @@ struct Shaded {
 // viewer (`view_position` in the viewer frame), or with the point light (Lambert on the side the
 // ray sees; the shadow ray decides the direct part). Its own light is weighted by
 // 1 − mirror − transmission.
-fn shade_hit(hit: Hit, dir: vec3<f32>, p: vec3<f32>, view_position: vec3<f32>, frag_xy: vec2<f32>) -> Shaded {
+fn shade_hit(hit: Hit, dir: vec3<f32>, p: vec3<f32>, view_position: vec3<f32>, frag_xy: vec2<f32>,
+             width: f32) -> Shaded {
     let a = vertices[indices[3u * hit.triangle]];
     let b = vertices[indices[3u * hit.triangle + 1u]];
     let c = vertices[indices[3u * hit.triangle + 2u]];
@@ -280,7 +303,8 @@ fn shade_hit(hit: Hit, dir: vec3<f32>, p: vec3<f32>, view_position: vec3<f32>, f
     // The normal in the viewer frame (to_scene is a rotation and a translation: its
     // transpose rotates back).
     let rotation = mat3x3<f32>(params.to_scene[0].xyz, params.to_scene[1].xyz, params.to_scene[2].xyz);
-    let surface = surface_color(a.material, color, uv, vec2<f32>(0.0), vec2<f32>(0.0), frag_xy, hit.front);
+    let f = texture_footprint(hit.triangle, dir, width);
+    let surface = surface_color(a.material, color, uv, vec2<f32>(f, 0.0), vec2<f32>(0.0, f), frag_xy, hit.front);
     let facing = select(n, -n, dot(n, dir) > 0.0);
     var own = 1.0;
     var out = Shaded(vec3<f32>(0.0), vec3<f32>(0.0), vec4<f32>(0.0), 0.0, 0.0, 1.5, hit.front, surface.rgb, facing);
@@ -384,13 +408,16 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
         reflect_max = u32(floor(level * f32(params.reflect_max) + 0.5));
     }
+    // The pixel's angular size: the cone's growth per metre (`pixel_spread`).
+    let spread = pixel_spread(proj, frag_xy);
     var task = Task((params.to_scene * vec4<f32>(ray.origin, 1.0)).xyz, PRIMARY,
-                    (params.to_scene * vec4<f32>(ray.dir, 0.0)).xyz, FAR, vec3<f32>(1.0), 0u);
+                    (params.to_scene * vec4<f32>(ray.dir, 0.0)).xyz, FAR, vec3<f32>(1.0), 0u,
+                    vec2<f32>(0.0, spread));
     var rays = 0u;
     var tests = 0u;
     var missed = false;
     loop {
-        let hit = closest_hit(task.origin, task.dir, frag_xy, task.limit, level);
+        let hit = closest_hit(task.origin, task.dir, frag_xy, task.limit, level, task.cone);
         rays += 1u;
         tests += hit.tests;
         if (task.kind == SHADOW) {
@@ -412,14 +439,17 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
                 out_object[slot] = vertices[indices[3u * hit.triangle]].object + 1u;
                 out_distance[slot] = bitcast<u32>(hit.t);
             }
-            let s = shade_hit(hit, task.dir, p, to_view * (p - viewer), frag_xy);
+            // The cone's width here; mirrored and refracted rays go on growing from it, shadow
+            // rays keep it (they converge on a point light).
+            let width = task.cone.x + task.cone.y * hit.t;
+            let s = shade_hit(hit, task.dir, p, to_view * (p - viewer), frag_xy, width);
             color += task.weight * s.color;
             let offset = 1e-4 * max(1.0, length(p));
             if (task.bounces < reflect_max) {
                 if (s.mirror > 0.0 && count < TRACE_PENDING) {
                     let d = reflect(task.dir, s.normal);
                     pending[count] = Task(p + offset * s.normal, SECONDARY, d, FAR,
-                                          task.weight * s.mirror * s.tint, task.bounces + 1u);
+                                          task.weight * s.mirror * s.tint, task.bounces + 1u, vec2<f32>(width, spread));
                     count += 1u;
                 }
                 if (s.transmission > 0.0 && count < TRACE_PENDING) {
@@ -428,13 +458,13 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
                     let d = refract_or_reflect(task.dir, s.normal, eta);
                     let side = select(s.normal, -s.normal, dot(d, s.normal) < 0.0);
                     pending[count] = Task(p + offset * side, SECONDARY, d, FAR, task.weight * s.transmission,
-                                          task.bounces + 1u);
+                                          task.bounces + 1u, vec2<f32>(width, spread));
                     count += 1u;
                 }
             }
             if (any(s.direct > vec3<f32>(0.0)) && count < TRACE_PENDING) {
                 pending[count] = Task(p + offset * s.normal, SHADOW, s.to_light.xyz, s.to_light.w - offset,
-                                      task.weight * s.direct, 0u);
+                                      task.weight * s.direct, 0u, vec2<f32>(width, 0.0));
                 count += 1u;
             }
         }

@@ -591,6 +591,21 @@ impl Twin for Trace {
                 ),
             ),
             (
+                "a checker floor and a mirror sphere: textures filtered by ray cones, reflected too".into(),
+                (
+                    {
+                        let mut scene = common::checker_floor();
+                        scene.materials.push(twister::core::material::Material { mirror: 0.7, ..Default::default() });
+                        let s = builtin::sphere_scene(800, Vec3::new(0.0, -0.3, -2.0), 0.5, "mirror");
+                        let first = scene.vertices.len();
+                        scene.add_mesh("mirror", &s.vertices, &s.indices);
+                        scene.vertices[first..].iter_mut().for_each(|v| v.material = 2);
+                        scene
+                    },
+                    RenderSettings::new(cylinder).with_method(Method::Trace),
+                ),
+            ),
+            (
                 "box room".into(),
                 (
                     builtin::builtin_scene("builtin:box-room", &cylinder).unwrap(),

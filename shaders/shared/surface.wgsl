@@ -180,6 +180,17 @@ fn screen_direction(proj: Projection, uv: vec2<f32>) -> vec3<f32> {
     return normalize(vec3<f32>(proj.screen_radius * sin(uv.x), uv.y, -proj.screen_radius * cos(uv.x)));
 }
 
+// The angle a pixel spans, radians (`pixel_spread` in fragment.rs): the larger of its width
+// (2π/W, on the sphere × cos latitude) and its height (on the cylinder 1/(pixels_per_v·R_T) seen
+// from the eyes, about R_T away; on the sphere 1/pixels_per_v).
+fn pixel_spread(proj: Projection, frag_xy: vec2<f32>) -> f32 {
+    let uv = from_pixel(proj, frag_xy);
+    if (is_sphere(proj)) {
+        return max(TAU / proj.width * cos(uv.y), 1.0 / proj.pixels_per_v);
+    }
+    return max(TAU / proj.width, 1.0 / (proj.pixels_per_v * proj.screen_radius));
+}
+
 // The display-position error of surface point p drawn at pixel centre `frag_xy` for this eye: the
 // distance in pixels to where the projection puts p (horizontal distance wrapping around the
 // panorama), or with `angle` the angle between the two directions in arcminutes; −1 where no eye

@@ -26,6 +26,20 @@ pub fn shade_linear(ambient: f32, view_position: Vec3, normal: Vec3, color: Vec4
     (color.truncate() * s).clamp(Vec3::ZERO, Vec3::ONE)
 }
 
+/// The angle a pixel spans, radians (`pixel_spread` in surface.wgsl): the larger of its width
+/// (2π/W, on the sphere × cos latitude) and its height (on the cylinder 1/(pixels_per_v·R_T),
+/// seen from the eyes about R_T away; on the sphere 1/pixels_per_v). A ray cone grows by this
+/// much per metre.
+pub fn pixel_spread(projection: &Projection, frag_xy: Vec2) -> f32 {
+    let (_, v) = projection.pixel_to_screen(frag_xy.x - 0.5, frag_xy.y - 0.5);
+    let uniform = crate::shader::types::ProjectionUniform::from(projection);
+    if projection.panorama == crate::core::projection::PanoramaKind::Equirect {
+        (std::f32::consts::TAU / uniform.width * v.cos()).max(1.0 / uniform.pixels_per_v)
+    } else {
+        (std::f32::consts::TAU / uniform.width).max(1.0 / (uniform.pixels_per_v * uniform.screen_radius))
+    }
+}
+
 /// The display-position error of surface point `p` drawn at pixel centre `frag_xy`: the
 /// distance in pixels to where the projection puts it (wrapping around the panorama), or with
 /// `angle` the angle between the two directions seen from the centre, in arcminutes; −1 where

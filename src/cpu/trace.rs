@@ -18,7 +18,7 @@ use crate::core::scene::SceneVertex;
 use crate::core::settings::RenderSettings;
 use crate::core::texture::MaterialTable;
 use crate::core::visual_field::Gaze;
-use crate::cpu::fragment::{pixel_error, pixel_ray, shade_linear, surface_color, Surface};
+use crate::cpu::fragment::{pixel_error, pixel_ray, pixel_spread, shade_linear, surface_color, Surface};
 use crate::cpu::raster::RasterImage;
 use crate::shader::constants::{TRACE_PENDING, TRACE_STACK};
 use crate::shader::types::TraceParams;
@@ -67,6 +67,17 @@ fn enter_box(n: &BvhNode, origin: Vec3, inv: Vec3, limit: f32) -> Option<f32> {
     (near <= far).then_some(near)
 }
 
+/// A ray to trace (scene frame): origin, unit direction, the distance it ends at, its visual
+/// level (eq. 8; 1 without LOD) and its cone (width at the origin, growth per metre).
+#[derive(Clone, Copy, Debug)]
+pub struct TracedRay {
+    pub origin: Vec3,
+    pub dir: Vec3,
+    pub limit: f32,
+    pub level: f32,
+    pub cone: Vec2,
+}
+
 /// What rays are traced against: the scene's BVH (with its triangles) and vertices, and the
 /// share of an object's triangles that eq. 10 gives a ray of level 0 (N_min / N_max).
 #[derive(Clone, Copy)]
@@ -77,20 +88,19 @@ pub struct TracedScene<'a> {
 }
 
 /// The closest hit along the ray (scene frame), nearer than `limit`, that `keeps` accepts
-/// (`closest_hit`): binary BVH,
+/// (given the ray's direction and its cone's width there; `cone`: width at the origin, growth
+/// per metre) (`closest_hit`): binary BVH,
 /// nearer child first (the farther kept with its entry distance, and skipped when popped if the
 /// best hit is nearer), Möller–Trumbore per triangle; at an object, the walk goes on in the
 /// level of its chain that the ray's visual `level` picks (eq. 10, [`SceneBvh::pick_level`]).
 /// Triangles are numbered in `bvh.indices`.
 pub fn closest_hit(
     scene: &TracedScene,
-    origin: Vec3,
-    dir: Vec3,
-    limit: f32,
-    level: f32,
-    keeps: &dyn Fn(u32, f32, f32, bool) -> bool,
+    ray: &TracedRay,
+    keeps: &dyn Fn(u32, f32, f32, bool, Vec3, f32) -> bool,
     tests: &Cell<u64>,
 ) -> Option<Hit> {
+    let TracedRay { origin, dir, limit, level, cone } = *ray;
     let TracedScene { bvh, vertices, min_share } = *scene;
     let indices = &bvh.indices;
     let mut best: Option<Hit> = None;
@@ -132,7 +142,7 @@ pub fn closest_hit(
                 if b1 < 0.0 || b2 < 0.0 || b1 + b2 > 1.0 || !(t > 0.0) || t >= best_t(&best) {
                     continue;
                 }
-                if keeps(tri, b1, b2, det > 0.0) {
+                if keeps(tri, b1, b2, det > 0.0, dir, cone.x + cone.y * t) {
                     best = Some(Hit { t, triangle: tri, b1, b2, front: det > 0.0 });
                 }
             }
@@ -209,7 +219,19 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
     let background = Vec3::new(r, g, b).map(srgb_to_linear);
     let corners = |tri: u32| [0, 1, 2].map(|k| &vertices[indices[(3 * tri + k) as usize] as usize]);
     let material = |tri: u32| &table.materials[(corners(tri)[0].material as usize).min(table.materials.len() - 1)];
-    let surface = |tri: u32, b1: f32, b2: f32, front: bool, frag_xy: Vec2| {
+    // The footprint in texture units of a ray cone `width` wide meeting `tri` along `dir`
+    // (`texture_footprint`).
+    let footprint = |tri: u32, dir: Vec3, width: f32| {
+        let [a, b, c] = corners(tri);
+        let n =
+            (Vec3::from(b.position) - Vec3::from(a.position)).cross(Vec3::from(c.position) - Vec3::from(a.position));
+        let world = n.length().max(1e-30);
+        let (d1, d2) = (Vec2::from(b.uv) - Vec2::from(a.uv), Vec2::from(c.uv) - Vec2::from(a.uv));
+        let uv = (d1.x * d2.y - d1.y * d2.x).abs();
+        let cos_i = (n.dot(dir).abs() / world).max(0.05);
+        width / cos_i * (uv / world).sqrt()
+    };
+    let surface = |tri: u32, b1: f32, b2: f32, front: bool, frag_xy: Vec2, f: f32| {
         let [a, b, c] = corners(tri);
         let b0 = 1.0 - b1 - b2;
         let mix4 = |x: [f32; 4], y: [f32; 4], z: [f32; 4]| b0 * Vec4::from(x) + b1 * Vec4::from(y) + b2 * Vec4::from(z);
@@ -218,8 +240,8 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
             material: a.material,
             color: mix4(a.color, b.color, c.color),
             uv: mix2(a.uv, b.uv, c.uv),
-            duv_dx: Vec2::ZERO,
-            duv_dy: Vec2::ZERO,
+            duv_dx: Vec2::new(f, 0.0),
+            duv_dy: Vec2::new(0.0, f),
             frag_xy,
             front_facing: front,
         }
@@ -236,7 +258,8 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
                      view_position: Vec3,
                      frag_xy: Vec2,
                      level: f32,
-                     keeps: &dyn Fn(u32, f32, f32, bool) -> bool| {
+                     width: f32,
+                     keeps: &dyn Fn(u32, f32, f32, bool, Vec3, f32) -> bool| {
         let [a, b, c] = corners(hit.triangle);
         let b0 = 1.0 - hit.b1 - hit.b2;
         let mut n = b0 * Vec3::from(a.normal) + hit.b1 * Vec3::from(b.normal) + hit.b2 * Vec3::from(c.normal);
@@ -245,7 +268,8 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
             n = (p(b) - p(a)).cross(p(c) - p(a));
         }
         let n = n.normalize();
-        let color = surface_color(table, &surface(hit.triangle, hit.b1, hit.b2, hit.front, frag_xy))
+        let f = footprint(hit.triangle, dir, width);
+        let color = surface_color(table, &surface(hit.triangle, hit.b1, hit.b2, hit.front, frag_xy, f))
             .expect("a kept hit has a colour");
         let m = material(hit.triangle);
         let own = (1.0 - m.mirror - m.transmission).max(0.0);
@@ -264,7 +288,13 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
                 let offset = 1e-4 * p.length().max(1.0);
                 if direct.max_element() > 0.0 {
                     rays.set(rays.get() + 1);
-                    let shadow = closest_hit(&traced, p + offset * facing, l, dist - offset, level, keeps, &tests);
+                    let cone = Vec2::new(width, 0.0);
+                    let shadow = closest_hit(
+                        &traced,
+                        &TracedRay { origin: p + offset * facing, dir: l, limit: dist - offset, level, cone },
+                        keeps,
+                        &tests,
+                    );
                     if shadow.is_none() {
                         lit += direct;
                     }
@@ -288,13 +318,15 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
         for y in 0..projection.height {
             for x in 0..projection.width {
                 let frag_xy = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-                let keeps = |tri: u32, b1: f32, b2: f32, front: bool| {
+                let keeps = |tri: u32, b1: f32, b2: f32, front: bool, dir: Vec3, width: f32| {
                     let m = material(tri);
                     if m.alpha_mode == AlphaMode::Opaque as u32 {
                         return front || m.double_sided != 0;
                     }
-                    surface_color(table, &surface(tri, b1, b2, front, frag_xy)).is_some()
+                    surface_color(table, &surface(tri, b1, b2, front, frag_xy, footprint(tri, dir, width))).is_some()
                 };
+                // The pixel's angular size: the cone's growth per metre.
+                let spread = pixel_spread(&projection, frag_xy);
                 let (origin_v, dir_v) = pixel_ray(&projection, eye, frag_xy);
                 // Seed 000's level of detail: untraced outside the visual field, level ×
                 // Reflect_max bounces (eq. 9, rounded).
@@ -313,7 +345,15 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
                 let origin = to_scene.transform_point3(origin_v);
                 let dir = to_scene.transform_vector3(dir_v);
                 rays.set(rays.get() + 1);
-                let Some(hit) = closest_hit(&traced, origin, dir, FAR, level, &keeps, &tests) else { continue };
+                let primary_cone = Vec2::new(0.0, spread);
+                let Some(hit) = closest_hit(
+                    &traced,
+                    &TracedRay { origin, dir, limit: FAR, level, cone: primary_cone },
+                    &keeps,
+                    &tests,
+                ) else {
+                    continue;
+                };
                 let i = (y * projection.width + x) as usize;
                 let view_position = origin_v + hit.t * dir_v;
                 img.error[i] = pixel_error(&projection, eye, view_position, frag_xy, params.error_angle != 0);
@@ -321,28 +361,36 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
                 img.distance[i] = hit.t;
                 img.depth[i] = hit.t;
                 // The colour gathers the mirror and refraction rays, depth first (as the WGSL).
-                let mut pending: Vec<(Vec3, u32, Vec3, Vec3)> = Vec::with_capacity(TRACE_PENDING as usize);
+                // (origin, bounces, direction, weight, the cone's width at the origin).
+                let mut pending: Vec<(Vec3, u32, Vec3, Vec3, f32)> = Vec::with_capacity(TRACE_PENDING as usize);
                 let mut color = Vec3::ZERO;
-                let (mut current, mut current_hit) = ((origin, 0u32, dir, Vec3::ONE), Some(hit));
+                let (mut current, mut current_hit) = ((origin, 0u32, dir, Vec3::ONE, 0.0f32), Some(hit));
                 loop {
-                    let (o, bounces, d, weight) = current;
+                    let (o, bounces, d, weight, cone) = current;
                     match current_hit {
                         None => color += weight * background,
                         Some(h) => {
                             let p = o + h.t * d;
-                            let s = shade_hit(&h, d, p, to_view * (p - viewer), frag_xy, level, &keeps);
+                            let width = cone + spread * h.t;
+                            let s = shade_hit(&h, d, p, to_view * (p - viewer), frag_xy, level, width, &keeps);
                             color += weight * s.color;
                             let offset = 1e-4 * p.length().max(1.0);
                             if bounces < reflect_max {
                                 if s.mirror > 0.0 && pending.len() < TRACE_PENDING as usize {
                                     let r = d - 2.0 * d.dot(s.normal) * s.normal;
-                                    pending.push((p + offset * s.normal, bounces + 1, r, weight * s.mirror * s.tint));
+                                    pending.push((
+                                        p + offset * s.normal,
+                                        bounces + 1,
+                                        r,
+                                        weight * s.mirror * s.tint,
+                                        width,
+                                    ));
                                 }
                                 if s.transmission > 0.0 && pending.len() < TRACE_PENDING as usize {
                                     let eta = if s.front { 1.0 / s.ior } else { s.ior };
                                     let t = refract_or_reflect(d, s.normal, eta);
                                     let side = if t.dot(s.normal) < 0.0 { -s.normal } else { s.normal };
-                                    pending.push((p + offset * side, bounces + 1, t, weight * s.transmission));
+                                    pending.push((p + offset * side, bounces + 1, t, weight * s.transmission, width));
                                 }
                             }
                         }
@@ -350,7 +398,12 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
                     let Some(next) = pending.pop() else { break };
                     current = next;
                     rays.set(rays.get() + 1);
-                    current_hit = closest_hit(&traced, next.0, next.2, FAR, level, &keeps, &tests);
+                    current_hit = closest_hit(
+                        &traced,
+                        &TracedRay { origin: next.0, dir: next.2, limit: FAR, level, cone: Vec2::new(next.4, spread) },
+                        &keeps,
+                        &tests,
+                    );
                 }
                 img.rgba[4 * i..4 * i + 4].copy_from_slice(&display_bytes(color));
             }
@@ -450,7 +503,13 @@ mod tests {
                 .collect::<Vec<_>>()
                 .concat();
             let want = brute_force(&scene.vertices, &picked, origin, dir);
-            let got = closest_hit(&traced, origin, dir, FAR, level, &|_, _, _, _| true, &tests).map(|h| h.t);
+            let got = closest_hit(
+                &traced,
+                &TracedRay { origin, dir, limit: FAR, level, cone: Vec2::ZERO },
+                &|_, _, _, _, _, _| true,
+                &tests,
+            )
+            .map(|h| h.t);
             match (want, got) {
                 (Some(w), Some(g)) => assert!((w - g).abs() < 1e-4 * w, "ray {i}, level {level}: {g} vs {w}"),
                 (None, None) => {}
@@ -461,15 +520,9 @@ mod tests {
         assert!(checked[1] > 300 && checked[0] > 20, "{checked:?}");
         // A coarse level is a different surface: the same ray may hit at another distance.
         let ray = |level| {
-            closest_hit(
-                &traced,
-                Vec3::ZERO,
-                Vec3::new(0.1, 0.05, -1.0).normalize(),
-                FAR,
-                level,
-                &|_, _, _, _| true,
-                &tests,
-            )
+            let dir = Vec3::new(0.1, 0.05, -1.0).normalize();
+            let ray = TracedRay { origin: Vec3::ZERO, dir, limit: FAR, level, cone: Vec2::ZERO };
+            closest_hit(&traced, &ray, &|_, _, _, _, _, _| true, &tests)
         };
         assert_ne!(ray(1.0).map(|h| h.triangle), ray(0.0).map(|h| h.triangle));
     }

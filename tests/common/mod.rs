@@ -79,3 +79,40 @@ pub fn read_exr(path: &std::path::Path) -> (usize, usize, Vec<f32>) {
         .unwrap();
     image.layer_data.channel_data.pixels
 }
+
+/// A floor 1 m below the eyes, 40 m wide and deep, with a one-texel black-and-white checker
+/// (64×64, trilinear) repeated 20 times: level 0 aliases towards the horizon, the mip levels
+/// average it to grey.
+#[allow(dead_code)]
+pub fn checker_floor() -> twister::Scene {
+    use twister::core::material::{Filter, Material, Mipmap};
+    use twister::core::scene::SceneVertex;
+    use twister::core::texture::Texture;
+    let mut scene = twister::Scene::new("checker floor");
+    let rgba =
+        (0..64u32 * 64).flat_map(|i| if (i % 64 + i / 64) % 2 == 0 { [255; 4] } else { [0, 0, 0, 255] }).collect();
+    scene.textures.push(Texture { name: "checker".into(), width: 64, height: 64, rgba });
+    scene.materials.push(Material {
+        texture: 0,
+        min_filter: Filter::Linear as u32,
+        mag_filter: Filter::Linear as u32,
+        mipmap: Mipmap::Linear as u32,
+        ..Default::default()
+    });
+    let corner = |x: f32, z: f32, u: f32, v: f32| SceneVertex {
+        position: [x, -1.0, z],
+        normal: [0.0, 1.0, 0.0],
+        color: [1.0; 4],
+        uv: [u, v],
+        material: 1,
+        ..Default::default()
+    };
+    let v = [
+        corner(-20.0, 0.5, 0.0, 0.0),
+        corner(20.0, 0.5, 20.0, 0.0),
+        corner(20.0, -40.0, 20.0, 20.0),
+        corner(-20.0, -40.0, 0.0, 20.0),
+    ];
+    scene.add_mesh("floor", &v, &[0, 1, 2, 0, 2, 3]);
+    scene
+}
