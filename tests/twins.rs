@@ -8,6 +8,7 @@ mod common;
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
 use twister::core::builtin;
+use twister::core::light::Tonemap;
 use twister::core::settings::{Method, Split};
 use twister::cpu::raster::{raster, raster_params};
 use twister::cpu::reduce_error::reduce_error;
@@ -393,6 +394,60 @@ fn compare_eyes(gpu: &EyeOutputs, cpu: &EyeOutputs, share: usize, error_toleranc
 /// show another sub-triangle of the same surface, whose interpolated error differs).
 type RasterCase = (Scene, RenderSettings, Option<f32>);
 
+/// Three spheres ahead — a rough white dielectric, a gold metal, an emissive one — under a point
+/// light with a range, a spot light and a directional light (`KHR_lights_punctual`): the glTF BRDF.
+fn lit_spheres() -> Scene {
+    use twister::core::light::{Light, LightKind};
+    use twister::core::material::Material;
+    let mut scene = Scene::new("lit spheres");
+    scene.materials = vec![
+        Material { metallic: 0.0, roughness: 0.5, ..Default::default() },
+        Material { metallic: 1.0, roughness: 0.3, ..Default::default() },
+        Material {
+            metallic: 0.0,
+            roughness: 0.8,
+            emissive_r: 0.6,
+            emissive_g: 0.3,
+            emissive_b: 0.1,
+            ..Default::default()
+        },
+    ];
+    let colours = [[0.9, 0.9, 0.9, 1.0], [1.0, 0.78, 0.34, 1.0], [0.2, 0.2, 0.2, 1.0]];
+    for (k, x) in [-1.3f32, 0.0, 1.3].into_iter().enumerate() {
+        let s = builtin::sphere_scene(800, Vec3::new(x, 0.0, -1.6), 0.6, "ball");
+        let first = scene.vertices.len();
+        scene.add_mesh(format!("ball {k}"), &s.vertices, &s.indices);
+        for v in &mut scene.vertices[first..] {
+            v.material = k as u32 + 1;
+            v.color = colours[k];
+        }
+    }
+    let light = |kind, position: Vec3, direction: Vec3, color: Vec3| Light {
+        kind,
+        position,
+        direction: direction.normalize(),
+        color,
+        range: None,
+        inner_cone: 0.2,
+        outer_cone: 0.5,
+    };
+    scene.lights = vec![
+        Light {
+            range: Some(6.0),
+            ..light(LightKind::Point, Vec3::new(-1.5, 1.5, -1.0), Vec3::NEG_Z, Vec3::splat(4.0))
+        },
+        light(LightKind::Spot, Vec3::new(1.0, 2.0, -2.5), Vec3::new(0.0, -1.0, 0.0), Vec3::new(6.0, 5.0, 4.0)),
+        light(LightKind::Directional, Vec3::ZERO, Vec3::new(0.3, -0.5, -1.0), Vec3::new(0.5, 0.5, 0.6)),
+    ];
+    scene
+}
+
+/// The material table as group 1 holds it for a frame: with the scene's lights and lighting.
+fn lit_table(scene: &Scene, settings: &RenderSettings) -> twister::core::texture::MaterialTable {
+    let (lights, lighting) = settings.lighting(&scene.lights);
+    scene.material_table(usize::MAX).with_lighting(lights, lighting)
+}
+
 impl Twin for Raster {
     type Case = RasterCase;
     type Output = (EyeOutputs, Option<f32>);
@@ -430,6 +485,16 @@ impl Twin for Raster {
             let settings = RenderSettings::new(sphere).with_method(Method::Vertex).with_error_angle(angle);
             out.push((format!("triangle@3 on the sphere, angle {angle}"), (triangle.clone(), settings, Some(0.02))));
         }
+        // The glTF BRDF under point, spot and directional lights, seen from a moved viewer, with
+        // each tone mapping.
+        let cylinder = Projection { width: 400, height: 100, vertical: Vertical::Exact, ..Projection::default() };
+        for tonemap in [Tonemap::PbrNeutral, Tonemap::Aces, Tonemap::None] {
+            let settings = RenderSettings::new(cylinder)
+                .with_viewer(Vec3::new(0.2, 0.1, 0.3))
+                .with_yaw_deg(10.0)
+                .with_tonemap(tonemap);
+            out.push((format!("lit spheres, {tonemap:?}"), (lit_spheres(), settings.with_exposure_ev(0.5), None)));
+        }
         out
     }
     fn gpu(_: &Renderer, (scene, settings, tolerance): &Self::Case) -> Self::Output {
@@ -438,7 +503,7 @@ impl Twin for Raster {
     fn cpu((scene, settings, tolerance): &Self::Case) -> Self::Output {
         let params = subdivide_params(settings, 0, scene.triangle_count() as u32);
         let tris = subdivide(&params, &scene.vertices, &scene.indices).vertices;
-        let table = scene.material_table(usize::MAX);
+        let table = lit_table(scene, settings);
         let eyes = raster(&raster_params(settings), &tris, &table, settings.shading.background)
             .map(|img| (img.rgba, img.error, img.object, img.distance));
         (eyes, *tolerance)
@@ -473,6 +538,10 @@ impl Twin for Slit {
                 (builtin::demo(), RenderSettings::new(sphere).with_method(Method::Slit(w))),
             ));
         }
+        cases.push((
+            "lit spheres slit:4".into(),
+            (lit_spheres(), RenderSettings::new(projection).with_method(Method::Slit(4))),
+        ));
         cases
     }
     fn gpu(_: &Renderer, (scene, settings): &Self::Case) -> Self::Output {
@@ -481,7 +550,7 @@ impl Twin for Slit {
     fn cpu((scene, settings): &Self::Case) -> Self::Output {
         let Method::Slit(w) = settings.subdivision.method else { unreachable!() };
         let p = settings.projection();
-        let table = scene.material_table(usize::MAX);
+        let table = lit_table(scene, settings);
         Eye::BOTH.map(|eye| {
             let params = slit_params(p, settings.view(), eye, settings.shading.ambient, settings.measure.error_angle);
             let img = slit(&params, &slits(p, eye, w), scene, &table, settings.shading.background);

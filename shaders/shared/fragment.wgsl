@@ -28,10 +28,11 @@ struct FragmentOut {
 }
 
 fn fragment_out(eye: u32, frag_xy: vec2<f32>, view_position: vec3<f32>, plane_normal: vec3<f32>,
-                normal: vec3<f32>, color: vec4<f32>, object: u32) -> FragmentOut {
+                normal: vec3<f32>, color: vec4<f32>, object: u32, material: u32) -> FragmentOut {
     let params = stage_params(eye);
     var out: FragmentOut;
-    out.color = shade(params.ambient, view_position, normal, color);
+    out.color = shade_surface(material, params.ambient, params.projection, params.eye_sign, frag_xy, view_position,
+                              normal, color);
     out.error = encode_error(pixel_error(params.projection, params.eye_sign, view_position, frag_xy,
                                          params.error_angle != 0u));
     out.object = object + 1u;
@@ -63,7 +64,9 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @locatio
     if (MATERIALS && c.a < 0.0) {
         discard;
     }
-    return shade(stage_params(in.eye).ambient, in.view_position, in.normal, c);
+    let params = stage_params(in.eye);
+    return shade_surface(in.material, params.ambient, params.projection, params.eye_sign, in.clip.xy, in.view_position,
+                         in.normal, c);
 }
 
 // The same, plus the display-position error, the object id and the distance (when the error or
@@ -99,5 +102,5 @@ fn measured(in: VertexOut, front_facing: bool) -> FragmentOut {
     if (MATERIALS && c.a < 0.0) {
         discard;
     }
-    return fragment_out(in.eye, in.clip.xy, in.view_position, plane_normal, in.normal, c, in.object);
+    return fragment_out(in.eye, in.clip.xy, in.view_position, plane_normal, in.normal, c, in.object, in.material);
 }

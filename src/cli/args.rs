@@ -3,6 +3,7 @@
 
 use clap::Args;
 use glam::Vec3;
+use twister::core::light::{LightingMode, Tonemap};
 
 use twister::core::lod::LodParams;
 use twister::core::projection::{PanoramaKind, DEFAULT_POLE_MERGE};
@@ -80,6 +81,17 @@ pub struct ViewArgs {
     /// of the headlight at the viewer.
     #[arg(long, value_parser = parse_vec3, value_name = "X,Y,Z")]
     pub light: Option<Vec3>,
+    /// How surfaces are lit: auto (the glTF BRDF under the scene's KHR_lights_punctual lights
+    /// where it has some, else the headlight), headlight, or pbr (the BRDF even without lights:
+    /// emission and ambient only). The ray tracer keeps the headlight or --light for now.
+    #[arg(long, value_enum, default_value_t = LightingMode::Auto)]
+    pub lighting: LightingMode,
+    /// Exposure in stops: the BRDF's linear colour is scaled by 2^EV before tone mapping.
+    #[arg(long, default_value_t = 0.0, value_name = "EV")]
+    pub exposure: f32,
+    /// Tone mapping of the BRDF's colour: pbr-neutral (Khronos PBR Neutral), aces, or none (clamp).
+    #[arg(long, value_enum, default_value_t = Tonemap::PbrNeutral)]
+    pub tonemap: Tonemap,
     /// N_max: the largest lattice step of one piece; larger polygons are pre-split.
     #[arg(long, default_value_t = DEFAULT_MAX_DIV)]
     pub max_div: u32,
@@ -270,7 +282,10 @@ impl ViewArgs {
             .with_max_div(self.max_div)
             .with_memory_mb(self.memory_mb)
             .with_reflect_max(self.reflect_max)
-            .with_light(self.light);
+            .with_light(self.light)
+            .with_lighting(self.lighting)
+            .with_exposure_ev(self.exposure)
+            .with_tonemap(self.tonemap);
         settings.validate()?;
         Ok(settings)
     }

@@ -8,7 +8,7 @@ pub const NO_TEXTURE: u32 = u32::MAX;
 
 /// A surface material as the fragment stage reads it (`Material` in shaders/shared/fragment.wgsl),
 /// indexed by a vertex's `material` (0: the default material). The base colour factor is
-/// already multiplied into the vertex colours; this holds what needs the fragment. 48 bytes.
+/// already multiplied into the vertex colours; this holds what needs the fragment. 76 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct Material {
@@ -37,6 +37,13 @@ pub struct Material {
     pub mirror: f32,
     pub transmission: f32,
     pub ior: f32,
+    /// The glTF metallic-roughness factors (`--lighting pbr`; the headlight ignores them).
+    pub metallic: f32,
+    pub roughness: f32,
+    /// Emitted linear colour (glTF emissive factor × `KHR_materials_emissive_strength`).
+    pub emissive_r: f32,
+    pub emissive_g: f32,
+    pub emissive_b: f32,
 }
 
 impl Default for Material {
@@ -57,6 +64,11 @@ impl Default for Material {
             mirror: 0.0,
             transmission: 0.0,
             ior: 1.5,
+            metallic: 0.0,
+            roughness: 1.0,
+            emissive_r: 0.0,
+            emissive_g: 0.0,
+            emissive_b: 0.0,
         }
     }
 }

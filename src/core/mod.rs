@@ -7,6 +7,7 @@ pub mod bvh;
 pub mod color;
 pub mod compare;
 pub mod frame;
+pub mod light;
 pub mod load;
 pub mod lod;
 pub mod material;

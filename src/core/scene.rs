@@ -54,6 +54,8 @@ pub struct Scene {
     pub textures: Vec<Texture>,
     /// Cameras placed in the file (glTF camera nodes), usable as the viewer.
     pub cameras: Vec<Camera>,
+    /// Punctual lights placed in the file (glTF `KHR_lights_punctual`).
+    pub lights: Vec<crate::core::light::Light>,
     /// Meshes drawn (glTF mesh instances, OBJ objects/groups, built-in shapes: one per object)
     /// and their primitives.
     pub meshes: usize,
@@ -200,6 +202,15 @@ impl Scene {
         }
         // The file's cameras move with the scene (so `--viewer camera` stands where it did
         // relative to the geometry after `--fit` or `--scale`), and turn with it.
+        // Lights move with it; a point or spot light scaled by s lights its scaled surroundings
+        // as before when its intensity grows by s² (its light falls as 1/d²).
+        let scale2 = m.transform_vector3(Vec3::X).length_squared();
+        for light in &mut self.lights {
+            *light = light.transformed(m);
+            if light.kind != crate::core::light::LightKind::Directional {
+                light.color *= scale2;
+            }
+        }
         for camera in &mut self.cameras {
             camera.position = m.transform_point3(Vec3::from(camera.position)).into();
             let yaw = camera.yaw_deg.to_radians();

@@ -170,6 +170,14 @@ pub struct ShadingSettings {
     /// With `trace_gaze`: N_min / N_max of eq. 10, the share of an object's triangles that a ray
     /// at level 0 meets (`--lod-p3`); the scene's BVH holds each object's chain down to it.
     pub trace_min_share: f32,
+    /// How surfaces are lit (`--lighting`): the glTF BRDF under the scene's lights, or the
+    /// headlight.
+    pub lighting: crate::core::light::LightingMode,
+    /// Exposure in stops (`--exposure`): the linear colour is scaled by 2^EV before tone mapping
+    /// (the glTF BRDF only).
+    pub exposure_ev: f32,
+    /// Tone mapping of the lit colour (`--tonemap`; the glTF BRDF only).
+    pub tonemap: crate::core::light::Tonemap,
 }
 
 /// What a render measures besides drawing.
@@ -219,6 +227,22 @@ impl MeasureSettings {
     }
 }
 
+impl RenderSettings {
+    /// A frame's lights as the fragment stage reads them (viewer frame of this view) and its
+    /// lighting, for a scene with `lights` (group 1's last two bindings; the CPU twins'
+    /// `MaterialTable::with_lighting`).
+    pub fn lighting(
+        &self,
+        lights: &[crate::core::light::Light],
+    ) -> (Vec<crate::core::light::GpuLight>, crate::core::light::LightingParams) {
+        let s = &self.shading;
+        (
+            crate::core::light::gpu_lights(lights, self.view()),
+            crate::core::light::LightingParams::of(s.lighting, lights.len(), s.exposure_ev, s.tonemap),
+        )
+    }
+}
+
 /// Everything a render needs besides the scene.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct RenderSettings {
@@ -255,6 +279,9 @@ impl Default for ShadingSettings {
             light: None,
             trace_gaze: None,
             trace_min_share: crate::core::lod::LodParams::DEFAULT.p3,
+            lighting: Default::default(),
+            exposure_ev: 0.0,
+            tonemap: Default::default(),
         }
     }
 }
@@ -288,6 +315,9 @@ builders! {
     with_light: Option<Vec3> => shading.light,
     with_trace_gaze: Option<crate::core::visual_field::Gaze> => shading.trace_gaze,
     with_trace_min_share: f32 => shading.trace_min_share,
+    with_lighting: crate::core::light::LightingMode => shading.lighting,
+    with_exposure_ev: f32 => shading.exposure_ev,
+    with_tonemap: crate::core::light::Tonemap => shading.tonemap,
     with_measure_edges: bool => measure.edges,
     with_measure_error: bool => measure.error,
     with_error_angle: bool => measure.error_angle,
@@ -350,6 +380,12 @@ impl RenderSettings {
                 "--method",
                 "trace follows each pixel's ray, and the paper's vertical model (v = R_T·y/r) has none \
                  (the points it shows at a pixel lie on a curve): use --vertical exact",
+            ));
+        }
+        if !(self.shading.exposure_ev.is_finite() && self.shading.exposure_ev.abs() <= 64.0) {
+            return Err(Error::option(
+                "--exposure",
+                format!("must be a number of stops between −64 and 64, got {}", self.shading.exposure_ev),
             ));
         }
         if self.shading.reflect_max > MAX_REFLECT {

@@ -72,9 +72,24 @@ pub struct MaterialTable {
     pub texels: Vec<u32>,
     /// Textures that lost their largest levels to the texel budget.
     pub warnings: Vec<String>,
+    /// The frame's lights (viewer frame) and lighting, as group 1 also holds them; empty and
+    /// the headlight by default ([`MaterialTable::with_lighting`]).
+    pub lights: Vec<crate::core::light::GpuLight>,
+    pub lighting: crate::core::light::LightingParams,
 }
 
 impl MaterialTable {
+    /// The same table with a frame's lights (viewer frame) and lighting (the CPU twins' group 1).
+    pub fn with_lighting(
+        mut self,
+        lights: Vec<crate::core::light::GpuLight>,
+        lighting: crate::core::light::LightingParams,
+    ) -> MaterialTable {
+        self.lights = lights;
+        self.lighting = lighting;
+        self
+    }
+
     /// Whether any material needs the fragment stage's material code: textured, not opaque, or
     /// single-sided. (Otherwise a fragment's colour is its vertex colour.)
     pub fn needs_materials(&self) -> bool {

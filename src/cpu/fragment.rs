@@ -7,6 +7,7 @@
 use glam::{Vec2, Vec3, Vec4};
 
 use crate::core::color::{linear_to_srgb, srgb_to_linear};
+use crate::core::light::{tonemap, GpuLight, LightKind};
 use crate::core::material::{AlphaMode, Filter, Material, MipLevel, Mipmap, Wrap, NO_TEXTURE};
 use crate::core::projection::{Eye, PanoramaKind, Projection};
 use crate::core::texture::MaterialTable;
@@ -24,6 +25,91 @@ pub fn shade_linear(ambient: f32, view_position: Vec3, normal: Vec3, color: Vec4
     let lambert = if normal.length() > 1e-6 { normal.normalize().dot(-view_position.normalize()).abs() } else { 1.0 };
     let s = ambient + (1.0 - ambient) * lambert;
     (color.truncate() * s).clamp(Vec3::ZERO, Vec3::ONE)
+}
+
+/// The glTF 2.0 BRDF (`brdf` in surface.wgsl; specification Appendix B): Lambert diffuse of
+/// c_diff = base·(1 − metallic) weighted by 1 − F, plus GGX D · Smith separable Vis · F, with
+/// α = roughness² and Fresnel–Schlick from f0 = mix(0.04, base, metallic). `n`, `v`, `l` unit.
+pub fn brdf(n: Vec3, v: Vec3, l: Vec3, base: Vec3, metallic: f32, roughness: f32) -> Vec3 {
+    let h = (l + v).normalize();
+    let nl = n.dot(l).max(0.0);
+    let nv = n.dot(v).abs().max(1e-4);
+    let nh = n.dot(h).max(0.0);
+    let vh = v.dot(h).abs();
+    let alpha = (roughness * roughness).max(1e-3);
+    let a2 = alpha * alpha;
+    let f0 = Vec3::splat(0.04).lerp(base, metallic);
+    let fresnel = f0 + (Vec3::ONE - f0) * (1.0 - vh).powf(5.0);
+    let k = nh * nh * (a2 - 1.0) + 1.0;
+    let d = a2 / (std::f32::consts::PI * k * k);
+    let g_l = 2.0 * nl / (nl + (a2 + (1.0 - a2) * nl * nl).sqrt());
+    let g_v = 2.0 * nv / (nv + (a2 + (1.0 - a2) * nv * nv).sqrt());
+    let vis = g_l * g_v / (4.0 * nl * nv).max(1e-8);
+    let c_diff = base.lerp(Vec3::ZERO, metallic);
+    (Vec3::ONE - fresnel) * c_diff / std::f32::consts::PI + fresnel * d * vis
+}
+
+/// The light arriving from `light` at `p` (viewer frame): the unit direction towards it and the
+/// factor on its colour (`light_at` in surface.wgsl).
+pub fn light_at(light: &GpuLight, p: Vec3) -> (Vec3, f32) {
+    if light.kind == LightKind::Directional as u32 {
+        return (-Vec3::from(light.direction), 1.0);
+    }
+    let to_light = Vec3::from(light.position) - p;
+    let d2 = to_light.length_squared().max(1e-8);
+    let l = to_light / d2.sqrt();
+    let mut scale = 1.0 / d2;
+    if light.range > 0.0 {
+        let r = d2 * d2 / (light.range * light.range * light.range * light.range);
+        let w = (1.0 - r).clamp(0.0, 1.0);
+        scale *= w * w;
+    }
+    if light.kind == LightKind::Spot as u32 {
+        let cd = Vec3::from(light.direction).dot(-l);
+        let t = ((cd - light.outer_cos) / (light.inner_cos - light.outer_cos).max(1e-4)).clamp(0.0, 1.0);
+        scale *= t * t;
+    }
+    (l, scale)
+}
+
+/// A surface's shaded colour as display bytes (`shade_surface` in surface.wgsl): with the
+/// table's lighting the glTF BRDF under its lights, seen from the eye's own point for the pixel
+/// (its ray's origin), plus ambient × diffuse colour and emission, tone mapped; else the
+/// headlight ([`shade`]).
+#[allow(clippy::too_many_arguments)]
+pub fn shade_surface(
+    table: &MaterialTable,
+    material: u32,
+    ambient: f32,
+    projection: &Projection,
+    eye: Eye,
+    frag_xy: Vec2,
+    view_position: Vec3,
+    normal: Vec3,
+    color: Vec4,
+) -> [u8; 4] {
+    if table.lighting.pbr == 0 {
+        return shade(ambient, view_position, normal, color);
+    }
+    let m = &table.materials[(material as usize).min(table.materials.len() - 1)];
+    let (origin, _) = pixel_ray(projection, eye, frag_xy);
+    let v = (origin - view_position).normalize();
+    let mut n = if normal.length_squared() < 1e-12 { v } else { normal.normalize() };
+    if n.dot(v) < 0.0 {
+        n = -n;
+    }
+    let base = color.truncate().max(Vec3::ZERO);
+    let mut c = ambient * base.lerp(Vec3::ZERO, m.metallic) + Vec3::new(m.emissive_r, m.emissive_g, m.emissive_b);
+    for light in &table.lights[..table.lighting.count as usize] {
+        let (l, scale) = light_at(light, view_position);
+        let nl = n.dot(l);
+        if nl > 0.0 && scale > 0.0 {
+            c += brdf(n, v, l, base, m.metallic, m.roughness) * Vec3::from(light.color) * (scale * nl);
+        }
+    }
+    let lit = tonemap(c, &table.lighting);
+    let q = |x: f32| (linear_to_srgb(x) * 255.0 + 0.5).floor() as u8;
+    [q(lit.x), q(lit.y), q(lit.z), 255]
 }
 
 /// The angle a pixel spans, radians (`pixel_spread` in surface.wgsl): the larger of its width

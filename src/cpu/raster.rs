@@ -13,7 +13,7 @@ use glam::{Vec2, Vec3, Vec4};
 use crate::core::projection::{azimuth, Eye, Projection};
 use crate::core::settings::RenderSettings;
 use crate::core::texture::MaterialTable;
-use crate::cpu::fragment::{pixel_distance, pixel_error, shade, surface_color, Surface};
+use crate::cpu::fragment::{pixel_distance, pixel_error, shade_surface, surface_color, Surface};
 use crate::shader::types::{DrawVertex, RasterParams};
 
 /// Clip-space position of a subdivided vertex (`vs_main` in raster.wgsl).
@@ -125,7 +125,17 @@ pub fn fragment(
     let color = surface_color(table, &f.surface)?;
     let frag_xy = f.surface.frag_xy;
     Some(FragmentOut {
-        rgba: shade(ambient, f.view_position, f.normal, color),
+        rgba: shade_surface(
+            table,
+            f.surface.material,
+            ambient,
+            projection,
+            eye,
+            frag_xy,
+            f.view_position,
+            f.normal,
+            color,
+        ),
         error: pixel_error(projection, eye, f.view_position, frag_xy, error_angle),
         distance: pixel_distance(projection, eye, f.view_position, f.dp_dx.cross(f.dp_dy), frag_xy),
     })

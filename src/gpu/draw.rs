@@ -45,10 +45,11 @@ pub(crate) enum Look {
 }
 
 impl Look {
-    pub fn of(scene: &GpuScene) -> Look {
+    /// What a scene needs, lit by the glTF BRDF (`pbr`, which reads the materials) or not.
+    pub fn of(scene: &GpuScene, pbr: bool) -> Look {
         if scene.cull_back_faces {
             Look::Culled
-        } else if scene.needs_materials {
+        } else if scene.needs_materials || pbr {
             Look::Materials
         } else {
             Look::Plain
@@ -76,10 +77,10 @@ impl DrawPipelines {
         (look as usize * 3 + outputs) * 3 + eyes
     }
 
-    /// The pipeline for a scene's look, writing `outputs` targets (`MeasureSettings::outputs`),
-    /// drawing `layers`.
-    pub fn get(&self, gpu: &Gpu, scene: &GpuScene, outputs: usize, layers: Layers) -> &wgpu::RenderPipeline {
-        self.get_look(gpu, Look::of(scene), outputs, layers)
+    /// The pipeline for a scene's look (lit by the glTF BRDF or not), writing `outputs` targets
+    /// (`MeasureSettings::outputs`), drawing `layers`.
+    pub fn get(&self, gpu: &Gpu, scene: &GpuScene, pbr: bool, outputs: usize, layers: Layers) -> &wgpu::RenderPipeline {
+        self.get_look(gpu, Look::of(scene, pbr), outputs, layers)
     }
 
     pub fn get_look(&self, gpu: &Gpu, look: Look, outputs: usize, layers: Layers) -> &wgpu::RenderPipeline {
@@ -89,8 +90,8 @@ impl DrawPipelines {
 
     /// The scene's material table (group 1).
     pub fn material_bind_group(&self, gpu: &Gpu, scene: &GpuScene) -> wgpu::BindGroup {
-        let [a, b, c] = &scene.materials;
-        self.stage.bind_group(gpu, None, 1, &[a, b, c])
+        let [a, b, c, d, e] = &scene.materials;
+        self.stage.bind_group(gpu, None, 1, &[a, b, c, d, e])
     }
 }
 

@@ -179,6 +179,7 @@ impl Renderer {
         settings.validate()?;
         self.check_size(settings)?;
         let mut resources = self.resources.lock().unwrap_or_else(|e| e.into_inner());
+        scene.write_lighting(&self.gpu, settings);
         self.gpu.scoped("rendering a frame", || match settings.subdivision.method {
             Method::Slit(width) => self.render_slit(&mut resources, scene, settings, width),
             Method::Trace => self.render_trace(&mut resources, scene, settings),
@@ -423,7 +424,7 @@ impl Renderer {
         let bind_group = self.raster.stage.bind_group(&self.gpu, None, 0, &[uniform]);
         let passes = Layers::passes(self.gpu.eyes_per_draw);
         for (k, &layers) in passes.iter().enumerate() {
-            let pipeline = self.raster.get(&self.gpu, scene, settings.measure.outputs(), layers);
+            let pipeline = self.raster.get(&self.gpu, scene, scene.pbr(settings), settings.measure.outputs(), layers);
             let writes = timestamps.map(|(q, begin, end)| wgpu::RenderPassTimestampWrites {
                 query_set: q,
                 beginning_of_pass_write_index: (k == 0).then_some(begin),

@@ -1,11 +1,13 @@
 //! A scene uploaded to the GPU: vertices, indices, the material table and the per-object
 //! factor on L; a level-of-detail selection swaps only the index buffer and the factors.
 
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 
 use crate::core::bvh::SceneBvh;
+use crate::core::light::{gpu_lights, Light, LightingParams};
 use crate::core::lod::LodSelection;
 use crate::core::scene::{object_spheres, Scene};
+use crate::core::settings::RenderSettings;
 use crate::error::{Error, Result};
 use crate::gpu::device::Gpu;
 use crate::shader::constants::TRACE_STACK;
@@ -25,7 +27,10 @@ pub struct GpuScene {
     pub triangle_count: u32,
     pub objects: Vec<ObjectRange>,
     /// The material table the fragment stage reads (group 1): materials, mip levels, texels.
-    pub materials: [wgpu::Buffer; 3],
+    /// Group 1: materials, mip levels, texels, lights, lighting.
+    pub materials: [wgpu::Buffer; 5],
+    /// The scene's lights (scene frame), written into group 1 per frame.
+    pub lights: Vec<Light>,
     /// What the packing of the textures had to say (levels dropped to fit the budget).
     pub warnings: Vec<String>,
     /// Per object: the factor on L of the adaptive subdivision (1; the level of detail sets it).
@@ -103,9 +108,20 @@ impl GpuScene {
                 storage("materials", bytemuck::cast_slice(&table.materials)),
                 storage("mip levels", bytemuck::cast_slice(&table.mips)),
                 storage("texels", bytemuck::cast_slice(&table.texels)),
+                gpu.init_buffer(
+                    "lights",
+                    bytemuck::cast_slice(&gpu_lights(&scene.lights, Mat4::IDENTITY)),
+                    wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                ),
+                gpu.init_buffer(
+                    "lighting",
+                    bytemuck::bytes_of(&LightingParams::default()),
+                    wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                ),
             ];
             let ones = vec![1.0f32; scene.objects.len().max(1)];
-            let needs_materials = table.needs_materials();
+            // The glTF BRDF reads the materials' factors.
+            let needs_materials = table.needs_materials() || !scene.lights.is_empty();
             let has_optics = table.has_optics();
             let cull_back_faces = table.all_single_sided(scene.vertices.iter().map(|v| v.material));
             Ok(GpuScene {
@@ -120,8 +136,21 @@ impl GpuScene {
                 cull_back_faces,
                 has_optics,
                 bvh: None,
+                lights: scene.lights.clone(),
             })
         })
+    }
+
+    /// Whether a frame with `settings` is lit by the glTF BRDF.
+    pub fn pbr(&self, settings: &RenderSettings) -> bool {
+        settings.lighting(&self.lights).1.pbr != 0
+    }
+
+    /// Writes a frame's lights (in the viewer frame of `settings`) and lighting into group 1.
+    pub fn write_lighting(&self, gpu: &Gpu, settings: &RenderSettings) {
+        let (lights, params) = settings.lighting(&self.lights);
+        gpu.queue.write_buffer(&self.materials[3], 0, bytemuck::cast_slice(&lights));
+        gpu.queue.write_buffer(&self.materials[4], 0, bytemuck::bytes_of(&params));
     }
 
     /// The same scene with its BVH built (on the CPU, one level per object) and uploaded, for
@@ -198,6 +227,7 @@ impl GpuScene {
             has_optics: self.has_optics,
             // The BVH indexes the full scene's triangles: a selection has none (yet).
             bvh: None,
+            lights: self.lights.clone(),
         }
     }
 }

@@ -35,7 +35,7 @@ impl Renderer {
         let camera_buffer =
             gpu.init_buffer("slit cameras", bytemuck::cast_slice(&cameras), wgpu::BufferUsages::STORAGE);
         let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, chunks: 1, ..Default::default() };
-        let pipeline = self.slit.get(gpu, scene, settings.measure.outputs(), Layers::Eye(0));
+        let pipeline = self.slit.get(gpu, scene, scene.pbr(settings), settings.measure.outputs(), Layers::Eye(0));
         let materials = self.slit.material_bind_group(gpu, scene);
         let timestamps = res.timestamps.as_ref();
         let t = Instant::now();

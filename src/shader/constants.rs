@@ -2,6 +2,7 @@
 //! `constants` (composed by `#import constants`) is generated from this list by [`wgsl`], so
 //! the two sides cannot drift apart.
 
+use crate::core::light::{LightKind, Tonemap};
 use crate::core::material::{AlphaMode, Filter, Mipmap, Wrap, NO_TEXTURE};
 use crate::core::settings::SplitRule;
 use crate::core::visual_field::{CENTRAL_RADIUS, FIELD_DOWN, FIELD_SIDEWAYS, FIELD_UP};
@@ -119,6 +120,12 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("ALPHA_OPAQUE", U32(AlphaMode::Opaque as u32)),
         ("ALPHA_MASK", U32(AlphaMode::Mask as u32)),
         ("ALPHA_BLEND", U32(AlphaMode::Blend as u32)),
+        ("LIGHT_DIRECTIONAL", U32(LightKind::Directional as u32)),
+        ("LIGHT_POINT", U32(LightKind::Point as u32)),
+        ("LIGHT_SPOT", U32(LightKind::Spot as u32)),
+        ("TONEMAP_NONE", U32(Tonemap::None.code())),
+        ("TONEMAP_PBR_NEUTRAL", U32(Tonemap::PbrNeutral.code())),
+        ("TONEMAP_ACES", U32(Tonemap::Aces.code())),
     ];
     out.extend(SplitRule::ALL.map(|m| (m.wgsl_name(), U32(m as u32))));
     out

@@ -110,8 +110,15 @@ impl Stage {
 }
 
 /// The material table the fragment module reads (group 1 of the drawing stages).
-const MATERIAL_TABLE: [Binding; 3] =
-    [bind(1, 0, "materials", Storage), bind(1, 1, "mips", Storage), bind(1, 2, "texels", Storage)];
+/// Group 1 of the stages that shade: the scene's materials and textures, its lights and the
+/// frame's lighting (src/gpu/scene.rs).
+const MATERIAL_TABLE: [Binding; 5] = [
+    bind(1, 0, "materials", Storage),
+    bind(1, 1, "mips", Storage),
+    bind(1, 2, "texels", Storage),
+    bind(1, 3, "lights", Storage),
+    bind(1, 4, "lighting", Uniform),
+];
 
 pub const SUBDIVIDE: Stage = Stage {
     name: "subdivide",
@@ -150,11 +157,18 @@ pub const RASTER: Stage = Stage {
     kind: StageKind::Draw,
     entry_points: &[
         entry("vs_main", &["params"]),
-        entry("fs_main", &["params", "materials", "mips", "texels"]),
-        entry("fs_error", &["params", "materials", "mips", "texels"]),
-        entry("fs_position", &["params", "materials", "mips", "texels"]),
+        entry("fs_main", &["params", "materials", "mips", "texels", "lights", "lighting"]),
+        entry("fs_error", &["params", "materials", "mips", "texels", "lights", "lighting"]),
+        entry("fs_position", &["params", "materials", "mips", "texels", "lights", "lighting"]),
     ],
-    bindings: &[bind(0, 0, "params", Uniform), MATERIAL_TABLE[0], MATERIAL_TABLE[1], MATERIAL_TABLE[2]],
+    bindings: &[
+        bind(0, 0, "params", Uniform),
+        MATERIAL_TABLE[0],
+        MATERIAL_TABLE[1],
+        MATERIAL_TABLE[2],
+        MATERIAL_TABLE[3],
+        MATERIAL_TABLE[4],
+    ],
 };
 
 pub const SLIT: Stage = Stage {
@@ -163,9 +177,9 @@ pub const SLIT: Stage = Stage {
     kind: StageKind::Draw,
     entry_points: &[
         entry("vs_main", &["params", "cameras"]),
-        entry("fs_main", &["params", "materials", "mips", "texels"]),
-        entry("fs_error", &["params", "materials", "mips", "texels"]),
-        entry("fs_position", &["params", "materials", "mips", "texels"]),
+        entry("fs_main", &["params", "materials", "mips", "texels", "lights", "lighting"]),
+        entry("fs_error", &["params", "materials", "mips", "texels", "lights", "lighting"]),
+        entry("fs_position", &["params", "materials", "mips", "texels", "lights", "lighting"]),
     ],
     bindings: &[
         bind(0, 0, "params", Uniform),
@@ -173,6 +187,8 @@ pub const SLIT: Stage = Stage {
         MATERIAL_TABLE[0],
         MATERIAL_TABLE[1],
         MATERIAL_TABLE[2],
+        MATERIAL_TABLE[3],
+        MATERIAL_TABLE[4],
     ],
 };
 
@@ -212,6 +228,8 @@ pub const TRACE: Stage = Stage {
         MATERIAL_TABLE[0],
         MATERIAL_TABLE[1],
         MATERIAL_TABLE[2],
+        MATERIAL_TABLE[3],
+        MATERIAL_TABLE[4],
     ],
 };
 

@@ -7,6 +7,7 @@ use std::mem::{offset_of, size_of};
 use bytemuck::{Pod, Zeroable};
 
 pub use crate::core::bvh::{BvhLevel, BvhNode};
+pub use crate::core::light::{GpuLight, LightingParams};
 use crate::core::material::{Material, MipLevel};
 use crate::core::projection::{PanoramaKind, Projection, Vertical};
 use crate::core::scene::SceneVertex;
@@ -353,10 +354,12 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("TraceParams" => TraceParams { to_scene, projection, background, light, gaze_forward, gaze_right, gaze_up, ambient, error_angle, row_texels, reflect_max, lod_min_share, original_root, original_level, _pad2 }),
     layout!("BvhNode" => BvhNode { min, first, max, count }),
     layout!("BvhLevel" => BvhLevel { root, triangles }),
+    layout!("Light" => GpuLight { position, kind, direction, range, color, inner_cos, outer_cos, _pad0, _pad1, _pad2 }),
+    layout!("Lighting" => LightingParams { count, pbr, exposure, tonemap }),
     layout!("ProjectParams" => ProjectParams { projection, eye_sign, count, _pad }),
     layout!("Material" => Material {
         texture, wrap_u, wrap_v, mag_filter, min_filter, mipmap, alpha_mode, alpha_cutoff, double_sided,
-        first_mip, mip_count, mirror, transmission, ior
+        first_mip, mip_count, mirror, transmission, ior, metallic, roughness, emissive_r, emissive_g, emissive_b
     }),
     layout!("MipLevel" => MipLevel { offset, width, height, _pad }),
     layout!("ReduceParams" => ReduceParams { width, height, row_stride, images, partial_count, partial_offset, _pad1, _pad2 }),

@@ -281,7 +281,7 @@ fn lod_section(runner: &Runner) -> Result<(String, Option<String>)> {
 #[derive(Subcommand)]
 pub enum BenchCommand {
     /// Median frame time of each method on each scene, and its ratio to the first method.
-    Speed(SpeedArgs),
+    Speed(Box<SpeedArgs>),
     /// Seed 002 Fig. 8: error vs edge divisions on the evaluation triangles.
     Fig8(FigureArgs),
     /// Seed 002 Fig. 10: error, time and triangles per method on the evaluation scenes.

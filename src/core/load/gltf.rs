@@ -5,6 +5,7 @@ use std::path::Path;
 
 use glam::{Mat4, Vec3};
 
+use crate::core::light::{Light, LightKind};
 use crate::core::material::{AlphaMode, Filter, Material, Mipmap, Wrap};
 use crate::core::scene::{compute_normals, Scene, SceneVertex};
 use crate::core::texture::Texture;
@@ -60,6 +61,45 @@ fn gltf_texture(name: String, data: &gltf::image::Data) -> std::result::Result<T
 /// transform (rows of a 2×3 affine matrix).
 type GltfMaterial = (Material, u32, Option<[[f32; 3]; 2]>);
 
+fn finite_or(x: f32, default: f32) -> f32 {
+    if x.is_finite() {
+        x
+    } else {
+        default
+    }
+}
+
+/// Channel `c` of a material's emitted linear colour: emissive factor × emissive strength.
+fn emissive(material: &gltf::Material, c: usize) -> f32 {
+    let strength = finite_or(material.emissive_strength().unwrap_or(1.0), 1.0).max(0.0);
+    (finite_or(material.emissive_factor()[c], 0.0).max(0.0) * strength).min(1e6)
+}
+
+/// A `KHR_lights_punctual` light placed by its node's world matrix (it shines along the node's −z).
+fn gltf_light(light: &gltf::khr_lights_punctual::Light, world: Mat4) -> Light {
+    use gltf::khr_lights_punctual::Kind;
+    let color = Vec3::from(light.color()).max(Vec3::ZERO) * finite_or(light.intensity(), 1.0).max(0.0);
+    let (kind, inner_cone, outer_cone) = match light.kind() {
+        Kind::Directional => (LightKind::Directional, 0.0, 0.0),
+        Kind::Point => (LightKind::Point, 0.0, 0.0),
+        Kind::Spot { inner_cone_angle, outer_cone_angle } => {
+            let outer =
+                finite_or(outer_cone_angle, std::f32::consts::FRAC_PI_4).clamp(1e-3, std::f32::consts::FRAC_PI_2);
+            (LightKind::Spot, finite_or(inner_cone_angle, 0.0).clamp(0.0, outer), outer)
+        }
+    };
+    Light {
+        kind,
+        position: Vec3::ZERO,
+        direction: -Vec3::Z,
+        color: color.min(Vec3::splat(1e9)),
+        range: light.range().filter(|r| r.is_finite() && *r > 0.0),
+        inner_cone,
+        outer_cone,
+    }
+    .transformed(world)
+}
+
 /// A glTF material as twister draws it, and the TEXCOORD set and `KHR_texture_transform`
 /// (u' = offset + R(rotation)·(scale·u)) of its base colour texture.
 fn gltf_material(material: &gltf::Material) -> GltfMaterial {
@@ -85,6 +125,12 @@ fn gltf_material(material: &gltf::Material) -> GltfMaterial {
         },
         transmission: material.transmission().map_or(0.0, |t| t.transmission_factor().clamp(0.0, 1.0)),
         ior: material.ior().filter(|i| i.is_finite() && *i >= 1.0).unwrap_or(1.5),
+        // The glTF BRDF's factors (`--lighting pbr`); emission × KHR_materials_emissive_strength.
+        metallic: finite_or(material.pbr_metallic_roughness().metallic_factor(), 1.0).clamp(0.0, 1.0),
+        roughness: finite_or(material.pbr_metallic_roughness().roughness_factor(), 1.0).clamp(0.0, 1.0),
+        emissive_r: emissive(material, 0),
+        emissive_g: emissive(material, 1),
+        emissive_b: emissive(material, 2),
         ..Default::default()
     };
     let Some(info) = material.pbr_metallic_roughness().base_color_texture() else {
@@ -239,6 +285,9 @@ pub(super) fn read_gltf(path: &Path) -> std::result::Result<Scene, String> {
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         if !world.is_finite() {
             return Err(format!("{name}: node {} has a NaN or infinite transform", node.index()));
+        }
+        if let Some(light) = node.light() {
+            scene.lights.push(gltf_light(&light, world));
         }
         if let Some(camera) = node.camera() {
             // The camera looks along its local −z.
