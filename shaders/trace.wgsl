@@ -324,6 +324,11 @@ fn shade_hit(hit: Hit, dir: vec3<f32>, p: vec3<f32>, view_position: vec3<f32>, f
         out.color = base * params.ambient;
         out.direct = base * (1.0 - params.ambient) * lambert;
         out.to_light = vec4<f32>(l, dist);
+    } else if (MATERIALS && lighting.pbr != 0u) {
+        // The glTF BRDF under the scene's lights, seen along the ray (no shadows yet, as in
+        // the drawing stages); tone mapped once the pixel's light is summed.
+        let back = transpose(rotation);
+        out.color = pbr_radiance(a.material, params.ambient, -(back * dir), view_position, back * n, surface) * own;
     } else {
         out.color = shade(params.ambient, view_position, transpose(rotation) * n, surface).rgb * own;
     }
@@ -481,6 +486,9 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (missed) {
         write_background(slot);
         return;
+    }
+    if (MATERIALS && lighting.pbr != 0u && params.light.w <= 0.0) {
+        color = tonemap(color);
     }
     out_color[slot] = pack_display(linear_to_srgb(color));
 }

@@ -202,3 +202,40 @@ fn emissive_strength_orders_the_cubes_brightness() {
         "{cubes:?}"
     );
 }
+
+/// The ray tracer shades with the same BRDF and lights as the drawing stages: on the lit spheres
+/// (point, spot and directional lights; dielectric, metal, emissive) its colours are the
+/// rasterizer's where both show the same sphere.
+#[test]
+fn the_ray_tracer_lights_the_spheres_as_the_rasterizer_does() {
+    use twister::core::settings::{Method, Split};
+    let p = Projection { width: 480, height: 120, vertical: Vertical::Exact, ..Projection::default() };
+    let scene = common::lit_spheres();
+    let settings = RenderSettings::new(p).with_measure_error(true);
+    let drawn = common::render(&scene, &settings.with_method(Method::Adaptive(Split::Error)));
+    let r = common::renderer();
+    let gs = twister::GpuScene::upload(&r.gpu, &scene).and_then(|g| g.with_bvh(&r.gpu, &scene)).unwrap();
+    let traced = r.render(&gs, &settings.with_method(Method::Trace)).unwrap();
+    let (mut n, mut sum, mut worst) = (0u64, 0u64, 0u8);
+    for (k, eye) in Eye::BOTH.into_iter().enumerate() {
+        let (a, b) = (drawn.eye(eye), traced.eye(eye));
+        let (oa, ob) =
+            (&drawn.measurement.as_ref().unwrap().object[k], &traced.measurement.as_ref().unwrap().object[k]);
+        for i in 0..(p.width * p.height) as usize {
+            if oa[i] == 0 || oa[i] != ob[i] {
+                continue;
+            }
+            for c in 0..3 {
+                let d = a.rgba[4 * i + c].abs_diff(b.rgba[4 * i + c]);
+                sum += d as u64;
+                worst = worst.max(d);
+            }
+            n += 1;
+        }
+    }
+    let mean = sum as f64 / (3 * n) as f64;
+    eprintln!(
+        "lit spheres: trace vs adaptive, mean colour difference {mean:.3} levels, worst {worst}, over {n} pixels"
+    );
+    assert!(n > 3000 && mean < 1.0, "{n} pixels, mean {mean}");
+}

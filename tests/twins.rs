@@ -394,54 +394,6 @@ fn compare_eyes(gpu: &EyeOutputs, cpu: &EyeOutputs, share: usize, error_toleranc
 /// show another sub-triangle of the same surface, whose interpolated error differs).
 type RasterCase = (Scene, RenderSettings, Option<f32>);
 
-/// Three spheres ahead — a rough white dielectric, a gold metal, an emissive one — under a point
-/// light with a range, a spot light and a directional light (`KHR_lights_punctual`): the glTF BRDF.
-fn lit_spheres() -> Scene {
-    use twister::core::light::{Light, LightKind};
-    use twister::core::material::Material;
-    let mut scene = Scene::new("lit spheres");
-    scene.materials = vec![
-        Material { metallic: 0.0, roughness: 0.5, ..Default::default() },
-        Material { metallic: 1.0, roughness: 0.3, ..Default::default() },
-        Material {
-            metallic: 0.0,
-            roughness: 0.8,
-            emissive_r: 0.6,
-            emissive_g: 0.3,
-            emissive_b: 0.1,
-            ..Default::default()
-        },
-    ];
-    let colours = [[0.9, 0.9, 0.9, 1.0], [1.0, 0.78, 0.34, 1.0], [0.2, 0.2, 0.2, 1.0]];
-    for (k, x) in [-1.3f32, 0.0, 1.3].into_iter().enumerate() {
-        let s = builtin::sphere_scene(800, Vec3::new(x, 0.0, -1.6), 0.6, "ball");
-        let first = scene.vertices.len();
-        scene.add_mesh(format!("ball {k}"), &s.vertices, &s.indices);
-        for v in &mut scene.vertices[first..] {
-            v.material = k as u32 + 1;
-            v.color = colours[k];
-        }
-    }
-    let light = |kind, position: Vec3, direction: Vec3, color: Vec3| Light {
-        kind,
-        position,
-        direction: direction.normalize(),
-        color,
-        range: None,
-        inner_cone: 0.2,
-        outer_cone: 0.5,
-    };
-    scene.lights = vec![
-        Light {
-            range: Some(6.0),
-            ..light(LightKind::Point, Vec3::new(-1.5, 1.5, -1.0), Vec3::NEG_Z, Vec3::splat(4.0))
-        },
-        light(LightKind::Spot, Vec3::new(1.0, 2.0, -2.5), Vec3::new(0.0, -1.0, 0.0), Vec3::new(6.0, 5.0, 4.0)),
-        light(LightKind::Directional, Vec3::ZERO, Vec3::new(0.3, -0.5, -1.0), Vec3::new(0.5, 0.5, 0.6)),
-    ];
-    scene
-}
-
 /// The material table as group 1 holds it for a frame: with the scene's lights and lighting.
 fn lit_table(scene: &Scene, settings: &RenderSettings) -> twister::core::texture::MaterialTable {
     let (lights, lighting) = settings.lighting(&scene.lights);
@@ -493,7 +445,10 @@ impl Twin for Raster {
                 .with_viewer(Vec3::new(0.2, 0.1, 0.3))
                 .with_yaw_deg(10.0)
                 .with_tonemap(tonemap);
-            out.push((format!("lit spheres, {tonemap:?}"), (lit_spheres(), settings.with_exposure_ev(0.5), None)));
+            out.push((
+                format!("lit spheres, {tonemap:?}"),
+                (common::lit_spheres(), settings.with_exposure_ev(0.5), None),
+            ));
         }
         out
     }
@@ -540,7 +495,7 @@ impl Twin for Slit {
         }
         cases.push((
             "lit spheres slit:4".into(),
-            (lit_spheres(), RenderSettings::new(projection).with_method(Method::Slit(4))),
+            (common::lit_spheres(), RenderSettings::new(projection).with_method(Method::Slit(4))),
         ));
         cases
     }
@@ -675,6 +630,10 @@ impl Twin for Trace {
                 ),
             ),
             (
+                "lit spheres: the glTF BRDF under point, spot and directional lights".into(),
+                (common::lit_spheres(), RenderSettings::new(cylinder).with_method(Method::Trace).with_exposure_ev(0.5)),
+            ),
+            (
                 "box room".into(),
                 (
                     builtin::builtin_scene("builtin:box-room", &cylinder).unwrap(),
@@ -695,7 +654,7 @@ impl Twin for Trace {
         let bvh = traced_bvh(scene, settings);
         let p = settings.projection();
         let params = twister::cpu::trace::trace_params(settings, p.width);
-        let table = scene.material_table(usize::MAX);
+        let table = lit_table(scene, settings);
         let out = twister::cpu::trace::trace(&params, &scene.vertices, &bvh, &table);
         (out.images.map(|img| (img.rgba, img.error, img.object, img.distance)), out.rays, out.triangle_tests)
     }

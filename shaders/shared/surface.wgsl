@@ -285,9 +285,17 @@ fn shade_surface(material: u32, ambient: f32, proj: Projection, eye_sign: f32, f
     if (!MATERIALS || lighting.pbr == 0u) {
         return shade(ambient, view_position, normal, color);
     }
-    let m = materials[min(material, arrayLength(&materials) - 1u)];
     let eye = pixel_ray(proj, eye_sign, frag_xy).origin;
-    let v = normalize(eye - view_position);
+    return vec4<f32>(tonemap(pbr_radiance(material, ambient, normalize(eye - view_position), view_position, normal,
+                                          color)), 1.0);
+}
+
+// The glTF BRDF's linear colour (before tone mapping) of a surface point p (viewer frame) seen
+// along the unit direction v (towards the eye): the scene's lights, ambient × the diffuse colour
+// and the emission (`pbr_radiance` in fragment.rs).
+fn pbr_radiance(material: u32, ambient: f32, v: vec3<f32>, view_position: vec3<f32>, normal: vec3<f32>,
+                color: vec4<f32>) -> vec3<f32> {
+    let m = materials[min(material, arrayLength(&materials) - 1u)];
     var n = normal;
     if (dot(n, n) < 1e-12) {
         n = v;
@@ -307,7 +315,7 @@ fn shade_surface(material: u32, ambient: f32, proj: Projection, eye_sign: f32, f
             c += brdf(n, v, at.xyz, base, m.metallic, m.roughness) * light.color * (at.w * nl);
         }
     }
-    return vec4<f32>(tonemap(c), 1.0);
+    return c;
 }
 
 // The screen point (u, v) at image position (x, y) (`Projection::pixel_to_screen`).

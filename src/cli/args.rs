@@ -83,7 +83,7 @@ pub struct ViewArgs {
     pub light: Option<Vec3>,
     /// How surfaces are lit: auto (the glTF BRDF under the scene's KHR_lights_punctual lights
     /// where it has some, else the headlight), headlight, or pbr (the BRDF even without lights:
-    /// emission and ambient only). The ray tracer keeps the headlight or --light for now.
+    /// emission and ambient only). The ray tracer's --light replaces the scene's lights.
     #[arg(long, value_enum, default_value_t = LightingMode::Auto)]
     pub lighting: LightingMode,
     /// Exposure in stops: the BRDF's linear colour is scaled by 2^EV before tone mapping.

@@ -91,9 +91,26 @@ pub fn shade_surface(
     if table.lighting.pbr == 0 {
         return shade(ambient, view_position, normal, color);
     }
-    let m = &table.materials[(material as usize).min(table.materials.len() - 1)];
     let (origin, _) = pixel_ray(projection, eye, frag_xy);
-    let v = (origin - view_position).normalize();
+    let c = pbr_radiance(table, material, ambient, (origin - view_position).normalize(), view_position, normal, color);
+    let lit = tonemap(c, &table.lighting);
+    let q = |x: f32| (linear_to_srgb(x) * 255.0 + 0.5).floor() as u8;
+    [q(lit.x), q(lit.y), q(lit.z), 255]
+}
+
+/// The glTF BRDF's linear colour, before tone mapping, of surface point `view_position` seen
+/// along unit `v` (towards the eye): the table's lights, ambient × diffuse colour, emission
+/// (`pbr_radiance` in surface.wgsl).
+pub fn pbr_radiance(
+    table: &MaterialTable,
+    material: u32,
+    ambient: f32,
+    v: Vec3,
+    view_position: Vec3,
+    normal: Vec3,
+    color: Vec4,
+) -> Vec3 {
+    let m = &table.materials[(material as usize).min(table.materials.len() - 1)];
     let mut n = if normal.length_squared() < 1e-12 { v } else { normal.normalize() };
     if n.dot(v) < 0.0 {
         n = -n;
@@ -107,9 +124,7 @@ pub fn shade_surface(
             c += brdf(n, v, l, base, m.metallic, m.roughness) * Vec3::from(light.color) * (scale * nl);
         }
     }
-    let lit = tonemap(c, &table.lighting);
-    let q = |x: f32| (linear_to_srgb(x) * 255.0 + 0.5).floor() as u8;
-    [q(lit.x), q(lit.y), q(lit.z), 255]
+    c
 }
 
 /// The angle a pixel spans, radians (`pixel_spread` in surface.wgsl): the larger of its width

@@ -12,13 +12,14 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use crate::core::bvh::{BvhNode, SceneBvh, OBJECT_LEAF};
 use crate::core::color::{linear_to_srgb, srgb_to_linear};
+use crate::core::light::tonemap;
 use crate::core::material::AlphaMode;
 use crate::core::projection::{Eye, Projection};
 use crate::core::scene::SceneVertex;
 use crate::core::settings::RenderSettings;
 use crate::core::texture::MaterialTable;
 use crate::core::visual_field::Gaze;
-use crate::cpu::fragment::{pixel_error, pixel_ray, pixel_spread, shade_linear, surface_color, Surface};
+use crate::cpu::fragment::{pbr_radiance, pixel_error, pixel_ray, pixel_spread, shade_linear, surface_color, Surface};
 use crate::cpu::raster::RasterImage;
 use crate::shader::constants::{TRACE_PENDING, TRACE_STACK};
 use crate::shader::types::TraceParams;
@@ -275,6 +276,19 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
         let own = (1.0 - m.mirror - m.transmission).max(0.0);
         let facing = if n.dot(dir) > 0.0 { -n } else { n };
         let lit = match light {
+            // The glTF BRDF under the scene's lights, seen along the ray (tone mapped once the
+            // pixel's light is summed).
+            None if table.lighting.pbr != 0 => {
+                pbr_radiance(
+                    table,
+                    corners(hit.triangle)[0].material,
+                    params.ambient,
+                    -(to_view * dir),
+                    view_position,
+                    to_view * n,
+                    color,
+                ) * own
+            }
             None => shade_linear(params.ambient, view_position, to_view * n, color) * own,
             Some(light) => {
                 // Lambert towards the light, one-sided; the direct part only if the shadow ray
@@ -404,6 +418,9 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
                         &keeps,
                         &tests,
                     );
+                }
+                if table.lighting.pbr != 0 && light.is_none() {
+                    color = tonemap(color, &table.lighting);
                 }
                 img.rgba[4 * i..4 * i + 4].copy_from_slice(&display_bytes(color));
             }

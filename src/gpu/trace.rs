@@ -106,7 +106,7 @@ impl Renderer {
                     end_of_pass_write_index: Some(1),
                 }),
             });
-            pass.set_pipeline(&pipelines[(scene.needs_materials || scene.has_optics) as usize]);
+            pass.set_pipeline(&pipelines[(scene.needs_materials || scene.has_optics || scene.pbr(settings)) as usize]);
             pass.set_bind_group(0, &bind_group, &[]);
             pass.set_bind_group(1, &materials, &[]);
             pass.dispatch_workgroups(p.width.div_ceil(8), p.height.div_ceil(8), 2);

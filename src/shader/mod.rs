@@ -212,6 +212,8 @@ pub const TRACE: Stage = Stage {
             "materials",
             "mips",
             "texels",
+            "lights",
+            "lighting",
         ],
     )],
     bindings: &[

@@ -116,3 +116,52 @@ pub fn checker_floor() -> twister::Scene {
     scene.add_mesh("floor", &v, &[0, 1, 2, 0, 2, 3]);
     scene
 }
+
+/// Three spheres ahead — a rough white dielectric, a gold metal, an emissive one — under a point
+/// light with a range, a spot light and a directional light (`KHR_lights_punctual`): the glTF BRDF.
+pub fn lit_spheres() -> twister::Scene {
+    use glam::Vec3;
+    use twister::core::light::{Light, LightKind};
+    use twister::core::material::Material;
+    let mut scene = twister::Scene::new("lit spheres");
+    scene.materials = vec![
+        Material { metallic: 0.0, roughness: 0.5, ..Default::default() },
+        Material { metallic: 1.0, roughness: 0.3, ..Default::default() },
+        Material {
+            metallic: 0.0,
+            roughness: 0.8,
+            emissive_r: 0.6,
+            emissive_g: 0.3,
+            emissive_b: 0.1,
+            ..Default::default()
+        },
+    ];
+    let colours = [[0.9, 0.9, 0.9, 1.0], [1.0, 0.78, 0.34, 1.0], [0.2, 0.2, 0.2, 1.0]];
+    for (k, x) in [-1.3f32, 0.0, 1.3].into_iter().enumerate() {
+        let s = twister::core::builtin::sphere_scene(800, Vec3::new(x, 0.0, -1.6), 0.6, "ball");
+        let first = scene.vertices.len();
+        scene.add_mesh(format!("ball {k}"), &s.vertices, &s.indices);
+        for v in &mut scene.vertices[first..] {
+            v.material = k as u32 + 1;
+            v.color = colours[k];
+        }
+    }
+    let light = |kind, position: Vec3, direction: Vec3, color: Vec3| Light {
+        kind,
+        position,
+        direction: direction.normalize(),
+        color,
+        range: None,
+        inner_cone: 0.2,
+        outer_cone: 0.5,
+    };
+    scene.lights = vec![
+        Light {
+            range: Some(6.0),
+            ..light(LightKind::Point, Vec3::new(-1.5, 1.5, -1.0), Vec3::NEG_Z, Vec3::splat(4.0))
+        },
+        light(LightKind::Spot, Vec3::new(1.0, 2.0, -2.5), Vec3::new(0.0, -1.0, 0.0), Vec3::new(6.0, 5.0, 4.0)),
+        light(LightKind::Directional, Vec3::ZERO, Vec3::new(0.3, -0.5, -1.0), Vec3::new(0.5, 0.5, 0.6)),
+    ];
+    scene
+}
