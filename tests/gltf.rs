@@ -549,18 +549,24 @@ fn optics_are_read_from_gltf_and_mtl_for_the_ray_tracer() {
     std::fs::write(
         dir.join("optics.mtl"),
         "newmtl chrome\nillum 3\nKs 0.8 0.9 0.7\nnewmtl glass\nillum 7\nKs 0.1 0.1 0.1\nd 0.3\nNi 1.33\n\
-         newmtl tinted\nillum 6\nTr 0.6\nnewmtl matte\nillum 2\nKs 1 1 1\n",
+         newmtl tinted\nillum 6\nTr 0.6\nnewmtl matte\nillum 2\nKs 1 1 1\nNs 98\nKe 0.5 0.25 0\n\
+         newmtl pbr\nPr 0.3\nPm 0.9\nNs 10\n",
     )
     .unwrap();
     std::fs::write(
         dir.join("optics.obj"),
         "mtllib optics.mtl\nv 0 0 -3\nv 1 0 -3\nv 0 1 -3\nusemtl chrome\nf 1 2 3\nusemtl glass\nf 1 2 3\n\
-         usemtl tinted\nf 1 2 3\nusemtl matte\nf 1 2 3\n",
+         usemtl tinted\nf 1 2 3\nusemtl matte\nf 1 2 3\nusemtl pbr\nf 1 2 3\n",
     )
     .unwrap();
     let scene = load_scene(dir.join("optics.obj").to_str().unwrap(), &Projection::default()).unwrap();
     let m = &scene.materials;
-    assert_eq!(m.len(), 4, "{m:?}");
+    assert_eq!(m.len(), 5, "{m:?}");
+    // The glTF BRDF's parameters: Ns 98 → roughness (2/100)^¼; Ke emits; Pr/Pm win over Ns.
+    assert!((m[3].roughness - 0.02f32.powf(0.25)).abs() < 1e-5 && m[3].metallic == 0.0, "{:?}", m[3]);
+    assert_eq!((m[3].emissive_r, m[3].emissive_g, m[3].emissive_b), (0.5, 0.25, 0.0));
+    assert_eq!((m[4].roughness, m[4].metallic), (0.3, 0.9));
+    assert_eq!((m[0].roughness, m[0].emissive_r), (1.0, 0.0));
     assert_eq!((m[0].mirror, m[0].transmission), (0.9, 0.0));
     assert!(
         (m[1].mirror - 0.1).abs() < 1e-6 && (m[1].transmission - 0.7).abs() < 1e-6 && m[1].ior == 1.33,

@@ -27,6 +27,13 @@ pub fn info(args: &InfoArgs) -> Result<()> {
         "textures": scene.textures.iter().map(|t| serde_json::json!({ "name": t.name, "width": t.width, "height": t.height })).collect::<Vec<_>>(),
         "bbox": { "min": lo.to_array(), "max": hi.to_array() },
         "cameras": scene.cameras,
+        "lights": scene.lights.iter().map(|l| serde_json::json!({
+            "kind": l.kind,
+            "position": l.position.to_array(),
+            "direction": l.direction.to_array(),
+            "color_intensity": l.color.to_array(),
+            "range": l.range,
+        })).collect::<Vec<_>>(),
         "warnings": scene.warnings,
         "suggested_viewer": suggestion.map(|(p, where_)| serde_json::json!({ "position": p, "where": where_ })),
     });

@@ -31,7 +31,7 @@ enum Command {
     Render(render::RenderArgs),
     /// Measure the display-position error of a method (seed 002 §4.1).
     Error(measure::ErrorArgs),
-    /// Describe a scene file as JSON: triangles, objects, materials, bounds, cameras, warnings,
+    /// Describe a scene file as JSON: triangles, objects, materials, bounds, cameras, lights, warnings,
     /// and a suggested viewer position.
     Info(info::InfoArgs),
     /// Benchmarks (release builds): `speed` times methods on scenes; the paper's figures; LOD.

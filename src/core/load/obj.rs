@@ -193,7 +193,8 @@ fn load_obj_texture(spec: &str, dirs: &[std::path::PathBuf]) -> std::result::Res
 /// The ray tracer's optics of an MTL material, by its illumination model: `illum` 3 and 5
 /// (ray-traced reflection) mirror the share `Ks` (its largest channel; the reflection is tinted by
 /// the surface colour); 4, 6 and 7 (ray-traced refraction) also transmit 1 − `d` (or `Tr`) with
-/// index `Ni` (1.5 when absent or below 1). Other models: no optics.
+/// index `Ni` (1.5 when absent or below 1). Other models: no optics. Also the glTF BRDF's
+/// roughness, metallic and emission (see the body).
 pub fn obj_optics(mat: &tobj::Material) -> Material {
     let illum = mat.illumination_model.unwrap_or(2);
     let ks = mat.specular.map_or(0.0, |s| s.iter().fold(0.0f32, |a, b| a.max(*b))).clamp(0.0, 1.0);
@@ -202,6 +203,24 @@ pub fn obj_optics(mat: &tobj::Material) -> Material {
         .or_else(|| mat.unknown_param.get("Tr").and_then(|t| t.trim().parse::<f32>().ok()).map(|t| 1.0 - t))
         .unwrap_or(1.0);
     let mut m = Material::default();
+    // The glTF BRDF's parameters (`--lighting pbr`): the PBR extension of MTL (`Pr` roughness,
+    // `Pm` metallic) where given; else roughness from the Phong exponent `Ns` by the
+    // Blinn-Phong–Beckmann correspondence α = √(2/(Ns + 2)), roughness = √α, and no metal;
+    // `Ke` is the emitted colour.
+    let param = |key: &str| -> Option<Vec<f32>> {
+        let v: Vec<f32> = mat.unknown_param.get(key)?.split_whitespace().filter_map(|x| x.parse().ok()).collect();
+        (!v.is_empty() && v.iter().all(|x| x.is_finite())).then_some(v)
+    };
+    m.roughness = match (param("Pr"), mat.shininess.filter(|n| n.is_finite() && *n >= 0.0)) {
+        (Some(r), _) => r[0].clamp(0.0, 1.0),
+        (None, Some(ns)) => (2.0 / (ns + 2.0)).sqrt().sqrt(),
+        (None, None) => 1.0,
+    };
+    m.metallic = param("Pm").map_or(0.0, |p| p[0].clamp(0.0, 1.0));
+    if let Some(ke) = mat.emissive.filter(|k| k.iter().all(|x| x.is_finite())) {
+        let k = |i: usize| ke[i].clamp(0.0, 1e6);
+        (m.emissive_r, m.emissive_g, m.emissive_b) = (k(0), k(1), k(2));
+    }
     if (3..=7).contains(&illum) {
         m.mirror = ks;
     }
