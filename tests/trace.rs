@@ -531,7 +531,7 @@ fn the_ray_tracer_filters_textures_as_the_rasterizer_does() {
         let (a, b) = (drawn.eye(eye), traced.eye(eye));
         let (oa, ob) =
             (&drawn.measurement.as_ref().unwrap().object[k], &traced.measurement.as_ref().unwrap().object[k]);
-        let (da, _) = (&drawn.depth.as_ref().unwrap()[k], ());
+        let da = &drawn.depth.as_ref().unwrap()[k];
         for i in 0..(p.width * p.height) as usize {
             if oa[i] == 0 || ob[i] == 0 {
                 continue;

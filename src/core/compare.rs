@@ -89,34 +89,29 @@ pub fn traced_display_error(
             let usable = |j: usize| tobj[j] == o && Vec3::from(tpos[j]).is_finite();
             let dist = |j: usize| (Vec3::from(tpos[j]) - x).length_squared();
             let (px, py) = ((i % width) as i64, (i / width) as i64);
-            // The start: p itself, or the nearest usable pixel around it.
-            let mut best = (usable(i)).then_some((px, py, dist(i)));
-            if best.is_none() {
+            // The 8-neighbour of (x, y) nearest X among those nearer than `bound`.
+            let nearer = |(qx, qy): (i64, i64), bound: f32| {
+                let mut best: Option<(i64, i64, f32)> = None;
                 for (dx, dy) in [(-1, 0), (1, 0), (0, -1), (0, 1), (-1, -1), (1, -1), (-1, 1), (1, 1)] {
-                    if let Some(j) = at(px + dx, py + dy).filter(|&j| usable(j)) {
-                        if best.is_none_or(|b| dist(j) < b.2) {
-                            best = Some((px + dx, py + dy, dist(j)));
+                    if let Some(j) = at(qx + dx, qy + dy).filter(|&j| usable(j)) {
+                        if dist(j) < best.map_or(bound, |b| b.2) {
+                            best = Some((qx + dx, qy + dy, dist(j)));
                         }
                     }
                 }
-            }
-            let Some(mut q) = best else {
+                best
+            };
+            // The start: p itself, or the nearest usable pixel around it; then descend.
+            let start = if usable(i) { Some((px, py, dist(i))) } else { nearer((px, py), f32::INFINITY) };
+            let Some(mut q) = start else {
                 unmatched += 1;
                 continue;
             };
             for _ in 0..TRACED_SEARCH_STEPS {
-                let mut next = q;
-                for (dx, dy) in [(-1, 0), (1, 0), (0, -1), (0, 1), (-1, -1), (1, -1), (-1, 1), (1, 1)] {
-                    if let Some(j) = at(q.0 + dx, q.1 + dy).filter(|&j| usable(j)) {
-                        if dist(j) < next.2 {
-                            next = (q.0 + dx, q.1 + dy, dist(j));
-                        }
-                    }
+                match nearer((q.0, q.1), q.2) {
+                    Some(next) => q = next,
+                    None => break,
                 }
-                if next == q {
-                    break;
-                }
-                q = next;
             }
             let y = Vec3::from(tpos[at(q.0, q.1).expect("inside")]);
             // The local map from the neighbours (one side or the other, same object).

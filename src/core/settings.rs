@@ -235,11 +235,13 @@ impl RenderSettings {
         &self,
         lights: &[crate::core::light::Light],
     ) -> (Vec<crate::core::light::GpuLight>, crate::core::light::LightingParams) {
+        (crate::core::light::gpu_lights(lights, self.view()), self.lighting_params(lights.len()))
+    }
+
+    /// The frame's lighting for a scene with `light_count` lights.
+    pub fn lighting_params(&self, light_count: usize) -> crate::core::light::LightingParams {
         let s = &self.shading;
-        (
-            crate::core::light::gpu_lights(lights, self.view()),
-            crate::core::light::LightingParams::of(s.lighting, lights.len(), s.exposure_ev, s.tonemap),
-        )
+        crate::core::light::LightingParams::of(s.lighting, light_count, s.exposure_ev, s.tonemap)
     }
 }
 

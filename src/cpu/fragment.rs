@@ -133,11 +133,10 @@ pub fn pbr_radiance(
 /// much per metre.
 pub fn pixel_spread(projection: &Projection, frag_xy: Vec2) -> f32 {
     let (_, v) = projection.pixel_to_screen(frag_xy.x - 0.5, frag_xy.y - 0.5);
-    let uniform = crate::shader::types::ProjectionUniform::from(projection);
-    if projection.panorama == crate::core::projection::PanoramaKind::Equirect {
-        (std::f32::consts::TAU / uniform.width * v.cos()).max(1.0 / uniform.pixels_per_v)
-    } else {
-        (std::f32::consts::TAU / uniform.width).max(1.0 / (uniform.pixels_per_v * uniform.screen_radius))
+    let across = std::f32::consts::TAU / projection.width as f32;
+    match projection.panorama {
+        PanoramaKind::Equirect => (across * v.cos()).max(1.0 / projection.pixels_per_v()),
+        PanoramaKind::Cylinder => across.max(1.0 / (projection.pixels_per_v() * projection.screen_radius)),
     }
 }
 

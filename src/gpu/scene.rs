@@ -143,7 +143,7 @@ impl GpuScene {
 
     /// Whether a frame with `settings` is lit by the glTF BRDF.
     pub fn pbr(&self, settings: &RenderSettings) -> bool {
-        settings.lighting(&self.lights).1.pbr != 0
+        settings.lighting_params(self.lights.len()).pbr != 0
     }
 
     /// Writes a frame's lights (in the viewer frame of `settings`) and lighting into group 1.

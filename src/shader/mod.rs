@@ -110,6 +110,9 @@ impl Stage {
 }
 
 /// The material table the fragment module reads (group 1 of the drawing stages).
+/// What the fragment entry points of the drawing stages read: their parameters and group 1.
+const SHADING: &[&str] = &["params", "materials", "mips", "texels", "lights", "lighting"];
+
 /// Group 1 of the stages that shade: the scene's materials and textures, its lights and the
 /// frame's lighting (src/gpu/scene.rs).
 const MATERIAL_TABLE: [Binding; 5] = [
@@ -157,9 +160,9 @@ pub const RASTER: Stage = Stage {
     kind: StageKind::Draw,
     entry_points: &[
         entry("vs_main", &["params"]),
-        entry("fs_main", &["params", "materials", "mips", "texels", "lights", "lighting"]),
-        entry("fs_error", &["params", "materials", "mips", "texels", "lights", "lighting"]),
-        entry("fs_position", &["params", "materials", "mips", "texels", "lights", "lighting"]),
+        entry("fs_main", SHADING),
+        entry("fs_error", SHADING),
+        entry("fs_position", SHADING),
     ],
     bindings: &[
         bind(0, 0, "params", Uniform),
@@ -177,9 +180,9 @@ pub const SLIT: Stage = Stage {
     kind: StageKind::Draw,
     entry_points: &[
         entry("vs_main", &["params", "cameras"]),
-        entry("fs_main", &["params", "materials", "mips", "texels", "lights", "lighting"]),
-        entry("fs_error", &["params", "materials", "mips", "texels", "lights", "lighting"]),
-        entry("fs_position", &["params", "materials", "mips", "texels", "lights", "lighting"]),
+        entry("fs_main", SHADING),
+        entry("fs_error", SHADING),
+        entry("fs_position", SHADING),
     ],
     bindings: &[
         bind(0, 0, "params", Uniform),
