@@ -30,22 +30,23 @@ trait Twin {
     fn compare(gpu: &Self::Output, cpu: &Self::Output) -> Result<(), String>;
 }
 
-/// Runs every case of a stage's twin check; returns how many ran.
-fn check<T: Twin>(stage: &str) -> usize {
+/// Runs every case of a stage's twin check; returns how many ran, or every case that differs.
+fn check<T: Twin>(stage: &str) -> Result<usize, Vec<String>> {
     let r = common::renderer();
     let cases = T::cases();
     assert!(!cases.is_empty(), "{stage}: no twin cases");
-    for (name, case) in &cases {
-        let (gpu, cpu) = (T::gpu(r, case), T::cpu(case));
-        if let Err(e) = T::compare(&gpu, &cpu) {
-            panic!("{stage}, {name}: GPU and CPU twin differ: {e}");
-        }
-    }
-    cases.len()
+    let differ: Vec<String> = cases
+        .iter()
+        .filter_map(|(name, case)| {
+            let (gpu, cpu) = (T::gpu(r, case), T::cpu(case));
+            T::compare(&gpu, &cpu).err().map(|e| format!("{stage}, {name}: GPU and CPU twin differ: {e}"))
+        })
+        .collect();
+    if differ.is_empty() { Ok(cases.len()) } else { Err(differ) }
 }
 
 /// The twin check of a registered stage, by name.
-fn twin_of(stage: &str) -> Option<fn(&str) -> usize> {
+fn twin_of(stage: &str) -> Option<fn(&str) -> Result<usize, Vec<String>>> {
     Some(match stage {
         "project_points" => check::<ProjectPoints>,
         "subdivide" => check::<Subdivide>,
@@ -57,15 +58,20 @@ fn twin_of(stage: &str) -> Option<fn(&str) -> usize> {
     })
 }
 
+/// Every stage is checked, and every case that differs is reported (not only the first).
 #[test]
 fn every_registered_stage_matches_its_cpu_twin() {
+    let mut differ = Vec::new();
     for stage in STAGES {
         let run = twin_of(stage.name).unwrap_or_else(|| {
             panic!("stage {} has no twin check: implement Twin for it in tests/twins.rs", stage.name)
         });
-        let n = run(stage.name);
-        eprintln!("{}: {n} cases agree", stage.name);
+        match run(stage.name) {
+            Ok(n) => eprintln!("{}: {n} cases agree", stage.name),
+            Err(cases) => differ.extend(cases),
+        }
     }
+    assert!(differ.is_empty(), "{} cases differ:\n{}", differ.len(), differ.join("\n"));
 }
 
 // ---- project_points ----
@@ -266,29 +272,35 @@ impl Twin for Subdivide {
         if cpu.cuts != gpu.cuts {
             return Err(format!("cuts around the axis: CPU {:#x}, GPU {:#x}", cpu.cuts, gpu.cuts));
         }
-        if cpu.pieces != gpu.pieces {
+        // On a software adapter (lavapipe: correctly rounded maths) the output is the twin's,
+        // exactly. A hardware GPU's sin, atan2 and acos differ from the CPU's in the last bits,
+        // which flips an edge's division count where its measure sits on a ceil boundary (seen
+        // on an H100: 36 of 53,697 nodes in a case of random triangles): there at most 1 % of
+        // the pieces, nodes and triangles may differ, and every other triangle is the twin's.
+        let slack = |n: usize| if common::renderer().gpu.info.device_type == wgpu::DeviceType::Cpu { 0 } else { n / 100 };
+        if cpu.pieces.abs_diff(gpu.pieces) as usize > slack(cpu.pieces as usize) {
             return Err(format!("pieces: CPU {}, GPU {}", cpu.pieces, gpu.pieces));
         }
         if (cpu.max_sub_edge_px - gpu.max_sub_edge_px).abs() >= 1e-2 * (1.0 + cpu.max_sub_edge_px) {
             return Err(format!("max edge: CPU {}, GPU {}", cpu.max_sub_edge_px, gpu.max_sub_edge_px));
         }
         // The indexed output: as many shared nodes, every index within them.
-        if cpu.nodes.len() != gpu.nodes.len() {
+        if cpu.nodes.len().abs_diff(gpu.nodes.len()) > slack(cpu.nodes.len()) {
             return Err(format!("nodes: CPU {}, GPU {}", cpu.nodes.len(), gpu.nodes.len()));
         }
         if let Some(i) = gpu.indices.iter().find(|&&i| i as usize >= gpu.nodes.len()) {
             return Err(format!("GPU index {i} beyond its {} nodes", gpu.nodes.len()));
         }
-        same_triangle_sets(&cpu.vertices, &gpu.vertices)
+        same_triangle_sets(&cpu.vertices, &gpu.vertices, slack(cpu.vertices.len() / 3))
     }
 }
 
 /// Matches each CPU triangle to the nearest unused GPU triangle (searched among those whose
 /// centroid and reference azimuth fall in neighbouring buckets: the GPU appends in another
-/// order) and checks they are the same.
-fn same_triangle_sets(cpu: &[DrawVertex], gpu: &[DrawVertex]) -> Result<(), String> {
+/// order) and checks they are the same; at most `allowed` CPU triangles may lack a twin.
+fn same_triangle_sets(cpu: &[DrawVertex], gpu: &[DrawVertex], allowed: usize) -> Result<(), String> {
     use std::collections::HashMap;
-    if cpu.len() != gpu.len() {
+    if cpu.len().abs_diff(gpu.len()) / 3 > allowed {
         return Err(format!("CPU made {} triangles, GPU {}", cpu.len() / 3, gpu.len() / 3));
     }
     let key = |t: &[DrawVertex]| (t.iter().fold(Vec3::ZERO, |a, v| a + Vec3::from(v.position)) / 3.0, t[0].theta_ref);
@@ -302,6 +314,7 @@ fn same_triangle_sets(cpu: &[DrawVertex], gpu: &[DrawVertex]) -> Result<(), Stri
         buckets.entry(cell(c, th)).or_default().push(j);
     }
     let mut used = vec![false; gpu_tris.len()];
+    let mut unmatched = Vec::new();
     for t in cpu.chunks(3) {
         let (c, th) = key(t);
         let k = cell(c, th);
@@ -318,20 +331,26 @@ fn same_triangle_sets(cpu: &[DrawVertex], gpu: &[DrawVertex]) -> Result<(), Stri
                 }
             }
         }
-        let (_, best) = best.ok_or_else(|| format!("CPU triangle {t:?} has no GPU twin"))?;
-        used[best] = true;
+        let Some((_, best)) = best else {
+            unmatched.push(format!("CPU triangle {t:?} has no GPU twin"));
+            continue;
+        };
         let close = |x: &[f32], y: &[f32]| x.iter().zip(y).all(|(p, q)| (p - q).abs() <= 1e-4 * (1.0 + p.abs()));
-        for (a, b) in t.iter().zip(gpu_tris[best]) {
-            let same = close(&a.position, &b.position)
+        let same = |a: &DrawVertex, b: &DrawVertex| {
+            close(&a.position, &b.position)
                 && close(&[a.theta_ref], &[b.theta_ref])
                 && close(&a.normal, &b.normal)
                 && close(&a.color, &b.color)
                 && close(&a.uv, &b.uv)
-                && a.material == b.material;
-            if !same {
-                return Err(format!("CPU vertex {a:?} differs from GPU vertex {b:?}"));
-            }
+                && a.material == b.material
+        };
+        match t.iter().zip(gpu_tris[best]).find(|(a, b)| !same(a, b)) {
+            None => used[best] = true,
+            Some((a, b)) => unmatched.push(format!("CPU vertex {a:?} differs from GPU vertex {b:?}")),
         }
+    }
+    if unmatched.len() > allowed {
+        return Err(format!("{} triangles without a twin (allowed {allowed}), first: {}", unmatched.len(), unmatched[0]));
     }
     Ok(())
 }
@@ -364,7 +383,8 @@ fn compare_eyes(gpu: &EyeOutputs, cpu: &EyeOutputs, share: usize, error_toleranc
             .iter()
             .zip(cd)
             .filter(|(g, c)| {
-                let same = (g.is_infinite() && c.is_infinite()) || (*g - *c).abs() <= 1e-3 * c.abs();
+                // 0.1 %, or 0.2 mm: thin needles near the axis interpolate a few cm away.
+                let same = (g.is_infinite() && c.is_infinite()) || (*g - *c).abs() <= 1e-3 * c.abs() + 2e-4;
                 !same
             })
             .count();
@@ -437,6 +457,13 @@ impl Twin for Raster {
             let settings = RenderSettings::new(sphere).with_method(Method::Vertex).with_error_angle(angle);
             out.push((format!("triangle@3 on the sphere, angle {angle}"), (triangle.clone(), settings, Some(0.02))));
         }
+        // Eyes 5 cm under a ceiling in the exact vertical model: needles reaching from the
+        // ceiling's image to points inside the eye circle, millions of pixels above it, drawn
+        // within GUARD_BAND_PX of the image (a real GPU left a pixel between such needles).
+        let cube = builtin::closed_box("cube", Vec3::splat(-1.0), Vec3::splat(1.0));
+        let exact = Projection { width: 192, height: 192, vertical: Vertical::Exact, ..Projection::default() };
+        let settings = RenderSettings::new(exact).with_viewer(Vec3::new(0.0, 0.95, 0.0)).with_method(Method::Fixed(7));
+        out.push(("cube, eyes under the ceiling, exact".into(), (cube, settings, None)));
         // The glTF BRDF under point, spot and directional lights, seen from a moved viewer, with
         // each tone mapping.
         let cylinder = Projection { width: 400, height: 100, vertical: Vertical::Exact, ..Projection::default() };

@@ -233,9 +233,11 @@ fn to_pixel(proj: Projection, u: f32, v: f32) -> vec2<f32> {
 // Clip-space position of a projected point. u is NOT wrapped: the pre-pass places seam copies
 // at u ± 2π and the rasterizer clips them. w = 1, so attributes interpolate linearly on the
 // screen as in the paper; depth r maps monotonically into (0, 1) as r / (r + 1).
+// y is kept within GUARD_BAND_PX of the image (constants.rs says why).
 fn to_clip(proj: Projection, uvd: vec3<f32>) -> vec4<f32> {
     let x = uvd.x / PI;
-    let y = uvd.y * proj.pixels_per_v / (0.5 * proj.height);
+    let y_limit = 1.0 + GUARD_BAND_PX / (0.5 * proj.height);
+    let y = clamp(uvd.y * proj.pixels_per_v / (0.5 * proj.height), -y_limit, y_limit);
     let z = min(uvd.z / (uvd.z + 1.0), MAX_DEPTH);
     return vec4<f32>(x, y, z, 1.0);
 }

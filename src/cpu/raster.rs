@@ -14,9 +14,11 @@ use crate::core::projection::{azimuth, Eye, Projection};
 use crate::core::settings::RenderSettings;
 use crate::core::texture::MaterialTable;
 use crate::cpu::fragment::{pixel_distance, pixel_error, shade_surface, surface_color, Surface};
+use crate::shader::constants::GUARD_BAND_PX;
 use crate::shader::types::{DrawVertex, RasterParams};
 
-/// Clip-space position of a subdivided vertex (`vs_main` in raster.wgsl).
+/// Clip-space position of a subdivided vertex (`vs_main` in raster.wgsl), at most
+/// `GUARD_BAND_PX` beyond the image's top or bottom edge.
 pub fn raster_vertex(params: &RasterParams, v: &DrawVertex) -> Vec4 {
     let projection = Projection::from(&params.projection);
     let p = Vec3::from(v.position);
@@ -24,9 +26,11 @@ pub fn raster_vertex(params: &RasterParams, v: &DrawVertex) -> Vec4 {
     let theta = theta0 + std::f32::consts::TAU * ((v.theta_ref - theta0) / std::f32::consts::TAU + 0.5).floor();
     let eye = if params.eye_sign > 0.0 { Eye::Right } else { Eye::Left };
     let q = projection.project_with_azimuth(p, theta, eye);
+    let half_height = 0.5 * projection.height as f32;
+    let y_limit = 1.0 + GUARD_BAND_PX / half_height;
     Vec4::new(
         q.u / std::f32::consts::PI + 2.0 * params.shift_px[0] / projection.width as f32,
-        q.v * projection.pixels_per_v() / (0.5 * projection.height as f32)
+        (q.v * projection.pixels_per_v() / half_height).clamp(-y_limit, y_limit)
             - 2.0 * params.shift_px[1] / projection.height as f32,
         (q.depth / (q.depth + 1.0)).min(crate::shader::constants::MAX_DEPTH),
         1.0,

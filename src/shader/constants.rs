@@ -64,6 +64,15 @@ pub const PIECES_FROM_COUNTER: u32 = u32::MAX;
 /// (r/(r+1)), beyond ~20 km for the slit cameras (1 − near/z).
 pub const MAX_DEPTH: f32 = 1.0 - 1.0 / (1 << 21) as f32;
 
+/// How far beyond the image's top or bottom edge, in pixels, the raster stage places a vertex
+/// at most: one further out is pulled in vertically to this distance. Points between the square
+/// around the axis and the eye circle (see `cpu::subdivide::axis`) project to millions of pixels
+/// in the exact vertical model; a real GPU clips such triangles outside its guard band, and two
+/// neighbours clipped apart can leave a pixel between them (seen on an H100: one background
+/// pixel at the tips of a fan of such needles). 8,192 px lies within every guard band, and moves
+/// the needles' in-image part by under 1 % of their width.
+pub const GUARD_BAND_PX: f32 = 8192.0;
+
 /// Error histogram of `reduce_error`: bins of 1/64 px in [0, 64) px ...
 pub const FINE_BINS: u32 = 4096;
 /// ... bins of 1 px in [64, 1024) px ...
@@ -105,6 +114,7 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("FIELD_DOWN", F32(FIELD_DOWN)),
         ("PIECES_FROM_COUNTER", U32(PIECES_FROM_COUNTER)),
         ("MAX_DEPTH", F32(MAX_DEPTH)),
+        ("GUARD_BAND_PX", F32(GUARD_BAND_PX)),
         ("FINE_BINS", U32(FINE_BINS)),
         ("COARSE_BINS", U32(COARSE_BINS)),
         ("BINS", U32(BINS)),
