@@ -416,7 +416,7 @@ type RasterCase = (Scene, RenderSettings, Option<f32>);
 
 /// The material table as group 1 holds it for a frame: with the scene's lights and lighting.
 fn lit_table(scene: &Scene, settings: &RenderSettings) -> twister::core::texture::MaterialTable {
-    let (lights, lighting) = settings.lighting(&scene.lights);
+    let (lights, lighting) = settings.lighting(&scene.lights, scene.environment.as_deref());
     scene.material_table(usize::MAX).with_lighting(lights, lighting)
 }
 
@@ -464,6 +464,15 @@ impl Twin for Raster {
         let exact = Projection { width: 192, height: 192, vertical: Vertical::Exact, ..Projection::default() };
         let settings = RenderSettings::new(exact).with_viewer(Vec3::new(0.0, 0.95, 0.0)).with_method(Method::Fixed(7));
         out.push(("cube, eyes under the ceiling, exact".into(), (cube, settings, None)));
+        // Image-based lighting: the lit spheres also in the neutral studio, the viewer turned
+        // (the environment stays put in the scene frame).
+        let mut studio = common::lit_spheres();
+        studio.environment =
+            Some(std::sync::Arc::new(twister::core::environment::Environment::neutral().prepare()));
+        let settings = RenderSettings::new(Projection { width: 400, height: 100, ..Projection::default() })
+            .with_yaw_deg(-25.0)
+            .with_viewer(Vec3::new(0.1, 0.2, 0.0));
+        out.push(("lit spheres in the neutral studio".into(), (studio, settings, None)));
         // The glTF BRDF under point, spot and directional lights, seen from a moved viewer, with
         // each tone mapping.
         let cylinder = Projection { width: 400, height: 100, vertical: Vertical::Exact, ..Projection::default() };

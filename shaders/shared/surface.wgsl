@@ -54,12 +54,22 @@ struct Light {
 }
 
 // The frame's lighting (`LightingParams`): lights in use, the glTF BRDF (1) or the headlight
-// (0), 2^EV, the tone mapping.
+// (0), 2^EV, the tone mapping; the environment's image-based lighting (src/core/environment.rs):
+// on or off, where its split-sum table starts, the rotation
+// from the viewer frame to the environment's, the irradiance's SH coefficients and the
+// prefiltered levels (first texel, width, height).
 struct Lighting {
     count: u32,
     pbr: u32,
     exposure: f32,
     tonemap: u32,
+    environment: u32,
+    _pad0: u32,
+    env_lut: u32,
+    _pad: u32,
+    env_rotation: array<vec4<f32>, 3>,
+    env_sh: array<vec4<f32>, 9>,
+    env_levels: array<vec4<u32>, ENV_LEVELS>,
 }
 
 struct MipLevel {
@@ -75,6 +85,8 @@ struct MipLevel {
 @group(1) @binding(2) var<storage, read> texels: array<u32>;
 @group(1) @binding(3) var<storage, read> lights: array<Light>;
 @group(1) @binding(4) var<uniform> lighting: Lighting;
+// The environment's prefiltered levels and split-sum table (linear RGB; a single texel when none).
+@group(1) @binding(5) var<storage, read> environment: array<vec4<f32>>;
 
 fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
     return select(pow((c + 0.055) / 1.055, vec3<f32>(2.4)), c / 12.92, c <= vec3<f32>(0.04045));
@@ -306,7 +318,12 @@ fn pbr_radiance(material: u32, ambient: f32, v: vec3<f32>, view_position: vec3<f
         n = -n;
     }
     let base = max(color.rgb, vec3<f32>(0.0));
-    var c = ambient * mix(base, vec3<f32>(0.0), m.metallic) + vec3<f32>(m.emissive_r, m.emissive_g, m.emissive_b);
+    var c = vec3<f32>(m.emissive_r, m.emissive_g, m.emissive_b);
+    if (lighting.environment != 0u) {
+        c += ibl_radiance(n, v, base, m.metallic, m.roughness);
+    } else {
+        c += ambient * mix(base, vec3<f32>(0.0), m.metallic);
+    }
     for (var i = 0u; i < lighting.count; i++) {
         let light = lights[i];
         let at = light_at(light, view_position);
@@ -316,6 +333,86 @@ fn pbr_radiance(material: u32, ambient: f32, v: vec3<f32>, view_position: vec3<f
         }
     }
     return c;
+}
+
+// ---- Image-based lighting (src/core/environment.rs; twins in fragment.rs) ----
+
+// A viewer-frame direction in the environment's frame.
+fn env_direction(d: vec3<f32>) -> vec3<f32> {
+    return lighting.env_rotation[0].xyz * d.x + lighting.env_rotation[1].xyz * d.y + lighting.env_rotation[2].xyz * d.z;
+}
+
+// Prefiltered level k, bilinear at environment-frame direction d (longitude wraps, latitude clamps).
+fn env_level(k: u32, d: vec3<f32>) -> vec3<f32> {
+    let level = lighting.env_levels[k];
+    let size = vec2<f32>(f32(level.y), f32(level.z));
+    let p = vec2<f32>(atan2(d.x, -d.z) / TAU + 0.5, 0.5 - asin(clamp(d.y, -1.0, 1.0)) / PI) * size - 0.5;
+    let base = floor(p);
+    let f = p - base;
+    var out = vec3<f32>(0.0);
+    for (var corner = 0u; corner < 4u; corner++) {
+        let dx = i32(corner & 1u);
+        let dy = i32(corner >> 1u);
+        let x = euclid_mod(i32(base.x) + dx, i32(level.y));
+        let y = clamp(i32(base.y) + dy, 0, i32(level.z) - 1);
+        let w = select(1.0 - f.x, f.x, dx == 1) * select(1.0 - f.y, f.y, dy == 1);
+        out += w * environment[level.x + u32(y) * level.y + u32(x)].rgb;
+    }
+    return out;
+}
+
+// The radiance around viewer-frame direction d convolved for `roughness` (levels blended).
+fn env_radiance(d: vec3<f32>, roughness: f32) -> vec3<f32> {
+    let e = env_direction(d);
+    let lod = clamp(roughness, 0.0, 1.0) * f32(ENV_LEVELS - 1u);
+    let k = min(u32(lod), ENV_LEVELS - 2u);
+    let t = lod - f32(k);
+    return mix(env_level(k, e), env_level(k + 1u, e), t);
+}
+
+// E(n)/π at viewer-frame normal n, from the SH coefficients.
+fn env_irradiance(n_view: vec3<f32>) -> vec3<f32> {
+    let d = env_direction(n_view);
+    let b = array<f32, 9>(0.282095, 0.488603 * d.y, 0.488603 * d.z, 0.488603 * d.x, 1.092548 * d.x * d.y,
+                          1.092548 * d.y * d.z, 0.315392 * (3.0 * d.z * d.z - 1.0), 1.092548 * d.x * d.z,
+                          0.546274 * (d.x * d.x - d.y * d.y));
+    var e = vec3<f32>(0.0);
+    for (var i = 0u; i < 9u; i++) {
+        e += lighting.env_sh[i].xyz * b[i];
+    }
+    return max(e, vec3<f32>(0.0));
+}
+
+// The split-sum table (A, B) at n·v and roughness, bilinear between texel centres.
+fn env_lut(nv: f32, roughness: f32) -> vec2<f32> {
+    let n = f32(LUT_SIZE);
+    let p = clamp(vec2<f32>(nv, roughness) * n - 0.5, vec2<f32>(0.0), vec2<f32>(n - 1.0));
+    let base = min(floor(p), vec2<f32>(n - 2.0));
+    let f = p - base;
+    var out = vec2<f32>(0.0);
+    for (var corner = 0u; corner < 4u; corner++) {
+        let dx = corner & 1u;
+        let dy = corner >> 1u;
+        let w = select(1.0 - f.x, f.x, dx == 1u) * select(1.0 - f.y, f.y, dy == 1u);
+        out += w * environment[lighting.env_lut + (u32(base.y) + dy) * LUT_SIZE + u32(base.x) + dx].xy;
+    }
+    return out;
+}
+
+// The environment's light reflected towards v by a surface with unit normal n (split sum with
+// Fdez-Agüera's multiple-scattering term; see src/core/environment.rs).
+fn ibl_radiance(n: vec3<f32>, v: vec3<f32>, base: vec3<f32>, metallic: f32, roughness: f32) -> vec3<f32> {
+    let nv = clamp(dot(n, v), 1e-4, 1.0);
+    let ab = env_lut(nv, roughness);
+    let f0 = mix(vec3<f32>(0.04), base, metallic);
+    let e_ss = f0 * ab.x + ab.y;
+    let e_ms = 1.0 - (ab.x + ab.y);
+    let f_avg = f0 + (1.0 - f0) / 21.0;
+    let f_ms = e_ss * f_avg / (1.0 - e_ms * f_avg);
+    let irradiance = env_irradiance(n);
+    let specular = env_radiance(2.0 * nv * n - v, roughness) * e_ss + irradiance * f_ms * e_ms;
+    let c_diff = mix(base, vec3<f32>(0.0), metallic);
+    return specular + c_diff * irradiance * max(vec3<f32>(1.0) - e_ss - f_ms * e_ms, vec3<f32>(0.0));
 }
 
 // The screen point (u, v) at image position (x, y) (`Projection::pixel_to_screen`).

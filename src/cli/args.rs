@@ -3,6 +3,7 @@
 
 use clap::Args;
 use glam::Vec3;
+use twister::core::environment::PreparedEnvironment;
 use twister::core::light::{LightingMode, Tonemap};
 
 use twister::core::lod::LodParams;
@@ -86,6 +87,11 @@ pub struct ViewArgs {
     /// emission and ambient only). The ray tracer's --light replaces the scene's lights.
     #[arg(long, value_enum, default_value_t = LightingMode::Auto)]
     pub lighting: LightingMode,
+    /// Image-based lighting: an equirectangular radiance map (.hdr or .exr; the centre column
+    /// looks along −z); `neutral`, the built-in grey studio; or `none`. Default: `neutral` for a glTF scene or `--lighting pbr` without
+    /// the scene's own lights, else none.
+    #[arg(long, value_name = "FILE|neutral|none")]
+    pub environment: Option<String>,
     /// Exposure in stops: the BRDF's linear colour is scaled by 2^EV before tone mapping.
     #[arg(long, default_value_t = 0.0, value_name = "EV")]
     pub exposure: f32,
@@ -291,6 +297,24 @@ impl ViewArgs {
     }
 
     /// `--light` is refused unless one of `methods` traces rays (it would do nothing).
+    /// The environment that lights the scene (see `--environment`), prepared.
+    pub fn environment(&self, scene: &twister::Scene) -> Result<Option<PreparedEnvironment>> {
+        use twister::core::environment::Environment;
+        let wants_default = scene.lights.is_empty()
+            && match self.lighting {
+                LightingMode::Auto => scene.physically_based,
+                LightingMode::Pbr => true,
+                LightingMode::Headlight => false,
+            };
+        Ok(match self.environment.as_deref() {
+            Some("none") => None,
+            Some("neutral") => Some(Environment::neutral().prepare()),
+            Some(file) => Some(Environment::load(std::path::Path::new(file))?.prepare()),
+            None if wants_default => Some(Environment::neutral().prepare()),
+            None => None,
+        })
+    }
+
     pub fn check_light(&self, methods: &[Method]) -> Result<()> {
         if self.light.is_some() && !methods.contains(&Method::Trace) {
             return Err(Error::option("--light", "lights the ray tracer: use it with --method trace"));

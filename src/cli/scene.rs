@@ -105,6 +105,7 @@ pub fn prepare(
     if let (Some(sel), true) = (&selection, overlay) {
         twister::core::lod::tint(&mut scene, sel);
     }
+    scene.environment = view.environment(&scene)?.map(std::sync::Arc::new);
     let mut gpu_scene = GpuScene::upload(&renderer.gpu, &scene)?;
     if methods.contains(&Method::Trace) {
         gpu_scene = match trace_min_share {

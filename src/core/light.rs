@@ -9,6 +9,8 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 
+use crate::core::environment::{PreparedEnvironment, ENV_LEVELS};
+
 /// `LIGHT_*` in the WGSL `constants` module.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -116,7 +118,7 @@ impl Tonemap {
     }
 }
 
-/// `Lighting` in shaders/shared/surface.wgsl (a uniform): the frame's lighting. 16 bytes.
+/// `Lighting` in shaders/shared/surface.wgsl (a uniform): the frame's lighting. 320 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct LightingParams {
@@ -128,18 +130,58 @@ pub struct LightingParams {
     pub exposure: f32,
     /// `TONEMAP_*`.
     pub tonemap: u32,
+    /// 1: image-based lighting from the environment (`core::environment`) replaces the ambient term.
+    pub environment: u32,
+    pub _pad0: u32,
+    /// First texel of the split-sum table in the environment buffer.
+    pub env_lut: u32,
+    pub _pad: u32,
+    /// Viewer frame → environment (scene) frame: the columns of the rotation (w unused).
+    pub env_rotation: [[f32; 4]; 3],
+    /// E(n)/π as spherical-harmonic coefficients (rgb, w unused).
+    pub env_sh: [[f32; 4]; 9],
+    /// The prefiltered levels: first texel, width, height, unused.
+    pub env_levels: [[u32; 4]; ENV_LEVELS],
 }
 
 impl LightingParams {
-    /// The frame's lighting for a scene with `lights` lights: the glTF BRDF with `--lighting
-    /// pbr`, or `auto` where the scene has lights; 2^EV; the tone mapping.
-    pub fn of(mode: LightingMode, lights: usize, exposure_ev: f32, tonemap: Tonemap) -> LightingParams {
+    /// The frame's lighting for a scene with `lights` lights and perhaps an environment: the
+    /// glTF BRDF with `--lighting pbr`, or `auto` where the scene has lights or an environment;
+    /// 2^EV; the tone mapping.
+    pub fn of(
+        mode: LightingMode,
+        lights: usize,
+        environment: Option<&PreparedEnvironment>,
+        exposure_ev: f32,
+        tonemap: Tonemap,
+    ) -> LightingParams {
         let pbr = match mode {
-            LightingMode::Auto => lights > 0,
+            LightingMode::Auto => lights > 0 || environment.is_some(),
             LightingMode::Headlight => false,
             LightingMode::Pbr => true,
         };
-        LightingParams { count: lights as u32, pbr: pbr as u32, exposure: exposure_ev.exp2(), tonemap: tonemap.code() }
+        let mut params = LightingParams {
+            count: lights as u32,
+            pbr: pbr as u32,
+            exposure: exposure_ev.exp2(),
+            tonemap: tonemap.code(),
+            ..Default::default()
+        };
+        if let (Some(env), true) = (environment, pbr) {
+            params.environment = 1;
+            params.env_lut = env.lut_offset;
+            params.env_sh = env.sh.map(|c| c.extend(0.0).to_array());
+            params.env_levels = env.levels.map(|[o, w, h]| [o, w, h, 0]);
+            params.env_rotation = [Vec3::X, Vec3::Y, Vec3::Z].map(|c| c.extend(0.0).to_array());
+        }
+        params
+    }
+
+    /// With the viewer frame → scene frame rotation of `view` (scene → viewer).
+    pub fn with_view(mut self, view: Mat4) -> LightingParams {
+        let m = glam::Mat3::from_mat4(view).transpose();
+        self.env_rotation = [m.x_axis, m.y_axis, m.z_axis].map(|c| c.extend(0.0).to_array());
+        self
     }
 }
 

@@ -5,6 +5,7 @@
 pub mod builtin;
 pub mod bvh;
 pub mod color;
+pub mod environment;
 pub mod compare;
 pub mod frame;
 pub mod light;

@@ -56,6 +56,11 @@ pub struct Scene {
     pub cameras: Vec<Camera>,
     /// Punctual lights placed in the file (glTF `KHR_lights_punctual`).
     pub lights: Vec<crate::core::light::Light>,
+    /// Whether the file describes its materials for the glTF BRDF (a glTF file): `--lighting
+    /// auto` then lights it so, with the neutral environment where it has no lights.
+    pub physically_based: bool,
+    /// The environment that lights it (image-based lighting, `--environment`), prepared.
+    pub environment: Option<std::sync::Arc<crate::core::environment::PreparedEnvironment>>,
     /// Meshes drawn (glTF mesh instances, OBJ objects/groups, built-in shapes: one per object)
     /// and their primitives.
     pub meshes: usize,
@@ -80,7 +85,11 @@ impl Scene {
     /// The table of the scene's materials and textures, as the fragment stage reads it, with at
     /// most `max_texels` texels (see [`MaterialTable::build`]).
     pub fn material_table(&self, max_texels: usize) -> MaterialTable {
-        MaterialTable::build(&self.materials, &self.textures, max_texels)
+        let table = MaterialTable::build(&self.materials, &self.textures, max_texels);
+        match &self.environment {
+            Some(env) => table.with_environment(env),
+            None => table,
+        }
     }
 
     pub fn triangle_count(&self) -> usize {

@@ -234,14 +234,22 @@ impl RenderSettings {
     pub fn lighting(
         &self,
         lights: &[crate::core::light::Light],
+        environment: Option<&crate::core::environment::PreparedEnvironment>,
     ) -> (Vec<crate::core::light::GpuLight>, crate::core::light::LightingParams) {
-        (crate::core::light::gpu_lights(lights, self.view()), self.lighting_params(lights.len()))
+        (
+            crate::core::light::gpu_lights(lights, self.view()),
+            self.lighting_params(lights.len(), environment).with_view(self.view()),
+        )
     }
 
-    /// The frame's lighting for a scene with `light_count` lights.
-    pub fn lighting_params(&self, light_count: usize) -> crate::core::light::LightingParams {
+    /// The frame's lighting for a scene with `light_count` lights and perhaps an environment.
+    pub fn lighting_params(
+        &self,
+        light_count: usize,
+        environment: Option<&crate::core::environment::PreparedEnvironment>,
+    ) -> crate::core::light::LightingParams {
         let s = &self.shading;
-        crate::core::light::LightingParams::of(s.lighting, light_count, s.exposure_ev, s.tonemap)
+        crate::core::light::LightingParams::of(s.lighting, light_count, environment, s.exposure_ev, s.tonemap)
     }
 }
 

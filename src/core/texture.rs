@@ -76,10 +76,19 @@ pub struct MaterialTable {
     /// the headlight by default ([`MaterialTable::with_lighting`]).
     pub lights: Vec<crate::core::light::GpuLight>,
     pub lighting: crate::core::light::LightingParams,
+    /// The environment's prefiltered levels and split-sum table, as group 1's binding 5 holds
+    /// them (empty without an environment; [`MaterialTable::with_environment`]).
+    pub environment: Vec<[f32; 4]>,
 }
 
 impl MaterialTable {
     /// The same table with a frame's lights (viewer frame) and lighting (the CPU twins' group 1).
+    /// With an environment's texels (its places and coefficients come with the lighting).
+    pub fn with_environment(mut self, environment: &crate::core::environment::PreparedEnvironment) -> MaterialTable {
+        self.environment = environment.texels.clone();
+        self
+    }
+
     pub fn with_lighting(
         mut self,
         lights: Vec<crate::core::light::GpuLight>,

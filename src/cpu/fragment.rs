@@ -7,6 +7,7 @@
 use glam::{Vec2, Vec3, Vec4};
 
 use crate::core::color::{linear_to_srgb, srgb_to_linear};
+use crate::core::environment::{ENV_LEVELS, LUT_SIZE};
 use crate::core::light::{tonemap, GpuLight, LightKind};
 use crate::core::material::{AlphaMode, Filter, Material, MipLevel, Mipmap, Wrap, NO_TEXTURE};
 use crate::core::projection::{Eye, PanoramaKind, Projection};
@@ -116,7 +117,12 @@ pub fn pbr_radiance(
         n = -n;
     }
     let base = color.truncate().max(Vec3::ZERO);
-    let mut c = ambient * base.lerp(Vec3::ZERO, m.metallic) + Vec3::new(m.emissive_r, m.emissive_g, m.emissive_b);
+    let mut c = Vec3::new(m.emissive_r, m.emissive_g, m.emissive_b);
+    if table.lighting.environment != 0 {
+        c += ibl_radiance(table, n, v, base, m.metallic, m.roughness);
+    } else {
+        c += ambient * base.lerp(Vec3::ZERO, m.metallic);
+    }
     for light in &table.lights[..table.lighting.count as usize] {
         let (l, scale) = light_at(light, view_position);
         let nl = n.dot(l);
@@ -125,6 +131,80 @@ pub fn pbr_radiance(
         }
     }
     c
+}
+
+// ---- Image-based lighting (`core::environment`; surface.wgsl's twins) ----
+
+/// A viewer-frame direction in the environment's frame (`env_direction`).
+pub fn env_direction(table: &MaterialTable, d: Vec3) -> Vec3 {
+    let r = &table.lighting.env_rotation;
+    Vec3::from_slice(&r[0][..3]) * d.x + Vec3::from_slice(&r[1][..3]) * d.y + Vec3::from_slice(&r[2][..3]) * d.z
+}
+
+/// Prefiltered level k, bilinear at environment-frame direction d (`env_level`).
+pub fn env_level(table: &MaterialTable, k: usize, d: Vec3) -> Vec3 {
+    let [offset, width, height, _] = table.lighting.env_levels[k];
+    let size = Vec2::new(width as f32, height as f32);
+    let p = Vec2::new(d.x.atan2(-d.z) / std::f32::consts::TAU + 0.5, 0.5 - d.y.clamp(-1.0, 1.0).asin() / std::f32::consts::PI)
+        * size
+        - 0.5;
+    let base = p.floor();
+    let f = p - base;
+    let mut out = Vec3::ZERO;
+    for corner in 0..4u32 {
+        let (dx, dy) = ((corner & 1) as i32, (corner >> 1) as i32);
+        let x = (base.x as i32 + dx).rem_euclid(width as i32);
+        let y = (base.y as i32 + dy).clamp(0, height as i32 - 1);
+        let w = if dx == 1 { f.x } else { 1.0 - f.x } * if dy == 1 { f.y } else { 1.0 - f.y };
+        out += w * Vec3::from_slice(&table.environment[(offset + y as u32 * width + x as u32) as usize][..3]);
+    }
+    out
+}
+
+/// The radiance around viewer-frame direction d convolved for `roughness` (`env_radiance`).
+pub fn env_radiance(table: &MaterialTable, d: Vec3, roughness: f32) -> Vec3 {
+    let e = env_direction(table, d);
+    let lod = roughness.clamp(0.0, 1.0) * (ENV_LEVELS - 1) as f32;
+    let k = (lod as usize).min(ENV_LEVELS - 2);
+    let t = lod - k as f32;
+    env_level(table, k, e).lerp(env_level(table, k + 1, e), t)
+}
+
+/// E(n)/π at viewer-frame normal n (`env_irradiance`).
+pub fn env_irradiance(table: &MaterialTable, n: Vec3) -> Vec3 {
+    let sh = table.lighting.env_sh.map(|c| Vec3::from_slice(&c[..3]));
+    crate::core::environment::irradiance(&sh, env_direction(table, n))
+}
+
+/// The split-sum table (A, B) at n·v and roughness (`env_lut`).
+pub fn env_lut(table: &MaterialTable, nv: f32, roughness: f32) -> Vec2 {
+    let n = LUT_SIZE as f32;
+    let p = (Vec2::new(nv, roughness) * n - 0.5).clamp(Vec2::ZERO, Vec2::splat(n - 1.0));
+    let base = p.floor().min(Vec2::splat(n - 2.0));
+    let f = p - base;
+    let mut out = Vec2::ZERO;
+    for corner in 0..4u32 {
+        let (dx, dy) = (corner & 1, corner >> 1);
+        let w = if dx == 1 { f.x } else { 1.0 - f.x } * if dy == 1 { f.y } else { 1.0 - f.y };
+        let i = table.lighting.env_lut as usize + (base.y as usize + dy as usize) * LUT_SIZE + base.x as usize + dx as usize;
+        out += w * Vec2::new(table.environment[i][0], table.environment[i][1]);
+    }
+    out
+}
+
+/// The environment's light reflected towards v by a surface with unit normal n (`ibl_radiance`).
+pub fn ibl_radiance(table: &MaterialTable, n: Vec3, v: Vec3, base: Vec3, metallic: f32, roughness: f32) -> Vec3 {
+    let nv = n.dot(v).clamp(1e-4, 1.0);
+    let ab = env_lut(table, nv, roughness);
+    let f0 = Vec3::splat(0.04).lerp(base, metallic);
+    let e_ss = f0 * ab.x + ab.y;
+    let e_ms = 1.0 - (ab.x + ab.y);
+    let f_avg = f0 + (1.0 - f0) / 21.0;
+    let f_ms = e_ss * f_avg / (1.0 - e_ms * f_avg);
+    let irradiance = env_irradiance(table, n);
+    let specular = env_radiance(table, 2.0 * nv * n - v, roughness) * e_ss + irradiance * f_ms * e_ms;
+    let c_diff = base.lerp(Vec3::ZERO, metallic);
+    specular + c_diff * irradiance * (Vec3::ONE - e_ss - f_ms * e_ms).max(Vec3::ZERO)
 }
 
 /// The angle a pixel spans, radians (`pixel_spread` in surface.wgsl): the larger of its width

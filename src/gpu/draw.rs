@@ -90,8 +90,8 @@ impl DrawPipelines {
 
     /// The scene's material table (group 1).
     pub fn material_bind_group(&self, gpu: &Gpu, scene: &GpuScene) -> wgpu::BindGroup {
-        let [a, b, c, d, e] = &scene.materials;
-        self.stage.bind_group(gpu, None, 1, &[a, b, c, d, e])
+        let [a, b, c, d, e, f] = &scene.materials;
+        self.stage.bind_group(gpu, None, 1, &[a, b, c, d, e, f])
     }
 }
 

@@ -4,6 +4,7 @@
 use glam::{Mat4, Vec3};
 
 use crate::core::bvh::SceneBvh;
+use crate::core::environment::PreparedEnvironment;
 use crate::core::light::{gpu_lights, Light, LightingParams};
 use crate::core::lod::LodSelection;
 use crate::core::scene::{object_spheres, Scene};
@@ -27,8 +28,10 @@ pub struct GpuScene {
     pub triangle_count: u32,
     pub objects: Vec<ObjectRange>,
     /// The material table the fragment stage reads (group 1): materials, mip levels, texels.
-    /// Group 1: materials, mip levels, texels, lights, lighting.
-    pub materials: [wgpu::Buffer; 5],
+    /// Group 1: materials, mip levels, texels, lights, lighting, environment.
+    pub materials: [wgpu::Buffer; 6],
+    /// The environment that lights the scene's frames (its texels are in `materials[5]`), if any.
+    pub environment: Option<std::sync::Arc<PreparedEnvironment>>,
     /// The scene's lights (scene frame), written into group 1 per frame.
     pub lights: Vec<Light>,
     /// What the packing of the textures had to say (levels dropped to fit the budget).
@@ -118,10 +121,16 @@ impl GpuScene {
                     bytemuck::bytes_of(&LightingParams::default()),
                     wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 ),
+                storage("environment", bytemuck::cast_slice(if table.environment.is_empty() {
+                    &[[0f32; 4]]
+                } else {
+                    &table.environment[..]
+                })),
             ];
             let ones = vec![1.0f32; scene.objects.len().max(1)];
             // The glTF BRDF reads the materials' factors.
-            let needs_materials = table.needs_materials() || !scene.lights.is_empty();
+            let needs_materials =
+                table.needs_materials() || !scene.lights.is_empty() || scene.environment.is_some();
             let has_optics = table.has_optics();
             let cull_back_faces = table.all_single_sided(scene.vertices.iter().map(|v| v.material));
             Ok(GpuScene {
@@ -137,18 +146,21 @@ impl GpuScene {
                 has_optics,
                 bvh: None,
                 lights: scene.lights.clone(),
+                environment: scene.environment.as_ref().map(|e| {
+                    std::sync::Arc::new(PreparedEnvironment { texels: Vec::new(), ..(**e).clone() })
+                }),
             })
         })
     }
 
     /// Whether a frame with `settings` is lit by the glTF BRDF.
     pub fn pbr(&self, settings: &RenderSettings) -> bool {
-        settings.lighting_params(self.lights.len()).pbr != 0
+        settings.lighting_params(self.lights.len(), self.environment.as_deref()).pbr != 0
     }
 
     /// Writes a frame's lights (in the viewer frame of `settings`) and lighting into group 1.
     pub fn write_lighting(&self, gpu: &Gpu, settings: &RenderSettings) {
-        let (lights, params) = settings.lighting(&self.lights);
+        let (lights, params) = settings.lighting(&self.lights, self.environment.as_deref());
         gpu.queue.write_buffer(&self.materials[3], 0, bytemuck::cast_slice(&lights));
         gpu.queue.write_buffer(&self.materials[4], 0, bytemuck::bytes_of(&params));
     }
@@ -228,6 +240,7 @@ impl GpuScene {
             // The BVH indexes the full scene's triangles: a selection has none (yet).
             bvh: None,
             lights: self.lights.clone(),
+            environment: self.environment.clone(),
         }
     }
 }

@@ -73,7 +73,7 @@ impl Renderer {
             ..params
         };
         gpu.queue.write_buffer(&res.trace_params, 0, bytemuck::bytes_of(&params));
-        let [a, b, c, d, e] = &scene.materials;
+        let [a, b, c, d, e, f] = &scene.materials;
         let [color, error, object, distance] = outputs;
         let bind_group = stage.bind_group(
             gpu,
@@ -92,7 +92,7 @@ impl Renderer {
                 &counts,
             ],
         );
-        let materials = stage.bind_group(gpu, Some("trace"), 1, &[a, b, c, d, e]);
+        let materials = stage.bind_group(gpu, Some("trace"), 1, &[a, b, c, d, e, f]);
         let timestamps = res.timestamps.as_ref();
         let t = Instant::now();
         let mut enc = gpu.device.create_command_encoder(&Default::default());

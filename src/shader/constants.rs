@@ -133,6 +133,8 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("LIGHT_DIRECTIONAL", U32(LightKind::Directional as u32)),
         ("LIGHT_POINT", U32(LightKind::Point as u32)),
         ("LIGHT_SPOT", U32(LightKind::Spot as u32)),
+        ("ENV_LEVELS", U32(crate::core::environment::ENV_LEVELS as u32)),
+        ("LUT_SIZE", U32(crate::core::environment::LUT_SIZE as u32)),
         ("TONEMAP_NONE", U32(Tonemap::None.code())),
         ("TONEMAP_PBR_NEUTRAL", U32(Tonemap::PbrNeutral.code())),
         ("TONEMAP_ACES", U32(Tonemap::Aces.code())),

@@ -111,16 +111,17 @@ impl Stage {
 
 /// The material table the fragment module reads (group 1 of the drawing stages).
 /// What the fragment entry points of the drawing stages read: their parameters and group 1.
-const SHADING: &[&str] = &["params", "materials", "mips", "texels", "lights", "lighting"];
+const SHADING: &[&str] = &["params", "materials", "mips", "texels", "lights", "lighting", "environment"];
 
-/// Group 1 of the stages that shade: the scene's materials and textures, its lights and the
-/// frame's lighting (src/gpu/scene.rs).
-const MATERIAL_TABLE: [Binding; 5] = [
+/// Group 1 of the stages that shade: the scene's materials and textures, its lights, the
+/// frame's lighting and the environment (src/gpu/scene.rs).
+const MATERIAL_TABLE: [Binding; 6] = [
     bind(1, 0, "materials", Storage),
     bind(1, 1, "mips", Storage),
     bind(1, 2, "texels", Storage),
     bind(1, 3, "lights", Storage),
     bind(1, 4, "lighting", Uniform),
+    bind(1, 5, "environment", Storage),
 ];
 
 pub const SUBDIVIDE: Stage = Stage {
@@ -171,6 +172,7 @@ pub const RASTER: Stage = Stage {
         MATERIAL_TABLE[2],
         MATERIAL_TABLE[3],
         MATERIAL_TABLE[4],
+        MATERIAL_TABLE[5],
     ],
 };
 
@@ -192,6 +194,7 @@ pub const SLIT: Stage = Stage {
         MATERIAL_TABLE[2],
         MATERIAL_TABLE[3],
         MATERIAL_TABLE[4],
+        MATERIAL_TABLE[5],
     ],
 };
 
@@ -217,6 +220,7 @@ pub const TRACE: Stage = Stage {
             "texels",
             "lights",
             "lighting",
+            "environment",
         ],
     )],
     bindings: &[
@@ -235,6 +239,7 @@ pub const TRACE: Stage = Stage {
         MATERIAL_TABLE[2],
         MATERIAL_TABLE[3],
         MATERIAL_TABLE[4],
+        MATERIAL_TABLE[5],
     ],
 };
 

@@ -272,6 +272,7 @@ pub(super) fn read_gltf(path: &Path) -> std::result::Result<Scene, String> {
     // material (single-sided, opaque), appended at the end.
     let materials: Vec<GltfMaterial> = doc.materials().map(|m| gltf_material(&m)).collect();
     scene.materials = materials.iter().map(|m| m.0).collect();
+    scene.physically_based = true;
     if let Some(p) = doc.meshes().flat_map(|m| m.primitives()).find(|p| p.material().index().is_none()) {
         scene.materials.push(gltf_material(&p.material()).0);
     }

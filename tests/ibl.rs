@@ -1,0 +1,170 @@
+//! Image-based lighting (issue 17): the white furnace on the GPU and in the CPU twin, metals
+//! mirroring the environment's colours, highlights growing with roughness, and bad environment
+//! files refused with one line.
+
+mod common;
+
+use std::sync::Arc;
+
+use glam::Vec3;
+use twister::core::builtin;
+use twister::core::color::srgb_to_linear;
+use twister::core::environment::Environment;
+use twister::core::light::Tonemap;
+use twister::core::material::Material;
+use twister::cpu::raster::{raster, raster_params};
+use twister::cpu::subdivide::{subdivide, subdivide_params};
+use twister::{Eye, Projection, RenderSettings, Scene, Vertical};
+
+/// Spheres of the given (metallic, roughness) and colour on a circle 1.8 m around the viewer,
+/// 45° apart, centred ahead.
+fn spheres(name: &str, looks: &[(f32, f32)], color: [f32; 4]) -> Scene {
+    let mut scene = Scene::new(name);
+    scene.materials = looks.iter().map(|&(metallic, roughness)| Material { metallic, roughness, ..Default::default() }).collect();
+    let n = looks.len() as f32;
+    for k in 0..looks.len() {
+        let azimuth = (k as f32 - 0.5 * (n - 1.0)) * std::f32::consts::FRAC_PI_4;
+        let s = builtin::sphere_scene(800, Vec3::new(1.8 * azimuth.sin(), 0.0, -1.8 * azimuth.cos()), 0.55, "ball");
+        let first = scene.vertices.len();
+        scene.add_mesh(format!("ball {k}"), &s.vertices, &s.indices);
+        for v in &mut scene.vertices[first..] {
+            v.material = k as u32 + 1;
+            v.color = color;
+        }
+    }
+    scene
+}
+
+fn settings(width: u32, height: u32) -> RenderSettings {
+    let projection = Projection { width, height, vertical: Vertical::Exact, ..Projection::default() };
+    RenderSettings::new(projection).with_tonemap(Tonemap::None).with_background([0.0, 0.0, 0.0])
+}
+
+/// Linear colours of the pixels the spheres cover, per sphere (split by image column).
+fn sphere_pixels(rgba: &[u8], width: u32, columns: &[(u32, u32)]) -> Vec<Vec<Vec3>> {
+    let mut out = vec![Vec::new(); columns.len()];
+    for (i, px) in rgba.chunks(4).enumerate() {
+        let x = i as u32 % width;
+        if px[..3] == [0, 0, 0] {
+            continue;
+        }
+        if let Some(k) = columns.iter().position(|&(a, b)| x >= a && x < b) {
+            out[k].push(Vec3::new(px[0] as f32, px[1] as f32, px[2] as f32).map(|c| srgb_to_linear(c / 255.0)));
+        }
+    }
+    out
+}
+
+/// Image columns of the spheres: contiguous runs of drawn columns in the middle rows.
+fn sphere_columns(rgba: &[u8], width: u32, height: u32) -> Vec<(u32, u32)> {
+    let drawn = |x: u32| (height / 3..2 * height / 3).any(|y| rgba[4 * (y * width + x) as usize..][..3] != [0, 0, 0]);
+    let mut runs = Vec::new();
+    let mut start = None;
+    for x in 0..=width {
+        match (x < width && drawn(x), start) {
+            (true, None) => start = Some(x),
+            (false, Some(a)) => {
+                runs.push((a, x));
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    runs
+}
+
+/// White furnace: white spheres, rough and smooth, dielectric and metal, inside a uniform
+/// environment of radiance 0.5 reflect 0.5 at every pixel (± 2 %): image-based lighting neither
+/// makes nor loses energy. On the GPU and in the CPU twin.
+#[test]
+fn white_spheres_in_a_uniform_environment_reflect_exactly_what_arrives() {
+    let looks = [(0.0, 1.0), (0.0, 0.5), (0.0, 0.1), (1.0, 1.0), (1.0, 0.5)];
+    let mut scene = spheres("furnace", &looks, [1.0; 4]);
+    scene.environment = Some(Arc::new(Environment::uniform(Vec3::splat(0.5)).prepare()));
+    let s = settings(480, 120);
+    let gpu = common::render(&scene, &s);
+    let params = subdivide_params(&s, 0, scene.triangle_count() as u32);
+    let tris = subdivide(&params, &scene.vertices, &scene.indices).vertices;
+    let (lights, lighting) = s.lighting(&scene.lights, scene.environment.as_deref());
+    let table = scene.material_table(usize::MAX).with_lighting(lights, lighting);
+    let cpu = raster(&raster_params(&s), &tris, &table, s.shading.background);
+    for (what, rgba) in [("GPU", &gpu.eye(Eye::Left).rgba), ("CPU twin", &cpu[0].rgba)] {
+        let columns = sphere_columns(rgba, 480, 120);
+        assert_eq!(columns.len(), looks.len(), "{what}: {columns:?}");
+        for (k, px) in sphere_pixels(rgba, 480, &columns).iter().enumerate() {
+            assert!(px.len() > 300, "{what}: sphere {k} covers {} pixels", px.len());
+            let worst = px.iter().map(|c| (*c - 0.5).abs().max_element()).fold(0.0, f32::max);
+            assert!(worst <= 0.01, "{what}: sphere {k} {:?}: radiance off by up to {worst} of 0.5", looks[k]);
+        }
+    }
+}
+
+/// An environment red above the horizon and green below, plus a small bright sun ahead-up.
+fn two_tone(sun: f32) -> Environment {
+    let (w, h) = (256u32, 128u32);
+    let sun_dir = Vec3::new(0.0, 0.5, 1.0).normalize();
+    let radiance = (0..w * h)
+        .map(|i| {
+            let d = twister::core::environment::direction_at((i % w) as f32 + 0.5, (i / w) as f32 + 0.5, w, h);
+            let base = if d.y > 0.0 { Vec3::new(0.6, 0.05, 0.05) } else { Vec3::new(0.05, 0.6, 0.05) };
+            base + if d.dot(sun_dir) > 0.995 { Vec3::splat(sun) } else { Vec3::ZERO }
+        })
+        .collect();
+    Environment { name: "two-tone".into(), width: w, height: h, radiance }
+}
+
+/// A smooth white metal mirrors the environment: red in its upper half, green in its lower;
+/// the sun's highlight (behind the viewer, up) covers more of a sphere the rougher it is.
+#[test]
+fn metals_mirror_the_environment_and_highlights_grow_with_roughness() {
+    let looks = [(1.0, 0.05), (1.0, 0.3), (1.0, 0.6)];
+    let mut scene = spheres("metals", &looks, [1.0; 4]);
+    scene.environment = Some(Arc::new(two_tone(40.0).prepare()));
+    let (w, h) = (480u32, 160u32);
+    let frame = common::render(&scene, &settings(w, h));
+    let rgba = &frame.eye(Eye::Left).rgba;
+    let columns = sphere_columns(rgba, w, h);
+    assert_eq!(columns.len(), 3, "{columns:?}");
+    // The smooth sphere's top and bottom rows.
+    let (a, b) = columns[0];
+    let rows: Vec<u32> = (0..h).filter(|&y| (a..b).any(|x| rgba[4 * (y * w + x) as usize..][..3] != [0, 0, 0])).collect();
+    let (top, bottom) = (rows[0] + 3, rows[rows.len() - 1] - 3);
+    let at = |x: u32, y: u32| Vec3::new(rgba[4 * (y * w + x) as usize] as f32, rgba[4 * (y * w + x) as usize + 1] as f32, 0.0);
+    let mid = (a + b) / 2;
+    let (up, down) = (at(mid, top), at(mid, bottom));
+    assert!(up.x > 2.0 * up.y, "the smooth metal's top shows the red sky: {up}");
+    assert!(down.y > 2.0 * down.x, "its bottom shows the green ground: {down}");
+    // Highlight: pixels brighter than the sky can make.
+    let highlight: Vec<usize> = sphere_pixels(rgba, w, &columns)
+        .iter()
+        .map(|px| px.iter().filter(|c| c.min_element() > 0.5).count())
+        .collect();
+    assert!(highlight[0] >= 1, "the smooth sphere shows the sun: {highlight:?}");
+    assert!(highlight[0] < highlight[1] && highlight[1] < highlight[2], "highlight pixels by roughness: {highlight:?}");
+}
+
+/// Absent, corrupt (a header claiming 10¹⁶ texels), truncated and wrongly typed environment
+/// files: one line naming `--environment` and the file, no panic, no huge allocation.
+#[test]
+fn bad_environment_files_are_refused_with_one_line() {
+    let dir = std::env::temp_dir().join(format!("twister-ibl-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let corrupt = dir.join("corrupt.hdr");
+    std::fs::write(&corrupt, b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 99999999 +X 99999999\n\x02\x02").unwrap();
+    let truncated = dir.join("truncated.hdr");
+    let real = std::fs::read(common::asset("environments/venice_sunset_1k.hdr")).unwrap();
+    std::fs::write(&truncated, &real[..real.len() / 3]).unwrap();
+    for (file, says) in [
+        (dir.join("absent.hdr"), "No such file"),
+        (corrupt, "texels"),
+        (truncated, ""),
+        (dir.join("picture.png"), "not a .hdr or .exr file"),
+    ] {
+        let err = Environment::load(&file).expect_err("refused");
+        let line = err.to_string();
+        assert!(line.starts_with("--environment: ") && line.contains(&*file.to_string_lossy()), "{line}");
+        assert!(line.contains(says) && !line.contains('\n'), "{line}");
+    }
+    let env = Environment::load(&common::asset("environments/venice_sunset_1k.hdr")).unwrap();
+    assert_eq!((env.width, env.height), (1024, 512));
+}
