@@ -342,44 +342,39 @@ fn env_direction(d: vec3<f32>) -> vec3<f32> {
     return lighting.env_rotation[0].xyz * d.x + lighting.env_rotation[1].xyz * d.y + lighting.env_rotation[2].xyz * d.z;
 }
 
-// Prefiltered level k, bilinear at environment-frame direction d (longitude wraps, latitude clamps).
-fn env_level(k: u32, d: vec3<f32>) -> vec3<f32> {
+// Prefiltered level k, bilinear at equirectangular coordinates st in [0, 1]² (longitude wraps,
+// latitude clamps).
+fn env_level(k: u32, st: vec2<f32>) -> vec3<f32> {
     let level = lighting.env_levels[k];
-    let size = vec2<f32>(f32(level.y), f32(level.z));
-    let p = vec2<f32>(atan2(d.x, -d.z) / TAU + 0.5, 0.5 - asin(clamp(d.y, -1.0, 1.0)) / PI) * size - 0.5;
+    let p = st * vec2<f32>(f32(level.y), f32(level.z)) - 0.5;
     let base = floor(p);
     let f = p - base;
-    var out = vec3<f32>(0.0);
-    for (var corner = 0u; corner < 4u; corner++) {
-        let dx = i32(corner & 1u);
-        let dy = i32(corner >> 1u);
-        let x = euclid_mod(i32(base.x) + dx, i32(level.y));
-        let y = clamp(i32(base.y) + dy, 0, i32(level.z) - 1);
-        let w = select(1.0 - f.x, f.x, dx == 1) * select(1.0 - f.y, f.y, dy == 1);
-        out += w * environment[level.x + u32(y) * level.y + u32(x)].rgb;
-    }
-    return out;
+    let x0 = euclid_mod(i32(base.x), i32(level.y));
+    let x1 = euclid_mod(i32(base.x) + 1, i32(level.y));
+    let y0 = u32(clamp(i32(base.y), 0, i32(level.z) - 1)) * level.y + level.x;
+    let y1 = u32(clamp(i32(base.y) + 1, 0, i32(level.z) - 1)) * level.y + level.x;
+    let top = mix(environment[y0 + u32(x0)].rgb, environment[y0 + u32(x1)].rgb, f.x);
+    let bottom = mix(environment[y1 + u32(x0)].rgb, environment[y1 + u32(x1)].rgb, f.x);
+    return mix(top, bottom, f.y);
 }
 
 // The radiance around viewer-frame direction d convolved for `roughness` (levels blended).
 fn env_radiance(d: vec3<f32>, roughness: f32) -> vec3<f32> {
     let e = env_direction(d);
+    let st = vec2<f32>(atan2(e.x, -e.z) / TAU + 0.5, 0.5 - asin(clamp(e.y, -1.0, 1.0)) / PI);
     let lod = clamp(roughness, 0.0, 1.0) * f32(ENV_LEVELS - 1u);
     let k = min(u32(lod), ENV_LEVELS - 2u);
     let t = lod - f32(k);
-    return mix(env_level(k, e), env_level(k + 1u, e), t);
+    return mix(env_level(k, st), env_level(k + 1u, st), t);
 }
 
-// E(n)/π at viewer-frame normal n, from the SH coefficients.
+// E(n)/π at viewer-frame normal n, from the SH coefficients (`irradiance` in environment.rs).
 fn env_irradiance(n_view: vec3<f32>) -> vec3<f32> {
     let d = env_direction(n_view);
-    let b = array<f32, 9>(0.282095, 0.488603 * d.y, 0.488603 * d.z, 0.488603 * d.x, 1.092548 * d.x * d.y,
-                          1.092548 * d.y * d.z, 0.315392 * (3.0 * d.z * d.z - 1.0), 1.092548 * d.x * d.z,
-                          0.546274 * (d.x * d.x - d.y * d.y));
-    var e = vec3<f32>(0.0);
-    for (var i = 0u; i < 9u; i++) {
-        e += lighting.env_sh[i].xyz * b[i];
-    }
+    let sh = lighting.env_sh;
+    let e = sh[0].xyz * 0.282095 + (sh[1].xyz * d.y + sh[2].xyz * d.z + sh[3].xyz * d.x) * 0.488603
+        + (sh[4].xyz * (d.x * d.y) + sh[5].xyz * (d.y * d.z) + sh[7].xyz * (d.x * d.z)) * 1.092548
+        + sh[6].xyz * (0.315392 * (3.0 * d.z * d.z - 1.0)) + sh[8].xyz * (0.546274 * (d.x * d.x - d.y * d.y));
     return max(e, vec3<f32>(0.0));
 }
 
@@ -389,14 +384,10 @@ fn env_lut(nv: f32, roughness: f32) -> vec2<f32> {
     let p = clamp(vec2<f32>(nv, roughness) * n - 0.5, vec2<f32>(0.0), vec2<f32>(n - 1.0));
     let base = min(floor(p), vec2<f32>(n - 2.0));
     let f = p - base;
-    var out = vec2<f32>(0.0);
-    for (var corner = 0u; corner < 4u; corner++) {
-        let dx = corner & 1u;
-        let dy = corner >> 1u;
-        let w = select(1.0 - f.x, f.x, dx == 1u) * select(1.0 - f.y, f.y, dy == 1u);
-        out += w * environment[lighting.env_lut + (u32(base.y) + dy) * LUT_SIZE + u32(base.x) + dx].xy;
-    }
-    return out;
+    let i = lighting.env_lut + u32(base.y) * LUT_SIZE + u32(base.x);
+    let top = mix(environment[i].xy, environment[i + 1u].xy, f.x);
+    let bottom = mix(environment[i + LUT_SIZE].xy, environment[i + LUT_SIZE + 1u].xy, f.x);
+    return mix(top, bottom, f.y);
 }
 
 // The environment's light reflected towards v by a surface with unit normal n (split sum with

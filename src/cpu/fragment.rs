@@ -141,33 +141,33 @@ pub fn env_direction(table: &MaterialTable, d: Vec3) -> Vec3 {
     Vec3::from_slice(&r[0][..3]) * d.x + Vec3::from_slice(&r[1][..3]) * d.y + Vec3::from_slice(&r[2][..3]) * d.z
 }
 
-/// Prefiltered level k, bilinear at environment-frame direction d (`env_level`).
-pub fn env_level(table: &MaterialTable, k: usize, d: Vec3) -> Vec3 {
+/// Prefiltered level k, bilinear at equirectangular coordinates st in [0, 1]² (`env_level`).
+pub fn env_level(table: &MaterialTable, k: usize, st: Vec2) -> Vec3 {
     let [offset, width, height, _] = table.lighting.env_levels[k];
-    let size = Vec2::new(width as f32, height as f32);
-    let p = Vec2::new(d.x.atan2(-d.z) / std::f32::consts::TAU + 0.5, 0.5 - d.y.clamp(-1.0, 1.0).asin() / std::f32::consts::PI)
-        * size
-        - 0.5;
+    let p = st * Vec2::new(width as f32, height as f32) - 0.5;
     let base = p.floor();
     let f = p - base;
-    let mut out = Vec3::ZERO;
-    for corner in 0..4u32 {
-        let (dx, dy) = ((corner & 1) as i32, (corner >> 1) as i32);
-        let x = (base.x as i32 + dx).rem_euclid(width as i32);
-        let y = (base.y as i32 + dy).clamp(0, height as i32 - 1);
-        let w = if dx == 1 { f.x } else { 1.0 - f.x } * if dy == 1 { f.y } else { 1.0 - f.y };
-        out += w * Vec3::from_slice(&table.environment[(offset + y as u32 * width + x as u32) as usize][..3]);
-    }
-    out
+    let texel = |dx: i32, dy: i32| {
+        let x = (base.x as i32 + dx).rem_euclid(width as i32) as u32;
+        let y = (base.y as i32 + dy).clamp(0, height as i32 - 1) as u32;
+        Vec3::from_slice(&table.environment[(offset + y * width + x) as usize][..3])
+    };
+    let top = texel(0, 0).lerp(texel(1, 0), f.x);
+    let bottom = texel(0, 1).lerp(texel(1, 1), f.x);
+    top.lerp(bottom, f.y)
 }
 
 /// The radiance around viewer-frame direction d convolved for `roughness` (`env_radiance`).
 pub fn env_radiance(table: &MaterialTable, d: Vec3, roughness: f32) -> Vec3 {
     let e = env_direction(table, d);
+    let st = Vec2::new(
+        e.x.atan2(-e.z) / std::f32::consts::TAU + 0.5,
+        0.5 - e.y.clamp(-1.0, 1.0).asin() / std::f32::consts::PI,
+    );
     let lod = roughness.clamp(0.0, 1.0) * (ENV_LEVELS - 1) as f32;
     let k = (lod as usize).min(ENV_LEVELS - 2);
     let t = lod - k as f32;
-    env_level(table, k, e).lerp(env_level(table, k + 1, e), t)
+    env_level(table, k, st).lerp(env_level(table, k + 1, st), t)
 }
 
 /// E(n)/π at viewer-frame normal n (`env_irradiance`).
