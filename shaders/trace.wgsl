@@ -328,7 +328,12 @@ fn shade_hit(hit: Hit, dir: vec3<f32>, p: vec3<f32>, view_position: vec3<f32>, f
         // The glTF BRDF under the scene's lights, seen along the ray (no shadows yet, as in
         // the drawing stages); tone mapped once the pixel's light is summed.
         let back = transpose(rotation);
-        out.color = pbr_radiance(a.material, params.ambient, -(back * dir), view_position, back * n, surface) * own;
+        // The tangent frame from the triangle's edges (what the drawing stages' screen
+        // derivatives give, as sub-triangles keep the triangle's plane and texture mapping).
+        let maps = surface_maps(a.material, uv, vec2<f32>(f, 0.0), vec2<f32>(0.0, f), back * (b.position - a.position),
+                                back * (c.position - a.position), b.uv - a.uv, c.uv - a.uv);
+        out.color = pbr_radiance(params.ambient, -(back * dir), view_position, back * n, surface, maps)
+            * own;
     } else {
         out.color = shade(params.ambient, view_position, transpose(rotation) * n, surface).rgb * own;
     }

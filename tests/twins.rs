@@ -420,6 +420,13 @@ impl Twin for Raster {
             .with_yaw_deg(-25.0)
             .with_viewer(Vec3::new(0.1, 0.2, 0.0));
         out.push(("lit spheres in the neutral studio".into(), (studio, settings, None)));
+        // Every glTF map (metallic-roughness, normal, occlusion, emissive), u mirrored on the
+        // middle quad, under a directional light and the studio.
+        let mut panels = common::mapped_panels();
+        panels.environment =
+            Some(std::sync::Arc::new(twister::core::environment::Environment::neutral().prepare()));
+        let settings = RenderSettings::new(Projection { width: 480, height: 120, ..Projection::default() });
+        out.push(("mapped panels".into(), (panels, settings, None)));
         // The glTF BRDF under point, spot and directional lights, seen from a moved viewer, with
         // each tone mapping.
         let cylinder = Projection { width: 400, height: 100, vertical: Vertical::Exact, ..Projection::default() };
@@ -615,6 +622,10 @@ impl Twin for Trace {
             (
                 "lit spheres: the glTF BRDF under point, spot and directional lights".into(),
                 (common::lit_spheres(), RenderSettings::new(cylinder).with_method(Method::Trace).with_exposure_ev(0.5)),
+            ),
+            (
+                "every glTF map on quads, u mirrored on one, the tangent frame from the triangle".into(),
+                (common::mapped_panels(), RenderSettings::new(cylinder).with_method(Method::Trace)),
             ),
             (
                 "box room".into(),

@@ -27,12 +27,14 @@ struct FragmentOut {
     @location(3) distance: ErrorTarget,
 }
 
-fn fragment_out(eye: u32, frag_xy: vec2<f32>, view_position: vec3<f32>, plane_normal: vec3<f32>,
-                normal: vec3<f32>, color: vec4<f32>, object: u32, material: u32) -> FragmentOut {
+fn fragment_out(eye: u32, frag_xy: vec2<f32>, view_position: vec3<f32>, dp_dx: vec3<f32>, dp_dy: vec3<f32>,
+                normal: vec3<f32>, color: vec4<f32>, object: u32, material: u32, uv: vec2<f32>, duv_dx: vec2<f32>,
+                duv_dy: vec2<f32>) -> FragmentOut {
     let params = stage_params(eye);
+    let plane_normal = cross(dp_dx, dp_dy);
     var out: FragmentOut;
     out.color = shade_surface(material, params.ambient, params.projection, params.eye_sign, frag_xy, view_position,
-                              normal, color);
+                              normal, color, uv, duv_dx, duv_dy, dp_dx, dp_dy);
     out.error = encode_error(pixel_error(params.projection, params.eye_sign, view_position, frag_xy,
                                          params.error_angle != 0u));
     out.object = object + 1u;
@@ -60,13 +62,15 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @locatio
     // Derivatives first, in uniform control flow.
     let duv_dx = dpdx(in.uv);
     let duv_dy = dpdy(in.uv);
+    let dp_dx = dpdxFine(in.view_position);
+    let dp_dy = dpdyFine(in.view_position);
     let c = surface_color(in.material, in.color, in.uv, duv_dx, duv_dy, in.clip.xy, front_facing);
     if (MATERIALS && c.a < 0.0) {
         discard;
     }
     let params = stage_params(in.eye);
     return shade_surface(in.material, params.ambient, params.projection, params.eye_sign, in.clip.xy, in.view_position,
-                         in.normal, c);
+                         in.normal, c, in.uv, duv_dx, duv_dy, dp_dx, dp_dy);
 }
 
 // The same, plus the display-position error, the object id and the distance (when the error or
@@ -96,11 +100,14 @@ fn fs_position(in: VertexOut, @builtin(front_facing) front_facing: bool) -> Frag
 fn measured(in: VertexOut, front_facing: bool) -> FragmentOut {
     let duv_dx = dpdx(in.uv);
     let duv_dy = dpdy(in.uv);
-    // Two vectors in the drawn triangle's plane (for the exact distance along the pixel's ray).
-    let plane_normal = cross(dpdxFine(in.view_position), dpdyFine(in.view_position));
+    // Two vectors in the drawn triangle's plane (for the exact distance along the pixel's ray,
+    // and the normal map's tangent frame).
+    let dp_dx = dpdxFine(in.view_position);
+    let dp_dy = dpdyFine(in.view_position);
     let c = surface_color(in.material, in.color, in.uv, duv_dx, duv_dy, in.clip.xy, front_facing);
     if (MATERIALS && c.a < 0.0) {
         discard;
     }
-    return fragment_out(in.eye, in.clip.xy, in.view_position, plane_normal, in.normal, c, in.object, in.material);
+    return fragment_out(in.eye, in.clip.xy, in.view_position, dp_dx, dp_dy, in.normal, c, in.object, in.material,
+                        in.uv, duv_dx, duv_dy);
 }

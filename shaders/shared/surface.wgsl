@@ -36,6 +36,21 @@ struct Material {
     emissive_r: f32,    // emitted linear colour (× KHR_materials_emissive_strength)
     emissive_g: f32,
     emissive_b: f32,
+    // The glTF maps: texture (unused here), first mip level, level count (0: none).
+    mr_texture: u32,
+    mr_first_mip: u32,
+    mr_mip_count: u32,
+    normal_texture: u32,
+    normal_first_mip: u32,
+    normal_mip_count: u32,
+    normal_scale: f32,
+    occlusion_texture: u32,
+    occlusion_first_mip: u32,
+    occlusion_mip_count: u32,
+    occlusion_strength: f32,
+    emissive_texture: u32,
+    emissive_first_mip: u32,
+    emissive_mip_count: u32,
 }
 
 // A punctual light (KHR_lights_punctual, src/core/light.rs), viewer frame: colour × intensity
@@ -116,10 +131,17 @@ fn wrap_index(i: i32, n: i32, mode: u32) -> i32 {
 // with one loop over (level, corner), so every wrap mode is exact and the function has one
 // texel read (lavapipe inlines every call).
 fn sample_texture(m: Material, uv_in: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>) -> vec4<f32> {
-    let top = mips[m.first_mip];
+    return sample_levels(m, m.first_mip, m.mip_count, uv_in, duv_dx, duv_dy);
+}
+
+// The same for the texture whose mip chain starts at `first_mip` (the material's maps), with the
+// material's sampler.
+fn sample_levels(m: Material, first_mip: u32, mip_count: u32, uv_in: vec2<f32>, duv_dx: vec2<f32>,
+                 duv_dy: vec2<f32>) -> vec4<f32> {
+    let top = mips[first_mip];
     let size = vec2<f32>(f32(top.width), f32(top.height));
     let lambda = log2(max(length(duv_dx * size), length(duv_dy * size)));
-    let last = f32(m.mip_count - 1u);
+    let last = f32(mip_count - 1u);
     var l0 = 0.0;
     var l1 = 0.0;
     var t = 0.0;
@@ -142,7 +164,7 @@ fn sample_texture(m: Material, uv_in: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2
         if (!(level_weight > 0.0)) {
             continue;
         }
-        let level = mips[m.first_mip + u32(select(l0, l1, k >= 4u))];
+        let level = mips[first_mip + u32(select(l0, l1, k >= 4u))];
         let n = vec2<i32>(i32(level.width), i32(level.height));
         let p = uv * vec2<f32>(n);
         // Nearest: the texel containing p. Linear: the four texels around p.
@@ -293,21 +315,100 @@ fn tonemap(c_in: vec3<f32>) -> vec3<f32> {
 // origin: highlights differ between the eyes), plus ambient × the diffuse colour and the
 // emission, tone mapped; else the headlight (`shade`). `shade_surface` in fragment.rs.
 fn shade_surface(material: u32, ambient: f32, proj: Projection, eye_sign: f32, frag_xy: vec2<f32>,
-                 view_position: vec3<f32>, normal: vec3<f32>, color: vec4<f32>) -> vec4<f32> {
+                 view_position: vec3<f32>, normal: vec3<f32>, color: vec4<f32>, uv: vec2<f32>,
+                 duv_dx: vec2<f32>, duv_dy: vec2<f32>, dp_dx: vec3<f32>, dp_dy: vec3<f32>) -> vec4<f32> {
     if (!MATERIALS || lighting.pbr == 0u) {
         return shade(ambient, view_position, normal, color);
     }
     let eye = pixel_ray(proj, eye_sign, frag_xy).origin;
-    return vec4<f32>(tonemap(pbr_radiance(material, ambient, normalize(eye - view_position), view_position, normal,
-                                          color)), 1.0);
+    let maps = surface_maps(material, uv, duv_dx, duv_dy, dp_dx, dp_dy, duv_dx, duv_dy);
+    return vec4<f32>(tonemap(pbr_radiance(ambient, normalize(eye - view_position), view_position, normal, color,
+                                          maps)), 1.0);
+}
+
+// A surface's BRDF inputs with the material's texture maps applied: metallic and roughness
+// (× the metallic-roughness map's blue and green), occlusion (1 + strength·(red − 1)), emission
+// (× the emissive map), the normal map's tangent-space normal ((0, 0, 1) without one), and two
+// in-plane position differentials with their texture-coordinate differences, which give the
+// tangent frame. `surface_maps` in fragment.rs.
+struct SurfaceMaps {
+    metallic: f32,
+    roughness: f32,
+    occlusion: f32,
+    emissive: vec3<f32>,
+    normal: vec3<f32>,
+    dp1: vec3<f32>,
+    dp2: vec3<f32>,
+    duv1: vec2<f32>,
+    duv2: vec2<f32>,
+}
+
+// The maps sampled at uv with the sampling derivatives duv_dx, duv_dy, in one loop (lavapipe
+// inlines every call, and a shader that merely contains more code runs slower).
+fn surface_maps(material: u32, uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>, dp1: vec3<f32>,
+                dp2: vec3<f32>, duv1: vec2<f32>, duv2: vec2<f32>) -> SurfaceMaps {
+    let m = materials[min(material, arrayLength(&materials) - 1u)];
+    var s = SurfaceMaps(m.metallic, m.roughness, 1.0, vec3<f32>(m.emissive_r, m.emissive_g, m.emissive_b),
+                        vec3<f32>(0.0, 0.0, 1.0), dp1, dp2, duv1, duv2);
+    for (var j = 0u; j < 4u; j++) {
+        var first = m.mr_first_mip;
+        var count = m.mr_mip_count;
+        if (j == 1u) {
+            first = m.normal_first_mip;
+            count = m.normal_mip_count;
+        } else if (j == 2u) {
+            first = m.occlusion_first_mip;
+            count = m.occlusion_mip_count;
+        } else if (j == 3u) {
+            first = m.emissive_first_mip;
+            count = m.emissive_mip_count;
+        }
+        if (count == 0u) {
+            continue;
+        }
+        let t = sample_levels(m, first, count, uv, duv_dx, duv_dy);
+        if (j == 0u) {
+            s.roughness *= t.g;
+            s.metallic *= t.b;
+        } else if (j == 1u) {
+            let xy = (t.xy * 2.0 - 1.0) * m.normal_scale;
+            s.normal = normalize(vec3<f32>(xy, t.z * 2.0 - 1.0));
+        } else if (j == 2u) {
+            s.occlusion = 1.0 + m.occlusion_strength * (t.r - 1.0);
+        } else {
+            s.emissive *= t.rgb;
+        }
+    }
+    return s;
+}
+
+// The unit normal n perturbed by the normal map: tangent T = ∇u and bitangent B = ∇v in the
+// surface's plane from the differentials (Schüler's cotangent frame, the sign of the
+// differentials' orientation taken out), both scaled by the larger's length; the map's +y
+// points up its image, against increasing v (glTF's convention). Unchanged without a map or
+// where the texture coordinates do not vary. `mapped_normal` in fragment.rs.
+fn mapped_normal(n: vec3<f32>, s: SurfaceMaps) -> vec3<f32> {
+    if (s.normal.z >= 1.0) {
+        return n;
+    }
+    let dp1perp = cross(n, s.dp1);
+    let dp2perp = cross(s.dp2, n);
+    let orientation = select(-1.0, 1.0, dot(n, cross(s.dp1, s.dp2)) >= 0.0);
+    let t = (dp2perp * s.duv1.x + dp1perp * s.duv2.x) * orientation;
+    let b = (dp2perp * s.duv1.y + dp1perp * s.duv2.y) * orientation;
+    let scale2 = max(dot(t, t), dot(b, b));
+    if (!(scale2 > 1e-30)) {
+        return n;
+    }
+    let k = inverseSqrt(scale2);
+    return normalize(t * (k * s.normal.x) - b * (k * s.normal.y) + n * s.normal.z);
 }
 
 // The glTF BRDF's linear colour (before tone mapping) of a surface point p (viewer frame) seen
 // along the unit direction v (towards the eye): the scene's lights, ambient × the diffuse colour
 // and the emission (`pbr_radiance` in fragment.rs).
-fn pbr_radiance(material: u32, ambient: f32, v: vec3<f32>, view_position: vec3<f32>, normal: vec3<f32>,
-                color: vec4<f32>) -> vec3<f32> {
-    let m = materials[min(material, arrayLength(&materials) - 1u)];
+fn pbr_radiance(ambient: f32, v: vec3<f32>, view_position: vec3<f32>, normal: vec3<f32>,
+                color: vec4<f32>, maps: SurfaceMaps) -> vec3<f32> {
     var n = normal;
     if (dot(n, n) < 1e-12) {
         n = v;
@@ -317,19 +418,20 @@ fn pbr_radiance(material: u32, ambient: f32, v: vec3<f32>, view_position: vec3<f
     if (dot(n, v) < 0.0) {
         n = -n;
     }
+    n = mapped_normal(n, maps);
     let base = max(color.rgb, vec3<f32>(0.0));
-    var c = vec3<f32>(m.emissive_r, m.emissive_g, m.emissive_b);
+    var c = maps.emissive;
     if (lighting.environment != 0u) {
-        c += ibl_radiance(n, v, base, m.metallic, m.roughness);
+        c += maps.occlusion * ibl_radiance(n, v, base, maps.metallic, maps.roughness);
     } else {
-        c += ambient * mix(base, vec3<f32>(0.0), m.metallic);
+        c += maps.occlusion * ambient * mix(base, vec3<f32>(0.0), maps.metallic);
     }
     for (var i = 0u; i < lighting.count; i++) {
         let light = lights[i];
         let at = light_at(light, view_position);
         let nl = dot(n, at.xyz);
         if (nl > 0.0 && at.w > 0.0) {
-            c += brdf(n, v, at.xyz, base, m.metallic, m.roughness) * light.color * (at.w * nl);
+            c += brdf(n, v, at.xyz, base, maps.metallic, maps.roughness) * light.color * (at.w * nl);
         }
     }
     return c;

@@ -44,6 +44,33 @@ pub struct Material {
     pub emissive_r: f32,
     pub emissive_g: f32,
     pub emissive_b: f32,
+    /// The glTF texture maps (`*_texture`: a scene texture, or NO_TEXTURE; `*_first_mip`,
+    /// `*_mip_count`: where the material table put its levels), sampled at the base colour's
+    /// texture coordinates with its sampler: metallic-roughness (blue × metallic, green ×
+    /// roughness), the tangent-space normal map (× `normal_scale` in x and y), occlusion (red,
+    /// blended by `occlusion_strength`), emission (× the emissive factor). The data maps are
+    /// stored sRGB-encoded like colour (see `Texture::encode_data`).
+    pub mr_texture: u32,
+    pub mr_first_mip: u32,
+    pub mr_mip_count: u32,
+    pub normal_texture: u32,
+    pub normal_first_mip: u32,
+    pub normal_mip_count: u32,
+    pub normal_scale: f32,
+    pub occlusion_texture: u32,
+    pub occlusion_first_mip: u32,
+    pub occlusion_mip_count: u32,
+    pub occlusion_strength: f32,
+    pub emissive_texture: u32,
+    pub emissive_first_mip: u32,
+    pub emissive_mip_count: u32,
+}
+
+impl Material {
+    /// Whether it has any of the glTF BRDF's texture maps.
+    pub fn has_maps(&self) -> bool {
+        [self.mr_texture, self.normal_texture, self.occlusion_texture, self.emissive_texture].iter().any(|&t| t != NO_TEXTURE)
+    }
 }
 
 impl Default for Material {
@@ -69,6 +96,20 @@ impl Default for Material {
             emissive_r: 0.0,
             emissive_g: 0.0,
             emissive_b: 0.0,
+            mr_texture: NO_TEXTURE,
+            mr_first_mip: 0,
+            mr_mip_count: 0,
+            normal_texture: NO_TEXTURE,
+            normal_first_mip: 0,
+            normal_mip_count: 0,
+            normal_scale: 1.0,
+            occlusion_texture: NO_TEXTURE,
+            occlusion_first_mip: 0,
+            occlusion_mip_count: 0,
+            occlusion_strength: 1.0,
+            emissive_texture: NO_TEXTURE,
+            emissive_first_mip: 0,
+            emissive_mip_count: 0,
         }
     }
 }

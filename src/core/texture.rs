@@ -51,6 +51,20 @@ impl Texture {
         Texture { name: self.name.clone(), width: w, height: h, rgba }
     }
 
+    /// The texture as data (metallic-roughness, normal, occlusion maps hold numbers, not colours):
+    /// each colour channel's value v/255 stored sRGB-encoded, so that the fragment stage's sRGB
+    /// decoding and the linear-light mip chain give back the numbers and their averages (alpha
+    /// is linear already). Quantisation adds at most half an sRGB step (≤ 0.45 % of the range).
+    pub fn encode_data(&self) -> Texture {
+        let q = |x: f32| (linear_to_srgb(x) * 255.0 + 0.5).floor() as u8;
+        let rgba = self
+            .rgba
+            .chunks_exact(4)
+            .flat_map(|t| [q(t[0] as f32 / 255.0), q(t[1] as f32 / 255.0), q(t[2] as f32 / 255.0), t[3]])
+            .collect();
+        Texture { name: format!("{} (data)", self.name), width: self.width, height: self.height, rgba }
+    }
+
     /// The mip chain from this level down to 1×1.
     pub fn mip_chain(&self) -> Vec<Texture> {
         let mut chain = vec![self.clone()];
@@ -104,7 +118,7 @@ impl MaterialTable {
     pub fn needs_materials(&self) -> bool {
         self.materials
             .iter()
-            .any(|m| m.texture != NO_TEXTURE || m.alpha_mode != AlphaMode::Opaque as u32 || m.double_sided == 0)
+            .any(|m| m.texture != NO_TEXTURE || m.alpha_mode != AlphaMode::Opaque as u32 || m.double_sided == 0 || m.has_maps())
     }
 
     /// Whether any material mirrors or transmits light (the ray tracer's optics, which need its
@@ -165,14 +179,20 @@ impl MaterialTable {
                 table.texels.extend(level.rgba.chunks_exact(4).map(|t| u32::from_le_bytes([t[0], t[1], t[2], t[3]])));
             }
         }
+        // A texture's place: (index, first level, level count), or none for a missing index.
+        let place = |t: u32| match chains.get(t as usize) {
+            Some(chain) => (t, first_mip[t as usize], chain.len() as u32),
+            None => (NO_TEXTURE, 0, 0),
+        };
         table.materials = std::iter::once(Material::default())
             .chain(materials.iter().map(|m| {
-                let t = m.texture as usize;
-                if m.texture == NO_TEXTURE || t >= chains.len() {
-                    Material { texture: NO_TEXTURE, first_mip: 0, mip_count: 0, ..*m }
-                } else {
-                    Material { first_mip: first_mip[t], mip_count: chains[t].len() as u32, ..*m }
-                }
+                let mut m = *m;
+                (m.texture, m.first_mip, m.mip_count) = place(m.texture);
+                (m.mr_texture, m.mr_first_mip, m.mr_mip_count) = place(m.mr_texture);
+                (m.normal_texture, m.normal_first_mip, m.normal_mip_count) = place(m.normal_texture);
+                (m.occlusion_texture, m.occlusion_first_mip, m.occlusion_mip_count) = place(m.occlusion_texture);
+                (m.emissive_texture, m.emissive_first_mip, m.emissive_mip_count) = place(m.emissive_texture);
+                m
             }))
             .collect();
         table

@@ -88,12 +88,18 @@ pub fn shade_surface(
     view_position: Vec3,
     normal: Vec3,
     color: Vec4,
+    surface: &Surface,
+    dp_dx: Vec3,
+    dp_dy: Vec3,
 ) -> [u8; 4] {
     if table.lighting.pbr == 0 {
         return shade(ambient, view_position, normal, color);
     }
     let (origin, _) = pixel_ray(projection, eye, frag_xy);
-    let c = pbr_radiance(table, material, ambient, (origin - view_position).normalize(), view_position, normal, color);
+    let (duv_dx, duv_dy) = (surface.duv_dx, surface.duv_dy);
+    let maps = surface_maps(table, material, surface.uv, duv_dx, duv_dy, [dp_dx, dp_dy], [duv_dx, duv_dy]);
+    let v = (origin - view_position).normalize();
+    let c = pbr_radiance(table, ambient, v, view_position, normal, color, &maps);
     let lit = tonemap(c, &table.lighting);
     let q = |x: f32| (linear_to_srgb(x) * 255.0 + 0.5).floor() as u8;
     [q(lit.x), q(lit.y), q(lit.z), 255]
@@ -102,35 +108,117 @@ pub fn shade_surface(
 /// The glTF BRDF's linear colour, before tone mapping, of surface point `view_position` seen
 /// along unit `v` (towards the eye): the table's lights, ambient × diffuse colour, emission
 /// (`pbr_radiance` in surface.wgsl).
+#[allow(clippy::too_many_arguments)]
 pub fn pbr_radiance(
     table: &MaterialTable,
-    material: u32,
     ambient: f32,
     v: Vec3,
     view_position: Vec3,
     normal: Vec3,
     color: Vec4,
+    maps: &SurfaceMaps,
 ) -> Vec3 {
-    let m = &table.materials[(material as usize).min(table.materials.len() - 1)];
     let mut n = if normal.length_squared() < 1e-12 { v } else { normal.normalize() };
     if n.dot(v) < 0.0 {
         n = -n;
     }
+    let n = mapped_normal(n, maps);
     let base = color.truncate().max(Vec3::ZERO);
-    let mut c = Vec3::new(m.emissive_r, m.emissive_g, m.emissive_b);
+    let mut c = maps.emissive;
     if table.lighting.environment != 0 {
-        c += ibl_radiance(table, n, v, base, m.metallic, m.roughness);
+        c += maps.occlusion * ibl_radiance(table, n, v, base, maps.metallic, maps.roughness);
     } else {
-        c += ambient * base.lerp(Vec3::ZERO, m.metallic);
+        c += maps.occlusion * ambient * base.lerp(Vec3::ZERO, maps.metallic);
     }
     for light in &table.lights[..table.lighting.count as usize] {
         let (l, scale) = light_at(light, view_position);
         let nl = n.dot(l);
         if nl > 0.0 && scale > 0.0 {
-            c += brdf(n, v, l, base, m.metallic, m.roughness) * Vec3::from(light.color) * (scale * nl);
+            c += brdf(n, v, l, base, maps.metallic, maps.roughness) * Vec3::from(light.color) * (scale * nl);
         }
     }
     c
+}
+
+/// A surface's BRDF inputs with its material's texture maps applied (`SurfaceMaps` in
+/// surface.wgsl): metallic, roughness, occlusion, emission, the normal map's tangent-space
+/// normal ((0, 0, 1) without one), and two in-plane position differentials with their
+/// texture-coordinate differences (the tangent frame).
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceMaps {
+    pub metallic: f32,
+    pub roughness: f32,
+    pub occlusion: f32,
+    pub emissive: Vec3,
+    pub normal: Vec3,
+    pub dp: [Vec3; 2],
+    pub duv: [Vec2; 2],
+}
+
+/// The maps sampled at uv with the sampling derivatives duv_dx, duv_dy (`surface_maps`).
+pub fn surface_maps(
+    table: &MaterialTable,
+    material: u32,
+    uv: Vec2,
+    duv_dx: Vec2,
+    duv_dy: Vec2,
+    dp: [Vec3; 2],
+    duv: [Vec2; 2],
+) -> SurfaceMaps {
+    let m = &table.materials[(material as usize).min(table.materials.len() - 1)];
+    let mut s = SurfaceMaps {
+        metallic: m.metallic,
+        roughness: m.roughness,
+        occlusion: 1.0,
+        emissive: Vec3::new(m.emissive_r, m.emissive_g, m.emissive_b),
+        normal: Vec3::Z,
+        dp,
+        duv,
+    };
+    let maps = [
+        (m.mr_first_mip, m.mr_mip_count),
+        (m.normal_first_mip, m.normal_mip_count),
+        (m.occlusion_first_mip, m.occlusion_mip_count),
+        (m.emissive_first_mip, m.emissive_mip_count),
+    ];
+    for (j, (first, count)) in maps.into_iter().enumerate() {
+        if count == 0 {
+            continue;
+        }
+        let t = sample_levels(table, m, first, count, uv, duv_dx, duv_dy);
+        match j {
+            0 => {
+                s.roughness *= t.y;
+                s.metallic *= t.z;
+            }
+            1 => {
+                let xy = (Vec2::new(t.x, t.y) * 2.0 - 1.0) * m.normal_scale;
+                s.normal = Vec3::new(xy.x, xy.y, t.z * 2.0 - 1.0).normalize();
+            }
+            2 => s.occlusion = 1.0 + m.occlusion_strength * (t.x - 1.0),
+            _ => s.emissive *= t.truncate(),
+        }
+    }
+    s
+}
+
+/// The unit normal n perturbed by the normal map (`mapped_normal`): T = ∇u, B = ∇v in the
+/// surface's plane (Schüler's cotangent frame, orientation taken out), the map's +y against v.
+pub fn mapped_normal(n: Vec3, s: &SurfaceMaps) -> Vec3 {
+    if s.normal.z >= 1.0 {
+        return n;
+    }
+    let dp1perp = n.cross(s.dp[0]);
+    let dp2perp = s.dp[1].cross(n);
+    let orientation = if n.dot(s.dp[0].cross(s.dp[1])) >= 0.0 { 1.0 } else { -1.0 };
+    let t = (dp2perp * s.duv[0].x + dp1perp * s.duv[1].x) * orientation;
+    let b = (dp2perp * s.duv[0].y + dp1perp * s.duv[1].y) * orientation;
+    let scale2 = t.length_squared().max(b.length_squared());
+    if !(scale2 > 1e-30) {
+        return n;
+    }
+    let k = 1.0 / scale2.sqrt();
+    (t * (k * s.normal.x) - b * (k * s.normal.y) + n * s.normal.z).normalize()
 }
 
 // ---- Image-based lighting (`core::environment`; surface.wgsl's twins) ----
@@ -299,8 +387,8 @@ fn texel(table: &MaterialTable, level: &MipLevel, x: i32, y: i32) -> Vec4 {
 }
 
 /// Samples one mip level at `uv` (texture space: 0..1 across the image, v down) with a filter.
-fn sample_level(table: &MaterialTable, m: &Material, level: u32, uv: Vec2, filter: u32) -> Vec4 {
-    let level = &table.mips[(m.first_mip + level) as usize];
+fn sample_level(table: &MaterialTable, m: &Material, first_mip: u32, level: u32, uv: Vec2, filter: u32) -> Vec4 {
+    let level = &table.mips[(first_mip + level) as usize];
     let (w, h) = (level.width as i32, level.height as i32);
     let p = uv.clamp(Vec2::splat(-1e6), Vec2::splat(1e6)) * Vec2::new(w as f32, h as f32);
     // Nearest: the texel containing p. Linear: the four texels around p, weights by distance.
@@ -326,10 +414,24 @@ fn sample_level(table: &MaterialTable, m: &Material, level: u32, uv: Vec2, filte
 /// (magnification filter, level 0), else the minification filter on level 0 (no mipmaps), the
 /// nearest level, or a blend of the two nearest.
 pub fn sample_texture(table: &MaterialTable, m: &Material, uv: Vec2, duv_dx: Vec2, duv_dy: Vec2) -> Vec4 {
-    let top = &table.mips[m.first_mip as usize];
+    sample_levels(table, m, m.first_mip, m.mip_count, uv, duv_dx, duv_dy)
+}
+
+/// The same for the texture whose mip chain starts at `first_mip` (a material's maps), with the
+/// material's sampler (`sample_levels`).
+pub fn sample_levels(
+    table: &MaterialTable,
+    m: &Material,
+    first_mip: u32,
+    mip_count: u32,
+    uv: Vec2,
+    duv_dx: Vec2,
+    duv_dy: Vec2,
+) -> Vec4 {
+    let top = &table.mips[first_mip as usize];
     let size = Vec2::new(top.width as f32, top.height as f32);
     let lambda = (duv_dx * size).length().max((duv_dy * size).length()).log2();
-    let last = (m.mip_count - 1) as f32;
+    let last = (mip_count - 1) as f32;
     // (first level, second level, weight of the second, filter)
     let (l0, l1, t, filter) = if !(lambda > 0.0) {
         (0.0, 0.0, 0.0, m.mag_filter)
@@ -346,7 +448,7 @@ pub fn sample_texture(table: &MaterialTable, m: &Material, uv: Vec2, duv_dx: Vec
     for (k, level) in [l0, l1].into_iter().enumerate() {
         let weight = if k == 0 { 1.0 - t } else { t };
         if weight > 0.0 {
-            out += weight * sample_level(table, m, level as u32, uv, filter);
+            out += weight * sample_level(table, m, first_mip, level as u32, uv, filter);
         }
     }
     out

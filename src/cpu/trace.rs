@@ -19,7 +19,9 @@ use crate::core::scene::SceneVertex;
 use crate::core::settings::RenderSettings;
 use crate::core::texture::MaterialTable;
 use crate::core::visual_field::Gaze;
-use crate::cpu::fragment::{pbr_radiance, pixel_error, pixel_ray, pixel_spread, shade_linear, surface_color, Surface};
+use crate::cpu::fragment::{
+    pbr_radiance, pixel_error, pixel_ray, pixel_spread, shade_linear, surface_color, surface_maps, Surface,
+};
 use crate::cpu::raster::RasterImage;
 use crate::shader::constants::{TRACE_PENDING, TRACE_STACK};
 use crate::shader::types::TraceParams;
@@ -270,8 +272,8 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
         }
         let n = n.normalize();
         let f = footprint(hit.triangle, dir, width);
-        let color = surface_color(table, &surface(hit.triangle, hit.b1, hit.b2, hit.front, frag_xy, f))
-            .expect("a kept hit has a colour");
+        let hit_surface = surface(hit.triangle, hit.b1, hit.b2, hit.front, frag_xy, f);
+        let color = surface_color(table, &hit_surface).expect("a kept hit has a colour");
         let m = material(hit.triangle);
         let own = (1.0 - m.mirror - m.transmission).max(0.0);
         let facing = if n.dot(dir) > 0.0 { -n } else { n };
@@ -279,15 +281,20 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
             // The glTF BRDF under the scene's lights, seen along the ray (tone mapped once the
             // pixel's light is summed).
             None if table.lighting.pbr != 0 => {
-                pbr_radiance(
+                // The tangent frame from the triangle's edges (`shade_hit` in trace.wgsl).
+                let [a, b, c] = corners(hit.triangle);
+                let (pa, pb, pc) = (Vec3::from(a.position), Vec3::from(b.position), Vec3::from(c.position));
+                let (ua, ub, uc) = (Vec2::from(a.uv), Vec2::from(b.uv), Vec2::from(c.uv));
+                let maps = surface_maps(
                     table,
-                    corners(hit.triangle)[0].material,
-                    params.ambient,
-                    -(to_view * dir),
-                    view_position,
-                    to_view * n,
-                    color,
-                ) * own
+                    a.material,
+                    hit_surface.uv,
+                    hit_surface.duv_dx,
+                    hit_surface.duv_dy,
+                    [to_view * (pb - pa), to_view * (pc - pa)],
+                    [ub - ua, uc - ua],
+                );
+                pbr_radiance(table, params.ambient, -(to_view * dir), view_position, to_view * n, color, &maps) * own
             }
             None => shade_linear(params.ambient, view_position, to_view * n, color) * own,
             Some(light) => {

@@ -361,7 +361,10 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("ProjectParams" => ProjectParams { projection, eye_sign, count, _pad }),
     layout!("Material" => Material {
         texture, wrap_u, wrap_v, mag_filter, min_filter, mipmap, alpha_mode, alpha_cutoff, double_sided,
-        first_mip, mip_count, mirror, transmission, ior, metallic, roughness, emissive_r, emissive_g, emissive_b
+        first_mip, mip_count, mirror, transmission, ior, metallic, roughness, emissive_r, emissive_g, emissive_b,
+        mr_texture, mr_first_mip, mr_mip_count, normal_texture, normal_first_mip, normal_mip_count, normal_scale,
+        occlusion_texture, occlusion_first_mip, occlusion_mip_count, occlusion_strength,
+        emissive_texture, emissive_first_mip, emissive_mip_count
     }),
     layout!("MipLevel" => MipLevel { offset, width, height, _pad }),
     layout!("ReduceParams" => ReduceParams { width, height, row_stride, images, partial_count, partial_offset, _pad1, _pad2 }),

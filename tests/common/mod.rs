@@ -165,3 +165,86 @@ pub fn lit_spheres() -> twister::Scene {
     ];
     scene
 }
+
+/// A textured quad facing the viewer, 2 m away at `azimuth_deg`, 1.2 m wide, its u running
+/// left to right (right to left when `mirrored`) and v top to bottom, material `material`.
+pub fn facing_quad(scene: &mut twister::Scene, azimuth_deg: f32, mirrored: bool, material: u32) {
+    use glam::Vec3;
+    use twister::core::scene::SceneVertex;
+    let a = azimuth_deg.to_radians();
+    let centre = Vec3::new(2.0 * a.sin(), 0.0, -2.0 * a.cos());
+    let right = Vec3::new(a.cos(), 0.0, a.sin());
+    let normal = -centre.normalize();
+    let corner = |sx: f32, sy: f32| {
+        let p = centre + right * (0.6 * sx) + Vec3::Y * (0.6 * sy);
+        let u = if mirrored { 0.5 - 0.5 * sx } else { 0.5 + 0.5 * sx };
+        SceneVertex {
+            position: p.into(),
+            normal: normal.into(),
+            color: [1.0; 4],
+            uv: [u, 0.5 - 0.5 * sy],
+            material,
+            ..Default::default()
+        }
+    };
+    let v = [corner(-1.0, 1.0), corner(1.0, 1.0), corner(1.0, -1.0), corner(-1.0, -1.0)];
+    // Counter-clockwise seen from the viewer.
+    scene.add_mesh(format!("quad {azimuth_deg}"), &v, &[0, 3, 2, 0, 2, 1]);
+}
+
+/// Quads with every glTF map — metallic-roughness (stripes), normal (bumps), occlusion
+/// (checker), emission (a warm spot) — the middle one with mirrored u, under a directional
+/// light from the upper right.
+pub fn mapped_panels() -> twister::Scene {
+    use glam::Vec3;
+    use twister::core::light::{Light, LightKind};
+    use twister::core::material::Material;
+    use twister::core::texture::Texture;
+    let mut scene = twister::Scene::new("mapped panels");
+    let image = |name: &str, f: &dyn Fn(u32, u32) -> [u8; 4]| Texture {
+        name: name.into(),
+        width: 16,
+        height: 16,
+        rgba: (0..256u32).flat_map(|i| f(i % 16, i / 16)).collect(),
+    };
+    let mr = image("mr", &|x, _| [0, 64 + 12 * x as u8, if x < 8 { 255 } else { 0 }, 255]);
+    let normal = image("normal", &|x, y| {
+        let (dx, dy) = ((x as f32 - 7.5) / 8.0, (y as f32 - 7.5) / 8.0);
+        let n = Vec3::new(dx * 0.8, -dy * 0.8, 1.0).normalize();
+        let e = |c: f32| ((c * 0.5 + 0.5) * 255.0).round() as u8;
+        [e(n.x), e(n.y), e(n.z), 255]
+    });
+    let occlusion = image("occlusion", &|x, y| if (x / 4 + y / 4) % 2 == 0 { [255; 4] } else { [90, 90, 90, 255] });
+    let emissive = image("emissive", &|x, y| {
+        let d = (x as f32 - 5.0).hypot(y as f32 - 10.0);
+        if d < 3.0 { [255, 160, 60, 255] } else { [0, 0, 0, 255] }
+    });
+    scene.textures = vec![mr.encode_data(), normal.encode_data(), occlusion.encode_data(), emissive];
+    scene.materials.push(Material {
+        metallic: 1.0,
+        roughness: 1.0,
+        emissive_r: 1.5,
+        emissive_g: 1.0,
+        emissive_b: 1.0,
+        mr_texture: 0,
+        normal_texture: 1,
+        normal_scale: 1.0,
+        occlusion_texture: 2,
+        occlusion_strength: 0.8,
+        emissive_texture: 3,
+        ..Default::default()
+    });
+    for (k, azimuth) in [-40.0f32, 0.0, 40.0].into_iter().enumerate() {
+        facing_quad(&mut scene, azimuth, k == 1, 1);
+    }
+    scene.lights = vec![Light {
+        kind: LightKind::Directional,
+        position: Vec3::ZERO,
+        direction: Vec3::new(-0.6, -0.5, -0.6).normalize(),
+        color: Vec3::splat(3.0),
+        range: None,
+        inner_cone: 0.0,
+        outer_cone: 0.5,
+    }];
+    scene
+}

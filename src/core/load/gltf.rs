@@ -133,6 +133,23 @@ fn gltf_material(material: &gltf::Material) -> GltfMaterial {
         emissive_b: emissive(material, 2),
         ..Default::default()
     };
+    // The BRDF's maps (sampled at the base colour's coordinates; `gltf_maps_note` says where a
+    // file asks otherwise).
+    let pbr = material.pbr_metallic_roughness();
+    if let Some(t) = pbr.metallic_roughness_texture() {
+        m.mr_texture = t.texture().source().index() as u32;
+    }
+    if let Some(t) = material.normal_texture() {
+        m.normal_texture = t.texture().source().index() as u32;
+        m.normal_scale = finite_or(t.scale(), 1.0);
+    }
+    if let Some(t) = material.occlusion_texture() {
+        m.occlusion_texture = t.texture().source().index() as u32;
+        m.occlusion_strength = finite_or(t.strength(), 1.0).clamp(0.0, 1.0);
+    }
+    if let Some(t) = material.emissive_texture() {
+        m.emissive_texture = t.texture().source().index() as u32;
+    }
     let Some(info) = material.pbr_metallic_roughness().base_color_texture() else {
         return (m, 0, None);
     };
@@ -168,6 +185,72 @@ fn gltf_material(material: &gltf::Material) -> GltfMaterial {
         [[c * sx, s * sy, ox], [-s * sx, c * sy, oy]]
     });
     (m, set, matrix)
+}
+
+/// The metallic-roughness, normal and occlusion maps hold numbers: their images become data
+/// textures (`Texture::encode_data`), converted in place where no material uses the image as a
+/// colour (base colour, emission), else as a copy.
+fn data_maps(scene: &mut Scene) {
+    use crate::core::material::NO_TEXTURE;
+    let n = scene.textures.len();
+    let mut as_colour = vec![false; n];
+    let mut as_data = vec![false; n];
+    for m in &scene.materials {
+        for t in [m.texture, m.emissive_texture] {
+            if (t as usize) < n {
+                as_colour[t as usize] = true;
+            }
+        }
+        for t in [m.mr_texture, m.normal_texture, m.occlusion_texture] {
+            if (t as usize) < n {
+                as_data[t as usize] = true;
+            }
+        }
+    }
+    let mut data_index: Vec<u32> = (0..n as u32).collect();
+    for k in 0..n {
+        if !as_data[k] {
+            continue;
+        }
+        let data = scene.textures[k].encode_data();
+        if as_colour[k] {
+            data_index[k] = scene.textures.len() as u32;
+            scene.textures.push(data);
+        } else {
+            scene.textures[k] = data;
+        }
+    }
+    for m in &mut scene.materials {
+        for t in [&mut m.mr_texture, &mut m.normal_texture, &mut m.occlusion_texture] {
+            if *t != NO_TEXTURE && (*t as usize) < n {
+                *t = data_index[*t as usize];
+            }
+        }
+    }
+}
+
+/// A note where a material's maps use other texture coordinates than its base colour (the maps
+/// are sampled at the base colour's).
+fn gltf_maps_note(material: &gltf::Material, set: u32, transformed: bool) -> Option<String> {
+    let pbr = material.pbr_metallic_roughness();
+    let maps = [
+        ("metallic-roughness", pbr.metallic_roughness_texture().map(|t| (t.tex_coord(), t.texture_transform().is_some()))),
+        ("normal", material.normal_texture().map(|t| (t.tex_coord(), false))),
+        ("occlusion", material.occlusion_texture().map(|t| (t.tex_coord(), false))),
+        ("emissive", material.emissive_texture().map(|t| (t.tex_coord(), t.texture_transform().is_some()))),
+    ];
+    let odd: Vec<&str> = maps
+        .iter()
+        .filter(|(_, m)| m.is_some_and(|(s, t)| s != set || t != transformed))
+        .map(|(name, _)| *name)
+        .collect();
+    (!odd.is_empty()).then(|| {
+        format!(
+            "material '{}': its {} map(s) use other texture coordinates than its base colour; drawn with the base colour's",
+            material.name().unwrap_or("unnamed"),
+            odd.join(", ")
+        )
+    })
 }
 
 /// glTF extensions twister draws (the others are ignored with a note, or refused when required).
@@ -275,6 +358,12 @@ pub(super) fn read_gltf(path: &Path) -> std::result::Result<Scene, String> {
     scene.physically_based = true;
     if let Some(p) = doc.meshes().flat_map(|m| m.primitives()).find(|p| p.material().index().is_none()) {
         scene.materials.push(gltf_material(&p.material()).0);
+    }
+    data_maps(&mut scene);
+    for (material, (_, set, transform)) in doc.materials().zip(&materials) {
+        if let Some(note) = gltf_maps_note(&material, *set, transform.is_some()) {
+            scene.warnings.push(note);
+        }
     }
     let root =
         doc.default_scene().or_else(|| doc.scenes().next()).ok_or_else(|| format!("{name}: the file has no scene"))?;

@@ -51,6 +51,22 @@ pub(super) fn read_obj(path: &Path) -> std::result::Result<Scene, String> {
                 loaded.push((spec.to_string(), material.texture));
             }
         }
+        // `map_Bump` / `bump` (tobj's normal texture) or `norm`: a normal map, or a height map
+        // turned into one (`normal_map_of`).
+        let bump = mat.normal_texture.as_deref().or(mat.unknown_param.get("norm").map(String::as_str));
+        if let Some(spec) = bump {
+            match load_obj_texture(spec, &texture_dirs) {
+                Ok(texture) => {
+                    let (map, note) = normal_map_of(&texture);
+                    if let Some(note) = note {
+                        scene.warnings.push(format!("material '{}': {note}", mat.name));
+                    }
+                    material.normal_texture = scene.textures.len() as u32;
+                    scene.textures.push(map.encode_data());
+                }
+                Err(e) => scene.warnings.push(format!("material '{}': {e}; drawn without its bump map", mat.name)),
+            }
+        }
         scene.materials.push(material);
     }
     for model in &models {
@@ -188,6 +204,41 @@ fn load_obj_texture(spec: &str, dirs: &[std::path::PathBuf]) -> std::result::Res
     let image =
         image::load_from_memory(&bytes).map_err(|e| format!("texture {} cannot be decoded: {e}", file.display()))?;
     Ok(Texture::from_image(file.display().to_string(), image))
+}
+
+/// Height-map bump strength: the slope of a full-range step over one texel, as a normal map's
+/// x or y (the texture's own scale is unknown to MTL; `-bm` is not read).
+const BUMP_SLOPE: f32 = 4.0;
+
+/// A bump texture as a tangent-space normal map: kept where it looks like one (mean blue above
+/// 0.6, mean red and green within 0.35–0.65: the colours of normals near (0, 0, 1)); else read
+/// as a height map (its luminance) and differentiated (central differences, wrapping, slope
+/// `BUMP_SLOPE`), with a note.
+pub fn normal_map_of(texture: &Texture) -> (Texture, Option<String>) {
+    let n = (texture.width * texture.height) as f32;
+    let mean = |c: usize| texture.rgba.chunks_exact(4).map(|t| t[c] as f32 / 255.0).sum::<f32>() / n.max(1.0);
+    let (r, g, b) = (mean(0), mean(1), mean(2));
+    if b > 0.6 && (0.35..=0.65).contains(&r) && (0.35..=0.65).contains(&g) {
+        return (texture.clone(), None);
+    }
+    let (w, h) = (texture.width as i64, texture.height as i64);
+    let height = |x: i64, y: i64| {
+        let t = &texture.rgba[(4 * (y.rem_euclid(h) * w + x.rem_euclid(w))) as usize..][..3];
+        (0.2126 * t[0] as f32 + 0.7152 * t[1] as f32 + 0.0722 * t[2] as f32) / 255.0
+    };
+    let e = |c: f32| ((c * 0.5 + 0.5) * 255.0).round() as u8;
+    let rgba = (0..w * h)
+        .flat_map(|i| {
+            let (x, y) = (i % w, i / w);
+            // +x along u; +y up the image (against v, whose rows run down).
+            let dx = 0.5 * (height(x + 1, y) - height(x - 1, y)) * BUMP_SLOPE;
+            let dy = 0.5 * (height(x, y - 1) - height(x, y + 1)) * BUMP_SLOPE;
+            let n = glam::Vec3::new(-dx, -dy, 1.0).normalize();
+            [e(n.x), e(n.y), e(n.z), 255]
+        })
+        .collect();
+    let note = format!("bump texture {} read as a height map and turned into a normal map", texture.name);
+    (Texture { name: texture.name.clone(), width: texture.width, height: texture.height, rgba }, Some(note))
 }
 
 /// The ray tracer's optics of an MTL material, by its illumination model: `illum` 3 and 5
