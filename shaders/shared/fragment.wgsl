@@ -65,7 +65,7 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @locatio
     let dp_dx = dpdxFine(in.view_position);
     let dp_dy = dpdyFine(in.view_position);
     let c = surface_color(in.material, in.color, in.uv, duv_dx, duv_dy, in.clip.xy, front_facing);
-    if (MATERIALS && c.a < 0.0) {
+    if (MATERIALS && DISCARDS && c.a < 0.0) {
         discard;
     }
     let params = stage_params(in.eye);
@@ -105,7 +105,7 @@ fn measured(in: VertexOut, front_facing: bool) -> FragmentOut {
     let dp_dx = dpdxFine(in.view_position);
     let dp_dy = dpdyFine(in.view_position);
     let c = surface_color(in.material, in.color, in.uv, duv_dx, duv_dy, in.clip.xy, front_facing);
-    if (MATERIALS && c.a < 0.0) {
+    if (MATERIALS && DISCARDS && c.a < 0.0) {
         discard;
     }
     return fragment_out(in.eye, in.clip.xy, in.view_position, dp_dx, dp_dy, in.normal, c, in.object, in.material,

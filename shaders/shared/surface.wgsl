@@ -14,6 +14,18 @@
 // code out (a pipeline constant), which restores early depth testing.
 override MATERIALS: bool = true;
 
+// false: no material of the scene can discard a fragment (all opaque and double-sided), so the
+// fragment entry points leave `discard` out and the rasterizer may test depth before shading.
+override DISCARDS: bool = true;
+
+// Parts of the glTF look a pipeline compiles in (src/gpu/draw.rs, `Lit`): the BRDF at all, the
+// environment's image-based lighting, the texture maps. lavapipe runs every branch under a mask,
+// so a part a frame does not use is left out rather than skipped. The ray tracer keeps all
+// (the uniform `lighting` decides).
+override PBR: bool = true;
+override ENVIRONMENT: bool = true;
+override MAPS: bool = true;
+
 // NO_TEXTURE, WRAP_*, FILTER_*, MIPMAP_*, ALPHA_*: from `constants` (src/core/material.rs).
 
 struct Material {
@@ -100,8 +112,9 @@ struct MipLevel {
 @group(1) @binding(2) var<storage, read> texels: array<u32>;
 @group(1) @binding(3) var<storage, read> lights: array<Light>;
 @group(1) @binding(4) var<uniform> lighting: Lighting;
-// The environment's prefiltered levels and split-sum table (linear RGB; a single texel when none).
-@group(1) @binding(5) var<storage, read> environment: array<vec4<f32>>;
+// The environment's prefiltered levels (RGB9E5) and split-sum table (two half floats); a single
+// entry when none (src/core/environment.rs).
+@group(1) @binding(5) var<storage, read> environment: array<u32>;
 
 fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
     return select(pow((c + 0.055) / 1.055, vec3<f32>(2.4)), c / 12.92, c <= vec3<f32>(0.04045));
@@ -204,14 +217,16 @@ fn surface_color(material: u32, color: vec4<f32>, uv: vec2<f32>, duv_dx: vec2<f3
     if (!MATERIALS) {
         return color;
     }
-    let m = materials[min(material, arrayLength(&materials) - 1u)];
-    if (m.double_sided == 0u && !front_facing) {
+    let index = min(material, arrayLength(&materials) - 1u);
+    if (materials[index].double_sided == 0u && !front_facing) {
         return vec4<f32>(-1.0);
     }
     var c = color;
-    if (m.texture != NO_TEXTURE && m.mip_count > 0u) {
+    if (materials[index].texture != NO_TEXTURE && materials[index].mip_count > 0u) {
+        let m = materials[index];
         c *= sample_texture(m, uv, duv_dx, duv_dy);
     }
+    let m = materials[index];
     if ((m.alpha_mode == ALPHA_MASK && c.a < m.alpha_cutoff)
         || (m.alpha_mode == ALPHA_BLEND && c.a <= blend_threshold(frag_xy))) {
         return vec4<f32>(-1.0);
@@ -317,7 +332,7 @@ fn tonemap(c_in: vec3<f32>) -> vec3<f32> {
 fn shade_surface(material: u32, ambient: f32, proj: Projection, eye_sign: f32, frag_xy: vec2<f32>,
                  view_position: vec3<f32>, normal: vec3<f32>, color: vec4<f32>, uv: vec2<f32>,
                  duv_dx: vec2<f32>, duv_dy: vec2<f32>, dp_dx: vec3<f32>, dp_dy: vec3<f32>) -> vec4<f32> {
-    if (!MATERIALS || lighting.pbr == 0u) {
+    if (!MATERIALS || !PBR || lighting.pbr == 0u) {
         return shade(ambient, view_position, normal, color);
     }
     let eye = pixel_ray(proj, eye_sign, frag_xy).origin;
@@ -347,7 +362,15 @@ struct SurfaceMaps {
 // inlines every call, and a shader that merely contains more code runs slower).
 fn surface_maps(material: u32, uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>, dp1: vec3<f32>,
                 dp2: vec3<f32>, duv1: vec2<f32>, duv2: vec2<f32>) -> SurfaceMaps {
-    let m = materials[min(material, arrayLength(&materials) - 1u)];
+    let index = min(material, arrayLength(&materials) - 1u);
+    let any_map = materials[index].mr_mip_count | materials[index].normal_mip_count
+        | materials[index].occlusion_mip_count | materials[index].emissive_mip_count;
+    if (!MAPS || any_map == 0u) {
+        return SurfaceMaps(materials[index].metallic, materials[index].roughness, 1.0,
+                           vec3<f32>(materials[index].emissive_r, materials[index].emissive_g, materials[index].emissive_b),
+                           vec3<f32>(0.0, 0.0, 1.0), dp1, dp2, duv1, duv2);
+    }
+    let m = materials[index];
     var s = SurfaceMaps(m.metallic, m.roughness, 1.0, vec3<f32>(m.emissive_r, m.emissive_g, m.emissive_b),
                         vec3<f32>(0.0, 0.0, 1.0), dp1, dp2, duv1, duv2);
     for (var j = 0u; j < 4u; j++) {
@@ -421,7 +444,7 @@ fn pbr_radiance(ambient: f32, v: vec3<f32>, view_position: vec3<f32>, normal: ve
     n = mapped_normal(n, maps);
     let base = max(color.rgb, vec3<f32>(0.0));
     var c = maps.emissive;
-    if (lighting.environment != 0u) {
+    if (ENVIRONMENT && lighting.environment != 0u) {
         c += maps.occlusion * ibl_radiance(n, v, base, maps.metallic, maps.roughness);
     } else {
         c += maps.occlusion * ambient * mix(base, vec3<f32>(0.0), maps.metallic);
@@ -444,6 +467,13 @@ fn env_direction(d: vec3<f32>) -> vec3<f32> {
     return lighting.env_rotation[0].xyz * d.x + lighting.env_rotation[1].xyz * d.y + lighting.env_rotation[2].xyz * d.z;
 }
 
+// An RGB9E5 texel of the environment (`rgb9e5_decode` in environment.rs).
+fn env_texel(i: u32) -> vec3<f32> {
+    let bits = environment[i];
+    let scale = exp2(f32(bits >> 27u) - 24.0);
+    return vec3<f32>(f32(bits & 511u), f32((bits >> 9u) & 511u), f32((bits >> 18u) & 511u)) * scale;
+}
+
 // Prefiltered level k, bilinear at equirectangular coordinates st in [0, 1]² (longitude wraps,
 // latitude clamps).
 fn env_level(k: u32, st: vec2<f32>) -> vec3<f32> {
@@ -455,8 +485,8 @@ fn env_level(k: u32, st: vec2<f32>) -> vec3<f32> {
     let x1 = euclid_mod(i32(base.x) + 1, i32(level.y));
     let y0 = u32(clamp(i32(base.y), 0, i32(level.z) - 1)) * level.y + level.x;
     let y1 = u32(clamp(i32(base.y) + 1, 0, i32(level.z) - 1)) * level.y + level.x;
-    let top = mix(environment[y0 + u32(x0)].rgb, environment[y0 + u32(x1)].rgb, f.x);
-    let bottom = mix(environment[y1 + u32(x0)].rgb, environment[y1 + u32(x1)].rgb, f.x);
+    let top = mix(env_texel(y0 + u32(x0)), env_texel(y0 + u32(x1)), f.x);
+    let bottom = mix(env_texel(y1 + u32(x0)), env_texel(y1 + u32(x1)), f.x);
     return mix(top, bottom, f.y);
 }
 
@@ -487,8 +517,8 @@ fn env_lut(nv: f32, roughness: f32) -> vec2<f32> {
     let base = min(floor(p), vec2<f32>(n - 2.0));
     let f = p - base;
     let i = lighting.env_lut + u32(base.y) * LUT_SIZE + u32(base.x);
-    let top = mix(environment[i].xy, environment[i + 1u].xy, f.x);
-    let bottom = mix(environment[i + LUT_SIZE].xy, environment[i + LUT_SIZE + 1u].xy, f.x);
+    let top = mix(unpack2x16float(environment[i]), unpack2x16float(environment[i + 1u]), f.x);
+    let bottom = mix(unpack2x16float(environment[i + LUT_SIZE]), unpack2x16float(environment[i + LUT_SIZE + 1u]), f.x);
     return mix(top, bottom, f.y);
 }
 

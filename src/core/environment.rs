@@ -51,12 +51,14 @@ pub struct Environment {
     pub radiance: Vec<Vec3>,
 }
 
-/// The environment as the fragment stage reads it: the prefiltered levels and the BRDF table in
-/// one texel array (RGB, A unused), the levels' places, and the irradiance coefficients.
+/// The environment as the fragment stage reads it: the prefiltered levels (RGB9E5, one u32 per
+/// texel: a shared 5-bit exponent and 9-bit mantissas, 0.2 % steps, up to 65,408) and the BRDF
+/// table (A, B as two half floats) in one array, the levels' places, and the irradiance
+/// coefficients. One 32-bit read per texel instead of four: lavapipe gathers each lane's read.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PreparedEnvironment {
     pub name: String,
-    pub texels: Vec<[f32; 4]>,
+    pub texels: Vec<u32>,
     /// Per level: first texel, width, height.
     pub levels: [[u32; 3]; ENV_LEVELS],
     /// First texel of the BRDF table (A, B in x, y).
@@ -192,7 +194,7 @@ impl Environment {
             let next = pyramid.last().unwrap().half();
             pyramid.push(next);
         }
-        let mut texels: Vec<[f32; 4]> = Vec::new();
+        let mut texels: Vec<u32> = Vec::new();
         let mut levels = [[0u32; 3]; ENV_LEVELS];
         for (k, level) in levels.iter_mut().enumerate() {
             let roughness = k as f32 / (ENV_LEVELS - 1) as f32;
@@ -203,12 +205,12 @@ impl Environment {
                 ((self.width >> (k + 1)).max(8), (self.height >> (k + 1)).max(4))
             };
             *level = [texels.len() as u32, w, h];
-            let rows: Vec<Vec<[f32; 4]>> = parallel_rows(h, |y| {
+            let rows: Vec<Vec<u32>> = parallel_rows(h, |y| {
                 (0..w)
                     .map(|x| {
                         let d = direction_at(x as f32 + 0.5, y as f32 + 0.5, w, h);
                         let c = if k == 0 { self.radiance[(y * w + x) as usize] } else { prefilter(&pyramid, d, roughness) };
-                        [c.x, c.y, c.z, 1.0]
+                        rgb9e5(c)
                     })
                     .collect()
             });
@@ -220,13 +222,44 @@ impl Environment {
                 let nv = (i as f32 + 0.5) / LUT_SIZE as f32;
                 let roughness = (j as f32 + 0.5) / LUT_SIZE as f32;
                 let (a, b) = split_sum(nv, roughness);
-                texels.push([a, b, 0.0, 1.0]);
+                texels.push(pack_half2(a, b));
             }
         }
         // Irradiance from a level of at most 64 texels across (box filtering keeps the energy).
         let small = pyramid.iter().find(|e| e.width <= 64).unwrap_or(&pyramid[0]);
         PreparedEnvironment { name: self.name.clone(), texels, levels, lut_offset, sh: irradiance_sh(small) }
     }
+}
+
+/// RGB9E5 (the shared-exponent format of EXT_texture_shared_exponent), rounding to nearest;
+/// channels clamped to [0, 65,408].
+pub fn rgb9e5(c: Vec3) -> u32 {
+    const MAX: f32 = 511.0 / 512.0 * 65536.0;
+    let c = c.clamp(Vec3::ZERO, Vec3::splat(MAX));
+    let max = c.max_element();
+    let mut exp = (max.log2().floor().max(-16.0) as i32) + 1 + 15;
+    let scale = |e: i32| 2f32.powi(e - 15 - 9);
+    if (max / scale(exp) + 0.5).floor() >= 512.0 {
+        exp += 1;
+    }
+    let m = |x: f32| ((x / scale(exp) + 0.5).floor() as u32).min(511);
+    m(c.x) | m(c.y) << 9 | m(c.z) << 18 | (exp.clamp(0, 31) as u32) << 27
+}
+
+/// The colour of an RGB9E5 texel (`env_texel` in surface.wgsl).
+pub fn rgb9e5_decode(bits: u32) -> Vec3 {
+    let scale = 2f32.powi((bits >> 27) as i32 - 15 - 9);
+    Vec3::new((bits & 511) as f32, (bits >> 9 & 511) as f32, (bits >> 18 & 511) as f32) * scale
+}
+
+/// Two half floats, a in the low 16 bits (WGSL's `pack2x16float`).
+pub fn pack_half2(a: f32, b: f32) -> u32 {
+    half::f16::from_f32(a).to_bits() as u32 | (half::f16::from_f32(b).to_bits() as u32) << 16
+}
+
+/// The inverse of [`pack_half2`] (`unpack2x16float`).
+pub fn unpack_half2(bits: u32) -> Vec2 {
+    Vec2::new(half::f16::from_bits(bits as u16).to_f32(), half::f16::from_bits((bits >> 16) as u16).to_f32())
 }
 
 fn check_size(width: u32, height: u32) -> std::result::Result<(), String> {
@@ -422,10 +455,20 @@ mod tests {
     }
 
     #[test]
+    fn shared_exponent_and_half_packing_round_trip() {
+        for c in [Vec3::new(0.7, 0.01, 3.0), Vec3::new(6496.0, 40.0, 0.0), Vec3::splat(1e-5), Vec3::ZERO] {
+            let d = rgb9e5_decode(rgb9e5(c));
+            assert!((d - c).abs().max_element() <= c.max_element() / 512.0 + 1e-7, "{c} -> {d}");
+        }
+        let ab = unpack_half2(pack_half2(0.8125, 0.0421));
+        assert!((ab - Vec2::new(0.8125, 0.0421)).abs().max_element() < 1e-4, "{ab}");
+    }
+
+    #[test]
     fn a_uniform_environment_prefilters_to_itself() {
         let p = Environment::uniform(Vec3::splat(0.7)).prepare();
-        for t in &p.texels[..p.lut_offset as usize] {
-            assert!((t[0] - 0.7).abs() < 1e-4, "{t:?}");
+        for &t in &p.texels[..p.lut_offset as usize] {
+            assert!((rgb9e5_decode(t) - Vec3::splat(0.7)).abs().max_element() < 2e-3, "{:?}", rgb9e5_decode(t));
         }
         assert!((irradiance(&p.sh, Vec3::new(0.2, -0.9, 0.1).normalize()) - Vec3::splat(0.7)).abs().max_element() < 2e-3);
     }

@@ -92,7 +92,7 @@ pub struct MaterialTable {
     pub lighting: crate::core::light::LightingParams,
     /// The environment's prefiltered levels and split-sum table, as group 1's binding 5 holds
     /// them (empty without an environment; [`MaterialTable::with_environment`]).
-    pub environment: Vec<[f32; 4]>,
+    pub environment: Vec<u32>,
 }
 
 impl MaterialTable {
@@ -119,6 +119,11 @@ impl MaterialTable {
         self.materials
             .iter()
             .any(|m| m.texture != NO_TEXTURE || m.alpha_mode != AlphaMode::Opaque as u32 || m.double_sided == 0 || m.has_maps())
+    }
+
+    /// Whether any material can discard a fragment: alpha-tested or blended, or single-sided.
+    pub fn discards(&self) -> bool {
+        self.materials.iter().any(|m| m.alpha_mode != AlphaMode::Opaque as u32 || m.double_sided == 0)
     }
 
     /// Whether any material mirrors or transmits light (the ray tracer's optics, which need its

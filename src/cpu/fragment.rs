@@ -238,7 +238,7 @@ pub fn env_level(table: &MaterialTable, k: usize, st: Vec2) -> Vec3 {
     let texel = |dx: i32, dy: i32| {
         let x = (base.x as i32 + dx).rem_euclid(width as i32) as u32;
         let y = (base.y as i32 + dy).clamp(0, height as i32 - 1) as u32;
-        Vec3::from_slice(&table.environment[(offset + y * width + x) as usize][..3])
+        crate::core::environment::rgb9e5_decode(table.environment[(offset + y * width + x) as usize])
     };
     let top = texel(0, 0).lerp(texel(1, 0), f.x);
     let bottom = texel(0, 1).lerp(texel(1, 1), f.x);
@@ -275,7 +275,7 @@ pub fn env_lut(table: &MaterialTable, nv: f32, roughness: f32) -> Vec2 {
         let (dx, dy) = (corner & 1, corner >> 1);
         let w = if dx == 1 { f.x } else { 1.0 - f.x } * if dy == 1 { f.y } else { 1.0 - f.y };
         let i = table.lighting.env_lut as usize + (base.y as usize + dy as usize) * LUT_SIZE + base.x as usize + dx as usize;
-        out += w * Vec2::new(table.environment[i][0], table.environment[i][1]);
+        out += w * crate::core::environment::unpack_half2(table.environment[i]);
     }
     out
 }

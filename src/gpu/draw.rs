@@ -28,7 +28,7 @@ pub(crate) struct DrawPipelines {
     pub stage: GpuStage,
     kind: DrawStage,
     /// By `Self::index`.
-    pipelines: [OnceLock<wgpu::RenderPipeline>; 27],
+    pipelines: [OnceLock<wgpu::RenderPipeline>; 288],
 }
 
 /// What a scene's materials need of a drawing pipeline.
@@ -42,6 +42,11 @@ pub(crate) enum Look {
     Materials = 1,
     /// With it, back faces culled by the rasterizer (every used material single-sided).
     Culled = 2,
+    /// With it but without `discard` (`DISCARDS = false`), for scenes whose materials are all
+    /// opaque and double-sided (textured, or lit by the glTF BRDF): a shader that may discard
+    /// loses early depth testing, and on Sponza, whose arcades overdraw the panorama several
+    /// times, lavapipe then shades every hidden fragment too (4.5× the frame).
+    Shaded = 3,
 }
 
 impl Look {
@@ -49,11 +54,35 @@ impl Look {
     pub fn of(scene: &GpuScene, pbr: bool) -> Look {
         if scene.cull_back_faces {
             Look::Culled
+        } else if (scene.needs_materials || pbr) && !scene.discards {
+            Look::Shaded
         } else if scene.needs_materials || pbr {
             Look::Materials
         } else {
             Look::Plain
         }
+    }
+}
+
+/// Which parts of the glTF look a pipeline compiles in (`PBR`, `ENVIRONMENT`, `MAPS` in
+/// surface.wgsl). lavapipe runs every branch of a fragment shader under a mask, so code a frame
+/// does not use still costs: a Sponza frame whose BRDF code sat unused behind a uniform flag took
+/// 4.5× the headlight's. Each part is compiled in only where the frame uses it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub(crate) struct Lit {
+    pub pbr: bool,
+    pub environment: bool,
+    pub maps: bool,
+}
+
+impl Lit {
+    /// What a frame of `scene` lit by the glTF BRDF (`pbr`) or not needs.
+    pub fn of(scene: &GpuScene, pbr: bool) -> Lit {
+        Lit { pbr, environment: pbr && scene.environment.is_some(), maps: pbr && scene.has_maps }
+    }
+
+    fn index(self) -> usize {
+        self.pbr as usize | (self.environment as usize) << 1 | (self.maps as usize) << 2
     }
 }
 
@@ -63,7 +92,7 @@ impl DrawPipelines {
         DrawPipelines { stage, kind, pipelines: std::array::from_fn(|_| OnceLock::new()) }
     }
 
-    fn index(&self, look: Look, outputs: usize, layers: Layers) -> usize {
+    fn index(&self, look: Look, lit: Lit, outputs: usize, layers: Layers) -> usize {
         let eyes = match (self.kind, layers) {
             (_, Layers::Both) => 0,
             (DrawStage::Slit, Layers::Eye(_)) => 1,
@@ -74,18 +103,18 @@ impl DrawPipelines {
             4 => 1,
             _ => 2,
         };
-        (look as usize * 3 + outputs) * 3 + eyes
+        ((look as usize * 3 + outputs) * 3 + eyes) * 8 + lit.index()
     }
 
     /// The pipeline for a scene's look (lit by the glTF BRDF or not), writing `outputs` targets
     /// (`MeasureSettings::outputs`), drawing `layers`.
     pub fn get(&self, gpu: &Gpu, scene: &GpuScene, pbr: bool, outputs: usize, layers: Layers) -> &wgpu::RenderPipeline {
-        self.get_look(gpu, Look::of(scene, pbr), outputs, layers)
+        self.get_look(gpu, Look::of(scene, pbr), Lit::of(scene, pbr), outputs, layers)
     }
 
-    pub fn get_look(&self, gpu: &Gpu, look: Look, outputs: usize, layers: Layers) -> &wgpu::RenderPipeline {
-        self.pipelines[self.index(look, outputs, layers)]
-            .get_or_init(|| draw_pipeline(gpu, &self.stage, self.kind, look, outputs, layers))
+    pub fn get_look(&self, gpu: &Gpu, look: Look, lit: Lit, outputs: usize, layers: Layers) -> &wgpu::RenderPipeline {
+        self.pipelines[self.index(look, lit, outputs, layers)]
+            .get_or_init(|| draw_pipeline(gpu, &self.stage, self.kind, look, lit, outputs, layers))
     }
 
     /// The scene's material table (group 1).
@@ -109,6 +138,7 @@ fn draw_pipeline(
     stage: &GpuStage,
     kind: DrawStage,
     look: Look,
+    lit: Lit,
     outputs: usize,
     layers: Layers,
 ) -> wgpu::RenderPipeline {
@@ -147,7 +177,13 @@ fn draw_pipeline(
     let error = error_target_format(gpu.error_target);
     let all_targets = [COLOR_FORMAT, error, OBJECT_FORMAT, error, POSITION_FORMAT]
         .map(|format| Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL }));
-    let mut constants = vec![("MATERIALS", (look != Look::Plain) as u32 as f64)];
+    let mut constants = vec![
+        ("MATERIALS", (look != Look::Plain) as u32 as f64),
+        ("DISCARDS", (look != Look::Shaded) as u32 as f64),
+        ("PBR", lit.pbr as u32 as f64),
+        ("ENVIRONMENT", lit.environment as u32 as f64),
+        ("MAPS", lit.maps as u32 as f64),
+    ];
     let multiview_mask = match layers {
         Layers::Both => std::num::NonZeroU32::new(0b11),
         Layers::Eye(k) => {

@@ -16,7 +16,7 @@ use crate::cpu::raster::raster_params;
 use crate::cpu::subdivide::{subdivide_params, SubdivideOutput};
 use crate::error::{Error, Result};
 use crate::gpu::device::Gpu;
-use crate::gpu::draw::{DrawPipelines, DrawStage, Look};
+use crate::gpu::draw::{DrawPipelines, DrawStage, Look, Lit};
 use crate::gpu::frame_plan::{
     on_overflow, Capacities, FramePlan, Overflow, SubdivisionBuffers, INDICES_SIZE, NODE_SIZE,
 };
@@ -148,7 +148,7 @@ impl Renderer {
             };
             let raster = DrawPipelines::new(&gpu, DrawStage::Raster);
             // The usual pipeline now, for the same reason.
-            raster.get_look(&gpu, Look::Plain, 1, Layers::passes(gpu.eyes_per_draw)[0]);
+            raster.get_look(&gpu, Look::Plain, Lit::default(), 1, Layers::passes(gpu.eyes_per_draw)[0]);
             Ok((
                 subdivide,
                 raster,

@@ -41,6 +41,10 @@ pub struct GpuScene {
     /// Whether some material is textured, not opaque or single-sided (else the drawing stages
     /// use their plain pipelines).
     pub needs_materials: bool,
+    /// Whether any material can discard a fragment (`MaterialTable::discards`).
+    pub discards: bool,
+    /// Whether any material has glTF texture maps (metallic-roughness, normal, occlusion, emissive).
+    pub has_maps: bool,
     /// Every material is single-sided: the drawing pipelines cull back faces.
     pub cull_back_faces: bool,
     /// Some material mirrors or transmits light (the ray tracer then runs its material code).
@@ -122,7 +126,7 @@ impl GpuScene {
                     wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 ),
                 storage("environment", bytemuck::cast_slice(if table.environment.is_empty() {
-                    &[[0f32; 4]]
+                    &[0u32]
                 } else {
                     &table.environment[..]
                 })),
@@ -132,6 +136,8 @@ impl GpuScene {
             let needs_materials =
                 table.needs_materials() || !scene.lights.is_empty() || scene.environment.is_some();
             let has_optics = table.has_optics();
+            let discards = table.discards();
+            let has_maps = table.materials.iter().any(|m| m.has_maps());
             let cull_back_faces = table.all_single_sided(scene.vertices.iter().map(|v| v.material));
             Ok(GpuScene {
                 vertices,
@@ -142,6 +148,8 @@ impl GpuScene {
                 warnings: table.warnings,
                 object_edge_scale: storage("object edge scale", bytemuck::cast_slice(&ones)),
                 needs_materials,
+                discards,
+                has_maps,
                 cull_back_faces,
                 has_optics,
                 bvh: None,
@@ -235,6 +243,8 @@ impl GpuScene {
                 wgpu::BufferUsages::STORAGE,
             ),
             needs_materials: self.needs_materials,
+            discards: self.discards,
+            has_maps: self.has_maps,
             cull_back_faces: self.cull_back_faces,
             has_optics: self.has_optics,
             // The BVH indexes the full scene's triangles: a selection has none (yet).
