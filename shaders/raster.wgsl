@@ -61,3 +61,9 @@ fn vs_main(in: VertexIn, eye_in: EyeIn) -> VertexOut {
     out.eye = eye;
     return out;
 }
+
+// The background triangle (fragment.wgsl), for the eye drawn.
+@vertex
+fn vs_background(@builtin(vertex_index) i: u32, eye_in: EyeIn) -> BackgroundOut {
+    return background_vertex(i, eye_index(eye_in));
+}

@@ -69,3 +69,9 @@ fn vs_main(in: VertexIn) -> VertexOut {
     out.eye = 0u;
     return out;
 }
+
+// The background triangle (fragment.wgsl), drawn once per eye's pass.
+@vertex
+fn vs_background(@builtin(vertex_index) i: u32) -> BackgroundOut {
+    return background_vertex(i, 0u);
+}

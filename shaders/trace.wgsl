@@ -281,6 +281,15 @@ struct Shaded {
     front: bool,
     tint: vec3<f32>,       // the surface colour, which tints the mirrored light
     normal: vec3<f32>,     // scene frame, facing the ray
+    // The glTF BRDF under the scene's lights: the first `shadowed` lights add their light only
+    // where their shadow rays meet nothing (`light_term` with these inputs × own).
+    shadowed: u32,
+    shading_normal: vec3<f32>,  // viewer frame, as the BRDF sees it
+    v: vec3<f32>,
+    view_position: vec3<f32>,
+    base: vec3<f32>,
+    own: f32,
+    maps: SurfaceMaps,
 }
 
 // The surface at a hit `p` (scene frame) with its optics; shaded with the headlight at the
@@ -307,7 +316,11 @@ fn shade_hit(hit: Hit, dir: vec3<f32>, p: vec3<f32>, view_position: vec3<f32>, f
     let surface = surface_color(a.material, color, uv, vec2<f32>(f, 0.0), vec2<f32>(0.0, f), frag_xy, hit.front);
     let facing = select(n, -n, dot(n, dir) > 0.0);
     var own = 1.0;
-    var out = Shaded(vec3<f32>(0.0), vec3<f32>(0.0), vec4<f32>(0.0), 0.0, 0.0, 1.5, hit.front, surface.rgb, facing);
+    var out: Shaded;
+    out.ior = 1.5;
+    out.front = hit.front;
+    out.tint = surface.rgb;
+    out.normal = facing;
     if (MATERIALS) {
         let m = materials[min(a.material, arrayLength(&materials) - 1u)];
         out.mirror = m.mirror;
@@ -325,15 +338,23 @@ fn shade_hit(hit: Hit, dir: vec3<f32>, p: vec3<f32>, view_position: vec3<f32>, f
         out.direct = base * (1.0 - params.ambient) * lambert;
         out.to_light = vec4<f32>(l, dist);
     } else if (MATERIALS && lighting.pbr != 0u) {
-        // The glTF BRDF under the scene's lights, seen along the ray (no shadows yet, as in
-        // the drawing stages); tone mapped once the pixel's light is summed.
+        // The glTF BRDF under the scene's lights, seen along the ray; the first
+        // MAX_SHADOWED_LIGHTS lights through shadow rays (the main loop), any others directly;
+        // tone mapped once the pixel's light is summed.
         let back = transpose(rotation);
         // The tangent frame from the triangle's edges (what the drawing stages' screen
         // derivatives give, as sub-triangles keep the triangle's plane and texture mapping).
         let maps = surface_maps(a.material, uv, vec2<f32>(f, 0.0), vec2<f32>(0.0, f), back * (b.position - a.position),
                                 back * (c.position - a.position), b.uv - a.uv, c.uv - a.uv);
-        out.color = pbr_radiance(params.ambient, -(back * dir), view_position, back * n, surface, maps)
-            * own;
+        let v = -(back * dir);
+        out.shadowed = min(lighting.count, MAX_SHADOWED_LIGHTS);
+        out.color = pbr_radiance(params.ambient, v, view_position, back * n, surface, maps, out.shadowed) * own;
+        out.shading_normal = shading_normal(back * n, v, maps);
+        out.v = v;
+        out.view_position = view_position;
+        out.base = max(surface.rgb, vec3<f32>(0.0));
+        out.own = own;
+        out.maps = maps;
     } else {
         out.color = shade(params.ambient, view_position, transpose(rotation) * n, surface).rgb * own;
     }
@@ -378,6 +399,11 @@ fn visual_level(d_in: vec3<f32>) -> f32 {
         return 0.0;
     }
     return (boundary - l) / (boundary - CENTRAL_RADIUS);
+}
+
+// Whether the environment lights this frame's rays (the glTF BRDF, no `--light`).
+fn environment_lit() -> bool {
+    return MATERIALS && lighting.pbr != 0u && lighting.environment != 0u && params.light.w <= 0.0;
 }
 
 // A pixel that shows no surface: the background colour, error −1, object 0, distance +∞.
@@ -439,7 +465,8 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
                 missed = true;
                 break;
             }
-            color += task.weight * background;
+            // A mirrored or refracted ray that leaves the scene brings the environment's light.
+            color += task.weight * select(background, env_level(0u, env_st(task.dir)), environment_lit());
         } else {
             let p = task.origin + hit.t * task.dir;
             if (task.kind == PRIMARY) {
@@ -472,6 +499,21 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
                     count += 1u;
                 }
             }
+            // The scene's lights, each behind its shadow ray.
+            for (var i = 0u; i < s.shadowed; i++) {
+                let term = light_term(i, s.shading_normal, s.v, s.view_position, s.base, s.maps) * s.own;
+                if (any(term > vec3<f32>(0.0)) && count < TRACE_PENDING) {
+                    let light = lights[i];
+                    var limit = FAR;
+                    if (light.kind != LIGHT_DIRECTIONAL) {
+                        limit = length(light.position - s.view_position) - offset;
+                    }
+                    let l = light_at(light, s.view_position).xyz;
+                    pending[count] = Task(p + offset * s.normal, SHADOW, transpose(to_view) * l, limit,
+                                          task.weight * term, 0u, vec2<f32>(width, 0.0));
+                    count += 1u;
+                }
+            }
             if (any(s.direct > vec3<f32>(0.0)) && count < TRACE_PENDING) {
                 pending[count] = Task(p + offset * s.normal, SHADOW, s.to_light.xyz, s.to_light.w - offset,
                                       task.weight * s.direct, 0u, vec2<f32>(width, 0.0));
@@ -490,6 +532,9 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     atomicAdd(&counts[2u * count_slot + 1u], tests);
     if (missed) {
         write_background(slot);
+        if (environment_lit() && lighting.env_background != 0u) {
+            out_color[slot] = pack_display(linear_to_srgb(tonemap(env_level(0u, env_st(task.dir)))));
+        }
         return;
     }
     if (MATERIALS && lighting.pbr != 0u && params.light.w <= 0.0) {

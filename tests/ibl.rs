@@ -20,7 +20,8 @@ use twister::{Eye, Projection, RenderSettings, Scene, Vertical};
 /// 45° apart, centred ahead.
 fn spheres(name: &str, looks: &[(f32, f32)], color: [f32; 4]) -> Scene {
     let mut scene = Scene::new(name);
-    scene.materials = looks.iter().map(|&(metallic, roughness)| Material { metallic, roughness, ..Default::default() }).collect();
+    scene.materials =
+        looks.iter().map(|&(metallic, roughness)| Material { metallic, roughness, ..Default::default() }).collect();
     let n = looks.len() as f32;
     for k in 0..looks.len() {
         let azimuth = (k as f32 - 0.5 * (n - 1.0)) * std::f32::consts::FRAC_PI_4;
@@ -127,18 +128,19 @@ fn metals_mirror_the_environment_and_highlights_grow_with_roughness() {
     assert_eq!(columns.len(), 3, "{columns:?}");
     // The smooth sphere's top and bottom rows.
     let (a, b) = columns[0];
-    let rows: Vec<u32> = (0..h).filter(|&y| (a..b).any(|x| rgba[4 * (y * w + x) as usize..][..3] != [0, 0, 0])).collect();
+    let rows: Vec<u32> =
+        (0..h).filter(|&y| (a..b).any(|x| rgba[4 * (y * w + x) as usize..][..3] != [0, 0, 0])).collect();
     let (top, bottom) = (rows[0] + 3, rows[rows.len() - 1] - 3);
-    let at = |x: u32, y: u32| Vec3::new(rgba[4 * (y * w + x) as usize] as f32, rgba[4 * (y * w + x) as usize + 1] as f32, 0.0);
+    let at = |x: u32, y: u32| {
+        Vec3::new(rgba[4 * (y * w + x) as usize] as f32, rgba[4 * (y * w + x) as usize + 1] as f32, 0.0)
+    };
     let mid = (a + b) / 2;
     let (up, down) = (at(mid, top), at(mid, bottom));
     assert!(up.x > 2.0 * up.y, "the smooth metal's top shows the red sky: {up}");
     assert!(down.y > 2.0 * down.x, "its bottom shows the green ground: {down}");
     // Highlight: pixels brighter than the sky can make.
-    let highlight: Vec<usize> = sphere_pixels(rgba, w, &columns)
-        .iter()
-        .map(|px| px.iter().filter(|c| c.min_element() > 0.5).count())
-        .collect();
+    let highlight: Vec<usize> =
+        sphere_pixels(rgba, w, &columns).iter().map(|px| px.iter().filter(|c| c.min_element() > 0.5).count()).collect();
     assert!(highlight[0] >= 1, "the smooth sphere shows the sun: {highlight:?}");
     assert!(highlight[0] < highlight[1] && highlight[1] < highlight[2], "highlight pixels by roughness: {highlight:?}");
 }
@@ -167,4 +169,29 @@ fn bad_environment_files_are_refused_with_one_line() {
     }
     let env = Environment::load(&common::asset("environments/venice_sunset_1k.hdr")).unwrap();
     assert_eq!((env.width, env.height), (1024, 512));
+}
+
+/// An environment the user gave shows all around as the background, along each pixel's own
+/// ray: red above the horizon, green below, the background's measuring values untouched; the
+/// built-in studio only lights (the background colour stays).
+#[test]
+fn a_given_environment_is_the_background_and_the_studio_is_not() {
+    let mut scene = spheres("one ball", &[(0.0, 0.5)], [0.8, 0.8, 0.8, 1.0]);
+    let prepared = two_tone(0.0).prepare();
+    let s = settings(256, 128).with_measure_error(true);
+    for (background, what) in [(true, "given"), (false, "studio-like")] {
+        scene.environment =
+            Some(Arc::new(twister::core::environment::PreparedEnvironment { background, ..prepared.clone() }));
+        let frame = common::render(&scene, &s);
+        let img = frame.eye(Eye::Right);
+        let objects = &frame.measurement.as_ref().unwrap().object[1];
+        let (top, bottom) = (img.pixel(10, 5), img.pixel(10, 122));
+        assert_eq!((objects[(5 * 256 + 10) as usize], objects[(122 * 256 + 10) as usize]), (0, 0), "{what}");
+        if background {
+            assert!(top[0] > 150 && top[1] < 90, "{what}: the sky behind, {top:?}");
+            assert!(bottom[1] > 150 && bottom[0] < 90, "{what}: the ground behind, {bottom:?}");
+        } else {
+            assert_eq!((&top[..3], &bottom[..3]), (&[0u8, 0, 0][..], &[0u8, 0, 0][..]), "{what}");
+        }
+    }
 }

@@ -99,12 +99,16 @@ fn a_khronos_samples_maps_are_read_as_data() {
 fn mtl_bump_textures_become_normal_maps() {
     let dir = std::env::temp_dir().join(format!("twister-maps-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let ramp = image::RgbaImage::from_fn(8, 8, |x, _| image::Rgba([(x * 32) as u8, (x * 32) as u8, (x * 32) as u8, 255]));
+    let ramp =
+        image::RgbaImage::from_fn(8, 8, |x, _| image::Rgba([(x * 32) as u8, (x * 32) as u8, (x * 32) as u8, 255]));
     ramp.save(dir.join("height.png")).unwrap();
     let flat = image::RgbaImage::from_pixel(8, 8, image::Rgba([128, 128, 255, 255]));
     flat.save(dir.join("normal.png")).unwrap();
-    std::fs::write(dir.join("m.mtl"), "newmtl bumpy\nKd 1 1 1\nmap_Bump height.png\nnewmtl normal\nKd 1 1 1\nnorm normal.png\n")
-        .unwrap();
+    std::fs::write(
+        dir.join("m.mtl"),
+        "newmtl bumpy\nKd 1 1 1\nmap_Bump height.png\nnewmtl normal\nKd 1 1 1\nnorm normal.png\n",
+    )
+    .unwrap();
     std::fs::write(
         dir.join("m.obj"),
         "mtllib m.mtl\nv 0 0 -2\nv 1 0 -2\nv 0 1 -2\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl bumpy\nf 1/1 2/2 3/3\nusemtl normal\nf 1/1 3/3 2/2\n",
@@ -118,7 +122,8 @@ fn mtl_bump_textures_become_normal_maps() {
     let texel = |t: u32| {
         let tex = &scene.textures[t as usize];
         let i = 4 * (4 * tex.width + 4) as usize;
-        Vec3::new(tex.rgba[i] as f32, tex.rgba[i + 1] as f32, tex.rgba[i + 2] as f32).map(|c| srgb_to_linear(c / 255.0) * 2.0 - 1.0)
+        Vec3::new(tex.rgba[i] as f32, tex.rgba[i + 1] as f32, tex.rgba[i + 2] as f32)
+            .map(|c| srgb_to_linear(c / 255.0) * 2.0 - 1.0)
     };
     let (b, n) = (texel(bumpy.normal_texture), texel(normal.normal_texture));
     assert!(b.x < -0.3 && b.y.abs() < 0.02 && b.z > 0.5, "height ramp → {b}");

@@ -551,3 +551,96 @@ fn the_ray_tracer_filters_textures_as_the_rasterizer_does() {
     // Sampled at level 0 (no cones) the floor differs by 18 levels on average, 22 beyond 8 m.
     assert!(mean < 8.0 && far_mean < 3.0, "mean {mean:.2}, far {far_mean:.2} levels");
 }
+
+/// The scene's own lights cast shadows in the ray tracer: a ball 0.6 m above a grey floor under
+/// a directional light (straight down) or a spot light above it darkens the floor it hides, by
+/// the light's whole share there — the ball's shadow is where the light's direction projects the
+/// ball (brute force: a floor point is shadowed if the way from it towards the light meets the
+/// ball; points within a pixel's footprint of the shadow's edge are left out).
+#[test]
+fn scene_lights_cast_shadows_in_the_ray_tracer() {
+    use twister::core::light::{Light, LightKind};
+    use twister::core::scene::SceneVertex;
+    let (centre, radius) = (Vec3::new(0.3, -0.6, -2.2), 0.3);
+    for (kind, light_position) in [(LightKind::Directional, None), (LightKind::Spot, Some(Vec3::new(0.3, 1.5, -2.2)))] {
+        let mut scene = Scene::new("shadow");
+        scene.materials.push(Material { metallic: 0.0, roughness: 1.0, ..Default::default() });
+        let corner = |x: f32, z: f32| SceneVertex {
+            position: [x, -1.2, z],
+            normal: [0.0, 1.0, 0.0],
+            color: [0.6, 0.6, 0.6, 1.0],
+            material: 1,
+            ..Default::default()
+        };
+        let floor = [corner(-3.0, 0.5), corner(3.0, 0.5), corner(3.0, -5.0), corner(-3.0, -5.0)];
+        scene.add_mesh("floor", &floor, &[0, 1, 2, 0, 2, 3]);
+        let ball = builtin::sphere_scene(800, centre, radius, "ball");
+        scene.add_mesh("ball", &ball.vertices, &ball.indices);
+        scene.lights = vec![Light {
+            kind,
+            position: light_position.unwrap_or(Vec3::ZERO),
+            direction: Vec3::NEG_Y,
+            color: Vec3::splat(if kind == LightKind::Spot { 40.0 } else { 3.0 }),
+            range: None,
+            inner_cone: 0.5,
+            outer_cone: 0.8,
+        }];
+        let p = exact(480, 160);
+        let settings = RenderSettings::new(p)
+            .with_method(Method::Trace)
+            .with_ambient(0.2)
+            .with_measure_error(true)
+            .with_depth(true);
+        let frame = render(&scene, &settings);
+        let m = frame.measurement.as_ref().unwrap();
+        let img = frame.eye(Eye::Left);
+        let (mut in_shadow, mut lit) = (Vec::new(), Vec::new());
+        for y in 0..p.height {
+            for x in 0..p.width {
+                let i = (y * p.width + x) as usize;
+                if m.object[0][i] != 1 {
+                    continue; // not the floor (object 0 + 1)
+                }
+                let frag = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                let (o, d) = pixel_ray(&p, Eye::Left, frag);
+                let point = o + d * ((-1.2 - o.y) / d.y);
+                let to_light = match light_position {
+                    Some(l) => (l - point).normalize(),
+                    None => Vec3::Y,
+                };
+                // Brute force: does the way to the light pass through the ball?
+                let q = point - centre;
+                let b = q.dot(to_light);
+                let blocked = b < 0.0 && b * b - (q.length_squared() - radius * radius) > 0.0;
+                // Stay clear of the shadow's edge (pixel footprint).
+                let margin = (b * b - (q.length_squared() - radius * radius)).abs();
+                if margin < 0.01 {
+                    continue;
+                }
+                let v = img.pixel(x, y)[0];
+                if blocked {
+                    in_shadow.push(v)
+                } else {
+                    lit.push(v)
+                }
+            }
+        }
+        assert!(
+            in_shadow.len() > 40 && lit.len() > 1000,
+            "{kind:?}: {} shadowed, {} lit floor pixels",
+            in_shadow.len(),
+            lit.len()
+        );
+        let mean = |v: &[u8]| v.iter().map(|&x| x as f64).sum::<f64>() / v.len() as f64;
+        assert!(
+            mean(&in_shadow) < 0.6 * mean(&lit),
+            "{kind:?}: shadowed floor {:.1} against lit {:.1}",
+            mean(&in_shadow),
+            mean(&lit)
+        );
+        // In the shadow only the ambient part is left, the same everywhere.
+        let spread =
+            in_shadow.iter().map(|&v| v as i32).max().unwrap() - in_shadow.iter().map(|&v| v as i32).min().unwrap();
+        assert!(spread <= 6, "{kind:?}: the shadow is the ambient part alone, evenly ({spread} levels)");
+    }
+}

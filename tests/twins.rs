@@ -45,7 +45,11 @@ fn check<T: Twin>(stage: &str) -> Result<usize, Vec<String>> {
             T::compare(&gpu, &cpu).err().map(|e| format!("{stage}, {name}: GPU and CPU twin differ: {e}"))
         })
         .collect();
-    if differ.is_empty() { Ok(cases.len()) } else { Err(differ) }
+    if differ.is_empty() {
+        Ok(cases.len())
+    } else {
+        Err(differ)
+    }
 }
 
 /// A stage's twin check: how many cases agree, or what differs.
@@ -283,7 +287,8 @@ impl Twin for Subdivide {
         // which flips an edge's division count where its measure sits on a ceil boundary (seen
         // on an H100: 36 of 53,697 nodes in a case of random triangles): there at most 1 % of
         // the pieces, nodes and triangles may differ, and every other triangle is the twin's.
-        let slack = |n: usize| if common::renderer().gpu.info.device_type == wgpu::DeviceType::Cpu { 0 } else { n / 100 };
+        let slack =
+            |n: usize| if common::renderer().gpu.info.device_type == wgpu::DeviceType::Cpu { 0 } else { n / 100 };
         if cpu.pieces.abs_diff(gpu.pieces) as usize > slack(cpu.pieces as usize) {
             return Err(format!("pieces: CPU {}, GPU {}", cpu.pieces, gpu.pieces));
         }
@@ -300,7 +305,6 @@ impl Twin for Subdivide {
         same_triangle_sets(&cpu.vertices, &gpu.vertices, slack(cpu.vertices.len() / 3))
     }
 }
-
 
 // ---- raster (with the fragment module and the error pass) ----
 
@@ -414,17 +418,19 @@ impl Twin for Raster {
         // Image-based lighting: the lit spheres also in the neutral studio, the viewer turned
         // (the environment stays put in the scene frame).
         let mut studio = common::lit_spheres();
-        studio.environment =
-            Some(std::sync::Arc::new(twister::core::environment::Environment::neutral().prepare()));
+        studio.environment = Some(common::studio(false));
         let settings = RenderSettings::new(Projection { width: 400, height: 100, ..Projection::default() })
             .with_yaw_deg(-25.0)
             .with_viewer(Vec3::new(0.1, 0.2, 0.0));
-        out.push(("lit spheres in the neutral studio".into(), (studio, settings, None)));
+        out.push(("lit spheres in the neutral studio".into(), (studio.clone(), settings, None)));
+        // The environment as the background too (the triangle drawn first), on the sphere.
+        studio.environment = Some(common::studio(true));
+        let sphere = RenderSettings::new(Projection::equirect(256)).with_yaw_deg(30.0);
+        out.push(("lit spheres, the studio as the background, on the sphere".into(), (studio, sphere, None)));
         // Every glTF map (metallic-roughness, normal, occlusion, emissive), u mirrored on the
         // middle quad, under a directional light and the studio.
         let mut panels = common::mapped_panels();
-        panels.environment =
-            Some(std::sync::Arc::new(twister::core::environment::Environment::neutral().prepare()));
+        panels.environment = Some(common::studio(false));
         let settings = RenderSettings::new(Projection { width: 480, height: 120, ..Projection::default() });
         out.push(("mapped panels".into(), (panels, settings, None)));
         // The glTF BRDF under point, spot and directional lights, seen from a moved viewer, with
@@ -486,6 +492,12 @@ impl Twin for Slit {
         cases.push((
             "lit spheres slit:4".into(),
             (common::lit_spheres(), RenderSettings::new(projection).with_method(Method::Slit(4))),
+        ));
+        let mut studio = common::lit_spheres();
+        studio.environment = Some(common::studio(true));
+        cases.push((
+            "lit spheres, the studio as the background".into(),
+            (studio, RenderSettings::new(projection).with_method(Method::Slit(4))),
         ));
         cases
     }
@@ -623,6 +635,17 @@ impl Twin for Trace {
                 "lit spheres: the glTF BRDF under point, spot and directional lights".into(),
                 (common::lit_spheres(), RenderSettings::new(cylinder).with_method(Method::Trace).with_exposure_ev(0.5)),
             ),
+            ("a mirror sphere and lit spheres in the studio, shown as the background and in the mirror".into(), {
+                let mut scene = common::lit_spheres();
+                scene.environment = Some(common::studio(true));
+                scene.materials.push(twister::core::material::Material { mirror: 0.8, ..Default::default() });
+                let s = builtin::sphere_scene(800, Vec3::new(0.0, 0.2, 1.6), 0.5, "mirror");
+                let first = scene.vertices.len();
+                scene.add_mesh("mirror", &s.vertices, &s.indices);
+                let m = scene.materials.len() as u32;
+                scene.vertices[first..].iter_mut().for_each(|v| v.material = m);
+                (scene, RenderSettings::new(cylinder).with_method(Method::Trace))
+            }),
             (
                 "every glTF map on quads, u mirrored on one, the tangent frame from the triangle".into(),
                 (common::mapped_panels(), RenderSettings::new(cylinder).with_method(Method::Trace)),

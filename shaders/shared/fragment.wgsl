@@ -111,3 +111,26 @@ fn measured(in: VertexOut, front_facing: bool) -> FragmentOut {
     return fragment_out(in.eye, in.clip.xy, in.view_position, dp_dx, dp_dy, in.normal, c, in.object, in.material,
                         in.uv, duv_dx, duv_dy);
 }
+
+// ---- The background: an environment the user gave, seen all around ----
+
+// A triangle covering the image, drawn first in a pass where the environment shows as the
+// background; only the colour target is written (`background_color` in fragment.rs).
+struct BackgroundOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) @interpolate(flat) eye: u32,
+}
+
+// Corner i of the triangle (−1, −1), (3, −1), (−1, 3), for eye `eye`.
+fn background_vertex(i: u32, eye: u32) -> BackgroundOut {
+    let xy = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u)) * 2.0 - 1.0;
+    return BackgroundOut(vec4<f32>(xy, 0.5, 1.0), eye);
+}
+
+// The environment's radiance along the pixel's own ray, tone mapped.
+@fragment
+fn fs_background(in: BackgroundOut) -> @location(0) vec4<f32> {
+    let params = stage_params(in.eye);
+    let ray = pixel_ray(params.projection, params.eye_sign, in.clip.xy);
+    return vec4<f32>(tonemap(env_level(0u, env_st(env_direction(ray.dir)))), 1.0);
+}

@@ -91,7 +91,7 @@ struct Lighting {
     exposure: f32,
     tonemap: u32,
     environment: u32,
-    _pad0: u32,
+    env_background: u32,
     env_lut: u32,
     _pad: u32,
     env_rotation: array<vec4<f32>, 3>,
@@ -338,7 +338,7 @@ fn shade_surface(material: u32, ambient: f32, proj: Projection, eye_sign: f32, f
     let eye = pixel_ray(proj, eye_sign, frag_xy).origin;
     let maps = surface_maps(material, uv, duv_dx, duv_dy, dp_dx, dp_dy, duv_dx, duv_dy);
     return vec4<f32>(tonemap(pbr_radiance(ambient, normalize(eye - view_position), view_position, normal, color,
-                                          maps)), 1.0);
+                                          maps, 0u)), 1.0);
 }
 
 // A surface's BRDF inputs with the material's texture maps applied: metallic and roughness
@@ -431,17 +431,9 @@ fn mapped_normal(n: vec3<f32>, s: SurfaceMaps) -> vec3<f32> {
 // along the unit direction v (towards the eye): the scene's lights, ambient × the diffuse colour
 // and the emission (`pbr_radiance` in fragment.rs).
 fn pbr_radiance(ambient: f32, v: vec3<f32>, view_position: vec3<f32>, normal: vec3<f32>,
-                color: vec4<f32>, maps: SurfaceMaps) -> vec3<f32> {
-    var n = normal;
-    if (dot(n, n) < 1e-12) {
-        n = v;
-    }
-    n = normalize(n);
+                color: vec4<f32>, maps: SurfaceMaps, first_light: u32) -> vec3<f32> {
     // Two-sided: the side the eye sees.
-    if (dot(n, v) < 0.0) {
-        n = -n;
-    }
-    n = mapped_normal(n, maps);
+    let n = shading_normal(normal, v, maps);
     let base = max(color.rgb, vec3<f32>(0.0));
     var c = maps.emissive;
     if (ENVIRONMENT && lighting.environment != 0u) {
@@ -449,15 +441,37 @@ fn pbr_radiance(ambient: f32, v: vec3<f32>, view_position: vec3<f32>, normal: ve
     } else {
         c += maps.occlusion * ambient * mix(base, vec3<f32>(0.0), maps.metallic);
     }
-    for (var i = 0u; i < lighting.count; i++) {
-        let light = lights[i];
-        let at = light_at(light, view_position);
-        let nl = dot(n, at.xyz);
-        if (nl > 0.0 && at.w > 0.0) {
-            c += brdf(n, v, at.xyz, base, maps.metallic, maps.roughness) * light.color * (at.w * nl);
-        }
+    for (var i = first_light; i < lighting.count; i++) {
+        c += light_term(i, n, v, view_position, base, maps);
     }
     return c;
+}
+
+// What light i adds at view_position (unit normal n facing v): the BRDF × its colour × its
+// falloff × n·l (`light_term` in fragment.rs).
+fn light_term(i: u32, n: vec3<f32>, v: vec3<f32>, view_position: vec3<f32>, base: vec3<f32>,
+              maps: SurfaceMaps) -> vec3<f32> {
+    let light = lights[i];
+    let at = light_at(light, view_position);
+    let nl = dot(n, at.xyz);
+    if (nl > 0.0 && at.w > 0.0) {
+        return brdf(n, v, at.xyz, base, maps.metallic, maps.roughness) * light.color * (at.w * nl);
+    }
+    return vec3<f32>(0.0);
+}
+
+// The unit normal the glTF BRDF shades with at a surface seen along v: the given one (v where
+// there is none), turned to the side the eye sees, perturbed by the normal map.
+fn shading_normal(normal: vec3<f32>, v: vec3<f32>, maps: SurfaceMaps) -> vec3<f32> {
+    var n = normal;
+    if (dot(n, n) < 1e-12) {
+        n = v;
+    }
+    n = normalize(n);
+    if (dot(n, v) < 0.0) {
+        n = -n;
+    }
+    return mapped_normal(n, maps);
 }
 
 // ---- Image-based lighting (src/core/environment.rs; twins in fragment.rs) ----
@@ -490,10 +504,14 @@ fn env_level(k: u32, st: vec2<f32>) -> vec3<f32> {
     return mix(top, bottom, f.y);
 }
 
+// The equirectangular coordinates in [0, 1]² of environment-frame direction e.
+fn env_st(e: vec3<f32>) -> vec2<f32> {
+    return vec2<f32>(atan2(e.x, -e.z) / TAU + 0.5, 0.5 - asin(clamp(e.y, -1.0, 1.0)) / PI);
+}
+
 // The radiance around viewer-frame direction d convolved for `roughness` (levels blended).
 fn env_radiance(d: vec3<f32>, roughness: f32) -> vec3<f32> {
-    let e = env_direction(d);
-    let st = vec2<f32>(atan2(e.x, -e.z) / TAU + 0.5, 0.5 - asin(clamp(e.y, -1.0, 1.0)) / PI);
+    let st = env_st(env_direction(d));
     let lod = clamp(roughness, 0.0, 1.0) * f32(ENV_LEVELS - 1u);
     let k = min(u32(lod), ENV_LEVELS - 2u);
     let t = lod - f32(k);

@@ -88,7 +88,8 @@ pub struct ViewArgs {
     #[arg(long, value_enum, default_value_t = LightingMode::Auto)]
     pub lighting: LightingMode,
     /// Image-based lighting: an equirectangular radiance map (.hdr or .exr; the centre column
-    /// looks along −z); `neutral`, the built-in grey studio; or `none`. Default: `neutral` for a glTF scene or `--lighting pbr` without
+    /// looks along −z), also shown as the background; `neutral`, the built-in grey studio (light
+    /// only); or `none`. Default: `neutral` for a glTF scene or `--lighting pbr` without
     /// the scene's own lights, else none.
     #[arg(long, value_name = "FILE|neutral|none")]
     pub environment: Option<String>,
@@ -309,7 +310,10 @@ impl ViewArgs {
         Ok(match self.environment.as_deref() {
             Some("none") => None,
             Some("neutral") => Some(Environment::neutral().prepare()),
-            Some(file) => Some(Environment::load(std::path::Path::new(file))?.prepare()),
+            Some(file) => Some(PreparedEnvironment {
+                background: true,
+                ..Environment::load(std::path::Path::new(file))?.prepare()
+            }),
             None if wants_default => Some(Environment::neutral().prepare()),
             None => None,
         })

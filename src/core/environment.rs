@@ -65,6 +65,9 @@ pub struct PreparedEnvironment {
     pub lut_offset: u32,
     /// E(n)/π = Σ sh[i]·Y_i(n), clamped at 0.
     pub sh: [Vec3; 9],
+    /// Whether background pixels show it (an environment the user gave does; the built-in
+    /// neutral studio only lights).
+    pub background: bool,
 }
 
 /// The unit direction at equirectangular image position (x, y) in texels (continuous).
@@ -78,10 +81,7 @@ pub fn direction_at(x: f32, y: f32, width: u32, height: u32) -> Vec3 {
 pub fn position_of(d: Vec3, width: u32, height: u32) -> Vec2 {
     let u = d.x.atan2(-d.z);
     let lat = d.y.clamp(-1.0, 1.0).asin();
-    Vec2::new(
-        (u / std::f32::consts::TAU + 0.5) * width as f32,
-        (0.5 - lat / std::f32::consts::PI) * height as f32,
-    )
+    Vec2::new((u / std::f32::consts::TAU + 0.5) * width as f32, (0.5 - lat / std::f32::consts::PI) * height as f32)
 }
 
 impl Environment {
@@ -100,7 +100,8 @@ impl Environment {
             .map(|i| {
                 let d = direction_at((i % width) as f32 + 0.5, (i / width) as f32 + 0.5, width, height);
                 let sky = 0.55 + 0.35 * d.y;
-                let lights: f32 = boxes.iter().map(|(c, l)| l * (((d.dot(*c) - 0.9) / 0.1).clamp(0.0, 1.0)).powi(2)).sum();
+                let lights: f32 =
+                    boxes.iter().map(|(c, l)| l * (((d.dot(*c) - 0.9) / 0.1).clamp(0.0, 1.0)).powi(2)).sum();
                 Vec3::splat(sky + lights)
             })
             .collect();
@@ -184,7 +185,8 @@ impl Environment {
             self.radiance[(y * self.width + x) as usize]
         };
         let (x0, y0) = (x0 as i64, y0 as i64);
-        (at(x0, y0) * (1.0 - fx) + at(x0 + 1, y0) * fx) * (1.0 - fy) + (at(x0, y0 + 1) * (1.0 - fx) + at(x0 + 1, y0 + 1) * fx) * fy
+        (at(x0, y0) * (1.0 - fx) + at(x0 + 1, y0) * fx) * (1.0 - fy)
+            + (at(x0, y0 + 1) * (1.0 - fx) + at(x0 + 1, y0 + 1) * fx) * fy
     }
 
     /// Everything the fragment stage reads (see the module doc).
@@ -209,7 +211,11 @@ impl Environment {
                 (0..w)
                     .map(|x| {
                         let d = direction_at(x as f32 + 0.5, y as f32 + 0.5, w, h);
-                        let c = if k == 0 { self.radiance[(y * w + x) as usize] } else { prefilter(&pyramid, d, roughness) };
+                        let c = if k == 0 {
+                            self.radiance[(y * w + x) as usize]
+                        } else {
+                            prefilter(&pyramid, d, roughness)
+                        };
                         rgb9e5(c)
                     })
                     .collect()
@@ -227,7 +233,14 @@ impl Environment {
         }
         // Irradiance from a level of at most 64 texels across (box filtering keeps the energy).
         let small = pyramid.iter().find(|e| e.width <= 64).unwrap_or(&pyramid[0]);
-        PreparedEnvironment { name: self.name.clone(), texels, levels, lut_offset, sh: irradiance_sh(small) }
+        PreparedEnvironment {
+            name: self.name.clone(),
+            texels,
+            levels,
+            lut_offset,
+            sh: irradiance_sh(small),
+            background: false,
+        }
     }
 }
 
@@ -277,7 +290,9 @@ fn parallel_rows<T: Send>(h: u32, row: impl Fn(u32) -> T + Sync) -> Vec<T> {
         let handles: Vec<_> = (0..threads)
             .map(|t| {
                 let row = &row;
-                s.spawn(move || ((t * chunk) as u32..((t + 1) * chunk).min(h as usize) as u32).map(row).collect::<Vec<T>>())
+                s.spawn(move || {
+                    ((t * chunk) as u32..((t + 1) * chunk).min(h as usize) as u32).map(row).collect::<Vec<T>>()
+                })
             })
             .collect();
         handles.into_iter().flat_map(|h| h.join().expect("environment worker")).collect()
@@ -328,7 +343,11 @@ fn prefilter(pyramid: &[Environment], r: Vec3, roughness: f32) -> Vec3 {
         sum += c * nl;
         weight += nl;
     }
-    if weight > 0.0 { sum / weight } else { Vec3::ZERO }
+    if weight > 0.0 {
+        sum / weight
+    } else {
+        Vec3::ZERO
+    }
 }
 
 /// Smith's separable GGX masking for one direction (as in `brdf`).
@@ -470,6 +489,8 @@ mod tests {
         for &t in &p.texels[..p.lut_offset as usize] {
             assert!((rgb9e5_decode(t) - Vec3::splat(0.7)).abs().max_element() < 2e-3, "{:?}", rgb9e5_decode(t));
         }
-        assert!((irradiance(&p.sh, Vec3::new(0.2, -0.9, 0.1).normalize()) - Vec3::splat(0.7)).abs().max_element() < 2e-3);
+        assert!(
+            (irradiance(&p.sh, Vec3::new(0.2, -0.9, 0.1).normalize()) - Vec3::splat(0.7)).abs().max_element() < 2e-3
+        );
     }
 }

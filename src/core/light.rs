@@ -132,7 +132,8 @@ pub struct LightingParams {
     pub tonemap: u32,
     /// 1: image-based lighting from the environment (`core::environment`) replaces the ambient term.
     pub environment: u32,
-    pub _pad0: u32,
+    /// 1: background pixels show the environment (one the user gave).
+    pub env_background: u32,
     /// First texel of the split-sum table in the environment buffer.
     pub env_lut: u32,
     pub _pad: u32,
@@ -169,6 +170,7 @@ impl LightingParams {
         };
         if let (Some(env), true) = (environment, pbr) {
             params.environment = 1;
+            params.env_background = env.background as u32;
             params.env_lut = env.lut_offset;
             params.env_sh = env.sh.map(|c| c.extend(0.0).to_array());
             params.env_levels = env.levels.map(|[o, w, h]| [o, w, h, 0]);

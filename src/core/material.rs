@@ -69,7 +69,9 @@ pub struct Material {
 impl Material {
     /// Whether it has any of the glTF BRDF's texture maps.
     pub fn has_maps(&self) -> bool {
-        [self.mr_texture, self.normal_texture, self.occlusion_texture, self.emissive_texture].iter().any(|&t| t != NO_TEXTURE)
+        [self.mr_texture, self.normal_texture, self.occlusion_texture, self.emissive_texture]
+            .iter()
+            .any(|&t| t != NO_TEXTURE)
     }
 }
 

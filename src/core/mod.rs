@@ -5,8 +5,8 @@
 pub mod builtin;
 pub mod bvh;
 pub mod color;
-pub mod environment;
 pub mod compare;
+pub mod environment;
 pub mod frame;
 pub mod light;
 pub mod load;

@@ -116,9 +116,9 @@ impl MaterialTable {
     /// Whether any material needs the fragment stage's material code: textured, not opaque, or
     /// single-sided. (Otherwise a fragment's colour is its vertex colour.)
     pub fn needs_materials(&self) -> bool {
-        self.materials
-            .iter()
-            .any(|m| m.texture != NO_TEXTURE || m.alpha_mode != AlphaMode::Opaque as u32 || m.double_sided == 0 || m.has_maps())
+        self.materials.iter().any(|m| {
+            m.texture != NO_TEXTURE || m.alpha_mode != AlphaMode::Opaque as u32 || m.double_sided == 0 || m.has_maps()
+        })
     }
 
     /// Whether any material can discard a fragment: alpha-tested or blended, or single-sided.

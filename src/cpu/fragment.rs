@@ -16,9 +16,13 @@ use crate::core::texture::MaterialTable;
 /// Linear colour × (ambient + (1 − ambient)·|n·l|), the light at the viewer, two-sided; as
 /// sRGB-encoded RGBA8 (the colour target holds display values).
 pub fn shade(ambient: f32, view_position: Vec3, normal: Vec3, color: Vec4) -> [u8; 4] {
-    let lit = shade_linear(ambient, view_position, normal, color);
-    let q = |x: f32| (linear_to_srgb(x) * 255.0 + 0.5).floor() as u8;
-    [q(lit.x), q(lit.y), q(lit.z), 255]
+    display_bytes(shade_linear(ambient, view_position, normal, color))
+}
+
+/// A linear colour in [0, 1] as the sRGB colour target stores it.
+pub fn display_bytes(c: Vec3) -> [u8; 4] {
+    let q = |x: f32| (linear_to_srgb(x.clamp(0.0, 1.0)) * 255.0 + 0.5).floor() as u8;
+    [q(c.x), q(c.y), q(c.z), 255]
 }
 
 /// The same in linear light, each channel clamped to [0, 1] (`shade` in surface.wgsl).
@@ -99,10 +103,21 @@ pub fn shade_surface(
     let (duv_dx, duv_dy) = (surface.duv_dx, surface.duv_dy);
     let maps = surface_maps(table, material, surface.uv, duv_dx, duv_dy, [dp_dx, dp_dy], [duv_dx, duv_dy]);
     let v = (origin - view_position).normalize();
-    let c = pbr_radiance(table, ambient, v, view_position, normal, color, &maps);
-    let lit = tonemap(c, &table.lighting);
-    let q = |x: f32| (linear_to_srgb(x) * 255.0 + 0.5).floor() as u8;
-    [q(lit.x), q(lit.y), q(lit.z), 255]
+    let c = pbr_radiance(table, ambient, v, view_position, normal, color, &maps, 0);
+    display_bytes(tonemap(c, &table.lighting))
+}
+
+/// Whether the frame's background shows the environment (one the user gave, lit by the BRDF).
+pub fn shows_environment(table: &MaterialTable) -> bool {
+    let l = &table.lighting;
+    l.pbr != 0 && l.environment != 0 && l.env_background != 0
+}
+
+/// The background at a pixel: the environment along the pixel's own ray, tone mapped
+/// (`fs_background` in fragment.wgsl).
+pub fn background_color(table: &MaterialTable, projection: &Projection, eye: Eye, frag_xy: Vec2) -> [u8; 4] {
+    let (_, dir) = pixel_ray(projection, eye, frag_xy);
+    display_bytes(tonemap(env_level(table, 0, env_st(env_direction(table, dir))), &table.lighting))
 }
 
 /// The glTF BRDF's linear colour, before tone mapping, of surface point `view_position` seen
@@ -117,12 +132,9 @@ pub fn pbr_radiance(
     normal: Vec3,
     color: Vec4,
     maps: &SurfaceMaps,
+    first_light: usize,
 ) -> Vec3 {
-    let mut n = if normal.length_squared() < 1e-12 { v } else { normal.normalize() };
-    if n.dot(v) < 0.0 {
-        n = -n;
-    }
-    let n = mapped_normal(n, maps);
+    let n = shading_normal(normal, v, maps);
     let base = color.truncate().max(Vec3::ZERO);
     let mut c = maps.emissive;
     if table.lighting.environment != 0 {
@@ -130,14 +142,29 @@ pub fn pbr_radiance(
     } else {
         c += maps.occlusion * ambient * base.lerp(Vec3::ZERO, maps.metallic);
     }
-    for light in &table.lights[..table.lighting.count as usize] {
-        let (l, scale) = light_at(light, view_position);
-        let nl = n.dot(l);
-        if nl > 0.0 && scale > 0.0 {
-            c += brdf(n, v, l, base, maps.metallic, maps.roughness) * Vec3::from(light.color) * (scale * nl);
-        }
+    for light in table.lights[..table.lighting.count as usize].iter().skip(first_light) {
+        c += light_term(light, n, v, view_position, base, maps);
     }
     c
+}
+
+/// What a light adds at view_position (unit normal n facing v): the BRDF × its colour × its
+/// falloff × n·l (`light_term` in surface.wgsl).
+pub fn light_term(light: &GpuLight, n: Vec3, v: Vec3, view_position: Vec3, base: Vec3, maps: &SurfaceMaps) -> Vec3 {
+    let (l, scale) = light_at(light, view_position);
+    let nl = n.dot(l);
+    if nl > 0.0 && scale > 0.0 {
+        brdf(n, v, l, base, maps.metallic, maps.roughness) * Vec3::from(light.color) * (scale * nl)
+    } else {
+        Vec3::ZERO
+    }
+}
+
+/// The unit normal the BRDF shades with (`shading_normal`): the given one (v where there is
+/// none), turned to the side the eye sees, perturbed by the normal map.
+pub fn shading_normal(normal: Vec3, v: Vec3, maps: &SurfaceMaps) -> Vec3 {
+    let n = if normal.length_squared() < 1e-12 { v } else { normal.normalize() };
+    mapped_normal(if n.dot(v) < 0.0 { -n } else { n }, maps)
 }
 
 /// A surface's BRDF inputs with its material's texture maps applied (`SurfaceMaps` in
@@ -245,13 +272,14 @@ pub fn env_level(table: &MaterialTable, k: usize, st: Vec2) -> Vec3 {
     top.lerp(bottom, f.y)
 }
 
+/// The equirectangular coordinates in [0, 1]² of environment-frame direction e (`env_st`).
+pub fn env_st(e: Vec3) -> Vec2 {
+    Vec2::new(e.x.atan2(-e.z) / std::f32::consts::TAU + 0.5, 0.5 - e.y.clamp(-1.0, 1.0).asin() / std::f32::consts::PI)
+}
+
 /// The radiance around viewer-frame direction d convolved for `roughness` (`env_radiance`).
 pub fn env_radiance(table: &MaterialTable, d: Vec3, roughness: f32) -> Vec3 {
-    let e = env_direction(table, d);
-    let st = Vec2::new(
-        e.x.atan2(-e.z) / std::f32::consts::TAU + 0.5,
-        0.5 - e.y.clamp(-1.0, 1.0).asin() / std::f32::consts::PI,
-    );
+    let st = env_st(env_direction(table, d));
     let lod = roughness.clamp(0.0, 1.0) * (ENV_LEVELS - 1) as f32;
     let k = (lod as usize).min(ENV_LEVELS - 2);
     let t = lod - k as f32;
@@ -274,7 +302,10 @@ pub fn env_lut(table: &MaterialTable, nv: f32, roughness: f32) -> Vec2 {
     for corner in 0..4u32 {
         let (dx, dy) = (corner & 1, corner >> 1);
         let w = if dx == 1 { f.x } else { 1.0 - f.x } * if dy == 1 { f.y } else { 1.0 - f.y };
-        let i = table.lighting.env_lut as usize + (base.y as usize + dy as usize) * LUT_SIZE + base.x as usize + dx as usize;
+        let i = table.lighting.env_lut as usize
+            + (base.y as usize + dy as usize) * LUT_SIZE
+            + base.x as usize
+            + dx as usize;
         out += w * crate::core::environment::unpack_half2(table.environment[i]);
     }
     out

@@ -13,7 +13,9 @@ use glam::{Vec2, Vec3, Vec4};
 use crate::core::projection::{azimuth, Eye, Projection};
 use crate::core::settings::RenderSettings;
 use crate::core::texture::MaterialTable;
-use crate::cpu::fragment::{pixel_distance, pixel_error, shade_surface, surface_color, Surface};
+use crate::cpu::fragment::{
+    background_color, pixel_distance, pixel_error, shade_surface, shows_environment, surface_color, Surface,
+};
 use crate::shader::constants::GUARD_BAND_PX;
 use crate::shader::types::{DrawVertex, RasterParams};
 
@@ -253,6 +255,11 @@ pub fn raster(
 ) -> [RasterImage; 2] {
     let projection = Projection::from(&params[0].projection);
     let mut images = params.map(|_| RasterImage::new(projection.width, projection.height, background));
+    if shows_environment(table) {
+        for (img, eye) in images.iter_mut().zip(Eye::BOTH) {
+            fill_background(img, table, &projection, eye);
+        }
+    }
     for tri in vertices.chunks_exact(3) {
         for ((eye_params, eye), img) in params.iter().zip(Eye::BOTH).zip(images.iter_mut()) {
             let cv = [0, 1, 2].map(|k| ClipVertex {
@@ -270,6 +277,17 @@ pub fn raster(
         }
     }
     images
+}
+
+/// Paints the environment into an image's background (the background triangle drawn first).
+pub fn fill_background(img: &mut RasterImage, table: &MaterialTable, projection: &Projection, eye: Eye) {
+    for y in 0..img.height {
+        for x in 0..img.width {
+            let i = 4 * (y * img.width + x) as usize;
+            let c = background_color(table, projection, eye, Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+            img.rgba[i..i + 4].copy_from_slice(&c);
+        }
+    }
 }
 
 /// The raster stage's parameters: the left eye's, then the right's (its `array<RasterParams, 2>`).

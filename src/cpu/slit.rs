@@ -181,6 +181,9 @@ pub fn slit(
     let eye = if params.eye_sign > 0.0 { Eye::Right } else { Eye::Left };
     let view = Mat4::from_cols_array_2d(&params.view);
     let mut img = RasterImage::new(projection.width, projection.height, background);
+    if crate::cpu::fragment::shows_environment(table) {
+        crate::cpu::raster::fill_background(&mut img, table, &projection, eye);
+    }
     let fragment = |f: &FragmentIn| fragment(table, params.ambient, &projection, eye, params.error_angle != 0, f);
     let spheres = object_spheres(scene);
     for slit in slits {

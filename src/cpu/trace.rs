@@ -11,8 +11,9 @@ use std::cell::Cell;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use crate::core::bvh::{BvhNode, SceneBvh, OBJECT_LEAF};
-use crate::core::color::{linear_to_srgb, srgb_to_linear};
+use crate::core::color::srgb_to_linear;
 use crate::core::light::tonemap;
+use crate::core::light::LightKind;
 use crate::core::material::AlphaMode;
 use crate::core::projection::{Eye, Projection};
 use crate::core::scene::SceneVertex;
@@ -20,10 +21,11 @@ use crate::core::settings::RenderSettings;
 use crate::core::texture::MaterialTable;
 use crate::core::visual_field::Gaze;
 use crate::cpu::fragment::{
-    pbr_radiance, pixel_error, pixel_ray, pixel_spread, shade_linear, surface_color, surface_maps, Surface,
+    display_bytes, env_level, env_st, light_at, light_term, pbr_radiance, pixel_error, pixel_ray, pixel_spread,
+    shade_linear, shading_normal, surface_color, surface_maps, Surface,
 };
 use crate::cpu::raster::RasterImage;
-use crate::shader::constants::{TRACE_PENDING, TRACE_STACK};
+use crate::shader::constants::{MAX_SHADOWED_LIGHTS, TRACE_PENDING, TRACE_STACK};
 use crate::shader::types::TraceParams;
 
 /// The trace stage's parameters (`row_texels`: the outputs' padded row length).
@@ -217,6 +219,7 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
     let projection = Projection::from(&params.projection);
     let to_scene = Mat4::from_cols_array_2d(&params.to_scene);
     let to_view = glam::Mat3::from_mat4(to_scene).transpose();
+    let to_scene_rotation = glam::Mat3::from_mat4(to_scene);
     let viewer = to_scene.w_axis.truncate();
     let [r, g, b, _] = params.background;
     let background = Vec3::new(r, g, b).map(srgb_to_linear);
@@ -294,7 +297,37 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
                     [to_view * (pb - pa), to_view * (pc - pa)],
                     [ub - ua, uc - ua],
                 );
-                pbr_radiance(table, params.ambient, -(to_view * dir), view_position, to_view * n, color, &maps) * own
+                // The first MAX_SHADOWED_LIGHTS lights behind their shadow rays, the others directly.
+                let v = -(to_view * dir);
+                let shadowed = (table.lighting.count as usize).min(MAX_SHADOWED_LIGHTS as usize);
+                let mut lit =
+                    pbr_radiance(table, params.ambient, v, view_position, to_view * n, color, &maps, shadowed) * own;
+                let shading_n = shading_normal(to_view * n, v, &maps);
+                let base = color.truncate().max(Vec3::ZERO);
+                let offset = 1e-4 * p.length().max(1.0);
+                for light in &table.lights[..shadowed] {
+                    let term = light_term(light, shading_n, v, view_position, base, &maps) * own;
+                    if term.max_element() > 0.0 {
+                        let limit = if light.kind == LightKind::Directional as u32 {
+                            FAR
+                        } else {
+                            (Vec3::from(light.position) - view_position).length() - offset
+                        };
+                        let (l, _) = light_at(light, view_position);
+                        rays.set(rays.get() + 1);
+                        let cone = Vec2::new(width, 0.0);
+                        let shadow = closest_hit(
+                            &traced,
+                            &TracedRay { origin: p + offset * facing, dir: to_scene_rotation * l, limit, level, cone },
+                            keeps,
+                            &tests,
+                        );
+                        if shadow.is_none() {
+                            lit += term;
+                        }
+                    }
+                }
+                lit
             }
             None => shade_linear(params.ambient, view_position, to_view * n, color) * own,
             Some(light) => {
@@ -333,6 +366,8 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
             front: hit.front,
         }
     };
+    // Whether the environment lights the rays (`environment_lit` in trace.wgsl).
+    let environment_lit = table.lighting.pbr != 0 && table.lighting.environment != 0 && light.is_none();
     let images = Eye::BOTH.map(|eye| {
         // The image's background is given in display values, as `RasterImage::new` takes it.
         let mut img = RasterImage::new(projection.width, projection.height, [r, g, b]);
@@ -373,6 +408,11 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
                     &keeps,
                     &tests,
                 ) else {
+                    if environment_lit && table.lighting.env_background != 0 {
+                        let i = 4 * (y * projection.width + x) as usize;
+                        let c = tonemap(env_level(table, 0, env_st(dir)), &table.lighting);
+                        img.rgba[i..i + 4].copy_from_slice(&display_bytes(c));
+                    }
                     continue;
                 };
                 let i = (y * projection.width + x) as usize;
@@ -389,6 +429,8 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
                 loop {
                     let (o, bounces, d, weight, cone) = current;
                     match current_hit {
+                        // A mirrored or refracted ray leaving the scene brings the environment's light.
+                        None if environment_lit => color += weight * env_level(table, 0, env_st(d)),
                         None => color += weight * background,
                         Some(h) => {
                             let p = o + h.t * d;
@@ -458,11 +500,6 @@ pub fn ray_hit_points(projection: &Projection, distances: &[Vec<f32>; 2]) -> [Ve
 }
 
 /// Linear colour → sRGB bytes as the colour target holds them (`pack_display(linear_to_srgb(c))`).
-fn display_bytes(c: Vec3) -> [u8; 4] {
-    let q = |x: f32| (linear_to_srgb(x.clamp(0.0, 1.0)) * 255.0 + 0.5).floor() as u8;
-    [q(c.x), q(c.y), q(c.z), 255]
-}
-
 /// "No hit" distance of a ray (`FAR` in trace.wgsl).
 const FAR: f32 = 3.0e38;
 

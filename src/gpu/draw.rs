@@ -29,6 +29,8 @@ pub(crate) struct DrawPipelines {
     kind: DrawStage,
     /// By `Self::index`.
     pipelines: [OnceLock<wgpu::RenderPipeline>; 288],
+    /// The background's (`fs_background`), by outputs and eyes.
+    backgrounds: [OnceLock<wgpu::RenderPipeline>; 9],
 }
 
 /// What a scene's materials need of a drawing pipeline.
@@ -89,7 +91,12 @@ impl Lit {
 impl DrawPipelines {
     pub fn new(gpu: &Gpu, kind: DrawStage) -> DrawPipelines {
         let stage = GpuStage::new(gpu, if kind == DrawStage::Raster { &RASTER } else { &SLIT });
-        DrawPipelines { stage, kind, pipelines: std::array::from_fn(|_| OnceLock::new()) }
+        DrawPipelines {
+            stage,
+            kind,
+            pipelines: std::array::from_fn(|_| OnceLock::new()),
+            backgrounds: std::array::from_fn(|_| OnceLock::new()),
+        }
     }
 
     fn index(&self, look: Look, lit: Lit, outputs: usize, layers: Layers) -> usize {
@@ -114,7 +121,14 @@ impl DrawPipelines {
 
     pub fn get_look(&self, gpu: &Gpu, look: Look, lit: Lit, outputs: usize, layers: Layers) -> &wgpu::RenderPipeline {
         self.pipelines[self.index(look, lit, outputs, layers)]
-            .get_or_init(|| draw_pipeline(gpu, &self.stage, self.kind, look, lit, outputs, layers))
+            .get_or_init(|| draw_pipeline(gpu, &self.stage, self.kind, Some((look, lit)), outputs, layers))
+    }
+
+    /// The background's pipeline (the environment along each pixel's ray, colour only), for a
+    /// pass with `outputs` targets drawing `layers`; drawn first, where `shows_environment`.
+    pub fn background(&self, gpu: &Gpu, outputs: usize, layers: Layers) -> &wgpu::RenderPipeline {
+        self.backgrounds[self.index(Look::Plain, Lit::default(), outputs, layers) / 8]
+            .get_or_init(|| draw_pipeline(gpu, &self.stage, self.kind, None, outputs, layers))
     }
 
     /// The scene's material table (group 1).
@@ -137,11 +151,13 @@ fn draw_pipeline(
     gpu: &Gpu,
     stage: &GpuStage,
     kind: DrawStage,
-    look: Look,
-    lit: Lit,
+    look: Option<(Look, Lit)>,
     outputs: usize,
     layers: Layers,
 ) -> wgpu::RenderPipeline {
+    // None: the background triangle (no vertex buffer; colour only; behind everything).
+    let background = look.is_none();
+    let (look, lit) = look.unwrap_or((Look::Materials, Lit { pbr: true, environment: true, maps: false }));
     use wgpu::VertexFormat::{Float32, Float32x2, Float32x3, Float32x4, Uint32};
     // Raster: the subdivided `DrawVertex`; slit: the scene's `SceneVertex` (`VertexIn` of each WGSL file).
     let (stride, attributes) = match kind {
@@ -174,9 +190,14 @@ fn draw_pipeline(
         step_mode: wgpu::VertexStepMode::Vertex,
         attributes: &attributes,
     };
+    let buffers = [Some(layout)];
     let error = error_target_format(gpu.error_target);
-    let all_targets = [COLOR_FORMAT, error, OBJECT_FORMAT, error, POSITION_FORMAT]
-        .map(|format| Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL }));
+    let all_targets = [COLOR_FORMAT, error, OBJECT_FORMAT, error, POSITION_FORMAT].map(|format| {
+        // The background writes the colour only: the measuring targets keep their clear values.
+        let write_mask =
+            if background && format != COLOR_FORMAT { wgpu::ColorWrites::empty() } else { wgpu::ColorWrites::ALL };
+        Some(wgpu::ColorTargetState { format, blend: None, write_mask })
+    });
     let mut constants = vec![
         ("MATERIALS", (look != Look::Plain) as u32 as f64),
         ("DISCARDS", (look != Look::Shaded) as u32 as f64),
@@ -198,29 +219,30 @@ fn draw_pipeline(
         layout: Some(stage.draw_layout()),
         vertex: wgpu::VertexState {
             module: &stage.module,
-            entry_point: Some("vs_main"),
+            entry_point: Some(if background { "vs_background" } else { "vs_main" }),
             compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
-            buffers: &[Some(layout)],
+            buffers: if background { &[] } else { &buffers },
         },
         primitive: wgpu::PrimitiveState {
             topology: wgpu::PrimitiveTopology::TriangleList,
             front_face: wgpu::FrontFace::Ccw,
-            cull_mode: (look == Look::Culled).then_some(wgpu::Face::Back),
+            cull_mode: (look == Look::Culled && !background).then_some(wgpu::Face::Back),
             ..Default::default()
         },
         depth_stencil: Some(wgpu::DepthStencilState {
             format: DEPTH_FORMAT,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Less),
+            depth_write_enabled: Some(!background),
+            depth_compare: Some(if background { wgpu::CompareFunction::Always } else { wgpu::CompareFunction::Less }),
             stencil: Default::default(),
             bias: Default::default(),
         }),
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
             module: &stage.module,
-            entry_point: Some(match outputs {
-                1 => "fs_main",
-                4 => "fs_error",
+            entry_point: Some(match (background, outputs) {
+                (true, _) => "fs_background",
+                (_, 1) => "fs_main",
+                (_, 4) => "fs_error",
                 _ => "fs_position",
             }),
             compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },

@@ -16,7 +16,7 @@ use crate::cpu::raster::raster_params;
 use crate::cpu::subdivide::{subdivide_params, SubdivideOutput};
 use crate::error::{Error, Result};
 use crate::gpu::device::Gpu;
-use crate::gpu::draw::{DrawPipelines, DrawStage, Look, Lit};
+use crate::gpu::draw::{DrawPipelines, DrawStage, Lit, Look};
 use crate::gpu::frame_plan::{
     on_overflow, Capacities, FramePlan, Overflow, SubdivisionBuffers, INDICES_SIZE, NODE_SIZE,
 };
@@ -431,9 +431,13 @@ impl Renderer {
                 end_of_pass_write_index: (k + 1 == passes.len()).then_some(end),
             });
             let mut pass = targets.begin_pass(enc, layers, settings, clear, writes);
-            pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &bind_group, &[]);
             pass.set_bind_group(1, &materials, &[]);
+            if clear && scene.shows_environment(settings) {
+                pass.set_pipeline(self.raster.background(&self.gpu, settings.measure.outputs(), layers));
+                pass.draw(0..3, 0..1);
+            }
+            pass.set_pipeline(pipeline);
             pass.set_vertex_buffer(0, buffers.nodes.slice(..));
             pass.set_index_buffer(buffers.indices.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed_indirect(&buffers.draw_args, 0);

@@ -125,16 +125,14 @@ impl GpuScene {
                     bytemuck::bytes_of(&LightingParams::default()),
                     wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 ),
-                storage("environment", bytemuck::cast_slice(if table.environment.is_empty() {
-                    &[0u32]
-                } else {
-                    &table.environment[..]
-                })),
+                storage(
+                    "environment",
+                    bytemuck::cast_slice(if table.environment.is_empty() { &[0u32] } else { &table.environment[..] }),
+                ),
             ];
             let ones = vec![1.0f32; scene.objects.len().max(1)];
             // The glTF BRDF reads the materials' factors.
-            let needs_materials =
-                table.needs_materials() || !scene.lights.is_empty() || scene.environment.is_some();
+            let needs_materials = table.needs_materials() || !scene.lights.is_empty() || scene.environment.is_some();
             let has_optics = table.has_optics();
             let discards = table.discards();
             let has_maps = table.materials.iter().any(|m| m.has_maps());
@@ -154,9 +152,10 @@ impl GpuScene {
                 has_optics,
                 bvh: None,
                 lights: scene.lights.clone(),
-                environment: scene.environment.as_ref().map(|e| {
-                    std::sync::Arc::new(PreparedEnvironment { texels: Vec::new(), ..(**e).clone() })
-                }),
+                environment: scene
+                    .environment
+                    .as_ref()
+                    .map(|e| std::sync::Arc::new(PreparedEnvironment { texels: Vec::new(), ..(**e).clone() })),
             })
         })
     }
@@ -164,6 +163,12 @@ impl GpuScene {
     /// Whether a frame with `settings` is lit by the glTF BRDF.
     pub fn pbr(&self, settings: &RenderSettings) -> bool {
         settings.lighting_params(self.lights.len(), self.environment.as_deref()).pbr != 0
+    }
+
+    /// Whether a frame with `settings` shows the environment as its background (one the user
+    /// gave, lit by the glTF BRDF).
+    pub fn shows_environment(&self, settings: &RenderSettings) -> bool {
+        self.pbr(settings) && self.environment.as_ref().is_some_and(|e| e.background)
     }
 
     /// Writes a frame's lights (in the viewer frame of `settings`) and lighting into group 1.

@@ -50,9 +50,13 @@ impl Renderer {
                 end_of_pass_write_index: (k == 1).then_some(1),
             });
             let mut pass = targets.begin_pass(&mut enc, Layers::Eye(k), settings, true, writes);
-            pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &bind_group, &[]);
             pass.set_bind_group(1, &materials, &[]);
+            if scene.shows_environment(settings) {
+                pass.set_pipeline(self.slit.background(gpu, settings.measure.outputs(), Layers::Eye(k)));
+                pass.draw(0..3, 0..1);
+            }
+            pass.set_pipeline(pipeline);
             pass.set_vertex_buffer(0, scene.vertices.slice(..));
             pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
             let first_instance = (k * eye_slits[0].len()) as u32;

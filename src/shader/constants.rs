@@ -37,9 +37,12 @@ pub const MAX_STRETCH: f32 = 2.0;
 pub const ERROR_SPLIT_LENGTH: f32 = 8.0;
 /// The ray tracer's traversal stack (entries): the host refuses a BVH deeper than this.
 pub const TRACE_STACK: u32 = 64;
+/// The scene lights whose shadows the ray tracer traces at each hit (the first ones of the
+/// scene's list); any further ones light without shadows.
+pub const MAX_SHADOWED_LIGHTS: u32 = 8;
 /// The ray tracer's pending rays per pixel, traced depth first: per bounce level one mirror or
-/// refraction ray waiting, plus the two a hit spawns and its shadow ray.
-pub const TRACE_PENDING: u32 = crate::core::settings::MAX_REFLECT + 3;
+/// refraction ray waiting, plus the two a hit spawns and its shadow rays (one per shadowed light).
+pub const TRACE_PENDING: u32 = crate::core::settings::MAX_REFLECT + 2 + MAX_SHADOWED_LIGHTS;
 /// The ray tracer counts rays and triangle tests per workgroup into this many slots (two 32-bit
 /// counters each, summed on the host in 64 bits, so that no slot overflows).
 pub const TRACE_COUNT_SLOTS: u32 = 4096;
@@ -107,6 +110,7 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("SEAM_MARGIN", F32(SEAM_MARGIN)),
         ("TRACE_STACK", U32(TRACE_STACK)),
         ("TRACE_PENDING", U32(TRACE_PENDING)),
+        ("MAX_SHADOWED_LIGHTS", U32(MAX_SHADOWED_LIGHTS)),
         ("TRACE_COUNT_SLOTS", U32(TRACE_COUNT_SLOTS)),
         ("CENTRAL_RADIUS", F32(CENTRAL_RADIUS)),
         ("FIELD_SIDEWAYS", F32(FIELD_SIDEWAYS)),

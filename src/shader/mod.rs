@@ -164,6 +164,8 @@ pub const RASTER: Stage = Stage {
         entry("fs_main", SHADING),
         entry("fs_error", SHADING),
         entry("fs_position", SHADING),
+        entry("vs_background", &[]),
+        entry("fs_background", &["params", "lighting", "environment"]),
     ],
     bindings: &[
         bind(0, 0, "params", Uniform),
@@ -185,6 +187,8 @@ pub const SLIT: Stage = Stage {
         entry("fs_main", SHADING),
         entry("fs_error", SHADING),
         entry("fs_position", SHADING),
+        entry("vs_background", &[]),
+        entry("fs_background", &["params", "lighting", "environment"]),
     ],
     bindings: &[
         bind(0, 0, "params", Uniform),

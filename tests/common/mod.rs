@@ -217,7 +217,11 @@ pub fn mapped_panels() -> twister::Scene {
     let occlusion = image("occlusion", &|x, y| if (x / 4 + y / 4) % 2 == 0 { [255; 4] } else { [90, 90, 90, 255] });
     let emissive = image("emissive", &|x, y| {
         let d = (x as f32 - 5.0).hypot(y as f32 - 10.0);
-        if d < 3.0 { [255, 160, 60, 255] } else { [0, 0, 0, 255] }
+        if d < 3.0 {
+            [255, 160, 60, 255]
+        } else {
+            [0, 0, 0, 255]
+        }
     });
     scene.textures = vec![mr.encode_data(), normal.encode_data(), occlusion.encode_data(), emissive];
     scene.materials.push(Material {
@@ -247,4 +251,10 @@ pub fn mapped_panels() -> twister::Scene {
         outer_cone: 0.5,
     }];
     scene
+}
+
+/// The neutral studio, prepared, shown as the background if `background`.
+pub fn studio(background: bool) -> std::sync::Arc<twister::core::environment::PreparedEnvironment> {
+    let prepared = twister::core::environment::Environment::neutral().prepare();
+    std::sync::Arc::new(twister::core::environment::PreparedEnvironment { background, ..prepared })
 }

@@ -58,7 +58,11 @@ pub fn same_triangle_sets(cpu: &[DrawVertex], gpu: &[DrawVertex], allowed: usize
         }
     }
     if unmatched.len() > allowed {
-        return Err(format!("{} triangles without a twin (allowed {allowed}), first: {}", unmatched.len(), unmatched[0]));
+        return Err(format!(
+            "{} triangles without a twin (allowed {allowed}), first: {}",
+            unmatched.len(),
+            unmatched[0]
+        ));
     }
     Ok(())
 }

@@ -234,7 +234,10 @@ fn data_maps(scene: &mut Scene) {
 fn gltf_maps_note(material: &gltf::Material, set: u32, transformed: bool) -> Option<String> {
     let pbr = material.pbr_metallic_roughness();
     let maps = [
-        ("metallic-roughness", pbr.metallic_roughness_texture().map(|t| (t.tex_coord(), t.texture_transform().is_some()))),
+        (
+            "metallic-roughness",
+            pbr.metallic_roughness_texture().map(|t| (t.tex_coord(), t.texture_transform().is_some())),
+        ),
         ("normal", material.normal_texture().map(|t| (t.tex_coord(), false))),
         ("occlusion", material.occlusion_texture().map(|t| (t.tex_coord(), false))),
         ("emissive", material.emissive_texture().map(|t| (t.tex_coord(), t.texture_transform().is_some()))),
