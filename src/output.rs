@@ -290,6 +290,23 @@ pub fn exr_file(path: PathBuf, depth: &DepthImage) -> Result<OutputFile> {
     Ok(OutputFile { path, bytes: cursor.into_inner() })
 }
 
+/// An eye's linear colour as OpenEXR: 32-bit float channels R, G, B, uncompressed scan lines.
+pub fn hdr_exr_file(path: PathBuf, width: u32, height: u32, rgb: &[[f32; 3]]) -> Result<OutputFile> {
+    use exr::prelude::*;
+    let w = width as usize;
+    let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
+        let [r, g, b] = rgb[p.y() * w + p.x()];
+        (r, g, b)
+    });
+    let image = Image::from_channels((w, height as usize), channels);
+    let mut cursor = std::io::Cursor::new(Vec::new());
+    image
+        .write()
+        .to_buffered(&mut cursor)
+        .map_err(|e| crate::error::Error::output(&path, format!("cannot encode OpenEXR: {e}")))?;
+    Ok(OutputFile { path, bytes: cursor.into_inner() })
+}
+
 /// The temporary name of an output while it is written: `.NAME.PID.tmp` beside it (and
 /// `.NAME.PID.old` for the file it replaces until all are in place).
 fn side_name(path: &Path, suffix: &str) -> PathBuf {
@@ -458,6 +475,7 @@ mod tests {
             measurement: None,
             depth: None,
             positions: None,
+            hdr: None,
         };
         for layout in [Layout::Eyes, Layout::TopBottom, Layout::SideBySide, Layout::Twister] {
             for format in [ImageFormat::Png, ImageFormat::Jpg] {

@@ -195,3 +195,124 @@ fn a_given_environment_is_the_background_and_the_studio_is_not() {
         }
     }
 }
+
+/// `--hdr`: the linear colour, not tone mapped and not clamped, from a float colour target. On
+/// the GPU: lit spheres under a strong light and the sunset reach well above 1, and tone mapping
+/// the linear colour on the CPU (PBR Neutral, sRGB) gives the ordinary frame's pixels. From the
+/// command line: left_hdr.exr and right_hdr.exr (R, G, B), and slit/trace refused in one line.
+#[test]
+fn hdr_frames_hold_the_linear_colour_and_tone_map_to_the_ordinary_frame() {
+    use twister::core::light::{tonemap, LightingParams};
+    use twister::cpu::fragment::display_bytes;
+    let mut scene = common::lit_spheres();
+    scene.environment = Some(common::studio(true));
+    let s = RenderSettings::new(Projection { width: 320, height: 80, ..Projection::default() }).with_exposure_ev(1.0);
+    let ldr = common::render(&scene, &s);
+    let hdr_frame = common::render(&scene, &s.with_hdr(true));
+    let hdr = hdr_frame.hdr.as_ref().expect("an HDR frame");
+    let peak = hdr[0].iter().flat_map(|c| *c).fold(0.0f32, f32::max);
+    assert!(peak > 2.0, "the linear colour is not clamped: peak {peak}");
+    let params = LightingParams { exposure: 1.0, tonemap: Tonemap::PbrNeutral.code(), ..Default::default() };
+    for (k, eye) in Eye::BOTH.into_iter().enumerate() {
+        let img = ldr.eye(eye);
+        let off = hdr[k]
+            .iter()
+            .enumerate()
+            .filter(|(i, c)| {
+                let want = &img.rgba[4 * i..4 * i + 3];
+                let got = display_bytes(tonemap(Vec3::from(**c), &params));
+                got.iter().zip(want).any(|(a, b)| a.abs_diff(*b) > 1)
+            })
+            .count();
+        assert!(off * 1000 <= hdr[k].len(), "{eye:?}: {off} of {} pixels tone map elsewhere", hdr[k].len());
+    }
+
+    let dir = std::env::temp_dir().join(format!("twister-hdr-{}", std::process::id()));
+    let run = |extra: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_twister"))
+            .args(["render", "builtin:demo", "--width", "128", "--height", "32", "--hdr", "--out"])
+            .arg(&dir)
+            .args(extra)
+            .env("NODEVICE_SELECT", "1")
+            .output()
+            .unwrap()
+    };
+    let o = run(&[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for name in ["left_hdr.exr", "right_hdr.exr"] {
+        use exr::prelude::*;
+        let image = read_first_rgba_layer_from_file(
+            dir.join(name),
+            |r, _| (r.width(), vec![0f32; r.width() * r.height()]),
+            |(w, v), p, (r, _g, _b, _a): (f32, f32, f32, f32)| v[p.y() * *w + p.x()] = r,
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let size = image.layer_data.size;
+        assert_eq!((size.width(), size.height()), (128, 32), "{name}");
+        assert!(image.layer_data.channel_data.pixels.1.iter().all(|r| r.is_finite() && *r >= 0.0), "{name}");
+    }
+    for method in ["slit:4", "trace"] {
+        let o = run(&["--method", method, "--vertical", "exact"]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && err.starts_with("error: --hdr: ") && err.trim().lines().count() == 1, "{err}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Khronos MetalRoughSpheresNoTextures in the red-sky, green-ground environment with a sun: each
+/// sphere (object id) mirrors the sky above and the ground below the sharper the smoother it is,
+/// and more so when metallic (the highlight's growth with roughness is tested on the synthetic
+/// spheres above, where the sun's image is not cut by the grid).
+#[test]
+fn metal_rough_spheres_mirror_the_environment_by_roughness() {
+    let path = common::asset("gltf/MetalRoughSpheresNoTextures/glTF-Binary/MetalRoughSpheresNoTextures.glb");
+    let (w, h) = (1024u32, 256u32);
+    let projection = Projection { width: w, height: h, vertical: Vertical::Exact, ..Projection::default() };
+    let mut scene = twister::core::load::load_scene(path.to_str().unwrap(), &projection).unwrap();
+    scene.fit(3.0, &projection).unwrap();
+    scene.environment = Some(Arc::new(two_tone(40.0).prepare()));
+    let frame = common::render(&scene, &settings(w, h).with_measure_error(true));
+    let objects = &frame.measurement.as_ref().unwrap().object[0];
+    let img = frame.eye(Eye::Left);
+    // Per object: its material's factors, and its pixels' rows and colours.
+    let mut spheres = Vec::new();
+    for (k, o) in scene.objects.iter().enumerate() {
+        let v = scene.vertices[scene.indices[3 * o.first_triangle as usize] as usize];
+        let m = scene.materials.get(v.material as usize - 1).copied().unwrap_or_default();
+        let px: Vec<(u32, Vec3)> = (0..w * h)
+            .filter(|&i| objects[i as usize] == k as u32 + 1)
+            .map(|i| {
+                let p = img.pixel(i % w, i / w);
+                (i / w, Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32))
+            })
+            .collect();
+        if px.len() < 200 {
+            continue; // the labels, the backdrop's edges
+        }
+        let (top, bottom) = (px.iter().map(|p| p.0).min().unwrap(), px.iter().map(|p| p.0).max().unwrap());
+        let band = |lo: u32, hi: u32| {
+            let sel: Vec<Vec3> = px.iter().filter(|p| p.0 >= lo && p.0 <= hi).map(|p| p.1).collect();
+            sel.iter().fold(Vec3::ZERO, |a, c| a + *c) / sel.len().max(1) as f32
+        };
+        let third = (bottom - top) / 3;
+        let (up, down) = (band(top, top + third), band(bottom - third, bottom));
+        // How much redder the top is than the bottom, and greener the bottom than the top.
+        let contrast = (up.x - down.x) + (down.y - up.y);
+        spheres.push((m.metallic, m.roughness, contrast));
+    }
+    assert!(spheres.len() >= 20, "{} spheres found", spheres.len());
+    let metals: Vec<_> = spheres.iter().filter(|s| s.0 > 0.9).collect();
+    let dielectrics: Vec<_> = spheres.iter().filter(|s| s.0 < 0.1).collect();
+    assert!(metals.len() >= 3 && dielectrics.len() >= 3, "{spheres:?}");
+    let smooth = |set: &[&(f32, f32, f32)], f: fn(f32) -> bool| {
+        let sel: Vec<_> = set.iter().filter(|s| f(s.1)).collect();
+        sel.iter().map(|s| s.2).sum::<f32>() / sel.len().max(1) as f32
+    };
+    let (metal_smooth, metal_rough) = (smooth(&metals, |r| r < 0.3), smooth(&metals, |r| r > 0.7));
+    let dielectric_smooth = smooth(&dielectrics, |r| r < 0.3);
+    assert!(metal_smooth > 1.8 * metal_rough.max(1.0), "metal contrast smooth {metal_smooth}, rough {metal_rough}");
+    assert!(
+        metal_smooth > dielectric_smooth,
+        "smooth metal {metal_smooth} against smooth dielectric {dielectric_smooth}"
+    );
+}

@@ -316,6 +316,9 @@ fn pbr_neutral(c_in: vec3<f32>) -> vec3<f32> {
 // The tone mapped colour, 0..1 (`tonemap` in light.rs).
 fn tonemap(c_in: vec3<f32>) -> vec3<f32> {
     let c = max(c_in * lighting.exposure, vec3<f32>(0.0));
+    if (lighting.tonemap == TONEMAP_LINEAR) {
+        return c;  // a float colour target (`--hdr`)
+    }
     var out = c;
     if (lighting.tonemap == TONEMAP_PBR_NEUTRAL) {
         out = pbr_neutral(c);

@@ -8,10 +8,11 @@ use clap::Args;
 use crate::args::{parse_rgb, LodMode, ViewArgs};
 use crate::scene::{lod_stats, open_renderer, prepare};
 use twister::core::projection::PanoramaKind;
+use twister::core::settings::Method;
 use twister::error::{Error, Result};
 use twister::output::{
-    check_outputs, depth_images, depth_names, exr_file, gpano_xmp, image_file, layout_images, layout_names, write_all,
-    Encoding, ImageFormat, Layout, OutputFile,
+    check_outputs, depth_images, depth_names, exr_file, gpano_xmp, hdr_exr_file, image_file, layout_images,
+    layout_names, write_all, Encoding, ImageFormat, Layout, OutputFile,
 };
 
 #[derive(Args)]
@@ -44,6 +45,11 @@ pub struct RenderArgs {
     /// or depth_LR.exr, following the layout.
     #[arg(long)]
     pub depth: bool,
+    /// Also write each eye's linear colour (× 2^EV, before tone mapping, not clamped) as 32-bit
+    /// float OpenEXR (channels R, G, B): left_hdr.exr, right_hdr.exr. A second frame is drawn
+    /// into a float colour target; the projection methods only.
+    #[arg(long)]
+    pub hdr: bool,
     /// Background colour R,G,B, each 0–255.
     #[arg(long, value_parser = parse_rgb, default_value = "26,26,31")]
     pub background: [f32; 3],
@@ -81,6 +87,15 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     if args.depth {
         image_paths.extend(depth_names(layout).iter().map(|name| args.out.join(name)));
     }
+    if args.hdr {
+        if matches!(settings.subdivision.method, Method::Slit(_) | Method::Trace) {
+            return Err(Error::option(
+                "--hdr",
+                "the linear colour comes from the projection methods (vertex, fixed, adaptive); slit and trace write display colours",
+            ));
+        }
+        image_paths.extend(["left_hdr.exr", "right_hdr.exr"].map(|name| args.out.join(name)));
+    }
     let mut all_paths: Vec<&std::path::Path> = image_paths.iter().map(PathBuf::as_path).collect();
     all_paths.extend(args.stats.as_deref());
     check_outputs(&all_paths)?;
@@ -100,6 +115,12 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         .collect::<Result<Vec<_>>>()?;
     for (name, depth) in depth_images(&frame, layout).unwrap_or_default() {
         files.push(exr_file(args.out.join(name), &depth)?);
+    }
+    if args.hdr {
+        let hdr = renderer.render(&prepared.gpu_scene, &settings.with_hdr(true))?.hdr.expect("an HDR frame");
+        for (name, eye) in ["left_hdr.exr", "right_hdr.exr"].into_iter().zip(&hdr) {
+            files.push(hdr_exr_file(args.out.join(name), w, h, eye)?);
+        }
     }
     // Encoding: the writing itself is a rename.
     let ms_write = t.elapsed().as_secs_f64() * 1e3;

@@ -96,6 +96,10 @@ pub struct Frame {
     /// stages' interpolated `view_position`; NaN: background), when
     /// `RenderSettings::measure.positions` was set.
     pub positions: Option<[Vec<[f32; 3]>; 2]>,
+    /// Per pixel, left and right eye: the linear colour × 2^EV (RGB, not tone mapped, not
+    /// clamped), when `RenderSettings::shading.hdr` was set (`left` and `right` then hold it
+    /// tone mapped on the CPU, as the frame's settings say).
+    pub hdr: Option<[Vec<[f32; 3]>; 2]>,
 }
 
 /// What the error pass measured (seed 002 §4.1).

@@ -105,6 +105,10 @@ pub enum Tonemap {
     Aces,
     /// Clamp to 0..1.
     None,
+    /// No tone mapping and no clamp: the linear colour × 2^EV, for a float colour target
+    /// (`--hdr`; not a `--tonemap` value).
+    #[value(skip)]
+    Linear,
 }
 
 impl Tonemap {
@@ -114,6 +118,7 @@ impl Tonemap {
             Tonemap::None => 0,
             Tonemap::PbrNeutral => 1,
             Tonemap::Aces => 2,
+            Tonemap::Linear => 3,
         }
     }
 }
@@ -228,6 +233,7 @@ pub fn tonemap(c: Vec3, params: &LightingParams) -> Vec3 {
     match params.tonemap {
         1 => pbr_neutral(c),
         2 => aces(c),
+        3 => return c,
         _ => c,
     }
     .clamp(Vec3::ZERO, Vec3::ONE)

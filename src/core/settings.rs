@@ -178,6 +178,9 @@ pub struct ShadingSettings {
     pub exposure_ev: f32,
     /// Tone mapping of the lit colour (`--tonemap`; the glTF BRDF only).
     pub tonemap: crate::core::light::Tonemap,
+    /// The colour target holds the linear colour × 2^EV in floats, not tone mapped (`--hdr`:
+    /// [`Frame::hdr`](crate::core::frame::Frame::hdr); the projection methods only).
+    pub hdr: bool,
 }
 
 /// What a render measures besides drawing.
@@ -249,7 +252,8 @@ impl RenderSettings {
         environment: Option<&crate::core::environment::PreparedEnvironment>,
     ) -> crate::core::light::LightingParams {
         let s = &self.shading;
-        crate::core::light::LightingParams::of(s.lighting, light_count, environment, s.exposure_ev, s.tonemap)
+        let tonemap = if s.hdr { crate::core::light::Tonemap::Linear } else { s.tonemap };
+        crate::core::light::LightingParams::of(s.lighting, light_count, environment, s.exposure_ev, tonemap)
     }
 }
 
@@ -292,6 +296,7 @@ impl Default for ShadingSettings {
             lighting: Default::default(),
             exposure_ev: 0.0,
             tonemap: Default::default(),
+            hdr: false,
         }
     }
 }
@@ -328,6 +333,7 @@ builders! {
     with_lighting: crate::core::light::LightingMode => shading.lighting,
     with_exposure_ev: f32 => shading.exposure_ev,
     with_tonemap: crate::core::light::Tonemap => shading.tonemap,
+    with_hdr: bool => shading.hdr,
     with_measure_edges: bool => measure.edges,
     with_measure_error: bool => measure.error,
     with_error_angle: bool => measure.error_angle,

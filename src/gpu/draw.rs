@@ -6,10 +6,11 @@ use std::mem::offset_of;
 use std::sync::OnceLock;
 
 use crate::core::scene::SceneVertex;
+use crate::core::settings::RenderSettings;
 use crate::gpu::device::{error_target_format, Gpu};
 use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
-use crate::gpu::targets::{Layers, COLOR_FORMAT, DEPTH_FORMAT, OBJECT_FORMAT, POSITION_FORMAT};
+use crate::gpu::targets::{Layers, COLOR_FORMAT, DEPTH_FORMAT, HDR_FORMAT, OBJECT_FORMAT, POSITION_FORMAT};
 use crate::shader::types::DrawVertex;
 use crate::shader::{RASTER, SLIT};
 
@@ -28,9 +29,9 @@ pub(crate) struct DrawPipelines {
     pub stage: GpuStage,
     kind: DrawStage,
     /// By `Self::index`.
-    pipelines: [OnceLock<wgpu::RenderPipeline>; 288],
-    /// The background's (`fs_background`), by outputs and eyes.
-    backgrounds: [OnceLock<wgpu::RenderPipeline>; 9],
+    pipelines: [OnceLock<wgpu::RenderPipeline>; 576],
+    /// The background's (`fs_background`), by outputs, eyes and colour target.
+    backgrounds: [OnceLock<wgpu::RenderPipeline>; 18],
 }
 
 /// What a scene's materials need of a drawing pipeline.
@@ -99,7 +100,7 @@ impl DrawPipelines {
         }
     }
 
-    fn index(&self, look: Look, lit: Lit, outputs: usize, layers: Layers) -> usize {
+    fn index(&self, look: Look, lit: Lit, outputs: usize, layers: Layers, hdr: bool) -> usize {
         let eyes = match (self.kind, layers) {
             (_, Layers::Both) => 0,
             (DrawStage::Slit, Layers::Eye(_)) => 1,
@@ -110,25 +111,38 @@ impl DrawPipelines {
             4 => 1,
             _ => 2,
         };
-        ((look as usize * 3 + outputs) * 3 + eyes) * 8 + lit.index()
+        (((look as usize * 3 + outputs) * 3 + eyes) * 8 + lit.index()) * 2 + hdr as usize
     }
 
     /// The pipeline for a scene's look (lit by the glTF BRDF or not), writing `outputs` targets
     /// (`MeasureSettings::outputs`), drawing `layers`.
-    pub fn get(&self, gpu: &Gpu, scene: &GpuScene, pbr: bool, outputs: usize, layers: Layers) -> &wgpu::RenderPipeline {
-        self.get_look(gpu, Look::of(scene, pbr), Lit::of(scene, pbr), outputs, layers)
+    /// The pipeline for a frame of `scene` with `settings` (its look, what of the glTF look it
+    /// uses, its outputs, its colour target), drawing `layers`.
+    pub fn get(&self, gpu: &Gpu, scene: &GpuScene, settings: &RenderSettings, layers: Layers) -> &wgpu::RenderPipeline {
+        let pbr = scene.pbr(settings);
+        let (outputs, hdr) = (settings.measure.outputs(), settings.shading.hdr);
+        self.get_look(gpu, Look::of(scene, pbr), Lit::of(scene, pbr), outputs, layers, hdr)
     }
 
-    pub fn get_look(&self, gpu: &Gpu, look: Look, lit: Lit, outputs: usize, layers: Layers) -> &wgpu::RenderPipeline {
-        self.pipelines[self.index(look, lit, outputs, layers)]
-            .get_or_init(|| draw_pipeline(gpu, &self.stage, self.kind, Some((look, lit)), outputs, layers))
+    pub fn get_look(
+        &self,
+        gpu: &Gpu,
+        look: Look,
+        lit: Lit,
+        outputs: usize,
+        layers: Layers,
+        hdr: bool,
+    ) -> &wgpu::RenderPipeline {
+        self.pipelines[self.index(look, lit, outputs, layers, hdr)]
+            .get_or_init(|| draw_pipeline(gpu, &self.stage, self.kind, Some((look, lit)), outputs, layers, hdr))
     }
 
     /// The background's pipeline (the environment along each pixel's ray, colour only), for a
-    /// pass with `outputs` targets drawing `layers`; drawn first, where `shows_environment`.
-    pub fn background(&self, gpu: &Gpu, outputs: usize, layers: Layers) -> &wgpu::RenderPipeline {
-        self.backgrounds[self.index(Look::Plain, Lit::default(), outputs, layers) / 8]
-            .get_or_init(|| draw_pipeline(gpu, &self.stage, self.kind, None, outputs, layers))
+    /// frame with `settings` drawing `layers`; drawn first, where `shows_environment`.
+    pub fn background(&self, gpu: &Gpu, settings: &RenderSettings, layers: Layers) -> &wgpu::RenderPipeline {
+        let (outputs, hdr) = (settings.measure.outputs(), settings.shading.hdr);
+        let index = self.index(Look::Plain, Lit::default(), outputs, layers, false) / 16 * 2 + hdr as usize;
+        self.backgrounds[index].get_or_init(|| draw_pipeline(gpu, &self.stage, self.kind, None, outputs, layers, hdr))
     }
 
     /// The scene's material table (group 1).
@@ -154,6 +168,7 @@ fn draw_pipeline(
     look: Option<(Look, Lit)>,
     outputs: usize,
     layers: Layers,
+    hdr: bool,
 ) -> wgpu::RenderPipeline {
     // None: the background triangle (no vertex buffer; colour only; behind everything).
     let background = look.is_none();
@@ -192,12 +207,14 @@ fn draw_pipeline(
     };
     let buffers = [Some(layout)];
     let error = error_target_format(gpu.error_target);
-    let all_targets = [COLOR_FORMAT, error, OBJECT_FORMAT, error, POSITION_FORMAT].map(|format| {
-        // The background writes the colour only: the measuring targets keep their clear values.
-        let write_mask =
-            if background && format != COLOR_FORMAT { wgpu::ColorWrites::empty() } else { wgpu::ColorWrites::ALL };
-        Some(wgpu::ColorTargetState { format, blend: None, write_mask })
-    });
+    let color = if hdr { HDR_FORMAT } else { COLOR_FORMAT };
+    let all_targets =
+        [color, error, OBJECT_FORMAT, error, POSITION_FORMAT].into_iter().enumerate().map(|(k, format)| {
+            // The background writes the colour only: the measuring targets keep their clear values.
+            let write_mask = if background && k > 0 { wgpu::ColorWrites::empty() } else { wgpu::ColorWrites::ALL };
+            Some(wgpu::ColorTargetState { format, blend: None, write_mask })
+        });
+    let all_targets: Vec<_> = all_targets.collect();
     let mut constants = vec![
         ("MATERIALS", (look != Look::Plain) as u32 as f64),
         ("DISCARDS", (look != Look::Shaded) as u32 as f64),

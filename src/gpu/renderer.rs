@@ -91,13 +91,11 @@ impl FrameResources {
     /// The targets for this size, made anew only when the size changed.
     /// The targets for this size (with the positions target if `positions`), made anew only
     /// when the size changed or the positions target is wanted and missing.
-    pub fn targets(&mut self, gpu: &Gpu, width: u32, height: u32, positions: bool) -> &Targets {
-        if !self
-            .targets
-            .as_ref()
-            .is_some_and(|t| t.width == width && t.height == height && (t.position.is_some() || !positions))
-        {
-            self.targets = Some(Targets::new(gpu, width, height, positions));
+    pub fn targets(&mut self, gpu: &Gpu, width: u32, height: u32, positions: bool, hdr: bool) -> &Targets {
+        if !self.targets.as_ref().is_some_and(|t| {
+            t.width == width && t.height == height && (t.position.is_some() || !positions) && t.hdr == hdr
+        }) {
+            self.targets = Some(Targets::new(gpu, width, height, positions, hdr));
         }
         self.targets.as_ref().expect("just made")
     }
@@ -148,7 +146,7 @@ impl Renderer {
             };
             let raster = DrawPipelines::new(&gpu, DrawStage::Raster);
             // The usual pipeline now, for the same reason.
-            raster.get_look(&gpu, Look::Plain, Lit::default(), 1, Layers::passes(gpu.eyes_per_draw)[0]);
+            raster.get_look(&gpu, Look::Plain, Lit::default(), 1, Layers::passes(gpu.eyes_per_draw)[0], false);
             Ok((
                 subdivide,
                 raster,
@@ -180,6 +178,12 @@ impl Renderer {
         self.check_size(settings)?;
         let mut resources = self.resources.lock().unwrap_or_else(|e| e.into_inner());
         scene.write_lighting(&self.gpu, settings);
+        if settings.shading.hdr && matches!(settings.subdivision.method, Method::Slit(_) | Method::Trace) {
+            return Err(Error::option(
+                "--hdr",
+                "the linear colour comes from the projection methods (vertex, fixed, adaptive); slit and trace write display colours",
+            ));
+        }
         self.gpu.scoped("rendering a frame", || match settings.subdivision.method {
             Method::Slit(width) => self.render_slit(&mut resources, scene, settings, width),
             Method::Trace => self.render_trace(&mut resources, scene, settings),
@@ -424,7 +428,7 @@ impl Renderer {
         let bind_group = self.raster.stage.bind_group(&self.gpu, None, 0, &[uniform]);
         let passes = Layers::passes(self.gpu.eyes_per_draw);
         for (k, &layers) in passes.iter().enumerate() {
-            let pipeline = self.raster.get(&self.gpu, scene, scene.pbr(settings), settings.measure.outputs(), layers);
+            let pipeline = self.raster.get(&self.gpu, scene, settings, layers);
             let writes = timestamps.map(|(q, begin, end)| wgpu::RenderPassTimestampWrites {
                 query_set: q,
                 beginning_of_pass_write_index: (k == 0).then_some(begin),
@@ -434,7 +438,7 @@ impl Renderer {
             pass.set_bind_group(0, &bind_group, &[]);
             pass.set_bind_group(1, &materials, &[]);
             if clear && scene.shows_environment(settings) {
-                pass.set_pipeline(self.raster.background(&self.gpu, settings.measure.outputs(), layers));
+                pass.set_pipeline(self.raster.background(&self.gpu, settings, layers));
                 pass.draw(0..3, 0..1);
             }
             pass.set_pipeline(pipeline);
@@ -494,7 +498,19 @@ impl Renderer {
         start: Instant,
     ) -> Result<Frame> {
         let t = Instant::now();
-        let [left, right] = targets.read_colors(&self.gpu)?;
+        let (hdr, [left, right]) = if targets.hdr {
+            // The linear colour, and as display bytes clamped (the frame is not tone mapped).
+            let hdr = targets.read_hdr(&self.gpu)?;
+            let image = |eye: &Vec<[f32; 3]>| crate::core::frame::EyeImage {
+                width: targets.width,
+                height: targets.height,
+                rgba: eye.iter().flat_map(|c| crate::cpu::fragment::display_bytes(glam::Vec3::from(*c))).collect(),
+            };
+            let images = [image(&hdr[0]), image(&hdr[1])];
+            (Some(hdr), images)
+        } else {
+            (None, targets.read_colors(&self.gpu)?)
+        };
         stats.ms_readback = t.elapsed().as_secs_f64() * 1e3;
         let depth = if settings.measure.depth { Some(targets.read_distances(&self.gpu)?) } else { None };
         let positions = if settings.measure.positions { Some(targets.read_positions(&self.gpu)?) } else { None };
@@ -506,7 +522,7 @@ impl Renderer {
             None
         };
         stats.ms_total = start.elapsed().as_secs_f64() * 1e3;
-        Ok(Frame { left, right, stats, measurement, depth, positions })
+        Ok(Frame { left, right, stats, measurement, depth, positions, hdr })
     }
 
     /// The subdivided frame: follows the [`FramePlan`].
@@ -519,7 +535,7 @@ impl Renderer {
         let start = Instant::now();
         let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, ..Default::default() };
         let p = settings.projection();
-        res.targets(&self.gpu, p.width, p.height, settings.measure.positions);
+        res.targets(&self.gpu, p.width, p.height, settings.measure.positions, settings.shading.hdr);
         let budget = Capacities::budget(settings.subdivision.memory_mb, self.gpu.max_binding());
         let n = scene.triangle_count;
         let mut plan = FramePlan::first(n, res.buffers.as_ref().map(|b| b.capacity), budget);

@@ -24,7 +24,7 @@ impl Renderer {
         let start = Instant::now();
         let gpu = &self.gpu;
         let projection = settings.projection();
-        res.targets(gpu, projection.width, projection.height, settings.measure.positions);
+        res.targets(gpu, projection.width, projection.height, settings.measure.positions, false);
         let res = &*res;
         let targets = res.targets.as_ref().expect("made");
         let view = settings.view();
@@ -35,7 +35,7 @@ impl Renderer {
         let camera_buffer =
             gpu.init_buffer("slit cameras", bytemuck::cast_slice(&cameras), wgpu::BufferUsages::STORAGE);
         let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, chunks: 1, ..Default::default() };
-        let pipeline = self.slit.get(gpu, scene, scene.pbr(settings), settings.measure.outputs(), Layers::Eye(0));
+        let pipeline = self.slit.get(gpu, scene, settings, Layers::Eye(0));
         let materials = self.slit.material_bind_group(gpu, scene);
         let timestamps = res.timestamps.as_ref();
         let t = Instant::now();
@@ -53,7 +53,7 @@ impl Renderer {
             pass.set_bind_group(0, &bind_group, &[]);
             pass.set_bind_group(1, &materials, &[]);
             if scene.shows_environment(settings) {
-                pass.set_pipeline(self.slit.background(gpu, settings.measure.outputs(), Layers::Eye(k)));
+                pass.set_pipeline(self.slit.background(gpu, settings, Layers::Eye(k)));
                 pass.draw(0..3, 0..1);
             }
             pass.set_pipeline(pipeline);

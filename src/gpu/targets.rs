@@ -18,6 +18,8 @@ pub const OBJECT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// The surface point each pixel shows (viewer frame) in xyz, w = 1 (0: background).
 pub const POSITION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+/// The colour target of an HDR frame (`--hdr`): the linear colour in floats.
+pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 /// Which layers a render pass draws.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -49,11 +51,13 @@ pub struct Targets {
     /// The surface points (`POSITION_FORMAT`), made only when asked for (16 bytes a pixel).
     pub position: Option<wgpu::Texture>,
     pub depth: wgpu::Texture,
+    /// Whether `color` holds floats (`HDR_FORMAT`) rather than sRGB bytes.
+    pub hdr: bool,
     error_target: ErrorTarget,
 }
 
 impl Targets {
-    pub fn new(gpu: &Gpu, width: u32, height: u32, positions: bool) -> Targets {
+    pub fn new(gpu: &Gpu, width: u32, height: u32, positions: bool, hdr: bool) -> Targets {
         let make = |format, usage, label: &str| {
             gpu.device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
@@ -74,12 +78,13 @@ impl Targets {
         Targets {
             width,
             height,
-            color: make(COLOR_FORMAT, copyable, "colour"),
+            color: make(if hdr { HDR_FORMAT } else { COLOR_FORMAT }, copyable, "colour"),
             error: make(error_format, copyable, "error"),
             object: make(OBJECT_FORMAT, copyable, "object"),
             distance: make(error_format, copyable, "distance"),
             position: positions.then(|| make(POSITION_FORMAT, copyable, "position")),
             depth: make(DEPTH_FORMAT, depth, "depth"),
+            hdr,
             error_target: gpu.error_target,
         }
     }
@@ -169,6 +174,13 @@ impl Targets {
         let [left, right] = unpad_eyes(&gpu.download(&buffer, buffer.size())?, w, h, stride);
         let image = |texels: Vec<u32>| EyeImage { width: w, height: h, rgba: bytemuck::cast_slice(&texels).to_vec() };
         Ok([image(left), image(right)])
+    }
+
+    /// Reads both eyes' linear colours back from an HDR colour target (RGB).
+    pub fn read_hdr(&self, gpu: &Gpu) -> Result<[Vec<[f32; 3]>; 2]> {
+        let (buffer, stride) = copy_eyes_to_buffer(gpu, &self.color, wgpu::BufferUsages::COPY_SRC);
+        let words = unpad_eyes(&gpu.download(&buffer, buffer.size())?, 4 * self.width, self.height, stride);
+        Ok(words.map(|v| v.chunks_exact(4).map(|p| [0, 1, 2].map(|k| f32::from_bits(p[k]))).collect()))
     }
 
     /// Reads both eyes' distances back (metres; +∞ where no surface is drawn).

@@ -48,7 +48,7 @@ impl Renderer {
                 ),
             ));
         }
-        res.targets(gpu, p.width, p.height, false);
+        res.targets(gpu, p.width, p.height, false, false);
         if !res.trace_outputs.as_ref().is_some_and(|(r, h, _)| *r == row_texels && *h == p.height) {
             let make = |what: &str| gpu.storage_buffer(&format!("trace {what}"), bytes, wgpu::BufferUsages::empty());
             res.trace_outputs = Some((row_texels, p.height, ["colour", "error", "object", "distance"].map(make)));

@@ -142,6 +142,7 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("TONEMAP_NONE", U32(Tonemap::None.code())),
         ("TONEMAP_PBR_NEUTRAL", U32(Tonemap::PbrNeutral.code())),
         ("TONEMAP_ACES", U32(Tonemap::Aces.code())),
+        ("TONEMAP_LINEAR", U32(Tonemap::Linear.code())),
     ];
     out.extend(SplitRule::ALL.map(|m| (m.wgsl_name(), U32(m as u32))));
     out
