@@ -1,8 +1,10 @@
 // Shared surface work of the drawing stages and the ray tracer: the material table and texture
 // sampling, the surface colour (alpha mask / screen-door blend, single-sided culling), headlight
-// shading in linear light, and the pixel geometry (a pixel's screen point and ray, the
-// display-position error of seed 002 §4.1 and the distance along a pixel's ray). Imported by
-// fragment.wgsl (raster, slit) and trace.wgsl. CPU twins: src/cpu/fragment.rs.
+// shading in linear light, the glTF look (metallic-roughness BRDF, punctual lights, texture maps
+// and their tangent frame, image-based lighting from the environment, tone mapping), and the
+// pixel geometry (a pixel's screen point and ray, the display-position error of seed 002 §4.1 and
+// the distance along a pixel's ray). Imported by fragment.wgsl (raster, slit) and trace.wgsl.
+// CPU twins: src/cpu/fragment.rs.
 
 #import projection
 #import constants
