@@ -347,7 +347,7 @@ fn shade_hit(hit: Hit, dir: vec3<f32>, p: vec3<f32>, view_position: vec3<f32>, f
         let maps = surface_maps(a.material, uv, vec2<f32>(f, 0.0), vec2<f32>(0.0, f), back * (b.position - a.position),
                                 back * (c.position - a.position), b.uv - a.uv, c.uv - a.uv);
         let v = -(back * dir);
-        out.shadowed = min(lighting.count, MAX_SHADOWED_LIGHTS);
+        out.shadowed = select(0u, min(lighting.count, MAX_SHADOWED_LIGHTS), lighting.shadows != 0u);
         out.color = pbr_radiance(params.ambient, v, view_position, back * n, surface, maps, out.shadowed) * own;
         out.shading_normal = shading_normal(back * n, v, maps);
         out.v = v;

@@ -556,7 +556,8 @@ fn the_ray_tracer_filters_textures_as_the_rasterizer_does() {
 /// a directional light (straight down) or a spot light above it darkens the floor it hides, by
 /// the light's whole share there — the ball's shadow is where the light's direction projects the
 /// ball (brute force: a floor point is shadowed if the way from it towards the light meets the
-/// ball; points within a pixel's footprint of the shadow's edge are left out).
+/// ball; points within a pixel's footprint of the shadow's edge are left out); `--no-shadows`
+/// lights it again.
 #[test]
 fn scene_lights_cast_shadows_in_the_ray_tracer() {
     use twister::core::light::{Light, LightKind};
@@ -594,7 +595,7 @@ fn scene_lights_cast_shadows_in_the_ray_tracer() {
         let frame = render(&scene, &settings);
         let m = frame.measurement.as_ref().unwrap();
         let img = frame.eye(Eye::Left);
-        let (mut in_shadow, mut lit) = (Vec::new(), Vec::new());
+        let (mut in_shadow, mut lit, mut shadow_pixels) = (Vec::new(), Vec::new(), Vec::new());
         for y in 0..p.height {
             for x in 0..p.width {
                 let i = (y * p.width + x) as usize;
@@ -619,7 +620,8 @@ fn scene_lights_cast_shadows_in_the_ray_tracer() {
                 }
                 let v = img.pixel(x, y)[0];
                 if blocked {
-                    in_shadow.push(v)
+                    in_shadow.push(v);
+                    shadow_pixels.push((x, y));
                 } else {
                     lit.push(v)
                 }
@@ -637,6 +639,15 @@ fn scene_lights_cast_shadows_in_the_ray_tracer() {
             "{kind:?}: shadowed floor {:.1} against lit {:.1}",
             mean(&in_shadow),
             mean(&lit)
+        );
+        // `--no-shadows`: the floor the ball hid is lit.
+        let unshadowed = render(&scene, &settings.with_shadows(false));
+        let freed: Vec<u8> = shadow_pixels.iter().map(|&(x, y)| unshadowed.eye(Eye::Left).pixel(x, y)[0]).collect();
+        let (s_mean, l_mean) = (mean(&in_shadow), mean(&lit));
+        assert!(
+            mean(&freed) > s_mean + 0.5 * (l_mean - s_mean),
+            "{kind:?}: without shadows the hidden floor is {:.1} (shadow {s_mean:.1}, lit {l_mean:.1})",
+            mean(&freed)
         );
         // In the shadow only the ambient part is left, the same everywhere.
         let spread =

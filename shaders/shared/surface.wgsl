@@ -95,7 +95,7 @@ struct Lighting {
     environment: u32,
     env_background: u32,
     env_lut: u32,
-    _pad: u32,
+    shadows: u32,
     env_rotation: array<vec4<f32>, 3>,
     env_sh: array<vec4<f32>, 9>,
     env_levels: array<vec4<u32>, ENV_LEVELS>,

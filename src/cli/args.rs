@@ -93,6 +93,9 @@ pub struct ViewArgs {
     /// the scene's own lights, else none.
     #[arg(long, value_name = "FILE|neutral|none")]
     pub environment: Option<String>,
+    /// The scene's lights cast no shadows (today: the ray tracer's shadow rays for them).
+    #[arg(long)]
+    pub no_shadows: bool,
     /// Exposure in stops: the BRDF's linear colour is scaled by 2^EV before tone mapping.
     #[arg(long, default_value_t = 0.0, value_name = "EV")]
     pub exposure: f32,
@@ -292,6 +295,7 @@ impl ViewArgs {
             .with_light(self.light)
             .with_lighting(self.lighting)
             .with_exposure_ev(self.exposure)
+            .with_shadows(!self.no_shadows)
             .with_tonemap(self.tonemap);
         settings.validate()?;
         Ok(settings)

@@ -141,7 +141,8 @@ pub struct LightingParams {
     pub env_background: u32,
     /// First texel of the split-sum table in the environment buffer.
     pub env_lut: u32,
-    pub _pad: u32,
+    /// 1: the scene's lights cast shadows (the ray tracer's shadow rays; `--no-shadows`: 0).
+    pub shadows: u32,
     /// Viewer frame → environment (scene) frame: the columns of the rotation (w unused).
     pub env_rotation: [[f32; 4]; 3],
     /// E(n)/π as spherical-harmonic coefficients (rgb, w unused).

@@ -178,6 +178,8 @@ pub struct ShadingSettings {
     pub exposure_ev: f32,
     /// Tone mapping of the lit colour (`--tonemap`; the glTF BRDF only).
     pub tonemap: crate::core::light::Tonemap,
+    /// Whether the scene's lights cast shadows (`--no-shadows`: false); today the ray tracer's.
+    pub shadows: bool,
     /// The colour target holds the linear colour × 2^EV in floats, not tone mapped (`--hdr`:
     /// [`Frame::hdr`](crate::core::frame::Frame::hdr); the projection methods only).
     pub hdr: bool,
@@ -253,7 +255,10 @@ impl RenderSettings {
     ) -> crate::core::light::LightingParams {
         let s = &self.shading;
         let tonemap = if s.hdr { crate::core::light::Tonemap::Linear } else { s.tonemap };
-        crate::core::light::LightingParams::of(s.lighting, light_count, environment, s.exposure_ev, tonemap)
+        crate::core::light::LightingParams {
+            shadows: s.shadows as u32,
+            ..crate::core::light::LightingParams::of(s.lighting, light_count, environment, s.exposure_ev, tonemap)
+        }
     }
 }
 
@@ -297,6 +302,7 @@ impl Default for ShadingSettings {
             exposure_ev: 0.0,
             tonemap: Default::default(),
             hdr: false,
+            shadows: true,
         }
     }
 }
@@ -334,6 +340,7 @@ builders! {
     with_exposure_ev: f32 => shading.exposure_ev,
     with_tonemap: crate::core::light::Tonemap => shading.tonemap,
     with_hdr: bool => shading.hdr,
+    with_shadows: bool => shading.shadows,
     with_measure_edges: bool => measure.edges,
     with_measure_error: bool => measure.error,
     with_error_angle: bool => measure.error_angle,

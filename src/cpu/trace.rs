@@ -299,7 +299,11 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
                 );
                 // The first MAX_SHADOWED_LIGHTS lights behind their shadow rays, the others directly.
                 let v = -(to_view * dir);
-                let shadowed = (table.lighting.count as usize).min(MAX_SHADOWED_LIGHTS as usize);
+                let shadowed = if table.lighting.shadows != 0 {
+                    (table.lighting.count as usize).min(MAX_SHADOWED_LIGHTS as usize)
+                } else {
+                    0
+                };
                 let mut lit =
                     pbr_radiance(table, params.ambient, v, view_position, to_view * n, color, &maps, shadowed) * own;
                 let shading_n = shading_normal(to_view * n, v, &maps);

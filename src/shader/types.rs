@@ -356,7 +356,7 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("BvhLevel" => BvhLevel { root, triangles }),
     layout!("Light" => GpuLight { position, kind, direction, range, color, inner_cos, outer_cos, _pad0, _pad1, _pad2 }),
     layout!("Lighting" => LightingParams {
-        count, pbr, exposure, tonemap, environment, env_background, env_lut, _pad, env_rotation, env_sh, env_levels
+        count, pbr, exposure, tonemap, environment, env_background, env_lut, shadows, env_rotation, env_sh, env_levels
     }),
     layout!("ProjectParams" => ProjectParams { projection, eye_sign, count, _pad }),
     layout!("Material" => Material {
