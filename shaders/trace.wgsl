@@ -466,7 +466,8 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
                 break;
             }
             // A mirrored or refracted ray that leaves the scene brings the environment's light.
-            color += task.weight * select(background, env_level(0u, env_st(task.dir)), environment_lit());
+            color += task.weight
+                * select(background, env_level(0u, env_st(env_direction(to_view * task.dir))), environment_lit());
         } else {
             let p = task.origin + hit.t * task.dir;
             if (task.kind == PRIMARY) {
@@ -533,7 +534,7 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (missed) {
         write_background(slot);
         if (environment_lit() && lighting.env_background != 0u) {
-            out_color[slot] = pack_display(linear_to_srgb(tonemap(env_level(0u, env_st(task.dir)))));
+            out_color[slot] = pack_display(linear_to_srgb(tonemap(env_level(0u, env_st(env_direction(ray.dir))))));
         }
         return;
     }

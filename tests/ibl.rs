@@ -256,6 +256,13 @@ fn hdr_frames_hold_the_linear_colour_and_tone_map_to_the_ordinary_frame() {
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(!o.status.success() && err.starts_with("error: --hdr: ") && err.trim().lines().count() == 1, "{err}");
     }
+    // An environment with the headlight look would do nothing: refused.
+    let o = run(&["--environment", "neutral", "--lighting", "headlight"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.starts_with("error: --environment: ") && err.trim().lines().count() == 1,
+        "{err}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -315,4 +322,50 @@ fn metal_rough_spheres_mirror_the_environment_by_roughness() {
         metal_smooth > dielectric_smooth,
         "smooth metal {metal_smooth} against smooth dielectric {dielectric_smooth}"
     );
+}
+
+/// `--environment-yaw`: an environment whose only bright part faces +x (azimuth 90°) shows it
+/// ahead when turned by −90°, in the rasterizer's background and the ray tracer's alike.
+#[test]
+fn the_environment_turns_by_its_yaw() {
+    let (w, h) = (256u32, 64u32);
+    let radiance = (0..w * h)
+        .map(|i| {
+            let d = twister::core::environment::direction_at((i % w) as f32 + 0.5, (i / w) as f32 + 0.5, w, h);
+            if d.x > 0.7 {
+                Vec3::new(0.9, 0.9, 0.1)
+            } else {
+                Vec3::splat(0.02)
+            }
+        })
+        .collect();
+    let env = Environment { name: "east".into(), width: w, height: h, radiance };
+    // A ball behind the viewer (columns 0 and 255 only): the frame's BRDF and environment on.
+    let mut scene = spheres("ball behind", &[(1.0, 0.0)], [1.0; 4]);
+    for v in &mut scene.vertices {
+        v.position[2] += 3.6;
+    }
+    scene.environment =
+        Some(Arc::new(twister::core::environment::PreparedEnvironment { background: true, ..env.prepare() }));
+    let bright_columns = |frame: &twister::Frame| -> Vec<u32> {
+        let img = frame.eye(Eye::Left);
+        (0..img.width).filter(|&x| img.pixel(x, img.height / 2)[0] > 150).collect()
+    };
+    let base = settings(256, 64);
+    use twister::core::settings::{Method, Split};
+    for method in [Method::Adaptive(Split::Error), Method::Trace] {
+        let straight = if method == Method::Trace {
+            let r = common::renderer();
+            let gs = twister::GpuScene::upload(&r.gpu, &scene).and_then(|g| g.with_bvh(&r.gpu, &scene)).unwrap();
+            let traced = base.with_method(method);
+            (r.render(&gs, &traced).unwrap(), r.render(&gs, &traced.with_environment_yaw_deg(-90.0)).unwrap())
+        } else {
+            (common::render(&scene, &base), common::render(&scene, &base.with_environment_yaw_deg(-90.0)))
+        };
+        let (east, turned) = (bright_columns(&straight.0), bright_columns(&straight.1));
+        let mid = |c: &[u32]| c.iter().map(|&x| x as f32).sum::<f32>() / c.len().max(1) as f32;
+        // Azimuth 90° is column 192 of 256; turned by −90°, column 128 (ahead).
+        assert!((mid(&east) - 192.0).abs() < 4.0, "{method:?}: bright columns around {}", mid(&east));
+        assert!((mid(&turned) - 128.0).abs() < 4.0, "{method:?}: turned, around {}", mid(&turned));
+    }
 }

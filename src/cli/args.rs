@@ -93,6 +93,10 @@ pub struct ViewArgs {
     /// the scene's own lights, else none.
     #[arg(long, value_name = "FILE|neutral|none")]
     pub environment: Option<String>,
+    /// Turns the environment about the vertical axis, degrees: what the map shows at azimuth θ
+    /// appears at θ + DEG (to put its sun where the scene wants it).
+    #[arg(long, default_value_t = 0.0, value_name = "DEG", allow_hyphen_values = true)]
+    pub environment_yaw: f32,
     /// The scene's lights cast no shadows (today: the ray tracer's shadow rays for them).
     #[arg(long)]
     pub no_shadows: bool,
@@ -296,6 +300,7 @@ impl ViewArgs {
             .with_lighting(self.lighting)
             .with_exposure_ev(self.exposure)
             .with_shadows(!self.no_shadows)
+            .with_environment_yaw_deg(self.environment_yaw)
             .with_tonemap(self.tonemap);
         settings.validate()?;
         Ok(settings)
@@ -305,6 +310,12 @@ impl ViewArgs {
     /// The environment that lights the scene (see `--environment`), prepared.
     pub fn environment(&self, scene: &twister::Scene) -> Result<Option<PreparedEnvironment>> {
         use twister::core::environment::Environment;
+        if self.lighting == LightingMode::Headlight && self.environment.as_deref().is_some_and(|e| e != "none") {
+            return Err(Error::option(
+                "--environment",
+                "lights the glTF BRDF, which --lighting headlight turns off: use --lighting auto or pbr",
+            ));
+        }
         let wants_default = scene.lights.is_empty()
             && match self.lighting {
                 LightingMode::Auto => scene.physically_based,

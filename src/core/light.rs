@@ -185,9 +185,12 @@ impl LightingParams {
         params
     }
 
-    /// With the viewer frame → scene frame rotation of `view` (scene → viewer).
-    pub fn with_view(mut self, view: Mat4) -> LightingParams {
-        let m = glam::Mat3::from_mat4(view).transpose();
+    /// With the viewer frame → environment frame rotation: back through `view` (scene →
+    /// viewer) to the scene, then the environment turned by `environment_yaw_deg` about +y (what
+    /// the map shows at azimuth θ appears at θ + yaw).
+    pub fn with_view(mut self, view: Mat4, environment_yaw_deg: f32) -> LightingParams {
+        let turn = glam::Mat3::from_rotation_y(environment_yaw_deg.to_radians());
+        let m = turn * glam::Mat3::from_mat4(view).transpose();
         self.env_rotation = [m.x_axis, m.y_axis, m.z_axis].map(|c| c.extend(0.0).to_array());
         self
     }

@@ -180,6 +180,8 @@ pub struct ShadingSettings {
     pub tonemap: crate::core::light::Tonemap,
     /// Whether the scene's lights cast shadows (`--no-shadows`: false); today the ray tracer's.
     pub shadows: bool,
+    /// The environment turned about the vertical axis, degrees (`--environment-yaw`).
+    pub environment_yaw_deg: f32,
     /// The colour target holds the linear colour × 2^EV in floats, not tone mapped (`--hdr`:
     /// [`Frame::hdr`](crate::core::frame::Frame::hdr); the projection methods only).
     pub hdr: bool,
@@ -243,7 +245,7 @@ impl RenderSettings {
     ) -> (Vec<crate::core::light::GpuLight>, crate::core::light::LightingParams) {
         (
             crate::core::light::gpu_lights(lights, self.view()),
-            self.lighting_params(lights.len(), environment).with_view(self.view()),
+            self.lighting_params(lights.len(), environment).with_view(self.view(), self.shading.environment_yaw_deg),
         )
     }
 
@@ -303,6 +305,7 @@ impl Default for ShadingSettings {
             tonemap: Default::default(),
             hdr: false,
             shadows: true,
+            environment_yaw_deg: 0.0,
         }
     }
 }
@@ -341,6 +344,7 @@ builders! {
     with_tonemap: crate::core::light::Tonemap => shading.tonemap,
     with_hdr: bool => shading.hdr,
     with_shadows: bool => shading.shadows,
+    with_environment_yaw_deg: f32 => shading.environment_yaw_deg,
     with_measure_edges: bool => measure.edges,
     with_measure_error: bool => measure.error,
     with_error_angle: bool => measure.error_angle,
@@ -409,6 +413,12 @@ impl RenderSettings {
             return Err(Error::option(
                 "--exposure",
                 format!("must be a number of stops between −64 and 64, got {}", self.shading.exposure_ev),
+            ));
+        }
+        if !(self.shading.environment_yaw_deg.is_finite() && self.shading.environment_yaw_deg.abs() <= 3600.0) {
+            return Err(Error::option(
+                "--environment-yaw",
+                format!("must be a number of degrees between −3600 and 3600, got {}", self.shading.environment_yaw_deg),
             ));
         }
         if self.shading.reflect_max > MAX_REFLECT {

@@ -21,8 +21,8 @@ use crate::core::settings::RenderSettings;
 use crate::core::texture::MaterialTable;
 use crate::core::visual_field::Gaze;
 use crate::cpu::fragment::{
-    display_bytes, env_level, env_st, light_at, light_term, pbr_radiance, pixel_error, pixel_ray, pixel_spread,
-    shade_linear, shading_normal, surface_color, surface_maps, Surface,
+    display_bytes, env_direction, env_level, env_st, light_at, light_term, pbr_radiance, pixel_error, pixel_ray,
+    pixel_spread, shade_linear, shading_normal, surface_color, surface_maps, Surface,
 };
 use crate::cpu::raster::RasterImage;
 use crate::shader::constants::{MAX_SHADOWED_LIGHTS, TRACE_PENDING, TRACE_STACK};
@@ -414,7 +414,7 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
                 ) else {
                     if environment_lit && table.lighting.env_background != 0 {
                         let i = 4 * (y * projection.width + x) as usize;
-                        let c = tonemap(env_level(table, 0, env_st(dir)), &table.lighting);
+                        let c = tonemap(env_level(table, 0, env_st(env_direction(table, dir_v))), &table.lighting);
                         img.rgba[i..i + 4].copy_from_slice(&display_bytes(c));
                     }
                     continue;
@@ -434,7 +434,9 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
                     let (o, bounces, d, weight, cone) = current;
                     match current_hit {
                         // A mirrored or refracted ray leaving the scene brings the environment's light.
-                        None if environment_lit => color += weight * env_level(table, 0, env_st(d)),
+                        None if environment_lit => {
+                            color += weight * env_level(table, 0, env_st(env_direction(table, to_view * d)))
+                        }
                         None => color += weight * background,
                         Some(h) => {
                             let p = o + h.t * d;
