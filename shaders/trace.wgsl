@@ -293,8 +293,9 @@ struct Shaded {
 }
 
 // The surface at a hit `p` (scene frame) with its optics; shaded with the headlight at the
-// viewer (`view_position` in the viewer frame), or with the point light (Lambert on the side the
-// ray sees; the shadow ray decides the direct part). Its own light is weighted by
+// viewer (`view_position` in the viewer frame), with the point light (Lambert on the side the
+// ray sees; the shadow ray decides the direct part), or with the glTF BRDF (the first
+// `shadowed` scene lights left to the main loop's shadow rays). Its own light is weighted by
 // 1 − mirror − transmission.
 fn shade_hit(hit: Hit, dir: vec3<f32>, p: vec3<f32>, view_position: vec3<f32>, frag_xy: vec2<f32>,
              width: f32) -> Shaded {

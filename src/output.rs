@@ -282,12 +282,7 @@ pub fn exr_file(path: PathBuf, depth: &DepthImage) -> Result<OutputFile> {
     let channel =
         SpecificChannels::build().with_channel("Z").with_pixel_fn(|p: Vec2<usize>| (depth.values[p.y() * w + p.x()],));
     let image = Image::from_channels((w, h), channel);
-    let mut cursor = std::io::Cursor::new(Vec::new());
-    image
-        .write()
-        .to_buffered(&mut cursor)
-        .map_err(|e| crate::error::Error::output(&path, format!("cannot encode OpenEXR: {e}")))?;
-    Ok(OutputFile { path, bytes: cursor.into_inner() })
+    exr_output(path, |cursor| image.write().to_buffered(cursor))
 }
 
 /// An eye's linear colour as OpenEXR: 32-bit float channels R, G, B, uncompressed scan lines.
@@ -299,11 +294,16 @@ pub fn hdr_exr_file(path: PathBuf, width: u32, height: u32, rgb: &[[f32; 3]]) ->
         (r, g, b)
     });
     let image = Image::from_channels((w, height as usize), channels);
+    exr_output(path, |cursor| image.write().to_buffered(cursor))
+}
+
+/// An OpenEXR output from what `write` encodes into memory.
+fn exr_output(
+    path: PathBuf,
+    write: impl FnOnce(&mut std::io::Cursor<Vec<u8>>) -> exr::error::UnitResult,
+) -> Result<OutputFile> {
     let mut cursor = std::io::Cursor::new(Vec::new());
-    image
-        .write()
-        .to_buffered(&mut cursor)
-        .map_err(|e| crate::error::Error::output(&path, format!("cannot encode OpenEXR: {e}")))?;
+    write(&mut cursor).map_err(|e| crate::error::Error::output(&path, format!("cannot encode OpenEXR: {e}")))?;
     Ok(OutputFile { path, bytes: cursor.into_inner() })
 }
 

@@ -84,11 +84,9 @@ pub fn light_at(light: &GpuLight, p: Vec3) -> (Vec3, f32) {
 #[allow(clippy::too_many_arguments)]
 pub fn shade_surface(
     table: &MaterialTable,
-    material: u32,
     ambient: f32,
     projection: &Projection,
     eye: Eye,
-    frag_xy: Vec2,
     view_position: Vec3,
     normal: Vec3,
     color: Vec4,
@@ -96,6 +94,7 @@ pub fn shade_surface(
     dp_dx: Vec3,
     dp_dy: Vec3,
 ) -> [u8; 4] {
+    let (material, frag_xy) = (surface.material, surface.frag_xy);
     if table.lighting.pbr == 0 {
         return shade(ambient, view_position, normal, color);
     }

@@ -133,11 +133,9 @@ pub fn fragment(
     Some(FragmentOut {
         rgba: shade_surface(
             table,
-            f.surface.material,
             ambient,
             projection,
             eye,
-            frag_xy,
             f.view_position,
             f.normal,
             color,

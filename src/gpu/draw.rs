@@ -102,7 +102,8 @@ impl DrawPipelines {
         }
     }
 
-    fn index(&self, look: Look, lit: Lit, outputs: usize, layers: Layers, hdr: bool) -> usize {
+    /// The pass a pipeline fits, 0..9: its targets (1, 4 or 5) and the eyes it draws.
+    fn pass_slot(&self, outputs: usize, layers: Layers) -> usize {
         let eyes = match (self.kind, layers) {
             (_, Layers::Both) => 0,
             (DrawStage::Slit, Layers::Eye(_)) => 1,
@@ -113,11 +114,13 @@ impl DrawPipelines {
             4 => 1,
             _ => 2,
         };
-        (((look as usize * 3 + outputs) * 3 + eyes) * 8 + lit.index()) * 2 + hdr as usize
+        outputs * 3 + eyes
     }
 
-    /// The pipeline for a scene's look (lit by the glTF BRDF or not), writing `outputs` targets
-    /// (`MeasureSettings::outputs`), drawing `layers`.
+    fn index(&self, look: Look, lit: Lit, outputs: usize, layers: Layers, hdr: bool) -> usize {
+        ((look as usize * 9 + self.pass_slot(outputs, layers)) * 8 + lit.index()) * 2 + hdr as usize
+    }
+
     /// The pipeline for a frame of `scene` with `settings` (its look, what of the glTF look it
     /// uses, its outputs, its colour target), drawing `layers`.
     pub fn get(&self, gpu: &Gpu, scene: &GpuScene, settings: &RenderSettings, layers: Layers) -> &wgpu::RenderPipeline {
@@ -143,8 +146,8 @@ impl DrawPipelines {
     /// frame with `settings` drawing `layers`; drawn first, where `shows_environment`.
     pub fn background(&self, gpu: &Gpu, settings: &RenderSettings, layers: Layers) -> &wgpu::RenderPipeline {
         let (outputs, hdr) = (settings.measure.outputs(), settings.shading.hdr);
-        let index = self.index(Look::Plain, Lit::default(), outputs, layers, false) / 16 * 2 + hdr as usize;
-        self.backgrounds[index].get_or_init(|| draw_pipeline(gpu, &self.stage, self.kind, None, outputs, layers, hdr))
+        self.backgrounds[self.pass_slot(outputs, layers) * 2 + hdr as usize]
+            .get_or_init(|| draw_pipeline(gpu, &self.stage, self.kind, None, outputs, layers, hdr))
     }
 
     /// The scene's material table (group 1).
