@@ -4,6 +4,10 @@
 //! fails `every_registered_stage_matches_its_cpu_twin`.
 
 mod common;
+#[path = "twins/shadow.rs"]
+mod shadow;
+#[path = "twins/slit.rs"]
+mod slit;
 #[path = "twins/triangles.rs"]
 mod triangles;
 use triangles::same_triangle_sets;
@@ -15,7 +19,6 @@ use twister::core::light::Tonemap;
 use twister::core::settings::{Method, Split};
 use twister::cpu::raster::{raster, raster_params};
 use twister::cpu::reduce_error::reduce_error;
-use twister::cpu::slit::{slit, slit_params, slits};
 use twister::cpu::subdivide::{subdivide, subdivide_params};
 use twister::shader::types::ErrorStats;
 use twister::shader::STAGES;
@@ -61,8 +64,9 @@ fn twin_of(stage: &str) -> Option<TwinCheck> {
         "project_points" => check::<ProjectPoints>,
         "subdivide" => check::<Subdivide>,
         "raster" => check::<Raster>,
-        "slit" => check::<Slit>,
+        "slit" => check::<slit::Slit>,
         "trace" => check::<Trace>,
+        "shadow" => check::<shadow::Shadow>,
         "reduce_error" => check::<ReduceError>,
         _ => return None,
     })
@@ -365,10 +369,14 @@ fn compare_eyes(gpu: &EyeOutputs, cpu: &EyeOutputs, share: usize, error_toleranc
 /// show another sub-triangle of the same surface, whose interpolated error differs).
 type RasterCase = (Scene, RenderSettings, Option<f32>);
 
-/// The material table as group 1 holds it for a frame: with the scene's lights and lighting.
+/// The material table as group 1 holds it for a frame: with the scene's lights, lighting and
+/// shadow maps (drawn by the shadow stage's twin).
 fn lit_table(scene: &Scene, settings: &RenderSettings) -> twister::core::texture::MaterialTable {
-    let (lights, lighting) = settings.lighting(&scene.lights, scene.environment.as_deref());
-    scene.material_table(usize::MAX).with_lighting(lights, lighting)
+    let (lights, lighting, maps) =
+        settings.shadowed_lighting(&scene.lights, scene.environment.as_deref(), scene.bounds());
+    let table = scene.material_table(usize::MAX);
+    let depths = twister::cpu::shadow::shadow(&scene.vertices, &scene.indices, &table, settings.view(), &maps);
+    table.with_lighting(lights, lighting).with_shadows(maps, depths)
 }
 
 impl Twin for Raster {
@@ -416,23 +424,42 @@ impl Twin for Raster {
         let settings = RenderSettings::new(exact).with_viewer(Vec3::new(0.0, 0.95, 0.0)).with_method(Method::Fixed(7));
         out.push(("cube, eyes under the ceiling, exact".into(), (cube, settings, None)));
         // Image-based lighting: the lit spheres also in the neutral studio, the viewer turned
-        // (the environment stays put in the scene frame).
+        // (the environment stays put in the scene frame). Shadow maps of 256² texels in these
+        // cases: the twin draws them on the CPU.
         let mut studio = common::lit_spheres();
         studio.environment = Some(common::studio(false));
         let settings = RenderSettings::new(Projection { width: 400, height: 100, ..Projection::default() })
             .with_yaw_deg(-25.0)
             .with_viewer(Vec3::new(0.1, 0.2, 0.0));
-        out.push(("lit spheres in the neutral studio".into(), (studio.clone(), settings, None)));
+        out.push((
+            "lit spheres in the neutral studio".into(),
+            (studio.clone(), settings.with_shadow_map_size(256), None),
+        ));
         // The environment as the background too (the triangle drawn first), on the sphere.
         studio.environment = Some(common::studio(true));
         let sphere = RenderSettings::new(Projection::equirect(256)).with_yaw_deg(30.0);
-        out.push(("lit spheres, the studio as the background, on the sphere".into(), (studio, sphere, None)));
+        out.push((
+            "lit spheres, the studio as the background, on the sphere".into(),
+            (studio, sphere.with_shadow_map_size(256), None),
+        ));
         // Every glTF map (metallic-roughness, normal, occlusion, emissive), u mirrored on the
         // middle quad, under a directional light and the studio.
         let mut panels = common::mapped_panels();
         panels.environment = Some(common::studio(false));
         let settings = RenderSettings::new(Projection { width: 480, height: 120, ..Projection::default() });
         out.push(("mapped panels".into(), (panels, settings, None)));
+        // Shadow maps: a ball and a masked screen over a floor under a spot light.
+        let shadows = common::ball_over_floor(twister::core::light::LightKind::Spot, true);
+        let settings = RenderSettings::new(Projection {
+            width: 400,
+            height: 120,
+            vertical: Vertical::Exact,
+            ..Projection::default()
+        });
+        out.push((
+            "ball and screen, spot light's shadow map".into(),
+            (shadows, settings.with_shadow_map_size(512), Some(0.01)),
+        ));
         // The glTF BRDF under point, spot and directional lights, seen from a moved viewer, with
         // each tone mapping.
         let cylinder = Projection { width: 400, height: 100, vertical: Vertical::Exact, ..Projection::default() };
@@ -443,7 +470,7 @@ impl Twin for Raster {
                 .with_tonemap(tonemap);
             out.push((
                 format!("lit spheres, {tonemap:?}"),
-                (common::lit_spheres(), settings.with_exposure_ev(0.5), None),
+                (common::lit_spheres(), settings.with_exposure_ev(0.5).with_shadow_map_size(256), None),
             ));
         }
         out
@@ -461,61 +488,6 @@ impl Twin for Raster {
     }
     fn compare((gpu, tolerance): &Self::Output, (cpu, _): &Self::Output) -> Result<(), String> {
         compare_eyes(gpu, cpu, 100, *tolerance)
-    }
-}
-
-// ---- slit ----
-
-struct Slit;
-
-impl Twin for Slit {
-    type Case = (Scene, RenderSettings);
-    type Output = EyeOutputs;
-    fn cases() -> Vec<(String, Self::Case)> {
-        let projection = Projection { width: 192, height: 48, vertical: Vertical::Exact, ..Projection::default() };
-        let mut cases: Vec<_> = [1, 4, 16]
-            .map(|w| {
-                (
-                    format!("demo slit:{w}"),
-                    (builtin::demo(), RenderSettings::new(projection).with_method(Method::Slit(w))),
-                )
-            })
-            .into();
-        // The sphere's tiles, parallel and converging rays.
-        for (w, convergence) in [(4, None), (16, Some(2.0))] {
-            let sphere = Projection { convergence, ..Projection::equirect(128) };
-            cases.push((
-                format!("demo on the sphere slit:{w} convergence {convergence:?}"),
-                (builtin::demo(), RenderSettings::new(sphere).with_method(Method::Slit(w))),
-            ));
-        }
-        cases.push((
-            "lit spheres slit:4".into(),
-            (common::lit_spheres(), RenderSettings::new(projection).with_method(Method::Slit(4))),
-        ));
-        let mut studio = common::lit_spheres();
-        studio.environment = Some(common::studio(true));
-        cases.push((
-            "lit spheres, the studio as the background".into(),
-            (studio, RenderSettings::new(projection).with_method(Method::Slit(4))),
-        ));
-        cases
-    }
-    fn gpu(_: &Renderer, (scene, settings): &Self::Case) -> Self::Output {
-        frame_outputs(&measured(scene, settings))
-    }
-    fn cpu((scene, settings): &Self::Case) -> Self::Output {
-        let Method::Slit(w) = settings.subdivision.method else { unreachable!() };
-        let p = settings.projection();
-        let table = lit_table(scene, settings);
-        Eye::BOTH.map(|eye| {
-            let params = slit_params(p, settings.view(), eye, settings.shading.ambient, settings.measure.error_angle);
-            let img = slit(&params, &slits(p, eye, w), scene, &table, settings.shading.background);
-            (img.rgba, img.error, img.object, img.distance)
-        })
-    }
-    fn compare(gpu: &Self::Output, cpu: &Self::Output) -> Result<(), String> {
-        compare_eyes(gpu, cpu, 50, Some(0.01))
     }
 }
 

@@ -28,6 +28,10 @@ override PBR: bool = true;
 override ENVIRONMENT: bool = true;
 override MAPS: bool = true;
 
+// false: the frame has no shadow maps (no directional or spot light, `--no-shadows`, the ray
+// tracer, which shadows by rays); the drawing pipelines then leave the look-up out.
+override SHADOW_MAPS: bool = true;
+
 // NO_TEXTURE, WRAP_*, FILTER_*, MIPMAP_*, ALPHA_*: from `constants` (src/core/material.rs).
 
 struct Material {
@@ -77,7 +81,7 @@ struct Light {
     color: vec3<f32>,
     inner_cos: f32,
     outer_cos: f32,
-    _pad0: u32,
+    shadow_map: u32,    // its shadow map (src/core/shadow.rs), or NO_SHADOW_MAP
     _pad1: u32,
     _pad2: u32,
 }
@@ -117,6 +121,22 @@ struct MipLevel {
 // The environment's prefiltered levels (RGB9E5) and split-sum table (two half floats); a single
 // entry when none (src/core/environment.rs).
 @group(1) @binding(5) var<storage, read> environment: array<u32>;
+
+// A directional or spot light's shadow map (src/core/shadow.rs): viewer frame → the light's
+// clip space, its first depth, its side in texels, a texel's world size (at unit distance along
+// the axis when perspective).
+struct ShadowMap {
+    clip_from_viewer: mat4x4<f32>,
+    offset: u32,
+    size: u32,
+    texel: f32,
+    perspective: u32,
+}
+
+// The frame's shadow maps and their depths (rows top to bottom, maps one after the other),
+// rendered by the `shadow` stage; a single entry each when none.
+@group(1) @binding(6) var<storage, read> shadow_maps: array<ShadowMap>;
+@group(1) @binding(7) var<storage, read> shadow_depths: array<f32>;
 
 fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
     return select(pow((c + 0.055) / 1.055, vec3<f32>(2.4)), c / 12.92, c <= vec3<f32>(0.04045));
@@ -447,9 +467,52 @@ fn pbr_radiance(ambient: f32, v: vec3<f32>, view_position: vec3<f32>, normal: ve
         c += maps.occlusion * ambient * mix(base, vec3<f32>(0.0), maps.metallic);
     }
     for (var i = first_light; i < lighting.count; i++) {
-        c += light_term(i, n, v, view_position, base, maps);
+        var term = light_term(i, n, v, view_position, base, maps);
+        let map = lights[i].shadow_map;
+        if (SHADOW_MAPS && map != NO_SHADOW_MAP && any(term > vec3<f32>(0.0))) {
+            term *= shadow_visibility(map, view_position, normal, light_at(lights[i], view_position).xyz);
+        }
+        c += term;
     }
     return c;
+}
+
+// The share of a light that reaches p (viewer frame; `normal` its interpolated normal, l the unit
+// direction towards the light) by the light's shadow map `map` (src/core/shadow.rs): the point
+// offset along the normal (turned towards the light) and towards the light by a few texels'
+// world size, its depth compared with the four nearest texels, the results weighted bilinearly.
+// Points the map does not see are lit (`shadow_visibility` in fragment.rs).
+fn shadow_visibility(map: u32, p: vec3<f32>, normal: vec3<f32>, l: vec3<f32>) -> f32 {
+    let m = shadow_maps[map];
+    let q0 = m.clip_from_viewer * vec4<f32>(p, 1.0);
+    if (q0.w <= 0.0) {
+        return 1.0;
+    }
+    let t = m.texel * select(1.0, q0.w, m.perspective != 0u);
+    var n = vec3<f32>(0.0);
+    if (dot(normal, normal) > 1e-12) {
+        n = normalize(normal);
+    }
+    n = select(-n, n, dot(n, l) >= 0.0);
+    let q = m.clip_from_viewer * vec4<f32>(p + (NORMAL_OFFSET_TEXELS * n + LIGHT_OFFSET_TEXELS * l) * t, 1.0);
+    if (q.w <= 0.0) {
+        return 1.0;
+    }
+    let ndc = q.xyz / q.w;
+    let size = f32(m.size);
+    let st = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * size - 0.5;
+    if (!(ndc.z < 1.0) || any(st < vec2<f32>(-1.0)) || any(st > vec2<f32>(size))) {
+        return 1.0;
+    }
+    let corner = floor(st);
+    let f = st - corner;
+    var lit: array<f32, 4>;
+    for (var k = 0u; k < 4u; k++) {
+        let x = u32(clamp(i32(corner.x) + i32(k & 1u), 0, i32(m.size) - 1));
+        let y = u32(clamp(i32(corner.y) + i32(k >> 1u), 0, i32(m.size) - 1));
+        lit[k] = select(0.0, 1.0, ndc.z <= shadow_depths[m.offset + y * m.size + x]);
+    }
+    return mix(mix(lit[0], lit[1], f.x), mix(lit[2], lit[3], f.x), f.y);
 }
 
 // What light i adds at view_position (unit normal n facing v): the BRDF × its colour × its

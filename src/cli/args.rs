@@ -97,9 +97,19 @@ pub struct ViewArgs {
     /// appears at θ + DEG (to put its sun where the scene wants it).
     #[arg(long, default_value_t = 0.0, value_name = "DEG", allow_hyphen_values = true)]
     pub environment_yaw: f32,
-    /// The scene's lights cast no shadows (today: the ray tracer's shadow rays for them).
+    /// Adds a sun: a directional light shining from azimuth AZ (degrees from −z towards +x, the
+    /// panorama's u) and elevation EL above the horizon, of LUX lux [default: 3]; it casts
+    /// shadows like the scene's own lights.
+    #[arg(long, value_parser = parse_sun, value_name = "AZ,EL[,LUX]", allow_hyphen_values = true)]
+    pub sun: Option<[f32; 3]>,
+    /// The scene's lights cast no shadows (the drawing methods' shadow maps for directional and
+    /// spot lights, the ray tracer's shadow rays).
     #[arg(long)]
     pub no_shadows: bool,
+    /// The side of a shadow map in texels (a multiple of 64; the first four directional and spot
+    /// lights get one, fitted to the scene's bounding box).
+    #[arg(long, default_value_t = twister::core::shadow::DEFAULT_SHADOW_MAP_SIZE, value_name = "N")]
+    pub shadow_map_size: u32,
     /// Exposure in stops: the BRDF's linear colour is scaled by 2^EV before tone mapping.
     #[arg(long, default_value_t = 0.0, value_name = "EV")]
     pub exposure: f32,
@@ -224,6 +234,21 @@ pub fn parse_vec3(s: &str) -> std::result::Result<Vec3, String> {
     }
 }
 
+pub fn parse_sun(s: &str) -> std::result::Result<[f32; 3], String> {
+    let v: Vec<f32> =
+        s.split(',').map(|x| x.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|e| format!("'{s}': {e}"))?;
+    let (az, el, lux) = match v[..] {
+        [az, el] => (az, el, 3.0),
+        [az, el, lux] => (az, el, lux),
+        _ => (f32::NAN, 0.0, 0.0),
+    };
+    if az.is_finite() && el.abs() <= 90.0 && lux.is_finite() && (0.0..=1e6).contains(&lux) {
+        Ok([az, el, lux])
+    } else {
+        Err(format!("'{s}': expected AZ,EL[,LUX]: degrees, the elevation within ±90, lux from 0 to 1e6"))
+    }
+}
+
 pub fn parse_rgb(s: &str) -> std::result::Result<[f32; 3], String> {
     let v: Vec<u32> =
         s.split(',').map(|x| x.trim().parse::<u32>()).collect::<Result<_, _>>().map_err(|e| format!("'{s}': {e}"))?;
@@ -300,6 +325,7 @@ impl ViewArgs {
             .with_lighting(self.lighting)
             .with_exposure_ev(self.exposure)
             .with_shadows(!self.no_shadows)
+            .with_shadow_map_size(self.shadow_map_size)
             .with_environment_yaw_deg(self.environment_yaw)
             .with_tonemap(self.tonemap);
         settings.validate()?;

@@ -100,6 +100,9 @@ pub fn prepare(
         lod = None;
     }
     let mut scene = place(spec, fit, view, settings)?;
+    if let Some([azimuth, elevation, lux]) = view.sun {
+        scene.lights.push(twister::core::light::Light::sun(azimuth, elevation, lux));
+    }
     let selection =
         lod.map(|(params, gaze)| LodChain::build(&scene, params.p3).select(&scene, settings.view(), &gaze, &params));
     if let (Some(sel), true) = (&selection, overlay) {

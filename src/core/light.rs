@@ -37,6 +37,22 @@ pub struct Light {
 }
 
 impl Light {
+    /// A sun: a directional light of `lux` shining from azimuth `azimuth_deg` (from −z towards
+    /// +x, as the panorama's u) and `elevation_deg` above the horizon (`--sun`).
+    pub fn sun(azimuth_deg: f32, elevation_deg: f32, lux: f32) -> Light {
+        let (az, el) = (azimuth_deg.to_radians(), elevation_deg.to_radians());
+        let towards = Vec3::new(az.sin() * el.cos(), el.sin(), -az.cos() * el.cos());
+        Light {
+            kind: LightKind::Directional,
+            position: Vec3::ZERO,
+            direction: -towards,
+            color: Vec3::splat(lux),
+            range: None,
+            inner_cone: 0.0,
+            outer_cone: 0.0,
+        }
+    }
+
     /// The light moved by `m` (a rigid transform: a node's world matrix or the view).
     pub fn transformed(&self, m: Mat4) -> Light {
         Light {
@@ -56,12 +72,15 @@ impl Light {
             color: self.color.to_array(),
             inner_cos: self.inner_cone.cos(),
             outer_cos: self.outer_cone.cos(),
-            _pad0: 0,
+            shadow_map: NO_SHADOW_MAP,
             _pad1: 0,
             _pad2: 0,
         }
     }
 }
+
+/// `GpuLight::shadow_map` of a light without a shadow map (`core::shadow`).
+pub const NO_SHADOW_MAP: u32 = u32::MAX;
 
 /// `Light` in shaders/shared/surface.wgsl (viewer frame). 64 bytes.
 #[repr(C)]
@@ -75,7 +94,8 @@ pub struct GpuLight {
     pub color: [f32; 3],
     pub inner_cos: f32,
     pub outer_cos: f32,
-    pub _pad0: u32,
+    /// Its shadow map's index in the frame's maps (`core::shadow`), or `NO_SHADOW_MAP`.
+    pub shadow_map: u32,
     pub _pad1: u32,
     pub _pad2: u32,
 }

@@ -15,6 +15,7 @@ pub mod material;
 pub mod projection;
 pub mod scene;
 pub mod settings;
+pub mod shadow;
 pub mod sphere;
 pub mod texture;
 pub mod visual_field;

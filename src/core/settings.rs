@@ -178,8 +178,11 @@ pub struct ShadingSettings {
     pub exposure_ev: f32,
     /// Tone mapping of the lit colour (`--tonemap`; the glTF BRDF only).
     pub tonemap: crate::core::light::Tonemap,
-    /// Whether the scene's lights cast shadows (`--no-shadows`: false); today the ray tracer's.
+    /// Whether the scene's lights cast shadows (`--no-shadows`: false): by shadow maps in the
+    /// drawing stages (directional and spot lights, `core::shadow`), by rays in the ray tracer.
     pub shadows: bool,
+    /// The side of a shadow map in texels (`--shadow-map-size`, a multiple of 64).
+    pub shadow_map_size: u32,
     /// The environment turned about the vertical axis, degrees (`--environment-yaw`).
     pub environment_yaw_deg: f32,
     /// The colour target holds the linear colour × 2^EV in floats, not tone mapped (`--hdr`:
@@ -234,7 +237,45 @@ impl MeasureSettings {
     }
 }
 
+/// The largest `--shadow-map-size` (a map of 8192² texels holds 256 MiB of depths).
+pub const MAX_SHADOW_MAP_SIZE: u32 = 8192;
+
 impl RenderSettings {
+    /// Whether a frame lit by the glTF BRDF (`pbr`) of a scene with `lights` has shadow maps:
+    /// shadows on, a drawing method (the ray tracer shadows by rays), and a directional or spot
+    /// light (the drawing pipelines' `SHADOW_MAPS`).
+    pub fn uses_shadow_maps(&self, lights: &[crate::core::light::Light], pbr: bool) -> bool {
+        pbr && self.shading.shadows
+            && self.subdivision.method != Method::Trace
+            && lights.iter().any(|l| l.kind != crate::core::light::LightKind::Point)
+    }
+
+    /// A frame's lights (viewer frame, each with its shadow map's index), lighting and shadow
+    /// maps, for a scene with `lights`, perhaps an environment, and the bounding box `bounds`
+    /// (scene frame; the maps are fitted to it).
+    pub fn shadowed_lighting(
+        &self,
+        lights: &[crate::core::light::Light],
+        environment: Option<&crate::core::environment::PreparedEnvironment>,
+        bounds: Option<(Vec3, Vec3)>,
+    ) -> (Vec<crate::core::light::GpuLight>, crate::core::light::LightingParams, Vec<crate::core::shadow::GpuShadowMap>)
+    {
+        let (mut gpu_lights, params) = self.lighting(lights, environment);
+        let maps = match bounds {
+            Some((min, max)) if self.uses_shadow_maps(lights, params.pbr != 0) => {
+                let corners = crate::core::shadow::box_corners(min, max, self.view());
+                crate::core::shadow::plan_shadow_maps(
+                    &mut gpu_lights,
+                    lights.len(),
+                    &corners,
+                    self.shading.shadow_map_size,
+                )
+            }
+            _ => Vec::new(),
+        };
+        (gpu_lights, params, maps)
+    }
+
     /// A frame's lights as the fragment stage reads them (viewer frame of this view) and its
     /// lighting, for a scene with `lights` (group 1's last two bindings; the CPU twins'
     /// `MaterialTable::with_lighting`).
@@ -305,6 +346,7 @@ impl Default for ShadingSettings {
             tonemap: Default::default(),
             hdr: false,
             shadows: true,
+            shadow_map_size: crate::core::shadow::DEFAULT_SHADOW_MAP_SIZE,
             environment_yaw_deg: 0.0,
         }
     }
@@ -344,6 +386,7 @@ builders! {
     with_tonemap: crate::core::light::Tonemap => shading.tonemap,
     with_hdr: bool => shading.hdr,
     with_shadows: bool => shading.shadows,
+    with_shadow_map_size: u32 => shading.shadow_map_size,
     with_environment_yaw_deg: f32 => shading.environment_yaw_deg,
     with_measure_edges: bool => measure.edges,
     with_measure_error: bool => measure.error,
@@ -432,6 +475,13 @@ impl RenderSettings {
             if !light.is_finite() || light.abs().max_element() > max {
                 return Err(Error::option("--light", format!("must lie within ±{max:e}, got {light}")));
             }
+        }
+        let size = self.shading.shadow_map_size;
+        if !(64..=MAX_SHADOW_MAP_SIZE).contains(&size) || size % 64 != 0 {
+            return Err(Error::option(
+                "--shadow-map-size",
+                format!("must be a multiple of 64 between 64 and {MAX_SHADOW_MAP_SIZE}, got {size}"),
+            ));
         }
         if s.memory_mb < 8 {
             return Err(Error::option("--memory-mb", format!("must be at least 8, got {}", s.memory_mb)));

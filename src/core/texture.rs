@@ -93,6 +93,10 @@ pub struct MaterialTable {
     /// The environment's prefiltered levels and split-sum table, as group 1's binding 5 holds
     /// them (empty without an environment; [`MaterialTable::with_environment`]).
     pub environment: Vec<u32>,
+    /// The frame's shadow maps and their depths, as group 1's bindings 6 and 7 hold them
+    /// (empty without; [`MaterialTable::with_shadows`]).
+    pub shadow_maps: Vec<crate::core::shadow::GpuShadowMap>,
+    pub shadow_depths: Vec<f32>,
 }
 
 impl MaterialTable {
@@ -100,6 +104,13 @@ impl MaterialTable {
     /// With an environment's texels (its places and coefficients come with the lighting).
     pub fn with_environment(mut self, environment: &crate::core::environment::PreparedEnvironment) -> MaterialTable {
         self.environment = environment.texels.clone();
+        self
+    }
+
+    /// With a frame's shadow maps and their depths (`cpu::shadow`).
+    pub fn with_shadows(mut self, maps: Vec<crate::core::shadow::GpuShadowMap>, depths: Vec<f32>) -> MaterialTable {
+        self.shadow_maps = maps;
+        self.shadow_depths = depths;
         self
     }
 

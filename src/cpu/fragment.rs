@@ -8,9 +8,10 @@ use glam::{Vec2, Vec3, Vec4};
 
 use crate::core::color::{linear_to_srgb, srgb_to_linear};
 use crate::core::environment::{ENV_LEVELS, LUT_SIZE};
-use crate::core::light::{tonemap, GpuLight, LightKind};
+use crate::core::light::{tonemap, GpuLight, LightKind, NO_SHADOW_MAP};
 use crate::core::material::{AlphaMode, Filter, Material, MipLevel, Mipmap, Wrap, NO_TEXTURE};
 use crate::core::projection::{Eye, PanoramaKind, Projection};
+use crate::core::shadow::{shadow_coordinates, LIGHT_OFFSET_TEXELS, NORMAL_OFFSET_TEXELS};
 use crate::core::texture::MaterialTable;
 
 /// Linear colour × (ambient + (1 − ambient)·|n·l|), the light at the viewer, two-sided; as
@@ -142,9 +143,48 @@ pub fn pbr_radiance(
         c += maps.occlusion * ambient * base.lerp(Vec3::ZERO, maps.metallic);
     }
     for light in table.lights[..table.lighting.count as usize].iter().skip(first_light) {
-        c += light_term(light, n, v, view_position, base, maps);
+        let mut term = light_term(light, n, v, view_position, base, maps);
+        // The drawing pipelines compile the look-up in where the frame has maps (`SHADOW_MAPS`).
+        if !table.shadow_maps.is_empty() && light.shadow_map != NO_SHADOW_MAP && term.cmpgt(Vec3::ZERO).any() {
+            let (l, _) = light_at(light, view_position);
+            term *= shadow_visibility(table, light.shadow_map, view_position, normal, l);
+        }
+        c += term;
     }
     c
+}
+
+/// The share of a light reaching p by its shadow map (`shadow_visibility` in surface.wgsl; the
+/// offsets and the filter in `core::shadow`).
+pub fn shadow_visibility(table: &MaterialTable, map: u32, p: Vec3, normal: Vec3, l: Vec3) -> f32 {
+    let m = &table.shadow_maps[map as usize];
+    let q0 = m.matrix() * p.extend(1.0);
+    if q0.w <= 0.0 {
+        return 1.0;
+    }
+    let t = m.texel * if m.perspective != 0 { q0.w } else { 1.0 };
+    let n = if normal.dot(normal) > 1e-12 { normal.normalize() } else { Vec3::ZERO };
+    let n = if n.dot(l) >= 0.0 { n } else { -n };
+    let Some((x, y, z)) = shadow_coordinates(m, p + (NORMAL_OFFSET_TEXELS * n + LIGHT_OFFSET_TEXELS * l) * t) else {
+        return 1.0;
+    };
+    let (sx, sy, size) = (x - 0.5, y - 0.5, m.size as f32);
+    if !(z < 1.0) || sx < -1.0 || sy < -1.0 || sx > size || sy > size {
+        return 1.0;
+    }
+    let (cx, cy) = (sx.floor(), sy.floor());
+    let (fx, fy) = (sx - cx, sy - cy);
+    let lit = [0, 1, 2, 3].map(|k| {
+        let tx = (cx as i32 + (k & 1)).clamp(0, m.size as i32 - 1) as u32;
+        let ty = (cy as i32 + (k >> 1)).clamp(0, m.size as i32 - 1) as u32;
+        if z <= table.shadow_depths[(m.offset + ty * m.size + tx) as usize] {
+            1.0
+        } else {
+            0.0
+        }
+    });
+    let mix = |a: f32, b: f32, t: f32| a + (b - a) * t;
+    mix(mix(lit[0], lit[1], fx), mix(lit[2], lit[3], fx), fy)
 }
 
 /// What a light adds at view_position (unit normal n facing v): the BRDF × its colour × its

@@ -7,6 +7,7 @@
 //! | [`raster`] | `shaders/raster.wgsl` |
 //! | [`slit`] | `shaders/slit.wgsl` |
 //! | [`trace`] | `shaders/trace.wgsl` |
+//! | [`shadow`] | `shaders/shadow.wgsl` |
 //! | [`fragment`] | `shaders/shared/fragment.wgsl` and `surface.wgsl` (composed into raster, slit and trace) |
 //! | [`reduce_error`] | `shaders/reduce_error.wgsl` |
 //! | [`project_points`] | `shaders/project_points.wgsl` |
@@ -15,6 +16,7 @@ pub mod fragment;
 pub mod project_points;
 pub mod raster;
 pub mod reduce_error;
+pub mod shadow;
 pub mod slit;
 pub mod subdivide;
 pub mod trace;

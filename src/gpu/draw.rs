@@ -12,7 +12,7 @@ use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
 use crate::gpu::targets::{Layers, COLOR_FORMAT, DEPTH_FORMAT, HDR_FORMAT, OBJECT_FORMAT, POSITION_FORMAT};
 use crate::shader::types::DrawVertex;
-use crate::shader::{RASTER, SLIT};
+use crate::shader::{RASTER, SHADOW, SLIT};
 
 /// The two drawing stages.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -29,7 +29,7 @@ pub(crate) struct DrawPipelines {
     pub stage: GpuStage,
     kind: DrawStage,
     /// By `Self::index`.
-    pipelines: [OnceLock<wgpu::RenderPipeline>; 576],
+    pipelines: [OnceLock<wgpu::RenderPipeline>; 1152],
     /// The background's (`fs_background`), by outputs, eyes and colour target.
     backgrounds: [OnceLock<wgpu::RenderPipeline>; 18],
 }
@@ -78,16 +78,24 @@ pub(crate) struct Lit {
     pub pbr: bool,
     pub environment: bool,
     pub maps: bool,
+    /// The shadow maps' look-up (`SHADOW_MAPS`).
+    pub shadows: bool,
 }
 
 impl Lit {
     /// What a frame of `scene` lit by the glTF BRDF (`pbr`) or not needs.
-    pub fn of(scene: &GpuScene, pbr: bool) -> Lit {
-        Lit { pbr, environment: pbr && scene.environment.is_some(), maps: pbr && scene.has_maps }
+    pub fn of(scene: &GpuScene, settings: &RenderSettings) -> Lit {
+        let pbr = scene.pbr(settings);
+        Lit {
+            pbr,
+            environment: pbr && scene.environment.is_some(),
+            maps: pbr && scene.has_maps,
+            shadows: scene.shadow_maps(settings),
+        }
     }
 
     fn index(self) -> usize {
-        self.pbr as usize | (self.environment as usize) << 1 | (self.maps as usize) << 2
+        self.pbr as usize | (self.environment as usize) << 1 | (self.maps as usize) << 2 | (self.shadows as usize) << 3
     }
 }
 
@@ -118,15 +126,14 @@ impl DrawPipelines {
     }
 
     fn index(&self, look: Look, lit: Lit, outputs: usize, layers: Layers, hdr: bool) -> usize {
-        ((look as usize * 9 + self.pass_slot(outputs, layers)) * 8 + lit.index()) * 2 + hdr as usize
+        ((look as usize * 9 + self.pass_slot(outputs, layers)) * 16 + lit.index()) * 2 + hdr as usize
     }
 
     /// The pipeline for a frame of `scene` with `settings` (its look, what of the glTF look it
     /// uses, its outputs, its colour target), drawing `layers`.
     pub fn get(&self, gpu: &Gpu, scene: &GpuScene, settings: &RenderSettings, layers: Layers) -> &wgpu::RenderPipeline {
-        let pbr = scene.pbr(settings);
         let (outputs, hdr) = (settings.measure.outputs(), settings.shading.hdr);
-        self.get_look(gpu, Look::of(scene, pbr), Lit::of(scene, pbr), outputs, layers, hdr)
+        self.get_look(gpu, Look::of(scene, scene.pbr(settings)), Lit::of(scene, settings), outputs, layers, hdr)
     }
 
     pub fn get_look(
@@ -152,8 +159,8 @@ impl DrawPipelines {
 
     /// The scene's material table (group 1).
     pub fn material_bind_group(&self, gpu: &Gpu, scene: &GpuScene) -> wgpu::BindGroup {
-        let [a, b, c, d, e, f] = &scene.materials;
-        self.stage.bind_group(gpu, None, 1, &[a, b, c, d, e, f])
+        let buffers = scene.material_buffers();
+        self.stage.bind_group(gpu, None, 1, &buffers.each_ref())
     }
 }
 
@@ -177,7 +184,8 @@ fn draw_pipeline(
 ) -> wgpu::RenderPipeline {
     // None: the background triangle (no vertex buffer; colour only; behind everything).
     let background = look.is_none();
-    let (look, lit) = look.unwrap_or((Look::Materials, Lit { pbr: true, environment: true, maps: false }));
+    let (look, lit) =
+        look.unwrap_or((Look::Materials, Lit { pbr: true, environment: true, maps: false, shadows: false }));
     use wgpu::VertexFormat::{Float32, Float32x2, Float32x3, Float32x4, Uint32};
     // Raster: the subdivided `DrawVertex`; slit: the scene's `SceneVertex` (`VertexIn` of each WGSL file).
     let (stride, attributes) = match kind {
@@ -226,6 +234,7 @@ fn draw_pipeline(
         ("PBR", lit.pbr as u32 as f64),
         ("ENVIRONMENT", lit.environment as u32 as f64),
         ("MAPS", lit.maps as u32 as f64),
+        ("SHADOW_MAPS", lit.shadows as u32 as f64),
     ];
     let multiview_mask = match layers {
         Layers::Both => std::num::NonZeroU32::new(0b11),
@@ -273,4 +282,69 @@ fn draw_pipeline(
         multiview_mask,
         cache: None,
     })
+}
+
+/// The `shadow` stage's pipelines: depth only, and with `fs_mask` (scenes whose materials can
+/// discard), each made when first needed.
+pub(crate) struct ShadowPipelines {
+    pub stage: GpuStage,
+    pipelines: [OnceLock<wgpu::RenderPipeline>; 2],
+}
+
+impl ShadowPipelines {
+    pub fn new(gpu: &Gpu) -> ShadowPipelines {
+        ShadowPipelines { stage: GpuStage::new(gpu, &SHADOW), pipelines: [OnceLock::new(), OnceLock::new()] }
+    }
+
+    pub fn pipeline(&self, gpu: &Gpu, masked: bool) -> &wgpu::RenderPipeline {
+        self.pipelines[masked as usize].get_or_init(|| {
+            use wgpu::VertexFormat::{Float32x2, Float32x3, Float32x4, Uint32};
+            let attribute = |format, offset: usize, shader_location| wgpu::VertexAttribute {
+                format,
+                offset: offset as u64,
+                shader_location,
+            };
+            let attributes = [
+                attribute(Float32x3, offset_of!(SceneVertex, position), 0),
+                attribute(Float32x4, std::mem::offset_of!(SceneVertex, color), 1),
+                attribute(Float32x2, std::mem::offset_of!(SceneVertex, uv), 2),
+                attribute(Uint32, std::mem::offset_of!(SceneVertex, material), 3),
+            ];
+            let buffers = [Some(wgpu::VertexBufferLayout {
+                array_stride: std::mem::size_of::<SceneVertex>() as u64,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &attributes,
+            })];
+            gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("shadow"),
+                layout: Some(self.stage.draw_layout()),
+                vertex: wgpu::VertexState {
+                    module: &self.stage.module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &buffers,
+                },
+                primitive: wgpu::PrimitiveState {
+                    topology: wgpu::PrimitiveTopology::TriangleList,
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: masked.then(|| wgpu::FragmentState {
+                    module: &self.stage.module,
+                    entry_point: Some("fs_mask"),
+                    compilation_options: Default::default(),
+                    targets: &[],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        })
+    }
 }

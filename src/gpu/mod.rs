@@ -8,6 +8,7 @@ pub mod project_points;
 pub mod reduce_error;
 pub mod renderer;
 pub mod scene;
+pub mod shadow;
 pub mod slit;
 pub mod stages;
 pub mod targets;

@@ -16,7 +16,7 @@ use crate::cpu::raster::raster_params;
 use crate::cpu::subdivide::{subdivide_params, SubdivideOutput};
 use crate::error::{Error, Result};
 use crate::gpu::device::Gpu;
-use crate::gpu::draw::{DrawPipelines, DrawStage, Lit, Look};
+use crate::gpu::draw::{DrawPipelines, DrawStage, Lit, Look, ShadowPipelines};
 use crate::gpu::frame_plan::{
     on_overflow, Capacities, FramePlan, Overflow, SubdivisionBuffers, INDICES_SIZE, NODE_SIZE,
 };
@@ -109,6 +109,7 @@ pub struct Renderer {
     subdivide: SubdividePipelines,
     pub(crate) raster: DrawPipelines,
     pub(crate) slit: DrawPipelines,
+    pub(crate) shadow: ShadowPipelines,
     pub(crate) reduce: GpuStage,
     pub(crate) accumulate: wgpu::ComputePipeline,
     pub(crate) finish: wgpu::ComputePipeline,
@@ -151,18 +152,20 @@ impl Renderer {
                 subdivide,
                 raster,
                 DrawPipelines::new(&gpu, DrawStage::Slit),
+                ShadowPipelines::new(&gpu),
                 reduce.compute(&gpu, "accumulate"),
                 reduce.compute(&gpu, "finish"),
                 reduce,
                 resources,
             ))
         })?;
-        let (subdivide, raster, slit, accumulate, finish, reduce, resources) = built;
+        let (subdivide, raster, slit, shadow, accumulate, finish, reduce, resources) = built;
         Ok(Renderer {
             gpu,
             subdivide,
             raster,
             slit,
+            shadow,
             reduce,
             accumulate,
             finish,
@@ -177,13 +180,14 @@ impl Renderer {
         settings.validate()?;
         self.check_size(settings)?;
         let mut resources = self.resources.lock().unwrap_or_else(|e| e.into_inner());
-        scene.write_lighting(&self.gpu, settings);
+        let shadow_maps = scene.write_lighting(&self.gpu, settings);
         if settings.shading.hdr && matches!(settings.subdivision.method, Method::Slit(_) | Method::Trace) {
             return Err(Error::option(
                 "--hdr",
                 "the linear colour comes from the projection methods (vertex, fixed, adaptive); slit and trace write display colours",
             ));
         }
+        self.draw_shadow_maps(scene, settings.view(), &shadow_maps)?;
         self.gpu.scoped("rendering a frame", || match settings.subdivision.method {
             Method::Slit(width) => self.render_slit(&mut resources, scene, settings, width),
             Method::Trace => self.render_trace(&mut resources, scene, settings),

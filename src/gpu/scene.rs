@@ -1,6 +1,8 @@
 //! A scene uploaded to the GPU: vertices, indices, the material table and the per-object
 //! factor on L; a level-of-detail selection swaps only the index buffer and the factors.
 
+use std::sync::Mutex;
+
 use glam::{Mat4, Vec3};
 
 use crate::core::bvh::SceneBvh;
@@ -9,6 +11,7 @@ use crate::core::light::{gpu_lights, Light, LightingParams};
 use crate::core::lod::LodSelection;
 use crate::core::scene::{object_spheres, Scene};
 use crate::core::settings::RenderSettings;
+use crate::core::shadow::{GpuShadowMap, MAX_SHADOW_MAPS};
 use crate::error::{Error, Result};
 use crate::gpu::device::Gpu;
 use crate::shader::constants::TRACE_STACK;
@@ -51,6 +54,10 @@ pub struct GpuScene {
     pub has_optics: bool,
     /// The BVH the ray tracer walks (`--method trace`), once built ([`GpuScene::with_bvh`]).
     pub bvh: Option<GpuBvh>,
+    /// The scene's bounding box (scene frame), which the shadow maps are fitted to.
+    pub bounds: Option<(Vec3, Vec3)>,
+    /// The frame's shadow maps (group 1's bindings 6 and 7), drawn when a frame needs them.
+    pub shadows: Mutex<GpuShadows>,
 }
 
 /// A scene's BVH on the GPU ([`SceneBvh`]): nodes, the objects' chains of levels, and the
@@ -151,6 +158,8 @@ impl GpuScene {
                 cull_back_faces,
                 has_optics,
                 bvh: None,
+                bounds: scene.bounds(),
+                shadows: Mutex::new(GpuShadows::new(gpu)),
                 lights: scene.lights.clone(),
                 environment: scene
                     .environment
@@ -171,11 +180,30 @@ impl GpuScene {
         self.pbr(settings) && self.environment.as_ref().is_some_and(|e| e.background)
     }
 
-    /// Writes a frame's lights (in the viewer frame of `settings`) and lighting into group 1.
-    pub fn write_lighting(&self, gpu: &Gpu, settings: &RenderSettings) {
-        let (lights, params) = settings.lighting(&self.lights, self.environment.as_deref());
+    /// Writes a frame's lights (in the viewer frame of `settings`) and lighting into group 1;
+    /// returns the frame's shadow maps (drawn by the renderer).
+    pub fn write_lighting(&self, gpu: &Gpu, settings: &RenderSettings) -> Vec<GpuShadowMap> {
+        let (lights, params, maps) = settings.shadowed_lighting(&self.lights, self.environment.as_deref(), self.bounds);
         gpu.queue.write_buffer(&self.materials[3], 0, bytemuck::cast_slice(&lights));
         gpu.queue.write_buffer(&self.materials[4], 0, bytemuck::bytes_of(&params));
+        maps
+    }
+
+    /// Whether a frame with `settings` reads shadow maps (the drawing pipelines' `SHADOW_MAPS`).
+    pub fn shadow_maps(&self, settings: &RenderSettings) -> bool {
+        settings.uses_shadow_maps(&self.lights, self.pbr(settings))
+    }
+
+    /// Group 1's buffers in binding order: the material table, lights, lighting, environment,
+    /// and the shadow maps' table and depths of `shadows` (the scene's, locked).
+    pub fn group1(&self, shadows: &GpuShadows) -> [wgpu::Buffer; 8] {
+        let [a, b, c, d, e, f] = self.materials.clone();
+        [a, b, c, d, e, f, shadows.maps.clone(), shadows.depths.clone()]
+    }
+
+    /// Group 1's buffers as a frame binds them.
+    pub fn material_buffers(&self) -> [wgpu::Buffer; 8] {
+        self.group1(&self.shadows.lock().unwrap_or_else(|e| e.into_inner()))
     }
 
     /// The same scene with its BVH built (on the CPU, one level per object) and uploaded, for
@@ -254,8 +282,37 @@ impl GpuScene {
             has_optics: self.has_optics,
             // The BVH indexes the full scene's triangles: a selection has none (yet).
             bvh: None,
+            bounds: self.bounds,
+            shadows: Mutex::new(GpuShadows::new(gpu)),
             lights: self.lights.clone(),
             environment: self.environment.clone(),
+        }
+    }
+}
+
+/// A scene's shadow maps on the GPU: the maps' table (group 1 binding 6, [`MAX_SHADOW_MAPS`]
+/// entries) and their depths (binding 7), the depth texture they are drawn into, and what the
+/// depths hold now.
+pub struct GpuShadows {
+    pub maps: wgpu::Buffer,
+    pub depths: wgpu::Buffer,
+    pub(crate) texture: Option<wgpu::Texture>,
+    /// Each drawn map's projection (scene frame → clip) and side; empty: none drawn.
+    pub(crate) drawn: Vec<([[f32; 4]; 4], u32)>,
+}
+
+impl GpuShadows {
+    pub fn new(gpu: &Gpu) -> GpuShadows {
+        let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC;
+        GpuShadows {
+            maps: gpu.init_buffer(
+                "shadow maps",
+                bytemuck::cast_slice(&[GpuShadowMap::default(); MAX_SHADOW_MAPS]),
+                usage,
+            ),
+            depths: gpu.init_buffer("shadow depths", &[0; 4], usage),
+            texture: None,
+            drawn: Vec::new(),
         }
     }
 }

@@ -63,7 +63,8 @@ impl Renderer {
         let (_, _, outputs) = res.trace_outputs.as_ref().expect("made");
         let (stage, pipelines) = self.trace.get_or_init(|| {
             let stage = GpuStage::new(gpu, &crate::shader::TRACE);
-            let pipelines = [0.0, 1.0].map(|m| stage.compute_with(gpu, "trace", &[("MATERIALS", m)]));
+            let pipelines =
+                [0.0, 1.0].map(|m| stage.compute_with(gpu, "trace", &[("MATERIALS", m), ("SHADOW_MAPS", 0.0)]));
             (stage, pipelines)
         });
         let params = trace_params(settings, row_texels);
@@ -73,7 +74,7 @@ impl Renderer {
             ..params
         };
         gpu.queue.write_buffer(&res.trace_params, 0, bytemuck::bytes_of(&params));
-        let [a, b, c, d, e, f] = &scene.materials;
+        let group1 = scene.material_buffers();
         let [color, error, object, distance] = outputs;
         let bind_group = stage.bind_group(
             gpu,
@@ -92,7 +93,7 @@ impl Renderer {
                 &counts,
             ],
         );
-        let materials = stage.bind_group(gpu, Some("trace"), 1, &[a, b, c, d, e, f]);
+        let materials = stage.bind_group(gpu, Some("trace"), 1, &group1.each_ref());
         let timestamps = res.timestamps.as_ref();
         let t = Instant::now();
         let mut enc = gpu.device.create_command_encoder(&Default::default());

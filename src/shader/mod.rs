@@ -111,17 +111,20 @@ impl Stage {
 
 /// The material table the fragment module reads (group 1 of the drawing stages).
 /// What the fragment entry points of the drawing stages read: their parameters and group 1.
-const SHADING: &[&str] = &["params", "materials", "mips", "texels", "lights", "lighting", "environment"];
+const SHADING: &[&str] =
+    &["params", "materials", "mips", "texels", "lights", "lighting", "environment", "shadow_maps", "shadow_depths"];
 
 /// Group 1 of the stages that shade: the scene's materials and textures, its lights, the
-/// frame's lighting and the environment (src/gpu/scene.rs).
-const MATERIAL_TABLE: [Binding; 6] = [
+/// frame's lighting, the environment and the frame's shadow maps (src/gpu/scene.rs).
+const MATERIAL_TABLE: [Binding; 8] = [
     bind(1, 0, "materials", Storage),
     bind(1, 1, "mips", Storage),
     bind(1, 2, "texels", Storage),
     bind(1, 3, "lights", Storage),
     bind(1, 4, "lighting", Uniform),
     bind(1, 5, "environment", Storage),
+    bind(1, 6, "shadow_maps", Storage),
+    bind(1, 7, "shadow_depths", Storage),
 ];
 
 pub const SUBDIVIDE: Stage = Stage {
@@ -175,6 +178,8 @@ pub const RASTER: Stage = Stage {
         MATERIAL_TABLE[3],
         MATERIAL_TABLE[4],
         MATERIAL_TABLE[5],
+        MATERIAL_TABLE[6],
+        MATERIAL_TABLE[7],
     ],
 };
 
@@ -199,6 +204,8 @@ pub const SLIT: Stage = Stage {
         MATERIAL_TABLE[3],
         MATERIAL_TABLE[4],
         MATERIAL_TABLE[5],
+        MATERIAL_TABLE[6],
+        MATERIAL_TABLE[7],
     ],
 };
 
@@ -225,6 +232,8 @@ pub const TRACE: Stage = Stage {
             "lights",
             "lighting",
             "environment",
+            "shadow_maps",
+            "shadow_depths",
         ],
     )],
     bindings: &[
@@ -244,6 +253,26 @@ pub const TRACE: Stage = Stage {
         MATERIAL_TABLE[3],
         MATERIAL_TABLE[4],
         MATERIAL_TABLE[5],
+        MATERIAL_TABLE[6],
+        MATERIAL_TABLE[7],
+    ],
+};
+
+pub const SHADOW: Stage = Stage {
+    name: "shadow",
+    source: include_str!("../../shaders/shadow.wgsl"),
+    kind: StageKind::Draw,
+    entry_points: &[entry("vs_main", &["params"]), entry("fs_mask", &["materials", "mips", "texels"])],
+    bindings: &[
+        bind(0, 0, "params", Uniform),
+        MATERIAL_TABLE[0],
+        MATERIAL_TABLE[1],
+        MATERIAL_TABLE[2],
+        MATERIAL_TABLE[3],
+        MATERIAL_TABLE[4],
+        MATERIAL_TABLE[5],
+        MATERIAL_TABLE[6],
+        MATERIAL_TABLE[7],
     ],
 };
 
@@ -274,7 +303,7 @@ pub const REDUCE_ERROR: Stage = Stage {
 };
 
 /// The registry: every stage. The naga test validates and reflects each one composed.
-pub const STAGES: &[Stage] = &[SUBDIVIDE, RASTER, SLIT, TRACE, PROJECT_POINTS, REDUCE_ERROR];
+pub const STAGES: &[Stage] = &[SUBDIVIDE, RASTER, SLIT, TRACE, SHADOW, PROJECT_POINTS, REDUCE_ERROR];
 
 /// The shared WGSL modules in `shaders/shared/`, by import name.
 pub const SHARED: &[(&str, &str)] = &[

@@ -11,6 +11,7 @@ pub use crate::core::light::{GpuLight, LightingParams};
 use crate::core::material::{Material, MipLevel};
 use crate::core::projection::{PanoramaKind, Projection, Vertical};
 use crate::core::scene::SceneVertex;
+pub use crate::core::shadow::GpuShadowMap;
 
 /// A vertex of a prepared triangle (`DrawVertex` in shaders/subdivide.wgsl and raster.wgsl),
 /// in the viewer frame. `theta_ref` is the azimuth the vertex stage unwraps θ around; seam
@@ -333,6 +334,14 @@ pub struct TraceParams {
     pub _pad2: u32,
 }
 
+/// `ShadowParams` in shaders/shadow.wgsl: one shadow map's projection, scene frame → the
+/// light's clip space (`GpuShadowMap::clip_from_viewer` × the view).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ShadowParams {
+    pub clip_from_scene: [[f32; 4]; 4],
+}
+
 /// Every struct the stages bind (as a uniform or in a storage buffer), by its WGSL name.
 pub const LAYOUTS: &[StructLayout] = &[
     layout!("SceneVertex" => SceneVertex { position, material, normal, object, color, uv, _pad1 }),
@@ -354,7 +363,9 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("TraceParams" => TraceParams { to_scene, projection, background, light, gaze_forward, gaze_right, gaze_up, ambient, error_angle, row_texels, reflect_max, lod_min_share, original_root, original_level, _pad2 }),
     layout!("BvhNode" => BvhNode { min, first, max, count }),
     layout!("BvhLevel" => BvhLevel { root, triangles }),
-    layout!("Light" => GpuLight { position, kind, direction, range, color, inner_cos, outer_cos, _pad0, _pad1, _pad2 }),
+    layout!("Light" => GpuLight { position, kind, direction, range, color, inner_cos, outer_cos, shadow_map, _pad1, _pad2 }),
+    layout!("ShadowMap" => GpuShadowMap { clip_from_viewer, offset, size, texel, perspective }),
+    layout!("ShadowParams" => ShadowParams { clip_from_scene }),
     layout!("Lighting" => LightingParams {
         count, pbr, exposure, tonemap, environment, env_background, env_lut, shadows, env_rotation, env_sh, env_levels
     }),

@@ -12,9 +12,13 @@ pub fn renderer() -> &'static Renderer {
     R.get_or_init(|| Renderer::new(Gpu::new().unwrap_or_else(|e| panic!("{e}"))).unwrap_or_else(|e| panic!("{e}")))
 }
 
+/// A frame of `scene` (uploaded with its BVH for the ray tracer).
 pub fn render(scene: &Scene, settings: &RenderSettings) -> Frame {
     let r = renderer();
-    let gs = GpuScene::upload(&r.gpu, scene).expect("upload");
+    let mut gs = GpuScene::upload(&r.gpu, scene).expect("upload");
+    if settings.subdivision.method == twister::core::settings::Method::Trace {
+        gs = gs.with_bvh(&r.gpu, scene).expect("BVH");
+    }
     r.render(&gs, settings).expect("render")
 }
 
@@ -257,4 +261,66 @@ pub fn mapped_panels() -> twister::Scene {
 pub fn studio(background: bool) -> std::sync::Arc<twister::core::environment::PreparedEnvironment> {
     let prepared = twister::core::environment::Environment::neutral().prepare();
     std::sync::Arc::new(twister::core::environment::PreparedEnvironment { background, ..prepared })
+}
+
+/// A grey rough floor (y = −1.2) with a ball of radius 0.3 at (0.3, −0.6, −2.2) above it, under
+/// one light shining straight down: a directional light, or a spot light 2.1 m above the ball
+/// (cone 0.5/0.8 rad). With `screen`, also a 1 m square screen at y = −0.3 over x −1.6..−0.6,
+/// z −2.8..−1.8, whose alpha-masked 8×8 texture is a checker of holes (texel (i, j) opaque
+/// where i + j is even; u along +x, v along +z).
+pub fn ball_over_floor(kind: twister::core::light::LightKind, screen: bool) -> twister::Scene {
+    use glam::Vec3;
+    use twister::core::light::{Light, LightKind};
+    use twister::core::material::{AlphaMode, Filter, Material};
+    use twister::core::scene::SceneVertex;
+    use twister::core::texture::Texture;
+    let mut scene = twister::Scene::new("ball over floor");
+    scene.materials.push(Material { metallic: 0.0, roughness: 1.0, ..Default::default() });
+    let corner = |x: f32, y: f32, z: f32, material: u32| SceneVertex {
+        position: [x, y, z],
+        normal: [0.0, 1.0, 0.0],
+        color: [0.6, 0.6, 0.6, 1.0],
+        uv: [(x + 1.6) / 1.0, (z + 2.8) / 1.0],
+        material,
+        ..Default::default()
+    };
+    let floor = [
+        corner(-3.0, -1.2, 0.5, 1),
+        corner(3.0, -1.2, 0.5, 1),
+        corner(3.0, -1.2, -5.0, 1),
+        corner(-3.0, -1.2, -5.0, 1),
+    ];
+    scene.add_mesh("floor", &floor, &[0, 1, 2, 0, 2, 3]);
+    let ball = twister::core::builtin::sphere_scene(800, Vec3::new(0.3, -0.6, -2.2), 0.3, "ball");
+    scene.add_mesh("ball", &ball.vertices, &ball.indices);
+    if screen {
+        let rgba = (0..64u32).flat_map(|i| [200, 200, 200, if (i % 8 + i / 8) % 2 == 0 { 255 } else { 0 }]).collect();
+        scene.textures.push(Texture { name: "holes".into(), width: 8, height: 8, rgba });
+        scene.materials.push(Material {
+            texture: 0,
+            alpha_mode: AlphaMode::Mask as u32,
+            alpha_cutoff: 0.5,
+            min_filter: Filter::Nearest as u32,
+            mag_filter: Filter::Nearest as u32,
+            ..scene.materials[0]
+        });
+        let q = [
+            corner(-1.6, -0.3, -1.8, 2),
+            corner(-0.6, -0.3, -1.8, 2),
+            corner(-0.6, -0.3, -2.8, 2),
+            corner(-1.6, -0.3, -2.8, 2),
+        ];
+        scene.add_mesh("screen", &q, &[0, 1, 2, 0, 2, 3]);
+    }
+    let spot = kind == LightKind::Spot;
+    scene.lights = vec![Light {
+        kind,
+        position: if spot { Vec3::new(0.3, 1.5, -2.2) } else { Vec3::ZERO },
+        direction: Vec3::NEG_Y,
+        color: Vec3::splat(if spot { 40.0 } else { 3.0 }),
+        range: None,
+        inner_cone: 0.5,
+        outer_cone: 0.8,
+    }];
+    scene
 }

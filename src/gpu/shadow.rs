@@ -1,0 +1,135 @@
+//! The `shadow` stage on the GPU (maths in `core::shadow`, twin `cpu::shadow`): each of a frame's
+//! shadow maps drawn from its light (the scene's own triangles, a render pass per map into one
+//! depth texture) and copied into the scene's depth buffer, group 1's binding 7, which the
+//! drawing stages read. The maps are drawn again only when they change (another view or other
+//! lights); a frame without maps draws nothing.
+
+use glam::Mat4;
+
+use crate::core::shadow::GpuShadowMap;
+use crate::error::{Error, Result};
+use crate::gpu::renderer::Renderer;
+use crate::gpu::scene::GpuScene;
+use crate::gpu::targets::DEPTH_FORMAT;
+use crate::shader::types::ShadowParams;
+
+impl Renderer {
+    /// The depths of a scene's shadow maps as the last frame drew them (`bytes` of them).
+    pub fn shadow_depths(&self, scene: &GpuScene, bytes: u64) -> Result<Vec<f32>> {
+        let depths = scene.shadows.lock().unwrap_or_else(|e| e.into_inner()).depths.clone();
+        Ok(bytemuck::cast_slice(&self.gpu.download(&depths, bytes)?).to_vec())
+    }
+
+    /// Draws `maps` (the frame's, seen through `view`) into `scene`'s shadow depths, unless they
+    /// hold them already. Fails with one line where the maps do not fit the device.
+    pub(crate) fn draw_shadow_maps(&self, scene: &GpuScene, view: Mat4, maps: &[GpuShadowMap]) -> Result<()> {
+        let gpu = &self.gpu;
+        let Some(size) = maps.first().map(|m| m.size) else {
+            return Ok(());
+        };
+        let wanted: Vec<([[f32; 4]; 4], u32)> =
+            maps.iter().map(|m| ((m.matrix() * view).to_cols_array_2d(), m.size)).collect();
+        let mut shadows = scene.shadows.lock().unwrap_or_else(|e| e.into_inner());
+        if shadows.drawn == wanted {
+            return Ok(());
+        }
+        let max_size = gpu.limits.max_texture_dimension_2d;
+        let bytes = 4 * maps.len() as u64 * size as u64 * size as u64;
+        if size > max_size || bytes > gpu.max_binding() {
+            return Err(Error::option(
+                "--shadow-map-size",
+                format!(
+                    "{} maps of {size}×{size} texels ({} MiB) do not fit this GPU (images up to {max_size}, bindings up to {} MiB)",
+                    maps.len(),
+                    bytes >> 20,
+                    gpu.max_binding() >> 20
+                ),
+            ));
+        }
+        gpu.scoped("drawing the shadow maps", || {
+            if shadows.depths.size() < bytes {
+                shadows.depths = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("shadow depths"),
+                    size: bytes,
+                    // COPY_SRC: the twin test reads the depths back.
+                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+                    mapped_at_creation: false,
+                });
+            }
+            if shadows.texture.as_ref().is_none_or(|t| t.width() != size) {
+                shadows.texture = Some(gpu.device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some("shadow map"),
+                    size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: 1 },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: DEPTH_FORMAT,
+                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                    view_formats: &[],
+                }));
+            }
+            gpu.queue.write_buffer(&shadows.maps, 0, bytemuck::cast_slice(maps));
+            let texture = shadows.texture.as_ref().expect("just made");
+            let depth_view = texture.create_view(&Default::default());
+            let stage = &self.shadow.stage;
+            let pipeline = self.shadow.pipeline(gpu, scene.discards);
+            // The table's last two bindings are the maps being drawn: stand-ins there.
+            let [a, b, c, d, e, f, ..] = scene.group1(&shadows);
+            let empty = gpu.init_buffer("no shadow maps", &[0; 80], wgpu::BufferUsages::STORAGE);
+            let materials = stage.bind_group(gpu, None, 1, &[&a, &b, &c, &d, &e, &f, &empty, &empty]);
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            for ((clip_from_scene, _), map) in wanted.iter().zip(maps) {
+                let params = gpu.init_buffer(
+                    "shadow params",
+                    bytemuck::bytes_of(&ShadowParams { clip_from_scene: *clip_from_scene }),
+                    wgpu::BufferUsages::UNIFORM,
+                );
+                let group0 = stage.bind_group(gpu, None, 0, &[&params]);
+                {
+                    let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                        label: Some("shadow map"),
+                        color_attachments: &[],
+                        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                            view: &depth_view,
+                            depth_ops: Some(wgpu::Operations {
+                                load: wgpu::LoadOp::Clear(1.0),
+                                store: wgpu::StoreOp::Store,
+                            }),
+                            stencil_ops: None,
+                        }),
+                        timestamp_writes: None,
+                        occlusion_query_set: None,
+                        multiview_mask: None,
+                    });
+                    pass.set_pipeline(pipeline);
+                    pass.set_bind_group(0, &group0, &[]);
+                    pass.set_bind_group(1, &materials, &[]);
+                    pass.set_vertex_buffer(0, scene.vertices.slice(..));
+                    pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
+                    pass.draw_indexed(0..3 * scene.triangle_count, 0, 0..1);
+                }
+                enc.copy_texture_to_buffer(
+                    wgpu::TexelCopyTextureInfo {
+                        texture,
+                        mip_level: 0,
+                        origin: wgpu::Origin3d::ZERO,
+                        aspect: wgpu::TextureAspect::DepthOnly,
+                    },
+                    wgpu::TexelCopyBufferInfo {
+                        buffer: &shadows.depths,
+                        layout: wgpu::TexelCopyBufferLayout {
+                            offset: 4 * map.offset as u64,
+                            bytes_per_row: Some(4 * size),
+                            rows_per_image: Some(size),
+                        },
+                    },
+                    wgpu::Extent3d { width: size, height: size, depth_or_array_layers: 1 },
+                );
+            }
+            gpu.queue.submit([enc.finish()]);
+            Ok(())
+        })?;
+        shadows.drawn = wanted;
+        Ok(())
+    }
+}

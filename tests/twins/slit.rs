@@ -1,0 +1,68 @@
+//! The slit stage's twin check (tests/twins.rs): both eyes of slit mosaics on the GPU against
+//! `cpu::slit`.
+
+use twister::core::builtin;
+use twister::core::settings::Method;
+use twister::cpu::slit::{slit, slit_params, slits};
+use twister::{Eye, Projection, RenderSettings, Renderer, Scene, Vertical};
+
+use super::{common, compare_eyes, frame_outputs, lit_table, measured, EyeOutputs, Twin};
+
+pub struct Slit;
+
+impl Twin for Slit {
+    type Case = (Scene, RenderSettings);
+    type Output = EyeOutputs;
+    fn cases() -> Vec<(String, Self::Case)> {
+        let projection = Projection { width: 192, height: 48, vertical: Vertical::Exact, ..Projection::default() };
+        let mut cases: Vec<_> = [1, 4, 16]
+            .map(|w| {
+                (
+                    format!("demo slit:{w}"),
+                    (builtin::demo(), RenderSettings::new(projection).with_method(Method::Slit(w))),
+                )
+            })
+            .into();
+        // The sphere's tiles, parallel and converging rays.
+        for (w, convergence) in [(4, None), (16, Some(2.0))] {
+            let sphere = Projection { convergence, ..Projection::equirect(128) };
+            cases.push((
+                format!("demo on the sphere slit:{w} convergence {convergence:?}"),
+                (builtin::demo(), RenderSettings::new(sphere).with_method(Method::Slit(w))),
+            ));
+        }
+        cases.push((
+            "lit spheres slit:4".into(),
+            (
+                common::lit_spheres(),
+                RenderSettings::new(projection).with_method(Method::Slit(4)).with_shadow_map_size(256),
+            ),
+        ));
+        let shadows = common::ball_over_floor(twister::core::light::LightKind::Directional, true);
+        let settings = RenderSettings::new(projection).with_method(Method::Slit(4)).with_shadow_map_size(512);
+        cases.push(("ball and screen, directional light's shadow map".into(), (shadows, settings)));
+        let mut studio = common::lit_spheres();
+        studio.environment = Some(common::studio(true));
+        cases.push((
+            "lit spheres, the studio as the background".into(),
+            (studio, RenderSettings::new(projection).with_method(Method::Slit(4)).with_shadow_map_size(256)),
+        ));
+        cases
+    }
+    fn gpu(_: &Renderer, (scene, settings): &Self::Case) -> Self::Output {
+        frame_outputs(&measured(scene, settings))
+    }
+    fn cpu((scene, settings): &Self::Case) -> Self::Output {
+        let Method::Slit(w) = settings.subdivision.method else { unreachable!() };
+        let p = settings.projection();
+        let table = lit_table(scene, settings);
+        Eye::BOTH.map(|eye| {
+            let params = slit_params(p, settings.view(), eye, settings.shading.ambient, settings.measure.error_angle);
+            let img = slit(&params, &slits(p, eye, w), scene, &table, settings.shading.background);
+            (img.rgba, img.error, img.object, img.distance)
+        })
+    }
+    fn compare(gpu: &Self::Output, cpu: &Self::Output) -> Result<(), String> {
+        compare_eyes(gpu, cpu, 50, Some(0.01))
+    }
+}
