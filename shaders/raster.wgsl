@@ -5,6 +5,7 @@
 // one pass per eye (the `eyes` module, src/shader/mod.rs). CPU twin: src/cpu/raster.rs.
 
 #import projection
+#import scene
 #import fragment
 #import eyes
 
@@ -36,6 +37,7 @@ struct VertexIn {
     @location(4) color: vec4<f32>,
     @location(5) uv: vec2<f32>,
     @location(6) object: u32,
+    @location(7) tangent: u32,
 }
 
 
@@ -54,6 +56,7 @@ fn vs_main(in: VertexIn, eye_in: EyeIn) -> VertexOut {
     out.clip.y -= 2.0 * params.shift_px.y / params.projection.height;
     out.view_position = in.position;
     out.normal = in.normal;
+    out.tangent = unpack_tangent(in.tangent);
     out.color = in.color;
     out.object = in.object;
     out.uv = in.uv;

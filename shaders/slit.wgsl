@@ -9,6 +9,7 @@
 // CPU twin: src/cpu/slit.rs, which derives the camera form.
 
 #import projection
+#import scene
 #import fragment
 
 struct SlitParams {
@@ -45,6 +46,7 @@ struct VertexIn {
     @location(3) object: u32,
     @location(4) uv: vec2<f32>,
     @location(5) material: u32,
+    @location(6) tangent: u32,
 }
 
 
@@ -62,6 +64,8 @@ fn vs_main(in: VertexIn) -> VertexOut {
                          min(z_c - params.near, z_c * MAX_DEPTH), z_c);
     out.view_position = p;
     out.normal = (params.view * vec4<f32>(in.normal, 0.0)).xyz;
+    let t = unpack_tangent(in.tangent);
+    out.tangent = vec4<f32>((params.view * vec4<f32>(t.xyz, 0.0)).xyz, t.w);
     out.color = in.color;
     out.object = in.object;
     out.uv = in.uv;

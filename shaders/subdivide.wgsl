@@ -35,7 +35,7 @@ struct DrawVertex {
     color: vec4<f32>,
     uv: vec2<f32>,
     object: u32,
-    _pad: f32,
+    tangent: u32,   // the interpolated glTF tangent, viewer frame, packed (`pack_tangent`); 0: none
 }
 
 struct SubdivideParams {
@@ -125,6 +125,7 @@ var<private> tri_position: array<vec3<f32>, 3>;
 var<private> tri_normal: array<vec3<f32>, 3>;
 var<private> tri_color: array<vec4<f32>, 3>;
 var<private> tri_uv: array<vec2<f32>, 3>;
+var<private> tri_tangent: array<vec4<f32>, 3>;
 var<private> tri_material: u32;
 var<private> tri_object: u32;
 // L for this triangle: params.edge_px × its object's factor (read once in `load_triangle`).
@@ -318,6 +319,8 @@ fn load_triangle(t: u32) {
         tri_normal[k] = (params.view * vec4<f32>(v.normal, 0.0)).xyz;
         tri_color[k] = v.color;
         tri_uv[k] = v.uv;
+        let t = unpack_tangent(v.tangent);
+        tri_tangent[k] = vec4<f32>((params.view * vec4<f32>(t.xyz, 0.0)).xyz, t.w);
     }
     tri_material = vertices[indices[3u * t]].material;
     tri_object = vertices[indices[3u * t]].object;
@@ -851,7 +854,7 @@ fn draw_vertex(n: Node, theta_ref: f32) -> DrawVertex {
         b.x * tri_color[0] + b.y * tri_color[1] + b.z * tri_color[2],
         b.x * tri_uv[0] + b.y * tri_uv[1] + b.z * tri_uv[2],
         tri_object,
-        0.0,
+        pack_tangent(b.x * tri_tangent[0] + b.y * tri_tangent[1] + b.z * tri_tangent[2]),
     );
 }
 

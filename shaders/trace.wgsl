@@ -343,10 +343,12 @@ fn shade_hit(hit: Hit, dir: vec3<f32>, p: vec3<f32>, view_position: vec3<f32>, f
         // MAX_SHADOWED_LIGHTS lights through shadow rays (the main loop), any others directly;
         // tone mapped once the pixel's light is summed.
         let back = transpose(rotation);
-        // The tangent frame from the triangle's edges (what the drawing stages' screen
-        // derivatives give, as sub-triangles keep the triangle's plane and texture mapping).
+        // The tangent frame: the file's tangents interpolated, else from the triangle's edges
+        // (what the drawing stages' screen derivatives give, as sub-triangles keep the
+        // triangle's plane and texture mapping).
+        let t = b0 * unpack_tangent(a.tangent) + hit.b1 * unpack_tangent(b.tangent) + hit.b2 * unpack_tangent(c.tangent);
         let maps = surface_maps(a.material, uv, vec2<f32>(f, 0.0), vec2<f32>(0.0, f), back * (b.position - a.position),
-                                back * (c.position - a.position), b.uv - a.uv, c.uv - a.uv);
+                                back * (c.position - a.position), b.uv - a.uv, c.uv - a.uv, vec4<f32>(back * t.xyz, t.w));
         let v = -(back * dir);
         out.shadowed = select(0u, min(lighting.count, MAX_SHADOWED_LIGHTS), lighting.shadows != 0u);
         out.color = pbr_radiance(params.ambient, v, view_position, back * n, surface, maps, out.shadowed) * own;

@@ -8,6 +8,8 @@ use glam::Vec3;
 use twister::core::color::srgb_to_linear;
 use twister::core::light::{Light, LightKind, Tonemap};
 use twister::core::material::{Material, NO_TEXTURE};
+use twister::core::scene::pack_tangent;
+use twister::core::settings::{Method, Split};
 use twister::core::texture::Texture;
 use twister::{Eye, Projection, RenderSettings, Scene, Vertical};
 
@@ -35,8 +37,12 @@ fn tilted(tilt: [f32; 2], mirrored: bool, from: Vec3) -> Scene {
 
 /// Mean linear brightness of the quad's middle (the image's centre 40 × 40 pixels).
 fn brightness(scene: &Scene) -> f32 {
+    brightness_by(scene, Method::Adaptive(Split::Error))
+}
+
+fn brightness_by(scene: &Scene, method: Method) -> f32 {
     let projection = Projection { width: 640, height: 160, vertical: Vertical::Exact, ..Projection::default() };
-    let settings = RenderSettings::new(projection).with_tonemap(Tonemap::None).with_ambient(0.0);
+    let settings = RenderSettings::new(projection).with_tonemap(Tonemap::None).with_ambient(0.0).with_method(method);
     let frame = common::render(scene, &settings);
     let img = frame.eye(Eye::Left);
     let mut sum = 0.0;
@@ -70,6 +76,40 @@ fn the_normal_map_tilts_normals_along_u_and_up_the_image_mirrored_or_not() {
         // Lambert × (1 − F) / π: the ratio of the two n·l is 3.7; flat, both sides give 0.71.
         assert!(b_lit > 2.5 * b_dark, "{what}: lit side {b_lit}, other side {b_dark}");
         assert!(b_lit > 1.2 * flat && b_dark < 0.6 * flat, "{what}: {b_lit} / {b_dark} against flat {flat}");
+    }
+}
+
+/// Supplied tangents (glTF's TANGENT) give the normal map's frame instead of the texture
+/// coordinates: with the tangent pointing up the quad, a map tilting towards +x (the tangent)
+/// lights the quad from above, not from the right; with the tangent along +u and w = −1 the
+/// bitangent (n × t)·w points down, so a map tilting towards +y lights it from below. The
+/// drawing stages (adaptive, slits) and the ray tracer alike.
+#[test]
+fn supplied_tangents_give_the_normal_maps_frame() {
+    let (right, left) = (Vec3::new(1.0, 0.0, 1.0), Vec3::new(-1.0, 0.0, 1.0));
+    let (up, down) = (Vec3::new(0.0, 1.0, 1.0), Vec3::new(0.0, -1.0, 1.0));
+    let with_tangent = |tilt: [f32; 2], tangent: glam::Vec4, from: Vec3| {
+        let mut s = tilted(tilt, false, from);
+        for v in &mut s.vertices {
+            v.tangent = pack_tangent(tangent);
+        }
+        s
+    };
+    for method in [Method::Adaptive(Split::Error), Method::Slit(4), Method::Trace] {
+        for (what, tilt, tangent, lit, dark) in [
+            ("tangent up, map towards +x", [1.0, 0.0], glam::Vec4::new(0.0, 1.0, 0.0, 1.0), up, down),
+            ("tangent along u, w = −1, map towards +y", [0.0, 1.0], glam::Vec4::new(1.0, 0.0, 0.0, -1.0), down, up),
+        ] {
+            let b_lit = brightness_by(&with_tangent(tilt, tangent, lit), method);
+            let b_dark = brightness_by(&with_tangent(tilt, tangent, dark), method);
+            let b_side = [right, left].map(|from| brightness_by(&with_tangent(tilt, tangent, from), method));
+            assert!(b_lit > 2.5 * b_dark, "{} {what}: lit side {b_lit}, other side {b_dark}", method.name());
+            assert!(
+                b_side.iter().all(|&b| b < 0.9 * b_lit && b > 1.1 * b_dark),
+                "{} {what}: across the tilt {b_side:?}, along it {b_lit} / {b_dark}",
+                method.name()
+            );
+        }
     }
 }
 

@@ -216,6 +216,8 @@ impl Twin for Subdivide {
         let cases = [
             (random_triangle_scene(3, 600), base.with_method(Method::Vertex)),
             (random_triangle_scene(4, 300), base),
+            // glTF tangents, interpolated and packed again.
+            (common::with_tangents(random_triangle_scene(8, 200)), moved),
             (random_triangle_scene(5, 200), base.with_method(Method::Fixed(5))),
             (builtin::demo(), base),
             (builtin::demo(), moved.with_projection(tall_projection).with_method(Method::Vertex)),
@@ -447,7 +449,8 @@ impl Twin for Raster {
         let mut panels = common::mapped_panels();
         panels.environment = Some(common::studio(false));
         let settings = RenderSettings::new(Projection { width: 480, height: 120, ..Projection::default() });
-        out.push(("mapped panels".into(), (panels, settings, None)));
+        out.push(("mapped panels".into(), (panels.clone(), settings, None)));
+        out.push(("mapped panels with glTF tangents".into(), (common::with_tangents(panels), settings, None)));
         // Shadow maps: a ball and a masked screen over a floor under a spot light.
         let shadows = common::ball_over_floor(twister::core::light::LightKind::Spot, true);
         let settings = RenderSettings::new(Projection {
@@ -621,6 +624,13 @@ impl Twin for Trace {
             (
                 "every glTF map on quads, u mirrored on one, the tangent frame from the triangle".into(),
                 (common::mapped_panels(), RenderSettings::new(cylinder).with_method(Method::Trace)),
+            ),
+            (
+                "every glTF map, the file's tangents".into(),
+                (
+                    common::with_tangents(common::mapped_panels()),
+                    RenderSettings::new(cylinder).with_method(Method::Trace),
+                ),
             ),
             (
                 "box room".into(),

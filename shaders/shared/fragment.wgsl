@@ -28,13 +28,13 @@ struct FragmentOut {
 }
 
 fn fragment_out(eye: u32, frag_xy: vec2<f32>, view_position: vec3<f32>, dp_dx: vec3<f32>, dp_dy: vec3<f32>,
-                normal: vec3<f32>, color: vec4<f32>, object: u32, material: u32, uv: vec2<f32>, duv_dx: vec2<f32>,
-                duv_dy: vec2<f32>) -> FragmentOut {
+                normal: vec3<f32>, tangent: vec4<f32>, color: vec4<f32>, object: u32, material: u32, uv: vec2<f32>,
+                duv_dx: vec2<f32>, duv_dy: vec2<f32>) -> FragmentOut {
     let params = stage_params(eye);
     let plane_normal = cross(dp_dx, dp_dy);
     var out: FragmentOut;
     out.color = shade_surface(material, params.ambient, params.projection, params.eye_sign, frag_xy, view_position,
-                              normal, color, uv, duv_dx, duv_dy, dp_dx, dp_dy);
+                              normal, tangent, color, uv, duv_dx, duv_dy, dp_dx, dp_dy);
     out.error = encode_error(pixel_error(params.projection, params.eye_sign, view_position, frag_xy,
                                          params.error_angle != 0u));
     out.object = object + 1u;
@@ -55,6 +55,8 @@ struct VertexOut {
     @location(5) @interpolate(flat) material: u32,
     // The eye drawn: 0 left, 1 right.
     @location(6) @interpolate(flat) eye: u32,
+    // glTF's tangent (viewer frame xyz, bitangent sign w), zero where none.
+    @location(7) tangent: vec4<f32>,
 }
 
 @fragment
@@ -70,7 +72,7 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @locatio
     }
     let params = stage_params(in.eye);
     return shade_surface(in.material, params.ambient, params.projection, params.eye_sign, in.clip.xy, in.view_position,
-                         in.normal, c, in.uv, duv_dx, duv_dy, dp_dx, dp_dy);
+                         in.normal, in.tangent, c, in.uv, duv_dx, duv_dy, dp_dx, dp_dy);
 }
 
 // The same, plus the display-position error, the object id and the distance (when the error or
@@ -108,8 +110,8 @@ fn measured(in: VertexOut, front_facing: bool) -> FragmentOut {
     if (MATERIALS && DISCARDS && c.a < 0.0) {
         discard;
     }
-    return fragment_out(in.eye, in.clip.xy, in.view_position, dp_dx, dp_dy, in.normal, c, in.object, in.material,
-                        in.uv, duv_dx, duv_dy);
+    return fragment_out(in.eye, in.clip.xy, in.view_position, dp_dx, dp_dy, in.normal, in.tangent, c, in.object,
+                        in.material, in.uv, duv_dx, duv_dy);
 }
 
 // ---- The background: an environment the user gave, seen all around ----

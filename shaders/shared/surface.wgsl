@@ -355,22 +355,23 @@ fn tonemap(c_in: vec3<f32>) -> vec3<f32> {
 // origin: highlights differ between the eyes), plus ambient × the diffuse colour and the
 // emission, tone mapped; else the headlight (`shade`). `shade_surface` in fragment.rs.
 fn shade_surface(material: u32, ambient: f32, proj: Projection, eye_sign: f32, frag_xy: vec2<f32>,
-                 view_position: vec3<f32>, normal: vec3<f32>, color: vec4<f32>, uv: vec2<f32>,
+                 view_position: vec3<f32>, normal: vec3<f32>, tangent: vec4<f32>, color: vec4<f32>, uv: vec2<f32>,
                  duv_dx: vec2<f32>, duv_dy: vec2<f32>, dp_dx: vec3<f32>, dp_dy: vec3<f32>) -> vec4<f32> {
     if (!MATERIALS || !PBR || lighting.pbr == 0u) {
         return shade(ambient, view_position, normal, color);
     }
     let eye = pixel_ray(proj, eye_sign, frag_xy).origin;
-    let maps = surface_maps(material, uv, duv_dx, duv_dy, dp_dx, dp_dy, duv_dx, duv_dy);
+    let maps = surface_maps(material, uv, duv_dx, duv_dy, dp_dx, dp_dy, duv_dx, duv_dy, tangent);
     return vec4<f32>(tonemap(pbr_radiance(ambient, normalize(eye - view_position), view_position, normal, color,
                                           maps, 0u)), 1.0);
 }
 
 // A surface's BRDF inputs with the material's texture maps applied: metallic and roughness
 // (× the metallic-roughness map's blue and green), occlusion (1 + strength·(red − 1)), emission
-// (× the emissive map), the normal map's tangent-space normal ((0, 0, 1) without one), and two
-// in-plane position differentials with their texture-coordinate differences, which give the
-// tangent frame. `surface_maps` in fragment.rs.
+// (× the emissive map), the normal map's tangent-space normal ((0, 0, 1) without one), and the
+// tangent frame: the file's tangent where it gives one (xyz and the bitangent's sign w, viewer
+// frame; w = 0: none), else two in-plane position differentials with their texture-coordinate
+// differences. `surface_maps` in fragment.rs.
 struct SurfaceMaps {
     metallic: f32,
     roughness: f32,
@@ -381,23 +382,24 @@ struct SurfaceMaps {
     dp2: vec3<f32>,
     duv1: vec2<f32>,
     duv2: vec2<f32>,
+    tangent: vec4<f32>,
 }
 
 // The maps sampled at uv with the sampling derivatives duv_dx, duv_dy, in one loop (lavapipe
 // inlines every call, and a shader that merely contains more code runs slower).
 fn surface_maps(material: u32, uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>, dp1: vec3<f32>,
-                dp2: vec3<f32>, duv1: vec2<f32>, duv2: vec2<f32>) -> SurfaceMaps {
+                dp2: vec3<f32>, duv1: vec2<f32>, duv2: vec2<f32>, tangent: vec4<f32>) -> SurfaceMaps {
     let index = min(material, arrayLength(&materials) - 1u);
     let any_map = materials[index].mr_mip_count | materials[index].normal_mip_count
         | materials[index].occlusion_mip_count | materials[index].emissive_mip_count;
     if (!MAPS || any_map == 0u) {
         return SurfaceMaps(materials[index].metallic, materials[index].roughness, 1.0,
                            vec3<f32>(materials[index].emissive_r, materials[index].emissive_g, materials[index].emissive_b),
-                           vec3<f32>(0.0, 0.0, 1.0), dp1, dp2, duv1, duv2);
+                           vec3<f32>(0.0, 0.0, 1.0), dp1, dp2, duv1, duv2, tangent);
     }
     let m = materials[index];
     var s = SurfaceMaps(m.metallic, m.roughness, 1.0, vec3<f32>(m.emissive_r, m.emissive_g, m.emissive_b),
-                        vec3<f32>(0.0, 0.0, 1.0), dp1, dp2, duv1, duv2);
+                        vec3<f32>(0.0, 0.0, 1.0), dp1, dp2, duv1, duv2, tangent);
     for (var j = 0u; j < 4u; j++) {
         var first = m.mr_first_mip;
         var count = m.mr_mip_count;
@@ -529,17 +531,26 @@ fn light_term(i: u32, n: vec3<f32>, v: vec3<f32>, view_position: vec3<f32>, base
 }
 
 // The unit normal the glTF BRDF shades with at a surface seen along v: the given one (v where
-// there is none), turned to the side the eye sees, perturbed by the normal map.
+// there is none), turned to the side the eye sees, perturbed by the normal map (in the file's
+// tangent frame where it has one, else the derivatives' frame of `mapped_normal`).
 fn shading_normal(normal: vec3<f32>, v: vec3<f32>, maps: SurfaceMaps) -> vec3<f32> {
     var n = normal;
     if (dot(n, n) < 1e-12) {
         n = v;
     }
     n = normalize(n);
-    if (dot(n, v) < 0.0) {
-        n = -n;
+    let side = select(-1.0, 1.0, dot(n, v) >= 0.0);
+    if (maps.tangent.w != 0.0 && maps.normal.z < 1.0) {
+        // The file's frame: the tangent made normal to n, the bitangent (n × t)·sign(w) (glTF);
+        // seen from the back, the whole perturbed normal turns with the face (as three.js does).
+        let t = maps.tangent.xyz - n * dot(n, maps.tangent.xyz);
+        if (dot(t, t) > 1e-12) {
+            let tu = normalize(t);
+            let b = cross(n, tu) * select(-1.0, 1.0, maps.tangent.w >= 0.0);
+            return side * normalize(tu * maps.normal.x + b * maps.normal.y + n * maps.normal.z);
+        }
     }
-    return mapped_normal(n, maps);
+    return mapped_normal(side * n, maps);
 }
 
 // ---- Image-based lighting (src/core/environment.rs; twins in fragment.rs) ----

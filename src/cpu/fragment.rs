@@ -101,7 +101,8 @@ pub fn shade_surface(
     }
     let (origin, _) = pixel_ray(projection, eye, frag_xy);
     let (duv_dx, duv_dy) = (surface.duv_dx, surface.duv_dy);
-    let maps = surface_maps(table, material, surface.uv, duv_dx, duv_dy, [dp_dx, dp_dy], [duv_dx, duv_dy]);
+    let maps =
+        surface_maps(table, material, surface.uv, duv_dx, duv_dy, [dp_dx, dp_dy], [duv_dx, duv_dy], surface.tangent);
     let v = (origin - view_position).normalize();
     let c = pbr_radiance(table, ambient, v, view_position, normal, color, &maps, 0);
     display_bytes(tonemap(c, &table.lighting))
@@ -203,7 +204,17 @@ pub fn light_term(light: &GpuLight, n: Vec3, v: Vec3, view_position: Vec3, base:
 /// none), turned to the side the eye sees, perturbed by the normal map.
 pub fn shading_normal(normal: Vec3, v: Vec3, maps: &SurfaceMaps) -> Vec3 {
     let n = if normal.length_squared() < 1e-12 { v } else { normal.normalize() };
-    mapped_normal(if n.dot(v) < 0.0 { -n } else { n }, maps)
+    let side = if n.dot(v) >= 0.0 { 1.0 } else { -1.0 };
+    if maps.tangent.w != 0.0 && maps.normal.z < 1.0 {
+        // The file's frame: bitangent (n × t)·sign(w); from the back the whole normal turns.
+        let t = maps.tangent.truncate() - n * n.dot(maps.tangent.truncate());
+        if t.dot(t) > 1e-12 {
+            let tu = t.normalize();
+            let b = n.cross(tu) * if maps.tangent.w >= 0.0 { 1.0 } else { -1.0 };
+            return side * (tu * maps.normal.x + b * maps.normal.y + n * maps.normal.z).normalize();
+        }
+    }
+    mapped_normal(side * n, maps)
 }
 
 /// A surface's BRDF inputs with its material's texture maps applied (`SurfaceMaps` in
@@ -219,6 +230,8 @@ pub struct SurfaceMaps {
     pub normal: Vec3,
     pub dp: [Vec3; 2],
     pub duv: [Vec2; 2],
+    /// The file's tangent (viewer frame, sign w), zero where none.
+    pub tangent: Vec4,
 }
 
 /// The maps sampled at uv with the sampling derivatives duv_dx, duv_dy (`surface_maps`).
@@ -230,6 +243,7 @@ pub fn surface_maps(
     duv_dy: Vec2,
     dp: [Vec3; 2],
     duv: [Vec2; 2],
+    tangent: Vec4,
 ) -> SurfaceMaps {
     let m = &table.materials[(material as usize).min(table.materials.len() - 1)];
     let mut s = SurfaceMaps {
@@ -240,6 +254,7 @@ pub fn surface_maps(
         normal: Vec3::Z,
         dp,
         duv,
+        tangent,
     };
     let maps = [
         (m.mr_first_mip, m.mr_mip_count),
@@ -543,6 +558,8 @@ pub struct Surface {
     pub duv_dy: Vec2,
     pub frag_xy: Vec2,
     pub front_facing: bool,
+    /// glTF's tangent (viewer frame xyz, bitangent sign w), zero where none.
+    pub tangent: Vec4,
 }
 
 /// The linear surface colour of a fragment, or None where it is discarded (a single-sided face
@@ -646,6 +663,7 @@ mod tests {
             duv_dy: Vec2::ZERO,
             frag_xy: Vec2::new(0.5, 0.5),
             front_facing,
+            tangent: Vec4::ZERO,
         };
         let mut t = MaterialTable::build(
             &[

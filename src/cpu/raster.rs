@@ -11,6 +11,7 @@
 use glam::{Vec2, Vec3, Vec4};
 
 use crate::core::projection::{azimuth, Eye, Projection};
+use crate::core::scene::unpack_tangent;
 use crate::core::settings::RenderSettings;
 use crate::core::texture::MaterialTable;
 use crate::cpu::fragment::{
@@ -45,6 +46,8 @@ pub struct ClipVertex {
     pub clip: Vec4,
     pub view_position: Vec3,
     pub normal: Vec3,
+    /// glTF's tangent (viewer frame xyz, sign w), zero where none.
+    pub tangent: Vec4,
     pub color: Vec4,
     pub uv: Vec2,
     pub object: u32,
@@ -57,6 +60,7 @@ impl ClipVertex {
             clip: a.clip + (b.clip - a.clip) * t,
             view_position: a.view_position + (b.view_position - a.view_position) * t,
             normal: a.normal + (b.normal - a.normal) * t,
+            tangent: a.tangent + (b.tangent - a.tangent) * t,
             color: a.color + (b.color - a.color) * t,
             uv: a.uv + (b.uv - a.uv) * t,
             object: a.object,
@@ -229,6 +233,7 @@ fn rasterize_clipped(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: [u32;
                     // Counter-clockwise in normalized device coordinates (y up) is clockwise
                     // on the pixel grid (y down): negative `area`.
                     front_facing: area < 0.0,
+                    tangent: (0..3).map(|k| pw[k] * tri[k].tangent).sum::<Vec4>(),
                 },
             };
             let Some(out) = fragment(&input) else {
@@ -264,6 +269,7 @@ pub fn raster(
                 clip: raster_vertex(eye_params, &tri[k]),
                 view_position: Vec3::from(tri[k].position),
                 normal: Vec3::from(tri[k].normal),
+                tangent: unpack_tangent(tri[k].tangent),
                 color: Vec4::from(tri[k].color),
                 uv: Vec2::from(tri[k].uv),
                 object: tri[k].object,

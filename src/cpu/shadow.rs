@@ -35,6 +35,7 @@ pub fn shadow(
                     clip: clip_from_scene * Vec3::from(v.position).extend(1.0),
                     view_position: Vec3::ZERO,
                     normal: Vec3::ZERO,
+                    tangent: Vec4::ZERO,
                     color: Vec4::from(v.color),
                     uv: Vec2::from(v.uv),
                     object: 0,

@@ -34,7 +34,7 @@
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use crate::core::projection::{Eye, PanoramaKind, Projection};
-use crate::core::scene::{object_spheres, Scene, SceneVertex};
+use crate::core::scene::{object_spheres, unpack_tangent, Scene, SceneVertex};
 use crate::core::texture::MaterialTable;
 use crate::cpu::raster::{fragment, rasterize, ClipVertex, FragmentIn, RasterImage};
 pub use crate::shader::types::{SlitCamera, SlitParams};
@@ -199,6 +199,10 @@ pub fn slit(
                         clip: slit_vertex(params, &slit.camera, p),
                         view_position: p,
                         normal: view.transform_vector3(Vec3::from(v.normal)),
+                        tangent: {
+                            let t = unpack_tangent(v.tangent);
+                            view.transform_vector3(t.truncate()).extend(t.w)
+                        },
                         color: Vec4::from(v.color),
                         uv: Vec2::from(v.uv),
                         object: v.object,

@@ -16,7 +16,7 @@ use crate::core::light::tonemap;
 use crate::core::light::LightKind;
 use crate::core::material::AlphaMode;
 use crate::core::projection::{Eye, Projection};
-use crate::core::scene::SceneVertex;
+use crate::core::scene::{unpack_tangent, SceneVertex};
 use crate::core::settings::RenderSettings;
 use crate::core::texture::MaterialTable;
 use crate::core::visual_field::Gaze;
@@ -250,6 +250,7 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
             duv_dy: Vec2::new(0.0, f),
             frag_xy,
             front_facing: front,
+            tangent: b0 * unpack_tangent(a.tangent) + b1 * unpack_tangent(b.tangent) + b2 * unpack_tangent(c.tangent),
         }
     };
     let light = (params.light[3] > 0.0).then(|| Vec3::new(params.light[0], params.light[1], params.light[2]));
@@ -284,7 +285,7 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
             // The glTF BRDF under the scene's lights, seen along the ray (tone mapped once the
             // pixel's light is summed).
             None if table.lighting.pbr != 0 => {
-                // The tangent frame from the triangle's edges (`shade_hit` in trace.wgsl).
+                // The file's tangents, else the frame from the triangle's edges (`shade_hit`).
                 let [a, b, c] = corners(hit.triangle);
                 let (pa, pb, pc) = (Vec3::from(a.position), Vec3::from(b.position), Vec3::from(c.position));
                 let (ua, ub, uc) = (Vec2::from(a.uv), Vec2::from(b.uv), Vec2::from(c.uv));
@@ -296,6 +297,7 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
                     hit_surface.duv_dy,
                     [to_view * (pb - pa), to_view * (pc - pa)],
                     [ub - ua, uc - ua],
+                    (to_view * hit_surface.tangent.truncate()).extend(hit_surface.tangent.w),
                 );
                 // The first MAX_SHADOWED_LIGHTS lights behind their shadow rays, the others directly.
                 let v = -(to_view * dir);

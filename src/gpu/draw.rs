@@ -199,6 +199,7 @@ fn draw_pipeline(
                 attribute(Float32x4, offset_of!(DrawVertex, color), 4),
                 attribute(Float32x2, offset_of!(DrawVertex, uv), 5),
                 attribute(Uint32, offset_of!(DrawVertex, object), 6),
+                attribute(Uint32, offset_of!(DrawVertex, tangent), 7),
             ],
         ),
         DrawStage::Slit => (
@@ -210,6 +211,7 @@ fn draw_pipeline(
                 attribute(Uint32, offset_of!(SceneVertex, object), 3),
                 attribute(Float32x2, offset_of!(SceneVertex, uv), 4),
                 attribute(Uint32, offset_of!(SceneVertex, material), 5),
+                attribute(Uint32, offset_of!(SceneVertex, tangent), 6),
             ],
         ),
     };

@@ -26,7 +26,8 @@ pub struct DrawVertex {
     pub color: [f32; 4],
     pub uv: [f32; 2],
     pub object: u32,
-    pub _pad: f32,
+    /// The interpolated glTF tangent in the viewer frame, packed (`core::scene::pack_tangent`; 0: none).
+    pub tangent: u32,
 }
 
 /// `Projection` in shaders/shared/projection.wgsl. 48 bytes.
@@ -344,8 +345,8 @@ pub struct ShadowParams {
 
 /// Every struct the stages bind (as a uniform or in a storage buffer), by its WGSL name.
 pub const LAYOUTS: &[StructLayout] = &[
-    layout!("SceneVertex" => SceneVertex { position, material, normal, object, color, uv, _pad1 }),
-    layout!("DrawVertex" => DrawVertex { position, theta_ref, normal, material, color, uv, object, _pad }),
+    layout!("SceneVertex" => SceneVertex { position, material, normal, object, color, uv, tangent, _pad1 }),
+    layout!("DrawVertex" => DrawVertex { position, theta_ref, normal, material, color, uv, object, tangent }),
     layout!("Projection" => ProjectionUniform {
         screen_radius, eye_radius, width, height, acos_eye_screen, vertical_exact, pixels_per_v, panorama,
         convergence, pole_from, pole_to, _pad

@@ -257,6 +257,20 @@ pub fn mapped_panels() -> twister::Scene {
     scene
 }
 
+/// The scene with a tangent on every vertex (glTF's TANGENT): in the vertex's tangent plane,
+/// turning 0.3 rad from one vertex to the next, the bitangent's sign +1 on object 0 and −1 on the
+/// others.
+pub fn with_tangents(mut scene: twister::Scene) -> twister::Scene {
+    use glam::{Quat, Vec3};
+    for (i, v) in scene.vertices.iter_mut().enumerate() {
+        let n = Vec3::from(v.normal).normalize_or(Vec3::Z);
+        let side = if n.y.abs() < 0.9 { Vec3::Y } else { Vec3::X };
+        let t = Quat::from_axis_angle(n, 0.3 * i as f32) * n.cross(side).normalize();
+        v.tangent = twister::core::scene::pack_tangent(t.extend(if v.object == 0 { 1.0 } else { -1.0 }));
+    }
+    scene
+}
+
 /// The neutral studio, prepared, shown as the background if `background`.
 pub fn studio(background: bool) -> std::sync::Arc<twister::core::environment::PreparedEnvironment> {
     let prepared = twister::core::environment::Environment::neutral().prepare();

@@ -1,6 +1,7 @@
 //! The subdivide twin check's comparison of two triangle sets (tests/twins.rs).
 
 use glam::Vec3;
+use twister::core::scene::unpack_tangent;
 use twister::shader::types::DrawVertex;
 
 /// Matches each CPU triangle to the nearest unused GPU triangle (searched among those whose
@@ -50,6 +51,7 @@ pub fn same_triangle_sets(cpu: &[DrawVertex], gpu: &[DrawVertex], allowed: usize
                 && close(&a.normal, &b.normal)
                 && close(&a.color, &b.color)
                 && close(&a.uv, &b.uv)
+                && close(&unpack_tangent(a.tangent).to_array(), &unpack_tangent(b.tangent).to_array())
                 && a.material == b.material
         };
         match t.iter().zip(gpu_tris[best]).find(|(a, b)| !same(a, b)) {

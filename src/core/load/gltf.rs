@@ -7,7 +7,7 @@ use glam::{Mat4, Vec3};
 
 use crate::core::light::{Light, LightKind};
 use crate::core::material::{AlphaMode, Filter, Material, Mipmap, Wrap};
-use crate::core::scene::{compute_normals, Scene, SceneVertex};
+use crate::core::scene::{compute_normals, pack_tangent, Scene, SceneVertex};
 use crate::core::texture::Texture;
 
 /// An image decoded by the glTF importer, as RGBA8 (16-bit channels keep their high byte,
@@ -551,6 +551,7 @@ fn add_gltf_primitive(
     let positions: Vec<[f32; 3]> = reader.read_positions().ok_or("no POSITION attribute")?.collect();
     let n = positions.len();
     let normals: Option<Vec<[f32; 3]>> = reader.read_normals().map(|r| r.collect());
+    let tangents: Option<Vec<[f32; 4]>> = reader.read_tangents().map(|r| r.collect());
     let material = prim.material();
     let (set, transform) = material.index().map_or((0, None), |k| (materials[k].1, materials[k].2));
     let uvs: Option<Vec<[f32; 2]>> = reader.read_tex_coords(set).map(|r| {
@@ -582,6 +583,9 @@ fn add_gltf_primitive(
         _ => (1..raw.len().saturating_sub(1)).flat_map(|k| [raw[0], raw[k], raw[k + 1]]).collect(),
     };
     let normal_matrix = world.inverse().transpose();
+    // A tangent moves with the surface (the matrix itself); a mirroring matrix flips the
+    // bitangent's sign, as it flips the winding.
+    let mirror = if glam::Mat3::from_mat4(world).determinant() < 0.0 { -1.0 } else { 1.0 };
     let mut vertices: Vec<SceneVertex> = (0..n)
         .map(|i| {
             let c = colors.as_ref().and_then(|c| c.get(i).copied()).unwrap_or([1.0; 4]);
@@ -594,6 +598,9 @@ fn add_gltf_primitive(
                     .into(),
                 color: [0, 1, 2, 3].map(|k| c[k] * factor[k]),
                 uv: uvs.as_ref().and_then(|v| v.get(i)).copied().unwrap_or([0.0; 2]),
+                tangent: tangents.as_ref().and_then(|v| v.get(i)).map_or(0, |&[x, y, z, w]| {
+                    pack_tangent(world.transform_vector3(Vec3::new(x, y, z)).normalize_or_zero().extend(w * mirror))
+                }),
                 material: material_id,
                 ..Default::default()
             }

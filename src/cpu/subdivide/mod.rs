@@ -75,7 +75,7 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 use std::f32::consts::{PI, TAU};
 
 use crate::core::projection::{azimuth, horizontal_radius, wrap_angle, Eye, PanoramaKind, Projection, Vertical};
-use crate::core::scene::SceneVertex;
+use crate::core::scene::{pack_tangent, unpack_tangent, SceneVertex};
 use crate::core::settings::{RenderSettings, SplitRule};
 use crate::shader::constants::{
     EDGE_SAMPLES, ERROR_SPLIT_LENGTH, MAX_EDGE_DIVISIONS, MAX_MACRO_LEVEL, MAX_STRETCH, PIECE_DIVISIONS, SEAM_MARGIN,
@@ -120,6 +120,8 @@ struct Triangle {
     normal: [Vec3; 3],
     color: [Vec4; 3],
     uv: [Vec2; 3],
+    /// glTF tangents (viewer frame xyz, sign w), zero where none.
+    tangent: [Vec4; 3],
     material: u32,
     object: u32,
 }
@@ -365,6 +367,10 @@ impl<'a> Subdivider<'a> {
             normal: [0, 1, 2].map(|k| view.transform_vector3(Vec3::from(v(k).normal))),
             color: [0, 1, 2].map(|k| Vec4::from(v(k).color)),
             uv: [0, 1, 2].map(|k| Vec2::from(v(k).uv)),
+            tangent: [0, 1, 2].map(|k| {
+                let t = unpack_tangent(v(k).tangent);
+                view.transform_vector3(t.truncate()).extend(t.w)
+            }),
             material: v(0).material,
             object: v(0).object,
         }
@@ -737,7 +743,7 @@ fn draw_vertex(tri: &Triangle, n: Node, theta_ref: f32) -> DrawVertex {
         color: (b.x * tri.color[0] + b.y * tri.color[1] + b.z * tri.color[2]).into(),
         uv: (b.x * tri.uv[0] + b.y * tri.uv[1] + b.z * tri.uv[2]).into(),
         object: tri.object,
-        _pad: 0.0,
+        tangent: pack_tangent(b.x * tri.tangent[0] + b.y * tri.tangent[1] + b.z * tri.tangent[2]),
     }
 }
 
