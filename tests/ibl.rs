@@ -369,3 +369,49 @@ fn the_environment_turns_by_its_yaw() {
         assert!((mid(&turned) - 128.0).abs() < 4.0, "{method:?}: turned, around {}", mid(&turned));
     }
 }
+
+/// The preparation is cached on disk: read back, it is exactly what preparing gives; a damaged
+/// or truncated cache file is prepared again and replaced by a whole one; `--environment` in the
+/// command line fills the folder `TWISTER_CACHE_DIR` names.
+#[test]
+fn the_prepared_environment_is_cached_and_a_damaged_cache_is_replaced() {
+    use twister::core::environment_cache::cache_file;
+    let dir = std::env::temp_dir().join(format!("twister-env-cache-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let env = Environment::load(&common::asset("environments/venice_sunset_1k.hdr")).unwrap();
+    let fresh = env.prepare();
+    let first = env.prepare_cached_in(Some(&dir));
+    assert_eq!(first, fresh, "written");
+    let file = cache_file(&dir, &env);
+    let bytes = std::fs::read(&file).unwrap();
+    assert_eq!(env.prepare_cached_in(Some(&dir)), fresh, "read back");
+    for damage in ["truncated", "flipped"] {
+        let mut bad = bytes.clone();
+        if damage == "truncated" {
+            bad.truncate(bytes.len() / 2);
+        } else {
+            bad[bytes.len() / 3] ^= 0x40;
+        }
+        std::fs::write(&file, &bad).unwrap();
+        assert_eq!(env.prepare_cached_in(Some(&dir)), fresh, "{damage} cache file");
+        assert_eq!(std::fs::read(&file).unwrap(), bytes, "{damage} cache file replaced by a whole one");
+    }
+    // No temporary files are left behind.
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+    // The command line caches where TWISTER_CACHE_DIR says (the studio of a glTF scene too).
+    let cli_dir = dir.join("cli");
+    let out = dir.join("out");
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_twister"))
+        .env("TWISTER_CACHE_DIR", &cli_dir)
+        .args(["render", "--width", "64", "--height", "32", "--environment"])
+        .arg(common::asset("environments/venice_sunset_1k.hdr"))
+        .arg("--lighting")
+        .arg("pbr")
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(status.status.success(), "{}", String::from_utf8_lossy(&status.stderr));
+    assert!(cli_dir.join(cache_file(&cli_dir, &env).file_name().unwrap()).exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}

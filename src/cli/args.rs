@@ -350,12 +350,12 @@ impl ViewArgs {
             };
         Ok(match self.environment.as_deref() {
             Some("none") => None,
-            Some("neutral") => Some(Environment::neutral().prepare()),
+            Some("neutral") => Some(Environment::neutral().prepare_cached()),
             Some(file) => Some(PreparedEnvironment {
                 background: true,
-                ..Environment::load(std::path::Path::new(file))?.prepare()
+                ..Environment::load(std::path::Path::new(file))?.prepare_cached()
             }),
-            None if wants_default => Some(Environment::neutral().prepare()),
+            None if wants_default => Some(Environment::neutral().prepare_cached()),
             None => None,
         })
     }

@@ -7,6 +7,7 @@ pub mod bvh;
 pub mod color;
 pub mod compare;
 pub mod environment;
+pub mod environment_cache;
 pub mod frame;
 pub mod light;
 pub mod load;
