@@ -1,5 +1,6 @@
-// The `shadow` stage (src/core/shadow.rs): the depth of the scene seen from a directional or
-// spot light, one map per render pass, before the drawing stages read it (`shadow_visibility`
+// The `shadow` stage (src/core/shadow.rs): the depth of the scene seen from a light (a
+// directional light's orthographic map, a spot light's perspective one, each of a point light's
+// six cube faces), one map per render pass, before the drawing stages read it (`shadow_visibility`
 // in surface.wgsl). A plain linear projection, so the scene's own triangles are drawn, not
 // subdivided. Opaque scenes draw depth only; where a material can discard (alpha MASK, the
 // BLEND screen door, here at the map's texels), `fs_mask` leaves out what it leaves out. Both

@@ -1,5 +1,5 @@
 //! The scene's lights cast shadows (issue 17): shadow maps in the drawing stages (raster and
-//! slit) for directional and spot lights, shadow rays in the ray tracer; checked against brute
+//! slit) for directional, spot and point lights (a cube), shadow rays in the ray tracer; checked against brute
 //! force geometry (where a ball or a masked screen hides the light) on the floor below them.
 
 mod common;
@@ -43,8 +43,8 @@ fn floor_pixels(frame: &twister::Frame, p: &Projection, viewer: Vec3) -> Vec<((u
     out
 }
 
-/// A ball 0.6 m above a grey floor under a directional light (straight down) or a spot light
-/// above it darkens the floor it hides by the light's whole share there, with the exact methods
+/// A ball 0.6 m above a grey floor under a directional light (straight down), a spot light or a
+/// point light above it darkens the floor it hides by the light's whole share there, with the exact methods
 /// (the ray tracer, the adaptive subdivision, slits; the vertex method bends the floor): the
 /// shadow is where the light's direction projects the ball (brute force: a floor point is
 /// shadowed if the way from it towards the light meets the ball; points within 2 cm of the
@@ -53,7 +53,7 @@ fn floor_pixels(frame: &twister::Frame, p: &Projection, viewer: Vec3) -> Vec<((u
 fn a_ball_shadows_the_floor_where_brute_force_puts_its_shadow() {
     let p = exact(480, 160);
     for method in [Method::Trace, Method::Adaptive(Split::Error), Method::Slit(4)] {
-        for kind in [LightKind::Directional, LightKind::Spot] {
+        for kind in [LightKind::Directional, LightKind::Spot, LightKind::Point] {
             let scene = ball_over_floor(kind, false);
             let light = scene.lights[0].position;
             let settings = RenderSettings::new(p)
@@ -65,7 +65,7 @@ fn a_ball_shadows_the_floor_where_brute_force_puts_its_shadow() {
             let frame = render(&scene, &settings);
             let (mut in_shadow, mut lit, mut shadow_pixels) = (Vec::new(), Vec::new(), Vec::new());
             for (xy, point, v) in floor_pixels(&frame, &p, Vec3::ZERO) {
-                let to_light = if kind == LightKind::Spot { (light - point).normalize() } else { Vec3::Y };
+                let to_light = if kind == LightKind::Directional { Vec3::Y } else { (light - point).normalize() };
                 // Brute force: does the way to the light pass through the ball? The
                 // discriminant b² − (|q|² − r²) ≈ 2r·(distance inside the silhouette).
                 let q = point - CENTRE;
@@ -115,7 +115,7 @@ fn an_alpha_masked_screen_casts_the_shadow_of_its_opaque_cells() {
     let p = exact(1024, 360);
     let viewer = Vec3::new(0.0, -0.6, 0.0);
     for method in [Method::Adaptive(Split::Error), Method::Slit(4)] {
-        for kind in [LightKind::Directional, LightKind::Spot] {
+        for kind in [LightKind::Directional, LightKind::Spot, LightKind::Point] {
             let scene = ball_over_floor(kind, true);
             let light = scene.lights[0].position;
             let settings = RenderSettings::new(p)
@@ -128,9 +128,9 @@ fn an_alpha_masked_screen_casts_the_shadow_of_its_opaque_cells() {
             let (mut under_cells, mut under_holes) = (Vec::new(), Vec::new());
             for (_, point, v) in floor_pixels(&frame, &p, viewer) {
                 // Where the way towards the light crosses the screen's plane (y = −0.3).
-                let to_light = if kind == LightKind::Spot { (light - point).normalize() } else { Vec3::Y };
+                let to_light = if kind == LightKind::Directional { Vec3::Y } else { (light - point).normalize() };
                 // Well inside the spot light's cone (0.5..0.8 rad), where it lights the floor.
-                if to_light.y < 0.7f32.cos() {
+                if kind == LightKind::Spot && to_light.y < 0.7f32.cos() {
                     continue;
                 }
                 let at = point + to_light * ((-0.3 - point.y) / to_light.y);

@@ -122,15 +122,16 @@ struct MipLevel {
 // entry when none (src/core/environment.rs).
 @group(1) @binding(5) var<storage, read> environment: array<u32>;
 
-// A directional or spot light's shadow map (src/core/shadow.rs): viewer frame → the light's
-// clip space, its first depth, its side in texels, a texel's world size (at unit distance along
-// the axis when perspective).
+// A light's shadow map (src/core/shadow.rs): viewer frame → the light's clip space, its first
+// depth, its side in texels, a texel's world size (at unit distance along the axis when
+// perspective), its kind: SHADOW_ORTHOGRAPHIC, SHADOW_PERSPECTIVE, or SHADOW_CUBE (a point
+// light's six faces, +x −x +y −y +z −z, this the first).
 struct ShadowMap {
     clip_from_viewer: mat4x4<f32>,
     offset: u32,
     size: u32,
     texel: f32,
-    perspective: u32,
+    projection: u32,
 }
 
 // The frame's shadow maps and their depths (rows top to bottom, maps one after the other),
@@ -483,14 +484,19 @@ fn pbr_radiance(ambient: f32, v: vec3<f32>, view_position: vec3<f32>, normal: ve
 // direction towards the light) by the light's shadow map `map` (src/core/shadow.rs): the point
 // offset along the normal (turned towards the light) and towards the light by a few texels'
 // world size, its depth compared with the four nearest texels, the results weighted bilinearly.
-// Points the map does not see are lit (`shadow_visibility` in fragment.rs).
-fn shadow_visibility(map: u32, p: vec3<f32>, normal: vec3<f32>, l: vec3<f32>) -> f32 {
+// Points the map does not see are lit. A cube reads the face the light sees p through
+// (`shadow_visibility` in fragment.rs).
+fn shadow_visibility(first_map: u32, p: vec3<f32>, normal: vec3<f32>, l: vec3<f32>) -> f32 {
+    var map = first_map;
+    if (shadow_maps[map].projection == SHADOW_CUBE) {
+        map += cube_face(l);
+    }
     let m = shadow_maps[map];
     let q0 = m.clip_from_viewer * vec4<f32>(p, 1.0);
     if (q0.w <= 0.0) {
         return 1.0;
     }
-    let t = m.texel * select(1.0, q0.w, m.perspective != 0u);
+    let t = m.texel * select(q0.w, 1.0, m.projection == SHADOW_ORTHOGRAPHIC);
     var n = vec3<f32>(0.0);
     if (dot(normal, normal) > 1e-12) {
         n = normalize(normal);
@@ -551,6 +557,20 @@ fn shading_normal(normal: vec3<f32>, v: vec3<f32>, maps: SurfaceMaps) -> vec3<f3
         }
     }
     return mapped_normal(side * n, maps);
+}
+
+// The cube face a light is seen through from p, l the unit direction towards the light: the
+// major axis of −l, +x −x +y −y +z −z as 0..5 (`cube_face` in src/core/shadow.rs).
+fn cube_face(l: vec3<f32>) -> u32 {
+    let d = -l;
+    let a = abs(d);
+    if (a.x >= a.y && a.x >= a.z) {
+        return select(1u, 0u, d.x >= 0.0);
+    }
+    if (a.y >= a.z) {
+        return select(3u, 2u, d.y >= 0.0);
+    }
+    return select(5u, 4u, d.z >= 0.0);
 }
 
 // ---- Image-based lighting (src/core/environment.rs; twins in fragment.rs) ----

@@ -106,8 +106,8 @@ pub struct ViewArgs {
     /// spot lights, the ray tracer's shadow rays).
     #[arg(long)]
     pub no_shadows: bool,
-    /// The side of a shadow map in texels (a multiple of 64; the first four directional and spot
-    /// lights get one, fitted to the scene's bounding box).
+    /// The side of a shadow map in texels (a multiple of 64; the first four lights get maps,
+    /// fitted to the scene's bounding box; a point light a cube of six faces of half the side).
     #[arg(long, default_value_t = twister::core::shadow::DEFAULT_SHADOW_MAP_SIZE, value_name = "N")]
     pub shadow_map_size: u32,
     /// Exposure in stops: the BRDF's linear colour is scaled by 2^EV before tone mapping.

@@ -242,12 +242,10 @@ pub const MAX_SHADOW_MAP_SIZE: u32 = 8192;
 
 impl RenderSettings {
     /// Whether a frame lit by the glTF BRDF (`pbr`) of a scene with `lights` has shadow maps:
-    /// shadows on, a drawing method (the ray tracer shadows by rays), and a directional or spot
-    /// light (the drawing pipelines' `SHADOW_MAPS`).
+    /// shadows on, a drawing method (the ray tracer shadows by rays), and a light (the drawing
+    /// pipelines' `SHADOW_MAPS`).
     pub fn uses_shadow_maps(&self, lights: &[crate::core::light::Light], pbr: bool) -> bool {
-        pbr && self.shading.shadows
-            && self.subdivision.method != Method::Trace
-            && lights.iter().any(|l| l.kind != crate::core::light::LightKind::Point)
+        pbr && self.shading.shadows && self.subdivision.method != Method::Trace && !lights.is_empty()
     }
 
     /// A frame's lights (viewer frame, each with its shadow map's index), lighting and shadow

@@ -3,11 +3,12 @@
 //!
 //! A shadow map is a depth image of the scene rendered from the light (the `shadow` stage),
 //! independent of the panorama: an orthographic view along a directional light's direction
-//! fitted to the scene's bounding box, or a perspective view from a spot light's position
-//! covering its outer cone (at most [`MAX_SPOT_FOV_DEG`]) out to the farthest corner of the box
-//! (or its range). The first [`MAX_SHADOW_MAPS`] directional and spot lights of a frame get one;
-//! point lights and the rest light without shadow in the drawing stages (the ray tracer shadows
-//! every light by rays).
+//! fitted to the scene's bounding box; a perspective view from a spot light's position covering
+//! its outer cone (at most [`MAX_SPOT_FOV_DEG`]) out to the farthest corner of the box (or its
+//! range); for a point light a cube of six perspective faces (±x, ±y, ±z, 92° each, half the
+//! side), the face read chosen by the direction from the light. The first
+//! [`MAX_SHADOWED_LIGHTS`] lights of a frame get maps; any others light without shadow in the
+//! drawing stages (the ray tracer shadows every light by rays).
 //!
 //! A surface point p (viewer frame) with normal n facing the light l is looked up at
 //! p' = p + (NORMAL_OFFSET_TEXELS · n + LIGHT_OFFSET_TEXELS · l) · t, t the world size of one
@@ -22,8 +23,18 @@ use glam::{Mat4, Vec3, Vec4};
 
 use crate::core::light::{GpuLight, LightKind, NO_SHADOW_MAP};
 
-/// Shadow maps a frame may have (`MAX_SHADOW_MAPS` in the WGSL `constants` module).
-pub const MAX_SHADOW_MAPS: usize = 4;
+/// Lights of a frame that get shadow maps.
+pub const MAX_SHADOWED_LIGHTS: usize = 4;
+/// Map entries a frame may have (a point light takes six).
+pub const MAX_SHADOW_MAPS: usize = 6 * MAX_SHADOWED_LIGHTS;
+/// `GpuShadowMap::projection`: orthographic, perspective, or the first of a cube's six faces
+/// (+x, −x, +y, −y, +z, −z) (`SHADOW_*` in the WGSL `constants` module).
+pub const SHADOW_ORTHOGRAPHIC: u32 = 0;
+pub const SHADOW_PERSPECTIVE: u32 = 1;
+pub const SHADOW_CUBE: u32 = 2;
+/// A cube face's full angle: a little over 90° so that the filter's taps near a face's edge
+/// stay on it.
+pub const CUBE_FACE_FOV_DEG: f32 = 92.0;
 /// The widest spot light cone a map covers (its full angle); wider cones are cut to it.
 pub const MAX_SPOT_FOV_DEG: f32 = 170.0;
 /// The look-up's offsets along the normal and towards the light, in texels.
@@ -34,8 +45,8 @@ pub const DEFAULT_SHADOW_MAP_SIZE: u32 = 2048;
 
 /// `ShadowMap` in shaders/shared/surface.wgsl: a map's projection (viewer frame → the light's
 /// clip space, depth 0..1), where its depths start in the depth buffer, its side in texels, the
-/// world size of a texel (at unit distance along the axis for a perspective map) and whether
-/// it is perspective (a spot light). 80 bytes.
+/// world size of a texel (at unit distance along the axis for a perspective map) and its kind
+/// (`SHADOW_*`). 80 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuShadowMap {
@@ -43,7 +54,7 @@ pub struct GpuShadowMap {
     pub offset: u32,
     pub size: u32,
     pub texel: f32,
-    pub perspective: u32,
+    pub projection: u32,
 }
 
 impl GpuShadowMap {
@@ -107,22 +118,34 @@ fn up_for(forward: Vec3) -> Vec3 {
 }
 
 /// The maps of a frame's lights (viewer frame, the first `count` of `lights`), for a scene
-/// whose bounding box has `corners` (viewer frame), `size` texels square: the first
-/// [`MAX_SHADOW_MAPS`] directional and spot lights get one, and their `shadow_map` its index;
-/// the others get [`NO_SHADOW_MAP`].
+/// whose bounding box has `corners` (viewer frame), `size` texels square (a cube's faces half
+/// that, at least 64, a multiple of 64): the first [`MAX_SHADOWED_LIGHTS`] lights get maps and
+/// their `shadow_map` the index of the first; the others get [`NO_SHADOW_MAP`].
 pub fn plan_shadow_maps(lights: &mut [GpuLight], count: usize, corners: &[Vec3; 8], size: u32) -> Vec<GpuShadowMap> {
-    let mut maps = Vec::new();
+    let mut maps: Vec<GpuShadowMap> = Vec::new();
+    let mut shadowed = 0;
     let extent = corners.iter().fold(0.0f32, |m, c| m.max((*c - corners[0]).length())).max(1e-3);
+    let push = |maps: &mut Vec<GpuShadowMap>, matrix: Mat4, size: u32, texel: f32, projection: u32| {
+        let offset = maps.last().map_or(0, |m| m.offset + m.size * m.size);
+        maps.push(GpuShadowMap { clip_from_viewer: matrix.to_cols_array_2d(), offset, size, texel, projection });
+    };
     for light in lights.iter_mut().take(count) {
         light.shadow_map = NO_SHADOW_MAP;
-        if maps.len() == MAX_SHADOW_MAPS || light.kind == LightKind::Point as u32 {
-            continue;
-        }
         let dir = Vec3::from(light.direction).normalize_or_zero();
-        if dir == Vec3::ZERO {
+        let point = light.kind == LightKind::Point as u32;
+        if shadowed == MAX_SHADOWED_LIGHTS || (dir == Vec3::ZERO && !point) {
             continue;
         }
-        let (matrix, texel, perspective) = if light.kind == LightKind::Directional as u32 {
+        shadowed += 1;
+        light.shadow_map = maps.len() as u32;
+        let position = Vec3::from(light.position);
+        // A perspective map's far plane: the box's farthest corner, or the light's range.
+        let far = {
+            let far_box = corners.iter().map(|c| (*c - position).length()).fold(0.0f32, f32::max);
+            let far = if light.range > 0.0 { far_box.min(light.range) } else { far_box };
+            far.max(1e-3) * 1.01
+        };
+        if light.kind == LightKind::Directional as u32 {
             // Looking along the light from the box's centre; the box's extent across and along.
             let centre = corners.iter().sum::<Vec3>() / 8.0;
             let view = look_to(centre, dir, up_for(dir));
@@ -137,32 +160,48 @@ pub fn plan_shadow_maps(lights: &mut [GpuLight], count: usize, corners: &[Vec3; 
             let half = 0.5 * (hi.x - lo.x).max(hi.y - lo.y) + margin;
             let (cx, cy) = (0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y));
             let proj = orthographic(cx - half, cx + half, cy - half, cy + half, -hi.z - margin, -lo.z + margin);
-            (proj * view, 2.0 * half / size as f32, 0)
-        } else {
-            let position = Vec3::from(light.position);
-            let view = look_to(position, dir, up_for(dir));
-            let far_box = corners.iter().map(|c| (*c - position).length()).fold(0.0f32, f32::max);
-            let far = match light.range {
-                r if r > 0.0 => far_box.min(r),
-                _ => far_box,
+            push(&mut maps, proj * view, size, 2.0 * half / size as f32, SHADOW_ORTHOGRAPHIC);
+        } else if point {
+            let face = (size / 2 / 64 * 64).max(64);
+            let fov = CUBE_FACE_FOV_DEG.to_radians();
+            for axis in [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_Z] {
+                let view = look_to(position, axis, up_for(axis));
+                let texel = 2.0 * (0.5 * fov).tan() / face as f32;
+                push(&mut maps, perspective(fov, far * 1e-3, far) * view, face, texel, SHADOW_CUBE);
             }
-            .max(1e-3)
-                * 1.01;
+        } else {
+            let view = look_to(position, dir, up_for(dir));
             let outer = light.outer_cos.clamp(-1.0, 1.0).acos();
             let fov = (2.0 * outer + 2f32.to_radians()).min(MAX_SPOT_FOV_DEG.to_radians());
-            let proj = perspective(fov, far * 1e-3, far);
-            (proj * view, 2.0 * (0.5 * fov).tan() / size as f32, 1)
-        };
-        light.shadow_map = maps.len() as u32;
-        maps.push(GpuShadowMap {
-            clip_from_viewer: matrix.to_cols_array_2d(),
-            offset: maps.len() as u32 * size * size,
-            size,
-            texel,
-            perspective,
-        });
+            let texel = 2.0 * (0.5 * fov).tan() / size as f32;
+            push(&mut maps, perspective(fov, far * 1e-3, far) * view, size, texel, SHADOW_PERSPECTIVE);
+        }
     }
     maps
+}
+
+/// The face of a cube whose light is seen from p along the unit direction `l` (towards the
+/// light): the major axis of −l (+x, −x, +y, −y, +z, −z: 0..5).
+pub fn cube_face(l: Vec3) -> u32 {
+    let d = -l;
+    let a = d.abs();
+    if a.x >= a.y && a.x >= a.z {
+        if d.x >= 0.0 {
+            0
+        } else {
+            1
+        }
+    } else if a.y >= a.z {
+        if d.y >= 0.0 {
+            2
+        } else {
+            3
+        }
+    } else if d.z >= 0.0 {
+        4
+    } else {
+        5
+    }
 }
 
 /// Where p (viewer frame) falls in a map: texel coordinates (x right, y down, texel centres at
@@ -196,17 +235,29 @@ mod tests {
     }
 
     #[test]
-    fn maps_cover_the_box_and_go_to_directional_and_spot_lights_only() {
+    fn maps_cover_the_box_and_a_point_light_gets_a_cube() {
         let corners = box_corners(Vec3::new(-2.0, 0.0, -3.0), Vec3::new(2.0, 3.0, 1.0), Mat4::IDENTITY);
         let mut lights = vec![
             light(LightKind::Point, Vec3::new(0.0, 2.0, 0.0), Vec3::NEG_Y),
             light(LightKind::Directional, Vec3::ZERO, Vec3::new(0.3, -1.0, 0.2)),
             light(LightKind::Spot, Vec3::new(0.0, 2.9, -1.0), Vec3::NEG_Y),
         ];
-        let maps = plan_shadow_maps(&mut lights, 3, &corners, 256);
-        assert_eq!(maps.len(), 2);
-        assert_eq!(lights.iter().map(|l| l.shadow_map).collect::<Vec<_>>(), [NO_SHADOW_MAP, 0, 1]);
-        assert_eq!(maps[1].offset, 256 * 256);
+        let all = plan_shadow_maps(&mut lights, 3, &corners, 256);
+        assert_eq!(all.len(), 8);
+        assert_eq!(lights.iter().map(|l| l.shadow_map).collect::<Vec<_>>(), [0, 6, 7]);
+        // The cube's faces are half the side; each map starts where the last ended.
+        assert!(all[..6].iter().all(|m| m.size == 128 && m.projection == SHADOW_CUBE));
+        assert_eq!(all[7].offset, 6 * 128 * 128 + 256 * 256);
+        // Below the point light, the −y face sees the floor at its centre; beside it, +x.
+        let below = Vec3::new(0.0, 0.0, 0.0);
+        let face = cube_face((Vec3::new(0.0, 2.0, 0.0) - below).normalize());
+        assert_eq!(face, 3);
+        let (x, y, z) = shadow_coordinates(&all[face as usize], below).unwrap();
+        assert!((x - 64.0).abs() < 1e-2 && (y - 64.0).abs() < 1e-2 && (0.0..1.0).contains(&z));
+        assert_eq!(cube_face(Vec3::new(-1.0, 0.2, 0.1).normalize()), 0);
+        let beside = shadow_coordinates(&all[0], Vec3::new(1.5, 2.1, -0.2)).unwrap();
+        assert!((0.0..128.0).contains(&beside.0) && (0.0..128.0).contains(&beside.1));
+        let maps = &all[6..];
         // Every corner of the box is inside the directional light's map, depth within 0..1.
         for c in corners {
             let (x, y, z) = shadow_coordinates(&maps[0], c).unwrap();
@@ -229,12 +280,12 @@ mod tests {
     }
 
     #[test]
-    fn only_the_first_four_lights_get_maps() {
+    fn only_the_first_lights_get_maps() {
         let corners = box_corners(Vec3::splat(-1.0), Vec3::splat(1.0), Mat4::IDENTITY);
         let mut lights: Vec<GpuLight> =
             (0..6).map(|_| light(LightKind::Directional, Vec3::ZERO, Vec3::new(0.0, -1.0, 0.1))).collect();
         let maps = plan_shadow_maps(&mut lights, 6, &corners, 64);
-        assert_eq!(maps.len(), MAX_SHADOW_MAPS);
+        assert_eq!(maps.len(), MAX_SHADOWED_LIGHTS);
         assert_eq!(lights[4].shadow_map, NO_SHADOW_MAP);
         assert_eq!(lights[3].shadow_map, 3);
     }

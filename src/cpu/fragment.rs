@@ -11,7 +11,9 @@ use crate::core::environment::{ENV_LEVELS, LUT_SIZE};
 use crate::core::light::{tonemap, GpuLight, LightKind, NO_SHADOW_MAP};
 use crate::core::material::{AlphaMode, Filter, Material, MipLevel, Mipmap, Wrap, NO_TEXTURE};
 use crate::core::projection::{Eye, PanoramaKind, Projection};
-use crate::core::shadow::{shadow_coordinates, LIGHT_OFFSET_TEXELS, NORMAL_OFFSET_TEXELS};
+use crate::core::shadow::{
+    cube_face, shadow_coordinates, LIGHT_OFFSET_TEXELS, NORMAL_OFFSET_TEXELS, SHADOW_CUBE, SHADOW_ORTHOGRAPHIC,
+};
 use crate::core::texture::MaterialTable;
 
 /// Linear colour × (ambient + (1 − ambient)·|n·l|), the light at the viewer, two-sided; as
@@ -157,13 +159,17 @@ pub fn pbr_radiance(
 
 /// The share of a light reaching p by its shadow map (`shadow_visibility` in surface.wgsl; the
 /// offsets and the filter in `core::shadow`).
-pub fn shadow_visibility(table: &MaterialTable, map: u32, p: Vec3, normal: Vec3, l: Vec3) -> f32 {
+pub fn shadow_visibility(table: &MaterialTable, first_map: u32, p: Vec3, normal: Vec3, l: Vec3) -> f32 {
+    let mut map = first_map;
+    if table.shadow_maps[map as usize].projection == SHADOW_CUBE {
+        map += cube_face(l);
+    }
     let m = &table.shadow_maps[map as usize];
     let q0 = m.matrix() * p.extend(1.0);
     if q0.w <= 0.0 {
         return 1.0;
     }
-    let t = m.texel * if m.perspective != 0 { q0.w } else { 1.0 };
+    let t = m.texel * if m.projection == SHADOW_ORTHOGRAPHIC { 1.0 } else { q0.w };
     let n = if normal.dot(normal) > 1e-12 { normal.normalize() } else { Vec3::ZERO };
     let n = if n.dot(l) >= 0.0 { n } else { -n };
     let Some((x, y, z)) = shadow_coordinates(m, p + (NORMAL_OFFSET_TEXELS * n + LIGHT_OFFSET_TEXELS * l) * t) else {
@@ -235,6 +241,7 @@ pub struct SurfaceMaps {
 }
 
 /// The maps sampled at uv with the sampling derivatives duv_dx, duv_dy (`surface_maps`).
+#[allow(clippy::too_many_arguments)]
 pub fn surface_maps(
     table: &MaterialTable,
     material: u32,

@@ -291,12 +291,12 @@ impl GpuScene {
 }
 
 /// A scene's shadow maps on the GPU: the maps' table (group 1 binding 6, [`MAX_SHADOW_MAPS`]
-/// entries) and their depths (binding 7), the depth texture they are drawn into, and what the
+/// entries) and their depths (binding 7), the depth textures they are drawn into, and what the
 /// depths hold now.
 pub struct GpuShadows {
     pub maps: wgpu::Buffer,
     pub depths: wgpu::Buffer,
-    pub(crate) texture: Option<wgpu::Texture>,
+    pub(crate) textures: Vec<wgpu::Texture>,
     /// Each drawn map's projection (scene frame → clip) and side; empty: none drawn.
     pub(crate) drawn: Vec<([[f32; 4]; 4], u32)>,
 }
@@ -311,7 +311,7 @@ impl GpuShadows {
                 usage,
             ),
             depths: gpu.init_buffer("shadow depths", &[0; 4], usage),
-            texture: None,
+            textures: Vec::new(),
             drawn: Vec::new(),
         }
     }

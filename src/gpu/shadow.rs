@@ -1,6 +1,6 @@
 //! The `shadow` stage on the GPU (maths in `core::shadow`, twin `cpu::shadow`): each of a frame's
-//! shadow maps drawn from its light (the scene's own triangles, a render pass per map into one
-//! depth texture) and copied into the scene's depth buffer, group 1's binding 7, which the
+//! shadow maps drawn from its light (the scene's own triangles, a render pass per map into a
+//! depth texture of its size) and copied into the scene's depth buffer, group 1's binding 7, which the
 //! drawing stages read. The maps are drawn again only when they change (another view or other
 //! lights); a frame without maps draws nothing.
 
@@ -24,7 +24,7 @@ impl Renderer {
     /// hold them already. Fails with one line where the maps do not fit the device.
     pub(crate) fn draw_shadow_maps(&self, scene: &GpuScene, view: Mat4, maps: &[GpuShadowMap]) -> Result<()> {
         let gpu = &self.gpu;
-        let Some(size) = maps.first().map(|m| m.size) else {
+        let Some(size) = maps.iter().map(|m| m.size).max() else {
             return Ok(());
         };
         let wanted: Vec<([[f32; 4]; 4], u32)> =
@@ -34,12 +34,12 @@ impl Renderer {
             return Ok(());
         }
         let max_size = gpu.limits.max_texture_dimension_2d;
-        let bytes = 4 * maps.len() as u64 * size as u64 * size as u64;
+        let bytes: u64 = maps.iter().map(|m| 4 * m.size as u64 * m.size as u64).sum();
         if size > max_size || bytes > gpu.max_binding() {
             return Err(Error::option(
                 "--shadow-map-size",
                 format!(
-                    "{} maps of {size}×{size} texels ({} MiB) do not fit this GPU (images up to {max_size}, bindings up to {} MiB)",
+                    "{} shadow maps of up to {size}×{size} texels ({} MiB) do not fit this GPU (images up to {max_size}, bindings up to {} MiB)",
                     maps.len(),
                     bytes >> 20,
                     gpu.max_binding() >> 20
@@ -56,21 +56,24 @@ impl Renderer {
                     mapped_at_creation: false,
                 });
             }
-            if shadows.texture.as_ref().is_none_or(|t| t.width() != size) {
-                shadows.texture = Some(gpu.device.create_texture(&wgpu::TextureDescriptor {
-                    label: Some("shadow map"),
-                    size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: 1 },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format: DEPTH_FORMAT,
-                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-                    view_formats: &[],
-                }));
+            // A depth texture per map size (a depth texture is copied whole): the maps', and a
+            // cube's faces'.
+            shadows.textures.retain(|t| maps.iter().any(|m| m.size == t.width()));
+            for map in maps {
+                if !shadows.textures.iter().any(|t| t.width() == map.size) {
+                    shadows.textures.push(gpu.device.create_texture(&wgpu::TextureDescriptor {
+                        label: Some("shadow map"),
+                        size: wgpu::Extent3d { width: map.size, height: map.size, depth_or_array_layers: 1 },
+                        mip_level_count: 1,
+                        sample_count: 1,
+                        dimension: wgpu::TextureDimension::D2,
+                        format: DEPTH_FORMAT,
+                        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                        view_formats: &[],
+                    }));
+                }
             }
             gpu.queue.write_buffer(&shadows.maps, 0, bytemuck::cast_slice(maps));
-            let texture = shadows.texture.as_ref().expect("just made");
-            let depth_view = texture.create_view(&Default::default());
             let stage = &self.shadow.stage;
             let pipeline = self.shadow.pipeline(gpu, scene.discards);
             // The table's last two bindings are the maps being drawn: stand-ins there.
@@ -79,6 +82,8 @@ impl Renderer {
             let materials = stage.bind_group(gpu, None, 1, &[&a, &b, &c, &d, &e, &f, &empty, &empty]);
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             for ((clip_from_scene, _), map) in wanted.iter().zip(maps) {
+                let texture = shadows.textures.iter().find(|t| t.width() == map.size).expect("just made");
+                let depth_view = texture.create_view(&Default::default());
                 let params = gpu.init_buffer(
                     "shadow params",
                     bytemuck::bytes_of(&ShadowParams { clip_from_scene: *clip_from_scene }),
@@ -119,11 +124,11 @@ impl Renderer {
                         buffer: &shadows.depths,
                         layout: wgpu::TexelCopyBufferLayout {
                             offset: 4 * map.offset as u64,
-                            bytes_per_row: Some(4 * size),
-                            rows_per_image: Some(size),
+                            bytes_per_row: Some(4 * map.size),
+                            rows_per_image: Some(map.size),
                         },
                     },
-                    wgpu::Extent3d { width: size, height: size, depth_or_array_layers: 1 },
+                    wgpu::Extent3d { width: map.size, height: map.size, depth_or_array_layers: 1 },
                 );
             }
             gpu.queue.submit([enc.finish()]);

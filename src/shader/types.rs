@@ -365,7 +365,7 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("BvhNode" => BvhNode { min, first, max, count }),
     layout!("BvhLevel" => BvhLevel { root, triangles }),
     layout!("Light" => GpuLight { position, kind, direction, range, color, inner_cos, outer_cos, shadow_map, _pad1, _pad2 }),
-    layout!("ShadowMap" => GpuShadowMap { clip_from_viewer, offset, size, texel, perspective }),
+    layout!("ShadowMap" => GpuShadowMap { clip_from_viewer, offset, size, texel, projection }),
     layout!("ShadowParams" => ShadowParams { clip_from_scene }),
     layout!("Lighting" => LightingParams {
         count, pbr, exposure, tonemap, environment, env_background, env_lut, shadows, env_rotation, env_sh, env_levels

@@ -279,7 +279,7 @@ pub fn studio(background: bool) -> std::sync::Arc<twister::core::environment::Pr
 
 /// A grey rough floor (y = −1.2) with a ball of radius 0.3 at (0.3, −0.6, −2.2) above it, under
 /// one light shining straight down: a directional light, or a spot light 2.1 m above the ball
-/// (cone 0.5/0.8 rad). With `screen`, also a 1 m square screen at y = −0.3 over x −1.6..−0.6,
+/// (cone 0.5/0.8 rad), or a point light there. With `screen`, also a 1 m square screen at y = −0.3 over x −1.6..−0.6,
 /// z −2.8..−1.8, whose alpha-masked 8×8 texture is a checker of holes (texel (i, j) opaque
 /// where i + j is even; u along +x, v along +z).
 pub fn ball_over_floor(kind: twister::core::light::LightKind, screen: bool) -> twister::Scene {
@@ -326,12 +326,12 @@ pub fn ball_over_floor(kind: twister::core::light::LightKind, screen: bool) -> t
         ];
         scene.add_mesh("screen", &q, &[0, 1, 2, 0, 2, 3]);
     }
-    let spot = kind == LightKind::Spot;
+    let placed = kind != LightKind::Directional;
     scene.lights = vec![Light {
         kind,
-        position: if spot { Vec3::new(0.3, 1.5, -2.2) } else { Vec3::ZERO },
+        position: if placed { Vec3::new(0.3, 1.5, -2.2) } else { Vec3::ZERO },
         direction: Vec3::NEG_Y,
-        color: Vec3::splat(if spot { 40.0 } else { 3.0 }),
+        color: Vec3::splat(if placed { 40.0 } else { 3.0 }),
         range: None,
         inner_cone: 0.5,
         outer_cone: 0.8,
