@@ -157,6 +157,14 @@ fn mtl_bump_textures_become_normal_maps() {
     let scene = twister::core::load::load_scene(dir.join("m.obj").to_str().unwrap(), &Projection::default()).unwrap();
     let (bumpy, normal) = (&scene.materials[0], &scene.materials[1]);
     assert!(bumpy.normal_texture != NO_TEXTURE && normal.normal_texture != NO_TEXTURE);
+    // Tangents generated for the normal maps: along +u (+x here); on the triangle facing +z,
+    // w = +1 (the bitangent up the image, +y, as v runs down it); on the one wound the other way
+    // (facing −z, the image seen mirrored), w = −1.
+    for v in &scene.vertices {
+        let t = twister::core::scene::unpack_tangent(v.tangent);
+        let w = if v.normal[2] > 0.0 { 1.0 } else { -1.0 };
+        assert!((t - glam::Vec4::new(1.0, 0.0, 0.0, w)).abs().max_element() < 1e-3, "{t} at normal {:?}", v.normal);
+    }
     assert_eq!(scene.warnings.iter().filter(|w| w.contains("height map")).count(), 1, "{:?}", scene.warnings);
     // Decode the middle texel of each (stored sRGB-encoded as data).
     let texel = |t: u32| {

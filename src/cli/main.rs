@@ -11,6 +11,7 @@ mod measure;
 mod plot;
 mod render;
 mod scene;
+mod sequence;
 
 use std::process::ExitCode;
 

@@ -60,11 +60,42 @@ pub struct RenderArgs {
     /// (white) and visual-field (orange) boundaries.
     #[arg(long)]
     pub lod_overlay: bool,
+    /// Render frames A to B (inclusive) of the animation timeline (frame k at k / FPS seconds)
+    /// into numbered files: frame_000123_TB.png (top-bottom), frame_000123_left.png … (see
+    /// *Sequences* in the README); `N` alone renders frame N.
+    #[arg(long, value_parser = crate::sequence::parse_frames, value_name = "A..B")]
+    pub frames: Option<(u32, u32)>,
+    /// Frames per second of the sequence's timeline.
+    #[arg(long, default_value_t = 30.0)]
+    pub fps: f32,
+    /// The animation a sequence plays, by name or index [default: the file's first].
+    #[arg(long, value_name = "NAME|INDEX")]
+    pub animation: Option<String>,
+    /// Skip the frames whose files all exist (a sequence resumed after a stop).
+    #[arg(long)]
+    pub resume: bool,
+    /// Render only this shard's frames: I/N, frames whose index from A is ≡ I (mod N), or the
+    /// I-th of N contiguous blocks with --shard-mode blocks (a job array's task id).
+    #[arg(long, value_parser = crate::sequence::parse_shard, value_name = "I/N")]
+    pub shard: Option<(u32, u32)>,
+    /// How --shard splits the frames.
+    #[arg(long, value_enum, default_value_t = crate::sequence::ShardMode::Interleave)]
+    pub shard_mode: crate::sequence::ShardMode,
 }
 
 pub fn render(args: &RenderArgs) -> Result<()> {
     let mut settings = args.view.settings()?;
     settings.shading.background = args.background;
+    if let Some(frames) = args.frames {
+        return crate::sequence::render_sequence(args, frames, settings);
+    }
+    for (given, option) in
+        [(args.resume, "--resume"), (args.shard.is_some(), "--shard"), (args.animation.is_some(), "--animation")]
+    {
+        if given {
+            return Err(Error::option(option, "belongs to a sequence: use it with --frames A..B"));
+        }
+    }
     settings.measure.edges = args.stats.is_some();
     settings.measure.depth = args.depth;
     let panorama = settings.projection().panorama;
@@ -77,6 +108,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         format: args.format,
         quality: args.quality.unwrap_or(90),
         xmp: (panorama == PanoramaKind::Equirect).then(|| gpano_xmp(w, h)),
+        fast: false,
     };
     if args.lod_overlay && args.view.lod == LodMode::Off {
         return Err(Error::option("--lod-overlay", "needs --lod visual-field"));

@@ -68,6 +68,8 @@ fn check_in_range(scene: &Scene, spec: &str, option: &'static str) -> Result<()>
 /// A scene ready to render.
 pub struct Prepared {
     pub gpu_scene: GpuScene,
+    /// The placed scene (a sequence poses it frame by frame).
+    pub scene: Scene,
     pub selection: Option<LodSelection>,
     pub gaze: Option<Gaze>,
 }
@@ -129,7 +131,7 @@ pub fn prepare(
     if let Some(sel) = &selection {
         gpu_scene = gpu_scene.with_lod(&renderer.gpu, sel);
     }
-    Ok(Prepared { gpu_scene, selection, gaze: lod.map(|(_, g)| g) })
+    Ok(Prepared { gpu_scene, scene, selection, gaze: lod.map(|(_, g)| g) })
 }
 
 /// The LOD part of the stats: triangles selected and, per field, objects and triangles.

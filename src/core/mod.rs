@@ -2,6 +2,7 @@
 //! [`projection::Panorama`], scenes with their loaders and materials, the visual field and level
 //! of detail (seeds 000/001), render settings and the frames a renderer returns.
 
+pub mod animation;
 pub mod builtin;
 pub mod bvh;
 pub mod color;

@@ -106,6 +106,8 @@ pub struct Scene {
     /// and their primitives.
     pub meshes: usize,
     pub primitives: usize,
+    /// What moves (glTF animation, skins, morph targets), where the file has any.
+    pub rig: Option<Box<crate::core::animation::Rig>>,
 }
 
 /// A camera placed in a scene file: where it stands and which way it looks (yaw only: the
@@ -245,6 +247,9 @@ impl Scene {
 
     /// Applies an affine transform to positions and normals.
     pub fn transform(&mut self, m: Mat4) {
+        if let Some(rig) = self.rig.as_mut() {
+            rig.placement = m * rig.placement;
+        }
         let normal_matrix = m.inverse().transpose();
         for v in &mut self.vertices {
             v.position = m.transform_point3(Vec3::from(v.position)).into();
@@ -318,6 +323,111 @@ mod tests {
         // The camera keeps its place relative to the first vertex.
         let offset = Vec3::from(scene.vertices[0].position) - Vec3::from(c.position);
         assert!((offset - m.transform_vector3(Vec3::new(0.0, -0.5, -2.0))).length() < 1e-5);
+    }
+}
+
+/// Per-vertex tangents where a file gives none, MikkTSpace-style (issue 17): each triangle's
+/// ∇u and ∇v in its plane (from its positions and texture coordinates) summed over the
+/// triangles around a vertex, weighted by their corner angles; the tangent is the sum of ∇u made
+/// normal to the vertex normal (Gram–Schmidt), w = +1 where n × t points against the summed ∇v
+/// (up the image: glTF's bitangent) and −1 where along it (mirrored texture coordinates). Only vertices without a tangent whose
+/// material `wants` one (it has a normal map) get one; where the sum vanishes (texture
+/// coordinates that do not vary, or mirrored halves meeting at a shared vertex) the vertex keeps
+/// none and the fragment stage falls back to the derivatives' frame.
+pub fn generate_tangents(vertices: &mut [SceneVertex], indices: &[u32], wants: impl Fn(u32) -> bool) {
+    let n = vertices.len();
+    let mut t_sum = vec![Vec3::ZERO; n];
+    let mut b_sum = vec![Vec3::ZERO; n];
+    for tri in indices.chunks_exact(3) {
+        let k = [tri[0] as usize, tri[1] as usize, tri[2] as usize];
+        if k.iter().any(|&i| i >= n || vertices[i].tangent != 0 || !wants(vertices[i].material)) {
+            continue;
+        }
+        let p = k.map(|i| Vec3::from(vertices[i].position));
+        let uv = k.map(|i| glam::Vec2::from(vertices[i].uv));
+        let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+        let (d1, d2) = (uv[1] - uv[0], uv[2] - uv[0]);
+        let det = d1.x * d2.y - d2.x * d1.y;
+        if !(det.abs() > 1e-20) {
+            continue;
+        }
+        let t = (e1 * d2.y - e2 * d1.y) / det;
+        let b = (e2 * d1.x - e1 * d2.x) / det;
+        for c in 0..3 {
+            let (a, b_) = (p[(c + 1) % 3] - p[c], p[(c + 2) % 3] - p[c]);
+            let angle = a.angle_between(b_);
+            if angle.is_finite() {
+                t_sum[k[c]] += t.normalize_or_zero() * angle;
+                b_sum[k[c]] += b.normalize_or_zero() * angle;
+            }
+        }
+    }
+    for (i, v) in vertices.iter_mut().enumerate() {
+        if v.tangent != 0 || t_sum[i] == Vec3::ZERO {
+            continue;
+        }
+        let normal = Vec3::from(v.normal).normalize_or_zero();
+        let t = (t_sum[i] - normal * normal.dot(t_sum[i])).normalize_or_zero();
+        if t == Vec3::ZERO {
+            continue;
+        }
+        let w = if normal.cross(t).dot(b_sum[i]) > 0.0 { -1.0 } else { 1.0 };
+        v.tangent = pack_tangent(t.extend(w));
+    }
+}
+
+impl Scene {
+    /// Poses the scene's rig (`core::animation`) at time t of clip `clip` (None: the rest pose):
+    /// each mesh instance's vertices (morphed, skinned, moved by its node and the placement),
+    /// the nodes' lights and cameras. Nothing happens without a rig.
+    pub fn pose(&mut self, clip: Option<usize>, t: f32) {
+        use crate::core::animation::{pose_nodes, pose_vertex, world_matrices};
+        let Some(rig) = self.rig.take() else { return };
+        let poses = pose_nodes(&rig.nodes, clip.and_then(|c| rig.clips.get(c)), t);
+        let world = world_matrices(&rig.nodes, &poses, &rig.order);
+        let joint_matrices: Vec<Vec<Mat4>> = rig
+            .skins
+            .iter()
+            .map(|s| s.joints.iter().zip(&s.inverse_bind).map(|(&j, ib)| world[j] * *ib).collect())
+            .collect();
+        for inst in &rig.instances {
+            // A skinned mesh is placed by its joints alone (glTF ignores its node's transform).
+            let skin = inst.skin.and_then(|s| joint_matrices.get(s)).map(|m| &m[..]);
+            let m = rig.placement * if skin.is_some() { Mat4::IDENTITY } else { world[inst.node] };
+            let normal_m = m.inverse().transpose();
+            let mirror = if glam::Mat3::from_mat4(m).determinant() < 0.0 { -1.0 } else { 1.0 };
+            let weights = &poses[inst.node].weights;
+            for (i, v) in inst.local.iter().enumerate() {
+                let (p, n, tangent) = pose_vertex(v, i, inst, weights, skin);
+                let out = &mut self.vertices[inst.first_vertex + i];
+                out.position = m.transform_point3(p).into();
+                out.normal = normal_m.transform_vector3(n).normalize_or_zero().into();
+                if tangent.w != 0.0 {
+                    let t = m.transform_vector3(tangent.truncate()).normalize_or_zero();
+                    out.tangent = pack_tangent(t.extend(tangent.w * mirror));
+                }
+            }
+        }
+        // A point or spot light scaled by s keeps lighting its scaled surroundings as before
+        // with s² its intensity (as `Scene::transform` does).
+        let scale2 = rig.placement.transform_vector3(Vec3::X).length_squared();
+        for &(k, node, light) in &rig.lights {
+            if let Some(l) = self.lights.get_mut(k) {
+                *l = light.transformed(rig.placement * world[node]);
+                if l.kind != crate::core::light::LightKind::Directional {
+                    l.color *= scale2;
+                }
+            }
+        }
+        for &(k, node) in &rig.cameras {
+            if let Some(c) = self.cameras.get_mut(k) {
+                let m = rig.placement * world[node];
+                let forward = m.transform_vector3(-Vec3::Z);
+                c.position = m.transform_point3(Vec3::ZERO).into();
+                c.yaw_deg = (-forward.x).atan2(-forward.z).to_degrees();
+            }
+        }
+        self.rig = Some(rig);
     }
 }
 

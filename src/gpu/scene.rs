@@ -93,10 +93,11 @@ impl GpuScene {
             ));
         }
         gpu.scoped(&format!("uploading {}", scene.name), || {
+            // COPY_DST: an animated scene's frames write their poses in.
             let vertices = gpu.init_buffer(
                 "scene vertices",
                 bytemuck::cast_slice(&scene.vertices),
-                wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX,
+                wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
             );
             let indices = gpu.init_buffer(
                 "scene indices",
@@ -169,6 +170,23 @@ impl GpuScene {
         })
     }
 
+    /// Takes a new pose of the same scene (`core::animation::Rig::pose`): its vertices written
+    /// over the uploaded ones (the only upload), its lights and bounds; the shadow maps are
+    /// drawn again.
+    pub fn update_pose(&mut self, gpu: &Gpu, scene: &Scene) -> Result<()> {
+        if scene.vertices.len() as u64 * std::mem::size_of::<crate::core::scene::SceneVertex>() as u64
+            != self.vertices.size()
+        {
+            return Err(Error::scene(&scene.name, "a pose must keep the scene's vertices"));
+        }
+        scene.validate()?;
+        gpu.queue.write_buffer(&self.vertices, 0, bytemuck::cast_slice(&scene.vertices));
+        self.lights = scene.lights.clone();
+        self.bounds = scene.bounds();
+        self.shadows.lock().unwrap_or_else(|e| e.into_inner()).drawn.clear();
+        Ok(())
+    }
+
     /// Whether a frame with `settings` is lit by the glTF BRDF.
     pub fn pbr(&self, settings: &RenderSettings) -> bool {
         settings.lighting_params(self.lights.len(), self.environment.as_deref()).pbr != 0
@@ -216,6 +234,16 @@ impl GpuScene {
     /// The same scene with `bvh` (built over its vertices, e.g. with a level-of-detail chain
     /// per object) uploaded; `name` names the scene in errors.
     pub fn with_built_bvh(mut self, gpu: &Gpu, name: &str, bvh: &SceneBvh) -> Result<GpuScene> {
+        self.set_bvh(gpu, name, bvh)?;
+        Ok(self)
+    }
+
+    /// The BVH of a new pose of the scene (a sequence's frame), built and uploaded anew.
+    pub fn rebuild_bvh(&mut self, gpu: &Gpu, scene: &Scene) -> Result<()> {
+        self.set_bvh(gpu, &scene.name, &SceneBvh::of_scene(scene))
+    }
+
+    fn set_bvh(&mut self, gpu: &Gpu, name: &str, bvh: &SceneBvh) -> Result<()> {
         let depth = bvh.depth();
         if depth > TRACE_STACK {
             return Err(Error::scene(
@@ -247,7 +275,7 @@ impl GpuScene {
                 first_step: bvh.first_step,
             })
         })?);
-        Ok(self)
+        Ok(())
     }
 
     /// The scene as a level-of-detail selection draws it: the same vertices and materials, the

@@ -370,8 +370,11 @@ pub(super) fn read_gltf(path: &Path) -> std::result::Result<Scene, String> {
     }
     let root =
         doc.default_scene().or_else(|| doc.scenes().next()).ok_or_else(|| format!("{name}: the file has no scene"))?;
-    let mut stack: Vec<(gltf::Node, Mat4, usize)> = root.nodes().map(|n| (n, Mat4::IDENTITY, 0)).collect();
-    while let Some((node, parent, depth)) = stack.pop() {
+    // What moves, where the file animates, skins or morphs (`core::animation`).
+    let mut rig = super::gltf_rig::needs_rig(&doc).then(|| super::gltf_rig::rig_nodes(&doc, &buffers));
+    let mut stack: Vec<(gltf::Node, Mat4, usize, Option<usize>)> =
+        root.nodes().map(|n| (n, Mat4::IDENTITY, 0, None)).collect();
+    while let Some((node, parent, depth, parent_index)) = stack.pop() {
         if depth > 256 {
             return Err(format!("{name}: the node hierarchy is deeper than 256 levels"));
         }
@@ -379,8 +382,18 @@ pub(super) fn read_gltf(path: &Path) -> std::result::Result<Scene, String> {
         if !world.is_finite() {
             return Err(format!("{name}: node {} has a NaN or infinite transform", node.index()));
         }
+        if let Some(rig) = rig.as_mut() {
+            rig.nodes[node.index()].parent = parent_index;
+            rig.order.push(node.index());
+        }
         if let Some(light) = node.light() {
+            if let Some(rig) = rig.as_mut() {
+                rig.lights.push((scene.lights.len(), node.index(), gltf_light(&light, Mat4::IDENTITY)));
+            }
             scene.lights.push(gltf_light(&light, world));
+        }
+        if let (Some(_), Some(rig)) = (node.camera(), rig.as_mut()) {
+            rig.cameras.push((scene.cameras.len(), node.index()));
         }
         if let Some(camera) = node.camera() {
             // The camera looks along its local −z.
@@ -401,7 +414,7 @@ pub(super) fn read_gltf(path: &Path) -> std::result::Result<Scene, String> {
             let objects_before = scene.objects.len();
             for prim in mesh.primitives() {
                 let label = format!("{mesh_name} / primitive {}", prim.index());
-                add_gltf_primitive(&mut scene, &prim, &buffers, world, &label, &materials)
+                add_gltf_primitive(&mut scene, &prim, &buffers, (&node, world), &label, &materials, rig.as_mut())
                     .map_err(|e| format!("{name}: {label}: {e}"))?;
             }
             scene.merge_objects_from(objects_before, format!("{mesh_name} ({instance})"));
@@ -411,10 +424,17 @@ pub(super) fn read_gltf(path: &Path) -> std::result::Result<Scene, String> {
                 "{name}: its mesh instances hold more than {MAX_TRIANGLES} triangles, more than twister draws"
             ));
         }
-        stack.extend(node.children().map(|c| (c, world, depth + 1)));
+        stack.extend(node.children().map(|c| (c, world, depth + 1, Some(node.index()))));
     }
     if scene.triangle_count() == 0 {
         return Err(format!("{name}: the default scene has no triangles"));
+    }
+    if let Some(mut rig) = rig {
+        rig.clips = super::gltf_rig::clips(&doc, &buffers, &mut scene.warnings);
+        // The rest pose: skinned meshes placed by their joints (glTF ignores their nodes'
+        // transforms), morph targets at the meshes' default weights.
+        scene.rig = Some(Box::new(rig));
+        scene.pose(None, 0.0);
     }
     Ok(scene)
 }
@@ -531,9 +551,10 @@ fn add_gltf_primitive(
     scene: &mut Scene,
     prim: &gltf::Primitive,
     buffers: &[gltf::buffer::Data],
-    world: Mat4,
+    (node, world): (&gltf::Node, Mat4),
     label: &str,
     materials: &[GltfMaterial],
+    rig: Option<&mut crate::core::animation::Rig>,
 ) -> std::result::Result<(), String> {
     use gltf::mesh::Mode;
     let mode = prim.mode();
@@ -608,6 +629,25 @@ fn add_gltf_primitive(
         .collect();
     if normals.is_none() {
         compute_normals(&mut vertices, &indices);
+    }
+    if let Some(rig) = rig {
+        // The normals in the mesh frame: the file's, or the computed ones moved back.
+        let local_normals: Vec<Vec3> = match &normals {
+            Some(n) => n.iter().map(|v| Vec3::from(*v)).collect(),
+            None => vertices
+                .iter()
+                .map(|v| world.transpose().transform_vector3(Vec3::from(v.normal)).normalize_or_zero())
+                .collect(),
+        };
+        let first = scene.vertices.len();
+        rig.instances.push(super::gltf_rig::instance(
+            node,
+            &reader,
+            first,
+            &positions,
+            &local_normals,
+            tangents.as_deref(),
+        ));
     }
     scene.add_mesh(label, &vertices, &indices);
     Ok(())

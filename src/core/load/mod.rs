@@ -11,6 +11,7 @@
 
 mod gltf;
 mod gltf_check;
+mod gltf_rig;
 mod obj;
 
 use std::path::Path;
@@ -30,7 +31,7 @@ pub fn load_scene(spec: &str, projection: &Projection) -> Result<Scene> {
     }
     let path = Path::new(spec);
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-    let scene = match ext.as_deref() {
+    let mut scene = match ext.as_deref() {
         Some("obj") => load_obj(path)?,
         Some("gltf") | Some("glb") => load_gltf(path)?,
         _ => {
@@ -44,6 +45,16 @@ pub fn load_scene(spec: &str, projection: &Projection) -> Result<Scene> {
         }
     };
     scene.validate()?;
+    // Tangents for normal maps where the file gives none (a moving scene keeps the
+    // derivatives' frame: its rig poses only the file's tangents).
+    if scene.rig.is_none() {
+        let wants: Vec<bool> = std::iter::once(false)
+            .chain(scene.materials.iter().map(|m| m.normal_texture != crate::core::material::NO_TEXTURE))
+            .collect();
+        crate::core::scene::generate_tangents(&mut scene.vertices, &scene.indices, |m| {
+            wants.get(m as usize).copied().unwrap_or(false)
+        });
+    }
     Ok(scene)
 }
 

@@ -1,0 +1,206 @@
+//! `twister render --frames A..B`: a frame sequence of an animated scene (issue 18). The device,
+//! pipelines, scene buffers and targets are made once; each frame poses the scene's rig at
+//! frame / fps seconds (`core::animation`), uploads only the moved vertices, renders and writes
+//! its files atomically (all of a frame's files or none: `output::write_all`).
+//!
+//! `--resume` skips frames whose files all exist; `--shard I/N` renders the frames whose index
+//! ≡ I (mod N) (or the I-th of N contiguous blocks, `--shard-mode blocks`), so a scheduler's
+//! array job fans a sequence out over machines sharing the output folder; `--stats FILE.jsonl`
+//! appends one JSON line per frame. A frame's bytes depend on the frame alone (the pose is
+//! computed from the rest pose, never accumulated), so shards and reruns give the same files.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use glam::Vec3;
+
+use crate::args::Viewer;
+use crate::render::RenderArgs;
+use crate::scene::{open_renderer, prepare};
+use twister::core::projection::PanoramaKind;
+use twister::core::settings::Method;
+use twister::error::{Error, Result};
+use twister::output::{layout_images, layout_names, write_all, Encoding, Layout};
+use twister::RenderSettings;
+
+/// `--frames`: the first and last frame, inclusive.
+pub fn parse_frames(s: &str) -> std::result::Result<(u32, u32), String> {
+    let (a, b) = s.split_once("..").unwrap_or((s, s));
+    let (a, b) = (a.trim().parse::<u32>(), b.trim().parse::<u32>());
+    match (a, b) {
+        (Ok(a), Ok(b)) if a <= b && b < 100_000_000 => Ok((a, b)),
+        _ => Err(format!("'{s}': expected A..B, frame numbers from 0 with A ≤ B (or one frame N)")),
+    }
+}
+
+/// `--shard I/N`.
+pub fn parse_shard(s: &str) -> std::result::Result<(u32, u32), String> {
+    let parsed = s.split_once('/').map(|(i, n)| (i.trim().parse::<u32>(), n.trim().parse::<u32>()));
+    match parsed {
+        Some((Ok(i), Ok(n))) if n > 0 && i < n => Ok((i, n)),
+        _ => Err(format!("'{s}': expected I/N with 0 ≤ I < N (e.g. $SLURM_ARRAY_TASK_ID/$N)")),
+    }
+}
+
+/// How `--shard` splits the frames.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum ShardMode {
+    /// Frame k goes to shard k mod N.
+    #[default]
+    Interleave,
+    /// N contiguous blocks, as even as can be.
+    Blocks,
+}
+
+/// The frames of `first..=last` shard `i` of `n` renders.
+pub fn shard_frames(first: u32, last: u32, (i, n): (u32, u32), mode: ShardMode) -> Vec<u32> {
+    let count = (last - first + 1) as u64;
+    match mode {
+        ShardMode::Interleave => (first..=last).filter(|f| (f - first) % n == i).collect(),
+        ShardMode::Blocks => {
+            let (start, end) = (count * i as u64 / n as u64, count * (i as u64 + 1) / n as u64);
+            (start..end).map(|k| first + k as u32).collect()
+        }
+    }
+}
+
+/// A frame's file name: `frame_000123_` and the layout's name (`stereo_` dropped: `_TB`, `_LR`).
+pub fn frame_name(frame: u32, layout_name: &str) -> String {
+    format!("frame_{frame:06}_{}", layout_name.strip_prefix("stereo_").unwrap_or(layout_name))
+}
+
+/// Renders the sequence `args.frames` asks for.
+pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32), mut settings: RenderSettings) -> Result<()> {
+    for (given, option) in [(args.depth, "--depth"), (args.hdr, "--hdr"), (args.lod_overlay, "--lod-overlay")] {
+        if given {
+            return Err(Error::option(option, "writes one still: leave it out with --frames"));
+        }
+    }
+    if !(args.fps.is_finite() && args.fps > 0.0 && args.fps <= 1000.0) {
+        return Err(Error::option("--fps", format!("must be between 0 and 1000 frames per second, got {}", args.fps)));
+    }
+    let panorama = settings.projection().panorama;
+    let layout = args.layout.unwrap_or(Layout::default_for(panorama));
+    let (w, h) = (settings.projection().width, settings.projection().height);
+    let encoding = Encoding {
+        format: args.format,
+        quality: args.quality.unwrap_or(90),
+        xmp: (panorama == PanoramaKind::Equirect).then(|| twister::output::gpano_xmp(w, h)),
+        fast: true,
+    };
+    let frames = match args.shard {
+        Some(shard) => shard_frames(first, last, shard, args.shard_mode),
+        None => (first..=last).collect(),
+    };
+    let names = layout_names(layout, args.format);
+    let paths = |frame: u32| -> Vec<PathBuf> { names.iter().map(|n| args.out.join(frame_name(frame, n))).collect() };
+    let (renderer, _adapter) = open_renderer()?;
+    let method = [settings.subdivision.method];
+    let base_yaw = settings.view.yaw_deg;
+    let mut prepared = prepare(&renderer, &args.scene, args.fit, &args.view, &mut settings, false, &method)?;
+    let clip = match (&prepared.scene.rig, &args.animation) {
+        (Some(rig), Some(name)) => Some(rig.clip_index(name).ok_or_else(|| {
+            let known: Vec<&str> = rig.clips.iter().map(|c| c.name.as_str()).collect();
+            Error::option("--animation", format!("{name}: the file's animations are {}", known.join(", ")))
+        })?),
+        (Some(rig), None) => (!rig.clips.is_empty()).then_some(0),
+        (None, Some(_)) => return Err(Error::option("--animation", format!("{} has no animations", args.scene))),
+        (None, None) => None,
+    };
+    let camera = match args.view.viewer {
+        Viewer::Camera(n) => Some(n),
+        Viewer::At(_) => None,
+    };
+    let todo: Vec<u32> =
+        frames.into_iter().filter(|&f| !(args.resume && paths(f).iter().all(|p| p.exists()))).collect();
+    if let Some(dir) = args.stats.as_deref().and_then(|p| p.parent()).filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| Error::output(dir, format!("cannot create the folder: {e}")))?;
+    }
+    let mut stats = match &args.stats {
+        Some(path) => Some(
+            std::fs::OpenOptions::new()
+                .create(true)
+                .append(args.resume)
+                .write(true)
+                .truncate(!args.resume)
+                .open(path)
+                .map_err(|e| Error::output(path, format!("cannot write: {e}")))?,
+        ),
+        None => None,
+    };
+    let progress = indicatif::ProgressBar::new(todo.len() as u64).with_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames, {per_sec}, ETA {eta}")
+            .expect("a valid template"),
+    );
+    let start = std::time::Instant::now();
+    // A writer thread encodes and writes frame k while the GPU draws frame k + 1 (one frame in
+    // flight: bounded memory).
+    let (send, receive) = std::sync::mpsc::sync_channel::<(u32, f32, f64, twister::Frame)>(1);
+    std::thread::scope(|scope| -> Result<()> {
+        let writer = scope.spawn(|| -> Result<()> {
+            for (frame, time, ms_pose, rendered) in receive {
+                let t = std::time::Instant::now();
+                let files = layout_images(&rendered, layout, args.format)
+                    .iter()
+                    .map(|(name, img)| {
+                        twister::output::image_file(args.out.join(frame_name(frame, name)), img, &encoding)
+                    })
+                    .collect::<Result<Vec<_>>>()?;
+                write_all(&files)?;
+                let ms_write = t.elapsed().as_secs_f64() * 1e3;
+                if let (Some(file), Some(path)) = (stats.as_mut(), &args.stats) {
+                    let s = &rendered.stats;
+                    let line = serde_json::json!({
+                        "frame": frame,
+                        "time": time,
+                        "triangles_in": s.triangles_in,
+                        "triangles_out": s.triangles_out,
+                        "ms_pose": ms_pose,
+                        "ms_frame": s.ms_frame,
+                        "ms_gpu": s.ms_gpu,
+                        "ms_write": ms_write,
+                        "files": files.iter().map(|f| f.path.display().to_string()).collect::<Vec<_>>(),
+                    });
+                    writeln!(file, "{line}").map_err(|e| Error::output(path, format!("cannot write: {e}")))?;
+                }
+                progress.inc(1);
+            }
+            Ok(())
+        });
+        let drawn = (|| -> Result<()> {
+            for &frame in &todo {
+                let time = frame as f32 / args.fps;
+                let t = std::time::Instant::now();
+                if prepared.scene.rig.is_some() {
+                    prepared.scene.pose(clip, time);
+                    prepared.gpu_scene.update_pose(&renderer.gpu, &prepared.scene)?;
+                    if settings.subdivision.method == Method::Trace {
+                        prepared.gpu_scene.rebuild_bvh(&renderer.gpu, &prepared.scene)?;
+                    }
+                }
+                if let Some(cam) = camera.and_then(|n| prepared.scene.cameras.get(n)) {
+                    settings.view.viewer = Vec3::from(cam.position);
+                    settings.view.yaw_deg = base_yaw + cam.yaw_deg;
+                }
+                let ms_pose = t.elapsed().as_secs_f64() * 1e3;
+                let rendered = renderer.render(&prepared.gpu_scene, &settings)?;
+                if send.send((frame, time, ms_pose, rendered)).is_err() {
+                    break; // the writer stopped: its error is reported below
+                }
+            }
+            Ok(())
+        })();
+        drop(send);
+        let written = writer.join().expect("the writer thread does not panic");
+        drawn.and(written)
+    })?;
+    progress.finish_and_clear();
+    let skipped = (last - first + 1) as usize - todo.len();
+    eprintln!(
+        "{} frames rendered in {:.1} s{}",
+        todo.len(),
+        start.elapsed().as_secs_f64(),
+        if skipped > 0 { format!(" ({skipped} skipped: complete, or another shard's)") } else { String::new() }
+    );
+    Ok(())
+}

@@ -1,0 +1,253 @@
+//! Animation and sequences (issue 18): glTF interpolation against hand-computed values
+//! (InterpolationTest), a skinned pose drawn where the CPU evaluation puts it (RiggedSimple,
+//! CesiumMan), and the sequence command's numbered, resumable, shardable, atomic outputs.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use glam::{Quat, Vec2, Vec3, Vec4};
+use twister::core::animation::{pose_nodes, Interpolation, Property};
+use twister::core::load::load_scene;
+use twister::{Eye, GpuScene, Projection, RenderSettings, Scene, Vertical};
+
+fn asset_scene(relative: &str) -> Scene {
+    let path = common::asset(relative);
+    load_scene(path.to_str().unwrap(), &Projection::default()).unwrap()
+}
+
+/// Every channel of InterpolationTest (STEP, LINEAR and CUBICSPLINE on translation, rotation and
+/// scale) posed at its first key, halfway to the second, and at the second: the keys
+/// themselves, and halfway the previous key (STEP), the average (LINEAR; for rotations the
+/// normalised sum, which is where slerp's midpoint lies), or the Hermite curve at s = ½:
+/// ½·v₀ + ⅛·Δt·b₀ + ½·v₁ − ⅛·Δt·a₁ (CUBICSPLINE).
+#[test]
+fn interpolation_test_poses_at_hand_computed_values() {
+    let scene = asset_scene("gltf/InterpolationTest/glTF-Binary/InterpolationTest.glb");
+    let rig = scene.rig.as_ref().expect("an animated file has a rig");
+    let mut seen = Vec::new();
+    for clip in &rig.clips {
+        for channel in &clip.channels {
+            let s = &channel.sampler;
+            let w = s.width;
+            let cubic = s.interpolation == Interpolation::CubicSpline;
+            let key = |k: usize, part: usize| -> Vec<f32> {
+                let start = if cubic { (3 * k + part) * w } else { k * w };
+                s.values[start..start + w].to_vec()
+            };
+            let (t0, t1) = (s.times[0], s.times[1]);
+            let dt = t1 - t0;
+            let (v0, v1) = (key(0, 1), key(1, 1));
+            let half: Vec<f32> = match (s.interpolation, channel.property) {
+                (Interpolation::Step, _) => v0.clone(),
+                (Interpolation::Linear, Property::Rotation) => {
+                    let (a, b) = (Vec4::from_slice(&v0), Vec4::from_slice(&v1));
+                    let b = if a.dot(b) < 0.0 { -b } else { b };
+                    (a + b).normalize().to_array().to_vec()
+                }
+                (Interpolation::Linear, _) => v0.iter().zip(&v1).map(|(a, b)| 0.5 * (a + b)).collect(),
+                (Interpolation::CubicSpline, property) => {
+                    let (b0, a1) = (key(0, 2), key(1, 0));
+                    let p: Vec<f32> =
+                        (0..w).map(|i| 0.5 * v0[i] + 0.125 * dt * b0[i] + 0.5 * v1[i] - 0.125 * dt * a1[i]).collect();
+                    if property == Property::Rotation {
+                        Vec4::from_slice(&p).normalize().to_array().to_vec()
+                    } else {
+                        p
+                    }
+                }
+            };
+            for (t, want) in [(t0, v0.clone()), (0.5 * (t0 + t1), half), (t1, v1.clone())] {
+                let pose = &pose_nodes(&rig.nodes, Some(clip), t)[channel.node];
+                let got: Vec<f32> = match channel.property {
+                    Property::Translation => pose.translation.to_array().to_vec(),
+                    Property::Scale => pose.scale.to_array().to_vec(),
+                    Property::Rotation => {
+                        // q and −q are the same rotation.
+                        let (q, w) = (pose.rotation, Quat::from_slice(&want));
+                        (if q.dot(w) < 0.0 { -q } else { q }).to_array().to_vec()
+                    }
+                    Property::Weights => pose.weights.clone(),
+                };
+                let close = got.iter().zip(&want).all(|(a, b)| (a - b).abs() < 1e-4);
+                assert!(
+                    close,
+                    "{} {:?} {:?} at {t}: {got:?}, want {want:?}",
+                    clip.name, s.interpolation, channel.property
+                );
+            }
+            seen.push((s.interpolation, channel.property));
+        }
+    }
+    for i in [Interpolation::Step, Interpolation::Linear, Interpolation::CubicSpline] {
+        for p in [Property::Translation, Property::Rotation, Property::Scale] {
+            assert!(seen.contains(&(i, p)), "InterpolationTest has {i:?} on {p:?}");
+        }
+    }
+}
+
+/// The pixels an object covers in the left eye, as a box (min, max), or None.
+fn object_box(frame: &twister::Frame, object: u32) -> Option<(Vec2, Vec2)> {
+    let m = frame.measurement.as_ref().expect("measured");
+    let width = frame.left.width;
+    let mut b: Option<(Vec2, Vec2)> = None;
+    for (i, &o) in m.object[0].iter().enumerate() {
+        if o == object + 1 {
+            let p = Vec2::new((i as u32 % width) as f32 + 0.5, (i as u32 / width) as f32 + 0.5);
+            b = Some(b.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p))));
+        }
+    }
+    b
+}
+
+/// A skinned pose is drawn where the CPU evaluation puts it: RiggedSimple at t = 1 s and
+/// CesiumMan at 0.5 s, posed (joints × inverse bind matrices, weighted), uploaded as the only
+/// change, rendered; the drawn pixels' box is the box of the posed vertices projected (within 2
+/// px), and differs from the rest pose's.
+#[test]
+fn a_skinned_pose_is_drawn_where_the_cpu_evaluation_puts_it() {
+    let r = common::renderer();
+    for (file, t) in
+        [("gltf/RiggedSimple/glTF-Binary/RiggedSimple.glb", 1.0), ("gltf/CesiumMan/glTF-Binary/CesiumMan.glb", 0.5)]
+    {
+        let p = Projection { width: 720, height: 240, vertical: Vertical::Exact, ..Projection::default() };
+        let mut scene = asset_scene(file);
+        scene.fit(2.5, &p).unwrap();
+        let settings = RenderSettings::new(p).with_measure_error(true);
+        let mut gpu_scene = GpuScene::upload(&r.gpu, &scene).unwrap();
+        let rest = object_box(&r.render(&gpu_scene, &settings).unwrap(), 0).expect("drawn at rest");
+        let rig = scene.rig.as_ref().expect("a skinned file has a rig");
+        assert!(!rig.skins.is_empty() && !rig.clips.is_empty(), "{file}");
+        scene.pose(Some(0), t);
+        gpu_scene.update_pose(&r.gpu, &scene).unwrap();
+        let frame = r.render(&gpu_scene, &settings).unwrap();
+        let drawn = object_box(&frame, 0).expect("drawn posed");
+        // Where the posed vertices project (the CPU twin of the projection).
+        let points: Vec<Vec3> = scene.vertices.iter().map(|v| Vec3::from(v.position)).collect();
+        let pixels = twister::cpu::project_points::project_points(&p, Eye::Left, &points);
+        let (mut lo, mut hi) = (Vec2::splat(f32::MAX), Vec2::splat(f32::MIN));
+        for q in pixels.iter().filter(|q| q[3] == 1.0) {
+            lo = lo.min(Vec2::new(q[0], q[1]));
+            hi = hi.max(Vec2::new(q[0], q[1]));
+        }
+        let off = (drawn.0 - lo).abs().max_element().max((drawn.1 - hi).abs().max_element());
+        assert!(off <= 2.0, "{file}: drawn {drawn:?}, the posed vertices project to {lo}..{hi}");
+        let moved = (drawn.0 - rest.0).abs().max_element().max((drawn.1 - rest.1).abs().max_element());
+        assert!(moved >= 3.0, "{file}: the pose moved the drawing by {moved} px only");
+    }
+}
+
+fn twister() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_twister"));
+    c.env("NODEVICE_SELECT", "1");
+    c
+}
+
+fn sequence(out: &Path, extra: &[&str]) -> std::process::Output {
+    let scene = common::asset("gltf/AnimatedCube/glTF/AnimatedCube.gltf");
+    let output = twister()
+        .args(["render", scene.to_str().unwrap(), "--fit", "2.5", "--width", "128", "--height", "48", "--fps", "8"])
+        .arg("--out")
+        .arg(out)
+        .args(extra)
+        .output()
+        .unwrap();
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    output
+}
+
+fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .map(|p: PathBuf| (p.file_name().unwrap().to_string_lossy().into_owned(), std::fs::read(&p).unwrap()))
+        .collect();
+    v.sort();
+    v
+}
+
+/// `--frames 0..9`: numbered files per eye, one stats line per frame, frames that differ as the
+/// cube turns; `--resume` renders only missing frames; three interleaved shards and two blocks
+/// give the same bytes as one run; a run killed mid-way leaves only whole frames.
+#[test]
+fn sequences_are_numbered_resumable_shardable_and_atomic() {
+    let root = std::env::temp_dir().join(format!("twister-seq-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    let all = root.join("all");
+    let stats = root.join("stats.jsonl");
+    sequence(&all, &["--frames", "0..9", "--stats", stats.to_str().unwrap()]);
+    let full = files(&all);
+    let names: Vec<&str> = full.iter().map(|(n, _)| n.as_str()).collect();
+    let want: Vec<String> =
+        (0..10).flat_map(|k| [format!("frame_{k:06}_left.png"), format!("frame_{k:06}_right.png")]).collect();
+    assert_eq!(names, want);
+    let lines: Vec<serde_json::Value> =
+        std::fs::read_to_string(&stats).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(lines.iter().map(|l| l["frame"].as_u64().unwrap()).collect::<Vec<_>>(), (0..10).collect::<Vec<_>>());
+    assert!((lines[4]["time"].as_f64().unwrap() - 0.5).abs() < 1e-6, "frame 4 at 4/8 s");
+    assert_ne!(full[0].1, full[2].1, "the cube turns between frames 0 and 1");
+    // Resume: nothing to do, then only the frame whose file went missing.
+    let resumed = sequence(&all, &["--frames", "0..9", "--resume"]);
+    assert!(String::from_utf8_lossy(&resumed.stderr).contains("0 frames rendered"));
+    std::fs::remove_file(all.join("frame_000007_right.png")).unwrap();
+    let resumed = sequence(&all, &["--frames", "0..9", "--resume"]);
+    assert!(String::from_utf8_lossy(&resumed.stderr).contains("1 frames rendered"));
+    assert_eq!(files(&all), full, "the resumed frame has the same bytes");
+    // Shards, interleaved and in blocks: the same bytes as one run.
+    for (mode, n) in [("interleave", 3), ("blocks", 2)] {
+        let dir = root.join(mode);
+        for i in 0..n {
+            sequence(&dir, &["--frames", "0..9", "--shard", &format!("{i}/{n}"), "--shard-mode", mode]);
+        }
+        assert_eq!(files(&dir), full, "{n} {mode} shards");
+    }
+    // Killed mid-way: every file there is a whole PNG (written under a temporary name, then
+    // renamed), and a resumed run completes the sequence with the same bytes.
+    let killed = root.join("killed");
+    let scene = common::asset("gltf/AnimatedCube/glTF/AnimatedCube.gltf");
+    let mut child = twister()
+        .args(["render", scene.to_str().unwrap(), "--fit", "2.5", "--width", "128", "--height", "48", "--fps", "8"])
+        .args(["--frames", "0..9", "--out", killed.to_str().unwrap()])
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let start = std::time::Instant::now();
+    while !killed.join("frame_000002_left.png").exists() && start.elapsed().as_secs() < 60 {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    for (name, bytes) in files(&killed) {
+        if name.ends_with(".png") && !name.starts_with('.') {
+            image::load_from_memory(&bytes).unwrap_or_else(|e| panic!("{name} is not a whole PNG: {e}"));
+        }
+    }
+    sequence(&killed, &["--frames", "0..9", "--resume"]);
+    assert_eq!(files(&killed), full, "resumed after the kill");
+    std::fs::remove_dir_all(&root).unwrap();
+}
+
+/// Options of a sequence without `--frames`, an unknown animation, and a still-only option with
+/// `--frames` are one line each.
+#[test]
+fn sequence_options_are_checked() {
+    let scene = common::asset("gltf/AnimatedCube/glTF/AnimatedCube.gltf");
+    for (args, want) in [
+        (vec!["--resume"], "--resume"),
+        (vec!["--shard", "1/3"], "--shard"),
+        (vec!["--frames", "0..2", "--animation", "nope"], "--animation"),
+        (vec!["--frames", "0..2", "--depth"], "--depth"),
+        (vec!["--frames", "3..1"], "--frames"),
+        (vec!["--frames", "0..2", "--shard", "3/3"], "--shard"),
+        (vec!["--frames", "0..2", "--fps", "0"], "--fps"),
+    ] {
+        let out = twister()
+            .args(["render", scene.to_str().unwrap(), "--width", "64", "--height", "32", "--out", "/nonexistent/x"])
+            .args(&args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && err.contains(want) && err.trim().lines().count() <= 2, "{args:?}: {err}");
+    }
+}
