@@ -228,6 +228,35 @@ fn sequences_are_numbered_resumable_shardable_and_atomic() {
     std::fs::remove_dir_all(&root).unwrap();
 }
 
+/// The Slurm job-array example renders, task by task, the same frames as one run.
+#[test]
+fn the_slurm_example_shards_a_sequence() {
+    let root = std::env::temp_dir().join(format!("twister-slurm-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    let scene = common::asset("gltf/AnimatedCube/glTF/AnimatedCube.gltf");
+    let bin = Path::new(env!("CARGO_BIN_EXE_twister")).parent().unwrap().to_path_buf();
+    let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default());
+    let small = ["--fit", "2.5", "--width", "128", "--height", "48", "--fps", "8"];
+    for task in 0..3 {
+        let out = Command::new("bash")
+            .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/farm/slurm_array.sh"))
+            .args([scene.to_str().unwrap(), "0", "5", root.join("array").to_str().unwrap()])
+            .args(small)
+            .env("PATH", &path)
+            .env("NODEVICE_SELECT", "1")
+            .env("SLURM_ARRAY_TASK_ID", task.to_string())
+            .env("SLURM_ARRAY_TASK_COUNT", "3")
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "task {task}: {}", String::from_utf8_lossy(&out.stderr));
+    }
+    sequence(&root.join("one"), &["--frames", "0..5"]);
+    let pngs = |dir: &Path| files(dir).into_iter().filter(|(n, _)| n.ends_with(".png")).collect::<Vec<_>>();
+    assert_eq!(pngs(&root.join("array")), pngs(&root.join("one")));
+    assert_eq!(files(&root.join("array")).iter().filter(|(n, _)| n.ends_with(".jsonl")).count(), 3);
+    std::fs::remove_dir_all(&root).unwrap();
+}
+
 /// Options of a sequence without `--frames`, an unknown animation, and a still-only option with
 /// `--frames` are one line each.
 #[test]
