@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The project's test command (README quick start, and what CI runs).
-# Installs Mesa's software Vulkan driver (lavapipe) when no Vulkan driver is present, then runs
-# the whole test suite. Extra arguments go to `cargo test`.
+# Installs Mesa's software Vulkan driver (lavapipe) when no Vulkan driver is present, and ffmpeg
+# (for `render --video`) when it is missing, then runs the whole test suite. Extra arguments go
+# to `cargo test`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -13,13 +14,21 @@ have_vulkan_driver() {
     [[ "$libs" == *libvulkan.so.1* && -n "$icds" ]]
 }
 
+missing=()
 if ! have_vulkan_driver; then
     echo "No Vulkan driver found: installing Mesa's software Vulkan driver (lavapipe)..."
+    missing+=(mesa-vulkan-drivers libvulkan1)
+fi
+if ! command -v ffmpeg >/dev/null 2>&1; then
+    echo "No ffmpeg found: installing it (render --video encodes with it)..."
+    missing+=(ffmpeg)
+fi
+if [ ${#missing[@]} -gt 0 ]; then
     sudo=""
     if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
     export DEBIAN_FRONTEND=noninteractive
     $sudo apt-get update -qq
-    $sudo apt-get install -y -qq --no-install-recommends mesa-vulkan-drivers libvulkan1 >/dev/null
+    $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
 # Quiet Mesa's device-select layer, which complains when XDG_RUNTIME_DIR is unset.

@@ -21,6 +21,7 @@ pub mod error;
 pub mod gpu;
 pub mod output;
 pub mod shader;
+pub mod video;
 
 pub use crate::core::frame::{EyeImage, Frame, FrameStats};
 pub use crate::core::projection::{Eye, Projection, Vertical};

@@ -104,7 +104,8 @@ fn object_box(frame: &twister::Frame, object: u32) -> Option<(Vec2, Vec2)> {
 /// A skinned pose is drawn where the CPU evaluation puts it: RiggedSimple at t = 1 s and
 /// CesiumMan at 0.5 s, posed (joints × inverse bind matrices, weighted), uploaded as the only
 /// change, rendered; the drawn pixels' box is the box of the posed vertices projected (within 2
-/// px), and differs from the rest pose's.
+/// px), and differs from the rest pose's; posed by the GPU's skin stage instead, the same pixels
+/// are drawn, and the stage's twin gives the CPU pose's vertices.
 #[test]
 fn a_skinned_pose_is_drawn_where_the_cpu_evaluation_puts_it() {
     let r = common::renderer();
@@ -135,6 +136,27 @@ fn a_skinned_pose_is_drawn_where_the_cpu_evaluation_puts_it() {
         assert!(off <= 2.0, "{file}: drawn {drawn:?}, the posed vertices project to {lo}..{hi}");
         let moved = (drawn.0 - rest.0).abs().max_element().max((drawn.1 - rest.1).abs().max_element());
         assert!(moved >= 3.0, "{file}: the pose moved the drawing by {moved} px only");
+        // The GPU's skin stage poses the same: the same pixels drawn, and its twin gives the
+        // vertices the CPU pose gave.
+        let posed_on_cpu = scene.vertices.clone();
+        let mut rest_scene = asset_scene(file);
+        rest_scene.fit(2.5, &p).unwrap();
+        let mut on_gpu = GpuScene::upload(&r.gpu, &rest_scene).unwrap();
+        r.pose(&mut on_gpu, &mut rest_scene, Some(0), t).unwrap();
+        let gpu_box = object_box(&r.render(&on_gpu, &settings).unwrap(), 0).expect("drawn posed on the GPU");
+        let off = (gpu_box.0 - drawn.0).abs().max_element().max((gpu_box.1 - drawn.1).abs().max_element());
+        assert!(off <= 1.0, "{file}: posed on the GPU {gpu_box:?}, on the CPU {drawn:?}");
+        let rig = rest_scene.rig.as_deref().unwrap();
+        let mut twin = rest_scene.vertices.clone();
+        twister::cpu::skin::skin(
+            &twister::cpu::skin::SkinData::of(rig),
+            &twister::cpu::skin::SkinFrame::of(rig, Some(0), t),
+            &mut twin,
+        );
+        for (a, b) in twin.iter().zip(&posed_on_cpu) {
+            let d = (Vec3::from(a.position) - Vec3::from(b.position)).length();
+            assert!(d < 1e-4, "{file}: the skin twin and Scene::pose differ by {d} m");
+        }
     }
 }
 
@@ -257,6 +279,77 @@ fn the_slurm_example_shards_a_sequence() {
     std::fs::remove_dir_all(&root).unwrap();
 }
 
+/// `--video`: the sequence encoded by ffmpeg, with Google's spherical metadata in the video's
+/// sample entry — read back by our own box walk (st3d top-bottom; sv3d → proj → equi) and by
+/// ffprobe (Stereo 3D "top and bottom", Spherical Mapping "equirectangular"), every frame there.
+/// A file with its moov first (faststart) keeps decoding after the boxes are added (its chunk
+/// offsets moved with them). Without ffmpeg on PATH: one line naming the install command.
+/// (scripts/test.sh installs ffmpeg where it is missing.)
+#[test]
+fn a_video_carries_the_spherical_metadata() {
+    use twister::video::{find_boxes, with_spherical_metadata, StereoMode};
+    let root = std::env::temp_dir().join(format!("twister-video-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    let video = root.join("cube.mp4");
+    let scene = common::asset("gltf/AnimatedCube/glTF/AnimatedCube.gltf");
+    let made = twister()
+        .args(["render", scene.to_str().unwrap(), "--fit", "2.5", "--panorama", "equirect", "--width", "128"])
+        .args(["--frames", "0..11", "--fps", "12", "--out", root.join("frames").to_str().unwrap(), "--video"])
+        .arg(&video)
+        .output()
+        .unwrap();
+    assert!(made.status.success(), "{}", String::from_utf8_lossy(&made.stderr));
+    let mp4 = std::fs::read(&video).unwrap();
+    let entry = ["moov", "trak", "mdia", "minf", "stbl", "stsd", "avc1"];
+    let st3d = find_boxes(&mp4, &[&entry[..], &["st3d"]].concat());
+    assert_eq!(st3d.len(), 1);
+    assert_eq!(st3d[0][4], StereoMode::TopBottom as u8, "st3d: version/flags, then the stereo mode");
+    assert_eq!(find_boxes(&mp4, &[&entry[..], &["sv3d", "proj", "equi"]].concat()).len(), 1);
+    let probe = |file: &Path| -> serde_json::Value {
+        let out = Command::new("ffprobe")
+            .args(["-v", "error", "-count_frames", "-show_streams", "-of", "json"])
+            .arg(file)
+            .output()
+            .expect("ffprobe (scripts/test.sh installs ffmpeg)");
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()["streams"][0].clone()
+    };
+    let stream = probe(&video);
+    assert_eq!(stream["nb_read_frames"], "12");
+    assert_eq!((stream["width"].as_u64(), stream["height"].as_u64()), (Some(128), Some(128)), "top-bottom");
+    let side: Vec<String> =
+        stream["side_data_list"].as_array().unwrap().iter().map(|d| d.to_string()).collect::<Vec<_>>();
+    assert!(side.iter().any(|d| d.contains("top and bottom")), "{side:?}");
+    assert!(side.iter().any(|d| d.contains("equirectangular")), "{side:?}");
+    // faststart: moov before mdat, so the chunk offsets must move.
+    let fast = root.join("fast.mp4");
+    let status = Command::new("ffmpeg")
+        .args(["-y", "-loglevel", "error", "-i"])
+        .arg(&video)
+        .args(["-c", "copy", "-movflags", "+faststart"])
+        .arg(&fast)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let tagged = with_spherical_metadata(&std::fs::read(&fast).unwrap(), "fast", StereoMode::LeftRight, true).unwrap();
+    std::fs::write(&fast, &tagged).unwrap();
+    let stream = probe(&fast);
+    assert_eq!(stream["nb_read_frames"], "12", "every frame still decodes");
+    assert!(stream["side_data_list"].to_string().contains("side by side"), "{}", stream["side_data_list"]);
+    // No ffmpeg: one line.
+    let out = twister()
+        .args(["render", scene.to_str().unwrap(), "--frames", "0..1", "--layout", "top-bottom", "--video"])
+        .arg(root.join("none.mp4"))
+        .arg("--out")
+        .arg(root.join("none"))
+        .env("PATH", "/nonexistent")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("ffmpeg") && err.contains("install"), "{err}");
+    std::fs::remove_dir_all(&root).unwrap();
+}
+
 /// Options of a sequence without `--frames`, an unknown animation, and a still-only option with
 /// `--frames` are one line each.
 #[test]
@@ -270,6 +363,9 @@ fn sequence_options_are_checked() {
         (vec!["--frames", "3..1"], "--frames"),
         (vec!["--frames", "0..2", "--shard", "3/3"], "--shard"),
         (vec!["--frames", "0..2", "--fps", "0"], "--fps"),
+        (vec!["--video", "x.mp4"], "--video"),
+        (vec!["--frames", "0..2", "--video", "x.mp4"], "--video"),
+        (vec!["--frames", "0..2", "--layout", "top-bottom", "--shard", "0/2", "--video", "x.mp4"], "--video"),
     ] {
         let out = twister()
             .args(["render", scene.to_str().unwrap(), "--width", "64", "--height", "32", "--out", "/nonexistent/x"])
@@ -279,4 +375,119 @@ fn sequence_options_are_checked() {
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success() && err.contains(want) && err.trim().lines().count() <= 2, "{args:?}: {err}");
     }
+}
+
+/// A glTF file whose camera node moves from x = 0 to x = 1 m in one second (LINEAR), looking at a
+/// quad 3 m ahead.
+fn moving_camera_file(dir: &Path) -> PathBuf {
+    let mut bin: Vec<u8> = Vec::new();
+    let quad = [[-1.0f32, -1.0, 0.0], [1.0, -1.0, 0.0], [1.0, 1.0, 0.0], [-1.0, 1.0, 0.0]];
+    bin.extend(quad.iter().flatten().flat_map(|f| f.to_le_bytes()));
+    bin.extend([0u16, 1, 2, 0, 2, 3].iter().flat_map(|i| i.to_le_bytes()));
+    bin.extend([0u8; 0]);
+    bin.extend([0.0f32, 1.0].iter().flat_map(|f| f.to_le_bytes()));
+    bin.extend([0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0].iter().flat_map(|f| f.to_le_bytes()));
+    let json = serde_json::json!({
+        "asset": { "version": "2.0" },
+        "buffers": [{ "byteLength": bin.len(), "uri": format!("data:application/octet-stream;base64,{}", common::base64(&bin)) }],
+        "bufferViews": [
+            { "buffer": 0, "byteOffset": 0, "byteLength": 48 },
+            { "buffer": 0, "byteOffset": 48, "byteLength": 12 },
+            { "buffer": 0, "byteOffset": 60, "byteLength": 8 },
+            { "buffer": 0, "byteOffset": 68, "byteLength": 24 }
+        ],
+        "accessors": [
+            { "bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-1, -1, 0], "max": [1, 1, 0] },
+            { "bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR" },
+            { "bufferView": 2, "componentType": 5126, "count": 2, "type": "SCALAR", "min": [0], "max": [1] },
+            { "bufferView": 3, "componentType": 5126, "count": 2, "type": "VEC3" }
+        ],
+        "meshes": [{ "primitives": [{ "attributes": { "POSITION": 0 }, "indices": 1 }] }],
+        "cameras": [{ "type": "perspective", "perspective": { "yfov": 1.0, "znear": 0.1 } }],
+        "nodes": [
+            { "mesh": 0, "translation": [0, 0, -3] },
+            { "camera": 0, "name": "dolly" }
+        ],
+        "scenes": [{ "nodes": [0, 1] }],
+        "animations": [{
+            "channels": [{ "sampler": 0, "target": { "node": 1, "path": "translation" } }],
+            "samplers": [{ "input": 2, "output": 3, "interpolation": "LINEAR" }]
+        }]
+    });
+    let path = dir.join("dolly.gltf");
+    std::fs::create_dir_all(dir).unwrap();
+    std::fs::write(&path, json.to_string()).unwrap();
+    path
+}
+
+/// An animated camera moves the viewer as the file says: frames 0–2 at 2 fps with `--viewer
+/// camera` are, byte for byte, stills rendered with the viewer at x = 0, 0.5 and 1 m.
+#[test]
+fn an_animated_camera_moves_the_viewer() {
+    let root = std::env::temp_dir().join(format!("twister-dolly-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    let file = moving_camera_file(&root);
+    let small = ["--width", "128", "--height", "48"];
+    let run = |extra: &[&str]| {
+        let out = twister().arg("render").arg(&file).args(small).args(extra).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    };
+    run(&["--viewer", "camera", "--frames", "0..2", "--fps", "2", "--out", root.join("seq").to_str().unwrap()]);
+    for (k, x) in ["0", "0.5", "1"].into_iter().enumerate() {
+        let still = root.join(format!("still{k}"));
+        run(&["--viewer", &format!("{x},0,0"), "--out", still.to_str().unwrap()]);
+        for eye in ["left", "right"] {
+            let a = std::fs::read(root.join("seq").join(format!("frame_{k:06}_{eye}.png"))).unwrap();
+            let b = std::fs::read(still.join(format!("{eye}.png"))).unwrap();
+            let (a, b) = (image::load_from_memory(&a).unwrap(), image::load_from_memory(&b).unwrap());
+            assert!(a == b, "frame {k} ({eye}) is not the still at x = {x}");
+        }
+    }
+    std::fs::remove_dir_all(&root).unwrap();
+}
+
+/// `--gaze-path`: the tracked viewer's gaze steers each frame's level of detail — frames 0–2 at
+/// 2 fps of a path turning from yaw 0 to 180° in one second are, pixel for pixel, stills with
+/// `--gaze 0,0`, `90,0` and `180,0`; each frame's stats line has its selection. A malformed row
+/// is one line naming the file and the row.
+#[test]
+fn a_gaze_path_steers_each_frames_level_of_detail() {
+    let root = std::env::temp_dir().join(format!("twister-gaze-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    std::fs::create_dir_all(&root).unwrap();
+    let path = root.join("gaze.csv");
+    std::fs::write(&path, "time,yaw,pitch\n0,0,0\n1,180,0\n").unwrap();
+    let lod = ["--lod", "visual-field", "--width", "256", "--height", "64"];
+    let run = |extra: &[&str]| {
+        let out = twister().args(["render", "builtin:demo"]).args(lod).args(extra).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    };
+    let stats = root.join("stats.jsonl");
+    run(&["--gaze-path", path.to_str().unwrap(), "--frames", "0..2", "--fps", "2", "--out"]
+        .into_iter()
+        .chain([root.join("seq").to_str().unwrap(), "--stats", stats.to_str().unwrap()])
+        .collect::<Vec<_>>());
+    let lines: Vec<serde_json::Value> =
+        std::fs::read_to_string(&stats).unwrap().lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert!(lines.iter().all(|l| l["lod"]["triangles_selected"].as_u64().is_some()), "{lines:?}");
+    assert_ne!(lines[0]["lod"], lines[2]["lod"], "turning the gaze changes the selection");
+    for (k, yaw) in ["0", "90", "180"].into_iter().enumerate() {
+        let still = root.join(format!("still{k}"));
+        run(&["--gaze", &format!("{yaw},0"), "--out", still.to_str().unwrap()]);
+        for eye in ["left", "right"] {
+            let a = image::open(root.join("seq").join(format!("frame_{k:06}_{eye}.png"))).unwrap();
+            let b = image::open(still.join(format!("{eye}.png"))).unwrap();
+            assert!(a == b, "frame {k} ({eye}) is not the still gazing at yaw {yaw}");
+        }
+    }
+    std::fs::write(&path, "0,0,0\n1,nope,0\n").unwrap();
+    let out = twister()
+        .args(["render", "builtin:demo"])
+        .args(lod)
+        .args(["--frames", "0..1", "--gaze-path", path.to_str().unwrap(), "--out", root.join("x").to_str().unwrap()])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("gaze.csv") && err.contains("row 2"), "{err}");
+    std::fs::remove_dir_all(&root).unwrap();
 }

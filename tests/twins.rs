@@ -6,6 +6,8 @@
 mod common;
 #[path = "twins/shadow.rs"]
 mod shadow;
+#[path = "twins/skin.rs"]
+mod skin;
 #[path = "twins/slit.rs"]
 mod slit;
 #[path = "twins/triangles.rs"]
@@ -67,6 +69,7 @@ fn twin_of(stage: &str) -> Option<TwinCheck> {
         "slit" => check::<slit::Slit>,
         "trace" => check::<Trace>,
         "shadow" => check::<shadow::Shadow>,
+        "skin" => check::<skin::Skin>,
         "reduce_error" => check::<ReduceError>,
         _ => return None,
     })

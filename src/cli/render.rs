@@ -78,6 +78,16 @@ pub struct RenderArgs {
     /// I-th of N contiguous blocks with --shard-mode blocks (a job array's task id).
     #[arg(long, value_parser = crate::sequence::parse_shard, value_name = "I/N")]
     pub shard: Option<(u32, u32)>,
+    /// With --frames: also encode the sequence as an MP4 video (H.264 by the system's ffmpeg)
+    /// with Google's spherical video metadata (st3d stereo mode; sv3d equirectangular on the
+    /// sphere); needs a one-image layout (top-bottom or side-by-side). After --shard runs, run
+    /// once more with --resume --video to encode.
+    #[arg(long, value_name = "FILE.mp4")]
+    pub video: Option<PathBuf>,
+    /// With --frames and --lod visual-field: the gaze over time, a CSV of time,yaw,pitch rows
+    /// (seconds, degrees as --gaze): each frame's level of detail follows the tracked viewer.
+    #[arg(long, value_name = "FILE.csv")]
+    pub gaze_path: Option<PathBuf>,
     /// How --shard splits the frames.
     #[arg(long, value_enum, default_value_t = crate::sequence::ShardMode::Interleave)]
     pub shard_mode: crate::sequence::ShardMode,
@@ -89,9 +99,13 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     if let Some(frames) = args.frames {
         return crate::sequence::render_sequence(args, frames, settings);
     }
-    for (given, option) in
-        [(args.resume, "--resume"), (args.shard.is_some(), "--shard"), (args.animation.is_some(), "--animation")]
-    {
+    for (given, option) in [
+        (args.resume, "--resume"),
+        (args.shard.is_some(), "--shard"),
+        (args.animation.is_some(), "--animation"),
+        (args.video.is_some(), "--video"),
+        (args.gaze_path.is_some(), "--gaze-path"),
+    ] {
         if given {
             return Err(Error::option(option, "belongs to a sequence: use it with --frames A..B"));
         }

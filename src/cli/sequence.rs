@@ -1,7 +1,8 @@
 //! `twister render --frames A..B`: a frame sequence of an animated scene (issue 18). The device,
 //! pipelines, scene buffers and targets are made once; each frame poses the scene's rig at
-//! frame / fps seconds (`core::animation`), uploads only the moved vertices, renders and writes
-//! its files atomically (all of a frame's files or none: `output::write_all`).
+//! frame / fps seconds (`core::animation`; the vertices by the GPU's skin stage, which reads only
+//! the frame's matrices and weights), renders and writes its files atomically (all of a frame's
+//! files or none: `output::write_all`).
 //!
 //! `--resume` skips frames whose files all exist; `--shard I/N` renders the frames whose index
 //! ≡ I (mod N) (or the I-th of N contiguous blocks, `--shard-mode blocks`), so a scheduler's
@@ -88,12 +89,38 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32), mut setting
         xmp: (panorama == PanoramaKind::Equirect).then(|| twister::output::gpano_xmp(w, h)),
         fast: true,
     };
+    let stereo = match layout {
+        Layout::TopBottom => twister::video::StereoMode::TopBottom,
+        Layout::SideBySide => twister::video::StereoMode::LeftRight,
+        _ => twister::video::StereoMode::Mono,
+    };
+    if let Some(video) = &args.video {
+        if args.shard.is_some() {
+            return Err(Error::option(
+                "--video",
+                "encodes the whole sequence: render the shards, then run once more with --resume --video",
+            ));
+        }
+        if stereo == twister::video::StereoMode::Mono {
+            return Err(Error::option("--video", "needs a one-image layout: --layout top-bottom or side-by-side"));
+        }
+        if args.format != twister::output::ImageFormat::Png {
+            return Err(Error::option("--video", "encodes the PNG frames: leave --format png"));
+        }
+        twister::output::check_outputs(&[video.as_path()])?;
+        ffmpeg_version()?;
+    }
     let frames = match args.shard {
         Some(shard) => shard_frames(first, last, shard, args.shard_mode),
         None => (first..=last).collect(),
     };
     let names = layout_names(layout, args.format);
     let paths = |frame: u32| -> Vec<PathBuf> { names.iter().map(|n| args.out.join(frame_name(frame, n))).collect() };
+    let gaze_path = args.gaze_path.as_deref().map(twister::core::visual_field::GazePath::read).transpose()?;
+    let lod = args.view.lod()?;
+    if gaze_path.is_some() && lod.is_none() {
+        return Err(Error::option("--gaze-path", "steers the level of detail: use it with --lod visual-field"));
+    }
     let (renderer, _adapter) = open_renderer()?;
     let method = [settings.subdivision.method];
     let base_yaw = settings.view.yaw_deg;
@@ -106,6 +133,16 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32), mut setting
         (Some(rig), None) => (!rig.clips.is_empty()).then_some(0),
         (None, Some(_)) => return Err(Error::option("--animation", format!("{} has no animations", args.scene))),
         (None, None) => None,
+    };
+    // With a gaze path, each frame selects its level of detail from the whole scene.
+    let mut tracked = match (&gaze_path, &lod) {
+        (Some(path), Some((params, _))) => Some((
+            path,
+            *params,
+            twister::core::lod::LodChain::build(&prepared.scene, params.p3),
+            twister::GpuScene::upload(&renderer.gpu, &prepared.scene)?,
+        )),
+        _ => None,
     };
     let camera = match args.view.viewer {
         Viewer::Camera(n) => Some(n),
@@ -135,10 +172,11 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32), mut setting
     let start = std::time::Instant::now();
     // A writer thread encodes and writes frame k while the GPU draws frame k + 1 (one frame in
     // flight: bounded memory).
-    let (send, receive) = std::sync::mpsc::sync_channel::<(u32, f32, f64, twister::Frame)>(1);
+    type Done = (u32, f32, f64, twister::Frame, Option<twister::core::lod::LodSelection>);
+    let (send, receive) = std::sync::mpsc::sync_channel::<Done>(1);
     std::thread::scope(|scope| -> Result<()> {
         let writer = scope.spawn(|| -> Result<()> {
-            for (frame, time, ms_pose, rendered) in receive {
+            for (frame, time, ms_pose, rendered, selected) in receive {
                 let t = std::time::Instant::now();
                 let files = layout_images(&rendered, layout, args.format)
                     .iter()
@@ -160,6 +198,7 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32), mut setting
                         "ms_gpu": s.ms_gpu,
                         "ms_write": ms_write,
                         "files": files.iter().map(|f| f.path.display().to_string()).collect::<Vec<_>>(),
+                        "lod": crate::scene::lod_stats(&selected),
                     });
                     writeln!(file, "{line}").map_err(|e| Error::output(path, format!("cannot write: {e}")))?;
                 }
@@ -172,11 +211,26 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32), mut setting
                 let time = frame as f32 / args.fps;
                 let t = std::time::Instant::now();
                 if prepared.scene.rig.is_some() {
-                    prepared.scene.pose(clip, time);
-                    prepared.gpu_scene.update_pose(&renderer.gpu, &prepared.scene)?;
                     if settings.subdivision.method == Method::Trace {
+                        // The ray tracer's BVH is built on the CPU from the posed vertices.
+                        prepared.scene.pose(clip, time);
+                        prepared.gpu_scene.update_pose(&renderer.gpu, &prepared.scene)?;
                         prepared.gpu_scene.rebuild_bvh(&renderer.gpu, &prepared.scene)?;
+                    } else {
+                        // The skin stage poses the vertices on the GPU; only matrices and
+                        // weights are uploaded.
+                        let target = match tracked.as_mut() {
+                            Some((_, _, _, whole)) => whole,
+                            None => &mut prepared.gpu_scene,
+                        };
+                        renderer.pose(target, &mut prepared.scene, clip, time)?;
                     }
+                }
+                let mut selected = None;
+                if let Some((path, params, chain, whole)) = &tracked {
+                    let selection = chain.select(&prepared.scene, settings.view(), &path.at(time), params);
+                    prepared.gpu_scene = whole.with_lod(&renderer.gpu, &selection);
+                    selected = Some(selection);
                 }
                 if let Some(cam) = camera.and_then(|n| prepared.scene.cameras.get(n)) {
                     settings.view.viewer = Vec3::from(cam.position);
@@ -184,7 +238,7 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32), mut setting
                 }
                 let ms_pose = t.elapsed().as_secs_f64() * 1e3;
                 let rendered = renderer.render(&prepared.gpu_scene, &settings)?;
-                if send.send((frame, time, ms_pose, rendered)).is_err() {
+                if send.send((frame, time, ms_pose, rendered, selected)).is_err() {
                     break; // the writer stopped: its error is reported below
                 }
             }
@@ -202,5 +256,64 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32), mut setting
         start.elapsed().as_secs_f64(),
         if skipped > 0 { format!(" ({skipped} skipped: complete, or another shard's)") } else { String::new() }
     );
+    if let Some(video) = &args.video {
+        let name = frame_name(0, &names[0]).replacen("000000", "%06d", 1);
+        encode_video(video, &args.out.join(name), first, last - first + 1, args.fps, stereo, panorama)?;
+        println!("{}", video.display());
+    }
     Ok(())
+}
+
+/// The installed ffmpeg's first line, or one line saying how to install it.
+fn ffmpeg_version() -> Result<String> {
+    match std::process::Command::new("ffmpeg").arg("-version").output() {
+        Ok(out) if out.status.success() => {
+            Ok(String::from_utf8_lossy(&out.stdout).lines().next().unwrap_or("ffmpeg").to_string())
+        }
+        _ => Err(Error::option(
+            "--video",
+            "needs ffmpeg on PATH: install it (apt-get install ffmpeg, dnf install ffmpeg, brew install ffmpeg)",
+        )),
+    }
+}
+
+/// Encodes `count` frames from `first` (the numbered files `pattern`, `%06d` the frame) at `fps`
+/// into `video` with ffmpeg (H.264, yuv420p, CRF 18, sizes padded to even), then adds the
+/// spherical metadata and writes the file whole (temporary name, rename).
+fn encode_video(
+    video: &std::path::Path,
+    pattern: &std::path::Path,
+    first: u32,
+    count: u32,
+    fps: f32,
+    stereo: twister::video::StereoMode,
+    panorama: PanoramaKind,
+) -> Result<()> {
+    let missing = (first..first + count)
+        .find(|f| !PathBuf::from(pattern.to_string_lossy().replace("%06d", &format!("{f:06}"))).exists());
+    if let Some(f) = missing {
+        return Err(Error::option(
+            "--video",
+            format!("frame {f} is missing: render it first (--resume renders only missing frames)"),
+        ));
+    }
+    let temporary = std::env::temp_dir().join(format!("twister-video-{}.mp4", std::process::id()));
+    let out = std::process::Command::new("ffmpeg")
+        .args(["-y", "-loglevel", "error", "-framerate", &fps.to_string(), "-start_number", &first.to_string(), "-i"])
+        .arg(pattern)
+        .args(["-frames:v", &count.to_string(), "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264"])
+        .args(["-pix_fmt", "yuv420p", "-crf", "18", "-f", "mp4"])
+        .arg(&temporary)
+        .output()
+        .map_err(|e| Error::option("--video", format!("cannot run ffmpeg: {e}")))?;
+    let encoded = std::fs::read(&temporary);
+    let _ = std::fs::remove_file(&temporary);
+    if !out.status.success() {
+        let why = String::from_utf8_lossy(&out.stderr);
+        return Err(Error::output(video, format!("ffmpeg failed: {}", why.lines().last().unwrap_or("no message"))));
+    }
+    let encoded = encoded.map_err(|e| Error::output(video, format!("ffmpeg wrote nothing readable: {e}")))?;
+    let name = video.display().to_string();
+    let bytes = twister::video::with_spherical_metadata(&encoded, &name, stereo, panorama == PanoramaKind::Equirect)?;
+    write_all(&[twister::output::OutputFile { path: video.to_path_buf(), bytes }])
 }

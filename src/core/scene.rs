@@ -381,6 +381,12 @@ impl Scene {
     /// each mesh instance's vertices (morphed, skinned, moved by its node and the placement),
     /// the nodes' lights and cameras. Nothing happens without a rig.
     pub fn pose(&mut self, clip: Option<usize>, t: f32) {
+        self.pose_with(clip, t, true);
+    }
+
+    /// The same, the vertices left as they are unless `vertices` (the GPU's skin stage poses
+    /// them: `Renderer::pose`).
+    pub fn pose_with(&mut self, clip: Option<usize>, t: f32, vertices: bool) {
         use crate::core::animation::{pose_nodes, pose_vertex, world_matrices};
         let Some(rig) = self.rig.take() else { return };
         let poses = pose_nodes(&rig.nodes, clip.and_then(|c| rig.clips.get(c)), t);
@@ -390,7 +396,7 @@ impl Scene {
             .iter()
             .map(|s| s.joints.iter().zip(&s.inverse_bind).map(|(&j, ib)| world[j] * *ib).collect())
             .collect();
-        for inst in &rig.instances {
+        for inst in rig.instances.iter().filter(|_| vertices) {
             // A skinned mesh is placed by its joints alone (glTF ignores its node's transform).
             let skin = inst.skin.and_then(|s| joint_matrices.get(s)).map(|m| &m[..]);
             let m = rig.placement * if skin.is_some() { Mat4::IDENTITY } else { world[inst.node] };

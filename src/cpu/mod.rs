@@ -8,6 +8,7 @@
 //! | [`slit`] | `shaders/slit.wgsl` |
 //! | [`trace`] | `shaders/trace.wgsl` |
 //! | [`shadow`] | `shaders/shadow.wgsl` |
+//! | [`skin`] | `shaders/skin.wgsl` |
 //! | [`fragment`] | `shaders/shared/fragment.wgsl` and `surface.wgsl` (composed into raster, slit and trace) |
 //! | [`reduce_error`] | `shaders/reduce_error.wgsl` |
 //! | [`project_points`] | `shaders/project_points.wgsl` |
@@ -17,6 +18,7 @@ pub mod project_points;
 pub mod raster;
 pub mod reduce_error;
 pub mod shadow;
+pub mod skin;
 pub mod slit;
 pub mod subdivide;
 pub mod trace;

@@ -9,6 +9,7 @@ pub mod reduce_error;
 pub mod renderer;
 pub mod scene;
 pub mod shadow;
+pub mod skin;
 pub mod slit;
 pub mod stages;
 pub mod targets;

@@ -114,6 +114,8 @@ pub struct Renderer {
     pub(crate) accumulate: wgpu::ComputePipeline,
     pub(crate) finish: wgpu::ComputePipeline,
     pub(crate) project_points: OnceLock<(GpuStage, wgpu::ComputePipeline)>,
+    /// The skin stage and its pipeline (`gpu::skin`), made on the first pose.
+    pub(crate) skin: OnceLock<(GpuStage, wgpu::ComputePipeline)>,
     /// The trace stage and its pipelines without and with the material code.
     pub(crate) trace: OnceLock<(GpuStage, [wgpu::ComputePipeline; 2])>,
     pub(crate) resources: Mutex<FrameResources>,
@@ -170,6 +172,7 @@ impl Renderer {
             accumulate,
             finish,
             project_points: OnceLock::new(),
+            skin: OnceLock::new(),
             trace: OnceLock::new(),
             resources: Mutex::new(resources),
         })

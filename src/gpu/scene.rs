@@ -58,6 +58,8 @@ pub struct GpuScene {
     pub bounds: Option<(Vec3, Vec3)>,
     /// The frame's shadow maps (group 1's bindings 6 and 7), drawn when a frame needs them.
     pub shadows: Mutex<GpuShadows>,
+    /// An animated scene's skinning tables, made on its first pose on the GPU (`gpu::skin`).
+    pub rig: Option<GpuRig>,
 }
 
 /// A scene's BVH on the GPU ([`SceneBvh`]): nodes, the objects' chains of levels, and the
@@ -93,11 +95,15 @@ impl GpuScene {
             ));
         }
         gpu.scoped(&format!("uploading {}", scene.name), || {
-            // COPY_DST: an animated scene's frames write their poses in.
+            // COPY_DST: an animated scene's frames write their poses in; COPY_SRC: the skin
+            // stage's twin test reads them back.
             let vertices = gpu.init_buffer(
                 "scene vertices",
                 bytemuck::cast_slice(&scene.vertices),
-                wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+                wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::VERTEX
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
             );
             let indices = gpu.init_buffer(
                 "scene indices",
@@ -161,6 +167,7 @@ impl GpuScene {
                 bvh: None,
                 bounds: scene.bounds(),
                 shadows: Mutex::new(GpuShadows::new(gpu)),
+                rig: None,
                 lights: scene.lights.clone(),
                 environment: scene
                     .environment
@@ -312,6 +319,7 @@ impl GpuScene {
             bvh: None,
             bounds: self.bounds,
             shadows: Mutex::new(GpuShadows::new(gpu)),
+            rig: None,
             lights: self.lights.clone(),
             environment: self.environment.clone(),
         }
@@ -343,4 +351,16 @@ impl GpuShadows {
             drawn: Vec::new(),
         }
     }
+}
+
+/// A rig's tables on the GPU: uploaded once (sources, offsets), written per frame (instances,
+/// joints, weights), and the mesh-frame boxes for the posed bounds.
+pub struct GpuRig {
+    pub(crate) data: crate::cpu::skin::SkinData,
+    pub(crate) params: wgpu::Buffer,
+    pub(crate) sources: wgpu::Buffer,
+    pub(crate) deltas: wgpu::Buffer,
+    pub(crate) instances: wgpu::Buffer,
+    pub(crate) joints: wgpu::Buffer,
+    pub(crate) weights: wgpu::Buffer,
 }

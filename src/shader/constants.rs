@@ -143,6 +143,7 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("SHADOW_ORTHOGRAPHIC", U32(crate::core::shadow::SHADOW_ORTHOGRAPHIC)),
         ("SHADOW_PERSPECTIVE", U32(crate::core::shadow::SHADOW_PERSPECTIVE)),
         ("SHADOW_CUBE", U32(crate::core::shadow::SHADOW_CUBE)),
+        ("NO_SKIN", U32(crate::shader::types::NO_SKIN)),
         ("NO_SHADOW_MAP", U32(crate::core::light::NO_SHADOW_MAP)),
         ("NORMAL_OFFSET_TEXELS", F32(crate::core::shadow::NORMAL_OFFSET_TEXELS)),
         ("LIGHT_OFFSET_TEXELS", F32(crate::core::shadow::LIGHT_OFFSET_TEXELS)),

@@ -276,6 +276,25 @@ pub const SHADOW: Stage = Stage {
     ],
 };
 
+pub const SKIN: Stage = Stage {
+    name: "skin",
+    source: include_str!("../../shaders/skin.wgsl"),
+    kind: StageKind::Compute,
+    entry_points: &[entry(
+        "skin",
+        &["params", "sources", "deltas", "instances", "joints", "morph_weights", "vertices"],
+    )],
+    bindings: &[
+        bind(0, 0, "params", Uniform),
+        bind(0, 1, "sources", Storage),
+        bind(0, 2, "deltas", Storage),
+        bind(0, 3, "instances", Storage),
+        bind(0, 4, "joints", Storage),
+        bind(0, 5, "morph_weights", Storage),
+        bind(0, 6, "vertices", StorageReadWrite),
+    ],
+};
+
 pub const PROJECT_POINTS: Stage = Stage {
     name: "project_points",
     source: include_str!("../../shaders/project_points.wgsl"),
@@ -303,7 +322,7 @@ pub const REDUCE_ERROR: Stage = Stage {
 };
 
 /// The registry: every stage. The naga test validates and reflects each one composed.
-pub const STAGES: &[Stage] = &[SUBDIVIDE, RASTER, SLIT, TRACE, SHADOW, PROJECT_POINTS, REDUCE_ERROR];
+pub const STAGES: &[Stage] = &[SKIN, SUBDIVIDE, RASTER, SLIT, TRACE, SHADOW, PROJECT_POINTS, REDUCE_ERROR];
 
 /// The shared WGSL modules in `shaders/shared/`, by import name.
 pub const SHARED: &[(&str, &str)] = &[

@@ -343,6 +343,55 @@ pub struct ShadowParams {
     pub clip_from_scene: [[f32; 4]; 4],
 }
 
+/// `SkinSource` in shaders/skin.wgsl: a posed vertex's data in its mesh frame (`cpu::skin`):
+/// position and instance, normal and the scene vertex it poses, tangent (w = 0: none), four
+/// joints (16 bits each), its first morph offset (`NO_SKIN`: none), four weights. 80 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SkinSource {
+    pub position: [f32; 3],
+    pub instance: u32,
+    pub normal: [f32; 3],
+    pub vertex: u32,
+    pub tangent: [f32; 4],
+    pub joints: [u32; 2],
+    pub first_delta: u32,
+    pub _pad: u32,
+    pub weights: [f32; 4],
+}
+
+/// `SkinInstance` in shaders/skin.wgsl: an instance's matrix for a frame (placement × its
+/// node's, or the placement alone when skinned), its inverse transpose, its skin's joints
+/// (`NO_SKIN`: none) and morph weights in the frame's tables, −1 where the matrix mirrors.
+/// 160 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SkinInstance {
+    pub matrix: [[f32; 4]; 4],
+    pub normal_matrix: [[f32; 4]; 4],
+    pub first_joint: u32,
+    pub joint_count: u32,
+    pub first_weight: u32,
+    pub weight_count: u32,
+    pub mirror: f32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
+}
+
+/// `SkinParams` in shaders/skin.wgsl: how many sources.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct SkinParams {
+    pub count: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
+}
+
+/// No skin / no morph offsets (`NO_SKIN` in the WGSL `constants` module).
+pub const NO_SKIN: u32 = u32::MAX;
+
 /// Every struct the stages bind (as a uniform or in a storage buffer), by its WGSL name.
 pub const LAYOUTS: &[StructLayout] = &[
     layout!("SceneVertex" => SceneVertex { position, material, normal, object, color, uv, tangent, _pad1 }),
@@ -367,6 +416,9 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("Light" => GpuLight { position, kind, direction, range, color, inner_cos, outer_cos, shadow_map, _pad1, _pad2 }),
     layout!("ShadowMap" => GpuShadowMap { clip_from_viewer, offset, size, texel, projection }),
     layout!("ShadowParams" => ShadowParams { clip_from_scene }),
+    layout!("SkinSource" => SkinSource { position, instance, normal, vertex, tangent, joints, first_delta, _pad, weights }),
+    layout!("SkinInstance" => SkinInstance { matrix, normal_matrix, first_joint, joint_count, first_weight, weight_count, mirror, _pad0, _pad1, _pad2 }),
+    layout!("SkinParams" => SkinParams { count, _pad0, _pad1, _pad2 }),
     layout!("Lighting" => LightingParams {
         count, pbr, exposure, tonemap, environment, env_background, env_lut, shadows, env_rotation, env_sh, env_levels
     }),
