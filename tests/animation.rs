@@ -491,3 +491,32 @@ fn a_gaze_path_steers_each_frames_level_of_detail() {
     assert!(!out.status.success() && err.contains("gaze.csv") && err.contains("row 2"), "{err}");
     std::fs::remove_dir_all(&root).unwrap();
 }
+
+/// `--viewer-path`: the viewer moves through a still scene as the CSV says — frame 1 of 0–2 at
+/// 2 fps, halfway between rows (0, 0, 0, yaw 0) and (0.4, 0.1, −0.3, yaw 45) at 0 and 1 s, is
+/// pixel for pixel the still with `--viewer 0.2,0.05,-0.15 --yaw 22.5`, and frame 2 the last row.
+#[test]
+fn a_viewer_path_moves_the_viewer_through_a_still_scene() {
+    let root = std::env::temp_dir().join(format!("twister-walk-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    std::fs::create_dir_all(&root).unwrap();
+    let path = root.join("walk.csv");
+    std::fs::write(&path, "# time, x, y, z, yaw\n0,0,0,0,0\n1,0.4,0.1,-0.3,45\n").unwrap();
+    let small = ["--width", "256", "--height", "64"];
+    let run = |extra: &[&str]| {
+        let out = twister().args(["render", "builtin:demo"]).args(small).args(extra).output().unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    };
+    let seq = root.join("seq");
+    run(&["--viewer-path", path.to_str().unwrap(), "--frames", "0..2", "--fps", "2", "--out", seq.to_str().unwrap()]);
+    for (k, viewer, yaw) in [(1, "0.2,0.05,-0.15", "22.5"), (2, "0.4,0.1,-0.3", "45")] {
+        let still = root.join(format!("still{k}"));
+        run(&["--viewer", viewer, "--yaw", yaw, "--out", still.to_str().unwrap()]);
+        for eye in ["left", "right"] {
+            let a = image::open(seq.join(format!("frame_{k:06}_{eye}.png"))).unwrap();
+            let b = image::open(still.join(format!("{eye}.png"))).unwrap();
+            assert!(a == b, "frame {k} ({eye}) is not the still at {viewer}, yaw {yaw}");
+        }
+    }
+    std::fs::remove_dir_all(&root).unwrap();
+}

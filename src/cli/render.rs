@@ -88,6 +88,10 @@ pub struct RenderArgs {
     /// (seconds, degrees as --gaze): each frame's level of detail follows the tracked viewer.
     #[arg(long, value_name = "FILE.csv")]
     pub gaze_path: Option<PathBuf>,
+    /// With --frames: the viewer over time, a CSV of time,x,y,z[,yaw] rows (seconds; the place
+    /// in scene units as --viewer; degrees added to --yaw), blended linearly between rows.
+    #[arg(long, value_name = "FILE.csv")]
+    pub viewer_path: Option<PathBuf>,
     /// How --shard splits the frames.
     #[arg(long, value_enum, default_value_t = crate::sequence::ShardMode::Interleave)]
     pub shard_mode: crate::sequence::ShardMode,
@@ -105,6 +109,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         (args.animation.is_some(), "--animation"),
         (args.video.is_some(), "--video"),
         (args.gaze_path.is_some(), "--gaze-path"),
+        (args.viewer_path.is_some(), "--viewer-path"),
     ] {
         if given {
             return Err(Error::option(option, "belongs to a sequence: use it with --frames A..B"));

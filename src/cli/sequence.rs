@@ -118,6 +118,17 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32), mut setting
     let paths = |frame: u32| -> Vec<PathBuf> { names.iter().map(|n| args.out.join(frame_name(frame, n))).collect() };
     let gaze_path = args.gaze_path.as_deref().map(twister::core::visual_field::GazePath::read).transpose()?;
     let lod = args.view.lod()?;
+    let viewer_path = match &args.viewer_path {
+        Some(_) if matches!(args.view.viewer, Viewer::Camera(_)) => {
+            return Err(Error::option("--viewer-path", "moves the viewer itself: leave out --viewer camera"))
+        }
+        Some(path) => {
+            Some(twister::core::timeline::Timeline::read(path, "--viewer-path", (3, 4), "time,x,y,z[,yaw]", |v| {
+                (v[..3].iter().any(|c| c.abs() > 1e15)).then(|| "coordinates within ±1e15".to_string())
+            })?)
+        }
+        None => None,
+    };
     if gaze_path.is_some() && lod.is_none() {
         return Err(Error::option("--gaze-path", "steers the level of detail: use it with --lod visual-field"));
     }
@@ -196,6 +207,8 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32), mut setting
                         "ms_pose": ms_pose,
                         "ms_frame": s.ms_frame,
                         "ms_gpu": s.ms_gpu,
+                        "ms_readback": s.ms_readback,
+                        "ms_total": s.ms_total,
                         "ms_write": ms_write,
                         "files": files.iter().map(|f| f.path.display().to_string()).collect::<Vec<_>>(),
                         "lod": crate::scene::lod_stats(&selected),
@@ -231,6 +244,11 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32), mut setting
                     let selection = chain.select(&prepared.scene, settings.view(), &path.at(time), params);
                     prepared.gpu_scene = whole.with_lod(&renderer.gpu, &selection);
                     selected = Some(selection);
+                }
+                if let Some(path) = &viewer_path {
+                    let v = path.at(time);
+                    settings.view.viewer = Vec3::new(v[0], v[1], v[2]) * args.view.scale;
+                    settings.view.yaw_deg = base_yaw + v.get(3).copied().unwrap_or(0.0);
                 }
                 if let Some(cam) = camera.and_then(|n| prepared.scene.cameras.get(n)) {
                     settings.view.viewer = Vec3::from(cam.position);

@@ -20,4 +20,5 @@ pub mod settings;
 pub mod shadow;
 pub mod sphere;
 pub mod texture;
+pub mod timeline;
 pub mod visual_field;

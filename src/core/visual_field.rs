@@ -46,73 +46,21 @@ impl Default for Gaze {
 }
 
 /// A tracked viewer's gaze over time (`--gaze-path FILE`, the seeds' tracked viewer): rows of
-/// time (s), yaw and pitch (degrees, as `--gaze`), times increasing; between rows the angles
-/// are blended linearly, before the first and after the last they hold.
+/// time (s), yaw and pitch (degrees, as `--gaze`), blended linearly (`core::timeline`).
 #[derive(Clone, Debug, PartialEq)]
-pub struct GazePath {
-    pub keys: Vec<(f32, f32, f32)>,
-}
+pub struct GazePath(pub crate::core::timeline::Timeline);
 
 impl GazePath {
-    /// Reads a CSV of `time,yaw,pitch` rows (a header row of names is skipped); one line naming
-    /// the file and row where a row is not three finite numbers, pitch beyond ±89° or times do
-    /// not increase.
+    /// Reads a CSV of `time,yaw,pitch` rows; one line naming the file and row otherwise.
     pub fn read(path: &std::path::Path) -> crate::error::Result<GazePath> {
-        let bad = |m: String| crate::error::Error::option("--gaze-path", format!("{}: {m}", path.display()));
-        let size = std::fs::metadata(path).map_err(|e| bad(e.to_string()))?.len();
-        if size > 64 << 20 {
-            return Err(bad("larger than 64 MiB".into()));
-        }
-        let mut reader = csv::ReaderBuilder::new()
-            .has_headers(false)
-            .trim(csv::Trim::All)
-            .comment(Some(b'#'))
-            .from_path(path)
-            .map_err(|e| bad(e.to_string()))?;
-        let mut keys: Vec<(f32, f32, f32)> = Vec::new();
-        for (row, record) in reader.records().enumerate() {
-            let record = record.map_err(|e| bad(format!("row {}: {e}", row + 1)))?;
-            let numbers: Vec<Option<f32>> = record.iter().map(|f| f.parse::<f32>().ok()).collect();
-            if row == 0 && numbers.iter().all(Option::is_none) {
-                continue; // a header
-            }
-            match numbers[..] {
-                [Some(t), Some(yaw), Some(pitch)]
-                    if t.is_finite()
-                        && yaw.is_finite()
-                        && pitch.abs() <= 89.0
-                        && keys.last().is_none_or(|k| t > k.0) =>
-                {
-                    keys.push((t, yaw, pitch))
-                }
-                _ => {
-                    return Err(bad(format!(
-                        "row {}: expected time,yaw,pitch: finite numbers, pitch within ±89, times increasing",
-                        row + 1
-                    )))
-                }
-            }
-        }
-        if keys.is_empty() {
-            return Err(bad("no rows".into()));
-        }
-        Ok(GazePath { keys })
+        let check = |v: &[f32]| (v[1].abs() > 89.0).then(|| "pitch within ±89".to_string());
+        crate::core::timeline::Timeline::read(path, "--gaze-path", (2, 2), "time,yaw,pitch", check).map(GazePath)
     }
 
     /// The gaze at time t.
     pub fn at(&self, t: f32) -> Gaze {
-        let k = &self.keys;
-        let i = k.partition_point(|key| key.0 <= t);
-        let (yaw, pitch) = if i == 0 {
-            (k[0].1, k[0].2)
-        } else if i == k.len() {
-            (k[i - 1].1, k[i - 1].2)
-        } else {
-            let (a, b) = (k[i - 1], k[i]);
-            let s = (t - a.0) / (b.0 - a.0);
-            (a.1 + (b.1 - a.1) * s, a.2 + (b.2 - a.2) * s)
-        };
-        Gaze::new(yaw, pitch)
+        let v = self.0.at(t);
+        Gaze::new(v[0], v[1])
     }
 }
 
