@@ -384,7 +384,6 @@ fn moving_camera_file(dir: &Path) -> PathBuf {
     let quad = [[-1.0f32, -1.0, 0.0], [1.0, -1.0, 0.0], [1.0, 1.0, 0.0], [-1.0, 1.0, 0.0]];
     bin.extend(quad.iter().flatten().flat_map(|f| f.to_le_bytes()));
     bin.extend([0u16, 1, 2, 0, 2, 3].iter().flat_map(|i| i.to_le_bytes()));
-    bin.extend([0u8; 0]);
     bin.extend([0.0f32, 1.0].iter().flat_map(|f| f.to_le_bytes()));
     bin.extend([0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0].iter().flat_map(|f| f.to_le_bytes()));
     let json = serde_json::json!({

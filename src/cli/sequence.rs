@@ -124,7 +124,8 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32), mut setting
         }
         Some(path) => {
             Some(twister::core::timeline::Timeline::read(path, "--viewer-path", (3, 4), "time,x,y,z[,yaw]", |v| {
-                (v[..3].iter().any(|c| c.abs() > 1e15)).then(|| "coordinates within ±1e15".to_string())
+                let max = twister::core::scene::MAX_COORDINATE;
+                (v[..3].iter().any(|c| c.abs() > max)).then(|| format!("coordinates within ±{max:e}"))
             })?)
         }
         None => None,

@@ -394,6 +394,7 @@ impl Scene {
         let joint_matrices: Vec<Vec<Mat4>> = rig
             .skins
             .iter()
+            .filter(|_| vertices)
             .map(|s| s.joints.iter().zip(&s.inverse_bind).map(|(&j, ib)| world[j] * *ib).collect())
             .collect();
         for inst in rig.instances.iter().filter(|_| vertices) {

@@ -53,17 +53,19 @@ impl Renderer {
                 weights: storage("morph weights", bytemuck::cast_slice(&frame.weights), true),
                 data,
             });
-        }
-        let rig_gpu = gpu_scene.rig.as_ref().expect("just made");
-        for (buffer, bytes) in [
-            (&rig_gpu.instances, bytemuck::cast_slice::<_, u8>(&frame.instances)),
-            (&rig_gpu.joints, bytemuck::cast_slice(&frame.joints)),
-            (&rig_gpu.weights, bytemuck::cast_slice(&frame.weights)),
-        ] {
-            if !bytes.is_empty() {
-                gpu.queue.write_buffer(buffer, 0, bytes);
+        } else if let Some(rig_gpu) = &gpu_scene.rig {
+            // The first pose made the buffers with its tables; later ones write theirs.
+            for (buffer, bytes) in [
+                (&rig_gpu.instances, bytemuck::cast_slice::<_, u8>(&frame.instances)),
+                (&rig_gpu.joints, bytemuck::cast_slice(&frame.joints)),
+                (&rig_gpu.weights, bytemuck::cast_slice(&frame.weights)),
+            ] {
+                if !bytes.is_empty() {
+                    gpu.queue.write_buffer(buffer, 0, bytes);
+                }
             }
         }
+        let rig_gpu = gpu_scene.rig.as_ref().expect("made on the first pose");
         let (stage, pipeline) = self.skin.get_or_init(|| {
             let stage = GpuStage::new(gpu, &SKIN);
             let pipeline = stage.compute(gpu, "skin");

@@ -114,6 +114,23 @@ impl Stage {
 const SHADING: &[&str] =
     &["params", "materials", "mips", "texels", "lights", "lighting", "environment", "shadow_maps", "shadow_depths"];
 
+/// A stage's bindings: its own, then the material table as group 1.
+macro_rules! with_material_table {
+    ($($own:expr),* $(,)?) => {
+        &[
+            $($own,)*
+            MATERIAL_TABLE[0],
+            MATERIAL_TABLE[1],
+            MATERIAL_TABLE[2],
+            MATERIAL_TABLE[3],
+            MATERIAL_TABLE[4],
+            MATERIAL_TABLE[5],
+            MATERIAL_TABLE[6],
+            MATERIAL_TABLE[7],
+        ]
+    };
+}
+
 /// Group 1 of the stages that shade: the scene's materials and textures, its lights, the
 /// frame's lighting, the environment and the frame's shadow maps (src/gpu/scene.rs).
 const MATERIAL_TABLE: [Binding; 8] = [
@@ -170,17 +187,7 @@ pub const RASTER: Stage = Stage {
         entry("vs_background", &[]),
         entry("fs_background", &["params", "lighting", "environment"]),
     ],
-    bindings: &[
-        bind(0, 0, "params", Uniform),
-        MATERIAL_TABLE[0],
-        MATERIAL_TABLE[1],
-        MATERIAL_TABLE[2],
-        MATERIAL_TABLE[3],
-        MATERIAL_TABLE[4],
-        MATERIAL_TABLE[5],
-        MATERIAL_TABLE[6],
-        MATERIAL_TABLE[7],
-    ],
+    bindings: with_material_table![bind(0, 0, "params", Uniform),],
 };
 
 pub const SLIT: Stage = Stage {
@@ -195,18 +202,7 @@ pub const SLIT: Stage = Stage {
         entry("vs_background", &[]),
         entry("fs_background", &["params", "lighting", "environment"]),
     ],
-    bindings: &[
-        bind(0, 0, "params", Uniform),
-        bind(0, 1, "cameras", Storage),
-        MATERIAL_TABLE[0],
-        MATERIAL_TABLE[1],
-        MATERIAL_TABLE[2],
-        MATERIAL_TABLE[3],
-        MATERIAL_TABLE[4],
-        MATERIAL_TABLE[5],
-        MATERIAL_TABLE[6],
-        MATERIAL_TABLE[7],
-    ],
+    bindings: with_material_table![bind(0, 0, "params", Uniform), bind(0, 1, "cameras", Storage),],
 };
 
 pub const TRACE: Stage = Stage {
@@ -236,7 +232,7 @@ pub const TRACE: Stage = Stage {
             "shadow_depths",
         ],
     )],
-    bindings: &[
+    bindings: with_material_table![
         bind(0, 0, "params", Uniform),
         bind(0, 1, "vertices", Storage),
         bind(0, 2, "indices", Storage),
@@ -247,14 +243,6 @@ pub const TRACE: Stage = Stage {
         bind(0, 7, "out_object", StorageReadWrite),
         bind(0, 8, "out_distance", StorageReadWrite),
         bind(0, 9, "counts", StorageReadWrite),
-        MATERIAL_TABLE[0],
-        MATERIAL_TABLE[1],
-        MATERIAL_TABLE[2],
-        MATERIAL_TABLE[3],
-        MATERIAL_TABLE[4],
-        MATERIAL_TABLE[5],
-        MATERIAL_TABLE[6],
-        MATERIAL_TABLE[7],
     ],
 };
 
@@ -263,17 +251,7 @@ pub const SHADOW: Stage = Stage {
     source: include_str!("../../shaders/shadow.wgsl"),
     kind: StageKind::Draw,
     entry_points: &[entry("vs_main", &["params"]), entry("fs_mask", &["materials", "mips", "texels"])],
-    bindings: &[
-        bind(0, 0, "params", Uniform),
-        MATERIAL_TABLE[0],
-        MATERIAL_TABLE[1],
-        MATERIAL_TABLE[2],
-        MATERIAL_TABLE[3],
-        MATERIAL_TABLE[4],
-        MATERIAL_TABLE[5],
-        MATERIAL_TABLE[6],
-        MATERIAL_TABLE[7],
-    ],
+    bindings: with_material_table![bind(0, 0, "params", Uniform),],
 };
 
 pub const SKIN: Stage = Stage {
