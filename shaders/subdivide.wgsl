@@ -10,7 +10,8 @@
 // `plan`     one invocation per input triangle. A triangle that is its own single part (no cuts
 //            this frame, or inside one quadrant and one band) is planned here; the others are
 //            listed in `cut_list` for `plan_cuts` (the clipping code, kept out of this entry
-//            point: lavapipe runs a shader that merely contains it markedly slower).
+//            point: lavapipe runs a shader that merely contains it markedly slower), the wide
+//            ones near the axis apart from the rest.
 // `plan_cuts_args`, `plan_cuts`  one invocation per listed triangle (on the sphere per triangle
 //            and quadrant): its parts around the
 //            vertical axis under the frame's cuts (quadrants minus a small square around the axis,
@@ -19,8 +20,9 @@
 //            counts N (eq. 5 or the error split), the macro-lattice level K = ceil(M / N_max) of the pre-split, and
 //            K² piece records (triangle, cell, counts, the part's corners).
 // `lattice`  one invocation per piece: the part's corners from the piece record, the regular
-//            lattice of level m = max(counts), boundary nodes snapped to each edge's nodes; its
-//            nodes appended once and its drawn sub-triangles as indices into them, the whole
+//            lattice of level m = max(counts), boundary nodes snapped to each edge's nodes (or,
+//            for a sliver under the error split on the cylinder, a strip along its long edges);
+//            its nodes appended once and its drawn sub-triangles as indices into them, the whole
 //            piece again a turn away where its nodes' u range crosses ±π.
 // `finalize` the DrawIndexedIndirect arguments (none drawn if a buffer overflowed).
 // Appends never write past a capacity: they are counted, and the host grows the buffer or
@@ -63,9 +65,9 @@ struct Counters {
     pieces: atomic<u32>,
     triangles: atomic<u32>,
     max_edge_bits: atomic<u32>, // bits of the largest visible output edge, px (f32 ≥ 0 orders as u32)
-    cut_count: atomic<u32>,     // triangles `plan` listed for `plan_cuts`
+    cut_count: atomic<u32>,     // triangles `plan` listed for `plan_cuts` from the front of `cut_list`
     nodes: atomic<u32>,         // output nodes (`lattice`)
-    _pad0: u32,
+    cut_wide: atomic<u32>,      // ... and from its back: the wide ones (`wide_near_axis`)
     // The frame's cuts around the axis (`AxisCuts` in axis.rs): bit 0 the quadrant cuts and the
     // square, bit k the diamond c_k; bits 0–31 and 32–63. Kept across the chunks of a frame.
     cuts_low: atomic<u32>,
@@ -142,6 +144,8 @@ var<private> piece_counts: array<u32, 3>;
 var<private> piece_original: array<i32, 3>; // original edge under piece edge e, or −1
 var<private> piece_from: array<u32, 3>;     // fine index on that original edge at corner e
 var<private> piece_to: array<u32, 3>;
+var<private> strip_base: u32;               // a sliver's base edge (see `strip_base_of`); 3: the lattice
+var<private> strip_n: vec2<u32>;            // its long edges' counts: edge base + 1, edge base + 2
 
 // A polygon while it is clipped (at most 7 corners), and a quadrant's polygon kept while its
 // bands are cut from it.
@@ -895,13 +899,118 @@ fn node_slot(c: vec3<u32>, m: u32) -> u32 {
     return c.z * (2u * m + 3u - c.z) / 2u + c.y;
 }
 
-// Whether lattice triangle t of level m is drawn: not collapsed by snapping, not off screen.
-fn lattice_triangle_drawn(t: u32, m: u32) -> bool {
+// ---- the strip of a sliver piece (`strip_triangles` in subdivide.rs) ----
+
+// On the cylinder, under the error split, the base edge (one part, chord error within
+// STRIP_BASE_ERROR·τ by the quick profile, away from the eye circle) of a piece with another edge
+// in STRIP_MIN_DIVISIONS or more parts; 3: the regular lattice (`strip_base` in subdivide.rs).
+fn strip_base_of() -> u32 {
+    let m = max(max(piece_counts[0], piece_counts[1]), piece_counts[2]);
+    if (params.method != METHOD_ERROR || is_sphere(params.projection) || m < STRIP_MIN_DIVISIONS) {
+        return 3u;
+    }
+    var base = 3u;
+    for (var e = 0u; e < 3u; e++) {
+        if (base == 3u && piece_counts[e] == 1u) {
+            base = e;
+        }
+    }
+    if (base < 3u) {
+        let p = edge_profile(piece_q[base].position, piece_q[(base + 1u) % 3u].position, 2u);
+        if (p.ring || parts_for_bend(p.bend_px, 2u, STRIP_BASE_ERROR * tri_max_error_px) > 1.0) {
+            return 3u;
+        }
+    }
+    return base;
+}
+
+// Node `slot` of the strip: edge base + 1's nodes from its corner to the apex, then edge
+// base + 2's after the apex.
+fn strip_node(slot: u32) -> Node {
+    if (slot <= strip_n.x) {
+        return node_on_edge((strip_base + 1u) % 3u, slot);
+    }
+    return node_on_edge((strip_base + 2u) % 3u, slot - strip_n.x);
+}
+
+// The next triangle of the strip's walk at `walk` = (i, j) (left L_i = slot n1 + n2 − i, right
+// R_j = slot j), as slots; advances the walk.
+fn strip_step(walk: ptr<function, vec2<u32>>) -> vec3<u32> {
+    let i = (*walk).x;
+    let j = (*walk).y;
+    let n1 = strip_n.x;
+    let n2 = strip_n.y;
+    if (i < n2 && (j == n1 || (i + 1u) * n1 <= (j + 1u) * n2)) {
+        *walk = vec2<u32>(i + 1u, j);
+        return vec3<u32>(n1 + n2 - i, j, n1 + n2 - i - 1u);
+    }
+    *walk = vec2<u32>(i, j + 1u);
+    return vec3<u32>(n1 + n2 - i, j, j + 1u);
+}
+
+// ---- a piece's nodes and candidate triangles: the lattice of level m, or the strip ----
+
+// Node k in slot order; `row` is the lattice's running (j, l), advanced here.
+fn piece_node(k: u32, m: u32, row: ptr<function, vec2<u32>>) -> Node {
+    if (strip_base < 3u) {
+        return strip_node(k);
+    }
+    let j = (*row).x;
+    let l = (*row).y;
+    *row = select(vec2<u32>(j + 1u, l), vec2<u32>(0u, l + 1u), j + 1u > m - l);
+    return lattice_node(vec3<u32>(m - j - l, j, l), m);
+}
+
+// Candidate triangle t's slots (the strip's in walk order, advancing `walk`).
+fn piece_triangle_slots(t: u32, m: u32, walk: ptr<function, vec2<u32>>) -> vec3<u32> {
+    if (strip_base < 3u) {
+        return strip_step(walk);
+    }
     let cell = macro_cell(m, t);
-    let a = lattice_node(cell.c[0], m).position;
-    let b = lattice_node(cell.c[1], m).position;
-    let c = lattice_node(cell.c[2], m).position;
+    return vec3<u32>(node_slot(cell.c[0], m), node_slot(cell.c[1], m), node_slot(cell.c[2], m));
+}
+
+// Whether candidate triangle t is drawn: not collapsed by snapping, not off screen.
+fn piece_triangle_drawn(t: u32, m: u32, walk: ptr<function, vec2<u32>>) -> bool {
+    var a: vec3<f32>;
+    var b: vec3<f32>;
+    var c: vec3<f32>;
+    if (strip_base < 3u) {
+        let s = strip_step(walk);
+        a = strip_node(s.x).position;
+        b = strip_node(s.y).position;
+        c = strip_node(s.z).position;
+    } else {
+        let cell = macro_cell(m, t);
+        a = lattice_node(cell.c[0], m).position;
+        b = lattice_node(cell.c[1], m).position;
+        c = lattice_node(cell.c[2], m).position;
+    }
     return !(same(a, b) || same(b, c) || same(c, a) || off_screen_vertically(a, b, c));
+}
+
+// The u range (both eyes) of the piece's triangle on the cylinder, from its corners
+// (`piece_u_range` in subdivide.rs): its azimuths span those of its corners (its footprint is
+// convex and misses the axis), and α(r) grows with r, so |α| is largest at the footprint's
+// nearest or farthest point from the axis.
+fn piece_u_range(theta_c: f32) -> vec2<f32> {
+    var theta_min = 1e30;
+    var theta_max = -1e30;
+    var r_min = 1e30;
+    var r_max = 0.0;
+    for (var e = 0u; e < 3u; e++) {
+        let a = piece_q[e].position.xz;
+        let b = piece_q[(e + 1u) % 3u].position.xz;
+        let theta = theta_c + wrap_angle(azimuth(piece_q[e].position) - theta_c);
+        theta_min = min(theta_min, theta);
+        theta_max = max(theta_max, theta);
+        r_max = max(r_max, length(a));
+        let ab = b - a;
+        let t = clamp(-dot(a, ab) / max(dot(ab, ab), 1e-30), 0.0, 1.0);
+        r_min = min(r_min, length(a + t * ab));
+    }
+    let alpha = max(abs(eye_shift(params.projection, r_min)), abs(eye_shift(params.projection, r_max)));
+    return vec2<f32>(theta_min - alpha, theta_max + alpha);
 }
 
 // ---- entry points ----
@@ -952,10 +1061,42 @@ fn plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         append_pieces(t);
         return;
     }
-    let slot = atomicAdd(&counters.cut_count, 1u);
-    if (slot < arrayLength(&cut_list)) {
-        cut_list[slot] = t;
+    // Triangles wide next to their distance from the axis (a floor around the viewer) make many
+    // parts; listed apart, they share SIMD lanes with each other rather than stall lanes of the
+    // many small triangles that merely straddle a cut (Sponza: 602 and 9,007).
+    let len = arrayLength(&cut_list);
+    if (wide_near_axis()) {
+        let slot = atomicAdd(&counters.cut_wide, 1u);
+        if (slot < len) {
+            cut_list[len - 1u - slot] = t;
+        }
+    } else {
+        let slot = atomicAdd(&counters.cut_count, 1u);
+        if (slot < len) {
+            cut_list[slot] = t;
+        }
     }
+}
+
+// Whether the loaded triangle reaches the first diamond or spans a wide range of diamond
+// distances: those that ask for cuts (`triangle_cuts`).
+fn wide_near_axis() -> bool {
+    let range = diamond_range(tri_position);
+    return range.x < band_bound(1u) || range.y > WIDE_RATIO * range.x;
+}
+
+// The triangles `plan` listed, and the i-th of them: the narrow ones from the front of
+// `cut_list`, then the wide ones from its back.
+fn listed_cuts() -> vec2<u32> {
+    let len = arrayLength(&cut_list);
+    return vec2<u32>(min(atomicLoad(&counters.cut_count), len), min(atomicLoad(&counters.cut_wide), len));
+}
+
+fn listed_cut(i: u32, listed: vec2<u32>) -> u32 {
+    if (i < listed.x) {
+        return cut_list[i];
+    }
+    return cut_list[arrayLength(&cut_list) - 1u - (i - listed.x)];
 }
 
 // Invocations of `plan_cuts` per listed triangle: one per quadrant on the sphere, whose bands reach
@@ -968,7 +1109,8 @@ fn plan_cuts_split() -> u32 {
 
 @compute @workgroup_size(1)
 fn plan_cuts_args() {
-    let groups = (plan_cuts_split() * min(atomicLoad(&counters.cut_count), arrayLength(&cut_list)) + 63u) / 64u;
+    let listed = listed_cuts();
+    let groups = (plan_cuts_split() * min(listed.x + listed.y, arrayLength(&cut_list)) + 63u) / 64u;
     lattice_dispatch[3] = min(groups, 65535u);
     lattice_dispatch[4] = (groups + 65534u) / 65535u;
     lattice_dispatch[5] = 1u;
@@ -978,10 +1120,11 @@ fn plan_cuts_args() {
 fn plan_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let local = invocation_index(gid, groups);
     let split = plan_cuts_split();
-    if (local / split >= min(atomicLoad(&counters.cut_count), arrayLength(&cut_list))) {
+    let listed = listed_cuts();
+    if (local / split >= min(listed.x + listed.y, arrayLength(&cut_list))) {
         return;
     }
-    let t = cut_list[local / split];
+    let t = listed_cut(local / split, listed);
     cuts = vec2<u32>(atomicLoad(&counters.cuts_low), atomicLoad(&counters.cuts_high));
     load_triangle(t);
     if (split == 4u) {
@@ -1048,11 +1191,21 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         }
     }
     let m = max(max(piece_counts[0], piece_counts[1]), piece_counts[2]);
-    // Which of the m² lattice triangles are drawn (one bit each; m ≤ PIECE_DIVISIONS = 32).
+    strip_base = strip_base_of();
+    var candidates = m * m;
+    var node_count = (m + 1u) * (m + 2u) / 2u;
+    if (strip_base < 3u) {
+        strip_n = vec2<u32>(piece_counts[(strip_base + 1u) % 3u], piece_counts[(strip_base + 2u) % 3u]);
+        candidates = strip_n.x + strip_n.y - 1u;
+        node_count = strip_n.x + strip_n.y + 1u;
+    }
+    // Which of the candidate triangles (the m² of the lattice, or the strip's) are drawn (one
+    // bit each; m ≤ PIECE_DIVISIONS = 32).
     var drawn: array<u32, 32>;
     var count = 0u;
-    for (var t = 0u; t < m * m; t++) {
-        if (lattice_triangle_drawn(t, m)) {
+    var walk = vec2<u32>(0u, 0u);
+    for (var t = 0u; t < candidates; t++) {
+        if (piece_triangle_drawn(t, m, &walk)) {
             drawn[t / 32u] |= 1u << (t % 32u);
             count += 1u;
         }
@@ -1063,41 +1216,30 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     // The seam: every node is unwrapped towards the piece's reference azimuth; where the nodes'
     // u range (both eyes) reaches ±π, the piece is drawn again a turn away. Conservative by
     // SEAM_MARGIN: an extra copy is clipped by the rasterizer.
-    let node_count = (m + 1u) * (m + 2u) / 2u;
     let theta_c = azimuth((piece_q[0].position + piece_q[1].position + piece_q[2].position) / 3.0);
-    var u_min = 1e30;
-    var u_max = -1e30;
+    var u_range = vec2<f32>(1e30, -1e30);
     // Nodes in slot order: (i, j, l) row by row, kept by a running (j, l) rather than searched
     // for each slot (lavapipe stops an invocation after 65,535 loop iterations in all).
-    var j = 0u;
-    var l = 0u;
-    for (var k = 0u; k < node_count; k++) {
-        let p = lattice_node(vec3<u32>(m - j - l, j, l), m).position;
-        j += 1u;
-        if (j > m - l) {
-            j = 0u;
-            l += 1u;
-        }
-        let theta = theta_c + wrap_angle(azimuth(p) - theta_c);
-        if (is_sphere(params.projection)) {
+    var row = vec2<u32>(0u, 0u);
+    if (is_sphere(params.projection)) {
+        for (var k = 0u; k < node_count; k++) {
+            let p = piece_node(k, m, &row).position;
+            let theta = theta_c + wrap_angle(azimuth(p) - theta_c);
             for (var s = 0u; s < 2u; s++) {
                 let u = project_with_azimuth(params.projection, p, theta, select(-1.0, 1.0, s == 1u)).x;
-                u_min = min(u_min, u);
-                u_max = max(u_max, u);
+                u_range = vec2<f32>(min(u_range.x, u), max(u_range.y, u));
             }
-        } else {
-            let alpha = abs(eye_shift(params.projection, horizontal_radius(p)));
-            u_min = min(u_min, theta - alpha);
-            u_max = max(u_max, theta + alpha);
         }
+    } else {
+        u_range = piece_u_range(theta_c);
     }
     var refs = array<f32, 3>(theta_c, 0.0, 0.0);
     var copies = 1u;
-    if (u_max > PI - SEAM_MARGIN) {
+    if (u_range.y > PI - SEAM_MARGIN) {
         refs[copies] = theta_c - TAU;
         copies += 1u;
     }
-    if (u_min < -PI + SEAM_MARGIN) {
+    if (u_range.x < -PI + SEAM_MARGIN) {
         refs[copies] = theta_c + TAU;
         copies += 1u;
     }
@@ -1107,26 +1249,20 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         || first_triangle + copies * count > params.triangle_capacity) {
         return; // counted, never written
     }
-    j = 0u;
-    l = 0u;
+    row = vec2<u32>(0u, 0u);
     for (var k = 0u; k < node_count; k++) {
-        let node = lattice_node(vec3<u32>(m - j - l, j, l), m);
+        let node = piece_node(k, m, &row);
         for (var c = 0u; c < copies; c++) {
             out_nodes[first_node + c * node_count + k] = draw_vertex(node, refs[c]);
         }
-        j += 1u;
-        if (j > m - l) {
-            j = 0u;
-            l += 1u;
-        }
     }
     var slot = 3u * first_triangle;
-    for (var t = 0u; t < m * m; t++) {
+    walk = vec2<u32>(0u, 0u);
+    for (var t = 0u; t < candidates; t++) {
+        let local = piece_triangle_slots(t, m, &walk);
         if ((drawn[t / 32u] & (1u << (t % 32u))) == 0u) {
             continue;
         }
-        let cell = macro_cell(m, t);
-        let local = vec3<u32>(node_slot(cell.c[0], m), node_slot(cell.c[1], m), node_slot(cell.c[2], m));
         if (params.measure_edges != 0u) {
             let ps = array<vec3<f32>, 3>(out_nodes[first_node + local.x].position,
                                          out_nodes[first_node + local.y].position,

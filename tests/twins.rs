@@ -264,7 +264,7 @@ impl Twin for Subdivide {
                 RenderSettings::new(Projection::equirect(256)).with_method(Method::Fixed(3)),
             ),
         ];
-        let mut cut_frames = 0;
+        let (mut cut_frames, mut strip_frames) = (0, 0);
         let cases: Vec<_> = cases
             .into_iter()
             .enumerate()
@@ -273,11 +273,14 @@ impl Twin for Subdivide {
                 let cpu = Self::cpu(&(scene.clone(), s));
                 assert!(cpu.vertices.len() / 3 > scene.triangle_count(), "{name}: exercises splits and seam copies");
                 cut_frames += (cpu.cuts != 0) as usize;
+                strip_frames += (cpu.strips > 0) as usize;
                 (name, (scene, s))
             })
             .collect();
         // Frames with and without cuts around the axis.
         assert!(cut_frames >= 8 && cut_frames < cases.len(), "{cut_frames} of {} cases cut", cases.len());
+        // Slivers drawn as strips (the error split on the cylinder).
+        assert!(strip_frames >= 3, "only {strip_frames} cases draw strips");
         cases
     }
     fn gpu(r: &Renderer, (scene, settings): &Self::Case) -> Self::Output {

@@ -23,7 +23,7 @@ use crate::gpu::frame_plan::{
 use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
 use crate::gpu::targets::{Layers, Targets};
-use crate::gpu::timestamps::Timestamps;
+use crate::gpu::timestamps::{self as stamp, Timestamps};
 use crate::shader::constants::PIECES_FROM_COUNTER;
 use crate::shader::types::{RasterParams, SlitParams, SubdivideCounters, SubdivideParams, TraceParams};
 use crate::shader::{REDUCE_ERROR, SUBDIVIDE};
@@ -102,7 +102,16 @@ impl FrameResources {
 }
 
 const COUNTERS_SIZE: u64 = std::mem::size_of::<SubdivideCounters>() as u64;
-const STAGING_SIZE: u64 = COUNTERS_SIZE + 8 * crate::gpu::timestamps::COUNT as u64;
+const STAGING_SIZE: u64 = COUNTERS_SIZE + 8 * stamp::COUNT as u64;
+
+/// GPU times (ms) of a one-submission frame, from its timestamps.
+struct GpuTimes {
+    subdivide: f64,
+    /// The subdivision's passes: `plan` (with `active_cuts`), `plan_cuts`, `lattice`.
+    passes: [f64; 3],
+    raster: f64,
+    frame: f64,
+}
 
 pub struct Renderer {
     pub gpu: Gpu,
@@ -358,7 +367,7 @@ impl Renderer {
         targets: &Targets,
         b: &SubdivisionBuffers,
         mut params: SubdivideParams,
-    ) -> Result<Option<(SubdivideCounters, Option<[f64; 3]>)>> {
+    ) -> Result<Option<(SubdivideCounters, Option<GpuTimes>)>> {
         params.first_piece = 0;
         params.piece_count = PIECES_FROM_COUNTER;
         self.gpu.queue.write_buffer(&res.subdivide_params, 0, bytemuck::bytes_of(&params));
@@ -368,24 +377,25 @@ impl Renderer {
         let timestamps = res.timestamps.as_ref();
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         enc.clear_buffer(&b.counters, 0, None);
+        // Three compute passes (timed apart where the adapter has timestamps): the cuts and
+        // `plan`, `plan_cuts`, the lattice.
+        let variant = self.subdivide_for(&params);
         {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("subdivide"),
-                timestamp_writes: timestamps.map(|t| wgpu::ComputePassTimestampWrites {
-                    query_set: &t.set,
-                    beginning_of_pass_write_index: Some(0),
-                    end_of_pass_write_index: Some(1),
-                }),
-            });
+            let mut pass = stamp::compute_pass(&mut enc, "plan", timestamps, stamp::PLAN);
             let (x, y) = self.gpu.workgroups(params.triangle_count, 64);
-            let variant = self.subdivide_for(&params);
             pass.set_pipeline(&variant.active_cuts);
             pass.set_bind_group(0, &groups[0], &[]);
             pass.dispatch_workgroups(x, y, 1);
             pass.set_pipeline(&variant.plan);
             pass.set_bind_group(0, &groups[1], &[]);
             pass.dispatch_workgroups(x, y, 1);
+        }
+        {
+            let mut pass = stamp::compute_pass(&mut enc, "plan_cuts", timestamps, stamp::PLAN_CUTS);
             Self::encode_plan_cuts(variant, &mut pass, b, &cut_groups);
+        }
+        {
+            let mut pass = stamp::compute_pass(&mut enc, "lattice", timestamps, stamp::LATTICE);
             pass.set_pipeline(&variant.lattice_args);
             pass.set_bind_group(0, &groups[2], &[]);
             pass.dispatch_workgroups(1, 1, 1);
@@ -396,10 +406,19 @@ impl Renderer {
             pass.set_bind_group(0, &groups[4], &[]);
             pass.dispatch_workgroups(1, 1, 1);
         }
-        self.encode_raster(&mut enc, res, scene, targets, b, settings, true, timestamps.map(|t| (&t.set, 2, 3)));
+        self.encode_raster(
+            &mut enc,
+            res,
+            scene,
+            targets,
+            b,
+            settings,
+            true,
+            timestamps.map(|t| (&t.set, stamp::RASTER, stamp::RASTER + 1)),
+        );
         enc.copy_buffer_to_buffer(&b.counters, 0, &res.staging, 0, COUNTERS_SIZE);
         if let Some(t) = timestamps {
-            t.resolve(&mut enc, &res.staging, COUNTERS_SIZE);
+            t.resolve(&mut enc, &res.staging, COUNTERS_SIZE, stamp::COUNT);
         }
         self.gpu.queue.submit([enc.finish()]);
         let bytes = self.gpu.read_buffer(&res.staging)?;
@@ -409,7 +428,13 @@ impl Renderer {
         }
         let times = timestamps.map(|t| {
             let ticks: &[u64] = bytemuck::cast_slice(&bytes[COUNTERS_SIZE as usize..]);
-            [t.ms(ticks[0], ticks[1]), t.ms(ticks[2], ticks[3]), t.ms(ticks[0], ticks[3])]
+            let span = |first: u32| t.ms(ticks[first as usize], ticks[first as usize + 1]);
+            GpuTimes {
+                subdivide: t.ms(ticks[0], ticks[stamp::LATTICE as usize + 1]),
+                passes: [span(stamp::PLAN), span(stamp::PLAN_CUTS), span(stamp::LATTICE)],
+                raster: span(stamp::RASTER),
+                frame: t.ms(ticks[0], ticks[stamp::RASTER as usize + 1]),
+            }
         });
         Ok(Some((counters, times)))
     }
@@ -565,11 +590,12 @@ impl Renderer {
             if let Some((counters, times)) = self.render_one_submission(res, scene, settings, targets, b, params)? {
                 stats.ms_frame = t.elapsed().as_secs_f64() * 1e3;
                 match times {
-                    Some([subdivide, raster, frame]) => {
+                    Some(times) => {
                         stats.timing = Timing::GpuTimestamps;
-                        stats.ms_subdivide = Some(subdivide);
-                        stats.ms_raster = Some(raster);
-                        stats.ms_gpu = Some(frame);
+                        stats.ms_subdivide = Some(times.subdivide);
+                        stats.ms_subdivide_passes = Some(times.passes);
+                        stats.ms_raster = Some(times.raster);
+                        stats.ms_gpu = Some(times.frame);
                     }
                     None => stats.timing = Timing::WallOneSubmission,
                 }

@@ -1,6 +1,7 @@
 //! GPU timestamps of a frame's passes, where the adapter has timestamp queries: one query set
-//! of four (subdivision begin/end, raster begin/end) with its resolve buffer, made once; and the
-//! timed submission of the one-pass frames (slit, trace).
+//! of eight (begin/end of the subdivision's three passes — `plan`, `plan_cuts`, `lattice` — and
+//! of the raster) with its resolve buffer, made once; and the timed submission of the one-pass
+//! frames (slit, trace).
 
 use std::time::Instant;
 
@@ -8,7 +9,12 @@ use crate::core::frame::{FrameStats, Timing};
 use crate::error::Result;
 use crate::gpu::device::Gpu;
 
-pub const COUNT: u32 = 4;
+pub const COUNT: u32 = 8;
+/// Query indices: the begin of each subdivision pass (its end is the next index) and of the raster.
+pub const PLAN: u32 = 0;
+pub const PLAN_CUTS: u32 = 2;
+pub const LATTICE: u32 = 4;
+pub const RASTER: u32 = 6;
 
 pub struct Timestamps {
     pub set: wgpu::QuerySet,
@@ -34,16 +40,39 @@ impl Timestamps {
         })
     }
 
-    /// Resolves the timestamps and copies them to `staging` at `offset` (encoded, not submitted).
-    pub fn resolve(&self, enc: &mut wgpu::CommandEncoder, staging: &wgpu::Buffer, offset: u64) {
-        enc.resolve_query_set(&self.set, 0..COUNT, &self.resolve, 0);
-        enc.copy_buffer_to_buffer(&self.resolve, 0, staging, offset, 8 * COUNT as u64);
+    /// Resolves the first `count` timestamps and copies them to `staging` at `offset` (encoded,
+    /// not submitted).
+    pub fn resolve(&self, enc: &mut wgpu::CommandEncoder, staging: &wgpu::Buffer, offset: u64, count: u32) {
+        enc.resolve_query_set(&self.set, 0..count, &self.resolve, 0);
+        enc.copy_buffer_to_buffer(&self.resolve, 0, staging, offset, 8 * count as u64);
+    }
+
+    /// Timestamp writes at the begin and end (`first`, `first` + 1) of a compute pass.
+    pub fn compute_pass(&self, first: u32) -> wgpu::ComputePassTimestampWrites<'_> {
+        wgpu::ComputePassTimestampWrites {
+            query_set: &self.set,
+            beginning_of_pass_write_index: Some(first),
+            end_of_pass_write_index: Some(first + 1),
+        }
     }
 
     /// Milliseconds between two ticks.
     pub fn ms(&self, from: u64, to: u64) -> f64 {
         to.saturating_sub(from) as f64 * self.period_ns * 1e-6
     }
+}
+
+/// A compute pass, timed at queries `first` and `first` + 1 where there are timestamps.
+pub fn compute_pass<'e>(
+    enc: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    timestamps: Option<&Timestamps>,
+    first: u32,
+) -> wgpu::ComputePass<'e> {
+    enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some(label),
+        timestamp_writes: timestamps.map(|t| t.compute_pass(first)),
+    })
 }
 
 /// Submits the one-pass frame of the slit and trace stages (its timestamps, if any, at indices
@@ -58,7 +87,7 @@ pub fn submit_timed_pass(
     stats: &mut FrameStats,
 ) -> Result<()> {
     if let Some(t) = timestamps {
-        t.resolve(&mut enc, staging, 0);
+        t.resolve(&mut enc, staging, 0, 2);
     }
     gpu.queue.submit([enc.finish()]);
     gpu.wait();

@@ -99,14 +99,7 @@ impl Renderer {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         enc.clear_buffer(&counts, 0, None);
         {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("trace"),
-                timestamp_writes: timestamps.map(|t| wgpu::ComputePassTimestampWrites {
-                    query_set: &t.set,
-                    beginning_of_pass_write_index: Some(0),
-                    end_of_pass_write_index: Some(1),
-                }),
-            });
+            let mut pass = crate::gpu::timestamps::compute_pass(&mut enc, "trace", timestamps, 0);
             pass.set_pipeline(&pipelines[(scene.needs_materials || scene.has_optics || scene.pbr(settings)) as usize]);
             pass.set_bind_group(0, &bind_group, &[]);
             pass.set_bind_group(1, &materials, &[]);

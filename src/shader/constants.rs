@@ -53,6 +53,14 @@ pub const SEAM_MARGIN: f32 = 1e-5;
 /// this, so that one `lattice` invocation never makes more than this² triangles (lavapipe cut
 /// invocations short beyond about 1,900).
 pub const PIECE_DIVISIONS: u32 = 32;
+/// Under the error split, a piece with an edge in one part and another in at least this many is
+/// drawn as a strip instead of the regular lattice (`strip_triangles` in src/cpu/subdivide/);
+/// below it the two make the same number of triangles.
+pub const STRIP_MIN_DIVISIONS: u32 = 3;
+/// ... if that edge's chord error is within this share of τ: the strip's rungs, as long as the
+/// edge or shorter, are then drawn straight with little error (with the whole τ, random slivers
+/// across the seam reached p99 1.7 px at τ = 1 px, against 1.3 with the lattice).
+pub const STRIP_BASE_ERROR: f32 = 0.25;
 /// The largest macro-lattice level K: a part makes at most this² pieces, so that one `plan`
 /// invocation's loop stays short (lavapipe lost pieces with K = 342, 117k pieces per part). An
 /// adaptive part whose longest edge needs more than this × N_max divisions (an edge over
@@ -97,6 +105,8 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("MAX_EDGE_DIVISIONS", U32(MAX_EDGE_DIVISIONS)),
         ("EDGE_SAMPLES", U32(EDGE_SAMPLES)),
         ("PIECE_DIVISIONS", U32(PIECE_DIVISIONS)),
+        ("STRIP_MIN_DIVISIONS", U32(STRIP_MIN_DIVISIONS)),
+        ("STRIP_BASE_ERROR", F32(STRIP_BASE_ERROR)),
         ("MAX_MACRO_LEVEL", U32(MAX_MACRO_LEVEL)),
         ("AXIS_CLEARANCE_MIN", F32(AXIS_CLEARANCE_MIN)),
         ("AXIS_CLEARANCE_MAX", F32(AXIS_CLEARANCE_MAX)),

@@ -131,11 +131,12 @@ pub struct SubdivideCounters {
     pub triangles: u32,
     /// Bits of the largest visible output edge in pixels (an f32).
     pub max_edge_bits: u32,
-    /// Triangles `plan` listed for `plan_cuts`.
+    /// Triangles `plan` listed for `plan_cuts` (from the front of its list) ...
     pub cut_count: u32,
     /// Output nodes (`lattice`).
     pub nodes: u32,
-    pub _pad0: u32,
+    /// ... and the wide ones near the axis (from the back).
+    pub cut_wide: u32,
     /// The frame's cuts around the axis (`AxisCuts`), bits 0–31 and 32–63.
     pub cuts_low: u32,
     pub cuts_high: u32,
@@ -404,7 +405,7 @@ pub const LAYOUTS: &[StructLayout] = &[
         view, projection, axis_clearance, triangle_count, first_triangle, method, fixed_n, edge_px, max_div,
         piece_capacity, triangle_capacity, first_piece, piece_count, measure_edges, vertical_limit, max_error_px, _pad1, _pad2
     }),
-    layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, nodes, _pad0, cuts_low, cuts_high }),
+    layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, nodes, cut_wide, cuts_low, cuts_high }),
     layout!("Piece" => Piece { triangle, cell, counts01, count2_level, corner, bary1, bary2 }),
     layout!("DrawIndexedIndirectArgs" => DrawIndexedIndirectArgs { index_count, instance_count, first_index, base_vertex, first_instance }),
     layout!("RasterParams" => RasterParams { projection, eye_sign, ambient, shift_px, error_angle, _pad0, _pad1, _pad2 }),

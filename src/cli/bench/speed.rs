@@ -33,6 +33,8 @@ pub struct SpeedRow {
     pub ms_gpu: Option<f64>,
     /// Median times of the subdivision and the raster, where they were measured apart.
     pub ms_subdivide: Option<f64>,
+    /// Median times of the subdivision's passes (`plan`, `plan_cuts`, `lattice`), where timed.
+    pub ms_subdivide_passes: Option<[f64; 3]>,
     pub ms_raster: Option<f64>,
     pub ms_readback: f64,
     /// ms_frame / ms_frame of the first method on the same scene.
@@ -109,6 +111,13 @@ pub fn speed(
                 timing: last.timing.to_string(),
                 ms_gpu: measured(|s| s.ms_gpu),
                 ms_subdivide: measured(|s| s.ms_subdivide),
+                ms_subdivide_passes: (|| {
+                    let pass = |i: usize| {
+                        let v: Option<Vec<f64>> = frames.iter().map(|s| s.ms_subdivide_passes.map(|p| p[i])).collect();
+                        v.map(median)
+                    };
+                    Some([pass(0)?, pass(1)?, pass(2)?])
+                })(),
                 ms_raster: measured(|s| s.ms_raster),
                 ms_readback: median(frames.iter().map(|s| s.ms_readback).collect()),
                 ratio: ms_frame / first,
@@ -122,7 +131,7 @@ pub fn speed(
 /// A Markdown table of speed rows.
 pub fn speed_table(rows: &[SpeedRow]) -> String {
     let mut s = String::from(
-        "| scene | method | triangles in | triangles out | out / in | vertices per eye | ms frame (median) | ms subdivide | ms raster | ratio | max sub-edge px |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| scene | method | triangles in | triangles out | out / in | vertices per eye | ms frame (median) | ms subdivide (plan / cuts / lattice) | ms raster | ratio | max sub-edge px |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         s += &format!(
@@ -134,7 +143,11 @@ pub fn speed_table(rows: &[SpeedRow]) -> String {
             r.out_per_in,
             r.vertices_out,
             r.ms_frame,
-            r.ms_subdivide.map_or("—".into(), |t| format!("{t:.1}")),
+            match (r.ms_subdivide, r.ms_subdivide_passes) {
+                (Some(t), Some([plan, cuts, lattice])) => format!("{t:.1} ({plan:.1} / {cuts:.1} / {lattice:.1})"),
+                (Some(t), None) => format!("{t:.1}"),
+                _ => "—".into(),
+            },
             r.ms_raster.map_or("—".into(), |t| format!("{t:.1}")),
             r.ratio,
             r.max_sub_edge_px

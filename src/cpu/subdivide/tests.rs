@@ -198,14 +198,39 @@ fn the_lattice_stores_each_node_once_and_its_triangles_index_them() {
 /// every edge is shared by two triangles or lies on the boundary, the boundary edges are
 /// exactly the consecutive edge nodes, and the areas add up.
 fn check_conforming(counts: [u32; 3]) {
+    check_tiling(counts, None);
+}
+
+/// The piece's triangles (the lattice, or the strip on `strip` base) tile it exactly: positive
+/// area, the piece's winding, every inner edge shared by two triangles, every boundary segment
+/// (the edges' own nodes) used once; each triangle's slots name its nodes.
+fn check_tiling(counts: [u32; 3], strip: Option<usize>) -> usize {
     let q = [
         Node { position: Vec3::new(0.0, 0.0, -3.0), bary: Vec3::X },
         Node { position: Vec3::new(1.3, 0.1, -3.0), bary: Vec3::Y },
         Node { position: Vec3::new(0.4, 1.1, -3.2), bary: Vec3::Z },
     ];
     let node_on_edge = |e: usize, m: u32| edge_point(q[e], q[(e + 1) % 3], m, counts[e]);
-    let tris: Vec<[Vec3; 3]> =
-        lattice_triangles(counts, &q, &node_on_edge).into_iter().map(|(_, t)| t.map(|n| n.position)).collect();
+    let triangles = match strip {
+        Some(base) => strip_triangles(counts, base, &node_on_edge),
+        None => lattice_triangles(counts, &q, &node_on_edge),
+    };
+    if let Some(base) = strip {
+        let [n1, n2] = [counts[(base + 1) % 3], counts[(base + 2) % 3]];
+        assert_eq!(triangles.len() as u32, n1 + n2 - 1, "{counts:?}");
+        let nodes: Vec<Node> =
+            (0..strip_node_count(counts, base)).map(|k| strip_node(counts, base, &node_on_edge, k)).collect();
+        for (slots, t) in &triangles {
+            assert_eq!(slots.map(|k| nodes[k as usize]), *t, "{counts:?}: slots {slots:?}");
+        }
+    }
+    let normal = (q[1].position - q[0].position).cross(q[2].position - q[0].position);
+    for (_, t) in &triangles {
+        let n = (t[1].position - t[0].position).cross(t[2].position - t[0].position);
+        assert!(n.dot(normal) > 0.0, "{counts:?} ({strip:?}): triangle {t:?} turned over");
+    }
+    let tris: Vec<[Vec3; 3]> = triangles.into_iter().map(|(_, t)| t.map(|n| n.position)).collect();
+    let count = tris.len();
     let key = |p: Vec3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
     let mut edges: HashMap<([u32; 3], [u32; 3]), u32> = HashMap::new();
     let mut total = 0.0;
@@ -236,6 +261,7 @@ fn check_conforming(counts: [u32; 3]) {
         );
     }
     assert!(boundary.iter().all(|b| edges.contains_key(b)), "{counts:?}: a boundary segment is missing (T-junction)");
+    count
 }
 
 #[test]
@@ -244,6 +270,25 @@ fn lattice_is_conforming_for_equal_and_unequal_edge_counts() {
         for b in 1..=9 {
             for c in [1, 2, 3, 5, 9] {
                 check_conforming([a, b, c]);
+            }
+        }
+    }
+}
+
+#[test]
+fn a_slivers_strip_tiles_it_with_fewer_triangles_than_the_lattice() {
+    for base in 0..3 {
+        for a in 1..=9 {
+            for b in 1..=9 {
+                let mut counts = [a, b, b];
+                counts[base] = 1;
+                counts[(base + 1) % 3] = a;
+                counts[(base + 2) % 3] = b;
+                let (strip, lattice) = (check_tiling(counts, Some(base)), check_tiling(counts, None));
+                assert!(strip <= lattice, "{counts:?}: strip {strip} vs lattice {lattice}");
+                if a.max(b) >= 4 {
+                    assert!(strip < lattice, "{counts:?}: strip {strip} vs lattice {lattice}");
+                }
             }
         }
     }
