@@ -11,7 +11,7 @@
 //            this frame, or inside one quadrant and one band) is planned here; the others are
 //            listed in `cut_list` for `plan_cuts` (the clipping code, kept out of this entry
 //            point: lavapipe runs a shader that merely contains it markedly slower), the wide
-//            ones near the axis apart from the rest.
+//            ones near the axis (`asks_for_cuts`) apart from the rest.
 // `plan_cuts_args`, `plan_cuts`  one invocation per listed triangle (on the sphere per triangle
 //            and quadrant): its parts around the
 //            vertical axis under the frame's cuts (quadrants minus a small square around the axis,
@@ -67,7 +67,7 @@ struct Counters {
     max_edge_bits: atomic<u32>, // bits of the largest visible output edge, px (f32 ≥ 0 orders as u32)
     cut_count: atomic<u32>,     // triangles `plan` listed for `plan_cuts` from the front of `cut_list`
     nodes: atomic<u32>,         // output nodes (`lattice`)
-    cut_wide: atomic<u32>,      // ... and from its back: the wide ones (`wide_near_axis`)
+    cut_wide: atomic<u32>,      // ... and from its back: the wide ones (`asks_for_cuts`)
     // The frame's cuts around the axis (`AxisCuts` in axis.rs): bit 0 the quadrant cuts and the
     // square, bit k the diamond c_k; bits 0–31 and 32–63. Kept across the chunks of a frame.
     cuts_low: atomic<u32>,
@@ -684,7 +684,7 @@ fn triangle_cuts(limit: f32) -> vec2<u32> {
     let range = diamond_range(tri_position);
     let lo = range.x;
     let hi = range.y;
-    if (!(lo < band_bound(1u) || hi > WIDE_RATIO * lo)) {
+    if (!asks_for_cuts(range)) {
         return vec2<u32>(0u);
     }
     var bits = vec2<u32>(1u, 0u);
@@ -1065,7 +1065,7 @@ fn plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     // parts; listed apart, they share SIMD lanes with each other rather than stall lanes of the
     // many small triangles that merely straddle a cut (Sponza: 602 and 9,007).
     let len = arrayLength(&cut_list);
-    if (wide_near_axis()) {
+    if (asks_for_cuts(diamond_range(tri_position))) {
         let slot = atomicAdd(&counters.cut_wide, 1u);
         if (slot < len) {
             cut_list[len - 1u - slot] = t;
@@ -1078,10 +1078,9 @@ fn plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
 }
 
-// Whether the loaded triangle reaches the first diamond or spans a wide range of diamond
-// distances: those that ask for cuts (`triangle_cuts`).
-fn wide_near_axis() -> bool {
-    let range = diamond_range(tri_position);
+// Whether a triangle with diamond distances `range` (`diamond_range`) reaches the first diamond
+// or spans a wide range of them: those ask for cuts (`triangle_cuts`).
+fn asks_for_cuts(range: vec2<f32>) -> bool {
     return range.x < band_bound(1u) || range.y > WIDE_RATIO * range.x;
 }
 

@@ -48,7 +48,7 @@ impl Timestamps {
     }
 
     /// Timestamp writes at the begin and end (`first`, `first` + 1) of a compute pass.
-    pub fn compute_pass(&self, first: u32) -> wgpu::ComputePassTimestampWrites<'_> {
+    pub fn pass_writes(&self, first: u32) -> wgpu::ComputePassTimestampWrites<'_> {
         wgpu::ComputePassTimestampWrites {
             query_set: &self.set,
             beginning_of_pass_write_index: Some(first),
@@ -71,7 +71,7 @@ pub fn compute_pass<'e>(
 ) -> wgpu::ComputePass<'e> {
     enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
         label: Some(label),
-        timestamp_writes: timestamps.map(|t| t.compute_pass(first)),
+        timestamp_writes: timestamps.map(|t| t.pass_writes(first)),
     })
 }
 
