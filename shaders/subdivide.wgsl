@@ -15,13 +15,15 @@
 // `plan_cuts_args`, `plan_cuts`  one invocation per listed triangle (on the sphere per triangle
 //            and quadrant): its parts around the
 //            vertical axis under the frame's cuts (quadrants minus a small square around the axis,
-//            bands between the active diamonds, fan-triangulated).
+//            bands between the active diamonds, fan-triangulated; a band's quad whose two opposite
+//            sides are in one part each, one piece drawn as a strip between the other two).
 //            For every part, `plan` and `plan_cuts` find the edge
 //            counts N (eq. 5 or the error split), the macro-lattice level K = ceil(M / N_max) of the pre-split, and
 //            K² piece records (triangle, cell, counts, the part's corners).
 // `lattice`  one invocation per piece: the part's corners from the piece record, the regular
 //            lattice of level m = max(counts), boundary nodes snapped to each edge's nodes (or,
-//            for a sliver under the error split on the cylinder, a strip along its long edges);
+//            for a sliver under the error split on the cylinder, a strip along its long edges; for
+//            a band quad, a strip between its rails, corner 3 read from the next record);
 //            its nodes appended once and its drawn sub-triangles as indices into them, the whole
 //            piece again a turn away where its nodes' u range crosses ±π.
 // `finalize` the DrawIndexedIndirect arguments (none drawn if a buffer overflowed).
@@ -144,8 +146,11 @@ var<private> piece_counts: array<u32, 3>;
 var<private> piece_original: array<i32, 3>; // original edge under piece edge e, or −1
 var<private> piece_from: array<u32, 3>;     // fine index on that original edge at corner e
 var<private> piece_to: array<u32, 3>;
-var<private> strip_base: u32;               // a sliver's base edge (see `strip_base_of`); 3: the lattice
-var<private> strip_n: vec2<u32>;            // its long edges' counts: edge base + 1, edge base + 2
+var<private> strip_base: u32;               // a sliver's base edge (see `strip_base_of`); 3: the lattice; QUAD_STRIP
+var<private> strip_n: vec2<u32>;            // its long edges' counts: edge base + 1, edge base + 2; a quad's rails
+var<private> quad_last: Node;               // a band quad's corner 3 (its corners 0–2 in piece_q)
+var<private> quad_turn: u32;                // `plan_quad`: the polygon's corner that is the quad's corner 0
+var<private> poly_n: array<u32, 11>;        // edge counts of a band's polygon and its fan (`polygon_edge_ends`)
 
 // A polygon while it is clipped (at most 7 corners), and a quadrant's polygon kept while its
 // bands are cut from it.
@@ -343,6 +348,11 @@ fn plan_part() {
     for (var e = 0u; e < 3u; e++) {
         tri_n[e] = edge_divisions(part[e].position, part[(e + 1u) % 3u].position);
     }
+    plan_level();
+}
+
+// The macro-lattice level of the current part from its edge counts `tri_n`.
+fn plan_level() {
     let m = max(max(tri_n[0], tri_n[1]), tri_n[2]);
     tri_k = 1u;
     if (is_adaptive()) {
@@ -811,18 +821,133 @@ fn plan_quadrant(t: u32, q: u32) {
                     poly_count = band_count;
                 }
             }
+            // The fan's parts: those wholly beyond the image's rows make no pieces (`run` in
+            // subdivide.rs); the others' edges, each counted once (a diagonal is two parts').
+            var shown = 0u;
+            var needed = 0u;
             for (var i = 1u; i + 1u < poly_count; i++) {
-                part[0] = poly[0];
-                part[1] = poly[i];
-                part[2] = poly[i + 1u];
-                // A part wholly beyond the image's rows makes no pieces (`run` in subdivide.rs).
-                if (!off_screen_vertically(part[0].position, part[1].position, part[2].position)) {
-                    plan_part();
+                if (!off_screen_vertically(poly[0].position, poly[i].position, poly[i + 1u].position)) {
+                    shown |= 1u << i;
+                    let e = fan_edges(i);
+                    needed |= (1u << e.x) | (1u << e.y) | (1u << e.z);
+                }
+            }
+            for (var e = 0u; e + 3u < 2u * poly_count; e++) {
+                if ((needed & (1u << e)) != 0u) {
+                    let ends = polygon_edge_ends(e);
+                    poly_n[e] = edge_divisions(poly[ends.x].position, poly[ends.y].position);
+                }
+            }
+            if (plan_quad(shown)) {
+                append_quad(t);
+                continue;
+            }
+            for (var i = 1u; i + 1u < poly_count; i++) {
+                if ((shown & (1u << i)) != 0u) {
+                    part[0] = poly[0];
+                    part[1] = poly[i];
+                    part[2] = poly[i + 1u];
+                    let e = fan_edges(i);
+                    tri_n[0] = poly_n[e.x];
+                    tri_n[1] = poly_n[e.y];
+                    tri_n[2] = poly_n[e.z];
+                    plan_level();
                     append_pieces(t);
                 }
             }
         }
     }
+}
+
+// The edges of the polygon in `poly` and its fan: side e (corner e → e + 1, the last back to
+// corner 0) for e < poly_count, then diagonal d (corner 0 → d + 2) at poly_count + d. The ends of
+// edge e, as corner indices.
+fn polygon_edge_ends(e: u32) -> vec2<u32> {
+    if (e < poly_count) {
+        return vec2<u32>(e, (e + 1u) % poly_count);
+    }
+    return vec2<u32>(0u, e - poly_count + 2u);
+}
+
+// The edges of fan part i (corners 0, i, i + 1): 0 → i, i → i + 1, i + 1 → 0.
+fn fan_edges(i: u32) -> vec3<u32> {
+    let first = select(poly_count + i - 2u, 0u, i == 1u);
+    let last = select(poly_count + i - 1u, poly_count - 1u, i + 2u == poly_count);
+    return vec3<u32>(first, i, last);
+}
+
+// Whether the band polygon in `poly` (both fan parts `shown`, edge counts in `poly_n`) is drawn as one strip between two of its sides (the rails)
+// rather than as the two parts of its fan (`quad_strip` in subdivide.rs); then `strip_n` holds
+// the rails' counts and `quad_turn` the polygon corner that becomes the quad's corner 0 (rails
+// 0 → 1 and 3 → 2).
+fn plan_quad(shown: u32) -> bool {
+    if (params.method != METHOD_ERROR || is_sphere(params.projection) || poly_count != 4u || shown != 6u) {
+        return false;
+    }
+    let n = poly_n;
+    var turn = 2u;
+    for (var r = 0u; r < 2u; r++) {
+        if (turn == 2u && n[r + 1u] == 1u && n[(r + 3u) % 4u] == 1u) {
+            turn = r;
+        }
+    }
+    if (turn == 2u) {
+        return false;
+    }
+    let rails = vec2<u32>(n[turn], n[turn + 2u]);
+    let longest = max(rails.x, rails.y);
+    if (longest < QUAD_MIN_DIVISIONS || longest > min(params.max_div, PIECE_DIVISIONS)) {
+        return false;
+    }
+    // Every rung of the zigzag (`quad_strip_rungs` in subdivide.rs), the one-part sides among them.
+    let c0 = poly[turn];
+    let c1 = poly[turn + 1u];
+    let c2 = poly[(turn + 2u) % 4u];
+    let c3 = poly[(turn + 3u) % 4u];
+    var walk = vec2<u32>(0u, 0u);
+    for (var step = 0u; step <= rails.x + rails.y; step++) {
+        let a = edge_point(c0, c1, walk.x, rails.x).position;
+        let b = edge_point(c3, c2, walk.y, rails.y).position;
+        let q = edge_profile(a, b, 2u);
+        if (q.ring || parts_for_bend(q.bend_px, 2u, QUAD_RUNG_ERROR * tri_max_error_px) > 1.0) {
+            return false;
+        }
+        if (quad_advances_on_a(walk, rails)) {
+            walk.x += 1u;
+        } else {
+            walk.y += 1u;
+        }
+    }
+    strip_n = rails;
+    quad_turn = turn;
+    return true;
+}
+
+// A band quad's two records: corners 0–2 and the rails' counts (QUAD_HEAD), then corner 3
+// (QUAD_TAIL, whose `lattice` invocation draws nothing).
+fn append_quad(t: u32) {
+    let base = atomicAdd(&counters.pieces, 2u);
+    if (base + 2u > params.piece_capacity) {
+        return; // counted, never written
+    }
+    var record: Piece;
+    record.triangle = t;
+    record.cell = 0u;
+    record.counts01 = strip_n.x | (strip_n.y << 16u);
+    record.count2_level = QUAD_HEAD;
+    for (var i = 0u; i < 3u; i++) {
+        let c = poly[(quad_turn + i) % 4u];
+        record.corner[i] = vec4<f32>(c.position, c.bary.x);
+        record.bary1[i] = c.bary.y;
+        record.bary2[i] = c.bary.z;
+    }
+    pieces[base] = record;
+    let last = poly[(quad_turn + 3u) % 4u];
+    record.count2_level = QUAD_TAIL;
+    record.corner[0] = vec4<f32>(last.position, last.bary.x);
+    record.bary1[0] = last.bary.y;
+    record.bary2[0] = last.bary.z;
+    pieces[base + 1u] = record;
 }
 
 fn append_pieces(t: u32) {
@@ -948,10 +1073,44 @@ fn strip_step(walk: ptr<function, vec2<u32>>) -> vec3<u32> {
     return vec3<u32>(n1 + n2 - i, j, j + 1u);
 }
 
-// ---- a piece's nodes and candidate triangles: the lattice of level m, or the strip ----
+// ---- a band quad drawn as a strip between its rails (`quad_strip_triangles` in subdivide.rs) ----
+
+const QUAD_STRIP: u32 = 4u; // `strip_base` of a quad
+
+// Node `slot`: rail a (corner 0 → 1, strip_n.x parts), then rail d (corner 3 → 2, strip_n.y).
+fn quad_node(slot: u32) -> Node {
+    if (slot <= strip_n.x) {
+        return edge_point(piece_q[0], piece_q[1], slot, strip_n.x);
+    }
+    return edge_point(quad_last, piece_q[2], slot - strip_n.x - 1u, strip_n.y);
+}
+
+// Whether the zigzag at rung (a_i, d_j) = `walk` advances on rail a (`quad_advances_on_a`).
+fn quad_advances_on_a(walk: vec2<u32>, rails: vec2<u32>) -> bool {
+    return walk.x < rails.x && (walk.y == rails.y || (walk.x + 1u) * rails.y <= (walk.y + 1u) * rails.x);
+}
+
+// The next triangle of the zigzag at `walk` = (i, j) (rail a's node i = slot i, rail d's node j =
+// slot n1 + 1 + j), as slots; advances the walk.
+fn quad_step(walk: ptr<function, vec2<u32>>) -> vec3<u32> {
+    let i = (*walk).x;
+    let j = (*walk).y;
+    let n1 = strip_n.x;
+    if (quad_advances_on_a(*walk, strip_n)) {
+        *walk = vec2<u32>(i + 1u, j);
+        return vec3<u32>(i, i + 1u, n1 + 1u + j);
+    }
+    *walk = vec2<u32>(i, j + 1u);
+    return vec3<u32>(i, n1 + 2u + j, n1 + 1u + j);
+}
+
+// ---- a piece's nodes and candidate triangles: the lattice of level m, the strip or the quad ----
 
 // Node k in slot order; `row` is the lattice's running (j, l), advanced here.
 fn piece_node(k: u32, m: u32, row: ptr<function, vec2<u32>>) -> Node {
+    if (strip_base == QUAD_STRIP) {
+        return quad_node(k);
+    }
     if (strip_base < 3u) {
         return strip_node(k);
     }
@@ -963,6 +1122,9 @@ fn piece_node(k: u32, m: u32, row: ptr<function, vec2<u32>>) -> Node {
 
 // Candidate triangle t's slots (the strip's in walk order, advancing `walk`).
 fn piece_triangle_slots(t: u32, m: u32, walk: ptr<function, vec2<u32>>) -> vec3<u32> {
+    if (strip_base == QUAD_STRIP) {
+        return quad_step(walk);
+    }
     if (strip_base < 3u) {
         return strip_step(walk);
     }
@@ -975,7 +1137,12 @@ fn piece_triangle_drawn(t: u32, m: u32, walk: ptr<function, vec2<u32>>) -> bool 
     var a: vec3<f32>;
     var b: vec3<f32>;
     var c: vec3<f32>;
-    if (strip_base < 3u) {
+    if (strip_base == QUAD_STRIP) {
+        let s = quad_step(walk);
+        a = quad_node(s.x).position;
+        b = quad_node(s.y).position;
+        c = quad_node(s.z).position;
+    } else if (strip_base < 3u) {
         let s = strip_step(walk);
         a = strip_node(s.x).position;
         b = strip_node(s.y).position;
@@ -993,15 +1160,15 @@ fn piece_triangle_drawn(t: u32, m: u32, walk: ptr<function, vec2<u32>>) -> bool 
 // (`piece_u_range` in subdivide.rs): its azimuths span those of its corners (its footprint is
 // convex and misses the axis), and α(r) grows with r, so |α| is largest at the footprint's
 // nearest or farthest point from the axis.
-fn piece_u_range(theta_c: f32) -> vec2<f32> {
+fn piece_u_range(q: array<Node, 3>, theta_c: f32) -> vec2<f32> {
     var theta_min = 1e30;
     var theta_max = -1e30;
     var r_min = 1e30;
     var r_max = 0.0;
     for (var e = 0u; e < 3u; e++) {
-        let a = piece_q[e].position.xz;
-        let b = piece_q[(e + 1u) % 3u].position.xz;
-        let theta = theta_c + wrap_angle(azimuth(piece_q[e].position) - theta_c);
+        let a = q[e].position.xz;
+        let b = q[(e + 1u) % 3u].position.xz;
+        let theta = theta_c + wrap_angle(azimuth(q[e].position) - theta_c);
         theta_min = min(theta_min, theta);
         theta_max = max(theta_max, theta);
         r_max = max(r_max, length(a));
@@ -1146,57 +1313,78 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         return;
     }
     let piece = pieces[params.first_piece + local];
+    if ((piece.count2_level & QUAD_TAIL) != 0u) {
+        return; // drawn by the quad's first record
+    }
     load_triangle(piece.triangle);
     for (var i = 0u; i < 3u; i++) {
         part[i] = Node(piece.corner[i].xyz, vec3<f32>(piece.corner[i].w, piece.bary1[i], piece.bary2[i]));
     }
-    tri_n[0] = piece.counts01 & 0xffffu;
-    tri_n[1] = piece.counts01 >> 16u;
-    tri_n[2] = piece.count2_level & 0xffffu;
-    tri_k = piece.count2_level >> 16u;
-    let cell = macro_cell(tri_k, piece.cell);
-    var loc: array<vec3<u32>, 3>;
-    for (var i = 0u; i < 3u; i++) {
-        loc[i] = macro_location(cell.c[i]);
-        piece_q[i] = macro_node(cell.c[i], loc[i]);
-    }
-    if (same(piece_q[0].position, piece_q[1].position) || same(piece_q[1].position, piece_q[2].position)
-        || same(piece_q[2].position, piece_q[0].position)) {
-        return; // snapped corners coincide: no area
-    }
-    if (off_screen_vertically(piece_q[0].position, piece_q[1].position, piece_q[2].position)) {
-        return; // every sub-triangle would be culled
-    }
-    // Each piece edge: on an original edge (that edge's fine nodes, by global index) or interior.
-    for (var e = 0u; e < 3u; e++) {
-        piece_original[e] = -1;
-        for (var oe = 0u; oe < 3u; oe++) {
-            let start = index_on(oe, loc[e]);
-            let end = index_on(oe, loc[(e + 1u) % 3u]);
-            if (piece_original[e] < 0 && start >= 0 && end >= 0) {
-                piece_original[e] = i32(oe);
-                piece_from[e] = u32(start);
-                piece_to[e] = u32(end);
-                piece_counts[e] = u32(abs(start - end));
+    var m = 0u;
+    var candidates = 0u;
+    var node_count = 0u;
+    var theta_c = 0.0;
+    if ((piece.count2_level & QUAD_HEAD) != 0u) {
+        // A band quad: corners 0–2 here, corner 3 in the next record; its rails' counts.
+        piece_q = part;
+        let tail = pieces[params.first_piece + local + 1u];
+        quad_last = Node(tail.corner[0].xyz, vec3<f32>(tail.corner[0].w, tail.bary1[0], tail.bary2[0]));
+        strip_base = QUAD_STRIP;
+        strip_n = vec2<u32>(piece.counts01 & 0xffffu, piece.counts01 >> 16u);
+        m = max(strip_n.x, strip_n.y);
+        candidates = strip_n.x + strip_n.y;
+        node_count = candidates + 2u;
+        theta_c = azimuth((piece_q[0].position + piece_q[1].position + piece_q[2].position + quad_last.position) / 4.0);
+    } else {
+        tri_n[0] = piece.counts01 & 0xffffu;
+        tri_n[1] = piece.counts01 >> 16u;
+        tri_n[2] = piece.count2_level & 0xffffu;
+        tri_k = piece.count2_level >> 16u;
+        let cell = macro_cell(tri_k, piece.cell);
+        var loc: array<vec3<u32>, 3>;
+        for (var i = 0u; i < 3u; i++) {
+            loc[i] = macro_location(cell.c[i]);
+            piece_q[i] = macro_node(cell.c[i], loc[i]);
+        }
+        if (same(piece_q[0].position, piece_q[1].position) || same(piece_q[1].position, piece_q[2].position)
+            || same(piece_q[2].position, piece_q[0].position)) {
+            return; // snapped corners coincide: no area
+        }
+        if (off_screen_vertically(piece_q[0].position, piece_q[1].position, piece_q[2].position)) {
+            return; // every sub-triangle would be culled
+        }
+        // Each piece edge: on an original edge (that edge's fine nodes, by global index) or interior.
+        for (var e = 0u; e < 3u; e++) {
+            piece_original[e] = -1;
+            for (var oe = 0u; oe < 3u; oe++) {
+                let start = index_on(oe, loc[e]);
+                let end = index_on(oe, loc[(e + 1u) % 3u]);
+                if (piece_original[e] < 0 && start >= 0 && end >= 0) {
+                    piece_original[e] = i32(oe);
+                    piece_from[e] = u32(start);
+                    piece_to[e] = u32(end);
+                    piece_counts[e] = u32(abs(start - end));
+                }
+            }
+            if (piece_original[e] < 0) {
+                if (params.method == METHOD_FIXED) {
+                    // fixed:N pieces take N/K on interior edges (the regular N-lattice when K | N).
+                    piece_counts[e] = (params.fixed_n + tri_k - 1u) / tri_k;
+                } else {
+                    piece_counts[e] = min(min(edge_divisions(piece_q[e].position, piece_q[(e + 1u) % 3u].position), 2u * params.max_div), PIECE_DIVISIONS);
+                }
             }
         }
-        if (piece_original[e] < 0) {
-            if (params.method == METHOD_FIXED) {
-                // fixed:N pieces take N/K on interior edges (the regular N-lattice when K | N).
-                piece_counts[e] = (params.fixed_n + tri_k - 1u) / tri_k;
-            } else {
-                piece_counts[e] = min(min(edge_divisions(piece_q[e].position, piece_q[(e + 1u) % 3u].position), 2u * params.max_div), PIECE_DIVISIONS);
-            }
+        m = max(max(piece_counts[0], piece_counts[1]), piece_counts[2]);
+        strip_base = strip_base_of();
+        candidates = m * m;
+        node_count = (m + 1u) * (m + 2u) / 2u;
+        if (strip_base < 3u) {
+            strip_n = vec2<u32>(piece_counts[(strip_base + 1u) % 3u], piece_counts[(strip_base + 2u) % 3u]);
+            candidates = strip_n.x + strip_n.y - 1u;
+            node_count = strip_n.x + strip_n.y + 1u;
         }
-    }
-    let m = max(max(piece_counts[0], piece_counts[1]), piece_counts[2]);
-    strip_base = strip_base_of();
-    var candidates = m * m;
-    var node_count = (m + 1u) * (m + 2u) / 2u;
-    if (strip_base < 3u) {
-        strip_n = vec2<u32>(piece_counts[(strip_base + 1u) % 3u], piece_counts[(strip_base + 2u) % 3u]);
-        candidates = strip_n.x + strip_n.y - 1u;
-        node_count = strip_n.x + strip_n.y + 1u;
+        theta_c = azimuth((piece_q[0].position + piece_q[1].position + piece_q[2].position) / 3.0);
     }
     // Which of the candidate triangles (the m² of the lattice, or the strip's) are drawn (one
     // bit each; m ≤ PIECE_DIVISIONS = 32).
@@ -1215,7 +1403,6 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     // The seam: every node is unwrapped towards the piece's reference azimuth; where the nodes'
     // u range (both eyes) reaches ±π, the piece is drawn again a turn away. Conservative by
     // SEAM_MARGIN: an extra copy is clipped by the rasterizer.
-    let theta_c = azimuth((piece_q[0].position + piece_q[1].position + piece_q[2].position) / 3.0);
     var u_range = vec2<f32>(1e30, -1e30);
     // Nodes in slot order: (i, j, l) row by row, kept by a running (j, l) rather than searched
     // for each slot (lavapipe stops an invocation after 65,535 loop iterations in all).
@@ -1229,8 +1416,13 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
                 u_range = vec2<f32>(min(u_range.x, u), max(u_range.y, u));
             }
         }
+    } else if (strip_base == QUAD_STRIP) {
+        // The quad's range: that of its fan's two triangles, which cover it.
+        let ra = piece_u_range(piece_q, theta_c);
+        let rb = piece_u_range(array<Node, 3>(piece_q[0], piece_q[2], quad_last), theta_c);
+        u_range = vec2<f32>(min(ra.x, rb.x), max(ra.y, rb.y));
     } else {
-        u_range = piece_u_range(theta_c);
+        u_range = piece_u_range(piece_q, theta_c);
     }
     var refs = array<f32, 3>(theta_c, 0.0, 0.0);
     var copies = 1u;

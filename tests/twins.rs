@@ -264,7 +264,7 @@ impl Twin for Subdivide {
                 RenderSettings::new(Projection::equirect(256)).with_method(Method::Fixed(3)),
             ),
         ];
-        let (mut cut_frames, mut strip_frames) = (0, 0);
+        let (mut cut_frames, mut strip_frames, mut quad_frames) = (0, 0, 0);
         let cases: Vec<_> = cases
             .into_iter()
             .enumerate()
@@ -274,6 +274,7 @@ impl Twin for Subdivide {
                 assert!(cpu.vertices.len() / 3 > scene.triangle_count(), "{name}: exercises splits and seam copies");
                 cut_frames += (cpu.cuts != 0) as usize;
                 strip_frames += (cpu.strips > 0) as usize;
+                quad_frames += (cpu.quads > 0) as usize;
                 (name, (scene, s))
             })
             .collect();
@@ -281,6 +282,8 @@ impl Twin for Subdivide {
         assert!(cut_frames >= 8 && cut_frames < cases.len(), "{cut_frames} of {} cases cut", cases.len());
         // Slivers drawn as strips (the error split on the cylinder).
         assert!(strip_frames >= 3, "only {strip_frames} cases draw strips");
+        // Band quads drawn as one strip between their rails (the same, around the axis).
+        assert!(quad_frames >= 2, "only {quad_frames} cases draw band quads as strips");
         cases
     }
     fn gpu(r: &Renderer, (scene, settings): &Self::Case) -> Self::Output {

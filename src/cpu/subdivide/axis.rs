@@ -323,12 +323,23 @@ pub fn band_limit(method: u32, screen_radius: f32) -> f32 {
 /// ([`QUADRANTS`]), band by band outwards (the active diamonds), then along each fan. With no
 /// cut active, the triangle is its own part.
 pub fn parts(p: [Vec3; 3], rho: f32, cuts: AxisCuts) -> Vec<[Node; 3]> {
+    polygons(p, rho, cuts).iter().flat_map(|poly| fan(poly)).collect()
+}
+
+/// The fan triangulation of a band's polygon from its first corner: its parts.
+pub fn fan(poly: &[Node]) -> impl Iterator<Item = [Node; 3]> + '_ {
+    (1..poly.len().saturating_sub(1)).map(move |i| [poly[0], poly[i], poly[i + 1]])
+}
+
+/// The polygons of a triangle under the frame's cuts (see [`parts`]), each band's in its order
+/// (3 to 7 corners), whose fans are the parts.
+pub fn polygons(p: [Vec3; 3], rho: f32, cuts: AxisCuts) -> Vec<Vec<Node>> {
     let mut out = Vec::with_capacity(4);
     let bary = [Vec3::X, Vec3::Y, Vec3::Z];
     let triangle = Polygon { nodes: [0, 1, 2, 0, 0, 0, 0].map(|i| Node { position: p[i], bary: bary[i] }), count: 3 };
     // Most triangles: one quadrant, one band, one part (what the loop below would give, faster).
     if cuts == 0 || QUADRANTS.iter().any(|&q| single_band(p, q, rho, cuts)) {
-        return vec![[0, 1, 2].map(|i| triangle.nodes[i])];
+        return vec![triangle.nodes[..3].to_vec()];
     }
     let bounds: Vec<f32> = (1..MAX_DIAMONDS).filter(|k| cuts & (1 << k) != 0).map(|k| band_bound(rho, k)).collect();
     for (sx, sz) in QUADRANTS {
@@ -357,8 +368,8 @@ pub fn parts(p: [Vec3; 3], rho: f32, cuts: AxisCuts) -> Vec<[Node; 3]> {
                     }
                 }
             };
-            for i in 1..band.count.saturating_sub(1) {
-                out.push([band.nodes[0], band.nodes[i], band.nodes[i + 1]]);
+            if band.count >= 3 {
+                out.push(band.nodes[..band.count].to_vec());
             }
         }
     }
