@@ -153,12 +153,20 @@ var<private> quad_turn: u32;                // `plan_quad`: the polygon's corner
 var<private> poly_n: array<u32, 11>;        // edge counts of a band's polygon and its fan (`polygon_edge_ends`)
 
 // A polygon while it is clipped (at most 7 corners), and a quadrant's polygon kept while its
-// bands are cut from it.
-var<private> poly: array<Node, 7>;
+// bands are cut from it. Three slots of seven nodes in one pool, named by their offsets, so that a clip writes its
+// result into a free slot and no polygon is ever copied (lavapipe copies private arrays node by
+// node, lane by lane).
+var<private> pool: array<Node, 21>;
+var<private> poly_at: u32;      // the current polygon's slot
 var<private> poly_count: u32;
-var<private> scratch: array<Node, 7>;
-var<private> quadrant: array<Node, 7>;
+var<private> quadrant_at: u32;  // the quadrant's rest's slot
 var<private> quadrant_count: u32;
+var<private> keep_at: u32;      // a third slot a clip must not write (a band kept meanwhile)
+
+// Corner i of the current polygon.
+fn poly_node(i: u32) -> Node {
+    return pool[poly_at + i];
+}
 // The frame's cuts (bits 0–31, 32–63), read by `plan` from the counters.
 var<private> cuts: vec2<u32>;
 
@@ -537,51 +545,59 @@ fn cut_crossing(kind: u32, lo: Node, hi: Node, dl: f32, dh: f32) -> Node {
     return n;
 }
 
-fn push_clipped(n: u32, v: Node) -> u32 {
-    if (n > 0u && same(v.position, scratch[n - 1u].position)) {
+fn push_clipped(at: u32, n: u32, v: Node) -> u32 {
+    if (n > 0u && same(v.position, pool[at + n - 1u].position)) {
         return n;
     }
-    scratch[n] = v;
+    pool[at + n] = v;
     return n + 1u;
 }
 
-// Sutherland–Hodgman clip of `poly` against one half-plane; crossing points from the
-// canonically ordered edge.
+// Sutherland–Hodgman clip of the current polygon against one half-plane, into a slot that is
+// neither its own, the quadrant's nor `keep_at`'s, which becomes the current polygon's; crossing
+// points from the canonically ordered edge.
 fn clip_polygon(cut: Cut) {
+    var at = 0u;
+    for (var slot = 0u; slot < 21u; slot += 7u) {
+        if (slot != poly_at && slot != quadrant_at && slot != keep_at) {
+            at = slot;
+        }
+    }
     var n = 0u;
     for (var i = 0u; i < poly_count; i++) {
-        let cur = poly[i];
-        let next = poly[(i + 1u) % poly_count];
+        let cur = poly_node(i);
+        let next = poly_node((i + 1u) % poly_count);
         let d0 = cut_distance(cut, cur.position);
         let d1 = cut_distance(cut, next.position);
         if (d0 >= 0.0) {
-            n = push_clipped(n, cur);
+            n = push_clipped(at, n, cur);
         }
         if ((d0 >= 0.0) != (d1 >= 0.0) && d0 != 0.0 && d1 != 0.0) {
             if (lex_less(next.position, cur.position)) {
-                n = push_clipped(n, cut_crossing(cut.kind, next, cur, d1, d0));
+                n = push_clipped(at, n, cut_crossing(cut.kind, next, cur, d1, d0));
             } else {
-                n = push_clipped(n, cut_crossing(cut.kind, cur, next, d0, d1));
+                n = push_clipped(at, n, cut_crossing(cut.kind, cur, next, d0, d1));
             }
         }
     }
-    if (n > 1u && same(scratch[n - 1u].position, scratch[0].position)) {
+    if (n > 1u && same(pool[at + n - 1u].position, pool[at].position)) {
         n -= 1u;
     }
     if (n < 3u) {
         n = 0u;
     }
-    for (var i = 0u; i < n; i++) {
-        poly[i] = scratch[i];
-    }
+    poly_at = at;
     poly_count = n;
 }
 
 // Clips the input triangle to quadrant q (signs of x and z as in `QUADRANTS` of axis.rs).
 fn quadrant_polygon(s: vec2<f32>) {
-    poly[0] = Node(tri_position[0], vec3<f32>(1.0, 0.0, 0.0));
-    poly[1] = Node(tri_position[1], vec3<f32>(0.0, 1.0, 0.0));
-    poly[2] = Node(tri_position[2], vec3<f32>(0.0, 0.0, 1.0));
+    poly_at = 0u;
+    quadrant_at = 0u;
+    keep_at = 0u;
+    pool[0] = Node(tri_position[0], vec3<f32>(1.0, 0.0, 0.0));
+    pool[1] = Node(tri_position[1], vec3<f32>(0.0, 1.0, 0.0));
+    pool[2] = Node(tri_position[2], vec3<f32>(0.0, 0.0, 1.0));
     poly_count = 3u;
     // Quick tests (the clips would give the same): wholly on the far side of x = 0 or z = 0, or
     // two corners the same (no polygon); wholly inside the quadrant.
@@ -721,7 +737,7 @@ fn quadrant_beyond(cut: Cut) -> vec2<bool> {
     var beyond = true;
     var within = true;
     for (var i = 0u; i < quadrant_count; i++) {
-        let d = cut_distance(cut, quadrant[i].position);
+        let d = cut_distance(cut, pool[quadrant_at + i].position);
         beyond = beyond && d < 0.0;
         within = within && d >= 0.0;
     }
@@ -779,13 +795,13 @@ fn plan_quadrant(t: u32, q: u32) {
         // What lies beyond the current diamond (`rest` in axis.rs); each band is cut from it,
         // and the rest beyond the next diamond from the same polygon.
         clip_polygon(Cut(CUT_CHORD, s, params.axis_clearance, 1.0));
-        quadrant = poly;
+        quadrant_at = poly_at;
         quadrant_count = poly_count;
         // Start at the band of the nearest corner: the bands below are empty, and cutting them
         // away would leave the polygon as it is (the twin runs them; the parts are the same).
         var d_min = 1e30;
         for (var i = 0u; i < quadrant_count; i++) {
-            d_min = min(d_min, s.x * quadrant[i].position.x + s.y * quadrant[i].position.z);
+            d_min = min(d_min, s.x * pool[quadrant_at + i].position.x + s.y * pool[quadrant_at + i].position.z);
         }
         var k = zone_of(d_min);
         loop {
@@ -795,7 +811,7 @@ fn plan_quadrant(t: u32, q: u32) {
             k = next_cut(k);
             let c = band_bound(min(k, MAX_DIAMONDS - 1u));
             if (k >= MAX_DIAMONDS) {
-                poly = quadrant;
+                poly_at = quadrant_at;
                 poly_count = quadrant_count;
                 quadrant_count = 0u; // the last band: all the rest
             } else {
@@ -804,21 +820,23 @@ fn plan_quadrant(t: u32, q: u32) {
                 if (test.x) {
                     continue; // all of it lies beyond this band
                 }
-                poly = quadrant;
+                poly_at = quadrant_at;
                 poly_count = quadrant_count;
                 if (test.y) {
                     quadrant_count = 0u;
                 } else {
                     clip_polygon(within);
-                    let band = poly;
+                    let band_at = poly_at;
                     let band_count = poly_count;
-                    poly = quadrant;
+                    keep_at = band_at;
+                    poly_at = quadrant_at;
                     poly_count = quadrant_count;
                     clip_polygon(Cut(CUT_CHORD, s, c, 1.0));
-                    quadrant = poly;
+                    quadrant_at = poly_at;
                     quadrant_count = poly_count;
-                    poly = band;
+                    poly_at = band_at;
                     poly_count = band_count;
+                    keep_at = quadrant_at;
                 }
             }
             // The fan's parts: those wholly beyond the image's rows make no pieces (`run` in
@@ -826,7 +844,7 @@ fn plan_quadrant(t: u32, q: u32) {
             var shown = 0u;
             var needed = 0u;
             for (var i = 1u; i + 1u < poly_count; i++) {
-                if (!off_screen_vertically(poly[0].position, poly[i].position, poly[i + 1u].position)) {
+                if (!off_screen_vertically(poly_node(0).position, poly_node(i).position, poly_node(i + 1u).position)) {
                     shown |= 1u << i;
                     let e = fan_edges(i);
                     needed |= (1u << e.x) | (1u << e.y) | (1u << e.z);
@@ -835,7 +853,7 @@ fn plan_quadrant(t: u32, q: u32) {
             for (var e = 0u; e + 3u < 2u * poly_count; e++) {
                 if ((needed & (1u << e)) != 0u) {
                     let ends = polygon_edge_ends(e);
-                    poly_n[e] = edge_divisions(poly[ends.x].position, poly[ends.y].position);
+                    poly_n[e] = edge_divisions(poly_node(ends.x).position, poly_node(ends.y).position);
                 }
             }
             if (plan_quad(shown)) {
@@ -844,9 +862,9 @@ fn plan_quadrant(t: u32, q: u32) {
             }
             for (var i = 1u; i + 1u < poly_count; i++) {
                 if ((shown & (1u << i)) != 0u) {
-                    part[0] = poly[0];
-                    part[1] = poly[i];
-                    part[2] = poly[i + 1u];
+                    part[0] = poly_node(0);
+                    part[1] = poly_node(i);
+                    part[2] = poly_node(i + 1u);
                     let e = fan_edges(i);
                     tri_n[0] = poly_n[e.x];
                     tri_n[1] = poly_n[e.y];
@@ -900,10 +918,10 @@ fn plan_quad(shown: u32) -> bool {
         return false;
     }
     // Every rung of the zigzag (`quad_strip_rungs` in subdivide.rs), the one-part sides among them.
-    let c0 = poly[turn];
-    let c1 = poly[turn + 1u];
-    let c2 = poly[(turn + 2u) % 4u];
-    let c3 = poly[(turn + 3u) % 4u];
+    let c0 = poly_node(turn);
+    let c1 = poly_node(turn + 1u);
+    let c2 = poly_node((turn + 2u) % 4u);
+    let c3 = poly_node((turn + 3u) % 4u);
     var walk = vec2<u32>(0u, 0u);
     for (var step = 0u; step <= rails.x + rails.y; step++) {
         let a = edge_point(c0, c1, walk.x, rails.x).position;
@@ -936,13 +954,13 @@ fn append_quad(t: u32) {
     record.counts01 = strip_n.x | (strip_n.y << 16u);
     record.count2_level = QUAD_HEAD;
     for (var i = 0u; i < 3u; i++) {
-        let c = poly[(quad_turn + i) % 4u];
+        let c = poly_node((quad_turn + i) % 4u);
         record.corner[i] = vec4<f32>(c.position, c.bary.x);
         record.bary1[i] = c.bary.y;
         record.bary2[i] = c.bary.z;
     }
     pieces[base] = record;
-    let last = poly[(quad_turn + 3u) % 4u];
+    let last = poly_node((quad_turn + 3u) % 4u);
     record.count2_level = QUAD_TAIL;
     record.corner[0] = vec4<f32>(last.position, last.bary.x);
     record.bary1[0] = last.bary.y;
