@@ -769,7 +769,7 @@ fn single_band(s: vec2<f32>) -> bool {
 const QUADRANT_SIGNS = array<vec2<f32>, 4>(vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0), vec2<f32>(-1.0, 1.0), vec2<f32>(-1.0, -1.0));
 
 // Whether the current triangle is its own single part: no cuts this frame, or one quadrant and
-// one band (the loop of `plan_parts` would give that part).
+// one band (the loop of `plan_quadrant` would give that part).
 fn single_part() -> bool {
     if (all(cuts == vec2<u32>(0u))) {
         return true;
@@ -782,7 +782,7 @@ fn single_part() -> bool {
     return false;
 }
 
-// Plans every part of the current triangle in quadrant q (`parts` in axis.rs: band by band
+// Plans every part of the current triangle in quadrant q (`polygons` in axis.rs: band by band
 // outwards, along each fan) and appends its pieces.
 fn plan_quadrant(t: u32, q: u32) {
     let signs = QUADRANT_SIGNS;

@@ -294,7 +294,7 @@ fn zone_of(cuts: AxisCuts, rho: f32, d: f32) -> u32 {
 }
 
 /// Whether a triangle lies strictly inside quadrant (sx, sz) and between two consecutive active
-/// diamonds: then it is its own single part (the clips would change nothing, see [`parts`]).
+/// diamonds: then it is its own single part (the clips would change nothing, see [`polygons`]).
 /// `single_band` in the WGSL.
 fn single_band(p: [Vec3; 3], (sx, sz): (f32, f32), rho: f32, cuts: AxisCuts) -> bool {
     if !p.iter().all(|q| sx * q.x > 0.0 && sz * q.z > 0.0) {
@@ -318,21 +318,15 @@ pub fn band_limit(method: u32, screen_radius: f32) -> f32 {
     }
 }
 
-/// The parts of a triangle (corners in the viewer frame, already snapped) under the frame's
-/// `cuts`; part corners carry barycentric weights in the triangle. Numbered quadrant by quadrant
-/// ([`QUADRANTS`]), band by band outwards (the active diamonds), then along each fan. With no
-/// cut active, the triangle is its own part.
-pub fn parts(p: [Vec3; 3], rho: f32, cuts: AxisCuts) -> Vec<[Node; 3]> {
-    polygons(p, rho, cuts).iter().flat_map(|poly| fan(poly)).collect()
-}
-
 /// The fan triangulation of a band's polygon from its first corner: its parts.
 pub fn fan(poly: &[Node]) -> impl Iterator<Item = [Node; 3]> + '_ {
     (1..poly.len().saturating_sub(1)).map(move |i| [poly[0], poly[i], poly[i + 1]])
 }
 
-/// The polygons of a triangle under the frame's cuts (see [`parts`]), each band's in its order
-/// (3 to 7 corners), whose fans are the parts.
+/// The polygons of a triangle (corners in the viewer frame, already snapped) under the frame's
+/// `cuts`, each band's in its order (3 to 7 corners; their [`fan`]s are the parts); corners carry
+/// barycentric weights in the triangle. Numbered quadrant by quadrant ([`QUADRANTS`]), band by
+/// band outwards (the active diamonds). With no cut active, the triangle is its own polygon.
 pub fn polygons(p: [Vec3; 3], rho: f32, cuts: AxisCuts) -> Vec<Vec<Node>> {
     let mut out = Vec::with_capacity(4);
     let bary = [Vec3::X, Vec3::Y, Vec3::Z];

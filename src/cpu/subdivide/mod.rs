@@ -104,7 +104,7 @@ use crate::shader::types::{DrawVertex, SubdivideParams};
 mod axis;
 mod lattice;
 
-pub use axis::{axis_clearance, band_limit, fan, parts, polygons, snap_to_cut_planes, triangle_cuts, AxisCuts};
+pub use axis::{axis_clearance, band_limit, fan, polygons, snap_to_cut_planes, triangle_cuts, AxisCuts};
 pub use lattice::{
     boundary_edge, lattice_triangles, macro_cell, node_slot, quad_strip_node_count, quad_strip_triangles, slot_node,
     snap, strip_node_count, strip_triangles,
