@@ -194,8 +194,7 @@ fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
 /// give the same bytes as one run; a run killed mid-way leaves only whole frames.
 #[test]
 fn sequences_are_numbered_resumable_shardable_and_atomic() {
-    let root = std::env::temp_dir().join(format!("twister-seq-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&root);
+    let root = common::TempDir::new(format!("twister-seq-{}", std::process::id()));
     let all = root.join("all");
     let stats = root.join("stats.jsonl");
     sequence(&all, &["--frames", "0..9", "--stats", stats.to_str().unwrap()]);
@@ -253,8 +252,7 @@ fn sequences_are_numbered_resumable_shardable_and_atomic() {
 /// The Slurm job-array example renders, task by task, the same frames as one run.
 #[test]
 fn the_slurm_example_shards_a_sequence() {
-    let root = std::env::temp_dir().join(format!("twister-slurm-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&root);
+    let root = common::TempDir::new(format!("twister-slurm-{}", std::process::id()));
     let scene = common::asset("gltf/AnimatedCube/glTF/AnimatedCube.gltf");
     let bin = Path::new(env!("CARGO_BIN_EXE_twister")).parent().unwrap().to_path_buf();
     let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default());
@@ -288,8 +286,7 @@ fn the_slurm_example_shards_a_sequence() {
 #[test]
 fn a_video_carries_the_spherical_metadata() {
     use twister::video::{find_boxes, with_spherical_metadata, StereoMode};
-    let root = std::env::temp_dir().join(format!("twister-video-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&root);
+    let root = common::TempDir::new(format!("twister-video-{}", std::process::id()));
     let video = root.join("cube.mp4");
     let scene = common::asset("gltf/AnimatedCube/glTF/AnimatedCube.gltf");
     let made = twister()
@@ -423,8 +420,7 @@ fn moving_camera_file(dir: &Path) -> PathBuf {
 /// camera` are, byte for byte, stills rendered with the viewer at x = 0, 0.5 and 1 m.
 #[test]
 fn an_animated_camera_moves_the_viewer() {
-    let root = std::env::temp_dir().join(format!("twister-dolly-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&root);
+    let root = common::TempDir::new(format!("twister-dolly-{}", std::process::id()));
     let file = moving_camera_file(&root);
     let small = ["--width", "128", "--height", "48"];
     let run = |extra: &[&str]| {
@@ -451,8 +447,7 @@ fn an_animated_camera_moves_the_viewer() {
 /// is one line naming the file and the row.
 #[test]
 fn a_gaze_path_steers_each_frames_level_of_detail() {
-    let root = std::env::temp_dir().join(format!("twister-gaze-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&root);
+    let root = common::TempDir::new(format!("twister-gaze-{}", std::process::id()));
     std::fs::create_dir_all(&root).unwrap();
     let path = root.join("gaze.csv");
     std::fs::write(&path, "time,yaw,pitch\n0,0,0\n1,180,0\n").unwrap();
@@ -496,8 +491,7 @@ fn a_gaze_path_steers_each_frames_level_of_detail() {
 /// pixel for pixel the still with `--viewer 0.2,0.05,-0.15 --yaw 22.5`, and frame 2 the last row.
 #[test]
 fn a_viewer_path_moves_the_viewer_through_a_still_scene() {
-    let root = std::env::temp_dir().join(format!("twister-walk-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&root);
+    let root = common::TempDir::new(format!("twister-walk-{}", std::process::id()));
     std::fs::create_dir_all(&root).unwrap();
     let path = root.join("walk.csv");
     std::fs::write(&path, "# time, x, y, z, yaw\n0,0,0,0,0\n1,0.4,0.1,-0.3,45\n").unwrap();

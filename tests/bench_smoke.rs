@@ -29,8 +29,7 @@ fn csv_rows(path: &Path, header: &[&str]) -> Vec<csv::StringRecord> {
 
 #[test]
 fn quick_benchmark_writes_every_output_well_formed() {
-    let out = std::env::temp_dir().join(format!("twister-bench-smoke-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&out);
+    let out = common::TempDir::new(format!("twister-bench-smoke-{}", std::process::id()));
     let assets = common::asset("");
     // Every scene of the quick run is present (CI has the assets), so every row is expected.
     for needed in [
@@ -130,8 +129,7 @@ fn quick_benchmark_writes_every_output_well_formed() {
 
 #[test]
 fn absent_assets_are_skipped_with_a_clear_line() {
-    let out = std::env::temp_dir().join(format!("twister-bench-noassets-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&out);
+    let out = common::TempDir::new(format!("twister-bench-noassets-{}", std::process::id()));
     let o = Command::new(env!("CARGO_BIN_EXE_twister"))
         .env("NODEVICE_SELECT", "1")
         .args(["bench", "fig10", "--quick", "--reps", "1", "--assets", "/nonexistent/assets", "--out"])

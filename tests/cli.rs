@@ -1,5 +1,7 @@
 //! The `twister` binary as a user runs it.
 
+mod common;
+
 use std::path::Path;
 use std::process::Command;
 
@@ -9,10 +11,8 @@ fn twister() -> Command {
     c
 }
 
-fn tmp(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("twister-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+fn tmp(name: &str) -> common::TempDir {
+    common::TempDir::new(format!("twister-cli-{}-{name}", std::process::id()))
 }
 
 fn png_size(p: &Path) -> (u32, u32) {

@@ -14,9 +14,9 @@ use serde_json::json;
 use twister::core::load::load_scene;
 use twister::{GpuScene, Projection, RenderSettings};
 
-fn dir() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("twister-corpus-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
+fn dir(name: &str) -> common::TempDir {
+    let d = common::TempDir::new(format!("twister-corpus-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&*d).unwrap();
     d
 }
 
@@ -262,7 +262,7 @@ fn check_file(path: &Path, loaded: &mut Vec<PathBuf>) {
 
 #[test]
 fn malformed_files_are_one_clear_error_or_a_scene_never_a_panic() {
-    let d = dir();
+    let d = dir("files");
     std::fs::write(d.join("m.mtl"), MTL).unwrap();
     let mut loaded = Vec::new();
     let files = corpus();
@@ -298,8 +298,7 @@ fn malformed_files_are_one_clear_error_or_a_scene_never_a_panic() {
 fn random_mutations_of_valid_files_never_panic() {
     // A bounded property test (fixed seed, 400 cases): byte flips, deletions, insertions and
     // duplicated runs anywhere in a valid glTF, GLB or OBJ file.
-    let d = dir().join("mutations");
-    std::fs::create_dir_all(&d).unwrap();
+    let d = dir("mutations");
     std::fs::write(d.join("m.mtl"), MTL).unwrap();
     let (doc, bin) = valid_gltf();
     let seeds = [("gltf", gltf_text(&doc, &bin)), ("glb", glb(&doc, &bin)), ("obj", OBJ.as_bytes().to_vec())];

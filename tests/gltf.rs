@@ -13,10 +13,9 @@ fn assets() -> PathBuf {
     common::asset("gltf")
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("twister-gltf-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
+fn tmp(name: &str) -> common::TempDir {
+    let d = common::TempDir::new(format!("twister-gltf-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&*d).unwrap();
     d
 }
 

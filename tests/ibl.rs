@@ -149,7 +149,7 @@ fn metals_mirror_the_environment_and_highlights_grow_with_roughness() {
 /// files: one line naming `--environment` and the file, no panic, no huge allocation.
 #[test]
 fn bad_environment_files_are_refused_with_one_line() {
-    let dir = std::env::temp_dir().join(format!("twister-ibl-{}", std::process::id()));
+    let dir = common::TempDir::new(format!("twister-ibl-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let corrupt = dir.join("corrupt.hdr");
     std::fs::write(&corrupt, b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 99999999 +X 99999999\n\x02\x02").unwrap();
@@ -227,7 +227,7 @@ fn hdr_frames_hold_the_linear_colour_and_tone_map_to_the_ordinary_frame() {
         assert!(off * 1000 <= hdr[k].len(), "{eye:?}: {off} of {} pixels tone map elsewhere", hdr[k].len());
     }
 
-    let dir = std::env::temp_dir().join(format!("twister-hdr-{}", std::process::id()));
+    let dir = common::TempDir::new(format!("twister-hdr-{}", std::process::id()));
     let run = |extra: &[&str]| {
         std::process::Command::new(env!("CARGO_BIN_EXE_twister"))
             .args(["render", "builtin:demo", "--width", "128", "--height", "32", "--hdr", "--out"])
@@ -376,8 +376,7 @@ fn the_environment_turns_by_its_yaw() {
 #[test]
 fn the_prepared_environment_is_cached_and_a_damaged_cache_is_replaced() {
     use twister::core::environment_cache::cache_file;
-    let dir = std::env::temp_dir().join(format!("twister-env-cache-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
+    let dir = common::TempDir::new(format!("twister-env-cache-{}", std::process::id()));
     let env = Environment::load(&common::asset("environments/venice_sunset_1k.hdr")).unwrap();
     let fresh = env.prepare();
     let first = env.prepare_cached_in(Some(&dir));

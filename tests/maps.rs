@@ -137,7 +137,7 @@ fn a_khronos_samples_maps_are_read_as_data() {
 /// right) becomes normals tilted left (against the slope), with a note.
 #[test]
 fn mtl_bump_textures_become_normal_maps() {
-    let dir = std::env::temp_dir().join(format!("twister-maps-{}", std::process::id()));
+    let dir = common::TempDir::new(format!("twister-maps-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let ramp =
         image::RgbaImage::from_fn(8, 8, |x, _| image::Rgba([(x * 32) as u8, (x * 32) as u8, (x * 32) as u8, 255]));

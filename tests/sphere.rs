@@ -16,10 +16,8 @@ fn twister() -> std::process::Command {
     c
 }
 
-fn tmp(name: &str) -> std::path::PathBuf {
-    let d = std::env::temp_dir().join(format!("twister-sphere-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
+fn tmp(name: &str) -> common::TempDir {
+    common::TempDir::new(format!("twister-sphere-{}-{name}", std::process::id()))
 }
 
 #[test]

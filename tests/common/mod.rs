@@ -338,3 +338,41 @@ pub fn ball_over_floor(kind: twister::core::light::LightKind, screen: bool) -> t
     }];
     scene
 }
+
+/// A test's temporary folder under the system's, emptied when made and removed with everything
+/// in it when dropped (also when the test fails), so that test runs leave nothing behind.
+pub struct TempDir(std::path::PathBuf);
+
+impl TempDir {
+    /// `name` (made unique by the caller: the process id, the test) under the temporary folder.
+    pub fn new(name: impl AsRef<str>) -> TempDir {
+        let path = std::env::temp_dir().join(name.as_ref());
+        let _ = std::fs::remove_dir_all(&path);
+        TempDir(path)
+    }
+}
+
+impl std::ops::Deref for TempDir {
+    type Target = std::path::PathBuf;
+    fn deref(&self) -> &std::path::PathBuf {
+        &self.0
+    }
+}
+
+impl AsRef<std::path::Path> for TempDir {
+    fn as_ref(&self) -> &std::path::Path {
+        &self.0
+    }
+}
+
+impl AsRef<std::ffi::OsStr> for TempDir {
+    fn as_ref(&self) -> &std::ffi::OsStr {
+        self.0.as_os_str()
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
