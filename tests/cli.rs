@@ -647,9 +647,6 @@ fn both_eyes_in_one_multiview_draw_match_a_pass_per_eye() {
     // edges differ from run to run when the machine is busy, measured up to 0.6 %), so up to
     // 2 % of the pixels may differ here; mixing the eyes' parameters up would change nearly
     // every pixel (the eyes are apart by the disparity, and every distance changes).
-    #[path = "common/mod.rs"]
-    #[allow(unused)]
-    mod common;
     let duck = common::asset("gltf/Duck/glTF-Binary/Duck.glb");
     let alpha = common::asset("gltf/AlphaBlendModeTest/glTF-Binary/AlphaBlendModeTest.glb");
     let cases: Vec<(String, Vec<&str>)> = vec![
