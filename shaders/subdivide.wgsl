@@ -902,17 +902,16 @@ fn plan_quad(shown: u32) -> bool {
     if (params.method != METHOD_ERROR || is_sphere(params.projection) || poly_count != 4u || shown != 6u) {
         return false;
     }
-    let n = poly_n;
     var turn = 2u;
     for (var r = 0u; r < 2u; r++) {
-        if (turn == 2u && n[r + 1u] == 1u && n[(r + 3u) % 4u] == 1u) {
+        if (turn == 2u && poly_n[r + 1u] == 1u && poly_n[(r + 3u) % 4u] == 1u) {
             turn = r;
         }
     }
     if (turn == 2u) {
         return false;
     }
-    let rails = vec2<u32>(n[turn], n[turn + 2u]);
+    let rails = vec2<u32>(poly_n[turn], poly_n[turn + 2u]);
     let longest = max(rails.x, rails.y);
     if (longest < QUAD_MIN_DIVISIONS || longest > min(params.max_div, PIECE_DIVISIONS)) {
         return false;

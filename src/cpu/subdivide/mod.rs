@@ -96,20 +96,21 @@ use crate::core::projection::{azimuth, horizontal_radius, wrap_angle, Eye, Panor
 use crate::core::scene::{pack_tangent, unpack_tangent, SceneVertex};
 use crate::core::settings::{RenderSettings, SplitRule};
 use crate::shader::constants::{
-    EDGE_SAMPLES, ERROR_SPLIT_LENGTH, MAX_EDGE_DIVISIONS, MAX_MACRO_LEVEL, MAX_STRETCH, PIECE_DIVISIONS,
-    QUAD_MIN_DIVISIONS, QUAD_RUNG_ERROR, SEAM_MARGIN, STRIP_BASE_ERROR, STRIP_MIN_DIVISIONS,
+    EDGE_SAMPLES, ERROR_SPLIT_LENGTH, MAX_EDGE_DIVISIONS, MAX_MACRO_LEVEL, MAX_STRETCH, PIECE_DIVISIONS, SEAM_MARGIN,
+    STRIP_BASE_ERROR, STRIP_MIN_DIVISIONS,
 };
 use crate::shader::types::{DrawVertex, SubdivideParams};
 
 mod axis;
 mod lattice;
+mod quad;
 
 pub use axis::{axis_clearance, band_limit, fan, polygons, snap_to_cut_planes, triangle_cuts, AxisCuts};
 pub use lattice::{
     boundary_edge, lattice_triangles, macro_cell, node_slot, quad_strip_node_count, quad_strip_triangles, slot_node,
     snap, strip_node_count, strip_triangles,
 };
-use lattice::{lattice_node, quad_strip_node, quad_strip_rungs, strip_node, weighted};
+use lattice::{lattice_node, strip_node, weighted};
 
 /// The `subdivide` stage's parameters for a range of input triangles (capacities and piece
 /// ranges are left for the caller, 0).
@@ -451,49 +452,6 @@ impl<'a> Subdivider<'a> {
         polygons(tri.position, self.params.axis_clearance, cuts)
     }
 
-    /// Whether a band's polygon is drawn as one strip between two of its sides (the rails)
-    /// rather than as the two parts of its fan: under the error split, on the cylinder, a polygon
-    /// of four corners, both fan parts on screen, two opposite sides in one part each, rails in
-    /// at most N_max (as a part needing no pre-split), the longer in at least
-    /// `QUAD_MIN_DIVISIONS`, and every rung of the zigzag (the sides of its triangles that cross
-    /// between the rails, both one-part sides among them) within `QUAD_RUNG_ERROR`·τ of straight
-    /// by the quick profile, away from the eye circle, as every other edge drawn. Checking only
-    /// the one-part sides and a middle rung (at τ/4) let the long slanted rungs of narrow bands up
-    /// a wall (vertical rails, split only by length) reach p99 1.4 px in the box room at
-    /// τ = 0.5 px; with every rung the errors are the fan's (Sponza, the box room, the demo
-    /// room). The corners come back turned so that the rails run 0 → 1 and 3 → 2 (`plan_quad` in
-    /// the WGSL).
-    fn quad_strip(&self, tri: &Triangle, poly: &[Node]) -> Option<([Node; 4], [u32; 2])> {
-        if self.params.method != SplitRule::AdaptiveError as u32
-            || self.projection.panorama == PanoramaKind::Equirect
-            || poly.len() != 4
-        {
-            return None;
-        }
-        let p: Vec<Vec3> = poly.iter().map(|n| n.position).collect();
-        if self.off_screen_vertically([p[0], p[1], p[2]]) || self.off_screen_vertically([p[0], p[2], p[3]]) {
-            return None;
-        }
-        let limits = self.limits(tri.object);
-        let n: Vec<u32> = (0..4).map(|e| self.edge_divisions(p[e], p[(e + 1) % 4], limits)).collect();
-        let turn = (0..2).find(|&r| n[r + 1] == 1 && n[(r + 3) % 4] == 1)?;
-        let corners = [0, 1, 2, 3].map(|i| poly[(turn + i) % 4]);
-        let rails = [n[turn], n[turn + 2]];
-        let longest = rails[0].max(rails[1]);
-        if longest < QUAD_MIN_DIVISIONS || longest > self.params.max_div.min(PIECE_DIVISIONS) {
-            return None;
-        }
-        let straight = |[a, b]: [u32; 2]| {
-            let q = self.edge_profile(
-                quad_strip_node(&corners, rails, a).position,
-                quad_strip_node(&corners, rails, b).position,
-                2,
-            );
-            !q.ring && parts_for_bend(q.bend_px, 2, QUAD_RUNG_ERROR * limits.max_error_px) <= 1.0
-        };
-        quad_strip_rungs(rails).all(straight).then_some((corners, rails))
-    }
-
     /// `active_cuts`: the cuts around the axis the frame makes (see `axis.rs`), from every
     /// on-screen triangle of the scene: all of `indices`, whatever range the dispatch plans.
     pub fn active_cuts(&self, vertices: &[SceneVertex], indices: &[u32]) -> AxisCuts {
@@ -616,11 +574,7 @@ impl<'a> Subdivider<'a> {
             Some(base) => strip_triangles(counts, base, &node_on_edge),
             None => lattice_triangles(counts, &q, &node_on_edge),
         };
-        let drawn: Vec<[u32; 3]> = candidates
-            .into_iter()
-            .filter(|(_, t)| !self.off_screen_vertically(t.map(|n| n.position)))
-            .map(|(slots, _)| slots)
-            .collect();
+        let drawn = self.drawn(candidates);
         if drawn.is_empty() {
             return;
         }
@@ -651,25 +605,14 @@ impl<'a> Subdivider<'a> {
         self.emit(tri, &nodes, drawn, theta_c, u_range, out);
     }
 
-    /// `lattice` for a band's quad drawn as a strip between its rails ([`quad_strip_triangles`]).
-    fn quad_lattice(&self, tri: &Triangle, corners: &[Node; 4], rails: [u32; 2], out: &mut SubdivideOutput) {
-        let node = |k: u32| quad_strip_node(corners, rails, k);
-        let drawn: Vec<[u32; 3]> = quad_strip_triangles(rails, &node)
+    /// The candidate triangles (slots and nodes) a piece draws: those not wholly above or below
+    /// the image's rows, as slots.
+    fn drawn(&self, candidates: Vec<([u32; 3], [Node; 3])>) -> Vec<[u32; 3]> {
+        candidates
             .into_iter()
             .filter(|(_, t)| !self.off_screen_vertically(t.map(|n| n.position)))
             .map(|(slots, _)| slots)
-            .collect();
-        if drawn.is_empty() {
-            return;
-        }
-        out.quads += 1;
-        let nodes: Vec<Node> = (0..quad_strip_node_count(rails)).map(node).collect();
-        let c = corners.map(|n| n.position);
-        let theta_c = azimuth((c[0] + c[1] + c[2] + c[3]) / 4.0);
-        // The quad's u range: that of its fan's two triangles, which cover it.
-        let (a, b) = ([corners[0], corners[1], corners[2]], [corners[0], corners[2], corners[3]]);
-        let (ra, rb) = (self.piece_u_range(&a, theta_c), self.piece_u_range(&b, theta_c));
-        self.emit(tri, &nodes, drawn, theta_c, (ra.0.min(rb.0), ra.1.max(rb.1)), out);
+            .collect()
     }
 
     /// Appends a piece's nodes and its drawn triangles (slots into `nodes`). The seam: every

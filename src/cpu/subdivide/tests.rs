@@ -1,5 +1,6 @@
 //! Tests of the `subdivide` twin: lattice conformity, closed meshes, pre-split, seam, axis.
 
+use super::lattice::quad_strip_node;
 use super::*;
 use crate::core::projection::{Eye, Vertical};
 use crate::core::settings::{Method, Split, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV};
