@@ -6,14 +6,17 @@
 #import scene
 //
 // `active_cuts` one invocation per input triangle of the whole scene: the cuts around the axis
-//            the frame makes (quadrant cuts and the square, the diamonds), OR-ed into `counters`.
+//            the frame makes (quadrant cuts and the square, the diamonds), OR-ed into `counters`;
+//            a triangle that asks for cuts marks its edges in `cut_edges`.
 // `plan`     one invocation per input triangle. A triangle that is its own single part (no cuts
-//            this frame, or inside one quadrant and one band) is planned here; the others are
+//            this frame; asks for none and shares no marked edge; or inside one quadrant and one
+//            band) is planned here; the others are
 //            listed in `cut_list` for `plan_cuts` (the clipping code, kept out of this entry
 //            point: lavapipe runs a shader that merely contains it markedly slower), the wide
 //            ones near the axis (`asks_for_cuts`) apart from the rest.
 // `plan_cuts_args`, `plan_cuts`  one invocation per listed triangle (on the sphere per triangle
-//            and quadrant): its parts around the
+//            and quadrant): a triangle that asks for no cuts, fanned at the crossings of its
+//            marked edges (`plan_edge_split`); one that asks, its parts around the
 //            vertical axis under the frame's cuts (quadrants minus a small square around the axis,
 //            bands between the active diamonds, fan-triangulated; a band's quad whose two opposite
 //            sides are in one part each, one piece drawn as a strip between the other two).
@@ -114,6 +117,10 @@ struct Piece {
 // The triangles `plan` left for `plan_cuts` (room for every triangle of a dispatch).
 @group(0) @binding(9) var<storage, read_write> cut_list: array<u32>;
 @group(0) @binding(10) var<storage, read_write> out_indices: array<u32>;
+// Edge e of triangle t is the scene's shared edge triangle_edges[3t + e] (`SharedEdges`); bit i of
+// `cut_edges`: shared edge i is a triangle's that asks for cuts (set by `active_cuts`).
+@group(0) @binding(11) var<storage, read> triangle_edges: array<u32>;
+@group(0) @binding(12) var<storage, read_write> cut_edges: array<atomic<u32>>;
 
 // `params.piece_count == PIECES_FROM_COUNTER` (from `constants`): as many pieces as `plan` made
 // (read from the counter), so that plan, lattice and drawing can run in one submission.
@@ -768,11 +775,15 @@ fn single_band(s: vec2<f32>) -> bool {
 
 const QUADRANT_SIGNS = array<vec2<f32>, 4>(vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0), vec2<f32>(-1.0, 1.0), vec2<f32>(-1.0, -1.0));
 
-// Whether the current triangle is its own single part: no cuts this frame, or one quadrant and
-// one band (the loop of `plan_quadrant` would give that part).
-fn single_part() -> bool {
+// Whether the current triangle t is its own single part: no cuts this frame; asks for none
+// (`wide` false) and shares no edge with a triangle that does; or one quadrant and one band (the
+// loop of `plan_quadrant` would give that part).
+fn single_part(t: u32, wide: bool) -> bool {
     if (all(cuts == vec2<u32>(0u))) {
         return true;
+    }
+    if (!wide) {
+        return !(edge_cut(t, 0u) || edge_cut(t, 1u) || edge_cut(t, 2u));
     }
     for (var q = 0u; q < 4u; q++) {
         if (single_band(QUADRANT_SIGNS[q])) {
@@ -873,6 +884,154 @@ fn plan_quadrant(t: u32, q: u32) {
                     append_pieces(t);
                 }
             }
+        }
+    }
+}
+
+// ---- a triangle that asks for no cuts, cut at edges it shares with ones that do ----
+
+// Whether edge e of triangle t is a cut triangle's (`FrameCuts::is_cut` in subdivide.rs).
+fn edge_cut(t: u32, e: u32) -> bool {
+    let id = triangle_edges[3u * t + e];
+    return (atomicLoad(&cut_edges[id / 32u]) & (1u << (id % 32u))) != 0u;
+}
+
+// The segment being clipped (`clip_segment` in axis.rs), the edge it is part of, and where that
+// edge's crossings start in the pool.
+var<private> seg_p: Node;
+var<private> seg_q: Node;
+var<private> seg_live: bool;
+var<private> edge_ends: array<vec3<f32>, 2>;
+var<private> run_start: u32;
+
+// Appends a crossing of the current edge to the pool, unless it is an end of the edge or there
+// already (a plane's crossing is found in two or four quadrants).
+fn add_crossing(n: Node) {
+    if (same(n.position, edge_ends[0]) || same(n.position, edge_ends[1])) {
+        return;
+    }
+    for (var i = run_start; i < poly_count; i++) {
+        if (same(pool[i].position, n.position)) {
+            return;
+        }
+    }
+    if (poly_count < 21u) {
+        pool[poly_count] = n;
+        poly_count += 1u;
+    }
+}
+
+// Clips the segment to the side cut ≥ 0 as `clip_polygon` clips a polygon's edge, keeping the
+// crossing (`clip_segment` in axis.rs).
+fn clip_segment(cut: Cut) {
+    if (!seg_live) {
+        return;
+    }
+    let dp = cut_distance(cut, seg_p.position);
+    let dq = cut_distance(cut, seg_q.position);
+    if ((dp >= 0.0) != (dq >= 0.0) && dp != 0.0 && dq != 0.0) {
+        var x: Node;
+        if (lex_less(seg_q.position, seg_p.position)) {
+            x = cut_crossing(cut.kind, seg_q, seg_p, dq, dp);
+        } else {
+            x = cut_crossing(cut.kind, seg_p, seg_q, dp, dq);
+        }
+        add_crossing(x);
+        if (dp >= 0.0) {
+            seg_q = x;
+        } else {
+            seg_p = x;
+        }
+        return;
+    }
+    seg_live = dp >= 0.0 && dq >= 0.0;
+}
+
+// Appends to the pool the points where a cut triangle cuts edge a → b (ends excluded), in order
+// from a (`edge_crossings` in axis.rs): the same clips in the same order, on the edge alone.
+fn edge_crossings(a: Node, b: Node) {
+    run_start = poly_count;
+    edge_ends = array<vec3<f32>, 2>(a.position, b.position);
+    for (var q = 0u; q < 4u; q++) {
+        let s = QUADRANT_SIGNS[q];
+        seg_p = a;
+        seg_q = b;
+        seg_live = true;
+        clip_segment(Cut(CUT_X, s, 0.0, 1.0));
+        clip_segment(Cut(CUT_Z, s, 0.0, 1.0));
+        clip_segment(Cut(CUT_CHORD, s, params.axis_clearance, 1.0));
+        var k = 0u;
+        loop {
+            k = next_cut(k);
+            if (!seg_live || k >= MAX_DIAMONDS) {
+                break;
+            }
+            clip_segment(Cut(CUT_CHORD, s, band_bound(k), 1.0));
+        }
+    }
+    // In order along the edge (insertion sort; a few points).
+    let dir = b.position - a.position;
+    for (var i = run_start + 1u; i < poly_count; i++) {
+        let n = pool[i];
+        let key = dot(n.position - a.position, dir);
+        var j = i;
+        loop {
+            if (j == run_start || !(dot(pool[j - 1u].position - a.position, dir) > key)) {
+                break;
+            }
+            pool[j] = pool[j - 1u];
+            j -= 1u;
+        }
+        pool[j] = n;
+    }
+}
+
+// Plans part (apex, pool[i], pool[i + 1 mod the polygon's count]) unless it is off screen.
+fn plan_apex_part(t: u32, apex: Node, i: u32) {
+    part[0] = apex;
+    part[1] = pool[i];
+    part[2] = pool[(i + 1u) % poly_count];
+    if (!off_screen_vertically(part[0].position, part[1].position, part[2].position)) {
+        plan_part();
+        append_pieces(t);
+    }
+}
+
+// Plans the parts of triangle t, which asks for no cuts, cut at the crossings of its edges shared
+// with triangles that do (`edge_split_parts` in axis.rs): its boundary (corner e, then edge e's
+// crossings) in the pool; with crossings on one edge the fan from the opposite corner, on more
+// the fan from the centroid, on none the triangle.
+fn plan_edge_split(t: u32) {
+    let corners = array<Node, 3>(Node(tri_position[0], vec3<f32>(1.0, 0.0, 0.0)),
+                                 Node(tri_position[1], vec3<f32>(0.0, 1.0, 0.0)),
+                                 Node(tri_position[2], vec3<f32>(0.0, 0.0, 1.0)));
+    poly_count = 0u;
+    var crossed = 0u;
+    var chain = vec3<u32>(0u); // the crossed edge, its corner's slot, its nodes before the next corner
+    for (var e = 0u; e < 3u; e++) {
+        let at = poly_count;
+        pool[at] = corners[e];
+        poly_count += 1u;
+        if (edge_cut(t, e)) {
+            edge_crossings(corners[e], corners[(e + 1u) % 3u]);
+        }
+        if (poly_count > at + 1u) {
+            crossed += 1u;
+            chain = vec3<u32>(e, at, poly_count - at);
+        }
+    }
+    if (crossed == 0u) {
+        part = corners;
+        plan_part();
+        append_pieces(t);
+    } else if (crossed == 1u) {
+        for (var i = 0u; i < chain.z; i++) {
+            plan_apex_part(t, corners[(chain.x + 2u) % 3u], chain.y + i);
+        }
+    } else {
+        let centre = weighted(corners, vec3<f32>(1.0 / 3.0));
+        for (var i = 0u; i < poly_count; i++) {
+            plan_apex_part(t, centre, i);
         }
     }
 }
@@ -1223,6 +1382,13 @@ fn active_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     if (bits.y != 0u) {
         atomicOr(&counters.cuts_high, bits.y);
     }
+    if (any(bits != vec2<u32>(0u))) {
+        let t = params.first_triangle + local;
+        for (var e = 0u; e < 3u; e++) {
+            let id = triangle_edges[3u * t + e];
+            atomicOr(&cut_edges[id / 32u], 1u << (id % 32u));
+        }
+    }
 }
 
 @compute @workgroup_size(64)
@@ -1237,7 +1403,8 @@ fn plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if (off_screen_vertically(tri_position[0], tri_position[1], tri_position[2])) {
         return; // no pieces
     }
-    if (single_part()) {
+    let wide = asks_for_cuts(diamond_range(tri_position));
+    if (single_part(t, wide)) {
         part[0] = Node(tri_position[0], vec3<f32>(1.0, 0.0, 0.0));
         part[1] = Node(tri_position[1], vec3<f32>(0.0, 1.0, 0.0));
         part[2] = Node(tri_position[2], vec3<f32>(0.0, 0.0, 1.0));
@@ -1246,10 +1413,10 @@ fn plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         return;
     }
     // Triangles wide next to their distance from the axis (a floor around the viewer) make many
-    // parts; listed apart, they share SIMD lanes with each other rather than stall lanes of the
-    // many small triangles that merely straddle a cut (Sponza: 602 and 9,007).
+    // parts; listed apart (at the back), they share SIMD lanes with each other rather than stall
+    // lanes of the triangles cut only at edges they share with them (Sponza: 602 and 1,012).
     let len = arrayLength(&cut_list);
-    if (asks_for_cuts(diamond_range(tri_position))) {
+    if (wide) {
         let slot = atomicAdd(&counters.cut_wide, 1u);
         if (slot < len) {
             cut_list[len - 1u - slot] = t;
@@ -1310,6 +1477,13 @@ fn plan_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     let t = listed_cut(local / split, listed);
     cuts = vec2<u32>(atomicLoad(&counters.cuts_low), atomicLoad(&counters.cuts_high));
     load_triangle(t);
+    if (local / split < listed.x) {
+        // Asks for no cuts: cut only at its shared edges' crossings (one invocation of `split`).
+        if (local % split == 0u) {
+            plan_edge_split(t);
+        }
+        return;
+    }
     if (split == 4u) {
         plan_quadrant(t, local % 4u);
     } else {

@@ -264,7 +264,7 @@ impl Twin for Subdivide {
                 RenderSettings::new(Projection::equirect(256)).with_method(Method::Fixed(3)),
             ),
         ];
-        let (mut cut_frames, mut strip_frames, mut quad_frames) = (0, 0, 0);
+        let (mut cut_frames, mut strip_frames, mut quad_frames, mut edge_split_frames) = (0, 0, 0, 0);
         let cases: Vec<_> = cases
             .into_iter()
             .enumerate()
@@ -275,6 +275,7 @@ impl Twin for Subdivide {
                 cut_frames += (cpu.cuts != 0) as usize;
                 strip_frames += (cpu.strips > 0) as usize;
                 quad_frames += (cpu.quads > 0) as usize;
+                edge_split_frames += (cpu.edge_splits > 0) as usize;
                 (name, (scene, s))
             })
             .collect();
@@ -284,6 +285,8 @@ impl Twin for Subdivide {
         assert!(strip_frames >= 3, "only {strip_frames} cases draw strips");
         // Band quads drawn as one strip between their rails (the same, around the axis).
         assert!(quad_frames >= 2, "only {quad_frames} cases draw band quads as strips");
+        // Triangles that ask for no cuts, cut only at the edges they share with ones that do.
+        assert!(edge_split_frames >= 3, "only {edge_split_frames} cases cut triangles at shared edges alone");
         cases
     }
     fn gpu(r: &Renderer, (scene, settings): &Self::Case) -> Self::Output {

@@ -18,6 +18,7 @@ pub mod projection;
 pub mod scene;
 pub mod settings;
 pub mod shadow;
+pub mod shared_edges;
 pub mod sphere;
 pub mod texture;
 pub mod timeline;

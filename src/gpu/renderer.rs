@@ -244,8 +244,8 @@ impl Renderer {
     }
 
     /// The subdivide stage's bind group: params, vertices, indices, pieces, output nodes,
-    /// counters, draw args, lattice dispatch, per-object edge scale, cut list, output indices (the order of
-    /// `SUBDIVIDE.bindings`).
+    /// counters, draw args, lattice dispatch, per-object edge scale, cut list, output indices,
+    /// triangle edges, cut edges (the order of `SUBDIVIDE.bindings`).
     fn subdivide_bind_group(
         &self,
         entry: &str,
@@ -269,6 +269,8 @@ impl Renderer {
                 &scene.object_edge_scale,
                 &b.cut_list,
                 &b.indices,
+                &scene.triangle_edges,
+                &scene.cut_edges,
             ],
         )
     }
@@ -293,6 +295,7 @@ impl Renderer {
         let bind_group = self.subdivide_bind_group("active_cuts", uniform, scene, buffers);
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         enc.clear_buffer(&buffers.counters, 0, None);
+        enc.clear_buffer(&scene.cut_edges, 0, None);
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
             pass.set_pipeline(&self.subdivide_for(&params).active_cuts);
@@ -377,6 +380,7 @@ impl Renderer {
         let timestamps = res.timestamps.as_ref();
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         enc.clear_buffer(&b.counters, 0, None);
+        enc.clear_buffer(&scene.cut_edges, 0, None);
         // Three compute passes (timed apart where the adapter has timestamps): the cuts and
         // `plan`, `plan_cuts`, the lattice.
         let variant = self.subdivide_for(&params);

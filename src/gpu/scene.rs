@@ -12,6 +12,7 @@ use crate::core::lod::LodSelection;
 use crate::core::scene::{object_spheres, Scene};
 use crate::core::settings::RenderSettings;
 use crate::core::shadow::{GpuShadowMap, MAX_SHADOW_MAPS};
+use crate::core::shared_edges::{shared_edges_of, welded_points, SharedEdges};
 use crate::error::{Error, Result};
 use crate::gpu::device::Gpu;
 use crate::shader::constants::TRACE_STACK;
@@ -41,6 +42,12 @@ pub struct GpuScene {
     pub warnings: Vec<String>,
     /// Per object: the factor on L of the adaptive subdivision (1; the level of detail sets it).
     pub object_edge_scale: wgpu::Buffer,
+    /// The triangles' shared edges (`core::shared_edges`): three edge numbers per triangle, and
+    /// a bit per edge that the subdivision's `active_cuts` sets each frame (`cut_edges`).
+    pub triangle_edges: wgpu::Buffer,
+    pub cut_edges: wgpu::Buffer,
+    /// Each vertex's welded point, for the edges of a level-of-detail selection.
+    pub points: std::sync::Arc<Vec<u32>>,
     /// Whether some material is textured, not opaque or single-sided (else the drawing stages
     /// use their plain pipelines).
     pub needs_materials: bool,
@@ -151,7 +158,12 @@ impl GpuScene {
             let discards = table.discards();
             let has_maps = table.materials.iter().any(|m| m.has_maps());
             let cull_back_faces = table.all_single_sided(scene.vertices.iter().map(|v| v.material));
+            let points = welded_points(&scene.vertices);
+            let (triangle_edges, cut_edges) = edge_buffers(gpu, &shared_edges_of(&points, &scene.indices));
             Ok(GpuScene {
+                triangle_edges,
+                cut_edges,
+                points: std::sync::Arc::new(points),
                 vertices,
                 indices,
                 triangle_count: scene.triangle_count() as u32,
@@ -289,7 +301,11 @@ impl GpuScene {
     /// selection's triangles (a new index buffer, the only upload) and per-object factors on L.
     pub fn with_lod(&self, gpu: &Gpu, selection: &LodSelection) -> GpuScene {
         let scales = selection.edge_scales();
+        let (triangle_edges, cut_edges) = edge_buffers(gpu, &shared_edges_of(&self.points, &selection.indices));
         GpuScene {
+            triangle_edges,
+            cut_edges,
+            points: self.points.clone(),
             vertices: self.vertices.clone(),
             indices: gpu.init_buffer(
                 "lod indices",
@@ -324,6 +340,15 @@ impl GpuScene {
             environment: self.environment.clone(),
         }
     }
+}
+
+/// The subdivision's edge buffers for a scene's shared edges: their numbers per triangle, and
+/// room for a bit per edge.
+fn edge_buffers(gpu: &Gpu, edges: &SharedEdges) -> (wgpu::Buffer, wgpu::Buffer) {
+    (
+        gpu.init_buffer("triangle edges", bytemuck::cast_slice(&edges.ids), wgpu::BufferUsages::STORAGE),
+        gpu.storage_buffer("cut edges", 4 * edges.bit_words() as u64, wgpu::BufferUsages::empty()),
+    )
 }
 
 /// A scene's shadow maps on the GPU: the maps' table (group 1 binding 6, [`MAX_SHADOW_MAPS`]

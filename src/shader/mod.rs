@@ -149,10 +149,36 @@ pub const SUBDIVIDE: Stage = Stage {
     source: include_str!("../../shaders/subdivide.wgsl"),
     kind: StageKind::Compute,
     entry_points: &[
-        entry("active_cuts", &["params", "vertices", "indices", "counters"]),
-        entry("plan", &["params", "vertices", "indices", "pieces", "counters", "object_edge_scale", "cut_list"]),
+        entry("active_cuts", &["params", "vertices", "indices", "counters", "triangle_edges", "cut_edges"]),
+        entry(
+            "plan",
+            &[
+                "params",
+                "vertices",
+                "indices",
+                "pieces",
+                "counters",
+                "object_edge_scale",
+                "cut_list",
+                "triangle_edges",
+                "cut_edges",
+            ],
+        ),
         entry("plan_cuts_args", &["counters", "lattice_dispatch", "cut_list"]),
-        entry("plan_cuts", &["params", "vertices", "indices", "pieces", "counters", "object_edge_scale", "cut_list"]),
+        entry(
+            "plan_cuts",
+            &[
+                "params",
+                "vertices",
+                "indices",
+                "pieces",
+                "counters",
+                "object_edge_scale",
+                "cut_list",
+                "triangle_edges",
+                "cut_edges",
+            ],
+        ),
         entry("lattice_args", &["params", "counters", "lattice_dispatch"]),
         entry(
             "lattice",
@@ -172,6 +198,8 @@ pub const SUBDIVIDE: Stage = Stage {
         bind(0, 8, "object_edge_scale", Storage),
         bind(0, 9, "cut_list", StorageReadWrite),
         bind(0, 10, "out_indices", StorageReadWrite),
+        bind(0, 11, "triangle_edges", Storage),
+        bind(0, 12, "cut_edges", StorageReadWrite),
     ],
 };
 

@@ -60,14 +60,15 @@
 //!
 //! **The vertical axis.** No eye sees a point with r ≤ d_e, and a triangle around the axis covers
 //! every azimuth. Triangles that reach near the axis, or are large next to their distance from it,
-//! switch on cuts for the whole frame (`active_cuts`, a pass over the scene before `plan`): every
-//! triangle is then cut into its parts in the four quadrants around the axis (planes x = 0 and
-//! z = 0; the seam θ = ±π is one of the cuts, so no part crosses it in θ), minus a small square
-//! around the axis whose points no eye sees, and (adaptive) into bands between the diamonds those
-//! triangles need (see `axis.rs`). The cut points on an edge depend on that edge and the frame's
-//! cuts alone, so neighbours agree; the parts are then split as above, each part's edges counting
-//! as its "original" edges. On the GPU, `plan` plans the triangles that are their own single part
-//! and lists the others for `plan_cuts`, which clips them.
+//! switch on cuts for the whole frame (`active_cuts`, a pass over the scene before `plan`) and are
+//! cut into their parts in the four quadrants around the axis (planes x = 0 and z = 0; the seam
+//! θ = ±π is one of the cuts, so no part crosses it in θ), minus a small square around the axis
+//! whose points no eye sees, and (adaptive) into bands between the diamonds they need; their
+//! neighbours are cut only where the edges they share cross those cuts, and every other triangle
+//! is its own single part (see `axis.rs`). The cut points on an edge depend on that edge and the
+//! frame's cuts alone, so neighbours agree; the parts are then split as above, each part's edges
+//! counting as its "original" edges. On the GPU, `plan` plans the triangles that are their own
+//! single part and lists the others for `plan_cuts`, which clips them.
 //!
 //! **Off screen.** Triangles, parts and pieces that lie wholly above or below the image's rows
 //! (see [`Subdivider::off_screen_vertically`]) make no pieces or no lattice, and sub-triangles
@@ -95,6 +96,7 @@ use std::f32::consts::{PI, TAU};
 use crate::core::projection::{azimuth, horizontal_radius, wrap_angle, Eye, PanoramaKind, Projection, Vertical};
 use crate::core::scene::{pack_tangent, unpack_tangent, SceneVertex};
 use crate::core::settings::{RenderSettings, SplitRule};
+use crate::core::shared_edges::{shared_edges, SharedEdges};
 use crate::shader::constants::{
     EDGE_SAMPLES, ERROR_SPLIT_LENGTH, MAX_EDGE_DIVISIONS, MAX_MACRO_LEVEL, MAX_STRETCH, PIECE_DIVISIONS, SEAM_MARGIN,
     STRIP_BASE_ERROR, STRIP_MIN_DIVISIONS,
@@ -105,7 +107,10 @@ mod axis;
 mod lattice;
 mod quad;
 
-pub use axis::{axis_clearance, band_limit, fan, polygons, snap_to_cut_planes, triangle_cuts, AxisCuts};
+pub use axis::{
+    axis_clearance, band_limit, edge_crossings, edge_split_parts, fan, polygons, snap_to_cut_planes, triangle_cuts,
+    AxisCuts,
+};
 pub use lattice::{
     boundary_edge, lattice_triangles, macro_cell, node_slot, quad_strip_node_count, quad_strip_triangles, slot_node,
     snap, strip_node_count, strip_triangles,
@@ -228,6 +233,34 @@ pub struct SubdivideOutput {
     /// Band quads drawn as one strip between their rails (the twin's count, for tests; 0 from
     /// the GPU).
     pub quads: u32,
+    /// Triangles that ask for no cuts cut at edges they share with ones that do (the twin's
+    /// count, for tests; 0 from the GPU).
+    pub edge_splits: u32,
+}
+
+/// The frame's cuts around the axis (`active_cuts`): which cuts, and which of the scene's
+/// shared edges belong to a triangle that asks for cuts (the GPU's `cut_edges` bits).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FrameCuts {
+    pub axis: AxisCuts,
+    pub edges: SharedEdges,
+    /// Bit i: shared edge i is a cut triangle's.
+    pub cut_edges: Vec<u32>,
+}
+
+impl FrameCuts {
+    /// Whether edge e of triangle t is shared with a triangle that asks for cuts.
+    pub fn is_cut(&self, t: usize, e: usize) -> bool {
+        let id = self.edges.ids[3 * t + e] as usize;
+        self.cut_edges[id / 32] & (1 << (id % 32)) != 0
+    }
+
+    /// Cuts `axis` with every edge counted as a cut triangle's (tests of one triangle whose
+    /// neighbours, not given, ask for cuts).
+    pub fn every_edge(axis: AxisCuts, vertices: &[SceneVertex], indices: &[u32]) -> FrameCuts {
+        let edges = shared_edges(vertices, indices);
+        FrameCuts { axis, cut_edges: vec![u32::MAX; edges.bit_words() as usize], edges }
+    }
 }
 
 /// Indexed triangles as three vertices each.
@@ -245,7 +278,7 @@ impl SubdivideOutput {
         cuts: AxisCuts,
     ) -> Self {
         let vertices = expand(&nodes, &indices);
-        SubdivideOutput { nodes, indices, vertices, pieces, max_sub_edge_px, cuts, strips: 0, quads: 0 }
+        SubdivideOutput { nodes, indices, vertices, pieces, max_sub_edge_px, cuts, ..Default::default() }
     }
 }
 
@@ -444,37 +477,65 @@ impl<'a> Subdivider<'a> {
         (k, n)
     }
 
-    /// The polygons of an input triangle's parts (none if it lies wholly above or below the image).
-    fn triangle_polygons(&self, tri: &Triangle, cuts: AxisCuts) -> Vec<Vec<Node>> {
+    /// The polygons of input triangle t's parts (none if it lies wholly above or below the
+    /// image): a triangle that asks for cuts is cut by all of the frame's (`polygons`); any other
+    /// only at the edges it shares with one (`edge_split_parts`), each part its own polygon.
+    fn triangle_polygons(&self, tri: &Triangle, t: usize, frame: &FrameCuts, edge_splits: &mut u32) -> Vec<Vec<Node>> {
         if self.off_screen_vertically(tri.position) {
             return Vec::new();
         }
-        polygons(tri.position, self.params.axis_clearance, cuts)
+        let rho = self.params.axis_clearance;
+        let limit = band_limit(self.params.method, self.projection.screen_radius);
+        if frame.axis == 0 || triangle_cuts(tri.position, rho, limit) != 0 {
+            return polygons(tri.position, rho, frame.axis);
+        }
+        let shared = [0, 1, 2].map(|e| frame.is_cut(t, e));
+        let parts = if shared.contains(&true) {
+            edge_split_parts(tri.position, shared, rho, frame.axis)
+        } else {
+            vec![[0, 1, 2].map(|i| Node { position: tri.position[i], bary: Vec3::AXES[i] })]
+        };
+        *edge_splits += (parts.len() > 1) as u32;
+        parts.into_iter().map(|part| part.to_vec()).collect()
     }
 
-    /// `active_cuts`: the cuts around the axis the frame makes (see `axis.rs`), from every
-    /// on-screen triangle of the scene: all of `indices`, whatever range the dispatch plans.
-    pub fn active_cuts(&self, vertices: &[SceneVertex], indices: &[u32]) -> AxisCuts {
+    /// `active_cuts`: the cuts around the axis the frame makes and the edges of the triangles
+    /// that ask for them (see `axis.rs`), from every on-screen triangle of the scene: all of
+    /// `indices`, whatever range the dispatch plans.
+    pub fn active_cuts(&self, vertices: &[SceneVertex], indices: &[u32]) -> FrameCuts {
         let limit = band_limit(self.params.method, self.projection.screen_radius);
-        (0..indices.len() / 3)
-            .map(|t| self.positions(vertices, indices, t))
-            .filter(|&p| !self.off_screen_vertically(p))
-            .fold(0, |cuts, p| cuts | triangle_cuts(p, self.params.axis_clearance, limit))
+        let edges = shared_edges(vertices, indices);
+        let mut frame = FrameCuts { axis: 0, cut_edges: vec![0; edges.bit_words() as usize], edges };
+        for t in 0..indices.len() / 3 {
+            let p = self.positions(vertices, indices, t);
+            if self.off_screen_vertically(p) {
+                continue;
+            }
+            let asks = triangle_cuts(p, self.params.axis_clearance, limit);
+            frame.axis |= asks;
+            if asks != 0 {
+                for e in 0..3 {
+                    let id = frame.edges.ids[3 * t + e] as usize;
+                    frame.cut_edges[id / 32] |= 1 << (id % 32);
+                }
+            }
+        }
+        frame
     }
 
     /// The whole stage for the dispatch's triangles: `active_cuts` over the scene, then `plan`
     /// and `lattice`.
     pub fn run(&self, vertices: &[SceneVertex], indices: &[u32]) -> SubdivideOutput {
-        self.run_with_cuts(vertices, indices, self.active_cuts(vertices, indices))
+        self.run_with_cuts(vertices, indices, &self.active_cuts(vertices, indices))
     }
 
     /// The same with the frame's cuts already known (tests that subdivide one triangle at a time).
-    pub fn run_with_cuts(&self, vertices: &[SceneVertex], indices: &[u32], cuts: AxisCuts) -> SubdivideOutput {
-        let mut out = SubdivideOutput { cuts, ..Default::default() };
+    pub fn run_with_cuts(&self, vertices: &[SceneVertex], indices: &[u32], frame: &FrameCuts) -> SubdivideOutput {
+        let mut out = SubdivideOutput { cuts: frame.axis, ..Default::default() };
         let first = self.params.first_triangle as usize;
         for t in first..first + self.params.triangle_count as usize {
             let tri = self.load(vertices, indices, t);
-            for poly in self.triangle_polygons(&tri, cuts) {
+            for poly in self.triangle_polygons(&tri, t, frame, &mut out.edge_splits) {
                 if let Some((corners, rails)) = self.quad_strip(&tri, &poly) {
                     out.pieces += 2; // the GPU's two records of a quad
                     self.quad_lattice(&tri, &corners, rails, &mut out);

@@ -41,7 +41,7 @@ fn run_method(tri: [[f32; 3]; 3], method: Method) -> (Projection, Vec<DrawVertex
 fn run_method_with_cuts(tri: [[f32; 3]; 3], method: Method, cuts: AxisCuts) -> Vec<DrawVertex> {
     let params = params_for(&Projection::default(), method, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV, 1);
     let v: Vec<SceneVertex> = tri.iter().map(|&p| vertex(p)).collect();
-    Subdivider::new(&params).run_with_cuts(&v, &[0, 1, 2], cuts).vertices
+    Subdivider::new(&params).run_with_cuts(&v, &[0, 1, 2], &FrameCuts::every_edge(cuts, &v, &[0, 1, 2])).vertices
 }
 
 fn area3(t: &[DrawVertex]) -> f32 {
@@ -67,21 +67,31 @@ fn ordinary_triangle_passes_through_the_vertex_method_unchanged() {
 }
 
 #[test]
-fn triangle_straddling_a_cut_plane_becomes_a_part_on_each_side_when_the_frame_cuts() {
-    // Straight ahead, across x = 0. Alone, it is small next to its distance from the axis: no
-    // cuts. In a frame with the quadrant cuts on: a triangle on one side, a quad (two parts) on
-    // the other.
+fn triangle_straddling_a_cut_plane_is_cut_only_at_edges_it_shares_with_a_cut_triangle() {
+    // Straight ahead, across x = 0, small next to its distance from the axis: it asks for no
+    // cuts. In a frame with the quadrant cuts on, it stays whole unless an edge of it is a cut
+    // triangle's; with every edge such, its parts take the crossings of edges 0 and 2 with x = 0
+    // as corners (the points a cut neighbour makes there), a fan from its centroid: 5 parts.
     let tri = [[-0.5, 0.0, -3.0], [0.7, 0.0, -3.0], [0.2, 0.5, -3.0]];
     let (_, alone) = run_method(tri, Method::Vertex);
     assert_eq!(alone.len(), 3);
+    let params = params_for(&Projection::default(), Method::Vertex, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV, 1);
+    let v: Vec<SceneVertex> = tri.iter().map(|&p| vertex(p)).collect();
+    let unshared = FrameCuts { cut_edges: vec![0], ..FrameCuts::every_edge(1, &v, &[0, 1, 2]) };
+    assert_eq!(Subdivider::new(&params).run_with_cuts(&v, &[0, 1, 2], &unshared).vertices.len(), 3);
     let out = run_method_with_cuts(tri, Method::Vertex, 1);
-    assert_eq!(out.len(), 9);
-    for t in out.chunks(3) {
-        let side: Vec<f32> = t.iter().map(|d| d.position[0]).collect();
-        assert!(side.iter().all(|&x| x >= 0.0) || side.iter().all(|&x| x <= 0.0), "part {side:?} crosses x = 0");
+    assert_eq!(out.len(), 15);
+    let p = tri.map(Vec3::from);
+    let expected = [p[0] + (p[1] - p[0]) * (0.5 / 1.2), p[2] + (p[0] - p[2]) * (0.2 / 0.7)];
+    for x in expected {
+        assert!(
+            out.iter().any(|d| d.position[0] == 0.0 && (Vec3::from(d.position) - x).length() < 1e-6),
+            "no corner at the crossing {x}"
+        );
     }
     let area: f32 = out.chunks(3).map(area3).sum();
     assert!((area - 0.5 * 1.2 * 0.5).abs() < 1e-5, "area {area}");
+    assert!(out.chunks(3).all(|t| area3(t) > 0.0));
 }
 
 #[test]
@@ -484,7 +494,7 @@ mod real_mesh_tests {
         let outputs: Vec<Vec<DrawVertex>> = (0..scene.triangle_count())
             .map(|t| {
                 let one = SubdivideParams { first_triangle: t as u32, ..params };
-                Subdivider::new(&one).run_with_cuts(&scene.vertices, &scene.indices, cuts).vertices
+                Subdivider::new(&one).run_with_cuts(&scene.vertices, &scene.indices, &cuts).vertices
             })
             .collect();
         let (mut compared, mut split) = (0, 0);

@@ -177,7 +177,7 @@ fn check_case(
     edge_px: f32,
     max_div: u32,
     lod_scale: f32,
-) -> usize {
+) -> (usize, u32) {
     let what = format!(
         "{} ×{scale:.2} at {centre:.2}, {}x{} {:?} d_e={} R_T={}, {} L={edge_px:.1} N_max={max_div} LOD×{lod_scale}",
         mesh.name,
@@ -226,7 +226,8 @@ fn check_case(
     let on_square = |p: Vec3| (p.x.abs() + p.z.abs() - rho).abs() <= tol + 1e-3 * rho;
 
     let out = sd.run(&vertices, &mesh.indices);
-    let cuts = out.cuts;
+    let cuts = sd.active_cuts(&vertices, &mesh.indices);
+    assert_eq!(cuts.axis, out.cuts);
     let originals: Vec<&[DrawVertex]> = out.vertices.chunks(3).filter(|t| t[0].theta_ref.abs() <= PI).collect();
     let mut edges: HashMap<(Key, Key), u32> = HashMap::new();
     for t in &originals {
@@ -265,7 +266,7 @@ fn check_case(
     for _ in 0..12 {
         let t = rng.random_range(0..triangles);
         let one = SubdivideParams { first_triangle: t as u32, triangle_count: 1, ..params };
-        let out = Subdivider::with_edge_scale(&one, &lod).run_with_cuts(&vertices, &mesh.indices, cuts);
+        let out = Subdivider::with_edge_scale(&one, &lod).run_with_cuts(&vertices, &mesh.indices, &cuts);
         let corner = [0, 1, 2].map(|k| snap_to_cut_planes(placed[mesh.indices[3 * t + k] as usize]));
         let normal = (corner[1] - corner[0]).cross(corner[2] - corner[0]);
         if normal.length() == 0.0 {
@@ -309,7 +310,7 @@ fn check_case(
             assert!(covered, "{what}: visible point {p} of input triangle {t} is not covered by its output");
         }
     }
-    originals.len()
+    (originals.len(), out.edge_splits)
 }
 
 /// Two meshes as one (the second's indices shifted), each moved and scaled.
@@ -325,7 +326,7 @@ fn together(a: &Mesh, (ca, sa): (Vec3, f32), b: &Mesh, (cb, sb): (Vec3, f32)) ->
 fn random_closed_meshes_around_the_viewer_subdivide_watertight_and_whole() {
     let meshes = [icosphere(1), icosphere(2), grid_box(1), grid_box(3), torus(12, 8), cow()];
     let mut rng = StdRng::seed_from_u64(2026);
-    let mut total = 0;
+    let (mut total, mut edge_splits) = (0, 0);
     for case in 0..60 {
         let mesh = &meshes[case % meshes.len()];
         // Around (enclosing), above, below, beside the viewer; large and small; and beside the
@@ -391,7 +392,11 @@ fn random_closed_meshes_around_the_viewer_subdivide_watertight_and_whole() {
         };
         // With the level of detail: L relaxed (peripheral field) or no split (outside).
         let lod_scale = [1.0, 1.0, 2.5, crate::core::lod::NO_SPLIT][rng.random_range(0..4)];
-        total += check_case(mesh, centre, scale, &projection, method, edge_px, max_div, lod_scale);
+        let (triangles, splits) = check_case(mesh, centre, scale, &projection, method, edge_px, max_div, lod_scale);
+        total += triangles;
+        edge_splits += splits;
     }
     assert!(total > 10_000, "the cases made only {total} triangles");
+    // Triangles cut only at the edges they share with cut ones (`edge_split_parts`).
+    assert!(edge_splits >= 20, "only {edge_splits} triangles were cut at shared edges alone");
 }
