@@ -8,15 +8,16 @@
 // `active_cuts` one invocation per input triangle of the whole scene: the cuts around the axis
 //            the frame makes (quadrant cuts and the square, the diamonds), OR-ed into `counters`;
 //            a triangle that asks for cuts marks its edges in `cut_edges`.
+// `ring_cuts` the same, after it: a triangle with such an edge is cut too, and marks its edges.
 // `plan`     one invocation per input triangle. A triangle that is its own single part (no cuts
-//            this frame; asks for none and shares no marked edge; or inside one quadrant and one
-//            band) is planned here; the others are
+//            this frame; neither asks nor has an edge of one that does, nor an edge of a cut one;
+//            or inside one quadrant and one band) is planned here; the others are
 //            listed in `cut_list` for `plan_cuts` (the clipping code, kept out of this entry
 //            point: lavapipe runs a shader that merely contains it markedly slower), the wide
-//            ones near the axis (`asks_for_cuts`) apart from the rest.
+//            ones cut by all of the frame's cuts apart from the rest.
 // `plan_cuts_args`, `plan_cuts`  one invocation per listed triangle (on the sphere per triangle
-//            and quadrant): a triangle that asks for no cuts, fanned at the crossings of its
-//            marked edges (`plan_edge_split`); one that asks, its parts around the
+//            and quadrant): a triangle not cut by all cuts, fanned at the crossings of its edges
+//            that cut triangles have (`plan_edge_split`); one cut, its parts around the
 //            vertical axis under the frame's cuts (quadrants minus a small square around the axis,
 //            bands between the active diamonds, fan-triangulated; a band's quad whose two opposite
 //            sides are in one part each, one piece drawn as a strip between the other two).
@@ -117,8 +118,10 @@ struct Piece {
 // The triangles `plan` left for `plan_cuts` (room for every triangle of a dispatch).
 @group(0) @binding(9) var<storage, read_write> cut_list: array<u32>;
 @group(0) @binding(10) var<storage, read_write> out_indices: array<u32>;
-// Edge e of triangle t is the scene's shared edge triangle_edges[3t + e] (`SharedEdges`); bit i of
-// `cut_edges`: shared edge i is a triangle's that asks for cuts (set by `active_cuts`).
+// Edge e of triangle t is the scene's shared edge triangle_edges[3t + e] (`SharedEdges`).
+// `cut_edges`, two bit sets over the shared edges (`FrameCuts`), each half of the array: the
+// edges of the triangles that ask for cuts (set by `active_cuts`), and of the triangles cut (those
+// and their neighbours across those edges; set by `active_cuts` and `ring_cuts`).
 @group(0) @binding(11) var<storage, read> triangle_edges: array<u32>;
 @group(0) @binding(12) var<storage, read_write> cut_edges: array<atomic<u32>>;
 
@@ -775,14 +778,14 @@ fn single_band(s: vec2<f32>) -> bool {
 
 const QUADRANT_SIGNS = array<vec2<f32>, 4>(vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0), vec2<f32>(-1.0, 1.0), vec2<f32>(-1.0, -1.0));
 
-// Whether the current triangle t is its own single part: no cuts this frame; asks for none
-// (`wide` false) and shares no edge with a triangle that does; or one quadrant and one band (the
-// loop of `plan_quadrant` would give that part).
-fn single_part(t: u32, wide: bool) -> bool {
+// Whether the current triangle t is its own single part: no cuts this frame; not cut by all of
+// them (`full` false: asks for none and has no edge of one that does) and no edge of a cut
+// triangle; or one quadrant and one band (the loop of `plan_quadrant` would give that part).
+fn single_part(t: u32, full: bool) -> bool {
     if (all(cuts == vec2<u32>(0u))) {
         return true;
     }
-    if (!wide) {
+    if (!full) {
         return !(edge_cut(t, 0u) || edge_cut(t, 1u) || edge_cut(t, 2u));
     }
     for (var q = 0u; q < 4u; q++) {
@@ -890,10 +893,21 @@ fn plan_quadrant(t: u32, q: u32) {
 
 // ---- a triangle that asks for no cuts, cut at edges it shares with ones that do ----
 
-// Whether edge e of triangle t is a cut triangle's (`FrameCuts::is_cut` in subdivide.rs).
+// Whether edge e of triangle t is a cut triangle's (`FrameCuts::is_cut_edge` in subdivide.rs).
 fn edge_cut(t: u32, e: u32) -> bool {
     let id = triangle_edges[3u * t + e];
-    return (atomicLoad(&cut_edges[id / 32u]) & (1u << (id % 32u))) != 0u;
+    return (atomicLoad(&cut_edges[arrayLength(&cut_edges) / 2u + id / 32u]) & (1u << (id % 32u))) != 0u;
+}
+
+// Whether triangle t has an edge of a triangle that asks for cuts: then it is cut by all of them
+// (`FrameCuts::is_cut_triangle`).
+fn cut_triangle(t: u32) -> bool {
+    var asked = false;
+    for (var e = 0u; e < 3u; e++) {
+        let id = triangle_edges[3u * t + e];
+        asked = asked || (atomicLoad(&cut_edges[id / 32u]) & (1u << (id % 32u))) != 0u;
+    }
+    return asked;
 }
 
 // The segment being clipped (`clip_segment` in axis.rs), the edge it is part of, and where that
@@ -997,8 +1011,8 @@ fn plan_apex_part(t: u32, apex: Node, i: u32) {
     }
 }
 
-// Plans the parts of triangle t, which asks for no cuts, cut at the crossings of its edges shared
-// with triangles that do (`edge_split_parts` in axis.rs): its boundary (corner e, then edge e's
+// Plans the parts of triangle t, which is not cut by all cuts, at the crossings of its edges that
+// cut triangles have (`edge_split_parts` in axis.rs): its boundary (corner e, then edge e's
 // crossings) in the pool; with crossings on one edge the fan from the opposite corner, on more
 // the fan from the centroid, on none the triangle.
 fn plan_edge_split(t: u32) {
@@ -1384,10 +1398,33 @@ fn active_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     }
     if (any(bits != vec2<u32>(0u))) {
         let t = params.first_triangle + local;
+        let half = arrayLength(&cut_edges) / 2u;
         for (var e = 0u; e < 3u; e++) {
             let id = triangle_edges[3u * t + e];
             atomicOr(&cut_edges[id / 32u], 1u << (id % 32u));
+            atomicOr(&cut_edges[half + id / 32u], 1u << (id % 32u));
         }
+    }
+}
+
+// Over every triangle of the scene, after `active_cuts`: a triangle that asks for no cuts but
+// has an edge of one that does is cut too; its edges are marked as cut ones'.
+@compute @workgroup_size(64)
+fn ring_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let local = invocation_index(gid, groups);
+    if (local >= params.triangle_count) {
+        return;
+    }
+    let t = params.first_triangle + local;
+    load_positions(t);
+    if (off_screen_vertically(tri_position[0], tri_position[1], tri_position[2])
+        || asks_for_cuts(diamond_range(tri_position)) || !cut_triangle(t)) {
+        return;
+    }
+    let half = arrayLength(&cut_edges) / 2u;
+    for (var e = 0u; e < 3u; e++) {
+        let id = triangle_edges[3u * t + e];
+        atomicOr(&cut_edges[half + id / 32u], 1u << (id % 32u));
     }
 }
 
@@ -1403,8 +1440,8 @@ fn plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if (off_screen_vertically(tri_position[0], tri_position[1], tri_position[2])) {
         return; // no pieces
     }
-    let wide = asks_for_cuts(diamond_range(tri_position));
-    if (single_part(t, wide)) {
+    let full = asks_for_cuts(diamond_range(tri_position)) || cut_triangle(t);
+    if (single_part(t, full)) {
         part[0] = Node(tri_position[0], vec3<f32>(1.0, 0.0, 0.0));
         part[1] = Node(tri_position[1], vec3<f32>(0.0, 1.0, 0.0));
         part[2] = Node(tri_position[2], vec3<f32>(0.0, 0.0, 1.0));
@@ -1412,11 +1449,11 @@ fn plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         append_pieces(t);
         return;
     }
-    // Triangles wide next to their distance from the axis (a floor around the viewer) make many
-    // parts; listed apart (at the back), they share SIMD lanes with each other rather than stall
-    // lanes of the triangles listed for their shared edges (Sponza: 288 and 128).
+    // Triangles cut by all of the frame's cuts (a floor around the viewer and its neighbours)
+    // make many parts; listed apart (at the back), they share SIMD lanes with each other rather
+    // than stall lanes of the triangles listed for their shared edges (Sponza: 288 + 128 and 108).
     let len = arrayLength(&cut_list);
-    if (wide) {
+    if (full) {
         let slot = atomicAdd(&counters.cut_wide, 1u);
         if (slot < len) {
             cut_list[len - 1u - slot] = t;
@@ -1478,7 +1515,7 @@ fn plan_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     cuts = vec2<u32>(atomicLoad(&counters.cuts_low), atomicLoad(&counters.cuts_high));
     load_triangle(t);
     if (local / split < listed.x) {
-        // Asks for no cuts: cut only at its shared edges' crossings (one invocation of `split`).
+        // Cut only at its shared edges' crossings (one invocation of `split`).
         if (local % split == 0u) {
             plan_edge_split(t);
         }

@@ -31,6 +31,7 @@ use crate::shader::{REDUCE_ERROR, SUBDIVIDE};
 /// The `subdivide` stage's pipelines for one panorama, one per entry point.
 struct SubdivideVariant {
     active_cuts: wgpu::ComputePipeline,
+    ring_cuts: wgpu::ComputePipeline,
     plan: wgpu::ComputePipeline,
     plan_cuts_args: wgpu::ComputePipeline,
     plan_cuts: wgpu::ComputePipeline,
@@ -57,6 +58,7 @@ impl SubdividePipelines {
             let make = |entry| self.stage.compute_with(gpu, entry, &constants);
             SubdivideVariant {
                 active_cuts: make("active_cuts"),
+                ring_cuts: make("ring_cuts"),
                 plan: make("plan"),
                 plan_cuts_args: make("plan_cuts_args"),
                 plan_cuts: make("plan_cuts"),
@@ -281,8 +283,8 @@ impl Renderer {
         self.subdivide.variant(&self.gpu, panorama)
     }
 
-    /// Clears the counters and runs `active_cuts` over every triangle of the scene: the start of
-    /// a frame that runs `plan` and `lattice` apart (chunks, read-back).
+    /// Clears the counters and runs `active_cuts` and `ring_cuts` over every triangle of the
+    /// scene: the start of a frame that runs `plan` and `lattice` apart (chunks, read-back).
     fn run_active_cuts(
         &self,
         uniform: &wgpu::Buffer,
@@ -292,16 +294,19 @@ impl Renderer {
     ) {
         let params = SubdivideParams { first_triangle: 0, triangle_count: scene.triangle_count, ..*params };
         self.gpu.queue.write_buffer(uniform, 0, bytemuck::bytes_of(&params));
-        let bind_group = self.subdivide_bind_group("active_cuts", uniform, scene, buffers);
+        let groups = ["active_cuts", "ring_cuts"].map(|e| self.subdivide_bind_group(e, uniform, scene, buffers));
+        let variant = self.subdivide_for(&params);
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         enc.clear_buffer(&buffers.counters, 0, None);
         enc.clear_buffer(&scene.cut_edges, 0, None);
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&self.subdivide_for(&params).active_cuts);
-            pass.set_bind_group(0, &bind_group, &[]);
             let (x, y) = self.gpu.workgroups(scene.triangle_count, 64);
-            pass.dispatch_workgroups(x, y, 1);
+            for (pipeline, group) in [&variant.active_cuts, &variant.ring_cuts].into_iter().zip(&groups) {
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, group, &[]);
+                pass.dispatch_workgroups(x, y, 1);
+            }
         }
         self.gpu.queue.submit([enc.finish()]);
     }
@@ -375,24 +380,24 @@ impl Renderer {
         params.piece_count = PIECES_FROM_COUNTER;
         self.gpu.queue.write_buffer(&res.subdivide_params, 0, bytemuck::bytes_of(&params));
         let group = |entry| self.subdivide_bind_group(entry, &res.subdivide_params, scene, b);
-        let groups = ["active_cuts", "plan", "lattice_args", "lattice", "finalize"].map(group);
+        let groups = ["active_cuts", "ring_cuts", "plan", "lattice_args", "lattice", "finalize"].map(group);
         let cut_groups = ["plan_cuts_args", "plan_cuts"].map(group);
         let timestamps = res.timestamps.as_ref();
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         enc.clear_buffer(&b.counters, 0, None);
         enc.clear_buffer(&scene.cut_edges, 0, None);
-        // Three compute passes (timed apart where the adapter has timestamps): the cuts and
-        // `plan`, `plan_cuts`, the lattice.
+        // Three compute passes (timed apart where the adapter has timestamps): the cuts (both
+        // rings) and `plan`, `plan_cuts`, the lattice.
         let variant = self.subdivide_for(&params);
         {
             let mut pass = stamp::compute_pass(&mut enc, "plan", timestamps, stamp::PLAN);
             let (x, y) = self.gpu.workgroups(params.triangle_count, 64);
-            pass.set_pipeline(&variant.active_cuts);
-            pass.set_bind_group(0, &groups[0], &[]);
-            pass.dispatch_workgroups(x, y, 1);
-            pass.set_pipeline(&variant.plan);
-            pass.set_bind_group(0, &groups[1], &[]);
-            pass.dispatch_workgroups(x, y, 1);
+            for (pipeline, group) in [&variant.active_cuts, &variant.ring_cuts, &variant.plan].into_iter().zip(&groups)
+            {
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, group, &[]);
+                pass.dispatch_workgroups(x, y, 1);
+            }
         }
         {
             let mut pass = stamp::compute_pass(&mut enc, "plan_cuts", timestamps, stamp::PLAN_CUTS);
@@ -401,13 +406,13 @@ impl Renderer {
         {
             let mut pass = stamp::compute_pass(&mut enc, "lattice", timestamps, stamp::LATTICE);
             pass.set_pipeline(&variant.lattice_args);
-            pass.set_bind_group(0, &groups[2], &[]);
+            pass.set_bind_group(0, &groups[3], &[]);
             pass.dispatch_workgroups(1, 1, 1);
             pass.set_pipeline(&variant.lattice);
-            pass.set_bind_group(0, &groups[3], &[]);
+            pass.set_bind_group(0, &groups[4], &[]);
             pass.dispatch_workgroups_indirect(&b.lattice_dispatch, 0);
             pass.set_pipeline(&variant.finalize);
-            pass.set_bind_group(0, &groups[4], &[]);
+            pass.set_bind_group(0, &groups[5], &[]);
             pass.dispatch_workgroups(1, 1, 1);
         }
         self.encode_raster(

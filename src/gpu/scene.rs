@@ -43,7 +43,8 @@ pub struct GpuScene {
     /// Per object: the factor on L of the adaptive subdivision (1; the level of detail sets it).
     pub object_edge_scale: wgpu::Buffer,
     /// The triangles' shared edges (`core::shared_edges`): three edge numbers per triangle, and
-    /// a bit per edge that the subdivision's `active_cuts` sets each frame (`cut_edges`).
+    /// two bits per edge that the subdivision's `active_cuts` and `ring_cuts` set each frame
+    /// (`cut_edges`).
     pub triangle_edges: wgpu::Buffer,
     pub cut_edges: wgpu::Buffer,
     /// Each vertex's welded point, for the edges of a level-of-detail selection.
@@ -343,11 +344,11 @@ impl GpuScene {
 }
 
 /// The subdivision's edge buffers for a scene's shared edges: their numbers per triangle, and
-/// room for a bit per edge.
+/// room for two bits per edge (`FrameCuts`).
 fn edge_buffers(gpu: &Gpu, edges: &SharedEdges) -> (wgpu::Buffer, wgpu::Buffer) {
     (
         gpu.init_buffer("triangle edges", bytemuck::cast_slice(&edges.ids), wgpu::BufferUsages::STORAGE),
-        gpu.storage_buffer("cut edges", 4 * edges.bit_words() as u64, wgpu::BufferUsages::empty()),
+        gpu.storage_buffer("cut edges", 8 * edges.bit_words() as u64, wgpu::BufferUsages::empty()),
     )
 }
 

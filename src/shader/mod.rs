@@ -150,6 +150,7 @@ pub const SUBDIVIDE: Stage = Stage {
     kind: StageKind::Compute,
     entry_points: &[
         entry("active_cuts", &["params", "vertices", "indices", "counters", "triangle_edges", "cut_edges"]),
+        entry("ring_cuts", &["params", "vertices", "indices", "triangle_edges", "cut_edges"]),
         entry(
             "plan",
             &[
