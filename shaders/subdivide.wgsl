@@ -119,11 +119,17 @@ struct Piece {
 @group(0) @binding(9) var<storage, read_write> cut_list: array<u32>;
 @group(0) @binding(10) var<storage, read_write> out_indices: array<u32>;
 // Edge e of triangle t is the scene's shared edge triangle_edges[3t + e] (`SharedEdges`).
-// `cut_edges`, two bit sets over the shared edges (`FrameCuts`), each half of the array: the
-// edges of the triangles that ask for cuts (set by `active_cuts`), and of the triangles cut (those
-// and their neighbours across those edges; set by `active_cuts` and `ring_cuts`).
+// `cut_edges`: two bits per shared edge (`FrameCuts`), edge i's at bits 2(i mod 16) of word i / 16
+// (one load reads both): EDGE_ASKING, the edge is a triangle's that asks for cuts (set by
+// `active_cuts`); EDGE_CUT, a cut triangle's (those and their neighbours across those edges; set
+// by `active_cuts` and `ring_cuts`).
 @group(0) @binding(11) var<storage, read> triangle_edges: array<u32>;
 @group(0) @binding(12) var<storage, read_write> cut_edges: array<atomic<u32>>;
+// The same buffer, read only, for the passes after the marking (`plan`, `plan_cuts`): plain
+// loads rather than atomic ones.
+@group(0) @binding(13) var<storage, read> edge_marks_read: array<u32>;
+const EDGE_ASKING: u32 = 1u;
+const EDGE_CUT: u32 = 2u;
 
 // `params.piece_count == PIECES_FROM_COUNTER` (from `constants`): as many pieces as `plan` made
 // (read from the counter), so that plan, lattice and drawing can run in one submission.
@@ -778,15 +784,16 @@ fn single_band(s: vec2<f32>) -> bool {
 
 const QUADRANT_SIGNS = array<vec2<f32>, 4>(vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0), vec2<f32>(-1.0, 1.0), vec2<f32>(-1.0, -1.0));
 
-// Whether the current triangle t is its own single part: no cuts this frame; not cut by all of
+// Whether the current triangle is its own single part: no cuts this frame; not cut by all of
 // them (`full` false: asks for none and has no edge of one that does) and no edge of a cut
-// triangle; or one quadrant and one band (the loop of `plan_quadrant` would give that part).
-fn single_part(t: u32, full: bool) -> bool {
+// triangle (`marks`, its edges'); or one quadrant and one band (the loop of `plan_quadrant`
+// would give that part).
+fn single_part(full: bool, marks: vec3<u32>) -> bool {
     if (all(cuts == vec2<u32>(0u))) {
         return true;
     }
     if (!full) {
-        return !(edge_cut(t, 0u) || edge_cut(t, 1u) || edge_cut(t, 2u));
+        return all((marks & vec3<u32>(EDGE_CUT)) == vec3<u32>(0u));
     }
     for (var q = 0u; q < 4u; q++) {
         if (single_band(QUADRANT_SIGNS[q])) {
@@ -893,21 +900,38 @@ fn plan_quadrant(t: u32, q: u32) {
 
 // ---- a triangle that asks for no cuts, cut at edges it shares with ones that do ----
 
-// Whether edge e of triangle t is a cut triangle's (`FrameCuts::is_cut_edge` in subdivide.rs).
-fn edge_cut(t: u32, e: u32) -> bool {
-    let id = triangle_edges[3u * t + e];
-    return (atomicLoad(&cut_edges[arrayLength(&cut_edges) / 2u + id / 32u]) & (1u << (id % 32u))) != 0u;
-}
-
-// Whether triangle t has an edge of a triangle that asks for cuts: then it is cut by all of them
-// (`FrameCuts::is_cut_triangle`).
-fn cut_triangle(t: u32) -> bool {
-    var asked = false;
+// The marks of triangle t's three edges (EDGE_ASKING, EDGE_CUT; `FrameCuts` in subdivide.rs),
+// while they are being set (`ring_cuts`), and once they are (`plan`, `plan_cuts`).
+fn edge_marks_now(t: u32) -> vec3<u32> {
+    var marks: vec3<u32>;
     for (var e = 0u; e < 3u; e++) {
         let id = triangle_edges[3u * t + e];
-        asked = asked || (atomicLoad(&cut_edges[id / 32u]) & (1u << (id % 32u))) != 0u;
+        marks[e] = (atomicLoad(&cut_edges[id / 16u]) >> (2u * (id % 16u))) & 3u;
     }
-    return asked;
+    return marks;
+}
+
+fn edge_marks(t: u32) -> vec3<u32> {
+    var marks: vec3<u32>;
+    for (var e = 0u; e < 3u; e++) {
+        let id = triangle_edges[3u * t + e];
+        marks[e] = (edge_marks_read[id / 16u] >> (2u * (id % 16u))) & 3u;
+    }
+    return marks;
+}
+
+// Sets marks on triangle t's three edges.
+fn mark_edges(t: u32, marks: u32) {
+    for (var e = 0u; e < 3u; e++) {
+        let id = triangle_edges[3u * t + e];
+        atomicOr(&cut_edges[id / 16u], marks << (2u * (id % 16u)));
+    }
+}
+
+// Whether a triangle with edge marks `marks` has an edge of a triangle that asks for cuts: then
+// it is cut by all of them (`FrameCuts::is_cut_triangle`).
+fn cut_triangle(marks: vec3<u32>) -> bool {
+    return any((marks & vec3<u32>(EDGE_ASKING)) != vec3<u32>(0u));
 }
 
 // The segment being clipped (`clip_segment` in axis.rs), the edge it is part of, and where that
@@ -1022,11 +1046,12 @@ fn plan_edge_split(t: u32) {
     poly_count = 0u;
     var crossed = 0u;
     var chain = vec3<u32>(0u); // the crossed edge, its corner's slot, its nodes before the next corner
+    let marks = edge_marks(t);
     for (var e = 0u; e < 3u; e++) {
         let at = poly_count;
         pool[at] = corners[e];
         poly_count += 1u;
-        if (edge_cut(t, e)) {
+        if ((marks[e] & EDGE_CUT) != 0u) {
             edge_crossings(corners[e], corners[(e + 1u) % 3u]);
         }
         if (poly_count > at + 1u) {
@@ -1398,12 +1423,7 @@ fn active_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     }
     if (any(bits != vec2<u32>(0u))) {
         let t = params.first_triangle + local;
-        let half = arrayLength(&cut_edges) / 2u;
-        for (var e = 0u; e < 3u; e++) {
-            let id = triangle_edges[3u * t + e];
-            atomicOr(&cut_edges[id / 32u], 1u << (id % 32u));
-            atomicOr(&cut_edges[half + id / 32u], 1u << (id % 32u));
-        }
+        mark_edges(t, EDGE_ASKING | EDGE_CUT);
     }
 }
 
@@ -1416,16 +1436,16 @@ fn ring_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
         return;
     }
     let t = params.first_triangle + local;
-    load_positions(t);
-    if (off_screen_vertically(tri_position[0], tri_position[1], tri_position[2])
-        || asks_for_cuts(diamond_range(tri_position)) || !cut_triangle(t)) {
+    // The bits first: most triangles have no such edge, and need not be loaded. (A triangle
+    // that asks is marked already; marking it again changes nothing.)
+    if (!cut_triangle(edge_marks_now(t))) {
         return;
     }
-    let half = arrayLength(&cut_edges) / 2u;
-    for (var e = 0u; e < 3u; e++) {
-        let id = triangle_edges[3u * t + e];
-        atomicOr(&cut_edges[half + id / 32u], 1u << (id % 32u));
+    load_positions(t);
+    if (off_screen_vertically(tri_position[0], tri_position[1], tri_position[2])) {
+        return;
     }
+    mark_edges(t, EDGE_CUT);
 }
 
 @compute @workgroup_size(64)
@@ -1440,8 +1460,14 @@ fn plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     if (off_screen_vertically(tri_position[0], tri_position[1], tri_position[2])) {
         return; // no pieces
     }
-    let full = asks_for_cuts(diamond_range(tri_position)) || cut_triangle(t);
-    if (single_part(t, full)) {
+    // Cut by all of the frame's cuts (decided only when there are any; the marks first).
+    var marks = vec3<u32>(0u);
+    var full = false;
+    if (any(cuts != vec2<u32>(0u))) {
+        marks = edge_marks(t);
+        full = cut_triangle(marks) || asks_for_cuts(diamond_range(tri_position));
+    }
+    if (single_part(full, marks)) {
         part[0] = Node(tri_position[0], vec3<f32>(1.0, 0.0, 0.0));
         part[1] = Node(tri_position[1], vec3<f32>(0.0, 1.0, 0.0));
         part[2] = Node(tri_position[2], vec3<f32>(0.0, 0.0, 1.0));

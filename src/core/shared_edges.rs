@@ -20,9 +20,9 @@ pub struct SharedEdges {
 }
 
 impl SharedEdges {
-    /// The 32-bit words a bit set over the edges needs (at least one).
-    pub fn bit_words(&self) -> u32 {
-        self.count.div_ceil(32).max(1)
+    /// The 32-bit words a set of `bits` bits per edge needs (at least one).
+    pub fn bit_words(&self, bits: u32) -> u32 {
+        (self.count as u64 * bits as u64).div_ceil(32).max(1) as u32
     }
 }
 
@@ -88,7 +88,8 @@ mod tests {
         distinct.dedup();
         assert_eq!(distinct.len(), 5);
         assert!(edges.ids.iter().all(|&id| id < edges.count));
-        assert_eq!(edges.bit_words(), 1);
+        assert_eq!(edges.bit_words(1), 1);
+        assert_eq!(edges.bit_words(8), 2);
     }
 
     #[test]

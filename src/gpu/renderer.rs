@@ -247,7 +247,8 @@ impl Renderer {
 
     /// The subdivide stage's bind group: params, vertices, indices, pieces, output nodes,
     /// counters, draw args, lattice dispatch, per-object edge scale, cut list, output indices,
-    /// triangle edges, cut edges (the order of `SUBDIVIDE.bindings`).
+    /// triangle edges, cut edges (twice: read-write and read-only) (the order of
+    /// `SUBDIVIDE.bindings`).
     fn subdivide_bind_group(
         &self,
         entry: &str,
@@ -272,6 +273,7 @@ impl Renderer {
                 &b.cut_list,
                 &b.indices,
                 &scene.triangle_edges,
+                &scene.cut_edges,
                 &scene.cut_edges,
             ],
         )

@@ -348,7 +348,7 @@ impl GpuScene {
 fn edge_buffers(gpu: &Gpu, edges: &SharedEdges) -> (wgpu::Buffer, wgpu::Buffer) {
     (
         gpu.init_buffer("triangle edges", bytemuck::cast_slice(&edges.ids), wgpu::BufferUsages::STORAGE),
-        gpu.storage_buffer("cut edges", 8 * edges.bit_words() as u64, wgpu::BufferUsages::empty()),
+        gpu.storage_buffer("cut edges", 4 * edges.bit_words(2) as u64, wgpu::BufferUsages::empty()),
     )
 }
 

@@ -162,7 +162,7 @@ pub const SUBDIVIDE: Stage = Stage {
                 "object_edge_scale",
                 "cut_list",
                 "triangle_edges",
-                "cut_edges",
+                "edge_marks_read",
             ],
         ),
         entry("plan_cuts_args", &["counters", "lattice_dispatch", "cut_list"]),
@@ -177,7 +177,7 @@ pub const SUBDIVIDE: Stage = Stage {
                 "object_edge_scale",
                 "cut_list",
                 "triangle_edges",
-                "cut_edges",
+                "edge_marks_read",
             ],
         ),
         entry("lattice_args", &["params", "counters", "lattice_dispatch"]),
@@ -201,6 +201,7 @@ pub const SUBDIVIDE: Stage = Stage {
         bind(0, 10, "out_indices", StorageReadWrite),
         bind(0, 11, "triangle_edges", Storage),
         bind(0, 12, "cut_edges", StorageReadWrite),
+        bind(0, 13, "edge_marks_read", Storage),
     ],
 };
 

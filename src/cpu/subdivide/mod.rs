@@ -240,7 +240,7 @@ pub struct SubdivideOutput {
 
 /// The frame's cuts around the axis (`active_cuts`): which cuts, and which of the scene's
 /// shared edges are a triangle's that asks for cuts, or a cut triangle's (`cut_edges` in the
-/// WGSL: those two bit sets one after the other).
+/// WGSL: those two bits of each edge side by side).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FrameCuts {
     pub axis: AxisCuts,
@@ -274,7 +274,7 @@ impl FrameCuts {
     /// one triangle whose neighbours, not given, are cut).
     pub fn every_edge(axis: AxisCuts, vertices: &[SceneVertex], indices: &[u32]) -> FrameCuts {
         let edges = shared_edges(vertices, indices);
-        let words = edges.bit_words() as usize;
+        let words = edges.bit_words(1) as usize;
         FrameCuts { axis, asking_edges: vec![0; words], cut_edges: vec![u32::MAX; words], edges }
     }
 }
@@ -523,7 +523,7 @@ impl<'a> Subdivider<'a> {
     pub fn active_cuts(&self, vertices: &[SceneVertex], indices: &[u32]) -> FrameCuts {
         let limit = band_limit(self.params.method, self.projection.screen_radius);
         let edges = shared_edges(vertices, indices);
-        let words = edges.bit_words() as usize;
+        let words = edges.bit_words(1) as usize;
         let mut frame = FrameCuts { axis: 0, asking_edges: vec![0; words], cut_edges: vec![0; words], edges };
         let on_screen: Vec<(usize, AxisCuts)> = (0..indices.len() / 3)
             .map(|t| (t, self.positions(vertices, indices, t)))
