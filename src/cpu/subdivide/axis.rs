@@ -379,8 +379,8 @@ pub fn edge_crossings(a: Node, b: Node, rho: f32, cuts: AxisCuts) -> Vec<Node> {
     out
 }
 
-/// The parts of a triangle that asks for no cuts (corners `p`, snapped) whose edges marked in
-/// `shared` it shares with triangles that do: cut only at those edges' [`edge_crossings`], so
+/// The parts of a triangle that is not cut by all cuts (corners `p`, snapped) whose edges marked
+/// in `shared` are cut triangles' edges too: cut only at those edges' [`edge_crossings`], so
 /// that its neighbours' points are its corners too. With crossings on one edge, the fan from the
 /// opposite corner; on more, the fan from the centroid over the whole boundary; with none, the
 /// triangle. `plan_edge_split` in the WGSL.
