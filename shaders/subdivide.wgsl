@@ -906,7 +906,7 @@ fn edge_marks_now(t: u32) -> vec3<u32> {
     var marks: vec3<u32>;
     for (var e = 0u; e < 3u; e++) {
         let id = triangle_edges[3u * t + e];
-        marks[e] = (atomicLoad(&cut_edges[id / 16u]) >> (2u * (id % 16u))) & 3u;
+        marks[e] = mark_in(atomicLoad(&cut_edges[id / 16u]), id);
     }
     return marks;
 }
@@ -915,9 +915,14 @@ fn edge_marks(t: u32) -> vec3<u32> {
     var marks: vec3<u32>;
     for (var e = 0u; e < 3u; e++) {
         let id = triangle_edges[3u * t + e];
-        marks[e] = (edge_marks_read[id / 16u] >> (2u * (id % 16u))) & 3u;
+        marks[e] = mark_in(edge_marks_read[id / 16u], id);
     }
     return marks;
+}
+
+// Edge id's two bits in its word of `cut_edges`.
+fn mark_in(word: u32, id: u32) -> u32 {
+    return (word >> (2u * (id % 16u))) & 3u;
 }
 
 // Sets marks on triangle t's three edges.

@@ -144,6 +144,19 @@ const MATERIAL_TABLE: [Binding; 8] = [
     bind(1, 7, "shadow_depths", Storage),
 ];
 
+/// What `plan` and `plan_cuts` read and write (both plan parts and append pieces).
+const PLANNING: &[&str] = &[
+    "params",
+    "vertices",
+    "indices",
+    "pieces",
+    "counters",
+    "object_edge_scale",
+    "cut_list",
+    "triangle_edges",
+    "edge_marks_read",
+];
+
 pub const SUBDIVIDE: Stage = Stage {
     name: "subdivide",
     source: include_str!("../../shaders/subdivide.wgsl"),
@@ -151,35 +164,9 @@ pub const SUBDIVIDE: Stage = Stage {
     entry_points: &[
         entry("active_cuts", &["params", "vertices", "indices", "counters", "triangle_edges", "cut_edges"]),
         entry("ring_cuts", &["params", "vertices", "indices", "triangle_edges", "cut_edges"]),
-        entry(
-            "plan",
-            &[
-                "params",
-                "vertices",
-                "indices",
-                "pieces",
-                "counters",
-                "object_edge_scale",
-                "cut_list",
-                "triangle_edges",
-                "edge_marks_read",
-            ],
-        ),
+        entry("plan", PLANNING),
         entry("plan_cuts_args", &["counters", "lattice_dispatch", "cut_list"]),
-        entry(
-            "plan_cuts",
-            &[
-                "params",
-                "vertices",
-                "indices",
-                "pieces",
-                "counters",
-                "object_edge_scale",
-                "cut_list",
-                "triangle_edges",
-                "edge_marks_read",
-            ],
-        ),
+        entry("plan_cuts", PLANNING),
         entry("lattice_args", &["params", "counters", "lattice_dispatch"]),
         entry(
             "lattice",
