@@ -1482,7 +1482,7 @@ fn plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
     // Triangles cut by all of the frame's cuts (a floor around the viewer and its neighbours)
     // make many parts; listed apart (at the back), they share SIMD lanes with each other rather
-    // than stall lanes of the triangles listed for their shared edges (Sponza: 288 + 128 and 108).
+    // than stall lanes of the triangles listed for their shared edges.
     let len = arrayLength(&cut_list);
     if (full) {
         let slot = atomicAdd(&counters.cut_wide, 1u);

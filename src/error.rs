@@ -1,12 +1,19 @@
 //! The one error type of the library. Every variant reads as one line that names what was
-//! wrong — the option, the file, or the device — and the problem.
+//! wrong — the setting (or, from the command line, the option), the file, or the device — and
+//! the problem.
 
 use std::path::PathBuf;
 
 /// What went wrong.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
-    /// A setting (a command-line option) has a value twister cannot use.
+    /// A setting has a value twister cannot use: `setting` names the field of the settings the
+    /// library was given (e.g. `view.projection.eye_radius` of `RenderSettings`, `lod.p2`), or the
+    /// input it was handed (`environment`, `fit`).
+    #[error("{setting}: {message}")]
+    Setting { setting: &'static str, message: String },
+    /// A command-line option has a value twister cannot use (the command line names its flags;
+    /// it turns a [`Error::Setting`] into this, naming the flag that sets the field).
     #[error("{option}: {message}")]
     Option { option: &'static str, message: String },
     /// A scene — a file, a file it names, or a built-in — is unreadable or invalid.
@@ -30,6 +37,10 @@ pub enum Error {
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 impl Error {
+    pub fn setting(setting: &'static str, message: impl Into<String>) -> Error {
+        Error::Setting { setting, message: message.into() }
+    }
+
     pub fn option(option: &'static str, message: impl Into<String>) -> Error {
         Error::Option { option, message: message.into() }
     }

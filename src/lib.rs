@@ -1,11 +1,12 @@
 //! twister: a GPU rasterizer for omnidirectional stereo — the pair of concentric-mosaic
 //! panoramas (one per eye) that the TWISTER display shows around its viewer (seed 002).
 //!
-//! Layers, bottom up (a layer imports only the layers above it in this list; `core`, `shader`
-//! and `cpu` never import wgpu):
+//! Layers, bottom up (a layer imports only the layers above it in this list; `cpu` and `gpu`
+//! stand side by side and never import each other; only `gpu` imports wgpu):
 //! - [`core`]: the projection, scenes and their loaders, materials, level of detail, settings;
-//! - [`shader`]: the WGSL side's interface: sources composed by `#import`, one descriptor per
-//!   stage (its bindings), the plain-old-data structs and constants shared with WGSL;
+//! - [`encoding`]: what both engines agree on: the plain-old-data structs and constants shared
+//!   with WGSL, each stage's parameters and tables built from the settings, the stages' outputs;
+//! - [`shader`]: the WGSL sources composed by `#import`, one descriptor per stage (its bindings);
 //! - [`cpu`]: one CPU twin per GPU stage, named like its WGSL file (the test oracles);
 //! - [`gpu`]: the wgpu device, stage pipelines, targets, the frame plan and the renderer;
 //! - [`output`]: image layouts and all-or-nothing file writing.
@@ -17,6 +18,7 @@
 
 pub mod core;
 pub mod cpu;
+pub mod encoding;
 pub mod error;
 pub mod gpu;
 pub mod output;

@@ -24,6 +24,9 @@ fn asset_scene(relative: &str) -> Scene {
 /// ½·v₀ + ⅛·Δt·b₀ + ½·v₁ − ⅛·Δt·a₁ (CUBICSPLINE).
 #[test]
 fn interpolation_test_poses_at_hand_computed_values() {
+    if !common::assets_present() {
+        return;
+    }
     let scene = asset_scene("gltf/InterpolationTest/glTF-Binary/InterpolationTest.glb");
     let rig = scene.rig.as_ref().expect("an animated file has a rig");
     let mut seen = Vec::new();
@@ -108,6 +111,9 @@ fn object_box(frame: &twister::Frame, object: u32) -> Option<(Vec2, Vec2)> {
 /// are drawn, and the stage's twin gives the CPU pose's vertices.
 #[test]
 fn a_skinned_pose_is_drawn_where_the_cpu_evaluation_puts_it() {
+    if !common::assets_present() {
+        return;
+    }
     let r = common::renderer();
     for (file, t) in
         [("gltf/RiggedSimple/glTF-Binary/RiggedSimple.glb", 1.0), ("gltf/CesiumMan/glTF-Binary/CesiumMan.glb", 0.5)]
@@ -194,6 +200,9 @@ fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
 /// give the same bytes as one run; a run killed mid-way leaves only whole frames.
 #[test]
 fn sequences_are_numbered_resumable_shardable_and_atomic() {
+    if !common::assets_present() {
+        return;
+    }
     let root = common::TempDir::new(format!("twister-seq-{}", std::process::id()));
     let all = root.join("all");
     let stats = root.join("stats.jsonl");
@@ -252,6 +261,9 @@ fn sequences_are_numbered_resumable_shardable_and_atomic() {
 /// The Slurm job-array example renders, task by task, the same frames as one run.
 #[test]
 fn the_slurm_example_shards_a_sequence() {
+    if !common::assets_present() {
+        return;
+    }
     let root = common::TempDir::new(format!("twister-slurm-{}", std::process::id()));
     let scene = common::asset("gltf/AnimatedCube/glTF/AnimatedCube.gltf");
     let bin = Path::new(env!("CARGO_BIN_EXE_twister")).parent().unwrap().to_path_buf();
@@ -285,6 +297,9 @@ fn the_slurm_example_shards_a_sequence() {
 /// (scripts/test.sh installs ffmpeg where it is missing.)
 #[test]
 fn a_video_carries_the_spherical_metadata() {
+    if !common::assets_present() {
+        return;
+    }
     use twister::video::{find_boxes, with_spherical_metadata, StereoMode};
     let root = common::TempDir::new(format!("twister-video-{}", std::process::id()));
     let video = root.join("cube.mp4");
@@ -351,6 +366,9 @@ fn a_video_carries_the_spherical_metadata() {
 /// `--frames` are one line each.
 #[test]
 fn sequence_options_are_checked() {
+    if !common::assets_present() {
+        return;
+    }
     let scene = common::asset("gltf/AnimatedCube/glTF/AnimatedCube.gltf");
     for (args, want) in [
         (vec!["--resume"], "--resume"),

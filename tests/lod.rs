@@ -10,8 +10,8 @@ use twister::core::lod::{LodChain, LodParams, NO_SPLIT};
 use twister::core::projection::Projection;
 use twister::core::settings::Method;
 use twister::core::visual_field::{Field, Gaze};
-use twister::cpu::subdivide::subdivide_params;
 use twister::cpu::subdivide::Subdivider;
+use twister::encoding::subdivide::subdivide_params;
 use twister::{GpuScene, RenderSettings, Scene};
 
 /// Twelve 1024-triangle spheres 3 m around the viewer every 30°.
@@ -50,7 +50,7 @@ fn the_subdivision_follows_each_objects_level_as_the_cpu_twin_does() {
     assert_eq!(gpu.pieces, cpu.pieces);
     // Per object: outside the field nothing is split (vertex method); central objects are split
     // as without the level of detail.
-    let count = |out: &[twister::shader::types::DrawVertex], o: u32| out.iter().filter(|v| v.object == o).count() / 3;
+    let count = |out: &[twister::encoding::types::DrawVertex], o: u32| out.iter().filter(|v| v.object == o).count() / 3;
     let full = Subdivider::new(&params).run(&drawn.vertices, &drawn.indices);
     let vertex = Subdivider::new(&subdivide_params(&s.with_method(Method::Vertex), 0, params.triangle_count))
         .run(&drawn.vertices, &drawn.indices);

@@ -168,7 +168,7 @@ fn scene_too_big_for_the_memory_budget_is_drawn_in_chunks_without_loss() {
         (Projection { width: 256, height: 256, ..Projection::default() }, 2.5, true),
     ] {
         let roomy = RenderSettings::new(projection).with_method(Method::Adaptive(Split::Length)).with_edge_px(edge_px);
-        let params = twister::cpu::subdivide::subdivide_params(&roomy, 0, scene.triangle_count() as u32);
+        let params = twister::encoding::subdivide::subdivide_params(&roomy, 0, scene.triangle_count() as u32);
         let cuts = twister::cpu::subdivide::Subdivider::new(&params).active_cuts(&scene.vertices, &scene.indices).axis;
         assert_eq!(cuts != 0, cut, "{projection:?}: cuts {cuts:#x}");
         let tight = roomy.with_memory_mb(8);

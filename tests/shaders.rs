@@ -1,12 +1,12 @@
 //! The WGSL side against the Rust side, with naga: every stage of the registry composes and
 //! validates (both error-target variants); every file in shaders/ is used; each stage's
 //! declared bindings are exactly its descriptor's; and every struct a stage binds is laid out
-//! exactly as its Rust twin in `shader::types::LAYOUTS`, field offset by field offset.
+//! exactly as its Rust twin in `encoding::types::LAYOUTS`, field offset by field offset.
 
 use std::collections::BTreeSet;
 
 use naga::{AddressSpace, StorageAccess, TypeInner};
-use twister::shader::types::{StructLayout, LAYOUTS};
+use twister::encoding::types::{StructLayout, LAYOUTS};
 use twister::shader::{compose, imports, BindingKind, ShaderOptions, Stage, SHARED, STAGES};
 
 fn parse(name: &str, source: &str) -> naga::Module {
@@ -190,7 +190,7 @@ fn the_layout_check_catches_a_moved_field() {
 
 #[test]
 fn generated_constants_are_what_the_rust_side_says() {
-    use twister::shader::constants::{all, Value};
+    use twister::encoding::constants::{all, Value};
     let module = parse("subdivide", &compose(&twister::shader::SUBDIVIDE, ShaderOptions::ALL[0]));
     for (name, value) in all() {
         let (_, c) = module

@@ -162,13 +162,13 @@ fn an_alpha_masked_screen_casts_the_shadow_of_its_opaque_cells() {
     }
 }
 
-/// `--shadow-map-size` takes multiples of 64 from 64 to 8192; anything else is one line naming
-/// the option.
+/// The shadow maps' size takes multiples of 64 from 64 to 8192; anything else is one line naming
+/// the setting (the library names fields, not command-line flags).
 #[test]
 fn the_shadow_map_size_is_checked() {
     for bad in [0, 100, 65, 16384] {
         let e = RenderSettings::new(exact(64, 32)).with_shadow_map_size(bad).validate().unwrap_err().to_string();
-        assert!(e.contains("--shadow-map-size") && e.contains(&bad.to_string()) && !e.contains('\n'), "{e}");
+        assert!(e.contains("shading.shadow_map_size") && e.contains(&bad.to_string()) && !e.contains('\n'), "{e}");
     }
     RenderSettings::new(exact(64, 32)).with_shadow_map_size(64).validate().unwrap();
 }

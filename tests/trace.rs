@@ -87,6 +87,9 @@ fn trace_shows_the_surfaces_of_slit_1_on_the_demo_room() {
 
 #[test]
 fn trace_shows_the_surfaces_of_slit_1_on_the_bunny_and_a_ring_of_cows() {
+    if !common::assets_present() {
+        return;
+    }
     let p = exact(480, 120);
     let mut bunny =
         load_scene(common::asset("stanford-bunny/bun_zipper_res2.obj").to_str().unwrap(), &p).expect("bunny");
@@ -117,7 +120,7 @@ fn trace_refuses_the_paper_model_and_a_scene_without_its_bvh() {
     let gs = GpuScene::upload(&r.gpu, &scene).unwrap();
     let error = |s: &RenderSettings, g: &GpuScene| r.render(g, s).err().expect("an error").to_string();
     let e = error(&paper.with_method(Method::Trace), &gs);
-    assert!(e.contains("--vertical exact"), "{e}");
+    assert!(e.contains("view.projection.vertical") && !e.contains("--"), "{e}");
     let e = error(&RenderSettings::new(exact(64, 16)).with_method(Method::Trace), &gs);
     assert!(e.contains("BVH"), "{e}");
     // The sphere has a ray per pixel in either vertical model.
@@ -405,6 +408,9 @@ fn visual_field_lod_leaves_rays_outside_the_field_untraced_and_the_rest_as_witho
 /// `closest_hit_meets_each_object_at_the_level_eq_10_picks`.)
 #[test]
 fn per_ray_polygon_levels_keep_the_central_field_and_coarsen_the_periphery_within_the_chain_error() {
+    if !common::assets_present() {
+        return;
+    }
     use twister::core::bvh::SceneBvh;
     use twister::core::lod::LodChain;
     use twister::core::visual_field::{Field, Gaze};
@@ -479,6 +485,9 @@ fn per_ray_polygon_levels_keep_the_central_field_and_coarsen_the_periphery_withi
 /// 2 px as 2 px off.
 #[test]
 fn the_error_measured_on_the_traced_image_agrees_with_the_analytic_error() {
+    if !common::assets_present() {
+        return;
+    }
     use twister::core::compare::compare;
     use twister::core::settings::Split;
     let p = exact(480, 120);

@@ -47,9 +47,10 @@ pub struct ViewArgs {
     /// d_e: radius of the circle the eyes move on, metres.
     #[arg(long, default_value_t = 0.032)]
     pub eye_radius: f32,
-    /// Vertical model: paper (v = R_T·y/r) or exact (pinhole on the eye circle).
-    #[arg(long, value_enum, default_value_t = Vertical::Paper)]
-    pub vertical: Vertical,
+    /// Vertical model: paper (v = R_T·y/r) or exact (pinhole on the eye circle) [default: paper;
+    /// exact when `trace` draws the cylinder, since the paper's model has no ray per pixel].
+    #[arg(long, value_enum)]
+    pub vertical: Option<Vertical>,
     /// Viewer: a position x,y,z in scene units, or camera[:N] for the file's N-th camera (default 0;
     /// its position and yaw, plus --yaw).
     #[arg(long, value_parser = parse_viewer, default_value = "0,0,0", allow_hyphen_values = true)]
@@ -259,9 +260,9 @@ pub fn parse_rgb(s: &str) -> std::result::Result<[f32; 3], String> {
 }
 
 impl ViewArgs {
-    /// The render settings these options give (the viewer of `camera[:N]` is placed with the
-    /// scene, by `cli::scene::prepare`).
-    pub fn settings(&self) -> Result<RenderSettings> {
+    /// The render settings these options give for a command that draws with `methods` (the
+    /// viewer of `camera[:N]` is placed with the scene, by `cli::scene::prepare`).
+    pub fn settings(&self, methods: &[Method]) -> Result<RenderSettings> {
         let panorama = match (self.panorama, self.preset) {
             (Some(PanoramaKind::Cylinder), Some(_)) => {
                 return Err(Error::option("--preset", "sizes the full sphere: use it with --panorama equirect"))
@@ -291,7 +292,7 @@ impl ViewArgs {
             eye_radius: self.eye_radius,
             width,
             height,
-            vertical: self.vertical,
+            vertical: self.vertical_for(panorama, methods),
             panorama,
             convergence: self.convergence.and_then(|c| c.0),
             pole_merge: self.pole_merge.map_or(Some(DEFAULT_POLE_MERGE), |p| p.0),
@@ -332,7 +333,23 @@ impl ViewArgs {
         Ok(settings)
     }
 
-    /// `--light` is refused unless one of `methods` traces rays (it would do nothing).
+    /// The vertical model: as given, else the paper's, except where `trace` draws the cylinder:
+    /// the paper's model (v = R_T·y/r) has no ray per pixel, so the exact one is used and a
+    /// `note:` line says so.
+    fn vertical_for(&self, panorama: PanoramaKind, methods: &[Method]) -> Vertical {
+        match self.vertical {
+            Some(vertical) => vertical,
+            None if panorama == PanoramaKind::Cylinder && methods.contains(&Method::Trace) => {
+                eprintln!(
+                    "note: trace follows each pixel's ray, which the paper's vertical model (v = R_T·y/r) does not \
+                     have: the cylinder is drawn with --vertical exact"
+                );
+                Vertical::Exact
+            }
+            None => Vertical::Paper,
+        }
+    }
+
     /// The environment that lights the scene (see `--environment`), prepared.
     pub fn environment(&self, scene: &twister::Scene) -> Result<Option<PreparedEnvironment>> {
         use twister::core::environment::Environment;
@@ -360,6 +377,7 @@ impl ViewArgs {
         })
     }
 
+    /// `--light` is refused unless one of `methods` traces rays (it would do nothing).
     pub fn check_light(&self, methods: &[Method]) -> Result<()> {
         if self.light.is_some() && !methods.contains(&Method::Trace) {
             return Err(Error::option("--light", "lights the ray tracer: use it with --method trace"));

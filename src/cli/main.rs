@@ -5,6 +5,7 @@
 
 mod args;
 mod bench;
+mod flags;
 mod heatmap;
 mod info;
 mod measure;
@@ -69,7 +70,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}", flags::for_user(e));
             ExitCode::FAILURE
         }
     }

@@ -47,9 +47,10 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
     }
     // With --against, both frames also measure depth (the distance differences); against the ray
     // tracer, also the surface points (where the traced image shows what was drawn).
+    let drawn: Vec<Method> = std::iter::once(args.view.method).chain(args.against).collect();
     let mut settings = args
         .view
-        .settings()?
+        .settings(&drawn)?
         .with_measure_error(true)
         .with_depth(args.against.is_some())
         .with_positions(args.against == Some(Method::Trace));

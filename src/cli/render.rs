@@ -98,7 +98,7 @@ pub struct RenderArgs {
 }
 
 pub fn render(args: &RenderArgs) -> Result<()> {
-    let mut settings = args.view.settings()?;
+    let mut settings = args.view.settings(&[args.view.method])?;
     settings.shading.background = args.background;
     if let Some(frames) = args.frames {
         return crate::sequence::render_sequence(args, frames, settings);

@@ -123,7 +123,7 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32), mut setting
             return Err(Error::option("--viewer-path", "moves the viewer itself: leave out --viewer camera"))
         }
         Some(path) => {
-            Some(twister::core::timeline::Timeline::read(path, "--viewer-path", (3, 4), "time,x,y,z[,yaw]", |v| {
+            Some(twister::core::timeline::Timeline::read(path, "viewer_path", (3, 4), "time,x,y,z[,yaw]", |v| {
                 let max = twister::core::scene::MAX_COORDINATE;
                 (v[..3].iter().any(|c| c.abs() > max)).then(|| format!("coordinates within ±{max:e}"))
             })?)

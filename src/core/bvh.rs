@@ -102,7 +102,7 @@ impl SceneBvh {
     /// indices into `vertices` per triangle, level 0 the original, each level coarser than the
     /// one before, as `LodChain::levels`). The objects with one level only share one tree (a
     /// top level over objects whose boxes overlap, as in an atrium, costs rays up to twice the
-    /// time of one tree over all their triangles: measured on Sponza); each object with a chain
+    /// time of one tree over all their triangles); each object with a chain
     /// gets a tree per level, and then one more tree over every object's original serves the
     /// rays that meet the originals everywhere (level 1: the central field), at plain tracing's
     /// speed ([`SceneBvh::original_root`]). Objects without triangles are left out; an empty

@@ -111,7 +111,7 @@ impl Environment {
     /// Reads an equirectangular radiance map: Radiance RGBE (`.hdr`) or OpenEXR (`.exr`).
     pub fn load(path: &Path) -> Result<Environment> {
         let name = path.display().to_string();
-        let bad = |m: String| Error::option("--environment", format!("{name}: {m}"));
+        let bad = |m: String| Error::setting("environment", format!("{name}: {m}"));
         let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
         let (width, height, radiance) = match ext.as_str() {
             "hdr" => {

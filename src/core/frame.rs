@@ -2,7 +2,6 @@
 //! error pass measured.
 
 use crate::core::projection::Eye;
-use crate::shader::types::ErrorStats;
 
 /// One eye's image, tightly packed RGBA8 rows, top row first.
 #[derive(Clone, Debug)]
@@ -122,4 +121,20 @@ impl Frame {
             Eye::Right => &self.right,
         }
     }
+}
+
+/// The display-position error's statistics over a frame's pixels (`ErrorStats` in
+/// shaders/reduce_error.wgsl, which computes them; laid out as WGSL reads it).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable, serde::Serialize)]
+pub struct ErrorStats {
+    pub count: u32,
+    pub mean: f32,
+    pub std_dev: f32,
+    pub p50: f32,
+    pub p90: f32,
+    pub p99: f32,
+    pub max: f32,
+    #[serde(skip)]
+    pub _pad: f32,
 }

@@ -66,14 +66,14 @@ impl LodParams {
     pub fn validate(&self) -> crate::error::Result<()> {
         use crate::error::Error;
         if !(self.p3 > 0.0 && self.p3 <= self.p2 && self.p2 <= 1.0) {
-            return Err(Error::option(
-                "--lod-p2/--lod-p3",
+            return Err(Error::setting(
+                "lod.p2/p3",
                 format!("need 0 < P3 ≤ P2' ≤ 1, got P2' = {} and P3 = {}", self.p2, self.p3),
             ));
         }
         if !(self.d_inf > 0.0 && self.d_inf.is_finite()) {
-            return Err(Error::option(
-                "--lod-dinf",
+            return Err(Error::setting(
+                "lod.d_inf",
                 format!("must be a positive distance in metres, got {}", self.d_inf),
             ));
         }

@@ -3,6 +3,7 @@
 //! of detail (seeds 000/001), render settings and the frames a renderer returns.
 
 pub mod animation;
+pub mod assets;
 pub mod builtin;
 pub mod bvh;
 pub mod color;

@@ -30,7 +30,7 @@
 //!
 //! The WGSL twin of this module is `shaders/shared/projection.wgsl`; both must stay in step.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use crate::error::{Error, Result};
 
@@ -148,21 +148,21 @@ pub fn horizontal_radius(p: Vec3) -> f32 {
 impl Projection {
     pub fn validate(&self) -> Result<()> {
         if !(self.screen_radius.is_finite() && self.screen_radius > 0.0) {
-            return Err(Error::option(
-                "--screen-radius",
+            return Err(Error::setting(
+                "view.projection.screen_radius",
                 format!("must be a positive number of metres, got {}", self.screen_radius),
             ));
         }
         if !(self.eye_radius >= 0.0 && self.eye_radius < self.screen_radius) {
-            return Err(Error::option(
-                "--eye-radius",
+            return Err(Error::setting(
+                "view.projection.eye_radius",
                 format!("must be in [0, screen radius {}), got {}", self.screen_radius, self.eye_radius),
             ));
         }
         if let Some(c) = self.convergence {
             if !(c.is_finite() && c > self.eye_radius) {
-                return Err(Error::option(
-                    "--convergence",
+                return Err(Error::setting(
+                    "view.projection.convergence",
                     format!(
                         "must be `parallel` or a distance in metres beyond the eye radius {}, got {c}",
                         self.eye_radius
@@ -172,15 +172,15 @@ impl Projection {
         }
         if let Some((from, to)) = self.pole_merge {
             if !(from.is_finite() && to.is_finite() && 0.0 <= from && from < to && to <= 90.0) {
-                return Err(Error::option(
-                    "--pole-merge",
+                return Err(Error::setting(
+                    "view.projection.pole_merge",
                     format!("must be `off` or FROM,TO degrees with 0 ≤ FROM < TO ≤ 90, got {from},{to}"),
                 ));
             }
         }
         if self.width < 2 || self.height < 2 || self.width > 16384 || self.height > 16384 {
-            return Err(Error::option(
-                "--width/--height",
+            return Err(Error::setting(
+                "view.projection.width/height",
                 format!("image size must be between 2 and 16384 pixels per side, got {}x{}", self.width, self.height),
             ));
         }
@@ -398,6 +398,45 @@ impl Panorama for Projection {
         };
         Vec3::new(r * theta.sin(), height, -r * theta.cos())
     }
+}
+
+/// The ray of the pixel at `frag_xy`: its eye point and unit direction. The sphere: the
+/// pixel's ray ([`Projection::sphere_ray`]). The cylinder: from the eye whose tangent ray meets
+/// the screen at the pixel's column (viewing direction φ = u − s·asin(d_e/R_T), as the slit
+/// cameras) through the pixel's screen point (R_T sin u, v, −R_T cos u) — the exact vertical
+/// model's ray; the paper model has no single ray per pixel and uses the same.
+pub fn pixel_ray(projection: &Projection, eye: Eye, frag_xy: Vec2) -> (Vec3, Vec3) {
+    let (u, v) = projection.pixel_to_screen(frag_xy.x - 0.5, frag_xy.y - 0.5);
+    match projection.panorama {
+        PanoramaKind::Equirect => projection.sphere_ray(u, v, eye),
+        PanoramaKind::Cylinder => {
+            let (rt, de) = (projection.screen_radius, projection.eye_radius);
+            let phi = u - eye.sign() * (de / rt).asin();
+            let origin = eye.sign() * de * Vec3::new(phi.cos(), 0.0, phi.sin());
+            let screen = Vec3::new(rt * u.sin(), v, -rt * u.cos());
+            (origin, (screen - origin).normalize())
+        }
+    }
+}
+
+/// The points the pixels' rays meet at `distances` (per eye, +∞: none → NaN), viewer frame:
+/// a traced frame's surface points (`Frame::positions`).
+pub fn ray_hit_points(projection: &Projection, distances: &[Vec<f32>; 2]) -> [Vec<[f32; 3]>; 2] {
+    std::array::from_fn(|k| {
+        let eye = Eye::BOTH[k];
+        distances[k]
+            .iter()
+            .enumerate()
+            .map(|(i, &t)| {
+                if !t.is_finite() {
+                    return [f32::NAN; 3];
+                }
+                let (x, y) = ((i as u32 % projection.width) as f32 + 0.5, (i as u32 / projection.width) as f32 + 0.5);
+                let (o, d) = pixel_ray(projection, eye, Vec2::new(x, y));
+                (o + t * d).to_array()
+            })
+            .collect()
+    })
 }
 
 #[cfg(test)]

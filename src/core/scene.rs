@@ -187,7 +187,7 @@ impl Scene {
         for (k, v) in self.vertices.iter().enumerate() {
             if let Some(c) = v.position.iter().find(|c| c.abs() > MAX_COORDINATE) {
                 return Err(err(format!(
-                    "vertex {k} lies {c:e} from the origin; twister draws coordinates within ±{MAX_COORDINATE:e} (a wrong unit or --scale?)"
+                    "vertex {k} lies {c:e} from the origin; twister draws coordinates within ±{MAX_COORDINATE:e} (a wrong unit or scale?)"
                 )));
             }
             let attributes: [(&str, &[f32]); 4] =
@@ -280,11 +280,11 @@ impl Scene {
     /// straight ahead, centred on the eye height, its front face filling the screen height
     /// (v = R_T·y/r at the front).
     pub fn fit(&mut self, distance: f32, projection: &Projection) -> Result<()> {
-        let (lo, hi) = self.bounds().ok_or_else(|| Error::option("--fit", "needs a scene with triangles"))?;
+        let (lo, hi) = self.bounds().ok_or_else(|| Error::setting("fit", "needs a scene with triangles"))?;
         let size = hi - lo;
         if !(size.y > 0.0) || !(distance > projection.eye_radius) || !distance.is_finite() {
-            return Err(Error::option(
-                "--fit",
+            return Err(Error::setting(
+                "fit",
                 format!("needs a scene with height and a finite distance beyond the eye circle, got {distance}"),
             ));
         }

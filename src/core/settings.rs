@@ -414,28 +414,31 @@ impl RenderSettings {
         self.view.projection.validate()?;
         let max = crate::core::scene::MAX_COORDINATE;
         if !self.view.viewer.is_finite() || self.view.viewer.abs().max_element() > max {
-            return Err(Error::option("--viewer", format!("must lie within ±{max:e}, got {}", self.view.viewer)));
+            return Err(Error::setting("view.viewer", format!("must lie within ±{max:e}, got {}", self.view.viewer)));
         }
         if !self.view.yaw_deg.is_finite() {
-            return Err(Error::option("--yaw", "must be a finite number of degrees"));
+            return Err(Error::setting("view.yaw_deg", "must be a finite number of degrees"));
         }
         let s = &self.subdivision;
         if !(s.edge_px.is_finite() && s.edge_px >= 0.25) {
-            return Err(Error::option("--edge-px", format!("must be a number of pixels ≥ 0.25, got {}", s.edge_px)));
+            return Err(Error::setting(
+                "subdivision.edge_px",
+                format!("must be a number of pixels ≥ 0.25, got {}", s.edge_px),
+            ));
         }
         if !(s.max_error_px.is_finite() && s.max_error_px >= 0.01) {
-            return Err(Error::option(
-                "--max-error-px",
+            return Err(Error::setting(
+                "subdivision.max_error_px",
                 format!("must be a number of pixels ≥ 0.01, got {}", s.max_error_px),
             ));
         }
         if !(1..=64).contains(&s.max_div) {
-            return Err(Error::option("--max-div", format!("must be between 1 and 64, got {}", s.max_div)));
+            return Err(Error::setting("subdivision.max_div", format!("must be between 1 and 64, got {}", s.max_div)));
         }
         if let Method::Slit(w) = s.method {
             if w > self.view.projection.width {
-                return Err(Error::option(
-                    "--method",
+                return Err(Error::setting(
+                    "subdivision.method",
                     format!("slit:{w} is wider than the image ({} columns)", self.view.projection.width),
                 ));
             }
@@ -444,45 +447,45 @@ impl RenderSettings {
             && self.view.projection.panorama == PanoramaKind::Cylinder
             && self.view.projection.vertical == Vertical::Paper
         {
-            return Err(Error::option(
-                "--method",
+            return Err(Error::setting(
+                "view.projection.vertical",
                 "trace follows each pixel's ray, and the paper's vertical model (v = R_T·y/r) has none \
-                 (the points it shows at a pixel lie on a curve): use --vertical exact",
+                 (the points it shows at a pixel lie on a curve): use the exact model",
             ));
         }
         if !(self.shading.exposure_ev.is_finite() && self.shading.exposure_ev.abs() <= 64.0) {
-            return Err(Error::option(
-                "--exposure",
+            return Err(Error::setting(
+                "shading.exposure_ev",
                 format!("must be a number of stops between −64 and 64, got {}", self.shading.exposure_ev),
             ));
         }
         if !(self.shading.environment_yaw_deg.is_finite() && self.shading.environment_yaw_deg.abs() <= 3600.0) {
-            return Err(Error::option(
-                "--environment-yaw",
+            return Err(Error::setting(
+                "shading.environment_yaw_deg",
                 format!("must be a number of degrees between −3600 and 3600, got {}", self.shading.environment_yaw_deg),
             ));
         }
         if self.shading.reflect_max > MAX_REFLECT {
-            return Err(Error::option(
-                "--reflect-max",
+            return Err(Error::setting(
+                "shading.reflect_max",
                 format!("must be between 0 and {MAX_REFLECT}, got {}", self.shading.reflect_max),
             ));
         }
         if let Some(light) = self.shading.light {
             let max = crate::core::scene::MAX_COORDINATE;
             if !light.is_finite() || light.abs().max_element() > max {
-                return Err(Error::option("--light", format!("must lie within ±{max:e}, got {light}")));
+                return Err(Error::setting("shading.light", format!("must lie within ±{max:e}, got {light}")));
             }
         }
         let size = self.shading.shadow_map_size;
         if !(64..=MAX_SHADOW_MAP_SIZE).contains(&size) || size % 64 != 0 {
-            return Err(Error::option(
-                "--shadow-map-size",
+            return Err(Error::setting(
+                "shading.shadow_map_size",
                 format!("must be a multiple of 64 between 64 and {MAX_SHADOW_MAP_SIZE}, got {size}"),
             ));
         }
         if s.memory_mb < 8 {
-            return Err(Error::option("--memory-mb", format!("must be at least 8, got {}", s.memory_mb)));
+            return Err(Error::setting("subdivision.memory_mb", format!("must be at least 8, got {}", s.memory_mb)));
         }
         Ok(())
     }

@@ -14,18 +14,18 @@ pub struct Timeline {
 }
 
 impl Timeline {
-    /// Reads `path` for `option` (named in errors): rows of a time and `min..=max` further
+    /// Reads `path` for `setting` (named in errors): rows of a time and `min..=max` further
     /// numbers (all rows as many), `#` comments, a header row of names skipped; `check` says
     /// what is wrong with a row's numbers, if anything. One line naming the file and the row
     /// otherwise.
     pub fn read(
         path: &Path,
-        option: &'static str,
+        setting: &'static str,
         (min, max): (usize, usize),
         what: &str,
         check: impl Fn(&[f32]) -> Option<String>,
     ) -> Result<Timeline> {
-        let bad = |m: String| Error::option(option, format!("{}: {m}", path.display()));
+        let bad = |m: String| Error::setting(setting, format!("{}: {m}", path.display()));
         let size = std::fs::metadata(path).map_err(|e| bad(e.to_string()))?.len();
         if size > 64 << 20 {
             return Err(bad("larger than 64 MiB".into()));

@@ -54,7 +54,7 @@ impl GazePath {
     /// Reads a CSV of `time,yaw,pitch` rows; one line naming the file and row otherwise.
     pub fn read(path: &std::path::Path) -> crate::error::Result<GazePath> {
         let check = |v: &[f32]| (v[1].abs() > 89.0).then(|| "pitch within ±89".to_string());
-        crate::core::timeline::Timeline::read(path, "--gaze-path", (2, 2), "time,yaw,pitch", check).map(GazePath)
+        crate::core::timeline::Timeline::read(path, "gaze_path", (2, 2), "time,yaw,pitch", check).map(GazePath)
     }
 
     /// The gaze at time t.

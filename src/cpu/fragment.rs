@@ -6,10 +6,12 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::core::color::{linear_to_srgb, srgb_to_linear};
+pub use crate::core::color::display_bytes;
+use crate::core::color::srgb_to_linear;
 use crate::core::environment::{ENV_LEVELS, LUT_SIZE};
 use crate::core::light::{tonemap, GpuLight, LightKind, NO_SHADOW_MAP};
 use crate::core::material::{AlphaMode, Filter, Material, MipLevel, Mipmap, Wrap, NO_TEXTURE};
+pub use crate::core::projection::pixel_ray;
 use crate::core::projection::{Eye, PanoramaKind, Projection};
 use crate::core::shadow::{
     cube_face, shadow_coordinates, LIGHT_OFFSET_TEXELS, NORMAL_OFFSET_TEXELS, SHADOW_CUBE, SHADOW_ORTHOGRAPHIC,
@@ -20,12 +22,6 @@ use crate::core::texture::MaterialTable;
 /// sRGB-encoded RGBA8 (the colour target holds display values).
 pub fn shade(ambient: f32, view_position: Vec3, normal: Vec3, color: Vec4) -> [u8; 4] {
     display_bytes(shade_linear(ambient, view_position, normal, color))
-}
-
-/// A linear colour in [0, 1] as the sRGB colour target stores it.
-pub fn display_bytes(c: Vec3) -> [u8; 4] {
-    let q = |x: f32| (linear_to_srgb(x.clamp(0.0, 1.0)) * 255.0 + 0.5).floor() as u8;
-    [q(c.x), q(c.y), q(c.z), 255]
 }
 
 /// The same in linear light, each channel clamped to [0, 1] (`shade` in surface.wgsl).
@@ -420,25 +416,6 @@ pub fn pixel_error(projection: &Projection, eye: Eye, p: Vec3, frag_xy: Vec2, an
     }
 }
 
-/// The ray of the pixel at `frag_xy`: its eye point and unit direction. The sphere: the
-/// pixel's ray ([`Projection::sphere_ray`]). The cylinder: from the eye whose tangent ray meets
-/// the screen at the pixel's column (viewing direction φ = u − s·asin(d_e/R_T), as the slit
-/// cameras) through the pixel's screen point (R_T sin u, v, −R_T cos u) — the exact vertical
-/// model's ray; the paper model has no single ray per pixel and uses the same.
-pub fn pixel_ray(projection: &Projection, eye: Eye, frag_xy: Vec2) -> (Vec3, Vec3) {
-    let (u, v) = projection.pixel_to_screen(frag_xy.x - 0.5, frag_xy.y - 0.5);
-    match projection.panorama {
-        PanoramaKind::Equirect => projection.sphere_ray(u, v, eye),
-        PanoramaKind::Cylinder => {
-            let (rt, de) = (projection.screen_radius, projection.eye_radius);
-            let phi = u - eye.sign() * (de / rt).asin();
-            let origin = eye.sign() * de * Vec3::new(phi.cos(), 0.0, phi.sin());
-            let screen = Vec3::new(rt * u.sin(), v, -rt * u.cos());
-            (origin, (screen - origin).normalize())
-        }
-    }
-}
-
 /// What `--depth` writes: the distance in metres along the ray of the pixel at `frag_xy` to the
 /// plane through surface point `p` with normal `n` (the drawn triangle's plane: exact for flat
 /// input triangles, however coarse the subdivision), or |p − eye point| where the ray runs
@@ -591,6 +568,7 @@ pub fn surface_color(table: &MaterialTable, s: &Surface) -> Option<Vec4> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::core::color::linear_to_srgb;
     use crate::core::texture::Texture;
 
     #[test]

@@ -12,13 +12,12 @@ use glam::{Vec2, Vec3, Vec4};
 
 use crate::core::projection::{azimuth, Eye, Projection};
 use crate::core::scene::unpack_tangent;
-use crate::core::settings::RenderSettings;
 use crate::core::texture::MaterialTable;
 use crate::cpu::fragment::{
     background_color, pixel_distance, pixel_error, shade_surface, shows_environment, surface_color, Surface,
 };
-use crate::shader::constants::GUARD_BAND_PX;
-use crate::shader::types::{DrawVertex, RasterParams};
+use crate::encoding::constants::GUARD_BAND_PX;
+use crate::encoding::types::{DrawVertex, RasterParams};
 
 /// Clip-space position of a subdivided vertex (`vs_main` in raster.wgsl), at most
 /// `GUARD_BAND_PX` beyond the image's top or bottom edge.
@@ -35,7 +34,7 @@ pub fn raster_vertex(params: &RasterParams, v: &DrawVertex) -> Vec4 {
         q.u / std::f32::consts::PI + 2.0 * params.shift_px[0] / projection.width as f32,
         (q.v * projection.pixels_per_v() / half_height).clamp(-y_limit, y_limit)
             - 2.0 * params.shift_px[1] / projection.height as f32,
-        (q.depth / (q.depth + 1.0)).min(crate::shader::constants::MAX_DEPTH),
+        (q.depth / (q.depth + 1.0)).min(crate::encoding::constants::MAX_DEPTH),
         1.0,
     )
 }
@@ -292,16 +291,4 @@ pub fn fill_background(img: &mut RasterImage, table: &MaterialTable, projection:
             img.rgba[i..i + 4].copy_from_slice(&c);
         }
     }
-}
-
-/// The raster stage's parameters: the left eye's, then the right's (its `array<RasterParams, 2>`).
-pub fn raster_params(settings: &RenderSettings) -> [RasterParams; 2] {
-    Eye::BOTH.map(|eye| RasterParams {
-        projection: settings.projection().into(),
-        eye_sign: eye.sign(),
-        ambient: settings.shading.ambient,
-        shift_px: settings.measure.shift_px,
-        error_angle: settings.measure.error_angle as u32,
-        ..Default::default()
-    })
 }

@@ -7,12 +7,12 @@
 //! 1024 px (one overflow bin beyond, whose percentile reports the max), interpolated by rank
 //! within the bin: their resolution is 1/64 px below 64 px.
 
-use crate::shader::types::ErrorStats;
+use crate::encoding::types::ErrorStats;
 
 const FINE_BINS: usize = constants::FINE_BINS as usize;
 const COARSE_BINS: usize = constants::COARSE_BINS as usize;
 const BINS: usize = constants::BINS as usize;
-use crate::shader::constants;
+use crate::encoding::constants;
 
 pub fn bin_of(e: f32) -> usize {
     if e < 64.0 {

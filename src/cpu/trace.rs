@@ -17,7 +17,6 @@ use crate::core::light::LightKind;
 use crate::core::material::AlphaMode;
 use crate::core::projection::{Eye, Projection};
 use crate::core::scene::{unpack_tangent, SceneVertex};
-use crate::core::settings::RenderSettings;
 use crate::core::texture::MaterialTable;
 use crate::core::visual_field::Gaze;
 use crate::cpu::fragment::{
@@ -25,31 +24,8 @@ use crate::cpu::fragment::{
     pixel_spread, shade_linear, shading_normal, surface_color, surface_maps, Surface,
 };
 use crate::cpu::raster::RasterImage;
-use crate::shader::constants::{MAX_SHADOWED_LIGHTS, TRACE_PENDING, TRACE_STACK};
-use crate::shader::types::TraceParams;
-
-/// The trace stage's parameters (`row_texels`: the outputs' padded row length).
-pub fn trace_params(settings: &RenderSettings, row_texels: u32) -> TraceParams {
-    let [r, g, b] = settings.shading.background;
-    TraceParams {
-        to_scene: settings.view().inverse().to_cols_array_2d(),
-        projection: settings.projection().into(),
-        background: [r, g, b, 1.0],
-        light: settings.shading.light.map_or([0.0; 4], |l| [l.x, l.y, l.z, 1.0]),
-        gaze_forward: settings.shading.trace_gaze.map_or([0.0; 4], |g| g.forward.extend(1.0).to_array()),
-        gaze_right: settings.shading.trace_gaze.map_or([0.0; 4], |g| g.right.extend(0.0).to_array()),
-        gaze_up: settings.shading.trace_gaze.map_or([0.0; 4], |g| g.up.extend(0.0).to_array()),
-        ambient: settings.shading.ambient,
-        error_angle: settings.measure.error_angle as u32,
-        row_texels,
-        reflect_max: settings.shading.reflect_max,
-        lod_min_share: settings.shading.trace_min_share,
-        // Set from the scene's BVH where it is bound (`SceneBvh::original_root`, `original_level`).
-        original_root: 0,
-        original_level: -1.0,
-        _pad2: 0,
-    }
-}
+use crate::encoding::constants::{MAX_SHADOWED_LIGHTS, TRACE_PENDING, TRACE_STACK};
+use crate::encoding::types::TraceParams;
 
 /// The closest hit kept along a ray: distance, triangle, barycentrics of corners 1 and 2, and
 /// whether the ray meets the triangle's front (counter-clockwise) face.
@@ -485,26 +461,6 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
         img
     });
     TraceOutput { images, rays: rays.get(), triangle_tests: tests.get() }
-}
-
-/// The points the pixels' rays meet at `distances` (per eye, +∞: none → NaN), viewer frame:
-/// a traced frame's surface points (`Frame::positions`).
-pub fn ray_hit_points(projection: &Projection, distances: &[Vec<f32>; 2]) -> [Vec<[f32; 3]>; 2] {
-    std::array::from_fn(|k| {
-        let eye = Eye::BOTH[k];
-        distances[k]
-            .iter()
-            .enumerate()
-            .map(|(i, &t)| {
-                if !t.is_finite() {
-                    return [f32::NAN; 3];
-                }
-                let (x, y) = ((i as u32 % projection.width) as f32 + 0.5, (i as u32 / projection.width) as f32 + 0.5);
-                let (o, d) = pixel_ray(projection, eye, Vec2::new(x, y));
-                (o + t * d).to_array()
-            })
-            .collect()
-    })
 }
 
 /// Linear colour → sRGB bytes as the colour target holds them (`pack_display(linear_to_srgb(c))`).

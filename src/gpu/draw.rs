@@ -2,16 +2,17 @@
 //! faces culled or not), with or without the error pass (and the positions), and per way of drawing the eyes (one
 //! multiview draw, or a pass per eye), each built when a frame first needs it.
 
+use std::collections::HashMap;
 use std::mem::offset_of;
-use std::sync::OnceLock;
+use std::sync::{Mutex, OnceLock};
 
 use crate::core::scene::SceneVertex;
 use crate::core::settings::RenderSettings;
+use crate::encoding::types::DrawVertex;
 use crate::gpu::device::{error_target_format, Gpu};
 use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
 use crate::gpu::targets::{Layers, COLOR_FORMAT, DEPTH_FORMAT, HDR_FORMAT, OBJECT_FORMAT, POSITION_FORMAT};
-use crate::shader::types::DrawVertex;
 use crate::shader::{RASTER, SHADOW, SLIT};
 
 /// The two drawing stages.
@@ -21,21 +22,30 @@ pub(crate) enum DrawStage {
     Slit = 1,
 }
 
-/// A drawing stage's pipelines, each made when a frame first needs it, for: a scene's look
-/// ([`Look`]); colour only or with the error pass; and the eyes drawn ([`Layers`]: both in one
-/// multiview draw, or one eye, a pipeline per eye with the WGSL `override EYE`; the slit stage
-/// draws one eye per pass with per-eye parameters and needs no per-eye pipeline).
+/// A drawing stage's pipelines, each made when a frame first needs it and kept by its
+/// [`DrawKey`] (as bevy's specialised pipelines are kept by key).
 pub(crate) struct DrawPipelines {
     pub stage: GpuStage,
     kind: DrawStage,
-    /// By `Self::index`.
-    pipelines: [OnceLock<wgpu::RenderPipeline>; 1152],
-    /// The background's (`fs_background`), by outputs, eyes and colour target.
-    backgrounds: [OnceLock<wgpu::RenderPipeline>; 18],
+    pipelines: Mutex<HashMap<DrawKey, wgpu::RenderPipeline>>,
+}
+
+/// What makes one drawing pipeline differ from another: a scene's look ([`Look`]) and the parts
+/// of the glTF look it compiles in ([`Lit`]), or the background (`None`); the colour target
+/// alone or with the error pass's (and the surface points') targets; the eyes drawn
+/// ([`Layers`]: both in one multiview draw, or one eye, a pipeline per eye with the WGSL
+/// `override EYE`; the slit stage draws one eye per pass with per-eye parameters and keys every
+/// eye as the left); and the colour target's format (HDR or display).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) struct DrawKey {
+    pub look: Option<(Look, Lit)>,
+    pub outputs: usize,
+    pub layers: Layers,
+    pub hdr: bool,
 }
 
 /// What a scene's materials need of a drawing pipeline.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(crate) enum Look {
     /// Without the fragment stage's material code (`MATERIALS = false`), for scenes whose
     /// materials are all untextured, opaque and double-sided: on lavapipe it roughly halves
@@ -47,8 +57,8 @@ pub(crate) enum Look {
     Culled = 2,
     /// With it but without `discard` (`DISCARDS = false`), for scenes whose materials are all
     /// opaque and double-sided (textured, or lit by the glTF BRDF): a shader that may discard
-    /// loses early depth testing, so hidden fragments are shaded too (measured on Sponza under
-    /// the BRDF: 1,600 → 1,580 ms, little; it matters where overdraw is deep).
+    /// loses early depth testing, so hidden fragments are shaded too (it matters where overdraw
+    /// is deep).
     Shaded = 3,
 }
 
@@ -69,11 +79,9 @@ impl Look {
 
 /// Which parts of the glTF look a pipeline compiles in (`PBR`, `ENVIRONMENT`, `MAPS` in
 /// surface.wgsl). lavapipe runs every branch of a fragment shader under a mask, so code a frame
-/// does not use still costs: a Sponza frame shaded by the headlight through a pipeline that also
-/// held the material and BRDF code took 1,432 ms against 313 without it; with only the parts it
-/// uses compiled in, a BRDF frame without environment went from 1,480 to 898 ms. Each part is
-/// compiled in only where the frame uses it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+/// does not use still costs (docs/results.md has the figures). Each part is compiled in only
+/// where the frame uses it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub(crate) struct Lit {
     pub pbr: bool,
     pub environment: bool,
@@ -93,68 +101,40 @@ impl Lit {
             shadows: scene.shadow_maps(settings),
         }
     }
-
-    fn index(self) -> usize {
-        self.pbr as usize | (self.environment as usize) << 1 | (self.maps as usize) << 2 | (self.shadows as usize) << 3
-    }
 }
 
 impl DrawPipelines {
     pub fn new(gpu: &Gpu, kind: DrawStage) -> DrawPipelines {
         let stage = GpuStage::new(gpu, if kind == DrawStage::Raster { &RASTER } else { &SLIT });
-        DrawPipelines {
-            stage,
-            kind,
-            pipelines: std::array::from_fn(|_| OnceLock::new()),
-            backgrounds: std::array::from_fn(|_| OnceLock::new()),
-        }
-    }
-
-    /// The pass a pipeline fits, 0..9: its targets (1, 4 or 5) and the eyes it draws.
-    fn pass_slot(&self, outputs: usize, layers: Layers) -> usize {
-        let eyes = match (self.kind, layers) {
-            (_, Layers::Both) => 0,
-            (DrawStage::Slit, Layers::Eye(_)) => 1,
-            (DrawStage::Raster, Layers::Eye(k)) => 1 + k.min(1),
-        };
-        let outputs = match outputs {
-            1 => 0,
-            4 => 1,
-            _ => 2,
-        };
-        outputs * 3 + eyes
-    }
-
-    fn index(&self, look: Look, lit: Lit, outputs: usize, layers: Layers, hdr: bool) -> usize {
-        ((look as usize * 9 + self.pass_slot(outputs, layers)) * 16 + lit.index()) * 2 + hdr as usize
+        DrawPipelines { stage, kind, pipelines: Mutex::new(HashMap::new()) }
     }
 
     /// The pipeline for a frame of `scene` with `settings` (its look, what of the glTF look it
     /// uses, its outputs, its colour target), drawing `layers`.
-    pub fn get(&self, gpu: &Gpu, scene: &GpuScene, settings: &RenderSettings, layers: Layers) -> &wgpu::RenderPipeline {
-        let (outputs, hdr) = (settings.measure.outputs(), settings.shading.hdr);
-        self.get_look(gpu, Look::of(scene, scene.pbr(settings)), Lit::of(scene, settings), outputs, layers, hdr)
-    }
-
-    pub fn get_look(
-        &self,
-        gpu: &Gpu,
-        look: Look,
-        lit: Lit,
-        outputs: usize,
-        layers: Layers,
-        hdr: bool,
-    ) -> &wgpu::RenderPipeline {
-        self.pipelines[self.index(look, lit, outputs, layers, hdr)]
-            .get_or_init(|| draw_pipeline(gpu, &self.stage, self.kind, Some((look, lit)), outputs, layers, hdr))
+    pub fn get(&self, gpu: &Gpu, scene: &GpuScene, settings: &RenderSettings, layers: Layers) -> wgpu::RenderPipeline {
+        let look = (Look::of(scene, scene.pbr(settings)), Lit::of(scene, settings));
+        self.keyed(gpu, DrawKey { look: Some(look), ..Self::frame_key(settings, layers) })
     }
 
     /// The background's pipeline (the environment along each pixel's ray, colour only), for a
     /// frame with `settings` drawing `layers`; drawn first, where `shows_environment`.
-    pub fn background(&self, gpu: &Gpu, settings: &RenderSettings, layers: Layers) -> &wgpu::RenderPipeline {
-        let (outputs, hdr) = (settings.measure.outputs(), settings.shading.hdr);
-        self.backgrounds[self.pass_slot(outputs, layers) * 2 + hdr as usize]
-            .get_or_init(|| draw_pipeline(gpu, &self.stage, self.kind, None, outputs, layers, hdr))
+    pub fn background(&self, gpu: &Gpu, settings: &RenderSettings, layers: Layers) -> wgpu::RenderPipeline {
+        self.keyed(gpu, Self::frame_key(settings, layers))
+    }
+
+    /// A frame's key without its look (the background's).
+    fn frame_key(settings: &RenderSettings, layers: Layers) -> DrawKey {
+        DrawKey { look: None, outputs: settings.measure.outputs(), layers, hdr: settings.shading.hdr }
+    }
+
+    /// The pipeline of `key`, made the first time it is asked for.
+    pub fn keyed(&self, gpu: &Gpu, key: DrawKey) -> wgpu::RenderPipeline {
+        let key = match (self.kind, key.layers) {
+            (DrawStage::Slit, Layers::Eye(_)) => DrawKey { layers: Layers::Eye(0), ..key },
+            _ => key,
+        };
+        let mut pipelines = self.pipelines.lock().unwrap_or_else(|e| e.into_inner());
+        pipelines.entry(key).or_insert_with(|| draw_pipeline(gpu, &self.stage, self.kind, key)).clone()
     }
 
     /// The scene's material table (group 1).
@@ -177,10 +157,7 @@ fn draw_pipeline(
     gpu: &Gpu,
     stage: &GpuStage,
     kind: DrawStage,
-    look: Option<(Look, Lit)>,
-    outputs: usize,
-    layers: Layers,
-    hdr: bool,
+    DrawKey { look, outputs, layers, hdr }: DrawKey,
 ) -> wgpu::RenderPipeline {
     // None: the background triangle (no vertex buffer; colour only; behind everything).
     let background = look.is_none();

@@ -10,8 +10,8 @@
 //! output buffer. Ranges are drawn one after another into the same targets (`chunks` in the
 //! stats), so nothing is dropped; a single piece that cannot fit is an error.
 
+use crate::encoding::types::{DrawIndexedIndirectArgs, DrawVertex, Piece, SubdivideCounters};
 use crate::gpu::device::Gpu;
-use crate::shader::types::{DrawIndexedIndirectArgs, DrawVertex, Piece, SubdivideCounters};
 
 pub const PIECE_SIZE: u64 = std::mem::size_of::<Piece>() as u64;
 /// Bytes of one output node.

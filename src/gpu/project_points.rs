@@ -4,10 +4,10 @@
 use glam::Vec3;
 
 use crate::core::projection::{Eye, Projection};
+use crate::encoding::types::ProjectParams;
 use crate::error::Result;
 use crate::gpu::renderer::Renderer;
 use crate::gpu::stages::GpuStage;
-use crate::shader::types::ProjectParams;
 use crate::shader::PROJECT_POINTS;
 
 impl Renderer {

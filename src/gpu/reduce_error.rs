@@ -1,11 +1,11 @@
 //! The `reduce_error` stage on the GPU (twin `cpu::reduce_error`): error statistics of both
 //! eyes' error targets.
 
+use crate::encoding::constants::BINS;
+use crate::encoding::types::{ErrorStats, ReduceParams, Totals};
 use crate::error::Result;
 use crate::gpu::renderer::Renderer;
 use crate::gpu::targets::{copy_eyes_to_buffer, unpad_eyes, Targets};
-use crate::shader::constants::BINS;
-use crate::shader::types::{ErrorStats, ReduceParams, Totals};
 
 /// Invocations per workgroup of `accumulate` (`WG` in the WGSL).
 const WORKGROUP: u32 = 256;

@@ -12,11 +12,13 @@ use std::time::Instant;
 use crate::core::frame::{Frame, FrameStats, Measurement, Timing};
 use crate::core::projection::{Eye, PanoramaKind};
 use crate::core::settings::{Method, RenderSettings};
-use crate::cpu::raster::raster_params;
-use crate::cpu::subdivide::{subdivide_params, SubdivideOutput};
+use crate::encoding::constants::PIECES_FROM_COUNTER;
+use crate::encoding::params::raster_params;
+use crate::encoding::subdivide::{subdivide_params, SubdivideOutput};
+use crate::encoding::types::{RasterParams, SlitParams, SubdivideCounters, SubdivideParams, TraceParams};
 use crate::error::{Error, Result};
 use crate::gpu::device::Gpu;
-use crate::gpu::draw::{DrawPipelines, DrawStage, Lit, Look, ShadowPipelines};
+use crate::gpu::draw::{DrawKey, DrawPipelines, DrawStage, Lit, Look, ShadowPipelines};
 use crate::gpu::frame_plan::{
     on_overflow, Capacities, FramePlan, Overflow, SubdivisionBuffers, INDICES_SIZE, NODE_SIZE,
 };
@@ -24,8 +26,6 @@ use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
 use crate::gpu::targets::{Layers, Targets};
 use crate::gpu::timestamps::{self as stamp, Timestamps};
-use crate::shader::constants::PIECES_FROM_COUNTER;
-use crate::shader::types::{RasterParams, SlitParams, SubdivideCounters, SubdivideParams, TraceParams};
 use crate::shader::{REDUCE_ERROR, SUBDIVIDE};
 
 /// The `subdivide` stage's pipelines for one panorama, one per entry point.
@@ -160,7 +160,8 @@ impl Renderer {
             };
             let raster = DrawPipelines::new(&gpu, DrawStage::Raster);
             // The usual pipeline now, for the same reason.
-            raster.get_look(&gpu, Look::Plain, Lit::default(), 1, Layers::passes(gpu.eyes_per_draw)[0], false);
+            let layers = Layers::passes(gpu.eyes_per_draw)[0];
+            raster.keyed(&gpu, DrawKey { look: Some((Look::Plain, Lit::default())), outputs: 1, layers, hdr: false });
             Ok((
                 subdivide,
                 raster,
@@ -196,8 +197,8 @@ impl Renderer {
         let mut resources = self.resources.lock().unwrap_or_else(|e| e.into_inner());
         let shadow_maps = scene.write_lighting(&self.gpu, settings);
         if settings.shading.hdr && matches!(settings.subdivision.method, Method::Slit(_) | Method::Trace) {
-            return Err(Error::option(
-                "--hdr",
+            return Err(Error::setting(
+                "shading.hdr",
                 "the linear colour comes from the projection methods (vertex, fixed, adaptive); slit and trace write display colours",
             ));
         }
@@ -214,8 +215,8 @@ impl Renderer {
         let p = settings.projection();
         let max = self.gpu.limits.max_texture_dimension_2d;
         if p.width > max || p.height > max {
-            return Err(Error::option(
-                "--width/--height",
+            return Err(Error::setting(
+                "view.projection.width/height",
                 format!("{}x{} is larger than this GPU's largest image, {max}x{max}", p.width, p.height),
             ));
         }
@@ -231,8 +232,8 @@ impl Renderer {
             (max_buffer, "the read-back buffer")
         };
         if eyes_bytes > limit {
-            return Err(Error::option(
-                "--width/--height",
+            return Err(Error::setting(
+                "view.projection.width/height",
                 format!(
                     "{}x{} needs {} MiB for {what}, more than this GPU's {} MiB: use a smaller image",
                     p.width,
@@ -481,10 +482,10 @@ impl Renderer {
             pass.set_bind_group(0, &bind_group, &[]);
             pass.set_bind_group(1, &materials, &[]);
             if clear && scene.shows_environment(settings) {
-                pass.set_pipeline(self.raster.background(&self.gpu, settings, layers));
+                pass.set_pipeline(&self.raster.background(&self.gpu, settings, layers));
                 pass.draw(0..3, 0..1);
             }
-            pass.set_pipeline(pipeline);
+            pass.set_pipeline(&pipeline);
             pass.set_vertex_buffer(0, buffers.nodes.slice(..));
             pass.set_index_buffer(buffers.indices.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed_indirect(&buffers.draw_args, 0);
@@ -547,7 +548,7 @@ impl Renderer {
             let image = |eye: &Vec<[f32; 3]>| crate::core::frame::EyeImage {
                 width: targets.width,
                 height: targets.height,
-                rgba: eye.iter().flat_map(|c| crate::cpu::fragment::display_bytes(glam::Vec3::from(*c))).collect(),
+                rgba: eye.iter().flat_map(|c| crate::core::color::display_bytes(glam::Vec3::from(*c))).collect(),
             };
             let images = [image(&hdr[0]), image(&hdr[1])];
             (Some(hdr), images)
@@ -661,10 +662,10 @@ impl Renderer {
                     Overflow::Grow(p) => want.pieces = p,
                     Overflow::Halve(c) => tri_chunk = c,
                     Overflow::TooBig => {
-                        return Err(Error::option(
-                            "--memory-mb",
+                        return Err(Error::setting(
+                            "subdivision.memory_mb",
                             format!(
-                            "{memory_mb} is too small: one triangle needs {} pieces; raise --edge-px or --memory-mb",
+                            "{memory_mb} is too small: one triangle needs {} pieces; raise the edge length L or the memory budget",
                             planned.pieces
                         ),
                         ))
@@ -689,10 +690,10 @@ impl Renderer {
                         Overflow::Grow(t) => want.triangles = t,
                         Overflow::Halve(c) => piece_chunk = c,
                         Overflow::TooBig => {
-                            return Err(Error::option(
-                                "--memory-mb",
+                            return Err(Error::setting(
+                                "subdivision.memory_mb",
                                 format!(
-                                    "{memory_mb} is too small: one piece makes {} triangles and nodes; lower the fixed N or raise --memory-mb",
+                                    "{memory_mb} is too small: one piece makes {} triangles and nodes; lower the fixed N or raise the memory budget",
                                     done.output_units()
                                 ),
                             ))

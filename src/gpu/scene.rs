@@ -13,9 +13,9 @@ use crate::core::scene::{object_spheres, Scene};
 use crate::core::settings::RenderSettings;
 use crate::core::shadow::{GpuShadowMap, MAX_SHADOW_MAPS};
 use crate::core::shared_edges::{shared_edges_of, welded_points, SharedEdges};
+use crate::encoding::constants::TRACE_STACK;
 use crate::error::{Error, Result};
 use crate::gpu::device::Gpu;
-use crate::shader::constants::TRACE_STACK;
 
 /// One object's triangles and bounding sphere (scene coordinates), for the slit renderer's culling.
 #[derive(Clone, Copy, Debug)]
@@ -26,15 +26,27 @@ pub struct ObjectRange {
     pub radius: f32,
 }
 
+/// The scene's buffers of the drawing stages' and the ray tracer's group 1 (shaders/shared/
+/// surface.wgsl), the shadow maps' aside: the material table (materials, mip levels, texels),
+/// the lights and the frame's lighting (written per frame), the environment's texels.
+#[derive(Clone)]
+pub struct MaterialBuffers {
+    pub materials: wgpu::Buffer,
+    pub mip_levels: wgpu::Buffer,
+    pub texels: wgpu::Buffer,
+    pub lights: wgpu::Buffer,
+    pub lighting: wgpu::Buffer,
+    pub environment: wgpu::Buffer,
+}
+
 pub struct GpuScene {
     pub vertices: wgpu::Buffer,
     pub indices: wgpu::Buffer,
     pub triangle_count: u32,
     pub objects: Vec<ObjectRange>,
-    /// The material table the fragment stage reads (group 1): materials, mip levels, texels.
-    /// Group 1: materials, mip levels, texels, lights, lighting, environment.
-    pub materials: [wgpu::Buffer; 6],
-    /// The environment that lights the scene's frames (its texels are in `materials[5]`), if any.
+    /// What the drawing stages' and the ray tracer's group 1 binds of the scene.
+    pub materials: MaterialBuffers,
+    /// The environment that lights the scene's frames (its texels are in `materials.environment`), if any.
     pub environment: Option<std::sync::Arc<PreparedEnvironment>>,
     /// The scene's lights (scene frame), written into group 1 per frame.
     pub lights: Vec<Light>,
@@ -133,25 +145,25 @@ impl GpuScene {
             // bytes; levels are dropped, largest first, with a warning).
             let table = scene.material_table((max / 16) as usize);
             let storage = |label: &str, bytes: &[u8]| gpu.init_buffer(label, bytes, wgpu::BufferUsages::STORAGE);
-            let materials = [
-                storage("materials", bytemuck::cast_slice(&table.materials)),
-                storage("mip levels", bytemuck::cast_slice(&table.mips)),
-                storage("texels", bytemuck::cast_slice(&table.texels)),
-                gpu.init_buffer(
+            let materials = MaterialBuffers {
+                materials: storage("materials", bytemuck::cast_slice(&table.materials)),
+                mip_levels: storage("mip levels", bytemuck::cast_slice(&table.mips)),
+                texels: storage("texels", bytemuck::cast_slice(&table.texels)),
+                lights: gpu.init_buffer(
                     "lights",
                     bytemuck::cast_slice(&gpu_lights(&scene.lights, Mat4::IDENTITY)),
                     wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
                 ),
-                gpu.init_buffer(
+                lighting: gpu.init_buffer(
                     "lighting",
                     bytemuck::bytes_of(&LightingParams::default()),
                     wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                 ),
-                storage(
+                environment: storage(
                     "environment",
                     bytemuck::cast_slice(if table.environment.is_empty() { &[0u32] } else { &table.environment[..] }),
                 ),
-            ];
+            };
             let ones = vec![1.0f32; scene.objects.len().max(1)];
             // The glTF BRDF reads the materials' factors.
             let needs_materials = table.needs_materials() || !scene.lights.is_empty() || scene.environment.is_some();
@@ -222,8 +234,8 @@ impl GpuScene {
     /// returns the frame's shadow maps (drawn by the renderer).
     pub fn write_lighting(&self, gpu: &Gpu, settings: &RenderSettings) -> Vec<GpuShadowMap> {
         let (lights, params, maps) = settings.shadowed_lighting(&self.lights, self.environment.as_deref(), self.bounds);
-        gpu.queue.write_buffer(&self.materials[3], 0, bytemuck::cast_slice(&lights));
-        gpu.queue.write_buffer(&self.materials[4], 0, bytemuck::bytes_of(&params));
+        gpu.queue.write_buffer(&self.materials.lights, 0, bytemuck::cast_slice(&lights));
+        gpu.queue.write_buffer(&self.materials.lighting, 0, bytemuck::bytes_of(&params));
         maps
     }
 
@@ -235,8 +247,9 @@ impl GpuScene {
     /// Group 1's buffers in binding order: the material table, lights, lighting, environment,
     /// and the shadow maps' table and depths of `shadows` (the scene's, locked).
     pub fn group1(&self, shadows: &GpuShadows) -> [wgpu::Buffer; 8] {
-        let [a, b, c, d, e, f] = self.materials.clone();
-        [a, b, c, d, e, f, shadows.maps.clone(), shadows.depths.clone()]
+        let m = &self.materials;
+        [&m.materials, &m.mip_levels, &m.texels, &m.lights, &m.lighting, &m.environment, &shadows.maps, &shadows.depths]
+            .map(Clone::clone)
     }
 
     /// Group 1's buffers as a frame binds them.
@@ -382,7 +395,7 @@ impl GpuShadows {
 /// A rig's tables on the GPU: uploaded once (sources, offsets), written per frame (instances,
 /// joints, weights), and the mesh-frame boxes for the posed bounds.
 pub struct GpuRig {
-    pub(crate) data: crate::cpu::skin::SkinData,
+    pub(crate) data: crate::encoding::skin::SkinData,
     pub(crate) params: wgpu::Buffer,
     pub(crate) sources: wgpu::Buffer,
     pub(crate) deltas: wgpu::Buffer,

@@ -7,11 +7,11 @@
 use glam::Mat4;
 
 use crate::core::shadow::GpuShadowMap;
+use crate::encoding::types::ShadowParams;
 use crate::error::{Error, Result};
 use crate::gpu::renderer::Renderer;
 use crate::gpu::scene::GpuScene;
 use crate::gpu::targets::DEPTH_FORMAT;
-use crate::shader::types::ShadowParams;
 
 impl Renderer {
     /// The depths of a scene's shadow maps as the last frame drew them (`bytes` of them).
@@ -36,8 +36,8 @@ impl Renderer {
         let max_size = gpu.limits.max_texture_dimension_2d;
         let bytes: u64 = maps.iter().map(|m| 4 * m.size as u64 * m.size as u64).sum();
         if size > max_size || bytes > gpu.max_binding() {
-            return Err(Error::option(
-                "--shadow-map-size",
+            return Err(Error::setting(
+                "shading.shadow_map_size",
                 format!(
                     "{} shadow maps of up to {size}×{size} texels ({} MiB) do not fit this GPU (images up to {max_size}, bindings up to {} MiB)",
                     maps.len(),

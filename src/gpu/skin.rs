@@ -4,12 +4,12 @@
 //! joint matrices and the morph weights.
 
 use crate::core::scene::Scene;
-use crate::cpu::skin::{SkinData, SkinFrame};
+use crate::encoding::skin::{SkinData, SkinFrame};
+use crate::encoding::types::SkinParams;
 use crate::error::{Error, Result};
 use crate::gpu::renderer::Renderer;
 use crate::gpu::scene::{GpuRig, GpuScene};
 use crate::gpu::stages::GpuStage;
-use crate::shader::types::SkinParams;
 use crate::shader::SKIN;
 
 const IDENTITY: [[[f32; 4]; 4]; 1] =

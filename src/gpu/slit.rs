@@ -6,7 +6,8 @@ use std::time::Instant;
 use crate::core::frame::{Frame, FrameStats};
 use crate::core::projection::Eye;
 use crate::core::settings::RenderSettings;
-use crate::cpu::slit::{slit_params, slits, sphere_in_slit, SlitCamera};
+use crate::encoding::slits::{slit_params, slits, sphere_in_slit};
+use crate::encoding::types::SlitCamera;
 use crate::error::Result;
 use crate::gpu::renderer::{FrameResources, Renderer};
 use crate::gpu::scene::GpuScene;
@@ -53,10 +54,10 @@ impl Renderer {
             pass.set_bind_group(0, &bind_group, &[]);
             pass.set_bind_group(1, &materials, &[]);
             if scene.shows_environment(settings) {
-                pass.set_pipeline(self.slit.background(gpu, settings, Layers::Eye(k)));
+                pass.set_pipeline(&self.slit.background(gpu, settings, Layers::Eye(k)));
                 pass.draw(0..3, 0..1);
             }
-            pass.set_pipeline(pipeline);
+            pass.set_pipeline(&pipeline);
             pass.set_vertex_buffer(0, scene.vertices.slice(..));
             pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
             let first_instance = (k * eye_slits[0].len()) as u32;

@@ -7,15 +7,16 @@ use std::time::Instant;
 
 use crate::core::bvh::SceneBvh;
 use crate::core::frame::{Frame, FrameStats};
+use crate::core::projection::ray_hit_points;
 use crate::core::settings::RenderSettings;
-use crate::cpu::trace::{ray_hit_points, trace_params};
+use crate::encoding::constants::TRACE_COUNT_SLOTS;
+use crate::encoding::params::trace_params;
+use crate::encoding::types::TraceParams;
 use crate::error::{Error, Result};
 use crate::gpu::renderer::{FrameResources, Renderer};
 use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
 use crate::gpu::timestamps::submit_timed_pass;
-use crate::shader::constants::TRACE_COUNT_SLOTS;
-use crate::shader::types::TraceParams;
 
 impl Renderer {
     pub(crate) fn render_trace(
@@ -27,8 +28,8 @@ impl Renderer {
         let start = Instant::now();
         let gpu = &self.gpu;
         let Some(bvh) = &scene.bvh else {
-            return Err(Error::option(
-                "--method",
+            return Err(Error::setting(
+                "subdivision.method",
                 "trace needs the scene's BVH, and this scene was uploaded without one (GpuScene::with_bvh; a level-of-detail selection has none yet)",
             ));
         };
@@ -37,8 +38,8 @@ impl Renderer {
         let row_texels = p.width.div_ceil(64) * 64;
         let bytes = 4 * row_texels as u64 * p.height as u64 * 2;
         if bytes > gpu.max_binding() {
-            return Err(Error::option(
-                "--width/--height",
+            return Err(Error::setting(
+                "view.projection.width/height",
                 format!(
                     "{}x{} needs {} MiB per output of the ray tracer, more than this GPU binds ({} MiB): use a smaller image",
                     p.width,

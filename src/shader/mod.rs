@@ -6,17 +6,16 @@
 //! the stage's explicit bind group layouts and pipelines from the descriptor
 //! (`gpu::stages`), and `tests/shaders.rs` checks every descriptor against the composed WGSL
 //! (reflected with naga): the same bindings, and every uniform/storage struct laid out exactly
-//! as its Rust twin in [`types::LAYOUTS`], field offset by field offset. Adding a stage is: the
+//! as its Rust twin in [`crate::encoding::types::LAYOUTS`], field offset by field offset. Adding a stage is: the
 //! WGSL file, its twin, a `Stage` constant, a line in [`STAGES`].
 //!
 //! **Composition.** A WGSL file pulls in shared code with `#import NAME` lines (vello's
 //! convention): `shaders/shared/NAME.wgsl`, or one of the generated modules `constants`
-//! ([`constants::wgsl`]), `error_target` (how the error pass writes its target) and `eyes` (how
+//! ([`crate::encoding::constants::wgsl`]), `error_target` (how the error pass writes its target) and `eyes` (how
 //! a drawing stage learns which eye it draws, [`EyesPerDraw`]). Each module is composed in once,
 //! after the modules it imports.
 
-pub mod constants;
-pub mod types;
+use crate::encoding::constants;
 
 /// Which pipeline kind a stage makes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

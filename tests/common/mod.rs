@@ -39,17 +39,19 @@ pub fn is_background(px: [u8; 4], bg: [f32; 3]) -> bool {
     (0..3).all(|c| (px[c] as f32 - bg[c] * 255.0).abs() <= 1.0)
 }
 
-/// A file or folder of the shared third-party assets (`../shared/assets`). CI always has them:
-/// a missing one fails the test, naming it, so that an absent asset never turns a test green.
+/// A file or folder of the third-party assets (`TWISTER_ASSETS`, default `../shared/assets`).
+/// Call [`assets_present`] first: where the folder is here, a missing file fails the test, naming it.
 pub fn asset(relative: &str) -> std::path::PathBuf {
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets");
-    let path = root.join(relative);
-    assert!(
-        path.exists(),
-        "test asset {} is missing: this test needs ../shared/assets (see its README) next to the project",
-        path.display()
-    );
+    let path = twister::core::assets::root().join(relative);
+    assert!(path.exists(), "test asset {} is missing (see the assets' README)", path.display());
     path
+}
+
+/// Whether this test can use the third-party assets; where they are absent it is recorded as
+/// not run (the test script counts it) and should return. Under CI a missing folder fails it.
+pub fn assets_present() -> bool {
+    let thread = std::thread::current();
+    twister::core::assets::present_for_test(thread.name().unwrap_or("a test"))
 }
 
 /// Standard base64 (for data: URIs in generated glTF files).

@@ -15,6 +15,7 @@ pub struct Skin;
 impl Twin for Skin {
     type Case = (Scene, Option<usize>, f32);
     type Output = Vec<SceneVertex>;
+    const NEEDS_ASSETS: bool = true;
     fn cases() -> Vec<(String, Self::Case)> {
         let load = |f: &str| {
             let mut s = load_scene(common::asset(f).to_str().unwrap(), &Projection::default()).unwrap();

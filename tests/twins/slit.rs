@@ -3,7 +3,8 @@
 
 use twister::core::builtin;
 use twister::core::settings::Method;
-use twister::cpu::slit::{slit, slit_params, slits};
+use twister::cpu::slit::slit;
+use twister::encoding::slits::{slit_params, slits};
 use twister::{Eye, Projection, RenderSettings, Renderer, Scene, Vertical};
 
 use super::{common, compare_eyes, frame_outputs, lit_table, measured, EyeOutputs, Twin};

@@ -2,7 +2,7 @@
 
 use glam::Vec3;
 use twister::core::scene::unpack_tangent;
-use twister::shader::types::DrawVertex;
+use twister::encoding::types::DrawVertex;
 
 /// Matches each CPU triangle to the nearest unused GPU triangle (searched among those whose
 /// centroid and reference azimuth fall in neighbouring buckets: the GPU appends in another

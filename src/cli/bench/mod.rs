@@ -309,7 +309,7 @@ pub struct FigureArgs {
     #[arg(long)]
     pub reps: Option<usize>,
     /// Folder of the third-party assets (bunny, Sponza); absent ones are skipped.
-    #[arg(long, default_value = "../shared/assets")]
+    #[arg(long, env = twister::core::assets::ASSETS_VAR, default_value = twister::core::assets::DEFAULT_ASSETS)]
     pub assets: PathBuf,
 }
 
@@ -358,7 +358,7 @@ pub fn bench_speed(args: &SpeedArgs) -> Result<()> {
     if !(1..=MAX_REPS).contains(&args.reps) {
         return Err(Error::option("--reps", format!("must be between 1 and {MAX_REPS}, got {}", args.reps)));
     }
-    let base = args.view.settings()?;
+    let base = args.view.settings(&args.methods)?;
     let (renderer, adapter) = open_renderer()?;
     // Every scene as `render` would draw it: --scale, --fit (file scenes), --viewer camera:N, --lod.
     let mut scenes = Vec::new();

@@ -18,10 +18,9 @@
 //! cuts ([`edge_crossings`], [`edge_split_parts`]), so that it meets its cut neighbours there; a
 //! triangle with no marked edge is its own single part. A scene with no triangle that asks is
 //! not cut at all; in a room, the floor and ceiling near the axis and two rings of their
-//! neighbours are. (Cutting every triangle that straddles x = 0, z = 0 or an active diamond, as
-//! this did before, cut 4,126 such triangles of Sponza into two parts or more each: 75.6k
-//! triangles drawn instead of 69.6k. The second ring keeps large walls beside a floor in bands:
-//! fanned at their marked edges, the box room's walls made 29.0k triangles instead of 22.4k.)
+//! neighbours are. (A triangle that straddles x = 0, z = 0 or an active diamond but needs none
+//! of it stays whole; the second ring keeps large walls beside a floor in bands, which are
+//! fewer triangles than fanning them at their marked edges: see docs/results.md.)
 //!
 //! **Why bands.** The projection stretches ∝ 1/r (v = R_T·y/r, and θ turns fast near the axis),
 //! so eq. 5's equal parts of an edge that runs from near the axis outwards would be far longer on
@@ -62,32 +61,11 @@ use glam::Vec3;
 
 use super::lattice::weighted;
 use super::Node;
-use crate::core::projection::{PanoramaKind, Projection};
-use crate::shader::constants::{
-    AXIS_CLEARANCE_MAX, AXIS_CLEARANCE_MIN, BAND_LIMIT, BAND_RATIO, MAX_DIAMONDS, SNAP, WIDE_RATIO,
-};
+use crate::encoding::constants::{BAND_LIMIT, BAND_RATIO, MAX_DIAMONDS, SNAP, WIDE_RATIO};
+pub use crate::encoding::subdivide::{axis_clearance, AxisCuts};
 
 /// The quadrants (sign of x, sign of z), in the order the twin and the WGSL number parts.
 pub const QUADRANTS: [(f32, f32); 4] = [(1.0, -1.0), (1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0)];
-
-/// ρ, the half-diagonal of the square cut around the axis: the eye radius clamped to
-/// `[AXIS_CLEARANCE_MIN, AXIS_CLEARANCE_MAX]`·R_T = [10⁻⁵, 10⁻³]·R_T. At most d_e, so only points no
-/// eye sees are removed, unless d_e < 10⁻⁵·R_T (a mono camera): then the removed points within
-/// 10⁻⁵·R_T of the axis could show only if they were as close to the eyes' height. Small, so that
-/// the paper model's image of a ceiling just above the eyes reaches past the top of the image;
-/// not smaller, so that the thin parts beside the square keep distinct lattice nodes in f32.
-///
-/// The sphere with pole merge sees every point near the axis (at the poles the eyes meet at the
-/// centre): there ρ is `AXIS_CLEARANCE_MIN` metres, so the hole the square leaves at a pole (the
-/// colatitudes below ρ/h for a surface h above or below the eyes) is smaller than half a pixel
-/// row unless h < 2ρ·H/π (1.3 cm at 4096×2048).
-pub fn axis_clearance(projection: &Projection) -> f32 {
-    if projection.panorama == PanoramaKind::Equirect && projection.pole_merge.is_some() {
-        return AXIS_CLEARANCE_MIN;
-    }
-    let rt = projection.screen_radius;
-    projection.eye_radius.clamp(AXIS_CLEARANCE_MIN * rt, AXIS_CLEARANCE_MAX * rt)
-}
 
 /// Moves a vertex within `SNAP` (relative to |x| + |z|) of the plane x = 0 or z = 0 onto it.
 pub fn snap_to_cut_planes(p: Vec3) -> Vec3 {
@@ -220,11 +198,6 @@ pub fn band_bound(rho: f32, k: u32) -> f32 {
     let base = if k % 2 == 0 { rho } else { rho * BAND_RATIO };
     base * 2f32.powi((k / 2) as i32)
 }
-
-/// The cuts around the axis that a frame makes (see [`triangle_cuts`]): bit 0 the quadrant cuts
-/// (planes x = 0 and z = 0) and the square around the axis, bit k ≥ 1 the diamond c_k
-/// ([`band_bound`]). With no bit set, no triangle is cut.
-pub type AxisCuts = u64;
 
 /// The smallest and largest diamond distance |x| + |z| of a triangle's points: the largest at
 /// a corner; the smallest 0 where the triangle's footprint (its projection along y) holds the

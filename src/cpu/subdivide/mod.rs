@@ -47,7 +47,7 @@
 //! within a quarter of τ, the piece is drawn as a strip instead ([`strip_triangles`]): its two
 //! long edges' own nodes joined by a zigzag, n1 + n2 − 1 triangles (13), whose rungs are no
 //! longer than the base. The boundary nodes are the edges' own, so neighbours still meet without
-//! cracks. Sponza at 3168×600: 81k triangles instead of 102k at the same error. Not on the sphere,
+//! cracks, and the error bound is the lattice's. Not on the sphere,
 //! where a sliver reaching towards a pole bends ever more towards its apex.
 //!
 //! **Band quads (likewise).** A band of a floor or wall between two diamonds is often a polygon
@@ -55,8 +55,7 @@
 //! are in one part each, the quad is drawn as one strip between the other two (its rails) instead
 //! ([`quad_strip_triangles`]): n1 + n2 triangles, no diagonal. The rails' nodes are their own, the
 //! diagonal was inside the polygon, so neighbours still meet without cracks; every rung of the
-//! zigzag must be within τ of straight, like any edge drawn. Sponza: 75.6k triangles instead of
-//! 81.0k, on 159k nodes instead of 169k, at the same error.
+//! zigzag must be within τ of straight, like any edge drawn.
 //!
 //! **The vertical axis.** No eye sees a point with r ≤ d_e, and a triangle around the axis covers
 //! every azimuth. Triangles that reach near the axis, or are large next to their distance from it,
@@ -73,12 +72,11 @@
 //! **Off screen.** Triangles, parts and pieces that lie wholly above or below the image's rows
 //! (see [`Subdivider::off_screen_vertically`]) make no pieces or no lattice, and sub-triangles
 //! that do are not emitted: a floor or ceiling near the axis is not subdivided where no one can
-//! see it (the box room at 1024×1024: 750 pieces instead of 1,956, the same image).
+//! see it (the same image with fewer pieces).
 //!
 //! **Output (indexed).** Each piece writes its lattice's (m + 1)(m + 2)/2 nodes once
 //! ([`node_slot`] order) and its drawn triangles as indices into them, so the vertex stage
-//! projects a node once per eye instead of once per triangle around it (up to six). Sponza at
-//! 3168×600: 102k triangles on about 60k nodes instead of 307k vertices.
+//! projects a node once per eye instead of once per triangle around it (up to six).
 //!
 //! **The seam.** Every node of a piece carries the azimuth of the piece's centroid, `theta_ref`;
 //! the vertex stage unwraps θ by whole turns towards it (a piece spans less than π in azimuth: it
@@ -95,12 +93,13 @@ use std::f32::consts::{PI, TAU};
 
 use crate::core::projection::{azimuth, horizontal_radius, wrap_angle, Eye, PanoramaKind, Projection, Vertical};
 use crate::core::scene::{pack_tangent, unpack_tangent, SceneVertex};
-use crate::core::settings::{RenderSettings, SplitRule};
-use crate::shader::constants::{
+use crate::core::settings::SplitRule;
+use crate::encoding::constants::{
     EDGE_SAMPLES, ERROR_SPLIT_LENGTH, MAX_EDGE_DIVISIONS, MAX_MACRO_LEVEL, MAX_STRETCH, PIECE_DIVISIONS, SEAM_MARGIN,
     STRIP_BASE_ERROR, STRIP_MIN_DIVISIONS,
 };
-use crate::shader::types::{DrawVertex, SubdivideParams};
+pub use crate::encoding::subdivide::{expand, subdivide_params, SubdivideOutput};
+use crate::encoding::types::{DrawVertex, SubdivideParams};
 
 mod axis;
 mod frame_cuts;
@@ -117,33 +116,6 @@ pub use lattice::{
     snap, strip_node_count, strip_triangles,
 };
 use lattice::{lattice_node, strip_node, weighted};
-
-/// The `subdivide` stage's parameters for a range of input triangles (capacities and piece
-/// ranges are left for the caller, 0).
-pub fn subdivide_params(settings: &RenderSettings, first_triangle: u32, triangle_count: u32) -> SubdivideParams {
-    let projection = settings.projection();
-    let sub = &settings.subdivision;
-    let (rule, fixed_n) = sub.method.split_rule();
-    SubdivideParams {
-        view: settings.view().to_cols_array_2d(),
-        projection: projection.into(),
-        axis_clearance: axis_clearance(projection),
-        triangle_count,
-        first_triangle,
-        method: rule as u32,
-        fixed_n,
-        edge_px: sub.edge_px,
-        max_error_px: sub.max_error_px,
-        max_div: sub.max_div.max(1),
-        piece_capacity: 0,
-        triangle_capacity: 0,
-        first_piece: 0,
-        piece_count: 0,
-        measure_edges: (settings.measure.edges || settings.measure.error) as u32,
-        vertical_limit: projection.vertical_limit(),
-        ..Default::default()
-    }
-}
 
 /// An input triangle in the viewer frame.
 #[derive(Clone, Copy, Debug)]
@@ -213,49 +185,6 @@ pub struct Subdivider<'a> {
     /// Per object: the factor its L is multiplied by (the level of detail's relaxation; 1 where
     /// missing). `object_edge_scale` in shaders/subdivide.wgsl.
     edge_scale: &'a [f32],
-}
-
-/// The stage's output, and counters the GPU keeps too.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct SubdivideOutput {
-    /// Every piece's lattice nodes, once per seam copy (the raster's vertex buffer).
-    pub nodes: Vec<DrawVertex>,
-    /// The output triangles: three indices into `nodes` each.
-    pub indices: Vec<u32>,
-    /// The same triangles as three vertices each (`nodes` by `indices`), for comparisons.
-    pub vertices: Vec<DrawVertex>,
-    pub pieces: u32,
-    /// Largest projected length, in pixels, of an output edge with an end on the screen rows.
-    pub max_sub_edge_px: f32,
-    /// The cuts around the axis the frame made (`active_cuts`).
-    pub cuts: AxisCuts,
-    /// Pieces drawn as a sliver's strip (the twin's count, for tests; 0 from the GPU).
-    pub strips: u32,
-    /// Band quads drawn as one strip between their rails (the twin's count, for tests; 0 from
-    /// the GPU).
-    pub quads: u32,
-    /// Triangles that ask for no cuts cut at edges they share with ones that do (the twin's
-    /// count, for tests; 0 from the GPU).
-    pub edge_splits: u32,
-}
-
-/// Indexed triangles as three vertices each.
-fn expand(nodes: &[DrawVertex], indices: &[u32]) -> Vec<DrawVertex> {
-    indices.iter().map(|&i| nodes[i as usize]).collect()
-}
-
-impl SubdivideOutput {
-    /// An output from its nodes and indices (the GPU's read-back), with `vertices` expanded.
-    pub fn indexed(
-        nodes: Vec<DrawVertex>,
-        indices: Vec<u32>,
-        pieces: u32,
-        max_sub_edge_px: f32,
-        cuts: AxisCuts,
-    ) -> Self {
-        let vertices = expand(&nodes, &indices);
-        SubdivideOutput { nodes, indices, vertices, pieces, max_sub_edge_px, cuts, ..Default::default() }
-    }
 }
 
 impl<'a> Subdivider<'a> {

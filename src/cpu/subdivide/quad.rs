@@ -8,7 +8,7 @@ use super::lattice::{quad_strip_node, quad_strip_node_count, quad_strip_rungs, q
 use super::{parts_for_bend, Node, SubdivideOutput, Subdivider, Triangle};
 use crate::core::projection::{azimuth, PanoramaKind};
 use crate::core::settings::SplitRule;
-use crate::shader::constants::{PIECE_DIVISIONS, QUAD_MIN_DIVISIONS, QUAD_RUNG_ERROR};
+use crate::encoding::constants::{PIECE_DIVISIONS, QUAD_MIN_DIVISIONS, QUAD_RUNG_ERROR};
 
 impl Subdivider<'_> {
     /// Whether a band's polygon is drawn as one strip between two of its sides (the rails)
@@ -17,11 +17,9 @@ impl Subdivider<'_> {
     /// at most N_max (as a part needing no pre-split), the longer in at least
     /// `QUAD_MIN_DIVISIONS`, and every rung of the zigzag (the sides of its triangles that cross
     /// between the rails, both one-part sides among them) within `QUAD_RUNG_ERROR`·τ of straight
-    /// by the quick profile, away from the eye circle, as every other edge drawn. Checking only
-    /// the one-part sides and a middle rung (at τ/4) let the long slanted rungs of narrow bands up
-    /// a wall (vertical rails, split only by length) reach p99 1.4 px in the box room at
-    /// τ = 0.5 px; with every rung the errors are the fan's (Sponza, the box room, the demo
-    /// room). The corners come back turned so that the rails run 0 → 1 and 3 → 2 (`plan_quad` in
+    /// by the quick profile, away from the eye circle, as every other edge drawn (a rung is an
+    /// edge drawn: checking fewer lets the long slanted rungs of narrow bands up a wall exceed τ).
+    /// The corners come back turned so that the rails run 0 → 1 and 3 → 2 (`plan_quad` in
     /// the WGSL).
     pub(super) fn quad_strip(&self, tri: &Triangle, poly: &[Node]) -> Option<([Node; 4], [u32; 2])> {
         if self.params.method != SplitRule::AdaptiveError as u32

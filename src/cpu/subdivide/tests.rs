@@ -3,7 +3,7 @@
 use super::lattice::quad_strip_node;
 use super::*;
 use crate::core::projection::{Eye, Vertical};
-use crate::core::settings::{Method, Split, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV};
+use crate::core::settings::{Method, RenderSettings, Split, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV};
 use std::collections::HashMap;
 use std::f32::consts::FRAC_PI_2;
 
@@ -473,8 +473,10 @@ mod real_mesh_tests {
     /// one leaves on a shared edge are compared.
     #[test]
     fn shared_edges_get_bit_identical_nodes_on_a_real_mesh() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/cow/cow.obj");
-        assert!(path.exists(), "test asset {} is missing: this test needs ../shared/assets", path.display());
+        if !crate::core::assets::present_for_test("shared_edges_get_bit_identical_nodes_on_a_real_mesh") {
+            return;
+        }
+        let path = crate::core::assets::root().join("cow/cow.obj");
         let projection = Projection { width: 1600, height: 300, ..Projection::default() };
         let mut scene = crate::core::load::load_obj(&path).unwrap();
         scene.fit(3.0, &projection).unwrap();

@@ -73,7 +73,7 @@ pub const QUAD_RUNG_ERROR: f32 = 1.0;
 pub const QUAD_HEAD: u32 = 1 << 31;
 pub const QUAD_TAIL: u32 = 1 << 30;
 /// The largest macro-lattice level K: a part makes at most this² pieces, so that one `plan`
-/// invocation's loop stays short (lavapipe lost pieces with K = 342, 117k pieces per part). An
+/// invocation's loop stays short (lavapipe cuts long invocations short and loses pieces). An
 /// adaptive part whose longest edge needs more than this × N_max divisions (an edge over
 /// 224·L long at N_max = 7) gets pieces of up to `PIECE_DIVISIONS` per edge instead of N_max.
 pub const MAX_MACRO_LEVEL: u32 = MAX_EDGE_DIVISIONS / PIECE_DIVISIONS;
@@ -168,7 +168,7 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("SHADOW_ORTHOGRAPHIC", U32(crate::core::shadow::SHADOW_ORTHOGRAPHIC)),
         ("SHADOW_PERSPECTIVE", U32(crate::core::shadow::SHADOW_PERSPECTIVE)),
         ("SHADOW_CUBE", U32(crate::core::shadow::SHADOW_CUBE)),
-        ("NO_SKIN", U32(crate::shader::types::NO_SKIN)),
+        ("NO_SKIN", U32(crate::encoding::types::NO_SKIN)),
         ("NO_SHADOW_MAP", U32(crate::core::light::NO_SHADOW_MAP)),
         ("NORMAL_OFFSET_TEXELS", F32(crate::core::shadow::NORMAL_OFFSET_TEXELS)),
         ("LIGHT_OFFSET_TEXELS", F32(crate::core::shadow::LIGHT_OFFSET_TEXELS)),

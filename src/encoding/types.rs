@@ -7,6 +7,7 @@ use std::mem::{offset_of, size_of};
 use bytemuck::{Pod, Zeroable};
 
 pub use crate::core::bvh::{BvhLevel, BvhNode};
+pub use crate::core::frame::ErrorStats;
 pub use crate::core::light::{GpuLight, LightingParams};
 use crate::core::material::{Material, MipLevel};
 use crate::core::projection::{PanoramaKind, Projection, Vertical};
@@ -188,21 +189,6 @@ pub struct DrawIndexedIndirectArgs {
     pub first_index: u32,
     pub base_vertex: i32,
     pub first_instance: u32,
-}
-
-/// `ErrorStats` in shaders/reduce_error.wgsl.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable, serde::Serialize)]
-pub struct ErrorStats {
-    pub count: u32,
-    pub mean: f32,
-    pub std_dev: f32,
-    pub p50: f32,
-    pub p90: f32,
-    pub p99: f32,
-    pub max: f32,
-    #[serde(skip)]
-    pub _pad: f32,
 }
 
 /// `ReduceParams` in shaders/reduce_error.wgsl.

@@ -1,0 +1,41 @@
+//! Uniform builders: the parameters of the raster and trace stages, built from the settings
+//! (the subdivide and slit stages' are in [`super::subdivide`] and [`super::slits`]).
+
+use crate::core::projection::Eye;
+use crate::core::settings::RenderSettings;
+use crate::encoding::types::{RasterParams, TraceParams};
+
+/// The raster stage's parameters: the left eye's, then the right's (its `array<RasterParams, 2>`).
+pub fn raster_params(settings: &RenderSettings) -> [RasterParams; 2] {
+    Eye::BOTH.map(|eye| RasterParams {
+        projection: settings.projection().into(),
+        eye_sign: eye.sign(),
+        ambient: settings.shading.ambient,
+        shift_px: settings.measure.shift_px,
+        error_angle: settings.measure.error_angle as u32,
+        ..Default::default()
+    })
+}
+
+/// The trace stage's parameters (`row_texels`: the outputs' padded row length).
+pub fn trace_params(settings: &RenderSettings, row_texels: u32) -> TraceParams {
+    let [r, g, b] = settings.shading.background;
+    TraceParams {
+        to_scene: settings.view().inverse().to_cols_array_2d(),
+        projection: settings.projection().into(),
+        background: [r, g, b, 1.0],
+        light: settings.shading.light.map_or([0.0; 4], |l| [l.x, l.y, l.z, 1.0]),
+        gaze_forward: settings.shading.trace_gaze.map_or([0.0; 4], |g| g.forward.extend(1.0).to_array()),
+        gaze_right: settings.shading.trace_gaze.map_or([0.0; 4], |g| g.right.extend(0.0).to_array()),
+        gaze_up: settings.shading.trace_gaze.map_or([0.0; 4], |g| g.up.extend(0.0).to_array()),
+        ambient: settings.shading.ambient,
+        error_angle: settings.measure.error_angle as u32,
+        row_texels,
+        reflect_max: settings.shading.reflect_max,
+        lod_min_share: settings.shading.trace_min_share,
+        // Set from the scene's BVH where it is bound (`SceneBvh::original_root`, `original_level`).
+        original_root: 0,
+        original_level: -1.0,
+        _pad2: 0,
+    }
+}

@@ -1,0 +1,101 @@
+//! The `subdivide` stage's encoding: its parameters built from the settings, the cuts around the
+//! axis it reports, and its output as both the GPU (read back) and the CPU twin give it.
+
+use crate::core::projection::{PanoramaKind, Projection};
+use crate::core::settings::RenderSettings;
+use crate::encoding::constants::{AXIS_CLEARANCE_MAX, AXIS_CLEARANCE_MIN};
+use crate::encoding::types::{DrawVertex, SubdivideParams};
+
+/// The `subdivide` stage's parameters for a range of input triangles (capacities and piece
+/// ranges are left for the caller, 0).
+pub fn subdivide_params(settings: &RenderSettings, first_triangle: u32, triangle_count: u32) -> SubdivideParams {
+    let projection = settings.projection();
+    let sub = &settings.subdivision;
+    let (rule, fixed_n) = sub.method.split_rule();
+    SubdivideParams {
+        view: settings.view().to_cols_array_2d(),
+        projection: projection.into(),
+        axis_clearance: axis_clearance(projection),
+        triangle_count,
+        first_triangle,
+        method: rule as u32,
+        fixed_n,
+        edge_px: sub.edge_px,
+        max_error_px: sub.max_error_px,
+        max_div: sub.max_div.max(1),
+        piece_capacity: 0,
+        triangle_capacity: 0,
+        first_piece: 0,
+        piece_count: 0,
+        measure_edges: (settings.measure.edges || settings.measure.error) as u32,
+        vertical_limit: projection.vertical_limit(),
+        ..Default::default()
+    }
+}
+
+/// ρ, the half-diagonal of the square cut around the axis: the eye radius clamped to
+/// `[AXIS_CLEARANCE_MIN, AXIS_CLEARANCE_MAX]`·R_T = [10⁻⁵, 10⁻³]·R_T. At most d_e, so only points no
+/// eye sees are removed, unless d_e < 10⁻⁵·R_T (a mono camera): then the removed points within
+/// 10⁻⁵·R_T of the axis could show only if they were as close to the eyes' height. Small, so that
+/// the paper model's image of a ceiling just above the eyes reaches past the top of the image;
+/// not smaller, so that the thin parts beside the square keep distinct lattice nodes in f32.
+///
+/// The sphere with pole merge sees every point near the axis (at the poles the eyes meet at the
+/// centre): there ρ is `AXIS_CLEARANCE_MIN` metres, so the hole the square leaves at a pole (the
+/// colatitudes below ρ/h for a surface h above or below the eyes) is smaller than half a pixel
+/// row unless h < 2ρ·H/π (1.3 cm at 4096×2048).
+pub fn axis_clearance(projection: &Projection) -> f32 {
+    if projection.panorama == PanoramaKind::Equirect && projection.pole_merge.is_some() {
+        return AXIS_CLEARANCE_MIN;
+    }
+    let rt = projection.screen_radius;
+    projection.eye_radius.clamp(AXIS_CLEARANCE_MIN * rt, AXIS_CLEARANCE_MAX * rt)
+}
+
+/// The cuts around the axis that a frame makes (see `cpu::subdivide::triangle_cuts`): bit 0 the quadrant cuts
+/// (planes x = 0 and z = 0) and the square around the axis, bit k ≥ 1 the diamond c_k
+/// (`band_bound`). With no bit set, no triangle is cut.
+pub type AxisCuts = u64;
+
+/// The stage's output, and counters the GPU keeps too.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SubdivideOutput {
+    /// Every piece's lattice nodes, once per seam copy (the raster's vertex buffer).
+    pub nodes: Vec<DrawVertex>,
+    /// The output triangles: three indices into `nodes` each.
+    pub indices: Vec<u32>,
+    /// The same triangles as three vertices each (`nodes` by `indices`), for comparisons.
+    pub vertices: Vec<DrawVertex>,
+    pub pieces: u32,
+    /// Largest projected length, in pixels, of an output edge with an end on the screen rows.
+    pub max_sub_edge_px: f32,
+    /// The cuts around the axis the frame made (`active_cuts`).
+    pub cuts: AxisCuts,
+    /// Pieces drawn as a sliver's strip (the twin's count, for tests; 0 from the GPU).
+    pub strips: u32,
+    /// Band quads drawn as one strip between their rails (the twin's count, for tests; 0 from
+    /// the GPU).
+    pub quads: u32,
+    /// Triangles that ask for no cuts cut at edges they share with ones that do (the twin's
+    /// count, for tests; 0 from the GPU).
+    pub edge_splits: u32,
+}
+
+/// Indexed triangles as three vertices each.
+pub fn expand(nodes: &[DrawVertex], indices: &[u32]) -> Vec<DrawVertex> {
+    indices.iter().map(|&i| nodes[i as usize]).collect()
+}
+
+impl SubdivideOutput {
+    /// An output from its nodes and indices (the GPU's read-back), with `vertices` expanded.
+    pub fn indexed(
+        nodes: Vec<DrawVertex>,
+        indices: Vec<u32>,
+        pieces: u32,
+        max_sub_edge_px: f32,
+        cuts: AxisCuts,
+    ) -> Self {
+        let vertices = expand(&nodes, &indices);
+        SubdivideOutput { nodes, indices, vertices, pieces, max_sub_edge_px, cuts, ..Default::default() }
+    }
+}
