@@ -1,6 +1,8 @@
 //! Options shared by the commands that render: the view (projection, viewer, method) and the
 //! level of detail, with their parsers and checks.
 
+use std::path::PathBuf;
+
 use clap::Args;
 use glam::Vec3;
 use twister::core::environment::PreparedEnvironment;
@@ -13,6 +15,7 @@ use twister::core::settings::{
 };
 use twister::core::visual_field::Gaze;
 use twister::error::{Error, Result};
+use twister::output::{ImageFormat, Layout};
 use twister::{Projection, RenderSettings, Vertical};
 
 #[derive(Args)]
@@ -413,4 +416,116 @@ impl ViewArgs {
             }
         }
     }
+}
+
+/// `twister render`'s options: the scene, the view, the outputs, and a sequence's frames.
+#[derive(Args)]
+#[command(allow_negative_numbers = true)]
+pub struct RenderArgs {
+    /// Scene to render: a .obj, .gltf or .glb file, or builtin:demo, builtin:box-room, builtin:cube, builtin:sphere100, builtin:sphere1024, builtin:triangle@D.
+    #[arg(default_value = "builtin:demo")]
+    pub scene: String,
+    /// Move and scale the scene so that it stands DIST metres ahead, filling the screen height.
+    #[arg(long, value_name = "DIST")]
+    pub fit: Option<f32>,
+    /// Output folder.
+    #[arg(long, default_value = "out")]
+    pub out: PathBuf,
+    #[command(flatten)]
+    pub view: ViewArgs,
+    /// Output layout: eyes (left.png, right.png), top-bottom (stereo_TB.png, left eye on top),
+    /// side-by-side (stereo_LR.png, left eye on the left), twister (four W/2×H images)
+    /// [default: eyes; top-bottom for --panorama equirect].
+    #[arg(long, value_enum)]
+    pub layout: Option<Layout>,
+    /// Image format: png or jpg (full-sphere images carry GPano XMP metadata in both).
+    #[arg(long, value_enum, default_value_t = ImageFormat::Png)]
+    pub format: ImageFormat,
+    /// JPEG quality, 1–100 (with --format jpg).
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=100))]
+    pub quality: Option<u8>,
+    /// Also write each eye's distance from its eye point along the ray, metres, as 32-bit float
+    /// OpenEXR (channel Z, +inf where no surface): left_depth.exr/right_depth.exr, depth_TB.exr
+    /// or depth_LR.exr, following the layout.
+    #[arg(long)]
+    pub depth: bool,
+    /// Also write each eye's linear colour (× 2^EV, before tone mapping, not clamped) as 32-bit
+    /// float OpenEXR (channels R, G, B): left_hdr.exr, right_hdr.exr. A second frame is drawn
+    /// into a float colour target; the projection methods only.
+    #[arg(long)]
+    pub hdr: bool,
+    /// Background colour R,G,B, each 0–255.
+    #[arg(long, value_parser = parse_rgb, default_value = "26,26,31")]
+    pub background: [f32; 3],
+    /// Write render statistics as JSON to this file.
+    #[arg(long)]
+    pub stats: Option<PathBuf>,
+    /// With --lod visual-field: tint each object by its level and draw the central-field
+    /// (white) and visual-field (orange) boundaries.
+    #[arg(long)]
+    pub lod_overlay: bool,
+    /// Render frames A to B (inclusive) of the animation timeline (frame k at k / FPS seconds)
+    /// into numbered files: frame_000123_TB.png (top-bottom), frame_000123_left.png … (see
+    /// *Sequences* in the README); `N` alone renders frame N.
+    #[arg(long, value_parser = parse_frames, value_name = "A..B")]
+    pub frames: Option<(u32, u32)>,
+    /// Frames per second of the sequence's timeline.
+    #[arg(long, default_value_t = 30.0)]
+    pub fps: f32,
+    /// The animation a sequence plays, by name or index [default: the file's first].
+    #[arg(long, value_name = "NAME|INDEX")]
+    pub animation: Option<String>,
+    /// Skip the frames whose files all exist (a sequence resumed after a stop).
+    #[arg(long)]
+    pub resume: bool,
+    /// Render only this shard's frames: I/N, frames whose index from A is ≡ I (mod N), or the
+    /// I-th of N contiguous blocks with --shard-mode blocks (a job array's task id).
+    #[arg(long, value_parser = parse_shard, value_name = "I/N")]
+    pub shard: Option<(u32, u32)>,
+    /// With --frames: also encode the sequence as an MP4 video (H.264 by the system's ffmpeg)
+    /// with Google's spherical video metadata (st3d stereo mode; sv3d equirectangular on the
+    /// sphere); needs a one-image layout (top-bottom or side-by-side). After --shard runs, run
+    /// once more with --resume --video to encode.
+    #[arg(long, value_name = "FILE.mp4")]
+    pub video: Option<PathBuf>,
+    /// With --frames and --lod visual-field: the gaze over time, a CSV of time,yaw,pitch rows
+    /// (seconds, degrees as --gaze): each frame's level of detail follows the tracked viewer.
+    #[arg(long, value_name = "FILE.csv")]
+    pub gaze_path: Option<PathBuf>,
+    /// With --frames: the viewer over time, a CSV of time,x,y,z[,yaw] rows (seconds; the place
+    /// in scene units as --viewer; degrees added to --yaw), blended linearly between rows.
+    #[arg(long, value_name = "FILE.csv")]
+    pub viewer_path: Option<PathBuf>,
+    /// How --shard splits the frames.
+    #[arg(long, value_enum, default_value_t = ShardMode::Interleave)]
+    pub shard_mode: ShardMode,
+}
+
+/// `--frames`: the first and last frame, inclusive.
+pub fn parse_frames(s: &str) -> std::result::Result<(u32, u32), String> {
+    let (a, b) = s.split_once("..").unwrap_or((s, s));
+    let (a, b) = (a.trim().parse::<u32>(), b.trim().parse::<u32>());
+    match (a, b) {
+        (Ok(a), Ok(b)) if a <= b && b < 100_000_000 => Ok((a, b)),
+        _ => Err(format!("'{s}': expected A..B, frame numbers from 0 with A ≤ B (or one frame N)")),
+    }
+}
+
+/// `--shard I/N`.
+pub fn parse_shard(s: &str) -> std::result::Result<(u32, u32), String> {
+    let parsed = s.split_once('/').map(|(i, n)| (i.trim().parse::<u32>(), n.trim().parse::<u32>()));
+    match parsed {
+        Some((Ok(i), Ok(n))) if n > 0 && i < n => Ok((i, n)),
+        _ => Err(format!("'{s}': expected I/N with 0 ≤ I < N (e.g. $SLURM_ARRAY_TASK_ID/$N)")),
+    }
+}
+
+/// How `--shard` splits the frames.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum ShardMode {
+    /// Frame k goes to shard k mod N.
+    #[default]
+    Interleave,
+    /// N contiguous blocks, as even as can be.
+    Blocks,
 }

@@ -13,6 +13,7 @@ mod plot;
 mod render;
 mod scene;
 mod sequence;
+mod writer;
 
 use std::process::ExitCode;
 
@@ -30,7 +31,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene into the left- and right-eye panoramas.
-    Render(render::RenderArgs),
+    Render(args::RenderArgs),
     /// Measure the display-position error of a method (seed 002 §4.1).
     Error(measure::ErrorArgs),
     /// Describe a scene file as JSON: triangles, objects, materials, bounds, cameras, lights, warnings,
@@ -56,7 +57,10 @@ fn main() -> ExitCode {
         }
     };
     let result = match &cli.command {
-        Command::Render(args) => render::render(args),
+        Command::Render(args) => match args.frames {
+            Some(frames) => sequence::render_sequence(args, frames),
+            None => render::render(args),
+        },
         Command::Error(args) => measure::measure(args),
         Command::Info(args) => info::info(args),
         Command::Bench(BenchCommand::Speed(args)) => bench::bench_speed(args),

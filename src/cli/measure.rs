@@ -48,7 +48,7 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
     // With --against, both frames also measure depth (the distance differences); against the ray
     // tracer, also the surface points (where the traced image shows what was drawn).
     let drawn: Vec<Method> = std::iter::once(args.view.method).chain(args.against).collect();
-    let mut settings = args
+    let settings = args
         .view
         .settings(&drawn)?
         .with_measure_error(true)
@@ -56,7 +56,8 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
         .with_positions(args.against == Some(Method::Trace));
     let (renderer, adapter) = open_renderer()?;
     let methods: Vec<Method> = std::iter::once(settings.subdivision.method).chain(args.against).collect();
-    let prepared = prepare(&renderer, &args.scene, args.fit, &args.view, &mut settings, false, &methods)?;
+    let prepared = prepare(&renderer, &args.scene, args.fit, &args.view, settings, false, &methods)?;
+    let settings = prepared.settings;
     let gpu_scene = &prepared.gpu_scene;
     let frame = renderer.render(gpu_scene, &settings)?;
     let measured = frame.measurement.as_ref().expect("rendered with the error pass");

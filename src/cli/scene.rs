@@ -28,8 +28,14 @@ pub fn warn(spec: &str, warning: &str) {
 }
 
 /// Loads and places a scene: `--scale`, then `--fit`; a `camera[:N]` viewer takes that
-/// camera's place and yaw (the camera moved with the scene). Prints the loader's warnings.
-pub fn place(spec: &str, fit: Option<f32>, view: &ViewArgs, settings: &mut RenderSettings) -> Result<Scene> {
+/// camera's place and yaw (the camera moved with the scene): the settings returned say so.
+/// Prints the loader's warnings.
+pub fn place(
+    spec: &str,
+    fit: Option<f32>,
+    view: &ViewArgs,
+    settings: RenderSettings,
+) -> Result<(Scene, RenderSettings)> {
     let mut scene = load_scene(spec, settings.projection())?;
     for w in &scene.warnings {
         warn(spec, w);
@@ -46,10 +52,10 @@ pub fn place(spec: &str, fit: Option<f32>, view: &ViewArgs, settings: &mut Rende
         let cam = scene.cameras.get(n).ok_or_else(|| {
             Error::scene(spec, format!("--viewer camera:{n}, but the file has {} cameras", scene.cameras.len()))
         })?;
-        settings.view.viewer = Vec3::from(cam.position);
-        settings.view.yaw_deg += cam.yaw_deg;
+        let placed = settings.with_viewer(Vec3::from(cam.position)).with_yaw_deg(settings.view.yaw_deg + cam.yaw_deg);
+        return Ok((scene, placed));
     }
-    Ok(scene)
+    Ok((scene, settings))
 }
 
 /// After a transform: coordinates beyond what the projection computes in f32 (or an overflow
@@ -65,9 +71,12 @@ fn check_in_range(scene: &Scene, spec: &str, option: &'static str) -> Result<()>
     }
 }
 
-/// A scene ready to render.
+/// A scene ready to render, and the settings to render it with.
 pub struct Prepared {
     pub gpu_scene: GpuScene,
+    /// The settings as placed with the scene (a file camera's viewer, the ray tracer's gaze),
+    /// validated: read only from here on.
+    pub settings: RenderSettings,
     /// The placed scene (a sequence poses it frame by frame).
     pub scene: Scene,
     pub selection: Option<LodSelection>,
@@ -75,13 +84,14 @@ pub struct Prepared {
 }
 
 /// Places the scene and uploads it, with its BVH when one of `methods` traces rays; with
-/// `--lod visual-field`, draws the gaze's selection (tinted by level when `overlay`).
+/// `--lod visual-field`, draws the gaze's selection (tinted by level when `overlay`). The
+/// settings come back placed with the scene and validated.
 pub fn prepare(
     renderer: &Renderer,
     spec: &str,
     fit: Option<f32>,
     view: &ViewArgs,
-    settings: &mut RenderSettings,
+    settings: RenderSettings,
     overlay: bool,
     methods: &[Method],
 ) -> Result<Prepared> {
@@ -89,6 +99,7 @@ pub fn prepare(
     let mut lod = view.lod()?;
     // The ray tracer's level of detail: each object's chain down to P3 of its triangles.
     let mut trace_min_share = None;
+    let mut settings = settings;
     if let (Some((params, gaze)), true) = (&lod, methods.contains(&Method::Trace)) {
         // The ray tracer's level of detail is per ray (seed 000), not a selection of objects.
         if methods.len() > 1 {
@@ -97,11 +108,12 @@ pub fn prepare(
                 "with --method trace, the level of detail is per ray: run trace apart from the other methods",
             ));
         }
-        *settings = settings.with_trace_gaze(Some(*gaze)).with_trace_min_share(params.p3);
+        settings = settings.with_trace_gaze(Some(*gaze)).with_trace_min_share(params.p3);
         trace_min_share = Some(params.p3);
         lod = None;
     }
-    let mut scene = place(spec, fit, view, settings)?;
+    let (mut scene, settings) = place(spec, fit, view, settings)?;
+    settings.validate()?;
     if let Some([azimuth, elevation, lux]) = view.sun {
         scene.lights.push(twister::core::light::Light::sun(azimuth, elevation, lux));
     }
@@ -131,7 +143,7 @@ pub fn prepare(
     if let Some(sel) = &selection {
         gpu_scene = gpu_scene.with_lod(&renderer.gpu, sel);
     }
-    Ok(Prepared { gpu_scene, scene, selection, gaze: lod.map(|(_, g)| g) })
+    Ok(Prepared { gpu_scene, settings, scene, selection, gaze: lod.map(|(_, g)| g) })
 }
 
 /// The LOD part of the stats: triangles selected and, per field, objects and triangles.

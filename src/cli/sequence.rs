@@ -15,43 +15,14 @@ use std::path::PathBuf;
 
 use glam::Vec3;
 
-use crate::args::Viewer;
-use crate::render::RenderArgs;
+use crate::args::{RenderArgs, ShardMode, Viewer};
+use crate::render::render_settings;
 use crate::scene::{open_renderer, prepare};
+use crate::writer::{frame_name, FrameRecord, FrameWriter};
 use twister::core::projection::PanoramaKind;
 use twister::core::settings::Method;
 use twister::error::{Error, Result};
-use twister::output::{layout_images, layout_names, write_all, Encoding, Layout};
-use twister::RenderSettings;
-
-/// `--frames`: the first and last frame, inclusive.
-pub fn parse_frames(s: &str) -> std::result::Result<(u32, u32), String> {
-    let (a, b) = s.split_once("..").unwrap_or((s, s));
-    let (a, b) = (a.trim().parse::<u32>(), b.trim().parse::<u32>());
-    match (a, b) {
-        (Ok(a), Ok(b)) if a <= b && b < 100_000_000 => Ok((a, b)),
-        _ => Err(format!("'{s}': expected A..B, frame numbers from 0 with A ≤ B (or one frame N)")),
-    }
-}
-
-/// `--shard I/N`.
-pub fn parse_shard(s: &str) -> std::result::Result<(u32, u32), String> {
-    let parsed = s.split_once('/').map(|(i, n)| (i.trim().parse::<u32>(), n.trim().parse::<u32>()));
-    match parsed {
-        Some((Ok(i), Ok(n))) if n > 0 && i < n => Ok((i, n)),
-        _ => Err(format!("'{s}': expected I/N with 0 ≤ I < N (e.g. $SLURM_ARRAY_TASK_ID/$N)")),
-    }
-}
-
-/// How `--shard` splits the frames.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
-pub enum ShardMode {
-    /// Frame k goes to shard k mod N.
-    #[default]
-    Interleave,
-    /// N contiguous blocks, as even as can be.
-    Blocks,
-}
+use twister::output::{write_all, Layout};
 
 /// The frames of `first..=last` shard `i` of `n` renders.
 pub fn shard_frames(first: u32, last: u32, (i, n): (u32, u32), mode: ShardMode) -> Vec<u32> {
@@ -65,13 +36,9 @@ pub fn shard_frames(first: u32, last: u32, (i, n): (u32, u32), mode: ShardMode) 
     }
 }
 
-/// A frame's file name: `frame_000123_` and the layout's name (`stereo_` dropped: `_TB`, `_LR`).
-pub fn frame_name(frame: u32, layout_name: &str) -> String {
-    format!("frame_{frame:06}_{}", layout_name.strip_prefix("stereo_").unwrap_or(layout_name))
-}
-
 /// Renders the sequence `args.frames` asks for.
-pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32), mut settings: RenderSettings) -> Result<()> {
+pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32)) -> Result<()> {
+    let settings = render_settings(args)?;
     for (given, option) in [(args.depth, "--depth"), (args.hdr, "--hdr"), (args.lod_overlay, "--lod-overlay")] {
         if given {
             return Err(Error::option(option, "writes one still: leave it out with --frames"));
@@ -81,15 +48,8 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32), mut setting
         return Err(Error::option("--fps", format!("must be between 0 and 1000 frames per second, got {}", args.fps)));
     }
     let panorama = settings.projection().panorama;
-    let layout = args.layout.unwrap_or(Layout::default_for(panorama));
-    let (w, h) = (settings.projection().width, settings.projection().height);
-    let encoding = Encoding {
-        format: args.format,
-        quality: args.quality.unwrap_or(90),
-        xmp: (panorama == PanoramaKind::Equirect).then(|| twister::output::gpano_xmp(w, h)),
-        fast: true,
-    };
-    let stereo = match layout {
+    let writer = FrameWriter::new(args, &settings, true)?;
+    let stereo = match writer.layout() {
         Layout::TopBottom => twister::video::StereoMode::TopBottom,
         Layout::SideBySide => twister::video::StereoMode::LeftRight,
         _ => twister::video::StereoMode::Mono,
@@ -114,8 +74,6 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32), mut setting
         Some(shard) => shard_frames(first, last, shard, args.shard_mode),
         None => (first..=last).collect(),
     };
-    let names = layout_names(layout, args.format);
-    let paths = |frame: u32| -> Vec<PathBuf> { names.iter().map(|n| args.out.join(frame_name(frame, n))).collect() };
     let gaze_path = args.gaze_path.as_deref().map(twister::core::visual_field::GazePath::read).transpose()?;
     let lod = args.view.lod()?;
     let viewer_path = match &args.viewer_path {
@@ -133,10 +91,11 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32), mut setting
     if gaze_path.is_some() && lod.is_none() {
         return Err(Error::option("--gaze-path", "steers the level of detail: use it with --lod visual-field"));
     }
-    let (renderer, _adapter) = open_renderer()?;
+    let (renderer, adapter) = open_renderer()?;
     let method = [settings.subdivision.method];
     let base_yaw = settings.view.yaw_deg;
-    let mut prepared = prepare(&renderer, &args.scene, args.fit, &args.view, &mut settings, false, &method)?;
+    let mut prepared = prepare(&renderer, &args.scene, args.fit, &args.view, settings, false, &method)?;
+    let base = prepared.settings;
     let clip = match (&prepared.scene.rig, &args.animation) {
         (Some(rig), Some(name)) => Some(rig.clip_index(name).ok_or_else(|| {
             let known: Vec<&str> = rig.clips.iter().map(|c| c.name.as_str()).collect();
@@ -161,7 +120,7 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32), mut setting
         Viewer::At(_) => None,
     };
     let todo: Vec<u32> =
-        frames.into_iter().filter(|&f| !(args.resume && paths(f).iter().all(|p| p.exists()))).collect();
+        frames.into_iter().filter(|&f| !(args.resume && writer.paths(Some(f)).iter().all(|p| p.exists()))).collect();
     if let Some(dir) = args.stats.as_deref().and_then(|p| p.parent()).filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| Error::output(dir, format!("cannot create the folder: {e}")))?;
     }
@@ -184,36 +143,26 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32), mut setting
     let start = std::time::Instant::now();
     // A writer thread encodes and writes frame k while the GPU draws frame k + 1 (one frame in
     // flight: bounded memory).
-    type Done = (u32, f32, f64, twister::Frame, Option<twister::core::lod::LodSelection>);
+    type Done = (u32, f32, f64, twister::Frame, twister::RenderSettings, Option<twister::core::lod::LodSelection>);
     let (send, receive) = std::sync::mpsc::sync_channel::<Done>(1);
     std::thread::scope(|scope| -> Result<()> {
-        let writer = scope.spawn(|| -> Result<()> {
-            for (frame, time, ms_pose, rendered, selected) in receive {
+        let writing = scope.spawn(|| -> Result<()> {
+            for (frame, time, ms_pose, rendered, drawn_with, selected) in receive {
                 let t = std::time::Instant::now();
-                let files = layout_images(&rendered, layout, args.format)
-                    .iter()
-                    .map(|(name, img)| {
-                        twister::output::image_file(args.out.join(frame_name(frame, name)), img, &encoding)
-                    })
-                    .collect::<Result<Vec<_>>>()?;
+                let files = writer.files(&rendered, Some(frame))?;
                 write_all(&files)?;
                 let ms_write = t.elapsed().as_secs_f64() * 1e3;
                 if let (Some(file), Some(path)) = (stats.as_mut(), &args.stats) {
-                    let s = &rendered.stats;
-                    let line = serde_json::json!({
-                        "frame": frame,
-                        "time": time,
-                        "triangles_in": s.triangles_in,
-                        "triangles_out": s.triangles_out,
-                        "ms_pose": ms_pose,
-                        "ms_frame": s.ms_frame,
-                        "ms_gpu": s.ms_gpu,
-                        "ms_readback": s.ms_readback,
-                        "ms_total": s.ms_total,
-                        "ms_write": ms_write,
-                        "files": files.iter().map(|f| f.path.display().to_string()).collect::<Vec<_>>(),
-                        "lod": crate::scene::lod_stats(&selected),
-                    });
+                    let lod = crate::scene::lod_stats(&selected);
+                    let record = FrameRecord {
+                        frame: Some(frame),
+                        time: Some(time),
+                        ms_pose: Some(ms_pose),
+                        ms_write,
+                        files: Some(files.iter().map(|f| f.path.display().to_string()).collect()),
+                        ..FrameRecord::new(&args.scene, &drawn_with, &rendered, &writer, &adapter, lod)
+                    };
+                    let line = serde_json::to_string(&record).expect("JSON of plain values");
                     writeln!(file, "{line}").map_err(|e| Error::output(path, format!("cannot write: {e}")))?;
                 }
                 progress.inc(1);
@@ -225,7 +174,7 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32), mut setting
                 let time = frame as f32 / args.fps;
                 let t = std::time::Instant::now();
                 if prepared.scene.rig.is_some() {
-                    if settings.subdivision.method == Method::Trace {
+                    if base.subdivision.method == Method::Trace {
                         // The ray tracer's BVH is built on the CPU from the posed vertices.
                         prepared.scene.pose(clip, time);
                         prepared.gpu_scene.update_pose(&renderer.gpu, &prepared.scene)?;
@@ -240,31 +189,32 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32), mut setting
                         renderer.pose(target, &mut prepared.scene, clip, time)?;
                     }
                 }
+                // The frame's settings: the base's, with the viewer the path or the posed camera puts.
+                let mut settings = base;
+                if let Some(path) = &viewer_path {
+                    let v = path.at(time);
+                    let yaw = base_yaw + v.get(3).copied().unwrap_or(0.0);
+                    settings = base.with_viewer(Vec3::new(v[0], v[1], v[2]) * args.view.scale).with_yaw_deg(yaw);
+                }
+                if let Some(cam) = camera.and_then(|n| prepared.scene.cameras.get(n)) {
+                    settings = base.with_viewer(Vec3::from(cam.position)).with_yaw_deg(base_yaw + cam.yaw_deg);
+                }
                 let mut selected = None;
                 if let Some((path, params, chain, whole)) = &tracked {
                     let selection = chain.select(&prepared.scene, settings.view(), &path.at(time), params);
                     prepared.gpu_scene = whole.with_lod(&renderer.gpu, &selection);
                     selected = Some(selection);
                 }
-                if let Some(path) = &viewer_path {
-                    let v = path.at(time);
-                    settings.view.viewer = Vec3::new(v[0], v[1], v[2]) * args.view.scale;
-                    settings.view.yaw_deg = base_yaw + v.get(3).copied().unwrap_or(0.0);
-                }
-                if let Some(cam) = camera.and_then(|n| prepared.scene.cameras.get(n)) {
-                    settings.view.viewer = Vec3::from(cam.position);
-                    settings.view.yaw_deg = base_yaw + cam.yaw_deg;
-                }
                 let ms_pose = t.elapsed().as_secs_f64() * 1e3;
                 let rendered = renderer.render(&prepared.gpu_scene, &settings)?;
-                if send.send((frame, time, ms_pose, rendered, selected)).is_err() {
+                if send.send((frame, time, ms_pose, rendered, settings, selected)).is_err() {
                     break; // the writer stopped: its error is reported below
                 }
             }
             Ok(())
         })();
         drop(send);
-        let written = writer.join().expect("the writer thread does not panic");
+        let written = writing.join().expect("the writer thread does not panic");
         drawn.and(written)
     })?;
     progress.finish_and_clear();
@@ -276,7 +226,7 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32), mut setting
         if skipped > 0 { format!(" ({skipped} skipped: complete, or another shard's)") } else { String::new() }
     );
     if let Some(video) = &args.video {
-        let name = frame_name(0, &names[0]).replacen("000000", "%06d", 1);
+        let name = frame_name(0, &writer.image_names()[0]).replacen("000000", "%06d", 1);
         encode_video(video, &args.out.join(name), first, last - first + 1, args.fps, stereo, panorama)?;
         println!("{}", video.display());
     }

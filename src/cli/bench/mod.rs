@@ -363,10 +363,13 @@ pub fn bench_speed(args: &SpeedArgs) -> Result<()> {
     // Every scene as `render` would draw it: --scale, --fit (file scenes), --viewer camera:N, --lod.
     let mut scenes = Vec::new();
     for spec in &args.scenes {
-        let mut settings = base;
         let fit = args.fit.filter(|_| !spec.starts_with("builtin:"));
-        let prepared = crate::scene::prepare(&renderer, spec, fit, &args.view, &mut settings, false, &args.methods)?;
-        scenes.push(speed::SpeedScene { spec: spec.clone(), gpu_scene: prepared.gpu_scene, settings });
+        let prepared = crate::scene::prepare(&renderer, spec, fit, &args.view, base, false, &args.methods)?;
+        scenes.push(speed::SpeedScene {
+            spec: spec.clone(),
+            gpu_scene: prepared.gpu_scene,
+            settings: prepared.settings,
+        });
     }
     let rows = speed::speed(&renderer, &scenes, &args.methods, args.reps, |what| eprintln!("timing {what} ..."))?;
     let timing = rows.first().map_or("-".to_string(), |r| r.timing.clone());

@@ -1,0 +1,209 @@
+//! One frame writer for a still and for each frame of a sequence: which files a frame makes
+//! (the layout's images, depth, linear colour), how they are encoded and named, and the
+//! statistics record written beside them (`--stats`: one JSON object for a still, one line per
+//! frame for a sequence).
+
+use std::path::PathBuf;
+
+use serde::Serialize;
+use twister::core::projection::PanoramaKind;
+use twister::error::{Error, Result};
+use twister::output::{
+    depth_images, depth_names, exr_file, gpano_xmp, hdr_exr_file, image_file, layout_images, layout_names, Encoding,
+    ImageFormat, Layout, OutputFile,
+};
+use twister::{Frame, RenderSettings};
+
+use crate::args::RenderArgs;
+
+/// The linear colour's files (`--hdr`), per eye.
+const HDR_NAMES: [&str; 2] = ["left_hdr.exr", "right_hdr.exr"];
+
+/// How a render's frames become files.
+pub struct FrameWriter {
+    out: PathBuf,
+    layout: Layout,
+    format: ImageFormat,
+    encoding: Encoding,
+    depth: bool,
+    hdr: bool,
+}
+
+impl FrameWriter {
+    /// The writer the options ask for, for frames drawn with `settings`; `fast`: PNGs deflated
+    /// quickly (sequences).
+    pub fn new(args: &RenderArgs, settings: &RenderSettings, fast: bool) -> Result<FrameWriter> {
+        if args.quality.is_some() && args.format != ImageFormat::Jpg {
+            return Err(Error::option("--quality", "needs --format jpg"));
+        }
+        let projection = settings.projection();
+        let sphere = projection.panorama == PanoramaKind::Equirect;
+        Ok(FrameWriter {
+            out: args.out.clone(),
+            layout: args.layout.unwrap_or(Layout::default_for(projection.panorama)),
+            format: args.format,
+            encoding: Encoding {
+                format: args.format,
+                quality: args.quality.unwrap_or(90),
+                xmp: sphere.then(|| gpano_xmp(projection.width, projection.height)),
+                fast,
+            },
+            depth: args.depth,
+            hdr: args.hdr,
+        })
+    }
+
+    pub fn layout(&self) -> Layout {
+        self.layout
+    }
+
+    /// The layout's image names (`left.png`, `stereo_TB.png`, …).
+    pub fn image_names(&self) -> Vec<String> {
+        layout_names(self.layout, self.format)
+    }
+
+    /// Where a file of a frame goes: as named for a still, numbered for frame `k` of a sequence.
+    fn path(&self, frame: Option<u32>, name: &str) -> PathBuf {
+        self.out.join(match frame {
+            Some(k) => frame_name(k, name),
+            None => name.to_string(),
+        })
+    }
+
+    /// Every file a frame writes, the images first.
+    pub fn paths(&self, frame: Option<u32>) -> Vec<PathBuf> {
+        let mut names = self.image_names();
+        if self.depth {
+            names.extend(depth_names(self.layout));
+        }
+        if self.hdr {
+            names.extend(HDR_NAMES.map(String::from));
+        }
+        names.iter().map(|name| self.path(frame, name)).collect()
+    }
+
+    /// A frame's files, encoded: the layout's images, then depth and linear colour where the
+    /// frame holds them.
+    pub fn files(&self, rendered: &Frame, frame: Option<u32>) -> Result<Vec<OutputFile>> {
+        let mut files = layout_images(rendered, self.layout, self.format)
+            .iter()
+            .map(|(name, img)| image_file(self.path(frame, name), img, &self.encoding))
+            .collect::<Result<Vec<_>>>()?;
+        for (name, depth) in depth_images(rendered, self.layout).unwrap_or_default() {
+            files.push(exr_file(self.path(frame, &name), &depth)?);
+        }
+        if let Some(hdr) = &rendered.hdr {
+            for (name, eye) in HDR_NAMES.into_iter().zip(hdr) {
+                files.push(hdr_exr_file(self.path(frame, name), rendered.left.width, rendered.left.height, eye)?);
+            }
+        }
+        Ok(files)
+    }
+}
+
+/// A frame's file name: `frame_000123_` and the layout's name (`stereo_` dropped: `_TB`, `_LR`).
+pub fn frame_name(frame: u32, layout_name: &str) -> String {
+    format!("frame_{frame:06}_{}", layout_name.strip_prefix("stereo_").unwrap_or(layout_name))
+}
+
+/// What `--stats` records of a frame: the scene, the method and its parameters, the view, the
+/// counts and times. A sequence's lines also carry the frame, its time, the pose's time and
+/// the files written.
+#[derive(Serialize)]
+pub struct FrameRecord<'a> {
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub frame: Option<u32>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time: Option<f32>,
+    pub scene: &'a str,
+    pub method: String,
+    pub edge_px: f32,
+    pub max_error_px: f32,
+    pub max_div: u32,
+    pub triangles_in: u64,
+    pub triangles_out: u64,
+    pub triangles_drawn: u64,
+    pub pieces: u64,
+    pub rays_traced: Option<u64>,
+    pub triangle_tests: Option<u64>,
+    pub max_sub_edge_px: f32,
+    pub chunks: u32,
+    pub width: u32,
+    pub height: u32,
+    pub screen_radius: f32,
+    pub eye_radius: f32,
+    pub vertical: twister::Vertical,
+    pub panorama: PanoramaKind,
+    pub convergence: serde_json::Value,
+    pub pole_merge: Option<(f32, f32)>,
+    pub layout: Layout,
+    pub format: ImageFormat,
+    pub adapter: &'a str,
+    pub timing: twister::core::frame::Timing,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ms_pose: Option<f64>,
+    pub ms_frame: f64,
+    pub ms_gpu: Option<f64>,
+    pub ms_subdivide: Option<f64>,
+    pub ms_raster: Option<f64>,
+    pub ms_readback: f64,
+    pub ms_write: f64,
+    /// The render call's wall time; a still's includes the writing (encoding) too.
+    pub ms_total: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub files: Option<Vec<String>>,
+    pub lod: serde_json::Value,
+}
+
+impl<'a> FrameRecord<'a> {
+    /// The record of `rendered`, drawn from `scene` with `settings`, written by `writer`.
+    pub fn new(
+        scene: &'a str,
+        settings: &RenderSettings,
+        rendered: &Frame,
+        writer: &FrameWriter,
+        adapter: &'a str,
+        lod: serde_json::Value,
+    ) -> FrameRecord<'a> {
+        let (s, p, sub) = (&rendered.stats, settings.projection(), &settings.subdivision);
+        FrameRecord {
+            frame: None,
+            time: None,
+            scene,
+            method: sub.method.name(),
+            edge_px: sub.edge_px,
+            max_error_px: sub.max_error_px,
+            max_div: sub.max_div,
+            triangles_in: s.triangles_in,
+            triangles_out: s.triangles_out,
+            triangles_drawn: s.triangles_out,
+            pieces: s.pieces,
+            rays_traced: s.rays_traced,
+            triangle_tests: s.triangle_tests,
+            max_sub_edge_px: s.max_sub_edge_px,
+            chunks: s.chunks,
+            width: p.width,
+            height: p.height,
+            screen_radius: p.screen_radius,
+            eye_radius: p.eye_radius,
+            vertical: p.vertical,
+            panorama: p.panorama,
+            convergence: p.convergence.map_or(serde_json::json!("parallel"), |c| serde_json::json!(c)),
+            pole_merge: p.pole_merge,
+            layout: writer.layout,
+            format: writer.format,
+            adapter,
+            timing: s.timing,
+            ms_pose: None,
+            ms_frame: s.ms_frame,
+            ms_gpu: s.ms_gpu,
+            ms_subdivide: s.ms_subdivide,
+            ms_raster: s.ms_raster,
+            ms_readback: s.ms_readback,
+            ms_write: 0.0,
+            ms_total: s.ms_total,
+            files: None,
+            lod,
+        }
+    }
+}
