@@ -25,8 +25,10 @@ struct RasterParams {
 // Left eye, right eye.
 @group(0) @binding(0) var<uniform> params: array<RasterParams, 2>;
 
-fn stage_params(eye: u32) -> RasterParams {
-    return params[eye];
+// What the fragments of eye `eye` (0 left, 1 right) need of its parameters.
+fn fragment_view(eye: u32) -> FragmentView {
+    let p = params[eye];
+    return FragmentView(p.projection, p.eye_sign, p.ambient, p.error_angle);
 }
 
 struct VertexIn {
@@ -44,7 +46,7 @@ struct VertexIn {
 @vertex
 fn vs_main(in: VertexIn, eye_in: EyeIn) -> VertexOut {
     let eye = eye_index(eye_in);
-    let params = stage_params(eye);
+    let params = params[eye];
     // Unwrap θ by whole turns towards the triangle's reference, so the triangle is never split
     // by the seam; a vertex shared by neighbours gets the same bits in both.
     let theta0 = azimuth(in.position);
@@ -69,4 +71,26 @@ fn vs_main(in: VertexIn, eye_in: EyeIn) -> VertexOut {
 @vertex
 fn vs_background(@builtin(vertex_index) i: u32, eye_in: EyeIn) -> BackgroundOut {
     return background_vertex(i, eye_index(eye_in));
+}
+
+// ---- The fragment entry points (what they compute: fragment.wgsl) ----
+
+@fragment
+fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    return fragment_color(in, front_facing, fragment_view(in.eye));
+}
+
+@fragment
+fn fs_error(in: VertexOut, @builtin(front_facing) front_facing: bool) -> FragmentOut {
+    return measured(in, front_facing, fragment_view(in.eye));
+}
+
+@fragment
+fn fs_position(in: VertexOut, @builtin(front_facing) front_facing: bool) -> FragmentOutPosition {
+    return measured_position(in, front_facing, fragment_view(in.eye));
+}
+
+@fragment
+fn fs_background(in: BackgroundOut) -> @location(0) vec4<f32> {
+    return background_color(fragment_view(in.eye), in.clip.xy);
 }

@@ -33,8 +33,8 @@ struct SlitCamera {
 @group(0) @binding(0) var<uniform> params: SlitParams;
 
 // The slit stage draws one eye per pass, with that eye's `params`.
-fn stage_params(eye: u32) -> SlitParams {
-    return params;
+fn fragment_view(eye: u32) -> FragmentView {
+    return FragmentView(params.projection, params.eye_sign, params.ambient, params.error_angle);
 }
 @group(0) @binding(1) var<storage, read> cameras: array<SlitCamera>;
 
@@ -78,4 +78,26 @@ fn vs_main(in: VertexIn) -> VertexOut {
 @vertex
 fn vs_background(@builtin(vertex_index) i: u32) -> BackgroundOut {
     return background_vertex(i, 0u);
+}
+
+// ---- The fragment entry points (what they compute: fragment.wgsl) ----
+
+@fragment
+fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+    return fragment_color(in, front_facing, fragment_view(in.eye));
+}
+
+@fragment
+fn fs_error(in: VertexOut, @builtin(front_facing) front_facing: bool) -> FragmentOut {
+    return measured(in, front_facing, fragment_view(in.eye));
+}
+
+@fragment
+fn fs_position(in: VertexOut, @builtin(front_facing) front_facing: bool) -> FragmentOutPosition {
+    return measured_position(in, front_facing, fragment_view(in.eye));
+}
+
+@fragment
+fn fs_background(in: BackgroundOut) -> @location(0) vec4<f32> {
+    return background_color(fragment_view(in.eye), in.clip.xy);
 }

@@ -88,7 +88,7 @@ fn white_spheres_in_a_uniform_environment_reflect_exactly_what_arrives() {
     let gpu = common::render(&scene, &s);
     let params = subdivide_params(&s, 0, scene.triangle_count() as u32);
     let tris = subdivide(&params, &scene.vertices, &scene.indices).vertices;
-    let (lights, lighting) = s.lighting(&scene.lights, scene.environment.as_deref());
+    let (lights, lighting) = s.lighting(&scene.lights, scene.physically_based, scene.environment.as_deref());
     let table = scene.material_table(usize::MAX).with_lighting(lights, lighting);
     let cpu = raster(&raster_params(&s), &tris, &table, s.shading.background);
     for (what, rgba) in [("GPU", &gpu.eye(Eye::Left).rgba), ("CPU twin", &cpu[0].rgba)] {

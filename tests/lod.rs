@@ -12,6 +12,7 @@ use twister::core::settings::Method;
 use twister::core::visual_field::{Field, Gaze};
 use twister::cpu::subdivide::Subdivider;
 use twister::encoding::subdivide::subdivide_params;
+use twister::gpu::subdivide::Schedule;
 use twister::{GpuScene, RenderSettings, Scene};
 
 /// Twelve 1024-triangle spheres 3 m around the viewer every 30°.
@@ -41,7 +42,7 @@ fn the_subdivision_follows_each_objects_level_as_the_cpu_twin_does() {
     );
     let r = common::renderer();
     let base = GpuScene::upload(&r.gpu, &scene).unwrap();
-    let gpu = r.subdivide_readback(&base.with_lod(&r.gpu, &sel), &s).unwrap();
+    let gpu = r.subdivide_readback(&base.with_lod(&r.gpu, &sel), &s, Schedule::OneSubmission).unwrap();
     let drawn = sel.scene(&scene);
     let params = subdivide_params(&s, 0, drawn.triangle_count() as u32);
     let scales = sel.edge_scales();

@@ -253,3 +253,30 @@ fn the_ray_tracer_lights_the_spheres_as_the_rasterizer_does() {
     );
     assert!(n > 3000 && mean < 1.0, "{n} pixels, mean {mean}");
 }
+
+/// Under `--lighting auto` a physically based scene (a glTF file's) is lit by the BRDF even with
+/// no lights and no environment (`--environment none`): an emissive white ball with a black base
+/// colour shows its emission, as with `--lighting pbr` (it used to fall back to the headlight and
+/// render black). The same scene not physically based (an OBJ's) keeps the paper's headlight.
+#[test]
+fn auto_lighting_keeps_a_physically_based_scenes_emission_without_lights_or_environment() {
+    let mut scene = Scene::new("emissive ball");
+    scene.materials = vec![Material { emissive_r: 1.0, emissive_g: 1.0, emissive_b: 1.0, ..Default::default() }];
+    let ball = builtin::sphere_scene(400, Vec3::new(0.0, 0.0, -2.0), 0.5, "ball");
+    scene.add_mesh("ball", &ball.vertices, &ball.indices);
+    for v in &mut scene.vertices {
+        v.material = 1;
+        v.color = [0.0, 0.0, 0.0, 1.0];
+    }
+    scene.physically_based = true;
+    assert!(scene.lights.is_empty() && scene.environment.is_none());
+    let s = RenderSettings::new(Projection { width: 256, height: 64, ..Projection::default() }).with_ambient(0.0);
+    let auto = common::render(&scene, &s);
+    let pbr = common::render(&scene, &s.with_lighting(LightingMode::Pbr));
+    assert!(auto.left.rgba == pbr.left.rgba && auto.right.rgba == pbr.right.rgba, "auto lights it as pbr does");
+    let centre = auto.left.pixel(128, 32);
+    assert!(centre[..3].iter().all(|&c| c > 150), "the emission shows: {centre:?}");
+    scene.physically_based = false;
+    let headlight = common::render(&scene, &s);
+    assert!(headlight.left.pixel(128, 32)[..3].iter().all(|&c| c < 60), "{:?}", headlight.left.pixel(128, 32));
+}

@@ -209,3 +209,19 @@ fn generated_constants_are_what_the_rust_side_says() {
         }
     }
 }
+
+#[test]
+fn shared_modules_declare_no_entry_points_and_only_binding_modules_declare_bindings() {
+    for (name, source) in SHARED {
+        let code: Vec<&str> = source.lines().map(str::trim).filter(|l| !l.starts_with("//")).collect();
+        let entry =
+            code.iter().find(|l| l.starts_with("@vertex") || l.starts_with("@fragment") || l.starts_with("@compute"));
+        assert!(entry.is_none(), "shaders/shared/{name}.wgsl declares an entry point: each stage file owns its own");
+        let binding = code.iter().find(|l| l.contains("@group("));
+        assert!(
+            name.ends_with("_bindings") || binding.is_none(),
+            "shaders/shared/{name}.wgsl declares a binding ({}): bindings live in *_bindings modules",
+            binding.unwrap_or(&"")
+        );
+    }
+}

@@ -310,7 +310,10 @@ fn box_textured_shows_its_logo_colours() {
         return;
     }
     let dir = common::asset("gltf/BoxTextured/glTF");
-    let mut s = settings(1200, 300, Method::Adaptive(Split::Length));
+    // The texture's colours under the paper's headlight (a glTF scene is otherwise lit by the
+    // BRDF, and this one has no lights of its own).
+    let mut s = settings(1200, 300, Method::Adaptive(Split::Length))
+        .with_lighting(twister::core::light::LightingMode::Headlight);
     let mut scene =
         twister::core::load::load_scene(dir.join("BoxTextured.gltf").to_str().unwrap(), &s.view.projection).unwrap();
     assert_eq!(scene.textures.len(), 1);

@@ -23,8 +23,9 @@ use twister::cpu::raster::raster;
 use twister::cpu::reduce_error::reduce_error;
 use twister::cpu::subdivide::subdivide;
 use twister::encoding::params::{raster_params, trace_params};
-use twister::encoding::subdivide::subdivide_params;
+use twister::encoding::subdivide::{subdivide_params, SubdivideOutput};
 use twister::encoding::types::ErrorStats;
+use twister::gpu::subdivide::Schedule;
 use twister::shader::STAGES;
 use twister::{Eye, Frame, GpuScene, Projection, RenderSettings, Renderer, Scene, Vertical};
 
@@ -211,7 +212,9 @@ fn random_triangle_scene(seed: u64, n: usize) -> Scene {
 
 impl Twin for Subdivide {
     type Case = (Scene, RenderSettings);
-    type Output = twister::cpu::subdivide::SubdivideOutput;
+    /// The GPU's outputs with the usual frame's schedule (one submission, indirect) and with the
+    /// chunked one (ranges of triangles); the twin's, once.
+    type Output = Vec<twister::cpu::subdivide::SubdivideOutput>;
     fn cases() -> Vec<(String, Self::Case)> {
         let projection = Projection { width: 640, height: 160, ..Projection::default() };
         let base = RenderSettings::new(projection).with_measure_edges(true);
@@ -278,7 +281,7 @@ impl Twin for Subdivide {
             .enumerate()
             .map(|(k, (scene, s))| {
                 let name = format!("case {k}: {} {}", scene.name, s.subdivision.method.name());
-                let cpu = Self::cpu(&(scene.clone(), s));
+                let cpu = Self::cpu(&(scene.clone(), s)).remove(0);
                 assert!(cpu.vertices.len() / 3 > scene.triangle_count(), "{name}: exercises splits and seam copies");
                 cut_frames += (cpu.cuts != 0) as usize;
                 strip_frames += (cpu.strips > 0) as usize;
@@ -299,37 +302,47 @@ impl Twin for Subdivide {
     }
     fn gpu(r: &Renderer, (scene, settings): &Self::Case) -> Self::Output {
         let gs = GpuScene::upload(&r.gpu, scene).unwrap();
-        r.subdivide_readback(&gs, settings).unwrap()
+        // Three ranges or more where the scene has the triangles.
+        let chunked = Schedule::Chunked { triangles_per_chunk: (scene.triangle_count() as u32 / 3).max(1) };
+        [Schedule::OneSubmission, chunked].map(|schedule| r.subdivide_readback(&gs, settings, schedule).unwrap()).into()
     }
     fn cpu((scene, settings): &Self::Case) -> Self::Output {
-        subdivide(&subdivide_params(settings, 0, scene.triangle_count() as u32), &scene.vertices, &scene.indices)
+        vec![subdivide(&subdivide_params(settings, 0, scene.triangle_count() as u32), &scene.vertices, &scene.indices)]
     }
     fn compare(gpu: &Self::Output, cpu: &Self::Output) -> Result<(), String> {
-        if cpu.cuts != gpu.cuts {
-            return Err(format!("cuts around the axis: CPU {:#x}, GPU {:#x}", cpu.cuts, gpu.cuts));
+        let schedules = ["one submission", "chunked"];
+        for (output, schedule) in gpu.iter().zip(schedules) {
+            compare_subdivided(output, &cpu[0]).map_err(|e| format!("{schedule} schedule: {e}"))?;
         }
-        // On a software adapter (lavapipe: correctly rounded maths) the output is the twin's,
-        // exactly. A hardware GPU's sin, atan2 and acos differ from the CPU's in the last bits,
-        // which flips an edge's division count where its measure sits on a ceil boundary (seen
-        // on an H100: 36 of 53,697 nodes in a case of random triangles): there at most 1 % of
-        // the pieces, nodes and triangles may differ, and every other triangle is the twin's.
-        let slack =
-            |n: usize| if common::renderer().gpu.info.device_type == wgpu::DeviceType::Cpu { 0 } else { n / 100 };
-        if cpu.pieces.abs_diff(gpu.pieces) as usize > slack(cpu.pieces as usize) {
-            return Err(format!("pieces: CPU {}, GPU {}", cpu.pieces, gpu.pieces));
-        }
-        if (cpu.max_sub_edge_px - gpu.max_sub_edge_px).abs() >= 1e-2 * (1.0 + cpu.max_sub_edge_px) {
-            return Err(format!("max edge: CPU {}, GPU {}", cpu.max_sub_edge_px, gpu.max_sub_edge_px));
-        }
-        // The indexed output: as many shared nodes, every index within them.
-        if cpu.nodes.len().abs_diff(gpu.nodes.len()) > slack(cpu.nodes.len()) {
-            return Err(format!("nodes: CPU {}, GPU {}", cpu.nodes.len(), gpu.nodes.len()));
-        }
-        if let Some(i) = gpu.indices.iter().find(|&&i| i as usize >= gpu.nodes.len()) {
-            return Err(format!("GPU index {i} beyond its {} nodes", gpu.nodes.len()));
-        }
-        same_triangle_sets(&cpu.vertices, &gpu.vertices, slack(cpu.vertices.len() / 3))
+        Ok(())
     }
+}
+
+/// One GPU output of the subdivide stage against the twin's.
+fn compare_subdivided(gpu: &SubdivideOutput, cpu: &SubdivideOutput) -> Result<(), String> {
+    if cpu.cuts != gpu.cuts {
+        return Err(format!("cuts around the axis: CPU {:#x}, GPU {:#x}", cpu.cuts, gpu.cuts));
+    }
+    // On a software adapter (lavapipe: correctly rounded maths) the output is the twin's,
+    // exactly. A hardware GPU's sin, atan2 and acos differ from the CPU's in the last bits,
+    // which flips an edge's division count where its measure sits on a ceil boundary (seen
+    // on an H100: 36 of 53,697 nodes in a case of random triangles): there at most 1 % of
+    // the pieces, nodes and triangles may differ, and every other triangle is the twin's.
+    let slack = |n: usize| if common::renderer().gpu.info.device_type == wgpu::DeviceType::Cpu { 0 } else { n / 100 };
+    if cpu.pieces.abs_diff(gpu.pieces) as usize > slack(cpu.pieces as usize) {
+        return Err(format!("pieces: CPU {}, GPU {}", cpu.pieces, gpu.pieces));
+    }
+    if (cpu.max_sub_edge_px - gpu.max_sub_edge_px).abs() >= 1e-2 * (1.0 + cpu.max_sub_edge_px) {
+        return Err(format!("max edge: CPU {}, GPU {}", cpu.max_sub_edge_px, gpu.max_sub_edge_px));
+    }
+    // The indexed output: as many shared nodes, every index within them.
+    if cpu.nodes.len().abs_diff(gpu.nodes.len()) > slack(cpu.nodes.len()) {
+        return Err(format!("nodes: CPU {}, GPU {}", cpu.nodes.len(), gpu.nodes.len()));
+    }
+    if let Some(i) = gpu.indices.iter().find(|&&i| i as usize >= gpu.nodes.len()) {
+        return Err(format!("GPU index {i} beyond its {} nodes", gpu.nodes.len()));
+    }
+    same_triangle_sets(&cpu.vertices, &gpu.vertices, slack(cpu.vertices.len() / 3))
 }
 
 // ---- raster (with the fragment module and the error pass) ----
@@ -395,7 +408,7 @@ type RasterCase = (Scene, RenderSettings, Option<f32>);
 /// shadow maps (drawn by the shadow stage's twin).
 fn lit_table(scene: &Scene, settings: &RenderSettings) -> twister::core::texture::MaterialTable {
     let (lights, lighting, maps) =
-        settings.shadowed_lighting(&scene.lights, scene.environment.as_deref(), scene.bounds());
+        settings.shadowed_lighting(&scene.lights, scene.physically_based, scene.environment.as_deref(), scene.bounds());
     let table = scene.material_table(usize::MAX);
     let depths = twister::cpu::shadow::shadow(&scene.vertices, &scene.indices, &table, settings.view(), &maps);
     table.with_lighting(lights, lighting).with_shadows(maps, depths)

@@ -1,13 +1,9 @@
 // Shared fragment work of the drawing stages (raster, slit), imported by raster.wgsl and slit.wgsl:
-// their varyings, the output targets and the fragment entry points, which take the surface
-// colour, shading and display-position error from surface.wgsl (the sRGB colour target encodes
-// the linear colour). CPU twins: src/cpu/fragment.rs (sampling, shading, error).
-//
-// Contract: a stage composing this module defines `fn stage_params(eye: u32)` returning the
-// drawn eye's parameters, a struct with the fields `projection: Projection`, `eye_sign: f32`
-// (+1 right eye), `ambient: f32` and `error_angle: u32`; its vertex stage returns `VertexOut`
-// with `eye` set (0 left, 1 right: the raster stage draws both eyes in one draw where it can);
-// its pipelines bind the material table as group 1.
+// their varyings, the output targets and what each fragment entry point computes, taking the
+// surface colour, shading and display-position error from surface.wgsl (the sRGB colour target
+// encodes the linear colour). No bindings and no entry points: each stage declares its
+// `fs_main`, `fs_error`, `fs_position` and `fs_background`, passing the drawn eye's
+// `FragmentView`. CPU twins: src/cpu/fragment/ (sampling, shading, error).
 
 #import projection
 #import constants
@@ -15,6 +11,14 @@
 // bits to an R32Uint target (generated: src/shader/mod.rs, `ErrorTarget::wgsl`).
 #import error_target
 #import surface
+
+// What a fragment needs of the stage drawing it, for the eye drawn.
+struct FragmentView {
+    projection: Projection,
+    eye_sign: f32,      // +1 right eye, −1 left eye
+    ambient: f32,
+    error_angle: u32,   // 1: the error target holds arcminutes
+}
 
 struct FragmentOut {
     @location(0) color: vec4<f32>,
@@ -27,10 +31,9 @@ struct FragmentOut {
     @location(3) distance: ErrorTarget,
 }
 
-fn fragment_out(eye: u32, frag_xy: vec2<f32>, view_position: vec3<f32>, dp_dx: vec3<f32>, dp_dy: vec3<f32>,
-                normal: vec3<f32>, tangent: vec4<f32>, color: vec4<f32>, object: u32, material: u32, uv: vec2<f32>,
-                duv_dx: vec2<f32>, duv_dy: vec2<f32>) -> FragmentOut {
-    let params = stage_params(eye);
+fn fragment_out(params: FragmentView, frag_xy: vec2<f32>, view_position: vec3<f32>, dp_dx: vec3<f32>,
+                dp_dy: vec3<f32>, normal: vec3<f32>, tangent: vec4<f32>, color: vec4<f32>, object: u32,
+                material: u32, uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>) -> FragmentOut {
     let plane_normal = cross(dp_dx, dp_dy);
     var out: FragmentOut;
     out.color = shade_surface(material, params.ambient, params.projection, params.eye_sign, frag_xy, view_position,
@@ -59,8 +62,8 @@ struct VertexOut {
     @location(7) tangent: vec4<f32>,
 }
 
-@fragment
-fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+// The shaded colour (`fs_main`).
+fn fragment_color(in: VertexOut, front_facing: bool, params: FragmentView) -> vec4<f32> {
     // Derivatives first, in uniform control flow.
     let duv_dx = dpdx(in.uv);
     let duv_dy = dpdy(in.uv);
@@ -70,16 +73,8 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @locatio
     if (MATERIALS && DISCARDS && c.a < 0.0) {
         discard;
     }
-    let params = stage_params(in.eye);
     return shade_surface(in.material, params.ambient, params.projection, params.eye_sign, in.clip.xy, in.view_position,
                          in.normal, in.tangent, c, in.uv, duv_dx, duv_dy, dp_dx, dp_dy);
-}
-
-// The same, plus the display-position error, the object id and the distance (when the error or
-// the depth is measured).
-@fragment
-fn fs_error(in: VertexOut, @builtin(front_facing) front_facing: bool) -> FragmentOut {
-    return measured(in, front_facing);
 }
 
 struct FragmentOutPosition {
@@ -91,15 +86,16 @@ struct FragmentOutPosition {
     @location(4) position: vec4<f32>,
 }
 
-// The same, plus the surface point drawn (for the display-position error against the ray tracer).
-@fragment
-fn fs_position(in: VertexOut, @builtin(front_facing) front_facing: bool) -> FragmentOutPosition {
-    let m = measured(in, front_facing);
+// What `fs_position` writes: `measured`, plus the surface point drawn (for the display-position
+// error against the ray tracer).
+fn measured_position(in: VertexOut, front_facing: bool, params: FragmentView) -> FragmentOutPosition {
+    let m = measured(in, front_facing, params);
     return FragmentOutPosition(m.color, m.error, m.object, m.distance, vec4<f32>(in.view_position, 1.0));
 }
 
-// What fs_error writes (a discarded fragment writes nothing).
-fn measured(in: VertexOut, front_facing: bool) -> FragmentOut {
+// What `fs_error` writes: the colour, plus the display-position error, the object id and the
+// distance (when the error or the depth is measured); a discarded fragment writes nothing.
+fn measured(in: VertexOut, front_facing: bool, params: FragmentView) -> FragmentOut {
     let duv_dx = dpdx(in.uv);
     let duv_dy = dpdy(in.uv);
     // Two vectors in the drawn triangle's plane (for the exact distance along the pixel's ray,
@@ -110,7 +106,7 @@ fn measured(in: VertexOut, front_facing: bool) -> FragmentOut {
     if (MATERIALS && DISCARDS && c.a < 0.0) {
         discard;
     }
-    return fragment_out(in.eye, in.clip.xy, in.view_position, dp_dx, dp_dy, in.normal, in.tangent, c, in.object,
+    return fragment_out(params, in.clip.xy, in.view_position, dp_dx, dp_dy, in.normal, in.tangent, c, in.object,
                         in.material, in.uv, duv_dx, duv_dy);
 }
 
@@ -129,10 +125,8 @@ fn background_vertex(i: u32, eye: u32) -> BackgroundOut {
     return BackgroundOut(vec4<f32>(xy, 0.5, 1.0), eye);
 }
 
-// The environment's radiance along the pixel's own ray, tone mapped.
-@fragment
-fn fs_background(in: BackgroundOut) -> @location(0) vec4<f32> {
-    let params = stage_params(in.eye);
-    let ray = pixel_ray(params.projection, params.eye_sign, in.clip.xy);
+// The environment's radiance along the pixel's own ray, tone mapped (`fs_background`).
+fn background_color(params: FragmentView, frag_xy: vec2<f32>) -> vec4<f32> {
+    let ray = pixel_ray(params.projection, params.eye_sign, frag_xy);
     return vec4<f32>(tonemap(env_level(0u, env_st(env_direction(ray.dir)))), 1.0);
 }

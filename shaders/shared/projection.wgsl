@@ -25,15 +25,12 @@ struct Projection {
     acos_eye_screen: f32,  // acos(d_e / R_T)
     vertical_exact: u32,   // 0: paper model, 1: exact model
     pixels_per_v: f32,     // W / (2π·R_T) (cylinder: v in metres), H/π (sphere: v in radians)
-    panorama: u32,         // PANORAMA_CYLINDER or PANORAMA_SPHERE
+    panorama: u32,         // PANORAMA_CYLINDER or PANORAMA_EQUIRECT (generated constants)
     convergence: f32,      // sphere: rays converge on this radius, metres; 0: parallel
     pole_from: f32,        // sphere: pole merge, radians of altitude; pole_to 0: off
     pole_to: f32,
     _pad: f32,
 }
-
-const PANORAMA_CYLINDER: u32 = 0u;
-const PANORAMA_SPHERE: u32 = 1u;
 
 // The panoramas a pipeline can draw (bit 0 the cylinder, bit 1 the sphere). The subdivide stage's
 // pipelines are built for one panorama each, so the other's code is compiled out: on lavapipe a
@@ -42,7 +39,7 @@ const PANORAMA_SPHERE: u32 = 1u;
 override PANORAMAS: u32 = 3u;
 
 fn is_sphere(proj: Projection) -> bool {
-    return (PANORAMAS & 2u) != 0u && ((PANORAMAS & 1u) == 0u || proj.panorama == PANORAMA_SPHERE);
+    return (PANORAMAS & 2u) != 0u && ((PANORAMAS & 1u) == 0u || proj.panorama == PANORAMA_EQUIRECT);
 }
 
 // atan2 and acos accurate to about 1e-7 rad. Drivers' built-ins may be far less precise (lavapipe's

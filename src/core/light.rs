@@ -171,19 +171,29 @@ pub struct LightingParams {
     pub env_levels: [[u32; 4]; ENV_LEVELS],
 }
 
+/// What a scene brings to a frame's lighting: its number of lights, and whether its materials
+/// are physically based (a glTF file's).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SceneLighting {
+    pub lights: usize,
+    pub physically_based: bool,
+}
+
 impl LightingParams {
     /// The frame's lighting for a scene with `lights` lights and perhaps an environment: the
-    /// glTF BRDF with `--lighting pbr`, or `auto` where the scene has lights or an environment;
-    /// 2^EV; the tone mapping.
+    /// glTF BRDF with `LightingMode::Pbr`, or with `Auto` where the scene is physically based
+    /// (a glTF file: its emission and factors are the BRDF's, with or without lights and an
+    /// environment) or has lights or an environment; 2^EV; the tone mapping.
     pub fn of(
         mode: LightingMode,
-        lights: usize,
+        scene: SceneLighting,
         environment: Option<&PreparedEnvironment>,
         exposure_ev: f32,
         tonemap: Tonemap,
     ) -> LightingParams {
+        let lights = scene.lights;
         let pbr = match mode {
-            LightingMode::Auto => lights > 0 || environment.is_some(),
+            LightingMode::Auto => scene.physically_based || lights > 0 || environment.is_some(),
             LightingMode::Headlight => false,
             LightingMode::Pbr => true,
         };

@@ -346,6 +346,19 @@ impl PanoramaKind {
             PanoramaKind::Equirect => "equirect",
         }
     }
+
+    /// Its code in the WGSL projection uniform (`PANORAMA_CYLINDER`, `PANORAMA_EQUIRECT`).
+    pub const fn code(self) -> u32 {
+        match self {
+            PanoramaKind::Cylinder => 0,
+            PanoramaKind::Equirect => 1,
+        }
+    }
+
+    /// The panorama of a code; None for a code no panorama has.
+    pub fn from_code(code: u32) -> Option<PanoramaKind> {
+        [PanoramaKind::Cylinder, PanoramaKind::Equirect].into_iter().find(|p| p.code() == code)
+    }
 }
 
 /// A panorama as a camera model (pbrt's `Camera`, for two eyes): where an eye's image shows a

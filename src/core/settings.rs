@@ -254,11 +254,12 @@ impl RenderSettings {
     pub fn shadowed_lighting(
         &self,
         lights: &[crate::core::light::Light],
+        physically_based: bool,
         environment: Option<&crate::core::environment::PreparedEnvironment>,
         bounds: Option<(Vec3, Vec3)>,
     ) -> (Vec<crate::core::light::GpuLight>, crate::core::light::LightingParams, Vec<crate::core::shadow::GpuShadowMap>)
     {
-        let (mut gpu_lights, params) = self.lighting(lights, environment);
+        let (mut gpu_lights, params) = self.lighting(lights, physically_based, environment);
         let maps = match bounds {
             Some((min, max)) if self.uses_shadow_maps(lights, params.pbr != 0) => {
                 let corners = crate::core::shadow::box_corners(min, max, self.view());
@@ -275,30 +276,32 @@ impl RenderSettings {
     }
 
     /// A frame's lights as the fragment stage reads them (viewer frame of this view) and its
-    /// lighting, for a scene with `lights` (group 1's last two bindings; the CPU twins'
-    /// `MaterialTable::with_lighting`).
+    /// lighting, for a scene with `lights`, physically based or not (group 1's last two
+    /// bindings; the CPU twins' `MaterialTable::with_lighting`).
     pub fn lighting(
         &self,
         lights: &[crate::core::light::Light],
+        physically_based: bool,
         environment: Option<&crate::core::environment::PreparedEnvironment>,
     ) -> (Vec<crate::core::light::GpuLight>, crate::core::light::LightingParams) {
+        let scene = crate::core::light::SceneLighting { lights: lights.len(), physically_based };
         (
             crate::core::light::gpu_lights(lights, self.view()),
-            self.lighting_params(lights.len(), environment).with_view(self.view(), self.shading.environment_yaw_deg),
+            self.lighting_params(scene, environment).with_view(self.view(), self.shading.environment_yaw_deg),
         )
     }
 
-    /// The frame's lighting for a scene with `light_count` lights and perhaps an environment.
+    /// The frame's lighting for a scene with what it brings (`scene`) and perhaps an environment.
     pub fn lighting_params(
         &self,
-        light_count: usize,
+        scene: crate::core::light::SceneLighting,
         environment: Option<&crate::core::environment::PreparedEnvironment>,
     ) -> crate::core::light::LightingParams {
         let s = &self.shading;
         let tonemap = if s.hdr { crate::core::light::Tonemap::Linear } else { s.tonemap };
         crate::core::light::LightingParams {
             shadows: s.shadows as u32,
-            ..crate::core::light::LightingParams::of(s.lighting, light_count, environment, s.exposure_ev, tonemap)
+            ..crate::core::light::LightingParams::of(s.lighting, scene, environment, s.exposure_ev, tonemap)
         }
     }
 }

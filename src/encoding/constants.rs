@@ -4,6 +4,7 @@
 
 use crate::core::light::{LightKind, Tonemap};
 use crate::core::material::{AlphaMode, Filter, Mipmap, Wrap, NO_TEXTURE};
+use crate::core::projection::PanoramaKind;
 use crate::core::settings::SplitRule;
 use crate::core::visual_field::{CENTRAL_RADIUS, FIELD_DOWN, FIELD_SIDEWAYS, FIELD_UP};
 
@@ -147,6 +148,8 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("FINE_BINS", U32(FINE_BINS)),
         ("COARSE_BINS", U32(COARSE_BINS)),
         ("BINS", U32(BINS)),
+        ("PANORAMA_CYLINDER", U32(PanoramaKind::Cylinder.code())),
+        ("PANORAMA_EQUIRECT", U32(PanoramaKind::Equirect.code())),
         ("NO_TEXTURE", U32(NO_TEXTURE)),
         ("WRAP_REPEAT", U32(Wrap::Repeat as u32)),
         ("WRAP_CLAMP", U32(Wrap::ClampToEdge as u32)),
@@ -183,7 +186,7 @@ pub fn all() -> Vec<(&'static str, Value)> {
 
 /// The generated WGSL module `constants`.
 pub fn wgsl() -> String {
-    let mut s = String::from("// Generated from src/shader/constants.rs: edit the Rust side.\n");
+    let mut s = String::from("// Generated from src/encoding/constants.rs: edit the Rust side.\n");
     for (name, value) in all() {
         match value {
             // `{:?}` prints the shortest decimal that reads back as the same f32 (e.g. 1e-6).

@@ -61,7 +61,7 @@ impl From<&ProjectionUniform> for Projection {
             width: p.width as u32,
             height: p.height as u32,
             vertical: if p.vertical_exact != 0 { Vertical::Exact } else { Vertical::Paper },
-            panorama: if p.panorama == 1 { PanoramaKind::Equirect } else { PanoramaKind::Cylinder },
+            panorama: PanoramaKind::from_code(p.panorama).unwrap_or_default(),
             convergence: (p.convergence > 0.0).then_some(p.convergence),
             pole_merge: (p.pole_to > 0.0).then(|| (p.pole_from.to_degrees(), p.pole_to.to_degrees())),
         }
@@ -79,7 +79,7 @@ impl From<&Projection> for ProjectionUniform {
             acos_eye_screen: p.acos_eye_screen(),
             vertical_exact: (p.vertical == Vertical::Exact) as u32,
             pixels_per_v: p.pixels_per_v(),
-            panorama: (p.panorama == PanoramaKind::Equirect) as u32,
+            panorama: p.panorama.code(),
             convergence: p.convergence.unwrap_or(0.0),
             pole_from,
             pole_to,

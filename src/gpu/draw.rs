@@ -4,7 +4,7 @@
 
 use std::collections::HashMap;
 use std::mem::offset_of;
-use std::sync::{Mutex, OnceLock};
+use std::sync::Mutex;
 
 use crate::core::scene::SceneVertex;
 use crate::core::settings::RenderSettings;
@@ -13,7 +13,7 @@ use crate::gpu::device::{error_target_format, Gpu};
 use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
 use crate::gpu::targets::{Layers, COLOR_FORMAT, DEPTH_FORMAT, HDR_FORMAT, OBJECT_FORMAT, POSITION_FORMAT};
-use crate::shader::{RASTER, SHADOW, SLIT};
+use crate::shader::{RASTER, SLIT};
 
 /// The two drawing stages.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -261,69 +261,4 @@ fn draw_pipeline(
         multiview_mask,
         cache: None,
     })
-}
-
-/// The `shadow` stage's pipelines: depth only, and with `fs_mask` (scenes whose materials can
-/// discard), each made when first needed.
-pub(crate) struct ShadowPipelines {
-    pub stage: GpuStage,
-    pipelines: [OnceLock<wgpu::RenderPipeline>; 2],
-}
-
-impl ShadowPipelines {
-    pub fn new(gpu: &Gpu) -> ShadowPipelines {
-        ShadowPipelines { stage: GpuStage::new(gpu, &SHADOW), pipelines: [OnceLock::new(), OnceLock::new()] }
-    }
-
-    pub fn pipeline(&self, gpu: &Gpu, masked: bool) -> &wgpu::RenderPipeline {
-        self.pipelines[masked as usize].get_or_init(|| {
-            use wgpu::VertexFormat::{Float32x2, Float32x3, Float32x4, Uint32};
-            let attribute = |format, offset: usize, shader_location| wgpu::VertexAttribute {
-                format,
-                offset: offset as u64,
-                shader_location,
-            };
-            let attributes = [
-                attribute(Float32x3, offset_of!(SceneVertex, position), 0),
-                attribute(Float32x4, std::mem::offset_of!(SceneVertex, color), 1),
-                attribute(Float32x2, std::mem::offset_of!(SceneVertex, uv), 2),
-                attribute(Uint32, std::mem::offset_of!(SceneVertex, material), 3),
-            ];
-            let buffers = [Some(wgpu::VertexBufferLayout {
-                array_stride: std::mem::size_of::<SceneVertex>() as u64,
-                step_mode: wgpu::VertexStepMode::Vertex,
-                attributes: &attributes,
-            })];
-            gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("shadow"),
-                layout: Some(self.stage.draw_layout()),
-                vertex: wgpu::VertexState {
-                    module: &self.stage.module,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
-                    buffers: &buffers,
-                },
-                primitive: wgpu::PrimitiveState {
-                    topology: wgpu::PrimitiveTopology::TriangleList,
-                    ..Default::default()
-                },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::Less),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: Default::default(),
-                fragment: masked.then(|| wgpu::FragmentState {
-                    module: &self.stage.module,
-                    entry_point: Some("fs_mask"),
-                    compilation_options: Default::default(),
-                    targets: &[],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        })
-    }
 }

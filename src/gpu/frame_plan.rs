@@ -12,6 +12,7 @@
 
 use crate::encoding::types::{DrawIndexedIndirectArgs, DrawVertex, Piece, SubdivideCounters};
 use crate::gpu::device::Gpu;
+use crate::gpu::scene::GpuScene;
 
 pub const PIECE_SIZE: u64 = std::mem::size_of::<Piece>() as u64;
 /// Bytes of one output node.
@@ -114,7 +115,15 @@ pub struct SubdivisionBuffers {
     /// The triangles `plan` leaves to `plan_cuts`: room for every triangle of the scene.
     pub cut_list: wgpu::Buffer,
     pub cut_list_capacity: u32,
+    /// Two bits per shared edge of the scene, set by `active_cuts` and `ring_cuts` each frame
+    /// (the frame's scratch: the uploaded scene holds only the edges' numbers), and its words.
+    pub cut_edges: wgpu::Buffer,
+    pub cut_edge_words: u32,
     pub capacity: Capacities,
+}
+
+fn cut_edges_buffer(gpu: &Gpu, words: u32) -> wgpu::Buffer {
+    gpu.storage_buffer("cut edges", 4 * words.max(1) as u64, wgpu::BufferUsages::empty())
 }
 
 fn pieces_buffer(gpu: &Gpu, n: u32) -> wgpu::Buffer {
@@ -149,25 +158,32 @@ impl SubdivisionBuffers {
             lattice_dispatch: gpu.storage_buffer("lattice dispatch", 24, wgpu::BufferUsages::INDIRECT),
             cut_list: gpu.storage_buffer("cut list", 4, wgpu::BufferUsages::empty()),
             cut_list_capacity: 1,
+            cut_edges: cut_edges_buffer(gpu, 1),
+            cut_edge_words: 1,
             capacity,
         }
     }
 
     /// Makes sure the cached buffers hold at least `want`. Each buffer is replaced only if it is
     /// too small, so growing the output keeps the pieces already planned.
-    /// The cut list gets room for `triangles` (the scene's triangle count, at most what one
-    /// binding holds: [`SubdivisionBuffers::cut_list_capacity`] bounds a dispatch's triangles).
+    /// The cut list gets room for the scene's triangles (at most what one binding holds:
+    /// [`SubdivisionBuffers::cut_list_capacity`] bounds a dispatch's triangles), the edge marks
+    /// for its shared edges.
     pub fn ensure<'c>(
         cache: &'c mut Option<SubdivisionBuffers>,
         gpu: &Gpu,
         want: Capacities,
-        triangles: u32,
+        scene: &GpuScene,
     ) -> &'c SubdivisionBuffers {
-        let cut_list = (triangles as u64).min(gpu.max_binding() / 4).max(1) as u32;
+        let cut_list = (scene.triangle_count as u64).min(gpu.max_binding() / 4).max(1) as u32;
         if let Some(b) = cache.as_mut() {
             if b.cut_list_capacity < cut_list {
                 b.cut_list = gpu.storage_buffer("cut list", 4 * cut_list as u64, wgpu::BufferUsages::empty());
                 b.cut_list_capacity = cut_list;
+            }
+            if b.cut_edge_words < scene.cut_edge_words {
+                b.cut_edges = cut_edges_buffer(gpu, scene.cut_edge_words);
+                b.cut_edge_words = scene.cut_edge_words;
             }
         }
         match cache {
@@ -175,6 +191,8 @@ impl SubdivisionBuffers {
                 let mut b = SubdivisionBuffers::new(gpu, want);
                 b.cut_list = gpu.storage_buffer("cut list", 4 * cut_list as u64, wgpu::BufferUsages::empty());
                 b.cut_list_capacity = cut_list;
+                b.cut_edges = cut_edges_buffer(gpu, scene.cut_edge_words);
+                b.cut_edge_words = scene.cut_edge_words;
                 *cache = Some(b);
             }
             Some(b) => {

@@ -12,6 +12,8 @@ pub mod shadow;
 pub mod skin;
 pub mod slit;
 pub mod stages;
+pub mod subdivide;
+pub mod subdivided;
 pub mod targets;
 pub mod timestamps;
 pub mod trace;

@@ -1,25 +1,30 @@
 //! The `project_points` stage on the GPU (twin `cpu::project_points`): pixel positions of
 //! viewer-frame points for one eye, the check of the WGSL projection against the CPU oracle.
 
+use std::sync::OnceLock;
+
 use glam::Vec3;
 
 use crate::core::projection::{Eye, Projection};
 use crate::encoding::types::ProjectParams;
 use crate::error::Result;
-use crate::gpu::renderer::Renderer;
+use crate::gpu::device::Gpu;
 use crate::gpu::stages::GpuStage;
 use crate::shader::PROJECT_POINTS;
 
-impl Renderer {
+/// The stage's layouts and pipeline, made on first use.
+#[derive(Default)]
+pub(crate) struct ProjectPointsStage(OnceLock<(GpuStage, wgpu::ComputePipeline)>);
+
+impl ProjectPointsStage {
     /// `[pixel x, pixel y, depth, 1]` per point, or zeros where no eye sees it. The pipeline is
     /// built on first use; any number of points (none included) within the device's buffer size.
-    pub fn project_points(&self, projection: &Projection, eye: Eye, points: &[Vec3]) -> Result<Vec<[f32; 4]>> {
+    pub fn project(&self, gpu: &Gpu, projection: &Projection, eye: Eye, points: &[Vec3]) -> Result<Vec<[f32; 4]>> {
         if points.is_empty() {
             return Ok(Vec::new());
         }
-        let gpu = &self.gpu;
         gpu.scoped("projecting points", || {
-            let (stage, pipeline) = self.project_points.get_or_init(|| {
+            let (stage, pipeline) = self.0.get_or_init(|| {
                 let stage = GpuStage::new(gpu, &PROJECT_POINTS);
                 let pipeline = stage.compute(gpu, "project_points");
                 (stage, pipeline)

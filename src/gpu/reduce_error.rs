@@ -4,18 +4,31 @@
 use crate::encoding::constants::BINS;
 use crate::encoding::types::{ErrorStats, ReduceParams, Totals};
 use crate::error::Result;
-use crate::gpu::renderer::Renderer;
+use crate::gpu::device::Gpu;
+use crate::gpu::stages::GpuStage;
 use crate::gpu::targets::{copy_eyes_to_buffer, unpad_eyes, Targets};
+use crate::shader::REDUCE_ERROR;
 
 /// Invocations per workgroup of `accumulate` (`WG` in the WGSL).
 const WORKGROUP: u32 = 256;
 
-impl Renderer {
+/// The stage's layouts and its two pipelines (`accumulate`, `finish`).
+pub(crate) struct ReduceStage {
+    stage: GpuStage,
+    accumulate: wgpu::ComputePipeline,
+    finish: wgpu::ComputePipeline,
+}
+
+impl ReduceStage {
+    pub fn new(gpu: &Gpu) -> ReduceStage {
+        let stage = GpuStage::new(gpu, &REDUCE_ERROR);
+        ReduceStage { accumulate: stage.compute(gpu, "accumulate"), finish: stage.compute(gpu, "finish"), stage }
+    }
+
     /// Runs `reduce_error` over the error targets of both eyes; also returns the per-pixel errors.
     /// Both eyes in one dispatch where they fit one storage binding, else one dispatch per eye
     /// (each eye's rows bound as a range; their sums and histogram add up).
-    pub(crate) fn reduce_errors(&self, targets: &Targets, per_eye: bool) -> Result<(ErrorStats, [Vec<f32>; 2])> {
-        let gpu = &self.gpu;
+    pub fn reduce(&self, gpu: &Gpu, targets: &Targets, per_eye: bool) -> Result<(ErrorStats, [Vec<f32>; 2])> {
         let (w, h) = (targets.width, targets.height);
         let (errors, stride) =
             copy_eyes_to_buffer(gpu, &targets.error, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
@@ -54,14 +67,14 @@ impl Renderer {
                 totals.as_entire_buffer_binding(),
                 result.as_entire_buffer_binding(),
             ];
-            let accumulate = self.reduce.bind_group_ranges(gpu, Some("accumulate"), 0, &buffers);
+            let accumulate = self.stage.bind_group_ranges(gpu, Some("accumulate"), 0, &buffers);
             {
                 let mut pass = enc.begin_compute_pass(&Default::default());
                 pass.set_pipeline(&self.accumulate);
                 pass.set_bind_group(0, &accumulate, &[]);
                 pass.dispatch_workgroups(gx, gy, 1);
                 if k + 1 == dispatches.len() {
-                    let finish = self.reduce.bind_group_ranges(gpu, Some("finish"), 0, &buffers);
+                    let finish = self.stage.bind_group_ranges(gpu, Some("finish"), 0, &buffers);
                     pass.set_pipeline(&self.finish);
                     pass.set_bind_group(0, &finish, &[]);
                     pass.dispatch_workgroups(1, 1, 1);

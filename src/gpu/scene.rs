@@ -7,7 +7,7 @@ use glam::{Mat4, Vec3};
 
 use crate::core::bvh::SceneBvh;
 use crate::core::environment::PreparedEnvironment;
-use crate::core::light::{gpu_lights, Light, LightingParams};
+use crate::core::light::{gpu_lights, Light, LightingParams, SceneLighting};
 use crate::core::lod::LodSelection;
 use crate::core::scene::{object_spheres, Scene};
 use crate::core::settings::RenderSettings;
@@ -50,15 +50,17 @@ pub struct GpuScene {
     pub environment: Option<std::sync::Arc<PreparedEnvironment>>,
     /// The scene's lights (scene frame), written into group 1 per frame.
     pub lights: Vec<Light>,
+    /// Whether its materials are physically based (a glTF file's: `Scene::physically_based`).
+    pub physically_based: bool,
     /// What the packing of the textures had to say (levels dropped to fit the budget).
     pub warnings: Vec<String>,
     /// Per object: the factor on L of the adaptive subdivision (1; the level of detail sets it).
     pub object_edge_scale: wgpu::Buffer,
     /// The triangles' shared edges (`core::shared_edges`): three edge numbers per triangle, and
     /// two bits per edge that the subdivision's `active_cuts` and `ring_cuts` set each frame
-    /// (`cut_edges`).
+    /// (`cut_edges`, in the frame's `SubdivisionBuffers`: `cut_edge_words` words).
     pub triangle_edges: wgpu::Buffer,
-    pub cut_edges: wgpu::Buffer,
+    pub cut_edge_words: u32,
     /// Each vertex's welded point, for the edges of a level-of-detail selection.
     pub points: std::sync::Arc<Vec<u32>>,
     /// Whether some material is textured, not opaque or single-sided (else the drawing stages
@@ -172,10 +174,10 @@ impl GpuScene {
             let has_maps = table.materials.iter().any(|m| m.has_maps());
             let cull_back_faces = table.all_single_sided(scene.vertices.iter().map(|v| v.material));
             let points = welded_points(&scene.vertices);
-            let (triangle_edges, cut_edges) = edge_buffers(gpu, &shared_edges_of(&points, &scene.indices));
+            let (triangle_edges, cut_edge_words) = edge_buffers(gpu, &shared_edges_of(&points, &scene.indices));
             Ok(GpuScene {
                 triangle_edges,
-                cut_edges,
+                cut_edge_words,
                 points: std::sync::Arc::new(points),
                 vertices,
                 indices,
@@ -194,6 +196,7 @@ impl GpuScene {
                 shadows: Mutex::new(GpuShadows::new(gpu)),
                 rig: None,
                 lights: scene.lights.clone(),
+                physically_based: scene.physically_based,
                 environment: scene
                     .environment
                     .as_ref()
@@ -221,7 +224,8 @@ impl GpuScene {
 
     /// Whether a frame with `settings` is lit by the glTF BRDF.
     pub fn pbr(&self, settings: &RenderSettings) -> bool {
-        settings.lighting_params(self.lights.len(), self.environment.as_deref()).pbr != 0
+        let scene = SceneLighting { lights: self.lights.len(), physically_based: self.physically_based };
+        settings.lighting_params(scene, self.environment.as_deref()).pbr != 0
     }
 
     /// Whether a frame with `settings` shows the environment as its background (one the user
@@ -233,7 +237,8 @@ impl GpuScene {
     /// Writes a frame's lights (in the viewer frame of `settings`) and lighting into group 1;
     /// returns the frame's shadow maps (drawn by the renderer).
     pub fn write_lighting(&self, gpu: &Gpu, settings: &RenderSettings) -> Vec<GpuShadowMap> {
-        let (lights, params, maps) = settings.shadowed_lighting(&self.lights, self.environment.as_deref(), self.bounds);
+        let (lights, params, maps) =
+            settings.shadowed_lighting(&self.lights, self.physically_based, self.environment.as_deref(), self.bounds);
         gpu.queue.write_buffer(&self.materials.lights, 0, bytemuck::cast_slice(&lights));
         gpu.queue.write_buffer(&self.materials.lighting, 0, bytemuck::bytes_of(&params));
         maps
@@ -315,10 +320,10 @@ impl GpuScene {
     /// selection's triangles (a new index buffer, the only upload) and per-object factors on L.
     pub fn with_lod(&self, gpu: &Gpu, selection: &LodSelection) -> GpuScene {
         let scales = selection.edge_scales();
-        let (triangle_edges, cut_edges) = edge_buffers(gpu, &shared_edges_of(&self.points, &selection.indices));
+        let (triangle_edges, cut_edge_words) = edge_buffers(gpu, &shared_edges_of(&self.points, &selection.indices));
         GpuScene {
             triangle_edges,
-            cut_edges,
+            cut_edge_words,
             points: self.points.clone(),
             vertices: self.vertices.clone(),
             indices: gpu.init_buffer(
@@ -351,6 +356,7 @@ impl GpuScene {
             shadows: Mutex::new(GpuShadows::new(gpu)),
             rig: None,
             lights: self.lights.clone(),
+            physically_based: self.physically_based,
             environment: self.environment.clone(),
         }
     }
@@ -358,10 +364,11 @@ impl GpuScene {
 
 /// The subdivision's edge buffers for a scene's shared edges: their numbers per triangle, and
 /// room for two bits per edge (`FrameCuts`).
-fn edge_buffers(gpu: &Gpu, edges: &SharedEdges) -> (wgpu::Buffer, wgpu::Buffer) {
+/// The triangles' edge numbers, and the words of two bits per edge the frame's marks need.
+fn edge_buffers(gpu: &Gpu, edges: &SharedEdges) -> (wgpu::Buffer, u32) {
     (
         gpu.init_buffer("triangle edges", bytemuck::cast_slice(&edges.ids), wgpu::BufferUsages::STORAGE),
-        gpu.storage_buffer("cut edges", 4 * edges.bit_words(2) as u64, wgpu::BufferUsages::empty()),
+        edges.bit_words(2),
     )
 }
 

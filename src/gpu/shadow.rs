@@ -4,26 +4,96 @@
 //! drawing stages read. The maps are drawn again only when they change (another view or other
 //! lights); a frame without maps draws nothing.
 
+use std::mem::offset_of;
+use std::sync::OnceLock;
+
 use glam::Mat4;
 
+use crate::core::scene::SceneVertex;
 use crate::core::shadow::GpuShadowMap;
 use crate::encoding::types::ShadowParams;
 use crate::error::{Error, Result};
-use crate::gpu::renderer::Renderer;
+use crate::gpu::device::Gpu;
 use crate::gpu::scene::GpuScene;
+use crate::gpu::stages::GpuStage;
 use crate::gpu::targets::DEPTH_FORMAT;
+use crate::shader::SHADOW;
 
-impl Renderer {
-    /// The depths of a scene's shadow maps as the last frame drew them (`bytes` of them).
-    pub fn shadow_depths(&self, scene: &GpuScene, bytes: u64) -> Result<Vec<f32>> {
-        let depths = scene.shadows.lock().unwrap_or_else(|e| e.into_inner()).depths.clone();
-        Ok(bytemuck::cast_slice(&self.gpu.download(&depths, bytes)?).to_vec())
+/// The `shadow` stage: its layouts and pipelines, depth only, and with `fs_mask` (scenes whose materials can
+/// discard), each made when first needed.
+pub(crate) struct ShadowStage {
+    pub stage: GpuStage,
+    pipelines: [OnceLock<wgpu::RenderPipeline>; 2],
+}
+
+impl ShadowStage {
+    pub fn new(gpu: &Gpu) -> ShadowStage {
+        ShadowStage { stage: GpuStage::new(gpu, &SHADOW), pipelines: [OnceLock::new(), OnceLock::new()] }
     }
 
+    pub fn pipeline(&self, gpu: &Gpu, masked: bool) -> &wgpu::RenderPipeline {
+        self.pipelines[masked as usize].get_or_init(|| {
+            use wgpu::VertexFormat::{Float32x2, Float32x3, Float32x4, Uint32};
+            let attribute = |format, offset: usize, shader_location| wgpu::VertexAttribute {
+                format,
+                offset: offset as u64,
+                shader_location,
+            };
+            let attributes = [
+                attribute(Float32x3, offset_of!(SceneVertex, position), 0),
+                attribute(Float32x4, std::mem::offset_of!(SceneVertex, color), 1),
+                attribute(Float32x2, std::mem::offset_of!(SceneVertex, uv), 2),
+                attribute(Uint32, std::mem::offset_of!(SceneVertex, material), 3),
+            ];
+            let buffers = [Some(wgpu::VertexBufferLayout {
+                array_stride: std::mem::size_of::<SceneVertex>() as u64,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &attributes,
+            })];
+            gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("shadow"),
+                layout: Some(self.stage.draw_layout()),
+                vertex: wgpu::VertexState {
+                    module: &self.stage.module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &buffers,
+                },
+                primitive: wgpu::PrimitiveState {
+                    topology: wgpu::PrimitiveTopology::TriangleList,
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: masked.then(|| wgpu::FragmentState {
+                    module: &self.stage.module,
+                    entry_point: Some("fs_mask"),
+                    compilation_options: Default::default(),
+                    targets: &[],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        })
+    }
+}
+
+/// The depths of a scene's shadow maps as the last frame drew them (`bytes` of them).
+pub fn shadow_depths(gpu: &Gpu, scene: &GpuScene, bytes: u64) -> Result<Vec<f32>> {
+    let depths = scene.shadows.lock().unwrap_or_else(|e| e.into_inner()).depths.clone();
+    Ok(bytemuck::cast_slice(&gpu.download(&depths, bytes)?).to_vec())
+}
+
+impl ShadowStage {
     /// Draws `maps` (the frame's, seen through `view`) into `scene`'s shadow depths, unless they
     /// hold them already. Fails with one line where the maps do not fit the device.
-    pub(crate) fn draw_shadow_maps(&self, scene: &GpuScene, view: Mat4, maps: &[GpuShadowMap]) -> Result<()> {
-        let gpu = &self.gpu;
+    pub fn draw_maps(&self, gpu: &Gpu, scene: &GpuScene, view: Mat4, maps: &[GpuShadowMap]) -> Result<()> {
         let Some(size) = maps.iter().map(|m| m.size).max() else {
             return Ok(());
         };
@@ -74,8 +144,8 @@ impl Renderer {
                 }
             }
             gpu.queue.write_buffer(&shadows.maps, 0, bytemuck::cast_slice(maps));
-            let stage = &self.shadow.stage;
-            let pipeline = self.shadow.pipeline(gpu, scene.discards);
+            let stage = &self.stage;
+            let pipeline = self.pipeline(gpu, scene.discards);
             // The table's last two bindings are the maps being drawn: stand-ins there.
             let [a, b, c, d, e, f, ..] = scene.group1(&shadows);
             let empty = gpu.init_buffer("no shadow maps", &[0; 80], wgpu::BufferUsages::STORAGE);

@@ -3,11 +3,13 @@
 //! offsets are uploaded on the first pose; each frame writes only the instances' matrices, the
 //! joint matrices and the morph weights.
 
+use std::sync::OnceLock;
+
 use crate::core::scene::Scene;
 use crate::encoding::skin::{SkinData, SkinFrame};
 use crate::encoding::types::SkinParams;
 use crate::error::{Error, Result};
-use crate::gpu::renderer::Renderer;
+use crate::gpu::device::Gpu;
 use crate::gpu::scene::{GpuRig, GpuScene};
 use crate::gpu::stages::GpuStage;
 use crate::shader::SKIN;
@@ -15,14 +17,24 @@ use crate::shader::SKIN;
 const IDENTITY: [[[f32; 4]; 4]; 1] =
     [[[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]]];
 
-impl Renderer {
+/// The stage's layouts and pipeline, made on the first pose.
+#[derive(Default)]
+pub(crate) struct SkinStage(OnceLock<(GpuStage, wgpu::ComputePipeline)>);
+
+impl SkinStage {
     /// Poses `scene` at time t of clip `clip` (None: the rest pose) on the GPU: its lights and
     /// cameras on the CPU (`Scene::pose_with`, vertices left), its vertices by the skin stage
     /// into `gpu_scene`'s vertex buffer; the bounds the shadow maps fit follow the pose. A scene
     /// without a rig is left as it is.
-    pub fn pose(&self, gpu_scene: &mut GpuScene, scene: &mut Scene, clip: Option<usize>, t: f32) -> Result<()> {
+    pub fn pose(
+        &self,
+        gpu: &Gpu,
+        gpu_scene: &mut GpuScene,
+        scene: &mut Scene,
+        clip: Option<usize>,
+        t: f32,
+    ) -> Result<()> {
         let Some(rig) = scene.rig.as_deref() else { return Ok(()) };
-        let gpu = &self.gpu;
         let frame = SkinFrame::of(rig, clip, t);
         if gpu_scene.rig.is_none() {
             let data = SkinData::of(rig);
@@ -66,7 +78,7 @@ impl Renderer {
             }
         }
         let rig_gpu = gpu_scene.rig.as_ref().expect("made on the first pose");
-        let (stage, pipeline) = self.skin.get_or_init(|| {
+        let (stage, pipeline) = self.0.get_or_init(|| {
             let stage = GpuStage::new(gpu, &SKIN);
             let pipeline = stage.compute(gpu, "skin");
             (stage, pipeline)

@@ -9,21 +9,37 @@ use crate::core::settings::RenderSettings;
 use crate::encoding::slits::{slit_params, slits, sphere_in_slit};
 use crate::encoding::types::SlitCamera;
 use crate::error::Result;
-use crate::gpu::renderer::{FrameResources, Renderer};
+use crate::gpu::device::Gpu;
+use crate::gpu::draw::{DrawPipelines, DrawStage};
+use crate::gpu::renderer::{FrameResources, Method, Renderer};
 use crate::gpu::scene::GpuScene;
 use crate::gpu::targets::Layers;
 use crate::gpu::timestamps::submit_timed_pass;
 
-impl Renderer {
-    pub(crate) fn render_slit(
+/// The slit renderer: its drawing pipelines.
+pub(crate) struct SlitMethod {
+    pipelines: DrawPipelines,
+}
+
+impl SlitMethod {
+    pub fn new(gpu: &Gpu) -> SlitMethod {
+        SlitMethod { pipelines: DrawPipelines::new(gpu, DrawStage::Slit) }
+    }
+}
+
+impl Method for SlitMethod {
+    fn draw(
         &self,
+        r: &Renderer,
         res: &mut FrameResources,
         scene: &GpuScene,
         settings: &RenderSettings,
-        width: u32,
     ) -> Result<Frame> {
+        let crate::core::settings::Method::Slit(width) = settings.subdivision.method else {
+            unreachable!("the slit renderer draws slit:W")
+        };
         let start = Instant::now();
-        let gpu = &self.gpu;
+        let gpu = &r.gpu;
         let projection = settings.projection();
         res.targets(gpu, projection.width, projection.height, settings.measure.positions, false);
         let res = &*res;
@@ -36,15 +52,15 @@ impl Renderer {
         let camera_buffer =
             gpu.init_buffer("slit cameras", bytemuck::cast_slice(&cameras), wgpu::BufferUsages::STORAGE);
         let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, chunks: 1, ..Default::default() };
-        let pipeline = self.slit.get(gpu, scene, settings, Layers::Eye(0));
-        let materials = self.slit.material_bind_group(gpu, scene);
+        let pipeline = self.pipelines.get(gpu, scene, settings, Layers::Eye(0));
+        let materials = self.pipelines.material_bind_group(gpu, scene);
         let timestamps = res.timestamps.as_ref();
         let t = Instant::now();
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         for (k, eye) in Eye::BOTH.into_iter().enumerate() {
             let params = slit_params(projection, view, eye, settings.shading.ambient, settings.measure.error_angle);
             gpu.queue.write_buffer(&res.slit_params[k], 0, bytemuck::bytes_of(&params));
-            let bind_group = self.slit.stage.bind_group(gpu, None, 0, &[&res.slit_params[k], &camera_buffer]);
+            let bind_group = self.pipelines.stage.bind_group(gpu, None, 0, &[&res.slit_params[k], &camera_buffer]);
             let writes = timestamps.map(|t| wgpu::RenderPassTimestampWrites {
                 query_set: &t.set,
                 beginning_of_pass_write_index: (k == 0).then_some(0),
@@ -54,7 +70,7 @@ impl Renderer {
             pass.set_bind_group(0, &bind_group, &[]);
             pass.set_bind_group(1, &materials, &[]);
             if scene.shows_environment(settings) {
-                pass.set_pipeline(&self.slit.background(gpu, settings, Layers::Eye(k)));
+                pass.set_pipeline(&self.pipelines.background(gpu, settings, Layers::Eye(k)));
                 pass.draw(0..3, 0..1);
             }
             pass.set_pipeline(&pipeline);
@@ -79,6 +95,6 @@ impl Renderer {
             }
         }
         submit_timed_pass(gpu, enc, timestamps, &res.staging, t, &mut stats)?;
-        self.finish_frame(targets, settings, stats, start)
+        r.finish_frame(targets, settings, stats, start)
     }
 }

@@ -13,20 +13,26 @@ use crate::encoding::constants::TRACE_COUNT_SLOTS;
 use crate::encoding::params::trace_params;
 use crate::encoding::types::TraceParams;
 use crate::error::{Error, Result};
-use crate::gpu::renderer::{FrameResources, Renderer};
+use crate::gpu::renderer::{FrameResources, Method, Renderer};
 use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
 use crate::gpu::timestamps::submit_timed_pass;
 
-impl Renderer {
-    pub(crate) fn render_trace(
+/// The ray tracer: its stage and pipelines without and with the material code, made on first
+/// use.
+#[derive(Default)]
+pub(crate) struct TraceMethod(std::sync::OnceLock<(GpuStage, [wgpu::ComputePipeline; 2])>);
+
+impl Method for TraceMethod {
+    fn draw(
         &self,
+        r: &Renderer,
         res: &mut FrameResources,
         scene: &GpuScene,
         settings: &RenderSettings,
     ) -> Result<Frame> {
         let start = Instant::now();
-        let gpu = &self.gpu;
+        let gpu = &r.gpu;
         let Some(bvh) = &scene.bvh else {
             return Err(Error::setting(
                 "subdivision.method",
@@ -62,7 +68,7 @@ impl Renderer {
         let res = &*res;
         let targets = res.targets.as_ref().expect("made");
         let (_, _, outputs) = res.trace_outputs.as_ref().expect("made");
-        let (stage, pipelines) = self.trace.get_or_init(|| {
+        let (stage, pipelines) = self.0.get_or_init(|| {
             let stage = GpuStage::new(gpu, &crate::shader::TRACE);
             let pipelines =
                 [0.0, 1.0].map(|m| stage.compute_with(gpu, "trace", &[("MATERIALS", m), ("SHADOW_MAPS", 0.0)]));
@@ -132,7 +138,7 @@ impl Renderer {
         // The surface points are where the pixels' rays meet their hits.
         let wanted = settings.measure.positions;
         let inner = settings.with_positions(false).with_depth(settings.measure.depth || wanted);
-        let mut frame = self.finish_frame(targets, &inner, stats, start)?;
+        let mut frame = r.finish_frame(targets, &inner, stats, start)?;
         if wanted {
             frame.positions = Some(ray_hit_points(p, frame.depth.as_ref().expect("read with the positions")));
             if !settings.measure.depth {

@@ -11,7 +11,7 @@ pub struct Shadow;
 
 /// The maps a frame of `scene` with `settings` draws.
 fn maps(scene: &Scene, settings: &RenderSettings) -> Vec<twister::core::shadow::GpuShadowMap> {
-    settings.shadowed_lighting(&scene.lights, scene.environment.as_deref(), scene.bounds()).2
+    settings.shadowed_lighting(&scene.lights, scene.physically_based, scene.environment.as_deref(), scene.bounds()).2
 }
 
 impl Twin for Shadow {

@@ -1,18 +1,28 @@
-//! CPU twin of `shaders/shared/fragment.wgsl`, the fragment work shared by the drawing stages: the
-//! surface colour (material: base colour texture with its sampler, alpha mask / screen-door
-//! blend, single-sided culling), headlight shading in linear light with an sRGB-encoded output,
-//! and the display-position error (seed 002 §4.1): the distance in pixels between the pixel
-//! centre where a surface point was drawn and where the projection puts it.
+//! CPU twin of `shaders/shared/surface.wgsl` and `fragment.wgsl`, the fragment work shared by the
+//! drawing stages and the ray tracer: the surface colour (material: base colour texture with its
+//! sampler, alpha mask / screen-door blend, single-sided culling), headlight shading in linear
+//! light with an sRGB-encoded output, the glTF look's shading. Its modules mirror the WGSL
+//! modules of the same names: [`texture`], [`brdf`], [`ibl`], [`pixel_error`].
+
+pub mod brdf;
+pub mod ibl;
+pub mod pixel_error;
+pub mod texture;
+
+pub use brdf::{brdf, light_at};
+pub use ibl::{env_direction, env_irradiance, env_level, env_lut, env_radiance, env_st, ibl_radiance};
+pub use pixel_error::{pixel_distance, pixel_error, pixel_spread};
+#[cfg(test)]
+use texture::texel;
+pub use texture::{sample_levels, sample_texture, wrap_index};
 
 use glam::{Vec2, Vec3, Vec4};
 
 pub use crate::core::color::display_bytes;
-use crate::core::color::srgb_to_linear;
-use crate::core::environment::{ENV_LEVELS, LUT_SIZE};
-use crate::core::light::{tonemap, GpuLight, LightKind, NO_SHADOW_MAP};
-use crate::core::material::{AlphaMode, Filter, Material, MipLevel, Mipmap, Wrap, NO_TEXTURE};
+use crate::core::light::{tonemap, GpuLight, NO_SHADOW_MAP};
+use crate::core::material::{AlphaMode, NO_TEXTURE};
 pub use crate::core::projection::pixel_ray;
-use crate::core::projection::{Eye, PanoramaKind, Projection};
+use crate::core::projection::{Eye, Projection};
 use crate::core::shadow::{
     cube_face, shadow_coordinates, LIGHT_OFFSET_TEXELS, NORMAL_OFFSET_TEXELS, SHADOW_CUBE, SHADOW_ORTHOGRAPHIC,
 };
@@ -29,51 +39,6 @@ pub fn shade_linear(ambient: f32, view_position: Vec3, normal: Vec3, color: Vec4
     let lambert = if normal.length() > 1e-6 { normal.normalize().dot(-view_position.normalize()).abs() } else { 1.0 };
     let s = ambient + (1.0 - ambient) * lambert;
     (color.truncate() * s).clamp(Vec3::ZERO, Vec3::ONE)
-}
-
-/// The glTF 2.0 BRDF (`brdf` in surface.wgsl; specification Appendix B): Lambert diffuse of
-/// c_diff = base·(1 − metallic) weighted by 1 − F, plus GGX D · Smith separable Vis · F, with
-/// α = roughness² and Fresnel–Schlick from f0 = mix(0.04, base, metallic). `n`, `v`, `l` unit.
-pub fn brdf(n: Vec3, v: Vec3, l: Vec3, base: Vec3, metallic: f32, roughness: f32) -> Vec3 {
-    let h = (l + v).normalize();
-    let nl = n.dot(l).max(0.0);
-    let nv = n.dot(v).abs().max(1e-4);
-    let nh = n.dot(h).max(0.0);
-    let vh = v.dot(h).abs();
-    let alpha = (roughness * roughness).max(1e-3);
-    let a2 = alpha * alpha;
-    let f0 = Vec3::splat(0.04).lerp(base, metallic);
-    let fresnel = f0 + (Vec3::ONE - f0) * (1.0 - vh).powf(5.0);
-    let k = nh * nh * (a2 - 1.0) + 1.0;
-    let d = a2 / (std::f32::consts::PI * k * k);
-    let g_l = 2.0 * nl / (nl + (a2 + (1.0 - a2) * nl * nl).sqrt());
-    let g_v = 2.0 * nv / (nv + (a2 + (1.0 - a2) * nv * nv).sqrt());
-    let vis = g_l * g_v / (4.0 * nl * nv).max(1e-8);
-    let c_diff = base.lerp(Vec3::ZERO, metallic);
-    (Vec3::ONE - fresnel) * c_diff / std::f32::consts::PI + fresnel * d * vis
-}
-
-/// The light arriving from `light` at `p` (viewer frame): the unit direction towards it and the
-/// factor on its colour (`light_at` in surface.wgsl).
-pub fn light_at(light: &GpuLight, p: Vec3) -> (Vec3, f32) {
-    if light.kind == LightKind::Directional as u32 {
-        return (-Vec3::from(light.direction), 1.0);
-    }
-    let to_light = Vec3::from(light.position) - p;
-    let d2 = to_light.length_squared().max(1e-8);
-    let l = to_light / d2.sqrt();
-    let mut scale = 1.0 / d2;
-    if light.range > 0.0 {
-        let r = d2 * d2 / (light.range * light.range * light.range * light.range);
-        let w = (1.0 - r).clamp(0.0, 1.0);
-        scale *= w * w;
-    }
-    if light.kind == LightKind::Spot as u32 {
-        let cd = Vec3::from(light.direction).dot(-l);
-        let t = ((cd - light.outer_cos) / (light.inner_cos - light.outer_cos).max(1e-4)).clamp(0.0, 1.0);
-        scale *= t * t;
-    }
-    (l, scale)
 }
 
 /// A surface's shaded colour as display bytes (`shade_surface` in surface.wgsl): with the
@@ -307,222 +272,6 @@ pub fn mapped_normal(n: Vec3, s: &SurfaceMaps) -> Vec3 {
 
 // ---- Image-based lighting (`core::environment`; surface.wgsl's twins) ----
 
-/// A viewer-frame direction in the environment's frame (`env_direction`).
-pub fn env_direction(table: &MaterialTable, d: Vec3) -> Vec3 {
-    let r = &table.lighting.env_rotation;
-    Vec3::from_slice(&r[0][..3]) * d.x + Vec3::from_slice(&r[1][..3]) * d.y + Vec3::from_slice(&r[2][..3]) * d.z
-}
-
-/// Prefiltered level k, bilinear at equirectangular coordinates st in [0, 1]² (`env_level`).
-pub fn env_level(table: &MaterialTable, k: usize, st: Vec2) -> Vec3 {
-    let [offset, width, height, _] = table.lighting.env_levels[k];
-    let p = st * Vec2::new(width as f32, height as f32) - 0.5;
-    let base = p.floor();
-    let f = p - base;
-    let texel = |dx: i32, dy: i32| {
-        let x = (base.x as i32 + dx).rem_euclid(width as i32) as u32;
-        let y = (base.y as i32 + dy).clamp(0, height as i32 - 1) as u32;
-        crate::core::environment::rgb9e5_decode(table.environment[(offset + y * width + x) as usize])
-    };
-    let top = texel(0, 0).lerp(texel(1, 0), f.x);
-    let bottom = texel(0, 1).lerp(texel(1, 1), f.x);
-    top.lerp(bottom, f.y)
-}
-
-/// The equirectangular coordinates in [0, 1]² of environment-frame direction e (`env_st`).
-pub fn env_st(e: Vec3) -> Vec2 {
-    Vec2::new(e.x.atan2(-e.z) / std::f32::consts::TAU + 0.5, 0.5 - e.y.clamp(-1.0, 1.0).asin() / std::f32::consts::PI)
-}
-
-/// The radiance around viewer-frame direction d convolved for `roughness` (`env_radiance`).
-pub fn env_radiance(table: &MaterialTable, d: Vec3, roughness: f32) -> Vec3 {
-    let st = env_st(env_direction(table, d));
-    let lod = roughness.clamp(0.0, 1.0) * (ENV_LEVELS - 1) as f32;
-    let k = (lod as usize).min(ENV_LEVELS - 2);
-    let t = lod - k as f32;
-    env_level(table, k, st).lerp(env_level(table, k + 1, st), t)
-}
-
-/// E(n)/π at viewer-frame normal n (`env_irradiance`).
-pub fn env_irradiance(table: &MaterialTable, n: Vec3) -> Vec3 {
-    let sh = table.lighting.env_sh.map(|c| Vec3::from_slice(&c[..3]));
-    crate::core::environment::irradiance(&sh, env_direction(table, n))
-}
-
-/// The split-sum table (A, B) at n·v and roughness (`env_lut`).
-pub fn env_lut(table: &MaterialTable, nv: f32, roughness: f32) -> Vec2 {
-    let n = LUT_SIZE as f32;
-    let p = (Vec2::new(nv, roughness) * n - 0.5).clamp(Vec2::ZERO, Vec2::splat(n - 1.0));
-    let base = p.floor().min(Vec2::splat(n - 2.0));
-    let f = p - base;
-    let mut out = Vec2::ZERO;
-    for corner in 0..4u32 {
-        let (dx, dy) = (corner & 1, corner >> 1);
-        let w = if dx == 1 { f.x } else { 1.0 - f.x } * if dy == 1 { f.y } else { 1.0 - f.y };
-        let i = table.lighting.env_lut as usize
-            + (base.y as usize + dy as usize) * LUT_SIZE
-            + base.x as usize
-            + dx as usize;
-        out += w * crate::core::environment::unpack_half2(table.environment[i]);
-    }
-    out
-}
-
-/// The environment's light reflected towards v by a surface with unit normal n (`ibl_radiance`).
-pub fn ibl_radiance(table: &MaterialTable, n: Vec3, v: Vec3, base: Vec3, metallic: f32, roughness: f32) -> Vec3 {
-    let nv = n.dot(v).clamp(1e-4, 1.0);
-    let ab = env_lut(table, nv, roughness);
-    let f0 = Vec3::splat(0.04).lerp(base, metallic);
-    let e_ss = f0 * ab.x + ab.y;
-    let e_ms = 1.0 - (ab.x + ab.y);
-    let f_avg = f0 + (1.0 - f0) / 21.0;
-    let f_ms = e_ss * f_avg / (1.0 - e_ms * f_avg);
-    let irradiance = env_irradiance(table, n);
-    let specular = env_radiance(table, 2.0 * nv * n - v, roughness) * e_ss + irradiance * f_ms * e_ms;
-    let c_diff = base.lerp(Vec3::ZERO, metallic);
-    specular + c_diff * irradiance * (Vec3::ONE - e_ss - f_ms * e_ms).max(Vec3::ZERO)
-}
-
-/// The angle a pixel spans, radians (`pixel_spread` in surface.wgsl): the larger of its width
-/// (2π/W, on the sphere × cos latitude) and its height (on the cylinder 1/(pixels_per_v·R_T),
-/// seen from the eyes about R_T away; on the sphere 1/pixels_per_v). A ray cone grows by this
-/// much per metre.
-pub fn pixel_spread(projection: &Projection, frag_xy: Vec2) -> f32 {
-    let (_, v) = projection.pixel_to_screen(frag_xy.x - 0.5, frag_xy.y - 0.5);
-    let across = std::f32::consts::TAU / projection.width as f32;
-    match projection.panorama {
-        PanoramaKind::Equirect => (across * v.cos()).max(1.0 / projection.pixels_per_v()),
-        PanoramaKind::Cylinder => across.max(1.0 / (projection.pixels_per_v() * projection.screen_radius)),
-    }
-}
-
-/// The display-position error of surface point `p` drawn at pixel centre `frag_xy`: the
-/// distance in pixels to where the projection puts it (wrapping around the panorama), or with
-/// `angle` the angle between the two directions seen from the centre, in arcminutes; −1 where
-/// no eye sees the point.
-pub fn pixel_error(projection: &Projection, eye: Eye, p: Vec3, frag_xy: Vec2, angle: bool) -> f32 {
-    match projection.project(p, eye) {
-        None => -1.0,
-        Some(q) if angle => {
-            let a = projection.screen_direction(q.u, q.v);
-            let (u, v) = projection.pixel_to_screen(frag_xy.x - 0.5, frag_xy.y - 0.5);
-            let b = projection.screen_direction(u, v);
-            a.cross(b).length().atan2(a.dot(b)).to_degrees() * 60.0
-        }
-        Some(q) => {
-            let [x, y] = projection.to_pixel(q.u, q.v);
-            Vec2::new(projection.wrapped_dx(x, frag_xy.x), y - frag_xy.y).length()
-        }
-    }
-}
-
-/// What `--depth` writes: the distance in metres along the ray of the pixel at `frag_xy` to the
-/// plane through surface point `p` with normal `n` (the drawn triangle's plane: exact for flat
-/// input triangles, however coarse the subdivision), or |p − eye point| where the ray runs
-/// nearly within the plane.
-pub fn pixel_distance(projection: &Projection, eye: Eye, p: Vec3, n: Vec3, frag_xy: Vec2) -> f32 {
-    let (origin, dir) = pixel_ray(projection, eye, frag_xy);
-    let denom = dir.dot(n);
-    if denom.abs() > 1e-3 * n.length() {
-        let t = (p - origin).dot(n) / denom;
-        if t > 0.0 {
-            return t;
-        }
-    }
-    (p - origin).length()
-}
-
-/// Texel index `i` folded into `0..n` by a wrap mode.
-pub fn wrap_index(i: i32, n: i32, mode: u32) -> i32 {
-    if mode == Wrap::ClampToEdge as u32 {
-        i.clamp(0, n - 1)
-    } else if mode == Wrap::MirroredRepeat as u32 {
-        let m = i.rem_euclid(2 * n);
-        if m >= n {
-            2 * n - 1 - m
-        } else {
-            m
-        }
-    } else {
-        i.rem_euclid(n)
-    }
-}
-
-/// The linear-light RGBA of texel (x, y) of a level.
-fn texel(table: &MaterialTable, level: &MipLevel, x: i32, y: i32) -> Vec4 {
-    let t = table.texels[(level.offset + y as u32 * level.width + x as u32) as usize].to_le_bytes();
-    let c = t.map(|b| b as f32 / 255.0);
-    Vec4::new(srgb_to_linear(c[0]), srgb_to_linear(c[1]), srgb_to_linear(c[2]), c[3])
-}
-
-/// Samples one mip level at `uv` (texture space: 0..1 across the image, v down) with a filter.
-fn sample_level(table: &MaterialTable, m: &Material, first_mip: u32, level: u32, uv: Vec2, filter: u32) -> Vec4 {
-    let level = &table.mips[(first_mip + level) as usize];
-    let (w, h) = (level.width as i32, level.height as i32);
-    let p = uv.clamp(Vec2::splat(-1e6), Vec2::splat(1e6)) * Vec2::new(w as f32, h as f32);
-    // Nearest: the texel containing p. Linear: the four texels around p, weights by distance.
-    let (base, f) = if filter == Filter::Linear as u32 {
-        let q = p - 0.5;
-        (q.floor(), q - q.floor())
-    } else {
-        (p.floor(), Vec2::ZERO)
-    };
-    let mut sum = Vec4::ZERO;
-    for corner in 0..4i32 {
-        let (dx, dy) = (corner & 1, corner >> 1);
-        let weight = (if dx == 1 { f.x } else { 1.0 - f.x }) * (if dy == 1 { f.y } else { 1.0 - f.y });
-        let x = wrap_index(base.x as i32 + dx, w, m.wrap_u);
-        let y = wrap_index(base.y as i32 + dy, h, m.wrap_v);
-        sum += weight * texel(table, level, x, y);
-    }
-    sum
-}
-
-/// Samples a material's base colour texture at `uv` with the screen-space derivatives of uv:
-/// level of detail λ = log2 of the longest footprint in level-0 texels; λ ≤ 0 magnifies
-/// (magnification filter, level 0), else the minification filter on level 0 (no mipmaps), the
-/// nearest level, or a blend of the two nearest.
-pub fn sample_texture(table: &MaterialTable, m: &Material, uv: Vec2, duv_dx: Vec2, duv_dy: Vec2) -> Vec4 {
-    sample_levels(table, m, m.first_mip, m.mip_count, uv, duv_dx, duv_dy)
-}
-
-/// The same for the texture whose mip chain starts at `first_mip` (a material's maps), with the
-/// material's sampler (`sample_levels`).
-pub fn sample_levels(
-    table: &MaterialTable,
-    m: &Material,
-    first_mip: u32,
-    mip_count: u32,
-    uv: Vec2,
-    duv_dx: Vec2,
-    duv_dy: Vec2,
-) -> Vec4 {
-    let top = &table.mips[first_mip as usize];
-    let size = Vec2::new(top.width as f32, top.height as f32);
-    let lambda = (duv_dx * size).length().max((duv_dy * size).length()).log2();
-    let last = (mip_count - 1) as f32;
-    // (first level, second level, weight of the second, filter)
-    let (l0, l1, t, filter) = if !(lambda > 0.0) {
-        (0.0, 0.0, 0.0, m.mag_filter)
-    } else if m.mipmap == Mipmap::None as u32 {
-        (0.0, 0.0, 0.0, m.min_filter)
-    } else if m.mipmap == Mipmap::Nearest as u32 {
-        let l = (lambda.min(last) + 0.5).floor();
-        (l, l, 0.0, m.min_filter)
-    } else {
-        let l = lambda.min(last);
-        (l.floor(), (l.floor() + 1.0).min(last), l - l.floor(), m.min_filter)
-    };
-    let mut out = Vec4::ZERO;
-    for (k, level) in [l0, l1].into_iter().enumerate() {
-        let weight = if k == 0 { 1.0 - t } else { t };
-        if weight > 0.0 {
-            out += weight * sample_level(table, m, first_mip, level as u32, uv, filter);
-        }
-    }
-    out
-}
-
 /// Screen-door threshold of a pixel for BLEND materials: a 4×4 ordered-dither (Bayer) matrix,
 /// so a surface of opacity a covers about a of the pixels, independently of drawing order.
 pub fn blend_threshold(frag_xy: Vec2) -> f32 {
@@ -568,7 +317,8 @@ pub fn surface_color(table: &MaterialTable, s: &Surface) -> Option<Vec4> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::core::color::linear_to_srgb;
+    use crate::core::color::{linear_to_srgb, srgb_to_linear};
+    use crate::core::material::{Filter, Material, Mipmap, Wrap};
     use crate::core::texture::Texture;
 
     #[test]

@@ -1,3 +1,5 @@
+//! CPU twin of `shaders/shared/subdivide_axis.wgsl`.
+//!
 //! The vertical axis (see the module doc of `cpu::subdivide`). Triangles near the axis, or
 //! large next to their distance from it, are cut into **parts**: their polygon in each of the
 //! four quadrants around the axis (cut by the planes x = 0 and z = 0), for the adaptive method

@@ -1,3 +1,5 @@
+//! CPU twin of `shaders/shared/subdivide_frame_cuts.wgsl`.
+//!
 //! Which triangles a frame cuts around the vertical axis (see `axis.rs`): `active_cuts` and
 //! `ring_cuts` mark the scene's shared edges (`FrameCuts`), and each triangle's polygons follow
 //! from its marks (`triangle_polygons`).

@@ -1,3 +1,5 @@
+//! CPU twin of `shaders/shared/subdivide_lattice.wgsl`.
+//!
 //! The piece's triangulation (seed 002 Fig. 6, see the module doc of `cpu::subdivide`): the
 //! level-K macro cells of the pre-split, the regular lattice of level m with its boundary nodes
 //! snapped to each edge's own nodes, and a sliver's strip. Shared by the twin's `plan` and

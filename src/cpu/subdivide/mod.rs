@@ -1,6 +1,8 @@
-//! The `subdivide` stage, CPU twin of `shaders/subdivide.wgsl`: adaptive subdivision (seed 002
-//! §2.3, eq. 5, Fig. 6) plus the handling of the vertical axis and the ±π seam. The projection
-//! itself (eq. 1–4) is applied per vertex afterwards, in the raster stage.
+//! The `subdivide` stage, CPU twin of `shaders/subdivide.wgsl` (its entry points) and of
+//! `shaders/shared/subdivide_edges.wgsl` (this file; the other modules mirror `subdivide_axis`,
+//! `subdivide_frame_cuts`, `subdivide_quad` and `subdivide_lattice`): adaptive subdivision (seed
+//! 002 §2.3, eq. 5, Fig. 6) plus the handling of the vertical axis and the ±π seam. The
+//! projection itself (eq. 1–4) is applied per vertex afterwards, in the raster stage.
 //!
 //! **Edges (eq. 5).** Each edge of a triangle is split into N equal parts:
 //! `adaptive`: N = ceil(l / L), l the edge's projected length in pixels (the projected curve,
@@ -183,7 +185,7 @@ pub struct Subdivider<'a> {
     params: &'a SubdivideParams,
     projection: Projection,
     /// Per object: the factor its L is multiplied by (the level of detail's relaxation; 1 where
-    /// missing). `object_edge_scale` in shaders/subdivide.wgsl.
+    /// missing). `object_edge_scale` in shaders/shared/subdivide_bindings.wgsl.
     edge_scale: &'a [f32],
 }
 

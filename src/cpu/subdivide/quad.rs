@@ -1,3 +1,5 @@
+//! CPU twin of `shaders/shared/subdivide_quad.wgsl`.
+//!
 //! Band quads drawn as one strip between their rails (see the module doc of `cpu::subdivide`):
 //! which band polygons qualify (`plan_quad` in the WGSL) and their `lattice`. The quad's nodes
 //! and triangles are in `lattice.rs` ([`quad_strip_triangles`]).

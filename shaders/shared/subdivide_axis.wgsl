@@ -1,0 +1,556 @@
+// The parts around the vertical axis: the quadrant and diamond cuts, clipping a triangle's polygon
+// by them, the bands, and a triangle cut only at the crossings of its shared edges. CPU twin:
+// src/cpu/subdivide/axis.rs.
+
+#import constants
+#import subdivide_bindings
+#import subdivide_state
+#import subdivide_edges
+#import subdivide_frame_cuts
+#import subdivide_quad
+
+// ---- the parts around the vertical axis (src/cpu/subdivide/axis.rs) ----
+
+// Moves a vertex within SNAP (relative to |x| + |z|) of the plane x = 0 or z = 0 onto it.
+fn snap_to_cut_planes(p: vec3<f32>) -> vec3<f32> {
+    let scale = SNAP * (abs(p.x) + abs(p.z));
+    return vec3<f32>(select(p.x, 0.0, abs(p.x) <= scale), p.y, select(p.z, 0.0, abs(p.z) <= scale));
+}
+
+// The half-planes: CUT_X s·x ≥ 0, CUT_Z s·z ≥ 0, CUT_CHORD side·(sx·x + sz·z − c) ≥ 0 (beyond
+// or within the diamond |x| + |z| = c of the quadrant).
+const CUT_X: u32 = 0u;
+const CUT_Z: u32 = 1u;
+const CUT_CHORD: u32 = 2u;
+
+struct Cut {
+    kind: u32,
+    s: vec2<f32>,
+    c: f32,
+    side: f32,
+}
+
+fn cut_distance(cut: Cut, p: vec3<f32>) -> f32 {
+    if (cut.kind == CUT_X) {
+        return cut.s.x * p.x;
+    }
+    if (cut.kind == CUT_Z) {
+        return cut.s.y * p.z;
+    }
+    let d = cut.s.x * p.x + cut.s.y * p.z - cut.c;
+    return select(cut.side * d, 0.0, abs(d) <= SNAP * (abs(p.x) + abs(p.z) + cut.c));
+}
+
+// The crossing of lo→hi (canonically ordered); on x = 0 or z = 0 that coordinate is set to 0.
+fn cut_crossing(kind: u32, lo: Node, hi: Node, dl: f32, dh: f32) -> Node {
+    let t = dl / (dl - dh);
+    var n = Node(lo.position + (hi.position - lo.position) * t, lo.bary + (hi.bary - lo.bary) * t);
+    let scale = SNAP * (abs(lo.position.x) + abs(lo.position.z) + abs(hi.position.x) + abs(hi.position.z));
+    if (kind == CUT_X) {
+        n.position.x = 0.0;
+        n.position.z = select(n.position.z, 0.0, abs(n.position.z) <= scale);
+    } else if (kind == CUT_Z) {
+        n.position.z = 0.0;
+        n.position.x = select(n.position.x, 0.0, abs(n.position.x) <= scale);
+    }
+    return n;
+}
+
+fn push_clipped(at: u32, n: u32, v: Node) -> u32 {
+    if (n > 0u && same(v.position, pool[at + n - 1u].position)) {
+        return n;
+    }
+    pool[at + n] = v;
+    return n + 1u;
+}
+
+// Sutherland–Hodgman clip of the current polygon against one half-plane, into a slot that is
+// neither its own, the quadrant's nor `keep_at`'s, which becomes the current polygon's; crossing
+// points from the canonically ordered edge.
+fn clip_polygon(cut: Cut) {
+    var at = 0u;
+    for (var slot = 0u; slot < 21u; slot += 7u) {
+        if (slot != poly_at && slot != quadrant_at && slot != keep_at) {
+            at = slot;
+        }
+    }
+    var n = 0u;
+    for (var i = 0u; i < poly_count; i++) {
+        let cur = poly_node(i);
+        let next = poly_node((i + 1u) % poly_count);
+        let d0 = cut_distance(cut, cur.position);
+        let d1 = cut_distance(cut, next.position);
+        if (d0 >= 0.0) {
+            n = push_clipped(at, n, cur);
+        }
+        if ((d0 >= 0.0) != (d1 >= 0.0) && d0 != 0.0 && d1 != 0.0) {
+            if (lex_less(next.position, cur.position)) {
+                n = push_clipped(at, n, cut_crossing(cut.kind, next, cur, d1, d0));
+            } else {
+                n = push_clipped(at, n, cut_crossing(cut.kind, cur, next, d0, d1));
+            }
+        }
+    }
+    if (n > 1u && same(pool[at + n - 1u].position, pool[at].position)) {
+        n -= 1u;
+    }
+    if (n < 3u) {
+        n = 0u;
+    }
+    poly_at = at;
+    poly_count = n;
+}
+
+// Clips the input triangle to quadrant q (signs of x and z as in `QUADRANTS` of axis.rs).
+fn quadrant_polygon(s: vec2<f32>) {
+    poly_at = 0u;
+    quadrant_at = 0u;
+    keep_at = 0u;
+    pool[0] = Node(tri_position[0], vec3<f32>(1.0, 0.0, 0.0));
+    pool[1] = Node(tri_position[1], vec3<f32>(0.0, 1.0, 0.0));
+    pool[2] = Node(tri_position[2], vec3<f32>(0.0, 0.0, 1.0));
+    poly_count = 3u;
+    // Quick tests (the clips would give the same): wholly on the far side of x = 0 or z = 0, or
+    // two corners the same (no polygon); wholly inside the quadrant.
+    let p = tri_position;
+    let dx = vec3<f32>(s.x * p[0].x, s.x * p[1].x, s.x * p[2].x);
+    let dz = vec3<f32>(s.y * p[0].z, s.y * p[1].z, s.y * p[2].z);
+    if (all(dx < vec3<f32>(0.0)) || all(dz < vec3<f32>(0.0)) || same(p[0], p[1]) || same(p[1], p[2])
+        || same(p[2], p[0])) {
+        poly_count = 0u;
+        return;
+    }
+    if (all(dx >= vec3<f32>(0.0)) && all(dz >= vec3<f32>(0.0))) {
+        return;
+    }
+    clip_polygon(Cut(CUT_X, s, 0.0, 1.0));
+    clip_polygon(Cut(CUT_Z, s, 0.0, 1.0));
+}
+
+// c_k = ρ·√2^k, exactly as the twin (`band_bound` in axis.rs): ρ or ρ·√2, times 2^(k/2).
+fn band_bound(k: u32) -> f32 {
+    let base = select(params.axis_clearance, params.axis_clearance * BAND_RATIO, (k & 1u) == 1u);
+    return ldexp(base, i32(k / 2u));
+}
+
+// The largest k < MAX_DIAMONDS with c_k ≤ d (0 if none): an estimate from the logarithm, then
+// exact steps. `band_of` in axis.rs.
+fn band_of(d: f32) -> u32 {
+    var k = u32(min(2.0 * log2(max(d / params.axis_clearance, 1.0)), f32(MAX_DIAMONDS - 1u)));
+    loop {
+        if (k == 0u || !(band_bound(k) > d)) {
+            break;
+        }
+        k -= 1u;
+    }
+    loop {
+        if (!(k + 1u < MAX_DIAMONDS && band_bound(k + 1u) <= d)) {
+            break;
+        }
+        k += 1u;
+    }
+    return k;
+}
+
+fn cut_active(k: u32) -> bool {
+    if (k < 32u) {
+        return ((cuts.x >> k) & 1u) != 0u;
+    }
+    return k < 64u && ((cuts.y >> (k - 32u)) & 1u) != 0u;
+}
+
+// The next active diamond after k, or MAX_DIAMONDS. `next_cut` in axis.rs.
+fn next_cut(k: u32) -> u32 {
+    let j = k + 1u;
+    if (j < 32u) {
+        let low = cuts.x & (0xffffffffu << j);
+        if (low != 0u) {
+            return firstTrailingBit(low);
+        }
+    }
+    if (j < 64u) {
+        let high = cuts.y & (0xffffffffu << (max(j, 32u) - 32u));
+        if (high != 0u) {
+            return 32u + firstTrailingBit(high);
+        }
+    }
+    return MAX_DIAMONDS;
+}
+
+// The largest active k with c_k ≤ d (k = 0, the square, always counts). `zone_of` in axis.rs.
+fn zone_of(d: f32) -> u32 {
+    var k = band_of(d);
+    loop {
+        if (k == 0u || cut_active(k)) {
+            break;
+        }
+        k -= 1u;
+    }
+    return k;
+}
+
+// The smallest and largest |x| + |z| of the triangle's points (`diamond_range` in axis.rs).
+fn diamond_range(p: array<vec3<f32>, 3>) -> vec2<f32> {
+    let d = vec3<f32>(abs(p[0].x) + abs(p[0].z), abs(p[1].x) + abs(p[1].z), abs(p[2].x) + abs(p[2].z));
+    let hi = max(max(d.x, d.y), d.z);
+    var s: vec3<f32>;
+    for (var e = 0u; e < 3u; e++) {
+        let a = p[e];
+        let b = p[(e + 1u) % 3u];
+        s[e] = (b.z - a.z) * a.x - (b.x - a.x) * a.z;
+    }
+    if (all(s >= vec3<f32>(0.0)) || all(s <= vec3<f32>(0.0))) {
+        return vec2<f32>(0.0, hi);
+    }
+    var lo = min(min(d.x, d.y), d.z);
+    for (var e = 0u; e < 3u; e++) {
+        let a = p[e];
+        let b = p[(e + 1u) % 3u];
+        if ((a.x < 0.0) != (b.x < 0.0) && a.x != 0.0 && b.x != 0.0) {
+            lo = min(lo, abs(a.z + (b.z - a.z) * (a.x / (a.x - b.x))));
+        }
+        if ((a.z < 0.0) != (b.z < 0.0) && a.z != 0.0 && b.z != 0.0) {
+            lo = min(lo, abs(a.x + (b.x - a.x) * (a.z / (a.z - b.z))));
+        }
+    }
+    return vec2<f32>(lo, hi);
+}
+
+// The cuts the current triangle asks for (`triangle_cuts` in axis.rs), as bits 0–31, 32–63.
+fn triangle_cuts(limit: f32) -> vec2<u32> {
+    let range = diamond_range(tri_position);
+    let lo = range.x;
+    let hi = range.y;
+    if (!asks_for_cuts(range)) {
+        return vec2<u32>(0u);
+    }
+    var bits = vec2<u32>(1u, 0u);
+    for (var k = 1u; k < MAX_DIAMONDS; k++) {
+        let c = band_bound(k);
+        if (c >= limit || c >= hi) {
+            break;
+        }
+        if (lo < c) {
+            if (k < 32u) {
+                bits.x |= 1u << k;
+            } else {
+                bits.y |= 1u << (k - 32u);
+            }
+        }
+    }
+    return bits;
+}
+
+// Whether every corner of the polygon kept in `quadrant` is on the far side of the cut (x: the
+// clip would be empty), or none is (y: the clip would change nothing). `Polygon::all_beyond`
+// in axis.rs.
+fn quadrant_beyond(cut: Cut) -> vec2<bool> {
+    var beyond = true;
+    var within = true;
+    for (var i = 0u; i < quadrant_count; i++) {
+        let d = cut_distance(cut, pool[quadrant_at + i].position);
+        beyond = beyond && d < 0.0;
+        within = within && d >= 0.0;
+    }
+    return vec2<bool>(beyond, within);
+}
+
+// Whether the input triangle lies strictly inside quadrant s and between two consecutive active
+// diamonds: then it is its own single part. `single_band` in axis.rs.
+fn single_band(s: vec2<f32>) -> bool {
+    let p = tri_position;
+    let dx = vec3<f32>(s.x * p[0].x, s.x * p[1].x, s.x * p[2].x);
+    let dz = vec3<f32>(s.y * p[0].z, s.y * p[1].z, s.y * p[2].z);
+    if (!(all(dx > vec3<f32>(0.0)) && all(dz > vec3<f32>(0.0)))) {
+        return false;
+    }
+    let d = dx + dz;
+    let k = zone_of(min(min(d.x, d.y), d.z));
+    let lower = Cut(CUT_CHORD, s, band_bound(k), 1.0);
+    let next = next_cut(k);
+    let upper = Cut(CUT_CHORD, s, band_bound(min(next, MAX_DIAMONDS - 1u)), -1.0);
+    for (var i = 0u; i < 3u; i++) {
+        if (cut_distance(lower, p[i]) <= 0.0 || (next < MAX_DIAMONDS && cut_distance(upper, p[i]) <= 0.0)) {
+            return false;
+        }
+    }
+    return true;
+}
+
+const QUADRANT_SIGNS = array<vec2<f32>, 4>(vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0), vec2<f32>(-1.0, 1.0), vec2<f32>(-1.0, -1.0));
+
+// Whether the current triangle is its own single part: no cuts this frame; not cut by all of
+// them (`full` false: asks for none and has no edge of one that does) and no edge of a cut
+// triangle (`marks`, its edges'); or one quadrant and one band (the loop of `plan_quadrant`
+// would give that part).
+fn single_part(full: bool, marks: vec3<u32>) -> bool {
+    if (all(cuts == vec2<u32>(0u))) {
+        return true;
+    }
+    if (!full) {
+        return all((marks & vec3<u32>(EDGE_CUT)) == vec3<u32>(0u));
+    }
+    for (var q = 0u; q < 4u; q++) {
+        if (single_band(QUADRANT_SIGNS[q])) {
+            return true;
+        }
+    }
+    return false;
+}
+
+// Plans every part of the current triangle in quadrant q (`polygons` in axis.rs: band by band
+// outwards, along each fan) and appends its pieces.
+fn plan_quadrant(t: u32, q: u32) {
+    let signs = QUADRANT_SIGNS;
+    {
+        let s = signs[q];
+        quadrant_polygon(s);
+        if (poly_count == 0u) {
+            return;
+        }
+        // What lies beyond the current diamond (`rest` in axis.rs); each band is cut from it,
+        // and the rest beyond the next diamond from the same polygon.
+        clip_polygon(Cut(CUT_CHORD, s, params.axis_clearance, 1.0));
+        quadrant_at = poly_at;
+        quadrant_count = poly_count;
+        // Start at the band of the nearest corner: the bands below are empty, and cutting them
+        // away would leave the polygon as it is (the twin runs them; the parts are the same).
+        var d_min = 1e30;
+        for (var i = 0u; i < quadrant_count; i++) {
+            d_min = min(d_min, s.x * pool[quadrant_at + i].position.x + s.y * pool[quadrant_at + i].position.z);
+        }
+        var k = zone_of(d_min);
+        loop {
+            if (quadrant_count == 0u) {
+                break;
+            }
+            k = next_cut(k);
+            let c = band_bound(min(k, MAX_DIAMONDS - 1u));
+            if (k >= MAX_DIAMONDS) {
+                poly_at = quadrant_at;
+                poly_count = quadrant_count;
+                quadrant_count = 0u; // the last band: all the rest
+            } else {
+                let within = Cut(CUT_CHORD, s, c, -1.0);
+                let test = quadrant_beyond(within);
+                if (test.x) {
+                    continue; // all of it lies beyond this band
+                }
+                poly_at = quadrant_at;
+                poly_count = quadrant_count;
+                if (test.y) {
+                    quadrant_count = 0u;
+                } else {
+                    clip_polygon(within);
+                    let band_at = poly_at;
+                    let band_count = poly_count;
+                    keep_at = band_at;
+                    poly_at = quadrant_at;
+                    poly_count = quadrant_count;
+                    clip_polygon(Cut(CUT_CHORD, s, c, 1.0));
+                    quadrant_at = poly_at;
+                    quadrant_count = poly_count;
+                    poly_at = band_at;
+                    poly_count = band_count;
+                    keep_at = quadrant_at;
+                }
+            }
+            // The fan's parts: those wholly beyond the image's rows make no pieces (`run` in
+            // subdivide.rs); the others' edges, each counted once (a diagonal is two parts').
+            var shown = 0u;
+            var needed = 0u;
+            for (var i = 1u; i + 1u < poly_count; i++) {
+                if (!off_screen_vertically(poly_node(0).position, poly_node(i).position, poly_node(i + 1u).position)) {
+                    shown |= 1u << i;
+                    let e = fan_edges(i);
+                    needed |= (1u << e.x) | (1u << e.y) | (1u << e.z);
+                }
+            }
+            for (var e = 0u; e + 3u < 2u * poly_count; e++) {
+                if ((needed & (1u << e)) != 0u) {
+                    let ends = polygon_edge_ends(e);
+                    poly_n[e] = edge_divisions(poly_node(ends.x).position, poly_node(ends.y).position);
+                }
+            }
+            if (plan_quad(shown)) {
+                append_quad(t);
+                continue;
+            }
+            for (var i = 1u; i + 1u < poly_count; i++) {
+                if ((shown & (1u << i)) != 0u) {
+                    part[0] = poly_node(0);
+                    part[1] = poly_node(i);
+                    part[2] = poly_node(i + 1u);
+                    let e = fan_edges(i);
+                    tri_n[0] = poly_n[e.x];
+                    tri_n[1] = poly_n[e.y];
+                    tri_n[2] = poly_n[e.z];
+                    plan_level();
+                    append_pieces(t);
+                }
+            }
+        }
+    }
+}
+
+
+var<private> seg_p: Node;
+var<private> seg_q: Node;
+var<private> seg_live: bool;
+var<private> edge_ends: array<vec3<f32>, 2>;
+var<private> run_start: u32;
+
+// Appends a crossing of the current edge to the pool, unless it is an end of the edge or there
+// already (a plane's crossing is found in two or four quadrants).
+fn add_crossing(n: Node) {
+    if (same(n.position, edge_ends[0]) || same(n.position, edge_ends[1])) {
+        return;
+    }
+    for (var i = run_start; i < poly_count; i++) {
+        if (same(pool[i].position, n.position)) {
+            return;
+        }
+    }
+    if (poly_count < 21u) {
+        pool[poly_count] = n;
+        poly_count += 1u;
+    }
+}
+
+// Clips the segment to the side cut ≥ 0 as `clip_polygon` clips a polygon's edge, keeping the
+// crossing (`clip_segment` in axis.rs).
+fn clip_segment(cut: Cut) {
+    if (!seg_live) {
+        return;
+    }
+    let dp = cut_distance(cut, seg_p.position);
+    let dq = cut_distance(cut, seg_q.position);
+    if ((dp >= 0.0) != (dq >= 0.0) && dp != 0.0 && dq != 0.0) {
+        var x: Node;
+        if (lex_less(seg_q.position, seg_p.position)) {
+            x = cut_crossing(cut.kind, seg_q, seg_p, dq, dp);
+        } else {
+            x = cut_crossing(cut.kind, seg_p, seg_q, dp, dq);
+        }
+        add_crossing(x);
+        if (dp >= 0.0) {
+            seg_q = x;
+        } else {
+            seg_p = x;
+        }
+        return;
+    }
+    seg_live = dp >= 0.0 && dq >= 0.0;
+}
+
+// Appends to the pool the points where a cut triangle cuts edge a → b (ends excluded), in order
+// from a (`edge_crossings` in axis.rs): the same clips in the same order, on the edge alone.
+fn edge_crossings(a: Node, b: Node) {
+    run_start = poly_count;
+    edge_ends = array<vec3<f32>, 2>(a.position, b.position);
+    for (var q = 0u; q < 4u; q++) {
+        let s = QUADRANT_SIGNS[q];
+        seg_p = a;
+        seg_q = b;
+        seg_live = true;
+        clip_segment(Cut(CUT_X, s, 0.0, 1.0));
+        clip_segment(Cut(CUT_Z, s, 0.0, 1.0));
+        clip_segment(Cut(CUT_CHORD, s, params.axis_clearance, 1.0));
+        var k = 0u;
+        loop {
+            k = next_cut(k);
+            if (!seg_live || k >= MAX_DIAMONDS) {
+                break;
+            }
+            clip_segment(Cut(CUT_CHORD, s, band_bound(k), 1.0));
+        }
+    }
+    // In order along the edge (insertion sort; a few points).
+    let dir = b.position - a.position;
+    for (var i = run_start + 1u; i < poly_count; i++) {
+        let n = pool[i];
+        let key = dot(n.position - a.position, dir);
+        var j = i;
+        loop {
+            if (j == run_start || !(dot(pool[j - 1u].position - a.position, dir) > key)) {
+                break;
+            }
+            pool[j] = pool[j - 1u];
+            j -= 1u;
+        }
+        pool[j] = n;
+    }
+}
+
+// Plans part (apex, pool[i], pool[i + 1 mod the polygon's count]) unless it is off screen.
+fn plan_apex_part(t: u32, apex: Node, i: u32) {
+    part[0] = apex;
+    part[1] = pool[i];
+    part[2] = pool[(i + 1u) % poly_count];
+    if (!off_screen_vertically(part[0].position, part[1].position, part[2].position)) {
+        plan_part();
+        append_pieces(t);
+    }
+}
+
+// Plans the parts of triangle t, which is not cut by all cuts, at the crossings of its edges that
+// cut triangles have (`edge_split_parts` in axis.rs): its boundary (corner e, then edge e's
+// crossings) in the pool; with crossings on one edge the fan from the opposite corner, on more
+// the fan from the centroid, on none the triangle.
+fn plan_edge_split(t: u32) {
+    let corners = array<Node, 3>(Node(tri_position[0], vec3<f32>(1.0, 0.0, 0.0)),
+                                 Node(tri_position[1], vec3<f32>(0.0, 1.0, 0.0)),
+                                 Node(tri_position[2], vec3<f32>(0.0, 0.0, 1.0)));
+    poly_count = 0u;
+    var crossed = 0u;
+    var chain = vec3<u32>(0u); // the crossed edge, its corner's slot, its nodes before the next corner
+    let marks = edge_marks(t);
+    for (var e = 0u; e < 3u; e++) {
+        let at = poly_count;
+        pool[at] = corners[e];
+        poly_count += 1u;
+        if ((marks[e] & EDGE_CUT) != 0u) {
+            edge_crossings(corners[e], corners[(e + 1u) % 3u]);
+        }
+        if (poly_count > at + 1u) {
+            crossed += 1u;
+            chain = vec3<u32>(e, at, poly_count - at);
+        }
+    }
+    if (crossed == 0u) {
+        part = corners;
+        plan_part();
+        append_pieces(t);
+    } else if (crossed == 1u) {
+        for (var i = 0u; i < chain.z; i++) {
+            plan_apex_part(t, corners[(chain.x + 2u) % 3u], chain.y + i);
+        }
+    } else {
+        let centre = weighted(corners, vec3<f32>(1.0 / 3.0));
+        for (var i = 0u; i < poly_count; i++) {
+            plan_apex_part(t, centre, i);
+        }
+    }
+}
+
+// The edges of the polygon in `poly` and its fan: side e (corner e → e + 1, the last back to
+// corner 0) for e < poly_count, then diagonal d (corner 0 → d + 2) at poly_count + d. The ends of
+// edge e, as corner indices.
+fn polygon_edge_ends(e: u32) -> vec2<u32> {
+    if (e < poly_count) {
+        return vec2<u32>(e, (e + 1u) % poly_count);
+    }
+    return vec2<u32>(0u, e - poly_count + 2u);
+}
+
+// The edges of fan part i (corners 0, i, i + 1): 0 → i, i → i + 1, i + 1 → 0.
+fn fan_edges(i: u32) -> vec3<u32> {
+    let first = select(poly_count + i - 2u, 0u, i == 1u);
+    let last = select(poly_count + i - 1u, poly_count - 1u, i + 2u == poly_count);
+    return vec3<u32>(first, i, last);
+}
+
+// Whether the band polygon in `poly` (both fan parts `shown`, edge counts in `poly_n`) is drawn as one strip between two of its sides (the rails)
+// rather than as the two parts of its fan (`quad_strip` in subdivide.rs); then `strip_n` holds
+// the rails' counts and `quad_turn` the polygon corner that becomes the quad's corner 0 (rails
+// 0 → 1 and 3 → 2).

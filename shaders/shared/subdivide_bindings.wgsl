@@ -1,0 +1,33 @@
+// The `subdivide` stage's bindings (group 0; descriptor `SUBDIVIDE` in src/shader/mod.rs).
+
+#import subdivide_types
+
+@group(0) @binding(0) var<uniform> params: SubdivideParams;
+@group(0) @binding(1) var<storage, read> vertices: array<SceneVertex>;
+@group(0) @binding(2) var<storage, read> indices: array<u32>;
+
+@group(0) @binding(3) var<storage, read_write> pieces: array<Piece>;
+// The output: each piece's lattice nodes once (per seam copy), and its triangles as indices
+// into them (`SubdivideOutput` in src/cpu/subdivide/).
+@group(0) @binding(4) var<storage, read_write> out_nodes: array<DrawVertex>;
+@group(0) @binding(5) var<storage, read_write> counters: Counters;
+@group(0) @binding(6) var<storage, read_write> draw_args: DrawIndexedIndirectArgs;
+// Workgroup counts of the `lattice` dispatch (0–2), written by `lattice_args` from the piece
+// counter, and of the `plan_cuts` dispatch (3–5), written by `plan_cuts_args`.
+@group(0) @binding(7) var<storage, read_write> lattice_dispatch: array<u32, 6>;
+// Per object: the factor its L is multiplied by (the visual-field level of detail relaxes the
+// subdivision away from the gaze; 1 without it). CPU twin: `Subdivider::edge_px`.
+@group(0) @binding(8) var<storage, read> object_edge_scale: array<f32>;
+// The triangles `plan` left for `plan_cuts` (room for every triangle of a dispatch).
+@group(0) @binding(9) var<storage, read_write> cut_list: array<u32>;
+@group(0) @binding(10) var<storage, read_write> out_indices: array<u32>;
+// Edge e of triangle t is the scene's shared edge triangle_edges[3t + e] (`SharedEdges`).
+// `cut_edges`: two bits per shared edge (`FrameCuts`), edge i's at bits 2(i mod 16) of word i / 16
+// (one load reads both): EDGE_ASKING, the edge is a triangle's that asks for cuts (set by
+// `active_cuts`); EDGE_CUT, a cut triangle's (those and their neighbours across those edges; set
+// by `active_cuts` and `ring_cuts`).
+@group(0) @binding(11) var<storage, read> triangle_edges: array<u32>;
+@group(0) @binding(12) var<storage, read_write> cut_edges: array<atomic<u32>>;
+// The same buffer, read only, for the passes after the marking (`plan`, `plan_cuts`): plain
+// loads rather than atomic ones.
+@group(0) @binding(13) var<storage, read> edge_marks_read: array<u32>;

@@ -1,0 +1,209 @@
+// A triangle's edges (seed 002 §2.3, eq. 5, and the error split): edge nodes computed from the
+// canonically ordered pair, the projected profile of an edge, its division count; loading an
+// input triangle; the part's level and pre-split. CPU twin: src/cpu/subdivide/mod.rs.
+
+#import projection
+#import constants
+#import subdivide_bindings
+#import subdivide_state
+
+fn lex_less(a: vec3<f32>, b: vec3<f32>) -> bool {
+    return a.x < b.x || (a.x == b.x && (a.y < b.y || (a.y == b.y && a.z < b.z)));
+}
+
+fn same(a: vec3<f32>, b: vec3<f32>) -> bool {
+    return all(a == b);
+}
+
+// The point j/n of the way from a to b, from the canonically ordered pair; the ends are exact.
+fn edge_point(a: Node, b: Node, j: u32, n: u32) -> Node {
+    var lo = a;
+    var hi = b;
+    var jj = j;
+    if (lex_less(b.position, a.position)) {
+        lo = b;
+        hi = a;
+        jj = n - j;
+    }
+    if (jj == 0u) {
+        return lo;
+    }
+    if (jj == n) {
+        return hi;
+    }
+    let t = f32(jj) / f32(n);
+    return Node(lo.position + (hi.position - lo.position) * t, lo.bary + (hi.bary - lo.bary) * t);
+}
+
+// Image position in pixels (x not wrapped) of a viewer-frame point for one eye sign.
+fn pixel(p: vec3<f32>, eye_sign: f32) -> vec2<f32> {
+    let q = project_with_azimuth(params.projection, p, azimuth(p), eye_sign);
+    return vec2<f32>(q.x * params.projection.width / TAU, q.y * params.projection.pixels_per_v);
+}
+
+// What the split rules read of the straight edge ab (`Subdivider::edge_profile`): sampled at
+// `segments` segments, both eyes, in canonical order: the projected length by which eq. 5 splits
+// it (heights clamped, segments beyond the clamp at both ends counting 0, stretch-adjusted), the
+// largest second difference of the sampled points (x unwrapped, triples beyond the clamp
+// skipped) by which the error split splits it, and whether it comes near the eye circle.
+struct EdgeProfile {
+    length_px: f32,
+    bend_px: f32,
+    ring: bool,
+}
+
+fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
+    var lo = a;
+    var hi = b;
+    if (lex_less(b, a)) {
+        lo = b;
+        hi = a;
+    }
+    let clamp_v = 1.5 * params.projection.height;
+    let width = params.projection.width;
+    var length_px = 0.0;
+    var longest = 0.0;
+    var nearest = 1e30;
+    var bend = 0.0;
+    for (var s = 0u; s < 2u; s++) {
+        let eye_sign = select(-1.0, 1.0, s == 1u);
+        var total = 0.0;
+        var prev = vec2<f32>(0.0, 0.0);
+        var q0 = vec2<f32>(0.0, 0.0);
+        var q1 = vec2<f32>(0.0, 0.0);
+        for (var k = 0u; k <= segments; k++) {
+            let t = f32(k) / f32(segments);
+            let p = lo + (hi - lo) * t;
+            nearest = min(nearest, horizontal_radius(p));
+            let raw = pixel(p, eye_sign);
+            var q = raw;
+            q.y = clamp(q.y, -clamp_v, clamp_v);
+            let dx = (q.x - prev.x) - width * round((q.x - prev.x) / width);
+            if (k > 0u && !(q.y == prev.y && abs(q.y) == clamp_v)) {
+                let segment = length(vec2<f32>(dx, q.y - prev.y));
+                longest = max(longest, segment);
+                total += segment;
+            }
+            let unwrapped = vec2<f32>(select(raw.x, q1.x + dx, k > 0u), raw.y);
+            if (k >= 2u && abs(unwrapped.y) < clamp_v && abs(q1.y) < clamp_v && abs(q0.y) < clamp_v) {
+                bend = max(bend, length(unwrapped - 2.0 * q1 + q0));
+            }
+            q0 = q1;
+            q1 = unwrapped;
+            prev = q;
+        }
+        length_px = max(length_px, total);
+    }
+    // Near the eye circle, which the paper model and the sphere show on screen (α and the
+    // longitude ∝ √(r − d_e)), no stretch is allowed (the exact model puts it at v = ±∞).
+    let shows_ring = params.projection.vertical_exact == 0u || is_sphere(params.projection);
+    let ring = shows_ring && nearest < 2.0 * params.projection.eye_radius;
+    let stretch = select(MAX_STRETCH, 1.0, ring);
+    return EdgeProfile(max(length_px, f32(segments) * longest / stretch), bend, ring);
+}
+
+// Parts for a chord error of at most τ (`parts_for_bend`).
+fn parts_for_bend(bend_px: f32, segments: u32, max_error_px: f32) -> f32 {
+    return ceil(f32(segments) * sqrt(bend_px / (8.0 * max_error_px)));
+}
+
+// Divisions of an edge (`Subdivider::edge_divisions`): eq. 5 for METHOD_ADAPTIVE, the error
+// split for METHOD_ERROR. The quick 2-segment profile, then the 8-segment one, from one call site
+// in a loop (lavapipe's compiler inlines every call, and a shader that merely contains more code
+// runs slower).
+fn edge_divisions(a: vec3<f32>, b: vec3<f32>) -> u32 {
+    if (params.method == METHOD_VERTEX) {
+        return 1u;
+    }
+    if (params.method == METHOD_FIXED) {
+        return params.fixed_n;
+    }
+    let by_length = params.method == METHOD_ADAPTIVE;
+    var n = 0.0;
+    for (var round = 0u; round < 2u; round++) {
+        let segments = select(2u, EDGE_SAMPLES, round == 1u);
+        let p = edge_profile(a, b, segments);
+        let by_bend = parts_for_bend(p.bend_px, segments, tri_max_error_px);
+        if (round == 0u) {
+            let whole = select(p.length_px <= tri_edge_px && !p.ring && by_bend <= 1.0,
+                               p.length_px <= 0.5 * tri_edge_px, by_length);
+            if (whole) {
+                return 1u;
+            }
+        } else if (by_length) {
+            n = ceil(p.length_px / tri_edge_px);
+        } else {
+            let longest = select(ERROR_SPLIT_LENGTH * tri_edge_px, tri_edge_px, p.ring);
+            n = max(by_bend, ceil(p.length_px / longest));
+        }
+    }
+    if (n >= f32(MAX_EDGE_DIVISIONS) || !(n == n)) {
+        return MAX_EDGE_DIVISIONS;
+    }
+    return max(u32(n), 1u);
+}
+
+// Whether a triangle lies wholly above or below the image (see `off_screen_vertically` in
+// src/cpu/subdivide/ for why testing the corners suffices).
+fn off_screen_vertically(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> bool {
+    let k = params.vertical_limit;
+    let r = vec3<f32>(horizontal_radius(p0), horizontal_radius(p1), horizontal_radius(p2));
+    let y = vec3<f32>(p0.y, p1.y, p2.y);
+    return all(y > k * r) || all(y < -k * r);
+}
+
+// The corners of input triangle t in the viewer frame, snapped to the cut planes.
+fn load_positions(t: u32) {
+    for (var k = 0u; k < 3u; k++) {
+        let v = vertices[indices[3u * t + k]];
+        tri_position[k] = snap_to_cut_planes((params.view * vec4<f32>(v.position, 1.0)).xyz);
+    }
+}
+
+// Loads an input triangle into the viewer frame, its vertices snapped to the cut planes
+// (its parts, their edge counts and K come from `visit_parts` or from the piece record).
+fn load_triangle(t: u32) {
+    load_positions(t);
+    for (var k = 0u; k < 3u; k++) {
+        let v = vertices[indices[3u * t + k]];
+        tri_normal[k] = (params.view * vec4<f32>(v.normal, 0.0)).xyz;
+        tri_color[k] = v.color;
+        tri_uv[k] = v.uv;
+        let t = unpack_tangent(v.tangent);
+        tri_tangent[k] = vec4<f32>((params.view * vec4<f32>(t.xyz, 0.0)).xyz, t.w);
+    }
+    tri_material = vertices[indices[3u * t]].material;
+    tri_object = vertices[indices[3u * t]].object;
+    let scale = object_edge_scale[min(tri_object, arrayLength(&object_edge_scale) - 1u)];
+    tri_edge_px = params.edge_px * scale;
+    tri_max_error_px = params.max_error_px * (scale * scale);
+}
+
+// Whether the method is one of the adaptive rules (eq. 5 or the error split).
+fn is_adaptive() -> bool {
+    return params.method == METHOD_ADAPTIVE || params.method == METHOD_ERROR;
+}
+
+// Edge counts and macro-lattice level of the current part.
+fn plan_part() {
+    for (var e = 0u; e < 3u; e++) {
+        tri_n[e] = edge_divisions(part[e].position, part[(e + 1u) % 3u].position);
+    }
+    plan_level();
+}
+
+// The macro-lattice level of the current part from its edge counts `tri_n`.
+fn plan_level() {
+    let m = max(max(tri_n[0], tri_n[1]), tri_n[2]);
+    tri_k = 1u;
+    if (is_adaptive()) {
+        let step = min(params.max_div, PIECE_DIVISIONS);
+        tri_k = min((m + step - 1u) / step, MAX_MACRO_LEVEL);
+    } else if (params.method == METHOD_FIXED) {
+        tri_k = (m + PIECE_DIVISIONS - 1u) / PIECE_DIVISIONS;
+    }
+}
+
+// Where macro node (a, b, c)/K lies, as (kind, i, j): kind 0 = triangle corner i; kind 1 = fine
+// node j (0 < j < n_i) of original edge i; kind 2 = interior. Nodes on an original edge snap to
+// its fine nodes and may land on a corner. (`Location` in subdivide.rs.)

@@ -1,0 +1,334 @@
+// A piece's lattice: macro cells of the pre-split, lattice and boundary nodes, the strips of
+// slivers, the piece records `plan` appends, and what `lattice` emits (nodes once, triangles as
+// indices). CPU twin: src/cpu/subdivide/lattice.rs.
+
+#import constants
+#import subdivide_bindings
+#import subdivide_state
+#import subdivide_edges
+#import subdivide_quad
+
+const CORNER: u32 = 0u;
+const ON_EDGE: u32 = 1u;
+const INTERIOR: u32 = 2u;
+
+// The boundary edge a node (a, b, c) of a level-k lattice lies on, and its index along that edge
+// from the edge's start: (0, b) for c = 0, (1, c) for a = 0, (2, a) for b = 0; edge 3 = interior.
+// Both lattice levels (the macro pre-split and each piece) place such nodes on the edge's own
+// nodes with `snap`. (`boundary_edge` and `snap` in subdivide.rs.)
+fn boundary_edge(abc: vec3<u32>) -> vec2<u32> {
+    if (abc.z == 0u) {
+        return vec2<u32>(0u, abc.y);
+    }
+    if (abc.x == 0u) {
+        return vec2<u32>(1u, abc.z);
+    }
+    if (abc.y == 0u) {
+        return vec2<u32>(2u, abc.x);
+    }
+    return vec2<u32>(3u, 0u);
+}
+
+// The edge node nearest to lattice index idx of `level` on an edge of `count` parts.
+fn snap(idx: u32, count: u32, level: u32) -> u32 {
+    return (2u * idx * count + level) / (2u * level);
+}
+
+fn macro_location(abc: vec3<u32>) -> vec3<u32> {
+    let on = boundary_edge(abc);
+    let e = on.x;
+    if (e == 3u) {
+        return vec3<u32>(INTERIOR, 0u, 0u);
+    }
+    let j = snap(on.y, tri_n[e], tri_k);
+    if (j == 0u) {
+        return vec3<u32>(CORNER, e, 0u);
+    }
+    if (j == tri_n[e]) {
+        return vec3<u32>(CORNER, (e + 1u) % 3u, 0u);
+    }
+    return vec3<u32>(ON_EDGE, e, j);
+}
+
+fn macro_node(abc: vec3<u32>, loc: vec3<u32>) -> Node {
+    if (loc.x == CORNER) {
+        return corner(loc.y);
+    }
+    if (loc.x == ON_EDGE) {
+        return edge_point(corner(loc.y), corner((loc.y + 1u) % 3u), loc.z, tri_n[loc.y]);
+    }
+    return weighted(part, vec3<f32>(abc) / f32(tri_k));
+}
+
+// The node's fine index along original edge oe from its start, or −1 if it is not on that edge.
+fn index_on(oe: u32, loc: vec3<u32>) -> i32 {
+    if (loc.x == CORNER && loc.y == oe) {
+        return 0;
+    }
+    if (loc.x == CORNER && loc.y == (oe + 1u) % 3u) {
+        return i32(tri_n[oe]);
+    }
+    if (loc.x == ON_EDGE && loc.y == oe) {
+        return i32(loc.z);
+    }
+    return -1;
+}
+
+struct Cell {
+    c: array<vec3<u32>, 3>,
+}
+
+// Corners of cell `cell` of a level-k lattice (row r: k − r upward cells, then k − r − 1 downward).
+fn macro_cell(k: u32, cell: u32) -> Cell {
+    var rest = cell;
+    var row = 0u;
+    while (rest >= 2u * (k - row) - 1u) {
+        rest -= 2u * (k - row) - 1u;
+        row += 1u;
+    }
+    let up = k - row;
+    var out: Cell;
+    if (rest < up) {
+        let j = rest;
+        out.c[0] = vec3<u32>(k - row - j, j, row);
+        out.c[1] = vec3<u32>(k - row - j - 1u, j + 1u, row);
+        out.c[2] = vec3<u32>(k - row - j - 1u, j, row + 1u);
+    } else {
+        let j = rest - up;
+        out.c[0] = vec3<u32>(k - row - j - 1u, j + 1u, row);
+        out.c[1] = vec3<u32>(k - row - j - 2u, j + 1u, row + 1u);
+        out.c[2] = vec3<u32>(k - row - j - 1u, j, row + 1u);
+    }
+    return out;
+}
+
+// The m-th node of piece edge e, from piece corner e towards corner e + 1.
+fn node_on_edge(e: u32, m: u32) -> Node {
+    let oe = piece_original[e];
+    var a = piece_q[e];
+    var b = piece_q[(e + 1u) % 3u];
+    var j = m;
+    var n = piece_counts[e];
+    if (oe >= 0) {
+        // On an original edge: the fine nodes of that edge, by their global index.
+        let o = u32(oe);
+        a = corner(o);
+        b = corner((o + 1u) % 3u);
+        n = tri_n[o];
+        j = select(piece_from[e] + m, piece_from[e] - m, piece_to[e] < piece_from[e]);
+    }
+    return edge_point(a, b, j, n);
+}
+
+// The point with weights w of a triangle of nodes (positions and barycentric weights alike).
+fn weighted(q: array<Node, 3>, w: vec3<f32>) -> Node {
+    return Node(
+        w.x * q[0].position + w.y * q[1].position + w.z * q[2].position,
+        w.x * q[0].bary + w.y * q[1].bary + w.z * q[2].bary,
+    );
+}
+
+fn interior_node(i: u32, j: u32, l: u32, m: u32) -> Node {
+    return weighted(piece_q, vec3<f32>(f32(i), f32(j), f32(l)) / f32(m));
+}
+
+
+fn append_pieces(t: u32) {
+    let count = tri_k * tri_k;
+    let base = atomicAdd(&counters.pieces, count);
+    if (base + count > params.piece_capacity) {
+        return; // counted, never written
+    }
+    var record: Piece;
+    record.triangle = t;
+    record.counts01 = tri_n[0] | (tri_n[1] << 16u);
+    record.count2_level = tri_n[2] | (tri_k << 16u);
+    for (var i = 0u; i < 3u; i++) {
+        record.corner[i] = vec4<f32>(part[i].position, part[i].bary.x);
+        record.bary1[i] = part[i].bary.y;
+        record.bary2[i] = part[i].bary.z;
+    }
+    for (var c = 0u; c < count; c++) {
+        record.cell = c;
+        pieces[base + c] = record;
+    }
+}
+
+// ---- emission ----
+
+fn draw_vertex(n: Node, theta_ref: f32) -> DrawVertex {
+    let b = n.bary;
+    return DrawVertex(
+        n.position,
+        theta_ref,
+        b.x * tri_normal[0] + b.y * tri_normal[1] + b.z * tri_normal[2],
+        tri_material,
+        b.x * tri_color[0] + b.y * tri_color[1] + b.z * tri_color[2],
+        b.x * tri_uv[0] + b.y * tri_uv[1] + b.z * tri_uv[2],
+        tri_object,
+        pack_tangent(b.x * tri_tangent[0] + b.y * tri_tangent[1] + b.z * tri_tangent[2]),
+    );
+}
+
+fn visible_edge_px(p: array<vec3<f32>, 3>) -> f32 {
+    let half_h = 0.5 * params.projection.height;
+    let width = params.projection.width;
+    var longest = 0.0;
+    for (var s = 0u; s < 2u; s++) {
+        let eye_sign = select(-1.0, 1.0, s == 1u);
+        let q = array<vec2<f32>, 3>(pixel(p[0], eye_sign), pixel(p[1], eye_sign), pixel(p[2], eye_sign));
+        for (var e = 0u; e < 3u; e++) {
+            let a = q[e];
+            let b = q[(e + 1u) % 3u];
+            if (abs(a.y) <= half_h || abs(b.y) <= half_h) {
+                let dx = (b.x - a.x) - width * round((b.x - a.x) / width);
+                longest = max(longest, length(vec2<f32>(dx, b.y - a.y)));
+            }
+        }
+    }
+    return longest;
+}
+
+// ---- the lattice of a piece: its nodes once, its triangles as indices ----
+
+// Node (i, j, l) of the piece's lattice of level m: the regular lattice, whose boundary nodes on
+// an edge with fewer divisions snap to that edge's nearest node (see subdivide.rs).
+fn lattice_node(c: vec3<u32>, m: u32) -> Node {
+    let on = boundary_edge(c);
+    if (on.x < 3u) {
+        return node_on_edge(on.x, snap(on.y, piece_counts[on.x], m));
+    }
+    return interior_node(c.x, c.y, c.z, m);
+}
+
+// Slot of lattice node (i, j, l) among the piece's (m + 1)(m + 2)/2: rows l = 0..m of m + 1 − l
+// nodes, by j (`node_slot` in subdivide.rs).
+fn node_slot(c: vec3<u32>, m: u32) -> u32 {
+    return c.z * (2u * m + 3u - c.z) / 2u + c.y;
+}
+
+// ---- the strip of a sliver piece (`strip_triangles` in subdivide.rs) ----
+
+// On the cylinder, under the error split, the base edge (one part, chord error within
+// STRIP_BASE_ERROR·τ by the quick profile, away from the eye circle) of a piece with another edge
+// in STRIP_MIN_DIVISIONS or more parts; 3: the regular lattice (`strip_base` in subdivide.rs).
+fn strip_base_of() -> u32 {
+    let m = max(max(piece_counts[0], piece_counts[1]), piece_counts[2]);
+    if (params.method != METHOD_ERROR || is_sphere(params.projection) || m < STRIP_MIN_DIVISIONS) {
+        return 3u;
+    }
+    var base = 3u;
+    for (var e = 0u; e < 3u; e++) {
+        if (base == 3u && piece_counts[e] == 1u) {
+            base = e;
+        }
+    }
+    if (base < 3u) {
+        let p = edge_profile(piece_q[base].position, piece_q[(base + 1u) % 3u].position, 2u);
+        if (p.ring || parts_for_bend(p.bend_px, 2u, STRIP_BASE_ERROR * tri_max_error_px) > 1.0) {
+            return 3u;
+        }
+    }
+    return base;
+}
+
+// Node `slot` of the strip: edge base + 1's nodes from its corner to the apex, then edge
+// base + 2's after the apex.
+fn strip_node(slot: u32) -> Node {
+    if (slot <= strip_n.x) {
+        return node_on_edge((strip_base + 1u) % 3u, slot);
+    }
+    return node_on_edge((strip_base + 2u) % 3u, slot - strip_n.x);
+}
+
+// The next triangle of the strip's walk at `walk` = (i, j) (left L_i = slot n1 + n2 − i, right
+// R_j = slot j), as slots; advances the walk.
+fn strip_step(walk: ptr<function, vec2<u32>>) -> vec3<u32> {
+    let i = (*walk).x;
+    let j = (*walk).y;
+    let n1 = strip_n.x;
+    let n2 = strip_n.y;
+    if (i < n2 && (j == n1 || (i + 1u) * n1 <= (j + 1u) * n2)) {
+        *walk = vec2<u32>(i + 1u, j);
+        return vec3<u32>(n1 + n2 - i, j, n1 + n2 - i - 1u);
+    }
+    *walk = vec2<u32>(i, j + 1u);
+    return vec3<u32>(n1 + n2 - i, j, j + 1u);
+}
+
+
+// ---- a piece's nodes and candidate triangles: the lattice of level m, the strip or the quad ----
+
+// Node k in slot order; `row` is the lattice's running (j, l), advanced here.
+fn piece_node(k: u32, m: u32, row: ptr<function, vec2<u32>>) -> Node {
+    if (strip_base == QUAD_STRIP) {
+        return quad_node(k);
+    }
+    if (strip_base < 3u) {
+        return strip_node(k);
+    }
+    let j = (*row).x;
+    let l = (*row).y;
+    *row = select(vec2<u32>(j + 1u, l), vec2<u32>(0u, l + 1u), j + 1u > m - l);
+    return lattice_node(vec3<u32>(m - j - l, j, l), m);
+}
+
+// Candidate triangle t's slots (the strip's in walk order, advancing `walk`).
+fn piece_triangle_slots(t: u32, m: u32, walk: ptr<function, vec2<u32>>) -> vec3<u32> {
+    if (strip_base == QUAD_STRIP) {
+        return quad_step(walk);
+    }
+    if (strip_base < 3u) {
+        return strip_step(walk);
+    }
+    let cell = macro_cell(m, t);
+    return vec3<u32>(node_slot(cell.c[0], m), node_slot(cell.c[1], m), node_slot(cell.c[2], m));
+}
+
+// Whether candidate triangle t is drawn: not collapsed by snapping, not off screen.
+fn piece_triangle_drawn(t: u32, m: u32, walk: ptr<function, vec2<u32>>) -> bool {
+    var a: vec3<f32>;
+    var b: vec3<f32>;
+    var c: vec3<f32>;
+    if (strip_base == QUAD_STRIP) {
+        let s = quad_step(walk);
+        a = quad_node(s.x).position;
+        b = quad_node(s.y).position;
+        c = quad_node(s.z).position;
+    } else if (strip_base < 3u) {
+        let s = strip_step(walk);
+        a = strip_node(s.x).position;
+        b = strip_node(s.y).position;
+        c = strip_node(s.z).position;
+    } else {
+        let cell = macro_cell(m, t);
+        a = lattice_node(cell.c[0], m).position;
+        b = lattice_node(cell.c[1], m).position;
+        c = lattice_node(cell.c[2], m).position;
+    }
+    return !(same(a, b) || same(b, c) || same(c, a) || off_screen_vertically(a, b, c));
+}
+
+// The u range (both eyes) of the piece's triangle on the cylinder, from its corners
+// (`piece_u_range` in subdivide.rs): its azimuths span those of its corners (its footprint is
+// convex and misses the axis), and α(r) grows with r, so |α| is largest at the footprint's
+// nearest or farthest point from the axis.
+fn piece_u_range(q: array<Node, 3>, theta_c: f32) -> vec2<f32> {
+    var theta_min = 1e30;
+    var theta_max = -1e30;
+    var r_min = 1e30;
+    var r_max = 0.0;
+    for (var e = 0u; e < 3u; e++) {
+        let a = q[e].position.xz;
+        let b = q[(e + 1u) % 3u].position.xz;
+        let theta = theta_c + wrap_angle(azimuth(q[e].position) - theta_c);
+        theta_min = min(theta_min, theta);
+        theta_max = max(theta_max, theta);
+        r_max = max(r_max, length(a));
+        let ab = b - a;
+        let t = clamp(-dot(a, ab) / max(dot(ab, ab), 1e-30), 0.0, 1.0);
+        r_min = min(r_min, length(a + t * ab));
+    }
+    let alpha = max(abs(eye_shift(params.projection, r_min)), abs(eye_shift(params.projection, r_max)));
+    return vec2<f32>(theta_min - alpha, theta_max + alpha);
+}

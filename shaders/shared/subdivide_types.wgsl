@@ -1,0 +1,85 @@
+// The `subdivide` stage's data: its output vertex, its parameters and counters, the draw's
+// indirect arguments, a piece record, a node, the edge marks' bits. Rust twins:
+// src/encoding/types.rs (checked field by field by tests/shaders.rs).
+
+#import projection
+#import constants
+#import scene
+
+struct DrawVertex {
+    position: vec3<f32>,
+    theta_ref: f32,
+    normal: vec3<f32>,
+    material: u32,
+    color: vec4<f32>,
+    uv: vec2<f32>,
+    object: u32,
+    tangent: u32,   // the interpolated glTF tangent, viewer frame, packed (`pack_tangent`); 0: none
+}
+
+struct SubdivideParams {
+    view: mat4x4<f32>,
+    projection: Projection,
+    axis_clearance: f32,
+    triangle_count: u32,
+    first_triangle: u32,
+    method: u32,            // METHOD_VERTEX, METHOD_FIXED, METHOD_ADAPTIVE (length) or METHOD_ERROR
+    fixed_n: u32,
+    edge_px: f32,           // L
+    max_div: u32,           // N_max
+    piece_capacity: u32,
+    triangle_capacity: u32,
+    first_piece: u32,
+    piece_count: u32,
+    measure_edges: u32,  // 1: also track the longest visible output edge
+    vertical_limit: f32, // |y| > this·r: no pixel row shows the point (`Projection::vertical_limit`)
+    max_error_px: f32,   // τ of the error split
+    _pad1: u32,
+    _pad2: u32,
+}
+
+struct Counters {
+    pieces: atomic<u32>,
+    triangles: atomic<u32>,
+    max_edge_bits: atomic<u32>, // bits of the largest visible output edge, px (f32 ≥ 0 orders as u32)
+    cut_count: atomic<u32>,     // triangles `plan` listed for `plan_cuts` from the front of `cut_list`
+    nodes: atomic<u32>,         // output nodes (`lattice`)
+    cut_wide: atomic<u32>,      // ... and from its back: the wide ones (`asks_for_cuts`)
+    // The frame's cuts around the axis (`AxisCuts` in axis.rs): bit 0 the quadrant cuts and the
+    // square, bit k the diamond c_k; bits 0–31 and 32–63. Kept across the chunks of a frame.
+    cuts_low: atomic<u32>,
+    cuts_high: atomic<u32>,
+}
+
+struct DrawIndexedIndirectArgs {
+    index_count: u32,
+    instance_count: u32,
+    first_index: u32,
+    base_vertex: i32,
+    first_instance: u32,
+}
+
+
+// A piece: its triangle, macro cell, the part's edge counts and K, and the part's corners
+// (position and barycentric weights), so that `lattice` need not cut the triangle again.
+struct Piece {
+    triangle: u32,
+    cell: u32,
+    counts01: u32,      // n0 | n1 << 16
+    count2_level: u32,  // n2 | K << 16
+    corner: array<vec4<f32>, 3>, // position, barycentric weight of the triangle's corner 0
+    bary1: vec4<f32>,   // weights of corners 1 and 2 at the part's corners 0, 1, 2
+    bary2: vec4<f32>,
+}
+
+const EDGE_ASKING: u32 = 1u;
+const EDGE_CUT: u32 = 2u;
+
+// `params.piece_count == PIECES_FROM_COUNTER` (from `constants`): as many pieces as `plan` made
+// (read from the counter), so that plan, lattice and drawing can run in one submission.
+// MAX_EDGE_DIVISIONS, EDGE_SAMPLES, BAND_LIMIT, BAND_RATIO, SNAP, SEAM_MARGIN: from src/shader/constants.rs.
+
+struct Node {
+    position: vec3<f32>,
+    bary: vec3<f32>,   // weights of the input triangle's corners, for the attributes
+}
