@@ -224,79 +224,22 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     for (var i = 0u; i < 3u; i++) {
         part[i] = Node(piece.corner[i].xyz, vec3<f32>(piece.corner[i].w, piece.bary1[i], piece.bary2[i]));
     }
-    var m = 0u;
-    var candidates = 0u;
-    var node_count = 0u;
-    var theta_c = 0.0;
+    var shape: PieceShape;
     if ((piece.count2_level & QUAD_HEAD) != 0u) {
-        // A band quad: corners 0–2 here, corner 3 in the next record; its rails' counts.
-        piece_q = part;
-        let tail = pieces[params.first_piece + local + 1u];
-        quad_last = Node(tail.corner[0].xyz, vec3<f32>(tail.corner[0].w, tail.bary1[0], tail.bary2[0]));
-        strip_base = QUAD_STRIP;
-        strip_n = vec2<u32>(piece.counts01 & 0xffffu, piece.counts01 >> 16u);
-        m = max(strip_n.x, strip_n.y);
-        candidates = strip_n.x + strip_n.y;
-        node_count = candidates + 2u;
-        theta_c = azimuth((piece_q[0].position + piece_q[1].position + piece_q[2].position + quad_last.position) / 4.0);
+        shape = quad_shape(piece, pieces[params.first_piece + local + 1u]);
     } else {
-        tri_n[0] = piece.counts01 & 0xffffu;
-        tri_n[1] = piece.counts01 >> 16u;
-        tri_n[2] = piece.count2_level & 0xffffu;
-        tri_k = piece.count2_level >> 16u;
-        let cell = macro_cell(tri_k, piece.cell);
-        var loc: array<vec3<u32>, 3>;
-        for (var i = 0u; i < 3u; i++) {
-            loc[i] = macro_location(cell.c[i]);
-            piece_q[i] = macro_node(cell.c[i], loc[i]);
-        }
-        if (same(piece_q[0].position, piece_q[1].position) || same(piece_q[1].position, piece_q[2].position)
-            || same(piece_q[2].position, piece_q[0].position)) {
-            return; // snapped corners coincide: no area
-        }
-        if (off_screen_vertically(piece_q[0].position, piece_q[1].position, piece_q[2].position)) {
-            return; // every sub-triangle would be culled
-        }
-        // Each piece edge: on an original edge (that edge's fine nodes, by global index) or interior.
-        for (var e = 0u; e < 3u; e++) {
-            piece_original[e] = -1;
-            for (var oe = 0u; oe < 3u; oe++) {
-                let start = index_on(oe, loc[e]);
-                let end = index_on(oe, loc[(e + 1u) % 3u]);
-                if (piece_original[e] < 0 && start >= 0 && end >= 0) {
-                    piece_original[e] = i32(oe);
-                    piece_from[e] = u32(start);
-                    piece_to[e] = u32(end);
-                    piece_counts[e] = u32(abs(start - end));
-                }
-            }
-            if (piece_original[e] < 0) {
-                if (params.method == METHOD_FIXED) {
-                    // fixed:N pieces take N/K on interior edges (the regular N-lattice when K | N).
-                    piece_counts[e] = (params.fixed_n + tri_k - 1u) / tri_k;
-                } else {
-                    piece_counts[e] = min(min(edge_divisions(piece_q[e].position, piece_q[(e + 1u) % 3u].position), 2u * params.max_div), PIECE_DIVISIONS);
-                }
-            }
-        }
-        m = max(max(piece_counts[0], piece_counts[1]), piece_counts[2]);
-        strip_base = strip_base_of();
-        candidates = m * m;
-        node_count = (m + 1u) * (m + 2u) / 2u;
-        if (strip_base < 3u) {
-            strip_n = vec2<u32>(piece_counts[(strip_base + 1u) % 3u], piece_counts[(strip_base + 2u) % 3u]);
-            candidates = strip_n.x + strip_n.y - 1u;
-            node_count = strip_n.x + strip_n.y + 1u;
-        }
-        theta_c = azimuth((piece_q[0].position + piece_q[1].position + piece_q[2].position) / 3.0);
+        shape = lattice_shape(piece);
+    }
+    if (shape.candidates == 0u) {
+        return;
     }
     // Which of the candidate triangles (the m² of the lattice, or the strip's) are drawn (one
     // bit each; m ≤ PIECE_DIVISIONS = 32).
     var drawn: array<u32, 32>;
     var count = 0u;
     var walk = vec2<u32>(0u, 0u);
-    for (var t = 0u; t < candidates; t++) {
-        if (piece_triangle_drawn(t, m, &walk)) {
+    for (var t = 0u; t < shape.candidates; t++) {
+        if (piece_triangle_drawn(t, shape.m, &walk)) {
             drawn[t / 32u] |= 1u << (t % 32u);
             count += 1u;
         }
@@ -304,74 +247,7 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     if (count == 0u) {
         return;
     }
-    // The seam: every node is unwrapped towards the piece's reference azimuth; where the nodes'
-    // u range (both eyes) reaches ±π, the piece is drawn again a turn away. Conservative by
-    // SEAM_MARGIN: an extra copy is clipped by the rasterizer.
-    var u_range = vec2<f32>(1e30, -1e30);
-    // Nodes in slot order: (i, j, l) row by row, kept by a running (j, l) rather than searched
-    // for each slot (lavapipe stops an invocation after 65,535 loop iterations in all).
-    var row = vec2<u32>(0u, 0u);
-    if (is_sphere(params.projection)) {
-        for (var k = 0u; k < node_count; k++) {
-            let p = piece_node(k, m, &row).position;
-            let theta = theta_c + wrap_angle(azimuth(p) - theta_c);
-            for (var s = 0u; s < 2u; s++) {
-                let u = project_with_azimuth(params.projection, p, theta, select(-1.0, 1.0, s == 1u)).x;
-                u_range = vec2<f32>(min(u_range.x, u), max(u_range.y, u));
-            }
-        }
-    } else if (strip_base == QUAD_STRIP) {
-        // The quad's range: that of its fan's two triangles, which cover it.
-        let ra = piece_u_range(piece_q, theta_c);
-        let rb = piece_u_range(array<Node, 3>(piece_q[0], piece_q[2], quad_last), theta_c);
-        u_range = vec2<f32>(min(ra.x, rb.x), max(ra.y, rb.y));
-    } else {
-        u_range = piece_u_range(piece_q, theta_c);
-    }
-    var refs = array<f32, 3>(theta_c, 0.0, 0.0);
-    var copies = 1u;
-    if (u_range.y > PI - SEAM_MARGIN) {
-        refs[copies] = theta_c - TAU;
-        copies += 1u;
-    }
-    if (u_range.x < -PI + SEAM_MARGIN) {
-        refs[copies] = theta_c + TAU;
-        copies += 1u;
-    }
-    let first_node = atomicAdd(&counters.nodes, copies * node_count);
-    let first_triangle = atomicAdd(&counters.triangles, copies * count);
-    if (first_node + copies * node_count > params.triangle_capacity
-        || first_triangle + copies * count > params.triangle_capacity) {
-        return; // counted, never written
-    }
-    row = vec2<u32>(0u, 0u);
-    for (var k = 0u; k < node_count; k++) {
-        let node = piece_node(k, m, &row);
-        for (var c = 0u; c < copies; c++) {
-            out_nodes[first_node + c * node_count + k] = draw_vertex(node, refs[c]);
-        }
-    }
-    var slot = 3u * first_triangle;
-    walk = vec2<u32>(0u, 0u);
-    for (var t = 0u; t < candidates; t++) {
-        let local = piece_triangle_slots(t, m, &walk);
-        if ((drawn[t / 32u] & (1u << (t % 32u))) == 0u) {
-            continue;
-        }
-        if (params.measure_edges != 0u) {
-            let ps = array<vec3<f32>, 3>(out_nodes[first_node + local.x].position,
-                                         out_nodes[first_node + local.y].position,
-                                         out_nodes[first_node + local.z].position);
-            atomicMax(&counters.max_edge_bits, bitcast<u32>(visible_edge_px(ps)));
-        }
-        for (var c = 0u; c < copies; c++) {
-            let base = first_node + c * node_count;
-            out_indices[slot] = base + local.x;
-            out_indices[slot + 1u] = base + local.y;
-            out_indices[slot + 2u] = base + local.z;
-            slot += 3u;
-        }
-    }
+    emit_piece(shape, seam_copies(shape), &drawn, count);
 }
 
 @compute @workgroup_size(1)

@@ -151,6 +151,35 @@ fn pick_level(first: u32, count: u32, level: f32) -> u32 {
     return first + k;
 }
 
+// The triangles of leaf `n` the ray meets nearer than `best` (Möller–Trumbore) that `keeps`
+// accepts: the nearest becomes `best`.
+fn leaf_hits(n: BvhNode, origin: vec3<f32>, dir: vec3<f32>, frag_xy: vec2<f32>, cone: vec2<f32>,
+             best: ptr<function, Hit>) {
+    for (var k = 0u; k < n.count; k++) {
+        let tri = n.first + k;
+        let v0 = vertices[indices[3u * tri]].position;
+        let e1 = vertices[indices[3u * tri + 1u]].position - v0;
+        let e2 = vertices[indices[3u * tri + 2u]].position - v0;
+        let p = cross(dir, e2);
+        let det = dot(e1, p);
+        if (abs(det) < 1e-12) {
+            continue;
+        }
+        let inv_det = 1.0 / det;
+        let s = origin - v0;
+        let b1 = dot(s, p) * inv_det;
+        let q = cross(s, e1);
+        let b2 = dot(dir, q) * inv_det;
+        let t = dot(e2, q) * inv_det;
+        if (b1 < 0.0 || b2 < 0.0 || b1 + b2 > 1.0 || !(t > 0.0) || t >= (*best).t) {
+            continue;
+        }
+        if (keeps(tri, b1, b2, det > 0.0, frag_xy, dir, cone.x + cone.y * t)) {
+            *best = Hit(t, tri, b1, b2, det > 0.0, 0u);
+        }
+    }
+}
+
 // The closest kept hit along the ray (scene frame) nearer than `limit` for a ray of visual
 // level `level` and cone `cone` (width at the origin, growth per metre), Möller–Trumbore per
 // triangle.
@@ -178,29 +207,7 @@ fn closest_hit(origin: vec3<f32>, dir: vec3<f32>, frag_xy: vec2<f32>, limit: f32
         }
         if (n.count > 0u) {
             tests += n.count;
-            for (var k = 0u; k < n.count; k++) {
-                let tri = n.first + k;
-                let v0 = vertices[indices[3u * tri]].position;
-                let e1 = vertices[indices[3u * tri + 1u]].position - v0;
-                let e2 = vertices[indices[3u * tri + 2u]].position - v0;
-                let p = cross(dir, e2);
-                let det = dot(e1, p);
-                if (abs(det) < 1e-12) {
-                    continue;
-                }
-                let inv_det = 1.0 / det;
-                let s = origin - v0;
-                let b1 = dot(s, p) * inv_det;
-                let q = cross(s, e1);
-                let b2 = dot(dir, q) * inv_det;
-                let t = dot(e2, q) * inv_det;
-                if (b1 < 0.0 || b2 < 0.0 || b1 + b2 > 1.0 || !(t > 0.0) || t >= best.t) {
-                    continue;
-                }
-                if (keeps(tri, b1, b2, det > 0.0, frag_xy, dir, cone.x + cone.y * t)) {
-                    best = Hit(t, tri, b1, b2, det > 0.0, 0u);
-                }
-            }
+            leaf_hits(n, origin, dir, frag_xy, cone, &best);
         } else {
             let ta = enter_box(bvh_nodes[n.first], origin, inv, best.t);
             let tb = enter_box(bvh_nodes[n.first + 1u], origin, inv, best.t);
@@ -417,6 +424,10 @@ fn write_background(slot: u32) {
     out_distance[slot] = 0x7f800000u;
 }
 
+// One pixel of one eye (gid.z): its primary ray, then the mirror, refraction and shadow rays it
+// leads to, from a stack of tasks. Seed 000's level of detail: rays outside the visual field
+// are not traced (background), and a ray's bounces are level × Reflect_max (eq. 9, rounded);
+// its rays meet each object at the level of detail eq. 10 gives (level 1: the original).
 @compute @workgroup_size(8, 8, 1)
 fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     let proj = params.projection;
@@ -434,9 +445,6 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     var pending: array<Task, TRACE_PENDING>;
     var count = 0u;
     var color = vec3<f32>(0.0);
-    // Seed 000's level of detail: rays outside the visual field are not traced (background), and
-    // a ray's bounces are level × Reflect_max (eq. 9, rounded).
-    // Its rays meet each object at the level of detail eq. 10 gives (level 1: the original).
     var reflect_max = params.reflect_max;
     var level = 1.0;
     if (params.gaze_forward.w > 0.0) {
@@ -487,42 +495,9 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
             color += task.weight * s.color;
             let offset = 1e-4 * max(1.0, length(p));
             if (task.bounces < reflect_max) {
-                if (s.mirror > 0.0 && count < TRACE_PENDING) {
-                    let d = reflect(task.dir, s.normal);
-                    pending[count] = Task(p + offset * s.normal, SECONDARY, d, FAR,
-                                          task.weight * s.mirror * s.tint, task.bounces + 1u, vec2<f32>(width, spread));
-                    count += 1u;
-                }
-                if (s.transmission > 0.0 && count < TRACE_PENDING) {
-                    // Entering through the front face: n₁/n₂ = 1/ior; leaving: ior.
-                    let eta = select(s.ior, 1.0 / s.ior, s.front);
-                    let d = refract_or_reflect(task.dir, s.normal, eta);
-                    let side = select(s.normal, -s.normal, dot(d, s.normal) < 0.0);
-                    pending[count] = Task(p + offset * side, SECONDARY, d, FAR, task.weight * s.transmission,
-                                          task.bounces + 1u, vec2<f32>(width, spread));
-                    count += 1u;
-                }
+                push_bounces(&pending, &count, task, s, p, offset, vec2<f32>(width, spread));
             }
-            // The scene's lights, each behind its shadow ray.
-            for (var i = 0u; i < s.shadowed; i++) {
-                let term = light_term(i, s.shading_normal, s.v, s.view_position, s.base, s.maps) * s.own;
-                if (any(term > vec3<f32>(0.0)) && count < TRACE_PENDING) {
-                    let light = lights[i];
-                    var limit = FAR;
-                    if (light.kind != LIGHT_DIRECTIONAL) {
-                        limit = length(light.position - s.view_position) - offset;
-                    }
-                    let l = light_at(light, s.view_position).xyz;
-                    pending[count] = Task(p + offset * s.normal, SHADOW, transpose(to_view) * l, limit,
-                                          task.weight * term, 0u, vec2<f32>(width, 0.0));
-                    count += 1u;
-                }
-            }
-            if (any(s.direct > vec3<f32>(0.0)) && count < TRACE_PENDING) {
-                pending[count] = Task(p + offset * s.normal, SHADOW, s.to_light.xyz, s.to_light.w - offset,
-                                      task.weight * s.direct, 0u, vec2<f32>(width, 0.0));
-                count += 1u;
-            }
+            push_shadow_rays(&pending, &count, task, s, p, offset, width, to_view);
         }
         if (count == 0u) {
             break;
@@ -530,6 +505,15 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
         count -= 1u;
         task = pending[count];
     }
+    finish_pixel(gid, slot, rays, tests, missed, color, ray.dir);
+}
+
+// Writes a traced pixel's colour (tone mapped once its light is summed; the background or the
+// environment where the primary ray missed) and counts its rays and triangle tests.
+fn finish_pixel(gid: vec3<u32>, slot: u32, rays: u32, tests: u32, missed: bool, color_in: vec3<f32>,
+                primary_dir: vec3<f32>) {
+    let proj = params.projection;
+    var color = color_in;
     // Counted per group of 64 pixels (a wrapping slot), so that no 32-bit counter overflows.
     let count_slot = (((gid.z * u32(proj.height) + gid.y) * u32(proj.width) + gid.x) / 64u) % TRACE_COUNT_SLOTS;
     atomicAdd(&counts[2u * count_slot], rays);
@@ -537,7 +521,7 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (missed) {
         write_background(slot);
         if (environment_lit() && lighting.env_background != 0u) {
-            out_color[slot] = pack_display(linear_to_srgb(tonemap(env_level(0u, env_st(env_direction(ray.dir))))));
+            out_color[slot] = pack_display(linear_to_srgb(tonemap(env_level(0u, env_st(env_direction(primary_dir))))));
         }
         return;
     }
@@ -545,4 +529,49 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
         color = tonemap(color);
     }
     out_color[slot] = pack_display(linear_to_srgb(color));
+}
+
+// The mirrored and refracted rays a hit sends on (its bounces left), onto the task stack.
+fn push_bounces(pending: ptr<function, array<Task, TRACE_PENDING>>, count: ptr<function, u32>, task: Task,
+                s: Shaded, p: vec3<f32>, offset: f32, cone: vec2<f32>) {
+    if (s.mirror > 0.0 && *count < TRACE_PENDING) {
+        let d = reflect(task.dir, s.normal);
+        (*pending)[*count] = Task(p + offset * s.normal, SECONDARY, d, FAR, task.weight * s.mirror * s.tint,
+                                  task.bounces + 1u, cone);
+        *count += 1u;
+    }
+    if (s.transmission > 0.0 && *count < TRACE_PENDING) {
+        // Entering through the front face: n₁/n₂ = 1/ior; leaving: ior.
+        let eta = select(s.ior, 1.0 / s.ior, s.front);
+        let d = refract_or_reflect(task.dir, s.normal, eta);
+        let side = select(s.normal, -s.normal, dot(d, s.normal) < 0.0);
+        (*pending)[*count] = Task(p + offset * side, SECONDARY, d, FAR, task.weight * s.transmission,
+                                  task.bounces + 1u, cone);
+        *count += 1u;
+    }
+}
+
+// The shadow rays of a hit, onto the task stack: the scene's lights, each behind its shadow
+// ray (the light it brings if nothing blocks it), or `--light`'s direct light.
+fn push_shadow_rays(pending: ptr<function, array<Task, TRACE_PENDING>>, count: ptr<function, u32>, task: Task,
+                    s: Shaded, p: vec3<f32>, offset: f32, width: f32, to_view: mat3x3<f32>) {
+    for (var i = 0u; i < s.shadowed; i++) {
+        let term = light_term(i, s.shading_normal, s.v, s.view_position, s.base, s.maps) * s.own;
+        if (any(term > vec3<f32>(0.0)) && *count < TRACE_PENDING) {
+            let light = lights[i];
+            var limit = FAR;
+            if (light.kind != LIGHT_DIRECTIONAL) {
+                limit = length(light.position - s.view_position) - offset;
+            }
+            let l = light_at(light, s.view_position).xyz;
+            (*pending)[*count] = Task(p + offset * s.normal, SHADOW, transpose(to_view) * l, limit, task.weight * term,
+                                      0u, vec2<f32>(width, 0.0));
+            *count += 1u;
+        }
+    }
+    if (any(s.direct > vec3<f32>(0.0)) && *count < TRACE_PENDING) {
+        (*pending)[*count] = Task(p + offset * s.normal, SHADOW, s.to_light.xyz, s.to_light.w - offset,
+                                  task.weight * s.direct, 0u, vec2<f32>(width, 0.0));
+        *count += 1u;
+    }
 }

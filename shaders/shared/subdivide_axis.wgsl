@@ -355,40 +355,7 @@ fn plan_quadrant(t: u32, q: u32) {
                     keep_at = quadrant_at;
                 }
             }
-            // The fan's parts: those wholly beyond the image's rows make no pieces (`run` in
-            // subdivide.rs); the others' edges, each counted once (a diagonal is two parts').
-            var shown = 0u;
-            var needed = 0u;
-            for (var i = 1u; i + 1u < poly_count; i++) {
-                if (!off_screen_vertically(poly_node(0).position, poly_node(i).position, poly_node(i + 1u).position)) {
-                    shown |= 1u << i;
-                    let e = fan_edges(i);
-                    needed |= (1u << e.x) | (1u << e.y) | (1u << e.z);
-                }
-            }
-            for (var e = 0u; e + 3u < 2u * poly_count; e++) {
-                if ((needed & (1u << e)) != 0u) {
-                    let ends = polygon_edge_ends(e);
-                    poly_n[e] = edge_divisions(poly_node(ends.x).position, poly_node(ends.y).position);
-                }
-            }
-            if (plan_quad(shown)) {
-                append_quad(t);
-                continue;
-            }
-            for (var i = 1u; i + 1u < poly_count; i++) {
-                if ((shown & (1u << i)) != 0u) {
-                    part[0] = poly_node(0);
-                    part[1] = poly_node(i);
-                    part[2] = poly_node(i + 1u);
-                    let e = fan_edges(i);
-                    tri_n[0] = poly_n[e.x];
-                    tri_n[1] = poly_n[e.y];
-                    tri_n[2] = poly_n[e.z];
-                    plan_level();
-                    append_pieces(t);
-                }
-            }
+            plan_band(t);
         }
     }
 }
@@ -554,3 +521,42 @@ fn fan_edges(i: u32) -> vec3<u32> {
 // rather than as the two parts of its fan (`quad_strip` in subdivide.rs); then `strip_n` holds
 // the rails' counts and `quad_turn` the polygon corner that becomes the quad's corner 0 (rails
 // 0 → 1 and 3 → 2).
+
+// The band polygon in `poly` (of triangle `t`), planned: one strip between its rails where it
+// is a band quad, else its fan's parts, those wholly beyond the image's rows left out.
+fn plan_band(t: u32) {
+    // The fan's parts: those wholly beyond the image's rows make no pieces (`run` in
+    // subdivide.rs); the others' edges, each counted once (a diagonal is two parts').
+    var shown = 0u;
+    var needed = 0u;
+    for (var i = 1u; i + 1u < poly_count; i++) {
+        if (!off_screen_vertically(poly_node(0).position, poly_node(i).position, poly_node(i + 1u).position)) {
+            shown |= 1u << i;
+            let e = fan_edges(i);
+            needed |= (1u << e.x) | (1u << e.y) | (1u << e.z);
+        }
+    }
+    for (var e = 0u; e + 3u < 2u * poly_count; e++) {
+        if ((needed & (1u << e)) != 0u) {
+            let ends = polygon_edge_ends(e);
+            poly_n[e] = edge_divisions(poly_node(ends.x).position, poly_node(ends.y).position);
+        }
+    }
+    if (plan_quad(shown)) {
+        append_quad(t);
+        return;
+    }
+    for (var i = 1u; i + 1u < poly_count; i++) {
+        if ((shown & (1u << i)) != 0u) {
+            part[0] = poly_node(0);
+            part[1] = poly_node(i);
+            part[2] = poly_node(i + 1u);
+            let e = fan_edges(i);
+            tri_n[0] = poly_n[e.x];
+            tri_n[1] = poly_n[e.y];
+            tri_n[2] = poly_n[e.z];
+            plan_level();
+            append_pieces(t);
+        }
+    }
+}

@@ -332,3 +332,168 @@ fn piece_u_range(q: array<Node, 3>, theta_c: f32) -> vec2<f32> {
     let alpha = max(abs(eye_shift(params.projection, r_min)), abs(eye_shift(params.projection, r_max)));
     return vec2<f32>(theta_min - alpha, theta_max + alpha);
 }
+
+// ---- what `lattice` does with a piece record: its shape, its seam copies, its output ----
+
+// What `lattice` draws of a piece: its lattice level m (or its strip's), its candidate
+// triangles and nodes, the reference azimuth of its seam; no candidates: nothing.
+struct PieceShape {
+    m: u32,
+    candidates: u32,
+    node_count: u32,
+    theta_c: f32,
+}
+
+// A band quad: corners 0–2 in `piece`, corner 3 in the next record (`tail`); its rails' counts.
+fn quad_shape(piece: Piece, tail: Piece) -> PieceShape {
+    piece_q = part;
+    quad_last = Node(tail.corner[0].xyz, vec3<f32>(tail.corner[0].w, tail.bary1[0], tail.bary2[0]));
+    strip_base = QUAD_STRIP;
+    strip_n = vec2<u32>(piece.counts01 & 0xffffu, piece.counts01 >> 16u);
+    let candidates = strip_n.x + strip_n.y;
+    let theta_c = azimuth((piece_q[0].position + piece_q[1].position + piece_q[2].position + quad_last.position) / 4.0);
+    return PieceShape(max(strip_n.x, strip_n.y), candidates, candidates + 2u, theta_c);
+}
+
+// A piece of the pre-split: its macro cell's corners, each edge's count, lattice or strip.
+// Nothing where its snapped corners coincide (no area) or it lies wholly off screen.
+fn lattice_shape(piece: Piece) -> PieceShape {
+    tri_n[0] = piece.counts01 & 0xffffu;
+    tri_n[1] = piece.counts01 >> 16u;
+    tri_n[2] = piece.count2_level & 0xffffu;
+    tri_k = piece.count2_level >> 16u;
+    let cell = macro_cell(tri_k, piece.cell);
+    var loc: array<vec3<u32>, 3>;
+    for (var i = 0u; i < 3u; i++) {
+        loc[i] = macro_location(cell.c[i]);
+        piece_q[i] = macro_node(cell.c[i], loc[i]);
+    }
+    if (same(piece_q[0].position, piece_q[1].position) || same(piece_q[1].position, piece_q[2].position)
+        || same(piece_q[2].position, piece_q[0].position)) {
+        return PieceShape(0u, 0u, 0u, 0.0); // snapped corners coincide: no area
+    }
+    if (off_screen_vertically(piece_q[0].position, piece_q[1].position, piece_q[2].position)) {
+        return PieceShape(0u, 0u, 0u, 0.0); // every sub-triangle would be culled
+    }
+    piece_edge_counts(loc);
+    let m = max(max(piece_counts[0], piece_counts[1]), piece_counts[2]);
+    strip_base = strip_base_of();
+    var candidates = m * m;
+    var node_count = (m + 1u) * (m + 2u) / 2u;
+    if (strip_base < 3u) {
+        strip_n = vec2<u32>(piece_counts[(strip_base + 1u) % 3u], piece_counts[(strip_base + 2u) % 3u]);
+        candidates = strip_n.x + strip_n.y - 1u;
+        node_count = strip_n.x + strip_n.y + 1u;
+    }
+    let theta_c = azimuth((piece_q[0].position + piece_q[1].position + piece_q[2].position) / 3.0);
+    return PieceShape(m, candidates, node_count, theta_c);
+}
+
+// Each piece edge's count: on an original edge, that edge's fine nodes (by global index,
+// `piece_original`, `piece_from`, `piece_to`); inside, its own division.
+fn piece_edge_counts(loc: array<vec3<u32>, 3>) {
+    for (var e = 0u; e < 3u; e++) {
+        piece_original[e] = -1;
+        for (var oe = 0u; oe < 3u; oe++) {
+            let start = index_on(oe, loc[e]);
+            let end = index_on(oe, loc[(e + 1u) % 3u]);
+            if (piece_original[e] < 0 && start >= 0 && end >= 0) {
+                piece_original[e] = i32(oe);
+                piece_from[e] = u32(start);
+                piece_to[e] = u32(end);
+                piece_counts[e] = u32(abs(start - end));
+            }
+        }
+        if (piece_original[e] < 0) {
+            if (params.method == METHOD_FIXED) {
+                // fixed:N pieces take N/K on interior edges (the regular N-lattice when K | N).
+                piece_counts[e] = (params.fixed_n + tri_k - 1u) / tri_k;
+            } else {
+                piece_counts[e] = min(min(edge_divisions(piece_q[e].position, piece_q[(e + 1u) % 3u].position), 2u * params.max_div), PIECE_DIVISIONS);
+            }
+        }
+    }
+}
+
+// The azimuths a piece is drawn at: its own, and a turn away where its nodes' u range (both
+// eyes) reaches ±π. Conservative by SEAM_MARGIN: an extra copy is clipped by the rasterizer.
+struct SeamCopies {
+    refs: array<f32, 3>,
+    copies: u32,
+}
+
+fn seam_copies(shape: PieceShape) -> SeamCopies {
+    let theta_c = shape.theta_c;
+    var u_range = vec2<f32>(1e30, -1e30);
+    // Nodes in slot order: (i, j, l) row by row, kept by a running (j, l) rather than searched
+    // for each slot (lavapipe stops an invocation after 65,535 loop iterations in all).
+    var row = vec2<u32>(0u, 0u);
+    if (is_sphere(params.projection)) {
+        for (var k = 0u; k < shape.node_count; k++) {
+            let p = piece_node(k, shape.m, &row).position;
+            let theta = theta_c + wrap_angle(azimuth(p) - theta_c);
+            for (var s = 0u; s < 2u; s++) {
+                let u = project_with_azimuth(params.projection, p, theta, select(-1.0, 1.0, s == 1u)).x;
+                u_range = vec2<f32>(min(u_range.x, u), max(u_range.y, u));
+            }
+        }
+    } else if (strip_base == QUAD_STRIP) {
+        // The quad's range: that of its fan's two triangles, which cover it.
+        let ra = piece_u_range(piece_q, theta_c);
+        let rb = piece_u_range(array<Node, 3>(piece_q[0], piece_q[2], quad_last), theta_c);
+        u_range = vec2<f32>(min(ra.x, rb.x), max(ra.y, rb.y));
+    } else {
+        u_range = piece_u_range(piece_q, theta_c);
+    }
+    var seam = SeamCopies(array<f32, 3>(theta_c, 0.0, 0.0), 1u);
+    if (u_range.y > PI - SEAM_MARGIN) {
+        seam.refs[seam.copies] = theta_c - TAU;
+        seam.copies += 1u;
+    }
+    if (u_range.x < -PI + SEAM_MARGIN) {
+        seam.refs[seam.copies] = theta_c + TAU;
+        seam.copies += 1u;
+    }
+    return seam;
+}
+
+// Appends the piece's nodes once per seam copy and its `count` drawn triangles (bits of
+// `drawn`) as indices into them; counted, never written past a capacity.
+fn emit_piece(shape: PieceShape, seam: SeamCopies, drawn: ptr<function, array<u32, 32>>, count: u32) {
+    let copies = seam.copies;
+    let node_count = shape.node_count;
+    let first_node = atomicAdd(&counters.nodes, copies * node_count);
+    let first_triangle = atomicAdd(&counters.triangles, copies * count);
+    if (first_node + copies * node_count > params.triangle_capacity
+        || first_triangle + copies * count > params.triangle_capacity) {
+        return; // counted, never written
+    }
+    var row = vec2<u32>(0u, 0u);
+    for (var k = 0u; k < node_count; k++) {
+        let node = piece_node(k, shape.m, &row);
+        for (var c = 0u; c < copies; c++) {
+            out_nodes[first_node + c * node_count + k] = draw_vertex(node, seam.refs[c]);
+        }
+    }
+    var slot = 3u * first_triangle;
+    var walk = vec2<u32>(0u, 0u);
+    for (var t = 0u; t < shape.candidates; t++) {
+        let local = piece_triangle_slots(t, shape.m, &walk);
+        if (((*drawn)[t / 32u] & (1u << (t % 32u))) == 0u) {
+            continue;
+        }
+        if (params.measure_edges != 0u) {
+            let ps = array<vec3<f32>, 3>(out_nodes[first_node + local.x].position,
+                                         out_nodes[first_node + local.y].position,
+                                         out_nodes[first_node + local.z].position);
+            atomicMax(&counters.max_edge_bits, bitcast<u32>(visible_edge_px(ps)));
+        }
+        for (var c = 0u; c < copies; c++) {
+            let base = first_node + c * node_count;
+            out_indices[slot] = base + local.x;
+            out_indices[slot + 1u] = base + local.y;
+            out_indices[slot + 2u] = base + local.z;
+            slot += 3u;
+        }
+    }
+}

@@ -88,49 +88,75 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
     // (seen from the centre), by a second render whose error pass writes arcminutes.
     if settings.view.projection.panorama == twister::core::projection::PanoramaKind::Equirect {
         let angular = renderer.render(gpu_scene, &settings.with_error_angle(true))?;
-        let a = angular.measurement.as_ref().expect("rendered with the error pass").stats;
-        json["panorama"] = serde_json::json!("equirect");
-        json["mean_arcmin"] = serde_json::json!(a.mean);
-        json["p50_arcmin"] = serde_json::json!(a.p50);
-        json["p90_arcmin"] = serde_json::json!(a.p90);
-        json["p99_arcmin"] = serde_json::json!(a.p99);
-        json["max_arcmin"] = serde_json::json!(a.max);
+        add_angles(&mut json, &angular.measurement.as_ref().expect("rendered with the error pass").stats);
     }
     if let Some(method) = args.against {
         let reference = renderer.render(gpu_scene, &settings.with_method(method))?;
-        let c = twister::core::compare::compare(&frame, &reference)?;
-        json["against"] = serde_json::json!(method.name());
-        json["different_surface_fraction"] = serde_json::json!(c.different_surface_fraction);
-        json["psnr_db"] = serde_json::json!(c.psnr_db);
-        json["depth_rel_mean"] = serde_json::json!(c.depth_rel_mean);
-        json["depth_rel_p99"] = serde_json::json!(c.depth_rel_p99);
-        json["different_triangle_fraction"] = serde_json::json!(c.different_triangle_fraction);
-        if let Some(t) = c.traced_error {
-            json["traced_mean_px"] = serde_json::json!(t.mean_px);
-            json["traced_p99_px"] = serde_json::json!(t.p99_px);
-            json["traced_max_px"] = serde_json::json!(t.max_px);
-            json["traced_pixels"] = serde_json::json!(t.pixels);
-            json["traced_unmatched"] = serde_json::json!(t.unmatched);
-        }
+        add_comparison(&mut json, method, &twister::core::compare::compare(&frame, &reference)?);
     }
     if let Some(path) = &args.heatmap {
         let max = args.heatmap_max.unwrap_or_else(|| crate::heatmap::nice_max(e.p99));
-        let (w, h, rgba) = crate::heatmap::heatmap(
-            &measured.error,
-            settings.view.projection.width,
-            settings.view.projection.height,
-            max,
-        );
-        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "heatmap.png".into());
-        let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
-        write_images(dir, &[(name, EyeImage { width: w, height: h, rgba })])?;
+        write_heatmap(path, &measured.error, settings.projection(), max)?;
     }
     if args.json {
         println!("{}", serde_json::to_string(&json).unwrap());
     } else {
-        println!(
+        print_summary(&args.scene, &settings, &json, e, s);
+    }
+    Ok(())
+}
+
+/// The error as an angle (arcminutes seen from the centre), on the sphere.
+fn add_angles(json: &mut serde_json::Value, a: &twister::encoding::types::ErrorStats) {
+    json["panorama"] = serde_json::json!("equirect");
+    json["mean_arcmin"] = serde_json::json!(a.mean);
+    json["p50_arcmin"] = serde_json::json!(a.p50);
+    json["p90_arcmin"] = serde_json::json!(a.p90);
+    json["p99_arcmin"] = serde_json::json!(a.p99);
+    json["max_arcmin"] = serde_json::json!(a.max);
+}
+
+/// `--against`: the comparison with the other method's frame (and the error found on a traced one).
+fn add_comparison(json: &mut serde_json::Value, method: Method, c: &twister::core::compare::Comparison) {
+    json["against"] = serde_json::json!(method.name());
+    json["different_surface_fraction"] = serde_json::json!(c.different_surface_fraction);
+    json["psnr_db"] = serde_json::json!(c.psnr_db);
+    json["depth_rel_mean"] = serde_json::json!(c.depth_rel_mean);
+    json["depth_rel_p99"] = serde_json::json!(c.depth_rel_p99);
+    json["different_triangle_fraction"] = serde_json::json!(c.different_triangle_fraction);
+    if let Some(t) = &c.traced_error {
+        json["traced_mean_px"] = serde_json::json!(t.mean_px);
+        json["traced_p99_px"] = serde_json::json!(t.p99_px);
+        json["traced_max_px"] = serde_json::json!(t.max_px);
+        json["traced_pixels"] = serde_json::json!(t.pixels);
+        json["traced_unmatched"] = serde_json::json!(t.unmatched);
+    }
+}
+
+/// `--heatmap FILE.png`: the per-pixel error (left eye on top) colour-mapped up to `max` pixels.
+fn write_heatmap(
+    path: &std::path::Path,
+    error: &[Vec<f32>; 2],
+    projection: &twister::Projection,
+    max: f32,
+) -> Result<()> {
+    let (w, h, rgba) = crate::heatmap::heatmap(error, projection.width, projection.height, max);
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "heatmap.png".into());
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+    write_images(dir, &[(name, EyeImage { width: w, height: h, rgba })]).map(|_| ())
+}
+
+/// The measurement in words (without `--json`).
+fn print_summary(
+    scene: &str,
+    settings: &twister::RenderSettings,
+    json: &serde_json::Value,
+    e: &twister::encoding::types::ErrorStats,
+    s: &twister::FrameStats,
+) {
+    println!(
             "{} {} ({}): mean {:.3} px, std {:.3}, p50 {:.3}, p90 {:.3}, p99 {:.3}, max {:.3} over {} pixels; {} triangles drawn; {:.1} ms",
-            args.scene,
+            scene,
             settings.subdivision.method.name(),
             json["vertical"].as_str().unwrap_or(""),
             e.mean,
@@ -143,19 +169,19 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
             s.triangles_out,
             s.ms_frame
         );
-        if let Some(m) = json.get("mean_arcmin") {
-            println!(
-                "as an angle: mean {:.3}′, p50 {:.3}′, p90 {:.3}′, p99 {:.3}′, max {:.3}′ (arcminutes)",
-                m.as_f64().unwrap_or(f64::NAN),
-                json["p50_arcmin"].as_f64().unwrap_or(f64::NAN),
-                json["p90_arcmin"].as_f64().unwrap_or(f64::NAN),
-                json["p99_arcmin"].as_f64().unwrap_or(f64::NAN),
-                json["max_arcmin"].as_f64().unwrap_or(f64::NAN)
-            );
-        }
-        if json.get("different_surface_fraction").is_some() {
-            let num = |k: &str| json[k].as_f64().map_or("—".to_string(), |v| format!("{v:.3e}"));
-            println!(
+    if let Some(m) = json.get("mean_arcmin") {
+        println!(
+            "as an angle: mean {:.3}′, p50 {:.3}′, p90 {:.3}′, p99 {:.3}′, max {:.3}′ (arcminutes)",
+            m.as_f64().unwrap_or(f64::NAN),
+            json["p50_arcmin"].as_f64().unwrap_or(f64::NAN),
+            json["p90_arcmin"].as_f64().unwrap_or(f64::NAN),
+            json["p99_arcmin"].as_f64().unwrap_or(f64::NAN),
+            json["max_arcmin"].as_f64().unwrap_or(f64::NAN)
+        );
+    }
+    if json.get("different_surface_fraction").is_some() {
+        let num = |k: &str| json[k].as_f64().map_or("—".to_string(), |v| format!("{v:.3e}"));
+        println!(
                 "against {}: different surface on {} of pixels (another triangle of the same object on {}), PSNR {} dB, distance off by {} (mean) / {} (p99) of the reference's",
                 json["against"].as_str().unwrap_or(""),
                 num("different_surface_fraction"),
@@ -164,9 +190,9 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
                 num("depth_rel_mean"),
                 num("depth_rel_p99")
             );
-        }
-        if let Some(m) = json.get("traced_mean_px") {
-            println!(
+    }
+    if let Some(m) = json.get("traced_mean_px") {
+        println!(
                 "display-position error measured on the traced image: mean {:.3} px, p99 {:.3}, max {:.3} over {} pixels ({} not found there)",
                 m.as_f64().unwrap_or(f64::NAN),
                 json["traced_p99_px"].as_f64().unwrap_or(f64::NAN),
@@ -174,7 +200,5 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
                 json["traced_pixels"],
                 json["traced_unmatched"]
             );
-        }
     }
-    Ok(())
 }

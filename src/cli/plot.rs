@@ -179,18 +179,25 @@ where
     }
     // The legend, in its own column so it never hides data.
     if let Some(f) = font {
-        for (k, s) in chart.series.iter().enumerate() {
-            let y = 60 + 20 * k as i32;
-            let line = color(s.color).stroke_width(2);
-            if s.dashed {
-                for d in 0..3 {
-                    legend_area.draw(&PathElement::new([(4 + 8 * d, y), (8 + 8 * d, y)], line)).map_err(err)?;
-                }
-            } else {
-                legend_area.draw(&PathElement::new([(4, y), (28, y)], line)).map_err(err)?;
+        draw_legend(&legend_area, chart, f)?;
+    }
+    Ok(())
+}
+
+/// The series' legend: a line (dashed like its series) and the label, one row each.
+fn draw_legend(legend_area: &Area, chart: &Chart, f: &str) -> Result<(), String> {
+    let err = |e: DrawingAreaErrorKind<_>| e.to_string();
+    for (k, s) in chart.series.iter().enumerate() {
+        let y = 60 + 20 * k as i32;
+        let line = color(s.color).stroke_width(2);
+        if s.dashed {
+            for d in 0..3 {
+                legend_area.draw(&PathElement::new([(4 + 8 * d, y), (8 + 8 * d, y)], line)).map_err(err)?;
             }
-            legend_area.draw(&Text::new(s.label.clone(), (34, y - 7), (f, 13).into_font())).map_err(err)?;
+        } else {
+            legend_area.draw(&PathElement::new([(4, y), (28, y)], line)).map_err(err)?;
         }
+        legend_area.draw(&Text::new(s.label.clone(), (34, y - 7), (f, 13).into_font())).map_err(err)?;
     }
     Ok(())
 }

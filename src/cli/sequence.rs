@@ -17,12 +17,16 @@ use glam::Vec3;
 
 use crate::args::{RenderArgs, ShardMode, Viewer};
 use crate::render::render_settings;
-use crate::scene::{open_renderer, prepare};
+use crate::scene::{open_renderer, prepare, Prepared};
 use crate::writer::{frame_name, FrameRecord, FrameWriter};
+use twister::core::lod::{LodChain, LodParams, LodSelection};
 use twister::core::projection::PanoramaKind;
 use twister::core::settings::Method;
+use twister::core::timeline::Timeline;
+use twister::core::visual_field::GazePath;
 use twister::error::{Error, Result};
 use twister::output::{write_all, Layout};
+use twister::video::StereoMode;
 
 /// The frames of `first..=last` shard `i` of `n` renders.
 pub fn shard_frames(first: u32, last: u32, (i, n): (u32, u32), mode: ShardMode) -> Vec<u32> {
@@ -36,106 +40,138 @@ pub fn shard_frames(first: u32, last: u32, (i, n): (u32, u32), mode: ShardMode) 
     }
 }
 
+/// A drawn frame on its way to the writer thread: its number, time, the pose's milliseconds,
+/// the frame, the settings it was drawn with and its level-of-detail selection.
+struct Drawn {
+    frame: u32,
+    time: f32,
+    ms_pose: f64,
+    rendered: twister::Frame,
+    settings: twister::RenderSettings,
+    selected: Option<LodSelection>,
+}
+
+/// With a gaze path, each frame selects its level of detail from the whole scene: the path,
+/// the parameters, the scene's chains and the whole scene uploaded.
+struct Tracked<'a> {
+    path: &'a GazePath,
+    params: LodParams,
+    chain: LodChain,
+    whole: twister::GpuScene,
+}
+
+/// What draws a sequence's frames: the renderer, the placed scene, the base settings and what
+/// moves from frame to frame (the clip, the viewer path, the file camera, the gaze path).
+struct Sequence<'a> {
+    args: &'a RenderArgs,
+    renderer: &'a twister::Renderer,
+    prepared: Prepared,
+    base: twister::RenderSettings,
+    /// `--yaw` before a file camera's yaw was added (a posed camera adds its own per frame).
+    base_yaw: f32,
+    clip: Option<usize>,
+    viewer_path: Option<Timeline>,
+    camera: Option<usize>,
+    tracked: Option<Tracked<'a>>,
+}
+
+impl Sequence<'_> {
+    /// Poses the scene at frame `frame`, places the viewer, selects the level of detail, draws.
+    fn draw(&mut self, frame: u32) -> Result<Drawn> {
+        let time = frame as f32 / self.args.fps;
+        let t = std::time::Instant::now();
+        self.pose(time)?;
+        let settings = self.frame_settings(time);
+        let mut selected = None;
+        if let Some(Tracked { path, params, chain, whole }) = &self.tracked {
+            let selection = chain.select(&self.prepared.scene, settings.view(), &path.at(time), params);
+            self.prepared.gpu_scene = whole.with_lod(&self.renderer.gpu, &selection);
+            selected = Some(selection);
+        }
+        let ms_pose = t.elapsed().as_secs_f64() * 1e3;
+        let rendered = self.renderer.render(&self.prepared.gpu_scene, &settings)?;
+        Ok(Drawn { frame, time, ms_pose, rendered, settings, selected })
+    }
+
+    /// Poses an animated scene at `time`.
+    fn pose(&mut self, time: f32) -> Result<()> {
+        let (renderer, prepared) = (self.renderer, &mut self.prepared);
+        if prepared.scene.rig.is_none() {
+            return Ok(());
+        }
+        if self.base.subdivision.method == Method::Trace {
+            // The ray tracer's BVH is built on the CPU from the posed vertices.
+            prepared.scene.pose(self.clip, time);
+            prepared.gpu_scene.update_pose(&renderer.gpu, &prepared.scene)?;
+            prepared.gpu_scene.rebuild_bvh(&renderer.gpu, &prepared.scene)
+        } else {
+            // The skin stage poses the vertices on the GPU; only matrices and weights are uploaded.
+            let target = match self.tracked.as_mut() {
+                Some(tracked) => &mut tracked.whole,
+                None => &mut prepared.gpu_scene,
+            };
+            renderer.pose(target, &mut prepared.scene, self.clip, time)
+        }
+    }
+
+    /// The frame's settings: the base's, with the viewer the path or the posed camera puts.
+    fn frame_settings(&self, time: f32) -> twister::RenderSettings {
+        let base = self.base;
+        if let Some(cam) = self.camera.and_then(|n| self.prepared.scene.cameras.get(n)) {
+            return base.with_viewer(Vec3::from(cam.position)).with_yaw_deg(self.base_yaw + cam.yaw_deg);
+        }
+        match &self.viewer_path {
+            Some(path) => {
+                let v = path.at(time);
+                let yaw = self.base_yaw + v.get(3).copied().unwrap_or(0.0);
+                base.with_viewer(Vec3::new(v[0], v[1], v[2]) * self.args.view.scale).with_yaw_deg(yaw)
+            }
+            None => base,
+        }
+    }
+}
+
 /// Renders the sequence `args.frames` asks for.
 pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32)) -> Result<()> {
     let settings = render_settings(args)?;
-    for (given, option) in [(args.depth, "--depth"), (args.hdr, "--hdr"), (args.lod_overlay, "--lod-overlay")] {
-        if given {
-            return Err(Error::option(option, "writes one still: leave it out with --frames"));
-        }
-    }
-    if !(args.fps.is_finite() && args.fps > 0.0 && args.fps <= 1000.0) {
-        return Err(Error::option("--fps", format!("must be between 0 and 1000 frames per second, got {}", args.fps)));
-    }
+    check_sequence_options(args)?;
     let panorama = settings.projection().panorama;
     let writer = FrameWriter::new(args, &settings, true)?;
-    let stereo = match writer.layout() {
-        Layout::TopBottom => twister::video::StereoMode::TopBottom,
-        Layout::SideBySide => twister::video::StereoMode::LeftRight,
-        _ => twister::video::StereoMode::Mono,
-    };
-    if let Some(video) = &args.video {
-        if args.shard.is_some() {
-            return Err(Error::option(
-                "--video",
-                "encodes the whole sequence: render the shards, then run once more with --resume --video",
-            ));
-        }
-        if stereo == twister::video::StereoMode::Mono {
-            return Err(Error::option("--video", "needs a one-image layout: --layout top-bottom or side-by-side"));
-        }
-        if args.format != twister::output::ImageFormat::Png {
-            return Err(Error::option("--video", "encodes the PNG frames: leave --format png"));
-        }
-        twister::output::check_outputs(&[video.as_path()])?;
-        ffmpeg_version()?;
-    }
+    let stereo = video_stereo(args, &writer)?;
     let frames = match args.shard {
         Some(shard) => shard_frames(first, last, shard, args.shard_mode),
         None => (first..=last).collect(),
     };
-    let gaze_path = args.gaze_path.as_deref().map(twister::core::visual_field::GazePath::read).transpose()?;
+    let gaze_path = args.gaze_path.as_deref().map(GazePath::read).transpose()?;
     let lod = args.view.lod()?;
-    let viewer_path = match &args.viewer_path {
-        Some(_) if matches!(args.view.viewer, Viewer::Camera(_)) => {
-            return Err(Error::option("--viewer-path", "moves the viewer itself: leave out --viewer camera"))
-        }
-        Some(path) => {
-            Some(twister::core::timeline::Timeline::read(path, "viewer_path", (3, 4), "time,x,y,z[,yaw]", |v| {
-                let max = twister::core::scene::MAX_COORDINATE;
-                (v[..3].iter().any(|c| c.abs() > max)).then(|| format!("coordinates within ±{max:e}"))
-            })?)
-        }
-        None => None,
-    };
+    let viewer_path = read_viewer_path(args)?;
     if gaze_path.is_some() && lod.is_none() {
         return Err(Error::option("--gaze-path", "steers the level of detail: use it with --lod visual-field"));
     }
     let (renderer, adapter) = open_renderer()?;
-    let method = [settings.subdivision.method];
     let base_yaw = settings.view.yaw_deg;
-    let mut prepared = prepare(&renderer, &args.scene, args.fit, &args.view, settings, false, &method)?;
-    let base = prepared.settings;
-    let clip = match (&prepared.scene.rig, &args.animation) {
-        (Some(rig), Some(name)) => Some(rig.clip_index(name).ok_or_else(|| {
-            let known: Vec<&str> = rig.clips.iter().map(|c| c.name.as_str()).collect();
-            Error::option("--animation", format!("{name}: the file's animations are {}", known.join(", ")))
-        })?),
-        (Some(rig), None) => (!rig.clips.is_empty()).then_some(0),
-        (None, Some(_)) => return Err(Error::option("--animation", format!("{} has no animations", args.scene))),
-        (None, None) => None,
-    };
-    // With a gaze path, each frame selects its level of detail from the whole scene.
-    let mut tracked = match (&gaze_path, &lod) {
-        (Some(path), Some((params, _))) => Some((
+    let method = [settings.subdivision.method];
+    let prepared = prepare(&renderer, &args.scene, args.fit, &args.view, settings, false, &method)?;
+    let clip = animation_clip(args, &prepared.scene)?;
+    let tracked = match (&gaze_path, &lod) {
+        (Some(path), Some((params, _))) => Some(Tracked {
             path,
-            *params,
-            twister::core::lod::LodChain::build(&prepared.scene, params.p3),
-            twister::GpuScene::upload(&renderer.gpu, &prepared.scene)?,
-        )),
+            params: *params,
+            chain: LodChain::build(&prepared.scene, params.p3),
+            whole: twister::GpuScene::upload(&renderer.gpu, &prepared.scene)?,
+        }),
         _ => None,
     };
     let camera = match args.view.viewer {
         Viewer::Camera(n) => Some(n),
         Viewer::At(_) => None,
     };
+    let base = prepared.settings;
+    let mut sequence =
+        Sequence { args, renderer: &renderer, prepared, base, base_yaw, clip, viewer_path, camera, tracked };
     let todo: Vec<u32> =
         frames.into_iter().filter(|&f| !(args.resume && writer.paths(Some(f)).iter().all(|p| p.exists()))).collect();
-    if let Some(dir) = args.stats.as_deref().and_then(|p| p.parent()).filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| Error::output(dir, format!("cannot create the folder: {e}")))?;
-    }
-    let mut stats = match &args.stats {
-        Some(path) => Some(
-            std::fs::OpenOptions::new()
-                .create(true)
-                .append(args.resume)
-                .write(true)
-                .truncate(!args.resume)
-                .open(path)
-                .map_err(|e| Error::output(path, format!("cannot write: {e}")))?,
-        ),
-        None => None,
-    };
+    let stats = open_stats(args)?;
     let progress = indicatif::ProgressBar::new(todo.len() as u64).with_style(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames, {per_sec}, ETA {eta}")
             .expect("a valid template"),
@@ -143,71 +179,12 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32)) -> Result<(
     let start = std::time::Instant::now();
     // A writer thread encodes and writes frame k while the GPU draws frame k + 1 (one frame in
     // flight: bounded memory).
-    type Done = (u32, f32, f64, twister::Frame, twister::RenderSettings, Option<twister::core::lod::LodSelection>);
-    let (send, receive) = std::sync::mpsc::sync_channel::<Done>(1);
+    let (send, receive) = std::sync::mpsc::sync_channel::<Drawn>(1);
     std::thread::scope(|scope| -> Result<()> {
-        let writing = scope.spawn(|| -> Result<()> {
-            for (frame, time, ms_pose, rendered, drawn_with, selected) in receive {
-                let t = std::time::Instant::now();
-                let files = writer.files(&rendered, Some(frame))?;
-                write_all(&files)?;
-                let ms_write = t.elapsed().as_secs_f64() * 1e3;
-                if let (Some(file), Some(path)) = (stats.as_mut(), &args.stats) {
-                    let lod = crate::scene::lod_stats(&selected);
-                    let record = FrameRecord {
-                        frame: Some(frame),
-                        time: Some(time),
-                        ms_pose: Some(ms_pose),
-                        ms_write,
-                        files: Some(files.iter().map(|f| f.path.display().to_string()).collect()),
-                        ..FrameRecord::new(&args.scene, &drawn_with, &rendered, &writer, &adapter, lod)
-                    };
-                    let line = serde_json::to_string(&record).expect("JSON of plain values");
-                    writeln!(file, "{line}").map_err(|e| Error::output(path, format!("cannot write: {e}")))?;
-                }
-                progress.inc(1);
-            }
-            Ok(())
-        });
+        let writing = scope.spawn(|| write_frames(receive, args, &writer, stats, &progress, &adapter));
         let drawn = (|| -> Result<()> {
             for &frame in &todo {
-                let time = frame as f32 / args.fps;
-                let t = std::time::Instant::now();
-                if prepared.scene.rig.is_some() {
-                    if base.subdivision.method == Method::Trace {
-                        // The ray tracer's BVH is built on the CPU from the posed vertices.
-                        prepared.scene.pose(clip, time);
-                        prepared.gpu_scene.update_pose(&renderer.gpu, &prepared.scene)?;
-                        prepared.gpu_scene.rebuild_bvh(&renderer.gpu, &prepared.scene)?;
-                    } else {
-                        // The skin stage poses the vertices on the GPU; only matrices and
-                        // weights are uploaded.
-                        let target = match tracked.as_mut() {
-                            Some((_, _, _, whole)) => whole,
-                            None => &mut prepared.gpu_scene,
-                        };
-                        renderer.pose(target, &mut prepared.scene, clip, time)?;
-                    }
-                }
-                // The frame's settings: the base's, with the viewer the path or the posed camera puts.
-                let mut settings = base;
-                if let Some(path) = &viewer_path {
-                    let v = path.at(time);
-                    let yaw = base_yaw + v.get(3).copied().unwrap_or(0.0);
-                    settings = base.with_viewer(Vec3::new(v[0], v[1], v[2]) * args.view.scale).with_yaw_deg(yaw);
-                }
-                if let Some(cam) = camera.and_then(|n| prepared.scene.cameras.get(n)) {
-                    settings = base.with_viewer(Vec3::from(cam.position)).with_yaw_deg(base_yaw + cam.yaw_deg);
-                }
-                let mut selected = None;
-                if let Some((path, params, chain, whole)) = &tracked {
-                    let selection = chain.select(&prepared.scene, settings.view(), &path.at(time), params);
-                    prepared.gpu_scene = whole.with_lod(&renderer.gpu, &selection);
-                    selected = Some(selection);
-                }
-                let ms_pose = t.elapsed().as_secs_f64() * 1e3;
-                let rendered = renderer.render(&prepared.gpu_scene, &settings)?;
-                if send.send((frame, time, ms_pose, rendered, settings, selected)).is_err() {
+                if send.send(sequence.draw(frame)?).is_err() {
                     break; // the writer stopped: its error is reported below
                 }
             }
@@ -231,6 +208,122 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32)) -> Result<(
         println!("{}", video.display());
     }
     Ok(())
+}
+
+/// The writer thread: encodes and writes each drawn frame's files (all of a frame or none) and
+/// its `--stats` line.
+fn write_frames(
+    receive: std::sync::mpsc::Receiver<Drawn>,
+    args: &RenderArgs,
+    writer: &FrameWriter,
+    mut stats: Option<std::fs::File>,
+    progress: &indicatif::ProgressBar,
+    adapter: &str,
+) -> Result<()> {
+    for drawn in receive {
+        let t = std::time::Instant::now();
+        let files = writer.files(&drawn.rendered, Some(drawn.frame))?;
+        write_all(&files)?;
+        let ms_write = t.elapsed().as_secs_f64() * 1e3;
+        if let (Some(file), Some(path)) = (stats.as_mut(), &args.stats) {
+            let lod = crate::scene::lod_stats(&drawn.selected);
+            let record = FrameRecord {
+                frame: Some(drawn.frame),
+                time: Some(drawn.time),
+                ms_pose: Some(drawn.ms_pose),
+                ms_write,
+                files: Some(files.iter().map(|f| f.path.display().to_string()).collect()),
+                ..FrameRecord::new(&args.scene, &drawn.settings, &drawn.rendered, writer, adapter, lod)
+            };
+            let line = serde_json::to_string(&record).expect("JSON of plain values");
+            writeln!(file, "{line}").map_err(|e| Error::output(path, format!("cannot write: {e}")))?;
+        }
+        progress.inc(1);
+    }
+    Ok(())
+}
+
+/// The options a sequence refuses (a still's outputs) and its frame rate.
+fn check_sequence_options(args: &RenderArgs) -> Result<()> {
+    for (given, option) in [(args.depth, "--depth"), (args.hdr, "--hdr"), (args.lod_overlay, "--lod-overlay")] {
+        if given {
+            return Err(Error::option(option, "writes one still: leave it out with --frames"));
+        }
+    }
+    if !(args.fps.is_finite() && args.fps > 0.0 && args.fps <= 1000.0) {
+        return Err(Error::option("--fps", format!("must be between 0 and 1000 frames per second, got {}", args.fps)));
+    }
+    Ok(())
+}
+
+/// The stereo mode a video of the layout carries; with `--video`, its conditions checked (one
+/// image per frame, PNG, not a shard, ffmpeg installed, the output writable).
+fn video_stereo(args: &RenderArgs, writer: &FrameWriter) -> Result<StereoMode> {
+    let stereo = match writer.layout() {
+        Layout::TopBottom => StereoMode::TopBottom,
+        Layout::SideBySide => StereoMode::LeftRight,
+        _ => StereoMode::Mono,
+    };
+    if let Some(video) = &args.video {
+        if args.shard.is_some() {
+            return Err(Error::option(
+                "--video",
+                "encodes the whole sequence: render the shards, then run once more with --resume --video",
+            ));
+        }
+        if stereo == StereoMode::Mono {
+            return Err(Error::option("--video", "needs a one-image layout: --layout top-bottom or side-by-side"));
+        }
+        if args.format != twister::output::ImageFormat::Png {
+            return Err(Error::option("--video", "encodes the PNG frames: leave --format png"));
+        }
+        twister::output::check_outputs(&[video.as_path()])?;
+        ffmpeg_version()?;
+    }
+    Ok(stereo)
+}
+
+/// `--viewer-path`, read and checked.
+fn read_viewer_path(args: &RenderArgs) -> Result<Option<Timeline>> {
+    match &args.viewer_path {
+        Some(_) if matches!(args.view.viewer, Viewer::Camera(_)) => {
+            Err(Error::option("--viewer-path", "moves the viewer itself: leave out --viewer camera"))
+        }
+        Some(path) => Ok(Some(Timeline::read(path, "viewer_path", (3, 4), "time,x,y,z[,yaw]", |v| {
+            let max = twister::core::scene::MAX_COORDINATE;
+            (v[..3].iter().any(|c| c.abs() > max)).then(|| format!("coordinates within ±{max:e}"))
+        })?)),
+        None => Ok(None),
+    }
+}
+
+/// The animation a sequence plays: `--animation` by name or index, else the file's first.
+fn animation_clip(args: &RenderArgs, scene: &twister::Scene) -> Result<Option<usize>> {
+    Ok(match (&scene.rig, &args.animation) {
+        (Some(rig), Some(name)) => Some(rig.clip_index(name).ok_or_else(|| {
+            let known: Vec<&str> = rig.clips.iter().map(|c| c.name.as_str()).collect();
+            Error::option("--animation", format!("{name}: the file's animations are {}", known.join(", ")))
+        })?),
+        (Some(rig), None) => (!rig.clips.is_empty()).then_some(0),
+        (None, Some(_)) => return Err(Error::option("--animation", format!("{} has no animations", args.scene))),
+        (None, None) => None,
+    })
+}
+
+/// The `--stats` file: appended to with `--resume`, else written anew.
+fn open_stats(args: &RenderArgs) -> Result<Option<std::fs::File>> {
+    let Some(path) = &args.stats else { return Ok(None) };
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| Error::output(dir, format!("cannot create the folder: {e}")))?;
+    }
+    let file = std::fs::OpenOptions::new()
+        .create(true)
+        .append(args.resume)
+        .write(true)
+        .truncate(!args.resume)
+        .open(path)
+        .map_err(|e| Error::output(path, format!("cannot write: {e}")))?;
+    Ok(Some(file))
 }
 
 /// The installed ffmpeg's first line, or one line saying how to install it.

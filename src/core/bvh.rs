@@ -84,6 +84,26 @@ fn node(n: &obvhs::bvh2::node::Bvh2Node, first: u32, count: u32) -> BvhNode {
     BvhNode { min: n.aabb.min.to_array(), first, max: n.aabb.max.to_array(), count }
 }
 
+/// The top level over the objects' boxes, one object per leaf: a leaf's `first` is the
+/// object's first level in `levels`, its count `OBJECT_LEAF` | the object's levels.
+fn top_level(boxes: &[obvhs::aabb::Aabb], object_levels: &[(u32, u32)]) -> Vec<BvhNode> {
+    let params = obvhs::BvhBuildParams { max_prims_per_leaf: 1, ..obvhs::BvhBuildParams::medium_build() };
+    let mut build_time = std::time::Duration::ZERO;
+    let top = obvhs::bvh2::builder::build_bvh2(boxes, params, &mut build_time);
+    top.nodes
+        .iter()
+        .map(|n| {
+            if n.prim_count == 0 {
+                node(n, n.first_index, 0)
+            } else {
+                assert_eq!(n.prim_count, 1, "one object per top-level leaf");
+                let (first_level, count) = object_levels[top.primitive_indices[n.first_index as usize] as usize];
+                node(n, first_level, OBJECT_LEAF | count)
+            }
+        })
+        .collect()
+}
+
 impl SceneBvh {
     /// The BVH of a scene drawn as it is: one level per object.
     pub fn of_scene(scene: &Scene) -> SceneBvh {
@@ -161,19 +181,8 @@ impl SceneBvh {
         } else {
             None
         };
-        let params = obvhs::BvhBuildParams { max_prims_per_leaf: 1, ..obvhs::BvhBuildParams::medium_build() };
-        let mut build_time = std::time::Duration::ZERO;
-        let top = obvhs::bvh2::builder::build_bvh2(&boxes, params, &mut build_time);
-        let top_len = top.nodes.len() as u32;
-        for n in &top.nodes {
-            out.nodes.push(if n.prim_count == 0 {
-                node(n, n.first_index, 0)
-            } else {
-                assert_eq!(n.prim_count, 1, "one object per top-level leaf");
-                let (first_level, count) = object_levels[top.primitive_indices[n.first_index as usize] as usize];
-                node(n, first_level, OBJECT_LEAF | count)
-            });
-        }
+        out.nodes = top_level(&boxes, &object_levels);
+        let top_len = out.nodes.len() as u32;
         // The subtrees follow the top level: shift their inner nodes' child indices and roots.
         out.nodes.extend(subtrees.into_iter().map(|n| {
             if n.count == 0 {

@@ -9,6 +9,7 @@ use crate::core::color::linear_to_srgb;
 use crate::core::frame::Frame;
 use crate::core::scene::Scene;
 use crate::error::{Error, Result};
+use glam::Vec3;
 
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Comparison {
@@ -73,77 +74,23 @@ pub fn traced_display_error(
     width: usize,
     height: usize,
 ) -> TracedError {
-    use glam::Vec3;
     let mut errors: Vec<f64> = Vec::new();
     let mut unmatched = 0u64;
     for k in 0..2 {
-        let (pos, obj, tpos, tobj) = (&drawn[k], &drawn_object[k], &traced[k], &traced_object[k]);
-        let at = |x: i64, y: i64| -> Option<usize> {
-            (0..height as i64).contains(&y).then(|| y as usize * width + x.rem_euclid(width as i64) as usize)
+        let eye = TracedEye {
+            pos: &drawn[k],
+            obj: &drawn_object[k],
+            tpos: &traced[k],
+            tobj: &traced_object[k],
+            width,
+            height,
         };
         for i in 0..width * height {
-            let (o, x) = (obj[i], Vec3::from(pos[i]));
-            if o == 0 || !x.is_finite() {
-                continue;
+            match eye.error_at(i) {
+                Some(Some(e)) => errors.push(e),
+                Some(None) => unmatched += 1,
+                None => {}
             }
-            let usable = |j: usize| tobj[j] == o && Vec3::from(tpos[j]).is_finite();
-            let dist = |j: usize| (Vec3::from(tpos[j]) - x).length_squared();
-            let (px, py) = ((i % width) as i64, (i / width) as i64);
-            // The 8-neighbour of (x, y) nearest X among those nearer than `bound`.
-            let nearer = |(qx, qy): (i64, i64), bound: f32| {
-                let mut best: Option<(i64, i64, f32)> = None;
-                for (dx, dy) in [(-1, 0), (1, 0), (0, -1), (0, 1), (-1, -1), (1, -1), (-1, 1), (1, 1)] {
-                    if let Some(j) = at(qx + dx, qy + dy).filter(|&j| usable(j)) {
-                        if dist(j) < best.map_or(bound, |b| b.2) {
-                            best = Some((qx + dx, qy + dy, dist(j)));
-                        }
-                    }
-                }
-                best
-            };
-            // The start: p itself, or the nearest usable pixel around it; then descend.
-            let start = if usable(i) { Some((px, py, dist(i))) } else { nearer((px, py), f32::INFINITY) };
-            let Some(mut q) = start else {
-                unmatched += 1;
-                continue;
-            };
-            for _ in 0..TRACED_SEARCH_STEPS {
-                match nearer((q.0, q.1), q.2) {
-                    Some(next) => q = next,
-                    None => break,
-                }
-            }
-            let y = Vec3::from(tpos[at(q.0, q.1).expect("inside")]);
-            // The local map from the neighbours (one side or the other, same object).
-            let axis = |dx: i64, dy: i64| {
-                [1i64, -1].into_iter().find_map(|s| {
-                    at(q.0 + s * dx, q.1 + s * dy).filter(|&j| usable(j)).map(|j| (Vec3::from(tpos[j]) - y) * s as f32)
-                })
-            };
-            let (Some(a), Some(b)) = (axis(1, 0), axis(0, 1)) else {
-                unmatched += 1;
-                continue;
-            };
-            let r = x - y;
-            let (aa, ab, bb) = (a.dot(a), a.dot(b), b.dot(b));
-            let det = aa * bb - ab * ab;
-            let (dx, dy) = if det > 1e-12 * aa * bb {
-                (
-                    ((bb * a.dot(r) - ab * b.dot(r)) / det).clamp(-1.5, 1.5),
-                    ((aa * b.dot(r) - ab * a.dot(r)) / det).clamp(-1.5, 1.5),
-                )
-            } else {
-                (0.0, 0.0)
-            };
-            let footprint = aa.max(bb).sqrt();
-            if (y + dx * a + dy * b - x).length() > footprint {
-                unmatched += 1;
-                continue;
-            }
-            let mut ex = (q.0 as f32 + dx - px as f32).abs();
-            ex = ex.min(width as f32 - ex);
-            let ey = q.1 as f32 + dy - py as f32;
-            errors.push((ex * ex + ey * ey).sqrt() as f64);
         }
     }
     errors.sort_by(f64::total_cmp);
@@ -154,6 +101,96 @@ pub fn traced_display_error(
         max_px: errors.last().copied().unwrap_or(0.0),
         pixels: n as u64,
         unmatched,
+    }
+}
+
+/// One eye's drawn surface points and object ids, and the traced image's (see
+/// [`traced_display_error`]).
+struct TracedEye<'e> {
+    pos: &'e [[f32; 3]],
+    obj: &'e [u32],
+    tpos: &'e [[f32; 3]],
+    tobj: &'e [u32],
+    width: usize,
+    height: usize,
+}
+
+impl TracedEye<'_> {
+    /// The pixel (x, y), x wrapped around the panorama; None beyond the top or bottom.
+    fn at(&self, x: i64, y: i64) -> Option<usize> {
+        (0..self.height as i64).contains(&y).then(|| y as usize * self.width + x.rem_euclid(self.width as i64) as usize)
+    }
+
+    /// Whether traced pixel j shows a point of object `o`.
+    fn usable(&self, j: usize, o: u32) -> bool {
+        self.tobj[j] == o && Vec3::from(self.tpos[j]).is_finite()
+    }
+
+    /// The 8-neighbour of (qx, qy) whose traced point of object `o` is nearest `x`, among those
+    /// nearer than `bound` (squared).
+    fn nearer(&self, (qx, qy): (i64, i64), bound: f32, o: u32, x: Vec3) -> Option<(i64, i64, f32)> {
+        let mut best: Option<(i64, i64, f32)> = None;
+        for (dx, dy) in [(-1, 0), (1, 0), (0, -1), (0, 1), (-1, -1), (1, -1), (-1, 1), (1, 1)] {
+            if let Some(j) = self.at(qx + dx, qy + dy).filter(|&j| self.usable(j, o)) {
+                let dist = (Vec3::from(self.tpos[j]) - x).length_squared();
+                if dist < best.map_or(bound, |b| b.2) {
+                    best = Some((qx + dx, qy + dy, dist));
+                }
+            }
+        }
+        best
+    }
+
+    /// The display-position error of drawn pixel i, pixels: None where it shows no surface;
+    /// Some(None) where the traced image has no match for its point.
+    fn error_at(&self, i: usize) -> Option<Option<f64>> {
+        let (o, x) = (self.obj[i], Vec3::from(self.pos[i]));
+        if o == 0 || !x.is_finite() {
+            return None;
+        }
+        let (px, py) = ((i % self.width) as i64, (i / self.width) as i64);
+        // The start: p itself, or the nearest usable pixel around it; then descend.
+        let start = if self.usable(i, o) {
+            Some((px, py, (Vec3::from(self.tpos[i]) - x).length_squared()))
+        } else {
+            self.nearer((px, py), f32::INFINITY, o, x)
+        };
+        let Some(mut q) = start else { return Some(None) };
+        for _ in 0..TRACED_SEARCH_STEPS {
+            match self.nearer((q.0, q.1), q.2, o, x) {
+                Some(next) => q = next,
+                None => break,
+            }
+        }
+        let y = Vec3::from(self.tpos[self.at(q.0, q.1).expect("inside")]);
+        // The local map from the neighbours (one side or the other, same object).
+        let axis = |dx: i64, dy: i64| {
+            [1i64, -1].into_iter().find_map(|s| {
+                self.at(q.0 + s * dx, q.1 + s * dy)
+                    .filter(|&j| self.usable(j, o))
+                    .map(|j| (Vec3::from(self.tpos[j]) - y) * s as f32)
+            })
+        };
+        let (Some(a), Some(b)) = (axis(1, 0), axis(0, 1)) else { return Some(None) };
+        let r = x - y;
+        let (aa, ab, bb) = (a.dot(a), a.dot(b), b.dot(b));
+        let det = aa * bb - ab * ab;
+        let (dx, dy) = if det > 1e-12 * aa * bb {
+            (
+                ((bb * a.dot(r) - ab * b.dot(r)) / det).clamp(-1.5, 1.5),
+                ((aa * b.dot(r) - ab * a.dot(r)) / det).clamp(-1.5, 1.5),
+            )
+        } else {
+            (0.0, 0.0)
+        };
+        let footprint = aa.max(bb).sqrt();
+        if (y + dx * a + dy * b - x).length() > footprint {
+            return Some(None);
+        }
+        let mut ex = (q.0 as f32 + dx - px as f32).abs();
+        ex = ex.min(self.width as f32 - ex);
+        let ey = q.1 as f32 + dy - py as f32;
+        Some(Some((ex * ex + ey * ey).sqrt() as f64))
     }
 }
 

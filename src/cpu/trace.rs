@@ -189,22 +189,90 @@ pub struct TraceOutput {
 
 /// The trace stage on the CPU.
 pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, table: &MaterialTable) -> TraceOutput {
-    let (rays, tests) = (Cell::new(0u64), Cell::new(0u64));
-    let traced = TracedScene { bvh, vertices, min_share: params.lod_min_share };
-    let indices = &bvh.indices;
-    let projection = Projection::from(&params.projection);
-    let to_scene = Mat4::from_cols_array_2d(&params.to_scene);
-    let to_view = glam::Mat3::from_mat4(to_scene).transpose();
-    let to_scene_rotation = glam::Mat3::from_mat4(to_scene);
-    let viewer = to_scene.w_axis.truncate();
+    let tracer = Tracer::new(params, vertices, bvh, table);
+    let projection = &tracer.projection;
     let [r, g, b, _] = params.background;
-    let background = Vec3::new(r, g, b).map(srgb_to_linear);
-    let corners = |tri: u32| [0, 1, 2].map(|k| &vertices[indices[(3 * tri + k) as usize] as usize]);
-    let material = |tri: u32| &table.materials[(corners(tri)[0].material as usize).min(table.materials.len() - 1)];
-    // The footprint in texture units of a ray cone `width` wide meeting `tri` along `dir`
-    // (`texture_footprint`).
-    let footprint = |tri: u32, dir: Vec3, width: f32| {
-        let [a, b, c] = corners(tri);
+    let images = Eye::BOTH.map(|eye| {
+        // The image's background is given in display values, as `RasterImage::new` takes it.
+        let mut img = RasterImage::new(projection.width, projection.height, [r, g, b]);
+        for y in 0..projection.height {
+            for x in 0..projection.width {
+                tracer.trace_pixel(eye, x, y, &mut img);
+            }
+        }
+        img
+    });
+    TraceOutput { images, rays: tracer.rays.get(), triangle_tests: tracer.tests.get() }
+}
+
+/// A ray's choice of the triangles it meets (`keeps` of [`closest_hit`]).
+type Keeps<'k> = &'k dyn Fn(u32, f32, f32, bool, Vec3, f32) -> bool;
+
+/// What tracing a frame reads (the scene, its tree and material table, the frame's parameters
+/// and what follows from them) and what it counts (rays traced, ray–triangle tests).
+struct Tracer<'a> {
+    params: &'a TraceParams,
+    vertices: &'a [SceneVertex],
+    traced: TracedScene<'a>,
+    table: &'a MaterialTable,
+    projection: Projection,
+    to_scene: Mat4,
+    to_view: glam::Mat3,
+    to_scene_rotation: glam::Mat3,
+    viewer: Vec3,
+    /// The background, linear.
+    background: Vec3,
+    /// `--light`: a point light (scene frame) instead of the scene's lights.
+    light: Option<Vec3>,
+    gaze: Option<Gaze>,
+    /// Whether the environment lights the rays (`environment_lit` in trace.wgsl).
+    environment_lit: bool,
+    rays: Cell<u64>,
+    tests: Cell<u64>,
+}
+
+impl<'a> Tracer<'a> {
+    fn new(params: &'a TraceParams, vertices: &'a [SceneVertex], bvh: &'a SceneBvh, table: &'a MaterialTable) -> Self {
+        let to_scene = Mat4::from_cols_array_2d(&params.to_scene);
+        let [r, g, b, _] = params.background;
+        let light = (params.light[3] > 0.0).then(|| Vec3::new(params.light[0], params.light[1], params.light[2]));
+        Tracer {
+            params,
+            vertices,
+            traced: TracedScene { bvh, vertices, min_share: params.lod_min_share },
+            table,
+            projection: Projection::from(&params.projection),
+            to_scene,
+            to_view: glam::Mat3::from_mat4(to_scene).transpose(),
+            to_scene_rotation: glam::Mat3::from_mat4(to_scene),
+            viewer: to_scene.w_axis.truncate(),
+            background: Vec3::new(r, g, b).map(srgb_to_linear),
+            light,
+            gaze: (params.gaze_forward[3] > 0.0).then(|| Gaze {
+                forward: Vec4::from(params.gaze_forward).truncate(),
+                right: Vec4::from(params.gaze_right).truncate(),
+                up: Vec4::from(params.gaze_up).truncate(),
+            }),
+            environment_lit: table.lighting.pbr != 0 && table.lighting.environment != 0 && light.is_none(),
+            rays: Cell::new(0),
+            tests: Cell::new(0),
+        }
+    }
+
+    fn corners(&self, tri: u32) -> [&'a SceneVertex; 3] {
+        let indices = &self.traced.bvh.indices;
+        [0, 1, 2].map(|k| &self.vertices[indices[(3 * tri + k) as usize] as usize])
+    }
+
+    fn material(&self, tri: u32) -> &'a crate::core::material::Material {
+        let materials = &self.table.materials;
+        &materials[(self.corners(tri)[0].material as usize).min(materials.len() - 1)]
+    }
+
+    /// The footprint in texture units of a ray cone `width` wide meeting `tri` along `dir`
+    /// (`texture_footprint`).
+    fn footprint(&self, tri: u32, dir: Vec3, width: f32) -> f32 {
+        let [a, b, c] = self.corners(tri);
         let n =
             (Vec3::from(b.position) - Vec3::from(a.position)).cross(Vec3::from(c.position) - Vec3::from(a.position));
         let world = n.length().max(1e-30);
@@ -212,9 +280,11 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
         let uv = (d1.x * d2.y - d1.y * d2.x).abs();
         let cos_i = (n.dot(dir).abs() / world).max(0.05);
         width / cos_i * (uv / world).sqrt()
-    };
-    let surface = |tri: u32, b1: f32, b2: f32, front: bool, frag_xy: Vec2, f: f32| {
-        let [a, b, c] = corners(tri);
+    }
+
+    /// The surface at barycentrics (b1, b2) of `tri`, its texture footprint `f`.
+    fn surface(&self, tri: u32, b1: f32, b2: f32, front: bool, frag_xy: Vec2, f: f32) -> Surface {
+        let [a, b, c] = self.corners(tri);
         let b0 = 1.0 - b1 - b2;
         let mix4 = |x: [f32; 4], y: [f32; 4], z: [f32; 4]| b0 * Vec4::from(x) + b1 * Vec4::from(y) + b2 * Vec4::from(z);
         let mix2 = |x: [f32; 2], y: [f32; 2], z: [f32; 2]| b0 * Vec2::from(x) + b1 * Vec2::from(y) + b2 * Vec2::from(z);
@@ -228,22 +298,41 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
             front_facing: front,
             tangent: b0 * unpack_tangent(a.tangent) + b1 * unpack_tangent(b.tangent) + b2 * unpack_tangent(c.tangent),
         }
-    };
-    let light = (params.light[3] > 0.0).then(|| Vec3::new(params.light[0], params.light[1], params.light[2]));
-    let gaze = (params.gaze_forward[3] > 0.0).then(|| Gaze {
-        forward: Vec4::from(params.gaze_forward).truncate(),
-        right: Vec4::from(params.gaze_right).truncate(),
-        up: Vec4::from(params.gaze_up).truncate(),
-    });
-    let shade_hit = |hit: &Hit,
-                     dir: Vec3,
-                     p: Vec3,
-                     view_position: Vec3,
-                     frag_xy: Vec2,
-                     level: f32,
-                     width: f32,
-                     keeps: &dyn Fn(u32, f32, f32, bool, Vec3, f32) -> bool| {
-        let [a, b, c] = corners(hit.triangle);
+    }
+
+    /// Whether a ray of the pixel at `frag_xy` stops at this hit of `tri` (opaque and facing it,
+    /// or a masked or blended surface that shows there).
+    #[allow(clippy::too_many_arguments)]
+    fn keeps(&self, frag_xy: Vec2, tri: u32, b1: f32, b2: f32, front: bool, dir: Vec3, width: f32) -> bool {
+        let m = self.material(tri);
+        if m.alpha_mode == AlphaMode::Opaque as u32 {
+            return front || m.double_sided != 0;
+        }
+        let f = self.footprint(tri, dir, width);
+        surface_color(self.table, &self.surface(tri, b1, b2, front, frag_xy, f)).is_some()
+    }
+
+    /// Traces a shadow ray; whether it meets nothing.
+    fn unshadowed(&self, origin: Vec3, dir: Vec3, limit: f32, level: f32, width: f32, keeps: Keeps) -> bool {
+        self.rays.set(self.rays.get() + 1);
+        let ray = TracedRay { origin, dir, limit, level, cone: Vec2::new(width, 0.0) };
+        closest_hit(&self.traced, &ray, keeps, &self.tests).is_none()
+    }
+
+    /// What a hit shows (`shade_hit` in trace.wgsl).
+    #[allow(clippy::too_many_arguments)]
+    fn shade_hit(
+        &self,
+        hit: &Hit,
+        dir: Vec3,
+        p: Vec3,
+        view_position: Vec3,
+        frag_xy: Vec2,
+        level: f32,
+        width: f32,
+        keeps: Keeps,
+    ) -> Shaded {
+        let [a, b, c] = self.corners(hit.triangle);
         let b0 = 1.0 - hit.b1 - hit.b2;
         let mut n = b0 * Vec3::from(a.normal) + hit.b1 * Vec3::from(b.normal) + hit.b2 * Vec3::from(c.normal);
         if n.length_squared() < 1e-12 {
@@ -251,67 +340,20 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
             n = (p(b) - p(a)).cross(p(c) - p(a));
         }
         let n = n.normalize();
-        let f = footprint(hit.triangle, dir, width);
-        let hit_surface = surface(hit.triangle, hit.b1, hit.b2, hit.front, frag_xy, f);
-        let color = surface_color(table, &hit_surface).expect("a kept hit has a colour");
-        let m = material(hit.triangle);
+        let f = self.footprint(hit.triangle, dir, width);
+        let hit_surface = self.surface(hit.triangle, hit.b1, hit.b2, hit.front, frag_xy, f);
+        let color = surface_color(self.table, &hit_surface).expect("a kept hit has a colour");
+        let m = self.material(hit.triangle);
         let own = (1.0 - m.mirror - m.transmission).max(0.0);
         let facing = if n.dot(dir) > 0.0 { -n } else { n };
-        let lit = match light {
+        let lit = match self.light {
             // The glTF BRDF under the scene's lights, seen along the ray (tone mapped once the
             // pixel's light is summed).
-            None if table.lighting.pbr != 0 => {
-                // The file's tangents, else the frame from the triangle's edges (`shade_hit`).
-                let [a, b, c] = corners(hit.triangle);
-                let (pa, pb, pc) = (Vec3::from(a.position), Vec3::from(b.position), Vec3::from(c.position));
-                let (ua, ub, uc) = (Vec2::from(a.uv), Vec2::from(b.uv), Vec2::from(c.uv));
-                let maps = surface_maps(
-                    table,
-                    a.material,
-                    hit_surface.uv,
-                    hit_surface.duv_dx,
-                    hit_surface.duv_dy,
-                    [to_view * (pb - pa), to_view * (pc - pa)],
-                    [ub - ua, uc - ua],
-                    (to_view * hit_surface.tangent.truncate()).extend(hit_surface.tangent.w),
-                );
-                // The first MAX_SHADOWED_LIGHTS lights behind their shadow rays, the others directly.
-                let v = -(to_view * dir);
-                let shadowed = if table.lighting.shadows != 0 {
-                    (table.lighting.count as usize).min(MAX_SHADOWED_LIGHTS as usize)
-                } else {
-                    0
-                };
-                let mut lit =
-                    pbr_radiance(table, params.ambient, v, view_position, to_view * n, color, &maps, shadowed) * own;
-                let shading_n = shading_normal(to_view * n, v, &maps);
-                let base = color.truncate().max(Vec3::ZERO);
-                let offset = 1e-4 * p.length().max(1.0);
-                for light in &table.lights[..shadowed] {
-                    let term = light_term(light, shading_n, v, view_position, base, &maps) * own;
-                    if term.max_element() > 0.0 {
-                        let limit = if light.kind == LightKind::Directional as u32 {
-                            FAR
-                        } else {
-                            (Vec3::from(light.position) - view_position).length() - offset
-                        };
-                        let (l, _) = light_at(light, view_position);
-                        rays.set(rays.get() + 1);
-                        let cone = Vec2::new(width, 0.0);
-                        let shadow = closest_hit(
-                            &traced,
-                            &TracedRay { origin: p + offset * facing, dir: to_scene_rotation * l, limit, level, cone },
-                            keeps,
-                            &tests,
-                        );
-                        if shadow.is_none() {
-                            lit += term;
-                        }
-                    }
-                }
-                lit
+            None if self.table.lighting.pbr != 0 => {
+                let shading = Shading { n, facing, color, own, level, width };
+                self.shade_pbr(hit, &hit_surface, dir, p, view_position, &shading, keeps)
             }
-            None => shade_linear(params.ambient, view_position, to_view * n, color) * own,
+            None => shade_linear(self.params.ambient, view_position, self.to_view * n, color) * own,
             Some(light) => {
                 // Lambert towards the light, one-sided; the direct part only if the shadow ray
                 // (traced where there is direct light to lose) meets nothing.
@@ -319,21 +361,13 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
                 let dist = to_light.length();
                 let l = to_light / dist.max(1e-20);
                 let base = color.truncate().clamp(Vec3::ZERO, Vec3::ONE) * own;
-                let direct = base * (1.0 - params.ambient) * facing.dot(l).max(0.0);
-                let mut lit = base * params.ambient;
+                let direct = base * (1.0 - self.params.ambient) * facing.dot(l).max(0.0);
+                let mut lit = base * self.params.ambient;
                 let offset = 1e-4 * p.length().max(1.0);
-                if direct.max_element() > 0.0 {
-                    rays.set(rays.get() + 1);
-                    let cone = Vec2::new(width, 0.0);
-                    let shadow = closest_hit(
-                        &traced,
-                        &TracedRay { origin: p + offset * facing, dir: l, limit: dist - offset, level, cone },
-                        keeps,
-                        &tests,
-                    );
-                    if shadow.is_none() {
-                        lit += direct;
-                    }
+                if direct.max_element() > 0.0
+                    && self.unshadowed(p + offset * facing, l, dist - offset, level, width, keeps)
+                {
+                    lit += direct;
                 }
                 lit
             }
@@ -347,120 +381,180 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
             ior: m.ior,
             front: hit.front,
         }
-    };
-    // Whether the environment lights the rays (`environment_lit` in trace.wgsl).
-    let environment_lit = table.lighting.pbr != 0 && table.lighting.environment != 0 && light.is_none();
-    let images = Eye::BOTH.map(|eye| {
-        // The image's background is given in display values, as `RasterImage::new` takes it.
-        let mut img = RasterImage::new(projection.width, projection.height, [r, g, b]);
-        for y in 0..projection.height {
-            for x in 0..projection.width {
-                let frag_xy = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-                let keeps = |tri: u32, b1: f32, b2: f32, front: bool, dir: Vec3, width: f32| {
-                    let m = material(tri);
-                    if m.alpha_mode == AlphaMode::Opaque as u32 {
-                        return front || m.double_sided != 0;
-                    }
-                    surface_color(table, &surface(tri, b1, b2, front, frag_xy, footprint(tri, dir, width))).is_some()
+    }
+
+    /// The glTF BRDF at a hit under the scene's lights: the first `MAX_SHADOWED_LIGHTS` behind
+    /// their shadow rays, the others directly; the file's tangents, else the frame from the
+    /// triangle's edges.
+    #[allow(clippy::too_many_arguments)]
+    fn shade_pbr(
+        &self,
+        hit: &Hit,
+        hit_surface: &Surface,
+        dir: Vec3,
+        p: Vec3,
+        view_position: Vec3,
+        shading: &Shading,
+        keeps: Keeps,
+    ) -> Vec3 {
+        let (table, to_view) = (self.table, self.to_view);
+        let Shading { n, facing, color, own, level, width } = *shading;
+        let [a, b, c] = self.corners(hit.triangle);
+        let (pa, pb, pc) = (Vec3::from(a.position), Vec3::from(b.position), Vec3::from(c.position));
+        let (ua, ub, uc) = (Vec2::from(a.uv), Vec2::from(b.uv), Vec2::from(c.uv));
+        let maps = surface_maps(
+            table,
+            a.material,
+            hit_surface.uv,
+            hit_surface.duv_dx,
+            hit_surface.duv_dy,
+            [to_view * (pb - pa), to_view * (pc - pa)],
+            [ub - ua, uc - ua],
+            (to_view * hit_surface.tangent.truncate()).extend(hit_surface.tangent.w),
+        );
+        let v = -(to_view * dir);
+        let shadowed = if table.lighting.shadows != 0 {
+            (table.lighting.count as usize).min(MAX_SHADOWED_LIGHTS as usize)
+        } else {
+            0
+        };
+        let mut lit =
+            pbr_radiance(table, self.params.ambient, v, view_position, to_view * n, color, &maps, shadowed) * own;
+        let shading_n = shading_normal(to_view * n, v, &maps);
+        let base = color.truncate().max(Vec3::ZERO);
+        let offset = 1e-4 * p.length().max(1.0);
+        for light in &table.lights[..shadowed] {
+            let term = light_term(light, shading_n, v, view_position, base, &maps) * own;
+            if term.max_element() > 0.0 {
+                let limit = if light.kind == LightKind::Directional as u32 {
+                    FAR
+                } else {
+                    (Vec3::from(light.position) - view_position).length() - offset
                 };
-                // The pixel's angular size: the cone's growth per metre.
-                let spread = pixel_spread(&projection, frag_xy);
-                let (origin_v, dir_v) = pixel_ray(&projection, eye, frag_xy);
-                // Seed 000's level of detail: untraced outside the visual field, level ×
-                // Reflect_max bounces (eq. 9, rounded).
-                // Its rays meet each object at the level of detail eq. 10 gives (level 1: the
-                // original).
-                let (level, reflect_max) = match gaze {
-                    None => (1.0, params.reflect_max),
-                    Some(g) => {
-                        let level = g.position(dir_v).level();
-                        if level <= 0.0 {
-                            continue;
-                        }
-                        (level, (level * params.reflect_max as f32 + 0.5).floor() as u32)
-                    }
-                };
-                let origin = to_scene.transform_point3(origin_v);
-                let dir = to_scene.transform_vector3(dir_v);
-                rays.set(rays.get() + 1);
-                let primary_cone = Vec2::new(0.0, spread);
-                let Some(hit) = closest_hit(
-                    &traced,
-                    &TracedRay { origin, dir, limit: FAR, level, cone: primary_cone },
-                    &keeps,
-                    &tests,
-                ) else {
-                    if environment_lit && table.lighting.env_background != 0 {
-                        let i = 4 * (y * projection.width + x) as usize;
-                        let c = tonemap(env_level(table, 0, env_st(env_direction(table, dir_v))), &table.lighting);
-                        img.rgba[i..i + 4].copy_from_slice(&display_bytes(c));
-                    }
-                    continue;
-                };
-                let i = (y * projection.width + x) as usize;
-                let view_position = origin_v + hit.t * dir_v;
-                img.error[i] = pixel_error(&projection, eye, view_position, frag_xy, params.error_angle != 0);
-                img.object[i] = corners(hit.triangle)[0].object + 1;
-                img.distance[i] = hit.t;
-                img.depth[i] = hit.t;
-                // The colour gathers the mirror and refraction rays, depth first (as the WGSL).
-                // (origin, bounces, direction, weight, the cone's width at the origin).
-                let mut pending: Vec<(Vec3, u32, Vec3, Vec3, f32)> = Vec::with_capacity(TRACE_PENDING as usize);
-                let mut color = Vec3::ZERO;
-                let (mut current, mut current_hit) = ((origin, 0u32, dir, Vec3::ONE, 0.0f32), Some(hit));
-                loop {
-                    let (o, bounces, d, weight, cone) = current;
-                    match current_hit {
-                        // A mirrored or refracted ray leaving the scene brings the environment's light.
-                        None if environment_lit => {
-                            color += weight * env_level(table, 0, env_st(env_direction(table, to_view * d)))
-                        }
-                        None => color += weight * background,
-                        Some(h) => {
-                            let p = o + h.t * d;
-                            let width = cone + spread * h.t;
-                            let s = shade_hit(&h, d, p, to_view * (p - viewer), frag_xy, level, width, &keeps);
-                            color += weight * s.color;
-                            let offset = 1e-4 * p.length().max(1.0);
-                            if bounces < reflect_max {
-                                if s.mirror > 0.0 && pending.len() < TRACE_PENDING as usize {
-                                    let r = d - 2.0 * d.dot(s.normal) * s.normal;
-                                    pending.push((
-                                        p + offset * s.normal,
-                                        bounces + 1,
-                                        r,
-                                        weight * s.mirror * s.tint,
-                                        width,
-                                    ));
-                                }
-                                if s.transmission > 0.0 && pending.len() < TRACE_PENDING as usize {
-                                    let eta = if s.front { 1.0 / s.ior } else { s.ior };
-                                    let t = refract_or_reflect(d, s.normal, eta);
-                                    let side = if t.dot(s.normal) < 0.0 { -s.normal } else { s.normal };
-                                    pending.push((p + offset * side, bounces + 1, t, weight * s.transmission, width));
-                                }
-                            }
-                        }
-                    }
-                    let Some(next) = pending.pop() else { break };
-                    current = next;
-                    rays.set(rays.get() + 1);
-                    current_hit = closest_hit(
-                        &traced,
-                        &TracedRay { origin: next.0, dir: next.2, limit: FAR, level, cone: Vec2::new(next.4, spread) },
-                        &keeps,
-                        &tests,
-                    );
+                let (l, _) = light_at(light, view_position);
+                let towards = self.to_scene_rotation * l;
+                if self.unshadowed(p + offset * facing, towards, limit, level, width, keeps) {
+                    lit += term;
                 }
-                if table.lighting.pbr != 0 && light.is_none() {
-                    color = tonemap(color, &table.lighting);
-                }
-                img.rgba[4 * i..4 * i + 4].copy_from_slice(&display_bytes(color));
             }
         }
-        img
-    });
-    TraceOutput { images, rays: rays.get(), triangle_tests: tests.get() }
+        lit
+    }
+
+    /// Traces the pixel (x, y) of `eye` into `img`: its primary ray, then its mirror and
+    /// refraction rays depth first (as the WGSL).
+    fn trace_pixel(&self, eye: Eye, x: u32, y: u32, img: &mut RasterImage) {
+        let (params, table, projection) = (self.params, self.table, &self.projection);
+        let frag_xy = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+        let keeps = |tri, b1, b2, front, dir, width| self.keeps(frag_xy, tri, b1, b2, front, dir, width);
+        // The pixel's angular size: the cone's growth per metre.
+        let spread = pixel_spread(projection, frag_xy);
+        let (origin_v, dir_v) = pixel_ray(projection, eye, frag_xy);
+        // Seed 000's level of detail: untraced outside the visual field, level × Reflect_max
+        // bounces (eq. 9, rounded). Its rays meet each object at the level of detail eq. 10
+        // gives (level 1: the original).
+        let (level, reflect_max) = match self.gaze {
+            None => (1.0, params.reflect_max),
+            Some(g) => {
+                let level = g.position(dir_v).level();
+                if level <= 0.0 {
+                    return;
+                }
+                (level, (level * params.reflect_max as f32 + 0.5).floor() as u32)
+            }
+        };
+        let origin = self.to_scene.transform_point3(origin_v);
+        let dir = self.to_scene.transform_vector3(dir_v);
+        self.rays.set(self.rays.get() + 1);
+        let primary = TracedRay { origin, dir, limit: FAR, level, cone: Vec2::new(0.0, spread) };
+        let Some(hit) = closest_hit(&self.traced, &primary, &keeps, &self.tests) else {
+            if self.environment_lit && table.lighting.env_background != 0 {
+                let i = 4 * (y * projection.width + x) as usize;
+                let c = tonemap(env_level(table, 0, env_st(env_direction(table, dir_v))), &table.lighting);
+                img.rgba[i..i + 4].copy_from_slice(&display_bytes(c));
+            }
+            return;
+        };
+        let i = (y * projection.width + x) as usize;
+        let view_position = origin_v + hit.t * dir_v;
+        img.error[i] = pixel_error(projection, eye, view_position, frag_xy, params.error_angle != 0);
+        img.object[i] = self.corners(hit.triangle)[0].object + 1;
+        img.distance[i] = hit.t;
+        img.depth[i] = hit.t;
+        let mut color = self.gather(origin, dir, hit, frag_xy, spread, level, reflect_max, &keeps);
+        if table.lighting.pbr != 0 && self.light.is_none() {
+            color = tonemap(color, &table.lighting);
+        }
+        img.rgba[4 * i..4 * i + 4].copy_from_slice(&display_bytes(color));
+    }
+
+    /// The light a primary ray gathers from its first hit and the mirror and refraction rays
+    /// after it, depth first (as the WGSL): each pending ray is (origin, bounces, direction,
+    /// weight, the cone's width at the origin).
+    #[allow(clippy::too_many_arguments)]
+    fn gather(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        hit: Hit,
+        frag_xy: Vec2,
+        spread: f32,
+        level: f32,
+        reflect_max: u32,
+        keeps: Keeps,
+    ) -> Vec3 {
+        let table = self.table;
+        let mut pending: Vec<(Vec3, u32, Vec3, Vec3, f32)> = Vec::with_capacity(TRACE_PENDING as usize);
+        let mut color = Vec3::ZERO;
+        let (mut current, mut current_hit) = ((origin, 0u32, dir, Vec3::ONE, 0.0f32), Some(hit));
+        loop {
+            let (o, bounces, d, weight, cone) = current;
+            match current_hit {
+                // A mirrored or refracted ray leaving the scene brings the environment's light.
+                None if self.environment_lit => {
+                    color += weight * env_level(table, 0, env_st(env_direction(table, self.to_view * d)))
+                }
+                None => color += weight * self.background,
+                Some(h) => {
+                    let p = o + h.t * d;
+                    let width = cone + spread * h.t;
+                    let s = self.shade_hit(&h, d, p, self.to_view * (p - self.viewer), frag_xy, level, width, keeps);
+                    color += weight * s.color;
+                    let offset = 1e-4 * p.length().max(1.0);
+                    if bounces < reflect_max {
+                        if s.mirror > 0.0 && pending.len() < TRACE_PENDING as usize {
+                            let r = d - 2.0 * d.dot(s.normal) * s.normal;
+                            pending.push((p + offset * s.normal, bounces + 1, r, weight * s.mirror * s.tint, width));
+                        }
+                        if s.transmission > 0.0 && pending.len() < TRACE_PENDING as usize {
+                            let eta = if s.front { 1.0 / s.ior } else { s.ior };
+                            let t = refract_or_reflect(d, s.normal, eta);
+                            let side = if t.dot(s.normal) < 0.0 { -s.normal } else { s.normal };
+                            pending.push((p + offset * side, bounces + 1, t, weight * s.transmission, width));
+                        }
+                    }
+                }
+            }
+            let Some(next) = pending.pop() else { break };
+            current = next;
+            self.rays.set(self.rays.get() + 1);
+            let ray = TracedRay { origin: next.0, dir: next.2, limit: FAR, level, cone: Vec2::new(next.4, spread) };
+            current_hit = closest_hit(&self.traced, &ray, keeps, &self.tests);
+        }
+        color
+    }
+}
+
+/// A hit's shading inputs shared by the lighting models: the normal (and facing the ray), the
+/// surface colour, the weight of its own light, the ray's level of detail and cone width.
+#[derive(Clone, Copy)]
+struct Shading {
+    n: Vec3,
+    facing: Vec3,
+    color: Vec4,
+    own: f32,
+    level: f32,
+    width: f32,
 }
 
 /// Linear colour → sRGB bytes as the colour target holds them (`pack_display(linear_to_srgb(c))`).

@@ -163,35 +163,7 @@ fn draw_pipeline(
     let background = look.is_none();
     let (look, lit) =
         look.unwrap_or((Look::Materials, Lit { pbr: true, environment: true, maps: false, shadows: false }));
-    use wgpu::VertexFormat::{Float32, Float32x2, Float32x3, Float32x4, Uint32};
-    // Raster: the subdivided `DrawVertex`; slit: the scene's `SceneVertex` (`VertexIn` of each WGSL file).
-    let (stride, attributes) = match kind {
-        DrawStage::Raster => (
-            std::mem::size_of::<DrawVertex>(),
-            vec![
-                attribute(Float32x3, offset_of!(DrawVertex, position), 0),
-                attribute(Float32, offset_of!(DrawVertex, theta_ref), 1),
-                attribute(Float32x3, offset_of!(DrawVertex, normal), 2),
-                attribute(Uint32, offset_of!(DrawVertex, material), 3),
-                attribute(Float32x4, offset_of!(DrawVertex, color), 4),
-                attribute(Float32x2, offset_of!(DrawVertex, uv), 5),
-                attribute(Uint32, offset_of!(DrawVertex, object), 6),
-                attribute(Uint32, offset_of!(DrawVertex, tangent), 7),
-            ],
-        ),
-        DrawStage::Slit => (
-            std::mem::size_of::<SceneVertex>(),
-            vec![
-                attribute(Float32x3, offset_of!(SceneVertex, position), 0),
-                attribute(Float32x3, offset_of!(SceneVertex, normal), 1),
-                attribute(Float32x4, offset_of!(SceneVertex, color), 2),
-                attribute(Uint32, offset_of!(SceneVertex, object), 3),
-                attribute(Float32x2, offset_of!(SceneVertex, uv), 4),
-                attribute(Uint32, offset_of!(SceneVertex, material), 5),
-                attribute(Uint32, offset_of!(SceneVertex, tangent), 6),
-            ],
-        ),
-    };
+    let (stride, attributes) = vertex_layout(kind);
     let layout = wgpu::VertexBufferLayout {
         array_stride: stride as u64,
         step_mode: wgpu::VertexStepMode::Vertex,
@@ -207,14 +179,7 @@ fn draw_pipeline(
             Some(wgpu::ColorTargetState { format, blend: None, write_mask })
         });
     let all_targets: Vec<_> = all_targets.collect();
-    let mut constants = vec![
-        ("MATERIALS", (look != Look::Plain) as u32 as f64),
-        ("DISCARDS", (look != Look::Shaded) as u32 as f64),
-        ("PBR", lit.pbr as u32 as f64),
-        ("ENVIRONMENT", lit.environment as u32 as f64),
-        ("MAPS", lit.maps as u32 as f64),
-        ("SHADOW_MAPS", lit.shadows as u32 as f64),
-    ];
+    let mut constants = look_constants(look, lit);
     let multiview_mask = match layers {
         Layers::Both => std::num::NonZeroU32::new(0b11),
         Layers::Eye(k) => {
@@ -261,4 +226,49 @@ fn draw_pipeline(
         multiview_mask,
         cache: None,
     })
+}
+
+/// The pipeline constants that compile the parts of the look in or out (surface.wgsl).
+fn look_constants(look: Look, lit: Lit) -> Vec<(&'static str, f64)> {
+    vec![
+        ("MATERIALS", (look != Look::Plain) as u32 as f64),
+        ("DISCARDS", (look != Look::Shaded) as u32 as f64),
+        ("PBR", lit.pbr as u32 as f64),
+        ("ENVIRONMENT", lit.environment as u32 as f64),
+        ("MAPS", lit.maps as u32 as f64),
+        ("SHADOW_MAPS", lit.shadows as u32 as f64),
+    ]
+}
+
+/// A drawing stage's vertex buffer: its stride and attributes. Raster: the subdivided
+/// `DrawVertex`; slit: the scene's `SceneVertex` (`VertexIn` of each WGSL file).
+fn vertex_layout(kind: DrawStage) -> (usize, Vec<wgpu::VertexAttribute>) {
+    use wgpu::VertexFormat::{Float32, Float32x2, Float32x3, Float32x4, Uint32};
+    match kind {
+        DrawStage::Raster => (
+            std::mem::size_of::<DrawVertex>(),
+            vec![
+                attribute(Float32x3, offset_of!(DrawVertex, position), 0),
+                attribute(Float32, offset_of!(DrawVertex, theta_ref), 1),
+                attribute(Float32x3, offset_of!(DrawVertex, normal), 2),
+                attribute(Uint32, offset_of!(DrawVertex, material), 3),
+                attribute(Float32x4, offset_of!(DrawVertex, color), 4),
+                attribute(Float32x2, offset_of!(DrawVertex, uv), 5),
+                attribute(Uint32, offset_of!(DrawVertex, object), 6),
+                attribute(Uint32, offset_of!(DrawVertex, tangent), 7),
+            ],
+        ),
+        DrawStage::Slit => (
+            std::mem::size_of::<SceneVertex>(),
+            vec![
+                attribute(Float32x3, offset_of!(SceneVertex, position), 0),
+                attribute(Float32x3, offset_of!(SceneVertex, normal), 1),
+                attribute(Float32x4, offset_of!(SceneVertex, color), 2),
+                attribute(Uint32, offset_of!(SceneVertex, object), 3),
+                attribute(Float32x2, offset_of!(SceneVertex, uv), 4),
+                attribute(Uint32, offset_of!(SceneVertex, material), 5),
+                attribute(Uint32, offset_of!(SceneVertex, tangent), 6),
+            ],
+        ),
+    }
 }

@@ -3,6 +3,7 @@
 
 pub mod device;
 pub mod draw;
+pub mod frame;
 pub mod frame_plan;
 pub mod project_points;
 pub mod reduce_error;

@@ -7,11 +7,10 @@
 //! scopes, so a GPU error is one [`Error::Gpu`] line.
 
 use std::sync::Mutex;
-use std::time::Instant;
 
 use glam::Vec3;
 
-use crate::core::frame::{Frame, FrameStats, Measurement};
+use crate::core::frame::Frame;
 use crate::core::projection::{Eye, Projection};
 use crate::core::scene::Scene;
 use crate::core::settings::{Method as MethodName, RenderSettings};
@@ -19,66 +18,17 @@ use crate::encoding::subdivide::SubdivideOutput;
 use crate::encoding::types::{RasterParams, SlitParams, SubdivideParams, TraceParams};
 use crate::error::{Error, Result};
 use crate::gpu::device::Gpu;
-use crate::gpu::frame_plan::SubdivisionBuffers;
+use crate::gpu::frame::{FrameEnd, FrameResources, Method, STAGING_SIZE};
 use crate::gpu::project_points::ProjectPointsStage;
 use crate::gpu::reduce_error::ReduceStage;
 use crate::gpu::scene::GpuScene;
 use crate::gpu::shadow::ShadowStage;
 use crate::gpu::skin::SkinStage;
 use crate::gpu::slit::SlitMethod;
-use crate::gpu::subdivide::{Schedule, COUNTERS_SIZE};
+use crate::gpu::subdivide::Schedule;
 use crate::gpu::subdivided::SubdividedMethod;
-use crate::gpu::targets::Targets;
-use crate::gpu::timestamps::{self as stamp, Timestamps};
+use crate::gpu::timestamps::Timestamps;
 use crate::gpu::trace::TraceMethod;
-
-/// What a renderer keeps between frames.
-pub(crate) struct FrameResources {
-    pub buffers: Option<SubdivisionBuffers>,
-    /// Targets of the last image size.
-    pub targets: Option<Targets>,
-    pub timestamps: Option<Timestamps>,
-    pub subdivide_params: wgpu::Buffer,
-    /// Both eyes' (left, right), as the raster stage's `array<RasterParams, 2>`.
-    pub raster_params: wgpu::Buffer,
-    pub slit_params: [wgpu::Buffer; 2],
-    /// Counters and timestamps of a one-submission frame.
-    pub staging: wgpu::Buffer,
-    pub trace_params: wgpu::Buffer,
-    /// The ray tracer's outputs of the last image size: (padded row texels, height, colour,
-    /// error, object and distance buffers), and its counters of rays and triangle tests.
-    pub trace_outputs: Option<(u32, u32, [wgpu::Buffer; 4])>,
-    pub trace_counts: Option<wgpu::Buffer>,
-}
-
-impl FrameResources {
-    /// The targets for this size, made anew only when the size changed.
-    /// The targets for this size (with the positions target if `positions`), made anew only
-    /// when the size changed or the positions target is wanted and missing.
-    pub fn targets(&mut self, gpu: &Gpu, width: u32, height: u32, positions: bool, hdr: bool) -> &Targets {
-        if !self.targets.as_ref().is_some_and(|t| {
-            t.width == width && t.height == height && (t.position.is_some() || !positions) && t.hdr == hdr
-        }) {
-            self.targets = Some(Targets::new(gpu, width, height, positions, hdr));
-        }
-        self.targets.as_ref().expect("just made")
-    }
-}
-
-const STAGING_SIZE: u64 = COUNTERS_SIZE + 8 * stamp::COUNT as u64;
-
-/// A way of drawing a frame (as pbrt's `Integrator`): the projection methods' subdivided
-/// raster, the slit mosaic, the ray tracer. Each reads the frame's resources and ends with
-/// [`Renderer::finish_frame`].
-pub(crate) trait Method {
-    fn draw(
-        &self,
-        r: &Renderer,
-        res: &mut FrameResources,
-        scene: &GpuScene,
-        settings: &RenderSettings,
-    ) -> Result<Frame>;
-}
 
 /// The renderer: the device, each method's driver and the stages they share, and the
 /// resources kept between frames.
@@ -88,7 +38,7 @@ pub struct Renderer {
     slit: SlitMethod,
     trace: TraceMethod,
     shadow: ShadowStage,
-    reduce: ReduceStage,
+    end: FrameEnd,
     skin: SkinStage,
     project_points: ProjectPointsStage,
     resources: Mutex<FrameResources>,
@@ -98,7 +48,7 @@ impl Renderer {
     /// Builds the usual frame's pipelines now (a GPU error here is returned, not a panic); the
     /// others are built when first needed.
     pub fn new(gpu: Gpu) -> Result<Renderer> {
-        let (subdivided, slit, shadow, reduce, resources) = gpu.scoped("building the pipelines", || {
+        let (subdivided, slit, shadow, end, resources) = gpu.scoped("building the pipelines", || {
             let resources = FrameResources {
                 buffers: None,
                 targets: None,
@@ -120,7 +70,7 @@ impl Renderer {
                 SubdividedMethod::new(&gpu),
                 SlitMethod::new(&gpu),
                 ShadowStage::new(&gpu),
-                ReduceStage::new(&gpu),
+                FrameEnd { reduce: ReduceStage::new(&gpu) },
                 resources,
             ))
         })?;
@@ -130,7 +80,7 @@ impl Renderer {
             slit,
             trace: TraceMethod::default(),
             shadow,
-            reduce,
+            end,
             skin: SkinStage::default(),
             project_points: ProjectPointsStage::default(),
             resources: Mutex::new(resources),
@@ -155,7 +105,7 @@ impl Renderer {
             MethodName::Trace => &self.trace,
             _ => &self.subdivided,
         };
-        self.gpu.scoped("rendering a frame", || method.draw(self, &mut resources, scene, settings))
+        self.gpu.scoped("rendering a frame", || method.draw(&self.gpu, &self.end, &mut resources, scene, settings))
     }
 
     /// Poses `scene` at time t of clip `clip` (None: the rest pose) on the GPU (the skin
@@ -220,41 +170,5 @@ impl Renderer {
         schedule: Schedule,
     ) -> Result<SubdivideOutput> {
         self.subdivided.subdivide.readback(&self.gpu, scene, settings, schedule)
-    }
-
-    /// Reads the targets back and reduces the error: the end of every render.
-    pub(crate) fn finish_frame(
-        &self,
-        targets: &Targets,
-        settings: &RenderSettings,
-        mut stats: FrameStats,
-        start: Instant,
-    ) -> Result<Frame> {
-        let t = Instant::now();
-        let (hdr, [left, right]) = if targets.hdr {
-            // The linear colour, and as display bytes clamped (the frame is not tone mapped).
-            let hdr = targets.read_hdr(&self.gpu)?;
-            let image = |eye: &Vec<[f32; 3]>| crate::core::frame::EyeImage {
-                width: targets.width,
-                height: targets.height,
-                rgba: eye.iter().flat_map(|c| crate::core::color::display_bytes(glam::Vec3::from(*c))).collect(),
-            };
-            let images = [image(&hdr[0]), image(&hdr[1])];
-            (Some(hdr), images)
-        } else {
-            (None, targets.read_colors(&self.gpu)?)
-        };
-        stats.ms_readback = t.elapsed().as_secs_f64() * 1e3;
-        let depth = if settings.measure.depth { Some(targets.read_distances(&self.gpu)?) } else { None };
-        let positions = if settings.measure.positions { Some(targets.read_positions(&self.gpu)?) } else { None };
-        let measurement = if settings.measure.error {
-            let object = targets.read_objects(&self.gpu)?;
-            let (stats, error) = self.reduce.reduce(&self.gpu, targets, settings.measure.reduce_per_eye)?;
-            Some(Measurement { error, object, stats })
-        } else {
-            None
-        };
-        stats.ms_total = start.elapsed().as_secs_f64() * 1e3;
-        Ok(Frame { left, right, stats, measurement, depth, positions, hdr })
     }
 }

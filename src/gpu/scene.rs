@@ -13,6 +13,7 @@ use crate::core::scene::{object_spheres, Scene};
 use crate::core::settings::RenderSettings;
 use crate::core::shadow::{GpuShadowMap, MAX_SHADOW_MAPS};
 use crate::core::shared_edges::{shared_edges_of, welded_points, SharedEdges};
+use crate::core::texture::MaterialTable;
 use crate::encoding::constants::TRACE_STACK;
 use crate::error::{Error, Result};
 use crate::gpu::device::Gpu;
@@ -37,6 +38,31 @@ pub struct MaterialBuffers {
     pub lights: wgpu::Buffer,
     pub lighting: wgpu::Buffer,
     pub environment: wgpu::Buffer,
+}
+
+impl MaterialBuffers {
+    /// The material table and the scene's lights uploaded (the lighting is written per frame).
+    fn upload(gpu: &Gpu, table: &MaterialTable, lights: &[Light]) -> MaterialBuffers {
+        let storage = |label: &str, bytes: &[u8]| gpu.init_buffer(label, bytes, wgpu::BufferUsages::STORAGE);
+        let written = |usage| usage | wgpu::BufferUsages::COPY_DST;
+        let environment: &[u32] = if table.environment.is_empty() { &[0] } else { &table.environment };
+        MaterialBuffers {
+            materials: storage("materials", bytemuck::cast_slice(&table.materials)),
+            mip_levels: storage("mip levels", bytemuck::cast_slice(&table.mips)),
+            texels: storage("texels", bytemuck::cast_slice(&table.texels)),
+            lights: gpu.init_buffer(
+                "lights",
+                bytemuck::cast_slice(&gpu_lights(lights, Mat4::IDENTITY)),
+                written(wgpu::BufferUsages::STORAGE),
+            ),
+            lighting: gpu.init_buffer(
+                "lighting",
+                bytemuck::bytes_of(&LightingParams::default()),
+                written(wgpu::BufferUsages::UNIFORM),
+            ),
+            environment: storage("environment", bytemuck::cast_slice(environment)),
+        }
+    }
 }
 
 pub struct GpuScene {
@@ -100,22 +126,8 @@ impl GpuScene {
     /// Validates and uploads a scene; fails with a clear message if it cannot fit the device.
     pub fn upload(gpu: &Gpu, scene: &Scene) -> Result<GpuScene> {
         scene.validate()?;
-        let vbytes = std::mem::size_of_val(scene.vertices.as_slice()) as u64;
-        let ibytes = std::mem::size_of_val(scene.indices.as_slice()) as u64;
+        check_fits(gpu, scene)?;
         let max = gpu.max_binding();
-        if vbytes > max || ibytes > max {
-            return Err(Error::scene(
-                &scene.name,
-                format!(
-                    "too big for this GPU: {} vertices ({} MiB) and {} triangles ({} MiB); one buffer may hold at most {} MiB",
-                    scene.vertices.len(),
-                    vbytes >> 20,
-                    scene.triangle_count(),
-                    ibytes >> 20,
-                    max >> 20
-                ),
-            ));
-        }
         gpu.scoped(&format!("uploading {}", scene.name), || {
             // COPY_DST: an animated scene's frames write their poses in; COPY_SRC: the skin
             // stage's twin test reads them back.
@@ -146,26 +158,8 @@ impl GpuScene {
             // Textures get at most a quarter of the device's largest binding (max/16 texels of 4
             // bytes; levels are dropped, largest first, with a warning).
             let table = scene.material_table((max / 16) as usize);
+            let materials = MaterialBuffers::upload(gpu, &table, &scene.lights);
             let storage = |label: &str, bytes: &[u8]| gpu.init_buffer(label, bytes, wgpu::BufferUsages::STORAGE);
-            let materials = MaterialBuffers {
-                materials: storage("materials", bytemuck::cast_slice(&table.materials)),
-                mip_levels: storage("mip levels", bytemuck::cast_slice(&table.mips)),
-                texels: storage("texels", bytemuck::cast_slice(&table.texels)),
-                lights: gpu.init_buffer(
-                    "lights",
-                    bytemuck::cast_slice(&gpu_lights(&scene.lights, Mat4::IDENTITY)),
-                    wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-                ),
-                lighting: gpu.init_buffer(
-                    "lighting",
-                    bytemuck::bytes_of(&LightingParams::default()),
-                    wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                ),
-                environment: storage(
-                    "environment",
-                    bytemuck::cast_slice(if table.environment.is_empty() { &[0u32] } else { &table.environment[..] }),
-                ),
-            };
             let ones = vec![1.0f32; scene.objects.len().max(1)];
             // The glTF BRDF reads the materials' factors.
             let needs_materials = table.needs_materials() || !scene.lights.is_empty() || scene.environment.is_some();
@@ -409,4 +403,26 @@ pub struct GpuRig {
     pub(crate) instances: wgpu::Buffer,
     pub(crate) joints: wgpu::Buffer,
     pub(crate) weights: wgpu::Buffer,
+}
+
+/// Fails with one line where the scene's vertices or indices are more than one buffer binding
+/// of this device holds.
+fn check_fits(gpu: &Gpu, scene: &Scene) -> Result<()> {
+    let vbytes = std::mem::size_of_val(scene.vertices.as_slice()) as u64;
+    let ibytes = std::mem::size_of_val(scene.indices.as_slice()) as u64;
+    let max = gpu.max_binding();
+    if vbytes > max || ibytes > max {
+        return Err(Error::scene(
+            &scene.name,
+            format!(
+                "too big for this GPU: {} vertices ({} MiB) and {} triangles ({} MiB); one buffer may hold at most {} MiB",
+                scene.vertices.len(),
+                vbytes >> 20,
+                scene.triangle_count(),
+                ibytes >> 20,
+                max >> 20
+            ),
+        ));
+    }
+    Ok(())
 }

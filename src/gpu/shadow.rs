@@ -14,7 +14,7 @@ use crate::core::shadow::GpuShadowMap;
 use crate::encoding::types::ShadowParams;
 use crate::error::{Error, Result};
 use crate::gpu::device::Gpu;
-use crate::gpu::scene::GpuScene;
+use crate::gpu::scene::{GpuScene, GpuShadows};
 use crate::gpu::stages::GpuStage;
 use crate::gpu::targets::DEPTH_FORMAT;
 use crate::shader::SHADOW;
@@ -117,32 +117,7 @@ impl ShadowStage {
             ));
         }
         gpu.scoped("drawing the shadow maps", || {
-            if shadows.depths.size() < bytes {
-                shadows.depths = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("shadow depths"),
-                    size: bytes,
-                    // COPY_SRC: the twin test reads the depths back.
-                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
-                    mapped_at_creation: false,
-                });
-            }
-            // A depth texture per map size (a depth texture is copied whole): the maps', and a
-            // cube's faces'.
-            shadows.textures.retain(|t| maps.iter().any(|m| m.size == t.width()));
-            for map in maps {
-                if !shadows.textures.iter().any(|t| t.width() == map.size) {
-                    shadows.textures.push(gpu.device.create_texture(&wgpu::TextureDescriptor {
-                        label: Some("shadow map"),
-                        size: wgpu::Extent3d { width: map.size, height: map.size, depth_or_array_layers: 1 },
-                        mip_level_count: 1,
-                        sample_count: 1,
-                        dimension: wgpu::TextureDimension::D2,
-                        format: DEPTH_FORMAT,
-                        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-                        view_formats: &[],
-                    }));
-                }
-            }
+            make_room(gpu, &mut shadows, maps, bytes);
             gpu.queue.write_buffer(&shadows.maps, 0, bytemuck::cast_slice(maps));
             let stage = &self.stage;
             let pipeline = self.pipeline(gpu, scene.discards);
@@ -183,23 +158,7 @@ impl ShadowStage {
                     pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
                     pass.draw_indexed(0..3 * scene.triangle_count, 0, 0..1);
                 }
-                enc.copy_texture_to_buffer(
-                    wgpu::TexelCopyTextureInfo {
-                        texture,
-                        mip_level: 0,
-                        origin: wgpu::Origin3d::ZERO,
-                        aspect: wgpu::TextureAspect::DepthOnly,
-                    },
-                    wgpu::TexelCopyBufferInfo {
-                        buffer: &shadows.depths,
-                        layout: wgpu::TexelCopyBufferLayout {
-                            offset: 4 * map.offset as u64,
-                            bytes_per_row: Some(4 * map.size),
-                            rows_per_image: Some(map.size),
-                        },
-                    },
-                    wgpu::Extent3d { width: map.size, height: map.size, depth_or_array_layers: 1 },
-                );
+                copy_depths(&mut enc, texture, &shadows.depths, map);
             }
             gpu.queue.submit([enc.finish()]);
             Ok(())
@@ -207,4 +166,54 @@ impl ShadowStage {
         shadows.drawn = wanted;
         Ok(())
     }
+}
+
+/// Room for `maps`: the depth buffer grown to `bytes`, a depth texture per map size (a depth
+/// texture is copied whole: the maps', and a cube's faces'), those of other sizes dropped.
+fn make_room(gpu: &Gpu, shadows: &mut GpuShadows, maps: &[GpuShadowMap], bytes: u64) {
+    if shadows.depths.size() < bytes {
+        shadows.depths = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("shadow depths"),
+            size: bytes,
+            // COPY_SRC: the twin test reads the depths back.
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+    }
+    shadows.textures.retain(|t| maps.iter().any(|m| m.size == t.width()));
+    for map in maps {
+        if !shadows.textures.iter().any(|t| t.width() == map.size) {
+            shadows.textures.push(gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("shadow map"),
+                size: wgpu::Extent3d { width: map.size, height: map.size, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: DEPTH_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            }));
+        }
+    }
+}
+
+/// Copies a drawn map's depth texture into its place in the depth buffer.
+fn copy_depths(enc: &mut wgpu::CommandEncoder, texture: &wgpu::Texture, depths: &wgpu::Buffer, map: &GpuShadowMap) {
+    enc.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::DepthOnly,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: depths,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 4 * map.offset as u64,
+                bytes_per_row: Some(4 * map.size),
+                rows_per_image: Some(map.size),
+            },
+        },
+        wgpu::Extent3d { width: map.size, height: map.size, depth_or_array_layers: 1 },
+    );
 }

@@ -37,34 +37,7 @@ impl SkinStage {
         let Some(rig) = scene.rig.as_deref() else { return Ok(()) };
         let frame = SkinFrame::of(rig, clip, t);
         if gpu_scene.rig.is_none() {
-            let data = SkinData::of(rig);
-            let bytes =
-                std::mem::size_of_val(data.sources.as_slice()).max(std::mem::size_of_val(data.deltas.as_slice()));
-            if bytes as u64 > gpu.max_binding() {
-                return Err(Error::scene(&scene.name, "its animated vertices are more than this GPU binds"));
-            }
-            let storage = |label: &str, bytes: &[u8], write: bool| {
-                let copy = if write { wgpu::BufferUsages::COPY_DST } else { wgpu::BufferUsages::empty() };
-                gpu.init_buffer(label, bytes, wgpu::BufferUsages::STORAGE | copy)
-            };
-            gpu_scene.rig = Some(GpuRig {
-                params: gpu.init_buffer(
-                    "skin params",
-                    bytemuck::bytes_of(&SkinParams { count: data.sources.len() as u32, ..Default::default() }),
-                    wgpu::BufferUsages::UNIFORM,
-                ),
-                sources: storage("skin sources", bytemuck::cast_slice(&data.sources), false),
-                deltas: storage("morph offsets", bytemuck::cast_slice(&data.deltas), false),
-                instances: storage("skin instances", bytemuck::cast_slice(&frame.instances), true),
-                // At least one matrix: a binding of mat4x4 holds 64 bytes or more.
-                joints: storage(
-                    "joint matrices",
-                    bytemuck::cast_slice(if frame.joints.is_empty() { &IDENTITY } else { &frame.joints[..] }),
-                    true,
-                ),
-                weights: storage("morph weights", bytemuck::cast_slice(&frame.weights), true),
-                data,
-            });
+            gpu_scene.rig = Some(upload_rig(gpu, &scene.name, SkinData::of(rig), &frame)?);
         } else if let Some(rig_gpu) = &gpu_scene.rig {
             // The first pose made the buffers with its tables; later ones write theirs.
             for (buffer, bytes) in [
@@ -116,4 +89,35 @@ impl SkinStage {
         gpu_scene.shadows.lock().unwrap_or_else(|e| e.into_inner()).drawn.clear();
         Ok(())
     }
+}
+
+/// The skin stage's tables on the GPU, made on the first pose with its frame's matrices and
+/// weights. Fails with one line where the animated vertices are more than the device binds.
+fn upload_rig(gpu: &Gpu, name: &str, data: SkinData, frame: &SkinFrame) -> Result<GpuRig> {
+    let bytes = std::mem::size_of_val(data.sources.as_slice()).max(std::mem::size_of_val(data.deltas.as_slice()));
+    if bytes as u64 > gpu.max_binding() {
+        return Err(Error::scene(name, "its animated vertices are more than this GPU binds"));
+    }
+    let storage = |label: &str, bytes: &[u8], write: bool| {
+        let copy = if write { wgpu::BufferUsages::COPY_DST } else { wgpu::BufferUsages::empty() };
+        gpu.init_buffer(label, bytes, wgpu::BufferUsages::STORAGE | copy)
+    };
+    Ok(GpuRig {
+        params: gpu.init_buffer(
+            "skin params",
+            bytemuck::bytes_of(&SkinParams { count: data.sources.len() as u32, ..Default::default() }),
+            wgpu::BufferUsages::UNIFORM,
+        ),
+        sources: storage("skin sources", bytemuck::cast_slice(&data.sources), false),
+        deltas: storage("morph offsets", bytemuck::cast_slice(&data.deltas), false),
+        instances: storage("skin instances", bytemuck::cast_slice(&frame.instances), true),
+        // At least one matrix: a binding of mat4x4 holds 64 bytes or more.
+        joints: storage(
+            "joint matrices",
+            bytemuck::cast_slice(if frame.joints.is_empty() { &IDENTITY } else { &frame.joints[..] }),
+            true,
+        ),
+        weights: storage("morph weights", bytemuck::cast_slice(&frame.weights), true),
+        data,
+    })
 }

@@ -11,7 +11,7 @@ use crate::encoding::types::SlitCamera;
 use crate::error::Result;
 use crate::gpu::device::Gpu;
 use crate::gpu::draw::{DrawPipelines, DrawStage};
-use crate::gpu::renderer::{FrameResources, Method, Renderer};
+use crate::gpu::frame::{FrameEnd, FrameResources, Method};
 use crate::gpu::scene::GpuScene;
 use crate::gpu::targets::Layers;
 use crate::gpu::timestamps::submit_timed_pass;
@@ -30,7 +30,8 @@ impl SlitMethod {
 impl Method for SlitMethod {
     fn draw(
         &self,
-        r: &Renderer,
+        gpu: &Gpu,
+        end: &FrameEnd,
         res: &mut FrameResources,
         scene: &GpuScene,
         settings: &RenderSettings,
@@ -39,7 +40,6 @@ impl Method for SlitMethod {
             unreachable!("the slit renderer draws slit:W")
         };
         let start = Instant::now();
-        let gpu = &r.gpu;
         let projection = settings.projection();
         res.targets(gpu, projection.width, projection.height, settings.measure.positions, false);
         let res = &*res;
@@ -95,6 +95,6 @@ impl Method for SlitMethod {
             }
         }
         submit_timed_pass(gpu, enc, timestamps, &res.staging, t, &mut stats)?;
-        r.finish_frame(targets, settings, stats, start)
+        end.finish(gpu, targets, settings, stats, start)
     }
 }

@@ -14,8 +14,8 @@ use crate::encoding::types::{SubdivideCounters, SubdivideParams};
 use crate::error::{Error, Result};
 use crate::gpu::device::Gpu;
 use crate::gpu::draw::{DrawKey, DrawPipelines, DrawStage, Lit, Look};
+use crate::gpu::frame::{FrameEnd, FrameResources, Method};
 use crate::gpu::frame_plan::{on_overflow, Capacities, FramePlan, Overflow, SubdivisionBuffers};
-use crate::gpu::renderer::{FrameResources, Method, Renderer};
 use crate::gpu::scene::GpuScene;
 use crate::gpu::subdivide::{SubdivideStage, COUNTERS_SIZE};
 use crate::gpu::targets::{Layers, Targets};
@@ -48,14 +48,67 @@ impl SubdividedMethod {
 }
 
 impl Method for SubdividedMethod {
+    /// The subdivided frame: follows the [`FramePlan`].
     fn draw(
         &self,
-        r: &Renderer,
+        gpu: &Gpu,
+        end: &FrameEnd,
         res: &mut FrameResources,
         scene: &GpuScene,
         settings: &RenderSettings,
     ) -> Result<Frame> {
-        self.render_subdivided(r, res, scene, settings)
+        let start = Instant::now();
+        let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, ..Default::default() };
+        let p = settings.projection();
+        res.targets(gpu, p.width, p.height, settings.measure.positions, settings.shading.hdr);
+        let budget = Capacities::budget(settings.subdivision.memory_mb, gpu.max_binding());
+        let n = scene.triangle_count;
+        let mut plan = FramePlan::first(n, res.buffers.as_ref().map(|b| b.capacity), budget);
+        if let FramePlan::OneSubmission(want) = plan {
+            SubdivisionBuffers::ensure(&mut res.buffers, gpu, want, scene);
+            let b = res.buffers.as_ref().expect("ensured");
+            if b.cut_list_capacity < n {
+                // More triangles than one binding lists for `plan_cuts`: chunks.
+                plan = plan.after_overflow(budget);
+            }
+        }
+        if let FramePlan::OneSubmission(_) = plan {
+            let b = res.buffers.as_ref().expect("ensured");
+            let targets = res.targets.as_ref().expect("made");
+            let mut params = subdivide_params(settings, 0, n);
+            let capacity = b.capacity.min(budget);
+            params.piece_capacity = capacity.pieces;
+            params.triangle_capacity = capacity.triangles;
+            let t = Instant::now();
+            if let Some((counters, times)) =
+                self.render_one_submission(gpu, res, scene, settings, targets, b, params)?
+            {
+                stats.ms_frame = t.elapsed().as_secs_f64() * 1e3;
+                match times {
+                    Some(times) => {
+                        stats.timing = Timing::GpuTimestamps;
+                        stats.ms_subdivide = Some(times.subdivide);
+                        stats.ms_subdivide_passes = Some(times.passes);
+                        stats.ms_raster = Some(times.raster);
+                        stats.ms_gpu = Some(times.frame);
+                    }
+                    None => stats.timing = Timing::WallOneSubmission,
+                }
+                stats.pieces = counters.pieces as u64;
+                stats.triangles_out = counters.triangles as u64;
+                stats.nodes_out = counters.nodes as u64;
+                stats.chunks = 1;
+                stats.max_sub_edge_px = f32::from_bits(counters.max_edge_bits);
+                return end.finish(gpu, targets, settings, stats, start);
+            }
+            plan = plan.after_overflow(budget);
+        }
+        let FramePlan::Chunked { mut want, budget } = plan else { unreachable!("a one-submission frame returned") };
+        self.render_chunked(gpu, res, scene, settings, &mut want, budget, &mut stats)?;
+        stats.ms_frame = stats.ms_subdivide.unwrap_or(0.0) + stats.ms_raster.unwrap_or(0.0);
+        stats.timing = Timing::WallPerPass;
+        let targets = res.targets.as_ref().expect("made");
+        end.finish(gpu, targets, settings, stats, start)
     }
 }
 
@@ -63,9 +116,10 @@ impl SubdividedMethod {
     /// The usual frame, in one submission (see [`FramePlan::OneSubmission`]). Returns None if a
     /// buffer overflowed; else the counters and, with timestamp queries, the GPU times (ms) of
     /// the subdivision, the raster and the whole frame.
+    #[allow(clippy::too_many_arguments)]
     fn render_one_submission(
         &self,
-        r: &Renderer,
+        gpu: &Gpu,
         res: &FrameResources,
         scene: &GpuScene,
         settings: &RenderSettings,
@@ -74,11 +128,11 @@ impl SubdividedMethod {
         params: SubdivideParams,
     ) -> Result<Option<(SubdivideCounters, Option<GpuTimes>)>> {
         let timestamps = res.timestamps.as_ref();
-        let mut enc = r.gpu.device.create_command_encoder(&Default::default());
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
         let panorama = settings.projection().panorama;
-        self.subdivide.encode(&r.gpu, &mut enc, &res.subdivide_params, scene, b, &params, panorama, timestamps);
+        self.subdivide.encode(gpu, &mut enc, &res.subdivide_params, scene, b, &params, panorama, timestamps);
         self.encode_raster(
-            r,
+            gpu,
             &mut enc,
             res,
             scene,
@@ -92,8 +146,8 @@ impl SubdividedMethod {
         if let Some(t) = timestamps {
             t.resolve(&mut enc, &res.staging, COUNTERS_SIZE, stamp::COUNT);
         }
-        r.gpu.queue.submit([enc.finish()]);
-        let bytes = r.gpu.read_buffer(&res.staging)?;
+        gpu.queue.submit([enc.finish()]);
+        let bytes = gpu.read_buffer(&res.staging)?;
         let counters: SubdivideCounters = *bytemuck::from_bytes(&bytes[..COUNTERS_SIZE as usize]);
         if counters.pieces > params.piece_capacity || counters.output_units() > params.triangle_capacity {
             return Ok(None);
@@ -117,7 +171,7 @@ impl SubdividedMethod {
     #[allow(clippy::too_many_arguments)]
     fn encode_raster(
         &self,
-        r: &Renderer,
+        gpu: &Gpu,
         enc: &mut wgpu::CommandEncoder,
         res: &FrameResources,
         scene: &GpuScene,
@@ -127,13 +181,13 @@ impl SubdividedMethod {
         clear: bool,
         timestamps: Option<(&wgpu::QuerySet, u32, u32)>,
     ) {
-        let materials = self.raster.material_bind_group(&r.gpu, scene);
+        let materials = self.raster.material_bind_group(gpu, scene);
         let uniform = &res.raster_params;
-        r.gpu.queue.write_buffer(uniform, 0, bytemuck::cast_slice(&raster_params(settings)));
-        let bind_group = self.raster.stage.bind_group(&r.gpu, None, 0, &[uniform]);
-        let passes = Layers::passes(r.gpu.eyes_per_draw);
+        gpu.queue.write_buffer(uniform, 0, bytemuck::cast_slice(&raster_params(settings)));
+        let bind_group = self.raster.stage.bind_group(gpu, None, 0, &[uniform]);
+        let passes = Layers::passes(gpu.eyes_per_draw);
         for (k, &layers) in passes.iter().enumerate() {
-            let pipeline = self.raster.get(&r.gpu, scene, settings, layers);
+            let pipeline = self.raster.get(gpu, scene, settings, layers);
             let writes = timestamps.map(|(q, begin, end)| wgpu::RenderPassTimestampWrites {
                 query_set: q,
                 beginning_of_pass_write_index: (k == 0).then_some(begin),
@@ -143,7 +197,7 @@ impl SubdividedMethod {
             pass.set_bind_group(0, &bind_group, &[]);
             pass.set_bind_group(1, &materials, &[]);
             if clear && scene.shows_environment(settings) {
-                pass.set_pipeline(&self.raster.background(&r.gpu, settings, layers));
+                pass.set_pipeline(&self.raster.background(gpu, settings, layers));
                 pass.draw(0..3, 0..1);
             }
             pass.set_pipeline(&pipeline);
@@ -153,70 +207,11 @@ impl SubdividedMethod {
         }
     }
 
-    /// The subdivided frame: follows the [`FramePlan`].
-    fn render_subdivided(
-        &self,
-        r: &Renderer,
-        res: &mut FrameResources,
-        scene: &GpuScene,
-        settings: &RenderSettings,
-    ) -> Result<Frame> {
-        let start = Instant::now();
-        let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, ..Default::default() };
-        let p = settings.projection();
-        res.targets(&r.gpu, p.width, p.height, settings.measure.positions, settings.shading.hdr);
-        let budget = Capacities::budget(settings.subdivision.memory_mb, r.gpu.max_binding());
-        let n = scene.triangle_count;
-        let mut plan = FramePlan::first(n, res.buffers.as_ref().map(|b| b.capacity), budget);
-        if let FramePlan::OneSubmission(want) = plan {
-            SubdivisionBuffers::ensure(&mut res.buffers, &r.gpu, want, scene);
-            let b = res.buffers.as_ref().expect("ensured");
-            if b.cut_list_capacity < n {
-                // More triangles than one binding lists for `plan_cuts`: chunks.
-                plan = plan.after_overflow(budget);
-            }
-        }
-        if let FramePlan::OneSubmission(_) = plan {
-            let b = res.buffers.as_ref().expect("ensured");
-            let targets = res.targets.as_ref().expect("made");
-            let mut params = subdivide_params(settings, 0, n);
-            let capacity = b.capacity.min(budget);
-            params.piece_capacity = capacity.pieces;
-            params.triangle_capacity = capacity.triangles;
-            let t = Instant::now();
-            if let Some((counters, times)) = self.render_one_submission(r, res, scene, settings, targets, b, params)? {
-                stats.ms_frame = t.elapsed().as_secs_f64() * 1e3;
-                match times {
-                    Some(times) => {
-                        stats.timing = Timing::GpuTimestamps;
-                        stats.ms_subdivide = Some(times.subdivide);
-                        stats.ms_subdivide_passes = Some(times.passes);
-                        stats.ms_raster = Some(times.raster);
-                        stats.ms_gpu = Some(times.frame);
-                    }
-                    None => stats.timing = Timing::WallOneSubmission,
-                }
-                stats.pieces = counters.pieces as u64;
-                stats.triangles_out = counters.triangles as u64;
-                stats.nodes_out = counters.nodes as u64;
-                stats.chunks = 1;
-                stats.max_sub_edge_px = f32::from_bits(counters.max_edge_bits);
-                return r.finish_frame(targets, settings, stats, start);
-            }
-            plan = plan.after_overflow(budget);
-        }
-        let FramePlan::Chunked { mut want, budget } = plan else { unreachable!("a one-submission frame returned") };
-        self.render_chunked(r, res, scene, settings, &mut want, budget, &mut stats)?;
-        stats.ms_frame = stats.ms_subdivide.unwrap_or(0.0) + stats.ms_raster.unwrap_or(0.0);
-        stats.timing = Timing::WallPerPass;
-        let targets = res.targets.as_ref().expect("made");
-        r.finish_frame(targets, settings, stats, start)
-    }
-
     /// The chunked schedule (see [`FramePlan::Chunked`]): wall times per pass.
+    #[allow(clippy::too_many_arguments)]
     fn render_chunked(
         &self,
-        r: &Renderer,
+        gpu: &Gpu,
         res: &mut FrameResources,
         scene: &GpuScene,
         settings: &RenderSettings,
@@ -225,92 +220,124 @@ impl SubdividedMethod {
         stats: &mut FrameStats,
     ) -> Result<()> {
         let n = scene.triangle_count;
-        let memory_mb = settings.subdivision.memory_mb;
-        let (mut ms_subdivide, mut ms_raster) = (0.0, 0.0);
+        let panorama = settings.projection().panorama;
+        let mut clock = ChunkClock::default();
         let (mut first_tri, mut tri_chunk) = (0u32, n.max(1));
-        let mut cleared = false;
-        let b = SubdivisionBuffers::ensure(&mut res.buffers, &r.gpu, *want, scene);
+        let b = SubdivisionBuffers::ensure(&mut res.buffers, gpu, *want, scene);
         tri_chunk = tri_chunk.min(b.cut_list_capacity);
         let t = Instant::now();
-        let panorama = settings.projection().panorama;
         let cuts_params = subdivide_params(settings, 0, n);
-        self.subdivide.run_active_cuts(&r.gpu, &res.subdivide_params, scene, b, &cuts_params, panorama);
-        ms_subdivide += t.elapsed().as_secs_f64() * 1e3;
-        while first_tri < n || !cleared {
+        self.subdivide.run_active_cuts(gpu, &res.subdivide_params, scene, b, &cuts_params, panorama);
+        clock.subdivide += t.elapsed().as_secs_f64() * 1e3;
+        while first_tri < n || !clock.drawn {
             let tri_count = tri_chunk.min(n - first_tri);
-            let b = SubdivisionBuffers::ensure(&mut res.buffers, &r.gpu, *want, scene);
+            let b = SubdivisionBuffers::ensure(&mut res.buffers, gpu, *want, scene);
             let mut params = subdivide_params(settings, first_tri, tri_count);
             params.piece_capacity = b.capacity.pieces.min(budget.pieces);
             params.triangle_capacity = b.capacity.triangles;
             let t = Instant::now();
-            let uniform = &res.subdivide_params;
-            let planned = self.subdivide.run(&r.gpu, "plan", uniform, scene, b, &params, panorama, tri_count)?;
-            ms_subdivide += t.elapsed().as_secs_f64() * 1e3;
+            let planned =
+                self.subdivide.run(gpu, "plan", &res.subdivide_params, scene, b, &params, panorama, tri_count)?;
+            clock.subdivide += t.elapsed().as_secs_f64() * 1e3;
             if planned.pieces > params.piece_capacity {
                 match on_overflow(planned.pieces, budget.pieces, tri_count) {
                     Overflow::Grow(p) => want.pieces = p,
                     Overflow::Halve(c) => tri_chunk = c,
                     Overflow::TooBig => {
-                        return Err(Error::setting(
-                            "subdivision.memory_mb",
+                        return Err(too_small(
+                            settings,
                             format!(
-                            "{memory_mb} is too small: one triangle needs {} pieces; raise the edge length L or the memory budget",
-                            planned.pieces
-                        ),
+                                "one triangle needs {} pieces; raise the edge length L or the memory budget",
+                                planned.pieces
+                            ),
                         ))
                     }
                 }
                 continue;
             }
             stats.pieces += planned.pieces as u64;
-            let (mut first_piece, mut piece_chunk) = (0u32, planned.pieces.max(1));
-            let mut piece_done = false;
-            while first_piece < planned.pieces || !piece_done {
-                let piece_count = piece_chunk.min(planned.pieces - first_piece);
-                let b = SubdivisionBuffers::ensure(&mut res.buffers, &r.gpu, *want, scene);
-                params.first_piece = first_piece;
-                params.piece_count = piece_count;
-                params.triangle_capacity = b.capacity.triangles.min(budget.triangles);
-                let t = Instant::now();
-                let uniform = &res.subdivide_params;
-                let done = self.subdivide.run(&r.gpu, "lattice", uniform, scene, b, &params, panorama, piece_count)?;
-                ms_subdivide += t.elapsed().as_secs_f64() * 1e3;
-                if done.output_units() > params.triangle_capacity {
-                    match on_overflow(done.output_units(), budget.triangles, piece_count) {
-                        Overflow::Grow(t) => want.triangles = t,
-                        Overflow::Halve(c) => piece_chunk = c,
-                        Overflow::TooBig => {
-                            return Err(Error::setting(
-                                "subdivision.memory_mb",
-                                format!(
-                                    "{memory_mb} is too small: one piece makes {} triangles and nodes; lower the fixed N or raise the memory budget",
-                                    done.output_units()
-                                ),
-                            ))
-                        }
-                    }
-                    continue;
-                }
-                let t = Instant::now();
-                let targets = res.targets.as_ref().expect("made");
-                let b = res.buffers.as_ref().expect("ensured");
-                let mut enc = r.gpu.device.create_command_encoder(&Default::default());
-                self.encode_raster(r, &mut enc, res, scene, targets, b, settings, !cleared, None);
-                r.gpu.queue.submit([enc.finish()]);
-                r.gpu.wait();
-                ms_raster += t.elapsed().as_secs_f64() * 1e3;
-                cleared = true;
-                piece_done = true;
-                stats.triangles_out += done.triangles as u64;
-                stats.nodes_out += done.nodes as u64;
-                stats.chunks += 1;
-                stats.max_sub_edge_px = stats.max_sub_edge_px.max(f32::from_bits(done.max_edge_bits));
-                first_piece += piece_count;
-            }
+            let pieces = planned.pieces;
+            self.draw_pieces(gpu, res, scene, settings, &mut params, pieces, (want, budget), stats, &mut clock)?;
             first_tri += tri_count;
         }
-        stats.ms_subdivide = Some(ms_subdivide);
-        stats.ms_raster = Some(ms_raster);
+        stats.ms_subdivide = Some(clock.subdivide);
+        stats.ms_raster = Some(clock.raster);
         Ok(())
     }
+
+    /// The lattices of a chunk's `pieces` planned pieces, in ranges that fit the output buffer
+    /// (grown within the budget, else halved), each range drawn into the targets at once.
+    #[allow(clippy::too_many_arguments)]
+    fn draw_pieces(
+        &self,
+        gpu: &Gpu,
+        res: &mut FrameResources,
+        scene: &GpuScene,
+        settings: &RenderSettings,
+        params: &mut SubdivideParams,
+        pieces: u32,
+        (want, budget): (&mut Capacities, Capacities),
+        stats: &mut FrameStats,
+        clock: &mut ChunkClock,
+    ) -> Result<()> {
+        let panorama = settings.projection().panorama;
+        let (mut first_piece, mut piece_chunk) = (0u32, pieces.max(1));
+        let mut piece_done = false;
+        while first_piece < pieces || !piece_done {
+            let piece_count = piece_chunk.min(pieces - first_piece);
+            let b = SubdivisionBuffers::ensure(&mut res.buffers, gpu, *want, scene);
+            params.first_piece = first_piece;
+            params.piece_count = piece_count;
+            params.triangle_capacity = b.capacity.triangles.min(budget.triangles);
+            let t = Instant::now();
+            let done =
+                self.subdivide.run(gpu, "lattice", &res.subdivide_params, scene, b, params, panorama, piece_count)?;
+            clock.subdivide += t.elapsed().as_secs_f64() * 1e3;
+            if done.output_units() > params.triangle_capacity {
+                match on_overflow(done.output_units(), budget.triangles, piece_count) {
+                    Overflow::Grow(t) => want.triangles = t,
+                    Overflow::Halve(c) => piece_chunk = c,
+                    Overflow::TooBig => {
+                        let why = format!(
+                            "one piece makes {} triangles and nodes; lower the fixed N or raise the memory budget",
+                            done.output_units()
+                        );
+                        return Err(too_small(settings, why));
+                    }
+                }
+                continue;
+            }
+            let t = Instant::now();
+            let targets = res.targets.as_ref().expect("made");
+            let b = res.buffers.as_ref().expect("ensured");
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            self.encode_raster(gpu, &mut enc, res, scene, targets, b, settings, !clock.drawn, None);
+            gpu.queue.submit([enc.finish()]);
+            gpu.wait();
+            clock.raster += t.elapsed().as_secs_f64() * 1e3;
+            clock.drawn = true;
+            piece_done = true;
+            stats.triangles_out += done.triangles as u64;
+            stats.nodes_out += done.nodes as u64;
+            stats.chunks += 1;
+            stats.max_sub_edge_px = stats.max_sub_edge_px.max(f32::from_bits(done.max_edge_bits));
+            first_piece += piece_count;
+        }
+        Ok(())
+    }
+}
+
+/// A chunked frame's wall times (ms) of the subdivision and the raster, and whether a range has
+/// been drawn (the first clears the targets).
+#[derive(Default)]
+struct ChunkClock {
+    subdivide: f64,
+    raster: f64,
+    drawn: bool,
+}
+
+/// The memory budget cannot hold what one triangle or piece makes.
+fn too_small(settings: &RenderSettings, why: String) -> Error {
+    let memory_mb = settings.subdivision.memory_mb;
+    Error::setting("subdivision.memory_mb", format!("{memory_mb} is too small: {why}"))
 }

@@ -7,15 +7,17 @@ use std::time::Instant;
 
 use crate::core::bvh::SceneBvh;
 use crate::core::frame::{Frame, FrameStats};
-use crate::core::projection::ray_hit_points;
+use crate::core::projection::{ray_hit_points, Projection};
 use crate::core::settings::RenderSettings;
 use crate::encoding::constants::TRACE_COUNT_SLOTS;
 use crate::encoding::params::trace_params;
 use crate::encoding::types::TraceParams;
 use crate::error::{Error, Result};
-use crate::gpu::renderer::{FrameResources, Method, Renderer};
+use crate::gpu::device::Gpu;
+use crate::gpu::frame::{FrameEnd, FrameResources, Method};
 use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
+use crate::gpu::targets::Targets;
 use crate::gpu::timestamps::submit_timed_pass;
 
 /// The ray tracer: its stage and pipelines without and with the material code, made on first
@@ -26,13 +28,13 @@ pub(crate) struct TraceMethod(std::sync::OnceLock<(GpuStage, [wgpu::ComputePipel
 impl Method for TraceMethod {
     fn draw(
         &self,
-        r: &Renderer,
+        gpu: &Gpu,
+        end: &FrameEnd,
         res: &mut FrameResources,
         scene: &GpuScene,
         settings: &RenderSettings,
     ) -> Result<Frame> {
         let start = Instant::now();
-        let gpu = &r.gpu;
         let Some(bvh) = &scene.bvh else {
             return Err(Error::setting(
                 "subdivision.method",
@@ -40,7 +42,70 @@ impl Method for TraceMethod {
             ));
         };
         let p = settings.projection();
-        // Rows padded to 256 bytes, as buffer-to-texture copies need.
+        let row_texels = Self::prepare_outputs(gpu, res, p)?;
+        let counts = res.trace_counts.clone().expect("made with the outputs");
+        let res = &*res;
+        let targets = res.targets.as_ref().expect("made");
+        let (_, _, outputs) = res.trace_outputs.as_ref().expect("made");
+        let (stage, pipelines) = self.0.get_or_init(|| {
+            let stage = GpuStage::new(gpu, &crate::shader::TRACE);
+            let pipelines =
+                [0.0, 1.0].map(|m| stage.compute_with(gpu, "trace", &[("MATERIALS", m), ("SHADOW_MAPS", 0.0)]));
+            (stage, pipelines)
+        });
+        let params = trace_params(settings, row_texels);
+        let params = TraceParams {
+            original_root: bvh.original_root,
+            original_level: SceneBvh::original_level_of(bvh.first_step, params.lod_min_share),
+            ..params
+        };
+        gpu.queue.write_buffer(&res.trace_params, 0, bytemuck::bytes_of(&params));
+        let group1 = scene.material_buffers();
+        let [color, error, object, distance] = outputs;
+        let buffers = [&res.trace_params, &scene.vertices, &bvh.indices, &bvh.nodes, &bvh.levels];
+        let outputs_and_counts = [color, error, object, distance, &counts];
+        let group0: Vec<&wgpu::Buffer> = buffers.into_iter().chain(outputs_and_counts).collect();
+        let bind_group = stage.bind_group(gpu, Some("trace"), 0, &group0);
+        let materials = stage.bind_group(gpu, Some("trace"), 1, &group1.each_ref());
+        let timestamps = res.timestamps.as_ref();
+        let t = Instant::now();
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        enc.clear_buffer(&counts, 0, None);
+        {
+            let mut pass = crate::gpu::timestamps::compute_pass(&mut enc, "trace", timestamps, 0);
+            pass.set_pipeline(&pipelines[(scene.needs_materials || scene.has_optics || scene.pbr(settings)) as usize]);
+            pass.set_bind_group(0, &bind_group, &[]);
+            pass.set_bind_group(1, &materials, &[]);
+            pass.dispatch_workgroups(p.width.div_ceil(8), p.height.div_ceil(8), 2);
+        }
+        copy_to_targets(&mut enc, outputs, targets, row_texels, p);
+        let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, chunks: 1, ..Default::default() };
+        submit_timed_pass(gpu, enc, timestamps, &res.staging, t, &mut stats)?;
+        // The counters are read after the frame's time is taken.
+        let words = gpu.download(&counts, 8 * TRACE_COUNT_SLOTS as u64)?;
+        let words: &[u32] = bytemuck::cast_slice(&words);
+        stats.rays_traced = Some(words.iter().step_by(2).map(|&w| w as u64).sum());
+        stats.triangle_tests = Some(words.iter().skip(1).step_by(2).map(|&w| w as u64).sum());
+        // The surface points are where the pixels' rays meet their hits.
+        let wanted = settings.measure.positions;
+        let inner = settings.with_positions(false).with_depth(settings.measure.depth || wanted);
+        let mut frame = end.finish(gpu, targets, &inner, stats, start)?;
+        if wanted {
+            frame.positions = Some(ray_hit_points(p, frame.depth.as_ref().expect("read with the positions")));
+            if !settings.measure.depth {
+                frame.depth = None;
+            }
+        }
+        Ok(frame)
+    }
+}
+
+impl TraceMethod {
+    /// The frame's targets and the ray tracer's outputs for the image size (rows padded to 256
+    /// bytes, as buffer-to-texture copies need: the padded row's texels are returned) and its
+    /// counters, made anew only when the size changed. Fails with one line where an output is
+    /// more than the device binds.
+    fn prepare_outputs(gpu: &Gpu, res: &mut FrameResources, p: &Projection) -> Result<u32> {
         let row_texels = p.width.div_ceil(64) * 64;
         let bytes = 4 * row_texels as u64 * p.height as u64 * 2;
         if bytes > gpu.max_binding() {
@@ -61,90 +126,33 @@ impl Method for TraceMethod {
             res.trace_outputs = Some((row_texels, p.height, ["colour", "error", "object", "distance"].map(make)));
         }
         let counts_bytes = 8 * TRACE_COUNT_SLOTS as u64;
-        let counts = res
-            .trace_counts
+        res.trace_counts
             .get_or_insert_with(|| gpu.storage_buffer("trace counts", counts_bytes, wgpu::BufferUsages::empty()));
-        let counts = counts.clone();
-        let res = &*res;
-        let targets = res.targets.as_ref().expect("made");
-        let (_, _, outputs) = res.trace_outputs.as_ref().expect("made");
-        let (stage, pipelines) = self.0.get_or_init(|| {
-            let stage = GpuStage::new(gpu, &crate::shader::TRACE);
-            let pipelines =
-                [0.0, 1.0].map(|m| stage.compute_with(gpu, "trace", &[("MATERIALS", m), ("SHADOW_MAPS", 0.0)]));
-            (stage, pipelines)
-        });
-        let params = trace_params(settings, row_texels);
-        let params = TraceParams {
-            original_root: bvh.original_root,
-            original_level: SceneBvh::original_level_of(bvh.first_step, params.lod_min_share),
-            ..params
-        };
-        gpu.queue.write_buffer(&res.trace_params, 0, bytemuck::bytes_of(&params));
-        let group1 = scene.material_buffers();
-        let [color, error, object, distance] = outputs;
-        let bind_group = stage.bind_group(
-            gpu,
-            Some("trace"),
-            0,
-            &[
-                &res.trace_params,
-                &scene.vertices,
-                &bvh.indices,
-                &bvh.nodes,
-                &bvh.levels,
-                color,
-                error,
-                object,
-                distance,
-                &counts,
-            ],
-        );
-        let materials = stage.bind_group(gpu, Some("trace"), 1, &group1.each_ref());
-        let timestamps = res.timestamps.as_ref();
-        let t = Instant::now();
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        enc.clear_buffer(&counts, 0, None);
-        {
-            let mut pass = crate::gpu::timestamps::compute_pass(&mut enc, "trace", timestamps, 0);
-            pass.set_pipeline(&pipelines[(scene.needs_materials || scene.has_optics || scene.pbr(settings)) as usize]);
-            pass.set_bind_group(0, &bind_group, &[]);
-            pass.set_bind_group(1, &materials, &[]);
-            pass.dispatch_workgroups(p.width.div_ceil(8), p.height.div_ceil(8), 2);
-        }
-        for (buffer, texture) in
-            outputs.iter().zip([&targets.color, &targets.error, &targets.object, &targets.distance])
-        {
-            enc.copy_buffer_to_texture(
-                wgpu::TexelCopyBufferInfo {
-                    buffer,
-                    layout: wgpu::TexelCopyBufferLayout {
-                        offset: 0,
-                        bytes_per_row: Some(4 * row_texels),
-                        rows_per_image: Some(p.height),
-                    },
+        Ok(row_texels)
+    }
+}
+
+/// Copies the ray tracer's outputs (colour, error, object, distance; both eyes, rows of
+/// `row_texels`) into the frame's targets, whose read-back the other methods share.
+fn copy_to_targets(
+    enc: &mut wgpu::CommandEncoder,
+    outputs: &[wgpu::Buffer; 4],
+    targets: &Targets,
+    row_texels: u32,
+    p: &Projection,
+) {
+    for (buffer, texture) in outputs.iter().zip([&targets.color, &targets.error, &targets.object, &targets.distance]) {
+        enc.copy_buffer_to_texture(
+            wgpu::TexelCopyBufferInfo {
+                buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(4 * row_texels),
+                    rows_per_image: Some(p.height),
                 },
-                texture.as_image_copy(),
-                wgpu::Extent3d { width: p.width, height: p.height, depth_or_array_layers: 2 },
-            );
-        }
-        let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, chunks: 1, ..Default::default() };
-        submit_timed_pass(gpu, enc, timestamps, &res.staging, t, &mut stats)?;
-        // The counters are read after the frame's time is taken.
-        let words = gpu.download(&counts, counts_bytes)?;
-        let words: &[u32] = bytemuck::cast_slice(&words);
-        stats.rays_traced = Some(words.iter().step_by(2).map(|&w| w as u64).sum());
-        stats.triangle_tests = Some(words.iter().skip(1).step_by(2).map(|&w| w as u64).sum());
-        // The surface points are where the pixels' rays meet their hits.
-        let wanted = settings.measure.positions;
-        let inner = settings.with_positions(false).with_depth(settings.measure.depth || wanted);
-        let mut frame = r.finish_frame(targets, &inner, stats, start)?;
-        if wanted {
-            frame.positions = Some(ray_hit_points(p, frame.depth.as_ref().expect("read with the positions")));
-            if !settings.measure.depth {
-                frame.depth = None;
-            }
-        }
-        Ok(frame)
+            },
+            texture.as_image_copy(),
+            wgpu::Extent3d { width: p.width, height: p.height, depth_or_array_layers: 2 },
+        );
     }
 }

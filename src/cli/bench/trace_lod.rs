@@ -299,6 +299,35 @@ pub fn report(
     text += &row("plain", "-", "plain", &|s| Some(s.3));
     text += &row("eq. 8–9 only (state 1)", "state 1", "lod without eq. 10", &|_| None);
     text += &row("eq. 8–9 only (state 2)", "state 2", "lod without eq. 10", &|_| None);
+    text += &share_table(points);
+    text += "\nRays traced and ray–triangle tests per frame:\n\n| scene | state | configuration | rays | triangle tests | tests per ray | pixels covered |\n|---|---|---|---|---|---|---|\n";
+    for p in points {
+        text += &format!(
+            "| {} | {} | {} | {} | {} | {:.1} | {} |\n",
+            p.scene,
+            p.state,
+            p.config,
+            p.rays_traced,
+            p.triangle_tests,
+            p.triangle_tests as f64 / p.rays_traced.max(1) as f64,
+            p.covered_pixels
+        );
+    }
+    text += "\nThe cow's chain (meshoptimizer's quadric simplifier, each level about 0.7 of the one before; the seed used progressive \
+             meshes, one triangle pair per step): triangles and the bound on how far a level lies from the original, as a share \
+             of the cow's extent (neighbouring pixels whose rays pick different levels show surfaces this far apart at most):\n\n\
+             | level | triangles | error bound |\n|---|---|---|\n";
+    for (k, (triangles, error)) in chain.iter().enumerate() {
+        text += &format!("| {k} | {triangles} | {:.2} % |\n", 100.0 * error);
+    }
+    text += "\nState 1, scene A, left eye, with LOD:\n\n![A, state 1](trace_lod_A_state1.png)\n\nState 2:\n\n![A, state 2](trace_lod_A_state2.png)\n\n";
+    Ok(text)
+}
+
+/// Time with LOD as a share of plain tracing, per scene and state, beside seed 000's; and which
+/// cases LOD made slower.
+fn share_table(points: &[TraceLodPoint]) -> String {
+    let mut text = String::new();
     text += "\nTime with LOD as a share of plain (seed 000 in parentheses; its best case 27.8 %, and 127 % / 114 % in A / B state 1, \
              where its polygon control cost more than it saved):\n\n| | A | B | C | D |\n|---|---|---|---|---|\n";
     let mut slower = Vec::new();
@@ -324,26 +353,5 @@ pub fn report(
     } else {
         format!("\n**Slower with LOD than plain: {}.**\n", slower.join(", "))
     };
-    text += "\nRays traced and ray–triangle tests per frame:\n\n| scene | state | configuration | rays | triangle tests | tests per ray | pixels covered |\n|---|---|---|---|---|---|---|\n";
-    for p in points {
-        text += &format!(
-            "| {} | {} | {} | {} | {} | {:.1} | {} |\n",
-            p.scene,
-            p.state,
-            p.config,
-            p.rays_traced,
-            p.triangle_tests,
-            p.triangle_tests as f64 / p.rays_traced.max(1) as f64,
-            p.covered_pixels
-        );
-    }
-    text += "\nThe cow's chain (meshoptimizer's quadric simplifier, each level about 0.7 of the one before; the seed used progressive \
-             meshes, one triangle pair per step): triangles and the bound on how far a level lies from the original, as a share \
-             of the cow's extent (neighbouring pixels whose rays pick different levels show surfaces this far apart at most):\n\n\
-             | level | triangles | error bound |\n|---|---|---|\n";
-    for (k, (triangles, error)) in chain.iter().enumerate() {
-        text += &format!("| {k} | {triangles} | {:.2} % |\n", 100.0 * error);
-    }
-    text += "\nState 1, scene A, left eye, with LOD:\n\n![A, state 1](trace_lod_A_state1.png)\n\nState 2:\n\n![A, state 2](trace_lod_A_state2.png)\n\n";
-    Ok(text)
+    text
 }

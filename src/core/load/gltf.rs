@@ -102,8 +102,33 @@ fn gltf_light(light: &gltf::khr_lights_punctual::Light, world: Mat4) -> Light {
 
 /// A glTF material as twister draws it, and the TEXCOORD set and `KHR_texture_transform`
 /// (u' = offset + R(rotation)·(scale·u)) of its base colour texture.
-fn gltf_material(material: &gltf::Material) -> GltfMaterial {
+/// The base colour texture's sampler: wrap modes, magnification, minification and mipmaps.
+fn set_sampler(m: &mut Material, sampler: &gltf::texture::Sampler) {
     use gltf::texture::{MagFilter, MinFilter, WrappingMode};
+    let wrap = |w: WrappingMode| match w {
+        WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+        WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+        WrappingMode::Repeat => Wrap::Repeat,
+    } as u32;
+    m.wrap_u = wrap(sampler.wrap_s());
+    m.wrap_v = wrap(sampler.wrap_t());
+    m.mag_filter = match sampler.mag_filter() {
+        Some(MagFilter::Nearest) => Filter::Nearest,
+        _ => Filter::Linear,
+    } as u32;
+    // No minification filter given: trilinear, the renderer's choice the spec leaves open.
+    let (min, mip) = match sampler.min_filter() {
+        Some(MinFilter::Nearest) => (Filter::Nearest, Mipmap::None),
+        Some(MinFilter::Linear) => (Filter::Linear, Mipmap::None),
+        Some(MinFilter::NearestMipmapNearest) => (Filter::Nearest, Mipmap::Nearest),
+        Some(MinFilter::LinearMipmapNearest) => (Filter::Linear, Mipmap::Nearest),
+        Some(MinFilter::NearestMipmapLinear) => (Filter::Nearest, Mipmap::Linear),
+        Some(MinFilter::LinearMipmapLinear) | None => (Filter::Linear, Mipmap::Linear),
+    };
+    (m.min_filter, m.mipmap) = (min as u32, mip as u32);
+}
+
+fn gltf_material(material: &gltf::Material) -> GltfMaterial {
     let mut m = Material {
         alpha_mode: match material.alpha_mode() {
             gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
@@ -154,29 +179,8 @@ fn gltf_material(material: &gltf::Material) -> GltfMaterial {
         return (m, 0, None);
     };
     let texture = info.texture();
-    let sampler = texture.sampler();
-    let wrap = |w: WrappingMode| match w {
-        WrappingMode::ClampToEdge => Wrap::ClampToEdge,
-        WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
-        WrappingMode::Repeat => Wrap::Repeat,
-    } as u32;
     m.texture = texture.source().index() as u32;
-    m.wrap_u = wrap(sampler.wrap_s());
-    m.wrap_v = wrap(sampler.wrap_t());
-    m.mag_filter = match sampler.mag_filter() {
-        Some(MagFilter::Nearest) => Filter::Nearest,
-        _ => Filter::Linear,
-    } as u32;
-    // No minification filter given: trilinear, the renderer's choice the spec leaves open.
-    let (min, mip) = match sampler.min_filter() {
-        Some(MinFilter::Nearest) => (Filter::Nearest, Mipmap::None),
-        Some(MinFilter::Linear) => (Filter::Linear, Mipmap::None),
-        Some(MinFilter::NearestMipmapNearest) => (Filter::Nearest, Mipmap::Nearest),
-        Some(MinFilter::LinearMipmapNearest) => (Filter::Linear, Mipmap::Nearest),
-        Some(MinFilter::NearestMipmapLinear) => (Filter::Nearest, Mipmap::Linear),
-        Some(MinFilter::LinearMipmapLinear) | None => (Filter::Linear, Mipmap::Linear),
-    };
-    (m.min_filter, m.mipmap) = (min as u32, mip as u32);
+    set_sampler(&mut m, &texture.sampler());
     let transform = info.texture_transform();
     let set = transform.as_ref().and_then(|t| t.tex_coord()).unwrap_or(info.tex_coord());
     let matrix = transform.map(|t| {
@@ -347,12 +351,7 @@ pub(super) fn read_gltf(path: &Path) -> std::result::Result<Scene, String> {
         scene.warnings.push(format!("optional extensions ignored: {}", used.join(", ")));
     }
     for (image, data) in doc.images().zip(&images) {
-        let label = match (image.name(), image.source()) {
-            (Some(n), _) => n.to_string(),
-            (None, gltf::image::Source::Uri { uri, .. }) if !uri.starts_with("data:") => uri.to_string(),
-            _ => format!("image {}", image.index()),
-        };
-        scene.textures.push(gltf_texture(label, data).map_err(|e| format!("{name}: {e}"))?);
+        scene.textures.push(gltf_texture(image_label(&image), data).map_err(|e| format!("{name}: {e}"))?);
     }
     // glTF material k is scene material k; primitives without one share the spec's default
     // material (single-sided, opaque), appended at the end.
@@ -386,27 +385,7 @@ pub(super) fn read_gltf(path: &Path) -> std::result::Result<Scene, String> {
             rig.nodes[node.index()].parent = parent_index;
             rig.order.push(node.index());
         }
-        if let Some(light) = node.light() {
-            if let Some(rig) = rig.as_mut() {
-                rig.lights.push((scene.lights.len(), node.index(), gltf_light(&light, Mat4::IDENTITY)));
-            }
-            scene.lights.push(gltf_light(&light, world));
-        }
-        if let (Some(_), Some(rig)) = (node.camera(), rig.as_mut()) {
-            rig.cameras.push((scene.cameras.len(), node.index()));
-        }
-        if let Some(camera) = node.camera() {
-            // The camera looks along its local −z.
-            let forward = world.transform_vector3(-Vec3::Z);
-            scene.cameras.push(crate::core::scene::Camera {
-                name: camera
-                    .name()
-                    .or(node.name())
-                    .map_or_else(|| format!("camera {}", scene.cameras.len()), str::to_string),
-                position: world.transform_point3(Vec3::ZERO).into(),
-                yaw_deg: (-forward.x).atan2(-forward.z).to_degrees(),
-            });
-        }
+        add_node_light_and_camera(&mut scene, &node, world, rig.as_mut());
         if let Some(mesh) = node.mesh() {
             // One scene object per mesh instance (node), its primitives one after the other.
             let mesh_name = mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_string);
@@ -437,6 +416,46 @@ pub(super) fn read_gltf(path: &Path) -> std::result::Result<Scene, String> {
         scene.pose(None, 0.0);
     }
     Ok(scene)
+}
+
+/// An image's name for messages: its own, else its file's, else its index.
+fn image_label(image: &gltf::Image) -> String {
+    match (image.name(), image.source()) {
+        (Some(n), _) => n.to_string(),
+        (None, gltf::image::Source::Uri { uri, .. }) if !uri.starts_with("data:") => uri.to_string(),
+        _ => format!("image {}", image.index()),
+    }
+}
+
+/// A node's punctual light and camera (placed by its `world` matrix; an animated file's rig
+/// notes which scene light and camera the node carries).
+fn add_node_light_and_camera(
+    scene: &mut Scene,
+    node: &gltf::Node,
+    world: Mat4,
+    mut rig: Option<&mut crate::core::animation::Rig>,
+) {
+    if let Some(light) = node.light() {
+        if let Some(rig) = rig.as_mut() {
+            rig.lights.push((scene.lights.len(), node.index(), gltf_light(&light, Mat4::IDENTITY)));
+        }
+        scene.lights.push(gltf_light(&light, world));
+    }
+    if let Some(camera) = node.camera() {
+        if let Some(rig) = rig {
+            rig.cameras.push((scene.cameras.len(), node.index()));
+        }
+        // The camera looks along its local −z.
+        let forward = world.transform_vector3(-Vec3::Z);
+        scene.cameras.push(crate::core::scene::Camera {
+            name: camera
+                .name()
+                .or(node.name())
+                .map_or_else(|| format!("camera {}", scene.cameras.len()), str::to_string),
+            position: world.transform_point3(Vec3::ZERO).into(),
+            yaw_deg: (-forward.x).atan2(-forward.z).to_degrees(),
+        });
+    }
 }
 
 /// Checks every external file a glTF document names (buffers, images) before anything reads
@@ -596,37 +615,10 @@ fn add_gltf_primitive(
     if let Some(&bad) = raw.iter().find(|&&i| i as usize >= n) {
         return Err(format!("index {bad} is out of range ({n} vertices)"));
     }
-    let indices: Vec<u32> = match mode {
-        Mode::Triangles => raw.chunks_exact(3).flatten().copied().collect(),
-        Mode::TriangleStrip => (0..raw.len().saturating_sub(2))
-            .flat_map(|k| if k % 2 == 0 { [raw[k], raw[k + 1], raw[k + 2]] } else { [raw[k + 1], raw[k], raw[k + 2]] })
-            .collect(),
-        _ => (1..raw.len().saturating_sub(1)).flat_map(|k| [raw[0], raw[k], raw[k + 1]]).collect(),
-    };
-    let normal_matrix = world.inverse().transpose();
-    // A tangent moves with the surface (the matrix itself); a mirroring matrix flips the
-    // bitangent's sign, as it flips the winding.
-    let mirror = if glam::Mat3::from_mat4(world).determinant() < 0.0 { -1.0 } else { 1.0 };
-    let mut vertices: Vec<SceneVertex> = (0..n)
-        .map(|i| {
-            let c = colors.as_ref().and_then(|c| c.get(i).copied()).unwrap_or([1.0; 4]);
-            SceneVertex {
-                position: world.transform_point3(Vec3::from(positions[i])).into(),
-                normal: normals
-                    .as_ref()
-                    .and_then(|v| v.get(i))
-                    .map_or(Vec3::ZERO, |&v| normal_matrix.transform_vector3(Vec3::from(v)).normalize_or_zero())
-                    .into(),
-                color: [0, 1, 2, 3].map(|k| c[k] * factor[k]),
-                uv: uvs.as_ref().and_then(|v| v.get(i)).copied().unwrap_or([0.0; 2]),
-                tangent: tangents.as_ref().and_then(|v| v.get(i)).map_or(0, |&[x, y, z, w]| {
-                    pack_tangent(world.transform_vector3(Vec3::new(x, y, z)).normalize_or_zero().extend(w * mirror))
-                }),
-                material: material_id,
-                ..Default::default()
-            }
-        })
-        .collect();
+    let indices = triangle_indices(mode, &raw);
+    let attributes =
+        Attributes { positions: &positions, normals: normals.as_deref(), tangents: tangents.as_deref(), uvs, colors };
+    let mut vertices = attributes.placed(world, factor, material_id);
     if normals.is_none() {
         compute_normals(&mut vertices, &indices);
     }
@@ -640,15 +632,62 @@ fn add_gltf_primitive(
                 .collect(),
         };
         let first = scene.vertices.len();
-        rig.instances.push(super::gltf_rig::instance(
-            node,
-            &reader,
-            first,
-            &positions,
-            &local_normals,
-            tangents.as_deref(),
-        ));
+        let instance = super::gltf_rig::instance(node, &reader, first, &positions, &local_normals, tangents.as_deref());
+        rig.instances.push(instance);
     }
     scene.add_mesh(label, &vertices, &indices);
     Ok(())
+}
+
+/// A primitive's triangles as three indices each: a list as it is, a strip with every other
+/// triangle turned back to the strip's winding, a fan around its first vertex.
+fn triangle_indices(mode: gltf::mesh::Mode, raw: &[u32]) -> Vec<u32> {
+    use gltf::mesh::Mode;
+    match mode {
+        Mode::Triangles => raw.chunks_exact(3).flatten().copied().collect(),
+        Mode::TriangleStrip => (0..raw.len().saturating_sub(2))
+            .flat_map(|k| if k % 2 == 0 { [raw[k], raw[k + 1], raw[k + 2]] } else { [raw[k + 1], raw[k], raw[k + 2]] })
+            .collect(),
+        _ => (1..raw.len().saturating_sub(1)).flat_map(|k| [raw[0], raw[k], raw[k + 1]]).collect(),
+    }
+}
+
+/// A primitive's vertex attributes as read (mesh frame).
+struct Attributes<'p> {
+    positions: &'p [[f32; 3]],
+    normals: Option<&'p [[f32; 3]]>,
+    tangents: Option<&'p [[f32; 4]]>,
+    uvs: Option<Vec<[f32; 2]>>,
+    colors: Option<Vec<[f32; 4]>>,
+}
+
+impl Attributes<'_> {
+    /// The vertices placed by the node's `world` matrix (normals by its inverse transpose),
+    /// coloured by the base colour `factor`, of material `material_id`.
+    fn placed(&self, world: Mat4, factor: [f32; 4], material_id: u32) -> Vec<SceneVertex> {
+        let normal_matrix = world.inverse().transpose();
+        // A tangent moves with the surface (the matrix itself); a mirroring matrix flips the
+        // bitangent's sign, as it flips the winding.
+        let mirror = if glam::Mat3::from_mat4(world).determinant() < 0.0 { -1.0 } else { 1.0 };
+        (0..self.positions.len())
+            .map(|i| {
+                let c = self.colors.as_ref().and_then(|c| c.get(i).copied()).unwrap_or([1.0; 4]);
+                SceneVertex {
+                    position: world.transform_point3(Vec3::from(self.positions[i])).into(),
+                    normal: self
+                        .normals
+                        .and_then(|v| v.get(i))
+                        .map_or(Vec3::ZERO, |&v| normal_matrix.transform_vector3(Vec3::from(v)).normalize_or_zero())
+                        .into(),
+                    color: [0, 1, 2, 3].map(|k| c[k] * factor[k]),
+                    uv: self.uvs.as_ref().and_then(|v| v.get(i)).copied().unwrap_or([0.0; 2]),
+                    tangent: self.tangents.and_then(|v| v.get(i)).map_or(0, |&[x, y, z, w]| {
+                        pack_tangent(world.transform_vector3(Vec3::new(x, y, z)).normalize_or_zero().extend(w * mirror))
+                    }),
+                    material: material_id,
+                    ..Default::default()
+                }
+            })
+            .collect()
+    }
 }

@@ -1,7 +1,7 @@
 //! OBJ files (tobj): objects and groups, positions, normals (computed when missing), texture
 //! coordinates (v flipped to texture space), vertex colours, MTL `Kd` colours and `map_Kd` textures.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use super::DEFAULT_COLOR;
 use crate::core::material::Material;
@@ -33,15 +33,36 @@ pub(super) fn read_obj(path: &Path) -> std::result::Result<Scene, String> {
         scene.warnings.push(format!("materials not loaded ({why}); using the default colour"));
         Vec::new()
     });
-    let texture_dirs = obj_texture_dirs(path);
+    add_obj_materials(&mut scene, &materials, &obj_texture_dirs(path));
+    for model in &models {
+        let m = &model.mesh;
+        let n = m.positions.len() / 3;
+        if m.indices.iter().any(|&i| i as usize >= n) {
+            return Err(format!("{name}: object '{}' has a face index beyond its {n} vertices", model.name));
+        }
+        let mut vertices = obj_vertices(m, &materials);
+        if m.normals.len() < 3 * n {
+            compute_normals(&mut vertices, &m.indices);
+        }
+        scene.add_mesh(model.name.clone(), &vertices, &m.indices);
+    }
+    if scene.triangle_count() == 0 {
+        return Err(format!("{name}: no faces"));
+    }
+    Ok(scene)
+}
+
+/// The MTL materials as scene materials, with their textures and bump maps (each texture file
+/// loaded once; one that cannot be read is a warning and the material is drawn without it).
+fn add_obj_materials(scene: &mut Scene, materials: &[tobj::Material], texture_dirs: &[PathBuf]) {
     let mut loaded: Vec<(String, u32)> = Vec::new(); // map_Kd as written → texture index
-    for mat in &materials {
+    for mat in materials {
         let mut material = obj_optics(mat);
         if let Some(spec) = mat.diffuse_texture.as_deref() {
             if let Some(&(_, k)) = loaded.iter().find(|(s, _)| s == spec) {
                 material.texture = k;
             } else {
-                match load_obj_texture(spec, &texture_dirs) {
+                match load_obj_texture(spec, texture_dirs) {
                     Ok(texture) => {
                         material.texture = scene.textures.len() as u32;
                         scene.textures.push(texture);
@@ -55,7 +76,7 @@ pub(super) fn read_obj(path: &Path) -> std::result::Result<Scene, String> {
         // turned into one (`normal_map_of`).
         let bump = mat.normal_texture.as_deref().or(mat.unknown_param.get("norm").map(String::as_str));
         if let Some(spec) = bump {
-            match load_obj_texture(spec, &texture_dirs) {
+            match load_obj_texture(spec, texture_dirs) {
                 Ok(texture) => {
                     let (map, note) = normal_map_of(&texture);
                     if let Some(note) = note {
@@ -69,46 +90,33 @@ pub(super) fn read_obj(path: &Path) -> std::result::Result<Scene, String> {
         }
         scene.materials.push(material);
     }
-    for model in &models {
-        let m = &model.mesh;
-        let n = m.positions.len() / 3;
-        if m.indices.iter().any(|&i| i as usize >= n) {
-            return Err(format!("{name}: object '{}' has a face index beyond its {n} vertices", model.name));
-        }
-        let mut vertices: Vec<SceneVertex> = (0..n)
-            .map(|i| SceneVertex {
-                position: [m.positions[3 * i], m.positions[3 * i + 1], m.positions[3 * i + 2]],
-                normal: if m.normals.len() >= 3 * n {
-                    [m.normals[3 * i], m.normals[3 * i + 1], m.normals[3 * i + 2]]
-                } else {
-                    [0.0; 3]
-                },
-                color: if m.vertex_color.len() >= 3 * n {
-                    [m.vertex_color[3 * i], m.vertex_color[3 * i + 1], m.vertex_color[3 * i + 2], 1.0]
-                } else {
-                    m.material_id
-                        .and_then(|k| materials.get(k))
-                        .and_then(|mat| mat.diffuse)
-                        .map_or(DEFAULT_COLOR, |d| [d[0], d[1], d[2], 1.0])
-                },
-                material: m.material_id.map_or(0, |k| k as u32 + 1),
-                uv: if m.texcoords.len() >= 2 * n {
-                    [m.texcoords[2 * i], 1.0 - m.texcoords[2 * i + 1]]
-                } else {
-                    [0.0; 2]
-                },
-                ..Default::default()
-            })
-            .collect();
-        if m.normals.len() < 3 * n {
-            compute_normals(&mut vertices, &m.indices);
-        }
-        scene.add_mesh(model.name.clone(), &vertices, &m.indices);
-    }
-    if scene.triangle_count() == 0 {
-        return Err(format!("{name}: no faces"));
-    }
-    Ok(scene)
+}
+
+/// An OBJ object's vertices: positions, normals (zero where the file has none: computed by the
+/// caller), vertex colours or the material's diffuse colour, texture coordinates (v flipped).
+fn obj_vertices(m: &tobj::Mesh, materials: &[tobj::Material]) -> Vec<SceneVertex> {
+    let n = m.positions.len() / 3;
+    (0..n)
+        .map(|i| SceneVertex {
+            position: [m.positions[3 * i], m.positions[3 * i + 1], m.positions[3 * i + 2]],
+            normal: if m.normals.len() >= 3 * n {
+                [m.normals[3 * i], m.normals[3 * i + 1], m.normals[3 * i + 2]]
+            } else {
+                [0.0; 3]
+            },
+            color: if m.vertex_color.len() >= 3 * n {
+                [m.vertex_color[3 * i], m.vertex_color[3 * i + 1], m.vertex_color[3 * i + 2], 1.0]
+            } else {
+                m.material_id
+                    .and_then(|k| materials.get(k))
+                    .and_then(|mat| mat.diffuse)
+                    .map_or(DEFAULT_COLOR, |d| [d[0], d[1], d[2], 1.0])
+            },
+            material: m.material_id.map_or(0, |k| k as u32 + 1),
+            uv: if m.texcoords.len() >= 2 * n { [m.texcoords[2 * i], 1.0 - m.texcoords[2 * i + 1]] } else { [0.0; 2] },
+            ..Default::default()
+        })
+        .collect()
 }
 
 thread_local! {

@@ -205,113 +205,19 @@ fn check_case(
     // Absolute precision of points computed from the mesh's corners.
     let tol = 4e-6 * placed.iter().fold(0.0f32, |m, p| m.max(p.abs().max_element()));
 
-    // Input edges used other than twice (an open or non-manifold input) may stay open.
-    let mut input_edges: HashMap<(Key, Key), u32> = HashMap::new();
-    for t in mesh.indices.chunks(3) {
-        for e in 0..3 {
-            let (a, b) = (placed[t[e] as usize], placed[t[(e + 1) % 3] as usize]);
-            *input_edges.entry(edge_key(snap_to_cut_planes(a), snap_to_cut_planes(b))).or_default() += 1;
-        }
-    }
-    let open_input: Vec<(Vec3, Vec3)> = input_edges
-        .iter()
-        .filter(|(_, &n)| n != 2)
-        .map(|((a, b), _)| (Vec3::from(a.map(f32::from_bits)), Vec3::from(b.map(f32::from_bits))))
-        .collect();
-    let on_open_input = |a: Vec3, b: Vec3| {
-        open_input.iter().any(|&(p, q)| {
-            let d = q - p;
-            [a, b].iter().all(|&x| {
-                (x - p).cross(d).length() <= tol * d.length() && (x - p).dot(d) >= -tol && (x - q).dot(-d) >= -tol
-            })
-        })
-    };
-    let on_square = |p: Vec3| (p.x.abs() + p.z.abs() - rho).abs() <= tol + 1e-3 * rho;
-
     let out = sd.run(&vertices, &mesh.indices);
     let cuts = sd.active_cuts(&vertices, &mesh.indices);
     assert_eq!(cuts.axis, out.cuts);
     let originals: Vec<&[DrawVertex]> = out.vertices.chunks(3).filter(|t| t[0].theta_ref.abs() <= PI).collect();
-    let mut edges: HashMap<(Key, Key), u32> = HashMap::new();
-    for t in &originals {
-        for e in 0..3 {
-            let (a, b) = (Vec3::from(t[e].position), Vec3::from(t[(e + 1) % 3].position));
-            *edges.entry(edge_key(a, b)).or_default() += 1;
-        }
-    }
-    // Slivers: triangles narrower than the coordinates' precision (beside the square around the
-    // axis, a part can be ρ wide and metres long; its lattice nodes may round together there).
-    let sliver = |t: &[DrawVertex]| {
-        let p = [0, 1, 2].map(|i| Vec3::from(t[i].position));
-        let longest = (p[1] - p[0]).length().max((p[2] - p[1]).length()).max((p[0] - p[2]).length());
-        (p[1] - p[0]).cross(p[2] - p[0]).length() <= 2.0 * tol * longest
-    };
-    let mut at_edge: HashMap<(Key, Key), bool> = HashMap::new();
-    for t in &originals {
-        for e in 0..3 {
-            let k = edge_key(Vec3::from(t[e].position), Vec3::from(t[(e + 1) % 3].position));
-            *at_edge.entry(k).or_insert(true) &= sliver(t);
-        }
-    }
-    for (edge, n) in &edges {
-        if *n == 2 || at_edge[edge] {
-            continue;
-        }
-        let (a, b) = (Vec3::from(edge.0.map(f32::from_bits)), Vec3::from(edge.1.map(f32::from_bits)));
-        let allowed =
-            *n == 1 && ((on_square(a) && on_square(b)) || sd.off_screen_vertically([a, b, a]) || on_open_input(a, b));
-        assert!(allowed, "{what}: edge {a} – {b} used by {n} triangles (crack or T-junction)");
-    }
+    check_watertight(&what, mesh, &placed, &sd, &originals, tol, rho);
 
     // Per input triangle (a sample of them): its output lies on it, outside the square, and
     // covers its visible points.
     let mut rng = StdRng::seed_from_u64(triangles as u64);
+    let case = OneTriangle { what: &what, mesh, placed: &placed, vertices: &vertices, params, lod: &lod, tol, rho };
     for _ in 0..12 {
         let t = rng.random_range(0..triangles);
-        let one = SubdivideParams { first_triangle: t as u32, triangle_count: 1, ..params };
-        let out = Subdivider::with_edge_scale(&one, &lod).run_with_cuts(&vertices, &mesh.indices, &cuts);
-        let corner = [0, 1, 2].map(|k| snap_to_cut_planes(placed[mesh.indices[3 * t + k] as usize]));
-        let normal = (corner[1] - corner[0]).cross(corner[2] - corner[0]);
-        if normal.length() == 0.0 {
-            continue;
-        }
-        let bary_of = |p: Vec3| -> Vec3 {
-            let area = |a: Vec3, b: Vec3, c: Vec3| (b - a).cross(c - a).dot(normal) / normal.length_squared();
-            Vec3::new(area(p, corner[1], corner[2]), area(corner[0], p, corner[2]), area(corner[0], corner[1], p))
-        };
-        let mine: Vec<&[DrawVertex]> = out.vertices.chunks(3).filter(|t| t[0].theta_ref.abs() <= PI).collect();
-        for v in mine.iter().flat_map(|t| t.iter()) {
-            let p = Vec3::from(v.position);
-            let off_plane = (p - corner[0]).dot(normal.normalize()).abs();
-            assert!(off_plane <= tol, "{what}: output point {p} is {off_plane} off its triangle's plane");
-            assert!(bary_of(p).min_element() >= -1e-4, "{what}: output point {p} outside its triangle");
-            assert!(p.x.abs() + p.z.abs() >= rho - tol, "{what}: output point {p} inside the square around the axis");
-        }
-        let k = sd.vertical_limit();
-        for _ in 0..40 {
-            let (a, b): (f32, f32) = (rng.random(), rng.random());
-            let (a, b) = if a + b > 1.0 { (1.0 - a, 1.0 - b) } else { (a, b) };
-            let p = corner[0] + a * (corner[1] - corner[0]) + b * (corner[2] - corner[0]);
-            let r = horizontal_radius(p);
-            // Clearly outside the square and clearly on screen (a margin for the sub-triangles
-            // culled whole: those lie wholly beyond the image, and so does this point then).
-            let off_screen = p.y.abs() > 0.99 * k * r;
-            if p.x.abs() + p.z.abs() < rho * 1.01 + 2.0 * tol || off_screen {
-                continue;
-            }
-            let w = bary_of(p);
-            let covered = mine.iter().any(|t| {
-                let q = [0, 1, 2].map(|i| bary_of(Vec3::from(t[i].position)));
-                let d = (q[1] - q[0]).truncate().perp_dot((q[2] - q[0]).truncate());
-                if d == 0.0 {
-                    return false;
-                }
-                let s = (w - q[0]).truncate().perp_dot((q[2] - q[0]).truncate()) / d;
-                let u = (q[1] - q[0]).truncate().perp_dot((w - q[0]).truncate()) / d;
-                s >= -1e-4 && u >= -1e-4 && s + u <= 1.0 + 1e-4
-            });
-            assert!(covered, "{what}: visible point {p} of input triangle {t} is not covered by its output");
-        }
+        case.check(t, &cuts, &mut rng);
     }
     (originals.len(), out.edge_splits)
 }
@@ -403,4 +309,137 @@ fn random_closed_meshes_around_the_viewer_subdivide_watertight_and_whole() {
     assert!(total > 10_000, "the cases made only {total} triangles");
     // Triangles cut only at the edges they share with cut ones (`edge_split_parts`).
     assert!(edge_splits >= 20, "only {edge_splits} triangles were cut at shared edges alone");
+}
+
+/// One input triangle of a case, subdivided alone (with the frame's cuts): checked as the
+/// property test requires (see `check_case`).
+struct OneTriangle<'a> {
+    what: &'a str,
+    mesh: &'a Mesh,
+    placed: &'a [Vec3],
+    vertices: &'a [SceneVertex],
+    params: SubdivideParams,
+    lod: &'a [f32],
+    tol: f32,
+    rho: f32,
+}
+
+impl OneTriangle<'_> {
+    /// Input triangle `t`'s output lies on its plane, inside it and outside the square around
+    /// the axis, and covers 40 random visible points of it.
+    fn check(&self, t: usize, cuts: &FrameCuts, rng: &mut StdRng) {
+        let OneTriangle { what, mesh, placed, vertices, params, lod, tol, rho } = *self;
+        let sd = Subdivider::with_edge_scale(&params, lod);
+        let one = SubdivideParams { first_triangle: t as u32, triangle_count: 1, ..params };
+        let out = Subdivider::with_edge_scale(&one, lod).run_with_cuts(vertices, &mesh.indices, cuts);
+        let corner = [0, 1, 2].map(|k| snap_to_cut_planes(placed[mesh.indices[3 * t + k] as usize]));
+        let normal = (corner[1] - corner[0]).cross(corner[2] - corner[0]);
+        if normal.length() == 0.0 {
+            return;
+        }
+        let bary_of = |p: Vec3| -> Vec3 {
+            let area = |a: Vec3, b: Vec3, c: Vec3| (b - a).cross(c - a).dot(normal) / normal.length_squared();
+            Vec3::new(area(p, corner[1], corner[2]), area(corner[0], p, corner[2]), area(corner[0], corner[1], p))
+        };
+        let mine: Vec<&[DrawVertex]> = out.vertices.chunks(3).filter(|t| t[0].theta_ref.abs() <= PI).collect();
+        for v in mine.iter().flat_map(|t| t.iter()) {
+            let p = Vec3::from(v.position);
+            let off_plane = (p - corner[0]).dot(normal.normalize()).abs();
+            assert!(off_plane <= tol, "{what}: output point {p} is {off_plane} off its triangle's plane");
+            assert!(bary_of(p).min_element() >= -1e-4, "{what}: output point {p} outside its triangle");
+            assert!(p.x.abs() + p.z.abs() >= rho - tol, "{what}: output point {p} inside the square around the axis");
+        }
+        let k = sd.vertical_limit();
+        for _ in 0..40 {
+            let (a, b): (f32, f32) = (rng.random(), rng.random());
+            let (a, b) = if a + b > 1.0 { (1.0 - a, 1.0 - b) } else { (a, b) };
+            let p = corner[0] + a * (corner[1] - corner[0]) + b * (corner[2] - corner[0]);
+            let r = horizontal_radius(p);
+            // Clearly outside the square and clearly on screen (a margin for the sub-triangles
+            // culled whole: those lie wholly beyond the image, and so does this point then).
+            let off_screen = p.y.abs() > 0.99 * k * r;
+            if p.x.abs() + p.z.abs() < rho * 1.01 + 2.0 * tol || off_screen {
+                continue;
+            }
+            let w = bary_of(p);
+            let covered = mine.iter().any(|t| {
+                let q = [0, 1, 2].map(|i| bary_of(Vec3::from(t[i].position)));
+                let d = (q[1] - q[0]).truncate().perp_dot((q[2] - q[0]).truncate());
+                if d == 0.0 {
+                    return false;
+                }
+                let s = (w - q[0]).truncate().perp_dot((q[2] - q[0]).truncate()) / d;
+                let u = (q[1] - q[0]).truncate().perp_dot((w - q[0]).truncate()) / d;
+                s >= -1e-4 && u >= -1e-4 && s + u <= 1.0 + 1e-4
+            });
+            assert!(covered, "{what}: visible point {p} of input triangle {t} is not covered by its output");
+        }
+    }
+}
+
+/// Every output edge of a case is shared by exactly two triangles (its `originals`, seam copies
+/// aside), except on the square around the axis, wholly off screen, along an input edge that is
+/// open itself, or between slivers narrower than the coordinates' precision (`tol`).
+fn check_watertight(
+    what: &str,
+    mesh: &Mesh,
+    placed: &[Vec3],
+    sd: &Subdivider,
+    originals: &[&[DrawVertex]],
+    tol: f32,
+    rho: f32,
+) {
+    // Input edges used other than twice (an open or non-manifold input) may stay open.
+    let mut input_edges: HashMap<(Key, Key), u32> = HashMap::new();
+    for t in mesh.indices.chunks(3) {
+        for e in 0..3 {
+            let (a, b) = (placed[t[e] as usize], placed[t[(e + 1) % 3] as usize]);
+            *input_edges.entry(edge_key(snap_to_cut_planes(a), snap_to_cut_planes(b))).or_default() += 1;
+        }
+    }
+    let open_input: Vec<(Vec3, Vec3)> = input_edges
+        .iter()
+        .filter(|(_, &n)| n != 2)
+        .map(|((a, b), _)| (Vec3::from(a.map(f32::from_bits)), Vec3::from(b.map(f32::from_bits))))
+        .collect();
+    let on_open_input = |a: Vec3, b: Vec3| {
+        open_input.iter().any(|&(p, q)| {
+            let d = q - p;
+            [a, b].iter().all(|&x| {
+                (x - p).cross(d).length() <= tol * d.length() && (x - p).dot(d) >= -tol && (x - q).dot(-d) >= -tol
+            })
+        })
+    };
+    let on_square = |p: Vec3| (p.x.abs() + p.z.abs() - rho).abs() <= tol + 1e-3 * rho;
+
+    let mut edges: HashMap<(Key, Key), u32> = HashMap::new();
+    for t in originals {
+        for e in 0..3 {
+            let (a, b) = (Vec3::from(t[e].position), Vec3::from(t[(e + 1) % 3].position));
+            *edges.entry(edge_key(a, b)).or_default() += 1;
+        }
+    }
+    // Slivers: triangles narrower than the coordinates' precision (beside the square around the
+    // axis, a part can be ρ wide and metres long; its lattice nodes may round together there).
+    let sliver = |t: &[DrawVertex]| {
+        let p = [0, 1, 2].map(|i| Vec3::from(t[i].position));
+        let longest = (p[1] - p[0]).length().max((p[2] - p[1]).length()).max((p[0] - p[2]).length());
+        (p[1] - p[0]).cross(p[2] - p[0]).length() <= 2.0 * tol * longest
+    };
+    let mut at_edge: HashMap<(Key, Key), bool> = HashMap::new();
+    for t in originals {
+        for e in 0..3 {
+            let k = edge_key(Vec3::from(t[e].position), Vec3::from(t[(e + 1) % 3].position));
+            *at_edge.entry(k).or_insert(true) &= sliver(t);
+        }
+    }
+    for (edge, n) in &edges {
+        if *n == 2 || at_edge[edge] {
+            continue;
+        }
+        let (a, b) = (Vec3::from(edge.0.map(f32::from_bits)), Vec3::from(edge.1.map(f32::from_bits)));
+        let allowed =
+            *n == 1 && ((on_square(a) && on_square(b)) || sd.off_screen_vertically([a, b, a]) || on_open_input(a, b));
+        assert!(allowed, "{what}: edge {a} – {b} used by {n} triangles (crack or T-junction)");
+    }
 }

@@ -1,0 +1,110 @@
+//! A frame's resources and its end: what a renderer keeps between frames (targets, uniforms,
+//! the subdivision's buffers), the [`Method`] each way of drawing a frame implements, and
+//! [`FrameEnd`], which reads a drawn frame back and reduces its error.
+
+use std::time::Instant;
+
+use crate::core::frame::{Frame, FrameStats, Measurement};
+use crate::core::settings::RenderSettings;
+use crate::error::Result;
+use crate::gpu::device::Gpu;
+use crate::gpu::frame_plan::SubdivisionBuffers;
+use crate::gpu::reduce_error::ReduceStage;
+use crate::gpu::scene::GpuScene;
+use crate::gpu::subdivide::COUNTERS_SIZE;
+use crate::gpu::targets::Targets;
+use crate::gpu::timestamps::{self as stamp, Timestamps};
+
+/// What a renderer keeps between frames.
+pub(crate) struct FrameResources {
+    pub buffers: Option<SubdivisionBuffers>,
+    /// Targets of the last image size.
+    pub targets: Option<Targets>,
+    pub timestamps: Option<Timestamps>,
+    pub subdivide_params: wgpu::Buffer,
+    /// Both eyes' (left, right), as the raster stage's `array<RasterParams, 2>`.
+    pub raster_params: wgpu::Buffer,
+    pub slit_params: [wgpu::Buffer; 2],
+    /// Counters and timestamps of a one-submission frame.
+    pub staging: wgpu::Buffer,
+    pub trace_params: wgpu::Buffer,
+    /// The ray tracer's outputs of the last image size: (padded row texels, height, colour,
+    /// error, object and distance buffers), and its counters of rays and triangle tests.
+    pub trace_outputs: Option<(u32, u32, [wgpu::Buffer; 4])>,
+    pub trace_counts: Option<wgpu::Buffer>,
+}
+
+impl FrameResources {
+    /// The targets for this size, made anew only when the size changed.
+    /// The targets for this size (with the positions target if `positions`), made anew only
+    /// when the size changed or the positions target is wanted and missing.
+    pub fn targets(&mut self, gpu: &Gpu, width: u32, height: u32, positions: bool, hdr: bool) -> &Targets {
+        if !self.targets.as_ref().is_some_and(|t| {
+            t.width == width && t.height == height && (t.position.is_some() || !positions) && t.hdr == hdr
+        }) {
+            self.targets = Some(Targets::new(gpu, width, height, positions, hdr));
+        }
+        self.targets.as_ref().expect("just made")
+    }
+}
+
+pub(crate) const STAGING_SIZE: u64 = COUNTERS_SIZE + 8 * stamp::COUNT as u64;
+
+/// A way of drawing a frame (as pbrt's `Integrator`): the projection methods' subdivided
+/// raster, the slit mosaic, the ray tracer. Each draws into the frame's resources and ends with
+/// [`FrameEnd::finish`].
+pub(crate) trait Method {
+    fn draw(
+        &self,
+        gpu: &Gpu,
+        end: &FrameEnd,
+        res: &mut FrameResources,
+        scene: &GpuScene,
+        settings: &RenderSettings,
+    ) -> Result<Frame>;
+}
+
+/// The end of every frame: the read-back of its targets and, with the error pass, the
+/// `reduce_error` stage.
+pub(crate) struct FrameEnd {
+    pub reduce: ReduceStage,
+}
+
+impl FrameEnd {
+    /// Reads the targets back and reduces the error: the end of every render.
+    pub fn finish(
+        &self,
+        gpu: &Gpu,
+        targets: &Targets,
+        settings: &RenderSettings,
+        mut stats: FrameStats,
+        start: Instant,
+    ) -> Result<Frame> {
+        let t = Instant::now();
+        let (hdr, [left, right]) = if targets.hdr {
+            // The linear colour, and as display bytes clamped (the frame is not tone mapped).
+            let hdr = targets.read_hdr(gpu)?;
+            let image = |eye: &Vec<[f32; 3]>| crate::core::frame::EyeImage {
+                width: targets.width,
+                height: targets.height,
+                rgba: eye.iter().flat_map(|c| crate::core::color::display_bytes(glam::Vec3::from(*c))).collect(),
+            };
+            let images = [image(&hdr[0]), image(&hdr[1])];
+            (Some(hdr), images)
+        } else {
+            (None, targets.read_colors(gpu)?)
+        };
+        stats.ms_readback = t.elapsed().as_secs_f64() * 1e3;
+        let depth = if settings.measure.depth { Some(targets.read_distances(gpu)?) } else { None };
+        let positions = if settings.measure.positions { Some(targets.read_positions(gpu)?) } else { None };
+        let measurement = if settings.measure.error {
+            let object = targets.read_objects(gpu)?;
+            let (stats, error) = self.reduce.reduce(gpu, targets, settings.measure.reduce_per_eye)?;
+            Some(Measurement { error, object, stats })
+        } else {
+            None
+        };
+        stats.ms_total = start.elapsed().as_secs_f64() * 1e3;
+        Ok(Frame { left, right, stats, measurement, depth, positions, hdr })
+    }
+}
