@@ -83,7 +83,7 @@ fn vs_background(@builtin(vertex_index) i: u32) -> BackgroundOut {
 // ---- The fragment entry points (what they compute: fragment.wgsl) ----
 
 @fragment
-fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> @location(0) vec4<f32> {
+fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> FragmentColor {
     return fragment_color(in, front_facing, fragment_view(in.eye));
 }
 
@@ -98,6 +98,6 @@ fn fs_position(in: VertexOut, @builtin(front_facing) front_facing: bool) -> Frag
 }
 
 @fragment
-fn fs_background(in: BackgroundOut) -> @location(0) vec4<f32> {
+fn fs_background(in: BackgroundOut) -> FragmentColor {
     return background_color(fragment_view(in.eye), in.clip.xy);
 }

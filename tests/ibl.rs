@@ -215,6 +215,8 @@ fn hdr_frames_hold_the_linear_colour_and_tone_map_to_the_ordinary_frame() {
     let ldr = common::render(&scene, &s);
     let hdr_frame = common::render(&scene, &s.with_hdr(true));
     let hdr = hdr_frame.hdr.as_ref().expect("an HDR frame");
+    // The same frame draws both: its display images are the ordinary frame's.
+    assert!(hdr_frame.left.rgba == ldr.left.rgba && hdr_frame.right.rgba == ldr.right.rgba);
     let peak = hdr[0].iter().flat_map(|c| *c).fold(0.0f32, f32::max);
     assert!(peak > 2.0, "the linear colour is not clamped: peak {peak}");
     let params = LightingParams { exposure: 1.0, tonemap: Tonemap::PbrNeutral.code(), ..Default::default() };
@@ -244,6 +246,19 @@ fn hdr_frames_hold_the_linear_colour_and_tone_map_to_the_ordinary_frame() {
     };
     let o = run(&[]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // One frame draws both: the display images are the bytes they are without --hdr.
+    let plain = common::TempDir::new(format!("twister-hdr-plain-{}", std::process::id()));
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_twister"))
+        .args(["render", "builtin:demo", "--width", "128", "--height", "32", "--out"])
+        .arg(&*plain)
+        .env("NODEVICE_SELECT", "1")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for name in ["left.png", "right.png"] {
+        let read = |d: &std::path::Path| std::fs::read(d.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert!(read(&dir) == read(&plain), "{name} differs with --hdr");
+    }
     for name in ["left_hdr.exr", "right_hdr.exr"] {
         use exr::prelude::*;
         let image = read_first_rgba_layer_from_file(

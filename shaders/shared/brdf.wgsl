@@ -74,9 +74,18 @@ fn pbr_neutral(c_in: vec3<f32>) -> vec3<f32> {
 
 // The tone mapped colour, 0..1 (`tonemap` in light.rs).
 fn tonemap(c_in: vec3<f32>) -> vec3<f32> {
-    let c = max(c_in * lighting.exposure, vec3<f32>(0.0));
+    return tone(exposed(c_in));
+}
+
+// The linear colour × 2^EV, not negative: what `--hdr` writes.
+fn exposed(c_in: vec3<f32>) -> vec3<f32> {
+    return max(c_in * lighting.exposure, vec3<f32>(0.0));
+}
+
+// An exposed colour tone mapped for display, 0..1 (`TONEMAP_LINEAR`: as it is).
+fn tone(c: vec3<f32>) -> vec3<f32> {
     if (lighting.tonemap == TONEMAP_LINEAR) {
-        return c;  // a float colour target (`--hdr`)
+        return c;
     }
     var out = c;
     if (lighting.tonemap == TONEMAP_PBR_NEUTRAL) {

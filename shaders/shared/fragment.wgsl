@@ -20,6 +20,13 @@ struct FragmentView {
     error_angle: u32,   // 1: the error target holds arcminutes
 }
 
+// The colour outputs: the display colour, and at location 5 the linear colour × 2^EV, which
+// only a pipeline with the HDR target (`--hdr`) keeps (an output without a target is dropped).
+struct FragmentColor {
+    @location(0) color: vec4<f32>,
+    @location(5) hdr: vec4<f32>,
+}
+
 struct FragmentOut {
     @location(0) color: vec4<f32>,
     // Display-position error in pixels (or arcminutes with `error_angle`); −1 where no eye
@@ -29,6 +36,7 @@ struct FragmentOut {
     @location(2) object: u32,
     // Distance in metres from the pixel's eye point to the surface point (cleared to +∞).
     @location(3) distance: ErrorTarget,
+    @location(5) hdr: vec4<f32>,
 }
 
 fn fragment_out(params: FragmentView, frag_xy: vec2<f32>, view_position: vec3<f32>, dp_dx: vec3<f32>,
@@ -36,8 +44,10 @@ fn fragment_out(params: FragmentView, frag_xy: vec2<f32>, view_position: vec3<f3
                 material: u32, uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>) -> FragmentOut {
     let plane_normal = cross(dp_dx, dp_dy);
     var out: FragmentOut;
-    out.color = shade_surface(material, params.ambient, params.projection, params.eye_sign, frag_xy, view_position,
-                              normal, tangent, color, uv, duv_dx, duv_dy, dp_dx, dp_dy);
+    let shaded = shade_surface(material, params.ambient, params.projection, params.eye_sign, frag_xy, view_position,
+                               normal, tangent, color, uv, duv_dx, duv_dy, dp_dx, dp_dy);
+    out.color = shaded.display;
+    out.hdr = shaded.linear;
     out.error = encode_error(pixel_error(params.projection, params.eye_sign, view_position, frag_xy,
                                          params.error_angle != 0u));
     out.object = object + 1u;
@@ -63,7 +73,7 @@ struct VertexOut {
 }
 
 // The shaded colour (`fs_main`).
-fn fragment_color(in: VertexOut, front_facing: bool, params: FragmentView) -> vec4<f32> {
+fn fragment_color(in: VertexOut, front_facing: bool, params: FragmentView) -> FragmentColor {
     // Derivatives first, in uniform control flow.
     let duv_dx = dpdx(in.uv);
     let duv_dy = dpdy(in.uv);
@@ -73,8 +83,9 @@ fn fragment_color(in: VertexOut, front_facing: bool, params: FragmentView) -> ve
     if (MATERIALS && DISCARDS && c.a < 0.0) {
         discard;
     }
-    return shade_surface(in.material, params.ambient, params.projection, params.eye_sign, in.clip.xy, in.view_position,
-                         in.normal, in.tangent, c, in.uv, duv_dx, duv_dy, dp_dx, dp_dy);
+    let shaded = shade_surface(in.material, params.ambient, params.projection, params.eye_sign, in.clip.xy,
+                               in.view_position, in.normal, in.tangent, c, in.uv, duv_dx, duv_dy, dp_dx, dp_dy);
+    return FragmentColor(shaded.display, shaded.linear);
 }
 
 struct FragmentOutPosition {
@@ -84,13 +95,14 @@ struct FragmentOutPosition {
     @location(3) distance: ErrorTarget,
     // The surface point drawn (viewer frame), w = 1 (cleared to 0: background).
     @location(4) position: vec4<f32>,
+    @location(5) hdr: vec4<f32>,
 }
 
 // What `fs_position` writes: `measured`, plus the surface point drawn (for the display-position
 // error against the ray tracer).
 fn measured_position(in: VertexOut, front_facing: bool, params: FragmentView) -> FragmentOutPosition {
     let m = measured(in, front_facing, params);
-    return FragmentOutPosition(m.color, m.error, m.object, m.distance, vec4<f32>(in.view_position, 1.0));
+    return FragmentOutPosition(m.color, m.error, m.object, m.distance, vec4<f32>(in.view_position, 1.0), m.hdr);
 }
 
 // What `fs_error` writes: the colour, plus the display-position error, the object id and the
@@ -113,7 +125,7 @@ fn measured(in: VertexOut, front_facing: bool, params: FragmentView) -> Fragment
 // ---- The background: an environment the user gave, seen all around ----
 
 // A triangle covering the image, drawn first in a pass where the environment shows as the
-// background; only the colour target is written (`background_color` in fragment.rs).
+// background; only the colour targets are written (`background_color` in fragment.rs).
 struct BackgroundOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) @interpolate(flat) eye: u32,
@@ -125,8 +137,10 @@ fn background_vertex(i: u32, eye: u32) -> BackgroundOut {
     return BackgroundOut(vec4<f32>(xy, 0.5, 1.0), eye);
 }
 
-// The environment's radiance along the pixel's own ray, tone mapped (`fs_background`).
-fn background_color(params: FragmentView, frag_xy: vec2<f32>) -> vec4<f32> {
+// The environment's radiance along the pixel's own ray, tone mapped, and linear
+// (`fs_background`).
+fn background_color(params: FragmentView, frag_xy: vec2<f32>) -> FragmentColor {
     let ray = pixel_ray(params.projection, params.eye_sign, frag_xy);
-    return vec4<f32>(tonemap(env_level(0u, env_st(env_direction(ray.dir)))), 1.0);
+    let linear = exposed(env_level(0u, env_st(env_direction(ray.dir))));
+    return FragmentColor(vec4<f32>(tone(linear), 1.0), vec4<f32>(linear, 1.0));
 }

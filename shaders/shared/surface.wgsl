@@ -63,14 +63,22 @@ fn shade(ambient: f32, view_position: vec3<f32>, normal: vec3<f32>, color: vec4<
 // emission, tone mapped; else the headlight (`shade`). `shade_surface` in fragment.rs.
 fn shade_surface(material: u32, ambient: f32, proj: Projection, eye_sign: f32, frag_xy: vec2<f32>,
                  view_position: vec3<f32>, normal: vec3<f32>, tangent: vec4<f32>, color: vec4<f32>, uv: vec2<f32>,
-                 duv_dx: vec2<f32>, duv_dy: vec2<f32>, dp_dx: vec3<f32>, dp_dy: vec3<f32>) -> vec4<f32> {
+                 duv_dx: vec2<f32>, duv_dy: vec2<f32>, dp_dx: vec3<f32>, dp_dy: vec3<f32>) -> Shading {
     if (!MATERIALS || !PBR || lighting.pbr == 0u) {
-        return shade(ambient, view_position, normal, color);
+        let lit = shade(ambient, view_position, normal, color);
+        return Shading(lit, lit);
     }
     let eye = pixel_ray(proj, eye_sign, frag_xy).origin;
     let maps = surface_maps(material, uv, duv_dx, duv_dy, dp_dx, dp_dy, duv_dx, duv_dy, tangent);
-    return vec4<f32>(tonemap(pbr_radiance(ambient, normalize(eye - view_position), view_position, normal, color,
-                                          maps, 0u)), 1.0);
+    let linear = exposed(pbr_radiance(ambient, normalize(eye - view_position), view_position, normal, color, maps, 0u));
+    return Shading(vec4<f32>(tone(linear), 1.0), vec4<f32>(linear, 1.0));
+}
+
+// A shaded fragment: the display colour (tone mapped, 0..1) and the linear colour × 2^EV
+// (`--hdr`; the headlight's colour is the same).
+struct Shading {
+    display: vec4<f32>,
+    linear: vec4<f32>,
 }
 
 // A surface's BRDF inputs with the material's texture maps applied: metallic and roughness

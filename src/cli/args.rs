@@ -450,8 +450,8 @@ pub struct RenderArgs {
     #[arg(long)]
     pub depth: bool,
     /// Also write each eye's linear colour (× 2^EV, before tone mapping, not clamped) as 32-bit
-    /// float OpenEXR (channels R, G, B): left_hdr.exr, right_hdr.exr. A second frame is drawn
-    /// into a float colour target; the projection methods only.
+    /// float OpenEXR (channels R, G, B): left_hdr.exr, right_hdr.exr. Drawn into a float colour
+    /// target beside the display colour, in the same frame; the projection methods only.
     #[arg(long)]
     pub hdr: bool,
     /// Background colour R,G,B, each 0–255.

@@ -12,7 +12,11 @@ use twister::output::{check_outputs, write_all, OutputFile};
 /// statistics, the linear colour) and the background; checked once, then only read.
 pub fn render_settings(args: &RenderArgs) -> Result<twister::RenderSettings> {
     let settings = args.view.settings(&[args.view.method])?;
-    Ok(settings.with_background(args.background).with_measure_edges(args.stats.is_some()).with_depth(args.depth))
+    Ok(settings
+        .with_background(args.background)
+        .with_measure_edges(args.stats.is_some())
+        .with_depth(args.depth)
+        .with_hdr(args.hdr))
 }
 
 pub fn render(args: &RenderArgs) -> Result<()> {
@@ -55,10 +59,6 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         }
     }
     let t = std::time::Instant::now();
-    if args.hdr {
-        // The linear colour is drawn into a float target by a second frame.
-        frame.hdr = renderer.render(&prepared.gpu_scene, &settings.with_hdr(true))?.hdr;
-    }
     let mut files = writer.files(&frame, None)?;
     // Encoding: the writing itself is a rename.
     let ms_write = t.elapsed().as_secs_f64() * 1e3;

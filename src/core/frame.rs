@@ -99,8 +99,8 @@ pub struct Frame {
     /// `RenderSettings::measure.positions` was set.
     pub positions: Option<[Vec<[f32; 3]>; 2]>,
     /// Per pixel, left and right eye: the linear colour × 2^EV (RGB, not tone mapped, not
-    /// clamped), when `RenderSettings::shading.hdr` was set (`left` and `right` then hold it
-    /// tone mapped on the CPU, as the frame's settings say).
+    /// clamped), when `RenderSettings::shading.hdr` was set: drawn in the same passes as `left`
+    /// and `right`, which are the same frame tone mapped.
     pub hdr: Option<[Vec<[f32; 3]>; 2]>,
 }
 

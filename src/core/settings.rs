@@ -185,8 +185,9 @@ pub struct ShadingSettings {
     pub shadow_map_size: u32,
     /// The environment turned about the vertical axis, degrees (`--environment-yaw`).
     pub environment_yaw_deg: f32,
-    /// The colour target holds the linear colour × 2^EV in floats, not tone mapped (`--hdr`:
-    /// [`Frame::hdr`](crate::core::frame::Frame::hdr); the projection methods only).
+    /// Also draw the linear colour × 2^EV in floats, not tone mapped, beside the display colour
+    /// of the same frame (`--hdr`: [`Frame::hdr`](crate::core::frame::Frame::hdr); the
+    /// projection methods only).
     pub hdr: bool,
 }
 
@@ -298,7 +299,7 @@ impl RenderSettings {
         environment: Option<&crate::core::environment::PreparedEnvironment>,
     ) -> crate::core::light::LightingParams {
         let s = &self.shading;
-        let tonemap = if s.hdr { crate::core::light::Tonemap::Linear } else { s.tonemap };
+        let tonemap = s.tonemap;
         crate::core::light::LightingParams {
             shadows: s.shadows as u32,
             ..crate::core::light::LightingParams::of(s.lighting, scene, environment, s.exposure_ev, tonemap)

@@ -12,7 +12,9 @@ use crate::encoding::types::DrawVertex;
 use crate::gpu::device::{error_target_format, Gpu};
 use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
-use crate::gpu::targets::{Layers, COLOR_FORMAT, DEPTH_FORMAT, HDR_FORMAT, OBJECT_FORMAT, POSITION_FORMAT};
+use crate::gpu::targets::{
+    Layers, COLOR_FORMAT, DEPTH_FORMAT, HDR_FORMAT, HDR_LOCATION, OBJECT_FORMAT, POSITION_FORMAT,
+};
 use crate::shader::{RASTER, SLIT};
 
 /// The two drawing stages.
@@ -171,14 +173,22 @@ fn draw_pipeline(
     };
     let buffers = [Some(layout)];
     let error = error_target_format(gpu.error_target);
-    let color = if hdr { HDR_FORMAT } else { COLOR_FORMAT };
     let all_targets =
-        [color, error, OBJECT_FORMAT, error, POSITION_FORMAT].into_iter().enumerate().map(|(k, format)| {
+        [COLOR_FORMAT, error, OBJECT_FORMAT, error, POSITION_FORMAT].into_iter().enumerate().map(|(k, format)| {
             // The background writes the colour only: the measuring targets keep their clear values.
             let write_mask = if background && k > 0 { wgpu::ColorWrites::empty() } else { wgpu::ColorWrites::ALL };
             Some(wgpu::ColorTargetState { format, blend: None, write_mask })
         });
-    let all_targets: Vec<_> = all_targets.collect();
+    let mut targets: Vec<_> = all_targets.take(outputs).collect();
+    if hdr {
+        // The linear colour at location 5 (`FragmentColor::hdr`), after any measuring targets.
+        targets.resize(HDR_LOCATION, None);
+        targets.push(Some(wgpu::ColorTargetState {
+            format: HDR_FORMAT,
+            blend: None,
+            write_mask: wgpu::ColorWrites::ALL,
+        }));
+    }
     let mut constants = look_constants(look, lit);
     let multiview_mask = match layers {
         Layers::Both => std::num::NonZeroU32::new(0b11),
@@ -221,7 +231,7 @@ fn draw_pipeline(
                 _ => "fs_position",
             }),
             compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
-            targets: &all_targets[..outputs],
+            targets: &targets,
         }),
         multiview_mask,
         cache: None,

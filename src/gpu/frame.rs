@@ -81,19 +81,8 @@ impl FrameEnd {
         start: Instant,
     ) -> Result<Frame> {
         let t = Instant::now();
-        let (hdr, [left, right]) = if targets.hdr {
-            // The linear colour, and as display bytes clamped (the frame is not tone mapped).
-            let hdr = targets.read_hdr(gpu)?;
-            let image = |eye: &Vec<[f32; 3]>| crate::core::frame::EyeImage {
-                width: targets.width,
-                height: targets.height,
-                rgba: eye.iter().flat_map(|c| crate::core::color::display_bytes(glam::Vec3::from(*c))).collect(),
-            };
-            let images = [image(&hdr[0]), image(&hdr[1])];
-            (Some(hdr), images)
-        } else {
-            (None, targets.read_colors(gpu)?)
-        };
+        let [left, right] = targets.read_colors(gpu)?;
+        let hdr = if targets.hdr { Some(targets.read_hdr(gpu)?) } else { None };
         stats.ms_readback = t.elapsed().as_secs_f64() * 1e3;
         let depth = if settings.measure.depth { Some(targets.read_distances(gpu)?) } else { None };
         let positions = if settings.measure.positions { Some(targets.read_positions(gpu)?) } else { None };

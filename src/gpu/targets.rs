@@ -18,8 +18,10 @@ pub const OBJECT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// The surface point each pixel shows (viewer frame) in xyz, w = 1 (0: background).
 pub const POSITION_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
-/// The colour target of an HDR frame (`--hdr`): the linear colour in floats.
+/// The linear colour's target of an HDR frame (`--hdr`): floats.
 pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+/// The location of the linear colour's target (after the colour and the measuring targets).
+pub const HDR_LOCATION: usize = 5;
 
 /// Which layers a render pass draws.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -51,7 +53,10 @@ pub struct Targets {
     /// The surface points (`POSITION_FORMAT`), made only when asked for (16 bytes a pixel).
     pub position: Option<wgpu::Texture>,
     pub depth: wgpu::Texture,
-    /// Whether `color` holds floats (`HDR_FORMAT`) rather than sRGB bytes.
+    /// The linear colour × 2^EV in floats (`HDR_FORMAT`, at `HDR_LOCATION`), made only for
+    /// `--hdr`; drawn beside `color` in the same passes.
+    pub hdr_color: Option<wgpu::Texture>,
+    /// Whether `hdr_color` is there.
     pub hdr: bool,
     error_target: ErrorTarget,
 }
@@ -78,7 +83,8 @@ impl Targets {
         Targets {
             width,
             height,
-            color: make(if hdr { HDR_FORMAT } else { COLOR_FORMAT }, copyable, "colour"),
+            color: make(COLOR_FORMAT, copyable, "colour"),
+            hdr_color: hdr.then(|| make(HDR_FORMAT, copyable, "linear colour")),
             error: make(error_format, copyable, "error"),
             object: make(OBJECT_FORMAT, copyable, "object"),
             distance: make(error_format, copyable, "distance"),
@@ -132,21 +138,25 @@ impl Targets {
             wgpu::Color { r: value(f32::INFINITY), ..wgpu::Color::TRANSPARENT },
             wgpu::Color::TRANSPARENT,
         ];
-        let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = views
-            .iter()
-            .zip(clears)
-            .map(|(view, c)| {
-                Some(wgpu::RenderPassColorAttachment {
-                    view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: if clear { wgpu::LoadOp::Clear(c) } else { wgpu::LoadOp::Load },
-                        store: wgpu::StoreOp::Store,
-                    },
-                })
+        let hdr_view = self.hdr_color.as_ref().map(view);
+        let attach = |view, c| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: if clear { wgpu::LoadOp::Clear(c) } else { wgpu::LoadOp::Load },
+                    store: wgpu::StoreOp::Store,
+                },
             })
-            .collect();
+        };
+        let mut attachments: Vec<Option<wgpu::RenderPassColorAttachment>> =
+            views.iter().zip(clears).map(|(view, c)| attach(view, c)).collect();
+        if let Some(hdr) = &hdr_view {
+            // The linear colour, cleared to the background's (linear) colour.
+            attachments.resize(HDR_LOCATION, None);
+            attachments.push(attach(hdr, clears[0]));
+        }
         enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some(match layers {
                 Layers::Eye(k) => Eye::BOTH[k].name(),
@@ -178,7 +188,8 @@ impl Targets {
 
     /// Reads both eyes' linear colours back from an HDR colour target (RGB).
     pub fn read_hdr(&self, gpu: &Gpu) -> Result<[Vec<[f32; 3]>; 2]> {
-        let (buffer, stride) = copy_eyes_to_buffer(gpu, &self.color, wgpu::BufferUsages::COPY_SRC);
+        let texture = self.hdr_color.as_ref().expect("made for the linear colour (shading.hdr)");
+        let (buffer, stride) = copy_eyes_to_buffer(gpu, texture, wgpu::BufferUsages::COPY_SRC);
         let words = unpad_eyes(&gpu.download(&buffer, buffer.size())?, 4 * self.width, self.height, stride);
         Ok(words.map(|v| v.chunks_exact(4).map(|p| [0, 1, 2].map(|k| f32::from_bits(p[k]))).collect()))
     }
