@@ -225,3 +225,35 @@ fn shared_modules_declare_no_entry_points_and_only_binding_modules_declare_bindi
         );
     }
 }
+
+#[test]
+fn the_subdivisions_recordings_name_its_entry_points_and_bindings() {
+    use twister::encoding::recording::Command;
+    use twister::encoding::subdivide::{active_cuts, one_submission, pass_run};
+    use twister::shader::SUBDIVIDE;
+    let entries: Vec<&str> = SUBDIVIDE.entry_points.iter().map(|e| e.name).collect();
+    let bound = |name: &str| SUBDIVIDE.bindings.iter().any(|b| b.name == name);
+    let usual = one_submission(1000, true);
+    // The usual frame dispatches every entry point, in the order the passes depend on.
+    let order: Vec<&str> = usual.entries().collect();
+    assert_eq!(
+        order,
+        ["active_cuts", "ring_cuts", "plan", "plan_cuts_args", "plan_cuts", "lattice_args", "lattice", "finalize"]
+    );
+    for recording in [usual, one_submission(7, false), active_cuts(7), pass_run("plan", 7), pass_run("lattice", 7)] {
+        let mut in_pass = false;
+        for command in &recording.commands {
+            match *command {
+                Command::Clear { buffer, .. } => {
+                    assert!(bound(buffer), "clears {buffer}, which SUBDIVIDE does not bind");
+                    in_pass = false;
+                }
+                Command::Pass { .. } => in_pass = true,
+                Command::Dispatch { entry, .. } => assert!(entries.contains(&entry) && in_pass, "{entry}"),
+                Command::DispatchIndirect { entry, args, .. } => {
+                    assert!(entries.contains(&entry) && in_pass && bound(args), "{entry} from {args}")
+                }
+            }
+        }
+    }
+}

@@ -6,10 +6,12 @@
 //! - [`types`]: the plain-old-data structs laid out as WGSL reads them, and their field offsets;
 //! - [`constants`]: constants shared with WGSL (the generated `constants` module);
 //! - [`params`], [`subdivide`], [`slits`], [`skin`]: each stage's parameters and tables built
-//!   from the settings and the scene, and the outputs both engines give.
+//!   from the settings and the scene, and the outputs both engines give;
+//! - [`recording`]: a stage's schedule as data (the subdivision's, in [`subdivide`]).
 
 pub mod constants;
 pub mod params;
+pub mod recording;
 pub mod skin;
 pub mod slits;
 pub mod subdivide;

@@ -4,7 +4,8 @@
 use crate::core::projection::{PanoramaKind, Projection};
 use crate::core::settings::RenderSettings;
 use crate::encoding::constants::{AXIS_CLEARANCE_MAX, AXIS_CLEARANCE_MIN};
-use crate::encoding::types::{DrawVertex, SubdivideParams};
+use crate::encoding::recording::Recording;
+use crate::encoding::types::{DrawVertex, SubdivideCounters, SubdivideParams};
 
 /// The `subdivide` stage's parameters for a range of input triangles (capacities and piece
 /// ranges are left for the caller, 0).
@@ -98,4 +99,51 @@ impl SubdivideOutput {
         let vertices = expand(&nodes, &indices);
         SubdivideOutput { nodes, indices, vertices, pieces, max_sub_edge_px, cuts, ..Default::default() }
     }
+}
+
+/// Timestamp query indices of the one-submission schedule's passes (each pass's begin; its end
+/// is the next index): `plan` (with the cuts), `plan_cuts`, `lattice`.
+pub const PLAN_TIMESTAMP: u32 = 0;
+pub const PLAN_CUTS_TIMESTAMP: u32 = 2;
+pub const LATTICE_TIMESTAMP: u32 = 4;
+
+/// The usual frame's schedule, in one submission over `triangles` input triangles: the counters
+/// and the edge marks cleared; `active_cuts`, `ring_cuts` and `plan` over every triangle;
+/// `plan_cuts_args`, then `plan_cuts` over the triangles `plan` listed; `lattice_args`, then
+/// `lattice` over the pieces counted on the GPU, and `finalize` (the draw's arguments).
+/// `timed`: each pass writes its timestamps.
+pub fn one_submission(triangles: u32, timed: bool) -> Recording {
+    let stamp = |index: u32| timed.then_some(index);
+    let mut r = Recording::default();
+    r.clear("counters", None).clear("cut_edges", None);
+    r.pass("plan", stamp(PLAN_TIMESTAMP));
+    r.dispatch("active_cuts", triangles).dispatch("ring_cuts", triangles).dispatch("plan", triangles);
+    r.pass("plan_cuts", stamp(PLAN_CUTS_TIMESTAMP));
+    r.dispatch("plan_cuts_args", 1).dispatch_indirect("plan_cuts", "lattice_dispatch", 12);
+    r.pass("lattice", stamp(LATTICE_TIMESTAMP));
+    r.dispatch("lattice_args", 1).dispatch_indirect("lattice", "lattice_dispatch", 0).dispatch("finalize", 1);
+    r
+}
+
+/// The start of a chunked schedule: the counters and the edge marks cleared, then
+/// `active_cuts` and `ring_cuts` over all of the scene's `triangles`.
+pub fn active_cuts(triangles: u32) -> Recording {
+    let mut r = Recording::default();
+    r.clear("counters", None).clear("cut_edges", None);
+    r.pass("cuts", None).dispatch("active_cuts", triangles).dispatch("ring_cuts", triangles);
+    r
+}
+
+/// One step of a chunked schedule: `entry` (`plan`, with `plan_cuts` after it, or `lattice`)
+/// over `count` invocations, then `finalize`; the counters of this run cleared first (the
+/// frame's cuts kept).
+pub fn pass_run(entry: &'static str, count: u32) -> Recording {
+    let mut r = Recording::default();
+    r.clear("counters", Some(SubdivideCounters::RUN_BYTES));
+    r.pass(entry, None).dispatch(entry, count);
+    if entry == "plan" {
+        r.dispatch("plan_cuts_args", 1).dispatch_indirect("plan_cuts", "lattice_dispatch", 12);
+    }
+    r.dispatch("finalize", 1);
+    r
 }

@@ -18,7 +18,8 @@ use std::sync::OnceLock;
 use crate::core::projection::PanoramaKind;
 use crate::core::settings::RenderSettings;
 use crate::encoding::constants::PIECES_FROM_COUNTER;
-use crate::encoding::subdivide::{subdivide_params, SubdivideOutput};
+use crate::encoding::recording::{Command, Recording};
+use crate::encoding::subdivide::{active_cuts, one_submission, pass_run, subdivide_params, SubdivideOutput};
 use crate::encoding::types::{DrawVertex, SubdivideCounters, SubdivideParams};
 use crate::error::Result;
 use crate::gpu::device::Gpu;
@@ -50,6 +51,23 @@ struct Variant {
     lattice_args: wgpu::ComputePipeline,
     lattice: wgpu::ComputePipeline,
     finalize: wgpu::ComputePipeline,
+}
+
+impl Variant {
+    /// The pipeline of an entry point a recording names.
+    fn pipeline(&self, entry: &str) -> &wgpu::ComputePipeline {
+        match entry {
+            "active_cuts" => &self.active_cuts,
+            "ring_cuts" => &self.ring_cuts,
+            "plan" => &self.plan,
+            "plan_cuts_args" => &self.plan_cuts_args,
+            "plan_cuts" => &self.plan_cuts,
+            "lattice_args" => &self.lattice_args,
+            "lattice" => &self.lattice,
+            "finalize" => &self.finalize,
+            other => panic!("the subdivide stage has no entry point {other}"),
+        }
+    }
 }
 
 /// The `subdivide` stage: its layouts, and its pipelines built for each panorama when first
@@ -90,39 +108,54 @@ impl SubdivideStage {
         })
     }
 
-    /// The bind group of `entry`: params, vertices, indices, pieces, output nodes, counters,
-    /// draw args, lattice dispatch, per-object edge scale, cut list, output indices, triangle
-    /// edges, cut edges (twice: read-write and read-only) (the order of `SUBDIVIDE.bindings`).
-    fn bind_group(
-        &self,
-        gpu: &Gpu,
-        entry: &str,
-        uniform: &wgpu::Buffer,
-        scene: &GpuScene,
-        b: &SubdivisionBuffers,
-    ) -> wgpu::BindGroup {
-        let buffers = [
-            uniform,
-            &scene.vertices,
-            &scene.indices,
-            &b.pieces,
-            &b.nodes,
-            &b.counters,
-            &b.draw_args,
-            &b.lattice_dispatch,
-            &scene.object_edge_scale,
-            &b.cut_list,
-            &b.indices,
-            &scene.triangle_edges,
-            &b.cut_edges,
-            &b.cut_edges,
-        ];
+    /// The bind group of `entry` (the bindings of `SUBDIVIDE` it uses, by name).
+    fn bind_group(&self, gpu: &Gpu, entry: &str, frame: &FrameBuffers) -> wgpu::BindGroup {
+        let buffers: Vec<&wgpu::Buffer> = SUBDIVIDE.bindings.iter().map(|b| frame.named(b.name)).collect();
         self.stage.bind_group(gpu, Some(entry), 0, &buffers)
     }
 
-    /// Encodes the one-submission schedule's three compute passes (timed apart where the
-    /// adapter has timestamps): the cuts (both rings) and `plan`; `plan_cuts`; the lattice and
-    /// `finalize`. `params` covers every triangle, its pieces counted on the GPU.
+    /// Replays `recording` into `enc` for a frame's buffers (each named as it is bound).
+    fn replay(
+        &self,
+        gpu: &Gpu,
+        enc: &mut wgpu::CommandEncoder,
+        recording: &Recording,
+        frame: &FrameBuffers,
+        panorama: PanoramaKind,
+        timestamps: Option<&Timestamps>,
+    ) {
+        let variant = self.variant(gpu, panorama);
+        let mut pass: Option<wgpu::ComputePass<'static>> = None;
+        for command in &recording.commands {
+            match *command {
+                Command::Clear { buffer, bytes } => {
+                    drop(pass.take());
+                    enc.clear_buffer(frame.named(buffer), 0, bytes);
+                }
+                Command::Pass { label, timestamp } => {
+                    drop(pass.take());
+                    let timed = timestamps.filter(|_| timestamp.is_some());
+                    pass = Some(stamp::compute_pass(enc, label, timed, timestamp.unwrap_or(0)).forget_lifetime());
+                }
+                Command::Dispatch { entry, invocations } => {
+                    let pass = pass.as_mut().expect("a recording dispatches inside a pass");
+                    pass.set_pipeline(variant.pipeline(entry));
+                    pass.set_bind_group(0, &self.bind_group(gpu, entry, frame), &[]);
+                    let (x, y) = gpu.workgroups(invocations, 64);
+                    pass.dispatch_workgroups(x, y, 1);
+                }
+                Command::DispatchIndirect { entry, args, offset } => {
+                    let pass = pass.as_mut().expect("a recording dispatches inside a pass");
+                    pass.set_pipeline(variant.pipeline(entry));
+                    pass.set_bind_group(0, &self.bind_group(gpu, entry, frame), &[]);
+                    pass.dispatch_workgroups_indirect(frame.named(args), offset);
+                }
+            }
+        }
+    }
+
+    /// Encodes the one-submission schedule ([`one_submission`]; each pass timed where the
+    /// adapter has timestamps). `params` covers every triangle, its pieces counted on the GPU.
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -137,124 +170,50 @@ impl SubdivideStage {
     ) {
         let params = SubdivideParams { first_piece: 0, piece_count: PIECES_FROM_COUNTER, ..*params };
         gpu.queue.write_buffer(uniform, 0, bytemuck::bytes_of(&params));
-        let group = |entry| self.bind_group(gpu, entry, uniform, scene, b);
-        let [active_cuts, ring_cuts, plan, lattice_args, lattice, finalize] =
-            ["active_cuts", "ring_cuts", "plan", "lattice_args", "lattice", "finalize"].map(group);
-        let cut_groups = ["plan_cuts_args", "plan_cuts"].map(group);
-        let variant = self.variant(gpu, panorama);
-        enc.clear_buffer(&b.counters, 0, None);
-        enc.clear_buffer(&b.cut_edges, 0, None);
-        {
-            let mut pass = stamp::compute_pass(enc, "plan", timestamps, stamp::PLAN);
-            let (x, y) = gpu.workgroups(params.triangle_count, 64);
-            for (pipeline, group) in
-                [(&variant.active_cuts, &active_cuts), (&variant.ring_cuts, &ring_cuts), (&variant.plan, &plan)]
-            {
-                pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, group, &[]);
-                pass.dispatch_workgroups(x, y, 1);
-            }
-        }
-        {
-            let mut pass = stamp::compute_pass(enc, "plan_cuts", timestamps, stamp::PLAN_CUTS);
-            Self::encode_plan_cuts(variant, &mut pass, b, &cut_groups);
-        }
-        let mut pass = stamp::compute_pass(enc, "lattice", timestamps, stamp::LATTICE);
-        pass.set_pipeline(&variant.lattice_args);
-        pass.set_bind_group(0, &lattice_args, &[]);
-        pass.dispatch_workgroups(1, 1, 1);
-        pass.set_pipeline(&variant.lattice);
-        pass.set_bind_group(0, &lattice, &[]);
-        pass.dispatch_workgroups_indirect(&b.lattice_dispatch, 0);
-        pass.set_pipeline(&variant.finalize);
-        pass.set_bind_group(0, &finalize, &[]);
-        pass.dispatch_workgroups(1, 1, 1);
+        let recording = one_submission(params.triangle_count, timestamps.is_some());
+        self.replay(gpu, enc, &recording, &FrameBuffers { uniform, scene, b }, panorama, timestamps);
     }
 
-    /// Clears the counters and the edge marks and runs `active_cuts` and `ring_cuts` over every
-    /// triangle of the scene: the start of a chunked schedule.
+    /// The start of a chunked schedule ([`active_cuts`]), submitted.
     pub fn run_active_cuts(
         &self,
         gpu: &Gpu,
         uniform: &wgpu::Buffer,
         scene: &GpuScene,
-        buffers: &SubdivisionBuffers,
+        b: &SubdivisionBuffers,
         params: &SubdivideParams,
         panorama: PanoramaKind,
     ) {
         let params = SubdivideParams { first_triangle: 0, triangle_count: scene.triangle_count, ..*params };
         gpu.queue.write_buffer(uniform, 0, bytemuck::bytes_of(&params));
-        let groups = ["active_cuts", "ring_cuts"].map(|e| self.bind_group(gpu, e, uniform, scene, buffers));
-        let variant = self.variant(gpu, panorama);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        enc.clear_buffer(&buffers.counters, 0, None);
-        enc.clear_buffer(&buffers.cut_edges, 0, None);
-        {
-            let mut pass = enc.begin_compute_pass(&Default::default());
-            let (x, y) = gpu.workgroups(scene.triangle_count, 64);
-            for (pipeline, group) in [&variant.active_cuts, &variant.ring_cuts].into_iter().zip(&groups) {
-                pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, group, &[]);
-                pass.dispatch_workgroups(x, y, 1);
-            }
-        }
+        let frame = FrameBuffers { uniform, scene, b };
+        self.replay(gpu, &mut enc, &active_cuts(scene.triangle_count), &frame, panorama, None);
         gpu.queue.submit([enc.finish()]);
     }
 
-    /// Runs one compute entry point (`plan` with `plan_cuts` after it, or `lattice`) over
-    /// `count` invocations, then `finalize`, and returns the counters afterwards (the frame's
-    /// cuts, from [`Self::run_active_cuts`], are kept).
+    /// One step of a chunked schedule ([`pass_run`]: `plan` with `plan_cuts` after it, or
+    /// `lattice`, over `count` invocations, then `finalize`), submitted; the counters afterwards
+    /// (the frame's cuts, from [`Self::run_active_cuts`], are kept).
     #[allow(clippy::too_many_arguments)]
     pub fn run(
         &self,
         gpu: &Gpu,
-        entry: &str,
+        entry: &'static str,
         uniform: &wgpu::Buffer,
         scene: &GpuScene,
-        buffers: &SubdivisionBuffers,
+        b: &SubdivisionBuffers,
         params: &SubdivideParams,
         panorama: PanoramaKind,
         count: u32,
     ) -> Result<SubdivideCounters> {
         gpu.queue.write_buffer(uniform, 0, bytemuck::bytes_of(params));
-        let variant = self.variant(gpu, panorama);
-        let pipeline = if entry == "plan" { &variant.plan } else { &variant.lattice };
-        let bind_group = self.bind_group(gpu, entry, uniform, scene, buffers);
-        let cut_groups = ["plan_cuts_args", "plan_cuts"].map(|e| self.bind_group(gpu, e, uniform, scene, buffers));
-        let finalize = self.bind_group(gpu, "finalize", uniform, scene, buffers);
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        enc.clear_buffer(&buffers.counters, 0, Some(SubdivideCounters::RUN_BYTES));
-        {
-            let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, &bind_group, &[]);
-            let (x, y) = gpu.workgroups(count, 64);
-            pass.dispatch_workgroups(x, y, 1);
-            if entry == "plan" {
-                Self::encode_plan_cuts(variant, &mut pass, buffers, &cut_groups);
-            }
-            pass.set_pipeline(&variant.finalize);
-            pass.set_bind_group(0, &finalize, &[]);
-            pass.dispatch_workgroups(1, 1, 1);
-        }
+        let frame = FrameBuffers { uniform, scene, b };
+        self.replay(gpu, &mut enc, &pass_run(entry, count), &frame, panorama, None);
         gpu.queue.submit([enc.finish()]);
-        let bytes = gpu.download(&buffers.counters, COUNTERS_SIZE)?;
+        let bytes = gpu.download(&b.counters, COUNTERS_SIZE)?;
         Ok(*bytemuck::from_bytes(&bytes))
-    }
-
-    /// `plan_cuts_args` and `plan_cuts` (the triangles `plan` listed), after `plan`.
-    fn encode_plan_cuts(
-        variant: &Variant,
-        pass: &mut wgpu::ComputePass,
-        b: &SubdivisionBuffers,
-        groups: &[wgpu::BindGroup; 2],
-    ) {
-        pass.set_pipeline(&variant.plan_cuts_args);
-        pass.set_bind_group(0, &groups[0], &[]);
-        pass.dispatch_workgroups(1, 1, 1);
-        pass.set_pipeline(&variant.plan_cuts);
-        pass.set_bind_group(0, &groups[1], &[]);
-        pass.dispatch_workgroups_indirect(&b.lattice_dispatch, 12);
     }
 
     /// Runs the whole stage on a scene with `schedule` and reads its output back (the GPU side
@@ -335,5 +294,35 @@ impl SubdivideStage {
             }
             Ok(SubdivideOutput::indexed(nodes, indices, pieces, max_edge, cuts))
         })
+    }
+}
+
+/// The buffers a subdivision's recording names: the uniform, the scene's, the frame's.
+struct FrameBuffers<'f> {
+    uniform: &'f wgpu::Buffer,
+    scene: &'f GpuScene,
+    b: &'f SubdivisionBuffers,
+}
+
+impl FrameBuffers<'_> {
+    /// The buffer bound as `name` (`SUBDIVIDE.bindings`).
+    fn named(&self, name: &str) -> &wgpu::Buffer {
+        let (scene, b) = (self.scene, self.b);
+        match name {
+            "params" => self.uniform,
+            "vertices" => &scene.vertices,
+            "indices" => &scene.indices,
+            "pieces" => &b.pieces,
+            "out_nodes" => &b.nodes,
+            "counters" => &b.counters,
+            "draw_args" => &b.draw_args,
+            "lattice_dispatch" => &b.lattice_dispatch,
+            "object_edge_scale" => &scene.object_edge_scale,
+            "cut_list" => &b.cut_list,
+            "out_indices" => &b.indices,
+            "triangle_edges" => &scene.triangle_edges,
+            "cut_edges" | "edge_marks_read" => &b.cut_edges,
+            other => panic!("the subdivide stage binds no buffer {other}"),
+        }
     }
 }

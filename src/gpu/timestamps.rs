@@ -11,9 +11,9 @@ use crate::gpu::device::Gpu;
 
 pub const COUNT: u32 = 8;
 /// Query indices: the begin of each subdivision pass (its end is the next index) and of the raster.
-pub const PLAN: u32 = 0;
-pub const PLAN_CUTS: u32 = 2;
-pub const LATTICE: u32 = 4;
+pub const PLAN: u32 = crate::encoding::subdivide::PLAN_TIMESTAMP;
+pub const PLAN_CUTS: u32 = crate::encoding::subdivide::PLAN_CUTS_TIMESTAMP;
+pub const LATTICE: u32 = crate::encoding::subdivide::LATTICE_TIMESTAMP;
 pub const RASTER: u32 = 6;
 
 pub struct Timestamps {

@@ -1,0 +1,57 @@
+//! A stage's schedule as data (as vello's `Recording`): the buffers it clears, its compute passes
+//! and, in each, the entry points it dispatches — over a number of invocations, or indirectly from
+//! arguments a previous dispatch wrote. An engine replays a recording; the subdivision's two
+//! schedules are recordings ([`crate::encoding::subdivide::one_submission`],
+//! [`crate::encoding::subdivide::active_cuts`], [`crate::encoding::subdivide::pass_run`]).
+//! Buffers are named by the WGSL variable they are bound as.
+
+/// One step of a recording.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Command {
+    /// Clears a buffer to zero: its first `bytes`, or all of it.
+    Clear { buffer: &'static str, bytes: Option<u64> },
+    /// Begins a compute pass (ending the one before); `timestamp`: the first of its two query
+    /// indices, where the frame is timed.
+    Pass { label: &'static str, timestamp: Option<u32> },
+    /// Dispatches `entry` over `invocations` (in workgroups of 64, spread over two dimensions
+    /// where one is not enough) or, for a one-thread setup entry, 1.
+    Dispatch { entry: &'static str, invocations: u32 },
+    /// Dispatches `entry` with the workgroup counts at `offset` in `args`.
+    DispatchIndirect { entry: &'static str, args: &'static str, offset: u64 },
+}
+
+/// A schedule: commands in order.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Recording {
+    pub commands: Vec<Command>,
+}
+
+impl Recording {
+    pub fn clear(&mut self, buffer: &'static str, bytes: Option<u64>) -> &mut Self {
+        self.commands.push(Command::Clear { buffer, bytes });
+        self
+    }
+
+    pub fn pass(&mut self, label: &'static str, timestamp: Option<u32>) -> &mut Self {
+        self.commands.push(Command::Pass { label, timestamp });
+        self
+    }
+
+    pub fn dispatch(&mut self, entry: &'static str, invocations: u32) -> &mut Self {
+        self.commands.push(Command::Dispatch { entry, invocations });
+        self
+    }
+
+    pub fn dispatch_indirect(&mut self, entry: &'static str, args: &'static str, offset: u64) -> &mut Self {
+        self.commands.push(Command::DispatchIndirect { entry, args, offset });
+        self
+    }
+
+    /// The entry points it dispatches, in order.
+    pub fn entries(&self) -> impl Iterator<Item = &'static str> + '_ {
+        self.commands.iter().filter_map(|c| match *c {
+            Command::Dispatch { entry, .. } | Command::DispatchIndirect { entry, .. } => Some(entry),
+            _ => None,
+        })
+    }
+}
