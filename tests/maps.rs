@@ -180,3 +180,48 @@ fn mtl_bump_textures_become_normal_maps() {
     assert!(b.x < -0.3 && b.y.abs() < 0.02 && b.z > 0.5, "height ramp → {b}");
     assert!(n.x.abs() < 0.02 && n.y.abs() < 0.02 && n.z > 0.98, "flat normal map → {n}");
 }
+
+/// Tangents generated where a file gives none are MikkTSpace's, the frame the file's own were
+/// baked with: NormalTangentMirrorTest with its tangents removed gets them back (per vertex),
+/// and shades as with the file's (mean |difference| per channel over the drawn pixels, reported).
+#[test]
+fn generated_tangents_are_the_files_own_on_normal_tangent_mirror_test() {
+    if !common::assets_present() {
+        return;
+    }
+    let path = common::asset("gltf/NormalTangentMirrorTest/glTF-Binary/NormalTangentMirrorTest.glb");
+    let p = Projection { width: 720, height: 240, ..Projection::default() };
+    let mut file = twister::core::load::load_scene(path.to_str().unwrap(), &p).unwrap();
+    file.fit(2.2, &p).unwrap();
+    file.lights.push(Light::sun(20.0, 35.0, 3.0));
+    let wants: Vec<bool> =
+        std::iter::once(false).chain(file.materials.iter().map(|m| m.normal_texture != NO_TEXTURE)).collect();
+    let mut generated = file.clone();
+    let supplied = generated.vertices.iter().filter(|v| v.tangent != 0).count();
+    assert!(supplied > 1000, "the sample gives its tangents: {supplied}");
+    for v in &mut generated.vertices {
+        v.tangent = 0;
+    }
+    twister::core::scene::generate_tangents(&mut generated.vertices, &generated.indices, |m| wants[m as usize]);
+    let unpack = twister::core::scene::unpack_tangent;
+    let mut off = 0;
+    for (a, b) in file.vertices.iter().zip(&generated.vertices).filter(|(a, _)| a.tangent != 0) {
+        let (a, b) = (unpack(a.tangent), unpack(b.tangent));
+        off += (a.truncate().dot(b.truncate()) < 0.999 || a.w != b.w) as usize;
+    }
+    assert!(off * 100 <= supplied, "{off} of {supplied} generated tangents differ from the file's");
+    let settings = RenderSettings::new(p).with_lighting(twister::core::light::LightingMode::Pbr);
+    let (a, b) = (common::render(&file, &settings), common::render(&generated, &settings));
+    let mut sum = [0.0f64; 3];
+    let mut differ = 0;
+    for (pa, pb) in a.left.rgba.chunks(4).zip(b.left.rgba.chunks(4)) {
+        differ += (pa != pb) as usize;
+        for c in 0..3 {
+            sum[c] += (pa[c] as f64 - pb[c] as f64).abs();
+        }
+    }
+    let pixels = (a.left.width * a.left.height) as f64;
+    let mean = sum.map(|s| s / pixels);
+    eprintln!("generated vs file tangents: mean |difference| per channel {mean:.4?} levels over {pixels} pixels ({differ} differ); {off} of {supplied} tangents differ");
+    assert!(mean.iter().all(|&m| m < 0.25), "mean |difference| per channel {mean:?}");
+}

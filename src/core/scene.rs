@@ -2,7 +2,7 @@
 //! `scale`), plus the named objects they belong to.
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec3, Vec4};
 
 use crate::core::material::Material;
 use crate::core::projection::Projection;
@@ -326,53 +326,73 @@ mod tests {
     }
 }
 
-/// Per-vertex tangents where a file gives none, MikkTSpace-style (issue 17): each triangle's
-/// ∇u and ∇v in its plane (from its positions and texture coordinates) summed over the
-/// triangles around a vertex, weighted by their corner angles; the tangent is the sum of ∇u made
-/// normal to the vertex normal (Gram–Schmidt), w = +1 where n × t points against the summed ∇v
-/// (up the image: glTF's bitangent) and −1 where along it (mirrored texture coordinates). Only vertices without a tangent whose
-/// material `wants` one (it has a normal map) get one; where the sum vanishes (texture
-/// coordinates that do not vary, or mirrored halves meeting at a shared vertex) the vertex keeps
-/// none and the fragment stage falls back to the derivatives' frame.
+/// Per-vertex tangents where a file gives none: MikkTSpace itself (the `bevy_mikktspace` crate),
+/// the frame every baker uses and glTF asks for, over the triangles whose vertices all lack one
+/// and whose material `wants` one (it has a normal map). Texture coordinates are given v up, as
+/// MikkTSpace expects (glTF's v runs down the image): on Khronos NormalTangentMirrorTest this
+/// reproduces the file's own tangents, sign included. A vertex the algorithm leaves without a
+/// frame (a degenerate triangle without neighbours) keeps none, and the fragment stage falls back
+/// to the derivatives' frame. A vertex shared by triangles that MikkTSpace gives different frames
+/// (a seam it would split) keeps the last.
 pub fn generate_tangents(vertices: &mut [SceneVertex], indices: &[u32], wants: impl Fn(u32) -> bool) {
     let n = vertices.len();
-    let mut t_sum = vec![Vec3::ZERO; n];
-    let mut b_sum = vec![Vec3::ZERO; n];
-    for tri in indices.chunks_exact(3) {
-        let k = [tri[0] as usize, tri[1] as usize, tri[2] as usize];
-        if k.iter().any(|&i| i >= n || vertices[i].tangent != 0 || !wants(vertices[i].material)) {
-            continue;
-        }
-        let p = k.map(|i| Vec3::from(vertices[i].position));
-        let uv = k.map(|i| glam::Vec2::from(vertices[i].uv));
-        let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
-        let (d1, d2) = (uv[1] - uv[0], uv[2] - uv[0]);
-        let det = d1.x * d2.y - d2.x * d1.y;
-        if !(det.abs() > 1e-20) {
-            continue;
-        }
-        let t = (e1 * d2.y - e2 * d1.y) / det;
-        let b = (e2 * d1.x - e1 * d2.x) / det;
-        for c in 0..3 {
-            let (a, b_) = (p[(c + 1) % 3] - p[c], p[(c + 2) % 3] - p[c]);
-            let angle = a.angle_between(b_);
-            if angle.is_finite() {
-                t_sum[k[c]] += t.normalize_or_zero() * angle;
-                b_sum[k[c]] += b.normalize_or_zero() * angle;
-            }
+    let needs = |i: u32| (i as usize) < n && vertices[i as usize].tangent == 0 && wants(vertices[i as usize].material);
+    let faces: Vec<[u32; 3]> =
+        indices.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).filter(|t| t.iter().all(|&i| needs(i))).collect();
+    if faces.is_empty() {
+        return;
+    }
+    let mut mikk = MikkTSpace { vertices, faces: &faces, tangents: vec![None; n] };
+    if bevy_mikktspace::generate_tangents(&mut mikk).is_err() {
+        return;
+    }
+    let tangents = mikk.tangents;
+    for (v, t) in vertices.iter_mut().zip(tangents) {
+        if let Some(t) = t.map(Vec4::from).filter(|t| t.truncate().length() > 0.5) {
+            v.tangent = pack_tangent(t);
         }
     }
-    for (i, v) in vertices.iter_mut().enumerate() {
-        if v.tangent != 0 || t_sum[i] == Vec3::ZERO {
-            continue;
+}
+
+/// A mesh's triangles as MikkTSpace reads them, and the tangents it writes back per vertex.
+struct MikkTSpace<'m> {
+    vertices: &'m [SceneVertex],
+    faces: &'m [[u32; 3]],
+    tangents: Vec<Option<[f32; 4]>>,
+}
+
+impl MikkTSpace<'_> {
+    fn vertex(&self, face: usize, vert: usize) -> &SceneVertex {
+        &self.vertices[self.faces[face][vert] as usize]
+    }
+}
+
+impl bevy_mikktspace::Geometry for MikkTSpace<'_> {
+    fn num_faces(&self) -> usize {
+        self.faces.len()
+    }
+
+    fn num_vertices_of_face(&self, _face: usize) -> usize {
+        3
+    }
+
+    fn position(&self, face: usize, vert: usize) -> [f32; 3] {
+        self.vertex(face, vert).position
+    }
+
+    fn normal(&self, face: usize, vert: usize) -> [f32; 3] {
+        self.vertex(face, vert).normal
+    }
+
+    fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
+        let [u, v] = self.vertex(face, vert).uv;
+        [u, 1.0 - v]
+    }
+
+    fn set_tangent(&mut self, tangent: Option<bevy_mikktspace::TangentSpace>, face: usize, vert: usize) {
+        if let Some(t) = tangent {
+            self.tangents[self.faces[face][vert] as usize] = Some(t.tangent_encoded());
         }
-        let normal = Vec3::from(v.normal).normalize_or_zero();
-        let t = (t_sum[i] - normal * normal.dot(t_sum[i])).normalize_or_zero();
-        if t == Vec3::ZERO {
-            continue;
-        }
-        let w = if normal.cross(t).dot(b_sum[i]) > 0.0 { -1.0 } else { 1.0 };
-        v.tangent = pack_tangent(t.extend(w));
     }
 }
 
