@@ -37,7 +37,8 @@ pub(crate) struct DrawPipelines {
 /// alone or with the error pass's (and the surface points') targets; the eyes drawn
 /// ([`Layers`]: both in one multiview draw, or one eye, a pipeline per eye with the WGSL
 /// `override EYE`; the slit stage draws one eye per pass with per-eye parameters and keys every
-/// eye as the left); and the colour target's format (HDR or display).
+/// eye as the left); and whether it also keeps the linear colour (`hdr`: a float target at
+/// `HDR_LOCATION`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(crate) struct DrawKey {
     pub look: Option<(Look, Lit)>,
