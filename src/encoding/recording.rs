@@ -1,8 +1,8 @@
 //! A stage's schedule as data (as vello's `Recording`): the buffers it clears, its compute passes
 //! and, in each, the entry points it dispatches — over a number of invocations, or indirectly from
 //! arguments a previous dispatch wrote. An engine replays a recording; the subdivision's two
-//! schedules are recordings ([`crate::encoding::subdivide::one_submission`],
-//! [`crate::encoding::subdivide::active_cuts`], [`crate::encoding::subdivide::pass_run`]).
+//! schedules are recordings (`one_submission`, `active_cuts` and `pass_run` in the subdivide
+//! stage's encoding).
 //! Buffers are named by the WGSL variable they are bound as.
 
 /// One step of a recording.
