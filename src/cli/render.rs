@@ -4,19 +4,21 @@
 use crate::args::{LodMode, RenderArgs};
 use crate::scene::{lod_stats, open_renderer, prepare};
 use crate::writer::{FrameRecord, FrameWriter};
-use twister::core::settings::Method;
 use twister::error::{Error, Result};
 use twister::output::{check_outputs, write_all, OutputFile};
 
 /// The render settings `args` ask for, with the outputs' measures (depth, edge lengths for the
-/// statistics, the linear colour) and the background; checked once, then only read.
+/// statistics, the linear colour) and the background, checked as a whole; then only read.
 pub fn render_settings(args: &RenderArgs) -> Result<twister::RenderSettings> {
-    let settings = args.view.settings(&[args.view.method])?;
-    Ok(settings
+    let settings = args
+        .view
+        .settings(&[args.view.method])?
         .with_background(args.background)
         .with_measure_edges(args.stats.is_some())
         .with_depth(args.depth)
-        .with_hdr(args.hdr))
+        .with_hdr(args.hdr);
+    settings.validate()?;
+    Ok(settings)
 }
 
 pub fn render(args: &RenderArgs) -> Result<()> {
@@ -36,12 +38,6 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     let writer = FrameWriter::new(args, &settings, false)?;
     if args.lod_overlay && args.view.lod == LodMode::Off {
         return Err(Error::option("--lod-overlay", "needs --lod visual-field"));
-    }
-    if args.hdr && matches!(settings.subdivision.method, Method::Slit(_) | Method::Trace) {
-        return Err(Error::option(
-            "--hdr",
-            "the linear colour comes from the projection methods (vertex, fixed, adaptive); slit and trace write display colours",
-        ));
     }
     // Every output is checked before anything is rendered, and all are written together.
     let image_paths = writer.paths(None);

@@ -23,7 +23,7 @@ const HDR_NAMES: [&str; 2] = ["left_hdr.exr", "right_hdr.exr"];
 pub struct FrameWriter {
     out: PathBuf,
     layout: Layout,
-    format: ImageFormat,
+    /// The images' format and how they are encoded.
     encoding: Encoding,
     depth: bool,
     hdr: bool,
@@ -41,7 +41,6 @@ impl FrameWriter {
         Ok(FrameWriter {
             out: args.out.clone(),
             layout: args.layout.unwrap_or(Layout::default_for(projection.panorama)),
-            format: args.format,
             encoding: Encoding {
                 format: args.format,
                 quality: args.quality.unwrap_or(90),
@@ -59,7 +58,7 @@ impl FrameWriter {
 
     /// The layout's image names (`left.png`, `stereo_TB.png`, …).
     pub fn image_names(&self) -> Vec<String> {
-        layout_names(self.layout, self.format)
+        layout_names(self.layout, self.encoding.format)
     }
 
     /// Where a file of a frame goes: as named for a still, numbered for frame `k` of a sequence.
@@ -85,7 +84,7 @@ impl FrameWriter {
     /// A frame's files, encoded: the layout's images, then depth and linear colour where the
     /// frame holds them.
     pub fn files(&self, rendered: &Frame, frame: Option<u32>) -> Result<Vec<OutputFile>> {
-        let mut files = layout_images(rendered, self.layout, self.format)
+        let mut files = layout_images(rendered, self.layout, self.encoding.format)
             .iter()
             .map(|(name, img)| image_file(self.path(frame, name), img, &self.encoding))
             .collect::<Result<Vec<_>>>()?;
@@ -191,7 +190,7 @@ impl<'a> FrameRecord<'a> {
             convergence: p.convergence.map_or(serde_json::json!("parallel"), |c| serde_json::json!(c)),
             pole_merge: p.pole_merge,
             layout: writer.layout,
-            format: writer.format,
+            format: writer.encoding.format,
             adapter,
             timing: s.timing,
             ms_pose: None,

@@ -457,6 +457,12 @@ impl RenderSettings {
                  (the points it shows at a pixel lie on a curve): use the exact model",
             ));
         }
+        if self.shading.hdr && matches!(s.method, Method::Slit(_) | Method::Trace) {
+            return Err(Error::setting(
+                "shading.hdr",
+                "the linear colour comes from the projection methods (vertex, fixed, adaptive); slit and trace write display colours",
+            ));
+        }
         if !(self.shading.exposure_ev.is_finite() && self.shading.exposure_ev.abs() <= 64.0) {
             return Err(Error::setting(
                 "shading.exposure_ev",

@@ -35,9 +35,9 @@ pub(crate) struct FrameResources {
 }
 
 impl FrameResources {
-    /// The targets for this size, made anew only when the size changed.
-    /// The targets for this size (with the positions target if `positions`), made anew only
-    /// when the size changed or the positions target is wanted and missing.
+    /// The targets for this size (with the positions target if `positions`, the linear colour's
+    /// if `hdr`), made anew only when the size or the linear colour changed or the positions
+    /// target is wanted and missing.
     pub fn targets(&mut self, gpu: &Gpu, width: u32, height: u32, positions: bool, hdr: bool) -> &Targets {
         if !self.targets.as_ref().is_some_and(|t| {
             t.width == width && t.height == height && (t.position.is_some() || !positions) && t.hdr == hdr

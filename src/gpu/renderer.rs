@@ -93,12 +93,6 @@ impl Renderer {
         self.check_size(settings)?;
         let mut resources = self.resources.lock().unwrap_or_else(|e| e.into_inner());
         let shadow_maps = scene.write_lighting(&self.gpu, settings);
-        if settings.shading.hdr && matches!(settings.subdivision.method, MethodName::Slit(_) | MethodName::Trace) {
-            return Err(Error::setting(
-                "shading.hdr",
-                "the linear colour comes from the projection methods (vertex, fixed, adaptive); slit and trace write display colours",
-            ));
-        }
         self.shadow.draw_maps(&self.gpu, scene, settings.view(), &shadow_maps)?;
         let method: &dyn Method = match settings.subdivision.method {
             MethodName::Slit(_) => &self.slit,
