@@ -11,8 +11,8 @@ use twister::core::projection::Projection;
 use twister::core::settings::Method;
 use twister::core::visual_field::{Field, Gaze};
 use twister::cpu::subdivide::Subdivider;
+use twister::encoding::schedule::Schedule;
 use twister::encoding::subdivide::subdivide_params;
-use twister::gpu::subdivide::Schedule;
 use twister::{GpuScene, RenderSettings, Scene};
 
 /// Twelve 1024-triangle spheres 3 m around the viewer every 30°.

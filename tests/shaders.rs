@@ -29,13 +29,13 @@ fn parse_with_info(name: &str, source: &str) -> (naga::Module, naga::valid::Modu
 #[test]
 fn every_stage_composes_and_validates_and_every_wgsl_file_is_used() {
     let mut used = BTreeSet::new();
-    for stage in STAGES {
+    for file in STAGES.iter().flat_map(|stage| stage.files()) {
         for options in ShaderOptions::ALL {
-            parse(&format!("{} ({options:?})", stage.file()), &compose(stage, options));
+            parse(&format!("{} ({options:?})", file.path), &compose(&file, options));
         }
-        used.insert(stage.file());
+        used.insert(file.path.clone());
         // Shared modules it reaches.
-        let mut pending: Vec<&str> = imports(stage.source);
+        let mut pending: Vec<&str> = imports(file.source);
         while let Some(name) = pending.pop() {
             if let Some((_, src)) = SHARED.iter().find(|(n, _)| *n == name) {
                 if used.insert(format!("shaders/shared/{name}.wgsl")) {
@@ -45,7 +45,7 @@ fn every_stage_composes_and_validates_and_every_wgsl_file_is_used() {
         }
     }
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    for dir in ["shaders", "shaders/shared"] {
+    for dir in ["shaders", "shaders/shared", "shaders/subdivide"] {
         for entry in std::fs::read_dir(root.join(dir)).unwrap() {
             let entry = entry.unwrap();
             if entry.path().extension().is_some_and(|e| e == "wgsl") {
@@ -91,12 +91,12 @@ fn descriptor_bindings(stage: &Stage) -> BTreeSet<(u32, u32, String, String)> {
 
 #[test]
 fn each_stage_declares_exactly_the_bindings_and_entry_points_of_its_descriptor() {
-    for stage in STAGES {
-        let (module, info) = parse_with_info(stage.name, &compose(stage, ShaderOptions::ALL[0]));
-        assert_eq!(declared_bindings(&module), descriptor_bindings(stage), "{}: bindings", stage.name);
+    for (stage, file) in STAGES.iter().flat_map(|stage| stage.files().into_iter().map(move |f| (stage, f))) {
+        let (module, info) = parse_with_info(&file.path, &compose(&file, ShaderOptions::ALL[0]));
+        assert_eq!(declared_bindings(&module), descriptor_bindings(stage), "{}: bindings", file.path);
         let entries: BTreeSet<&str> = module.entry_points.iter().map(|e| e.name.as_str()).collect();
-        let wanted: BTreeSet<&str> = stage.entry_points.iter().map(|e| e.name).collect();
-        assert_eq!(entries, wanted, "{}: entry points", stage.name);
+        let wanted: BTreeSet<&str> = file.entry_points.iter().copied().collect();
+        assert_eq!(entries, wanted, "{}: entry points", file.path);
         // Each entry point uses exactly the bindings its descriptor lists.
         for (k, ep) in module.entry_points.iter().enumerate() {
             let function = info.get_entry_point(k);
@@ -156,8 +156,8 @@ fn layout_mismatches(module: &naga::Module, ty: naga::Handle<naga::Type>, rust: 
 #[test]
 fn every_bound_struct_has_the_field_offsets_of_its_rust_twin() {
     let mut checked = BTreeSet::new();
-    for stage in STAGES {
-        let module = parse(stage.name, &compose(stage, ShaderOptions::ALL[0]));
+    for (stage, file) in STAGES.iter().flat_map(|stage| stage.files().into_iter().map(move |f| (stage, f))) {
+        let module = parse(&file.path, &compose(&file, ShaderOptions::ALL[0]));
         for ty in bound_structs(&module) {
             let name = module.types[ty].name.clone().unwrap_or_default();
             let rust = LAYOUTS
@@ -177,7 +177,8 @@ fn every_bound_struct_has_the_field_offsets_of_its_rust_twin() {
 
 #[test]
 fn the_layout_check_catches_a_moved_field() {
-    let module = parse("subdivide", &compose(&twister::shader::SUBDIVIDE, ShaderOptions::ALL[0]));
+    let module =
+        parse("lattice", &compose(&twister::shader::SUBDIVIDE.file_of(Some("lattice")), ShaderOptions::ALL[0]));
     let (ty, _) = module.types.iter().find(|(_, t)| t.name.as_deref() == Some("Counters")).unwrap();
     let good = LAYOUTS.iter().find(|l| l.wgsl_name == "Counters").unwrap();
     assert!(layout_mismatches(&module, ty, good).is_empty());
@@ -191,7 +192,8 @@ fn the_layout_check_catches_a_moved_field() {
 #[test]
 fn generated_constants_are_what_the_rust_side_says() {
     use twister::encoding::constants::{all, Value};
-    let module = parse("subdivide", &compose(&twister::shader::SUBDIVIDE, ShaderOptions::ALL[0]));
+    let module =
+        parse("lattice", &compose(&twister::shader::SUBDIVIDE.file_of(Some("lattice")), ShaderOptions::ALL[0]));
     for (name, value) in all() {
         let (_, c) = module
             .constants

@@ -21,11 +21,12 @@ use twister::core::light::Tonemap;
 use twister::core::settings::{Method, Split};
 use twister::cpu::raster::raster;
 use twister::cpu::reduce_error::reduce_error;
+use twister::cpu::subdivide::passes::run_scheduled;
 use twister::cpu::subdivide::subdivide;
 use twister::encoding::params::{raster_params, trace_params};
+use twister::encoding::schedule::{Capacities, Schedule};
 use twister::encoding::subdivide::{subdivide_params, SubdivideOutput};
 use twister::encoding::types::ErrorStats;
-use twister::gpu::subdivide::Schedule;
 use twister::shader::STAGES;
 use twister::{Eye, Frame, GpuScene, Projection, RenderSettings, Renderer, Scene, Vertical};
 
@@ -281,7 +282,8 @@ impl Twin for Subdivide {
             .enumerate()
             .map(|(k, (scene, s))| {
                 let name = format!("case {k}: {} {}", scene.name, s.subdivision.method.name());
-                let cpu = Self::cpu(&(scene.clone(), s)).remove(0);
+                let cpu =
+                    subdivide(&subdivide_params(&s, 0, scene.triangle_count() as u32), &scene.vertices, &scene.indices);
                 assert!(cpu.vertices.len() / 3 > scene.triangle_count(), "{name}: exercises splits and seam copies");
                 cut_frames += (cpu.cuts != 0) as usize;
                 strip_frames += (cpu.strips > 0) as usize;
@@ -302,20 +304,29 @@ impl Twin for Subdivide {
     }
     fn gpu(r: &Renderer, (scene, settings): &Self::Case) -> Self::Output {
         let gs = GpuScene::upload(&r.gpu, scene).unwrap();
-        // Three ranges or more where the scene has the triangles.
-        let chunked = Schedule::Chunked { triangles_per_chunk: (scene.triangle_count() as u32 / 3).max(1) };
-        [Schedule::OneSubmission, chunked].map(|schedule| r.subdivide_readback(&gs, settings, schedule).unwrap()).into()
+        subdivide_schedules(scene).map(|schedule| r.subdivide_readback(&gs, settings, schedule).unwrap()).into()
     }
+    /// The twin's passes replaying the same schedules (the same recordings, parameters and
+    /// capacities as the GPU's read-back).
     fn cpu((scene, settings): &Self::Case) -> Self::Output {
-        vec![subdivide(&subdivide_params(settings, 0, scene.triangle_count() as u32), &scene.vertices, &scene.indices)]
+        let budget = Capacities::budget(settings.subdivision.memory_mb, common::renderer().gpu.max_binding());
+        subdivide_schedules(scene)
+            .map(|schedule| run_scheduled(settings, &scene.vertices, &scene.indices, schedule, budget).unwrap())
+            .into()
     }
     fn compare(gpu: &Self::Output, cpu: &Self::Output) -> Result<(), String> {
         let schedules = ["one submission", "chunked"];
-        for (output, schedule) in gpu.iter().zip(schedules) {
-            compare_subdivided(output, &cpu[0]).map_err(|e| format!("{schedule} schedule: {e}"))?;
+        for ((g, c), schedule) in gpu.iter().zip(cpu).zip(schedules) {
+            compare_subdivided(g, c).map_err(|e| format!("{schedule} schedule: {e}"))?;
         }
         Ok(())
     }
+}
+
+/// The schedules the twin check runs: the usual frame's (one submission, indirect), and the
+/// chunked one over three ranges or more where the scene has the triangles.
+fn subdivide_schedules(scene: &Scene) -> [Schedule; 2] {
+    [Schedule::OneSubmission, Schedule::Chunked { triangles_per_chunk: (scene.triangle_count() as u32 / 3).max(1) }]
 }
 
 /// One GPU output of the subdivide stage against the twin's.

@@ -560,3 +560,9 @@ fn plan_band(t: u32) {
         }
     }
 }
+
+// Whether a triangle with diamond distances `range` (`diamond_range`) reaches the first diamond
+// or spans a wide range of them: those ask for cuts (`triangle_cuts`).
+fn asks_for_cuts(range: vec2<f32>) -> bool {
+    return range.x < band_bound(1u) || range.y > WIDE_RATIO * range.x;
+}

@@ -9,7 +9,7 @@ use crate::core::projection::Projection;
 use crate::core::texture::{MaterialTable, Texture};
 use crate::error::{Error, Result};
 
-/// A scene vertex as the stages read it (`SceneVertex` in shaders/subdivide.wgsl). 64 bytes.
+/// A scene vertex as the stages read it (`SceneVertex` in shaders/shared/scene.wgsl). 64 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct SceneVertex {

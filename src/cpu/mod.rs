@@ -3,7 +3,7 @@
 //!
 //! | twin | WGSL |
 //! |---|---|
-//! | [`subdivide`] | `shaders/subdivide.wgsl` (entry points `plan`, `lattice_args`, `lattice`, `finalize`) |
+//! | [`subdivide`] | `shaders/subdivide/*.wgsl`, one file per pass (`active_cuts`, `ring_cuts`, `plan`, `plan_cuts_args`, `plan_cuts`, `lattice_args`, `lattice`, `finalize`: `subdivide::passes`), and `shaders/shared/subdivide_*.wgsl` |
 //! | [`raster`] | `shaders/raster.wgsl` |
 //! | [`slit`] | `shaders/slit.wgsl` |
 //! | [`trace`] | `shaders/trace.wgsl` |

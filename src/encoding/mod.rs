@@ -7,11 +7,13 @@
 //! - [`constants`]: constants shared with WGSL (the generated `constants` module);
 //! - [`params`], [`subdivide`], [`slits`], [`skin`]: each stage's parameters and tables built
 //!   from the settings and the scene, and the outputs both engines give;
-//! - [`recording`]: a stage's schedule as data (the subdivision's, in [`subdivide`]).
+//! - [`recording`]: a stage's schedule as data (the subdivision's, in [`subdivide`]);
+//! - [`schedule`]: the subdivision's frame schedules, run by either engine.
 
 pub mod constants;
 pub mod params;
 pub mod recording;
+pub mod schedule;
 pub mod skin;
 pub mod slits;
 pub mod subdivide;

@@ -14,7 +14,7 @@ use crate::core::projection::{PanoramaKind, Projection, Vertical};
 use crate::core::scene::SceneVertex;
 pub use crate::core::shadow::GpuShadowMap;
 
-/// A vertex of a prepared triangle (`DrawVertex` in shaders/subdivide.wgsl and raster.wgsl),
+/// A vertex of a prepared triangle (`DrawVertex` in shaders/shared/subdivide_types.wgsl, read by raster.wgsl),
 /// in the viewer frame. `theta_ref` is the azimuth the vertex stage unwraps θ around; seam
 /// copies carry it shifted by ±2π. 64 bytes; also the vertex-buffer layout of the raster stage.
 #[repr(C)]
@@ -88,7 +88,7 @@ impl From<&Projection> for ProjectionUniform {
     }
 }
 
-/// `SubdivideParams` in shaders/subdivide.wgsl. 176 bytes.
+/// `SubdivideParams` in shaders/shared/subdivide_types.wgsl. 176 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct SubdivideParams {
@@ -124,7 +124,7 @@ pub struct SubdivideParams {
     pub _pad2: u32,
 }
 
-/// `Counters` in shaders/subdivide.wgsl.
+/// `Counters` in shaders/shared/subdivide_types.wgsl.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct SubdivideCounters {

@@ -204,7 +204,7 @@ fn draw_pipeline(
         label: Some(stage.stage.name),
         layout: Some(stage.draw_layout()),
         vertex: wgpu::VertexState {
-            module: &stage.module,
+            module: stage.module(None),
             entry_point: Some(if background { "vs_background" } else { "vs_main" }),
             compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
             buffers: if background { &[] } else { &buffers },
@@ -224,7 +224,7 @@ fn draw_pipeline(
         }),
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
-            module: &stage.module,
+            module: stage.module(None),
             entry_point: Some(match (background, outputs) {
                 (true, _) => "fs_background",
                 (_, 1) => "fs_main",

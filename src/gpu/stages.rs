@@ -17,7 +17,8 @@ pub struct PipelineLayout {
 
 pub struct GpuStage {
     pub stage: &'static Stage,
-    pub module: wgpu::ShaderModule,
+    /// One module per WGSL file of the stage, with the entry points it holds.
+    modules: Vec<(Vec<&'static str>, wgpu::ShaderModule)>,
     pub layouts: Vec<PipelineLayout>,
 }
 
@@ -41,10 +42,17 @@ fn layout_entry(b: &Binding, visibility: wgpu::ShaderStages) -> wgpu::BindGroupL
 impl GpuStage {
     pub fn new(gpu: &Gpu, stage: &'static Stage) -> GpuStage {
         let device = &gpu.device;
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some(stage.name),
-            source: wgpu::ShaderSource::Wgsl(compose(stage, gpu.shader_options()).into()),
-        });
+        let modules = stage
+            .files()
+            .into_iter()
+            .map(|file| {
+                let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some(&file.path),
+                    source: wgpu::ShaderSource::Wgsl(compose(&file, gpu.shader_options()).into()),
+                });
+                (file.entry_points, module)
+            })
+            .collect();
         let (visibility, pipelines): (_, Vec<Option<&'static str>>) = match stage.kind {
             StageKind::Compute => {
                 (wgpu::ShaderStages::COMPUTE, stage.entry_points.iter().map(|e| Some(e.name)).collect())
@@ -76,7 +84,13 @@ impl GpuStage {
                 PipelineLayout { entry, groups, layout }
             })
             .collect();
-        GpuStage { stage, module, layouts }
+        GpuStage { stage, modules, layouts }
+    }
+
+    /// The module that holds `entry` (None: the drawing pipeline's, the stage's one file).
+    pub fn module(&self, entry: Option<&str>) -> &wgpu::ShaderModule {
+        let holds = |(entries, _): &&(Vec<&str>, wgpu::ShaderModule)| entry.is_none_or(|e| entries.contains(&e));
+        &self.modules.iter().find(holds).unwrap_or_else(|| panic!("{} has no entry point {entry:?}", self.stage.name)).1
     }
 
     fn pipeline_layout(&self, entry: Option<&str>) -> &PipelineLayout {
@@ -101,7 +115,7 @@ impl GpuStage {
         gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some(entry),
             layout: Some(&self.pipeline_layout(Some(entry)).layout),
-            module: &self.module,
+            module: self.module(Some(entry)),
             entry_point: Some(entry),
             compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
             cache: None,

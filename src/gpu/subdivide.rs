@@ -1,17 +1,12 @@
-//! The `subdivide` stage on the GPU (shaders/subdivide.wgsl; CPU twin `cpu::subdivide`): its
-//! pipelines per panorama, its bind groups, and its two schedules.
+//! The `subdivide` stage on the GPU (shaders/subdivide/, one file per pass; CPU twin `cpu::subdivide`): its
+//! pipelines per panorama, its bind groups, and the replay of its recordings.
 //!
-//! - **One submission** (the usual frame, [`SubdivideStage::encode`]): the counters and the
-//!   edge marks cleared; `active_cuts`, `ring_cuts` and `plan` over every triangle;
-//!   `plan_cuts_args` and `plan_cuts` (indirect, over the triangles `plan` listed);
-//!   `lattice_args`, `lattice` (indirect, one invocation per piece), `finalize` (the draw's
-//!   arguments). The raster follows in the same submission.
-//! - **Chunked** ([`SubdivideStage::run_active_cuts`], then [`SubdivideStage::run`] with `plan`
-//!   over a range of triangles and `lattice` over a range of pieces, the counters read between):
-//!   where a buffer overflowed, or for the read-back over ranges.
-//!
-//! [`SubdivideStage::readback`] runs either schedule and reads the output back: what the twin
-//! test compares with `cpu::subdivide`.
+//! - **One submission** (the usual frame, [`SubdivideStage::encode`]): the `one_submission`
+//!   recording encoded before the raster, in the same submission.
+//! - **Any recording, submitted** ([`SubdivideStage::submit`]): what the schedules of
+//!   `encoding::schedule` replay through an engine — the chunked frame's (`gpu::subdivided`)
+//!   and the read-back's ([`SubdivideStage::readback`], what the twin test compares with the
+//!   CPU twin running the same schedule).
 
 use std::sync::OnceLock;
 
@@ -19,27 +14,18 @@ use crate::core::projection::PanoramaKind;
 use crate::core::settings::RenderSettings;
 use crate::encoding::constants::PIECES_FROM_COUNTER;
 use crate::encoding::recording::{Command, Recording};
-use crate::encoding::subdivide::{active_cuts, one_submission, pass_run, subdivide_params, SubdivideOutput};
+use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine, INDICES_SIZE, NODE_SIZE};
+use crate::encoding::subdivide::{one_submission, SubdivideOutput};
 use crate::encoding::types::{DrawVertex, SubdivideCounters, SubdivideParams};
 use crate::error::Result;
 use crate::gpu::device::Gpu;
-use crate::gpu::frame_plan::{Capacities, SubdivisionBuffers, INDICES_SIZE, NODE_SIZE};
+use crate::gpu::frame_plan::SubdivisionBuffers;
 use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
 use crate::gpu::timestamps::{self as stamp, Timestamps};
 use crate::shader::SUBDIVIDE;
 
 pub(crate) const COUNTERS_SIZE: u64 = std::mem::size_of::<SubdivideCounters>() as u64;
-
-/// Which schedule a read-back runs (see the module doc).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Schedule {
-    /// The usual frame's: everything in one submission, indirect dispatches sized on the GPU.
-    OneSubmission,
-    /// The chunked frame's: `plan` over ranges of this many triangles, `lattice` over all the
-    /// pieces of a range, the counters read between.
-    Chunked { triangles_per_chunk: u32 },
-}
 
 /// The stage's pipelines for one panorama, one per entry point.
 struct Variant {
@@ -174,51 +160,27 @@ impl SubdivideStage {
         self.replay(gpu, enc, &recording, &FrameBuffers { uniform, scene, b }, panorama, timestamps);
     }
 
-    /// The start of a chunked schedule ([`active_cuts`]), submitted.
-    pub fn run_active_cuts(
+    /// Replays `recording` with `params` as the uniform for a frame's buffers, submitted; the
+    /// counters afterwards.
+    pub fn submit(
         &self,
         gpu: &Gpu,
-        uniform: &wgpu::Buffer,
-        scene: &GpuScene,
-        b: &SubdivisionBuffers,
+        recording: &Recording,
+        frame: &FrameBuffers,
         params: &SubdivideParams,
         panorama: PanoramaKind,
-    ) {
-        let params = SubdivideParams { first_triangle: 0, triangle_count: scene.triangle_count, ..*params };
-        gpu.queue.write_buffer(uniform, 0, bytemuck::bytes_of(&params));
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        let frame = FrameBuffers { uniform, scene, b };
-        self.replay(gpu, &mut enc, &active_cuts(scene.triangle_count), &frame, panorama, None);
-        gpu.queue.submit([enc.finish()]);
-    }
-
-    /// One step of a chunked schedule ([`pass_run`]: `plan` with `plan_cuts` after it, or
-    /// `lattice`, over `count` invocations, then `finalize`), submitted; the counters afterwards
-    /// (the frame's cuts, from [`Self::run_active_cuts`], are kept).
-    #[allow(clippy::too_many_arguments)]
-    pub fn run(
-        &self,
-        gpu: &Gpu,
-        entry: &'static str,
-        uniform: &wgpu::Buffer,
-        scene: &GpuScene,
-        b: &SubdivisionBuffers,
-        params: &SubdivideParams,
-        panorama: PanoramaKind,
-        count: u32,
     ) -> Result<SubdivideCounters> {
-        gpu.queue.write_buffer(uniform, 0, bytemuck::bytes_of(params));
+        gpu.queue.write_buffer(frame.uniform, 0, bytemuck::bytes_of(params));
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        let frame = FrameBuffers { uniform, scene, b };
-        self.replay(gpu, &mut enc, &pass_run(entry, count), &frame, panorama, None);
+        self.replay(gpu, &mut enc, recording, frame, panorama, None);
         gpu.queue.submit([enc.finish()]);
-        let bytes = gpu.download(&b.counters, COUNTERS_SIZE)?;
+        let bytes = gpu.download(&frame.b.counters, COUNTERS_SIZE)?;
         Ok(*bytemuck::from_bytes(&bytes))
     }
 
     /// Runs the whole stage on a scene with `schedule` and reads its output back (the GPU side
-    /// of the twin test). Buffers grow until the output fits; a chunked schedule's ranges are
-    /// concatenated (indices moved by the nodes before them).
+    /// of the twin test): a chunked schedule's ranges concatenated, indices moved by the nodes
+    /// before them.
     pub fn readback(
         &self,
         gpu: &Gpu,
@@ -227,81 +189,63 @@ impl SubdivideStage {
         schedule: Schedule,
     ) -> Result<SubdivideOutput> {
         gpu.scoped("subdividing", || {
-            let panorama = settings.projection().panorama;
-            let n = scene.triangle_count;
-            let mut cache = None;
-            let uniform = gpu.uniform_buffer::<SubdivideParams>("subdivide params");
-            let mut want = Capacities { pieces: n.max(64), triangles: n.saturating_mul(4).max(1024) };
-            let read = |b: &SubdivisionBuffers, counters: &SubdivideCounters| -> Result<(Vec<DrawVertex>, Vec<u32>)> {
-                let nodes = gpu.download(&b.nodes, counters.nodes as u64 * NODE_SIZE)?;
-                let indices = gpu.download(&b.indices, counters.triangles as u64 * INDICES_SIZE)?;
-                Ok((bytemuck::cast_slice(&nodes).to_vec(), bytemuck::cast_slice(&indices).to_vec()))
+            let mut engine = Readback {
+                stage: self,
+                gpu,
+                scene,
+                panorama: settings.projection().panorama,
+                uniform: gpu.uniform_buffer::<SubdivideParams>("subdivide params"),
+                cache: None,
+                nodes: Vec::new(),
+                indices: Vec::new(),
             };
-            let chunk = match schedule {
-                Schedule::OneSubmission => loop {
-                    let b = SubdivisionBuffers::ensure(&mut cache, gpu, want, scene);
-                    let mut params = subdivide_params(settings, 0, n);
-                    (params.piece_capacity, params.triangle_capacity) = (b.capacity.pieces, b.capacity.triangles);
-                    let mut enc = gpu.device.create_command_encoder(&Default::default());
-                    self.encode(gpu, &mut enc, &uniform, scene, b, &params, panorama, None);
-                    gpu.queue.submit([enc.finish()]);
-                    let counters: SubdivideCounters = *bytemuck::from_bytes(&gpu.download(&b.counters, COUNTERS_SIZE)?);
-                    if counters.pieces > b.capacity.pieces || counters.output_units() > b.capacity.triangles {
-                        want = Capacities {
-                            pieces: want.pieces.max(counters.pieces),
-                            triangles: want.triangles.max(counters.output_units()),
-                        };
-                        continue;
-                    }
-                    let (nodes, indices) = read(b, &counters)?;
-                    return Ok(SubdivideOutput::indexed(
-                        nodes,
-                        indices,
-                        counters.pieces,
-                        f32::from_bits(counters.max_edge_bits),
-                        counters.cuts(),
-                    ));
-                },
-                Schedule::Chunked { triangles_per_chunk } => triangles_per_chunk.max(1),
-            };
-            let (mut nodes, mut indices, mut pieces, mut max_edge, mut cuts) = (Vec::new(), Vec::new(), 0, 0.0f32, 0);
-            let mut first = 0;
-            let b = SubdivisionBuffers::ensure(&mut cache, gpu, want, scene);
-            self.run_active_cuts(gpu, &uniform, scene, b, &subdivide_params(settings, 0, n), panorama);
-            while first < n {
-                let count = chunk.min(n - first);
-                let b = SubdivisionBuffers::ensure(&mut cache, gpu, want, scene);
-                let mut params = subdivide_params(settings, first, count);
-                (params.piece_capacity, params.triangle_capacity) = (b.capacity.pieces, b.capacity.triangles);
-                let planned = self.run(gpu, "plan", &uniform, scene, b, &params, panorama, count)?;
-                if planned.pieces > b.capacity.pieces {
-                    want.pieces = planned.pieces;
-                    continue;
-                }
-                (params.first_piece, params.piece_count) = (0, planned.pieces);
-                let done = self.run(gpu, "lattice", &uniform, scene, b, &params, panorama, planned.pieces)?;
-                if done.output_units() > b.capacity.triangles {
-                    want.triangles = done.output_units();
-                    continue;
-                }
-                let (chunk_nodes, chunk_indices) = read(b, &done)?;
-                indices.extend(chunk_indices.iter().map(|i| i + nodes.len() as u32));
-                nodes.extend(chunk_nodes);
-                pieces += planned.pieces;
-                max_edge = max_edge.max(f32::from_bits(done.max_edge_bits));
-                cuts = done.cuts();
-                first += count;
-            }
-            Ok(SubdivideOutput::indexed(nodes, indices, pieces, max_edge, cuts))
+            let budget = Capacities::budget(settings.subdivision.memory_mb, gpu.max_binding());
+            let totals = run_schedule(&mut engine, settings, scene.triangle_count, schedule, budget)?;
+            let pieces = totals.pieces as u32;
+            Ok(SubdivideOutput::indexed(engine.nodes, engine.indices, pieces, totals.max_edge_px, totals.cuts))
         })
     }
 }
 
+/// The read-back's engine: submits each recording, downloads each range's output.
+struct Readback<'a> {
+    stage: &'a SubdivideStage,
+    gpu: &'a Gpu,
+    scene: &'a GpuScene,
+    panorama: PanoramaKind,
+    uniform: wgpu::Buffer,
+    cache: Option<SubdivisionBuffers>,
+    nodes: Vec<DrawVertex>,
+    indices: Vec<u32>,
+}
+
+impl SubdivisionEngine for Readback<'_> {
+    fn ensure(&mut self, want: Capacities) -> Capacities {
+        SubdivisionBuffers::ensure(&mut self.cache, self.gpu, want, self.scene).capacity
+    }
+
+    fn replay(&mut self, recording: &Recording, params: &SubdivideParams) -> Result<SubdivideCounters> {
+        let b = self.cache.as_ref().expect("ensured before a replay");
+        let frame = FrameBuffers { uniform: &self.uniform, scene: self.scene, b };
+        self.stage.submit(self.gpu, recording, &frame, params, self.panorama)
+    }
+
+    fn take(&mut self, counters: &SubdivideCounters) -> Result<()> {
+        let b = self.cache.as_ref().expect("ensured before a replay");
+        let nodes = self.gpu.download(&b.nodes, counters.nodes as u64 * NODE_SIZE)?;
+        let indices = self.gpu.download(&b.indices, counters.triangles as u64 * INDICES_SIZE)?;
+        let offset = self.nodes.len() as u32;
+        self.indices.extend(bytemuck::cast_slice::<u8, u32>(&indices).iter().map(|i| i + offset));
+        self.nodes.extend_from_slice(bytemuck::cast_slice(&nodes));
+        Ok(())
+    }
+}
+
 /// The buffers a subdivision's recording names: the uniform, the scene's, the frame's.
-struct FrameBuffers<'f> {
-    uniform: &'f wgpu::Buffer,
-    scene: &'f GpuScene,
-    b: &'f SubdivisionBuffers,
+pub(crate) struct FrameBuffers<'f> {
+    pub uniform: &'f wgpu::Buffer,
+    pub scene: &'f GpuScene,
+    pub b: &'f SubdivisionBuffers,
 }
 
 impl FrameBuffers<'_> {

@@ -7,17 +7,20 @@
 use std::time::Instant;
 
 use crate::core::frame::{Frame, FrameStats, Timing};
+use crate::core::projection::PanoramaKind;
 use crate::core::settings::RenderSettings;
 use crate::encoding::params::raster_params;
+use crate::encoding::recording::Recording;
+use crate::encoding::schedule::{run_chunked, Capacities, FramePlan, SubdivisionEngine};
 use crate::encoding::subdivide::subdivide_params;
 use crate::encoding::types::{SubdivideCounters, SubdivideParams};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::gpu::device::Gpu;
 use crate::gpu::draw::{DrawKey, DrawPipelines, DrawStage, Lit, Look};
 use crate::gpu::frame::{FrameEnd, FrameResources, Method};
-use crate::gpu::frame_plan::{on_overflow, Capacities, FramePlan, Overflow, SubdivisionBuffers};
+use crate::gpu::frame_plan::SubdivisionBuffers;
 use crate::gpu::scene::GpuScene;
-use crate::gpu::subdivide::{SubdivideStage, COUNTERS_SIZE};
+use crate::gpu::subdivide::{FrameBuffers, SubdivideStage, COUNTERS_SIZE};
 use crate::gpu::targets::{Layers, Targets};
 use crate::gpu::timestamps as stamp;
 
@@ -207,7 +210,7 @@ impl SubdividedMethod {
         }
     }
 
-    /// The chunked schedule (see [`FramePlan::Chunked`]): wall times per pass.
+    /// The chunked schedule (see [`FramePlan::Chunked`]; [`run_chunked`]): wall times per pass.
     #[allow(clippy::too_many_arguments)]
     fn render_chunked(
         &self,
@@ -220,109 +223,59 @@ impl SubdividedMethod {
         stats: &mut FrameStats,
     ) -> Result<()> {
         let n = scene.triangle_count;
-        let panorama = settings.projection().panorama;
-        let mut clock = ChunkClock::default();
-        let (mut first_tri, mut tri_chunk) = (0u32, n.max(1));
         let b = SubdivisionBuffers::ensure(&mut res.buffers, gpu, *want, scene);
-        tri_chunk = tri_chunk.min(b.cut_list_capacity);
-        let t = Instant::now();
-        let cuts_params = subdivide_params(settings, 0, n);
-        self.subdivide.run_active_cuts(gpu, &res.subdivide_params, scene, b, &cuts_params, panorama);
-        clock.subdivide += t.elapsed().as_secs_f64() * 1e3;
-        while first_tri < n || !clock.drawn {
-            let tri_count = tri_chunk.min(n - first_tri);
-            let b = SubdivisionBuffers::ensure(&mut res.buffers, gpu, *want, scene);
-            let mut params = subdivide_params(settings, first_tri, tri_count);
-            params.piece_capacity = b.capacity.pieces.min(budget.pieces);
-            params.triangle_capacity = b.capacity.triangles;
-            let t = Instant::now();
-            let planned =
-                self.subdivide.run(gpu, "plan", &res.subdivide_params, scene, b, &params, panorama, tri_count)?;
-            clock.subdivide += t.elapsed().as_secs_f64() * 1e3;
-            if planned.pieces > params.piece_capacity {
-                match on_overflow(planned.pieces, budget.pieces, tri_count) {
-                    Overflow::Grow(p) => want.pieces = p,
-                    Overflow::Halve(c) => tri_chunk = c,
-                    Overflow::TooBig => {
-                        return Err(too_small(
-                            settings,
-                            format!(
-                                "one triangle needs {} pieces; raise the edge length L or the memory budget",
-                                planned.pieces
-                            ),
-                        ))
-                    }
-                }
-                continue;
-            }
-            stats.pieces += planned.pieces as u64;
-            let pieces = planned.pieces;
-            self.draw_pieces(gpu, res, scene, settings, &mut params, pieces, (want, budget), stats, &mut clock)?;
-            first_tri += tri_count;
-        }
-        stats.ms_subdivide = Some(clock.subdivide);
-        stats.ms_raster = Some(clock.raster);
+        let chunk = n.max(1).min(b.cut_list_capacity);
+        let panorama = settings.projection().panorama;
+        let mut engine = ChunkDraw { method: self, gpu, res, scene, settings, panorama, clock: ChunkClock::default() };
+        let totals = run_chunked(&mut engine, settings, n, want, budget, chunk)?;
+        stats.pieces += totals.pieces;
+        stats.triangles_out += totals.triangles;
+        stats.nodes_out += totals.nodes;
+        stats.chunks += totals.chunks;
+        stats.max_sub_edge_px = stats.max_sub_edge_px.max(totals.max_edge_px);
+        stats.ms_subdivide = Some(engine.clock.subdivide);
+        stats.ms_raster = Some(engine.clock.raster);
         Ok(())
     }
+}
 
-    /// The lattices of a chunk's `pieces` planned pieces, in ranges that fit the output buffer
-    /// (grown within the budget, else halved), each range drawn into the targets at once.
-    #[allow(clippy::too_many_arguments)]
-    fn draw_pieces(
-        &self,
-        gpu: &Gpu,
-        res: &mut FrameResources,
-        scene: &GpuScene,
-        settings: &RenderSettings,
-        params: &mut SubdivideParams,
-        pieces: u32,
-        (want, budget): (&mut Capacities, Capacities),
-        stats: &mut FrameStats,
-        clock: &mut ChunkClock,
-    ) -> Result<()> {
-        let panorama = settings.projection().panorama;
-        let (mut first_piece, mut piece_chunk) = (0u32, pieces.max(1));
-        let mut piece_done = false;
-        while first_piece < pieces || !piece_done {
-            let piece_count = piece_chunk.min(pieces - first_piece);
-            let b = SubdivisionBuffers::ensure(&mut res.buffers, gpu, *want, scene);
-            params.first_piece = first_piece;
-            params.piece_count = piece_count;
-            params.triangle_capacity = b.capacity.triangles.min(budget.triangles);
-            let t = Instant::now();
-            let done =
-                self.subdivide.run(gpu, "lattice", &res.subdivide_params, scene, b, params, panorama, piece_count)?;
-            clock.subdivide += t.elapsed().as_secs_f64() * 1e3;
-            if done.output_units() > params.triangle_capacity {
-                match on_overflow(done.output_units(), budget.triangles, piece_count) {
-                    Overflow::Grow(t) => want.triangles = t,
-                    Overflow::Halve(c) => piece_chunk = c,
-                    Overflow::TooBig => {
-                        let why = format!(
-                            "one piece makes {} triangles and nodes; lower the fixed N or raise the memory budget",
-                            done.output_units()
-                        );
-                        return Err(too_small(settings, why));
-                    }
-                }
-                continue;
-            }
-            let t = Instant::now();
-            let targets = res.targets.as_ref().expect("made");
-            let b = res.buffers.as_ref().expect("ensured");
-            let mut enc = gpu.device.create_command_encoder(&Default::default());
-            self.encode_raster(gpu, &mut enc, res, scene, targets, b, settings, !clock.drawn, None);
-            gpu.queue.submit([enc.finish()]);
-            gpu.wait();
-            clock.raster += t.elapsed().as_secs_f64() * 1e3;
-            clock.drawn = true;
-            piece_done = true;
-            stats.triangles_out += done.triangles as u64;
-            stats.nodes_out += done.nodes as u64;
-            stats.chunks += 1;
-            stats.max_sub_edge_px = stats.max_sub_edge_px.max(f32::from_bits(done.max_edge_bits));
-            first_piece += piece_count;
-        }
+/// The chunked frame's engine: submits each recording, draws each range's output into the
+/// targets (the first range clears them).
+struct ChunkDraw<'a> {
+    method: &'a SubdividedMethod,
+    gpu: &'a Gpu,
+    res: &'a mut FrameResources,
+    scene: &'a GpuScene,
+    settings: &'a RenderSettings,
+    panorama: PanoramaKind,
+    clock: ChunkClock,
+}
+
+impl SubdivisionEngine for ChunkDraw<'_> {
+    fn ensure(&mut self, want: Capacities) -> Capacities {
+        SubdivisionBuffers::ensure(&mut self.res.buffers, self.gpu, want, self.scene).capacity
+    }
+
+    fn replay(&mut self, recording: &Recording, params: &SubdivideParams) -> Result<SubdivideCounters> {
+        let t = Instant::now();
+        let b = self.res.buffers.as_ref().expect("ensured before a replay");
+        let frame = FrameBuffers { uniform: &self.res.subdivide_params, scene: self.scene, b };
+        let counters = self.method.subdivide.submit(self.gpu, recording, &frame, params, self.panorama)?;
+        self.clock.subdivide += t.elapsed().as_secs_f64() * 1e3;
+        Ok(counters)
+    }
+
+    fn take(&mut self, _: &SubdivideCounters) -> Result<()> {
+        let t = Instant::now();
+        let (gpu, res) = (self.gpu, &*self.res);
+        let targets = res.targets.as_ref().expect("made");
+        let b = res.buffers.as_ref().expect("ensured");
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        self.method.encode_raster(gpu, &mut enc, res, self.scene, targets, b, self.settings, !self.clock.drawn, None);
+        gpu.queue.submit([enc.finish()]);
+        gpu.wait();
+        self.clock.raster += t.elapsed().as_secs_f64() * 1e3;
+        self.clock.drawn = true;
         Ok(())
     }
 }
@@ -334,10 +287,4 @@ struct ChunkClock {
     subdivide: f64,
     raster: f64,
     drawn: bool,
-}
-
-/// The memory budget cannot hold what one triangle or piece makes.
-fn too_small(settings: &RenderSettings, why: String) -> Error {
-    let memory_mb = settings.subdivision.memory_mb;
-    Error::setting("subdivision.memory_mb", format!("{memory_mb} is too small: {why}"))
 }

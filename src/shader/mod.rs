@@ -1,13 +1,14 @@
 //! The WGSL side's interface, with no GPU in it: the stage registry, WGSL composition, the
 //! shared constants and the plain-old-data structs.
 //!
-//! **A stage** is one WGSL file in `shaders/` (its entry points), a CPU twin of the same name
-//! in `src/cpu/`, and one [`Stage`] descriptor here listing its bindings. The GPU layer builds
+//! **A stage** is one WGSL file in `shaders/` (its entry points) or, for a stage of several
+//! passes (`subdivide`), one file per pass in `shaders/NAME/` (as vello's), a CPU twin of the
+//! same name in `src/cpu/`, and one [`Stage`] descriptor here listing its bindings. The GPU layer builds
 //! the stage's explicit bind group layouts and pipelines from the descriptor
 //! (`gpu::stages`), and `tests/shaders.rs` checks every descriptor against the composed WGSL
 //! (reflected with naga): the same bindings, and every uniform/storage struct laid out exactly
 //! as its Rust twin in [`crate::encoding::types::LAYOUTS`], field offset by field offset. Adding a stage is: the
-//! WGSL file, its twin, a `Stage` constant, a line in [`STAGES`].
+//! WGSL file (or files), its twin, a `Stage` constant, a line in [`STAGES`].
 //!
 //! **Composition.** A WGSL file pulls in shared code with `#import NAME` lines (vello's
 //! convention): `shaders/shared/NAME.wgsl`, or one of the generated modules `constants`
@@ -62,18 +63,36 @@ use BindingKind::{Storage, StorageReadWrite, Uniform};
 pub struct EntryPoint {
     pub name: &'static str,
     pub uses: &'static [&'static str],
+    /// The pass's own WGSL file, `shaders/STAGE/NAME.wgsl`, in a stage of several passes (as
+    /// vello's); None: in the stage's file.
+    pub source: Option<&'static str>,
 }
 
 const fn entry(name: &'static str, uses: &'static [&'static str]) -> EntryPoint {
-    EntryPoint { name, uses }
+    EntryPoint { name, uses, source: None }
 }
 
-/// A stage: its WGSL file, entry points and bindings.
+/// An entry point in its own file (see [`EntryPoint::source`]).
+const fn pass(name: &'static str, uses: &'static [&'static str], source: &'static str) -> EntryPoint {
+    EntryPoint { name, uses, source: Some(source) }
+}
+
+/// One WGSL file of a stage, and the entry points it holds.
+#[derive(Clone, Debug)]
+pub struct WgslFile {
+    pub path: String,
+    pub source: &'static str,
+    pub entry_points: Vec<&'static str>,
+}
+
+/// A stage: its WGSL file (or one per pass), entry points and bindings.
 #[derive(Clone, Copy, Debug)]
 pub struct Stage {
-    /// The stage's name: its WGSL file is `shaders/NAME.wgsl`, its CPU twin `cpu::NAME`.
+    /// The stage's name: its WGSL file is `shaders/NAME.wgsl` (or, one per pass,
+    /// `shaders/NAME/ENTRY.wgsl`), its CPU twin `cpu::NAME`.
     pub name: &'static str,
-    pub source: &'static str,
+    /// `shaders/NAME.wgsl`; None where each entry point has its own file.
+    pub source: Option<&'static str>,
     pub kind: StageKind,
     pub entry_points: &'static [EntryPoint],
     /// Every binding, ordered by group then binding number.
@@ -81,8 +100,29 @@ pub struct Stage {
 }
 
 impl Stage {
-    pub fn file(&self) -> String {
-        format!("shaders/{}.wgsl", self.name)
+    /// Its WGSL files: the stage's one, or one per pass.
+    pub fn files(&self) -> Vec<WgslFile> {
+        match self.source {
+            Some(source) => vec![WgslFile {
+                path: format!("shaders/{}.wgsl", self.name),
+                source,
+                entry_points: self.entry_points.iter().map(|e| e.name).collect(),
+            }],
+            None => self.entry_points.iter().map(|e| self.pass_file(e)).collect(),
+        }
+    }
+
+    /// The file that holds `entry` (None: the drawing pipeline's, the stage's one file).
+    pub fn file_of(&self, entry: Option<&str>) -> WgslFile {
+        match (self.source, entry.and_then(|e| self.entry_point(e))) {
+            (None, Some(e)) => self.pass_file(e),
+            _ => self.files().remove(0),
+        }
+    }
+
+    fn pass_file(&self, e: &EntryPoint) -> WgslFile {
+        let source = e.source.unwrap_or_else(|| panic!("{}: {} has no file of its own", self.name, e.name));
+        WgslFile { path: format!("shaders/{}/{}.wgsl", self.name, e.name), source, entry_points: vec![e.name] }
     }
 
     /// The groups the stage binds (0, 1, … without gaps).
@@ -158,20 +198,37 @@ const PLANNING: &[&str] = &[
 
 pub const SUBDIVIDE: Stage = Stage {
     name: "subdivide",
-    source: include_str!("../../shaders/subdivide.wgsl"),
+    source: None,
     kind: StageKind::Compute,
     entry_points: &[
-        entry("active_cuts", &["params", "vertices", "indices", "counters", "triangle_edges", "cut_edges"]),
-        entry("ring_cuts", &["params", "vertices", "indices", "triangle_edges", "cut_edges"]),
-        entry("plan", PLANNING),
-        entry("plan_cuts_args", &["counters", "lattice_dispatch", "cut_list"]),
-        entry("plan_cuts", PLANNING),
-        entry("lattice_args", &["params", "counters", "lattice_dispatch"]),
-        entry(
+        pass(
+            "active_cuts",
+            &["params", "vertices", "indices", "counters", "triangle_edges", "cut_edges"],
+            include_str!("../../shaders/subdivide/active_cuts.wgsl"),
+        ),
+        pass(
+            "ring_cuts",
+            &["params", "vertices", "indices", "triangle_edges", "cut_edges"],
+            include_str!("../../shaders/subdivide/ring_cuts.wgsl"),
+        ),
+        pass("plan", PLANNING, include_str!("../../shaders/subdivide/plan.wgsl")),
+        pass(
+            "plan_cuts_args",
+            &["counters", "lattice_dispatch", "cut_list"],
+            include_str!("../../shaders/subdivide/plan_cuts_args.wgsl"),
+        ),
+        pass("plan_cuts", PLANNING, include_str!("../../shaders/subdivide/plan_cuts.wgsl")),
+        pass(
+            "lattice_args",
+            &["params", "counters", "lattice_dispatch"],
+            include_str!("../../shaders/subdivide/lattice_args.wgsl"),
+        ),
+        pass(
             "lattice",
             &["params", "vertices", "indices", "pieces", "out_nodes", "counters", "object_edge_scale", "out_indices"],
+            include_str!("../../shaders/subdivide/lattice.wgsl"),
         ),
-        entry("finalize", &["params", "counters", "draw_args"]),
+        pass("finalize", &["params", "counters", "draw_args"], include_str!("../../shaders/subdivide/finalize.wgsl")),
     ],
     bindings: &[
         bind(0, 0, "params", Uniform),
@@ -193,7 +250,7 @@ pub const SUBDIVIDE: Stage = Stage {
 
 pub const RASTER: Stage = Stage {
     name: "raster",
-    source: include_str!("../../shaders/raster.wgsl"),
+    source: Some(include_str!("../../shaders/raster.wgsl")),
     kind: StageKind::Draw,
     entry_points: &[
         entry("vs_main", &["params"]),
@@ -208,7 +265,7 @@ pub const RASTER: Stage = Stage {
 
 pub const SLIT: Stage = Stage {
     name: "slit",
-    source: include_str!("../../shaders/slit.wgsl"),
+    source: Some(include_str!("../../shaders/slit.wgsl")),
     kind: StageKind::Draw,
     entry_points: &[
         entry("vs_main", &["params", "cameras"]),
@@ -223,7 +280,7 @@ pub const SLIT: Stage = Stage {
 
 pub const TRACE: Stage = Stage {
     name: "trace",
-    source: include_str!("../../shaders/trace.wgsl"),
+    source: Some(include_str!("../../shaders/trace.wgsl")),
     kind: StageKind::Compute,
     entry_points: &[entry(
         "trace",
@@ -264,7 +321,7 @@ pub const TRACE: Stage = Stage {
 
 pub const SHADOW: Stage = Stage {
     name: "shadow",
-    source: include_str!("../../shaders/shadow.wgsl"),
+    source: Some(include_str!("../../shaders/shadow.wgsl")),
     kind: StageKind::Draw,
     entry_points: &[entry("vs_main", &["params"]), entry("fs_mask", &["materials", "mips", "texels"])],
     bindings: with_material_table![bind(0, 0, "params", Uniform),],
@@ -272,7 +329,7 @@ pub const SHADOW: Stage = Stage {
 
 pub const SKIN: Stage = Stage {
     name: "skin",
-    source: include_str!("../../shaders/skin.wgsl"),
+    source: Some(include_str!("../../shaders/skin.wgsl")),
     kind: StageKind::Compute,
     entry_points: &[entry(
         "skin",
@@ -291,7 +348,7 @@ pub const SKIN: Stage = Stage {
 
 pub const PROJECT_POINTS: Stage = Stage {
     name: "project_points",
-    source: include_str!("../../shaders/project_points.wgsl"),
+    source: Some(include_str!("../../shaders/project_points.wgsl")),
     kind: StageKind::Compute,
     entry_points: &[entry("project_points", &["params", "points", "pixels"])],
     bindings: &[bind(0, 0, "params", Uniform), bind(0, 1, "points", Storage), bind(0, 2, "pixels", StorageReadWrite)],
@@ -299,7 +356,7 @@ pub const PROJECT_POINTS: Stage = Stage {
 
 pub const REDUCE_ERROR: Stage = Stage {
     name: "reduce_error",
-    source: include_str!("../../shaders/reduce_error.wgsl"),
+    source: Some(include_str!("../../shaders/reduce_error.wgsl")),
     kind: StageKind::Compute,
     entry_points: &[
         entry("accumulate", &["params", "errors", "histogram", "partials", "totals"]),
@@ -328,6 +385,7 @@ pub const SHARED: &[(&str, &str)] = &[
     ("subdivide_edges", include_str!("../../shaders/shared/subdivide_edges.wgsl")),
     ("subdivide_frame_cuts", include_str!("../../shaders/shared/subdivide_frame_cuts.wgsl")),
     ("subdivide_axis", include_str!("../../shaders/shared/subdivide_axis.wgsl")),
+    ("subdivide_dispatch", include_str!("../../shaders/shared/subdivide_dispatch.wgsl")),
     ("subdivide_quad", include_str!("../../shaders/shared/subdivide_quad.wgsl")),
     ("subdivide_lattice", include_str!("../../shaders/shared/subdivide_lattice.wgsl")),
     ("surface_bindings", include_str!("../../shaders/shared/surface_bindings.wgsl")),
@@ -417,9 +475,9 @@ pub fn imports(source: &str) -> Vec<&str> {
     source.lines().filter_map(|l| l.trim().strip_prefix("#import ")).map(str::trim).collect()
 }
 
-/// The full WGSL of a stage: its imports (recursively, each once, dependencies first), then
-/// the stage's own file with its `#import` lines commented out.
-pub fn compose(stage: &Stage, options: ShaderOptions) -> String {
+/// The full WGSL of one of a stage's files: its imports (recursively, each once, dependencies
+/// first), then the file with its `#import` lines commented out.
+pub fn compose(file: &WgslFile, options: ShaderOptions) -> String {
     fn add(name: &str, source: &str, options: ShaderOptions, done: &mut Vec<String>, out: &mut String) {
         for dep in imports(source) {
             if done.iter().any(|d| d == dep) {
@@ -439,6 +497,6 @@ pub fn compose(stage: &Stage, options: ShaderOptions) -> String {
     }
     let mut out = String::new();
     let mut done = Vec::new();
-    add(&stage.file(), stage.source, options, &mut done, &mut out);
+    add(&file.path, file.source, options, &mut done, &mut out);
     out
 }

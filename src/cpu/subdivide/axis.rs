@@ -391,43 +391,53 @@ pub fn fan(poly: &[Node]) -> impl Iterator<Item = [Node; 3]> + '_ {
 /// barycentric weights in the triangle. Numbered quadrant by quadrant ([`QUADRANTS`]), band by
 /// band outwards (the active diamonds). With no cut active, the triangle is its own polygon.
 pub fn polygons(p: [Vec3; 3], rho: f32, cuts: AxisCuts) -> Vec<Vec<Node>> {
-    let mut out = Vec::with_capacity(4);
+    // Most triangles: one quadrant, one band, one part (what the clips would give, faster).
+    if one_part(p, rho, cuts) {
+        return vec![[0, 1, 2].map(|i| Node { position: p[i], bary: Vec3::AXES[i] }).to_vec()];
+    }
+    (0..QUADRANTS.len()).flat_map(|q| quadrant_polygons(p, rho, cuts, q)).collect()
+}
+
+/// Whether a triangle is its own single polygon under `cuts`: none active, or it lies in one
+/// quadrant and one band ([`single_band`]). `single_part` in the WGSL.
+pub fn one_part(p: [Vec3; 3], rho: f32, cuts: AxisCuts) -> bool {
+    cuts == 0 || QUADRANTS.iter().any(|&q| single_band(p, q, rho, cuts))
+}
+
+/// The polygons of [`polygons`] in quadrant `q` of [`QUADRANTS`], band by band outwards
+/// (`plan_quadrant` in the WGSL).
+pub fn quadrant_polygons(p: [Vec3; 3], rho: f32, cuts: AxisCuts, q: usize) -> Vec<Vec<Node>> {
+    let (sx, sz) = QUADRANTS[q];
+    let mut out = Vec::new();
     let bary = [Vec3::X, Vec3::Y, Vec3::Z];
     let triangle = Polygon { nodes: [0, 1, 2, 0, 0, 0, 0].map(|i| Node { position: p[i], bary: bary[i] }), count: 3 };
-    // Most triangles: one quadrant, one band, one part (what the loop below would give, faster).
-    if cuts == 0 || QUADRANTS.iter().any(|&q| single_band(p, q, rho, cuts)) {
-        return vec![triangle.nodes[..3].to_vec()];
-    }
-    let bounds: Vec<f32> = active_bounds(rho, cuts).collect();
-    for (sx, sz) in QUADRANTS {
-        // What lies beyond the current diamond; each band is cut from it, and the rest beyond
-        // the next diamond is cut from the same polygon, so both sides of a diamond get the
-        // same points (from the same edges).
-        let mut rest = triangle.clip(Cut::X(sx)).clip(Cut::Z(sz)).clip(Cut::Chord(sx, sz, rho, 1.0));
-        for next in bounds.iter().map(Some).chain([None]) {
-            if rest.count == 0 {
-                break;
-            }
-            let band = match next {
-                None => rest.take(),
-                Some(&c) => {
-                    let (within, beyond) = (Cut::Chord(sx, sz, c, -1.0), Cut::Chord(sx, sz, c, 1.0));
-                    let (none, all) = rest.all_beyond(within);
-                    if none {
-                        continue; // all of it lies beyond this band
-                    }
-                    if all {
-                        rest.take()
-                    } else {
-                        let band = rest.clip(within);
-                        rest = rest.clip(beyond);
-                        band
-                    }
+    // What lies beyond the current diamond; each band is cut from it, and the rest beyond the
+    // next diamond is cut from the same polygon, so both sides of a diamond get the same points
+    // (from the same edges).
+    let mut rest = triangle.clip(Cut::X(sx)).clip(Cut::Z(sz)).clip(Cut::Chord(sx, sz, rho, 1.0));
+    for next in active_bounds(rho, cuts).map(Some).chain([None]) {
+        if rest.count == 0 {
+            break;
+        }
+        let band = match next {
+            None => rest.take(),
+            Some(c) => {
+                let (within, beyond) = (Cut::Chord(sx, sz, c, -1.0), Cut::Chord(sx, sz, c, 1.0));
+                let (none, all) = rest.all_beyond(within);
+                if none {
+                    continue; // all of it lies beyond this band
                 }
-            };
-            if band.count >= 3 {
-                out.push(band.nodes[..band.count].to_vec());
+                if all {
+                    rest.take()
+                } else {
+                    let band = rest.clip(within);
+                    rest = rest.clip(beyond);
+                    band
+                }
             }
+        };
+        if band.count >= 3 {
+            out.push(band.nodes[..band.count].to_vec());
         }
     }
     out

@@ -42,6 +42,24 @@ impl FrameCuts {
         bit(&self.cut_edges, self.edges.ids[3 * t + e])
     }
 
+    /// Marks the three edges of triangle t as a cut triangle's and, if `asking`, as one's that
+    /// asks for cuts (`mark_edges` in the WGSL).
+    pub fn mark(&mut self, t: usize, asking: bool) {
+        for e in 0..3 {
+            let id = self.edges.ids[3 * t + e];
+            set_bit(&mut self.cut_edges, id);
+            if asking {
+                set_bit(&mut self.asking_edges, id);
+            }
+        }
+    }
+
+    /// No edge marked (the `cut_edges` buffer cleared).
+    pub fn clear_marks(&mut self) {
+        self.asking_edges.fill(0);
+        self.cut_edges.fill(0);
+    }
+
     /// Cuts `axis` with every edge counted as a cut triangle's, none as one that asks (tests of
     /// one triangle whose neighbours, not given, are cut).
     pub fn every_edge(axis: AxisCuts, vertices: &[SceneVertex], indices: &[u32]) -> FrameCuts {

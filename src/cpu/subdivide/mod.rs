@@ -1,4 +1,4 @@
-//! The `subdivide` stage, CPU twin of `shaders/subdivide.wgsl` (its entry points) and of
+//! The `subdivide` stage, CPU twin of `shaders/subdivide/*.wgsl` (its passes: `passes.rs`) and of
 //! `shaders/shared/subdivide_edges.wgsl` (this file; the other modules mirror `subdivide_axis`,
 //! `subdivide_frame_cuts`, `subdivide_quad` and `subdivide_lattice`): adaptive subdivision (seed
 //! 002 §2.3, eq. 5, Fig. 6) plus the handling of the vertical axis and the ±π seam. The
@@ -106,11 +106,12 @@ use crate::encoding::types::{DrawVertex, SubdivideParams};
 mod axis;
 mod frame_cuts;
 mod lattice;
+pub mod passes;
 mod quad;
 
 pub use axis::{
-    axis_clearance, band_limit, edge_crossings, edge_split_parts, fan, polygons, snap_to_cut_planes, triangle_cuts,
-    AxisCuts,
+    axis_clearance, band_limit, edge_crossings, edge_split_parts, fan, one_part, polygons, quadrant_polygons,
+    snap_to_cut_planes, triangle_cuts, AxisCuts,
 };
 pub use frame_cuts::FrameCuts;
 pub use lattice::{

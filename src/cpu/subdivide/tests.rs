@@ -525,3 +525,71 @@ mod real_mesh_tests {
         assert!(compared > 1000 && split > 100, "{compared} shared edges compared, {split} of them split");
     }
 }
+
+/// The twin's passes replaying the GPU's schedules (`passes.rs`) make exactly the triangles the
+/// twin makes directly, whatever the schedule and however small the budget (a budget too small
+/// for the one submission falls back to chunks, halved until each range fits).
+#[test]
+fn the_passes_replaying_every_schedule_make_the_twins_triangles() {
+    use super::passes::run_scheduled;
+    use crate::core::builtin;
+    use crate::encoding::schedule::{Capacities, Schedule};
+    use rand::{Rng, SeedableRng};
+
+    let cylinder = Projection { width: 480, height: 120, ..Projection::default() };
+    let mut rng = rand::rngs::StdRng::seed_from_u64(11);
+    let mut random = crate::core::scene::Scene::new("random");
+    for k in 0..120 {
+        let near_axis = k % 3 == 2;
+        let c = if near_axis {
+            Vec3::new(rng.random_range(-0.05..0.05), rng.random_range(-2.0..2.0), rng.random_range(-0.05..0.05))
+        } else {
+            Vec3::new(rng.random_range(-8.0..8.0), rng.random_range(-3.0..3.0), rng.random_range(-8.0..8.0))
+        };
+        let scale = [0.3f32, 6.0, 1.0][k % 3];
+        let v: Vec<SceneVertex> = (0..3)
+            .map(|_| {
+                let d =
+                    Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+                vertex((c + scale * d).into())
+            })
+            .collect();
+        random.add_mesh("t", &v, &[0, 1, 2]);
+    }
+    let box_room = builtin::closed_box("box", Vec3::new(-4.0, -1.7, -4.0), Vec3::new(4.0, 2.3, 4.0));
+    let cases = [
+        (builtin::demo(), RenderSettings::new(cylinder)),
+        (builtin::demo(), RenderSettings::new(Projection::equirect(256))),
+        (box_room.clone(), RenderSettings::new(cylinder)),
+        (box_room, RenderSettings::new(Projection::equirect(128)).with_method(Method::Fixed(3))),
+        (random.clone(), RenderSettings::new(cylinder).with_method(Method::Adaptive(Split::Length))),
+        (random, RenderSettings::new(Projection::equirect(128))),
+    ];
+    let sorted = |out: &SubdivideOutput| {
+        let mut t: Vec<Vec<u8>> = out.vertices.chunks(3).map(|t| bytemuck::cast_slice(t).to_vec()).collect();
+        t.sort();
+        t
+    };
+    let (mut quads, mut cut_frames) = (0, 0);
+    for (scene, settings) in cases {
+        let n = scene.triangle_count() as u32;
+        let direct = subdivide(&subdivide_params(&settings, 0, n), &scene.vertices, &scene.indices);
+        (quads, cut_frames) = (quads + direct.quads, cut_frames + (direct.cuts != 0) as u32);
+        let roomy = Capacities::budget(settings.subdivision.memory_mb, u64::MAX);
+        let tiny = Capacities { pieces: 256, triangles: direct.nodes.len().min(direct.indices.len()) as u32 / 8 + 64 };
+        for schedule in [Schedule::OneSubmission, Schedule::Chunked { triangles_per_chunk: (n / 3).max(1) }] {
+            for budget in [roomy, tiny] {
+                let what =
+                    format!("{} {:?}, {schedule:?}, budget {budget:?}", scene.name, settings.projection().panorama);
+                let out = run_scheduled(&settings, &scene.vertices, &scene.indices, schedule, budget).expect(&what);
+                assert_eq!((out.pieces, out.cuts), (direct.pieces, direct.cuts), "{what}");
+                assert_eq!(out.nodes.len(), direct.nodes.len(), "{what}");
+                assert!(sorted(&out) == sorted(&direct), "{what}: not the twin's triangles");
+            }
+        }
+    }
+    assert!(
+        quads > 0 && cut_frames >= 4,
+        "the cases must draw band quads ({quads}) and cut around the axis ({cut_frames})"
+    );
+}

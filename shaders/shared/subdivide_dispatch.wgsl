@@ -1,0 +1,34 @@
+// The `subdivide` stage's dispatch helpers: an invocation's index in a dispatch spread over two
+// dimensions, and the triangles `plan` listed for `plan_cuts` (CPU twin: `listed_cuts` and
+// `plan_cuts_split` in src/cpu/subdivide/passes.rs).
+
+#import constants
+#import projection
+#import subdivide_types
+#import subdivide_bindings
+
+fn invocation_index(gid: vec3<u32>, groups: vec3<u32>) -> u32 {
+    return gid.x + gid.y * groups.x * 64u;
+}
+
+// The triangles `plan` listed, and the i-th of them: the narrow ones from the front of
+// `cut_list`, then the wide ones from its back.
+fn listed_cuts() -> vec2<u32> {
+    let len = arrayLength(&cut_list);
+    return vec2<u32>(min(atomicLoad(&counters.cut_count), len), min(atomicLoad(&counters.cut_wide), len));
+}
+
+fn listed_cut(i: u32, listed: vec2<u32>) -> u32 {
+    if (i < listed.x) {
+        return cut_list[i];
+    }
+    return cut_list[arrayLength(&cut_list) - 1u - (i - listed.x)];
+}
+
+// Invocations of `plan_cuts` per listed triangle: one per quadrant on the sphere, whose bands reach
+// 10⁻⁵ m from the axis (many more bands: one quadrant's keep an invocation within lavapipe's loop
+// budget, which stops any invocation after 65,535 loop iterations); one per triangle on the
+// cylinder (its few bands fit, and lanes of a triangle's empty quadrants would idle).
+fn plan_cuts_split() -> u32 {
+    return select(1u, 4u, (PANORAMAS & 2u) != 0u);
+}

@@ -1,0 +1,47 @@
+// The `plan_cuts` pass of the `subdivide` stage: one invocation per listed triangle (on the sphere
+// per triangle and quadrant). A triangle not cut by all cuts is fanned at the crossings of its
+// edges that cut triangles have (`plan_edge_split`); one cut by all, its parts around the
+// vertical axis under the frame's cuts (quadrants minus a small square around the axis, bands
+// between the active diamonds, fan-triangulated; a band's quad whose two opposite sides are in
+// one part each, one piece drawn as a strip between the other two), each planned as in `plan`.
+// CPU twin: `CpuSubdivision::plan_cuts`.
+
+#import projection
+#import constants
+#import scene
+#import subdivide_types
+#import subdivide_bindings
+#import subdivide_state
+#import subdivide_edges
+#import subdivide_frame_cuts
+#import subdivide_axis
+#import subdivide_quad
+#import subdivide_lattice
+#import subdivide_dispatch
+
+@compute @workgroup_size(64)
+fn plan_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let local = invocation_index(gid, groups);
+    let split = plan_cuts_split();
+    let listed = listed_cuts();
+    if (local / split >= min(listed.x + listed.y, arrayLength(&cut_list))) {
+        return;
+    }
+    let t = listed_cut(local / split, listed);
+    cuts = vec2<u32>(atomicLoad(&counters.cuts_low), atomicLoad(&counters.cuts_high));
+    load_triangle(t);
+    if (local / split < listed.x) {
+        // Cut only at its shared edges' crossings (one invocation of `split`).
+        if (local % split == 0u) {
+            plan_edge_split(t);
+        }
+        return;
+    }
+    if (split == 4u) {
+        plan_quadrant(t, local % 4u);
+    } else {
+        for (var q = 0u; q < 4u; q++) {
+            plan_quadrant(t, q);
+        }
+    }
+}

@@ -1,0 +1,16 @@
+// The `plan_cuts_args` setup pass of the `subdivide` stage (one thread): the indirect dispatch of
+// `plan_cuts` over the triangles `plan` listed. CPU twin: `CpuSubdivision::plan_cuts_args`.
+
+#import constants
+#import subdivide_types
+#import subdivide_bindings
+#import subdivide_dispatch
+
+@compute @workgroup_size(1)
+fn plan_cuts_args() {
+    let listed = listed_cuts();
+    let groups = (plan_cuts_split() * min(listed.x + listed.y, arrayLength(&cut_list)) + 63u) / 64u;
+    lattice_dispatch[3] = min(groups, 65535u);
+    lattice_dispatch[4] = (groups + 65534u) / 65535u;
+    lattice_dispatch[5] = 1u;
+}

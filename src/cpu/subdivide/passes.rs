@@ -1,0 +1,398 @@
+//! The `subdivide` stage's passes on the CPU: the twin of its pass files
+//! `shaders/subdivide/*.wgsl`, one method each of the same name, over buffers named as the WGSL binds them
+//! (`counters`, `cut_edges`, `cut_list`, `pieces`, `out_nodes`, `out_indices`,
+//! `lattice_dispatch`, `draw_args`), run by replaying the same recordings as the GPU: an engine
+//! of `encoding::schedule`, so that the twin test runs the GPU's schedules (one submission with
+//! its indirect dispatches, and the chunked one) on both sides. The work inside each pass is the
+//! twin's (`Subdivider`): the passes only decide, as the WGSL does, which invocation plans which
+//! triangle, lists which for `plan_cuts`, and where records and output land.
+//!
+//! Invocations run one after another in index order, so the output's order differs from the
+//! GPU's (whose appends race); both are compared as sets.
+
+use glam::Vec3;
+
+use super::{
+    band_limit, edge_split_parts, fan, one_part, quadrant_polygons, triangle_cuts, FrameCuts, Node, SubdivideOutput,
+    Subdivider, Triangle,
+};
+use crate::core::projection::PanoramaKind;
+use crate::core::scene::SceneVertex;
+use crate::core::settings::RenderSettings;
+use crate::core::shared_edges::shared_edges;
+use crate::encoding::constants::{PIECES_FROM_COUNTER, QUAD_HEAD, QUAD_TAIL};
+use crate::encoding::recording::{Command, Recording};
+use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine};
+use crate::encoding::types::{DrawIndexedIndirectArgs, DrawVertex, Piece, SubdivideCounters, SubdivideParams};
+use crate::error::Result;
+
+/// Runs the whole stage on the CPU with `schedule` within `budget`, as the GPU's read-back
+/// does (`gpu::subdivide::SubdivideStage::readback`): the twin side of the twin test.
+pub fn run_scheduled(
+    settings: &RenderSettings,
+    vertices: &[SceneVertex],
+    indices: &[u32],
+    schedule: Schedule,
+    budget: Capacities,
+) -> Result<SubdivideOutput> {
+    let mut engine = CpuSubdivision::new(vertices, indices, &[]);
+    let totals = run_schedule(&mut engine, settings, (indices.len() / 3) as u32, schedule, budget)?;
+    let pieces = totals.pieces as u32;
+    Ok(SubdivideOutput::indexed(engine.nodes, engine.taken_indices, pieces, totals.max_edge_px, totals.cuts))
+}
+
+/// The stage's buffers on the CPU, and what [`SubdivisionEngine::take`] kept.
+pub struct CpuSubdivision<'s> {
+    /// The scene's `vertices` and `indices`.
+    scene: (&'s [SceneVertex], &'s [u32]),
+    /// `object_edge_scale`.
+    edge_scale: &'s [f32],
+    /// `cut_edges`, with the scene's shared edges (`triangle_edges`).
+    frame: FrameCuts,
+    counters: SubdivideCounters,
+    /// Room for every triangle of the scene.
+    cut_list: Vec<u32>,
+    pieces: Vec<Piece>,
+    out_nodes: Vec<DrawVertex>,
+    out_indices: Vec<u32>,
+    lattice_dispatch: [u32; 6],
+    pub draw_args: DrawIndexedIndirectArgs,
+    /// Every taken range's nodes, and its triangles' indices into them.
+    pub nodes: Vec<DrawVertex>,
+    pub taken_indices: Vec<u32>,
+}
+
+/// A part's corner from a piece record.
+fn record_corner(piece: &Piece, i: usize) -> Node {
+    let c = piece.corner[i];
+    Node { position: Vec3::new(c[0], c[1], c[2]), bary: Vec3::new(c[3], piece.bary1[i], piece.bary2[i]) }
+}
+
+/// A piece record of triangle t with these corners (`append_pieces` in the WGSL).
+fn record(t: u32, counts01: u32, count2_level: u32, corners: [Node; 3]) -> Piece {
+    let mut piece = Piece { triangle: t, counts01, count2_level, ..Default::default() };
+    for (i, n) in corners.iter().enumerate() {
+        piece.corner[i] = n.position.extend(n.bary.x).into();
+        piece.bary1[i] = n.bary.y;
+        piece.bary2[i] = n.bary.z;
+    }
+    piece
+}
+
+impl<'s> CpuSubdivision<'s> {
+    pub fn new(vertices: &'s [SceneVertex], indices: &'s [u32], edge_scale: &'s [f32]) -> Self {
+        let edges = shared_edges(vertices, indices);
+        let words = edges.bit_words(1) as usize;
+        let frame = FrameCuts { axis: 0, asking_edges: vec![0; words], cut_edges: vec![0; words], edges };
+        CpuSubdivision {
+            scene: (vertices, indices),
+            edge_scale,
+            frame,
+            counters: SubdivideCounters::default(),
+            cut_list: vec![0; (indices.len() / 3).max(1)],
+            pieces: vec![Piece::default(); 1],
+            out_nodes: vec![DrawVertex::default(); 1],
+            out_indices: vec![0; 3],
+            lattice_dispatch: [0; 6],
+            draw_args: DrawIndexedIndirectArgs::default(),
+            nodes: Vec::new(),
+            taken_indices: Vec::new(),
+        }
+    }
+
+    fn clear(&mut self, buffer: &str, bytes: Option<u64>) {
+        match (buffer, bytes) {
+            ("counters", None) => self.counters = SubdivideCounters::default(),
+            ("counters", Some(SubdivideCounters::RUN_BYTES)) => {
+                self.counters = SubdivideCounters {
+                    cuts_low: self.counters.cuts_low,
+                    cuts_high: self.counters.cuts_high,
+                    ..Default::default()
+                }
+            }
+            ("cut_edges", None) => self.frame.clear_marks(),
+            other => panic!("the subdivide twin clears no {other:?}"),
+        }
+    }
+
+    /// Runs `entry` over `invocations` (whole workgroups of 64; each invocation past its pass's
+    /// count returns at once, as on the GPU) or, for a one-thread setup entry, once.
+    fn dispatch(&mut self, sub: &Subdivider, entry: &str, invocations: u32) {
+        let all = 0..invocations.div_ceil(64) * 64;
+        match entry {
+            "active_cuts" => all.for_each(|i| self.active_cuts(sub, i)),
+            "ring_cuts" => all.for_each(|i| self.ring_cuts(sub, i)),
+            "plan" => all.for_each(|i| self.plan(sub, i)),
+            "plan_cuts_args" => self.plan_cuts_args(sub),
+            "plan_cuts" => all.for_each(|i| self.plan_cuts(sub, i)),
+            "lattice_args" => self.lattice_args(sub),
+            "lattice" => all.for_each(|i| self.lattice(sub, i)),
+            "finalize" => self.finalize(sub),
+            other => panic!("the subdivide stage has no entry point {other}"),
+        }
+    }
+
+    // ---- the entry points ----
+
+    /// Over every triangle of the scene: the cuts it asks for, OR-ed into the counters; its
+    /// edges marked if it asks.
+    fn active_cuts(&mut self, sub: &Subdivider, local: u32) {
+        let params = sub.params;
+        if local >= params.triangle_count {
+            return;
+        }
+        let t = (params.first_triangle + local) as usize;
+        let p = sub.positions(self.scene.0, self.scene.1, t);
+        if sub.off_screen_vertically(p) {
+            return;
+        }
+        let bits = triangle_cuts(p, params.axis_clearance, band_limit(params.method, sub.projection.screen_radius));
+        self.counters.cuts_low |= bits as u32;
+        self.counters.cuts_high |= (bits >> 32) as u32;
+        if bits != 0 {
+            self.frame.mark(t, true);
+        }
+    }
+
+    /// After `active_cuts`: a triangle with an edge of one that asks is cut too; its edges
+    /// are marked as a cut one's.
+    fn ring_cuts(&mut self, sub: &Subdivider, local: u32) {
+        let params = sub.params;
+        if local >= params.triangle_count {
+            return;
+        }
+        let t = (params.first_triangle + local) as usize;
+        if !self.frame.is_cut_triangle(t) || sub.off_screen_vertically(sub.positions(self.scene.0, self.scene.1, t)) {
+            return;
+        }
+        self.frame.mark(t, false);
+    }
+
+    /// Plans a triangle that is its own single part; lists the others for `plan_cuts` (those
+    /// cut by all of the frame's cuts from the back of `cut_list`).
+    fn plan(&mut self, sub: &Subdivider, local: u32) {
+        let params = sub.params;
+        if local >= params.triangle_count {
+            return;
+        }
+        let t = (params.first_triangle + local) as usize;
+        let tri = sub.load(self.scene.0, self.scene.1, t);
+        if sub.off_screen_vertically(tri.position) {
+            return;
+        }
+        let cuts = self.counters.cuts();
+        let rho = params.axis_clearance;
+        let limit = band_limit(params.method, sub.projection.screen_radius);
+        let full = cuts != 0 && (self.frame.is_cut_triangle(t) || triangle_cuts(tri.position, rho, limit) != 0);
+        let marked = cuts != 0 && (0..3).any(|e| self.frame.is_cut_edge(t, e));
+        let single = if full { one_part(tri.position, rho, cuts) } else { !marked };
+        if single {
+            let corners = [0, 1, 2].map(|i| Node { position: tri.position[i], bary: Vec3::AXES[i] });
+            self.plan_polygon(sub, &tri, t as u32, &corners);
+            return;
+        }
+        let len = self.cut_list.len() as u32;
+        if full {
+            let slot = self.counters.cut_wide;
+            self.counters.cut_wide += 1;
+            if slot < len {
+                self.cut_list[(len - 1 - slot) as usize] = t as u32;
+            }
+        } else {
+            let slot = self.counters.cut_count;
+            self.counters.cut_count += 1;
+            if slot < len {
+                self.cut_list[slot as usize] = t as u32;
+            }
+        }
+    }
+
+    /// `plan_cuts`' invocations per listed triangle: one per quadrant on the sphere, one on the
+    /// cylinder.
+    fn plan_cuts_split(sub: &Subdivider) -> u32 {
+        if sub.projection.panorama == PanoramaKind::Equirect {
+            4
+        } else {
+            1
+        }
+    }
+
+    /// The listed triangles: (narrow, wide), within the list.
+    fn listed_cuts(&self) -> (u32, u32) {
+        let len = self.cut_list.len() as u32;
+        (self.counters.cut_count.min(len), self.counters.cut_wide.min(len))
+    }
+
+    fn plan_cuts_args(&mut self, sub: &Subdivider) {
+        let (narrow, wide) = self.listed_cuts();
+        let listed = (narrow + wide).min(self.cut_list.len() as u32);
+        let groups = (Self::plan_cuts_split(sub) * listed).div_ceil(64);
+        self.lattice_dispatch[3..6].copy_from_slice(&[groups.min(65535), groups.div_ceil(65535), 1]);
+    }
+
+    /// A listed triangle: a narrow one cut at its marked edges' crossings, a wide one's parts
+    /// in one quadrant (the sphere) or all four.
+    fn plan_cuts(&mut self, sub: &Subdivider, local: u32) {
+        let split = Self::plan_cuts_split(sub);
+        let (narrow, wide) = self.listed_cuts();
+        let len = self.cut_list.len() as u32;
+        let i = local / split;
+        if i >= (narrow + wide).min(len) {
+            return;
+        }
+        let t = if i < narrow { self.cut_list[i as usize] } else { self.cut_list[(len - 1 - (i - narrow)) as usize] };
+        let tri = sub.load(self.scene.0, self.scene.1, t as usize);
+        let (cuts, rho) = (self.counters.cuts(), sub.params.axis_clearance);
+        if i < narrow {
+            if local % split == 0 {
+                let shared = [0, 1, 2].map(|e| self.frame.is_cut_edge(t as usize, e));
+                for part in edge_split_parts(tri.position, shared, rho, cuts) {
+                    self.plan_polygon(sub, &tri, t, &part);
+                }
+            }
+            return;
+        }
+        let quadrants = if split == 4 { (local % 4) as usize..(local % 4) as usize + 1 } else { 0..4 };
+        for q in quadrants {
+            for poly in quadrant_polygons(tri.position, rho, cuts, q) {
+                self.plan_polygon(sub, &tri, t, &poly);
+            }
+        }
+    }
+
+    fn lattice_args(&mut self, sub: &Subdivider) {
+        let groups = self.counters.pieces.min(sub.params.piece_capacity).div_ceil(64);
+        self.lattice_dispatch[0..3].copy_from_slice(&[groups.min(65535), groups.div_ceil(65535), 1]);
+    }
+
+    /// One piece record: its lattice (or a band quad's strip, from its two records), emitted.
+    fn lattice(&mut self, sub: &Subdivider, local: u32) {
+        let params = sub.params;
+        let mut piece_count = params.piece_count;
+        if piece_count == PIECES_FROM_COUNTER {
+            piece_count = self.counters.pieces.min(params.piece_capacity);
+        }
+        if local >= piece_count {
+            return;
+        }
+        let at = (params.first_piece + local) as usize;
+        let piece = self.pieces[at];
+        if piece.count2_level & QUAD_TAIL != 0 {
+            return; // drawn by the quad's first record
+        }
+        let tri = sub.load(self.scene.0, self.scene.1, piece.triangle as usize);
+        let corners = [0, 1, 2].map(|i| record_corner(&piece, i));
+        let mut out = SubdivideOutput::default();
+        let (n0, n1) = (piece.counts01 & 0xffff, piece.counts01 >> 16);
+        if piece.count2_level & QUAD_HEAD != 0 {
+            let last = record_corner(&self.pieces[at + 1], 0);
+            sub.quad_lattice(&tri, &[corners[0], corners[1], corners[2], last], [n0, n1], &mut out);
+        } else {
+            let n = [n0, n1, piece.count2_level & 0xffff];
+            let k = (piece.count2_level >> 16) & 0x3fff;
+            sub.lattice(&tri, &corners, k, n, piece.cell, &mut out);
+        }
+        self.emit(params, &out);
+    }
+
+    /// The draw's arguments: none drawn if a buffer overflowed.
+    fn finalize(&mut self, sub: &Subdivider) {
+        let c = &self.counters;
+        let capacity = sub.params.triangle_capacity;
+        let written = if c.triangles > capacity || c.nodes > capacity { 0 } else { c.triangles };
+        self.draw_args = DrawIndexedIndirectArgs { index_count: 3 * written, instance_count: 1, ..Default::default() };
+    }
+
+    // ---- what the passes share ----
+
+    /// A polygon of triangle t: a band quad's two records, or its fan's parts planned (those
+    /// on screen) and their pieces appended.
+    fn plan_polygon(&mut self, sub: &Subdivider, tri: &Triangle, t: u32, poly: &[Node]) {
+        if let Some((c, rails)) = sub.quad_strip(tri, poly) {
+            let head = record(t, rails[0] | rails[1] << 16, QUAD_HEAD, [c[0], c[1], c[2]]);
+            let tail = record(t, head.counts01, QUAD_TAIL, [c[3], c[1], c[2]]);
+            self.append(sub.params, &[head, tail]);
+            return;
+        }
+        for part in fan(poly) {
+            if sub.off_screen_vertically(part.map(|n| n.position)) {
+                continue;
+            }
+            let (k, n) = sub.plan(tri, &part);
+            let first = record(t, n[0] | n[1] << 16, n[2] | k << 16, part);
+            let cells: Vec<Piece> = (0..k * k).map(|cell| Piece { cell, ..first }).collect();
+            self.append(sub.params, &cells);
+        }
+    }
+
+    /// Appends records: counted always, written only if all fit.
+    fn append(&mut self, params: &SubdivideParams, records: &[Piece]) {
+        let base = self.counters.pieces;
+        self.counters.pieces += records.len() as u32;
+        if base + records.len() as u32 > params.piece_capacity {
+            return; // counted, never written
+        }
+        self.pieces[base as usize..base as usize + records.len()].copy_from_slice(records);
+    }
+
+    /// Appends a piece's nodes and triangles (indices local to `out.nodes`): counted always,
+    /// written only if both fit.
+    fn emit(&mut self, params: &SubdivideParams, out: &SubdivideOutput) {
+        let (node_count, triangle_count) = (out.nodes.len() as u32, (out.indices.len() / 3) as u32);
+        let first_node = self.counters.nodes;
+        let first_triangle = self.counters.triangles;
+        self.counters.nodes += node_count;
+        self.counters.triangles += triangle_count;
+        let max_edge = f32::from_bits(self.counters.max_edge_bits).max(out.max_sub_edge_px);
+        self.counters.max_edge_bits = max_edge.to_bits();
+        let capacity = params.triangle_capacity;
+        if first_node + node_count > capacity || first_triangle + triangle_count > capacity {
+            return; // counted, never written
+        }
+        let nodes = first_node as usize..(first_node + node_count) as usize;
+        self.out_nodes[nodes].copy_from_slice(&out.nodes);
+        let slots = 3 * first_triangle as usize..3 * (first_triangle + triangle_count) as usize;
+        for (slot, &i) in self.out_indices[slots].iter_mut().zip(&out.indices) {
+            *slot = first_node + i;
+        }
+    }
+}
+
+impl SubdivisionEngine for CpuSubdivision<'_> {
+    fn ensure(&mut self, want: Capacities) -> Capacities {
+        if self.pieces.len() < want.pieces as usize {
+            self.pieces.resize(want.pieces as usize, Piece::default());
+        }
+        if self.out_nodes.len() < want.triangles as usize {
+            self.out_nodes.resize(want.triangles as usize, DrawVertex::default());
+            self.out_indices.resize(3 * want.triangles as usize, 0);
+        }
+        Capacities { pieces: self.pieces.len() as u32, triangles: self.out_nodes.len() as u32 }
+    }
+
+    fn replay(&mut self, recording: &Recording, params: &SubdivideParams) -> Result<SubdivideCounters> {
+        let sub = Subdivider::with_edge_scale(params, self.edge_scale);
+        for command in &recording.commands {
+            match *command {
+                Command::Clear { buffer, bytes } => self.clear(buffer, bytes),
+                Command::Pass { .. } => {}
+                Command::Dispatch { entry, invocations } => self.dispatch(&sub, entry, invocations),
+                Command::DispatchIndirect { entry, args, offset } => {
+                    assert_eq!(args, "lattice_dispatch", "the subdivide stage's indirect arguments");
+                    let at = offset as usize / 4;
+                    let groups = &self.lattice_dispatch[at..at + 3];
+                    let invocations = groups[0] * groups[1] * groups[2] * 64;
+                    self.dispatch(&sub, entry, invocations);
+                }
+            }
+        }
+        Ok(self.counters)
+    }
+
+    fn take(&mut self, counters: &SubdivideCounters) -> Result<()> {
+        let offset = self.nodes.len() as u32;
+        self.nodes.extend_from_slice(&self.out_nodes[..counters.nodes as usize]);
+        self.taken_indices.extend(self.out_indices[..3 * counters.triangles as usize].iter().map(|i| i + offset));
+        Ok(())
+    }
+}
