@@ -56,75 +56,75 @@ fn cut_crossing(kind: u32, lo: Node, hi: Node, dl: f32, dh: f32) -> Node {
     return n;
 }
 
-fn push_clipped(at: u32, n: u32, v: Node) -> u32 {
-    if (n > 0u && same(v.position, pool[at + n - 1u].position)) {
+fn push_clipped(at: u32, n: u32, v: Node, clip: ptr<function, ClipState>) -> u32 {
+    if (n > 0u && same(v.position, (*clip).pool[at + n - 1u].position)) {
         return n;
     }
-    pool[at + n] = v;
+    (*clip).pool[at + n] = v;
     return n + 1u;
 }
 
 // Sutherland–Hodgman clip of the current polygon against one half-plane, into a slot that is
 // neither its own, the quadrant's nor `keep_at`'s, which becomes the current polygon's; crossing
 // points from the canonically ordered edge.
-fn clip_polygon(cut: Cut) {
+fn clip_polygon(cut: Cut, clip: ptr<function, ClipState>) {
     var at = 0u;
     for (var slot = 0u; slot < 21u; slot += 7u) {
-        if (slot != poly_at && slot != quadrant_at && slot != keep_at) {
+        if (slot != (*clip).poly_at && slot != (*clip).quadrant_at && slot != (*clip).keep_at) {
             at = slot;
         }
     }
     var n = 0u;
-    for (var i = 0u; i < poly_count; i++) {
-        let cur = poly_node(i);
-        let next = poly_node((i + 1u) % poly_count);
+    for (var i = 0u; i < (*clip).poly_count; i++) {
+        let cur = poly_node(i, clip);
+        let next = poly_node((i + 1u) % (*clip).poly_count, clip);
         let d0 = cut_distance(cut, cur.position);
         let d1 = cut_distance(cut, next.position);
         if (d0 >= 0.0) {
-            n = push_clipped(at, n, cur);
+            n = push_clipped(at, n, cur, clip);
         }
         if ((d0 >= 0.0) != (d1 >= 0.0) && d0 != 0.0 && d1 != 0.0) {
             if (lex_less(next.position, cur.position)) {
-                n = push_clipped(at, n, cut_crossing(cut.kind, next, cur, d1, d0));
+                n = push_clipped(at, n, cut_crossing(cut.kind, next, cur, d1, d0), clip);
             } else {
-                n = push_clipped(at, n, cut_crossing(cut.kind, cur, next, d0, d1));
+                n = push_clipped(at, n, cut_crossing(cut.kind, cur, next, d0, d1), clip);
             }
         }
     }
-    if (n > 1u && same(pool[at + n - 1u].position, pool[at].position)) {
+    if (n > 1u && same((*clip).pool[at + n - 1u].position, (*clip).pool[at].position)) {
         n -= 1u;
     }
     if (n < 3u) {
         n = 0u;
     }
-    poly_at = at;
-    poly_count = n;
+    (*clip).poly_at = at;
+    (*clip).poly_count = n;
 }
 
 // Clips the input triangle to quadrant q (signs of x and z as in `QUADRANTS` of axis.rs).
-fn quadrant_polygon(s: vec2<f32>) {
-    poly_at = 0u;
-    quadrant_at = 0u;
-    keep_at = 0u;
-    pool[0] = Node(tri_position[0], vec3<f32>(1.0, 0.0, 0.0));
-    pool[1] = Node(tri_position[1], vec3<f32>(0.0, 1.0, 0.0));
-    pool[2] = Node(tri_position[2], vec3<f32>(0.0, 0.0, 1.0));
-    poly_count = 3u;
+fn quadrant_polygon(s: vec2<f32>, tri: ptr<function, InputTriangle>, clip: ptr<function, ClipState>) {
+    (*clip).poly_at = 0u;
+    (*clip).quadrant_at = 0u;
+    (*clip).keep_at = 0u;
+    (*clip).pool[0] = Node((*tri).position[0], vec3<f32>(1.0, 0.0, 0.0));
+    (*clip).pool[1] = Node((*tri).position[1], vec3<f32>(0.0, 1.0, 0.0));
+    (*clip).pool[2] = Node((*tri).position[2], vec3<f32>(0.0, 0.0, 1.0));
+    (*clip).poly_count = 3u;
     // Quick tests (the clips would give the same): wholly on the far side of x = 0 or z = 0, or
     // two corners the same (no polygon); wholly inside the quadrant.
-    let p = tri_position;
+    let p = (*tri).position;
     let dx = vec3<f32>(s.x * p[0].x, s.x * p[1].x, s.x * p[2].x);
     let dz = vec3<f32>(s.y * p[0].z, s.y * p[1].z, s.y * p[2].z);
     if (all(dx < vec3<f32>(0.0)) || all(dz < vec3<f32>(0.0)) || same(p[0], p[1]) || same(p[1], p[2])
         || same(p[2], p[0])) {
-        poly_count = 0u;
+        (*clip).poly_count = 0u;
         return;
     }
     if (all(dx >= vec3<f32>(0.0)) && all(dz >= vec3<f32>(0.0))) {
         return;
     }
-    clip_polygon(Cut(CUT_X, s, 0.0, 1.0));
-    clip_polygon(Cut(CUT_Z, s, 0.0, 1.0));
+    clip_polygon(Cut(CUT_X, s, 0.0, 1.0), clip);
+    clip_polygon(Cut(CUT_Z, s, 0.0, 1.0), clip);
 }
 
 // c_k = ρ·√2^k, exactly as the twin (`band_bound` in axis.rs): ρ or ρ·√2, times 2^(k/2).
@@ -152,7 +152,7 @@ fn band_of(d: f32) -> u32 {
     return k;
 }
 
-fn cut_active(k: u32) -> bool {
+fn cut_active(k: u32, cuts: vec2<u32>) -> bool {
     if (k < 32u) {
         return ((cuts.x >> k) & 1u) != 0u;
     }
@@ -160,7 +160,7 @@ fn cut_active(k: u32) -> bool {
 }
 
 // The next active diamond after k, or MAX_DIAMONDS. `next_cut` in axis.rs.
-fn next_cut(k: u32) -> u32 {
+fn next_cut(k: u32, cuts: vec2<u32>) -> u32 {
     let j = k + 1u;
     if (j < 32u) {
         let low = cuts.x & (0xffffffffu << j);
@@ -178,10 +178,10 @@ fn next_cut(k: u32) -> u32 {
 }
 
 // The largest active k with c_k ≤ d (k = 0, the square, always counts). `zone_of` in axis.rs.
-fn zone_of(d: f32) -> u32 {
+fn zone_of(d: f32, cuts: vec2<u32>) -> u32 {
     var k = band_of(d);
     loop {
-        if (k == 0u || cut_active(k)) {
+        if (k == 0u || cut_active(k, cuts)) {
             break;
         }
         k -= 1u;
@@ -217,8 +217,8 @@ fn diamond_range(p: array<vec3<f32>, 3>) -> vec2<f32> {
 }
 
 // The cuts the current triangle asks for (`triangle_cuts` in axis.rs), as bits 0–31, 32–63.
-fn triangle_cuts(limit: f32) -> vec2<u32> {
-    let range = diamond_range(tri_position);
+fn triangle_cuts(limit: f32, tri: ptr<function, InputTriangle>) -> vec2<u32> {
+    let range = diamond_range((*tri).position);
     let lo = range.x;
     let hi = range.y;
     if (!asks_for_cuts(range)) {
@@ -244,11 +244,11 @@ fn triangle_cuts(limit: f32) -> vec2<u32> {
 // Whether every corner of the polygon kept in `quadrant` is on the far side of the cut (x: the
 // clip would be empty), or none is (y: the clip would change nothing). `Polygon::all_beyond`
 // in axis.rs.
-fn quadrant_beyond(cut: Cut) -> vec2<bool> {
+fn quadrant_beyond(cut: Cut, clip: ptr<function, ClipState>) -> vec2<bool> {
     var beyond = true;
     var within = true;
-    for (var i = 0u; i < quadrant_count; i++) {
-        let d = cut_distance(cut, pool[quadrant_at + i].position);
+    for (var i = 0u; i < (*clip).quadrant_count; i++) {
+        let d = cut_distance(cut, (*clip).pool[(*clip).quadrant_at + i].position);
         beyond = beyond && d < 0.0;
         within = within && d >= 0.0;
     }
@@ -257,17 +257,17 @@ fn quadrant_beyond(cut: Cut) -> vec2<bool> {
 
 // Whether the input triangle lies strictly inside quadrant s and between two consecutive active
 // diamonds: then it is its own single part. `single_band` in axis.rs.
-fn single_band(s: vec2<f32>) -> bool {
-    let p = tri_position;
+fn single_band(s: vec2<f32>, tri: ptr<function, InputTriangle>, cuts: vec2<u32>) -> bool {
+    let p = (*tri).position;
     let dx = vec3<f32>(s.x * p[0].x, s.x * p[1].x, s.x * p[2].x);
     let dz = vec3<f32>(s.y * p[0].z, s.y * p[1].z, s.y * p[2].z);
     if (!(all(dx > vec3<f32>(0.0)) && all(dz > vec3<f32>(0.0)))) {
         return false;
     }
     let d = dx + dz;
-    let k = zone_of(min(min(d.x, d.y), d.z));
+    let k = zone_of(min(min(d.x, d.y), d.z), cuts);
     let lower = Cut(CUT_CHORD, s, band_bound(k), 1.0);
-    let next = next_cut(k);
+    let next = next_cut(k, cuts);
     let upper = Cut(CUT_CHORD, s, band_bound(min(next, MAX_DIAMONDS - 1u)), -1.0);
     for (var i = 0u; i < 3u; i++) {
         if (cut_distance(lower, p[i]) <= 0.0 || (next < MAX_DIAMONDS && cut_distance(upper, p[i]) <= 0.0)) {
@@ -283,7 +283,7 @@ const QUADRANT_SIGNS = array<vec2<f32>, 4>(vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 
 // them (`full` false: asks for none and has no edge of one that does) and no edge of a cut
 // triangle (`marks`, its edges'); or one quadrant and one band (the loop of `plan_quadrant`
 // would give that part).
-fn single_part(full: bool, marks: vec3<u32>) -> bool {
+fn single_part(full: bool, marks: vec3<u32>, tri: ptr<function, InputTriangle>, cuts: vec2<u32>) -> bool {
     if (all(cuts == vec2<u32>(0u))) {
         return true;
     }
@@ -291,7 +291,7 @@ fn single_part(full: bool, marks: vec3<u32>) -> bool {
         return all((marks & vec3<u32>(EDGE_CUT)) == vec3<u32>(0u));
     }
     for (var q = 0u; q < 4u; q++) {
-        if (single_band(QUADRANT_SIGNS[q])) {
+        if (single_band(QUADRANT_SIGNS[q], tri, cuts)) {
             return true;
         }
     }
@@ -300,163 +300,156 @@ fn single_part(full: bool, marks: vec3<u32>) -> bool {
 
 // Plans every part of the current triangle in quadrant q (`polygons` in axis.rs: band by band
 // outwards, along each fan) and appends its pieces.
-fn plan_quadrant(t: u32, q: u32) {
+fn plan_quadrant(t: u32, q: u32, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>, clip: ptr<function, ClipState>, cuts: vec2<u32>) {
     let signs = QUADRANT_SIGNS;
     {
         let s = signs[q];
-        quadrant_polygon(s);
-        if (poly_count == 0u) {
+        quadrant_polygon(s, tri, clip);
+        if ((*clip).poly_count == 0u) {
             return;
         }
         // What lies beyond the current diamond (`rest` in axis.rs); each band is cut from it,
         // and the rest beyond the next diamond from the same polygon.
-        clip_polygon(Cut(CUT_CHORD, s, params.axis_clearance, 1.0));
-        quadrant_at = poly_at;
-        quadrant_count = poly_count;
+        clip_polygon(Cut(CUT_CHORD, s, params.axis_clearance, 1.0), clip);
+        (*clip).quadrant_at = (*clip).poly_at;
+        (*clip).quadrant_count = (*clip).poly_count;
         // Start at the band of the nearest corner: the bands below are empty, and cutting them
         // away would leave the polygon as it is (the twin runs them; the parts are the same).
         var d_min = 1e30;
-        for (var i = 0u; i < quadrant_count; i++) {
-            d_min = min(d_min, s.x * pool[quadrant_at + i].position.x + s.y * pool[quadrant_at + i].position.z);
+        for (var i = 0u; i < (*clip).quadrant_count; i++) {
+            d_min = min(d_min, s.x * (*clip).pool[(*clip).quadrant_at + i].position.x + s.y * (*clip).pool[(*clip).quadrant_at + i].position.z);
         }
-        var k = zone_of(d_min);
+        var k = zone_of(d_min, cuts);
         loop {
-            if (quadrant_count == 0u) {
+            if ((*clip).quadrant_count == 0u) {
                 break;
             }
-            k = next_cut(k);
+            k = next_cut(k, cuts);
             let c = band_bound(min(k, MAX_DIAMONDS - 1u));
             if (k >= MAX_DIAMONDS) {
-                poly_at = quadrant_at;
-                poly_count = quadrant_count;
-                quadrant_count = 0u; // the last band: all the rest
+                (*clip).poly_at = (*clip).quadrant_at;
+                (*clip).poly_count = (*clip).quadrant_count;
+                (*clip).quadrant_count = 0u; // the last band: all the rest
             } else {
                 let within = Cut(CUT_CHORD, s, c, -1.0);
-                let test = quadrant_beyond(within);
+                let test = quadrant_beyond(within, clip);
                 if (test.x) {
                     continue; // all of it lies beyond this band
                 }
-                poly_at = quadrant_at;
-                poly_count = quadrant_count;
+                (*clip).poly_at = (*clip).quadrant_at;
+                (*clip).poly_count = (*clip).quadrant_count;
                 if (test.y) {
-                    quadrant_count = 0u;
+                    (*clip).quadrant_count = 0u;
                 } else {
-                    clip_polygon(within);
-                    let band_at = poly_at;
-                    let band_count = poly_count;
-                    keep_at = band_at;
-                    poly_at = quadrant_at;
-                    poly_count = quadrant_count;
-                    clip_polygon(Cut(CUT_CHORD, s, c, 1.0));
-                    quadrant_at = poly_at;
-                    quadrant_count = poly_count;
-                    poly_at = band_at;
-                    poly_count = band_count;
-                    keep_at = quadrant_at;
+                    clip_polygon(within, clip);
+                    let band_at = (*clip).poly_at;
+                    let band_count = (*clip).poly_count;
+                    (*clip).keep_at = band_at;
+                    (*clip).poly_at = (*clip).quadrant_at;
+                    (*clip).poly_count = (*clip).quadrant_count;
+                    clip_polygon(Cut(CUT_CHORD, s, c, 1.0), clip);
+                    (*clip).quadrant_at = (*clip).poly_at;
+                    (*clip).quadrant_count = (*clip).poly_count;
+                    (*clip).poly_at = band_at;
+                    (*clip).poly_count = band_count;
+                    (*clip).keep_at = (*clip).quadrant_at;
                 }
             }
-            plan_band(t);
+            plan_band(t, tri, part, piece_state, clip);
         }
     }
 }
 
-
-var<private> seg_p: Node;
-var<private> seg_q: Node;
-var<private> seg_live: bool;
-var<private> edge_ends: array<vec3<f32>, 2>;
-var<private> run_start: u32;
-
 // Appends a crossing of the current edge to the pool, unless it is an end of the edge or there
 // already (a plane's crossing is found in two or four quadrants).
-fn add_crossing(n: Node) {
-    if (same(n.position, edge_ends[0]) || same(n.position, edge_ends[1])) {
+fn add_crossing(n: Node, clip: ptr<function, ClipState>) {
+    if (same(n.position, (*clip).edge_ends[0]) || same(n.position, (*clip).edge_ends[1])) {
         return;
     }
-    for (var i = run_start; i < poly_count; i++) {
-        if (same(pool[i].position, n.position)) {
+    for (var i = (*clip).run_start; i < (*clip).poly_count; i++) {
+        if (same((*clip).pool[i].position, n.position)) {
             return;
         }
     }
-    if (poly_count < 21u) {
-        pool[poly_count] = n;
-        poly_count += 1u;
+    if ((*clip).poly_count < 21u) {
+        (*clip).pool[(*clip).poly_count] = n;
+        (*clip).poly_count += 1u;
     }
 }
 
 // Clips the segment to the side cut ≥ 0 as `clip_polygon` clips a polygon's edge, keeping the
 // crossing (`clip_segment` in axis.rs).
-fn clip_segment(cut: Cut) {
-    if (!seg_live) {
+fn clip_segment(cut: Cut, clip: ptr<function, ClipState>) {
+    if (!(*clip).seg_live) {
         return;
     }
-    let dp = cut_distance(cut, seg_p.position);
-    let dq = cut_distance(cut, seg_q.position);
+    let dp = cut_distance(cut, (*clip).seg_p.position);
+    let dq = cut_distance(cut, (*clip).seg_q.position);
     if ((dp >= 0.0) != (dq >= 0.0) && dp != 0.0 && dq != 0.0) {
         var x: Node;
-        if (lex_less(seg_q.position, seg_p.position)) {
-            x = cut_crossing(cut.kind, seg_q, seg_p, dq, dp);
+        if (lex_less((*clip).seg_q.position, (*clip).seg_p.position)) {
+            x = cut_crossing(cut.kind, (*clip).seg_q, (*clip).seg_p, dq, dp);
         } else {
-            x = cut_crossing(cut.kind, seg_p, seg_q, dp, dq);
+            x = cut_crossing(cut.kind, (*clip).seg_p, (*clip).seg_q, dp, dq);
         }
-        add_crossing(x);
+        add_crossing(x, clip);
         if (dp >= 0.0) {
-            seg_q = x;
+            (*clip).seg_q = x;
         } else {
-            seg_p = x;
+            (*clip).seg_p = x;
         }
         return;
     }
-    seg_live = dp >= 0.0 && dq >= 0.0;
+    (*clip).seg_live = dp >= 0.0 && dq >= 0.0;
 }
 
 // Appends to the pool the points where a cut triangle cuts edge a → b (ends excluded), in order
 // from a (`edge_crossings` in axis.rs): the same clips in the same order, on the edge alone.
-fn edge_crossings(a: Node, b: Node) {
-    run_start = poly_count;
-    edge_ends = array<vec3<f32>, 2>(a.position, b.position);
+fn edge_crossings(a: Node, b: Node, clip: ptr<function, ClipState>, cuts: vec2<u32>) {
+    (*clip).run_start = (*clip).poly_count;
+    (*clip).edge_ends = array<vec3<f32>, 2>(a.position, b.position);
     for (var q = 0u; q < 4u; q++) {
         let s = QUADRANT_SIGNS[q];
-        seg_p = a;
-        seg_q = b;
-        seg_live = true;
-        clip_segment(Cut(CUT_X, s, 0.0, 1.0));
-        clip_segment(Cut(CUT_Z, s, 0.0, 1.0));
-        clip_segment(Cut(CUT_CHORD, s, params.axis_clearance, 1.0));
+        (*clip).seg_p = a;
+        (*clip).seg_q = b;
+        (*clip).seg_live = true;
+        clip_segment(Cut(CUT_X, s, 0.0, 1.0), clip);
+        clip_segment(Cut(CUT_Z, s, 0.0, 1.0), clip);
+        clip_segment(Cut(CUT_CHORD, s, params.axis_clearance, 1.0), clip);
         var k = 0u;
         loop {
-            k = next_cut(k);
-            if (!seg_live || k >= MAX_DIAMONDS) {
+            k = next_cut(k, cuts);
+            if (!(*clip).seg_live || k >= MAX_DIAMONDS) {
                 break;
             }
-            clip_segment(Cut(CUT_CHORD, s, band_bound(k), 1.0));
+            clip_segment(Cut(CUT_CHORD, s, band_bound(k), 1.0), clip);
         }
     }
     // In order along the edge (insertion sort; a few points).
     let dir = b.position - a.position;
-    for (var i = run_start + 1u; i < poly_count; i++) {
-        let n = pool[i];
+    for (var i = (*clip).run_start + 1u; i < (*clip).poly_count; i++) {
+        let n = (*clip).pool[i];
         let key = dot(n.position - a.position, dir);
         var j = i;
         loop {
-            if (j == run_start || !(dot(pool[j - 1u].position - a.position, dir) > key)) {
+            if (j == (*clip).run_start || !(dot((*clip).pool[j - 1u].position - a.position, dir) > key)) {
                 break;
             }
-            pool[j] = pool[j - 1u];
+            (*clip).pool[j] = (*clip).pool[j - 1u];
             j -= 1u;
         }
-        pool[j] = n;
+        (*clip).pool[j] = n;
     }
 }
 
 // Plans part (apex, pool[i], pool[i + 1 mod the polygon's count]) unless it is off screen.
-fn plan_apex_part(t: u32, apex: Node, i: u32) {
-    part[0] = apex;
-    part[1] = pool[i];
-    part[2] = pool[(i + 1u) % poly_count];
-    if (!off_screen_vertically(part[0].position, part[1].position, part[2].position)) {
-        plan_part();
-        append_pieces(t);
+fn plan_apex_part(t: u32, apex: Node, i: u32, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, clip: ptr<function, ClipState>) {
+    (*part).corner[0] = apex;
+    (*part).corner[1] = (*clip).pool[i];
+    (*part).corner[2] = (*clip).pool[(i + 1u) % (*clip).poly_count];
+    if (!off_screen_vertically((*part).corner[0].position, (*part).corner[1].position, (*part).corner[2].position)) {
+        plan_part(tri, part);
+        append_pieces(t, part);
     }
 }
 
@@ -464,38 +457,38 @@ fn plan_apex_part(t: u32, apex: Node, i: u32) {
 // cut triangles have (`edge_split_parts` in axis.rs): its boundary (corner e, then edge e's
 // crossings) in the pool; with crossings on one edge the fan from the opposite corner, on more
 // the fan from the centroid, on none the triangle.
-fn plan_edge_split(t: u32) {
-    let corners = array<Node, 3>(Node(tri_position[0], vec3<f32>(1.0, 0.0, 0.0)),
-                                 Node(tri_position[1], vec3<f32>(0.0, 1.0, 0.0)),
-                                 Node(tri_position[2], vec3<f32>(0.0, 0.0, 1.0)));
-    poly_count = 0u;
+fn plan_edge_split(t: u32, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, clip: ptr<function, ClipState>, cuts: vec2<u32>) {
+    let corners = array<Node, 3>(Node((*tri).position[0], vec3<f32>(1.0, 0.0, 0.0)),
+                                 Node((*tri).position[1], vec3<f32>(0.0, 1.0, 0.0)),
+                                 Node((*tri).position[2], vec3<f32>(0.0, 0.0, 1.0)));
+    (*clip).poly_count = 0u;
     var crossed = 0u;
     var chain = vec3<u32>(0u); // the crossed edge, its corner's slot, its nodes before the next corner
     let marks = edge_marks(t);
     for (var e = 0u; e < 3u; e++) {
-        let at = poly_count;
-        pool[at] = corners[e];
-        poly_count += 1u;
+        let at = (*clip).poly_count;
+        (*clip).pool[at] = corners[e];
+        (*clip).poly_count += 1u;
         if ((marks[e] & EDGE_CUT) != 0u) {
-            edge_crossings(corners[e], corners[(e + 1u) % 3u]);
+            edge_crossings(corners[e], corners[(e + 1u) % 3u], clip, cuts);
         }
-        if (poly_count > at + 1u) {
+        if ((*clip).poly_count > at + 1u) {
             crossed += 1u;
-            chain = vec3<u32>(e, at, poly_count - at);
+            chain = vec3<u32>(e, at, (*clip).poly_count - at);
         }
     }
     if (crossed == 0u) {
-        part = corners;
-        plan_part();
-        append_pieces(t);
+        (*part).corner = corners;
+        plan_part(tri, part);
+        append_pieces(t, part);
     } else if (crossed == 1u) {
         for (var i = 0u; i < chain.z; i++) {
-            plan_apex_part(t, corners[(chain.x + 2u) % 3u], chain.y + i);
+            plan_apex_part(t, corners[(chain.x + 2u) % 3u], chain.y + i, tri, part, clip);
         }
     } else {
         let centre = weighted(corners, vec3<f32>(1.0 / 3.0));
-        for (var i = 0u; i < poly_count; i++) {
-            plan_apex_part(t, centre, i);
+        for (var i = 0u; i < (*clip).poly_count; i++) {
+            plan_apex_part(t, centre, i, tri, part, clip);
         }
     }
 }
@@ -503,17 +496,17 @@ fn plan_edge_split(t: u32) {
 // The edges of the polygon in `poly` and its fan: side e (corner e → e + 1, the last back to
 // corner 0) for e < poly_count, then diagonal d (corner 0 → d + 2) at poly_count + d. The ends of
 // edge e, as corner indices.
-fn polygon_edge_ends(e: u32) -> vec2<u32> {
-    if (e < poly_count) {
-        return vec2<u32>(e, (e + 1u) % poly_count);
+fn polygon_edge_ends(e: u32, clip: ptr<function, ClipState>) -> vec2<u32> {
+    if (e < (*clip).poly_count) {
+        return vec2<u32>(e, (e + 1u) % (*clip).poly_count);
     }
-    return vec2<u32>(0u, e - poly_count + 2u);
+    return vec2<u32>(0u, e - (*clip).poly_count + 2u);
 }
 
 // The edges of fan part i (corners 0, i, i + 1): 0 → i, i → i + 1, i + 1 → 0.
-fn fan_edges(i: u32) -> vec3<u32> {
-    let first = select(poly_count + i - 2u, 0u, i == 1u);
-    let last = select(poly_count + i - 1u, poly_count - 1u, i + 2u == poly_count);
+fn fan_edges(i: u32, clip: ptr<function, ClipState>) -> vec3<u32> {
+    let first = select((*clip).poly_count + i - 2u, 0u, i == 1u);
+    let last = select((*clip).poly_count + i - 1u, (*clip).poly_count - 1u, i + 2u == (*clip).poly_count);
     return vec3<u32>(first, i, last);
 }
 
@@ -524,39 +517,39 @@ fn fan_edges(i: u32) -> vec3<u32> {
 
 // The band polygon in `poly` (of triangle `t`), planned: one strip between its rails where it
 // is a band quad, else its fan's parts, those wholly beyond the image's rows left out.
-fn plan_band(t: u32) {
+fn plan_band(t: u32, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>, clip: ptr<function, ClipState>) {
     // The fan's parts: those wholly beyond the image's rows make no pieces (`run` in
     // subdivide.rs); the others' edges, each counted once (a diagonal is two parts').
     var shown = 0u;
     var needed = 0u;
-    for (var i = 1u; i + 1u < poly_count; i++) {
-        if (!off_screen_vertically(poly_node(0).position, poly_node(i).position, poly_node(i + 1u).position)) {
+    for (var i = 1u; i + 1u < (*clip).poly_count; i++) {
+        if (!off_screen_vertically(poly_node(0, clip).position, poly_node(i, clip).position, poly_node(i + 1u, clip).position)) {
             shown |= 1u << i;
-            let e = fan_edges(i);
+            let e = fan_edges(i, clip);
             needed |= (1u << e.x) | (1u << e.y) | (1u << e.z);
         }
     }
-    for (var e = 0u; e + 3u < 2u * poly_count; e++) {
+    for (var e = 0u; e + 3u < 2u * (*clip).poly_count; e++) {
         if ((needed & (1u << e)) != 0u) {
-            let ends = polygon_edge_ends(e);
-            poly_n[e] = edge_divisions(poly_node(ends.x).position, poly_node(ends.y).position);
+            let ends = polygon_edge_ends(e, clip);
+            (*clip).poly_n[e] = edge_divisions(poly_node(ends.x, clip).position, poly_node(ends.y, clip).position, tri);
         }
     }
-    if (plan_quad(shown)) {
-        append_quad(t);
+    if (plan_quad(shown, tri, piece_state, clip)) {
+        append_quad(t, piece_state, clip);
         return;
     }
-    for (var i = 1u; i + 1u < poly_count; i++) {
+    for (var i = 1u; i + 1u < (*clip).poly_count; i++) {
         if ((shown & (1u << i)) != 0u) {
-            part[0] = poly_node(0);
-            part[1] = poly_node(i);
-            part[2] = poly_node(i + 1u);
-            let e = fan_edges(i);
-            tri_n[0] = poly_n[e.x];
-            tri_n[1] = poly_n[e.y];
-            tri_n[2] = poly_n[e.z];
-            plan_level();
-            append_pieces(t);
+            (*part).corner[0] = poly_node(0, clip);
+            (*part).corner[1] = poly_node(i, clip);
+            (*part).corner[2] = poly_node(i + 1u, clip);
+            let e = fan_edges(i, clip);
+            (*part).n[0] = (*clip).poly_n[e.x];
+            (*part).n[1] = (*clip).poly_n[e.y];
+            (*part).n[2] = (*clip).poly_n[e.z];
+            plan_level(part);
+            append_pieces(t, part);
         }
     }
 }

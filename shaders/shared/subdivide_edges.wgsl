@@ -111,7 +111,7 @@ fn parts_for_bend(bend_px: f32, segments: u32, max_error_px: f32) -> f32 {
 // split for METHOD_ERROR. The quick 2-segment profile, then the 8-segment one, from one call site
 // in a loop (lavapipe's compiler inlines every call, and a shader that merely contains more code
 // runs slower).
-fn edge_divisions(a: vec3<f32>, b: vec3<f32>) -> u32 {
+fn edge_divisions(a: vec3<f32>, b: vec3<f32>, tri: ptr<function, InputTriangle>) -> u32 {
     if (params.method == METHOD_VERTEX) {
         return 1u;
     }
@@ -123,17 +123,17 @@ fn edge_divisions(a: vec3<f32>, b: vec3<f32>) -> u32 {
     for (var round = 0u; round < 2u; round++) {
         let segments = select(2u, EDGE_SAMPLES, round == 1u);
         let p = edge_profile(a, b, segments);
-        let by_bend = parts_for_bend(p.bend_px, segments, tri_max_error_px);
+        let by_bend = parts_for_bend(p.bend_px, segments, (*tri).max_error_px);
         if (round == 0u) {
-            let whole = select(p.length_px <= tri_edge_px && !p.ring && by_bend <= 1.0,
-                               p.length_px <= 0.5 * tri_edge_px, by_length);
+            let whole = select(p.length_px <= (*tri).edge_px && !p.ring && by_bend <= 1.0,
+                               p.length_px <= 0.5 * (*tri).edge_px, by_length);
             if (whole) {
                 return 1u;
             }
         } else if (by_length) {
-            n = ceil(p.length_px / tri_edge_px);
+            n = ceil(p.length_px / (*tri).edge_px);
         } else {
-            let longest = select(ERROR_SPLIT_LENGTH * tri_edge_px, tri_edge_px, p.ring);
+            let longest = select(ERROR_SPLIT_LENGTH * (*tri).edge_px, (*tri).edge_px, p.ring);
             n = max(by_bend, ceil(p.length_px / longest));
         }
     }
@@ -153,30 +153,30 @@ fn off_screen_vertically(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> bool {
 }
 
 // The corners of input triangle t in the viewer frame, snapped to the cut planes.
-fn load_positions(t: u32) {
+fn load_positions(t: u32, tri: ptr<function, InputTriangle>) {
     for (var k = 0u; k < 3u; k++) {
         let v = vertices[indices[3u * t + k]];
-        tri_position[k] = snap_to_cut_planes((params.view * vec4<f32>(v.position, 1.0)).xyz);
+        (*tri).position[k] = snap_to_cut_planes((params.view * vec4<f32>(v.position, 1.0)).xyz);
     }
 }
 
 // Loads an input triangle into the viewer frame, its vertices snapped to the cut planes
 // (its parts, their edge counts and K come from `visit_parts` or from the piece record).
-fn load_triangle(t: u32) {
-    load_positions(t);
+fn load_triangle(t: u32, tri: ptr<function, InputTriangle>) {
+    load_positions(t, tri);
     for (var k = 0u; k < 3u; k++) {
         let v = vertices[indices[3u * t + k]];
-        tri_normal[k] = (params.view * vec4<f32>(v.normal, 0.0)).xyz;
-        tri_color[k] = v.color;
-        tri_uv[k] = v.uv;
+        (*tri).normal[k] = (params.view * vec4<f32>(v.normal, 0.0)).xyz;
+        (*tri).color[k] = v.color;
+        (*tri).uv[k] = v.uv;
         let t = unpack_tangent(v.tangent);
-        tri_tangent[k] = vec4<f32>((params.view * vec4<f32>(t.xyz, 0.0)).xyz, t.w);
+        (*tri).tangent[k] = vec4<f32>((params.view * vec4<f32>(t.xyz, 0.0)).xyz, t.w);
     }
-    tri_material = vertices[indices[3u * t]].material;
-    tri_object = vertices[indices[3u * t]].object;
-    let scale = object_edge_scale[min(tri_object, arrayLength(&object_edge_scale) - 1u)];
-    tri_edge_px = params.edge_px * scale;
-    tri_max_error_px = params.max_error_px * (scale * scale);
+    (*tri).material = vertices[indices[3u * t]].material;
+    (*tri).object = vertices[indices[3u * t]].object;
+    let scale = object_edge_scale[min((*tri).object, arrayLength(&object_edge_scale) - 1u)];
+    (*tri).edge_px = params.edge_px * scale;
+    (*tri).max_error_px = params.max_error_px * (scale * scale);
 }
 
 // Whether the method is one of the adaptive rules (eq. 5 or the error split).
@@ -185,22 +185,22 @@ fn is_adaptive() -> bool {
 }
 
 // Edge counts and macro-lattice level of the current part.
-fn plan_part() {
+fn plan_part(tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>) {
     for (var e = 0u; e < 3u; e++) {
-        tri_n[e] = edge_divisions(part[e].position, part[(e + 1u) % 3u].position);
+        (*part).n[e] = edge_divisions((*part).corner[e].position, (*part).corner[(e + 1u) % 3u].position, tri);
     }
-    plan_level();
+    plan_level(part);
 }
 
 // The macro-lattice level of the current part from its edge counts `tri_n`.
-fn plan_level() {
-    let m = max(max(tri_n[0], tri_n[1]), tri_n[2]);
-    tri_k = 1u;
+fn plan_level(part: ptr<function, PartPlan>) {
+    let m = max(max((*part).n[0], (*part).n[1]), (*part).n[2]);
+    (*part).k = 1u;
     if (is_adaptive()) {
         let step = min(params.max_div, PIECE_DIVISIONS);
-        tri_k = min((m + step - 1u) / step, MAX_MACRO_LEVEL);
+        (*part).k = min((m + step - 1u) / step, MAX_MACRO_LEVEL);
     } else if (params.method == METHOD_FIXED) {
-        tri_k = (m + PIECE_DIVISIONS - 1u) / PIECE_DIVISIONS;
+        (*part).k = (m + PIECE_DIVISIONS - 1u) / PIECE_DIVISIONS;
     }
 }
 

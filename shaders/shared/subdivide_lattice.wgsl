@@ -34,39 +34,39 @@ fn snap(idx: u32, count: u32, level: u32) -> u32 {
     return (2u * idx * count + level) / (2u * level);
 }
 
-fn macro_location(abc: vec3<u32>) -> vec3<u32> {
+fn macro_location(abc: vec3<u32>, part: ptr<function, PartPlan>) -> vec3<u32> {
     let on = boundary_edge(abc);
     let e = on.x;
     if (e == 3u) {
         return vec3<u32>(INTERIOR, 0u, 0u);
     }
-    let j = snap(on.y, tri_n[e], tri_k);
+    let j = snap(on.y, (*part).n[e], (*part).k);
     if (j == 0u) {
         return vec3<u32>(CORNER, e, 0u);
     }
-    if (j == tri_n[e]) {
+    if (j == (*part).n[e]) {
         return vec3<u32>(CORNER, (e + 1u) % 3u, 0u);
     }
     return vec3<u32>(ON_EDGE, e, j);
 }
 
-fn macro_node(abc: vec3<u32>, loc: vec3<u32>) -> Node {
+fn macro_node(abc: vec3<u32>, loc: vec3<u32>, part: ptr<function, PartPlan>) -> Node {
     if (loc.x == CORNER) {
-        return corner(loc.y);
+        return corner(loc.y, part);
     }
     if (loc.x == ON_EDGE) {
-        return edge_point(corner(loc.y), corner((loc.y + 1u) % 3u), loc.z, tri_n[loc.y]);
+        return edge_point(corner(loc.y, part), corner((loc.y + 1u) % 3u, part), loc.z, (*part).n[loc.y]);
     }
-    return weighted(part, vec3<f32>(abc) / f32(tri_k));
+    return weighted((*part).corner, vec3<f32>(abc) / f32((*part).k));
 }
 
 // The node's fine index along original edge oe from its start, or −1 if it is not on that edge.
-fn index_on(oe: u32, loc: vec3<u32>) -> i32 {
+fn index_on(oe: u32, loc: vec3<u32>, part: ptr<function, PartPlan>) -> i32 {
     if (loc.x == CORNER && loc.y == oe) {
         return 0;
     }
     if (loc.x == CORNER && loc.y == (oe + 1u) % 3u) {
-        return i32(tri_n[oe]);
+        return i32((*part).n[oe]);
     }
     if (loc.x == ON_EDGE && loc.y == oe) {
         return i32(loc.z);
@@ -103,19 +103,19 @@ fn macro_cell(k: u32, cell: u32) -> Cell {
 }
 
 // The m-th node of piece edge e, from piece corner e towards corner e + 1.
-fn node_on_edge(e: u32, m: u32) -> Node {
-    let oe = piece_original[e];
-    var a = piece_q[e];
-    var b = piece_q[(e + 1u) % 3u];
+fn node_on_edge(e: u32, m: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Node {
+    let oe = (*piece_state).original[e];
+    var a = (*piece_state).corner[e];
+    var b = (*piece_state).corner[(e + 1u) % 3u];
     var j = m;
-    var n = piece_counts[e];
+    var n = (*piece_state).counts[e];
     if (oe >= 0) {
         // On an original edge: the fine nodes of that edge, by their global index.
         let o = u32(oe);
-        a = corner(o);
-        b = corner((o + 1u) % 3u);
-        n = tri_n[o];
-        j = select(piece_from[e] + m, piece_from[e] - m, piece_to[e] < piece_from[e]);
+        a = corner(o, part);
+        b = corner((o + 1u) % 3u, part);
+        n = (*part).n[o];
+        j = select((*piece_state).from_index[e] + m, (*piece_state).from_index[e] - m, (*piece_state).to_index[e] < (*piece_state).from_index[e]);
     }
     return edge_point(a, b, j, n);
 }
@@ -128,25 +128,25 @@ fn weighted(q: array<Node, 3>, w: vec3<f32>) -> Node {
     );
 }
 
-fn interior_node(i: u32, j: u32, l: u32, m: u32) -> Node {
-    return weighted(piece_q, vec3<f32>(f32(i), f32(j), f32(l)) / f32(m));
+fn interior_node(i: u32, j: u32, l: u32, m: u32, piece_state: ptr<function, PieceState>) -> Node {
+    return weighted((*piece_state).corner, vec3<f32>(f32(i), f32(j), f32(l)) / f32(m));
 }
 
 
-fn append_pieces(t: u32) {
-    let count = tri_k * tri_k;
+fn append_pieces(t: u32, part: ptr<function, PartPlan>) {
+    let count = (*part).k * (*part).k;
     let base = atomicAdd(&counters.pieces, count);
     if (base + count > params.piece_capacity) {
         return; // counted, never written
     }
     var record: Piece;
     record.triangle = t;
-    record.counts01 = tri_n[0] | (tri_n[1] << 16u);
-    record.count2_level = tri_n[2] | (tri_k << 16u);
+    record.counts01 = (*part).n[0] | ((*part).n[1] << 16u);
+    record.count2_level = (*part).n[2] | ((*part).k << 16u);
     for (var i = 0u; i < 3u; i++) {
-        record.corner[i] = vec4<f32>(part[i].position, part[i].bary.x);
-        record.bary1[i] = part[i].bary.y;
-        record.bary2[i] = part[i].bary.z;
+        record.corner[i] = vec4<f32>((*part).corner[i].position, (*part).corner[i].bary.x);
+        record.bary1[i] = (*part).corner[i].bary.y;
+        record.bary2[i] = (*part).corner[i].bary.z;
     }
     for (var c = 0u; c < count; c++) {
         record.cell = c;
@@ -156,17 +156,17 @@ fn append_pieces(t: u32) {
 
 // ---- emission ----
 
-fn draw_vertex(n: Node, theta_ref: f32) -> DrawVertex {
+fn draw_vertex(n: Node, theta_ref: f32, tri: ptr<function, InputTriangle>) -> DrawVertex {
     let b = n.bary;
     return DrawVertex(
         n.position,
         theta_ref,
-        b.x * tri_normal[0] + b.y * tri_normal[1] + b.z * tri_normal[2],
-        tri_material,
-        b.x * tri_color[0] + b.y * tri_color[1] + b.z * tri_color[2],
-        b.x * tri_uv[0] + b.y * tri_uv[1] + b.z * tri_uv[2],
-        tri_object,
-        pack_tangent(b.x * tri_tangent[0] + b.y * tri_tangent[1] + b.z * tri_tangent[2]),
+        b.x * (*tri).normal[0] + b.y * (*tri).normal[1] + b.z * (*tri).normal[2],
+        (*tri).material,
+        b.x * (*tri).color[0] + b.y * (*tri).color[1] + b.z * (*tri).color[2],
+        b.x * (*tri).uv[0] + b.y * (*tri).uv[1] + b.z * (*tri).uv[2],
+        (*tri).object,
+        pack_tangent(b.x * (*tri).tangent[0] + b.y * (*tri).tangent[1] + b.z * (*tri).tangent[2]),
     );
 }
 
@@ -193,12 +193,12 @@ fn visible_edge_px(p: array<vec3<f32>, 3>) -> f32 {
 
 // Node (i, j, l) of the piece's lattice of level m: the regular lattice, whose boundary nodes on
 // an edge with fewer divisions snap to that edge's nearest node (see subdivide.rs).
-fn lattice_node(c: vec3<u32>, m: u32) -> Node {
+fn lattice_node(c: vec3<u32>, m: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Node {
     let on = boundary_edge(c);
     if (on.x < 3u) {
-        return node_on_edge(on.x, snap(on.y, piece_counts[on.x], m));
+        return node_on_edge(on.x, snap(on.y, (*piece_state).counts[on.x], m), part, piece_state);
     }
-    return interior_node(c.x, c.y, c.z, m);
+    return interior_node(c.x, c.y, c.z, m, piece_state);
 }
 
 // Slot of lattice node (i, j, l) among the piece's (m + 1)(m + 2)/2: rows l = 0..m of m + 1 − l
@@ -212,20 +212,20 @@ fn node_slot(c: vec3<u32>, m: u32) -> u32 {
 // On the cylinder, under the error split, the base edge (one part, chord error within
 // STRIP_BASE_ERROR·τ by the quick profile, away from the eye circle) of a piece with another edge
 // in STRIP_MIN_DIVISIONS or more parts; 3: the regular lattice (`strip_base` in subdivide.rs).
-fn strip_base_of() -> u32 {
-    let m = max(max(piece_counts[0], piece_counts[1]), piece_counts[2]);
+fn strip_base_of(tri: ptr<function, InputTriangle>, piece_state: ptr<function, PieceState>) -> u32 {
+    let m = max(max((*piece_state).counts[0], (*piece_state).counts[1]), (*piece_state).counts[2]);
     if (params.method != METHOD_ERROR || is_sphere(params.projection) || m < STRIP_MIN_DIVISIONS) {
         return 3u;
     }
     var base = 3u;
     for (var e = 0u; e < 3u; e++) {
-        if (base == 3u && piece_counts[e] == 1u) {
+        if (base == 3u && (*piece_state).counts[e] == 1u) {
             base = e;
         }
     }
     if (base < 3u) {
-        let p = edge_profile(piece_q[base].position, piece_q[(base + 1u) % 3u].position, 2u);
-        if (p.ring || parts_for_bend(p.bend_px, 2u, STRIP_BASE_ERROR * tri_max_error_px) > 1.0) {
+        let p = edge_profile((*piece_state).corner[base].position, (*piece_state).corner[(base + 1u) % 3u].position, 2u);
+        if (p.ring || parts_for_bend(p.bend_px, 2u, STRIP_BASE_ERROR * (*tri).max_error_px) > 1.0) {
             return 3u;
         }
     }
@@ -234,20 +234,20 @@ fn strip_base_of() -> u32 {
 
 // Node `slot` of the strip: edge base + 1's nodes from its corner to the apex, then edge
 // base + 2's after the apex.
-fn strip_node(slot: u32) -> Node {
-    if (slot <= strip_n.x) {
-        return node_on_edge((strip_base + 1u) % 3u, slot);
+fn strip_node(slot: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Node {
+    if (slot <= (*piece_state).strip_n.x) {
+        return node_on_edge(((*piece_state).strip_base + 1u) % 3u, slot, part, piece_state);
     }
-    return node_on_edge((strip_base + 2u) % 3u, slot - strip_n.x);
+    return node_on_edge(((*piece_state).strip_base + 2u) % 3u, slot - (*piece_state).strip_n.x, part, piece_state);
 }
 
 // The next triangle of the strip's walk at `walk` = (i, j) (left L_i = slot n1 + n2 − i, right
 // R_j = slot j), as slots; advances the walk.
-fn strip_step(walk: ptr<function, vec2<u32>>) -> vec3<u32> {
+fn strip_step(walk: ptr<function, vec2<u32>>, piece_state: ptr<function, PieceState>) -> vec3<u32> {
     let i = (*walk).x;
     let j = (*walk).y;
-    let n1 = strip_n.x;
-    let n2 = strip_n.y;
+    let n1 = (*piece_state).strip_n.x;
+    let n2 = (*piece_state).strip_n.y;
     if (i < n2 && (j == n1 || (i + 1u) * n1 <= (j + 1u) * n2)) {
         *walk = vec2<u32>(i + 1u, j);
         return vec3<u32>(n1 + n2 - i, j, n1 + n2 - i - 1u);
@@ -260,51 +260,51 @@ fn strip_step(walk: ptr<function, vec2<u32>>) -> vec3<u32> {
 // ---- a piece's nodes and candidate triangles: the lattice of level m, the strip or the quad ----
 
 // Node k in slot order; `row` is the lattice's running (j, l), advanced here.
-fn piece_node(k: u32, m: u32, row: ptr<function, vec2<u32>>) -> Node {
-    if (strip_base == QUAD_STRIP) {
-        return quad_node(k);
+fn piece_node(k: u32, m: u32, row: ptr<function, vec2<u32>>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Node {
+    if ((*piece_state).strip_base == QUAD_STRIP) {
+        return quad_node(k, piece_state);
     }
-    if (strip_base < 3u) {
-        return strip_node(k);
+    if ((*piece_state).strip_base < 3u) {
+        return strip_node(k, part, piece_state);
     }
     let j = (*row).x;
     let l = (*row).y;
     *row = select(vec2<u32>(j + 1u, l), vec2<u32>(0u, l + 1u), j + 1u > m - l);
-    return lattice_node(vec3<u32>(m - j - l, j, l), m);
+    return lattice_node(vec3<u32>(m - j - l, j, l), m, part, piece_state);
 }
 
 // Candidate triangle t's slots (the strip's in walk order, advancing `walk`).
-fn piece_triangle_slots(t: u32, m: u32, walk: ptr<function, vec2<u32>>) -> vec3<u32> {
-    if (strip_base == QUAD_STRIP) {
-        return quad_step(walk);
+fn piece_triangle_slots(t: u32, m: u32, walk: ptr<function, vec2<u32>>, piece_state: ptr<function, PieceState>) -> vec3<u32> {
+    if ((*piece_state).strip_base == QUAD_STRIP) {
+        return quad_step(walk, piece_state);
     }
-    if (strip_base < 3u) {
-        return strip_step(walk);
+    if ((*piece_state).strip_base < 3u) {
+        return strip_step(walk, piece_state);
     }
     let cell = macro_cell(m, t);
     return vec3<u32>(node_slot(cell.c[0], m), node_slot(cell.c[1], m), node_slot(cell.c[2], m));
 }
 
 // Whether candidate triangle t is drawn: not collapsed by snapping, not off screen.
-fn piece_triangle_drawn(t: u32, m: u32, walk: ptr<function, vec2<u32>>) -> bool {
+fn piece_triangle_drawn(t: u32, m: u32, walk: ptr<function, vec2<u32>>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> bool {
     var a: vec3<f32>;
     var b: vec3<f32>;
     var c: vec3<f32>;
-    if (strip_base == QUAD_STRIP) {
-        let s = quad_step(walk);
-        a = quad_node(s.x).position;
-        b = quad_node(s.y).position;
-        c = quad_node(s.z).position;
-    } else if (strip_base < 3u) {
-        let s = strip_step(walk);
-        a = strip_node(s.x).position;
-        b = strip_node(s.y).position;
-        c = strip_node(s.z).position;
+    if ((*piece_state).strip_base == QUAD_STRIP) {
+        let s = quad_step(walk, piece_state);
+        a = quad_node(s.x, piece_state).position;
+        b = quad_node(s.y, piece_state).position;
+        c = quad_node(s.z, piece_state).position;
+    } else if ((*piece_state).strip_base < 3u) {
+        let s = strip_step(walk, piece_state);
+        a = strip_node(s.x, part, piece_state).position;
+        b = strip_node(s.y, part, piece_state).position;
+        c = strip_node(s.z, part, piece_state).position;
     } else {
         let cell = macro_cell(m, t);
-        a = lattice_node(cell.c[0], m).position;
-        b = lattice_node(cell.c[1], m).position;
-        c = lattice_node(cell.c[2], m).position;
+        a = lattice_node(cell.c[0], m, part, piece_state).position;
+        b = lattice_node(cell.c[1], m, part, piece_state).position;
+        c = lattice_node(cell.c[2], m, part, piece_state).position;
     }
     return !(same(a, b) || same(b, c) || same(c, a) || off_screen_vertically(a, b, c));
 }
@@ -345,71 +345,71 @@ struct PieceShape {
 }
 
 // A band quad: corners 0–2 in `piece`, corner 3 in the next record (`tail`); its rails' counts.
-fn quad_shape(piece: Piece, tail: Piece) -> PieceShape {
-    piece_q = part;
-    quad_last = Node(tail.corner[0].xyz, vec3<f32>(tail.corner[0].w, tail.bary1[0], tail.bary2[0]));
-    strip_base = QUAD_STRIP;
-    strip_n = vec2<u32>(piece.counts01 & 0xffffu, piece.counts01 >> 16u);
-    let candidates = strip_n.x + strip_n.y;
-    let theta_c = azimuth((piece_q[0].position + piece_q[1].position + piece_q[2].position + quad_last.position) / 4.0);
-    return PieceShape(max(strip_n.x, strip_n.y), candidates, candidates + 2u, theta_c);
+fn quad_shape(piece: Piece, tail: Piece, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> PieceShape {
+    (*piece_state).corner = (*part).corner;
+    (*piece_state).quad_last = Node(tail.corner[0].xyz, vec3<f32>(tail.corner[0].w, tail.bary1[0], tail.bary2[0]));
+    (*piece_state).strip_base = QUAD_STRIP;
+    (*piece_state).strip_n = vec2<u32>(piece.counts01 & 0xffffu, piece.counts01 >> 16u);
+    let candidates = (*piece_state).strip_n.x + (*piece_state).strip_n.y;
+    let theta_c = azimuth(((*piece_state).corner[0].position + (*piece_state).corner[1].position + (*piece_state).corner[2].position + (*piece_state).quad_last.position) / 4.0);
+    return PieceShape(max((*piece_state).strip_n.x, (*piece_state).strip_n.y), candidates, candidates + 2u, theta_c);
 }
 
 // A piece of the pre-split: its macro cell's corners, each edge's count, lattice or strip.
 // Nothing where its snapped corners coincide (no area) or it lies wholly off screen.
-fn lattice_shape(piece: Piece) -> PieceShape {
-    tri_n[0] = piece.counts01 & 0xffffu;
-    tri_n[1] = piece.counts01 >> 16u;
-    tri_n[2] = piece.count2_level & 0xffffu;
-    tri_k = piece.count2_level >> 16u;
-    let cell = macro_cell(tri_k, piece.cell);
+fn lattice_shape(piece: Piece, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> PieceShape {
+    (*part).n[0] = piece.counts01 & 0xffffu;
+    (*part).n[1] = piece.counts01 >> 16u;
+    (*part).n[2] = piece.count2_level & 0xffffu;
+    (*part).k = piece.count2_level >> 16u;
+    let cell = macro_cell((*part).k, piece.cell);
     var loc: array<vec3<u32>, 3>;
     for (var i = 0u; i < 3u; i++) {
-        loc[i] = macro_location(cell.c[i]);
-        piece_q[i] = macro_node(cell.c[i], loc[i]);
+        loc[i] = macro_location(cell.c[i], part);
+        (*piece_state).corner[i] = macro_node(cell.c[i], loc[i], part);
     }
-    if (same(piece_q[0].position, piece_q[1].position) || same(piece_q[1].position, piece_q[2].position)
-        || same(piece_q[2].position, piece_q[0].position)) {
+    if (same((*piece_state).corner[0].position, (*piece_state).corner[1].position) || same((*piece_state).corner[1].position, (*piece_state).corner[2].position)
+        || same((*piece_state).corner[2].position, (*piece_state).corner[0].position)) {
         return PieceShape(0u, 0u, 0u, 0.0); // snapped corners coincide: no area
     }
-    if (off_screen_vertically(piece_q[0].position, piece_q[1].position, piece_q[2].position)) {
+    if (off_screen_vertically((*piece_state).corner[0].position, (*piece_state).corner[1].position, (*piece_state).corner[2].position)) {
         return PieceShape(0u, 0u, 0u, 0.0); // every sub-triangle would be culled
     }
-    piece_edge_counts(loc);
-    let m = max(max(piece_counts[0], piece_counts[1]), piece_counts[2]);
-    strip_base = strip_base_of();
+    piece_edge_counts(loc, tri, part, piece_state);
+    let m = max(max((*piece_state).counts[0], (*piece_state).counts[1]), (*piece_state).counts[2]);
+    (*piece_state).strip_base = strip_base_of(tri, piece_state);
     var candidates = m * m;
     var node_count = (m + 1u) * (m + 2u) / 2u;
-    if (strip_base < 3u) {
-        strip_n = vec2<u32>(piece_counts[(strip_base + 1u) % 3u], piece_counts[(strip_base + 2u) % 3u]);
-        candidates = strip_n.x + strip_n.y - 1u;
-        node_count = strip_n.x + strip_n.y + 1u;
+    if ((*piece_state).strip_base < 3u) {
+        (*piece_state).strip_n = vec2<u32>((*piece_state).counts[((*piece_state).strip_base + 1u) % 3u], (*piece_state).counts[((*piece_state).strip_base + 2u) % 3u]);
+        candidates = (*piece_state).strip_n.x + (*piece_state).strip_n.y - 1u;
+        node_count = (*piece_state).strip_n.x + (*piece_state).strip_n.y + 1u;
     }
-    let theta_c = azimuth((piece_q[0].position + piece_q[1].position + piece_q[2].position) / 3.0);
+    let theta_c = azimuth(((*piece_state).corner[0].position + (*piece_state).corner[1].position + (*piece_state).corner[2].position) / 3.0);
     return PieceShape(m, candidates, node_count, theta_c);
 }
 
 // Each piece edge's count: on an original edge, that edge's fine nodes (by global index,
 // `piece_original`, `piece_from`, `piece_to`); inside, its own division.
-fn piece_edge_counts(loc: array<vec3<u32>, 3>) {
+fn piece_edge_counts(loc: array<vec3<u32>, 3>, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
     for (var e = 0u; e < 3u; e++) {
-        piece_original[e] = -1;
+        (*piece_state).original[e] = -1;
         for (var oe = 0u; oe < 3u; oe++) {
-            let start = index_on(oe, loc[e]);
-            let end = index_on(oe, loc[(e + 1u) % 3u]);
-            if (piece_original[e] < 0 && start >= 0 && end >= 0) {
-                piece_original[e] = i32(oe);
-                piece_from[e] = u32(start);
-                piece_to[e] = u32(end);
-                piece_counts[e] = u32(abs(start - end));
+            let start = index_on(oe, loc[e], part);
+            let end = index_on(oe, loc[(e + 1u) % 3u], part);
+            if ((*piece_state).original[e] < 0 && start >= 0 && end >= 0) {
+                (*piece_state).original[e] = i32(oe);
+                (*piece_state).from_index[e] = u32(start);
+                (*piece_state).to_index[e] = u32(end);
+                (*piece_state).counts[e] = u32(abs(start - end));
             }
         }
-        if (piece_original[e] < 0) {
+        if ((*piece_state).original[e] < 0) {
             if (params.method == METHOD_FIXED) {
                 // fixed:N pieces take N/K on interior edges (the regular N-lattice when K | N).
-                piece_counts[e] = (params.fixed_n + tri_k - 1u) / tri_k;
+                (*piece_state).counts[e] = (params.fixed_n + (*part).k - 1u) / (*part).k;
             } else {
-                piece_counts[e] = min(min(edge_divisions(piece_q[e].position, piece_q[(e + 1u) % 3u].position), 2u * params.max_div), PIECE_DIVISIONS);
+                (*piece_state).counts[e] = min(min(edge_divisions((*piece_state).corner[e].position, (*piece_state).corner[(e + 1u) % 3u].position, tri), 2u * params.max_div), PIECE_DIVISIONS);
             }
         }
     }
@@ -422,7 +422,7 @@ struct SeamCopies {
     copies: u32,
 }
 
-fn seam_copies(shape: PieceShape) -> SeamCopies {
+fn seam_copies(shape: PieceShape, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> SeamCopies {
     let theta_c = shape.theta_c;
     var u_range = vec2<f32>(1e30, -1e30);
     // Nodes in slot order: (i, j, l) row by row, kept by a running (j, l) rather than searched
@@ -430,20 +430,20 @@ fn seam_copies(shape: PieceShape) -> SeamCopies {
     var row = vec2<u32>(0u, 0u);
     if (is_sphere(params.projection)) {
         for (var k = 0u; k < shape.node_count; k++) {
-            let p = piece_node(k, shape.m, &row).position;
+            let p = piece_node(k, shape.m, &row, part, piece_state).position;
             let theta = theta_c + wrap_angle(azimuth(p) - theta_c);
             for (var s = 0u; s < 2u; s++) {
                 let u = project_with_azimuth(params.projection, p, theta, select(-1.0, 1.0, s == 1u)).x;
                 u_range = vec2<f32>(min(u_range.x, u), max(u_range.y, u));
             }
         }
-    } else if (strip_base == QUAD_STRIP) {
+    } else if ((*piece_state).strip_base == QUAD_STRIP) {
         // The quad's range: that of its fan's two triangles, which cover it.
-        let ra = piece_u_range(piece_q, theta_c);
-        let rb = piece_u_range(array<Node, 3>(piece_q[0], piece_q[2], quad_last), theta_c);
+        let ra = piece_u_range((*piece_state).corner, theta_c);
+        let rb = piece_u_range(array<Node, 3>((*piece_state).corner[0], (*piece_state).corner[2], (*piece_state).quad_last), theta_c);
         u_range = vec2<f32>(min(ra.x, rb.x), max(ra.y, rb.y));
     } else {
-        u_range = piece_u_range(piece_q, theta_c);
+        u_range = piece_u_range((*piece_state).corner, theta_c);
     }
     var seam = SeamCopies(array<f32, 3>(theta_c, 0.0, 0.0), 1u);
     if (u_range.y > PI - SEAM_MARGIN) {
@@ -459,7 +459,7 @@ fn seam_copies(shape: PieceShape) -> SeamCopies {
 
 // Appends the piece's nodes once per seam copy and its `count` drawn triangles (bits of
 // `drawn`) as indices into them; counted, never written past a capacity.
-fn emit_piece(shape: PieceShape, seam: SeamCopies, drawn: ptr<function, array<u32, 32>>, count: u32) {
+fn emit_piece(shape: PieceShape, seam: SeamCopies, drawn: ptr<function, array<u32, 32>>, count: u32, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
     let copies = seam.copies;
     let node_count = shape.node_count;
     let first_node = atomicAdd(&counters.nodes, copies * node_count);
@@ -470,15 +470,15 @@ fn emit_piece(shape: PieceShape, seam: SeamCopies, drawn: ptr<function, array<u3
     }
     var row = vec2<u32>(0u, 0u);
     for (var k = 0u; k < node_count; k++) {
-        let node = piece_node(k, shape.m, &row);
+        let node = piece_node(k, shape.m, &row, part, piece_state);
         for (var c = 0u; c < copies; c++) {
-            out_nodes[first_node + c * node_count + k] = draw_vertex(node, seam.refs[c]);
+            out_nodes[first_node + c * node_count + k] = draw_vertex(node, seam.refs[c], tri);
         }
     }
     var slot = 3u * first_triangle;
     var walk = vec2<u32>(0u, 0u);
     for (var t = 0u; t < shape.candidates; t++) {
-        let local = piece_triangle_slots(t, shape.m, &walk);
+        let local = piece_triangle_slots(t, shape.m, &walk, piece_state);
         if (((*drawn)[t / 32u] & (1u << (t % 32u))) == 0u) {
             continue;
         }

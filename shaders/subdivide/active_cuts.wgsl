@@ -19,17 +19,18 @@
 // Over every triangle of the scene, before `plan` (and before every chunk of a chunked frame).
 @compute @workgroup_size(64)
 fn active_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    var tri: InputTriangle;
     let local = invocation_index(gid, groups);
     if (local >= params.triangle_count) {
         return;
     }
-    load_positions(params.first_triangle + local);
-    if (off_screen_vertically(tri_position[0], tri_position[1], tri_position[2])) {
+    load_positions(params.first_triangle + local, &tri);
+    if (off_screen_vertically(tri.position[0], tri.position[1], tri.position[2])) {
         return;
     }
     // Diamonds for the adaptive method only (`band_limit` in axis.rs).
     let limit = select(0.0, BAND_LIMIT * params.projection.screen_radius, is_adaptive());
-    let bits = triangle_cuts(limit);
+    let bits = triangle_cuts(limit, &tri);
     if (bits.x != 0u) {
         atomicOr(&counters.cuts_low, bits.x);
     }

@@ -22,6 +22,9 @@
 
 @compute @workgroup_size(64)
 fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    var tri: InputTriangle;
+    var part: PartPlan;
+    var piece_state: PieceState;
     let local = invocation_index(gid, groups);
     var piece_count = params.piece_count;
     if (piece_count == PIECES_FROM_COUNTER) {
@@ -34,15 +37,15 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     if ((piece.count2_level & QUAD_TAIL) != 0u) {
         return; // drawn by the quad's first record
     }
-    load_triangle(piece.triangle);
+    load_triangle(piece.triangle, &tri);
     for (var i = 0u; i < 3u; i++) {
-        part[i] = Node(piece.corner[i].xyz, vec3<f32>(piece.corner[i].w, piece.bary1[i], piece.bary2[i]));
+        part.corner[i] = Node(piece.corner[i].xyz, vec3<f32>(piece.corner[i].w, piece.bary1[i], piece.bary2[i]));
     }
     var shape: PieceShape;
     if ((piece.count2_level & QUAD_HEAD) != 0u) {
-        shape = quad_shape(piece, pieces[params.first_piece + local + 1u]);
+        shape = quad_shape(piece, pieces[params.first_piece + local + 1u], &part, &piece_state);
     } else {
-        shape = lattice_shape(piece);
+        shape = lattice_shape(piece, &tri, &part, &piece_state);
     }
     if (shape.candidates == 0u) {
         return;
@@ -53,7 +56,7 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     var count = 0u;
     var walk = vec2<u32>(0u, 0u);
     for (var t = 0u; t < shape.candidates; t++) {
-        if (piece_triangle_drawn(t, shape.m, &walk)) {
+        if (piece_triangle_drawn(t, shape.m, &walk, &part, &piece_state)) {
             drawn[t / 32u] |= 1u << (t % 32u);
             count += 1u;
         }
@@ -61,5 +64,5 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     if (count == 0u) {
         return;
     }
-    emit_piece(shape, seam_copies(shape), &drawn, count);
+    emit_piece(shape, seam_copies(shape, &part, &piece_state), &drawn, count, &tri, &part, &piece_state);
 }

@@ -21,14 +21,17 @@
 
 @compute @workgroup_size(64)
 fn plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    var tri: InputTriangle;
+    var part: PartPlan;
+    var cuts: vec2<u32>;
     let local = invocation_index(gid, groups);
     if (local >= params.triangle_count) {
         return;
     }
     let t = params.first_triangle + local;
     cuts = vec2<u32>(atomicLoad(&counters.cuts_low), atomicLoad(&counters.cuts_high));
-    load_triangle(t);
-    if (off_screen_vertically(tri_position[0], tri_position[1], tri_position[2])) {
+    load_triangle(t, &tri);
+    if (off_screen_vertically(tri.position[0], tri.position[1], tri.position[2])) {
         return; // no pieces
     }
     // Cut by all of the frame's cuts (decided only when there are any; the marks first).
@@ -36,14 +39,14 @@ fn plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     var full = false;
     if (any(cuts != vec2<u32>(0u))) {
         marks = edge_marks(t);
-        full = cut_triangle(marks) || asks_for_cuts(diamond_range(tri_position));
+        full = cut_triangle(marks) || asks_for_cuts(diamond_range(tri.position));
     }
-    if (single_part(full, marks)) {
-        part[0] = Node(tri_position[0], vec3<f32>(1.0, 0.0, 0.0));
-        part[1] = Node(tri_position[1], vec3<f32>(0.0, 1.0, 0.0));
-        part[2] = Node(tri_position[2], vec3<f32>(0.0, 0.0, 1.0));
-        plan_part();
-        append_pieces(t);
+    if (single_part(full, marks, &tri, cuts)) {
+        part.corner[0] = Node(tri.position[0], vec3<f32>(1.0, 0.0, 0.0));
+        part.corner[1] = Node(tri.position[1], vec3<f32>(0.0, 1.0, 0.0));
+        part.corner[2] = Node(tri.position[2], vec3<f32>(0.0, 0.0, 1.0));
+        plan_part(&tri, &part);
+        append_pieces(t, &part);
         return;
     }
     // Triangles cut by all of the frame's cuts (a floor around the viewer and its neighbours)

@@ -21,6 +21,11 @@
 
 @compute @workgroup_size(64)
 fn plan_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    var tri: InputTriangle;
+    var part: PartPlan;
+    var piece_state: PieceState;
+    var clip: ClipState;
+    var cuts: vec2<u32>;
     let local = invocation_index(gid, groups);
     let split = plan_cuts_split();
     let listed = listed_cuts();
@@ -29,19 +34,19 @@ fn plan_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     }
     let t = listed_cut(local / split, listed);
     cuts = vec2<u32>(atomicLoad(&counters.cuts_low), atomicLoad(&counters.cuts_high));
-    load_triangle(t);
+    load_triangle(t, &tri);
     if (local / split < listed.x) {
         // Cut only at its shared edges' crossings (one invocation of `split`).
         if (local % split == 0u) {
-            plan_edge_split(t);
+            plan_edge_split(t, &tri, &part, &clip, cuts);
         }
         return;
     }
     if (split == 4u) {
-        plan_quadrant(t, local % 4u);
+        plan_quadrant(t, local % 4u, &tri, &part, &piece_state, &clip, cuts);
     } else {
         for (var q = 0u; q < 4u; q++) {
-            plan_quadrant(t, q);
+            plan_quadrant(t, q, &tri, &part, &piece_state, &clip, cuts);
         }
     }
 }

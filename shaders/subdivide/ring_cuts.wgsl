@@ -18,6 +18,7 @@
 // has an edge of one that does is cut too; its edges are marked as cut ones'.
 @compute @workgroup_size(64)
 fn ring_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    var tri: InputTriangle;
     let local = invocation_index(gid, groups);
     if (local >= params.triangle_count) {
         return;
@@ -28,8 +29,8 @@ fn ring_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     if (!cut_triangle(edge_marks_now(t))) {
         return;
     }
-    load_positions(t);
-    if (off_screen_vertically(tri_position[0], tri_position[1], tri_position[2])) {
+    load_positions(t, &tri);
+    if (off_screen_vertically(tri.position[0], tri.position[1], tri.position[2])) {
         return;
     }
     mark_edges(t, EDGE_CUT);
