@@ -166,15 +166,9 @@ fn a_skinned_pose_is_drawn_where_the_cpu_evaluation_puts_it() {
     }
 }
 
-fn twister() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_twister"));
-    c.env("NODEVICE_SELECT", "1");
-    c
-}
-
 fn sequence(out: &Path, extra: &[&str]) -> std::process::Output {
     let scene = common::asset("gltf/AnimatedCube/glTF/AnimatedCube.gltf");
-    let output = twister()
+    let output = common::twister()
         .args(["render", scene.to_str().unwrap(), "--fit", "2.5", "--width", "128", "--height", "48", "--fps", "8"])
         .arg("--out")
         .arg(out)
@@ -236,7 +230,7 @@ fn sequences_are_numbered_resumable_shardable_and_atomic() {
     // renamed), and a resumed run completes the sequence with the same bytes.
     let killed = root.join("killed");
     let scene = common::asset("gltf/AnimatedCube/glTF/AnimatedCube.gltf");
-    let mut child = twister()
+    let mut child = common::twister()
         .args(["render", scene.to_str().unwrap(), "--fit", "2.5", "--width", "128", "--height", "48", "--fps", "8"])
         .args(["--frames", "0..9", "--out", killed.to_str().unwrap()])
         .stderr(std::process::Stdio::null())
@@ -304,7 +298,7 @@ fn a_video_carries_the_spherical_metadata() {
     let root = common::TempDir::new(format!("twister-video-{}", std::process::id()));
     let video = root.join("cube.mp4");
     let scene = common::asset("gltf/AnimatedCube/glTF/AnimatedCube.gltf");
-    let made = twister()
+    let made = common::twister()
         .args(["render", scene.to_str().unwrap(), "--fit", "2.5", "--panorama", "equirect", "--width", "128"])
         .args(["--frames", "0..11", "--fps", "12", "--out", root.join("frames").to_str().unwrap(), "--video"])
         .arg(&video)
@@ -349,7 +343,7 @@ fn a_video_carries_the_spherical_metadata() {
     assert_eq!(stream["nb_read_frames"], "12", "every frame still decodes");
     assert!(stream["side_data_list"].to_string().contains("side by side"), "{}", stream["side_data_list"]);
     // No ffmpeg: one line.
-    let out = twister()
+    let out = common::twister()
         .args(["render", scene.to_str().unwrap(), "--frames", "0..1", "--layout", "top-bottom", "--video"])
         .arg(root.join("none.mp4"))
         .arg("--out")
@@ -382,7 +376,7 @@ fn sequence_options_are_checked() {
         (vec!["--frames", "0..2", "--video", "x.mp4"], "--video"),
         (vec!["--frames", "0..2", "--layout", "top-bottom", "--shard", "0/2", "--video", "x.mp4"], "--video"),
     ] {
-        let out = twister()
+        let out = common::twister()
             .args(["render", scene.to_str().unwrap(), "--width", "64", "--height", "32", "--out", "/nonexistent/x"])
             .args(&args)
             .output()
@@ -442,7 +436,7 @@ fn an_animated_camera_moves_the_viewer() {
     let file = moving_camera_file(&root);
     let small = ["--width", "128", "--height", "48"];
     let run = |extra: &[&str]| {
-        let out = twister().arg("render").arg(&file).args(small).args(extra).output().unwrap();
+        let out = common::twister().arg("render").arg(&file).args(small).args(extra).output().unwrap();
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     };
     run(&["--viewer", "camera", "--frames", "0..2", "--fps", "2", "--out", root.join("seq").to_str().unwrap()]);
@@ -471,7 +465,7 @@ fn a_gaze_path_steers_each_frames_level_of_detail() {
     std::fs::write(&path, "time,yaw,pitch\n0,0,0\n1,180,0\n").unwrap();
     let lod = ["--lod", "visual-field", "--width", "256", "--height", "64"];
     let run = |extra: &[&str]| {
-        let out = twister().args(["render", "builtin:demo"]).args(lod).args(extra).output().unwrap();
+        let out = common::twister().args(["render", "builtin:demo"]).args(lod).args(extra).output().unwrap();
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     };
     let stats = root.join("stats.jsonl");
@@ -493,7 +487,7 @@ fn a_gaze_path_steers_each_frames_level_of_detail() {
         }
     }
     std::fs::write(&path, "0,0,0\n1,nope,0\n").unwrap();
-    let out = twister()
+    let out = common::twister()
         .args(["render", "builtin:demo"])
         .args(lod)
         .args(["--frames", "0..1", "--gaze-path", path.to_str().unwrap(), "--out", root.join("x").to_str().unwrap()])
@@ -515,7 +509,7 @@ fn a_viewer_path_moves_the_viewer_through_a_still_scene() {
     std::fs::write(&path, "# time, x, y, z, yaw\n0,0,0,0,0\n1,0.4,0.1,-0.3,45\n").unwrap();
     let small = ["--width", "256", "--height", "64"];
     let run = |extra: &[&str]| {
-        let out = twister().args(["render", "builtin:demo"]).args(small).args(extra).output().unwrap();
+        let out = common::twister().args(["render", "builtin:demo"]).args(small).args(extra).output().unwrap();
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     };
     let seq = root.join("seq");

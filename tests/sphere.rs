@@ -10,12 +10,6 @@ use twister::core::projection::PanoramaKind;
 use twister::core::settings::{Method, Split};
 use twister::{Eye, Projection, RenderSettings, Scene};
 
-fn twister() -> std::process::Command {
-    let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_twister"));
-    c.env("NODEVICE_SELECT", "1");
-    c
-}
-
 fn tmp(name: &str) -> common::TempDir {
     common::TempDir::new(format!("twister-sphere-{}-{name}", std::process::id()))
 }
@@ -155,7 +149,7 @@ fn sphere_images_carry_photo_sphere_metadata_in_png_and_jpeg_and_players_names()
         ("jpg", Some("side-by-side"), "stereo_LR.jpg", (512, 128)),
         ("png", Some("eyes"), "left.png", (256, 128)),
     ] {
-        let mut cmd = twister();
+        let mut cmd = common::twister();
         cmd.args(["render", "builtin:demo", "--panorama", "equirect", "--width", "256", "--method", "vertex"]);
         cmd.args(["--format", format, "--out"]).arg(&out);
         if let Some(l) = layout {
@@ -176,7 +170,7 @@ fn sphere_images_carry_photo_sphere_metadata_in_png_and_jpeg_and_players_names()
         assert_eq!((g["CroppedAreaLeftPixels"].as_str(), g["CroppedAreaTopPixels"].as_str()), ("0", "0"));
     }
     // The cylinder is no photo sphere: no GPano.
-    let o = twister()
+    let o = common::twister()
         .args(["render", "builtin:demo", "--width", "320", "--height", "80", "--out"])
         .arg(&out)
         .output()
@@ -207,7 +201,7 @@ fn depth_files_hold_the_distance_along_each_pixels_ray() {
     for panorama in ["equirect", "cylinder"] {
         let size: &[&str] =
             if panorama == "equirect" { &["--width", "256"] } else { &["--width", "256", "--height", "64"] };
-        let o = twister()
+        let o = common::twister()
             .args([
                 "render",
                 "builtin:box-room",
@@ -266,7 +260,7 @@ fn depth_files_hold_the_distance_along_each_pixels_ray() {
         }
     }
     // Background: +∞.
-    let o = twister()
+    let o = common::twister()
         .args(["render", "builtin:sphere100", "--panorama", "equirect", "--width", "128", "--depth", "--out"])
         .arg(&out)
         .output()

@@ -463,6 +463,15 @@ impl RenderSettings {
                 "the linear colour comes from the projection methods (vertex, fixed, adaptive); slit and trace write display colours",
             ));
         }
+        self.validate_shading()?;
+        if s.memory_mb < 8 {
+            return Err(Error::setting("subdivision.memory_mb", format!("must be at least 8, got {}", s.memory_mb)));
+        }
+        Ok(())
+    }
+
+    /// The shading's part of [`Self::validate`].
+    fn validate_shading(&self) -> Result<()> {
         if !(self.shading.exposure_ev.is_finite() && self.shading.exposure_ev.abs() <= 64.0) {
             return Err(Error::setting(
                 "shading.exposure_ev",
@@ -493,9 +502,6 @@ impl RenderSettings {
                 "shading.shadow_map_size",
                 format!("must be a multiple of 64 between 64 and {MAX_SHADOW_MAP_SIZE}, got {size}"),
             ));
-        }
-        if s.memory_mb < 8 {
-            return Err(Error::setting("subdivision.memory_mb", format!("must be at least 8, got {}", s.memory_mb)));
         }
         Ok(())
     }

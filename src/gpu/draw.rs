@@ -173,23 +173,7 @@ fn draw_pipeline(
         attributes: &attributes,
     };
     let buffers = [Some(layout)];
-    let error = error_target_format(gpu.error_target);
-    let all_targets =
-        [COLOR_FORMAT, error, OBJECT_FORMAT, error, POSITION_FORMAT].into_iter().enumerate().map(|(k, format)| {
-            // The background writes the colour only: the measuring targets keep their clear values.
-            let write_mask = if background && k > 0 { wgpu::ColorWrites::empty() } else { wgpu::ColorWrites::ALL };
-            Some(wgpu::ColorTargetState { format, blend: None, write_mask })
-        });
-    let mut targets: Vec<_> = all_targets.take(outputs).collect();
-    if hdr {
-        // The linear colour at location 5 (`FragmentColor::hdr`), after any measuring targets.
-        targets.resize(HDR_LOCATION, None);
-        targets.push(Some(wgpu::ColorTargetState {
-            format: HDR_FORMAT,
-            blend: None,
-            write_mask: wgpu::ColorWrites::ALL,
-        }));
-    }
+    let targets = color_targets(gpu, outputs, hdr, background);
     let mut constants = look_constants(look, lit);
     let multiview_mask = match layers {
         Layers::Both => std::num::NonZeroU32::new(0b11),
@@ -237,6 +221,29 @@ fn draw_pipeline(
         multiview_mask,
         cache: None,
     })
+}
+
+/// A drawing pipeline's colour targets: the colour, then the measuring targets the frame
+/// writes (`outputs` in all), then the linear colour at location 5 with `hdr`. The background
+/// writes the colour only: the measuring targets keep their clear values.
+fn color_targets(gpu: &Gpu, outputs: usize, hdr: bool, background: bool) -> Vec<Option<wgpu::ColorTargetState>> {
+    let error = error_target_format(gpu.error_target);
+    let all_targets =
+        [COLOR_FORMAT, error, OBJECT_FORMAT, error, POSITION_FORMAT].into_iter().enumerate().map(|(k, format)| {
+            let write_mask = if background && k > 0 { wgpu::ColorWrites::empty() } else { wgpu::ColorWrites::ALL };
+            Some(wgpu::ColorTargetState { format, blend: None, write_mask })
+        });
+    let mut targets: Vec<_> = all_targets.take(outputs).collect();
+    if hdr {
+        // The linear colour at location 5 (`FragmentColor::hdr`), after any measuring targets.
+        targets.resize(HDR_LOCATION, None);
+        targets.push(Some(wgpu::ColorTargetState {
+            format: HDR_FORMAT,
+            blend: None,
+            write_mask: wgpu::ColorWrites::ALL,
+        }));
+    }
+    targets
 }
 
 /// The pipeline constants that compile the parts of the look in or out (surface.wgsl).

@@ -7,6 +7,18 @@ use twister::gpu::Gpu;
 use twister::{EyeImage, Frame};
 use twister::{GpuScene, RenderSettings, Renderer, Scene};
 
+/// The `twister` binary, with Mesa's device-select layer quiet.
+pub fn twister() -> std::process::Command {
+    let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_twister"));
+    c.env("NODEVICE_SELECT", "1");
+    c
+}
+
+/// A PNG file's width and height.
+pub fn png_size(p: &std::path::Path) -> (u32, u32) {
+    image::image_dimensions(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
 pub fn renderer() -> &'static Renderer {
     static R: OnceLock<Renderer> = OnceLock::new();
     R.get_or_init(|| Renderer::new(Gpu::new().unwrap_or_else(|e| panic!("{e}"))).unwrap_or_else(|e| panic!("{e}")))
