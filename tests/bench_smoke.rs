@@ -79,7 +79,13 @@ fn quick_benchmark_writes_every_output_well_formed() {
         }
         assert!(report.contains(s), "report.md lacks {s}");
     }
-    // Seed 001's level-of-detail simulation: per ring, two gazes × off / polygons / polygons+subdivision.
+    check_lod(&out, &report);
+    check_trace_lod(&out, &report);
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// The quick run's seed 001 outputs: per ring, two gazes × off / polygons / polygons+subdivision.
+fn check_lod(out: &std::path::Path, report: &str) {
     let lod = csv_rows(
         &out.join("lod.csv"),
         &["scene", "gaze_yaw", "gaze_pitch", "config", "triangles_in", "triangles_out", "ms_frame", "central_mean_px"],
@@ -95,7 +101,11 @@ fn quick_benchmark_writes_every_output_well_formed() {
     }
     assert!(report.contains("## Visual-field level of detail") && out.join("lod.png").exists());
     assert!(!report.contains("bunny ring of the level-of-detail benchmark did not run"));
-    // Seed 000's Table 2: per scene A–D, plain, then LOD and LOD without eq. 10 for states 1 and 2.
+}
+
+/// The quick run's seed 000 Table 2 outputs: per scene A–D, plain, then LOD and LOD without
+/// eq. 10 for states 1 and 2.
+fn check_trace_lod(out: &std::path::Path, report: &str) {
     let trace = csv_rows(
         &out.join("trace_lod.csv"),
         &["scene", "state", "config", "s_frame", "rays_traced", "triangle_tests", "covered_pixels"],
@@ -127,7 +137,6 @@ fn quick_benchmark_writes_every_output_well_formed() {
     for f in ["trace_lod.png", "trace_lod_A_state1.png", "trace_lod_A_state2.png", "trace_lod.json"] {
         assert!(out.join(f).exists(), "{f}");
     }
-    let _ = std::fs::remove_dir_all(&out);
 }
 
 #[test]

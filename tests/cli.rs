@@ -584,3 +584,44 @@ fn both_eyes_in_one_multiview_draw_match_a_pass_per_eye() {
         assert!(apart * 2 > covered, "{scene} {extra:?}: left and right differ on only {apart} of {covered} distances");
     }
 }
+
+/// The pipeline cache on disk (`gpu::pipeline_cache`): written after a run; a damaged file
+/// (empty, foreign bytes, truncated) is ignored and replaced, with the same image and no word on
+/// stderr; a cache that cannot be written (its folder is a file) or is switched off changes
+/// nothing either.
+#[test]
+fn a_damaged_or_unwritable_pipeline_cache_is_never_an_error() {
+    let dir = tmp("pipeline-cache");
+    let cache = dir.join("cache");
+    let run = |cache_dir: &Path| {
+        let o = twister()
+            .args(["render", "builtin:triangle@3", "--width", "64", "--height", "16", "--out"])
+            .arg(dir.join("out"))
+            .env("TWISTER_CACHE_DIR", cache_dir)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        assert!(o.stderr.is_empty(), "a plain run says nothing: {}", String::from_utf8_lossy(&o.stderr));
+        std::fs::read(dir.join("out/left.png")).unwrap()
+    };
+    let image = run(&cache);
+    let files: Vec<std::path::PathBuf> =
+        std::fs::read_dir(&cache).map(|d| d.flatten().map(|e| e.path()).collect()).unwrap_or_default();
+    if files.is_empty() {
+        eprintln!("this adapter has no pipeline cache: only the runs without one were checked");
+    }
+    for file in &files {
+        let whole = std::fs::read(file).unwrap();
+        for damaged in
+            [Vec::new(), b"not a pipeline cache".to_vec(), vec![0xa5; 4096], whole[..whole.len() / 2].to_vec()]
+        {
+            std::fs::write(file, &damaged).unwrap();
+            assert_eq!(run(&cache), image, "the image with a damaged cache");
+            assert_ne!(std::fs::read(file).unwrap(), damaged, "the damaged cache is replaced");
+        }
+    }
+    let not_a_folder = dir.join("a-file");
+    std::fs::write(&not_a_folder, b"x").unwrap();
+    assert_eq!(run(&not_a_folder.join("cache")), image, "with a cache that cannot be written");
+    assert_eq!(run(Path::new("off")), image, "with the cache switched off");
+}

@@ -184,3 +184,29 @@ fn a_chunked_frame_reports_wall_times_per_pass() {
     assert!(sub > 0.0 && ras > 0.0 && (sub + ras - frame).abs() < 1e-6, "{json}");
     let _ = std::fs::remove_dir_all(&out);
 }
+
+/// `bench startup` times whole `render` processes, cold, warm and warm without the pipeline
+/// cache, and writes its rows; anything but a `render` case and reps out of range are refused.
+#[test]
+fn bench_startup_times_fresh_processes_and_refuses_bad_cases() {
+    let dir = tmp("startup");
+    let json = dir.join("startup.json");
+    std::fs::create_dir_all(&*dir).unwrap();
+    let case = "render builtin:triangle@3 --width 16 --height 8";
+    let o = twister().args(["bench", "startup", "--reps", "1", "--case", case, "--json"]).arg(&json).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let rows: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let caches: Vec<&str> = rows["rows"].as_array().unwrap().iter().map(|r| r["caches"].as_str().unwrap()).collect();
+    assert_eq!(caches, ["cold", "warm", "warm, no pipeline cache"]);
+    for r in rows["rows"].as_array().unwrap() {
+        let ms = r["ms_median"].as_f64().unwrap();
+        assert!(ms > 0.0 && ms < 600_000.0 && r["command"] == case, "{r}");
+    }
+    for bad in [["--case", "error builtin:demo"], ["--reps", "0"], ["--case", "render --width nope"]] {
+        let o = twister().args(["bench", "startup"]).args(bad).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        let errors: Vec<&str> = err.lines().filter(|l| l.starts_with("error")).collect();
+        assert!(!o.status.success() && errors.len() == 1 && errors[0].contains(bad[0]), "{bad:?}: {err}");
+        assert!(!err.contains("panicked"), "{bad:?}: {err}");
+    }
+}

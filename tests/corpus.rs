@@ -98,8 +98,51 @@ fn corpus() -> Vec<(String, Vec<u8>)> {
             files.push((format!("flip{k}.{name}"), b));
         }
     }
-    // Wrong counts, offsets, strides, types, indices, hierarchies, numbers.
-    let edits: Vec<(&str, &str, serde_json::Value)> = vec![
+    for (name, pointer, value) in gltf_edits() {
+        let mut d = doc.clone();
+        match d.pointer_mut(pointer) {
+            Some(slot) => *slot = value,
+            None => {
+                let (parent, key) = pointer.rsplit_once('/').unwrap();
+                d.pointer_mut(parent).unwrap()[key] = value;
+            }
+        }
+        files.push((format!("{name}.gltf"), gltf_text(&d, &bin)));
+        files.push((format!("{name}.glb"), glb(&d, &bin)));
+    }
+    // A deep chain of nodes, and one that shares children (the exponential instance bomb).
+    let mut deep = doc.clone();
+    deep["nodes"] = json!((0..300)
+        .map(|k| if k < 299 { json!({ "children": [k + 1] }) } else { json!({ "mesh": 0 }) })
+        .collect::<Vec<_>>());
+    files.push(("deep.gltf".into(), gltf_text(&deep, &bin)));
+    let mut bomb = doc.clone();
+    bomb["nodes"] = json!((0..25)
+        .map(|k| if k < 24 { json!({ "children": [k + 1, k + 1] }) } else { json!({ "mesh": 0 }) })
+        .collect::<Vec<_>>());
+    files.push(("bomb.gltf".into(), gltf_text(&bomb, &bin)));
+    // Bad base64, bad GLB header fields.
+    files.push((
+        "base64.gltf".into(),
+        String::from_utf8(text.clone()).unwrap().replace("base64,AAAA", "base64,A!AA").into_bytes(),
+    ));
+    let mut g = binary.clone();
+    g[8..12].copy_from_slice(&u32::MAX.to_le_bytes());
+    files.push(("length_max.glb".into(), g));
+    let mut g = binary.clone();
+    g[12..16].copy_from_slice(&u32::MAX.to_le_bytes());
+    files.push(("chunk_max.glb".into(), g));
+    let mut g = binary.clone();
+    g[0] = b'x';
+    files.push(("magic.glb".into(), g));
+    files.extend(obj_faults());
+    files
+}
+
+/// The glTF corpus's edits of the valid file: wrong counts, offsets, strides, types, indices,
+/// hierarchies, numbers (a JSON pointer and the value put there).
+fn gltf_edits() -> Vec<(&'static str, &'static str, serde_json::Value)> {
+    vec![
         ("count_huge", "/accessors/0/count", json!(4_000_000_000u64)),
         ("count_zero", "/accessors/0/count", json!(0)),
         ("count_over", "/accessors/1/count", json!(600)),
@@ -166,45 +209,13 @@ fn corpus() -> Vec<(String, Vec<u8>)> {
             "/accessors/0/sparse",
             json!({ "count": 1, "indices": { "bufferView": 1, "componentType": 5123 }, "values": { "bufferView": 0, "byteOffset": 12 } }),
         ),
-    ];
-    for (name, pointer, value) in edits {
-        let mut d = doc.clone();
-        match d.pointer_mut(pointer) {
-            Some(slot) => *slot = value,
-            None => {
-                let (parent, key) = pointer.rsplit_once('/').unwrap();
-                d.pointer_mut(parent).unwrap()[key] = value;
-            }
-        }
-        files.push((format!("{name}.gltf"), gltf_text(&d, &bin)));
-        files.push((format!("{name}.glb"), glb(&d, &bin)));
-    }
-    // A deep chain of nodes, and one that shares children (the exponential instance bomb).
-    let mut deep = doc.clone();
-    deep["nodes"] = json!((0..300)
-        .map(|k| if k < 299 { json!({ "children": [k + 1] }) } else { json!({ "mesh": 0 }) })
-        .collect::<Vec<_>>());
-    files.push(("deep.gltf".into(), gltf_text(&deep, &bin)));
-    let mut bomb = doc.clone();
-    bomb["nodes"] = json!((0..25)
-        .map(|k| if k < 24 { json!({ "children": [k + 1, k + 1] }) } else { json!({ "mesh": 0 }) })
-        .collect::<Vec<_>>());
-    files.push(("bomb.gltf".into(), gltf_text(&bomb, &bin)));
-    // Bad base64, bad GLB header fields.
-    files.push((
-        "base64.gltf".into(),
-        String::from_utf8(text.clone()).unwrap().replace("base64,AAAA", "base64,A!AA").into_bytes(),
-    ));
-    let mut g = binary.clone();
-    g[8..12].copy_from_slice(&u32::MAX.to_le_bytes());
-    files.push(("length_max.glb".into(), g));
-    let mut g = binary.clone();
-    g[12..16].copy_from_slice(&u32::MAX.to_le_bytes());
-    files.push(("chunk_max.glb".into(), g));
-    let mut g = binary.clone();
-    g[0] = b'x';
-    files.push(("magic.glb".into(), g));
-    // OBJ faults.
+    ]
+}
+
+/// The OBJ corpus's faults: short faces, indices out of range, non-finite numbers, empty and
+/// binary files.
+fn obj_faults() -> Vec<(String, Vec<u8>)> {
+    let mut files = Vec::new();
     for (name, text) in [
         ("face1.obj", "v 0 0 -3\nf 1\n".to_string()),
         ("face2.obj", "v 0 0 -3\nv 1 0 -3\nf 1 2\n".to_string()),

@@ -125,9 +125,10 @@ fn khronos_samples_load_with_their_hierarchy() {
     assert_eq!((lo.to_array(), hi.to_array()), ([0.0, 0.0, 0.0], [2.0, 1.0, 0.0]));
 }
 
-#[test]
-fn broken_files_are_one_clear_error_without_panic_or_output() {
-    let dir = tmp("broken");
+/// Broken glTF files for `broken_files_are_one_clear_error_without_panic_or_output`: not JSON,
+/// truncated, out-of-range indices, NaN, missing and undecodable buffers and images, required
+/// extensions, a bad GLB, empty files, a folder, devices; with what the error must say.
+fn broken_files(dir: &Path) -> Vec<(PathBuf, &'static str)> {
     let mut cases: Vec<(PathBuf, &str)> = Vec::new();
     let garbage = dir.join("garbage.gltf");
     std::fs::write(&garbage, "{ this is not json").unwrap();
@@ -136,27 +137,27 @@ fn broken_files_are_one_clear_error_without_panic_or_output() {
     let truncated = dir.join("truncated.gltf");
     std::fs::write(&truncated, &good[..good.len() / 2]).unwrap();
     cases.push((truncated, "not a glTF file (invalid JSON"));
-    cases.push((write(&dir, "index.gltf", &gltf_json(&QUAD, Some(&[0, 1, 9]), 4)), "index 9 is out of range"));
+    cases.push((write(dir, "index.gltf", &gltf_json(&QUAD, Some(&[0, 1, 9]), 4)), "index 9 is out of range"));
     cases.push((
-        write(&dir, "nan.gltf", &gltf_json(&[[0.0, f32::NAN, -3.0], [1.0, 0.0, -3.0], [0.0, 1.0, -3.0]], None, 4)),
+        write(dir, "nan.gltf", &gltf_json(&[[0.0, f32::NAN, -3.0], [1.0, 0.0, -3.0], [0.0, 1.0, -3.0]], None, 4)),
         "NaN",
     ));
     let mut overrun = gltf_json(&QUAD, None, 4);
     overrun["accessors"][0]["count"] = serde_json::json!(400);
-    cases.push((write(&dir, "overrun.gltf", &overrun), "overruns"));
+    cases.push((write(dir, "overrun.gltf", &overrun), "overruns"));
     let mut missing = gltf_json(&QUAD, None, 4);
     missing["buffers"][0]["uri"] = serde_json::json!("missing.bin");
-    cases.push((write(&dir, "missing.gltf", &missing), "buffer 0 file 'missing.bin': no such file"));
+    cases.push((write(dir, "missing.gltf", &missing), "buffer 0 file 'missing.bin': no such file"));
     let mut no_image = gltf_json(&QUAD, None, 4);
     no_image["images"] = serde_json::json!([{ "uri": "missing.png" }]);
-    cases.push((write(&dir, "no_image.gltf", &no_image), "image 0 file 'missing.png': no such file"));
+    cases.push((write(dir, "no_image.gltf", &no_image), "image 0 file 'missing.png': no such file"));
     let mut bad_image = gltf_json(&QUAD, None, 4);
     bad_image["images"] = serde_json::json!([{ "uri": "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAA" }]);
-    cases.push((write(&dir, "bad_image.gltf", &bad_image), "image 0: cannot be decoded"));
+    cases.push((write(dir, "bad_image.gltf", &bad_image), "image 0: cannot be decoded"));
     let mut ext = gltf_json(&QUAD, None, 4);
     ext["extensionsUsed"] = serde_json::json!(["KHR_draco_mesh_compression"]);
     ext["extensionsRequired"] = serde_json::json!(["KHR_draco_mesh_compression"]);
-    cases.push((write(&dir, "ext.gltf", &ext), "KHR_draco_mesh_compression"));
+    cases.push((write(dir, "ext.gltf", &ext), "KHR_draco_mesh_compression"));
     let glb = dir.join("truncated.glb");
     let mut bytes = b"glTF".to_vec();
     bytes.extend(2u32.to_le_bytes());
@@ -164,12 +165,35 @@ fn broken_files_are_one_clear_error_without_panic_or_output() {
     bytes.extend([0u8; 8]);
     std::fs::write(&glb, bytes).unwrap();
     cases.push((glb, "not a readable GLB file"));
-    // Invalid documents the gltf crate would panic on, or accept.
+    for (name, text, needle) in [
+        ("empty.gltf", "", "is empty"),
+        ("brace.gltf", "{", "invalid JSON"),
+        ("object.gltf", "{}", "asset.version is missing"),
+    ] {
+        std::fs::write(dir.join(name), text).unwrap();
+        cases.push((dir.join(name), needle));
+    }
+    std::fs::create_dir_all(dir.join("folder.gltf")).unwrap();
+    cases.push((dir.join("folder.gltf"), "is a folder, not a file"));
+    #[cfg(unix)]
+    {
+        let _ = std::os::unix::fs::symlink("/dev/zero", dir.join("zero.gltf"));
+        cases.push((dir.join("zero.gltf"), "not a regular file"));
+        let mut dev = gltf_json(&QUAD, None, 4);
+        dev["buffers"][0]["uri"] = "/dev/zero".into();
+        cases.push((write(dir, "devzero.gltf", &dev), "buffer 0 file '/dev/zero': is not a regular file"));
+    }
+    cases
+}
+
+/// Invalid documents the gltf crate would panic on, or accept, with what the error must say.
+fn broken_documents(dir: &Path) -> Vec<(PathBuf, &'static str)> {
+    let mut cases: Vec<(PathBuf, &'static str)> = Vec::new();
     let doc = || gltf_json(&QUAD, None, 4);
     let mut edit = |name: &str, f: &dyn Fn(&mut serde_json::Value), needle: &'static str| {
         let mut d = doc();
         f(&mut d);
-        cases.push((write(&dir, name, &d), needle));
+        cases.push((write(dir, name, &d), needle));
     };
     edit(
         "acc99.gltf",
@@ -199,24 +223,14 @@ fn broken_files_are_one_clear_error_without_panic_or_output() {
         &|d| d["buffers"][0]["uri"] = "data:application/octet-stream;base64,AAA!AAAA".into(),
         "buffer 0:",
     );
-    for (name, text, needle) in [
-        ("empty.gltf", "", "is empty"),
-        ("brace.gltf", "{", "invalid JSON"),
-        ("object.gltf", "{}", "asset.version is missing"),
-    ] {
-        std::fs::write(dir.join(name), text).unwrap();
-        cases.push((dir.join(name), needle));
-    }
-    std::fs::create_dir_all(dir.join("folder.gltf")).unwrap();
-    cases.push((dir.join("folder.gltf"), "is a folder, not a file"));
-    #[cfg(unix)]
-    {
-        let _ = std::os::unix::fs::symlink("/dev/zero", dir.join("zero.gltf"));
-        cases.push((dir.join("zero.gltf"), "not a regular file"));
-        let mut dev = doc();
-        dev["buffers"][0]["uri"] = "/dev/zero".into();
-        cases.push((write(&dir, "devzero.gltf", &dev), "buffer 0 file '/dev/zero': is not a regular file"));
-    }
+    cases
+}
+
+#[test]
+fn broken_files_are_one_clear_error_without_panic_or_output() {
+    let dir = tmp("broken");
+    let mut cases = broken_files(&dir);
+    cases.extend(broken_documents(&dir));
     for (file, needle) in cases {
         let out = dir.join("out");
         let o = Command::new(env!("CARGO_BIN_EXE_twister"))

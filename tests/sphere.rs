@@ -184,6 +184,25 @@ fn sphere_images_carry_photo_sphere_metadata_in_png_and_jpeg_and_players_names()
 /// The depth files hold the distance from each pixel's eye point along its ray: checked against
 /// the ray (built here from the pixel: Cycles' construction) meeting the box room's walls, for
 /// both panoramas' eyes, and +∞ where no surface is.
+/// A pixel's ray for an eye 0.032 m off the axis (independently of `Projection::pixel_ray`):
+/// the sphere's from Cycles' construction; the cylinder's the tangent ray of the eye whose view
+/// meets the screen at this column, through the screen point (exact model).
+fn pixel_eye_ray(projection: &Projection, eye: Eye, x: usize, y: usize) -> (Vec3, Vec3) {
+    let (u, v) = projection.pixel_to_screen(x as f32, y as f32);
+    let s = eye.sign();
+    if projection.panorama == PanoramaKind::Equirect {
+        let d = Vec3::new(v.cos() * u.sin(), v.sin(), -v.cos() * u.cos());
+        let side = d.cross(Vec3::Y).normalize();
+        let fade = projection.pole_fade(v.abs());
+        (s * 0.032 * fade * side, d)
+    } else {
+        let phi = u - s * (0.032f32).asin();
+        let origin = s * 0.032 * Vec3::new(phi.cos(), 0.0, phi.sin());
+        let screen = Vec3::new(u.sin(), v, -u.cos());
+        (origin, (screen - origin).normalize())
+    }
+}
+
 #[test]
 fn depth_files_hold_the_distance_along_each_pixels_ray() {
     let out = tmp("depth");
@@ -231,22 +250,7 @@ fn depth_files_hold_the_distance_along_each_pixels_ray() {
             let mut checked = 0;
             for y in (2..h - 2).step_by(5) {
                 for x in (0..w).step_by(7) {
-                    // The pixel's ray: the sphere's from Cycles' construction; the cylinder's
-                    // the tangent ray of the eye whose view meets the screen at this column,
-                    // through the screen point (exact model).
-                    let (u, v) = projection.pixel_to_screen(x as f32, y as f32);
-                    let s = eye.sign();
-                    let (origin, dir) = if panorama == "equirect" {
-                        let d = Vec3::new(v.cos() * u.sin(), v.sin(), -v.cos() * u.cos());
-                        let side = d.cross(Vec3::Y).normalize();
-                        let fade = projection.pole_fade(v.abs());
-                        (s * 0.032 * fade * side, d)
-                    } else {
-                        let phi = u - s * (0.032f32).asin();
-                        let origin = s * 0.032 * Vec3::new(phi.cos(), 0.0, phi.sin());
-                        let screen = Vec3::new(u.sin(), v, -u.cos());
-                        (origin, (screen - origin).normalize())
-                    };
+                    let (origin, dir) = pixel_eye_ray(&projection, eye, x, y);
                     let want = to_wall(origin, dir);
                     let got = z[y * w + x];
                     assert!(

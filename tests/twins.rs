@@ -243,101 +243,106 @@ fn lit_table(scene: &Scene, settings: &RenderSettings) -> twister::core::texture
     table.with_lighting(lights, lighting).with_shadows(maps, depths)
 }
 
+/// The raster twin's geometry cases: the demo and the evaluation triangle with each split rule
+/// in both vertical models, the full sphere, eyes just under a ceiling.
+fn raster_geometry_cases() -> Vec<(String, RasterCase)> {
+    let mut out = Vec::new();
+    for vertical in [Vertical::Paper, Vertical::Exact] {
+        let projection = Projection { width: 400, height: 100, vertical, ..Projection::default() };
+        out.push((format!("demo {vertical:?}"), (builtin::demo(), RenderSettings::new(projection), None)));
+        let triangle = builtin::builtin_scene("builtin:triangle@3", &projection).unwrap();
+        for method in [Method::Vertex, Method::Adaptive(Split::Length), Method::Adaptive(Split::Error)] {
+            let settings = RenderSettings::new(projection).with_method(method);
+            out.push((format!("triangle@3 {} {vertical:?}", method.name()), (triangle.clone(), settings, Some(0.01))));
+        }
+    }
+    // The full sphere, with the error in pixels and as an angle (arcminutes).
+    let sphere = Projection::equirect(320);
+    out.push(("demo on the sphere".into(), (builtin::demo(), RenderSettings::new(sphere), None)));
+    // A triangle 2 m ahead reaching ±60° across and 50° up and down.
+    let mut triangle = Scene::new("big triangle");
+    let corner = |p: [f32; 3]| twister::core::scene::SceneVertex {
+        position: p,
+        normal: [0.0, 0.0, 1.0],
+        color: [0.8, 0.7, 0.6, 1.0],
+        ..Default::default()
+    };
+    triangle.add_mesh(
+        "t",
+        &[corner([-3.5, -2.4, -2.0]), corner([3.5, -2.4, -2.0]), corner([0.0, 2.4, -2.0])],
+        &[0, 1, 2],
+    );
+    for angle in [false, true] {
+        let settings = RenderSettings::new(sphere).with_method(Method::Vertex).with_error_angle(angle);
+        out.push((format!("triangle@3 on the sphere, angle {angle}"), (triangle.clone(), settings, Some(0.02))));
+    }
+    // Eyes 5 cm under a ceiling in the exact vertical model: needles reaching from the
+    // ceiling's image to points inside the eye circle, millions of pixels above it, drawn
+    // within GUARD_BAND_PX of the image (a real GPU left a pixel between such needles).
+    let cube = builtin::closed_box("cube", Vec3::splat(-1.0), Vec3::splat(1.0));
+    let exact = Projection { width: 192, height: 192, vertical: Vertical::Exact, ..Projection::default() };
+    let settings = RenderSettings::new(exact).with_viewer(Vec3::new(0.0, 0.95, 0.0)).with_method(Method::Fixed(7));
+    out.push(("cube, eyes under the ceiling, exact".into(), (cube, settings, None)));
+    out
+}
+
+/// The raster twin's look cases: image-based lighting, every glTF map, shadow maps, the BRDF
+/// under each light kind and tone mapping.
+fn raster_look_cases() -> Vec<(String, RasterCase)> {
+    let mut out = Vec::new();
+    // Image-based lighting: the lit spheres also in the neutral studio, the viewer turned
+    // (the environment stays put in the scene frame). Shadow maps of 256² texels in these
+    // cases: the twin draws them on the CPU.
+    let mut studio = common::lit_spheres();
+    studio.environment = Some(common::studio(false));
+    let settings = RenderSettings::new(Projection { width: 400, height: 100, ..Projection::default() })
+        .with_yaw_deg(-25.0)
+        .with_viewer(Vec3::new(0.1, 0.2, 0.0));
+    out.push(("lit spheres in the neutral studio".into(), (studio.clone(), settings.with_shadow_map_size(256), None)));
+    // The environment as the background too (the triangle drawn first), on the sphere.
+    studio.environment = Some(common::studio(true));
+    let sphere = RenderSettings::new(Projection::equirect(256)).with_yaw_deg(30.0);
+    out.push((
+        "lit spheres, the studio as the background, on the sphere".into(),
+        (studio, sphere.with_shadow_map_size(256), None),
+    ));
+    // Every glTF map (metallic-roughness, normal, occlusion, emissive), u mirrored on the
+    // middle quad, under a directional light and the studio.
+    let mut panels = common::mapped_panels();
+    panels.environment = Some(common::studio(false));
+    let settings = RenderSettings::new(Projection { width: 480, height: 120, ..Projection::default() });
+    out.push(("mapped panels".into(), (panels.clone(), settings, None)));
+    out.push(("mapped panels with glTF tangents".into(), (common::with_tangents(panels), settings, None)));
+    // Shadow maps: a ball and a masked screen over a floor under a spot light.
+    let shadows = common::ball_over_floor(twister::core::light::LightKind::Spot, true);
+    let settings =
+        RenderSettings::new(Projection { width: 400, height: 120, vertical: Vertical::Exact, ..Projection::default() });
+    out.push((
+        "ball and screen, spot light's shadow map".into(),
+        (shadows, settings.with_shadow_map_size(512), Some(0.01)),
+    ));
+    // The glTF BRDF under point, spot and directional lights, seen from a moved viewer, with
+    // each tone mapping.
+    let cylinder = Projection { width: 400, height: 100, vertical: Vertical::Exact, ..Projection::default() };
+    for tonemap in [Tonemap::PbrNeutral, Tonemap::Aces, Tonemap::None] {
+        let settings = RenderSettings::new(cylinder)
+            .with_viewer(Vec3::new(0.2, 0.1, 0.3))
+            .with_yaw_deg(10.0)
+            .with_tonemap(tonemap);
+        out.push((
+            format!("lit spheres, {tonemap:?}"),
+            (common::lit_spheres(), settings.with_exposure_ev(0.5).with_shadow_map_size(256), None),
+        ));
+    }
+    out
+}
+
 impl Twin for Raster {
     type Case = RasterCase;
     type Output = (EyeOutputs, Option<f32>);
     fn cases() -> Vec<(String, Self::Case)> {
-        let mut out = Vec::new();
-        for vertical in [Vertical::Paper, Vertical::Exact] {
-            let projection = Projection { width: 400, height: 100, vertical, ..Projection::default() };
-            out.push((format!("demo {vertical:?}"), (builtin::demo(), RenderSettings::new(projection), None)));
-            let triangle = builtin::builtin_scene("builtin:triangle@3", &projection).unwrap();
-            for method in [Method::Vertex, Method::Adaptive(Split::Length), Method::Adaptive(Split::Error)] {
-                let settings = RenderSettings::new(projection).with_method(method);
-                out.push((
-                    format!("triangle@3 {} {vertical:?}", method.name()),
-                    (triangle.clone(), settings, Some(0.01)),
-                ));
-            }
-        }
-        // The full sphere, with the error in pixels and as an angle (arcminutes).
-        let sphere = Projection::equirect(320);
-        out.push(("demo on the sphere".into(), (builtin::demo(), RenderSettings::new(sphere), None)));
-        // A triangle 2 m ahead reaching ±60° across and 50° up and down.
-        let mut triangle = Scene::new("big triangle");
-        let corner = |p: [f32; 3]| twister::core::scene::SceneVertex {
-            position: p,
-            normal: [0.0, 0.0, 1.0],
-            color: [0.8, 0.7, 0.6, 1.0],
-            ..Default::default()
-        };
-        triangle.add_mesh(
-            "t",
-            &[corner([-3.5, -2.4, -2.0]), corner([3.5, -2.4, -2.0]), corner([0.0, 2.4, -2.0])],
-            &[0, 1, 2],
-        );
-        for angle in [false, true] {
-            let settings = RenderSettings::new(sphere).with_method(Method::Vertex).with_error_angle(angle);
-            out.push((format!("triangle@3 on the sphere, angle {angle}"), (triangle.clone(), settings, Some(0.02))));
-        }
-        // Eyes 5 cm under a ceiling in the exact vertical model: needles reaching from the
-        // ceiling's image to points inside the eye circle, millions of pixels above it, drawn
-        // within GUARD_BAND_PX of the image (a real GPU left a pixel between such needles).
-        let cube = builtin::closed_box("cube", Vec3::splat(-1.0), Vec3::splat(1.0));
-        let exact = Projection { width: 192, height: 192, vertical: Vertical::Exact, ..Projection::default() };
-        let settings = RenderSettings::new(exact).with_viewer(Vec3::new(0.0, 0.95, 0.0)).with_method(Method::Fixed(7));
-        out.push(("cube, eyes under the ceiling, exact".into(), (cube, settings, None)));
-        // Image-based lighting: the lit spheres also in the neutral studio, the viewer turned
-        // (the environment stays put in the scene frame). Shadow maps of 256² texels in these
-        // cases: the twin draws them on the CPU.
-        let mut studio = common::lit_spheres();
-        studio.environment = Some(common::studio(false));
-        let settings = RenderSettings::new(Projection { width: 400, height: 100, ..Projection::default() })
-            .with_yaw_deg(-25.0)
-            .with_viewer(Vec3::new(0.1, 0.2, 0.0));
-        out.push((
-            "lit spheres in the neutral studio".into(),
-            (studio.clone(), settings.with_shadow_map_size(256), None),
-        ));
-        // The environment as the background too (the triangle drawn first), on the sphere.
-        studio.environment = Some(common::studio(true));
-        let sphere = RenderSettings::new(Projection::equirect(256)).with_yaw_deg(30.0);
-        out.push((
-            "lit spheres, the studio as the background, on the sphere".into(),
-            (studio, sphere.with_shadow_map_size(256), None),
-        ));
-        // Every glTF map (metallic-roughness, normal, occlusion, emissive), u mirrored on the
-        // middle quad, under a directional light and the studio.
-        let mut panels = common::mapped_panels();
-        panels.environment = Some(common::studio(false));
-        let settings = RenderSettings::new(Projection { width: 480, height: 120, ..Projection::default() });
-        out.push(("mapped panels".into(), (panels.clone(), settings, None)));
-        out.push(("mapped panels with glTF tangents".into(), (common::with_tangents(panels), settings, None)));
-        // Shadow maps: a ball and a masked screen over a floor under a spot light.
-        let shadows = common::ball_over_floor(twister::core::light::LightKind::Spot, true);
-        let settings = RenderSettings::new(Projection {
-            width: 400,
-            height: 120,
-            vertical: Vertical::Exact,
-            ..Projection::default()
-        });
-        out.push((
-            "ball and screen, spot light's shadow map".into(),
-            (shadows, settings.with_shadow_map_size(512), Some(0.01)),
-        ));
-        // The glTF BRDF under point, spot and directional lights, seen from a moved viewer, with
-        // each tone mapping.
-        let cylinder = Projection { width: 400, height: 100, vertical: Vertical::Exact, ..Projection::default() };
-        for tonemap in [Tonemap::PbrNeutral, Tonemap::Aces, Tonemap::None] {
-            let settings = RenderSettings::new(cylinder)
-                .with_viewer(Vec3::new(0.2, 0.1, 0.3))
-                .with_yaw_deg(10.0)
-                .with_tonemap(tonemap);
-            out.push((
-                format!("lit spheres, {tonemap:?}"),
-                (common::lit_spheres(), settings.with_exposure_ev(0.5).with_shadow_map_size(256), None),
-            ));
-        }
+        let mut out = raster_geometry_cases();
+        out.extend(raster_look_cases());
         out
     }
     fn gpu(_: &Renderer, (scene, settings, tolerance): &Self::Case) -> Self::Output {
@@ -402,6 +407,30 @@ fn traced_bvh(scene: &Scene, settings: &RenderSettings) -> twister::core::bvh::S
     }
 }
 
+/// A checker floor and a mirror sphere on it (the trace twin: textures by ray cones, reflected).
+fn mirror_over_checker() -> Scene {
+    let mut scene = common::checker_floor();
+    scene.materials.push(twister::core::material::Material { mirror: 0.7, ..Default::default() });
+    let s = builtin::sphere_scene(800, Vec3::new(0.0, -0.3, -2.0), 0.5, "mirror");
+    let first = scene.vertices.len();
+    scene.add_mesh("mirror", &s.vertices, &s.indices);
+    scene.vertices[first..].iter_mut().for_each(|v| v.material = 2);
+    scene
+}
+
+/// The lit spheres and a mirror sphere in the studio, shown as the background too.
+fn mirror_in_studio() -> Scene {
+    let mut scene = common::lit_spheres();
+    scene.environment = Some(common::studio(true));
+    scene.materials.push(twister::core::material::Material { mirror: 0.8, ..Default::default() });
+    let s = builtin::sphere_scene(800, Vec3::new(0.0, 0.2, 1.6), 0.5, "mirror");
+    let first = scene.vertices.len();
+    scene.add_mesh("mirror", &s.vertices, &s.indices);
+    let m = scene.materials.len() as u32;
+    scene.vertices[first..].iter_mut().for_each(|v| v.material = m);
+    scene
+}
+
 impl Twin for Trace {
     type Case = (Scene, RenderSettings);
     /// The images, and the rays traced and triangle tests made.
@@ -455,34 +484,16 @@ impl Twin for Trace {
             ),
             (
                 "a checker floor and a mirror sphere: textures filtered by ray cones, reflected too".into(),
-                (
-                    {
-                        let mut scene = common::checker_floor();
-                        scene.materials.push(twister::core::material::Material { mirror: 0.7, ..Default::default() });
-                        let s = builtin::sphere_scene(800, Vec3::new(0.0, -0.3, -2.0), 0.5, "mirror");
-                        let first = scene.vertices.len();
-                        scene.add_mesh("mirror", &s.vertices, &s.indices);
-                        scene.vertices[first..].iter_mut().for_each(|v| v.material = 2);
-                        scene
-                    },
-                    RenderSettings::new(cylinder).with_method(Method::Trace),
-                ),
+                (mirror_over_checker(), RenderSettings::new(cylinder).with_method(Method::Trace)),
             ),
             (
                 "lit spheres: the glTF BRDF under point, spot and directional lights".into(),
                 (common::lit_spheres(), RenderSettings::new(cylinder).with_method(Method::Trace).with_exposure_ev(0.5)),
             ),
-            ("a mirror sphere and lit spheres in the studio, shown as the background and in the mirror".into(), {
-                let mut scene = common::lit_spheres();
-                scene.environment = Some(common::studio(true));
-                scene.materials.push(twister::core::material::Material { mirror: 0.8, ..Default::default() });
-                let s = builtin::sphere_scene(800, Vec3::new(0.0, 0.2, 1.6), 0.5, "mirror");
-                let first = scene.vertices.len();
-                scene.add_mesh("mirror", &s.vertices, &s.indices);
-                let m = scene.materials.len() as u32;
-                scene.vertices[first..].iter_mut().for_each(|v| v.material = m);
-                (scene, RenderSettings::new(cylinder).with_method(Method::Trace))
-            }),
+            (
+                "a mirror sphere and lit spheres in the studio, shown as the background and in the mirror".into(),
+                (mirror_in_studio(), RenderSettings::new(cylinder).with_method(Method::Trace)),
+            ),
             (
                 "every glTF map on quads, u mirrored on one, the tangent frame from the triangle".into(),
                 (common::mapped_panels(), RenderSettings::new(cylinder).with_method(Method::Trace)),

@@ -536,7 +536,7 @@ fn plan_band(t: u32, tri: ptr<function, InputTriangle>, part: ptr<function, Part
         }
     }
     if (plan_quad(shown, tri, piece_state, clip)) {
-        append_quad(t, piece_state, clip);
+        append_quad(t, part, piece_state, clip);
         return;
     }
     for (var i = 1u; i + 1u < (*clip).poly_count; i++) {

@@ -135,6 +135,7 @@ fn interior_node(i: u32, j: u32, l: u32, m: u32, piece_state: ptr<function, Piec
 
 fn append_pieces(t: u32, part: ptr<function, PartPlan>) {
     let count = (*part).k * (*part).k;
+    (*part).appended += count;
     let base = atomicAdd(&counters.pieces, count);
     if (base + count > params.piece_capacity) {
         return; // counted, never written
@@ -464,6 +465,7 @@ fn emit_piece(shape: PieceShape, seam: SeamCopies, drawn: ptr<function, array<u3
     let node_count = shape.node_count;
     let first_node = atomicAdd(&counters.nodes, copies * node_count);
     let first_triangle = atomicAdd(&counters.triangles, copies * count);
+    atomicMax(&counters.max_output, copies * max(node_count, count));
     if (first_node + copies * node_count > params.triangle_capacity
         || first_triangle + copies * count > params.triangle_capacity) {
         return; // counted, never written

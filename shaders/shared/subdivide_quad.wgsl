@@ -50,7 +50,8 @@ fn plan_quad(shown: u32, tri: ptr<function, InputTriangle>, piece_state: ptr<fun
 
 // A band quad's two records: corners 0–2 and the rails' counts (QUAD_HEAD), then corner 3
 // (QUAD_TAIL, whose `lattice` invocation draws nothing).
-fn append_quad(t: u32, piece_state: ptr<function, PieceState>, clip: ptr<function, ClipState>) {
+fn append_quad(t: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>, clip: ptr<function, ClipState>) {
+    (*part).appended += 2u;
     let base = atomicAdd(&counters.pieces, 2u);
     if (base + 2u > params.piece_capacity) {
         return; // counted, never written

@@ -25,6 +25,7 @@ struct PartPlan {
     corner: array<Node, 3>,
     n: array<u32, 3>,   // divisions of the part's edges Q0Q1, Q1Q2, Q2Q0
     k: u32,             // macro-lattice level
+    appended: u32,      // piece records the invocation appended so far (`max_pieces`)
 }
 
 // The piece being subdivided (`lattice`).

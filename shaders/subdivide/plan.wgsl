@@ -47,6 +47,7 @@ fn plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
         part.corner[2] = Node(tri.position[2], vec3<f32>(0.0, 0.0, 1.0));
         plan_part(&tri, &part);
         append_pieces(t, &part);
+        atomicMax(&counters.max_pieces, part.appended);
         return;
     }
     // Triangles cut by all of the frame's cuts (a floor around the viewer and its neighbours)

@@ -40,13 +40,12 @@ fn plan_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
         if (local % split == 0u) {
             plan_edge_split(t, &tri, &part, &clip, cuts);
         }
-        return;
-    }
-    if (split == 4u) {
+    } else if (split == 4u) {
         plan_quadrant(t, local % 4u, &tri, &part, &piece_state, &clip, cuts);
     } else {
         for (var q = 0u; q < 4u; q++) {
             plan_quadrant(t, q, &tri, &part, &piece_state, &clip, cuts);
         }
     }
+    atomicMax(&counters.max_pieces, part.appended);
 }

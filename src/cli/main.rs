@@ -70,6 +70,7 @@ fn main() -> ExitCode {
         Command::Bench(BenchCommand::Lod(args)) => bench::bench_figures(args, Figure::Lod),
         Command::Bench(BenchCommand::TraceLod(args)) => bench::bench_figures(args, Figure::TraceLod),
         Command::Bench(BenchCommand::All(args)) => bench::bench_figures(args, Figure::All),
+        Command::Bench(BenchCommand::Startup(args)) => bench::bench_startup(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

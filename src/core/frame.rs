@@ -65,6 +65,14 @@ pub struct FrameStats {
     pub max_sub_edge_px: f32,
     /// Number of `lattice` + raster rounds the scene needed to fit the memory budget.
     pub chunks: u32,
+    /// The subdivision's invocations per entry point, in schedule order (a chunked frame's runs
+    /// summed); empty for the slit renderer and the ray tracer.
+    pub subdivide_invocations: Vec<(&'static str, u64)>,
+    /// The balance of the subdivision's work: the most piece records one `plan` or `plan_cuts`
+    /// invocation appended, and the most nodes or triangles (seam copies included) one
+    /// `lattice` invocation wrote.
+    pub max_pieces_per_invocation: u32,
+    pub max_output_per_invocation: u32,
     /// Wall time of the frame's GPU work, subdivision and raster of both eyes, from the first
     /// submission until it completed (read-backs excluded).
     pub ms_frame: f64,

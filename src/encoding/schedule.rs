@@ -17,7 +17,9 @@
 use crate::core::settings::RenderSettings;
 use crate::encoding::constants::PIECES_FROM_COUNTER;
 use crate::encoding::recording::Recording;
-use crate::encoding::subdivide::{active_cuts, one_submission, pass_run, subdivide_params, AxisCuts};
+use crate::encoding::subdivide::{
+    active_cuts, dispatched, one_submission, pass_run, subdivide_params, AxisCuts, SubdivideOutput,
+};
 use crate::encoding::types::{DrawVertex, Piece, SubdivideCounters, SubdivideParams};
 use crate::error::{Error, Result};
 
@@ -132,7 +134,7 @@ pub trait SubdivisionEngine {
 }
 
 /// What a run made, over all its ranges.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct RunTotals {
     pub pieces: u64,
     pub triangles: u64,
@@ -143,9 +145,17 @@ pub struct RunTotals {
     pub max_edge_px: f32,
     /// The cuts around the axis the frame made.
     pub cuts: AxisCuts,
+    /// Invocations per entry point, in the order first dispatched, over the run's replays (a
+    /// chunked run's ranges redone after an overflow included: work done).
+    pub invocations: Vec<(&'static str, u64)>,
+    /// The most piece records one `plan` or `plan_cuts` invocation appended, and the most nodes
+    /// or triangles one `lattice` invocation wrote.
+    pub max_pieces: u32,
+    pub max_output: u32,
 }
 
 impl RunTotals {
+    /// A finished range's output.
     fn add(&mut self, done: &SubdivideCounters) {
         self.triangles += done.triangles as u64;
         self.nodes += done.nodes as u64;
@@ -153,6 +163,44 @@ impl RunTotals {
         self.max_edge_px = self.max_edge_px.max(f32::from_bits(done.max_edge_bits));
         self.cuts = done.cuts();
     }
+
+    /// The work of one replay: its invocations and its largest outputs of one invocation.
+    pub fn count(
+        &mut self,
+        recording: &Recording,
+        params: &SubdivideParams,
+        after: &SubdivideCounters,
+        settings: &RenderSettings,
+    ) {
+        for (entry, n) in dispatched(recording, params, after, settings.projection().panorama) {
+            match self.invocations.iter_mut().find(|(e, _)| *e == entry) {
+                Some((_, total)) => *total += n,
+                None => self.invocations.push((entry, n)),
+            }
+        }
+        self.max_pieces = self.max_pieces.max(after.max_pieces);
+        self.max_output = self.max_output.max(after.max_output);
+    }
+
+    /// The output of a read-back run: its nodes and indices, with these totals.
+    pub fn output(&self, nodes: Vec<DrawVertex>, indices: Vec<u32>) -> SubdivideOutput {
+        let mut out = SubdivideOutput::indexed(nodes, indices, self.pieces as u32, self.max_edge_px, self.cuts);
+        (out.max_pieces, out.max_output) = (self.max_pieces, self.max_output);
+        out
+    }
+}
+
+/// Replays `recording` and counts its work into `totals`.
+fn replay_counted<E: SubdivisionEngine>(
+    engine: &mut E,
+    recording: &Recording,
+    params: &SubdivideParams,
+    settings: &RenderSettings,
+    totals: &mut RunTotals,
+) -> Result<SubdivideCounters> {
+    let counters = engine.replay(recording, params)?;
+    totals.count(recording, params, &counters, settings);
+    Ok(counters)
 }
 
 /// Runs `schedule` over the scene's `triangles` to the end, within `budget`: one submission
@@ -192,7 +240,9 @@ pub fn run_one_submission<E: SubdivisionEngine>(
     let mut params = subdivide_params(settings, 0, triangles);
     (params.piece_capacity, params.triangle_capacity) = (capacity.pieces, capacity.triangles);
     (params.first_piece, params.piece_count) = (0, PIECES_FROM_COUNTER);
-    let counters = engine.replay(&one_submission(triangles, false), &params)?;
+    let recording = one_submission(triangles, false);
+    let mut totals = RunTotals::default();
+    let counters = replay_counted(engine, &recording, &params, settings, &mut totals)?;
     if counters.pieces > capacity.pieces || counters.output_units() > capacity.triangles {
         let wanted = Capacities {
             pieces: capacity.pieces.max(counters.pieces),
@@ -201,7 +251,7 @@ pub fn run_one_submission<E: SubdivisionEngine>(
         return Ok(Err(wanted));
     }
     engine.take(&counters)?;
-    let mut totals = RunTotals { pieces: counters.pieces as u64, ..Default::default() };
+    totals.pieces = counters.pieces as u64;
     totals.add(&counters);
     Ok(Ok(totals))
 }
@@ -221,7 +271,7 @@ pub fn run_chunked<E: SubdivisionEngine>(
     let n = triangles;
     let mut totals = RunTotals::default();
     engine.ensure(*want);
-    engine.replay(&active_cuts(n), &subdivide_params(settings, 0, n))?;
+    replay_counted(engine, &active_cuts(n), &subdivide_params(settings, 0, n), settings, &mut totals)?;
     let (mut first, mut chunk) = (0u32, chunk.max(1));
     while first < n || totals.chunks == 0 {
         let count = chunk.min(n - first);
@@ -229,7 +279,7 @@ pub fn run_chunked<E: SubdivisionEngine>(
         let mut params = subdivide_params(settings, first, count);
         params.piece_capacity = capacity.pieces.min(budget.pieces);
         params.triangle_capacity = capacity.triangles;
-        let planned = engine.replay(&pass_run("plan", count), &params)?;
+        let planned = replay_counted(engine, &pass_run("plan", count), &params, settings, &mut totals)?;
         if planned.pieces > params.piece_capacity {
             match on_overflow(planned.pieces, budget.pieces, count) {
                 Overflow::Grow(p) => want.pieces = p,
@@ -267,7 +317,7 @@ fn lattice_ranges<E: SubdivisionEngine>(
         let capacity = engine.ensure(*want);
         (params.first_piece, params.piece_count) = (first, count);
         params.triangle_capacity = capacity.triangles.min(budget.triangles);
-        let done = engine.replay(&pass_run("lattice", count), params)?;
+        let done = replay_counted(engine, &pass_run("lattice", count), params, settings, totals)?;
         if done.output_units() > params.triangle_capacity {
             match on_overflow(done.output_units(), budget.triangles, count) {
                 Overflow::Grow(t) => want.triangles = t,

@@ -4,7 +4,7 @@
 use crate::core::projection::{PanoramaKind, Projection};
 use crate::core::settings::RenderSettings;
 use crate::encoding::constants::{AXIS_CLEARANCE_MAX, AXIS_CLEARANCE_MIN};
-use crate::encoding::recording::Recording;
+use crate::encoding::recording::{Command, Recording};
 use crate::encoding::types::{DrawVertex, SubdivideCounters, SubdivideParams};
 
 /// The `subdivide` stage's parameters for a range of input triangles (capacities and piece
@@ -80,6 +80,11 @@ pub struct SubdivideOutput {
     /// Triangles that ask for no cuts cut at edges they share with ones that do (the twin's
     /// count, for tests; 0 from the GPU).
     pub edge_splits: u32,
+    /// The most piece records one `plan` or `plan_cuts` invocation appended (from a schedule's
+    /// run; 0 from the twin's direct run), and the most nodes or triangles one piece's lattice
+    /// wrote.
+    pub max_pieces: u32,
+    pub max_output: u32,
 }
 
 /// Indexed triangles as three vertices each.
@@ -88,6 +93,13 @@ pub fn expand(nodes: &[DrawVertex], indices: &[u32]) -> Vec<DrawVertex> {
 }
 
 impl SubdivideOutput {
+    /// Counts one piece's output (the nodes and triangles added since `before`) into
+    /// `max_output`.
+    pub fn note_output(&mut self, (nodes, triangles): (usize, usize)) {
+        let added = (self.nodes.len() - nodes).max(self.indices.len() / 3 - triangles);
+        self.max_output = self.max_output.max(added as u32);
+    }
+
     /// An output from its nodes and indices (the GPU's read-back), with `vertices` expanded.
     pub fn indexed(
         nodes: Vec<DrawVertex>,
@@ -99,6 +111,41 @@ impl SubdivideOutput {
         let vertices = expand(&nodes, &indices);
         SubdivideOutput { nodes, indices, vertices, pieces, max_sub_edge_px, cuts, ..Default::default() }
     }
+}
+
+/// Invocations of `plan_cuts` per listed triangle: one per quadrant on the sphere (whose bands
+/// reach 10⁻⁵ m from the axis: one quadrant's keep an invocation within lavapipe's loop budget),
+/// one per triangle on the cylinder (`plan_cuts_split` in the WGSL).
+pub fn plan_cuts_split(panorama: PanoramaKind) -> u32 {
+    match panorama {
+        PanoramaKind::Equirect => 4,
+        PanoramaKind::Cylinder => 1,
+    }
+}
+
+/// The invocations each dispatch of `recording` ran, read from the counters after it (the
+/// indirect ones: `plan_cuts` over the listed triangles, `lattice` over the pieces counted): the
+/// balance of the subdivision's work, with `max_pieces` and `max_output`.
+pub fn dispatched(
+    recording: &Recording,
+    params: &SubdivideParams,
+    counters: &SubdivideCounters,
+    panorama: PanoramaKind,
+) -> Vec<(&'static str, u64)> {
+    let listed = counters.cut_count as u64 + counters.cut_wide as u64;
+    let pieces = counters.pieces.min(params.piece_capacity) as u64;
+    recording
+        .commands
+        .iter()
+        .filter_map(|c| match *c {
+            Command::Dispatch { entry, invocations } => Some((entry, invocations as u64)),
+            Command::DispatchIndirect { entry: "plan_cuts", .. } => {
+                Some(("plan_cuts", plan_cuts_split(panorama) as u64 * listed))
+            }
+            Command::DispatchIndirect { entry, .. } => Some((entry, pieces)),
+            _ => None,
+        })
+        .collect()
 }
 
 /// Timestamp query indices of the one-submission schedule's passes (each pass's begin; its end

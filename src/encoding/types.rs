@@ -138,6 +138,11 @@ pub struct SubdivideCounters {
     pub nodes: u32,
     /// ... and the wide ones near the axis (from the back).
     pub cut_wide: u32,
+    /// The most piece records one `plan` or `plan_cuts` invocation appended (the balance of the
+    /// work: see `bench speed`).
+    pub max_pieces: u32,
+    /// The most nodes or triangles (seam copies included) one `lattice` invocation wrote.
+    pub max_output: u32,
     /// The frame's cuts around the axis (`AxisCuts`), bits 0–31 and 32–63.
     pub cuts_low: u32,
     pub cuts_high: u32,
@@ -146,7 +151,7 @@ pub struct SubdivideCounters {
 impl SubdivideCounters {
     /// Bytes of the counters that each `plan` or `lattice` run starts from zero; the cuts after
     /// them are set once per frame by `active_cuts`.
-    pub const RUN_BYTES: u64 = 24;
+    pub const RUN_BYTES: u64 = 32;
 
     /// What the output buffers must hold, in their unit (a triangle's indices and a node each):
     /// the larger of the triangle and node counts.
@@ -391,7 +396,7 @@ pub const LAYOUTS: &[StructLayout] = &[
         view, projection, axis_clearance, triangle_count, first_triangle, method, fixed_n, edge_px, max_div,
         piece_capacity, triangle_capacity, first_piece, piece_count, measure_edges, vertical_limit, max_error_px, _pad1, _pad2
     }),
-    layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, nodes, cut_wide, cuts_low, cuts_high }),
+    layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, nodes, cut_wide, max_pieces, max_output, cuts_low, cuts_high }),
     layout!("Piece" => Piece { triangle, cell, counts01, count2_level, corner, bary1, bary2 }),
     layout!("DrawIndexedIndirectArgs" => DrawIndexedIndirectArgs { index_count, instance_count, first_index, base_vertex, first_instance }),
     layout!("RasterParams" => RasterParams { projection, eye_sign, ambient, shift_px, error_angle, _pad0, _pad1, _pad2 }),

@@ -4,6 +4,7 @@
 use std::sync::{Arc, Mutex};
 
 use crate::error::{Error, Result};
+use crate::gpu::pipeline_cache::DiskPipelineCache;
 use crate::shader::{ErrorTarget, EyesPerDraw, ShaderOptions};
 
 pub const NO_ADAPTER_HELP: &str = "no GPU adapter found: no Vulkan, Metal, DX12 or OpenGL driver is usable on this machine. \
@@ -28,6 +29,14 @@ pub struct Gpu {
     pub eyes_per_draw: EyesPerDraw,
     /// GPU errors raised outside any error scope (kept instead of wgpu's default panic).
     uncaptured: Arc<Mutex<Vec<String>>>,
+    /// The pipelines' cache on disk, where the adapter has one (saved when the device closes).
+    pipeline_cache: Option<DiskPipelineCache>,
+}
+
+impl Drop for Gpu {
+    fn drop(&mut self) {
+        self.save_pipeline_cache();
+    }
 }
 
 /// The texture format of an error target.
@@ -92,7 +101,8 @@ impl Gpu {
                 _ => info.device_type != wgpu::DeviceType::Cpu,
             };
         let eyes_per_draw = if multiview { EyesPerDraw::Both } else { EyesPerDraw::One };
-        let features = adapter.features() & (wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::MULTIVIEW);
+        let wanted = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::MULTIVIEW | wgpu::Features::PIPELINE_CACHE;
+        let features = adapter.features() & wanted;
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("twister"),
@@ -107,7 +117,21 @@ impl Gpu {
         device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
             sink.lock().unwrap_or_else(|p| p.into_inner()).push(one_line(&e));
         }));
-        Ok(Gpu { device, queue, info, limits, features, error_target, eyes_per_draw, uncaptured })
+        let pipeline_cache = DiskPipelineCache::open(&device, &info);
+        Ok(Gpu { device, queue, info, limits, features, error_target, eyes_per_draw, uncaptured, pipeline_cache })
+    }
+
+    /// The pipeline cache for a pipeline about to be built (`cache` of its descriptor).
+    pub fn pipeline_cache(&self) -> Option<&wgpu::PipelineCache> {
+        self.pipeline_cache.as_ref().map(DiskPipelineCache::for_build)
+    }
+
+    /// Writes the pipeline cache to disk if pipelines were built since it was loaded (also done
+    /// when the device closes).
+    pub fn save_pipeline_cache(&self) {
+        if let Some(cache) = &self.pipeline_cache {
+            cache.save();
+        }
     }
 
     /// What the generated shader modules depend on.

@@ -219,7 +219,7 @@ fn draw_pipeline(
             targets: &targets,
         }),
         multiview_mask,
-        cache: None,
+        cache: gpu.pipeline_cache(),
     })
 }
 

@@ -65,9 +65,10 @@ pub(crate) trait Method {
 }
 
 /// The end of every frame: the read-back of its targets and, with the error pass, the
-/// `reduce_error` stage.
+/// `reduce_error` stage (built when first needed).
+#[derive(Default)]
 pub(crate) struct FrameEnd {
-    pub reduce: ReduceStage,
+    reduce: std::sync::OnceLock<ReduceStage>,
 }
 
 impl FrameEnd {
@@ -88,7 +89,8 @@ impl FrameEnd {
         let positions = if settings.measure.positions { Some(targets.read_positions(gpu)?) } else { None };
         let measurement = if settings.measure.error {
             let object = targets.read_objects(gpu)?;
-            let (stats, error) = self.reduce.reduce(gpu, targets, settings.measure.reduce_per_eye)?;
+            let reduce = self.reduce.get_or_init(|| ReduceStage::new(gpu));
+            let (stats, error) = reduce.reduce(gpu, targets, settings.measure.reduce_per_eye)?;
             Some(Measurement { error, object, stats })
         } else {
             None

@@ -5,6 +5,7 @@ pub mod device;
 pub mod draw;
 pub mod frame;
 pub mod frame_plan;
+pub mod pipeline_cache;
 pub mod project_points;
 pub mod reduce_error;
 pub mod renderer;

@@ -6,7 +6,7 @@
 //! and buffers are made once and reused across frames. Every frame runs inside GPU error
 //! scopes, so a GPU error is one [`Error::Gpu`] line.
 
-use std::sync::Mutex;
+use std::sync::{Mutex, OnceLock};
 
 use glam::Vec3;
 
@@ -21,7 +21,6 @@ use crate::error::{Error, Result};
 use crate::gpu::device::Gpu;
 use crate::gpu::frame::{FrameEnd, FrameResources, Method, STAGING_SIZE};
 use crate::gpu::project_points::ProjectPointsStage;
-use crate::gpu::reduce_error::ReduceStage;
 use crate::gpu::scene::GpuScene;
 use crate::gpu::shadow::ShadowStage;
 use crate::gpu::skin::SkinStage;
@@ -34,10 +33,10 @@ use crate::gpu::trace::TraceMethod;
 /// resources kept between frames.
 pub struct Renderer {
     pub gpu: Gpu,
-    subdivided: SubdividedMethod,
-    slit: SlitMethod,
+    subdivided: OnceLock<SubdividedMethod>,
+    slit: OnceLock<SlitMethod>,
     trace: TraceMethod,
-    shadow: ShadowStage,
+    shadow: OnceLock<ShadowStage>,
     end: FrameEnd,
     skin: SkinStage,
     project_points: ProjectPointsStage,
@@ -45,11 +44,12 @@ pub struct Renderer {
 }
 
 impl Renderer {
-    /// Builds the usual frame's pipelines now (a GPU error here is returned, not a panic); the
-    /// others are built when first needed.
+    /// The renderer on a device: its uniforms and read-back buffer now; the stages' shader
+    /// modules and pipelines when a frame first needs them (only those it uses: a still in a
+    /// fresh process builds little), inside that frame's error scope.
     pub fn new(gpu: Gpu) -> Result<Renderer> {
-        let (subdivided, slit, shadow, end, resources) = gpu.scoped("building the pipelines", || {
-            let resources = FrameResources {
+        let resources = gpu.scoped("making the frame's resources", || {
+            Ok(FrameResources {
                 buffers: None,
                 targets: None,
                 timestamps: Timestamps::new(&gpu),
@@ -65,26 +65,23 @@ impl Renderer {
                 trace_params: gpu.uniform_buffer::<TraceParams>("trace params"),
                 trace_outputs: None,
                 trace_counts: None,
-            };
-            Ok((
-                SubdividedMethod::new(&gpu),
-                SlitMethod::new(&gpu),
-                ShadowStage::new(&gpu),
-                FrameEnd { reduce: ReduceStage::new(&gpu) },
-                resources,
-            ))
+            })
         })?;
         Ok(Renderer {
             gpu,
-            subdivided,
-            slit,
+            subdivided: OnceLock::new(),
+            slit: OnceLock::new(),
             trace: TraceMethod::default(),
-            shadow,
-            end,
+            shadow: OnceLock::new(),
+            end: FrameEnd::default(),
             skin: SkinStage::default(),
             project_points: ProjectPointsStage::default(),
             resources: Mutex::new(resources),
         })
+    }
+
+    fn subdivided(&self) -> &SubdividedMethod {
+        self.subdivided.get_or_init(|| SubdividedMethod::new(&self.gpu))
     }
 
     /// Renders both eyes of an uploaded scene.
@@ -93,13 +90,18 @@ impl Renderer {
         self.check_size(settings)?;
         let mut resources = self.resources.lock().unwrap_or_else(|e| e.into_inner());
         let shadow_maps = scene.write_lighting(&self.gpu, settings);
-        self.shadow.draw_maps(&self.gpu, scene, settings.view(), &shadow_maps)?;
-        let method: &dyn Method = match settings.subdivision.method {
-            MethodName::Slit(_) => &self.slit,
-            MethodName::Trace => &self.trace,
-            _ => &self.subdivided,
-        };
-        self.gpu.scoped("rendering a frame", || method.draw(&self.gpu, &self.end, &mut resources, scene, settings))
+        self.gpu.scoped("rendering a frame", || {
+            if !shadow_maps.is_empty() {
+                let shadow = self.shadow.get_or_init(|| ShadowStage::new(&self.gpu));
+                shadow.draw_maps(&self.gpu, scene, settings.view(), &shadow_maps)?;
+            }
+            let method: &dyn Method = match settings.subdivision.method {
+                MethodName::Slit(_) => self.slit.get_or_init(|| SlitMethod::new(&self.gpu)),
+                MethodName::Trace => &self.trace,
+                _ => self.subdivided(),
+            };
+            method.draw(&self.gpu, &self.end, &mut resources, scene, settings)
+        })
     }
 
     /// Poses `scene` at time t of clip `clip` (None: the rest pose) on the GPU (the skin
@@ -163,6 +165,6 @@ impl Renderer {
         settings: &RenderSettings,
         schedule: Schedule,
     ) -> Result<SubdivideOutput> {
-        self.subdivided.subdivide.readback(&self.gpu, scene, settings, schedule)
+        self.subdivided().subdivide.readback(&self.gpu, scene, settings, schedule)
     }
 }

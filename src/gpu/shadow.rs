@@ -78,7 +78,7 @@ impl ShadowStage {
                     targets: &[],
                 }),
                 multiview_mask: None,
-                cache: None,
+                cache: gpu.pipeline_cache(),
             })
         })
     }

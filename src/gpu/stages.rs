@@ -118,7 +118,7 @@ impl GpuStage {
             module: self.module(Some(entry)),
             entry_point: Some(entry),
             compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
-            cache: None,
+            cache: gpu.pipeline_cache(),
         })
     }
 

@@ -29,30 +29,14 @@ pub(crate) const COUNTERS_SIZE: u64 = std::mem::size_of::<SubdivideCounters>() a
 
 /// The stage's pipelines for one panorama, one per entry point.
 struct Variant {
-    active_cuts: wgpu::ComputePipeline,
-    ring_cuts: wgpu::ComputePipeline,
-    plan: wgpu::ComputePipeline,
-    plan_cuts_args: wgpu::ComputePipeline,
-    plan_cuts: wgpu::ComputePipeline,
-    lattice_args: wgpu::ComputePipeline,
-    lattice: wgpu::ComputePipeline,
-    finalize: wgpu::ComputePipeline,
+    pipelines: Vec<(&'static str, wgpu::ComputePipeline)>,
 }
 
 impl Variant {
     /// The pipeline of an entry point a recording names.
     fn pipeline(&self, entry: &str) -> &wgpu::ComputePipeline {
-        match entry {
-            "active_cuts" => &self.active_cuts,
-            "ring_cuts" => &self.ring_cuts,
-            "plan" => &self.plan,
-            "plan_cuts_args" => &self.plan_cuts_args,
-            "plan_cuts" => &self.plan_cuts,
-            "lattice_args" => &self.lattice_args,
-            "lattice" => &self.lattice,
-            "finalize" => &self.finalize,
-            other => panic!("the subdivide stage has no entry point {other}"),
-        }
+        let found = self.pipelines.iter().find(|(name, _)| *name == entry);
+        &found.unwrap_or_else(|| panic!("the subdivide stage has no entry point {entry}")).1
     }
 }
 
@@ -64,13 +48,9 @@ pub(crate) struct SubdivideStage {
 }
 
 impl SubdivideStage {
-    /// The stage, with the cylinder's pipelines built now (a GPU error building them shows
-    /// when the renderer is made, not mid-frame).
+    /// The stage; each panorama's pipelines are built when a frame first needs them.
     pub fn new(gpu: &Gpu) -> SubdivideStage {
-        let stage =
-            SubdivideStage { stage: GpuStage::new(gpu, &SUBDIVIDE), variants: [OnceLock::new(), OnceLock::new()] };
-        stage.variant(gpu, PanoramaKind::Cylinder);
-        stage
+        SubdivideStage { stage: GpuStage::new(gpu, &SUBDIVIDE), variants: [OnceLock::new(), OnceLock::new()] }
     }
 
     fn variant(&self, gpu: &Gpu, panorama: PanoramaKind) -> &Variant {
@@ -79,18 +59,18 @@ impl SubdivideStage {
             PanoramaKind::Equirect => (1, 2.0),
         };
         self.variants[k].get_or_init(|| {
+            // Built side by side: the driver's compiling of the large passes (`plan_cuts`,
+            // `lattice`) is most of a fresh process's time.
             let constants = [("PANORAMAS", bits)];
-            let make = |entry| self.stage.compute_with(gpu, entry, &constants);
-            Variant {
-                active_cuts: make("active_cuts"),
-                ring_cuts: make("ring_cuts"),
-                plan: make("plan"),
-                plan_cuts_args: make("plan_cuts_args"),
-                plan_cuts: make("plan_cuts"),
-                lattice_args: make("lattice_args"),
-                lattice: make("lattice"),
-                finalize: make("finalize"),
-            }
+            let pipelines = std::thread::scope(|scope| {
+                let builds: Vec<_> = SUBDIVIDE
+                    .entry_points
+                    .iter()
+                    .map(|e| (e.name, scope.spawn(|| self.stage.compute_with(gpu, e.name, &constants))))
+                    .collect();
+                builds.into_iter().map(|(name, b)| (name, b.join().expect("a pipeline build panicked"))).collect()
+            });
+            Variant { pipelines }
         })
     }
 
@@ -201,8 +181,7 @@ impl SubdivideStage {
             };
             let budget = Capacities::budget(settings.subdivision.memory_mb, gpu.max_binding());
             let totals = run_schedule(&mut engine, settings, scene.triangle_count, schedule, budget)?;
-            let pieces = totals.pieces as u32;
-            Ok(SubdivideOutput::indexed(engine.nodes, engine.indices, pieces, totals.max_edge_px, totals.cuts))
+            Ok(totals.output(engine.nodes, engine.indices))
         })
     }
 }

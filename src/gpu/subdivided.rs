@@ -12,11 +12,11 @@ use crate::core::settings::RenderSettings;
 use crate::encoding::params::raster_params;
 use crate::encoding::recording::Recording;
 use crate::encoding::schedule::{run_chunked, Capacities, FramePlan, SubdivisionEngine};
-use crate::encoding::subdivide::subdivide_params;
+use crate::encoding::subdivide::{dispatched, one_submission, subdivide_params};
 use crate::encoding::types::{SubdivideCounters, SubdivideParams};
 use crate::error::Result;
 use crate::gpu::device::Gpu;
-use crate::gpu::draw::{DrawKey, DrawPipelines, DrawStage, Lit, Look};
+use crate::gpu::draw::{DrawPipelines, DrawStage};
 use crate::gpu::frame::{FrameEnd, FrameResources, Method};
 use crate::gpu::frame_plan::SubdivisionBuffers;
 use crate::gpu::scene::GpuScene;
@@ -40,13 +40,9 @@ pub(crate) struct SubdividedMethod {
 }
 
 impl SubdividedMethod {
-    /// The stages, with the cylinder's subdivision and the usual drawing pipeline built now (a
-    /// GPU error building them shows when the renderer is made, not mid-frame).
+    /// The stages; their pipelines are built when a frame first needs them.
     pub fn new(gpu: &Gpu) -> SubdividedMethod {
-        let raster = DrawPipelines::new(gpu, DrawStage::Raster);
-        let layers = Layers::passes(gpu.eyes_per_draw)[0];
-        raster.keyed(gpu, DrawKey { look: Some((Look::Plain, Lit::default())), outputs: 1, layers, hdr: false });
-        SubdividedMethod { subdivide: SubdivideStage::new(gpu), raster }
+        SubdividedMethod { subdivide: SubdivideStage::new(gpu), raster: DrawPipelines::new(gpu, DrawStage::Raster) }
     }
 }
 
@@ -98,6 +94,9 @@ impl Method for SubdividedMethod {
                     None => stats.timing = Timing::WallOneSubmission,
                 }
                 stats.pieces = counters.pieces as u64;
+                stats.subdivide_invocations = dispatched(&one_submission(n, false), &params, &counters, p.panorama);
+                stats.max_pieces_per_invocation = counters.max_pieces;
+                stats.max_output_per_invocation = counters.max_output;
                 stats.triangles_out = counters.triangles as u64;
                 stats.nodes_out = counters.nodes as u64;
                 stats.chunks = 1;
@@ -233,6 +232,9 @@ impl SubdividedMethod {
         stats.nodes_out += totals.nodes;
         stats.chunks += totals.chunks;
         stats.max_sub_edge_px = stats.max_sub_edge_px.max(totals.max_edge_px);
+        stats.max_pieces_per_invocation = totals.max_pieces;
+        stats.max_output_per_invocation = totals.max_output;
+        stats.subdivide_invocations = totals.invocations;
         stats.ms_subdivide = Some(engine.clock.subdivide);
         stats.ms_raster = Some(engine.clock.raster);
         Ok(())

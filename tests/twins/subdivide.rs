@@ -49,71 +49,70 @@ fn random_triangle_scene(seed: u64, n: usize) -> Scene {
     scene
 }
 
+/// The subdivide twin's scenes and settings: random triangles with every split rule, rooms and
+/// spheres around the viewer, tall images, both vertical models, the full sphere.
+fn subdivide_cases() -> Vec<(Scene, RenderSettings)> {
+    let projection = Projection { width: 640, height: 160, ..Projection::default() };
+    let base = RenderSettings::new(projection).with_measure_edges(true);
+    let moved = base.with_viewer(Vec3::new(1.0, 0.3, -2.0)).with_yaw_deg(37.0);
+    let sphere = builtin::builtin_scene("builtin:sphere100", &projection).unwrap();
+    let around = builtin::sphere_scene(1024, Vec3::ZERO, 2.5, "sphere around the viewer");
+    let box_room = builtin::builtin_scene("builtin:box-room", &projection).unwrap();
+    let cube = builtin::builtin_scene("builtin:cube", &projection).unwrap();
+    let tall_projection = Projection { width: 192, height: 256, ..Projection::default() };
+    let tall = RenderSettings::new(tall_projection);
+    let small = RenderSettings::new(Projection { width: 64, height: 96, ..tall_projection });
+    let tall_exact = RenderSettings::new(Projection { vertical: Vertical::Exact, ..tall_projection });
+    vec![
+        (random_triangle_scene(3, 600), base.with_method(Method::Vertex)),
+        (random_triangle_scene(4, 300), base),
+        // glTF tangents, interpolated and packed again.
+        (common::with_tangents(random_triangle_scene(8, 200)), moved),
+        (random_triangle_scene(5, 200), base.with_method(Method::Fixed(5))),
+        (builtin::demo(), base),
+        (builtin::demo(), moved.with_projection(tall_projection).with_method(Method::Vertex)),
+        (builtin::demo(), moved.with_method(Method::Adaptive(Split::Length)).with_edge_px(12.0).with_max_div(4)),
+        (sphere.clone(), base.with_method(Method::Adaptive(Split::Length)).with_edge_px(8.0)),
+        // The error split (the default method) with a fine tolerance.
+        (sphere, base.with_max_error_px(0.05)),
+        (around, base.with_method(Method::Adaptive(Split::Length)).with_edge_px(16.0)),
+        (builtin::sphere_scene(1024, Vec3::ZERO, 2.5, "sphere around the viewer"), base.with_max_error_px(0.2)),
+        // fixed:N beyond 32 divisions: pre-split into pieces (one invocation used to stop short).
+        (builtin::builtin_scene("builtin:triangle@3", &projection).unwrap(), base.with_method(Method::Fixed(64))),
+        (random_triangle_scene(6, 12), base.with_method(Method::Fixed(45))),
+        // Surround scenes: quadrant and band cuts, the square around the axis, tall images,
+        // both vertical models, a part beyond 32 × N_max divisions (K capped).
+        (box_room.clone(), base),
+        (box_room.clone(), tall.with_method(Method::Vertex)),
+        (box_room, tall_exact.with_method(Method::Fixed(7))),
+        (cube.clone(), tall.with_viewer(Vec3::new(0.0, 0.95, 0.0))),
+        (
+            cube.clone(),
+            small
+                .with_viewer(Vec3::new(0.0, 0.95, 0.0))
+                .with_method(Method::Adaptive(Split::Length))
+                .with_edge_px(4.0)
+                .with_max_div(3),
+        ),
+        (cube, tall_exact.with_viewer(Vec3::new(0.1, -0.8, 0.2)).with_edge_px(12.0)),
+        // The full sphere: the poles (pole merge on and off), converging rays, the seam.
+        (builtin::demo(), RenderSettings::new(Projection::equirect(256))),
+        (
+            builtin::demo(),
+            RenderSettings::new(Projection { convergence: Some(2.0), pole_merge: None, ..Projection::equirect(192) })
+                .with_method(Method::Vertex),
+        ),
+        (random_triangle_scene(7, 200), RenderSettings::new(Projection::equirect(256)).with_method(Method::Fixed(3))),
+    ]
+}
+
 impl Twin for Subdivide {
     type Case = (Scene, RenderSettings);
     /// The GPU's outputs with the usual frame's schedule (one submission, indirect) and with the
     /// chunked one (ranges of triangles); the twin's, once.
     type Output = Vec<twister::cpu::subdivide::SubdivideOutput>;
     fn cases() -> Vec<(String, Self::Case)> {
-        let projection = Projection { width: 640, height: 160, ..Projection::default() };
-        let base = RenderSettings::new(projection).with_measure_edges(true);
-        let moved = base.with_viewer(Vec3::new(1.0, 0.3, -2.0)).with_yaw_deg(37.0);
-        let sphere = builtin::builtin_scene("builtin:sphere100", &projection).unwrap();
-        let around = builtin::sphere_scene(1024, Vec3::ZERO, 2.5, "sphere around the viewer");
-        let box_room = builtin::builtin_scene("builtin:box-room", &projection).unwrap();
-        let cube = builtin::builtin_scene("builtin:cube", &projection).unwrap();
-        let tall_projection = Projection { width: 192, height: 256, ..Projection::default() };
-        let tall = RenderSettings::new(tall_projection);
-        let small = RenderSettings::new(Projection { width: 64, height: 96, ..tall_projection });
-        let tall_exact = RenderSettings::new(Projection { vertical: Vertical::Exact, ..tall_projection });
-        let cases = [
-            (random_triangle_scene(3, 600), base.with_method(Method::Vertex)),
-            (random_triangle_scene(4, 300), base),
-            // glTF tangents, interpolated and packed again.
-            (common::with_tangents(random_triangle_scene(8, 200)), moved),
-            (random_triangle_scene(5, 200), base.with_method(Method::Fixed(5))),
-            (builtin::demo(), base),
-            (builtin::demo(), moved.with_projection(tall_projection).with_method(Method::Vertex)),
-            (builtin::demo(), moved.with_method(Method::Adaptive(Split::Length)).with_edge_px(12.0).with_max_div(4)),
-            (sphere.clone(), base.with_method(Method::Adaptive(Split::Length)).with_edge_px(8.0)),
-            // The error split (the default method) with a fine tolerance.
-            (sphere, base.with_max_error_px(0.05)),
-            (around, base.with_method(Method::Adaptive(Split::Length)).with_edge_px(16.0)),
-            (builtin::sphere_scene(1024, Vec3::ZERO, 2.5, "sphere around the viewer"), base.with_max_error_px(0.2)),
-            // fixed:N beyond 32 divisions: pre-split into pieces (one invocation used to stop short).
-            (builtin::builtin_scene("builtin:triangle@3", &projection).unwrap(), base.with_method(Method::Fixed(64))),
-            (random_triangle_scene(6, 12), base.with_method(Method::Fixed(45))),
-            // Surround scenes: quadrant and band cuts, the square around the axis, tall images,
-            // both vertical models, a part beyond 32 × N_max divisions (K capped).
-            (box_room.clone(), base),
-            (box_room.clone(), tall.with_method(Method::Vertex)),
-            (box_room, tall_exact.with_method(Method::Fixed(7))),
-            (cube.clone(), tall.with_viewer(Vec3::new(0.0, 0.95, 0.0))),
-            (
-                cube.clone(),
-                small
-                    .with_viewer(Vec3::new(0.0, 0.95, 0.0))
-                    .with_method(Method::Adaptive(Split::Length))
-                    .with_edge_px(4.0)
-                    .with_max_div(3),
-            ),
-            (cube, tall_exact.with_viewer(Vec3::new(0.1, -0.8, 0.2)).with_edge_px(12.0)),
-            // The full sphere: the poles (pole merge on and off), converging rays, the seam.
-            (builtin::demo(), RenderSettings::new(Projection::equirect(256))),
-            (
-                builtin::demo(),
-                RenderSettings::new(Projection {
-                    convergence: Some(2.0),
-                    pole_merge: None,
-                    ..Projection::equirect(192)
-                })
-                .with_method(Method::Vertex),
-            ),
-            (
-                random_triangle_scene(7, 200),
-                RenderSettings::new(Projection::equirect(256)).with_method(Method::Fixed(3)),
-            ),
-        ];
+        let cases = subdivide_cases();
         let (mut cut_frames, mut strip_frames, mut quad_frames, mut edge_split_frames) = (0, 0, 0, 0);
         let cases: Vec<_> = cases
             .into_iter()
@@ -180,6 +179,14 @@ fn compare_subdivided(gpu: &SubdivideOutput, cpu: &SubdivideOutput) -> Result<()
     let slack = |n: usize| if common::renderer().gpu.info.device_type == wgpu::DeviceType::Cpu { 0 } else { n / 100 };
     if cpu.pieces.abs_diff(gpu.pieces) as usize > slack(cpu.pieces as usize) {
         return Err(format!("pieces: CPU {}, GPU {}", cpu.pieces, gpu.pieces));
+    }
+    // The balance counters: the largest output of one invocation (a piece one division more or
+    // less on a hardware GPU moves them by a few).
+    for (what, c, g) in [("max pieces", cpu.max_pieces, gpu.max_pieces), ("max output", cpu.max_output, gpu.max_output)]
+    {
+        if c.abs_diff(g) as usize > slack(100 * c as usize) / 10 || (c == 0) != (g == 0) {
+            return Err(format!("{what} per invocation: CPU {c}, GPU {g}"));
+        }
     }
     if (cpu.max_sub_edge_px - gpu.max_sub_edge_px).abs() >= 1e-2 * (1.0 + cpu.max_sub_edge_px) {
         return Err(format!("max edge: CPU {}, GPU {}", cpu.max_sub_edge_px, gpu.max_sub_edge_px));

@@ -5,6 +5,7 @@
 pub mod figures;
 pub mod lod;
 pub mod speed;
+pub mod startup;
 pub mod trace_lod;
 
 use std::path::{Path, PathBuf};
@@ -294,6 +295,48 @@ pub enum BenchCommand {
     TraceLod(FigureArgs),
     /// Every benchmark figure: fig8, fig10, fig12, lod and trace-lod.
     All(FigureArgs),
+    /// Whole-process time of `twister render` commands in fresh processes: cold (Mesa's and
+    /// twister's caches emptied), warm, and warm without twister's pipeline cache.
+    Startup(StartupArgs),
+}
+
+#[derive(Args)]
+pub struct StartupArgs {
+    /// A command to time (its arguments after `twister`, output into a scratch folder); may be
+    /// repeated. Default: `render`, and `render builtin:triangle@3 --width 64 --height 16`.
+    #[arg(long = "case", value_name = "ARGS")]
+    pub cases: Vec<String>,
+    /// Runs per case and cache state; the median is reported.
+    #[arg(long, default_value_t = 3)]
+    pub reps: usize,
+    /// Also write the rows as JSON to this file.
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+}
+
+pub fn bench_startup(args: &StartupArgs) -> Result<()> {
+    if !(1..=100).contains(&args.reps) {
+        return Err(Error::option("--reps", format!("must be between 1 and 100, got {}", args.reps)));
+    }
+    let cases: Vec<String> = if args.cases.is_empty() {
+        startup::DEFAULT_CASES.iter().map(|c| c.to_string()).collect()
+    } else {
+        args.cases.clone()
+    };
+    if let Some(bad) = cases.iter().find(|c| c.split_whitespace().next() != Some("render")) {
+        return Err(Error::option("--case", format!("times `render` commands only, got `{bad}`")));
+    }
+    let scratch = std::env::temp_dir().join(format!("twister-startup-{}", std::process::id()));
+    let rows = startup::startup(&cases, args.reps, &scratch, |what| eprintln!("timing {what} ..."));
+    let _ = std::fs::remove_dir_all(&scratch);
+    let rows = rows?;
+    println!("whole process, median of {} runs per case and cache state\n", args.reps);
+    print!("{}", startup::startup_table(&rows));
+    if let Some(path) = &args.json {
+        let json = serde_json::json!({ "reps": args.reps, "rows": rows });
+        twister::output::write_text(path, &serde_json::to_string_pretty(&json).unwrap())?;
+    }
+    Ok(())
 }
 
 #[derive(Args)]
@@ -378,6 +421,8 @@ pub fn bench_speed(args: &SpeedArgs) -> Result<()> {
         base.view.projection.width, base.view.projection.height, args.reps
     );
     print!("{}", speed::speed_table(&rows));
+    println!("\nthe subdivision's balance:\n");
+    print!("{}", speed::balance_table(&rows));
     if let Some(path) = &args.json {
         let json = serde_json::json!({ "adapter": adapter, "width": base.view.projection.width, "height": base.view.projection.height, "rows": rows });
         twister::output::write_text(path, &serde_json::to_string_pretty(&json).unwrap())?;

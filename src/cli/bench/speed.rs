@@ -40,6 +40,16 @@ pub struct SpeedRow {
     /// ms_frame / ms_frame of the first method on the same scene.
     pub ratio: f64,
     pub reps: usize,
+    /// The balance of the subdivision's work (projection methods): invocations per entry point
+    /// of its passes, in schedule order ...
+    pub subdivide_invocations: Vec<(&'static str, u64)>,
+    /// ... the most piece records one `plan` or `plan_cuts` invocation appended, the most nodes
+    /// or triangles one `lattice` invocation wrote ...
+    pub max_pieces_per_invocation: u32,
+    pub max_output_per_invocation: u32,
+    /// ... and the subdivision's share of the frame (ms_subdivide / (ms_subdivide + ms_raster)),
+    /// where both were measured.
+    pub subdivide_share: Option<f64>,
 }
 
 pub fn median(mut v: Vec<f64>) -> f64 {
@@ -122,10 +132,37 @@ pub fn speed(
                 ms_readback: median(frames.iter().map(|s| s.ms_readback).collect()),
                 ratio: ms_frame / first,
                 reps,
+                subdivide_invocations: last.subdivide_invocations.clone(),
+                max_pieces_per_invocation: last.max_pieces_per_invocation,
+                max_output_per_invocation: last.max_output_per_invocation,
+                subdivide_share: measured(|s| s.ms_subdivide)
+                    .zip(measured(|s| s.ms_raster))
+                    .map(|(sub, raster)| sub / (sub + raster).max(1e-9)),
             });
         }
     }
     Ok(rows)
+}
+
+/// A Markdown table of the subdivision's balance: per scene and projection method, each
+/// pass's invocations, the largest output of one invocation, and its share of the frame.
+pub fn balance_table(rows: &[SpeedRow]) -> String {
+    let mut s = String::from(
+        "| scene | method | invocations per pass | max pieces / invocation | max nodes or triangles / invocation | subdivision's share |\n|---|---|---|---|---|---|\n",
+    );
+    for r in rows.iter().filter(|r| !r.subdivide_invocations.is_empty()) {
+        let passes: Vec<String> = r.subdivide_invocations.iter().map(|(p, n)| format!("{p} {n}")).collect();
+        s += &format!(
+            "| {} | {} | {} | {} | {} | {} |\n",
+            r.scene,
+            r.method,
+            passes.join(", "),
+            r.max_pieces_per_invocation,
+            r.max_output_per_invocation,
+            r.subdivide_share.map_or("—".into(), |x| format!("{:.0} %", 100.0 * x)),
+        );
+    }
+    s
 }
 
 /// A Markdown table of speed rows.

@@ -400,7 +400,9 @@ impl<'a> Subdivider<'a> {
             for poly in self.triangle_polygons(&tri, t, frame, &mut out.edge_splits) {
                 if let Some((corners, rails)) = self.quad_strip(&tri, &poly) {
                     out.pieces += 2; // the GPU's two records of a quad
+                    let before = (out.nodes.len(), out.indices.len() / 3);
                     self.quad_lattice(&tri, &corners, rails, &mut out);
+                    out.note_output(before);
                     continue;
                 }
                 for part in fan(&poly) {
@@ -412,7 +414,9 @@ impl<'a> Subdivider<'a> {
                     let (k, n) = self.plan(&tri, &part);
                     for cell in 0..k * k {
                         out.pieces += 1;
+                        let before = (out.nodes.len(), out.indices.len() / 3);
                         self.lattice(&tri, &part, k, n, cell, &mut out);
+                        out.note_output(before);
                     }
                 }
             }

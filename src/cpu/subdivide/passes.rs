@@ -16,13 +16,13 @@ use super::{
     band_limit, edge_split_parts, fan, one_part, quadrant_polygons, triangle_cuts, FrameCuts, Node, SubdivideOutput,
     Subdivider, Triangle,
 };
-use crate::core::projection::PanoramaKind;
 use crate::core::scene::SceneVertex;
 use crate::core::settings::RenderSettings;
 use crate::core::shared_edges::shared_edges;
 use crate::encoding::constants::{PIECES_FROM_COUNTER, QUAD_HEAD, QUAD_TAIL};
 use crate::encoding::recording::{Command, Recording};
 use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine};
+use crate::encoding::subdivide::plan_cuts_split;
 use crate::encoding::types::{DrawIndexedIndirectArgs, DrawVertex, Piece, SubdivideCounters, SubdivideParams};
 use crate::error::Result;
 
@@ -37,8 +37,7 @@ pub fn run_scheduled(
 ) -> Result<SubdivideOutput> {
     let mut engine = CpuSubdivision::new(vertices, indices, &[]);
     let totals = run_schedule(&mut engine, settings, (indices.len() / 3) as u32, schedule, budget)?;
-    let pieces = totals.pieces as u32;
-    Ok(SubdivideOutput::indexed(engine.nodes, engine.taken_indices, pieces, totals.max_edge_px, totals.cuts))
+    Ok(totals.output(engine.nodes, engine.taken_indices))
 }
 
 /// The stage's buffers on the CPU, and what [`SubdivisionEngine::take`] kept.
@@ -188,7 +187,9 @@ impl<'s> CpuSubdivision<'s> {
         let single = if full { one_part(tri.position, rho, cuts) } else { !marked };
         if single {
             let corners = [0, 1, 2].map(|i| Node { position: tri.position[i], bary: Vec3::AXES[i] });
+            let before = self.counters.pieces;
             self.plan_polygon(sub, &tri, t as u32, &corners);
+            self.counters.max_pieces = self.counters.max_pieces.max(self.counters.pieces - before);
             return;
         }
         let len = self.cut_list.len() as u32;
@@ -207,16 +208,6 @@ impl<'s> CpuSubdivision<'s> {
         }
     }
 
-    /// `plan_cuts`' invocations per listed triangle: one per quadrant on the sphere, one on the
-    /// cylinder.
-    fn plan_cuts_split(sub: &Subdivider) -> u32 {
-        if sub.projection.panorama == PanoramaKind::Equirect {
-            4
-        } else {
-            1
-        }
-    }
-
     /// The listed triangles: (narrow, wide), within the list.
     fn listed_cuts(&self) -> (u32, u32) {
         let len = self.cut_list.len() as u32;
@@ -226,14 +217,14 @@ impl<'s> CpuSubdivision<'s> {
     fn plan_cuts_args(&mut self, sub: &Subdivider) {
         let (narrow, wide) = self.listed_cuts();
         let listed = (narrow + wide).min(self.cut_list.len() as u32);
-        let groups = (Self::plan_cuts_split(sub) * listed).div_ceil(64);
+        let groups = (plan_cuts_split(sub.projection.panorama) * listed).div_ceil(64);
         self.lattice_dispatch[3..6].copy_from_slice(&[groups.min(65535), groups.div_ceil(65535), 1]);
     }
 
     /// A listed triangle: a narrow one cut at its marked edges' crossings, a wide one's parts
     /// in one quadrant (the sphere) or all four.
     fn plan_cuts(&mut self, sub: &Subdivider, local: u32) {
-        let split = Self::plan_cuts_split(sub);
+        let split = plan_cuts_split(sub.projection.panorama);
         let (narrow, wide) = self.listed_cuts();
         let len = self.cut_list.len() as u32;
         let i = local / split;
@@ -243,6 +234,7 @@ impl<'s> CpuSubdivision<'s> {
         let t = if i < narrow { self.cut_list[i as usize] } else { self.cut_list[(len - 1 - (i - narrow)) as usize] };
         let tri = sub.load(self.scene.0, self.scene.1, t as usize);
         let (cuts, rho) = (self.counters.cuts(), sub.params.axis_clearance);
+        let before = self.counters.pieces;
         if i < narrow {
             if local % split == 0 {
                 let shared = [0, 1, 2].map(|e| self.frame.is_cut_edge(t as usize, e));
@@ -250,14 +242,15 @@ impl<'s> CpuSubdivision<'s> {
                     self.plan_polygon(sub, &tri, t, &part);
                 }
             }
-            return;
-        }
-        let quadrants = if split == 4 { (local % 4) as usize..(local % 4) as usize + 1 } else { 0..4 };
-        for q in quadrants {
-            for poly in quadrant_polygons(tri.position, rho, cuts, q) {
-                self.plan_polygon(sub, &tri, t, &poly);
+        } else {
+            let quadrants = if split == 4 { (local % 4) as usize..(local % 4) as usize + 1 } else { 0..4 };
+            for q in quadrants {
+                for poly in quadrant_polygons(tri.position, rho, cuts, q) {
+                    self.plan_polygon(sub, &tri, t, &poly);
+                }
             }
         }
+        self.counters.max_pieces = self.counters.max_pieces.max(self.counters.pieces - before);
     }
 
     fn lattice_args(&mut self, sub: &Subdivider) {
@@ -343,6 +336,7 @@ impl<'s> CpuSubdivision<'s> {
         let first_triangle = self.counters.triangles;
         self.counters.nodes += node_count;
         self.counters.triangles += triangle_count;
+        self.counters.max_output = self.counters.max_output.max(node_count.max(triangle_count));
         let max_edge = f32::from_bits(self.counters.max_edge_bits).max(out.max_sub_edge_px);
         self.counters.max_edge_bits = max_edge.to_bits();
         let capacity = params.triangle_capacity;

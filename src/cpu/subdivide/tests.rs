@@ -583,6 +583,8 @@ fn the_passes_replaying_every_schedule_make_the_twins_triangles() {
                     format!("{} {:?}, {schedule:?}, budget {budget:?}", scene.name, settings.projection().panorama);
                 let out = run_scheduled(&settings, &scene.vertices, &scene.indices, schedule, budget).expect(&what);
                 assert_eq!((out.pieces, out.cuts), (direct.pieces, direct.cuts), "{what}");
+                assert_eq!(out.max_output, direct.max_output, "{what}: the largest output of one lattice invocation");
+                assert!(out.max_pieces >= 1 && out.max_output >= 1, "{what}: the balance counters");
                 assert_eq!(out.nodes.len(), direct.nodes.len(), "{what}");
                 assert!(sorted(&out) == sorted(&direct), "{what}: not the twin's triangles");
             }
