@@ -19,7 +19,7 @@ use rand::{Rng, SeedableRng};
 
 use super::tests::params_for;
 use super::*;
-use crate::core::projection::{PanoramaKind, Vertical};
+use crate::core::projection::{horizontal_radius, PanoramaKind, Vertical};
 use crate::core::settings::{Method, Split};
 
 /// A mesh as positions and triangle indices; shared vertices are shared indices, so shared

@@ -1,0 +1,241 @@
+//! CPU twin of `shaders/shared/subdivide_edges.wgsl`: eq. 5's edge counts (the projected
+//! length, or the error split's bend), the nodes on an edge from its canonically ordered ends, a
+//! triangle's loading and its vertical culling, and a part's plan (see the module doc of
+//! `cpu::subdivide`).
+
+use glam::{Mat4, Vec2, Vec3, Vec4};
+
+use super::{snap_to_cut_planes, Node, Subdivider, Triangle};
+use crate::core::projection::{azimuth, horizontal_radius, Eye, PanoramaKind, Vertical};
+use crate::core::scene::{unpack_tangent, SceneVertex};
+use crate::core::settings::SplitRule;
+use crate::encoding::constants::{
+    EDGE_SAMPLES, ERROR_SPLIT_LENGTH, MAX_EDGE_DIVISIONS, MAX_MACRO_LEVEL, MAX_STRETCH, PIECE_DIVISIONS,
+};
+
+pub(super) fn lex_less(a: Vec3, b: Vec3) -> bool {
+    a.x < b.x || (a.x == b.x && (a.y < b.y || (a.y == b.y && a.z < b.z)))
+}
+
+/// The point j/n of the way from `a` to `b`, computed from the canonically ordered pair so that
+/// both triangles sharing the edge get the same bits; the ends are exact.
+pub(super) fn edge_point(a: Node, b: Node, j: u32, n: u32) -> Node {
+    let (lo, hi, jj) = if lex_less(b.position, a.position) { (b, a, n - j) } else { (a, b, j) };
+    if jj == 0 {
+        return lo;
+    }
+    if jj == n {
+        return hi;
+    }
+    let t = jj as f32 / n as f32;
+    Node { position: lo.position + (hi.position - lo.position) * t, bary: lo.bary + (hi.bary - lo.bary) * t }
+}
+
+/// What [`Subdivider::edge_profile`] measures of an edge.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EdgeProfile {
+    pub length_px: f32,
+    pub bend_px: f32,
+    pub ring: bool,
+}
+
+/// A triangle's L and τ (see [`Subdivider::limits`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Limits {
+    pub(super) edge_px: f32,
+    pub(super) max_error_px: f32,
+}
+
+/// Parts an edge needs so that its chord error, about bend·S²/(8n²) for n parts (see
+/// [`Subdivider::edge_profile`]), is at most τ: ceil(S·√(bend / 8τ)) (not rounded to an integer
+/// count yet; NaN stays NaN).
+pub(super) fn parts_for_bend(bend_px: f32, segments: u32, max_error_px: f32) -> f32 {
+    (segments as f32 * (bend_px / (8.0 * max_error_px)).sqrt()).ceil()
+}
+
+impl Subdivider<'_> {
+    /// L and τ for a triangle of `object`: the level of detail scales L by its factor s, and τ by
+    /// s² (an edge's error grows as the square of its parts' length).
+    pub(super) fn limits(&self, object: u32) -> Limits {
+        let s = self.edge_scale.get(object as usize).copied().unwrap_or(1.0);
+        Limits { edge_px: self.params.edge_px * s, max_error_px: self.params.max_error_px * (s * s) }
+    }
+
+    /// Image position (x, y) in pixels of a viewer-frame point for one eye sign, x not wrapped.
+    pub(super) fn pixel(&self, p: Vec3, eye_sign: f32) -> Vec2 {
+        let eye = if eye_sign > 0.0 { Eye::Right } else { Eye::Left };
+        let q = self.projection.project_with_azimuth(p, azimuth(p), eye);
+        Vec2::new(q.u * self.projection.pixels_per_radian(), q.v * self.projection.pixels_per_v())
+    }
+
+    /// What the split rules read of the straight edge ab, projected and sampled as a polyline
+    /// through `segments` + 1 points (both eyes, x unwrapped across the seam), in the edge's
+    /// canonical order:
+    /// - `length_px`, by which eq. 5 splits it: the polyline's length l (the larger of the two
+    ///   eyes) or, if larger, `segments` × its longest segment / `MAX_STRETCH` (/ 1 in the paper
+    ///   model where the edge comes within 2·d_e of the axis: α ∝ √(r − d_e) bends it sharply):
+    ///   an edge the projection stretches unevenly gets equal parts short enough where it is
+    ///   stretched most. Heights are clamped to ±1.5 image heights from the middle row, so
+    ///   off-screen parts count little, and segments beyond the clamp at both ends (on one side)
+    ///   count nothing.
+    /// - `bend_px`, by which the error split splits it: the largest second difference
+    ///   |q(k+1) − 2 q(k) + q(k−1)| of the sampled points (both eyes; triples with a point beyond the
+    ///   height clamp are skipped). A straight edge drawn with its nodes at the projected places
+    ///   is wrong between the nodes by about |q''|·(t/n)²/8 for n parts (q'' the second derivative
+    ///   along the edge's parameter t, whose sampled estimate is bend·S²): the chord's error,
+    ///   across and along the curve (the drawn point j/n of the way is not where the point j/n
+    ///   of the way along the 3-D edge projects).
+    /// - `ring`: the edge comes within 2·d_e of the axis where the panorama shows the eye circle.
+    pub fn edge_profile(&self, a: Vec3, b: Vec3, segments: u32) -> EdgeProfile {
+        let (lo, hi) = if lex_less(b, a) { (b, a) } else { (a, b) };
+        let clamp_v = 1.5 * self.projection.height as f32;
+        let width = self.projection.width as f32;
+        let (mut length, mut longest, mut nearest, mut bend) = (0.0f32, 0.0f32, f32::INFINITY, 0.0f32);
+        for eye_sign in [-1.0f32, 1.0] {
+            let mut total = 0.0;
+            let mut prev = Vec2::ZERO;
+            // The last two points, x unwrapped, y unclamped.
+            let (mut q0, mut q1) = (Vec2::ZERO, Vec2::ZERO);
+            for k in 0..=segments {
+                let t = k as f32 / segments as f32;
+                let p = lo + (hi - lo) * t;
+                nearest = nearest.min(horizontal_radius(p));
+                let raw = self.pixel(p, eye_sign);
+                let mut q = raw;
+                q.y = q.y.clamp(-clamp_v, clamp_v);
+                let dx = (q.x - prev.x) - width * ((q.x - prev.x) / width).round();
+                if k > 0 && !(q.y == prev.y && q.y.abs() == clamp_v) {
+                    let segment = Vec2::new(dx, q.y - prev.y).length();
+                    longest = longest.max(segment);
+                    total += segment;
+                }
+                let unwrapped = Vec2::new(if k > 0 { q1.x + dx } else { raw.x }, raw.y);
+                if k >= 2 && unwrapped.y.abs() < clamp_v && q1.y.abs() < clamp_v && q0.y.abs() < clamp_v {
+                    bend = bend.max((unwrapped - 2.0 * q1 + q0).length());
+                }
+                q0 = q1;
+                q1 = unwrapped;
+                prev = q;
+            }
+            length = length.max(total);
+        }
+        // Near the eye circle, which the paper model and the sphere show on screen (α and the
+        // longitude ∝ √(r − d_e)), no stretch is allowed (the exact model puts it at v = ±∞).
+        let shows_ring =
+            self.projection.vertical == Vertical::Paper || self.projection.panorama == PanoramaKind::Equirect;
+        let ring = shows_ring && nearest < 2.0 * self.projection.eye_radius;
+        let stretch = if ring { 1.0 } else { MAX_STRETCH };
+        EdgeProfile { length_px: length.max(segments as f32 * longest / stretch), bend_px: bend, ring }
+    }
+
+    /// Divisions of an edge (not capped by N_max: the pre-split handles that), `edge_px` L and
+    /// `max_error_px` τ being the triangle's (scaled by its object's level of detail).
+    /// `adaptive:length` (eq. 5): a quick 2-segment length first: if it is at most L/2 the edge
+    /// stays whole, else N = ceil(l/L) from the 8-segment length (never shorter, as it refines
+    /// the same polyline). `adaptive` (the error split): an edge whose 2-segment polyline is at
+    /// most L long, away from the eye circle, and whose midpoint bend asks for one part stays
+    /// whole; else N = ceil(S·√(bend / 8τ)) from the 8-segment profile, at least l / (8·L)
+    /// (no edge longer than 8·L: depth and attributes interpolate over bounded spans), and near
+    /// the eye circle at least l / L, as eq. 5 (the second differences miss the ring's √ bend).
+    pub(super) fn edge_divisions(&self, a: Vec3, b: Vec3, limits: Limits) -> u32 {
+        let Limits { edge_px, max_error_px } = limits;
+        let n = match self.params.method {
+            0 => return 1,
+            1 => return self.params.fixed_n,
+            2 => {
+                if self.edge_profile(a, b, 2).length_px <= 0.5 * edge_px {
+                    return 1;
+                }
+                (self.edge_profile(a, b, EDGE_SAMPLES).length_px / edge_px).ceil()
+            }
+            _ => {
+                let quick = self.edge_profile(a, b, 2);
+                if quick.length_px <= edge_px && !quick.ring && parts_for_bend(quick.bend_px, 2, max_error_px) <= 1.0 {
+                    return 1;
+                }
+                let p = self.edge_profile(a, b, EDGE_SAMPLES);
+                let longest = if p.ring { edge_px } else { ERROR_SPLIT_LENGTH * edge_px };
+                parts_for_bend(p.bend_px, EDGE_SAMPLES, max_error_px).max((p.length_px / longest).ceil())
+            }
+        };
+        if n.is_finite() {
+            (n as u32).clamp(1, MAX_EDGE_DIVISIONS)
+        } else {
+            MAX_EDGE_DIVISIONS
+        }
+    }
+
+    /// Divisions of an interior edge of the macro-lattice. Macro edges are about N_max·L long,
+    /// but the projection stretches unevenly across a large triangle, so some need more: they may
+    /// take up to 2·N_max, and at most `PIECE_DIVISIONS` (a piece then makes at most 32² triangles).
+    /// `fixed:N` pieces (K per edge) take N/K (rounded up) on their interior edges: the union is the
+    /// regular N-lattice when K divides N.
+    pub(super) fn interior_divisions(&self, a: Vec3, b: Vec3, limits: Limits, k: u32) -> u32 {
+        if self.params.method == SplitRule::Fixed as u32 {
+            return self.params.fixed_n.div_ceil(k.max(1));
+        }
+        self.edge_divisions(a, b, limits).min(2 * self.params.max_div).min(PIECE_DIVISIONS)
+    }
+
+    /// The corners of input triangle t in the viewer frame, snapped to the cut planes.
+    pub(super) fn positions(&self, vertices: &[SceneVertex], indices: &[u32], t: usize) -> [Vec3; 3] {
+        let view = Mat4::from_cols_array_2d(&self.params.view);
+        [0, 1, 2].map(|k| {
+            snap_to_cut_planes(view.transform_point3(Vec3::from(vertices[indices[3 * t + k] as usize].position)))
+        })
+    }
+
+    pub(super) fn load(&self, vertices: &[SceneVertex], indices: &[u32], t: usize) -> Triangle {
+        let view = Mat4::from_cols_array_2d(&self.params.view);
+        let v = |k: usize| &vertices[indices[3 * t + k] as usize];
+        Triangle {
+            position: self.positions(vertices, indices, t),
+            normal: [0, 1, 2].map(|k| view.transform_vector3(Vec3::from(v(k).normal))),
+            color: [0, 1, 2].map(|k| Vec4::from(v(k).color)),
+            uv: [0, 1, 2].map(|k| Vec2::from(v(k).uv)),
+            tangent: [0, 1, 2].map(|k| {
+                let t = unpack_tangent(v(k).tangent);
+                view.transform_vector3(t.truncate()).extend(t.w)
+            }),
+            material: v(0).material,
+            object: v(0).object,
+        }
+    }
+
+    /// The slope k such that a point with |y| > k·r shows in no pixel row
+    /// ([`Projection::vertical_limit`], passed to the GPU in `SubdivideParams`).
+    pub fn vertical_limit(&self) -> f32 {
+        self.params.vertical_limit
+    }
+
+    /// Whether a triangle shows in no pixel row: wholly above or wholly below the image's rows
+    /// ([`Subdivider::vertical_limit`]). Along a segment with y > 0, y is linear and r convex, so
+    /// y/r never falls below its smaller end value (the set y ≥ k·r is convex): corners all
+    /// beyond mean the whole triangle is.
+    pub fn off_screen_vertically(&self, p: [Vec3; 3]) -> bool {
+        let k = self.vertical_limit();
+        let above = p.iter().all(|q| q.y > k * horizontal_radius(*q));
+        let below = p.iter().all(|q| q.y < -k * horizontal_radius(*q));
+        above || below
+    }
+
+    /// `plan`: the macro-lattice level K of a part (K² pieces) and its edge counts.
+    pub(super) fn plan(&self, tri: &Triangle, part: &[Node; 3]) -> (u32, [u32; 3]) {
+        let p = part.map(|n| n.position);
+        let l = self.limits(tri.object);
+        let n = [
+            self.edge_divisions(p[0], p[1], l),
+            self.edge_divisions(p[1], p[2], l),
+            self.edge_divisions(p[2], p[0], l),
+        ];
+        let m = n[0].max(n[1]).max(n[2]);
+        let k = if SplitRule::is_adaptive(self.params.method) {
+            m.div_ceil(self.params.max_div.min(PIECE_DIVISIONS)).min(MAX_MACRO_LEVEL)
+        } else if self.params.method == SplitRule::Fixed as u32 {
+            m.div_ceil(PIECE_DIVISIONS)
+        } else {
+            1
+        };
+        (k, n)
+    }
+}
