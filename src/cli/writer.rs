@@ -84,10 +84,18 @@ impl FrameWriter {
     /// A frame's files, encoded: the layout's images, then depth and linear colour where the
     /// frame holds them.
     pub fn files(&self, rendered: &Frame, frame: Option<u32>) -> Result<Vec<OutputFile>> {
-        let mut files = layout_images(rendered, self.layout, self.encoding.format)
-            .iter()
-            .map(|(name, img)| image_file(self.path(frame, name), img, &self.encoding))
-            .collect::<Result<Vec<_>>>()?;
+        // The images are encoded side by side (a still's two eyes: half the wait on two cores).
+        let images = layout_images(rendered, self.layout, self.encoding.format);
+        let mut files = std::thread::scope(|scope| {
+            let encoders: Vec<_> = images
+                .iter()
+                .map(|(name, img)| {
+                    let path = self.path(frame, name);
+                    scope.spawn(move || image_file(path, img, &self.encoding))
+                })
+                .collect();
+            encoders.into_iter().map(|e| e.join().expect("an image encoder panicked")).collect::<Result<Vec<_>>>()
+        })?;
         for (name, depth) in depth_images(rendered, self.layout).unwrap_or_default() {
             files.push(exr_file(self.path(frame, &name), &depth)?);
         }
