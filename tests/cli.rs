@@ -624,4 +624,20 @@ fn a_damaged_or_unwritable_pipeline_cache_is_never_an_error() {
     std::fs::write(&not_a_folder, b"x").unwrap();
     assert_eq!(run(&not_a_folder.join("cache")), image, "with a cache that cannot be written");
     assert_eq!(run(Path::new("off")), image, "with the cache switched off");
+    // Relative cache homes are ignored: nothing lands in the working folder.
+    let work = dir.join("work");
+    std::fs::create_dir_all(&work).unwrap();
+    let o = twister()
+        .args(["render", "builtin:triangle@3", "--width", "64", "--height", "16", "--out"])
+        .arg(dir.join("out"))
+        .current_dir(&work)
+        .env_remove("TWISTER_CACHE_DIR")
+        .env("XDG_CACHE_HOME", "relative-cache")
+        .env("HOME", "relative-home")
+        .env("MESA_SHADER_CACHE_DIR", dir.join("mesa"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let left: Vec<_> = std::fs::read_dir(&work).unwrap().flatten().map(|e| e.file_name()).collect();
+    assert!(left.is_empty(), "the working folder got {left:?}");
 }

@@ -3,7 +3,7 @@
 //! built meanwhile, so that a fresh process does less of the driver's compiling.
 //!
 //! Where: `TWISTER_CACHE_DIR` (`off`: no cache), else `$XDG_CACHE_HOME/twister`, else
-//! `~/.cache/twister`. One file per adapter class (`wgpu::util::pipeline_cache_key`) and build
+//! `~/.cache/twister` (relative ones ignored). One file per adapter class (`wgpu::util::pipeline_cache_key`) and build
 //! of the shaders (a hash of every WGSL source and of twister's version): a newer build's file
 //! replaces the older one's. A damaged, foreign or unreadable file is ignored and replaced
 //! (wgpu checks the header and falls back to an empty cache); a cache that cannot be written
@@ -28,10 +28,12 @@ pub fn cache_dir() -> Option<PathBuf> {
     match std::env::var_os("TWISTER_CACHE_DIR") {
         Some(dir) if dir == "off" => None,
         Some(dir) if !dir.is_empty() => Some(PathBuf::from(dir)),
+        // A relative XDG_CACHE_HOME (or HOME) is ignored, as the XDG base directory spec says:
+        // the cache never lands in the working folder.
         _ => std::env::var_os("XDG_CACHE_HOME")
-            .filter(|d| !d.is_empty())
             .map(PathBuf::from)
-            .or_else(|| std::env::var_os("HOME").filter(|d| !d.is_empty()).map(|h| Path::new(&h).join(".cache")))
+            .filter(|d| d.is_absolute())
+            .or_else(|| std::env::var_os("HOME").map(|h| Path::new(&h).join(".cache")).filter(|d| d.is_absolute()))
             .map(|d| d.join("twister")),
     }
 }
