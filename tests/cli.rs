@@ -204,6 +204,17 @@ fn subdivision_flags_take_effect_and_are_reported() {
     assert!(strict["max_sub_edge_px"].as_f64() < loose["max_sub_edge_px"].as_f64());
     let tight = stats(&["--split", "length", "--edge-px", "0.25", "--memory-mb", "8"]);
     assert!(tight["chunks"].as_u64().unwrap() > 1, "{tight}");
+    // The subdivision's balance: one `lattice` invocation per piece; a vertex piece writes its 3
+    // nodes (twice at the seam), a fixed:3 piece its 10; a chunked frame sums its ranges.
+    let invocations = |j: &serde_json::Value, pass: &str| {
+        let passes = j["subdivide_invocations"].as_array().unwrap();
+        passes.iter().find(|p| p[0] == pass).map_or(0, |p| p[1].as_u64().unwrap())
+    };
+    assert_eq!(invocations(&vertex, "lattice"), vertex["pieces"].as_u64().unwrap(), "{vertex}");
+    assert!((3..=6).contains(&vertex["max_output_per_invocation"].as_u64().unwrap()), "{vertex}");
+    assert!((10..=20).contains(&fixed["max_output_per_invocation"].as_u64().unwrap()), "{fixed}");
+    assert!(invocations(&tight, "plan") >= tight["triangles_in"].as_u64().unwrap(), "{tight}");
+    assert!(tight["max_pieces_per_invocation"].as_u64().unwrap() >= 1, "{tight}");
     let _ = std::fs::remove_dir_all(&out);
 }
 

@@ -135,6 +135,11 @@ pub struct FrameRecord<'a> {
     pub triangle_tests: Option<u64>,
     pub max_sub_edge_px: f32,
     pub chunks: u32,
+    /// The subdivision's balance: invocations per pass, and the largest output of one
+    /// invocation (`FrameStats`).
+    pub subdivide_invocations: Vec<(&'static str, u64)>,
+    pub max_pieces_per_invocation: u32,
+    pub max_output_per_invocation: u32,
     pub width: u32,
     pub height: u32,
     pub screen_radius: f32,
@@ -189,6 +194,9 @@ impl<'a> FrameRecord<'a> {
             triangle_tests: s.triangle_tests,
             max_sub_edge_px: s.max_sub_edge_px,
             chunks: s.chunks,
+            subdivide_invocations: s.subdivide_invocations.clone(),
+            max_pieces_per_invocation: s.max_pieces_per_invocation,
+            max_output_per_invocation: s.max_output_per_invocation,
             width: p.width,
             height: p.height,
             screen_radius: p.screen_radius,
