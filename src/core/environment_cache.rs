@@ -3,9 +3,9 @@
 //! result is kept under a key of what it depends on — the radiance itself and the preparation's
 //! parameters — and read back instead of prepared again.
 //!
-//! Where: `$TWISTER_CACHE_DIR`, else `$XDG_CACHE_HOME/twister`, else `~/.cache/twister`;
-//! `TWISTER_CACHE_DIR=` (empty) turns the cache off. A file is written whole under a temporary
-//! name and renamed into place, so a reader never sees half of one; one that does not read back
+//! Where: the folder of `core::disk_cache` (`TWISTER_CACHE_DIR`, empty or `off` turns it off). A
+//! file is written whole (`disk_cache::write_whole`), so a reader never sees half of one; one
+//! that does not read back
 //! exactly (wrong magic, size or checksum: truncated, corrupt, another version) is prepared
 //! again and replaced. The cache is an optimisation: failing to read or write it is silent.
 
@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
+use crate::core::disk_cache::{cache_dir, fnv1a, write_whole, FNV_OFFSET};
 use crate::core::environment::{
     Environment, PreparedEnvironment, ENV_LEVELS, LUT_SAMPLES, LUT_SIZE, MAX_ENV_WIDTH, PREFILTER_SAMPLES,
 };
@@ -20,30 +21,6 @@ use crate::core::environment::{
 const MAGIC: &[u8; 8] = b"TWENVC01";
 /// The largest cache file read (a prepared 2048-wide map is about 12 MiB).
 const MAX_FILE_BYTES: u64 = 64 << 20;
-
-/// FNV-1a, 64 bits: the key of a radiance map and the checksum of a cache file.
-fn fnv1a(bytes: &[u8], mut hash: u64) -> u64 {
-    for &b in bytes {
-        hash ^= b as u64;
-        hash = hash.wrapping_mul(0x0100_0000_01b3);
-    }
-    hash
-}
-
-const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
-
-/// The cache folder from the environment variables (None: caching off).
-pub fn cache_dir() -> Option<PathBuf> {
-    match std::env::var_os("TWISTER_CACHE_DIR") {
-        Some(dir) if dir.is_empty() => None,
-        Some(dir) => Some(PathBuf::from(dir)),
-        None => std::env::var_os("XDG_CACHE_HOME")
-            .filter(|d| !d.is_empty())
-            .map(PathBuf::from)
-            .or_else(|| std::env::var_os("HOME").filter(|d| !d.is_empty()).map(|h| PathBuf::from(h).join(".cache")))
-            .map(|d| d.join("twister")),
-    }
-}
 
 /// The key of an environment's preparation: its size and radiance, and the preparation's
 /// parameters (a change to them makes new keys).
@@ -120,13 +97,7 @@ impl Environment {
             return prepared;
         }
         let prepared = self.prepare();
-        let temporary = dir.join(format!(".environment-{}-{:?}.tmp", std::process::id(), std::thread::current().id()));
-        let written = std::fs::create_dir_all(dir)
-            .and_then(|_| std::fs::write(&temporary, encode(&prepared)))
-            .and_then(|_| std::fs::rename(&temporary, &file));
-        if written.is_err() {
-            let _ = std::fs::remove_file(&temporary);
-        }
+        write_whole(dir, &file, &encode(&prepared));
         prepared
     }
 

@@ -2,16 +2,17 @@
 //! adapter has one, loaded when the device opens and saved when it closes if pipelines were
 //! built meanwhile, so that a fresh process does less of the driver's compiling.
 //!
-//! Where: `TWISTER_CACHE_DIR` (`off`: no cache), else `$XDG_CACHE_HOME/twister`, else
-//! `~/.cache/twister` (relative ones ignored). One file per adapter class (`wgpu::util::pipeline_cache_key`) and build
-//! of the shaders (a hash of every WGSL source and of twister's version): a newer build's file
-//! replaces the older one's. A damaged, foreign or unreadable file is ignored and replaced
+//! Where: the folder of `core::disk_cache` (`TWISTER_CACHE_DIR`, `off` or empty: none). One
+//! file per adapter class (`wgpu::util::pipeline_cache_key`) and build of the shaders (a hash of
+//! every WGSL source and of twister's version): a newer build's file replaces the older one's. A damaged, foreign or unreadable file is ignored and replaced
 //! (wgpu checks the header and falls back to an empty cache); a cache that cannot be written
 //! is skipped. Never an error, never a message.
 
 use std::hash::{Hash, Hasher};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
+
+use crate::core::disk_cache::{cache_dir, fnv1a, write_whole, FNV_OFFSET};
 
 /// The cache and its file.
 pub struct DiskPipelineCache {
@@ -23,51 +24,22 @@ pub struct DiskPipelineCache {
     loaded: u64,
 }
 
-/// The cache directory, or None where there is none (or it is switched off).
-pub fn cache_dir() -> Option<PathBuf> {
-    match std::env::var_os("TWISTER_CACHE_DIR") {
-        Some(dir) if dir == "off" => None,
-        Some(dir) if !dir.is_empty() => Some(PathBuf::from(dir)),
-        // A relative XDG_CACHE_HOME (or HOME) is ignored, as the XDG base directory spec says:
-        // the cache never lands in the working folder.
-        _ => std::env::var_os("XDG_CACHE_HOME")
-            .map(PathBuf::from)
-            .filter(|d| d.is_absolute())
-            .or_else(|| std::env::var_os("HOME").map(|h| Path::new(&h).join(".cache")).filter(|d| d.is_absolute()))
-            .map(|d| d.join("twister")),
-    }
-}
-
-/// FNV-1a: the same hash in every process.
+/// FNV-1a as a `Hasher`, for hashing the shader sources' parts in turn.
 struct Fnv(u64);
-
-impl Default for Fnv {
-    fn default() -> Fnv {
-        Fnv(0xcbf2_9ce4_8422_2325)
-    }
-}
 
 impl Hasher for Fnv {
     fn finish(&self) -> u64 {
         self.0
     }
     fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.0 = (self.0 ^ b as u64).wrapping_mul(0x100_0000_01b3);
-        }
+        self.0 = fnv1a(bytes, self.0);
     }
-}
-
-fn bytes_hash(bytes: &[u8]) -> u64 {
-    let mut h = Fnv::default();
-    h.write(bytes);
-    h.finish()
 }
 
 /// A hash of what the pipelines are built from: every WGSL source, the generated constants and
 /// twister's version.
 fn shader_hash() -> u64 {
-    let mut h = Fnv::default();
+    let mut h = Fnv(FNV_OFFSET);
     env!("CARGO_PKG_VERSION").hash(&mut h);
     crate::encoding::constants::wgsl().hash(&mut h);
     for stage in crate::shader::STAGES {
@@ -101,7 +73,7 @@ impl DiskPipelineCache {
                 fallback: true,
             })
         };
-        let loaded = data.as_deref().map_or(0, bytes_hash);
+        let loaded = data.as_deref().map_or(0, |d| fnv1a(d, FNV_OFFSET));
         Some(DiskPipelineCache { cache, path, used: AtomicBool::new(false), loaded })
     }
 
@@ -119,16 +91,11 @@ impl DiskPipelineCache {
             return;
         }
         let Some(data) = self.cache.get_data() else { return };
-        if bytes_hash(&data) == self.loaded && self.path.exists() {
+        if fnv1a(&data, FNV_OFFSET) == self.loaded && self.path.exists() {
             return;
         }
         let (Some(dir), Some(name)) = (self.path.parent(), self.path.file_name()) else { return };
-        if std::fs::create_dir_all(dir).is_err() {
-            return;
-        }
-        let tmp = dir.join(format!(".{}.{}", name.to_string_lossy(), std::process::id()));
-        if std::fs::write(&tmp, &data).is_err() || std::fs::rename(&tmp, &self.path).is_err() {
-            let _ = std::fs::remove_file(&tmp);
+        if !write_whole(dir, &self.path, &data) {
             return;
         }
         let name = name.to_string_lossy();

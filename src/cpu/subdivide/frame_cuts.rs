@@ -63,9 +63,17 @@ impl FrameCuts {
     /// Cuts `axis` with every edge counted as a cut triangle's, none as one that asks (tests of
     /// one triangle whose neighbours, not given, are cut).
     pub fn every_edge(axis: AxisCuts, vertices: &[SceneVertex], indices: &[u32]) -> FrameCuts {
+        let mut frame = FrameCuts::unmarked(vertices, indices);
+        frame.axis = axis;
+        frame.cut_edges.fill(u32::MAX);
+        frame
+    }
+
+    /// No cuts, no edge marked, over the scene's shared edges (the `cut_edges` buffer cleared).
+    pub fn unmarked(vertices: &[SceneVertex], indices: &[u32]) -> FrameCuts {
         let edges = shared_edges(vertices, indices);
         let words = edges.bit_words(1) as usize;
-        FrameCuts { axis, asking_edges: vec![0; words], cut_edges: vec![u32::MAX; words], edges }
+        FrameCuts { axis: 0, asking_edges: vec![0; words], cut_edges: vec![0; words], edges }
     }
 }
 
@@ -105,9 +113,7 @@ impl Subdivider<'_> {
     /// all of `indices`, whatever range the dispatch plans.
     pub fn active_cuts(&self, vertices: &[SceneVertex], indices: &[u32]) -> FrameCuts {
         let limit = band_limit(self.params.method, self.projection.screen_radius);
-        let edges = shared_edges(vertices, indices);
-        let words = edges.bit_words(1) as usize;
-        let mut frame = FrameCuts { axis: 0, asking_edges: vec![0; words], cut_edges: vec![0; words], edges };
+        let mut frame = FrameCuts::unmarked(vertices, indices);
         let on_screen: Vec<(usize, AxisCuts)> = (0..indices.len() / 3)
             .map(|t| (t, self.positions(vertices, indices, t)))
             .filter(|&(_, p)| !self.off_screen_vertically(p))
@@ -115,16 +121,11 @@ impl Subdivider<'_> {
             .collect();
         for &(t, asks) in on_screen.iter().filter(|(_, asks)| *asks != 0) {
             frame.axis |= asks;
-            for e in 0..3 {
-                set_bit(&mut frame.asking_edges, frame.edges.ids[3 * t + e]);
-                set_bit(&mut frame.cut_edges, frame.edges.ids[3 * t + e]);
-            }
+            frame.mark(t, true);
         }
         for &(t, _) in on_screen.iter().filter(|(_, asks)| *asks == 0) {
             if frame.is_cut_triangle(t) {
-                for e in 0..3 {
-                    set_bit(&mut frame.cut_edges, frame.edges.ids[3 * t + e]);
-                }
+                frame.mark(t, false);
             }
         }
         frame

@@ -18,7 +18,6 @@ use super::{
 };
 use crate::core::scene::SceneVertex;
 use crate::core::settings::RenderSettings;
-use crate::core::shared_edges::shared_edges;
 use crate::encoding::constants::{PIECES_FROM_COUNTER, QUAD_HEAD, QUAD_TAIL};
 use crate::encoding::recording::{Command, Recording};
 use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine};
@@ -80,9 +79,7 @@ fn record(t: u32, counts01: u32, count2_level: u32, corners: [Node; 3]) -> Piece
 
 impl<'s> CpuSubdivision<'s> {
     pub fn new(vertices: &'s [SceneVertex], indices: &'s [u32], edge_scale: &'s [f32]) -> Self {
-        let edges = shared_edges(vertices, indices);
-        let words = edges.bit_words(1) as usize;
-        let frame = FrameCuts { axis: 0, asking_edges: vec![0; words], cut_edges: vec![0; words], edges };
+        let frame = FrameCuts::unmarked(vertices, indices);
         CpuSubdivision {
             scene: (vertices, indices),
             edge_scale,
