@@ -192,7 +192,8 @@ fn plan_part(tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>) {
     plan_level(part);
 }
 
-// The macro-lattice level of the current part from its edge counts `tri_n`.
+// The macro-lattice level of the current part from its edge counts `tri_n`, and whether it is
+// cut in bands instead (`PartSplit::new` in src/cpu/subdivide/lattice.rs).
 fn plan_level(part: ptr<function, PartPlan>) {
     let m = max(max((*part).n[0], (*part).n[1]), (*part).n[2]);
     (*part).k = 1u;
@@ -202,6 +203,21 @@ fn plan_level(part: ptr<function, PartPlan>) {
     } else if (params.method == METHOD_FIXED) {
         (*part).k = (m + PIECE_DIVISIONS - 1u) / PIECE_DIVISIONS;
     }
+    (*part).bands = is_adaptive() && (*part).k >= 3u && (*part).n[band_base((*part).n)] <= band_rows();
+}
+
+// Whether `parts` parts across a band of a piece's rows are enough for the zipper's diagonals,
+// judged on one of the band's whole diagonals (its quick profile): `adaptive:length`, the
+// length within parts × L/2; the error split, the bend within parts × ROW_DIAGONAL_ERROR·τ and
+// the length within parts × ERROR_SPLIT_LENGTH·L (`diagonal_fits` in src/cpu/subdivide/edges.rs;
+// products, not quotients, which round alike on both sides).
+fn diagonal_fits(whole: EdgeProfile, parts: u32, tri: ptr<function, InputTriangle>) -> bool {
+    let w = f32(parts);
+    if (params.method == METHOD_ADAPTIVE) {
+        return 2.0 * whole.length_px <= w * (*tri).edge_px;
+    }
+    return whole.bend_px <= w * (2.0 * ROW_DIAGONAL_ERROR * (*tri).max_error_px)
+        && whole.length_px <= w * (ERROR_SPLIT_LENGTH * (*tri).edge_px);
 }
 
 // Where macro node (a, b, c)/K lies, as (kind, i, j): kind 0 = triangle corner i; kind 1 = fine

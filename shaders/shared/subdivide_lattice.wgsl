@@ -40,7 +40,12 @@ fn macro_location(abc: vec3<u32>, part: ptr<function, PartPlan>) -> vec3<u32> {
     if (e == 3u) {
         return vec3<u32>(INTERIOR, 0u, 0u);
     }
-    let j = snap(on.y, (*part).n[e], (*part).k);
+    return edge_location(e, snap(on.y, (*part).n[e], (*part).k), part);
+}
+
+// Fine node j (0 ≤ j ≤ n_e) of original edge e as a location: a corner at either end
+// (`Location::on_edge`).
+fn edge_location(e: u32, j: u32, part: ptr<function, PartPlan>) -> vec3<u32> {
     if (j == 0u) {
         return vec3<u32>(CORNER, e, 0u);
     }
@@ -48,16 +53,6 @@ fn macro_location(abc: vec3<u32>, part: ptr<function, PartPlan>) -> vec3<u32> {
         return vec3<u32>(CORNER, (e + 1u) % 3u, 0u);
     }
     return vec3<u32>(ON_EDGE, e, j);
-}
-
-fn macro_node(abc: vec3<u32>, loc: vec3<u32>, part: ptr<function, PartPlan>) -> Node {
-    if (loc.x == CORNER) {
-        return corner(loc.y, part);
-    }
-    if (loc.x == ON_EDGE) {
-        return edge_point(corner(loc.y, part), corner((loc.y + 1u) % 3u, part), loc.z, (*part).n[loc.y]);
-    }
-    return weighted((*part).corner, vec3<f32>(abc) / f32((*part).k));
 }
 
 // The node's fine index along original edge oe from its start, or −1 if it is not on that edge.
@@ -134,7 +129,10 @@ fn interior_node(i: u32, j: u32, l: u32, m: u32, piece_state: ptr<function, Piec
 
 
 fn append_pieces(t: u32, part: ptr<function, PartPlan>) {
-    let count = (*part).k * (*part).k;
+    var count = (*part).k * (*part).k;
+    if ((*part).bands) {
+        count = band_pieces(part);
+    }
     (*part).appended += count;
     let base = atomicAdd(&counters.pieces, count);
     if (base + count > params.piece_capacity) {
@@ -143,7 +141,7 @@ fn append_pieces(t: u32, part: ptr<function, PartPlan>) {
     var record: Piece;
     record.triangle = t;
     record.counts01 = (*part).n[0] | ((*part).n[1] << 16u);
-    record.count2_level = (*part).n[2] | ((*part).k << 16u);
+    record.count2_level = (*part).n[2] | ((*part).k << 16u) | select(0u, BANDS, (*part).bands);
     for (var i = 0u; i < 3u; i++) {
         record.corner[i] = vec4<f32>((*part).corner[i].position, (*part).corner[i].bary.x);
         record.bary1[i] = (*part).corner[i].bary.y;
@@ -244,16 +242,16 @@ fn strip_node(slot: u32, part: ptr<function, PartPlan>, piece_state: ptr<functio
 
 // The next triangle of the strip's walk at `walk` = (i, j) (left L_i = slot n1 + n2 − i, right
 // R_j = slot j), as slots; advances the walk.
-fn strip_step(walk: ptr<function, vec2<u32>>, piece_state: ptr<function, PieceState>) -> vec3<u32> {
+fn strip_step(walk: ptr<function, vec4<u32>>, piece_state: ptr<function, PieceState>) -> vec3<u32> {
     let i = (*walk).x;
     let j = (*walk).y;
     let n1 = (*piece_state).strip_n.x;
     let n2 = (*piece_state).strip_n.y;
     if (i < n2 && (j == n1 || (i + 1u) * n1 <= (j + 1u) * n2)) {
-        *walk = vec2<u32>(i + 1u, j);
+        (*walk).x = i + 1u;
         return vec3<u32>(n1 + n2 - i, j, n1 + n2 - i - 1u);
     }
-    *walk = vec2<u32>(i, j + 1u);
+    (*walk).y = j + 1u;
     return vec3<u32>(n1 + n2 - i, j, j + 1u);
 }
 
@@ -268,6 +266,12 @@ fn piece_node(k: u32, m: u32, row: ptr<function, vec2<u32>>, part: ptr<function,
     if ((*piece_state).strip_base < 3u) {
         return strip_node(k, part, piece_state);
     }
+    if ((*piece_state).strip_base == ROWS_SHAPE) {
+        // `row` = (node a, row k), advanced along the row, then to the next.
+        let node = row_node((*row).y, (*row).x, part, piece_state);
+        *row = select(vec2<u32>((*row).x + 1u, (*row).y), vec2<u32>(0u, (*row).y + 1u), (*row).x + 1u > (*piece_state).row_w[(*row).y]);
+        return node;
+    }
     let j = (*row).x;
     let l = (*row).y;
     *row = select(vec2<u32>(j + 1u, l), vec2<u32>(0u, l + 1u), j + 1u > m - l);
@@ -275,9 +279,13 @@ fn piece_node(k: u32, m: u32, row: ptr<function, vec2<u32>>, part: ptr<function,
 }
 
 // Candidate triangle t's slots (the strip's in walk order, advancing `walk`).
-fn piece_triangle_slots(t: u32, m: u32, walk: ptr<function, vec2<u32>>, piece_state: ptr<function, PieceState>) -> vec3<u32> {
+fn piece_triangle_slots(t: u32, m: u32, walk: ptr<function, vec4<u32>>, piece_state: ptr<function, PieceState>) -> vec3<u32> {
     if ((*piece_state).strip_base == QUAD_STRIP) {
         return quad_step(walk, piece_state);
+    }
+    if ((*piece_state).strip_base == ROWS_SHAPE) {
+        var at: array<vec2<u32>, 3>;
+        return rows_step(walk, &at, piece_state);
     }
     if ((*piece_state).strip_base < 3u) {
         return strip_step(walk, piece_state);
@@ -287,11 +295,17 @@ fn piece_triangle_slots(t: u32, m: u32, walk: ptr<function, vec2<u32>>, piece_st
 }
 
 // Whether candidate triangle t is drawn: not collapsed by snapping, not off screen.
-fn piece_triangle_drawn(t: u32, m: u32, walk: ptr<function, vec2<u32>>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> bool {
+fn piece_triangle_drawn(t: u32, m: u32, walk: ptr<function, vec4<u32>>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> bool {
     var a: vec3<f32>;
     var b: vec3<f32>;
     var c: vec3<f32>;
-    if ((*piece_state).strip_base == QUAD_STRIP) {
+    if ((*piece_state).strip_base == ROWS_SHAPE) {
+        var at: array<vec2<u32>, 3>;
+        rows_step(walk, &at, piece_state);
+        a = row_node(at[0].x, at[0].y, part, piece_state).position;
+        b = row_node(at[1].x, at[1].y, part, piece_state).position;
+        c = row_node(at[2].x, at[2].y, part, piece_state).position;
+    } else if ((*piece_state).strip_base == QUAD_STRIP) {
         let s = quad_step(walk, piece_state);
         a = quad_node(s.x, piece_state).position;
         b = quad_node(s.y, piece_state).position;
@@ -362,11 +376,16 @@ fn lattice_shape(piece: Piece, tri: ptr<function, InputTriangle>, part: ptr<func
     (*part).n[0] = piece.counts01 & 0xffffu;
     (*part).n[1] = piece.counts01 >> 16u;
     (*part).n[2] = piece.count2_level & 0xffffu;
-    (*part).k = piece.count2_level >> 16u;
+    (*part).k = (piece.count2_level >> 16u) & 0x1fffu;
     let cell = macro_cell((*part).k, piece.cell);
     var loc: array<vec3<u32>, 3>;
+    if ((piece.count2_level & BANDS) != 0u) {
+        loc = band_cell(piece.cell, part);
+    }
     for (var i = 0u; i < 3u; i++) {
-        loc[i] = macro_location(cell.c[i], part);
+        if ((piece.count2_level & BANDS) == 0u) {
+            loc[i] = macro_location(cell.c[i], part);
+        }
         (*piece_state).corner[i] = macro_node(cell.c[i], loc[i], part);
     }
     if (same((*piece_state).corner[0].position, (*piece_state).corner[1].position) || same((*piece_state).corner[1].position, (*piece_state).corner[2].position)
@@ -385,6 +404,13 @@ fn lattice_shape(piece: Piece, tri: ptr<function, InputTriangle>, part: ptr<func
         (*piece_state).strip_n = vec2<u32>((*piece_state).counts[((*piece_state).strip_base + 1u) % 3u], (*piece_state).counts[((*piece_state).strip_base + 2u) % 3u]);
         candidates = (*piece_state).strip_n.x + (*piece_state).strip_n.y - 1u;
         node_count = (*piece_state).strip_n.x + (*piece_state).strip_n.y + 1u;
+    } else {
+        let rows = plan_rows(tri, part, piece_state);
+        if (rows.x < candidates) {
+            (*piece_state).strip_base = ROWS_SHAPE;
+            candidates = rows.x;
+            node_count = rows.y;
+        }
     }
     let theta_c = azimuth(((*piece_state).corner[0].position + (*piece_state).corner[1].position + (*piece_state).corner[2].position) / 3.0);
     return PieceShape(m, candidates, node_count, theta_c);
@@ -478,7 +504,7 @@ fn emit_piece(shape: PieceShape, seam: SeamCopies, drawn: ptr<function, array<u3
         }
     }
     var slot = 3u * first_triangle;
-    var walk = vec2<u32>(0u, 0u);
+    var walk = vec4<u32>(0u);
     for (var t = 0u; t < shape.candidates; t++) {
         let local = piece_triangle_slots(t, shape.m, &walk, piece_state);
         if (((*drawn)[t / 32u] & (1u << (t % 32u))) == 0u) {

@@ -96,14 +96,14 @@ fn quad_advances_on_a(walk: vec2<u32>, rails: vec2<u32>) -> bool {
 
 // The next triangle of the zigzag at `walk` = (i, j) (rail a's node i = slot i, rail d's node j =
 // slot n1 + 1 + j), as slots; advances the walk.
-fn quad_step(walk: ptr<function, vec2<u32>>, piece_state: ptr<function, PieceState>) -> vec3<u32> {
+fn quad_step(walk: ptr<function, vec4<u32>>, piece_state: ptr<function, PieceState>) -> vec3<u32> {
     let i = (*walk).x;
     let j = (*walk).y;
     let n1 = (*piece_state).strip_n.x;
-    if (quad_advances_on_a(*walk, (*piece_state).strip_n)) {
-        *walk = vec2<u32>(i + 1u, j);
+    if (quad_advances_on_a((*walk).xy, (*piece_state).strip_n)) {
+        (*walk).x = i + 1u;
         return vec3<u32>(i, i + 1u, n1 + 1u + j);
     }
-    *walk = vec2<u32>(i, j + 1u);
+    (*walk).y = j + 1u;
     return vec3<u32>(i, n1 + 2u + j, n1 + 1u + j);
 }

@@ -25,6 +25,7 @@ struct PartPlan {
     corner: array<Node, 3>,
     n: array<u32, 3>,   // divisions of the part's edges Q0Q1, Q1Q2, Q2Q0
     k: u32,             // macro-lattice level
+    bands: bool,        // a long thin part cut in bands (`PartSplit::bands`), not K² cells
     appended: u32,      // piece records the invocation appended so far (`max_pieces`)
 }
 
@@ -35,8 +36,10 @@ struct PieceState {
     original: array<i32, 3>, // original edge under piece edge e, or −1
     from_index: array<u32, 3>,    // fine index on that original edge at corner e
     to_index: array<u32, 3>,  // and at corner e + 1
-    strip_base: u32,         // a sliver's base edge (see `strip_base_of`); 3: the lattice; QUAD_STRIP
-    strip_n: vec2<u32>,      // its long edges' counts: edge base + 1, edge base + 2; a quad's rails
+    strip_base: u32,         // a sliver's base edge (see `strip_base_of`); 3: the lattice; QUAD_STRIP; ROWS_SHAPE
+    strip_n: vec2<u32>,      // its long edges' counts: edge base + 1, edge base + 2; a quad's rails; rows' sides (left, right)
+    row_base: u32,           // rows: the base edge
+    row_w: array<u32, 33>,   // rows: each row's parts, from the base to the apex (`Rows::widths`)
     quad_last: Node,         // a band quad's corner 3 (its corners 0–2 in `corner`)
     quad_turn: u32,          // `plan_quad`: the polygon's corner that is the quad's corner 0
 }

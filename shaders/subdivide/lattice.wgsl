@@ -18,6 +18,7 @@
 #import subdivide_axis
 #import subdivide_quad
 #import subdivide_lattice
+#import subdivide_rows
 #import subdivide_dispatch
 
 @compute @workgroup_size(64)
@@ -54,7 +55,7 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     // bit each; m ≤ PIECE_DIVISIONS = 32).
     var drawn: array<u32, 32>;
     var count = 0u;
-    var walk = vec2<u32>(0u, 0u);
+    var walk = vec4<u32>(0u);
     for (var t = 0u; t < shape.candidates; t++) {
         if (piece_triangle_drawn(t, shape.m, &walk, &part, &piece_state)) {
             drawn[t / 32u] |= 1u << (t % 32u);

@@ -12,6 +12,7 @@
 #import subdivide_axis
 #import subdivide_quad
 #import subdivide_lattice
+#import subdivide_rows
 #import subdivide_dispatch
 
 // Over every triangle of the scene, after `active_cuts`: a triangle that asks for no cuts but

@@ -73,6 +73,13 @@ pub const QUAD_RUNG_ERROR: f32 = 1.0;
 /// the rails' counts in `counts01`) and the second (corner 3 only; its invocation draws nothing).
 pub const QUAD_HEAD: u32 = 1 << 31;
 pub const QUAD_TAIL: u32 = 1 << 30;
+/// ... and a piece of a thin part split in bands (`PartSplit` and `band_cell` in
+/// src/cpu/subdivide/; `cell` is the piece's index among the bands' halves).
+pub const BANDS: u32 = 1 << 29;
+/// Under an adaptive rule a piece drawn in rows (`Rows` in src/cpu/subdivide/) gives each band
+/// between two rows the parts w its zipper's diagonals need: its whole diagonals' middles within
+/// w × this many τ of their chords (each zipper diagonal bends about 1/w as much).
+pub const ROW_DIAGONAL_ERROR: f32 = 1.5;
 /// The largest macro-lattice level K: a part makes at most this² pieces, so that one `plan`
 /// invocation's loop stays short (lavapipe cuts long invocations short and loses pieces). An
 /// adaptive part whose longest edge needs more than this × N_max divisions (an edge over
@@ -117,6 +124,8 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("MAX_EDGE_DIVISIONS", U32(MAX_EDGE_DIVISIONS)),
         ("EDGE_SAMPLES", U32(EDGE_SAMPLES)),
         ("PIECE_DIVISIONS", U32(PIECE_DIVISIONS)),
+        ("BANDS", U32(BANDS)),
+        ("ROW_DIAGONAL_ERROR", F32(ROW_DIAGONAL_ERROR)),
         ("STRIP_MIN_DIVISIONS", U32(STRIP_MIN_DIVISIONS)),
         ("STRIP_BASE_ERROR", F32(STRIP_BASE_ERROR)),
         ("QUAD_MIN_DIVISIONS", U32(QUAD_MIN_DIVISIONS)),

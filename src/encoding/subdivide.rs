@@ -74,6 +74,10 @@ pub struct SubdivideOutput {
     pub cuts: AxisCuts,
     /// Pieces drawn as a sliver's strip (the twin's count, for tests; 0 from the GPU).
     pub strips: u32,
+    /// Pieces drawn in rows (`Rows`; the twin's count, for tests; 0 from the GPU).
+    pub rows: u32,
+    /// Pieces that are halves of a long thin part's bands (`band_cell`; likewise).
+    pub bands: u32,
     /// Band quads drawn as one strip between their rails (the twin's count, for tests; 0 from
     /// the GPU).
     pub quads: u32,

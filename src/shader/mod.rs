@@ -388,6 +388,7 @@ pub const SHARED: &[(&str, &str)] = &[
     ("subdivide_dispatch", include_str!("../../shaders/shared/subdivide_dispatch.wgsl")),
     ("subdivide_quad", include_str!("../../shaders/shared/subdivide_quad.wgsl")),
     ("subdivide_lattice", include_str!("../../shaders/shared/subdivide_lattice.wgsl")),
+    ("subdivide_rows", include_str!("../../shaders/shared/subdivide_rows.wgsl")),
     ("surface_bindings", include_str!("../../shaders/shared/surface_bindings.wgsl")),
     ("texture", include_str!("../../shaders/shared/texture.wgsl")),
     ("brdf", include_str!("../../shaders/shared/brdf.wgsl")),

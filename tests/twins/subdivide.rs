@@ -114,6 +114,7 @@ impl Twin for Subdivide {
     fn cases() -> Vec<(String, Self::Case)> {
         let cases = subdivide_cases();
         let (mut cut_frames, mut strip_frames, mut quad_frames, mut edge_split_frames) = (0, 0, 0, 0);
+        let (mut row_frames, mut band_frames) = (0, 0);
         let cases: Vec<_> = cases
             .into_iter()
             .enumerate()
@@ -126,6 +127,8 @@ impl Twin for Subdivide {
                 strip_frames += (cpu.strips > 0) as usize;
                 quad_frames += (cpu.quads > 0) as usize;
                 edge_split_frames += (cpu.edge_splits > 0) as usize;
+                row_frames += (cpu.rows > 0) as usize;
+                band_frames += (cpu.bands > 0) as usize;
                 (name, (scene, s))
             })
             .collect();
@@ -137,6 +140,9 @@ impl Twin for Subdivide {
         assert!(quad_frames >= 2, "only {quad_frames} cases draw band quads as strips");
         // Triangles that ask for no cuts, cut only at the edges they share with ones that do.
         assert!(edge_split_frames >= 3, "only {edge_split_frames} cases cut triangles at shared edges alone");
+        // Pieces drawn in rows, and long thin parts cut in bands (adaptive rules).
+        assert!(row_frames >= 4, "only {row_frames} cases draw pieces in rows");
+        assert!(band_frames >= 2, "only {band_frames} cases cut long thin parts in bands");
         cases
     }
     fn gpu(r: &Renderer, (scene, settings): &Self::Case) -> Self::Output {
@@ -171,20 +177,29 @@ fn compare_subdivided(gpu: &SubdivideOutput, cpu: &SubdivideOutput) -> Result<()
     if cpu.cuts != gpu.cuts {
         return Err(format!("cuts around the axis: CPU {:#x}, GPU {:#x}", cpu.cuts, gpu.cuts));
     }
-    // On a software adapter (lavapipe: correctly rounded maths) the output is the twin's,
-    // exactly. A hardware GPU's sin, atan2 and acos differ from the CPU's in the last bits,
-    // which flips an edge's division count where its measure sits on a ceil boundary (seen
-    // on an H100: 36 of 53,697 nodes in a case of random triangles): there at most 1 % of
-    // the pieces, nodes and triangles may differ, and every other triangle is the twin's.
-    let slack = |n: usize| if common::renderer().gpu.info.device_type == wgpu::DeviceType::Cpu { 0 } else { n / 100 };
-    if cpu.pieces.abs_diff(gpu.pieces) as usize > slack(cpu.pieces as usize) {
+    // A measure that sits on a ceil boundary flips a division count with the last bit of its
+    // inputs. A hardware GPU's sin, atan2 and acos differ from the CPU's in the last bits (seen
+    // on an H100: 36 of 53,697 nodes in a case of random triangles): there at most 1 % of the
+    // pieces, nodes and triangles may differ. On a software adapter (lavapipe: correctly rounded
+    // maths, but fused multiply-adds where the twin rounds twice) the edges' and macro edges'
+    // counts come out the twin's; a piece's rows measure every row and its diagonals, many more
+    // measures, and one in 10⁴–10⁵ flips a row's width or the piece's choice between rows and
+    // the lattice (one piece of 84 triangles in a case of 200 random triangles): there 0.1 %
+    // plus one piece (the largest output of an invocation) may differ. Every other triangle is
+    // the twin's.
+    let software = common::renderer().gpu.info.device_type == wgpu::DeviceType::Cpu;
+    let one_piece = cpu.max_output as usize;
+    let slack = |n: usize| if software { n / 1000 + one_piece } else { n / 100 };
+    // Piece records come from the parts' edges alone: exact on a software adapter.
+    let piece_slack = if software { 0 } else { cpu.pieces as usize / 100 };
+    if cpu.pieces.abs_diff(gpu.pieces) as usize > piece_slack {
         return Err(format!("pieces: CPU {}, GPU {}", cpu.pieces, gpu.pieces));
     }
     // The balance counters: the largest output of one invocation (a piece one division more or
-    // less on a hardware GPU moves them by a few).
+    // less moves them by a few): within 10 %.
     for (what, c, g) in [("max pieces", cpu.max_pieces, gpu.max_pieces), ("max output", cpu.max_output, gpu.max_output)]
     {
-        if c.abs_diff(g) as usize > slack(100 * c as usize) / 10 || (c == 0) != (g == 0) {
+        if c.abs_diff(g) > c / 10 || (c == 0) != (g == 0) {
             return Err(format!("{what} per invocation: CPU {c}, GPU {g}"));
         }
     }

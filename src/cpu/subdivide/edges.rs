@@ -5,12 +5,13 @@
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
-use super::{snap_to_cut_planes, Node, Subdivider, Triangle};
+use super::{snap_to_cut_planes, Node, PartSplit, Subdivider, Triangle};
 use crate::core::projection::{azimuth, horizontal_radius, Eye, PanoramaKind, Vertical};
 use crate::core::scene::{unpack_tangent, SceneVertex};
 use crate::core::settings::SplitRule;
 use crate::encoding::constants::{
     EDGE_SAMPLES, ERROR_SPLIT_LENGTH, MAX_EDGE_DIVISIONS, MAX_MACRO_LEVEL, MAX_STRETCH, PIECE_DIVISIONS,
+    ROW_DIAGONAL_ERROR,
 };
 
 pub(super) fn lex_less(a: Vec3, b: Vec3) -> bool {
@@ -165,6 +166,23 @@ impl Subdivider<'_> {
         }
     }
 
+    /// Whether `parts` parts across a band of a piece's rows are enough for the zipper's
+    /// diagonals, judged on one of the band's whole diagonals (its quick profile `whole`): a zipper diagonal spans the band's side step and one part across, and the
+    /// projection's mixed term bends it in proportion to that part. `adaptive:length`: the
+    /// length within parts × L/2 (a side step of up to L plus a part of L/2 keeps it near L); the
+    /// error split: the bend within parts × `ROW_DIAGONAL_ERROR`·τ (at the middle) and the length
+    /// within parts × `ERROR_SPLIT_LENGTH`·L. Products, not quotients: the GPU rounds a division
+    /// differently in the last bit.
+    pub(super) fn diagonal_fits(&self, whole: EdgeProfile, parts: u32, limits: Limits) -> bool {
+        let w = parts as f32;
+        if self.params.method == SplitRule::Adaptive as u32 {
+            2.0 * whole.length_px <= w * limits.edge_px
+        } else {
+            whole.bend_px <= w * (2.0 * ROW_DIAGONAL_ERROR * limits.max_error_px)
+                && whole.length_px <= w * (ERROR_SPLIT_LENGTH * limits.edge_px)
+        }
+    }
+
     /// Divisions of an interior edge of the macro-lattice. Macro edges are about N_max·L long,
     /// but the projection stretches unevenly across a large triangle, so some need more: they may
     /// take up to 2·N_max, and at most `PIECE_DIVISIONS` (a piece then makes at most 32² triangles).
@@ -220,7 +238,7 @@ impl Subdivider<'_> {
     }
 
     /// `plan`: the macro-lattice level K of a part (K² pieces) and its edge counts.
-    pub(super) fn plan(&self, tri: &Triangle, part: &[Node; 3]) -> (u32, [u32; 3]) {
+    pub(super) fn plan(&self, tri: &Triangle, part: &[Node; 3]) -> PartSplit {
         let p = part.map(|n| n.position);
         let l = self.limits(tri.object);
         let n = [
@@ -229,13 +247,14 @@ impl Subdivider<'_> {
             self.edge_divisions(p[2], p[0], l),
         ];
         let m = n[0].max(n[1]).max(n[2]);
-        let k = if SplitRule::is_adaptive(self.params.method) {
+        let adaptive = SplitRule::is_adaptive(self.params.method);
+        let k = if adaptive {
             m.div_ceil(self.params.max_div.min(PIECE_DIVISIONS)).min(MAX_MACRO_LEVEL)
         } else if self.params.method == SplitRule::Fixed as u32 {
             m.div_ceil(PIECE_DIVISIONS)
         } else {
             1
         };
-        (k, n)
+        PartSplit::new(n, k, adaptive, self.params.max_div)
     }
 }

@@ -52,6 +52,16 @@
 //! cracks, and the error bound is the lattice's. Not on the sphere,
 //! where a sliver reaching towards a pole bends ever more towards its apex.
 //!
+//! **Rows (adaptive rules, both panoramas).** A piece may instead be drawn in rows parallel to
+//! its base edge (the one with the fewest parts), from the base to the apex, each row in as many
+//! parts as it and its zipper's diagonals need (see [`Rows`] and `Subdivider::piece_shape`),
+//! consecutive rows zipped: about rows × width triangles where the lattice makes m². Used where
+//! that makes fewer candidates than the lattice; the base and sides keep their own nodes.
+//!
+//! **Bands (adaptive rules).** A part with K ≥ 3 whose base needs at most N_max parts is cut
+//! not into K² macro cells but into bands of N_max of its rows, two pieces per band
+//! ([`band_cell`], [`PartSplit`]); the pieces' corners lie on the part's edges' fine nodes.
+//!
 //! **Band quads (likewise).** A band of a floor or wall between two diamonds is often a polygon
 //! of four corners whose fan makes two slivers along its long diagonal. When two opposite sides
 //! are in one part each, the quad is drawn as one strip between the other two (its rails) instead
@@ -106,6 +116,7 @@ mod frame_cuts;
 mod lattice;
 pub mod passes;
 mod quad;
+mod rows;
 
 pub use axis::{
     axis_clearance, band_limit, edge_crossings, edge_split_parts, fan, one_part, polygons, quadrant_polygons,
@@ -119,6 +130,7 @@ pub use lattice::{
     snap, strip_node_count, strip_triangles,
 };
 use lattice::{lattice_node, strip_node, weighted};
+pub use rows::{band_cell, PartSplit, Rows};
 
 /// An input triangle in the viewer frame.
 #[derive(Clone, Copy, Debug)]
@@ -186,11 +198,11 @@ impl<'a> Subdivider<'a> {
                     if self.off_screen_vertically(part.map(|n| n.position)) {
                         continue;
                     }
-                    let (k, n) = self.plan(&tri, &part);
-                    for cell in 0..k * k {
+                    let split = self.plan(&tri, &part);
+                    for cell in 0..split.pieces(self.params.max_div) {
                         out.pieces += 1;
                         let before = (out.nodes.len(), out.indices.len() / 3);
-                        self.lattice(&tri, &part, k, n, cell, &mut out);
+                        self.lattice(&tri, &part, split, cell, &mut out);
                         out.note_output(before);
                     }
                 }
@@ -206,14 +218,7 @@ impl<'a> Subdivider<'a> {
         let Some((e, idx)) = boundary_edge(abc) else {
             return Location::Interior(abc);
         };
-        let j = snap(idx, n[e], k);
-        if j == 0 {
-            Location::Corner(e)
-        } else if j == n[e] {
-            Location::Corner((e + 1) % 3)
-        } else {
-            Location::OnEdge(e, j)
-        }
+        Location::on_edge(e, snap(idx, n[e], k), n)
     }
 
     fn macro_node(&self, part: &[Node; 3], n: [u32; 3], k: u32, loc: Location) -> Node {
@@ -227,9 +232,16 @@ impl<'a> Subdivider<'a> {
         }
     }
 
-    /// `lattice`: subdivides macro cell `cell` of a part and emits its sub-triangles.
-    fn lattice(&self, tri: &Triangle, part: &[Node; 3], k: u32, n: [u32; 3], cell: u32, out: &mut SubdivideOutput) {
-        let loc = macro_cell(k, cell).map(|c| self.macro_location(n, k, c));
+    /// `lattice`: subdivides piece `cell` of a part (a macro cell, or a band's half) and emits
+    /// its sub-triangles.
+    fn lattice(&self, tri: &Triangle, part: &[Node; 3], split: PartSplit, cell: u32, out: &mut SubdivideOutput) {
+        let PartSplit { n, k, .. } = split;
+        out.bands += split.bands as u32;
+        let loc = if split.bands {
+            band_cell(n, self.params.max_div, cell).map(|(e, j)| Location::on_edge(e, j, n))
+        } else {
+            macro_cell(k, cell).map(|c| self.macro_location(n, k, c))
+        };
         let q = loc.map(|l| self.macro_node(part, n, k, l));
         if q[0].position == q[1].position || q[1].position == q[2].position || q[2].position == q[0].position {
             return; // snapped corners coincide: no area
@@ -267,28 +279,17 @@ impl<'a> Subdivider<'a> {
                 None => edge_point(q[e], q[(e + 1) % 3], m, pe.count),
             }
         };
-        // The lattice of level m, or a sliver's strip: which of its triangles are drawn (not
+        // The lattice of level m, a sliver's strip or rows: which of its triangles are drawn (not
         // collapsed by snapping, not off screen), then its nodes once, then the drawn triangles
         // as indices into them.
-        let m = counts[0].max(counts[1]).max(counts[2]);
-        let strip = self.strip_base(counts, &q, self.limits(tri.object));
-        let candidates = match strip {
-            Some(base) => strip_triangles(counts, base, &node_on_edge),
-            None => lattice_triangles(counts, &q, &node_on_edge),
-        };
-        let drawn = self.drawn(candidates);
+        let shape = self.piece_shape(counts, &q, self.limits(tri.object), k, &node_on_edge);
+        let drawn = self.drawn(shape.triangles(counts, &q, &node_on_edge));
         if drawn.is_empty() {
             return;
         }
-        out.strips += strip.is_some() as u32;
-        let nodes: Vec<Node> = match strip {
-            Some(base) => {
-                (0..strip_node_count(counts, base)).map(|k| strip_node(counts, base, &node_on_edge, k)).collect()
-            }
-            None => (0..(m + 1) * (m + 2) / 2)
-                .map(|k| lattice_node(counts, &q, &node_on_edge, m, slot_node(k, m)))
-                .collect(),
-        };
+        out.strips += matches!(shape, Shape::Strip(_)) as u32;
+        out.rows += matches!(shape, Shape::Rows(_)) as u32;
+        let nodes = shape.nodes(counts, &q, &node_on_edge);
         let theta_c = azimuth((q[0].position + q[1].position + q[2].position) / 3.0);
         let u_range = if self.projection.panorama == PanoramaKind::Equirect {
             let (mut u_min, mut u_max) = (f32::INFINITY, f32::NEG_INFINITY);
@@ -305,6 +306,27 @@ impl<'a> Subdivider<'a> {
             self.piece_u_range(&q, theta_c)
         };
         self.emit(tri, &nodes, drawn, theta_c, u_range, out);
+    }
+
+    /// How a piece is triangulated: a sliver's strip on the cylinder ([`Subdivider::strip_base`]),
+    /// else under an adaptive rule its rows ([`Rows`]) where they make fewer candidate triangles
+    /// than the regular lattice of level m = max(counts), else that lattice.
+    fn piece_shape(
+        &self,
+        counts: [u32; 3],
+        q: &[Node; 3],
+        limits: Limits,
+        k: u32,
+        node_on_edge: &dyn Fn(usize, u32) -> Node,
+    ) -> Shape {
+        let m = counts[0].max(counts[1]).max(counts[2]);
+        if let Some(base) = self.strip_base(counts, q, limits) {
+            return Shape::Strip(base);
+        }
+        match self.rows(counts, q, limits, k, node_on_edge) {
+            Some(rows) if rows.candidates() < m * m => Shape::Rows(rows),
+            _ => Shape::Lattice(m),
+        }
     }
 
     /// The candidate triangles (slots and nodes) a piece draws: those not wholly above or below
@@ -426,6 +448,17 @@ enum Location {
 }
 
 impl Location {
+    /// Fine node j of original edge e (0 ≤ j ≤ n_e): a corner at either end.
+    fn on_edge(e: usize, j: u32, n: [u32; 3]) -> Location {
+        if j == 0 {
+            Location::Corner(e)
+        } else if j == n[e] {
+            Location::Corner((e + 1) % 3)
+        } else {
+            Location::OnEdge(e, j)
+        }
+    }
+
     /// The node's fine index along original edge `oe` from its start, if it lies on that edge.
     fn index_on(self, oe: usize, n: [u32; 3]) -> Option<u32> {
         match self {
@@ -433,6 +466,42 @@ impl Location {
             Location::Corner(c) if c == (oe + 1) % 3 => Some(n[oe]),
             Location::OnEdge(e, j) if e == oe => Some(j),
             _ => None,
+        }
+    }
+}
+
+/// How a piece is triangulated (`piece_shape`).
+enum Shape {
+    Lattice(u32),
+    Strip(usize),
+    Rows(Rows),
+}
+
+impl Shape {
+    /// Its candidate triangles, as slots and nodes.
+    fn triangles(
+        &self,
+        counts: [u32; 3],
+        q: &[Node; 3],
+        node_on_edge: &dyn Fn(usize, u32) -> Node,
+    ) -> Vec<([u32; 3], [Node; 3])> {
+        match self {
+            Shape::Lattice(_) => lattice_triangles(counts, q, node_on_edge),
+            Shape::Strip(base) => strip_triangles(counts, *base, node_on_edge),
+            Shape::Rows(rows) => rows.triangles(node_on_edge),
+        }
+    }
+
+    /// Its nodes in slot order.
+    fn nodes(&self, counts: [u32; 3], q: &[Node; 3], node_on_edge: &dyn Fn(usize, u32) -> Node) -> Vec<Node> {
+        match self {
+            Shape::Lattice(m) => (0..(m + 1) * (m + 2) / 2)
+                .map(|k| lattice_node(counts, q, node_on_edge, *m, slot_node(k, *m)))
+                .collect(),
+            Shape::Strip(base) => {
+                (0..strip_node_count(counts, *base)).map(|k| strip_node(counts, *base, node_on_edge, k)).collect()
+            }
+            Shape::Rows(rows) => rows.nodes(node_on_edge),
         }
     }
 }

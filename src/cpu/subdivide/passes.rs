@@ -13,12 +13,12 @@
 use glam::Vec3;
 
 use super::{
-    band_limit, edge_split_parts, fan, one_part, quadrant_polygons, triangle_cuts, FrameCuts, Node, SubdivideOutput,
-    Subdivider, Triangle,
+    band_limit, edge_split_parts, fan, one_part, quadrant_polygons, triangle_cuts, FrameCuts, Node, PartSplit,
+    SubdivideOutput, Subdivider, Triangle,
 };
 use crate::core::scene::SceneVertex;
 use crate::core::settings::RenderSettings;
-use crate::encoding::constants::{PIECES_FROM_COUNTER, QUAD_HEAD, QUAD_TAIL};
+use crate::encoding::constants::{BANDS, PIECES_FROM_COUNTER, QUAD_HEAD, QUAD_TAIL};
 use crate::encoding::recording::{Command, Recording};
 use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine};
 use crate::encoding::subdivide::plan_cuts_split;
@@ -279,8 +279,9 @@ impl<'s> CpuSubdivision<'s> {
             sub.quad_lattice(&tri, &[corners[0], corners[1], corners[2], last], [n0, n1], &mut out);
         } else {
             let n = [n0, n1, piece.count2_level & 0xffff];
-            let k = (piece.count2_level >> 16) & 0x3fff;
-            sub.lattice(&tri, &corners, k, n, piece.cell, &mut out);
+            let k = (piece.count2_level >> 16) & 0x1fff;
+            let bands = piece.count2_level & BANDS != 0;
+            sub.lattice(&tri, &corners, PartSplit { n, k, bands }, piece.cell, &mut out);
         }
         self.emit(params, &out);
     }
@@ -308,9 +309,11 @@ impl<'s> CpuSubdivision<'s> {
             if sub.off_screen_vertically(part.map(|n| n.position)) {
                 continue;
             }
-            let (k, n) = sub.plan(tri, &part);
-            let first = record(t, n[0] | n[1] << 16, n[2] | k << 16, part);
-            let cells: Vec<Piece> = (0..k * k).map(|cell| Piece { cell, ..first }).collect();
+            let split = sub.plan(tri, &part);
+            let [n0, n1, n2] = split.n;
+            let flags = if split.bands { BANDS } else { 0 };
+            let first = record(t, n0 | n1 << 16, n2 | split.k << 16 | flags, part);
+            let cells: Vec<Piece> = (0..split.pieces(sub.params.max_div)).map(|cell| Piece { cell, ..first }).collect();
             self.append(sub.params, &cells);
         }
     }

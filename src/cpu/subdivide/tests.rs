@@ -213,19 +213,55 @@ fn check_conforming(counts: [u32; 3]) {
     check_tiling(counts, None);
 }
 
+/// A piece's triangulation under test: the lattice, a sliver's strip on a base, or rows of these
+/// widths.
+enum Tiling {
+    Lattice,
+    Strip(usize),
+    Rows(Vec<u32>),
+}
+
+impl From<Option<usize>> for Tiling {
+    fn from(strip: Option<usize>) -> Tiling {
+        strip.map_or(Tiling::Lattice, Tiling::Strip)
+    }
+}
+
 /// The piece's triangles (the lattice, or the strip on `strip` base) tile it exactly: positive
 /// area, the piece's winding, every inner edge shared by two triangles, every boundary segment
 /// (the edges' own nodes) used once; each triangle's slots name its nodes.
-fn check_tiling(counts: [u32; 3], strip: Option<usize>) -> usize {
+fn check_tiling(counts: [u32; 3], tiling: impl Into<Tiling>) -> usize {
+    let tiling = tiling.into();
     let q = [
         Node { position: Vec3::new(0.0, 0.0, -3.0), bary: Vec3::X },
         Node { position: Vec3::new(1.3, 0.1, -3.0), bary: Vec3::Y },
         Node { position: Vec3::new(0.4, 1.1, -3.2), bary: Vec3::Z },
     ];
     let node_on_edge = |e: usize, m: u32| edge_point(q[e], q[(e + 1) % 3], m, counts[e]);
-    let triangles = match strip {
-        Some(base) => strip_triangles(counts, base, &node_on_edge),
-        None => lattice_triangles(counts, &q, &node_on_edge),
+    let rows = match &tiling {
+        Tiling::Rows(widths) => {
+            let (base, _) = Rows::base_of(counts);
+            let sides = [counts[(base + 2) % 3], counts[(base + 1) % 3]];
+            Some(Rows { base, sides, widths: widths.clone() })
+        }
+        _ => None,
+    };
+    let triangles = match (&tiling, &rows) {
+        (Tiling::Strip(base), _) => strip_triangles(counts, *base, &node_on_edge),
+        (_, Some(rows)) => rows.triangles(&node_on_edge),
+        _ => lattice_triangles(counts, &q, &node_on_edge),
+    };
+    if let Some(rows) = &rows {
+        let nodes = rows.nodes(&node_on_edge);
+        assert_eq!(nodes.len() as u32, rows.node_count());
+        assert!(triangles.len() as u32 <= rows.candidates());
+        for (slots, t) in &triangles {
+            assert_eq!(slots.map(|k| nodes[k as usize]), *t, "{counts:?}: slots {slots:?}");
+        }
+    }
+    let strip = match tiling {
+        Tiling::Strip(base) => Some(base),
+        _ => None,
     };
     if let Some(base) = strip {
         let [n1, n2] = [counts[(base + 1) % 3], counts[(base + 2) % 3]];
@@ -239,7 +275,7 @@ fn check_tiling(counts: [u32; 3], strip: Option<usize>) -> usize {
     let normal = (q[1].position - q[0].position).cross(q[2].position - q[0].position);
     for (_, t) in &triangles {
         let n = (t[1].position - t[0].position).cross(t[2].position - t[0].position);
-        assert!(n.dot(normal) > 0.0, "{counts:?} ({strip:?}): triangle {t:?} turned over");
+        assert!(n.dot(normal) > 0.0, "{counts:?}: triangle {t:?} turned over");
     }
     let tris: Vec<[Vec3; 3]> = triangles.into_iter().map(|(_, t)| t.map(|n| n.position)).collect();
     let count = tris.len();
@@ -302,6 +338,52 @@ fn a_slivers_strip_tiles_it_with_fewer_triangles_than_the_lattice() {
                     assert!(strip < lattice, "{counts:?}: strip {strip} vs lattice {lattice}");
                 }
             }
+        }
+    }
+}
+
+#[test]
+fn rows_tile_a_piece_whatever_each_rows_width() {
+    // Every count triple up to 8, each row's parts drawn at random (1 to 6): the base and the
+    // sides keep their own nodes, the triangles cover the piece once, winding kept.
+    let mut seed = 7u32;
+    let mut next = || {
+        seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        seed >> 16
+    };
+    for a in 1..=8 {
+        for b in 1..=8 {
+            for c in 1..=8 {
+                let counts = [a, b, c];
+                let (base, r) = Rows::base_of(counts);
+                let mut widths: Vec<u32> = (0..=r).map(|_| 1 + next() % 6).collect();
+                widths[0] = counts[base];
+                widths[r as usize] = 0;
+                check_tiling(counts, Tiling::Rows(widths));
+            }
+        }
+    }
+}
+
+#[test]
+fn a_long_thin_parts_bands_tile_it() {
+    // The halves of the bands of parts with a base of up to N_max parts and long sides: positive
+    // area in the part's winding (or none, corners coinciding), together the whole part.
+    let part = [Vec3::new(0.0, 0.0, -3.0), Vec3::new(0.4, 0.0, -3.0), Vec3::new(5.0, 1.0, -3.5)];
+    let normal = (part[1] - part[0]).cross(part[2] - part[0]);
+    for max_div in [3, 7] {
+        for n in [[1, 40, 41], [3, 29, 30], [7, 60, 22], [2, 9, 30], [30, 1, 30], [31, 29, 5]] {
+            let point = |(e, j): (usize, u32)| part[e] + (part[(e + 1) % 3] - part[e]) * (j as f32 / n[e] as f32);
+            let split = PartSplit { n, k: 5, bands: true };
+            let mut total = 0.0;
+            for cell in 0..split.pieces(max_div) {
+                let [a, b, c] = band_cell(n, max_div, cell).map(point);
+                let area = (b - a).cross(c - a).dot(normal) / normal.length();
+                assert!(area >= -1e-6, "{n:?} N_max {max_div}: cell {cell} turned over ({area})");
+                total += 0.5 * area;
+            }
+            let whole = 0.5 * normal.length();
+            assert!((total - whole).abs() < 1e-4 * whole, "{n:?} N_max {max_div}: area {total} vs {whole}");
         }
     }
 }

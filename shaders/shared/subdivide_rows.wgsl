@@ -1,0 +1,204 @@
+// A long thin part's bands (pieces of `band_rows` of its rows each, `append_pieces` and
+// `lattice_shape`) and a piece's rows (`lattice_shape` chooses them where they make fewer
+// triangles than the lattice): rows parallel to the base, each in the parts it and its zipper's
+// diagonals need, consecutive rows zipped. CPU twin: src/cpu/subdivide/rows.rs.
+
+#import constants
+#import subdivide_bindings
+#import subdivide_state
+#import subdivide_edges
+#import subdivide_lattice
+
+// ---- a long thin part's bands (`band_cell`) ----
+
+// The first edge with the fewest divisions: a thin part's (or a piece's rows') base.
+fn band_base(n: array<u32, 3>) -> u32 {
+    var base = 0u;
+    for (var e = 1u; e < 3u; e++) {
+        if (n[e] < n[base]) {
+            base = e;
+        }
+    }
+    return base;
+}
+
+// Steps along a thin part's sides per band: N_max (at most PIECE_DIVISIONS).
+fn band_rows() -> u32 {
+    return clamp(params.max_div, 1u, PIECE_DIVISIONS);
+}
+
+// The node, counted from the base, where row k of r meets a side of `count` ≤ r parts: the
+// fraction k/r of the way rounded down (only the last row reaches the apex).
+fn row_side_index(k: u32, count: u32, r: u32) -> u32 {
+    return k * count / max(r, 1u);
+}
+
+// Where row `row` of a thin part meets its left side (edge base + 2, from the apex) or its right
+// side (edge base + 1), as a location (`band_row_ends`).
+fn band_row_end(row: u32, right: bool, part: ptr<function, PartPlan>) -> vec3<u32> {
+    let base = band_base((*part).n);
+    let left_edge = (base + 2u) % 3u;
+    let right_edge = (base + 1u) % 3u;
+    let r = max((*part).n[left_edge], (*part).n[right_edge]);
+    if (right) {
+        return edge_location(right_edge, row_side_index(row, (*part).n[right_edge], r), part);
+    }
+    return edge_location(left_edge, (*part).n[left_edge] - row_side_index(row, (*part).n[left_edge], r), part);
+}
+
+// Pieces of a thin part: two per band of `band_rows` rows.
+fn band_pieces(part: ptr<function, PartPlan>) -> u32 {
+    let base = band_base((*part).n);
+    let r = max((*part).n[(base + 1u) % 3u], (*part).n[(base + 2u) % 3u]);
+    let step = band_rows();
+    return 2u * ((r + step - 1u) / step);
+}
+
+// Piece `cell` of a thin part: of band cell / 2's quad (L_k0, R_k0, R_k1, L_k1), the triangle
+// (L_k0, R_k0, R_k1) (even cells) or (L_k0, R_k1, L_k1) (odd), as locations.
+fn band_cell(cell: u32, part: ptr<function, PartPlan>) -> array<vec3<u32>, 3> {
+    let base = band_base((*part).n);
+    let r = max((*part).n[(base + 1u) % 3u], (*part).n[(base + 2u) % 3u]);
+    let k0 = min(cell / 2u * band_rows(), r);
+    let k1 = min(k0 + band_rows(), r);
+    if (cell % 2u == 0u) {
+        return array<vec3<u32>, 3>(band_row_end(k0, false, part), band_row_end(k0, true, part), band_row_end(k1, true, part));
+    }
+    return array<vec3<u32>, 3>(band_row_end(k0, false, part), band_row_end(k1, true, part), band_row_end(k1, false, part));
+}
+
+fn macro_node(abc: vec3<u32>, loc: vec3<u32>, part: ptr<function, PartPlan>) -> Node {
+    if (loc.x == CORNER) {
+        return corner(loc.y, part);
+    }
+    if (loc.x == ON_EDGE) {
+        return edge_point(corner(loc.y, part), corner((loc.y + 1u) % 3u, part), loc.z, (*part).n[loc.y]);
+    }
+    return weighted((*part).corner, vec3<f32>(abc) / f32((*part).k));
+}
+
+// ---- a piece's rows (`Rows`, `Subdivider::piece_shape`) ----
+
+const ROWS_SHAPE: u32 = 5u; // `strip_base` of a piece drawn in rows
+
+// Row k's left (edge base + 2, from the apex) or right (edge base + 1) end: the side's node at
+// the row's fraction k/R of the way to the apex (`Rows::row_ends`).
+fn row_end(k: u32, right: bool, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Node {
+    let base = (*piece_state).row_base;
+    let sides = (*piece_state).strip_n;
+    let r = max(sides.x, sides.y);
+    if (right) {
+        return node_on_edge((base + 1u) % 3u, row_side_index(k, sides.y, r), part, piece_state);
+    }
+    return node_on_edge((base + 2u) % 3u, sides.x - row_side_index(k, sides.x, r), part, piece_state);
+}
+
+// The least distance of a triangle's footprint from the vertical axis (`footprint_radius`).
+fn footprint_radius(q: array<Node, 3>) -> f32 {
+    var r_min = 1e30;
+    for (var e = 0u; e < 3u; e++) {
+        let a = q[e].position.xz;
+        let b = q[(e + 1u) % 3u].position.xz;
+        let ab = b - a;
+        let t = clamp(-dot(a, ab) / max(dot(ab, ab), 1e-30), 0.0, 1.0);
+        r_min = min(r_min, length(a + t * ab));
+    }
+    return r_min;
+}
+
+// The parts across (1 to cap) band b (rows b and b + 1) needs for the zipper's diagonals,
+// estimated from its two whole diagonals (`band_parts`).
+fn band_parts(b: u32, cap: u32, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> u32 {
+    let l0 = row_end(b, false, part, piece_state).position;
+    let r0 = row_end(b, true, part, piece_state).position;
+    let l1 = row_end(b + 1u, false, part, piece_state).position;
+    let r1 = row_end(b + 1u, true, part, piece_state).position;
+    let p = edge_profile(l0, r1, 2u);
+    let q = edge_profile(r0, l1, 2u);
+    for (var w = 1u; w < cap; w++) {
+        if (diagonal_fits(p, w, tri) && diagonal_fits(q, w, tri)) {
+            return w;
+        }
+    }
+    return cap;
+}
+
+// Under an adaptive rule, the piece's rows: their widths in `row_w`, and (candidate triangles,
+// nodes); (u32 max, 0) where the piece has fewer than two rows or the rule is not adaptive.
+fn plan_rows(tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> vec2<u32> {
+    let counts = (*piece_state).counts;
+    let base = band_base(counts);
+    let sides = vec2<u32>(counts[(base + 2u) % 3u], counts[(base + 1u) % 3u]);
+    let r = max(sides.x, sides.y);
+    // Not within 2·d_e of the axis, where every measure of a row jumps with its last bit.
+    if (!is_adaptive() || r < 2u || footprint_radius((*piece_state).corner) < 2.0 * params.projection.eye_radius) {
+        return vec2<u32>(0xffffffffu, 0u);
+    }
+    (*piece_state).row_base = base;
+    (*piece_state).strip_n = sides;
+    let cap = clamp(2u * params.max_div, 1u, PIECE_DIVISIONS);
+    (*piece_state).row_w[0] = counts[base];
+    var below = 0u;
+    for (var row = 1u; row < r; row++) {
+        let left = row_end(row, false, part, piece_state).position;
+        let right = row_end(row, true, part, piece_state).position;
+        let own = min(min(edge_divisions(left, right, tri), 2u * params.max_div), PIECE_DIVISIONS);
+        let above = band_parts(row, cap, tri, part, piece_state);
+        if (row == 1u) {
+            below = band_parts(0u, cap, tri, part, piece_state);
+        }
+        (*piece_state).row_w[row] = clamp(max(max(own, below), above), 1u, cap);
+        below = above;
+    }
+    (*piece_state).row_w[r] = 0u;
+    var candidates = 0u;
+    var nodes = 1u;
+    for (var k = 0u; k < r; k++) {
+        candidates += (*piece_state).row_w[k] + (*piece_state).row_w[k + 1u];
+        nodes += (*piece_state).row_w[k] + 1u;
+    }
+    return vec2<u32>(candidates, nodes);
+}
+
+// Node a of row k (`Rows::row_node`): the base edge's own nodes on row 0, else the point a/w of
+// the way between the row's ends.
+fn row_node(k: u32, a: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Node {
+    if (k == 0u) {
+        return node_on_edge((*piece_state).row_base, a, part, piece_state);
+    }
+    return edge_point(row_end(k, false, part, piece_state), row_end(k, true, part, piece_state), a, max((*piece_state).row_w[k], 1u));
+}
+
+// The next triangle of the rows' zipper (`Rows::triangles`) at `walk` = (i on row k, j on row
+// k + 1, k, row k's first slot): its slots, and its corners as (row, node) in `at`; advances the
+// walk, to the next band when this one is done.
+fn rows_step(walk: ptr<function, vec4<u32>>, at: ptr<function, array<vec2<u32>, 3>>, piece_state: ptr<function, PieceState>) -> vec3<u32> {
+    var k = (*walk).z;
+    var start = (*walk).w;
+    if ((*walk).x + (*walk).y == (*piece_state).row_w[k] + (*piece_state).row_w[k + 1u]) {
+        start += (*piece_state).row_w[k] + 1u;
+        k += 1u;
+        *walk = vec4<u32>(0u, 0u, k, start);
+    }
+    let w = (*piece_state).row_w[k];
+    let w2 = (*piece_state).row_w[k + 1u];
+    let i = (*walk).x;
+    let j = (*walk).y;
+    let next = start + w + 1u;
+    // `rows_advance_lower`: at a shared left end one step along the lower row, then the upper.
+    let sides = (*piece_state).strip_n;
+    let r = max(sides.x, sides.y);
+    let shared_left = row_side_index(k, sides.x, r) == row_side_index(k + 1u, sides.x, r);
+    var lower = (i + 1u) * w2 <= (j + 1u) * w;
+    if (shared_left && j == 0u) {
+        lower = i == 0u;
+    }
+    if (i < w && (j >= w2 || lower)) {
+        (*walk).x = i + 1u;
+        *at = array<vec2<u32>, 3>(vec2<u32>(k, i), vec2<u32>(k, i + 1u), vec2<u32>(k + 1u, j));
+        return vec3<u32>(start + i, start + i + 1u, next + j);
+    }
+    (*walk).y = j + 1u;
+    *at = array<vec2<u32>, 3>(vec2<u32>(k, i), vec2<u32>(k + 1u, j + 1u), vec2<u32>(k + 1u, j));
+    return vec3<u32>(start + i, next + j + 1u, next + j);
+}

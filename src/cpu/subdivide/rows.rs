@@ -1,0 +1,287 @@
+//! CPU twin of `shaders/shared/subdivide_rows.wgsl`: a long thin part's bands and a piece's rows
+//! (see the module doc of `cpu::subdivide`).
+//!
+//! **Rows.** Rows parallel to a piece's base edge (the first edge with the fewest parts), row k
+//! of R (the larger side's count) meeting each side at its node ⌊k·n/R⌋ from the base, each row
+//! in as many parts as it and its zipper's diagonals need; consecutive rows zipped. About rows ×
+//! width triangles where the regular lattice makes m².
+//!
+//! **Bands.** A long thin part (K ≥ 3, its base within N_max parts) cut into bands of N_max of
+//! its rows, two pieces per band, instead of K² macro cells.
+
+use glam::Vec2;
+
+use super::edges::Limits;
+use super::{edge_point, Node, Subdivider};
+use crate::core::settings::SplitRule;
+use crate::encoding::constants::PIECE_DIVISIONS;
+
+/// How `plan` cuts a part into pieces: the K² cells of its macro lattice of level K, or, for a
+/// long thin part under an adaptive rule, its bands ([`band_cell`]): K ≥ 3 and its base (the
+/// edge with the fewest divisions) within one piece's N_max. The macro lattice would cut such a
+/// part into K² cells, most of them as wide as the part; its bands make 2 per N_max steps along it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PartSplit {
+    pub n: [u32; 3],
+    pub k: u32,
+    /// Whether the pieces are bands (else macro cells).
+    pub bands: bool,
+}
+
+impl PartSplit {
+    pub fn new(n: [u32; 3], k: u32, adaptive: bool, max_div: u32) -> PartSplit {
+        let base = band_base(n);
+        PartSplit { n, k, bands: adaptive && k >= 3 && n[base] <= band_rows(max_div) }
+    }
+
+    /// Piece records: two per band, or the K² cells.
+    pub fn pieces(self, max_div: u32) -> u32 {
+        if self.bands {
+            2 * band_count(self.n, max_div)
+        } else {
+            self.k * self.k
+        }
+    }
+}
+
+/// A thin part's base: the first edge with the fewest divisions (corner `base` → `base` + 1;
+/// the apex is corner `base` + 2).
+pub fn band_base(n: [u32; 3]) -> usize {
+    (0..3).min_by_key(|&e| n[e]).unwrap_or(0)
+}
+
+/// Steps along a thin part's sides per band: N_max (at most `PIECE_DIVISIONS`).
+pub fn band_rows(max_div: u32) -> u32 {
+    max_div.clamp(1, PIECE_DIVISIONS)
+}
+
+/// A thin part's bands: its rows, R = the larger side's count, `band_rows` at a time.
+pub fn band_count(n: [u32; 3], max_div: u32) -> u32 {
+    let base = band_base(n);
+    n[(base + 1) % 3].max(n[(base + 2) % 3]).div_ceil(band_rows(max_div))
+}
+
+/// Where row `row` of a thin part (of R = the larger side's count, parallel to the base, at the
+/// row's fraction of the way to the apex on each side's fine nodes, [`row_side_index`]) meets
+/// its left side (corner `base` → apex, edge `base` + 2 reversed) and its right side (corner
+/// `base` + 1 → apex, edge `base` + 1): each as (edge, fine index from that edge's start).
+pub fn band_row_ends(n: [u32; 3], row: u32) -> [(usize, u32); 2] {
+    let base = band_base(n);
+    let (left, right) = ((base + 2) % 3, (base + 1) % 3);
+    let r = n[left].max(n[right]);
+    [(left, n[left] - row_side_index(row, n[left], r)), (right, row_side_index(row, n[right], r))]
+}
+
+/// The node, counted from the base, where row k of R meets a side of `count` ≤ R parts: the
+/// row's fraction k/R of the way rounded down, so that only the last row reaches the apex (a
+/// side that reached it earlier would leave rows lying along the other side, bands of no area)
+/// and each step between rows advances a side by at most one node.
+pub fn row_side_index(k: u32, count: u32, r: u32) -> u32 {
+    k * count / r.max(1)
+}
+
+/// Piece `cell` of a thin part split in bands: band `cell` / 2 between rows k0 = `band_rows`·band
+/// and k1 (the next band's first row, or the apex), and of that band's quad (L_k0, R_k0, R_k1,
+/// L_k1) the triangle (L_k0, R_k0, R_k1) (even cells) or (L_k0, R_k1, L_k1) (odd), the part's
+/// winding: each corner as (edge, fine index). Every corner lies on the part's edges, so the
+/// piece's sides along them keep their fine nodes and neighbours meet without cracks.
+pub fn band_cell(n: [u32; 3], max_div: u32, cell: u32) -> [(usize, u32); 3] {
+    let base = band_base(n);
+    let r = n[(base + 1) % 3].max(n[(base + 2) % 3]);
+    let k0 = (cell / 2 * band_rows(max_div)).min(r);
+    let k1 = (k0 + band_rows(max_div)).min(r);
+    let ([l0, r0], [l1, r1]) = (band_row_ends(n, k0), band_row_ends(n, k1));
+    if cell % 2 == 0 {
+        [l0, r0, r1]
+    } else {
+        [l0, r1, l1]
+    }
+}
+
+/// Whether the zipper between rows of `w` and `w2` parts at (i, j) advances on the lower row:
+/// its next node lies at the smaller fraction of the way (the lower first on a tie), or the upper
+/// row is done. Where the rows share their left end (the left side did not advance between
+/// them), one step along the lower row (a triangle of no area, dropped), then one along the
+/// upper: every other triangle with that end and two nodes of one row would lie on that row.
+/// (The right ends need no such rule: the lower row reaches its end only from the upper's last
+/// part, whose triangle is the one at that end.)
+pub(super) fn rows_advance_lower(i: u32, j: u32, [w, w2]: [u32; 2], shared_left: bool) -> bool {
+    if i >= w {
+        return false;
+    }
+    if j >= w2 {
+        return true;
+    }
+    if shared_left && j == 0 {
+        return i == 0;
+    }
+    (i + 1) * w2 <= (j + 1) * w
+}
+
+/// A piece drawn in rows ([`Rows::triangles`]): rows parallel to its base edge (the first edge
+/// with the fewest divisions), from the base to the apex (the opposite corner), each row in as
+/// many parts as it and its zipper's diagonals need; consecutive rows zipped into a strip. A thin
+/// piece (a band near a pole, a strip along a wall) then makes about (rows × its width in parts)
+/// triangles instead of the regular lattice's m². The base and the two sides keep their own
+/// nodes, so neighbours still meet without cracks; the rows are interior.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Rows {
+    /// The base edge (corner `base` → `base` + 1); the apex is corner `base` + 2.
+    pub base: usize,
+    /// The sides' counts: left (corner `base` → apex, edge `base` + 2 reversed) and right
+    /// (corner `base` + 1 → apex, edge `base` + 1).
+    pub sides: [u32; 2],
+    /// Each row's parts, from the base (its count) to the apex (0): max(sides) + 1 rows.
+    pub widths: Vec<u32>,
+}
+
+impl Rows {
+    /// The base edge of a piece's rows and the rows' count (the larger side's count).
+    pub fn base_of(counts: [u32; 3]) -> (usize, u32) {
+        let base = band_base(counts);
+        (base, counts[(base + 1) % 3].max(counts[(base + 2) % 3]))
+    }
+
+    /// Row k's ends (left, right): the sides' nodes at the row's fraction k/R of the way to the
+    /// apex ([`row_side_index`]); `node_on_edge(e, j)` is edge e's j-th node from corner e.
+    pub fn row_ends(base: usize, sides: [u32; 2], k: u32, node_on_edge: &dyn Fn(usize, u32) -> Node) -> [Node; 2] {
+        let r = sides[0].max(sides[1]);
+        let [i, j] = [row_side_index(k, sides[0], r), row_side_index(k, sides[1], r)];
+        [node_on_edge((base + 2) % 3, sides[0] - i), node_on_edge((base + 1) % 3, j)]
+    }
+
+    /// Nodes: each row's w + 1, the apex's one.
+    pub fn node_count(&self) -> u32 {
+        self.widths.iter().map(|w| w + 1).sum()
+    }
+
+    /// Candidate triangles: between rows k and k + 1, w_k + w_(k+1).
+    pub fn candidates(&self) -> u32 {
+        self.widths.windows(2).map(|w| w[0] + w[1]).sum()
+    }
+    /// Node a of row k: on the base row the base edge's own nodes, else the point a/w of the
+    /// way between the row's ends ([`edge_point`], exact at the ends).
+    pub fn row_node(&self, k: u32, a: u32, node_on_edge: &dyn Fn(usize, u32) -> Node) -> Node {
+        if k == 0 {
+            return node_on_edge(self.base, a);
+        }
+        let [left, right] = Self::row_ends(self.base, self.sides, k, node_on_edge);
+        edge_point(left, right, a, self.widths[k as usize].max(1))
+    }
+    /// Every node, row by row (the output's slot order).
+    pub fn nodes(&self, node_on_edge: &dyn Fn(usize, u32) -> Node) -> Vec<Node> {
+        self.widths
+            .iter()
+            .zip(0..)
+            .flat_map(|(&w, k)| (0..=w).map(move |a| (k, a)))
+            .map(|(k, a)| self.row_node(k, a, node_on_edge))
+            .collect()
+    }
+    /// The triangles: rows k (nodes A_0..A_w from left to right) and k + 1 (B_0..B_w') zipped
+    /// ([`rows_advance_lower`]), making (A_i, A_i+1, B_j) or (A_i, B_j+1, B_j), the piece's
+    /// winding. Where a side did not advance between the rows, a triangle at that end has two
+    /// coincident corners and is dropped. Each triangle as its corners' slots and nodes.
+    pub fn triangles(&self, node_on_edge: &dyn Fn(usize, u32) -> Node) -> Vec<([u32; 3], [Node; 3])> {
+        let nodes = self.nodes(node_on_edge);
+        let mut out = Vec::new();
+        let mut start = 0;
+        let r = self.sides[0].max(self.sides[1]);
+        for k in 0..self.widths.len() - 1 {
+            let (w, w2) = (self.widths[k], self.widths[k + 1]);
+            let next = start + w + 1;
+            let shared = row_side_index(k as u32, self.sides[0], r) == row_side_index(k as u32 + 1, self.sides[0], r);
+            let (mut i, mut j) = (0, 0);
+            for _ in 0..w + w2 {
+                let slots = if rows_advance_lower(i, j, [w, w2], shared) {
+                    i += 1;
+                    [start + i - 1, start + i, next + j]
+                } else {
+                    j += 1;
+                    [start + i, next + j, next + j - 1]
+                };
+                let t = slots.map(|s| nodes[s as usize]);
+                if t[0].position != t[1].position && t[1].position != t[2].position && t[2].position != t[0].position {
+                    out.push((slots, t));
+                }
+            }
+            start = next;
+        }
+        out
+    }
+}
+
+impl Subdivider<'_> {
+    /// Under an adaptive rule, a piece's rows (`piece_shape` keeps them where they make fewer
+    /// candidate triangles than the lattice): the base row in its edge's parts, the apex's none,
+    /// each other row in as many as it needs itself (the interior rule) and as its two bands'
+    /// diagonals need ([`Subdivider::band_parts`]), at least one and at most 2·N_max. None with
+    /// fewer than two rows, or within 2·d_e of the axis, where the eye circle's α ∝ √(r − d_e)
+    /// makes every measure of a row jump with its last bit (the GPU's rows and the twin's would
+    /// differ).
+    pub(super) fn rows(
+        &self,
+        counts: [u32; 3],
+        q: &[Node; 3],
+        limits: Limits,
+        k: u32,
+        node_on_edge: &dyn Fn(usize, u32) -> Node,
+    ) -> Option<Rows> {
+        let (base, r) = Rows::base_of(counts);
+        if !SplitRule::is_adaptive(self.params.method)
+            || r < 2
+            || footprint_radius(q) < 2.0 * self.projection.eye_radius
+        {
+            return None;
+        }
+        let sides = [counts[(base + 2) % 3], counts[(base + 1) % 3]];
+        let cap = self.params.max_div.saturating_mul(2).clamp(1, PIECE_DIVISIONS);
+        let mut widths = vec![counts[base]];
+        let mut below = 0; // the parts band row − 1 needs
+        for row in 1..r {
+            let [left, right] = Rows::row_ends(base, sides, row, node_on_edge);
+            let own = self.interior_divisions(left.position, right.position, limits, k);
+            let above = self.band_parts(base, sides, row, limits, cap, node_on_edge);
+            let below_row = if row == 1 { self.band_parts(base, sides, 0, limits, cap, node_on_edge) } else { below };
+            widths.push(own.max(below_row).max(above).clamp(1, cap));
+            below = above;
+        }
+        widths.push(0);
+        Some(Rows { base, sides, widths })
+    }
+
+    /// The parts across (1 to `cap`) that band b of a piece's rows (rows b and b + 1) needs for
+    /// the zipper's diagonals: each spans a side's step along and a row's part across, and the
+    /// projection's mixed term bends it in proportion to the part across, which neither the
+    /// row's nor the side's own bend shows (a vertical row on a wall is straight on the sphere, a
+    /// slanted line is not). Estimated from the band's two whole diagonals
+    /// ([`Subdivider::diagonal_fits`]): split across in w parts, each diagonal of the zipper
+    /// bends about 1/w as much.
+    fn band_parts(
+        &self,
+        base: usize,
+        sides: [u32; 2],
+        b: u32,
+        limits: Limits,
+        cap: u32,
+        node_on_edge: &dyn Fn(usize, u32) -> Node,
+    ) -> u32 {
+        let [l0, r0] = Rows::row_ends(base, sides, b, node_on_edge).map(|n| n.position);
+        let [l1, r1] = Rows::row_ends(base, sides, b + 1, node_on_edge).map(|n| n.position);
+        let (p, q) = (self.edge_profile(l0, r1, 2), self.edge_profile(r0, l1, 2));
+        (1..cap).find(|&w| self.diagonal_fits(p, w, limits) && self.diagonal_fits(q, w, limits)).unwrap_or(cap)
+    }
+}
+
+/// The least distance of a triangle's footprint (x, z) from the vertical axis, which it misses:
+/// the nearest point of one of its edges. `footprint_radius` in the WGSL.
+fn footprint_radius(q: &[Node; 3]) -> f32 {
+    let mut r_min = f32::INFINITY;
+    for e in 0..3 {
+        let a = Vec2::new(q[e].position.x, q[e].position.z);
+        let b = Vec2::new(q[(e + 1) % 3].position.x, q[(e + 1) % 3].position.z);
+        let ab = b - a;
+        let t = (-a.dot(ab) / ab.dot(ab).max(1e-30)).clamp(0.0, 1.0);
+        r_min = r_min.min((a + t * ab).length());
+    }
+    r_min
+}
