@@ -81,6 +81,11 @@ fn macro_node(abc: vec3<u32>, loc: vec3<u32>, part: ptr<function, PartPlan>) -> 
 
 const ROWS_SHAPE: u32 = 5u; // `strip_base` of a piece drawn in rows
 
+// Whether the `lattice` pipeline plans rows at all: the frame's method is adaptive. Built apart
+// for the other methods (false), whose `lattice` lavapipe runs ~40 % slower when the rows' code
+// is merely in it.
+override ROWS: bool = true;
+
 // Row k's left (edge base + 2, from the apex) or right (edge base + 1) end: the side's node at
 // the row's fraction k/R of the way to the apex (`Rows::row_ends`).
 fn row_end(k: u32, right: bool, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Node {
@@ -91,19 +96,6 @@ fn row_end(k: u32, right: bool, part: ptr<function, PartPlan>, piece_state: ptr<
         return node_on_edge((base + 1u) % 3u, row_side_index(k, sides.y, r), part, piece_state);
     }
     return node_on_edge((base + 2u) % 3u, sides.x - row_side_index(k, sides.x, r), part, piece_state);
-}
-
-// The least distance of a triangle's footprint from the vertical axis (`footprint_radius`).
-fn footprint_radius(q: array<Node, 3>) -> f32 {
-    var r_min = 1e30;
-    for (var e = 0u; e < 3u; e++) {
-        let a = q[e].position.xz;
-        let b = q[(e + 1u) % 3u].position.xz;
-        let ab = b - a;
-        let t = clamp(-dot(a, ab) / max(dot(ab, ab), 1e-30), 0.0, 1.0);
-        r_min = min(r_min, length(a + t * ab));
-    }
-    return r_min;
 }
 
 // The parts across (1 to cap) band b (rows b and b + 1) needs for the zipper's diagonals,
@@ -130,8 +122,7 @@ fn plan_rows(tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, p
     let base = band_base(counts);
     let sides = vec2<u32>(counts[(base + 2u) % 3u], counts[(base + 1u) % 3u]);
     let r = max(sides.x, sides.y);
-    // Not within 2·d_e of the axis, where every measure of a row jumps with its last bit.
-    if (!is_adaptive() || r < 2u || footprint_radius((*piece_state).corner) < 2.0 * params.projection.eye_radius) {
+    if (!ROWS || !is_adaptive() || r < 2u) {
         return vec2<u32>(0xffffffffu, 0u);
     }
     (*piece_state).row_base = base;

@@ -11,7 +11,7 @@
 use std::sync::OnceLock;
 
 use crate::core::projection::PanoramaKind;
-use crate::core::settings::RenderSettings;
+use crate::core::settings::{RenderSettings, SplitRule};
 use crate::encoding::constants::PIECES_FROM_COUNTER;
 use crate::encoding::recording::{Command, Recording};
 use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine, INDICES_SIZE, NODE_SIZE};
@@ -40,33 +40,41 @@ impl Variant {
     }
 }
 
-/// The `subdivide` stage: its layouts, and its pipelines built for each panorama when first
-/// needed (the WGSL `override PANORAMAS` compiles the other panorama's projection out).
+/// The `subdivide` stage: its layouts, and its pipelines built for each panorama and kind of
+/// split rule when first needed (the WGSL `override PANORAMAS` compiles the other panorama's
+/// projection out, `override ROWS` the rows of `lattice` for the rules that never use them).
 pub(crate) struct SubdivideStage {
     stage: GpuStage,
-    variants: [OnceLock<Variant>; 2],
+    variants: [OnceLock<Variant>; 4],
 }
 
 impl SubdivideStage {
     /// The stage; each panorama's pipelines are built when a frame first needs them.
     pub fn new(gpu: &Gpu) -> SubdivideStage {
-        SubdivideStage { stage: GpuStage::new(gpu, &SUBDIVIDE), variants: [OnceLock::new(), OnceLock::new()] }
+        SubdivideStage { stage: GpuStage::new(gpu, &SUBDIVIDE), variants: Default::default() }
     }
 
-    fn variant(&self, gpu: &Gpu, panorama: PanoramaKind) -> &Variant {
+    /// The pipelines for a panorama and a frame's split rule (`params.method`: rows for the
+    /// adaptive rules only).
+    fn variant(&self, gpu: &Gpu, panorama: PanoramaKind, params: &SubdivideParams) -> &Variant {
         let (k, bits) = match panorama {
             PanoramaKind::Cylinder => (0, 1.0),
             PanoramaKind::Equirect => (1, 2.0),
         };
-        self.variants[k].get_or_init(|| {
+        let rows = SplitRule::is_adaptive(params.method);
+        self.variants[2 * k + rows as usize].get_or_init(|| {
             // Built side by side: the driver's compiling of the large passes (`plan_cuts`,
             // `lattice`) is most of a fresh process's time.
             let constants = [("PANORAMAS", bits)];
+            let with_rows = [("PANORAMAS", bits), ("ROWS", if rows { 1.0 } else { 0.0 })];
             let pipelines = std::thread::scope(|scope| {
                 let builds: Vec<_> = SUBDIVIDE
                     .entry_points
                     .iter()
-                    .map(|e| (e.name, scope.spawn(|| self.stage.compute_with(gpu, e.name, &constants))))
+                    .map(|e| {
+                        let constants: &[(&str, f64)] = if e.name == "lattice" { &with_rows } else { &constants };
+                        (e.name, scope.spawn(move || self.stage.compute_with(gpu, e.name, constants)))
+                    })
                     .collect();
                 builds.into_iter().map(|(name, b)| (name, b.join().expect("a pipeline build panicked"))).collect()
             });
@@ -87,10 +95,10 @@ impl SubdivideStage {
         enc: &mut wgpu::CommandEncoder,
         recording: &Recording,
         frame: &FrameBuffers,
-        panorama: PanoramaKind,
+        (panorama, params): (PanoramaKind, &SubdivideParams),
         timestamps: Option<&Timestamps>,
     ) {
-        let variant = self.variant(gpu, panorama);
+        let variant = self.variant(gpu, panorama, params);
         let mut pass: Option<wgpu::ComputePass<'static>> = None;
         for command in &recording.commands {
             match *command {
@@ -137,7 +145,7 @@ impl SubdivideStage {
         let params = SubdivideParams { first_piece: 0, piece_count: PIECES_FROM_COUNTER, ..*params };
         gpu.queue.write_buffer(uniform, 0, bytemuck::bytes_of(&params));
         let recording = one_submission(params.triangle_count, timestamps.is_some());
-        self.replay(gpu, enc, &recording, &FrameBuffers { uniform, scene, b }, panorama, timestamps);
+        self.replay(gpu, enc, &recording, &FrameBuffers { uniform, scene, b }, (panorama, &params), timestamps);
     }
 
     /// Replays `recording` with `params` as the uniform for a frame's buffers, submitted; the
@@ -152,7 +160,7 @@ impl SubdivideStage {
     ) -> Result<SubdivideCounters> {
         gpu.queue.write_buffer(frame.uniform, 0, bytemuck::bytes_of(params));
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        self.replay(gpu, &mut enc, recording, frame, panorama, None);
+        self.replay(gpu, &mut enc, recording, frame, (panorama, params), None);
         gpu.queue.submit([enc.finish()]);
         let bytes = gpu.download(&frame.b.counters, COUNTERS_SIZE)?;
         Ok(*bytemuck::from_bytes(&bytes))

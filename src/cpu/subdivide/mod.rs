@@ -323,7 +323,7 @@ impl<'a> Subdivider<'a> {
         if let Some(base) = self.strip_base(counts, q, limits) {
             return Shape::Strip(base);
         }
-        match self.rows(counts, q, limits, k, node_on_edge) {
+        match self.rows(counts, limits, k, node_on_edge) {
             Some(rows) if rows.candidates() < m * m => Shape::Rows(rows),
             _ => Shape::Lattice(m),
         }

@@ -9,8 +9,6 @@
 //! **Bands.** A long thin part (K ≥ 3, its base within N_max parts) cut into bands of N_max of
 //! its rows, two pieces per band, instead of K² macro cells.
 
-use glam::Vec2;
-
 use super::edges::Limits;
 use super::{edge_point, Node, Subdivider};
 use crate::core::settings::SplitRule;
@@ -215,22 +213,16 @@ impl Subdivider<'_> {
     /// candidate triangles than the lattice): the base row in its edge's parts, the apex's none,
     /// each other row in as many as it needs itself (the interior rule) and as its two bands'
     /// diagonals need ([`Subdivider::band_parts`]), at least one and at most 2·N_max. None with
-    /// fewer than two rows, or within 2·d_e of the axis, where the eye circle's α ∝ √(r − d_e)
-    /// makes every measure of a row jump with its last bit (the GPU's rows and the twin's would
-    /// differ).
+    /// fewer than two rows.
     pub(super) fn rows(
         &self,
         counts: [u32; 3],
-        q: &[Node; 3],
         limits: Limits,
         k: u32,
         node_on_edge: &dyn Fn(usize, u32) -> Node,
     ) -> Option<Rows> {
         let (base, r) = Rows::base_of(counts);
-        if !SplitRule::is_adaptive(self.params.method)
-            || r < 2
-            || footprint_radius(q) < 2.0 * self.projection.eye_radius
-        {
+        if !SplitRule::is_adaptive(self.params.method) || r < 2 {
             return None;
         }
         let sides = [counts[(base + 2) % 3], counts[(base + 1) % 3]];
@@ -270,18 +262,4 @@ impl Subdivider<'_> {
         let (p, q) = (self.edge_profile(l0, r1, 2), self.edge_profile(r0, l1, 2));
         (1..cap).find(|&w| self.diagonal_fits(p, w, limits) && self.diagonal_fits(q, w, limits)).unwrap_or(cap)
     }
-}
-
-/// The least distance of a triangle's footprint (x, z) from the vertical axis, which it misses:
-/// the nearest point of one of its edges. `footprint_radius` in the WGSL.
-fn footprint_radius(q: &[Node; 3]) -> f32 {
-    let mut r_min = f32::INFINITY;
-    for e in 0..3 {
-        let a = Vec2::new(q[e].position.x, q[e].position.z);
-        let b = Vec2::new(q[(e + 1) % 3].position.x, q[(e + 1) % 3].position.z);
-        let ab = b - a;
-        let t = (-a.dot(ab) / ab.dot(ab).max(1e-30)).clamp(0.0, 1.0);
-        r_min = r_min.min((a + t * ab).length());
-    }
-    r_min
 }
