@@ -81,9 +81,9 @@ fn macro_node(abc: vec3<u32>, loc: vec3<u32>, part: ptr<function, PartPlan>) -> 
 
 const ROWS_SHAPE: u32 = 5u; // `strip_base` of a piece drawn in rows
 
-// Whether the `lattice` pipeline plans rows at all: the frame's method is adaptive. Built apart
-// for the other methods (false), whose `lattice` lavapipe runs ~40 % slower when the rows' code
-// is merely in it.
+// Whether the `lattice` pipeline plans rows at all: the full sphere under an adaptive rule. Built
+// apart for the other frames (false): lavapipe runs their `lattice` ~40 % slower, and builds it
+// ~0.3 s slower in a fresh process, when the rows' code is merely in it.
 override ROWS: bool = true;
 
 // Row k's left (edge base + 2, from the apex) or right (edge base + 1) end: the side's node at
@@ -105,41 +105,45 @@ fn band_parts(b: u32, cap: u32, tri: ptr<function, InputTriangle>, part: ptr<fun
     let r0 = row_end(b, true, part, piece_state).position;
     let l1 = row_end(b + 1u, false, part, piece_state).position;
     let r1 = row_end(b + 1u, true, part, piece_state).position;
-    let p = edge_profile(l0, r1, 2u);
-    let q = edge_profile(r0, l1, 2u);
+    // One call site of the profile (lavapipe inlines each: its time to build the pipeline grows
+    // with every copy).
+    var whole: array<EdgeProfile, 2>;
+    for (var d = 0u; d < 2u; d++) {
+        whole[d] = edge_profile(select(l0, r0, d == 1u), select(r1, l1, d == 1u), 2u);
+    }
     for (var w = 1u; w < cap; w++) {
-        if (diagonal_fits(p, w, tri) && diagonal_fits(q, w, tri)) {
+        if (diagonal_fits(whole[0], w, tri) && diagonal_fits(whole[1], w, tri)) {
             return w;
         }
     }
     return cap;
 }
 
-// Under an adaptive rule, the piece's rows: their widths in `row_w`, and (candidate triangles,
-// nodes); (u32 max, 0) where the piece has fewer than two rows or the rule is not adaptive.
+// On the sphere, under an adaptive rule, the piece's rows: their widths in `row_w`, and
+// (candidate triangles, nodes); (u32 max, 0) where the piece has fewer than two rows, or another
+// panorama or rule.
 fn plan_rows(tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> vec2<u32> {
     let counts = (*piece_state).counts;
     let base = band_base(counts);
     let sides = vec2<u32>(counts[(base + 2u) % 3u], counts[(base + 1u) % 3u]);
     let r = max(sides.x, sides.y);
-    if (!ROWS || !is_adaptive() || r < 2u) {
+    if (!ROWS || !is_adaptive() || !is_sphere(params.projection) || r < 2u) {
         return vec2<u32>(0xffffffffu, 0u);
     }
     (*piece_state).row_base = base;
     (*piece_state).strip_n = sides;
     let cap = clamp(2u * params.max_div, 1u, PIECE_DIVISIONS);
+    // Each band's need first (one call site of `band_parts`), then each row's own.
+    var need: array<u32, 32>;
+    for (var b = 0u; b < r; b++) {
+        need[b] = band_parts(b, cap, tri, part, piece_state);
+    }
     (*piece_state).row_w[0] = counts[base];
-    var below = 0u;
     for (var row = 1u; row < r; row++) {
         let left = row_end(row, false, part, piece_state).position;
         let right = row_end(row, true, part, piece_state).position;
         let own = min(min(edge_divisions(left, right, tri), 2u * params.max_div), PIECE_DIVISIONS);
-        let above = band_parts(row, cap, tri, part, piece_state);
-        if (row == 1u) {
-            below = band_parts(0u, cap, tri, part, piece_state);
-        }
-        (*piece_state).row_w[row] = clamp(max(max(own, below), above), 1u, cap);
-        below = above;
+        (*piece_state).row_w[row] = clamp(max(max(own, need[row - 1u]), need[row]), 1u, cap);
     }
     (*piece_state).row_w[r] = 0u;
     var candidates = 0u;

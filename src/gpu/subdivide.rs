@@ -42,7 +42,7 @@ impl Variant {
 
 /// The `subdivide` stage: its layouts, and its pipelines built for each panorama and kind of
 /// split rule when first needed (the WGSL `override PANORAMAS` compiles the other panorama's
-/// projection out, `override ROWS` the rows of `lattice` for the rules that never use them).
+/// projection out, `override ROWS` the rows of `lattice` for the frames that never use them).
 pub(crate) struct SubdivideStage {
     stage: GpuStage,
     variants: [OnceLock<Variant>; 4],
@@ -54,14 +54,14 @@ impl SubdivideStage {
         SubdivideStage { stage: GpuStage::new(gpu, &SUBDIVIDE), variants: Default::default() }
     }
 
-    /// The pipelines for a panorama and a frame's split rule (`params.method`: rows for the
-    /// adaptive rules only).
+    /// The pipelines for a panorama and a frame's split rule (`params.method`): rows on the
+    /// sphere under the adaptive rules only.
     fn variant(&self, gpu: &Gpu, panorama: PanoramaKind, params: &SubdivideParams) -> &Variant {
         let (k, bits) = match panorama {
             PanoramaKind::Cylinder => (0, 1.0),
             PanoramaKind::Equirect => (1, 2.0),
         };
-        let rows = SplitRule::is_adaptive(params.method);
+        let rows = SplitRule::is_adaptive(params.method) && panorama == PanoramaKind::Equirect;
         self.variants[2 * k + rows as usize].get_or_init(|| {
             // Built side by side: the driver's compiling of the large passes (`plan_cuts`,
             // `lattice`) is most of a fresh process's time.

@@ -103,6 +103,20 @@ fn subdivide_cases() -> Vec<(Scene, RenderSettings)> {
                 .with_method(Method::Vertex),
         ),
         (random_triangle_scene(7, 200), RenderSettings::new(Projection::equirect(256)).with_method(Method::Fixed(3))),
+        // Rows (the sphere, adaptive rules): random triangles, the box room (long thin parts in
+        // bands), eq. 5, a viewer off the axis.
+        (random_triangle_scene(9, 200), RenderSettings::new(Projection::equirect(320))),
+        (
+            builtin::builtin_scene("builtin:box-room", &projection).unwrap(),
+            RenderSettings::new(Projection::equirect(256)),
+        ),
+        (
+            builtin::demo(),
+            RenderSettings::new(Projection::equirect(256))
+                .with_viewer(Vec3::new(0.7, 0.2, -0.4))
+                .with_method(Method::Adaptive(Split::Length))
+                .with_edge_px(12.0),
+        ),
     ]
 }
 

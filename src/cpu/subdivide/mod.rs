@@ -52,7 +52,7 @@
 //! cracks, and the error bound is the lattice's. Not on the sphere,
 //! where a sliver reaching towards a pole bends ever more towards its apex.
 //!
-//! **Rows (adaptive rules, both panoramas).** A piece may instead be drawn in rows parallel to
+//! **Rows (the full sphere, adaptive rules).** A piece may instead be drawn in rows parallel to
 //! its base edge (the one with the fewest parts), from the base to the apex, each row in as many
 //! parts as it and its zipper's diagonals need (see [`Rows`] and `Subdivider::piece_shape`),
 //! consecutive rows zipped: about rows × width triangles where the lattice makes m². Used where

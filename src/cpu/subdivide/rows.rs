@@ -11,6 +11,7 @@
 
 use super::edges::Limits;
 use super::{edge_point, Node, Subdivider};
+use crate::core::projection::PanoramaKind;
 use crate::core::settings::SplitRule;
 use crate::encoding::constants::PIECE_DIVISIONS;
 
@@ -209,7 +210,7 @@ impl Rows {
 }
 
 impl Subdivider<'_> {
-    /// Under an adaptive rule, a piece's rows (`piece_shape` keeps them where they make fewer
+    /// On the sphere, under an adaptive rule, a piece's rows (`piece_shape` keeps them where they make fewer
     /// candidate triangles than the lattice): the base row in its edge's parts, the apex's none,
     /// each other row in as many as it needs itself (the interior rule) and as its two bands'
     /// diagonals need ([`Subdivider::band_parts`]), at least one and at most 2·N_max. None with
@@ -222,7 +223,7 @@ impl Subdivider<'_> {
         node_on_edge: &dyn Fn(usize, u32) -> Node,
     ) -> Option<Rows> {
         let (base, r) = Rows::base_of(counts);
-        if !SplitRule::is_adaptive(self.params.method) || r < 2 {
+        if !SplitRule::is_adaptive(self.params.method) || self.projection.panorama != PanoramaKind::Equirect || r < 2 {
             return None;
         }
         let sides = [counts[(base + 2) % 3], counts[(base + 1) % 3]];
