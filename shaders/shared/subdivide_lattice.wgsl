@@ -55,6 +55,16 @@ fn edge_location(e: u32, j: u32, part: ptr<function, PartPlan>) -> vec3<u32> {
     return vec3<u32>(ON_EDGE, e, j);
 }
 
+fn macro_node(abc: vec3<u32>, loc: vec3<u32>, part: ptr<function, PartPlan>) -> Node {
+    if (loc.x == CORNER) {
+        return corner(loc.y, part);
+    }
+    if (loc.x == ON_EDGE) {
+        return edge_point(corner(loc.y, part), corner((loc.y + 1u) % 3u, part), loc.z, (*part).n[loc.y]);
+    }
+    return weighted((*part).corner, vec3<f32>(abc) / f32((*part).k));
+}
+
 // The node's fine index along original edge oe from its start, or −1 if it is not on that edge.
 fn index_on(oe: u32, loc: vec3<u32>, part: ptr<function, PartPlan>) -> i32 {
     if (loc.x == CORNER && loc.y == oe) {

@@ -33,17 +33,23 @@ fn row_side_index(k: u32, count: u32, r: u32) -> u32 {
     return k * count / max(r, 1u);
 }
 
-// Where row `row` of a thin part meets its left side (edge base + 2, from the apex) or its right
-// side (edge base + 1), as a location (`band_row_ends`).
+// Where row k of rows on `base` with sides of `sides` (left, right) parts meets its left side
+// (edge base + 2, from the apex) or its right side (edge base + 1): (edge, fine index from that
+// edge's start) (`row_end_indices`).
+fn row_end_index(k: u32, right: bool, base: u32, sides: vec2<u32>) -> vec2<u32> {
+    let r = max(sides.x, sides.y);
+    if (right) {
+        return vec2<u32>((base + 1u) % 3u, row_side_index(k, sides.y, r));
+    }
+    return vec2<u32>((base + 2u) % 3u, sides.x - row_side_index(k, sides.x, r));
+}
+
+// Where row `row` of a thin part meets its left or right side, as a location (`band_cell`).
 fn band_row_end(row: u32, right: bool, part: ptr<function, PartPlan>) -> vec3<u32> {
     let base = band_base((*part).n);
-    let left_edge = (base + 2u) % 3u;
-    let right_edge = (base + 1u) % 3u;
-    let r = max((*part).n[left_edge], (*part).n[right_edge]);
-    if (right) {
-        return edge_location(right_edge, row_side_index(row, (*part).n[right_edge], r), part);
-    }
-    return edge_location(left_edge, (*part).n[left_edge] - row_side_index(row, (*part).n[left_edge], r), part);
+    let sides = vec2<u32>((*part).n[(base + 2u) % 3u], (*part).n[(base + 1u) % 3u]);
+    let at = row_end_index(row, right, base, sides);
+    return edge_location(at.x, at.y, part);
 }
 
 // Pieces of a thin part: two per band of `band_rows` rows.
@@ -67,16 +73,6 @@ fn band_cell(cell: u32, part: ptr<function, PartPlan>) -> array<vec3<u32>, 3> {
     return array<vec3<u32>, 3>(band_row_end(k0, false, part), band_row_end(k1, true, part), band_row_end(k1, false, part));
 }
 
-fn macro_node(abc: vec3<u32>, loc: vec3<u32>, part: ptr<function, PartPlan>) -> Node {
-    if (loc.x == CORNER) {
-        return corner(loc.y, part);
-    }
-    if (loc.x == ON_EDGE) {
-        return edge_point(corner(loc.y, part), corner((loc.y + 1u) % 3u, part), loc.z, (*part).n[loc.y]);
-    }
-    return weighted((*part).corner, vec3<f32>(abc) / f32((*part).k));
-}
-
 // ---- a piece's rows (`Rows`, `Subdivider::piece_shape`) ----
 
 const ROWS_SHAPE: u32 = 5u; // `strip_base` of a piece drawn in rows
@@ -89,13 +85,8 @@ override ROWS: bool = true;
 // Row k's left (edge base + 2, from the apex) or right (edge base + 1) end: the side's node at
 // the row's fraction k/R of the way to the apex (`Rows::row_ends`).
 fn row_end(k: u32, right: bool, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Node {
-    let base = (*piece_state).row_base;
-    let sides = (*piece_state).strip_n;
-    let r = max(sides.x, sides.y);
-    if (right) {
-        return node_on_edge((base + 1u) % 3u, row_side_index(k, sides.y, r), part, piece_state);
-    }
-    return node_on_edge((base + 2u) % 3u, sides.x - row_side_index(k, sides.x, r), part, piece_state);
+    let at = row_end_index(k, right, (*piece_state).row_base, (*piece_state).strip_n);
+    return node_on_edge(at.x, at.y, part, piece_state);
 }
 
 // The parts across (1 to cap) band b (rows b and b + 1) needs for the zipper's diagonals,

@@ -167,8 +167,9 @@ impl Subdivider<'_> {
     }
 
     /// Whether `parts` parts across a band of a piece's rows are enough for the zipper's
-    /// diagonals, judged on one of the band's whole diagonals (its quick profile `whole`): a zipper diagonal spans the band's side step and one part across, and the
-    /// projection's mixed term bends it in proportion to that part. `adaptive:length`: the
+    /// diagonals, judged on one of the band's whole diagonals (its quick profile `whole`): a
+    /// zipper diagonal spans the band's side step and one part across, and the projection's
+    /// mixed term bends it in proportion to that part. `adaptive:length`: the
     /// length within parts × L/2 (a side step of up to L plus a part of L/2 keeps it near L); the
     /// error split: the bend within parts × `ROW_DIAGONAL_ERROR`·τ (at the middle) and the length
     /// within parts × `ERROR_SPLIT_LENGTH`·L. Products, not quotients: the GPU rounds a division

@@ -56,19 +56,22 @@ pub fn band_rows(max_div: u32) -> u32 {
 
 /// A thin part's bands: its rows, R = the larger side's count, `band_rows` at a time.
 pub fn band_count(n: [u32; 3], max_div: u32) -> u32 {
-    let base = band_base(n);
-    n[(base + 1) % 3].max(n[(base + 2) % 3]).div_ceil(band_rows(max_div))
+    Rows::base_of(n).1.div_ceil(band_rows(max_div))
 }
 
-/// Where row `row` of a thin part (of R = the larger side's count, parallel to the base, at the
-/// row's fraction of the way to the apex on each side's fine nodes, [`row_side_index`]) meets
-/// its left side (corner `base` → apex, edge `base` + 2 reversed) and its right side (corner
-/// `base` + 1 → apex, edge `base` + 1): each as (edge, fine index from that edge's start).
-pub fn band_row_ends(n: [u32; 3], row: u32) -> [(usize, u32); 2] {
-    let base = band_base(n);
-    let (left, right) = ((base + 2) % 3, (base + 1) % 3);
-    let r = n[left].max(n[right]);
-    [(left, n[left] - row_side_index(row, n[left], r)), (right, row_side_index(row, n[right], r))]
+/// Where row k of rows on edge `base` with sides of `sides` (left, right) parts (R = the larger,
+/// parallel to the base, at the row's fraction of the way to the apex on each side's fine nodes,
+/// [`row_side_index`]) meets its left side (corner `base` → apex, edge `base` + 2 reversed) and
+/// its right side (corner `base` + 1 → apex, edge `base` + 1): each as (edge, fine index from that
+/// edge's start). Both a thin part's bands and a piece's rows.
+pub fn row_end_indices(base: usize, sides: [u32; 2], k: u32) -> [(usize, u32); 2] {
+    let r = sides[0].max(sides[1]);
+    [((base + 2) % 3, sides[0] - row_side_index(k, sides[0], r)), ((base + 1) % 3, row_side_index(k, sides[1], r))]
+}
+
+/// The sides' counts (left, right) of rows on edge `base`.
+fn sides_of(n: [u32; 3], base: usize) -> [u32; 2] {
+    [n[(base + 2) % 3], n[(base + 1) % 3]]
 }
 
 /// The node, counted from the base, where row k of R meets a side of `count` ≤ R parts: the
@@ -85,11 +88,11 @@ pub fn row_side_index(k: u32, count: u32, r: u32) -> u32 {
 /// winding: each corner as (edge, fine index). Every corner lies on the part's edges, so the
 /// piece's sides along them keep their fine nodes and neighbours meet without cracks.
 pub fn band_cell(n: [u32; 3], max_div: u32, cell: u32) -> [(usize, u32); 3] {
-    let base = band_base(n);
-    let r = n[(base + 1) % 3].max(n[(base + 2) % 3]);
+    let (base, r) = Rows::base_of(n);
     let k0 = (cell / 2 * band_rows(max_div)).min(r);
     let k1 = (k0 + band_rows(max_div)).min(r);
-    let ([l0, r0], [l1, r1]) = (band_row_ends(n, k0), band_row_ends(n, k1));
+    let sides = sides_of(n, base);
+    let ([l0, r0], [l1, r1]) = (row_end_indices(base, sides, k0), row_end_indices(base, sides, k1));
     if cell % 2 == 0 {
         [l0, r0, r1]
     } else {
@@ -144,9 +147,7 @@ impl Rows {
     /// Row k's ends (left, right): the sides' nodes at the row's fraction k/R of the way to the
     /// apex ([`row_side_index`]); `node_on_edge(e, j)` is edge e's j-th node from corner e.
     pub fn row_ends(base: usize, sides: [u32; 2], k: u32, node_on_edge: &dyn Fn(usize, u32) -> Node) -> [Node; 2] {
-        let r = sides[0].max(sides[1]);
-        let [i, j] = [row_side_index(k, sides[0], r), row_side_index(k, sides[1], r)];
-        [node_on_edge((base + 2) % 3, sides[0] - i), node_on_edge((base + 1) % 3, j)]
+        row_end_indices(base, sides, k).map(|(e, j)| node_on_edge(e, j))
     }
 
     /// Nodes: each row's w + 1, the apex's one.
@@ -158,6 +159,7 @@ impl Rows {
     pub fn candidates(&self) -> u32 {
         self.widths.windows(2).map(|w| w[0] + w[1]).sum()
     }
+
     /// Node a of row k: on the base row the base edge's own nodes, else the point a/w of the
     /// way between the row's ends ([`edge_point`], exact at the ends).
     pub fn row_node(&self, k: u32, a: u32, node_on_edge: &dyn Fn(usize, u32) -> Node) -> Node {
@@ -167,6 +169,7 @@ impl Rows {
         let [left, right] = Self::row_ends(self.base, self.sides, k, node_on_edge);
         edge_point(left, right, a, self.widths[k as usize].max(1))
     }
+
     /// Every node, row by row (the output's slot order).
     pub fn nodes(&self, node_on_edge: &dyn Fn(usize, u32) -> Node) -> Vec<Node> {
         self.widths
@@ -176,6 +179,7 @@ impl Rows {
             .map(|(k, a)| self.row_node(k, a, node_on_edge))
             .collect()
     }
+
     /// The triangles: rows k (nodes A_0..A_w from left to right) and k + 1 (B_0..B_w') zipped
     /// ([`rows_advance_lower`]), making (A_i, A_i+1, B_j) or (A_i, B_j+1, B_j), the piece's
     /// winding. Where a side did not advance between the rows, a triangle at that end has two
@@ -210,8 +214,8 @@ impl Rows {
 }
 
 impl Subdivider<'_> {
-    /// On the sphere, under an adaptive rule, a piece's rows (`piece_shape` keeps them where they make fewer
-    /// candidate triangles than the lattice): the base row in its edge's parts, the apex's none,
+    /// On the sphere, under an adaptive rule, a piece's rows (`piece_shape` keeps them where they
+    /// make fewer candidate triangles than the lattice): the base row in its edge's parts, the apex's none,
     /// each other row in as many as it needs itself (the interior rule) and as its two bands'
     /// diagonals need ([`Subdivider::band_parts`]), at least one and at most 2·N_max. None with
     /// fewer than two rows.
@@ -226,17 +230,15 @@ impl Subdivider<'_> {
         if !SplitRule::is_adaptive(self.params.method) || self.projection.panorama != PanoramaKind::Equirect || r < 2 {
             return None;
         }
-        let sides = [counts[(base + 2) % 3], counts[(base + 1) % 3]];
+        let sides = sides_of(counts, base);
         let cap = self.params.max_div.saturating_mul(2).clamp(1, PIECE_DIVISIONS);
+        // Each band's need first, then each row's own (as the WGSL does).
+        let need: Vec<u32> = (0..r).map(|b| self.band_parts(base, sides, b, limits, cap, node_on_edge)).collect();
         let mut widths = vec![counts[base]];
-        let mut below = 0; // the parts band row − 1 needs
         for row in 1..r {
             let [left, right] = Rows::row_ends(base, sides, row, node_on_edge);
             let own = self.interior_divisions(left.position, right.position, limits, k);
-            let above = self.band_parts(base, sides, row, limits, cap, node_on_edge);
-            let below_row = if row == 1 { self.band_parts(base, sides, 0, limits, cap, node_on_edge) } else { below };
-            widths.push(own.max(below_row).max(above).clamp(1, cap));
-            below = above;
+            widths.push(own.max(need[row as usize - 1]).max(need[row as usize]).clamp(1, cap));
         }
         widths.push(0);
         Some(Rows { base, sides, widths })
