@@ -7,7 +7,7 @@ use std::collections::BTreeSet;
 
 use naga::{AddressSpace, StorageAccess, TypeInner};
 use twister::encoding::types::{StructLayout, LAYOUTS};
-use twister::shader::{compose, imports, BindingKind, ShaderOptions, Stage, SHARED, STAGES};
+use twister::shader::{compose, compose_with, imports, BindingKind, ShaderOptions, Stage, SHARED, STAGES, STAND_INS};
 
 fn parse(name: &str, source: &str) -> naga::Module {
     parse_with_info(name, source).0
@@ -34,8 +34,15 @@ fn every_stage_composes_and_validates_and_every_wgsl_file_is_used() {
             parse(&format!("{} ({options:?})", file.path), &compose(&file, options));
         }
         used.insert(file.path.clone());
-        // Shared modules it reaches.
+        // Shared modules it reaches (and their stand-ins, with which it must compose too).
         let mut pending: Vec<&str> = imports(file.source);
+        for stand_in in STAND_INS {
+            let with = compose_with(&file, ShaderOptions::ALL[0], &[*stand_in]);
+            if with != compose(&file, ShaderOptions::ALL[0]) {
+                parse(&format!("{} (with {})", file.path, stand_in.1), &with);
+                pending.push(stand_in.1);
+            }
+        }
         while let Some(name) = pending.pop() {
             if let Some((_, src)) = SHARED.iter().find(|(n, _)| *n == name) {
                 if used.insert(format!("shaders/shared/{name}.wgsl")) {

@@ -17,6 +17,7 @@
 #import subdivide_axis
 #import subdivide_quad
 #import subdivide_lattice
+#import subdivide_bands
 #import subdivide_rows
 #import subdivide_dispatch
 

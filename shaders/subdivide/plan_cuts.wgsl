@@ -17,6 +17,7 @@
 #import subdivide_axis
 #import subdivide_quad
 #import subdivide_lattice
+#import subdivide_bands
 #import subdivide_rows
 #import subdivide_dispatch
 
@@ -41,10 +42,13 @@ fn plan_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
         if (local % split == 0u) {
             plan_edge_split(t, &tri, &part, &clip, cuts);
         }
-    } else if (split == 4u) {
-        plan_quadrant(t, local % 4u, &tri, &part, &piece_state, &clip, cuts);
     } else {
-        for (var q = 0u; q < 4u; q++) {
+        // Its quadrant (one invocation per quadrant where `split` is 4), or all four; one call
+        // site of `plan_quadrant` (lavapipe inlines each: its time to build the pipeline grows
+        // with every copy, whether a constant condition leaves it out later or not).
+        let first = select(0u, local % 4u, split == 4u);
+        let end = select(4u, first + 1u, split == 4u);
+        for (var q = first; q < end; q++) {
             plan_quadrant(t, q, &tri, &part, &piece_state, &clip, cuts);
         }
     }

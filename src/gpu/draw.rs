@@ -188,7 +188,7 @@ fn draw_pipeline(
         label: Some(stage.stage.name),
         layout: Some(stage.draw_layout()),
         vertex: wgpu::VertexState {
-            module: stage.module(None),
+            module: stage.module(gpu, None),
             entry_point: Some(if background { "vs_background" } else { "vs_main" }),
             compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
             buffers: if background { &[] } else { &buffers },
@@ -208,7 +208,7 @@ fn draw_pipeline(
         }),
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
-            module: stage.module(None),
+            module: stage.module(gpu, None),
             entry_point: Some(match (background, outputs) {
                 (true, _) => "fs_background",
                 (_, 1) => "fs_main",

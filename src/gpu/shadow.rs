@@ -54,7 +54,7 @@ impl ShadowStage {
                 label: Some("shadow"),
                 layout: Some(self.stage.draw_layout()),
                 vertex: wgpu::VertexState {
-                    module: self.stage.module(None),
+                    module: self.stage.module(gpu, None),
                     entry_point: Some("vs_main"),
                     compilation_options: Default::default(),
                     buffers: &buffers,
@@ -72,7 +72,7 @@ impl ShadowStage {
                 }),
                 multisample: Default::default(),
                 fragment: masked.then(|| wgpu::FragmentState {
-                    module: self.stage.module(None),
+                    module: self.stage.module(gpu, None),
                     entry_point: Some("fs_mask"),
                     compilation_options: Default::default(),
                     targets: &[],

@@ -4,8 +4,10 @@
 //! binding every binding. Bind groups are filled from the buffers of a whole group in binding
 //! order; each pipeline takes the ones it uses.
 
+use std::sync::OnceLock;
+
 use crate::gpu::device::Gpu;
-use crate::shader::{compose, Binding, BindingKind, Stage, StageKind};
+use crate::shader::{compose_with, Binding, BindingKind, Stage, StageKind, StandIn, WgslFile};
 
 /// The layouts of one pipeline of a stage.
 pub struct PipelineLayout {
@@ -17,8 +19,9 @@ pub struct PipelineLayout {
 
 pub struct GpuStage {
     pub stage: &'static Stage,
-    /// One module per WGSL file of the stage, with the entry points it holds.
-    modules: Vec<(Vec<&'static str>, wgpu::ShaderModule)>,
+    /// One module per WGSL file of the stage, with the entry points it holds (created when a
+    /// pipeline first needs it).
+    modules: Vec<(WgslFile, OnceLock<wgpu::ShaderModule>)>,
     pub layouts: Vec<PipelineLayout>,
 }
 
@@ -39,20 +42,18 @@ fn layout_entry(b: &Binding, visibility: wgpu::ShaderStages) -> wgpu::BindGroupL
     }
 }
 
+/// A stage file's module, composed with `stand_ins`.
+fn create_module(gpu: &Gpu, file: &WgslFile, stand_ins: &[StandIn]) -> wgpu::ShaderModule {
+    gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(&file.path),
+        source: wgpu::ShaderSource::Wgsl(compose_with(file, gpu.shader_options(), stand_ins).into()),
+    })
+}
+
 impl GpuStage {
     pub fn new(gpu: &Gpu, stage: &'static Stage) -> GpuStage {
         let device = &gpu.device;
-        let modules = stage
-            .files()
-            .into_iter()
-            .map(|file| {
-                let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                    label: Some(&file.path),
-                    source: wgpu::ShaderSource::Wgsl(compose(&file, gpu.shader_options()).into()),
-                });
-                (file.entry_points, module)
-            })
-            .collect();
+        let modules = stage.files().into_iter().map(|file| (file, OnceLock::new())).collect();
         let (visibility, pipelines): (_, Vec<Option<&'static str>>) = match stage.kind {
             StageKind::Compute => {
                 (wgpu::ShaderStages::COMPUTE, stage.entry_points.iter().map(|e| Some(e.name)).collect())
@@ -88,9 +89,16 @@ impl GpuStage {
     }
 
     /// The module that holds `entry` (None: the drawing pipeline's, the stage's one file).
-    pub fn module(&self, entry: Option<&str>) -> &wgpu::ShaderModule {
-        let holds = |(entries, _): &&(Vec<&str>, wgpu::ShaderModule)| entry.is_none_or(|e| entries.contains(&e));
-        &self.modules.iter().find(holds).unwrap_or_else(|| panic!("{} has no entry point {entry:?}", self.stage.name)).1
+    pub fn module(&self, gpu: &Gpu, entry: Option<&str>) -> &wgpu::ShaderModule {
+        let holds = |(file, _): &&(WgslFile, OnceLock<wgpu::ShaderModule>)| {
+            entry.is_none_or(|e| file.entry_points.contains(&e))
+        };
+        let (file, module) = self
+            .modules
+            .iter()
+            .find(holds)
+            .unwrap_or_else(|| panic!("{} has no entry point {entry:?}", self.stage.name));
+        module.get_or_init(|| create_module(gpu, file, &[]))
     }
 
     fn pipeline_layout(&self, entry: Option<&str>) -> &PipelineLayout {
@@ -112,10 +120,36 @@ impl GpuStage {
 
     /// The same with pipeline-overridable constants set (WGSL `override`).
     pub fn compute_with(&self, gpu: &Gpu, entry: &str, constants: &[(&str, f64)]) -> wgpu::ComputePipeline {
+        self.compute_in(gpu, self.module(gpu, Some(entry)), entry, constants)
+    }
+
+    /// The same from the entry point's file composed with stand-ins in place of modules
+    /// ([`crate::shader::STAND_INS`]).
+    pub fn compute_standing_in(
+        &self,
+        gpu: &Gpu,
+        entry: &str,
+        constants: &[(&str, f64)],
+        stand_ins: &[StandIn],
+    ) -> wgpu::ComputePipeline {
+        if stand_ins.is_empty() {
+            return self.compute_with(gpu, entry, constants);
+        }
+        let module = create_module(gpu, &self.stage.file_of(Some(entry)), stand_ins);
+        self.compute_in(gpu, &module, entry, constants)
+    }
+
+    fn compute_in(
+        &self,
+        gpu: &Gpu,
+        module: &wgpu::ShaderModule,
+        entry: &str,
+        constants: &[(&str, f64)],
+    ) -> wgpu::ComputePipeline {
         gpu.device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some(entry),
             layout: Some(&self.pipeline_layout(Some(entry)).layout),
-            module: self.module(Some(entry)),
+            module,
             entry_point: Some(entry),
             compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
             cache: gpu.pipeline_cache(),

@@ -23,7 +23,7 @@ use crate::gpu::frame_plan::SubdivisionBuffers;
 use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
 use crate::gpu::timestamps::{self as stamp, Timestamps};
-use crate::shader::SUBDIVIDE;
+use crate::shader::{StandIn, ROWS_OFF, SPHERE_OFF, SUBDIVIDE};
 
 pub(crate) const COUNTERS_SIZE: u64 = std::mem::size_of::<SubdivideCounters>() as u64;
 
@@ -42,7 +42,9 @@ impl Variant {
 
 /// The `subdivide` stage: its layouts, and its pipelines built for each panorama and kind of
 /// split rule when first needed (the WGSL `override PANORAMAS` compiles the other panorama's
-/// projection out, `override ROWS` the rows of `lattice` for the frames that never use them).
+/// projection's branches out; the cylinder's passes are composed without the sphere's projection
+/// (`projection_sphere_off`), and the frames that never draw rows without them
+/// (`subdivide_rows_off`): lavapipe builds a pipeline about twice as long with the code merely in it).
 pub(crate) struct SubdivideStage {
     stage: GpuStage,
     variants: [OnceLock<Variant>; 4],
@@ -66,14 +68,18 @@ impl SubdivideStage {
             // Built side by side: the driver's compiling of the large passes (`plan_cuts`,
             // `lattice`) is most of a fresh process's time.
             let constants = [("PANORAMAS", bits)];
-            let with_rows = [("PANORAMAS", bits), ("ROWS", if rows { 1.0 } else { 0.0 })];
+            let stand_ins: &[StandIn] = match (panorama, rows) {
+                (PanoramaKind::Cylinder, _) => &[ROWS_OFF, SPHERE_OFF],
+                (PanoramaKind::Equirect, false) => &[ROWS_OFF],
+                (PanoramaKind::Equirect, true) => &[],
+            };
             let pipelines = std::thread::scope(|scope| {
                 let builds: Vec<_> = SUBDIVIDE
                     .entry_points
                     .iter()
                     .map(|e| {
-                        let constants: &[(&str, f64)] = if e.name == "lattice" { &with_rows } else { &constants };
-                        (e.name, scope.spawn(move || self.stage.compute_with(gpu, e.name, constants)))
+                        let build = move || self.stage.compute_standing_in(gpu, e.name, &constants, stand_ins);
+                        (e.name, scope.spawn(build))
                     })
                     .collect();
                 builds.into_iter().map(|(name, b)| (name, b.join().expect("a pipeline build panicked"))).collect()

@@ -378,6 +378,8 @@ pub const STAGES: &[Stage] = &[SKIN, SUBDIVIDE, RASTER, SLIT, TRACE, SHADOW, PRO
 /// The shared WGSL modules in `shaders/shared/`, by import name.
 pub const SHARED: &[(&str, &str)] = &[
     ("projection", include_str!("../../shaders/shared/projection.wgsl")),
+    ("projection_sphere", include_str!("../../shaders/shared/projection_sphere.wgsl")),
+    ("projection_sphere_off", include_str!("../../shaders/shared/projection_sphere_off.wgsl")),
     ("scene", include_str!("../../shaders/shared/scene.wgsl")),
     ("subdivide_types", include_str!("../../shaders/shared/subdivide_types.wgsl")),
     ("subdivide_bindings", include_str!("../../shaders/shared/subdivide_bindings.wgsl")),
@@ -388,7 +390,9 @@ pub const SHARED: &[(&str, &str)] = &[
     ("subdivide_dispatch", include_str!("../../shaders/shared/subdivide_dispatch.wgsl")),
     ("subdivide_quad", include_str!("../../shaders/shared/subdivide_quad.wgsl")),
     ("subdivide_lattice", include_str!("../../shaders/shared/subdivide_lattice.wgsl")),
+    ("subdivide_bands", include_str!("../../shaders/shared/subdivide_bands.wgsl")),
     ("subdivide_rows", include_str!("../../shaders/shared/subdivide_rows.wgsl")),
+    ("subdivide_rows_off", include_str!("../../shaders/shared/subdivide_rows_off.wgsl")),
     ("surface_bindings", include_str!("../../shaders/shared/surface_bindings.wgsl")),
     ("texture", include_str!("../../shaders/shared/texture.wgsl")),
     ("brdf", include_str!("../../shaders/shared/brdf.wgsl")),
@@ -397,6 +401,20 @@ pub const SHARED: &[(&str, &str)] = &[
     ("surface", include_str!("../../shaders/shared/surface.wgsl")),
     ("fragment", include_str!("../../shaders/shared/fragment.wgsl")),
 ];
+
+/// A shared module, and the stand-in a pipeline that never runs its code may be composed with in
+/// its place: the same functions, doing nothing (lavapipe builds a pipeline, and may run it,
+/// slower for code it never takes: a constant `override` does not remove it).
+pub type StandIn = (&'static str, &'static str);
+
+/// Every stand-in (the naga test validates each file composed with each one).
+pub const STAND_INS: &[StandIn] = &[ROWS_OFF, SPHERE_OFF];
+
+/// `subdivide_rows` left out: the `lattice` pipeline of the frames that never draw rows.
+pub const ROWS_OFF: StandIn = ("subdivide_rows", "subdivide_rows_off");
+
+/// `projection_sphere` left out: the subdivide stage's pipelines for the cylinder.
+pub const SPHERE_OFF: StandIn = ("projection_sphere", "projection_sphere_off");
 
 /// How the error target is written: as f32 (R32Float) or as its bits (R32Uint), for adapters
 /// that cannot render to R32Float.
@@ -461,8 +479,10 @@ impl ShaderOptions {
     ];
 }
 
-/// The source of an importable module, or None for an unknown name.
-fn module_source(name: &str, options: ShaderOptions) -> Option<String> {
+/// The source of an importable module (its stand-in's where one is given), or None for an unknown
+/// name.
+fn module_source(name: &str, options: ShaderOptions, stand_ins: &[StandIn]) -> Option<String> {
+    let name = stand_ins.iter().find(|(module, _)| *module == name).map_or(name, |(_, stand_in)| *stand_in);
     match name {
         "constants" => Some(constants::wgsl()),
         "error_target" => Some(options.error_target.wgsl().to_string()),
@@ -479,16 +499,22 @@ pub fn imports(source: &str) -> Vec<&str> {
 /// The full WGSL of one of a stage's files: its imports (recursively, each once, dependencies
 /// first), then the file with its `#import` lines commented out.
 pub fn compose(file: &WgslFile, options: ShaderOptions) -> String {
-    fn add(name: &str, source: &str, options: ShaderOptions, done: &mut Vec<String>, out: &mut String) {
+    compose_with(file, options, &[])
+}
+
+/// The same, with stand-ins composed in place of the modules they stand for.
+pub fn compose_with(file: &WgslFile, options: ShaderOptions, stand_ins: &[StandIn]) -> String {
+    type Context<'a> = (ShaderOptions, &'a [StandIn]);
+    fn add(name: &str, source: &str, context: Context, done: &mut Vec<String>, out: &mut String) {
         for dep in imports(source) {
             if done.iter().any(|d| d == dep) {
                 continue;
             }
             done.push(dep.to_string());
-            let Some(dep_source) = module_source(dep, options) else {
+            let Some(dep_source) = module_source(dep, context.0, context.1) else {
                 panic!("{name}: `#import {dep}` names no module in shaders/shared/ or the generated ones")
             };
-            add(dep, &dep_source, options, done, out);
+            add(dep, &dep_source, context, done, out);
         }
         let body: Vec<String> = source
             .lines()
@@ -498,6 +524,6 @@ pub fn compose(file: &WgslFile, options: ShaderOptions) -> String {
     }
     let mut out = String::new();
     let mut done = Vec::new();
-    add(&file.path, file.source, options, &mut done, &mut out);
+    add(&file.path, file.source, (options, stand_ins), &mut done, &mut out);
     out
 }

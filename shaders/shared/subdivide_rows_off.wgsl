@@ -1,0 +1,18 @@
+// The stand-in for `subdivide_rows` in the pipelines of the frames that never draw rows (the
+// cylinder; the vertex and fixed rules): no piece has rows. Its functions are `subdivide_rows`'s
+// that other modules call, with the same signatures (the naga test composes both).
+
+#import subdivide_state
+
+// No rows: (u32 max, 0), as `plan_rows` says for a piece without them.
+fn plan_rows(tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> vec2<u32> {
+    return vec2<u32>(0xffffffffu, 0u);
+}
+
+fn row_node(k: u32, a: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Node {
+    return Node();
+}
+
+fn rows_step(walk: ptr<function, vec4<u32>>, at: ptr<function, array<vec2<u32>, 3>>, piece_state: ptr<function, PieceState>) -> vec3<u32> {
+    return vec3<u32>(0u);
+}
