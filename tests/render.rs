@@ -163,11 +163,16 @@ fn scene_too_big_for_the_memory_budget_is_drawn_in_chunks_without_loss() {
     let scene = builtin::demo();
     // Wide: no triangle asks for cuts around the axis. Square: the floor and the ceiling near the
     // axis show, and the cuts they ask for hold in every chunk.
-    for (projection, edge_px, cut) in [
-        (Projection { width: 960, height: 180, ..Projection::default() }, 2.0, false),
-        (Projection { width: 256, height: 256, ..Projection::default() }, 2.5, true),
+    // And with four samples per pixel: the multisampled colour is kept across the chunks.
+    for (projection, edge_px, cut, samples) in [
+        (Projection { width: 960, height: 180, ..Projection::default() }, 2.0, false, 1),
+        (Projection { width: 256, height: 256, ..Projection::default() }, 2.5, true, 1),
+        (Projection { width: 256, height: 256, ..Projection::default() }, 2.5, true, 4),
     ] {
-        let roomy = RenderSettings::new(projection).with_method(Method::Adaptive(Split::Length)).with_edge_px(edge_px);
+        let roomy = RenderSettings::new(projection)
+            .with_method(Method::Adaptive(Split::Length))
+            .with_edge_px(edge_px)
+            .with_samples(samples);
         let params = twister::encoding::subdivide::subdivide_params(&roomy, 0, scene.triangle_count() as u32);
         let cuts = twister::cpu::subdivide::Subdivider::new(&params).active_cuts(&scene.vertices, &scene.indices).axis;
         assert_eq!(cuts != 0, cut, "{projection:?}: cuts {cuts:#x}");

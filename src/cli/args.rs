@@ -68,6 +68,12 @@ pub struct ViewArgs {
     /// eq. 5, N = ceil(l/L) per edge), fixed:N (every edge N), vertex (none).
     #[arg(long, value_parser = Method::parse, default_value = "adaptive")]
     pub method: Method,
+    /// Samples per pixel of the colour image: 1, 2, 4, 8, 16 or 32 (multisampling, averaged in
+    /// linear light after tone mapping; the projection methods and slit:W, up to what the adapter
+    /// supports). Depth, --hdr and the error pass stay one sample at each pixel's centre.
+    /// [default: 4 for render (1 with trace); 1 for bench and error, the paper's geometry]
+    #[arg(long)]
+    pub samples: Option<u32>,
     /// What splits an adaptive edge: error (its projected error, --max-error-px) or length (its
     /// projected length, --edge-px: the paper's eq. 5) [default: error].
     #[arg(long, value_enum)]
@@ -331,7 +337,8 @@ impl ViewArgs {
             .with_shadows(!self.no_shadows)
             .with_shadow_map_size(self.shadow_map_size)
             .with_environment_yaw_deg(self.environment_yaw)
-            .with_tonemap(self.tonemap);
+            .with_tonemap(self.tonemap)
+            .with_samples(self.samples.unwrap_or(1));
         settings.validate()?;
         Ok(settings)
     }

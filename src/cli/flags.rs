@@ -25,6 +25,7 @@ pub const FLAGS: &[(&str, &str)] = &[
     ("shading.light", "--light"),
     ("shading.shadow_map_size", "--shadow-map-size"),
     ("shading.hdr", "--hdr"),
+    ("shading.samples", "--samples"),
     ("lod.p2/p3", "--lod-p2/--lod-p3"),
     ("lod.d_inf", "--lod-dinf"),
     ("environment", "--environment"),

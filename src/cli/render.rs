@@ -7,6 +7,10 @@ use crate::writer::{FrameRecord, FrameWriter};
 use twister::error::{Error, Result};
 use twister::output::{check_outputs, write_all, OutputFile};
 
+/// `render`'s samples per pixel where `--samples` is not given (WebGPU guarantees 4 on every
+/// adapter).
+pub const DEFAULT_SAMPLES: u32 = 4;
+
 /// The render settings `args` ask for, with the outputs' measures (depth, edge lengths for the
 /// statistics, the linear colour) and the background, checked as a whole; then only read.
 pub fn render_settings(args: &RenderArgs) -> Result<twister::RenderSettings> {
@@ -17,6 +21,12 @@ pub fn render_settings(args: &RenderArgs) -> Result<twister::RenderSettings> {
         .with_measure_edges(args.stats.is_some())
         .with_depth(args.depth)
         .with_hdr(args.hdr);
+    // Four samples unless asked otherwise; one for the ray tracer (a ray per pixel).
+    let samples = args.view.samples.unwrap_or(match settings.subdivision.method {
+        twister::core::settings::Method::Trace => 1,
+        _ => DEFAULT_SAMPLES,
+    });
+    let settings = settings.with_samples(samples);
     settings.validate()?;
     Ok(settings)
 }

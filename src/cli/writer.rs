@@ -140,6 +140,9 @@ pub struct FrameRecord<'a> {
     pub subdivide_invocations: Vec<(&'static str, u64)>,
     pub max_pieces_per_invocation: u32,
     pub max_output_per_invocation: u32,
+    /// Samples per pixel of the colour, and how they were drawn (`FrameStats`).
+    pub samples: u32,
+    pub sampling: String,
     pub width: u32,
     pub height: u32,
     pub screen_radius: f32,
@@ -197,6 +200,8 @@ impl<'a> FrameRecord<'a> {
             subdivide_invocations: s.subdivide_invocations.clone(),
             max_pieces_per_invocation: s.max_pieces_per_invocation,
             max_output_per_invocation: s.max_output_per_invocation,
+            samples: s.samples,
+            sampling: s.sampling.clone(),
             width: p.width,
             height: p.height,
             screen_radius: p.screen_radius,

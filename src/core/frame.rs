@@ -58,6 +58,11 @@ pub struct FrameStats {
     /// vertices the triangles index, shaded once per eye.
     pub nodes_out: u64,
     pub pieces: u64,
+    /// Samples per pixel of the colour image, and how they were drawn: "1 sample at the pixel's
+    /// centre", or "multisampled N (a pass per eye; depth, error and linear colour at the
+    /// centres)".
+    pub samples: u32,
+    pub sampling: String,
     /// The ray tracer: rays traced (primary, mirror, refraction, shadow) and ray–triangle tests.
     pub rays_traced: Option<u64>,
     pub triangle_tests: Option<u64>,

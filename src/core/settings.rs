@@ -189,7 +189,15 @@ pub struct ShadingSettings {
     /// of the same frame (`--hdr`: [`Frame::hdr`](crate::core::frame::Frame::hdr); the
     /// projection methods only).
     pub hdr: bool,
+    /// Samples per pixel of the display colour (`--samples`: 1, 2, 4, 8, 16 or 32; the
+    /// projection methods and slits): each pixel shows the average of its samples' tone-mapped
+    /// linear colours (multisampling, resolved in linear light). The other outputs (the error
+    /// pass's targets, depth, the linear HDR colour) stay one sample at the pixel's centre.
+    pub samples: u32,
 }
+
+/// The sample counts `--samples` takes.
+pub const SAMPLE_COUNTS: [u32; 6] = [1, 2, 4, 8, 16, 32];
 
 /// What a render measures besides drawing.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -347,6 +355,7 @@ impl Default for ShadingSettings {
             exposure_ev: 0.0,
             tonemap: Default::default(),
             hdr: false,
+            samples: 1,
             shadows: true,
             shadow_map_size: crate::core::shadow::DEFAULT_SHADOW_MAP_SIZE,
             environment_yaw_deg: 0.0,
@@ -387,6 +396,7 @@ builders! {
     with_exposure_ev: f32 => shading.exposure_ev,
     with_tonemap: crate::core::light::Tonemap => shading.tonemap,
     with_hdr: bool => shading.hdr,
+    with_samples: u32 => shading.samples,
     with_shadows: bool => shading.shadows,
     with_shadow_map_size: u32 => shading.shadow_map_size,
     with_environment_yaw_deg: f32 => shading.environment_yaw_deg,
@@ -472,6 +482,16 @@ impl RenderSettings {
 
     /// The shading's part of [`Self::validate`].
     fn validate_shading(&self) -> Result<()> {
+        let samples = self.shading.samples;
+        if !SAMPLE_COUNTS.contains(&samples) {
+            return Err(Error::setting("shading.samples", format!("must be 1, 2, 4, 8, 16 or 32, got {samples}")));
+        }
+        if samples > 1 && self.subdivision.method == Method::Trace {
+            return Err(Error::setting(
+                "shading.samples",
+                format!("the ray tracer draws one ray per pixel; {samples} samples are for the other methods"),
+            ));
+        }
         if !(self.shading.exposure_ev.is_finite() && self.shading.exposure_ev.abs() <= 64.0) {
             return Err(Error::setting(
                 "shading.exposure_ev",

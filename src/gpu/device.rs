@@ -27,6 +27,8 @@ pub struct Gpu {
     /// has multiview (2 views or more) and is a hardware GPU, else a pass per eye.
     /// `TWISTER_MULTIVIEW=on|off` overrides the choice (where the adapter has multiview).
     pub eyes_per_draw: EyesPerDraw,
+    /// The adapter the device was opened on (its format features: `targets::sample_counts`).
+    pub adapter: wgpu::Adapter,
     /// GPU errors raised outside any error scope (kept instead of wgpu's default panic).
     uncaptured: Arc<Mutex<Vec<String>>>,
     /// The pipelines' cache on disk, where the adapter has one (saved when the device closes).
@@ -101,7 +103,10 @@ impl Gpu {
                 _ => info.device_type != wgpu::DeviceType::Cpu,
             };
         let eyes_per_draw = if multiview { EyesPerDraw::Both } else { EyesPerDraw::One };
-        let wanted = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::MULTIVIEW | wgpu::Features::PIPELINE_CACHE;
+        let wanted = wgpu::Features::TIMESTAMP_QUERY
+            | wgpu::Features::MULTIVIEW
+            | wgpu::Features::PIPELINE_CACHE
+            | wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES;
         let features = adapter.features() & wanted;
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
@@ -118,7 +123,18 @@ impl Gpu {
             sink.lock().unwrap_or_else(|p| p.into_inner()).push(one_line(&e));
         }));
         let pipeline_cache = DiskPipelineCache::open(&device, &info);
-        Ok(Gpu { device, queue, info, limits, features, error_target, eyes_per_draw, uncaptured, pipeline_cache })
+        Ok(Gpu {
+            device,
+            queue,
+            info,
+            limits,
+            features,
+            error_target,
+            eyes_per_draw,
+            adapter,
+            uncaptured,
+            pipeline_cache,
+        })
     }
 
     /// The pipeline cache for a pipeline about to be built (`cache` of its descriptor).

@@ -4,7 +4,7 @@
 
 use std::collections::HashMap;
 use std::mem::offset_of;
-use std::sync::Mutex;
+use std::sync::{Mutex, OnceLock};
 
 use crate::core::scene::SceneVertex;
 use crate::core::settings::RenderSettings;
@@ -13,9 +13,9 @@ use crate::gpu::device::{error_target_format, Gpu};
 use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
 use crate::gpu::targets::{
-    Layers, COLOR_FORMAT, DEPTH_FORMAT, HDR_FORMAT, HDR_LOCATION, OBJECT_FORMAT, POSITION_FORMAT,
+    Layers, Samples, COLOR_FORMAT, DEPTH_FORMAT, HDR_FORMAT, HDR_LOCATION, OBJECT_FORMAT, POSITION_FORMAT,
 };
-use crate::shader::{RASTER, SLIT};
+use crate::shader::{EyesPerDraw, ShaderOptions, RASTER, SLIT};
 
 /// The two drawing stages.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -28,6 +28,9 @@ pub(crate) enum DrawStage {
 /// [`DrawKey`] (as bevy's specialised pipelines are kept by key).
 pub(crate) struct DrawPipelines {
     pub stage: GpuStage,
+    /// The raster stage composed to draw one eye per pass, on a device that draws both in one
+    /// (the multisampled colour's passes draw one eye each).
+    per_eye: OnceLock<GpuStage>,
     kind: DrawStage,
     pipelines: Mutex<HashMap<DrawKey, wgpu::RenderPipeline>>,
 }
@@ -45,6 +48,8 @@ pub(crate) struct DrawKey {
     pub outputs: usize,
     pub layers: Layers,
     pub hdr: bool,
+    /// Samples per pixel of the targets (1 but for the multisampled colour's passes).
+    pub samples: u32,
 }
 
 /// What a scene's materials need of a drawing pipeline.
@@ -109,25 +114,59 @@ impl Lit {
 impl DrawPipelines {
     pub fn new(gpu: &Gpu, kind: DrawStage) -> DrawPipelines {
         let stage = GpuStage::new(gpu, if kind == DrawStage::Raster { &RASTER } else { &SLIT });
-        DrawPipelines { stage, kind, pipelines: Mutex::new(HashMap::new()) }
+        DrawPipelines { stage, per_eye: OnceLock::new(), kind, pipelines: Mutex::new(HashMap::new()) }
     }
 
     /// The pipeline for a frame of `scene` with `settings` (its look, what of the glTF look it
-    /// uses, its outputs, its colour target), drawing `layers`.
-    pub fn get(&self, gpu: &Gpu, scene: &GpuScene, settings: &RenderSettings, layers: Layers) -> wgpu::RenderPipeline {
+    /// uses, its outputs, its colour target), drawing `layers` into `samples`' targets.
+    pub fn get(
+        &self,
+        gpu: &Gpu,
+        scene: &GpuScene,
+        settings: &RenderSettings,
+        layers: Layers,
+        samples: Samples,
+    ) -> wgpu::RenderPipeline {
         let look = (Look::of(scene, scene.pbr(settings)), Lit::of(scene, settings));
-        self.keyed(gpu, DrawKey { look: Some(look), ..Self::frame_key(settings, layers) })
+        self.keyed(gpu, DrawKey { look: Some(look), ..Self::frame_key(settings, layers, samples) })
     }
 
     /// The background's pipeline (the environment along each pixel's ray, colour only), for a
-    /// frame with `settings` drawing `layers`; drawn first, where `shows_environment`.
-    pub fn background(&self, gpu: &Gpu, settings: &RenderSettings, layers: Layers) -> wgpu::RenderPipeline {
-        self.keyed(gpu, Self::frame_key(settings, layers))
+    /// frame with `settings` drawing `layers` into `samples`' targets; drawn first, where
+    /// `shows_environment`.
+    pub fn background(
+        &self,
+        gpu: &Gpu,
+        settings: &RenderSettings,
+        layers: Layers,
+        samples: Samples,
+    ) -> wgpu::RenderPipeline {
+        self.keyed(gpu, Self::frame_key(settings, layers, samples))
     }
 
-    /// A frame's key without its look (the background's).
-    fn frame_key(settings: &RenderSettings, layers: Layers) -> DrawKey {
-        DrawKey { look: None, outputs: settings.measure.outputs(), layers, hdr: settings.shading.hdr }
+    /// A frame's key without its look (the background's): every output at the pixels' centres,
+    /// or the multisampled colour alone.
+    fn frame_key(settings: &RenderSettings, layers: Layers, samples: Samples) -> DrawKey {
+        match samples {
+            Samples::Centre => DrawKey {
+                look: None,
+                outputs: settings.measure.outputs(),
+                layers,
+                hdr: settings.shading.hdr,
+                samples: 1,
+            },
+            Samples::Multi(n) => DrawKey { look: None, outputs: 1, layers, hdr: false, samples: n },
+        }
+    }
+
+    /// The stage whose module a pipeline drawing `layers` is built from.
+    fn stage_for(&self, gpu: &Gpu, layers: Layers) -> &GpuStage {
+        match (self.kind, layers, gpu.eyes_per_draw) {
+            (DrawStage::Raster, Layers::Eye(_), EyesPerDraw::Both) => self.per_eye.get_or_init(|| {
+                GpuStage::with_options(gpu, &RASTER, ShaderOptions { eyes: EyesPerDraw::One, ..gpu.shader_options() })
+            }),
+            _ => &self.stage,
+        }
     }
 
     /// The pipeline of `key`, made the first time it is asked for.
@@ -137,7 +176,10 @@ impl DrawPipelines {
             _ => key,
         };
         let mut pipelines = self.pipelines.lock().unwrap_or_else(|e| e.into_inner());
-        pipelines.entry(key).or_insert_with(|| draw_pipeline(gpu, &self.stage, self.kind, key)).clone()
+        pipelines
+            .entry(key)
+            .or_insert_with(|| draw_pipeline(gpu, self.stage_for(gpu, key.layers), self.kind, key))
+            .clone()
     }
 
     /// The scene's material table (group 1).
@@ -160,7 +202,7 @@ fn draw_pipeline(
     gpu: &Gpu,
     stage: &GpuStage,
     kind: DrawStage,
-    DrawKey { look, outputs, layers, hdr }: DrawKey,
+    DrawKey { look, outputs, layers, hdr, samples }: DrawKey,
 ) -> wgpu::RenderPipeline {
     // None: the background triangle (no vertex buffer; colour only; behind everything).
     let background = look.is_none();
@@ -206,7 +248,7 @@ fn draw_pipeline(
             stencil: Default::default(),
             bias: Default::default(),
         }),
-        multisample: Default::default(),
+        multisample: wgpu::MultisampleState { count: samples, ..Default::default() },
         fragment: Some(wgpu::FragmentState {
             module: stage.module(gpu, None),
             entry_point: Some(match (background, outputs) {

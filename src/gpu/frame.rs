@@ -36,13 +36,27 @@ pub(crate) struct FrameResources {
 
 impl FrameResources {
     /// The targets for this size (with the positions target if `positions`, the linear colour's
-    /// if `hdr`), made anew only when the size or the linear colour changed or the positions
-    /// target is wanted and missing.
-    pub fn targets(&mut self, gpu: &Gpu, width: u32, height: u32, positions: bool, hdr: bool) -> &Targets {
+    /// if `hdr`, the multisampled colour for `samples` > 1), made anew only when the size, the
+    /// linear colour or the samples changed or the positions target is wanted and missing.
+    pub fn targets(
+        &mut self,
+        gpu: &Gpu,
+        width: u32,
+        height: u32,
+        positions: bool,
+        hdr: bool,
+        samples: u32,
+    ) -> &Targets {
         if !self.targets.as_ref().is_some_and(|t| {
-            t.width == width && t.height == height && (t.position.is_some() || !positions) && t.hdr == hdr
+            t.width == width
+                && t.height == height
+                && (t.position.is_some() || !positions)
+                && t.hdr == hdr
+                && t.multisampled.as_ref().map_or(1, |m| m.samples) == samples
         }) {
-            self.targets = Some(Targets::new(gpu, width, height, positions, hdr));
+            // The old ones first: a large frame's targets twice over may not fit.
+            self.targets = None;
+            self.targets = Some(Targets::new(gpu, width, height, positions, hdr, samples));
         }
         self.targets.as_ref().expect("just made")
     }

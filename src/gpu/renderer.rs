@@ -88,6 +88,7 @@ impl Renderer {
     pub fn render(&self, scene: &GpuScene, settings: &RenderSettings) -> Result<Frame> {
         settings.validate()?;
         self.check_size(settings)?;
+        self.check_samples(settings)?;
         let mut resources = self.resources.lock().unwrap_or_else(|e| e.into_inner());
         let shadow_maps = scene.write_lighting(&self.gpu, settings);
         self.gpu.scoped("rendering a frame", || {
@@ -100,7 +101,15 @@ impl Renderer {
                 MethodName::Trace => &self.trace,
                 _ => self.subdivided(),
             };
-            method.draw(&self.gpu, &self.end, &mut resources, scene, settings)
+            let mut frame = method.draw(&self.gpu, &self.end, &mut resources, scene, settings)?;
+            let n = settings.shading.samples;
+            frame.stats.samples = n;
+            frame.stats.sampling = match crate::gpu::targets::Samples::passes(settings).as_slice() {
+                [_] if n == 1 => "1 sample at each pixel's centre".to_string(),
+                [_] => format!("multisampled {n} (a pass per eye)"),
+                _ => format!("multisampled {n} (a pass per eye), depth, error and linear colour at the centres"),
+            };
+            Ok(frame)
         })
     }
 
@@ -119,6 +128,20 @@ impl Renderer {
     /// The depths of a scene's shadow maps as the last frame drew them (`bytes` of them).
     pub fn shadow_depths(&self, scene: &GpuScene, bytes: u64) -> Result<Vec<f32>> {
         crate::gpu::shadow::shadow_depths(&self.gpu, scene, bytes)
+    }
+
+    /// Fails with one line when the adapter cannot draw the samples asked for.
+    fn check_samples(&self, settings: &RenderSettings) -> Result<()> {
+        let n = settings.shading.samples;
+        let counts = crate::gpu::targets::sample_counts(&self.gpu);
+        if counts.contains(&n) {
+            return Ok(());
+        }
+        let listed: Vec<String> = counts.iter().map(u32::to_string).collect();
+        Err(Error::setting(
+            "shading.samples",
+            format!("the adapter '{}' draws {} samples per pixel, not {n}", self.gpu.info.name, listed.join(", ")),
+        ))
     }
 
     /// Fails with one line when the image cannot be drawn on this device.

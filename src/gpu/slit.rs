@@ -13,7 +13,7 @@ use crate::gpu::device::Gpu;
 use crate::gpu::draw::{DrawPipelines, DrawStage};
 use crate::gpu::frame::{FrameEnd, FrameResources, Method};
 use crate::gpu::scene::GpuScene;
-use crate::gpu::targets::Layers;
+use crate::gpu::targets::{Layers, Samples};
 use crate::gpu::timestamps::submit_timed_pass;
 
 /// The slit renderer: its drawing pipelines.
@@ -41,7 +41,14 @@ impl Method for SlitMethod {
         };
         let start = Instant::now();
         let projection = settings.projection();
-        res.targets(gpu, projection.width, projection.height, settings.measure.positions, false);
+        res.targets(
+            gpu,
+            projection.width,
+            projection.height,
+            settings.measure.positions,
+            false,
+            settings.shading.samples,
+        );
         let res = &*res;
         let targets = res.targets.as_ref().expect("made");
         let view = settings.view();
@@ -52,25 +59,31 @@ impl Method for SlitMethod {
         let camera_buffer =
             gpu.init_buffer("slit cameras", bytemuck::cast_slice(&cameras), wgpu::BufferUsages::STORAGE);
         let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, chunks: 1, ..Default::default() };
-        let pipeline = self.pipelines.get(gpu, scene, settings, Layers::Eye(0));
         let materials = self.pipelines.material_bind_group(gpu, scene);
         let timestamps = res.timestamps.as_ref();
         let t = Instant::now();
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        for (k, eye) in Eye::BOTH.into_iter().enumerate() {
+        // Every output at the pixels' centres, then (or only) the multisampled colour.
+        let passes: Vec<(Samples, usize)> =
+            Samples::passes(settings).into_iter().flat_map(|samples| [(samples, 0), (samples, 1)]).collect();
+        for (p, &(samples, k)) in passes.iter().enumerate() {
+            let eye = Eye::BOTH[k];
+            let pipeline = self.pipelines.get(gpu, scene, settings, Layers::Eye(0), samples);
             let params = slit_params(projection, view, eye, settings.shading.ambient, settings.measure.error_angle);
             gpu.queue.write_buffer(&res.slit_params[k], 0, bytemuck::bytes_of(&params));
             let bind_group = self.pipelines.stage.bind_group(gpu, None, 0, &[&res.slit_params[k], &camera_buffer]);
-            let writes = timestamps.map(|t| wgpu::RenderPassTimestampWrites {
-                query_set: &t.set,
-                beginning_of_pass_write_index: (k == 0).then_some(0),
-                end_of_pass_write_index: (k == 1).then_some(1),
-            });
-            let mut pass = targets.begin_pass(&mut enc, Layers::Eye(k), settings, true, writes);
+            // Timestamps at the start of the first pass and the end of the last only.
+            let writes =
+                timestamps.filter(|_| p == 0 || p + 1 == passes.len()).map(|t| wgpu::RenderPassTimestampWrites {
+                    query_set: &t.set,
+                    beginning_of_pass_write_index: (p == 0).then_some(0),
+                    end_of_pass_write_index: (p + 1 == passes.len()).then_some(1),
+                });
+            let mut pass = targets.begin_samples_pass(&mut enc, samples, Layers::Eye(k), settings, true, writes);
             pass.set_bind_group(0, &bind_group, &[]);
             pass.set_bind_group(1, &materials, &[]);
             if scene.shows_environment(settings) {
-                pass.set_pipeline(&self.pipelines.background(gpu, settings, Layers::Eye(k)));
+                pass.set_pipeline(&self.pipelines.background(gpu, settings, Layers::Eye(k), samples));
                 pass.draw(0..3, 0..1);
             }
             pass.set_pipeline(&pipeline);
@@ -89,11 +102,15 @@ impl Method for SlitMethod {
                     if sphere_in_slit(&params, slit, center, o.radius) {
                         let first = o.first_triangle;
                         pass.draw_indexed(3 * first..3 * (first + o.triangle_count), 0, instance..instance + 1);
-                        stats.triangles_out += o.triangle_count as u64;
+                        if p < 2 {
+                            // Counted in the first kind of pass only.
+                            stats.triangles_out += o.triangle_count as u64;
+                        }
                     }
                 }
             }
         }
+        targets.copy_resolved(&mut enc);
         submit_timed_pass(gpu, enc, timestamps, &res.staging, t, &mut stats)?;
         end.finish(gpu, targets, settings, stats, start)
     }

@@ -7,7 +7,7 @@
 use std::sync::OnceLock;
 
 use crate::gpu::device::Gpu;
-use crate::shader::{compose_with, Binding, BindingKind, Stage, StageKind, StandIn, WgslFile};
+use crate::shader::{compose_with, Binding, BindingKind, ShaderOptions, Stage, StageKind, StandIn, WgslFile};
 
 /// The layouts of one pipeline of a stage.
 pub struct PipelineLayout {
@@ -22,6 +22,9 @@ pub struct GpuStage {
     /// One module per WGSL file of the stage, with the entry points it holds (created when a
     /// pipeline first needs it).
     modules: Vec<(WgslFile, OnceLock<wgpu::ShaderModule>)>,
+    /// What the generated modules are composed for (the device's, or another way of drawing the
+    /// eyes).
+    options: ShaderOptions,
     pub layouts: Vec<PipelineLayout>,
 }
 
@@ -42,16 +45,21 @@ fn layout_entry(b: &Binding, visibility: wgpu::ShaderStages) -> wgpu::BindGroupL
     }
 }
 
-/// A stage file's module, composed with `stand_ins`.
-fn create_module(gpu: &Gpu, file: &WgslFile, stand_ins: &[StandIn]) -> wgpu::ShaderModule {
+/// A stage file's module, composed for `options` with `stand_ins`.
+fn create_module(gpu: &Gpu, file: &WgslFile, options: ShaderOptions, stand_ins: &[StandIn]) -> wgpu::ShaderModule {
     gpu.device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(&file.path),
-        source: wgpu::ShaderSource::Wgsl(compose_with(file, gpu.shader_options(), stand_ins).into()),
+        source: wgpu::ShaderSource::Wgsl(compose_with(file, options, stand_ins).into()),
     })
 }
 
 impl GpuStage {
     pub fn new(gpu: &Gpu, stage: &'static Stage) -> GpuStage {
+        GpuStage::with_options(gpu, stage, gpu.shader_options())
+    }
+
+    /// The same composed for `options` instead of the device's.
+    pub fn with_options(gpu: &Gpu, stage: &'static Stage, options: ShaderOptions) -> GpuStage {
         let device = &gpu.device;
         let modules = stage.files().into_iter().map(|file| (file, OnceLock::new())).collect();
         let (visibility, pipelines): (_, Vec<Option<&'static str>>) = match stage.kind {
@@ -85,7 +93,7 @@ impl GpuStage {
                 PipelineLayout { entry, groups, layout }
             })
             .collect();
-        GpuStage { stage, modules, layouts }
+        GpuStage { stage, modules, options, layouts }
     }
 
     /// The module that holds `entry` (None: the drawing pipeline's, the stage's one file).
@@ -98,7 +106,7 @@ impl GpuStage {
             .iter()
             .find(holds)
             .unwrap_or_else(|| panic!("{} has no entry point {entry:?}", self.stage.name));
-        module.get_or_init(|| create_module(gpu, file, &[]))
+        module.get_or_init(|| create_module(gpu, file, self.options, &[]))
     }
 
     fn pipeline_layout(&self, entry: Option<&str>) -> &PipelineLayout {
@@ -135,7 +143,7 @@ impl GpuStage {
         if stand_ins.is_empty() {
             return self.compute_with(gpu, entry, constants);
         }
-        let module = create_module(gpu, &self.stage.file_of(Some(entry)), stand_ins);
+        let module = create_module(gpu, &self.stage.file_of(Some(entry)), self.options, stand_ins);
         self.compute_in(gpu, &module, entry, constants)
     }
 

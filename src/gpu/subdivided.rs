@@ -21,7 +21,7 @@ use crate::gpu::frame::{FrameEnd, FrameResources, Method};
 use crate::gpu::frame_plan::SubdivisionBuffers;
 use crate::gpu::scene::GpuScene;
 use crate::gpu::subdivide::{FrameBuffers, SubdivideStage, COUNTERS_SIZE};
-use crate::gpu::targets::{Layers, Targets};
+use crate::gpu::targets::{Layers, Samples, Targets};
 use crate::gpu::timestamps as stamp;
 
 /// GPU times (ms) of a one-submission frame, from its timestamps.
@@ -59,7 +59,7 @@ impl Method for SubdividedMethod {
         let start = Instant::now();
         let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, ..Default::default() };
         let p = settings.projection();
-        res.targets(gpu, p.width, p.height, settings.measure.positions, settings.shading.hdr);
+        res.targets(gpu, p.width, p.height, settings.measure.positions, settings.shading.hdr, settings.shading.samples);
         let budget = Capacities::budget(settings.subdivision.memory_mb, gpu.max_binding());
         let n = scene.triangle_count;
         let mut plan = FramePlan::first(n, res.buffers.as_ref().map(|b| b.capacity), budget);
@@ -187,19 +187,26 @@ impl SubdividedMethod {
         let uniform = &res.raster_params;
         gpu.queue.write_buffer(uniform, 0, bytemuck::cast_slice(&raster_params(settings)));
         let bind_group = self.raster.stage.bind_group(gpu, None, 0, &[uniform]);
-        let passes = Layers::passes(gpu.eyes_per_draw);
-        for (k, &layers) in passes.iter().enumerate() {
-            let pipeline = self.raster.get(gpu, scene, settings, layers);
-            let writes = timestamps.map(|(q, begin, end)| wgpu::RenderPassTimestampWrites {
-                query_set: q,
-                beginning_of_pass_write_index: (k == 0).then_some(begin),
-                end_of_pass_write_index: (k + 1 == passes.len()).then_some(end),
+        // Every output at the pixels' centres, then (or only) the multisampled colour.
+        let passes: Vec<(Samples, Layers)> = Samples::passes(settings)
+            .into_iter()
+            .flat_map(|samples| samples.layers(gpu.eyes_per_draw).iter().map(move |&layers| (samples, layers)))
+            .collect();
+        for (k, &(samples, layers)) in passes.iter().enumerate() {
+            let pipeline = self.raster.get(gpu, scene, settings, layers, samples);
+            // Timestamps at the start of the first pass and the end of the last only.
+            let writes = timestamps.filter(|_| k == 0 || k + 1 == passes.len()).map(|(q, begin, end)| {
+                wgpu::RenderPassTimestampWrites {
+                    query_set: q,
+                    beginning_of_pass_write_index: (k == 0).then_some(begin),
+                    end_of_pass_write_index: (k + 1 == passes.len()).then_some(end),
+                }
             });
-            let mut pass = targets.begin_pass(enc, layers, settings, clear, writes);
+            let mut pass = targets.begin_samples_pass(enc, samples, layers, settings, clear, writes);
             pass.set_bind_group(0, &bind_group, &[]);
             pass.set_bind_group(1, &materials, &[]);
             if clear && scene.shows_environment(settings) {
-                pass.set_pipeline(&self.raster.background(gpu, settings, layers));
+                pass.set_pipeline(&self.raster.background(gpu, settings, layers, samples));
                 pass.draw(0..3, 0..1);
             }
             pass.set_pipeline(&pipeline);
@@ -207,6 +214,7 @@ impl SubdividedMethod {
             pass.set_index_buffer(buffers.indices.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed_indirect(&buffers.draw_args, 0);
         }
+        targets.copy_resolved(enc);
     }
 
     /// The chunked schedule (see [`FramePlan::Chunked`]; [`run_chunked`]): wall times per pass.

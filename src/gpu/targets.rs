@@ -42,6 +42,49 @@ impl Layers {
     }
 }
 
+/// What a render pass draws into: the frame's targets, one sample at each pixel's centre (every
+/// output the frame asks for), or the multisampled colour (`--samples` N > 1: colour only, a
+/// pass per eye, resolved into that eye's layer of the colour target).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Samples {
+    Centre,
+    Multi(u32),
+}
+
+impl Samples {
+    /// The kinds of pass a frame with `settings` draws, in order: the centre pass alone (one
+    /// sample), the multisampled colour alone, or both where the frame also wants outputs that
+    /// must not be averaged (the error pass's targets, depth, positions, the linear colour).
+    pub fn passes(settings: &RenderSettings) -> Vec<Samples> {
+        let n = settings.shading.samples;
+        let centre_outputs = settings.measure.outputs() > 1 || settings.shading.hdr;
+        match (n > 1, centre_outputs) {
+            (false, _) => vec![Samples::Centre],
+            (true, false) => vec![Samples::Multi(n)],
+            (true, true) => vec![Samples::Centre, Samples::Multi(n)],
+        }
+    }
+
+    /// The layers each pass of this kind draws: multisampled passes draw one eye each.
+    pub fn layers(self, eyes: EyesPerDraw) -> &'static [Layers] {
+        match self {
+            Samples::Centre => Layers::passes(eyes),
+            Samples::Multi(_) => Layers::passes(EyesPerDraw::One),
+        }
+    }
+}
+
+/// Per eye a colour and a depth target of N samples (single-layer: wgpu has no multisampled
+/// array textures), resolved into a single-layer target of the eye's and copied into its layer
+/// of the frame's colour target ([`Targets::copy_resolved`]; lavapipe resolved a pass into a
+/// layer view of the 2-layer target always into layer 0).
+pub struct Multisampled {
+    pub samples: u32,
+    color: [wgpu::Texture; 2],
+    depth: [wgpu::Texture; 2],
+    resolved: [wgpu::Texture; 2],
+}
+
 pub struct Targets {
     pub width: u32,
     pub height: u32,
@@ -58,23 +101,26 @@ pub struct Targets {
     pub hdr_color: Option<wgpu::Texture>,
     /// Whether `hdr_color` is there.
     pub hdr: bool,
+    /// The multisampled colour (`--samples` N > 1).
+    pub multisampled: Option<Multisampled>,
     error_target: ErrorTarget,
 }
 
 impl Targets {
-    pub fn new(gpu: &Gpu, width: u32, height: u32, positions: bool, hdr: bool) -> Targets {
-        let make = |format, usage, label: &str| {
+    pub fn new(gpu: &Gpu, width: u32, height: u32, positions: bool, hdr: bool, samples: u32) -> Targets {
+        let texture = |format, usage, label: &str, layers, sample_count| {
             gpu.device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
-                size: wgpu::Extent3d { width, height, depth_or_array_layers: 2 },
+                size: wgpu::Extent3d { width, height, depth_or_array_layers: layers },
                 mip_level_count: 1,
-                sample_count: 1,
+                sample_count,
                 dimension: wgpu::TextureDimension::D2,
                 format,
                 usage,
                 view_formats: &[],
             })
         };
+        let make = |format, usage, label: &str| texture(format, usage, label, 2, 1);
         // COPY_DST: the ray tracer copies its outputs in.
         let copyable =
             wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::COPY_DST;
@@ -91,6 +137,17 @@ impl Targets {
             position: positions.then(|| make(POSITION_FORMAT, copyable, "position")),
             depth: make(DEPTH_FORMAT, depth, "depth"),
             hdr,
+            multisampled: (samples > 1).then(|| Multisampled {
+                samples,
+                color: ["left", "right"]
+                    .map(|e| texture(COLOR_FORMAT, depth, &format!("{e} colour samples"), 1, samples)),
+                depth: ["left", "right"]
+                    .map(|e| texture(DEPTH_FORMAT, depth, &format!("{e} depth samples"), 1, samples)),
+                resolved: ["left", "right"].map(|e| {
+                    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+                    texture(COLOR_FORMAT, usage, &format!("{e} colour resolved"), 1, 1)
+                }),
+            }),
             error_target: gpu.error_target,
         }
     }
@@ -125,31 +182,19 @@ impl Targets {
         let all = [&self.color, &self.error, &self.object, &self.distance];
         let views: Vec<wgpu::TextureView> = all.into_iter().chain(position).take(outputs).map(view).collect();
         let depth_view = view(&self.depth);
-        // The background is given as display values; the sRGB target takes linear ones.
-        let [r, g, b] = settings.shading.background.map(|c| srgb_to_linear(c) as f64);
         let value = |x: f32| match self.error_target {
             ErrorTarget::Float => x as f64,
             ErrorTarget::UintBits => x.to_bits() as f64,
         };
         let clears = [
-            wgpu::Color { r, g, b, a: 1.0 },
+            background_clear(settings),
             wgpu::Color { r: value(-1.0), ..wgpu::Color::TRANSPARENT },
             wgpu::Color::TRANSPARENT,
             wgpu::Color { r: value(f32::INFINITY), ..wgpu::Color::TRANSPARENT },
             wgpu::Color::TRANSPARENT,
         ];
         let hdr_view = self.hdr_color.as_ref().map(view);
-        let attach = |view, c| {
-            Some(wgpu::RenderPassColorAttachment {
-                view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: if clear { wgpu::LoadOp::Clear(c) } else { wgpu::LoadOp::Load },
-                    store: wgpu::StoreOp::Store,
-                },
-            })
-        };
+        let attach = |view, c| attachment(view, None, c, clear);
         let mut attachments: Vec<Option<wgpu::RenderPassColorAttachment>> =
             views.iter().zip(clears).map(|(view, c)| attach(view, c)).collect();
         if let Some(hdr) = &hdr_view {
@@ -157,24 +202,54 @@ impl Targets {
             attachments.resize(HDR_LOCATION, None);
             attachments.push(attach(hdr, clears[0]));
         }
-        enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some(match layers {
-                Layers::Eye(k) => Eye::BOTH[k].name(),
-                Layers::Both => "both eyes",
-            }),
-            color_attachments: &attachments,
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: if clear { wgpu::LoadOp::Clear(1.0) } else { wgpu::LoadOp::Load },
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes,
-            occlusion_query_set: None,
-            multiview_mask,
-        })
+        let label = match layers {
+            Layers::Eye(k) => Eye::BOTH[k].name(),
+            Layers::Both => "both eyes",
+        };
+        begin(enc, label, &attachments, &depth_view, clear, timestamp_writes, multiview_mask)
+    }
+
+    /// Begins a render pass of `samples` (see [`Samples`]) drawing `layers`: the frame's targets
+    /// ([`Targets::begin_pass`]) or one eye's multisampled colour, resolved at the pass's end
+    /// into the eye's resolve target ([`Targets::copy_resolved`] copies it into the colour's
+    /// layer).
+    pub fn begin_samples_pass<'e>(
+        &self,
+        enc: &'e mut wgpu::CommandEncoder,
+        samples: Samples,
+        layers: Layers,
+        settings: &RenderSettings,
+        clear: bool,
+        timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'e>>,
+    ) -> wgpu::RenderPass<'e> {
+        let (Samples::Multi(_), Layers::Eye(k)) = (samples, layers) else {
+            return self.begin_pass(enc, layers, settings, clear, timestamp_writes);
+        };
+        let ms = self.multisampled.as_ref().expect("the targets were made with the frame's samples");
+        let resolve = ms.resolved[k].create_view(&Default::default());
+        let color = ms.color[k].create_view(&Default::default());
+        let depth = ms.depth[k].create_view(&Default::default());
+        let attachments = [attachment(&color, Some(&resolve), background_clear(settings), clear)];
+        let label = if k == 0 { "left eye's samples" } else { "right eye's samples" };
+        begin(enc, label, &attachments, &depth, clear, timestamp_writes, None)
+    }
+
+    /// After the multisampled colour's passes (if any were made): copies each eye's resolved
+    /// colour into its layer of the colour target.
+    pub fn copy_resolved(&self, enc: &mut wgpu::CommandEncoder) {
+        let Some(ms) = &self.multisampled else { return };
+        for (k, resolved) in ms.resolved.iter().enumerate() {
+            enc.copy_texture_to_texture(
+                resolved.as_image_copy(),
+                wgpu::TexelCopyTextureInfo {
+                    texture: &self.color,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d { x: 0, y: 0, z: k as u32 },
+                    aspect: wgpu::TextureAspect::All,
+                },
+                wgpu::Extent3d { width: self.width, height: self.height, depth_or_array_layers: 1 },
+            );
+        }
     }
 
     /// Reads both eyes' colour targets back.
@@ -226,6 +301,74 @@ impl Targets {
         let (buffer, stride) = copy_eyes_to_buffer(gpu, &self.object, wgpu::BufferUsages::COPY_SRC);
         Ok(unpad_eyes(&gpu.download(&buffer, buffer.size())?, self.width, self.height, stride))
     }
+}
+
+/// The samples per pixel the adapter draws the colour and depth targets with: 1 and 4 always
+/// (WebGPU's guarantee), others where the adapter's format features (asked for with
+/// `TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES`) list them for both.
+pub fn sample_counts(gpu: &Gpu) -> Vec<u32> {
+    let adapter = &gpu.adapter;
+    let specific = gpu.features.contains(wgpu::Features::TEXTURE_ADAPTER_SPECIFIC_FORMAT_FEATURES);
+    let supports = |n: u32| {
+        [COLOR_FORMAT, DEPTH_FORMAT]
+            .iter()
+            .all(|&f| adapter.get_texture_format_features(f).flags.sample_count_supported(n))
+    };
+    crate::core::settings::SAMPLE_COUNTS
+        .into_iter()
+        .filter(|&n| n == 1 || n == 4 || (specific && supports(n)))
+        .collect()
+}
+
+/// The background's clear colour: given as display values, the sRGB target takes linear ones.
+fn background_clear(settings: &RenderSettings) -> wgpu::Color {
+    let [r, g, b] = settings.shading.background.map(|c| srgb_to_linear(c) as f64);
+    wgpu::Color { r, g, b, a: 1.0 }
+}
+
+/// A colour attachment, cleared to `c` first if `clear`, resolved into `resolve` if given.
+fn attachment<'a>(
+    view: &'a wgpu::TextureView,
+    resolve: Option<&'a wgpu::TextureView>,
+    c: wgpu::Color,
+    clear: bool,
+) -> Option<wgpu::RenderPassColorAttachment<'a>> {
+    Some(wgpu::RenderPassColorAttachment {
+        view,
+        depth_slice: None,
+        resolve_target: resolve,
+        ops: wgpu::Operations {
+            load: if clear { wgpu::LoadOp::Clear(c) } else { wgpu::LoadOp::Load },
+            store: wgpu::StoreOp::Store,
+        },
+    })
+}
+
+/// Begins a render pass into `attachments` and `depth` (cleared to 1 first if `clear`).
+fn begin<'e>(
+    enc: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    attachments: &[Option<wgpu::RenderPassColorAttachment>],
+    depth: &wgpu::TextureView,
+    clear: bool,
+    timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'e>>,
+    multiview_mask: Option<std::num::NonZeroU32>,
+) -> wgpu::RenderPass<'e> {
+    enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: attachments,
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: depth,
+            depth_ops: Some(wgpu::Operations {
+                load: if clear { wgpu::LoadOp::Clear(1.0) } else { wgpu::LoadOp::Load },
+                store: wgpu::StoreOp::Store,
+            }),
+            stencil_ops: None,
+        }),
+        timestamp_writes,
+        occlusion_query_set: None,
+        multiview_mask,
+    })
 }
 
 /// Copies both layers (eyes) of a target into one buffer (rows padded to 256 bytes, eyes one

@@ -120,7 +120,7 @@ impl TraceMethod {
                 ),
             ));
         }
-        res.targets(gpu, p.width, p.height, false, false);
+        res.targets(gpu, p.width, p.height, false, false, 1);
         if !res.trace_outputs.as_ref().is_some_and(|(r, h, _)| *r == row_texels && *h == p.height) {
             let make = |what: &str| gpu.storage_buffer(&format!("trace {what}"), bytes, wgpu::BufferUsages::empty());
             res.trace_outputs = Some((row_texels, p.height, ["colour", "error", "object", "distance"].map(make)));
