@@ -262,3 +262,45 @@ fn triangles_reaching_into_the_eye_circle_are_drawn_whole() {
     }
     assert!(checked > 10_000, "only {checked} points checked");
 }
+
+/// Surround scenes at four samples per pixel, both panoramas: a crack narrower than a pixel
+/// would show as partial coverage of the background, which one sample at the centre can miss.
+/// The oracle: the same frame on a black and on a white background is the same image, pixel for
+/// pixel (any background a sample sees changes its pixel).
+#[test]
+fn surround_scenes_let_no_sample_see_the_background() {
+    use twister::core::projection::PanoramaKind;
+    let scenes: Vec<(&str, Scene, Vec3)> = vec![
+        ("box room", builtin::builtin_scene("builtin:box-room", &Projection::default()).unwrap(), Vec3::ZERO),
+        ("demo room", builtin::demo(), Vec3::ZERO),
+        ("sphere around", builtin::sphere_scene(1024, Vec3::new(0.2, 0.3, 0.0), 2.5, "sphere"), Vec3::ZERO),
+    ];
+    let r = common::renderer();
+    for (what, scene, viewer) in &scenes {
+        let gs = twister::GpuScene::upload(&r.gpu, scene).unwrap();
+        for (panorama, width, height) in
+            [(PanoramaKind::Cylinder, 320, 80), (PanoramaKind::Cylinder, 192, 192), (PanoramaKind::Equirect, 256, 128)]
+        {
+            for method in [Method::Vertex, Method::Fixed(7), Method::Adaptive(Split::Error)] {
+                let projection = Projection { width, height, panorama, ..Projection::default() };
+                let settings = RenderSettings::new(projection).with_viewer(*viewer).with_method(method).with_samples(4);
+                let black = r.render(&gs, &settings.with_background([0.0; 3])).unwrap();
+                let white = r.render(&gs, &settings.with_background([1.0; 3])).unwrap();
+                for eye in twister::Eye::BOTH {
+                    let (a, b) = (black.eye(eye), white.eye(eye));
+                    let seen: Vec<(u32, u32)> = (0..a.height)
+                        .flat_map(|y| (0..a.width).map(move |x| (x, y)))
+                        .filter(|&(x, y)| a.pixel(x, y) != b.pixel(x, y))
+                        .collect();
+                    assert!(
+                        seen.is_empty(),
+                        "{what}, {panorama:?} {width}x{height} {} {eye:?}: {} pixels see the background, e.g. {:?}",
+                        method.name(),
+                        seen.len(),
+                        &seen[..seen.len().min(5)]
+                    );
+                }
+            }
+        }
+    }
+}

@@ -71,14 +71,19 @@ fn a_pixel_shows_the_share_of_it_a_surface_covers() {
     for panorama in [PanoramaKind::Cylinder, PanoramaKind::Equirect] {
         let (mean1, _) = coverage_error(panorama, 1);
         let (mean4, worst4) = coverage_error(panorama, 4);
+        let (mean16, worst16) = coverage_error(panorama, 16);
         eprintln!(
-            "{panorama:?}: coverage error, 1 sample mean {mean1:.3}; 4 samples mean {mean4:.3}, worst {worst4:.3}"
+            "{panorama:?}: coverage error, 1 sample mean {mean1:.3}; 4 samples mean {mean4:.3}, worst {worst4:.3}; \
+             16 mean {mean16:.3}, worst {worst16:.3}"
         );
         // One sample: the pixel is all or nothing (the mean error of an edge at a uniform
         // fraction is 1/4). Four: the standard pattern's columns at 1/8, 3/8, 5/8, 7/8 of the
         // pixel count the share to within 1/8 (mean 1/16), plus the sRGB target's rounding.
+        // Sixteen (four per pixel of a 2×2 larger image where the adapter has no 16): eight
+        // columns, within 1/16 (mean 1/32).
         assert!(mean1 > 0.15, "{panorama:?}: one sample, mean {mean1}");
         assert!(worst4 <= 0.13 && mean4 <= 0.08, "{panorama:?}: four samples, mean {mean4}, worst {worst4}");
+        assert!(worst16 <= 0.07 && mean16 <= 0.05, "{panorama:?}: sixteen samples, mean {mean16}, worst {worst16}");
     }
 }
 
@@ -107,7 +112,8 @@ fn samples_change_only_the_edges() {
 
 /// What must not be averaged stays one sample at each pixel's centre whatever `--samples`: the
 /// depth, the error pass's error and objects, the linear HDR colour, bit for bit as with one
-/// sample; and the display colour drawn beside them is the multisampled one, as without them.
+/// sample; and the display colour drawn beside them is the multisampled one, as without them
+/// (4 samples: the adapter's own; 16: a larger image where the adapter has no 16).
 #[test]
 fn depth_error_and_hdr_stay_at_the_pixels_centre() {
     let projection = Projection { width: 256, height: 64, ..Projection::default() };
@@ -115,19 +121,39 @@ fn depth_error_and_hdr_stay_at_the_pixels_centre() {
     let measured = base.with_depth(true).with_measure_error(true).with_hdr(true);
     let scene = wall(-0.35);
     let one = common::render(&scene, &measured);
-    let four = common::render(&scene, &measured.with_samples(4));
-    let four_plain = common::render(&scene, &base.with_samples(4));
     let bits = |v: &[Vec<f32>; 2]| -> Vec<u32> { v.iter().flatten().map(|x| x.to_bits()).collect() };
-    assert_eq!(bits(one.depth.as_ref().unwrap()), bits(four.depth.as_ref().unwrap()), "depth");
-    let (m1, m4) = (one.measurement.as_ref().unwrap(), four.measurement.as_ref().unwrap());
-    assert_eq!(bits(&m1.error), bits(&m4.error), "error");
-    assert_eq!(m1.object, m4.object, "objects");
     let hdr = |f: &twister::Frame| -> Vec<u32> {
         f.hdr.as_ref().unwrap().iter().flatten().flatten().map(|x| x.to_bits()).collect()
     };
-    assert_eq!(hdr(&one), hdr(&four), "linear colour");
-    assert!(four.left.rgba == four_plain.left.rgba && four.right.rgba == four_plain.right.rgba, "colour");
-    assert!(one.left.rgba != four.left.rgba, "the colour is multisampled");
+    for samples in [4, 16] {
+        let many = common::render(&scene, &measured.with_samples(samples));
+        let plain = common::render(&scene, &base.with_samples(samples));
+        assert_eq!(bits(one.depth.as_ref().unwrap()), bits(many.depth.as_ref().unwrap()), "{samples}: depth");
+        let (m1, m) = (one.measurement.as_ref().unwrap(), many.measurement.as_ref().unwrap());
+        assert_eq!(bits(&m1.error), bits(&m.error), "{samples}: error");
+        assert_eq!(m1.object, m.object, "{samples}: objects");
+        assert_eq!(hdr(&one), hdr(&many), "{samples}: linear colour");
+        assert!(many.left.rgba == plain.left.rgba && many.right.rgba == plain.right.rgba, "{samples}: colour");
+        assert!(one.left.rgba != many.left.rgba, "{samples}: the colour is multisampled");
+        assert_eq!(many.stats.samples, samples);
+    }
+}
+
+/// Samples the adapter lacks are made up by a larger image; one beyond the adapter's largest
+/// image is refused with one error naming the setting, not drawn.
+#[test]
+fn samples_beyond_the_adapter_need_an_image_it_can_draw() {
+    let max = common::renderer().gpu.limits.max_texture_dimension_2d;
+    let counts = twister::gpu::targets::sample_counts(&common::renderer().gpu);
+    if counts.contains(&16) {
+        eprintln!("the adapter draws 16 samples itself: nothing made up to refuse");
+        return;
+    }
+    let projection = Projection { width: max, height: 16, ..Projection::default() };
+    let settings = RenderSettings::new(projection).with_samples(16);
+    let gs = twister::GpuScene::upload(&common::renderer().gpu, &wall(-0.35)).unwrap();
+    let err = common::renderer().render(&gs, &settings).err().expect("refused").to_string();
+    assert!(err.contains("shading.samples") && err.contains("larger image"), "{err}");
 }
 
 #[test]

@@ -165,7 +165,14 @@ fn to_pixel(proj: Projection, u: f32, v: f32) -> vec2<f32> {
 fn to_clip(proj: Projection, uvd: vec3<f32>) -> vec4<f32> {
     let x = uvd.x / PI;
     let y_limit = 1.0 + GUARD_BAND_PX / (0.5 * proj.height);
-    let y = clamp(uvd.y * proj.pixels_per_v / (0.5 * proj.height), -y_limit, y_limit);
+    var y = clamp(uvd.y * proj.pixels_per_v / (0.5 * proj.height), -y_limit, y_limit);
+    // The sphere: a vertex beyond the centre of the first (last) row, where every longitude
+    // meets within half a row of the pole, is put on the image's edge (the pole), so that the
+    // triangles drawn there reach it and the subdivision's culling beyond that centre leaves no
+    // sample of a multisampled pixel uncovered (`raster_vertex` in cpu/raster.rs).
+    if (is_sphere(proj) && abs(y) > 1.0 - 1.0 / proj.height) {
+        y = sign(y);
+    }
     let z = min(uvd.z / (uvd.z + 1.0), MAX_DEPTH);
     return vec4<f32>(x, y, z, 1.0);
 }

@@ -69,8 +69,9 @@ pub struct ViewArgs {
     #[arg(long, value_parser = Method::parse, default_value = "adaptive")]
     pub method: Method,
     /// Samples per pixel of the colour image: 1, 2, 4, 8, 16 or 32 (multisampling, averaged in
-    /// linear light after tone mapping; the projection methods and slit:W, up to what the adapter
-    /// supports). Depth, --hdr and the error pass stay one sample at each pixel's centre.
+    /// linear light after tone mapping; the projection methods and slit:W; counts the adapter
+    /// lacks are made up by a larger image). Depth, --hdr and the error pass stay one sample at
+    /// each pixel's centre.
     /// [default: 4 for render (1 with trace); 1 for bench and error, the paper's geometry]
     #[arg(long)]
     pub samples: Option<u32>,

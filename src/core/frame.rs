@@ -12,6 +12,37 @@ pub struct EyeImage {
 }
 
 impl EyeImage {
+    /// The image `kx`×`ky` times smaller, each pixel the average of its block in linear light
+    /// (sRGB decoded, averaged, encoded; alpha averaged as it is): the box filter that makes a
+    /// larger image's samples one pixel's.
+    pub fn box_filtered(&self, kx: u32, ky: u32) -> EyeImage {
+        let (w, h) = (self.width / kx, self.height / ky);
+        let decode: Vec<f32> = (0..=255).map(|b| crate::core::color::srgb_to_linear(b as f32 / 255.0)).collect();
+        let mut rgba = vec![0u8; (4 * w * h) as usize];
+        let n = (kx * ky) as f32;
+        for y in 0..h {
+            for x in 0..w {
+                let mut sum = [0.0f32; 4];
+                for dy in 0..ky {
+                    for dx in 0..kx {
+                        let p = self.pixel(kx * x + dx, ky * y + dy);
+                        for c in 0..3 {
+                            sum[c] += decode[p[c] as usize];
+                        }
+                        sum[3] += p[3] as f32 / 255.0;
+                    }
+                }
+                let i = 4 * (y * w + x) as usize;
+                for c in 0..3 {
+                    rgba[i + c] =
+                        (crate::core::color::linear_to_srgb(sum[c] / n) * 255.0).round().clamp(0.0, 255.0) as u8;
+                }
+                rgba[i + 3] = (sum[3] / n * 255.0).round().clamp(0.0, 255.0) as u8;
+            }
+        }
+        EyeImage { width: w, height: h, rgba }
+    }
+
     pub fn pixel(&self, x: u32, y: u32) -> [u8; 4] {
         let i = 4 * (y * self.width + x) as usize;
         [self.rgba[i], self.rgba[i + 1], self.rgba[i + 2], self.rgba[i + 3]]
@@ -58,9 +89,8 @@ pub struct FrameStats {
     /// vertices the triangles index, shaded once per eye.
     pub nodes_out: u64,
     pub pieces: u64,
-    /// Samples per pixel of the colour image, and how they were drawn: "1 sample at the pixel's
-    /// centre", or "multisampled N (a pass per eye; depth, error and linear colour at the
-    /// centres)".
+    /// Samples per pixel of the colour image, and how they were drawn: one at each pixel's
+    /// centre, multisampled by the adapter (a pass per eye), or made up by a larger image.
     pub samples: u32,
     pub sampling: String,
     /// The ray tracer: rays traced (primary, mirror, refraction, shadow) and ray–triangle tests.

@@ -10,7 +10,7 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::core::projection::{azimuth, Eye, Projection};
+use crate::core::projection::{azimuth, Eye, PanoramaKind, Projection};
 use crate::core::scene::unpack_tangent;
 use crate::core::texture::MaterialTable;
 use crate::cpu::fragment::{
@@ -20,7 +20,9 @@ use crate::encoding::constants::GUARD_BAND_PX;
 use crate::encoding::types::{DrawVertex, RasterParams};
 
 /// Clip-space position of a subdivided vertex (`vs_main` in raster.wgsl), at most
-/// `GUARD_BAND_PX` beyond the image's top or bottom edge.
+/// `GUARD_BAND_PX` beyond the image's top or bottom edge; on the sphere, beyond the centre of the
+/// first or last row on the image's edge (the subdivision culls what lies wholly beyond it, and
+/// the triangles drawn across it then reach the pole: no sample there sees the background).
 pub fn raster_vertex(params: &RasterParams, v: &DrawVertex) -> Vec4 {
     let projection = Projection::from(&params.projection);
     let p = Vec3::from(v.position);
@@ -30,10 +32,14 @@ pub fn raster_vertex(params: &RasterParams, v: &DrawVertex) -> Vec4 {
     let q = projection.project_with_azimuth(p, theta, eye);
     let half_height = 0.5 * projection.height as f32;
     let y_limit = 1.0 + GUARD_BAND_PX / half_height;
+    let mut y = (q.v * projection.pixels_per_v() / half_height).clamp(-y_limit, y_limit);
+    // The sphere: beyond the centre of the first (last) row, on the image's edge (the pole).
+    if projection.panorama == PanoramaKind::Equirect && y.abs() > 1.0 - 1.0 / projection.height as f32 {
+        y = y.signum();
+    }
     Vec4::new(
         q.u / std::f32::consts::PI + 2.0 * params.shift_px[0] / projection.width as f32,
-        (q.v * projection.pixels_per_v() / half_height).clamp(-y_limit, y_limit)
-            - 2.0 * params.shift_px[1] / projection.height as f32,
+        y - 2.0 * params.shift_px[1] / projection.height as f32,
         (q.depth / (q.depth + 1.0)).min(crate::encoding::constants::MAX_DEPTH),
         1.0,
     )

@@ -88,7 +88,72 @@ impl Renderer {
     pub fn render(&self, scene: &GpuScene, settings: &RenderSettings) -> Result<Frame> {
         settings.validate()?;
         self.check_size(settings)?;
-        self.check_samples(settings)?;
+        let n = settings.shading.samples;
+        let counts = crate::gpu::targets::sample_counts(&self.gpu);
+        if counts.contains(&n) {
+            return self.render_direct(scene, settings);
+        }
+        self.render_larger(scene, settings, &counts)
+    }
+
+    /// `--samples N` beyond the adapter's counts: the colour drawn at a larger size with the
+    /// most samples the adapter has that divide N (kx × ky pixels per pixel, kx·ky·base = N),
+    /// then box-filtered in linear light ([`EyeImage::box_filtered`]). The subdivision's L and τ
+    /// are scaled with the image, so that its geometry is that of the frame's size. The outputs
+    /// at the pixels' centres (depth, the error pass, the linear colour) come from a frame of the
+    /// asked size with one sample, drawn first.
+    fn render_larger(&self, scene: &GpuScene, settings: &RenderSettings, counts: &[u32]) -> Result<Frame> {
+        let n = settings.shading.samples;
+        let base = counts.iter().copied().filter(|&c| n % c == 0 && c < n).max().unwrap_or(1);
+        let cells = n / base;
+        let (kx, ky) = (1u32 << cells.ilog2().div_ceil(2), 1u32 << (cells.ilog2() / 2));
+        let p = *settings.projection();
+        let (width, height) = (p.width.saturating_mul(kx), p.height.saturating_mul(ky));
+        let max = self.gpu.limits.max_texture_dimension_2d;
+        if width > max || height > max {
+            return Err(Error::setting(
+                "shading.samples",
+                format!(
+                    "the adapter draws up to {base} samples per pixel; {n} would need a {kx}x{ky} larger image, \
+                     {width}x{height}, beyond its largest ({max}x{max}): ask for {base} or fewer"
+                ),
+            ));
+        }
+        let k = kx.min(ky) as f32;
+        let method = match settings.subdivision.method {
+            MethodName::Slit(w) => MethodName::Slit(w * kx),
+            m => m,
+        };
+        let larger = settings
+            .with_projection(Projection { width, height, ..p })
+            .with_method(method)
+            .with_edge_px(settings.subdivision.edge_px * k)
+            .with_max_error_px(settings.subdivision.max_error_px * k)
+            .with_samples(base)
+            .with_measure_error(false)
+            .with_depth(false)
+            .with_positions(false)
+            .with_hdr(false);
+        self.check_size(&larger)?;
+        let centre_outputs = settings.measure.outputs() > 1 || settings.shading.hdr;
+        let centre = if centre_outputs { Some(self.render_direct(scene, &settings.with_samples(1))?) } else { None };
+        let drawn = self.render_direct(scene, &larger)?;
+        let (left, right) = (drawn.left.box_filtered(kx, ky), drawn.right.box_filtered(kx, ky));
+        let mut frame = match centre {
+            Some(centre) => Frame { left, right, ..centre },
+            None => Frame { left, right, ..drawn },
+        };
+        frame.stats.samples = n;
+        frame.stats.sampling = format!(
+            "{base} sample{} per pixel of a {kx}x{ky} larger image, box-filtered{}",
+            if base > 1 { "s" } else { "" },
+            if centre_outputs { "; depth, error and linear colour at the centres" } else { "" }
+        );
+        Ok(frame)
+    }
+
+    /// A frame at the sample count the adapter draws.
+    fn render_direct(&self, scene: &GpuScene, settings: &RenderSettings) -> Result<Frame> {
         let mut resources = self.resources.lock().unwrap_or_else(|e| e.into_inner());
         let shadow_maps = scene.write_lighting(&self.gpu, settings);
         self.gpu.scoped("rendering a frame", || {
@@ -128,20 +193,6 @@ impl Renderer {
     /// The depths of a scene's shadow maps as the last frame drew them (`bytes` of them).
     pub fn shadow_depths(&self, scene: &GpuScene, bytes: u64) -> Result<Vec<f32>> {
         crate::gpu::shadow::shadow_depths(&self.gpu, scene, bytes)
-    }
-
-    /// Fails with one line when the adapter cannot draw the samples asked for.
-    fn check_samples(&self, settings: &RenderSettings) -> Result<()> {
-        let n = settings.shading.samples;
-        let counts = crate::gpu::targets::sample_counts(&self.gpu);
-        if counts.contains(&n) {
-            return Ok(());
-        }
-        let listed: Vec<String> = counts.iter().map(u32::to_string).collect();
-        Err(Error::setting(
-            "shading.samples",
-            format!("the adapter '{}' draws {} samples per pixel, not {n}", self.gpu.info.name, listed.join(", ")),
-        ))
     }
 
     /// Fails with one line when the image cannot be drawn on this device.

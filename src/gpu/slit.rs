@@ -14,7 +14,7 @@ use crate::gpu::draw::{DrawPipelines, DrawStage};
 use crate::gpu::frame::{FrameEnd, FrameResources, Method};
 use crate::gpu::scene::GpuScene;
 use crate::gpu::targets::{Layers, Samples};
-use crate::gpu::timestamps::submit_timed_pass;
+use crate::gpu::timestamps::{self as stamp, submit_timed_pass};
 
 /// The slit renderer: its drawing pipelines.
 pub(crate) struct SlitMethod {
@@ -41,14 +41,8 @@ impl Method for SlitMethod {
         };
         let start = Instant::now();
         let projection = settings.projection();
-        res.targets(
-            gpu,
-            projection.width,
-            projection.height,
-            settings.measure.positions,
-            false,
-            settings.shading.samples,
-        );
+        let (positions, samples) = (settings.measure.positions, settings.shading.samples);
+        res.targets(gpu, projection.width, projection.height, positions, false, samples);
         let res = &*res;
         let targets = res.targets.as_ref().expect("made");
         let view = settings.view();
@@ -72,13 +66,7 @@ impl Method for SlitMethod {
             let params = slit_params(projection, view, eye, settings.shading.ambient, settings.measure.error_angle);
             gpu.queue.write_buffer(&res.slit_params[k], 0, bytemuck::bytes_of(&params));
             let bind_group = self.pipelines.stage.bind_group(gpu, None, 0, &[&res.slit_params[k], &camera_buffer]);
-            // Timestamps at the start of the first pass and the end of the last only.
-            let writes =
-                timestamps.filter(|_| p == 0 || p + 1 == passes.len()).map(|t| wgpu::RenderPassTimestampWrites {
-                    query_set: &t.set,
-                    beginning_of_pass_write_index: (p == 0).then_some(0),
-                    end_of_pass_write_index: (p + 1 == passes.len()).then_some(1),
-                });
+            let writes = stamp::first_and_last(timestamps.map(|t| (&t.set, 0, 1)), p, passes.len());
             let mut pass = targets.begin_samples_pass(&mut enc, samples, Layers::Eye(k), settings, true, writes);
             pass.set_bind_group(0, &bind_group, &[]);
             pass.set_bind_group(1, &materials, &[]);

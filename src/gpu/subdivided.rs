@@ -194,14 +194,7 @@ impl SubdividedMethod {
             .collect();
         for (k, &(samples, layers)) in passes.iter().enumerate() {
             let pipeline = self.raster.get(gpu, scene, settings, layers, samples);
-            // Timestamps at the start of the first pass and the end of the last only.
-            let writes = timestamps.filter(|_| k == 0 || k + 1 == passes.len()).map(|(q, begin, end)| {
-                wgpu::RenderPassTimestampWrites {
-                    query_set: q,
-                    beginning_of_pass_write_index: (k == 0).then_some(begin),
-                    end_of_pass_write_index: (k + 1 == passes.len()).then_some(end),
-                }
-            });
+            let writes = stamp::first_and_last(timestamps, k, passes.len());
             let mut pass = targets.begin_samples_pass(enc, samples, layers, settings, clear, writes);
             pass.set_bind_group(0, &bind_group, &[]);
             pass.set_bind_group(1, &materials, &[]);

@@ -62,6 +62,21 @@ impl Timestamps {
     }
 }
 
+/// The timestamp writes of render pass `p` of `count` into `query` at slots (begin, end): the
+/// start of the first pass and the end of the last only (a pass with neither gets none).
+pub fn first_and_last(
+    query: Option<(&wgpu::QuerySet, u32, u32)>,
+    p: usize,
+    count: usize,
+) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+    let (first, last) = (p == 0, p + 1 == count);
+    query.filter(|_| first || last).map(|(query_set, begin, end)| wgpu::RenderPassTimestampWrites {
+        query_set,
+        beginning_of_pass_write_index: first.then_some(begin),
+        end_of_pass_write_index: last.then_some(end),
+    })
+}
+
 /// A compute pass, timed at queries `first` and `first` + 1 where there are timestamps.
 pub fn compute_pass<'e>(
     enc: &'e mut wgpu::CommandEncoder,

@@ -227,16 +227,19 @@ impl From<Option<usize>> for Tiling {
     }
 }
 
+/// The piece [`check_tiling`] tiles.
+const TILED: [Node; 3] = [
+    Node { position: Vec3::new(0.0, 0.0, -3.0), bary: Vec3::X },
+    Node { position: Vec3::new(1.3, 0.1, -3.0), bary: Vec3::Y },
+    Node { position: Vec3::new(0.4, 1.1, -3.2), bary: Vec3::Z },
+];
+
 /// The piece's triangles (the lattice, or the strip on `strip` base) tile it exactly: positive
 /// area, the piece's winding, every inner edge shared by two triangles, every boundary segment
 /// (the edges' own nodes) used once; each triangle's slots name its nodes.
 fn check_tiling(counts: [u32; 3], tiling: impl Into<Tiling>) -> usize {
     let tiling = tiling.into();
-    let q = [
-        Node { position: Vec3::new(0.0, 0.0, -3.0), bary: Vec3::X },
-        Node { position: Vec3::new(1.3, 0.1, -3.0), bary: Vec3::Y },
-        Node { position: Vec3::new(0.4, 1.1, -3.2), bary: Vec3::Z },
-    ];
+    let q = TILED;
     let node_on_edge = |e: usize, m: u32| edge_point(q[e], q[(e + 1) % 3], m, counts[e]);
     let rows = match &tiling {
         Tiling::Rows(widths) => {
