@@ -13,8 +13,11 @@
 @group(0) @binding(5) var<storage, read_write> counters: Counters;
 @group(0) @binding(6) var<storage, read_write> draw_args: DrawIndexedIndirectArgs;
 // Workgroup counts of the `lattice` dispatch (0–2), written by `lattice_args` from the piece
-// counter, and of the `plan_cuts` dispatch (3–5), written by `plan_cuts_args`.
-@group(0) @binding(7) var<storage, read_write> lattice_dispatch: array<u32, 6>;
+// counter, of the `plan_cuts` dispatch (3–5), written by `plan_cuts_args`, of the `plan_parts`
+// dispatch (6–8), written by `plan_parts_args`, and of `lattice_nodes` (9–11) and
+// `lattice_triangles` (12–14), written by `lattice_work_args` (`DISPATCH_*` in
+// src/encoding/subdivide.rs: their byte offsets).
+@group(0) @binding(7) var<storage, read_write> lattice_dispatch: array<u32, 15>;
 // Per object: the factor its L is multiplied by (the visual-field level of detail relaxes the
 // subdivision away from the gaze; 1 without it). CPU twin: `Subdivider::edge_px`.
 @group(0) @binding(8) var<storage, read> object_edge_scale: array<f32>;
@@ -31,3 +34,6 @@
 // The same buffer, read only, for the passes after the marking (`plan`, `plan_cuts`): plain
 // loads rather than atomic ones.
 @group(0) @binding(13) var<storage, read> edge_marks_read: array<u32>;
+// The parts `plan_cuts` cut (records as pieces', their counts unset), planned by `plan_parts`
+// (room for as many as `pieces`: each part makes at least one piece).
+@group(0) @binding(14) var<storage, read_write> parts: array<Piece>;

@@ -138,6 +138,23 @@ fn interior_node(i: u32, j: u32, l: u32, m: u32, piece_state: ptr<function, Piec
 }
 
 
+// The record of the current part of triangle t: its corners (position, barycentric weights),
+// its edge counts and K (`record` in src/cpu/subdivide/passes.rs).
+fn part_record(t: u32, part: ptr<function, PartPlan>) -> Piece {
+    var record: Piece;
+    record.triangle = t;
+    record.counts01 = (*part).n[0] | ((*part).n[1] << 16u);
+    record.count2_level = (*part).n[2] | ((*part).k << 16u) | select(0u, BANDS, (*part).bands);
+    for (var i = 0u; i < 3u; i++) {
+        record.corner[i] = vec4<f32>((*part).corner[i].position, (*part).corner[i].bary.x);
+        record.bary1[i] = (*part).corner[i].bary.y;
+        record.bary2[i] = (*part).corner[i].bary.z;
+    }
+    return record;
+}
+
+// The planned part's pieces: its K² macro cells or its bands' halves, appended; counted always,
+// written only if all fit.
 fn append_pieces(t: u32, part: ptr<function, PartPlan>) {
     var count = (*part).k * (*part).k;
     if ((*part).bands) {
@@ -148,18 +165,27 @@ fn append_pieces(t: u32, part: ptr<function, PartPlan>) {
     if (base + count > params.piece_capacity) {
         return; // counted, never written
     }
-    var record: Piece;
-    record.triangle = t;
-    record.counts01 = (*part).n[0] | ((*part).n[1] << 16u);
-    record.count2_level = (*part).n[2] | ((*part).k << 16u) | select(0u, BANDS, (*part).bands);
-    for (var i = 0u; i < 3u; i++) {
-        record.corner[i] = vec4<f32>((*part).corner[i].position, (*part).corner[i].bary.x);
-        record.bary1[i] = (*part).corner[i].bary.y;
-        record.bary2[i] = (*part).corner[i].bary.z;
-    }
+    var record = part_record(t, part);
     for (var c = 0u; c < count; c++) {
         record.cell = c;
         pieces[base + c] = record;
+    }
+}
+
+// A part `plan_cuts` cut, appended for `plan_parts` to plan (its counts unset); counted always,
+// written only if it fits.
+fn append_part(t: u32, part: ptr<function, PartPlan>) {
+    (*part).appended += 1u;
+    let slot = atomicAdd(&counters.parts, 1u);
+    if (slot < params.piece_capacity) {
+        parts[slot] = part_record(t, part);
+    }
+}
+
+// A part's corners from its record (`record_corner` in src/cpu/subdivide/passes.rs).
+fn record_corners(record: Piece, part: ptr<function, PartPlan>) {
+    for (var i = 0u; i < 3u; i++) {
+        (*part).corner[i] = Node(record.corner[i].xyz, vec3<f32>(record.corner[i].w, record.bary1[i], record.bary2[i]));
     }
 }
 

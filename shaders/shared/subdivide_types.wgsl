@@ -47,10 +47,12 @@ struct Counters {
     cut_wide: atomic<u32>,      // ... and from its back: the wide ones (`asks_for_cuts`)
     max_pieces: atomic<u32>,    // the most piece records one `plan` or `plan_cuts` invocation appended
     max_output: atomic<u32>,    // the most nodes or triangles one `lattice` invocation wrote
+    parts: atomic<u32>,         // part records `plan_cuts` appended for `plan_parts`
     // The frame's cuts around the axis (`AxisCuts` in axis.rs): bit 0 the quadrant cuts and the
     // square, bit k the diamond c_k; bits 0–31 and 32–63. Kept across the chunks of a frame.
     cuts_low: atomic<u32>,
     cuts_high: atomic<u32>,
+    _pad: u32,
 }
 
 struct DrawIndexedIndirectArgs {

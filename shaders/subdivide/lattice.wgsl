@@ -40,9 +40,7 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         return; // drawn by the quad's first record
     }
     load_triangle(piece.triangle, &tri);
-    for (var i = 0u; i < 3u; i++) {
-        part.corner[i] = Node(piece.corner[i].xyz, vec3<f32>(piece.corner[i].w, piece.bary1[i], piece.bary2[i]));
-    }
+    record_corners(piece, &part);
     var shape: PieceShape;
     if ((piece.count2_level & QUAD_HEAD) != 0u) {
         shape = quad_shape(piece, pieces[params.first_piece + local + 1u], &part, &piece_state);

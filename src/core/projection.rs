@@ -145,6 +145,9 @@ pub fn horizontal_radius(p: Vec3) -> f32 {
     (p.x * p.x + p.z * p.z).sqrt()
 }
 
+/// The largest image side a frame may have, in pixels, whatever the adapter.
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+
 impl Projection {
     pub fn validate(&self) -> Result<()> {
         if !(self.screen_radius.is_finite() && self.screen_radius > 0.0) {
@@ -178,10 +181,13 @@ impl Projection {
                 ));
             }
         }
-        if self.width < 2 || self.height < 2 || self.width > 16384 || self.height > 16384 {
+        if self.width < 2 || self.height < 2 || self.width > MAX_IMAGE_SIDE || self.height > MAX_IMAGE_SIDE {
             return Err(Error::setting(
                 "view.projection.width/height",
-                format!("image size must be between 2 and 16384 pixels per side, got {}x{}", self.width, self.height),
+                format!(
+                    "image size must be between 2 and {MAX_IMAGE_SIDE} pixels per side, got {}x{}",
+                    self.width, self.height
+                ),
             ));
         }
         Ok(())

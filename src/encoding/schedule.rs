@@ -23,7 +23,11 @@ use crate::encoding::subdivide::{
 use crate::encoding::types::{DrawVertex, Piece, SubdivideCounters, SubdivideParams};
 use crate::error::{Error, Result};
 
-pub const PIECE_SIZE: u64 = std::mem::size_of::<Piece>() as u64;
+/// Bytes of one piece record (`pieces`) or part record (`parts`).
+pub const RECORD_SIZE: u64 = std::mem::size_of::<Piece>() as u64;
+/// Bytes of one unit of piece capacity: its record and room for a part record (`parts` holds as
+/// many as `pieces`).
+pub const PIECE_SIZE: u64 = 2 * RECORD_SIZE;
 /// Bytes of one output node.
 pub const NODE_SIZE: u64 = std::mem::size_of::<DrawVertex>() as u64;
 /// Bytes of one output triangle's indices.
@@ -45,7 +49,7 @@ impl Capacities {
     /// indices), each buffer within the largest binding.
     pub fn budget(memory_mb: u32, max_binding: u64) -> Capacities {
         let budget = memory_mb as u64 * (1 << 20);
-        let pieces = (budget / 4).min(max_binding) / PIECE_SIZE;
+        let pieces = (budget / 4 / PIECE_SIZE).min(max_binding / RECORD_SIZE);
         let triangles = ((budget - budget / 4) / OUTPUT_UNIT_SIZE).min(max_binding / NODE_SIZE);
         Capacities { pieces: pieces.min(u32::MAX as u64) as u32, triangles: triangles.min(u32::MAX as u64) as u32 }
     }
@@ -243,9 +247,9 @@ pub fn run_one_submission<E: SubdivisionEngine>(
     let recording = one_submission(triangles, false);
     let mut totals = RunTotals::default();
     let counters = replay_counted(engine, &recording, &params, settings, &mut totals)?;
-    if counters.pieces > capacity.pieces || counters.output_units() > capacity.triangles {
+    if counters.overflowed(capacity.pieces, capacity.triangles) {
         let wanted = Capacities {
-            pieces: capacity.pieces.max(counters.pieces),
+            pieces: capacity.pieces.max(counters.piece_records()),
             triangles: capacity.triangles.max(counters.output_units()),
         };
         return Ok(Err(wanted));
@@ -280,14 +284,14 @@ pub fn run_chunked<E: SubdivisionEngine>(
         params.piece_capacity = capacity.pieces.min(budget.pieces);
         params.triangle_capacity = capacity.triangles;
         let planned = replay_counted(engine, &pass_run("plan", count), &params, settings, &mut totals)?;
-        if planned.pieces > params.piece_capacity {
-            match on_overflow(planned.pieces, budget.pieces, count) {
+        if planned.piece_records() > params.piece_capacity {
+            match on_overflow(planned.piece_records(), budget.pieces, count) {
                 Overflow::Grow(p) => want.pieces = p,
                 Overflow::Halve(c) => chunk = c,
                 Overflow::TooBig => {
                     let why = format!(
                         "one triangle needs {} pieces; raise the edge length L or the memory budget",
-                        planned.pieces
+                        planned.piece_records()
                     );
                     return Err(too_small(settings, why));
                 }

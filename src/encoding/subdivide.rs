@@ -146,11 +146,22 @@ pub fn dispatched(
             Command::DispatchIndirect { entry: "plan_cuts", .. } => {
                 Some(("plan_cuts", plan_cuts_split(panorama) as u64 * listed))
             }
+            Command::DispatchIndirect { entry: "plan_parts", .. } => {
+                Some(("plan_parts", counters.parts.min(params.piece_capacity) as u64))
+            }
             Command::DispatchIndirect { entry, .. } => Some((entry, pieces)),
             _ => None,
         })
         .collect()
 }
+
+/// Byte offsets in `lattice_dispatch` of the indirect dispatches' workgroup counts: `lattice`
+/// (written by `lattice_args`), `plan_cuts` (`plan_cuts_args`), `plan_parts` (`plan_parts_args`).
+pub const DISPATCH_LATTICE: u64 = 0;
+pub const DISPATCH_PLAN_CUTS: u64 = 12;
+pub const DISPATCH_PLAN_PARTS: u64 = 24;
+/// Words of `lattice_dispatch`.
+pub const DISPATCH_WORDS: usize = 15;
 
 /// Timestamp query indices of the one-submission schedule's passes (each pass's begin; its end
 /// is the next index): `plan` (with the cuts), `plan_cuts`, `lattice`.
@@ -160,8 +171,9 @@ pub const LATTICE_TIMESTAMP: u32 = 4;
 
 /// The usual frame's schedule, in one submission over `triangles` input triangles: the counters
 /// and the edge marks cleared; `active_cuts`, `ring_cuts` and `plan` over every triangle;
-/// `plan_cuts_args`, then `plan_cuts` over the triangles `plan` listed; `lattice_args`, then
-/// `lattice` over the pieces counted on the GPU, and `finalize` (the draw's arguments).
+/// `plan_cuts_args`, then `plan_cuts` over the triangles `plan` listed, `plan_parts_args`, then
+/// `plan_parts` over the parts it cut (the "plan_cuts" pass); `lattice_args`, then `lattice` over
+/// the pieces counted on the GPU, and `finalize` (the draw's arguments).
 /// `timed`: each pass writes its timestamps.
 pub fn one_submission(triangles: u32, timed: bool) -> Recording {
     let stamp = |index: u32| timed.then_some(index);
@@ -170,10 +182,18 @@ pub fn one_submission(triangles: u32, timed: bool) -> Recording {
     r.pass("plan", stamp(PLAN_TIMESTAMP));
     r.dispatch("active_cuts", triangles).dispatch("ring_cuts", triangles).dispatch("plan", triangles);
     r.pass("plan_cuts", stamp(PLAN_CUTS_TIMESTAMP));
-    r.dispatch("plan_cuts_args", 1).dispatch_indirect("plan_cuts", "lattice_dispatch", 12);
+    cut_and_plan_parts(&mut r);
     r.pass("lattice", stamp(LATTICE_TIMESTAMP));
-    r.dispatch("lattice_args", 1).dispatch_indirect("lattice", "lattice_dispatch", 0).dispatch("finalize", 1);
+    r.dispatch("lattice_args", 1).dispatch_indirect("lattice", "lattice_dispatch", DISPATCH_LATTICE);
+    r.dispatch("finalize", 1);
     r
+}
+
+/// `plan_cuts` over the triangles `plan` listed, then `plan_parts` over the parts it cut (each
+/// after its one-thread setup pass).
+fn cut_and_plan_parts(r: &mut Recording) {
+    r.dispatch("plan_cuts_args", 1).dispatch_indirect("plan_cuts", "lattice_dispatch", DISPATCH_PLAN_CUTS);
+    r.dispatch("plan_parts_args", 1).dispatch_indirect("plan_parts", "lattice_dispatch", DISPATCH_PLAN_PARTS);
 }
 
 /// The start of a chunked schedule: the counters and the edge marks cleared, then
@@ -193,7 +213,7 @@ pub fn pass_run(entry: &'static str, count: u32) -> Recording {
     r.clear("counters", Some(SubdivideCounters::RUN_BYTES));
     r.pass(entry, None).dispatch(entry, count);
     if entry == "plan" {
-        r.dispatch("plan_cuts_args", 1).dispatch_indirect("plan_cuts", "lattice_dispatch", 12);
+        cut_and_plan_parts(&mut r);
     }
     r.dispatch("finalize", 1);
     r

@@ -143,20 +143,35 @@ pub struct SubdivideCounters {
     pub max_pieces: u32,
     /// The most nodes or triangles (seam copies included) one `lattice` invocation wrote.
     pub max_output: u32,
+    /// Part records `plan_cuts` appended for `plan_parts`.
+    pub parts: u32,
     /// The frame's cuts around the axis (`AxisCuts`), bits 0–31 and 32–63.
     pub cuts_low: u32,
     pub cuts_high: u32,
+    /// Keeps the size a multiple of 8 (the timestamps read back after the counters are u64s).
+    pub _pad: u32,
 }
 
 impl SubdivideCounters {
     /// Bytes of the counters that each `plan` or `lattice` run starts from zero; the cuts after
     /// them are set once per frame by `active_cuts`.
-    pub const RUN_BYTES: u64 = 32;
+    pub const RUN_BYTES: u64 = 36;
 
     /// What the output buffers must hold, in their unit (a triangle's indices and a node each):
     /// the larger of the triangle and node counts.
     pub fn output_units(&self) -> u32 {
         self.triangles.max(self.nodes)
+    }
+
+    /// What the piece buffers must hold: the piece records, and as many part records (a part
+    /// that did not fit was never planned, so its pieces are not counted yet).
+    pub fn piece_records(&self) -> u32 {
+        self.pieces.max(self.parts)
+    }
+
+    /// Whether a run wanted more than its buffers held (then nothing it drew is complete).
+    pub fn overflowed(&self, piece_capacity: u32, triangle_capacity: u32) -> bool {
+        self.piece_records() > piece_capacity || self.output_units() > triangle_capacity
     }
 
     /// The frame's cuts as one mask.
@@ -396,7 +411,7 @@ pub const LAYOUTS: &[StructLayout] = &[
         view, projection, axis_clearance, triangle_count, first_triangle, method, fixed_n, edge_px, max_div,
         piece_capacity, triangle_capacity, first_piece, piece_count, measure_edges, vertical_limit, max_error_px, _pad1, _pad2
     }),
-    layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, nodes, cut_wide, max_pieces, max_output, cuts_low, cuts_high }),
+    layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, nodes, cut_wide, max_pieces, max_output, parts, cuts_low, cuts_high, _pad }),
     layout!("Piece" => Piece { triangle, cell, counts01, count2_level, corner, bary1, bary2 }),
     layout!("DrawIndexedIndirectArgs" => DrawIndexedIndirectArgs { index_count, instance_count, first_index, base_vertex, first_instance }),
     layout!("RasterParams" => RasterParams { projection, eye_sign, ambient, shift_px, error_angle, _pad0, _pad1, _pad2 }),

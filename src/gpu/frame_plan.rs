@@ -1,7 +1,8 @@
 //! The subdivision's GPU buffers, kept by the renderer across frames and grown as a frame's
 //! schedule ([`crate::encoding::schedule`]) asks.
 
-use crate::encoding::schedule::{Capacities, INDICES_SIZE, NODE_SIZE, PIECE_SIZE};
+use crate::encoding::schedule::{Capacities, INDICES_SIZE, NODE_SIZE, RECORD_SIZE};
+use crate::encoding::subdivide::DISPATCH_WORDS;
 use crate::encoding::types::{DrawIndexedIndirectArgs, SubdivideCounters};
 use crate::gpu::device::Gpu;
 use crate::gpu::scene::GpuScene;
@@ -9,6 +10,8 @@ use crate::gpu::scene::GpuScene;
 /// The subdivision's GPU buffers, with their capacities; kept by the renderer across frames.
 pub struct SubdivisionBuffers {
     pub pieces: wgpu::Buffer,
+    /// The parts `plan_cuts` cuts, for `plan_parts`: as many as `pieces` (each makes a piece or more).
+    pub parts: wgpu::Buffer,
     /// The output: lattice nodes (the raster's vertex buffer) and triangles' indices into them.
     pub nodes: wgpu::Buffer,
     pub indices: wgpu::Buffer,
@@ -30,8 +33,8 @@ fn cut_edges_buffer(gpu: &Gpu, words: u32) -> wgpu::Buffer {
     gpu.storage_buffer("cut edges", 4 * words.max(1) as u64, wgpu::BufferUsages::empty())
 }
 
-fn pieces_buffer(gpu: &Gpu, n: u32) -> wgpu::Buffer {
-    gpu.storage_buffer("pieces", n.max(1) as u64 * PIECE_SIZE, wgpu::BufferUsages::empty())
+fn pieces_buffer(gpu: &Gpu, label: &str, n: u32) -> wgpu::Buffer {
+    gpu.storage_buffer(label, n.max(1) as u64 * RECORD_SIZE, wgpu::BufferUsages::empty())
 }
 
 fn output_buffers(gpu: &Gpu, n: u32) -> (wgpu::Buffer, wgpu::Buffer) {
@@ -46,7 +49,8 @@ impl SubdivisionBuffers {
         let capacity = Capacities { pieces: capacity.pieces.max(1), triangles: capacity.triangles.max(1) };
         let (nodes, indices) = output_buffers(gpu, capacity.triangles);
         SubdivisionBuffers {
-            pieces: pieces_buffer(gpu, capacity.pieces),
+            pieces: pieces_buffer(gpu, "pieces", capacity.pieces),
+            parts: pieces_buffer(gpu, "parts", capacity.pieces),
             nodes,
             indices,
             counters: gpu.storage_buffer(
@@ -59,7 +63,11 @@ impl SubdivisionBuffers {
                 std::mem::size_of::<DrawIndexedIndirectArgs>() as u64,
                 wgpu::BufferUsages::INDIRECT,
             ),
-            lattice_dispatch: gpu.storage_buffer("lattice dispatch", 24, wgpu::BufferUsages::INDIRECT),
+            lattice_dispatch: gpu.storage_buffer(
+                "lattice dispatch",
+                4 * DISPATCH_WORDS as u64,
+                wgpu::BufferUsages::INDIRECT,
+            ),
             cut_list: gpu.storage_buffer("cut list", 4, wgpu::BufferUsages::empty()),
             cut_list_capacity: 1,
             cut_edges: cut_edges_buffer(gpu, 1),
@@ -101,7 +109,8 @@ impl SubdivisionBuffers {
             }
             Some(b) => {
                 if b.capacity.pieces < want.pieces {
-                    b.pieces = pieces_buffer(gpu, want.pieces);
+                    b.pieces = pieces_buffer(gpu, "pieces", want.pieces);
+                    b.parts = pieces_buffer(gpu, "parts", want.pieces);
                     b.capacity.pieces = want.pieces;
                 }
                 if b.capacity.triangles < want.triangles {

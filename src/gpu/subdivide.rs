@@ -26,6 +26,8 @@ use crate::gpu::timestamps::{self as stamp, Timestamps};
 use crate::shader::{StandIn, ROWS_OFF, SPHERE_OFF, SUBDIVIDE};
 
 pub(crate) const COUNTERS_SIZE: u64 = std::mem::size_of::<SubdivideCounters>() as u64;
+// The frame's timestamps are read back as u64s right after the counters.
+const _: () = assert!(COUNTERS_SIZE % 8 == 0);
 
 /// The stage's pipelines for one panorama, one per entry point.
 struct Variant {
@@ -250,6 +252,7 @@ impl FrameBuffers<'_> {
             "vertices" => &scene.vertices,
             "indices" => &scene.indices,
             "pieces" => &b.pieces,
+            "parts" => &b.parts,
             "out_nodes" => &b.nodes,
             "counters" => &b.counters,
             "draw_args" => &b.draw_args,

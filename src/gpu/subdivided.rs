@@ -151,7 +151,7 @@ impl SubdividedMethod {
         gpu.queue.submit([enc.finish()]);
         let bytes = gpu.read_buffer(&res.staging)?;
         let counters: SubdivideCounters = *bytemuck::from_bytes(&bytes[..COUNTERS_SIZE as usize]);
-        if counters.pieces > params.piece_capacity || counters.output_units() > params.triangle_capacity {
+        if counters.overflowed(params.piece_capacity, params.triangle_capacity) {
             return Ok(None);
         }
         let times = timestamps.map(|t| {

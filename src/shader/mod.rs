@@ -183,7 +183,8 @@ const MATERIAL_TABLE: [Binding; 8] = [
     bind(1, 7, "shadow_depths", Storage),
 ];
 
-/// What `plan` and `plan_cuts` read and write (both plan parts and append pieces).
+/// What `plan` reads and writes (it plans parts and appends pieces); `plan_cuts` also appends
+/// parts, and `plan_parts` plans them.
 const PLANNING: &[&str] = &[
     "params",
     "vertices",
@@ -194,6 +195,19 @@ const PLANNING: &[&str] = &[
     "cut_list",
     "triangle_edges",
     "edge_marks_read",
+];
+
+const CUTTING: &[&str] = &[
+    "params",
+    "vertices",
+    "indices",
+    "pieces",
+    "counters",
+    "object_edge_scale",
+    "cut_list",
+    "triangle_edges",
+    "edge_marks_read",
+    "parts",
 ];
 
 pub const SUBDIVIDE: Stage = Stage {
@@ -217,7 +231,17 @@ pub const SUBDIVIDE: Stage = Stage {
             &["counters", "lattice_dispatch", "cut_list"],
             include_str!("../../shaders/subdivide/plan_cuts_args.wgsl"),
         ),
-        pass("plan_cuts", PLANNING, include_str!("../../shaders/subdivide/plan_cuts.wgsl")),
+        pass("plan_cuts", CUTTING, include_str!("../../shaders/subdivide/plan_cuts.wgsl")),
+        pass(
+            "plan_parts_args",
+            &["params", "counters", "lattice_dispatch"],
+            include_str!("../../shaders/subdivide/plan_parts_args.wgsl"),
+        ),
+        pass(
+            "plan_parts",
+            &["params", "vertices", "indices", "pieces", "counters", "object_edge_scale", "parts"],
+            include_str!("../../shaders/subdivide/plan_parts.wgsl"),
+        ),
         pass(
             "lattice_args",
             &["params", "counters", "lattice_dispatch"],
@@ -245,6 +269,7 @@ pub const SUBDIVIDE: Stage = Stage {
         bind(0, 11, "triangle_edges", Storage),
         bind(0, 12, "cut_edges", StorageReadWrite),
         bind(0, 13, "edge_marks_read", Storage),
+        bind(0, 14, "parts", StorageReadWrite),
     ],
 };
 

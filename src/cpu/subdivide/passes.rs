@@ -1,6 +1,6 @@
 //! The `subdivide` stage's passes on the CPU: the twin of its pass files
 //! `shaders/subdivide/*.wgsl`, one method each of the same name, over buffers named as the WGSL binds them
-//! (`counters`, `cut_edges`, `cut_list`, `pieces`, `out_nodes`, `out_indices`,
+//! (`counters`, `cut_edges`, `cut_list`, `pieces`, `parts`, `out_nodes`, `out_indices`,
 //! `lattice_dispatch`, `draw_args`), run by replaying the same recordings as the GPU: an engine
 //! of `encoding::schedule`, so that the twin test runs the GPU's schedules (one submission with
 //! its indirect dispatches, and the chunked one) on both sides. The work inside each pass is the
@@ -21,7 +21,9 @@ use crate::core::settings::RenderSettings;
 use crate::encoding::constants::{BANDS, PIECES_FROM_COUNTER, QUAD_HEAD, QUAD_TAIL};
 use crate::encoding::recording::{Command, Recording};
 use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine};
-use crate::encoding::subdivide::plan_cuts_split;
+use crate::encoding::subdivide::{
+    plan_cuts_split, DISPATCH_LATTICE, DISPATCH_PLAN_CUTS, DISPATCH_PLAN_PARTS, DISPATCH_WORDS,
+};
 use crate::encoding::types::{DrawIndexedIndirectArgs, DrawVertex, Piece, SubdivideCounters, SubdivideParams};
 use crate::error::Result;
 
@@ -51,9 +53,11 @@ pub struct CpuSubdivision<'s> {
     /// Room for every triangle of the scene.
     cut_list: Vec<u32>,
     pieces: Vec<Piece>,
+    /// The parts `plan_cuts` cut, for `plan_parts` (room for as many as `pieces`).
+    parts: Vec<Piece>,
     out_nodes: Vec<DrawVertex>,
     out_indices: Vec<u32>,
-    lattice_dispatch: [u32; 6],
+    lattice_dispatch: [u32; DISPATCH_WORDS],
     pub draw_args: DrawIndexedIndirectArgs,
     /// Every taken range's nodes, and its triangles' indices into them.
     pub nodes: Vec<DrawVertex>,
@@ -87,9 +91,10 @@ impl<'s> CpuSubdivision<'s> {
             counters: SubdivideCounters::default(),
             cut_list: vec![0; (indices.len() / 3).max(1)],
             pieces: vec![Piece::default(); 1],
+            parts: vec![Piece::default(); 1],
             out_nodes: vec![DrawVertex::default(); 1],
             out_indices: vec![0; 3],
-            lattice_dispatch: [0; 6],
+            lattice_dispatch: [0; DISPATCH_WORDS],
             draw_args: DrawIndexedIndirectArgs::default(),
             nodes: Vec::new(),
             taken_indices: Vec::new(),
@@ -121,6 +126,8 @@ impl<'s> CpuSubdivision<'s> {
             "plan" => all.for_each(|i| self.plan(sub, i)),
             "plan_cuts_args" => self.plan_cuts_args(sub),
             "plan_cuts" => all.for_each(|i| self.plan_cuts(sub, i)),
+            "plan_parts_args" => self.plan_parts_args(sub),
+            "plan_parts" => all.for_each(|i| self.plan_parts(sub, i)),
             "lattice_args" => self.lattice_args(sub),
             "lattice" => all.for_each(|i| self.lattice(sub, i)),
             "finalize" => self.finalize(sub),
@@ -184,9 +191,8 @@ impl<'s> CpuSubdivision<'s> {
         let single = if full { one_part(tri.position, rho, cuts) } else { !marked };
         if single {
             let corners = [0, 1, 2].map(|i| Node { position: tri.position[i], bary: Vec3::AXES[i] });
-            let before = self.counters.pieces;
-            self.plan_polygon(sub, &tri, t as u32, &corners);
-            self.counters.max_pieces = self.counters.max_pieces.max(self.counters.pieces - before);
+            let appended = self.plan_part(sub, &tri, t as u32, corners);
+            self.counters.max_pieces = self.counters.max_pieces.max(appended);
             return;
         }
         let len = self.cut_list.len() as u32;
@@ -215,7 +221,8 @@ impl<'s> CpuSubdivision<'s> {
         let (narrow, wide) = self.listed_cuts();
         let listed = (narrow + wide).min(self.cut_list.len() as u32);
         let groups = (plan_cuts_split(sub.projection.panorama) * listed).div_ceil(64);
-        self.lattice_dispatch[3..6].copy_from_slice(&[groups.min(65535), groups.div_ceil(65535), 1]);
+        let at = DISPATCH_PLAN_CUTS as usize / 4;
+        self.lattice_dispatch[at..at + 3].copy_from_slice(&[groups.min(65535), groups.div_ceil(65535), 1]);
     }
 
     /// A listed triangle: a narrow one cut at its marked edges' crossings, a wide one's parts
@@ -231,28 +238,47 @@ impl<'s> CpuSubdivision<'s> {
         let t = if i < narrow { self.cut_list[i as usize] } else { self.cut_list[(len - 1 - (i - narrow)) as usize] };
         let tri = sub.load(self.scene.0, self.scene.1, t as usize);
         let (cuts, rho) = (self.counters.cuts(), sub.params.axis_clearance);
-        let before = self.counters.pieces;
+        let before = self.counters.pieces + self.counters.parts;
         if i < narrow {
             if local % split == 0 {
                 let shared = [0, 1, 2].map(|e| self.frame.is_cut_edge(t as usize, e));
                 for part in edge_split_parts(tri.position, shared, rho, cuts) {
-                    self.plan_polygon(sub, &tri, t, &part);
+                    self.cut_polygon(sub, &tri, t, &part);
                 }
             }
         } else {
             let quadrants = if split == 4 { (local % 4) as usize..(local % 4) as usize + 1 } else { 0..4 };
             for q in quadrants {
                 for poly in quadrant_polygons(tri.position, rho, cuts, q) {
-                    self.plan_polygon(sub, &tri, t, &poly);
+                    self.cut_polygon(sub, &tri, t, &poly);
                 }
             }
         }
-        self.counters.max_pieces = self.counters.max_pieces.max(self.counters.pieces - before);
+        let appended = self.counters.pieces + self.counters.parts - before;
+        self.counters.max_pieces = self.counters.max_pieces.max(appended);
+    }
+
+    fn plan_parts_args(&mut self, sub: &Subdivider) {
+        let groups = self.counters.parts.min(sub.params.piece_capacity).div_ceil(64);
+        let at = DISPATCH_PLAN_PARTS as usize / 4;
+        self.lattice_dispatch[at..at + 3].copy_from_slice(&[groups.min(65535), groups.div_ceil(65535), 1]);
+    }
+
+    /// A part `plan_cuts` cut: planned, its pieces appended.
+    fn plan_parts(&mut self, sub: &Subdivider, local: u32) {
+        if local >= self.counters.parts.min(sub.params.piece_capacity) {
+            return;
+        }
+        let record = self.parts[local as usize];
+        let tri = sub.load(self.scene.0, self.scene.1, record.triangle as usize);
+        let appended = self.plan_part(sub, &tri, record.triangle, [0, 1, 2].map(|i| record_corner(&record, i)));
+        self.counters.max_pieces = self.counters.max_pieces.max(appended);
     }
 
     fn lattice_args(&mut self, sub: &Subdivider) {
         let groups = self.counters.pieces.min(sub.params.piece_capacity).div_ceil(64);
-        self.lattice_dispatch[0..3].copy_from_slice(&[groups.min(65535), groups.div_ceil(65535), 1]);
+        let at = DISPATCH_LATTICE as usize / 4;
+        self.lattice_dispatch[at..at + 3].copy_from_slice(&[groups.min(65535), groups.div_ceil(65535), 1]);
     }
 
     /// One piece record: its lattice (or a band quad's strip, from its two records), emitted.
@@ -296,9 +322,9 @@ impl<'s> CpuSubdivision<'s> {
 
     // ---- what the passes share ----
 
-    /// A polygon of triangle t: a band quad's two records, or its fan's parts planned (those
-    /// on screen) and their pieces appended.
-    fn plan_polygon(&mut self, sub: &Subdivider, tri: &Triangle, t: u32, poly: &[Node]) {
+    /// A polygon `plan_cuts` cut from triangle t: a band quad's two records, or its fan's parts
+    /// on screen, appended for `plan_parts`.
+    fn cut_polygon(&mut self, sub: &Subdivider, tri: &Triangle, t: u32, poly: &[Node]) {
         if let Some((c, rails)) = sub.quad_strip(tri, poly) {
             let head = record(t, rails[0] | rails[1] << 16, QUAD_HEAD, [c[0], c[1], c[2]]);
             let tail = record(t, head.counts01, QUAD_TAIL, [c[3], c[1], c[2]]);
@@ -306,16 +332,26 @@ impl<'s> CpuSubdivision<'s> {
             return;
         }
         for part in fan(poly) {
-            if sub.off_screen_vertically(part.map(|n| n.position)) {
-                continue;
+            if !sub.off_screen_vertically(part.map(|n| n.position)) {
+                let slot = self.counters.parts;
+                self.counters.parts += 1;
+                if slot < sub.params.piece_capacity {
+                    self.parts[slot as usize] = record(t, 0, 0, part);
+                }
             }
-            let split = sub.plan(tri, &part);
-            let [n0, n1, n2] = split.n;
-            let flags = if split.bands { BANDS } else { 0 };
-            let first = record(t, n0 | n1 << 16, n2 | split.k << 16 | flags, part);
-            let cells: Vec<Piece> = (0..split.pieces(sub.params.max_div)).map(|cell| Piece { cell, ..first }).collect();
-            self.append(sub.params, &cells);
         }
+    }
+
+    /// Part `corners` of triangle t planned (`plan_part`, then `append_pieces` in the WGSL): its
+    /// pieces appended; how many.
+    fn plan_part(&mut self, sub: &Subdivider, tri: &Triangle, t: u32, corners: [Node; 3]) -> u32 {
+        let split = sub.plan(tri, &corners);
+        let [n0, n1, n2] = split.n;
+        let flags = if split.bands { BANDS } else { 0 };
+        let first = record(t, n0 | n1 << 16, n2 | split.k << 16 | flags, corners);
+        let cells: Vec<Piece> = (0..split.pieces(sub.params.max_div)).map(|cell| Piece { cell, ..first }).collect();
+        self.append(sub.params, &cells);
+        cells.len() as u32
     }
 
     /// Appends records: counted always, written only if all fit.
@@ -356,6 +392,7 @@ impl SubdivisionEngine for CpuSubdivision<'_> {
     fn ensure(&mut self, want: Capacities) -> Capacities {
         if self.pieces.len() < want.pieces as usize {
             self.pieces.resize(want.pieces as usize, Piece::default());
+            self.parts.resize(want.pieces as usize, Piece::default());
         }
         if self.out_nodes.len() < want.triangles as usize {
             self.out_nodes.resize(want.triangles as usize, DrawVertex::default());
