@@ -247,7 +247,7 @@ fn the_subdivisions_recordings_name_its_entry_points_and_bindings() {
     let order: Vec<&str> = usual.entries().collect();
     let expected = [
         ["active_cuts", "ring_cuts", "plan", "plan_cuts_args", "plan_cuts", "plan_parts_args", "plan_parts"].as_slice(),
-        &["lattice_args", "lattice", "finalize"],
+        &["lattice_args", "lattice", "lattice_work_args", "lattice_nodes", "lattice_triangles", "finalize"],
     ];
     assert_eq!(order, expected.concat());
     for recording in [usual, one_submission(7, false), active_cuts(7), pass_run("plan", 7), pass_run("lattice", 7)] {

@@ -37,3 +37,9 @@
 // The parts `plan_cuts` cut (records as pieces', their counts unset), planned by `plan_parts`
 // (room for as many as `pieces`: each part makes at least one piece).
 @group(0) @binding(14) var<storage, read_write> parts: array<Piece>;
+// What `lattice` planned for each piece (at the piece's index), and its work items: vec4(piece,
+// first node slot or candidate, the walk at that candidate (two u16 pairs)), for
+// `lattice_nodes` from the front and for `lattice_triangles` from the back (room for as many as
+// the output's nodes: each item has at least one node's worth, see `work_items` in lattice.rs).
+@group(0) @binding(15) var<storage, read_write> piece_work: array<PieceWork>;
+@group(0) @binding(16) var<storage, read_write> lattice_work: array<vec4<u32>>;

@@ -25,6 +25,13 @@ fn listed_cut(i: u32, listed: vec2<u32>) -> u32 {
     return cut_list[arrayLength(&cut_list) - 1u - (i - listed.x)];
 }
 
+// The work items `lattice` appended: (node items, triangle items), within `lattice_work`'s room
+// (`work_items` in src/cpu/subdivide/passes.rs).
+fn work_items() -> vec2<u32> {
+    let len = params.triangle_capacity;
+    return vec2<u32>(min(atomicLoad(&counters.node_items), len), min(atomicLoad(&counters.triangle_items), len));
+}
+
 // Invocations of `plan_cuts` per listed triangle: one per quadrant on the sphere, whose bands reach
 // 10⁻⁵ m from the axis (many more bands: one quadrant's keep an invocation within lavapipe's loop
 // budget, which stops any invocation after 65,535 loop iterations); one per triangle on the

@@ -330,33 +330,9 @@ fn piece_triangle_slots(t: u32, m: u32, walk: ptr<function, vec4<u32>>, piece_st
     return vec3<u32>(node_slot(cell.c[0], m), node_slot(cell.c[1], m), node_slot(cell.c[2], m));
 }
 
-// Whether candidate triangle t is drawn: not collapsed by snapping, not off screen.
-fn piece_triangle_drawn(t: u32, m: u32, walk: ptr<function, vec4<u32>>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> bool {
-    var a: vec3<f32>;
-    var b: vec3<f32>;
-    var c: vec3<f32>;
-    if ((*piece_state).strip_base == ROWS_SHAPE) {
-        var at: array<vec2<u32>, 3>;
-        rows_step(walk, &at, piece_state);
-        a = row_node(at[0].x, at[0].y, part, piece_state).position;
-        b = row_node(at[1].x, at[1].y, part, piece_state).position;
-        c = row_node(at[2].x, at[2].y, part, piece_state).position;
-    } else if ((*piece_state).strip_base == QUAD_STRIP) {
-        let s = quad_step(walk, piece_state);
-        a = quad_node(s.x, piece_state).position;
-        b = quad_node(s.y, piece_state).position;
-        c = quad_node(s.z, piece_state).position;
-    } else if ((*piece_state).strip_base < 3u) {
-        let s = strip_step(walk, piece_state);
-        a = strip_node(s.x, part, piece_state).position;
-        b = strip_node(s.y, part, piece_state).position;
-        c = strip_node(s.z, part, piece_state).position;
-    } else {
-        let cell = macro_cell(m, t);
-        a = lattice_node(cell.c[0], m, part, piece_state).position;
-        b = lattice_node(cell.c[1], m, part, piece_state).position;
-        c = lattice_node(cell.c[2], m, part, piece_state).position;
-    }
+// Whether a candidate triangle with these corners is drawn: not collapsed by snapping (two
+// corners the same point), not off screen (`drawn` in src/cpu/subdivide/).
+fn candidate_drawn(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> bool {
     return !(same(a, b) || same(b, c) || same(c, a) || off_screen_vertically(a, b, c));
 }
 
@@ -406,9 +382,9 @@ fn quad_shape(piece: Piece, tail: Piece, part: ptr<function, PartPlan>, piece_st
     return PieceShape(max((*piece_state).strip_n.x, (*piece_state).strip_n.y), candidates, candidates + 2u, theta_c);
 }
 
-// A piece of the pre-split: its macro cell's corners, each edge's count, lattice or strip.
-// Nothing where its snapped corners coincide (no area) or it lies wholly off screen.
-fn lattice_shape(piece: Piece, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> PieceShape {
+// A piece of the pre-split: its part's counts and K from its record, its corners (its macro
+// cell's, or its band's half), as locations on the part's edges.
+fn piece_corners(piece: Piece, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> array<vec3<u32>, 3> {
     (*part).n[0] = piece.counts01 & 0xffffu;
     (*part).n[1] = piece.counts01 >> 16u;
     (*part).n[2] = piece.count2_level & 0xffffu;
@@ -424,6 +400,13 @@ fn lattice_shape(piece: Piece, tri: ptr<function, InputTriangle>, part: ptr<func
         }
         (*piece_state).corner[i] = macro_node(cell.c[i], loc[i], part);
     }
+    return loc;
+}
+
+// A piece of the pre-split: its corners, each edge's count, lattice, strip or rows. Nothing
+// where its snapped corners coincide (no area) or it lies wholly off screen.
+fn lattice_shape(piece: Piece, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> PieceShape {
+    let loc = piece_corners(piece, part, piece_state);
     if (same((*piece_state).corner[0].position, (*piece_state).corner[1].position) || same((*piece_state).corner[1].position, (*piece_state).corner[2].position)
         || same((*piece_state).corner[2].position, (*piece_state).corner[0].position)) {
         return PieceShape(0u, 0u, 0u, 0.0); // snapped corners coincide: no area
@@ -431,7 +414,8 @@ fn lattice_shape(piece: Piece, tri: ptr<function, InputTriangle>, part: ptr<func
     if (off_screen_vertically((*piece_state).corner[0].position, (*piece_state).corner[1].position, (*piece_state).corner[2].position)) {
         return PieceShape(0u, 0u, 0u, 0.0); // every sub-triangle would be culled
     }
-    piece_edge_counts(loc, tri, part, piece_state);
+    piece_edges(loc, part, piece_state);
+    interior_counts(tri, part, piece_state);
     let m = max(max((*piece_state).counts[0], (*piece_state).counts[1]), (*piece_state).counts[2]);
     (*piece_state).strip_base = strip_base_of(tri, piece_state);
     var candidates = m * m;
@@ -452,9 +436,9 @@ fn lattice_shape(piece: Piece, tri: ptr<function, InputTriangle>, part: ptr<func
     return PieceShape(m, candidates, node_count, theta_c);
 }
 
-// Each piece edge's count: on an original edge, that edge's fine nodes (by global index,
-// `piece_original`, `piece_from`, `piece_to`); inside, its own division.
-fn piece_edge_counts(loc: array<vec3<u32>, 3>, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
+// Each piece edge on an original edge: that edge and the fine indices of its ends there
+// (`original`, `from_index`, `to_index`), and its count; −1 and no count inside.
+fn piece_edges(loc: array<vec3<u32>, 3>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
     for (var e = 0u; e < 3u; e++) {
         (*piece_state).original[e] = -1;
         for (var oe = 0u; oe < 3u; oe++) {
@@ -467,6 +451,12 @@ fn piece_edge_counts(loc: array<vec3<u32>, 3>, tri: ptr<function, InputTriangle>
                 (*piece_state).counts[e] = u32(abs(start - end));
             }
         }
+    }
+}
+
+// Each piece edge inside the part: its own division.
+fn interior_counts(tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
+    for (var e = 0u; e < 3u; e++) {
         if ((*piece_state).original[e] < 0) {
             if (params.method == METHOD_FIXED) {
                 // fixed:N pieces take N/K on interior edges (the regular N-lattice when K | N).
@@ -518,46 +508,4 @@ fn seam_copies(shape: PieceShape, part: ptr<function, PartPlan>, piece_state: pt
         seam.copies += 1u;
     }
     return seam;
-}
-
-// Appends the piece's nodes once per seam copy and its `count` drawn triangles (bits of
-// `drawn`) as indices into them; counted, never written past a capacity.
-fn emit_piece(shape: PieceShape, seam: SeamCopies, drawn: ptr<function, array<u32, 32>>, count: u32, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
-    let copies = seam.copies;
-    let node_count = shape.node_count;
-    let first_node = atomicAdd(&counters.nodes, copies * node_count);
-    let first_triangle = atomicAdd(&counters.triangles, copies * count);
-    atomicMax(&counters.max_output, copies * max(node_count, count));
-    if (first_node + copies * node_count > params.triangle_capacity
-        || first_triangle + copies * count > params.triangle_capacity) {
-        return; // counted, never written
-    }
-    var row = vec2<u32>(0u, 0u);
-    for (var k = 0u; k < node_count; k++) {
-        let node = piece_node(k, shape.m, &row, part, piece_state);
-        for (var c = 0u; c < copies; c++) {
-            out_nodes[first_node + c * node_count + k] = draw_vertex(node, seam.refs[c], tri);
-        }
-    }
-    var slot = 3u * first_triangle;
-    var walk = vec4<u32>(0u);
-    for (var t = 0u; t < shape.candidates; t++) {
-        let local = piece_triangle_slots(t, shape.m, &walk, piece_state);
-        if (((*drawn)[t / 32u] & (1u << (t % 32u))) == 0u) {
-            continue;
-        }
-        if (params.measure_edges != 0u) {
-            let ps = array<vec3<f32>, 3>(out_nodes[first_node + local.x].position,
-                                         out_nodes[first_node + local.y].position,
-                                         out_nodes[first_node + local.z].position);
-            atomicMax(&counters.max_edge_bits, bitcast<u32>(visible_edge_px(ps)));
-        }
-        for (var c = 0u; c < copies; c++) {
-            let base = first_node + c * node_count;
-            out_indices[slot] = base + local.x;
-            out_indices[slot + 1u] = base + local.y;
-            out_indices[slot + 2u] = base + local.z;
-            slot += 3u;
-        }
-    }
 }

@@ -48,6 +48,8 @@ struct Counters {
     max_pieces: atomic<u32>,    // the most piece records one `plan` or `plan_cuts` invocation appended
     max_output: atomic<u32>,    // the most nodes or triangles one `lattice` invocation wrote
     parts: atomic<u32>,         // part records `plan_cuts` appended for `plan_parts`
+    node_items: atomic<u32>,    // work items `lattice` appended for `lattice_nodes` (front of `lattice_work`)
+    triangle_items: atomic<u32>, // ... and for `lattice_triangles` (its back)
     // The frame's cuts around the axis (`AxisCuts` in axis.rs): bit 0 the quadrant cuts and the
     // square, bit k the diamond c_k; bits 0–31 and 32–63. Kept across the chunks of a frame.
     cuts_low: atomic<u32>,
@@ -74,6 +76,25 @@ struct Piece {
     corner: array<vec4<f32>, 3>, // position, barycentric weight of the triangle's corner 0
     bary1: vec4<f32>,   // weights of corners 1 and 2 at the part's corners 0, 1, 2
     bary2: vec4<f32>,
+}
+
+// What `lattice` planned for a piece (at the piece's index), which its work items read: its
+// shape (`strip_base`: a sliver's strip base 0–2, the lattice 3, QUAD_STRIP, ROWS_SHAPE), level
+// m, nodes, candidate triangles, seam copies (0: nothing drawn) and their reference azimuths, its
+// first output node, its edge counts (8 bits each; rows' base in bits 24–31), a strip's, quad's
+// or rows' sides' counts (x | y << 16), rows' widths (8 bits each, four a word).
+struct PieceWork {
+    shape: u32,
+    m: u32,
+    node_count: u32,
+    candidates: u32,
+    copies: u32,
+    first_node: u32,
+    counts: u32,
+    strip_n: u32,
+    refs: vec4<f32>,
+    row_w: array<u32, 9>,
+    _pad: array<u32, 3>,
 }
 
 const EDGE_ASKING: u32 = 1u;

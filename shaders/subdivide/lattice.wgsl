@@ -1,11 +1,11 @@
-// The `lattice` pass of the `subdivide` stage: one invocation per piece. The part's corners from
-// the piece record, the regular lattice of level m = max(counts), boundary nodes snapped to each
-// edge's nodes (or, for a sliver under the error split on the cylinder, a strip along its long
-// edges; for a band quad, a strip between its rails, corner 3 read from the next record); its
-// nodes appended once and its drawn sub-triangles as indices into them, the whole piece again a
-// turn away where its nodes' u range crosses ±π. Appends never write past a capacity: they are
-// counted, and the host grows the buffer or processes the scene in chunks.
-// CPU twin: `CpuSubdivision::lattice`.
+// The `lattice` pass of the `subdivide` stage: one invocation per piece record. The part's
+// corners from the record; the piece's shape: the regular lattice of level m = max(counts),
+// boundary nodes snapped to each edge's nodes, or a sliver's strip along its long edges (the
+// error split on the cylinder), a band quad's strip between its rails (corner 3 read from the
+// next record), rows (the sphere); its seam copies (again a turn away where its nodes' u range
+// crosses ±π). It writes no output: its plan (`piece_work`), its nodes' room, and its work items
+// (`plan_work`), which `lattice_nodes` and `lattice_triangles` then run, at most LATTICE_CHUNK
+// outputs each. CPU twin: `CpuSubdivision::lattice`.
 
 #import projection
 #import constants
@@ -20,6 +20,7 @@
 #import subdivide_lattice
 #import subdivide_bands
 #import subdivide_rows
+#import subdivide_work
 #import subdivide_dispatch
 
 @compute @workgroup_size(64)
@@ -35,7 +36,8 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     if (local >= piece_count) {
         return;
     }
-    let piece = pieces[params.first_piece + local];
+    let index = params.first_piece + local;
+    let piece = pieces[index];
     if ((piece.count2_level & QUAD_TAIL) != 0u) {
         return; // drawn by the quad's first record
     }
@@ -43,26 +45,12 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     record_corners(piece, &part);
     var shape: PieceShape;
     if ((piece.count2_level & QUAD_HEAD) != 0u) {
-        shape = quad_shape(piece, pieces[params.first_piece + local + 1u], &part, &piece_state);
+        shape = quad_shape(piece, pieces[index + 1u], &part, &piece_state);
     } else {
         shape = lattice_shape(piece, &tri, &part, &piece_state);
     }
     if (shape.candidates == 0u) {
         return;
     }
-    // Which of the candidate triangles (the m² of the lattice, or the strip's) are drawn (one
-    // bit each; m ≤ PIECE_DIVISIONS = 32).
-    var drawn: array<u32, 32>;
-    var count = 0u;
-    var walk = vec4<u32>(0u);
-    for (var t = 0u; t < shape.candidates; t++) {
-        if (piece_triangle_drawn(t, shape.m, &walk, &part, &piece_state)) {
-            drawn[t / 32u] |= 1u << (t % 32u);
-            count += 1u;
-        }
-    }
-    if (count == 0u) {
-        return;
-    }
-    emit_piece(shape, seam_copies(shape, &part, &piece_state), &drawn, count, &tri, &part, &piece_state);
+    plan_work(index, shape, seam_copies(shape, &part, &piece_state), &piece_state);
 }

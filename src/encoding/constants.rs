@@ -85,6 +85,10 @@ pub const ROW_DIAGONAL_ERROR: f32 = 1.5;
 /// adaptive part whose longest edge needs more than this × N_max divisions (an edge over
 /// 224·L long at N_max = 7) gets pieces of up to `PIECE_DIVISIONS` per edge instead of N_max.
 pub const MAX_MACRO_LEVEL: u32 = MAX_EDGE_DIVISIONS / PIECE_DIVISIONS;
+/// The most nodes or triangles (seam copies included) one work item of `lattice_nodes` or
+/// `lattice_triangles` writes: an item of a piece drawn c times (the seam) covers
+/// LATTICE_CHUNK / c node slots or candidate triangles (issue 32: no long threads).
+pub const LATTICE_CHUNK: u32 = 64;
 /// `SubdivideParams::piece_count` meaning "as many pieces as `plan` made" (read on the GPU).
 pub const PIECES_FROM_COUNTER: u32 = u32::MAX;
 
@@ -152,6 +156,7 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("FIELD_UP", F32(FIELD_UP)),
         ("FIELD_DOWN", F32(FIELD_DOWN)),
         ("PIECES_FROM_COUNTER", U32(PIECES_FROM_COUNTER)),
+        ("LATTICE_CHUNK", U32(LATTICE_CHUNK)),
         ("MAX_DEPTH", F32(MAX_DEPTH)),
         ("GUARD_BAND_PX", F32(GUARD_BAND_PX)),
         ("FINE_BINS", U32(FINE_BINS)),

@@ -20,21 +20,26 @@ use crate::encoding::recording::Recording;
 use crate::encoding::subdivide::{
     active_cuts, dispatched, one_submission, pass_run, subdivide_params, AxisCuts, SubdivideOutput,
 };
-use crate::encoding::types::{DrawVertex, Piece, SubdivideCounters, SubdivideParams};
+use crate::encoding::types::{DrawVertex, Piece, PieceWork, SubdivideCounters, SubdivideParams};
 use crate::error::{Error, Result};
 
 /// Bytes of one piece record (`pieces`) or part record (`parts`).
 pub const RECORD_SIZE: u64 = std::mem::size_of::<Piece>() as u64;
-/// Bytes of one unit of piece capacity: its record and room for a part record (`parts` holds as
-/// many as `pieces`).
-pub const PIECE_SIZE: u64 = 2 * RECORD_SIZE;
+/// Bytes of one unit of piece capacity: its record, room for a part record (`parts` holds as
+/// many as `pieces`) and its work (`piece_work`).
+pub const PIECE_SIZE: u64 = 2 * RECORD_SIZE + WORK_SIZE;
+/// Bytes of a piece's work (`piece_work`).
+pub const WORK_SIZE: u64 = std::mem::size_of::<PieceWork>() as u64;
+/// Bytes of one work item (`lattice_work`: room for one per output unit).
+pub const ITEM_SIZE: u64 = 16;
 /// Bytes of one output node.
 pub const NODE_SIZE: u64 = std::mem::size_of::<DrawVertex>() as u64;
 /// Bytes of one output triangle's indices.
 pub const INDICES_SIZE: u64 = 3 * 4;
-/// Bytes of one unit of output capacity: room for a node and for a triangle's indices (the
-/// lattices make about one node per output triangle or fewer: (m + 1)(m + 2)/2 for m²).
-pub const OUTPUT_UNIT_SIZE: u64 = NODE_SIZE + INDICES_SIZE;
+/// Bytes of one unit of output capacity: room for a node, for a triangle's indices (the
+/// lattices make about one node per output triangle or fewer: (m + 1)(m + 2)/2 for m²) and for
+/// a work item (a piece has fewer than its nodes).
+pub const OUTPUT_UNIT_SIZE: u64 = NODE_SIZE + INDICES_SIZE + ITEM_SIZE;
 
 /// Capacities of the piece and output buffers: pieces, and output units (each a node and a
 /// triangle's indices; `triangles` also caps the nodes).
@@ -49,7 +54,7 @@ impl Capacities {
     /// indices), each buffer within the largest binding.
     pub fn budget(memory_mb: u32, max_binding: u64) -> Capacities {
         let budget = memory_mb as u64 * (1 << 20);
-        let pieces = (budget / 4 / PIECE_SIZE).min(max_binding / RECORD_SIZE);
+        let pieces = (budget / 4 / PIECE_SIZE).min(max_binding / WORK_SIZE.max(RECORD_SIZE));
         let triangles = ((budget - budget / 4) / OUTPUT_UNIT_SIZE).min(max_binding / NODE_SIZE);
         Capacities { pieces: pieces.min(u32::MAX as u64) as u32, triangles: triangles.min(u32::MAX as u64) as u32 }
     }

@@ -84,11 +84,14 @@ pub struct SubdivideOutput {
     /// Triangles that ask for no cuts cut at edges they share with ones that do (the twin's
     /// count, for tests; 0 from the GPU).
     pub edge_splits: u32,
-    /// The most piece records one `plan` or `plan_cuts` invocation appended (from a schedule's
-    /// run; 0 from the twin's direct run), and the most nodes or triangles one piece's lattice
-    /// wrote.
+    /// The most piece or part records one `plan`, `plan_cuts` or `plan_parts` invocation
+    /// appended (from a schedule's run; 0 from the twin's direct run), and the most nodes or
+    /// triangles one work item of `lattice_nodes` or `lattice_triangles` wrote.
     pub max_pieces: u32,
     pub max_output: u32,
+    /// The most nodes or candidate triangles one piece has, seam copies included (the twin's,
+    /// for the twin test's slack; 0 from the GPU).
+    pub max_piece_output: u32,
 }
 
 /// Indexed triangles as three vertices each.
@@ -97,13 +100,6 @@ pub fn expand(nodes: &[DrawVertex], indices: &[u32]) -> Vec<DrawVertex> {
 }
 
 impl SubdivideOutput {
-    /// Counts one piece's output (the nodes and triangles added since `before`) into
-    /// `max_output`.
-    pub fn note_output(&mut self, (nodes, triangles): (usize, usize)) {
-        let added = (self.nodes.len() - nodes).max(self.indices.len() / 3 - triangles);
-        self.max_output = self.max_output.max(added as u32);
-    }
-
     /// An output from its nodes and indices (the GPU's read-back), with `vertices` expanded.
     pub fn indexed(
         nodes: Vec<DrawVertex>,
@@ -149,6 +145,12 @@ pub fn dispatched(
             Command::DispatchIndirect { entry: "plan_parts", .. } => {
                 Some(("plan_parts", counters.parts.min(params.piece_capacity) as u64))
             }
+            Command::DispatchIndirect { entry: "lattice_nodes", .. } => {
+                Some(("lattice_nodes", counters.node_items.min(params.triangle_capacity) as u64))
+            }
+            Command::DispatchIndirect { entry: "lattice_triangles", .. } => {
+                Some(("lattice_triangles", counters.triangle_items.min(params.triangle_capacity) as u64))
+            }
             Command::DispatchIndirect { entry, .. } => Some((entry, pieces)),
             _ => None,
         })
@@ -156,10 +158,13 @@ pub fn dispatched(
 }
 
 /// Byte offsets in `lattice_dispatch` of the indirect dispatches' workgroup counts: `lattice`
-/// (written by `lattice_args`), `plan_cuts` (`plan_cuts_args`), `plan_parts` (`plan_parts_args`).
+/// (written by `lattice_args`), `plan_cuts` (`plan_cuts_args`), `plan_parts` (`plan_parts_args`),
+/// `lattice_nodes` and `lattice_triangles` (`lattice_work_args`).
 pub const DISPATCH_LATTICE: u64 = 0;
 pub const DISPATCH_PLAN_CUTS: u64 = 12;
 pub const DISPATCH_PLAN_PARTS: u64 = 24;
+pub const DISPATCH_LATTICE_NODES: u64 = 36;
+pub const DISPATCH_LATTICE_TRIANGLES: u64 = 48;
 /// Words of `lattice_dispatch`.
 pub const DISPATCH_WORDS: usize = 15;
 
@@ -173,7 +178,9 @@ pub const LATTICE_TIMESTAMP: u32 = 4;
 /// and the edge marks cleared; `active_cuts`, `ring_cuts` and `plan` over every triangle;
 /// `plan_cuts_args`, then `plan_cuts` over the triangles `plan` listed, `plan_parts_args`, then
 /// `plan_parts` over the parts it cut (the "plan_cuts" pass); `lattice_args`, then `lattice` over
-/// the pieces counted on the GPU, and `finalize` (the draw's arguments).
+/// the pieces counted on the GPU, `lattice_work_args`, then `lattice_nodes` and
+/// `lattice_triangles` over the work items `lattice` appended, and `finalize` (the draw's
+/// arguments).
 /// `timed`: each pass writes its timestamps.
 pub fn one_submission(triangles: u32, timed: bool) -> Recording {
     let stamp = |index: u32| timed.then_some(index);
@@ -185,6 +192,7 @@ pub fn one_submission(triangles: u32, timed: bool) -> Recording {
     cut_and_plan_parts(&mut r);
     r.pass("lattice", stamp(LATTICE_TIMESTAMP));
     r.dispatch("lattice_args", 1).dispatch_indirect("lattice", "lattice_dispatch", DISPATCH_LATTICE);
+    lattice_work(&mut r);
     r.dispatch("finalize", 1);
     r
 }
@@ -196,6 +204,14 @@ fn cut_and_plan_parts(r: &mut Recording) {
     r.dispatch("plan_parts_args", 1).dispatch_indirect("plan_parts", "lattice_dispatch", DISPATCH_PLAN_PARTS);
 }
 
+/// The work items `lattice` appended: `lattice_nodes`, then `lattice_triangles` (which reads
+/// the nodes), each after the setup pass that counts them.
+fn lattice_work(r: &mut Recording) {
+    r.dispatch("lattice_work_args", 1);
+    r.dispatch_indirect("lattice_nodes", "lattice_dispatch", DISPATCH_LATTICE_NODES);
+    r.dispatch_indirect("lattice_triangles", "lattice_dispatch", DISPATCH_LATTICE_TRIANGLES);
+}
+
 /// The start of a chunked schedule: the counters and the edge marks cleared, then
 /// `active_cuts` and `ring_cuts` over all of the scene's `triangles`.
 pub fn active_cuts(triangles: u32) -> Recording {
@@ -205,8 +221,8 @@ pub fn active_cuts(triangles: u32) -> Recording {
     r
 }
 
-/// One step of a chunked schedule: `entry` (`plan`, with `plan_cuts` after it, or `lattice`)
-/// over `count` invocations, then `finalize`; the counters of this run cleared first (the
+/// One step of a chunked schedule: `entry` (`plan`, with `plan_cuts` and `plan_parts` after it,
+/// or `lattice`, with its work items' passes) over `count` invocations, then `finalize`; the counters of this run cleared first (the
 /// frame's cuts kept).
 pub fn pass_run(entry: &'static str, count: u32) -> Recording {
     let mut r = Recording::default();
@@ -214,6 +230,8 @@ pub fn pass_run(entry: &'static str, count: u32) -> Recording {
     r.pass(entry, None).dispatch(entry, count);
     if entry == "plan" {
         cut_and_plan_parts(&mut r);
+    } else {
+        lattice_work(&mut r);
     }
     r.dispatch("finalize", 1);
     r

@@ -145,6 +145,10 @@ pub struct SubdivideCounters {
     pub max_output: u32,
     /// Part records `plan_cuts` appended for `plan_parts`.
     pub parts: u32,
+    /// Work items `lattice` appended to `lattice_work` for `lattice_nodes` (from its front) ...
+    pub node_items: u32,
+    /// ... and for `lattice_triangles` (from its back).
+    pub triangle_items: u32,
     /// The frame's cuts around the axis (`AxisCuts`), bits 0–31 and 32–63.
     pub cuts_low: u32,
     pub cuts_high: u32,
@@ -155,7 +159,7 @@ pub struct SubdivideCounters {
 impl SubdivideCounters {
     /// Bytes of the counters that each `plan` or `lattice` run starts from zero; the cuts after
     /// them are set once per frame by `active_cuts`.
-    pub const RUN_BYTES: u64 = 36;
+    pub const RUN_BYTES: u64 = 44;
 
     /// What the output buffers must hold, in their unit (a triangle's indices and a node each):
     /// the larger of the triangle and node counts.
@@ -289,6 +293,34 @@ pub struct Piece {
     pub bary2: [f32; 4],
 }
 
+/// `PieceWork` in shaders/shared/subdivide_types.wgsl: what `lattice` planned for a piece (at
+/// the piece's index), which its work items read (`lattice_nodes`, `lattice_triangles`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct PieceWork {
+    /// How it is drawn: a sliver's strip (its base edge 0–2), the lattice (3), a band quad's
+    /// strip (`QUAD_STRIP`), rows (`ROWS_SHAPE`).
+    pub shape: u32,
+    /// Its lattice level (the largest edge count).
+    pub m: u32,
+    pub node_count: u32,
+    /// Candidate triangles (the lattice's m², the strip's, the rows').
+    pub candidates: u32,
+    /// Seam copies (1–3); 0: nothing drawn.
+    pub copies: u32,
+    /// The output node of the first copy's slot 0 (copy c's at + c·node_count).
+    pub first_node: u32,
+    /// The piece's edge counts, 8 bits each; rows: the base edge in bits 24–31.
+    pub counts: u32,
+    /// A strip's, a quad's rails' or rows' sides' counts: x | y << 16.
+    pub strip_n: u32,
+    /// Each copy's reference azimuth (`theta_ref`; x, y, z).
+    pub refs: [f32; 4],
+    /// Rows: each row's parts, 8 bits each, four rows a word (33 rows at most).
+    pub row_w: [u32; 9],
+    pub _pad: [u32; 3],
+}
+
 /// A Rust struct's layout, to be checked against its WGSL twin.
 #[derive(Clone, Copy, Debug)]
 pub struct StructLayout {
@@ -411,8 +443,9 @@ pub const LAYOUTS: &[StructLayout] = &[
         view, projection, axis_clearance, triangle_count, first_triangle, method, fixed_n, edge_px, max_div,
         piece_capacity, triangle_capacity, first_piece, piece_count, measure_edges, vertical_limit, max_error_px, _pad1, _pad2
     }),
-    layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, nodes, cut_wide, max_pieces, max_output, parts, cuts_low, cuts_high, _pad }),
+    layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, nodes, cut_wide, max_pieces, max_output, parts, node_items, triangle_items, cuts_low, cuts_high, _pad }),
     layout!("Piece" => Piece { triangle, cell, counts01, count2_level, corner, bary1, bary2 }),
+    layout!("PieceWork" => PieceWork { shape, m, node_count, candidates, copies, first_node, counts, strip_n, refs, row_w, _pad }),
     layout!("DrawIndexedIndirectArgs" => DrawIndexedIndirectArgs { index_count, instance_count, first_index, base_vertex, first_instance }),
     layout!("RasterParams" => RasterParams { projection, eye_sign, ambient, shift_px, error_angle, _pad0, _pad1, _pad2 }),
     layout!("SlitParams" => SlitParams { view, projection, eye_sign, ambient, near, error_angle }),

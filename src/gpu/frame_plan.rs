@@ -1,7 +1,7 @@
 //! The subdivision's GPU buffers, kept by the renderer across frames and grown as a frame's
 //! schedule ([`crate::encoding::schedule`]) asks.
 
-use crate::encoding::schedule::{Capacities, INDICES_SIZE, NODE_SIZE, RECORD_SIZE};
+use crate::encoding::schedule::{Capacities, INDICES_SIZE, ITEM_SIZE, NODE_SIZE, RECORD_SIZE, WORK_SIZE};
 use crate::encoding::subdivide::DISPATCH_WORDS;
 use crate::encoding::types::{DrawIndexedIndirectArgs, SubdivideCounters};
 use crate::gpu::device::Gpu;
@@ -12,6 +12,10 @@ pub struct SubdivisionBuffers {
     pub pieces: wgpu::Buffer,
     /// The parts `plan_cuts` cuts, for `plan_parts`: as many as `pieces` (each makes a piece or more).
     pub parts: wgpu::Buffer,
+    /// What `lattice` planned for each piece (as many as `pieces`).
+    pub piece_work: wgpu::Buffer,
+    /// `lattice`'s work items: room for one per output unit.
+    pub lattice_work: wgpu::Buffer,
     /// The output: lattice nodes (the raster's vertex buffer) and triangles' indices into them.
     pub nodes: wgpu::Buffer,
     pub indices: wgpu::Buffer,
@@ -37,20 +41,28 @@ fn pieces_buffer(gpu: &Gpu, label: &str, n: u32) -> wgpu::Buffer {
     gpu.storage_buffer(label, n.max(1) as u64 * RECORD_SIZE, wgpu::BufferUsages::empty())
 }
 
-fn output_buffers(gpu: &Gpu, n: u32) -> (wgpu::Buffer, wgpu::Buffer) {
+fn work_buffer(gpu: &Gpu, n: u32) -> wgpu::Buffer {
+    gpu.storage_buffer("piece work", n.max(1) as u64 * WORK_SIZE, wgpu::BufferUsages::empty())
+}
+
+/// The output's nodes and indices, and the work items (one per output unit).
+fn output_buffers(gpu: &Gpu, n: u32) -> (wgpu::Buffer, wgpu::Buffer, wgpu::Buffer) {
     (
         gpu.storage_buffer("subdivided nodes", n.max(1) as u64 * NODE_SIZE, wgpu::BufferUsages::VERTEX),
         gpu.storage_buffer("subdivided triangles", n.max(1) as u64 * INDICES_SIZE, wgpu::BufferUsages::INDEX),
+        gpu.storage_buffer("lattice work", n.max(1) as u64 * ITEM_SIZE, wgpu::BufferUsages::empty()),
     )
 }
 
 impl SubdivisionBuffers {
     pub fn new(gpu: &Gpu, capacity: Capacities) -> SubdivisionBuffers {
         let capacity = Capacities { pieces: capacity.pieces.max(1), triangles: capacity.triangles.max(1) };
-        let (nodes, indices) = output_buffers(gpu, capacity.triangles);
+        let (nodes, indices, lattice_work) = output_buffers(gpu, capacity.triangles);
         SubdivisionBuffers {
             pieces: pieces_buffer(gpu, "pieces", capacity.pieces),
             parts: pieces_buffer(gpu, "parts", capacity.pieces),
+            piece_work: work_buffer(gpu, capacity.pieces),
+            lattice_work,
             nodes,
             indices,
             counters: gpu.storage_buffer(
@@ -111,10 +123,11 @@ impl SubdivisionBuffers {
                 if b.capacity.pieces < want.pieces {
                     b.pieces = pieces_buffer(gpu, "pieces", want.pieces);
                     b.parts = pieces_buffer(gpu, "parts", want.pieces);
+                    b.piece_work = work_buffer(gpu, want.pieces);
                     b.capacity.pieces = want.pieces;
                 }
                 if b.capacity.triangles < want.triangles {
-                    (b.nodes, b.indices) = output_buffers(gpu, want.triangles);
+                    (b.nodes, b.indices, b.lattice_work) = output_buffers(gpu, want.triangles);
                     b.capacity.triangles = want.triangles;
                 }
             }

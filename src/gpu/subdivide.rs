@@ -253,6 +253,8 @@ impl FrameBuffers<'_> {
             "indices" => &scene.indices,
             "pieces" => &b.pieces,
             "parts" => &b.parts,
+            "piece_work" => &b.piece_work,
+            "lattice_work" => &b.lattice_work,
             "out_nodes" => &b.nodes,
             "counters" => &b.counters,
             "draw_args" => &b.draw_args,

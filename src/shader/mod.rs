@@ -249,8 +249,33 @@ pub const SUBDIVIDE: Stage = Stage {
         ),
         pass(
             "lattice",
-            &["params", "vertices", "indices", "pieces", "out_nodes", "counters", "object_edge_scale", "out_indices"],
+            &["params", "vertices", "indices", "pieces", "counters", "object_edge_scale", "piece_work", "lattice_work"],
             include_str!("../../shaders/subdivide/lattice.wgsl"),
+        ),
+        pass(
+            "lattice_work_args",
+            &["params", "counters", "lattice_dispatch"],
+            include_str!("../../shaders/subdivide/lattice_work_args.wgsl"),
+        ),
+        pass(
+            "lattice_nodes",
+            &[
+                "params",
+                "vertices",
+                "indices",
+                "pieces",
+                "out_nodes",
+                "counters",
+                "object_edge_scale",
+                "piece_work",
+                "lattice_work",
+            ],
+            include_str!("../../shaders/subdivide/lattice_nodes.wgsl"),
+        ),
+        pass(
+            "lattice_triangles",
+            &["params", "pieces", "out_nodes", "counters", "out_indices", "piece_work", "lattice_work"],
+            include_str!("../../shaders/subdivide/lattice_triangles.wgsl"),
         ),
         pass("finalize", &["params", "counters", "draw_args"], include_str!("../../shaders/subdivide/finalize.wgsl")),
     ],
@@ -270,6 +295,8 @@ pub const SUBDIVIDE: Stage = Stage {
         bind(0, 12, "cut_edges", StorageReadWrite),
         bind(0, 13, "edge_marks_read", Storage),
         bind(0, 14, "parts", StorageReadWrite),
+        bind(0, 15, "piece_work", StorageReadWrite),
+        bind(0, 16, "lattice_work", StorageReadWrite),
     ],
 };
 
@@ -418,6 +445,7 @@ pub const SHARED: &[(&str, &str)] = &[
     ("subdivide_bands", include_str!("../../shaders/shared/subdivide_bands.wgsl")),
     ("subdivide_rows", include_str!("../../shaders/shared/subdivide_rows.wgsl")),
     ("subdivide_rows_off", include_str!("../../shaders/shared/subdivide_rows_off.wgsl")),
+    ("subdivide_work", include_str!("../../shaders/shared/subdivide_work.wgsl")),
     ("surface_bindings", include_str!("../../shaders/shared/surface_bindings.wgsl")),
     ("texture", include_str!("../../shaders/shared/texture.wgsl")),
     ("brdf", include_str!("../../shaders/shared/brdf.wgsl")),

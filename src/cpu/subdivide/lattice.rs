@@ -69,14 +69,26 @@ pub fn lattice_triangles(
     node_on_edge: &dyn Fn(usize, u32) -> Node,
 ) -> Vec<([u32; 3], [Node; 3])> {
     let m = counts[0].max(counts[1]).max(counts[2]);
-    (0..m * m)
-        .filter_map(|t| {
-            let cell = macro_cell(m, t);
-            let [a, b, c] = cell.map(|c| lattice_node(counts, q, node_on_edge, m, c));
-            (a.position != b.position && b.position != c.position && c.position != a.position)
-                .then(|| (cell.map(|c| node_slot(c, m)), [a, b, c]))
-        })
+    with_nodes(lattice_slots(m), |k| lattice_node(counts, q, node_on_edge, m, slot_node(k, m)))
+        .into_iter()
+        .filter(|(_, t)| !collapsed(t))
         .collect()
+}
+
+/// The m² candidate triangles of a level-m lattice as their corners' slots ([`node_slot`]), in
+/// cell order ([`macro_cell`]).
+pub fn lattice_slots(m: u32) -> Vec<[u32; 3]> {
+    (0..m * m).map(|t| macro_cell(m, t).map(|c| node_slot(c, m))).collect()
+}
+
+/// Triangles as slots, with the nodes in those slots.
+pub(super) fn with_nodes(slots: Vec<[u32; 3]>, node: impl Fn(u32) -> Node) -> Vec<([u32; 3], [Node; 3])> {
+    slots.into_iter().map(|t| (t, t.map(&node))).collect()
+}
+
+/// Whether two corners of a triangle are the same point (a triangle that snapping collapsed).
+pub(super) fn collapsed(t: &[Node; 3]) -> bool {
+    t[0].position == t[1].position || t[1].position == t[2].position || t[2].position == t[0].position
 }
 
 /// Nodes of a sliver's strip with base edge `base`: the n1 + 1 nodes of edge base + 1 (from
@@ -108,20 +120,24 @@ pub fn strip_triangles(
     base: usize,
     node_on_edge: &dyn Fn(usize, u32) -> Node,
 ) -> Vec<([u32; 3], [Node; 3])> {
+    with_nodes(strip_slots(counts, base), |k| strip_node(counts, base, node_on_edge, k))
+}
+
+/// The strip's n1 + n2 − 1 triangles ([`strip_triangles`]) as their corners' slots, in walk order.
+pub fn strip_slots(counts: [u32; 3], base: usize) -> Vec<[u32; 3]> {
     let (n1, n2) = (counts[(base + 1) % 3], counts[(base + 2) % 3]);
     // Left side L_i (from corner `base` to the apex) is slot n1 + n2 − i; right side R_j is slot j.
     let left = |i: u32| n1 + n2 - i;
     let (mut i, mut j) = (0, 0);
     (0..n1 + n2 - 1)
         .map(|_| {
-            let slots = if strip_advances_left(i, j, n1, n2) {
+            if strip_advances_left(i, j, n1, n2) {
                 i += 1;
                 [left(i - 1), j, left(i)]
             } else {
                 j += 1;
                 [left(i), j - 1, j]
-            };
-            (slots, slots.map(|k| strip_node(counts, base, node_on_edge, k)))
+            }
         })
         .collect()
 }
@@ -156,19 +172,24 @@ pub(super) fn quad_strip_node(corners: &[Node; 4], rails: [u32; 2], slot: u32) -
 /// about n1 + n_diagonal triangles, more than the quad's strip. Same corner order (winding) as the quad. Each triangle as its corners' slots and
 /// nodes.
 pub fn quad_strip_triangles(rails: [u32; 2], node: &dyn Fn(u32) -> Node) -> Vec<([u32; 3], [Node; 3])> {
-    let [n1, n2] = rails;
+    with_nodes(quad_strip_slots(rails), node)
+}
+
+/// The quad strip's n1 + n2 triangles ([`quad_strip_triangles`]) as their corners' slots, in
+/// walk order.
+pub fn quad_strip_slots(rails: [u32; 2]) -> Vec<[u32; 3]> {
+    let [n1, _] = rails;
     let (a, d) = (|i: u32| i, |j: u32| n1 + 1 + j);
     let (mut i, mut j) = (0, 0);
-    (0..n1 + n2)
+    (0..rails[0] + rails[1])
         .map(|_| {
-            let slots = if quad_advances_on_a(i, j, rails) {
+            if quad_advances_on_a(i, j, rails) {
                 i += 1;
                 [a(i - 1), a(i), d(j)]
             } else {
                 j += 1;
                 [a(i), d(j), d(j - 1)]
-            };
-            (slots, slots.map(node))
+            }
         })
         .collect()
 }

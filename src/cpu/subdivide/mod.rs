@@ -117,6 +117,7 @@ mod lattice;
 pub mod passes;
 mod quad;
 mod rows;
+mod work;
 
 pub use axis::{
     axis_clearance, band_limit, edge_crossings, edge_split_parts, fan, one_part, polygons, quadrant_polygons,
@@ -129,8 +130,9 @@ pub use lattice::{
     boundary_edge, lattice_triangles, macro_cell, node_slot, quad_strip_node_count, quad_strip_triangles, slot_node,
     snap, strip_node_count, strip_triangles,
 };
-use lattice::{lattice_node, strip_node, weighted};
+use lattice::{lattice_node, lattice_slots, strip_node, strip_slots, weighted};
 pub use rows::{band_cell, PartSplit, Rows};
+pub use work::{chunk_of, PiecePlan};
 
 /// An input triangle in the viewer frame.
 #[derive(Clone, Copy, Debug)]
@@ -187,9 +189,11 @@ impl<'a> Subdivider<'a> {
             for poly in self.triangle_polygons(&tri, t, frame, &mut out.edge_splits) {
                 if let Some((corners, rails)) = self.quad_strip(&tri, &poly) {
                     out.pieces += 2; // the GPU's two records of a quad
-                    let before = (out.nodes.len(), out.indices.len() / 3);
-                    self.quad_lattice(&tri, &corners, rails, &mut out);
-                    out.note_output(before);
+                    if let Some(plan) = self.quad_lattice(&tri, &corners, rails) {
+                        out.quads += 1;
+                        out.max_piece_output = out.max_piece_output.max(plan.output());
+                        self.emit(&plan, &mut out);
+                    }
                     continue;
                 }
                 for part in fan(&poly) {
@@ -201,9 +205,13 @@ impl<'a> Subdivider<'a> {
                     let split = self.plan(&tri, &part);
                     for cell in 0..split.pieces(self.params.max_div) {
                         out.pieces += 1;
-                        let before = (out.nodes.len(), out.indices.len() / 3);
-                        self.lattice(&tri, &part, split, cell, &mut out);
-                        out.note_output(before);
+                        out.bands += split.bands as u32;
+                        if let Some((plan, shape)) = self.lattice(&tri, &part, split, cell) {
+                            out.strips += matches!(shape, Shape::Strip(_)) as u32;
+                            out.rows += matches!(shape, Shape::Rows(_)) as u32;
+                            out.max_piece_output = out.max_piece_output.max(plan.output());
+                            self.emit(&plan, &mut out);
+                        }
                     }
                 }
             }
@@ -232,11 +240,10 @@ impl<'a> Subdivider<'a> {
         }
     }
 
-    /// `lattice`: subdivides piece `cell` of a part (a macro cell, or a band's half) and emits
-    /// its sub-triangles.
-    fn lattice(&self, tri: &Triangle, part: &[Node; 3], split: PartSplit, cell: u32, out: &mut SubdivideOutput) {
+    /// `lattice`: plans piece `cell` of a part (a macro cell, or a band's half): its shape, its
+    /// nodes once per seam copy, its candidate triangles. None where it draws nothing.
+    fn lattice(&self, tri: &Triangle, part: &[Node; 3], split: PartSplit, cell: u32) -> Option<(PiecePlan, Shape)> {
         let PartSplit { n, k, .. } = split;
-        out.bands += split.bands as u32;
         let loc = if split.bands {
             band_cell(n, self.params.max_div, cell).map(|(e, j)| Location::on_edge(e, j, n))
         } else {
@@ -244,10 +251,10 @@ impl<'a> Subdivider<'a> {
         };
         let q = loc.map(|l| self.macro_node(part, n, k, l));
         if q[0].position == q[1].position || q[1].position == q[2].position || q[2].position == q[0].position {
-            return; // snapped corners coincide: no area
+            return None; // snapped corners coincide: no area
         }
         if self.off_screen_vertically(q.map(|n| n.position)) {
-            return; // every sub-triangle would be culled
+            return None; // every sub-triangle would be culled
         }
         // Each piece edge: on an original edge (that edge's fine nodes, by global index) or interior.
         let mut edges = [PieceEdge::default(); 3];
@@ -279,16 +286,8 @@ impl<'a> Subdivider<'a> {
                 None => edge_point(q[e], q[(e + 1) % 3], m, pe.count),
             }
         };
-        // The lattice of level m, a sliver's strip or rows: which of its triangles are drawn (not
-        // collapsed by snapping, not off screen), then its nodes once, then the drawn triangles
-        // as indices into them.
+        // The lattice of level m, a sliver's strip or rows: its nodes and candidate triangles.
         let shape = self.piece_shape(counts, &q, self.limits(tri.object), k, &node_on_edge);
-        let drawn = self.drawn(shape.triangles(counts, &q, &node_on_edge));
-        if drawn.is_empty() {
-            return;
-        }
-        out.strips += matches!(shape, Shape::Strip(_)) as u32;
-        out.rows += matches!(shape, Shape::Rows(_)) as u32;
         let nodes = shape.nodes(counts, &q, &node_on_edge);
         let theta_c = azimuth((q[0].position + q[1].position + q[2].position) / 3.0);
         let u_range = if self.projection.panorama == PanoramaKind::Equirect {
@@ -305,7 +304,8 @@ impl<'a> Subdivider<'a> {
         } else {
             self.piece_u_range(&q, theta_c)
         };
-        self.emit(tri, &nodes, drawn, theta_c, u_range, out);
+        let plan = self.piece_plan(tri, &nodes, shape.slots(counts), theta_c, u_range);
+        Some((plan, shape))
     }
 
     /// How a piece is triangulated: a sliver's strip on the cylinder ([`Subdivider::strip_base`]),
@@ -329,28 +329,17 @@ impl<'a> Subdivider<'a> {
         }
     }
 
-    /// The candidate triangles (slots and nodes) a piece draws: those not wholly above or below
-    /// the image's rows, as slots.
-    fn drawn(&self, candidates: Vec<([u32; 3], [Node; 3])>) -> Vec<[u32; 3]> {
-        candidates
-            .into_iter()
-            .filter(|(_, t)| !self.off_screen_vertically(t.map(|n| n.position)))
-            .map(|(slots, _)| slots)
-            .collect()
-    }
-
-    /// Appends a piece's nodes and its drawn triangles (slots into `nodes`). The seam: every
-    /// node is unwrapped towards the piece's reference azimuth `theta_c`; where the nodes' u
-    /// range (both eyes) reaches ±π, the piece is drawn again a turn away.
-    fn emit(
+    /// A piece's plan: its nodes once per seam copy, every node unwrapped towards the piece's
+    /// reference azimuth `theta_c`, again a turn away where the nodes' u range (both eyes)
+    /// reaches ±π; its candidate triangles (`plan_work` in the WGSL).
+    fn piece_plan(
         &self,
         tri: &Triangle,
         nodes: &[Node],
-        drawn: Vec<[u32; 3]>,
+        candidates: Vec<[u32; 3]>,
         theta_c: f32,
         (u_min, u_max): (f32, f32),
-        out: &mut SubdivideOutput,
-    ) {
+    ) -> PiecePlan {
         let mut refs = vec![theta_c];
         // Conservative by SEAM_MARGIN: a vertex exactly on the seam (θ = π, r = R_T) is a tie
         // that rounding could break either way; an extra copy is clipped by the rasterizer.
@@ -360,18 +349,31 @@ impl<'a> Subdivider<'a> {
         if u_min < -PI + SEAM_MARGIN {
             refs.push(theta_c + TAU);
         }
+        let nodes: Vec<DrawVertex> =
+            refs.iter().flat_map(|&theta_ref| nodes.iter().map(move |&n| draw_vertex(tri, n, theta_ref))).collect();
+        PiecePlan { node_count: (nodes.len() / refs.len()) as u32, nodes, copies: refs.len() as u32, candidates }
+    }
+
+    /// Appends a piece's nodes and its drawn triangles (indices into them), work item by work
+    /// item as `lattice_nodes` and `lattice_triangles` do; the largest item's output into
+    /// `max_output`.
+    fn emit(&self, plan: &PiecePlan, out: &mut SubdivideOutput) {
         let first = out.nodes.len() as u32;
-        let node_count = nodes.len() as u32;
-        for &theta_ref in &refs {
-            out.nodes.extend(nodes.iter().map(|&n| draw_vertex(tri, n, theta_ref)));
+        out.nodes.extend_from_slice(&plan.nodes);
+        for start in plan.node_items() {
+            out.max_output = out.max_output.max(plan.node_range(start).len() as u32 * plan.copies);
         }
-        for local in drawn {
-            if self.params.measure_edges != 0 {
-                out.max_sub_edge_px =
-                    out.max_sub_edge_px.max(self.visible_edge_px(local.map(|i| nodes[i as usize].position)));
-            }
-            for c in 0..refs.len() as u32 {
-                out.indices.extend(local.map(|i| first + c * node_count + i));
+        for start in plan.triangle_items() {
+            let drawn = plan.drawn(self, start, |k| plan.nodes[k as usize].position.into());
+            out.max_output = out.max_output.max(drawn.len() as u32 * plan.copies);
+            for local in drawn {
+                if self.params.measure_edges != 0 {
+                    let p = local.map(|i| plan.nodes[i as usize].position.into());
+                    out.max_sub_edge_px = out.max_sub_edge_px.max(self.visible_edge_px(p));
+                }
+                for c in 0..plan.copies {
+                    out.indices.extend(local.map(|i| first + c * plan.node_count + i));
+                }
             }
         }
     }
@@ -478,17 +480,12 @@ enum Shape {
 }
 
 impl Shape {
-    /// Its candidate triangles, as slots and nodes.
-    fn triangles(
-        &self,
-        counts: [u32; 3],
-        q: &[Node; 3],
-        node_on_edge: &dyn Fn(usize, u32) -> Node,
-    ) -> Vec<([u32; 3], [Node; 3])> {
+    /// Its candidate triangles, as their corners' slots.
+    fn slots(&self, counts: [u32; 3]) -> Vec<[u32; 3]> {
         match self {
-            Shape::Lattice(_) => lattice_triangles(counts, q, node_on_edge),
-            Shape::Strip(base) => strip_triangles(counts, *base, node_on_edge),
-            Shape::Rows(rows) => rows.triangles(node_on_edge),
+            Shape::Lattice(m) => lattice_slots(*m),
+            Shape::Strip(base) => strip_slots(counts, *base),
+            Shape::Rows(rows) => rows.slots(),
         }
     }
 

@@ -10,11 +10,13 @@
 //! Invocations run one after another in index order, so the output's order differs from the
 //! GPU's (whose appends race); both are compared as sets.
 
+use std::collections::HashMap;
+
 use glam::Vec3;
 
 use super::{
     band_limit, edge_split_parts, fan, one_part, quadrant_polygons, triangle_cuts, FrameCuts, Node, PartSplit,
-    SubdivideOutput, Subdivider, Triangle,
+    PiecePlan, SubdivideOutput, Subdivider, Triangle,
 };
 use crate::core::scene::SceneVertex;
 use crate::core::settings::RenderSettings;
@@ -22,7 +24,8 @@ use crate::encoding::constants::{BANDS, PIECES_FROM_COUNTER, QUAD_HEAD, QUAD_TAI
 use crate::encoding::recording::{Command, Recording};
 use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine};
 use crate::encoding::subdivide::{
-    plan_cuts_split, DISPATCH_LATTICE, DISPATCH_PLAN_CUTS, DISPATCH_PLAN_PARTS, DISPATCH_WORDS,
+    plan_cuts_split, DISPATCH_LATTICE, DISPATCH_LATTICE_NODES, DISPATCH_LATTICE_TRIANGLES, DISPATCH_PLAN_CUTS,
+    DISPATCH_PLAN_PARTS, DISPATCH_WORDS,
 };
 use crate::encoding::types::{DrawIndexedIndirectArgs, DrawVertex, Piece, SubdivideCounters, SubdivideParams};
 use crate::error::Result;
@@ -38,7 +41,8 @@ pub fn run_scheduled(
 ) -> Result<SubdivideOutput> {
     let mut engine = CpuSubdivision::new(vertices, indices, &[]);
     let totals = run_schedule(&mut engine, settings, (indices.len() / 3) as u32, schedule, budget)?;
-    Ok(totals.output(engine.nodes, engine.taken_indices))
+    let max_piece_output = engine.max_piece_output;
+    Ok(SubdivideOutput { max_piece_output, ..totals.output(engine.nodes, engine.taken_indices) })
 }
 
 /// The stage's buffers on the CPU, and what [`SubdivisionEngine::take`] kept.
@@ -57,6 +61,14 @@ pub struct CpuSubdivision<'s> {
     parts: Vec<Piece>,
     out_nodes: Vec<DrawVertex>,
     out_indices: Vec<u32>,
+    /// What `lattice` planned for each piece, by the piece's index: its first output node and
+    /// its plan (`piece_work`).
+    piece_work: HashMap<u32, (u32, PiecePlan)>,
+    /// `lattice`'s work items: [piece, first slot or candidate, 0, 0] (the twin needs no walk).
+    lattice_work: Vec<[u32; 4]>,
+    /// The most nodes or candidate triangles one piece has (seam copies included): the most a
+    /// piece's output changes when one of its measures flips (the twin test's slack).
+    pub max_piece_output: u32,
     lattice_dispatch: [u32; DISPATCH_WORDS],
     pub draw_args: DrawIndexedIndirectArgs,
     /// Every taken range's nodes, and its triangles' indices into them.
@@ -94,6 +106,9 @@ impl<'s> CpuSubdivision<'s> {
             parts: vec![Piece::default(); 1],
             out_nodes: vec![DrawVertex::default(); 1],
             out_indices: vec![0; 3],
+            piece_work: HashMap::new(),
+            lattice_work: vec![[0; 4]; 1],
+            max_piece_output: 0,
             lattice_dispatch: [0; DISPATCH_WORDS],
             draw_args: DrawIndexedIndirectArgs::default(),
             nodes: Vec::new(),
@@ -130,6 +145,9 @@ impl<'s> CpuSubdivision<'s> {
             "plan_parts" => all.for_each(|i| self.plan_parts(sub, i)),
             "lattice_args" => self.lattice_args(sub),
             "lattice" => all.for_each(|i| self.lattice(sub, i)),
+            "lattice_work_args" => self.lattice_work_args(sub),
+            "lattice_nodes" => all.for_each(|i| self.lattice_nodes(sub, i)),
+            "lattice_triangles" => all.for_each(|i| self.lattice_triangles(sub, i)),
             "finalize" => self.finalize(sub),
             other => panic!("the subdivide stage has no entry point {other}"),
         }
@@ -281,7 +299,8 @@ impl<'s> CpuSubdivision<'s> {
         self.lattice_dispatch[at..at + 3].copy_from_slice(&[groups.min(65535), groups.div_ceil(65535), 1]);
     }
 
-    /// One piece record: its lattice (or a band quad's strip, from its two records), emitted.
+    /// One piece record: its lattice (or a band quad's strip, from its two records) planned, its
+    /// nodes allocated, its work items appended (`plan_work`).
     fn lattice(&mut self, sub: &Subdivider, local: u32) {
         let params = sub.params;
         let mut piece_count = params.piece_count;
@@ -291,25 +310,115 @@ impl<'s> CpuSubdivision<'s> {
         if local >= piece_count {
             return;
         }
-        let at = (params.first_piece + local) as usize;
-        let piece = self.pieces[at];
+        let index = params.first_piece + local;
+        let piece = self.pieces[index as usize];
         if piece.count2_level & QUAD_TAIL != 0 {
             return; // drawn by the quad's first record
         }
         let tri = sub.load(self.scene.0, self.scene.1, piece.triangle as usize);
         let corners = [0, 1, 2].map(|i| record_corner(&piece, i));
-        let mut out = SubdivideOutput::default();
         let (n0, n1) = (piece.counts01 & 0xffff, piece.counts01 >> 16);
-        if piece.count2_level & QUAD_HEAD != 0 {
-            let last = record_corner(&self.pieces[at + 1], 0);
-            sub.quad_lattice(&tri, &[corners[0], corners[1], corners[2], last], [n0, n1], &mut out);
+        let plan = if piece.count2_level & QUAD_HEAD != 0 {
+            let last = record_corner(&self.pieces[index as usize + 1], 0);
+            sub.quad_lattice(&tri, &[corners[0], corners[1], corners[2], last], [n0, n1])
         } else {
             let n = [n0, n1, piece.count2_level & 0xffff];
             let k = (piece.count2_level >> 16) & 0x1fff;
             let bands = piece.count2_level & BANDS != 0;
-            sub.lattice(&tri, &corners, PartSplit { n, k, bands }, piece.cell, &mut out);
+            sub.lattice(&tri, &corners, PartSplit { n, k, bands }, piece.cell).map(|(plan, _)| plan)
+        };
+        let Some(plan) = plan else { return };
+        let first_node = self.counters.nodes;
+        self.counters.nodes += plan.copies * plan.node_count;
+        let len = params.triangle_capacity;
+        for start in plan.node_items() {
+            let slot = self.counters.node_items;
+            self.counters.node_items += 1;
+            if slot < len {
+                self.lattice_work[slot as usize] = [index, start, 0, 0];
+            }
         }
-        self.emit(params, &out);
+        for start in plan.triangle_items() {
+            let slot = self.counters.triangle_items;
+            self.counters.triangle_items += 1;
+            if slot < len {
+                self.lattice_work[(len - 1 - slot) as usize] = [index, start, 0, 0];
+            }
+        }
+        self.max_piece_output = self.max_piece_output.max(plan.output());
+        self.piece_work.insert(index, (first_node, plan));
+    }
+
+    /// The work items `lattice` appended: (node items, triangle items) within `lattice_work`.
+    fn work_items(&self, params: &SubdivideParams) -> (u32, u32) {
+        let len = params.triangle_capacity;
+        (self.counters.node_items.min(len), self.counters.triangle_items.min(len))
+    }
+
+    fn lattice_work_args(&mut self, sub: &Subdivider) {
+        let (nodes, triangles) = self.work_items(sub.params);
+        for (items, offset) in [(nodes, DISPATCH_LATTICE_NODES), (triangles, DISPATCH_LATTICE_TRIANGLES)] {
+            let groups = items.div_ceil(64);
+            let at = offset as usize / 4;
+            self.lattice_dispatch[at..at + 3].copy_from_slice(&[groups.min(65535), groups.div_ceil(65535), 1]);
+        }
+    }
+
+    /// A node item: its piece's nodes in its slots, once per seam copy.
+    fn lattice_nodes(&mut self, sub: &Subdivider, local: u32) {
+        let params = sub.params;
+        if local >= self.work_items(params).0 || self.counters.nodes > params.triangle_capacity {
+            return;
+        }
+        let [index, start, ..] = self.lattice_work[local as usize];
+        let (first_node, plan) = &self.piece_work[&index];
+        let range = plan.node_range(start);
+        for c in 0..plan.copies {
+            for k in range.clone() {
+                let (to, from) = (first_node + c * plan.node_count + k, c * plan.node_count + k);
+                self.out_nodes[to as usize] = plan.nodes[from as usize];
+            }
+        }
+        self.counters.max_output = self.counters.max_output.max(range.len() as u32 * plan.copies);
+    }
+
+    /// A triangle item: its piece's candidates in it that are drawn (their corners read from the
+    /// nodes written), appended once per seam copy.
+    fn lattice_triangles(&mut self, sub: &Subdivider, local: u32) {
+        let params = sub.params;
+        let len = params.triangle_capacity;
+        if local >= self.work_items(params).1 || self.counters.nodes > len {
+            return;
+        }
+        let [index, start, ..] = self.lattice_work[(len - 1 - local) as usize];
+        let (first_node, plan) = &self.piece_work[&index];
+        let node = |k: u32| Vec3::from(self.out_nodes[(first_node + k) as usize].position);
+        let drawn = plan.drawn(sub, start, node);
+        if drawn.is_empty() {
+            return;
+        }
+        let total = drawn.len() as u32 * plan.copies;
+        let first_triangle = self.counters.triangles;
+        self.counters.triangles += total;
+        self.counters.max_output = self.counters.max_output.max(total);
+        if first_triangle + total > len {
+            return; // counted, never written
+        }
+        if params.measure_edges != 0 {
+            for t in &drawn {
+                let edge = sub.visible_edge_px(t.map(node));
+                self.counters.max_edge_bits = f32::from_bits(self.counters.max_edge_bits).max(edge).to_bits();
+            }
+        }
+        let mut slot = 3 * first_triangle as usize;
+        for t in drawn {
+            for c in 0..plan.copies {
+                for k in t {
+                    self.out_indices[slot] = first_node + c * plan.node_count + k;
+                    slot += 1;
+                }
+            }
+        }
     }
 
     /// The draw's arguments: none drawn if a buffer overflowed.
@@ -363,29 +472,6 @@ impl<'s> CpuSubdivision<'s> {
         }
         self.pieces[base as usize..base as usize + records.len()].copy_from_slice(records);
     }
-
-    /// Appends a piece's nodes and triangles (indices local to `out.nodes`): counted always,
-    /// written only if both fit.
-    fn emit(&mut self, params: &SubdivideParams, out: &SubdivideOutput) {
-        let (node_count, triangle_count) = (out.nodes.len() as u32, (out.indices.len() / 3) as u32);
-        let first_node = self.counters.nodes;
-        let first_triangle = self.counters.triangles;
-        self.counters.nodes += node_count;
-        self.counters.triangles += triangle_count;
-        self.counters.max_output = self.counters.max_output.max(node_count.max(triangle_count));
-        let max_edge = f32::from_bits(self.counters.max_edge_bits).max(out.max_sub_edge_px);
-        self.counters.max_edge_bits = max_edge.to_bits();
-        let capacity = params.triangle_capacity;
-        if first_node + node_count > capacity || first_triangle + triangle_count > capacity {
-            return; // counted, never written
-        }
-        let nodes = first_node as usize..(first_node + node_count) as usize;
-        self.out_nodes[nodes].copy_from_slice(&out.nodes);
-        let slots = 3 * first_triangle as usize..3 * (first_triangle + triangle_count) as usize;
-        for (slot, &i) in self.out_indices[slots].iter_mut().zip(&out.indices) {
-            *slot = first_node + i;
-        }
-    }
 }
 
 impl SubdivisionEngine for CpuSubdivision<'_> {
@@ -397,6 +483,7 @@ impl SubdivisionEngine for CpuSubdivision<'_> {
         if self.out_nodes.len() < want.triangles as usize {
             self.out_nodes.resize(want.triangles as usize, DrawVertex::default());
             self.out_indices.resize(3 * want.triangles as usize, 0);
+            self.lattice_work.resize(want.triangles as usize, [0; 4]);
         }
         Capacities { pieces: self.pieces.len() as u32, triangles: self.out_nodes.len() as u32 }
     }

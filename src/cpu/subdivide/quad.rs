@@ -6,8 +6,8 @@
 
 use glam::Vec3;
 
-use super::lattice::{quad_strip_node, quad_strip_node_count, quad_strip_rungs, quad_strip_triangles};
-use super::{parts_for_bend, Node, SubdivideOutput, Subdivider, Triangle};
+use super::lattice::{quad_strip_node, quad_strip_node_count, quad_strip_rungs, quad_strip_slots};
+use super::{parts_for_bend, Node, PiecePlan, Subdivider, Triangle};
 use crate::core::projection::{azimuth, PanoramaKind};
 use crate::core::settings::SplitRule;
 use crate::encoding::constants::{PIECE_DIVISIONS, QUAD_MIN_DIVISIONS, QUAD_RUNG_ERROR};
@@ -54,20 +54,17 @@ impl Subdivider<'_> {
         quad_strip_rungs(rails).all(straight).then_some((corners, rails))
     }
 
-    /// `lattice` for a band's quad drawn as a strip between its rails ([`quad_strip_triangles`]).
-    pub(super) fn quad_lattice(&self, tri: &Triangle, corners: &[Node; 4], rails: [u32; 2], out: &mut SubdivideOutput) {
-        let node = |k: u32| quad_strip_node(corners, rails, k);
-        let drawn = self.drawn(quad_strip_triangles(rails, &node));
-        if drawn.is_empty() {
-            return;
-        }
-        out.quads += 1;
-        let nodes: Vec<Node> = (0..quad_strip_node_count(rails)).map(node).collect();
+    /// `lattice` for a band's quad drawn as a strip between its rails ([`quad_strip_triangles`]):
+    /// its plan.
+    pub(super) fn quad_lattice(&self, tri: &Triangle, corners: &[Node; 4], rails: [u32; 2]) -> Option<PiecePlan> {
+        let nodes: Vec<Node> = (0..quad_strip_node_count(rails)).map(|k| quad_strip_node(corners, rails, k)).collect();
         let c = corners.map(|n| n.position);
         let theta_c = azimuth((c[0] + c[1] + c[2] + c[3]) / 4.0);
         // The quad's u range: that of its fan's two triangles, which cover it.
         let (a, b) = ([corners[0], corners[1], corners[2]], [corners[0], corners[2], corners[3]]);
         let (ra, rb) = (self.piece_u_range(&a, theta_c), self.piece_u_range(&b, theta_c));
-        self.emit(tri, &nodes, drawn, theta_c, (ra.0.min(rb.0), ra.1.max(rb.1)), out);
+        let candidates = quad_strip_slots(rails);
+        (!candidates.is_empty())
+            .then(|| self.piece_plan(tri, &nodes, candidates, theta_c, (ra.0.min(rb.0), ra.1.max(rb.1))))
     }
 }

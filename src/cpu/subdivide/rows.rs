@@ -10,6 +10,7 @@
 //! its rows, two pieces per band, instead of K² macro cells.
 
 use super::edges::Limits;
+use super::lattice::{collapsed, with_nodes};
 use super::{edge_point, Node, Subdivider};
 use crate::core::projection::PanoramaKind;
 use crate::core::settings::SplitRule;
@@ -186,6 +187,12 @@ impl Rows {
     /// coincident corners and is dropped. Each triangle as its corners' slots and nodes.
     pub fn triangles(&self, node_on_edge: &dyn Fn(usize, u32) -> Node) -> Vec<([u32; 3], [Node; 3])> {
         let nodes = self.nodes(node_on_edge);
+        with_nodes(self.slots(), |k| nodes[k as usize]).into_iter().filter(|(_, t)| !collapsed(t)).collect()
+    }
+
+    /// Every candidate triangle of the zipper ([`Rows::triangles`], the collapsed ones too) as
+    /// its corners' slots, band by band.
+    pub fn slots(&self) -> Vec<[u32; 3]> {
         let mut out = Vec::new();
         let mut start = 0;
         let r = self.sides[0].max(self.sides[1]);
@@ -195,17 +202,13 @@ impl Rows {
             let shared = row_side_index(k as u32, self.sides[0], r) == row_side_index(k as u32 + 1, self.sides[0], r);
             let (mut i, mut j) = (0, 0);
             for _ in 0..w + w2 {
-                let slots = if rows_advance_lower(i, j, [w, w2], shared) {
+                out.push(if rows_advance_lower(i, j, [w, w2], shared) {
                     i += 1;
                     [start + i - 1, start + i, next + j]
                 } else {
                     j += 1;
                     [start + i, next + j, next + j - 1]
-                };
-                let t = slots.map(|s| nodes[s as usize]);
-                if t[0].position != t[1].position && t[1].position != t[2].position && t[2].position != t[0].position {
-                    out.push((slots, t));
-                }
+                });
             }
             start = next;
         }

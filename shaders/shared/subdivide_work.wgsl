@@ -1,0 +1,181 @@
+// A piece's work: what `lattice` planned for it (`PieceWork`), its work items of at most
+// LATTICE_CHUNK outputs each, and what `lattice_nodes` and `lattice_triangles` do with one (issue
+// 32: no invocation writes a whole piece). CPU twin: src/cpu/subdivide/work.rs.
+
+#import constants
+#import projection
+#import subdivide_types
+#import subdivide_bindings
+#import subdivide_state
+#import subdivide_edges
+#import subdivide_quad
+#import subdivide_lattice
+#import subdivide_bands
+#import subdivide_rows
+
+// Node slots or candidate triangles one item of a piece drawn `copies` times covers.
+fn chunk_of(copies: u32) -> u32 {
+    return LATTICE_CHUNK / copies;
+}
+
+// Room in `lattice_work`: as many items as output nodes (a piece's items are fewer than its nodes).
+fn work_capacity() -> u32 {
+    return params.triangle_capacity;
+}
+
+// Row k's parts from a piece's work (`row_w`: 8 bits each, four a word).
+fn work_row_width(work: PieceWork, k: u32) -> u32 {
+    return (work.row_w[k / 4u] >> (8u * (k % 4u))) & 0xffu;
+}
+
+// The piece at `index` (its shape in `piece_state`, its seam copies): its work written, its
+// nodes allocated, and its work items appended: node items from the front of `lattice_work`,
+// triangle items from its back, each triangle item with the walk (strip, quad, rows) at its first
+// candidate. Counted always, written only where they fit.
+fn plan_work(index: u32, shape: PieceShape, seam: SeamCopies, piece_state: ptr<function, PieceState>) {
+    let copies = seam.copies;
+    var work: PieceWork;
+    work.shape = (*piece_state).strip_base;
+    work.m = shape.m;
+    work.node_count = shape.node_count;
+    work.candidates = shape.candidates;
+    work.copies = copies;
+    work.counts = (*piece_state).counts[0] | ((*piece_state).counts[1] << 8u) | ((*piece_state).counts[2] << 16u) | ((*piece_state).row_base << 24u);
+    work.strip_n = (*piece_state).strip_n.x | ((*piece_state).strip_n.y << 16u);
+    work.refs = vec4<f32>(seam.refs[0], seam.refs[1], seam.refs[2], 0.0);
+    if (work.shape == ROWS_SHAPE) {
+        for (var k = 0u; k < 33u; k++) {
+            work.row_w[k / 4u] |= min((*piece_state).row_w[k], 255u) << (8u * (k % 4u));
+        }
+    }
+    work.first_node = atomicAdd(&counters.nodes, copies * shape.node_count);
+    piece_work[index] = work;
+    let chunk = chunk_of(copies);
+    let len = work_capacity();
+    let node_items = (shape.node_count + chunk - 1u) / chunk;
+    let at = atomicAdd(&counters.node_items, node_items);
+    for (var i = 0u; i < node_items; i++) {
+        if (at + i < len) {
+            lattice_work[at + i] = vec4<u32>(index, i * chunk, 0u, 0u);
+        }
+    }
+    let triangle_items = (shape.candidates + chunk - 1u) / chunk;
+    let back = atomicAdd(&counters.triangle_items, triangle_items);
+    // The lattice's candidates are found from their index; the others' by walking.
+    let walked = work.shape != 3u;
+    var walk = vec4<u32>(0u);
+    for (var t = 0u; t < shape.candidates; t++) {
+        if (t % chunk == 0u) {
+            let slot = back + t / chunk;
+            if (slot < len) {
+                lattice_work[len - 1u - slot] = vec4<u32>(index, t, walk.x | (walk.y << 16u), walk.z | (walk.w << 16u));
+            }
+            if (!walked) {
+                t += chunk - 1u;
+                continue;
+            }
+        }
+        piece_triangle_slots(t, shape.m, &walk, piece_state);
+    }
+}
+
+// A work item's piece reloaded as `lattice` left it: its part, corners, edges and counts, its
+// shape (and a quad's rails, rows' widths) from its work.
+fn load_work(index: u32, work: PieceWork, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
+    let piece = pieces[index];
+    record_corners(piece, part);
+    if ((piece.count2_level & QUAD_HEAD) != 0u) {
+        quad_shape(piece, pieces[index + 1u], part, piece_state);
+        return;
+    }
+    piece_edges(piece_corners(piece, part, piece_state), part, piece_state);
+    for (var e = 0u; e < 3u; e++) {
+        (*piece_state).counts[e] = (work.counts >> (8u * e)) & 0xffu;
+    }
+    (*piece_state).strip_base = work.shape;
+    (*piece_state).strip_n = vec2<u32>(work.strip_n & 0xffffu, work.strip_n >> 16u);
+    (*piece_state).row_base = work.counts >> 24u;
+    if (work.shape == ROWS_SHAPE) {
+        for (var k = 0u; k < 33u; k++) {
+            (*piece_state).row_w[k] = work_row_width(work, k);
+        }
+    }
+}
+
+// The running state `piece_node` keeps, at node slot k: the lattice's (j, l), rows' (node, row).
+fn node_row_at(k: u32, m: u32, piece_state: ptr<function, PieceState>) -> vec2<u32> {
+    var rest = k;
+    var row = 0u;
+    if ((*piece_state).strip_base == ROWS_SHAPE) {
+        while (rest > (*piece_state).row_w[row]) {
+            rest -= (*piece_state).row_w[row] + 1u;
+            row += 1u;
+        }
+        return vec2<u32>(rest, row);
+    }
+    while (rest > m - row) {
+        rest -= m + 1u - row;
+        row += 1u;
+    }
+    return vec2<u32>(rest, row);
+}
+
+// A node item: the piece's nodes in slots [first, first + chunk), written once per seam copy.
+fn write_nodes(first: u32, work: PieceWork, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
+    let end = min(first + chunk_of(work.copies), work.node_count);
+    var row = node_row_at(first, work.m, piece_state);
+    for (var k = first; k < end; k++) {
+        let node = piece_node(k, work.m, &row, part, piece_state);
+        for (var c = 0u; c < work.copies; c++) {
+            out_nodes[work.first_node + c * work.node_count + k] = draw_vertex(node, work.refs[c], tri);
+        }
+    }
+    atomicMax(&counters.max_output, (end - first) * work.copies);
+}
+
+// A triangle item: the piece's candidates [item.y, item.y + chunk) from the walk in item.zw,
+// those drawn (their corners read from the nodes written) appended as indices, once per copy.
+fn write_triangles(item: vec4<u32>, work: PieceWork, piece_state: ptr<function, PieceState>) {
+    let first = item.y;
+    let end = min(first + chunk_of(work.copies), work.candidates);
+    let start = vec4<u32>(item.z & 0xffffu, item.z >> 16u, item.w & 0xffffu, item.w >> 16u);
+    var walk = start;
+    var drawn = vec2<u32>(0u);
+    var count = 0u;
+    for (var t = first; t < end; t++) {
+        let s = piece_triangle_slots(t, work.m, &walk, piece_state) + vec3<u32>(work.first_node);
+        if (candidate_drawn(out_nodes[s.x].position, out_nodes[s.y].position, out_nodes[s.z].position)) {
+            drawn[(t - first) / 32u] |= 1u << ((t - first) % 32u);
+            count += 1u;
+        }
+    }
+    if (count == 0u) {
+        return;
+    }
+    let total = count * work.copies;
+    let first_triangle = atomicAdd(&counters.triangles, total);
+    atomicMax(&counters.max_output, total);
+    if (first_triangle + total > params.triangle_capacity) {
+        return; // counted, never written
+    }
+    walk = start;
+    var slot = 3u * first_triangle;
+    for (var t = first; t < end; t++) {
+        let local = piece_triangle_slots(t, work.m, &walk, piece_state);
+        if ((drawn[(t - first) / 32u] & (1u << ((t - first) % 32u))) == 0u) {
+            continue;
+        }
+        let s = local + vec3<u32>(work.first_node);
+        if (params.measure_edges != 0u) {
+            let ps = array<vec3<f32>, 3>(out_nodes[s.x].position, out_nodes[s.y].position, out_nodes[s.z].position);
+            atomicMax(&counters.max_edge_bits, bitcast<u32>(visible_edge_px(ps)));
+        }
+        for (var c = 0u; c < work.copies; c++) {
+            let base = c * work.node_count;
+            out_indices[slot] = s.x + base;
+            out_indices[slot + 1u] = s.y + base;
+            out_indices[slot + 2u] = s.z + base;
+            slot += 3u;
+        }
+    }
+}
