@@ -442,21 +442,21 @@ fn edge_crossings(a: Node, b: Node, clip: ptr<function, ClipState>, cuts: vec2<u
     }
 }
 
-// Appends part (apex, pool[i], pool[i + 1 mod the polygon's count]) for `plan_parts` unless it
-// is off screen.
-fn append_apex_part(t: u32, apex: Node, i: u32, part: ptr<function, PartPlan>, clip: ptr<function, ClipState>) {
+// Plans part (apex, pool[i], pool[i + 1 mod the polygon's count]) unless it is off screen.
+fn plan_apex_part(t: u32, apex: Node, i: u32, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, clip: ptr<function, ClipState>) {
     (*part).corner[0] = apex;
     (*part).corner[1] = (*clip).pool[i];
     (*part).corner[2] = (*clip).pool[(i + 1u) % (*clip).poly_count];
     if (!off_screen_vertically((*part).corner[0].position, (*part).corner[1].position, (*part).corner[2].position)) {
-        append_part(t, part);
+        plan_part(tri, part);
+        append_pieces(t, part);
     }
 }
 
-// The parts of triangle t, which is not cut by all cuts, at the crossings of its edges that cut
-// triangles have (`edge_split_parts` in axis.rs), appended for `plan_parts`: its boundary
-// (corner e, then edge e's crossings) in the pool; with crossings on one edge the fan from the
-// opposite corner, on more the fan from the centroid, on none the triangle.
+// Plans the parts of triangle t, which is not cut by all cuts, at the crossings of its edges that
+// cut triangles have (`edge_split_parts` in axis.rs): its boundary (corner e, then edge e's
+// crossings) in the pool; with crossings on one edge the fan from the opposite corner, on more
+// the fan from the centroid, on none the triangle.
 fn plan_edge_split(t: u32, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, clip: ptr<function, ClipState>, cuts: vec2<u32>) {
     let corners = array<Node, 3>(Node((*tri).position[0], vec3<f32>(1.0, 0.0, 0.0)),
                                  Node((*tri).position[1], vec3<f32>(0.0, 1.0, 0.0)),
@@ -479,15 +479,16 @@ fn plan_edge_split(t: u32, tri: ptr<function, InputTriangle>, part: ptr<function
     }
     if (crossed == 0u) {
         (*part).corner = corners;
-        append_part(t, part);
+        plan_part(tri, part);
+        append_pieces(t, part);
     } else if (crossed == 1u) {
         for (var i = 0u; i < chain.z; i++) {
-            append_apex_part(t, corners[(chain.x + 2u) % 3u], chain.y + i, part, clip);
+            plan_apex_part(t, corners[(chain.x + 2u) % 3u], chain.y + i, tri, part, clip);
         }
     } else {
         let centre = weighted(corners, vec3<f32>(1.0 / 3.0));
         for (var i = 0u; i < (*clip).poly_count; i++) {
-            append_apex_part(t, centre, i, part, clip);
+            plan_apex_part(t, centre, i, tri, part, clip);
         }
     }
 }
@@ -514,10 +515,12 @@ fn fan_edges(i: u32, clip: ptr<function, ClipState>) -> vec3<u32> {
 // the rails' counts and `quad_turn` the polygon corner that becomes the quad's corner 0 (rails
 // 0 → 1 and 3 → 2).
 
-// The band polygon in `poly` (of triangle `t`): one strip between its rails where it is a band
-// quad (planned here: the quad's test needs every side's count), else its fan's parts, those
-// wholly beyond the image's rows left out, appended for `plan_parts`.
+// The band polygon in `poly` (of triangle `t`): on the sphere, its fan's parts appended for
+// `plan_parts` (a quadrant near a pole has many bands: planning them all here made the longest
+// threads of the frame); on the cylinder (a few bands) planned here: one strip between its rails
+// where it is a band quad, else its fan's parts. Parts wholly beyond the image's rows left out.
 fn plan_band(t: u32, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>, clip: ptr<function, ClipState>) {
+    // The fan's parts shown, and their edges, each counted once (a diagonal is two parts').
     var shown = 0u;
     var needed = 0u;
     for (var i = 1u; i + 1u < (*clip).poly_count; i++) {
@@ -527,8 +530,8 @@ fn plan_band(t: u32, tri: ptr<function, InputTriangle>, part: ptr<function, Part
             needed |= (1u << e.x) | (1u << e.y) | (1u << e.z);
         }
     }
-    if (quad_possible(clip)) {
-        // The quad's sides and diagonal, each counted once.
+    let sphere = is_sphere(params.projection);
+    if (!sphere) {
         for (var e = 0u; e + 3u < 2u * (*clip).poly_count; e++) {
             if ((needed & (1u << e)) != 0u) {
                 let ends = polygon_edge_ends(e, clip);
@@ -545,7 +548,16 @@ fn plan_band(t: u32, tri: ptr<function, InputTriangle>, part: ptr<function, Part
             (*part).corner[0] = poly_node(0, clip);
             (*part).corner[1] = poly_node(i, clip);
             (*part).corner[2] = poly_node(i + 1u, clip);
-            append_part(t, part);
+            if (sphere) {
+                append_part(t, part);
+            } else {
+                let e = fan_edges(i, clip);
+                (*part).n[0] = (*clip).poly_n[e.x];
+                (*part).n[1] = (*clip).poly_n[e.y];
+                (*part).n[2] = (*clip).poly_n[e.z];
+                plan_level(part);
+                append_pieces(t, part);
+            }
         }
     }
 }

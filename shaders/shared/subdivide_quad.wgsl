@@ -6,14 +6,8 @@
 #import subdivide_state
 #import subdivide_edges
 
-// Whether the band polygon in `poly` may be a quad: four corners, under the error split, on
-// the cylinder (`quad_strip`'s first test).
-fn quad_possible(clip: ptr<function, ClipState>) -> bool {
-    return params.method == METHOD_ERROR && !is_sphere(params.projection) && (*clip).poly_count == 4u;
-}
-
 fn plan_quad(shown: u32, tri: ptr<function, InputTriangle>, piece_state: ptr<function, PieceState>, clip: ptr<function, ClipState>) -> bool {
-    if (!quad_possible(clip) || shown != 6u) {
+    if (params.method != METHOD_ERROR || is_sphere(params.projection) || (*clip).poly_count != 4u || shown != 6u) {
         return false;
     }
     var turn = 2u;

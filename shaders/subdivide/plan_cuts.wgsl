@@ -3,9 +3,9 @@
 // edges that cut triangles have (`plan_edge_split`); one cut by all, its parts around the
 // vertical axis under the frame's cuts (quadrants minus a small square around the axis, bands
 // between the active diamonds, fan-triangulated; a band's quad whose two opposite sides are in
-// one part each, one piece drawn as a strip between the other two). The parts are appended to
-// `parts` for `plan_parts`, which plans each as `plan` plans a triangle (a quad's two records are
-// appended here). CPU twin: `CpuSubdivision::plan_cuts`.
+// one part each, one piece drawn as a strip between the other two), each planned as in `plan` —
+// except the sphere's bands' parts, appended to `parts` for `plan_parts` (a quadrant near a pole
+// has many bands). CPU twin: `CpuSubdivision::plan_cuts`.
 
 #import projection
 #import constants

@@ -1,8 +1,8 @@
-// The `plan_parts` pass of the `subdivide` stage: one invocation per part `plan_cuts` cut (a
-// quadrant's band's fan part, an edge split's part): its edge counts N (eq. 5 or the error
-// split), its macro-lattice level K and its piece records, as `plan` plans a triangle that is its
-// own single part. `plan_cuts` only cuts, so that no invocation plans a whole floor's bands (the
-// edge profiles are most of the planning). CPU twin: `CpuSubdivision::plan_parts`.
+// The `plan_parts` pass of the `subdivide` stage: one invocation per part `plan_cuts` appended
+// (on the sphere, a quadrant's band's fan part): its edge counts N (eq. 5 or the error split),
+// its macro-lattice level K and its piece records, as `plan` plans a triangle that is its own
+// single part. So no invocation plans a whole floor's bands near a pole (the edge profiles are
+// most of the planning). CPU twin: `CpuSubdivision::plan_parts`.
 
 #import projection
 #import constants

@@ -18,6 +18,7 @@ use super::{
     band_limit, edge_split_parts, fan, one_part, quadrant_polygons, triangle_cuts, FrameCuts, Node, PartSplit,
     PiecePlan, SubdivideOutput, Subdivider, Triangle,
 };
+use crate::core::projection::PanoramaKind;
 use crate::core::scene::SceneVertex;
 use crate::core::settings::RenderSettings;
 use crate::encoding::constants::{BANDS, PIECES_FROM_COUNTER, QUAD_HEAD, QUAD_TAIL};
@@ -261,14 +262,14 @@ impl<'s> CpuSubdivision<'s> {
             if local % split == 0 {
                 let shared = [0, 1, 2].map(|e| self.frame.is_cut_edge(t as usize, e));
                 for part in edge_split_parts(tri.position, shared, rho, cuts) {
-                    self.cut_polygon(sub, &tri, t, &part);
+                    self.plan_polygon(sub, &tri, t, &part, false);
                 }
             }
         } else {
             let quadrants = if split == 4 { (local % 4) as usize..(local % 4) as usize + 1 } else { 0..4 };
             for q in quadrants {
                 for poly in quadrant_polygons(tri.position, rho, cuts, q) {
-                    self.cut_polygon(sub, &tri, t, &poly);
+                    self.plan_polygon(sub, &tri, t, &poly, sub.projection.panorama == PanoramaKind::Equirect);
                 }
             }
         }
@@ -432,8 +433,8 @@ impl<'s> CpuSubdivision<'s> {
     // ---- what the passes share ----
 
     /// A polygon `plan_cuts` cut from triangle t: a band quad's two records, or its fan's parts
-    /// on screen, appended for `plan_parts`.
-    fn cut_polygon(&mut self, sub: &Subdivider, tri: &Triangle, t: u32, poly: &[Node]) {
+    /// on screen, planned, or with `deferred` (the sphere's bands) appended for `plan_parts`.
+    fn plan_polygon(&mut self, sub: &Subdivider, tri: &Triangle, t: u32, poly: &[Node], deferred: bool) {
         if let Some((c, rails)) = sub.quad_strip(tri, poly) {
             let head = record(t, rails[0] | rails[1] << 16, QUAD_HEAD, [c[0], c[1], c[2]]);
             let tail = record(t, head.counts01, QUAD_TAIL, [c[3], c[1], c[2]]);
@@ -441,12 +442,17 @@ impl<'s> CpuSubdivision<'s> {
             return;
         }
         for part in fan(poly) {
-            if !sub.off_screen_vertically(part.map(|n| n.position)) {
-                let slot = self.counters.parts;
-                self.counters.parts += 1;
-                if slot < sub.params.piece_capacity {
-                    self.parts[slot as usize] = record(t, 0, 0, part);
-                }
+            if sub.off_screen_vertically(part.map(|n| n.position)) {
+                continue;
+            }
+            if !deferred {
+                self.plan_part(sub, tri, t, part);
+                continue;
+            }
+            let slot = self.counters.parts;
+            self.counters.parts += 1;
+            if slot < sub.params.piece_capacity {
+                self.parts[slot as usize] = record(t, 0, 0, part);
             }
         }
     }
