@@ -249,7 +249,7 @@ pub fn run_one_submission<E: SubdivisionEngine>(
     let mut params = subdivide_params(settings, 0, triangles);
     (params.piece_capacity, params.triangle_capacity) = (capacity.pieces, capacity.triangles);
     (params.first_piece, params.piece_count) = (0, PIECES_FROM_COUNTER);
-    let recording = one_submission(triangles, false);
+    let recording = one_submission(triangles, settings.projection().panorama, false);
     let mut totals = RunTotals::default();
     let counters = replay_counted(engine, &recording, &params, settings, &mut totals)?;
     if counters.overflowed(capacity.pieces, capacity.triangles) {
@@ -288,7 +288,13 @@ pub fn run_chunked<E: SubdivisionEngine>(
         let mut params = subdivide_params(settings, first, count);
         params.piece_capacity = capacity.pieces.min(budget.pieces);
         params.triangle_capacity = capacity.triangles;
-        let planned = replay_counted(engine, &pass_run("plan", count), &params, settings, &mut totals)?;
+        let planned = replay_counted(
+            engine,
+            &pass_run("plan", count, settings.projection().panorama),
+            &params,
+            settings,
+            &mut totals,
+        )?;
         if planned.piece_records() > params.piece_capacity {
             match on_overflow(planned.piece_records(), budget.pieces, count) {
                 Overflow::Grow(p) => want.pieces = p,
@@ -326,7 +332,13 @@ fn lattice_ranges<E: SubdivisionEngine>(
         let capacity = engine.ensure(*want);
         (params.first_piece, params.piece_count) = (first, count);
         params.triangle_capacity = capacity.triangles.min(budget.triangles);
-        let done = replay_counted(engine, &pass_run("lattice", count), params, settings, totals)?;
+        let done = replay_counted(
+            engine,
+            &pass_run("lattice", count, settings.projection().panorama),
+            params,
+            settings,
+            totals,
+        )?;
         if done.output_units() > params.triangle_capacity {
             match on_overflow(done.output_units(), budget.triangles, count) {
                 Overflow::Grow(t) => want.triangles = t,

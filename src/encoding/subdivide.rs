@@ -182,14 +182,14 @@ pub const LATTICE_TIMESTAMP: u32 = 4;
 /// `lattice_triangles` over the work items `lattice` appended, and `finalize` (the draw's
 /// arguments).
 /// `timed`: each pass writes its timestamps.
-pub fn one_submission(triangles: u32, timed: bool) -> Recording {
+pub fn one_submission(triangles: u32, panorama: PanoramaKind, timed: bool) -> Recording {
     let stamp = |index: u32| timed.then_some(index);
     let mut r = Recording::default();
     r.clear("counters", None).clear("cut_edges", None);
     r.pass("plan", stamp(PLAN_TIMESTAMP));
     r.dispatch("active_cuts", triangles).dispatch("ring_cuts", triangles).dispatch("plan", triangles);
     r.pass("plan_cuts", stamp(PLAN_CUTS_TIMESTAMP));
-    cut_and_plan_parts(&mut r);
+    cut_and_plan_parts(&mut r, panorama);
     r.pass("lattice", stamp(LATTICE_TIMESTAMP));
     r.dispatch("lattice_args", 1).dispatch_indirect("lattice", "lattice_dispatch", DISPATCH_LATTICE);
     lattice_work(&mut r);
@@ -197,11 +197,19 @@ pub fn one_submission(triangles: u32, timed: bool) -> Recording {
     r
 }
 
-/// `plan_cuts` over the triangles `plan` listed, then `plan_parts` over the parts it cut (each
-/// after its one-thread setup pass).
-fn cut_and_plan_parts(r: &mut Recording) {
+/// `plan_cuts` over the triangles `plan` listed, then on the sphere `plan_parts` over the parts
+/// it left (each after its one-thread setup pass).
+fn cut_and_plan_parts(r: &mut Recording, panorama: PanoramaKind) {
     r.dispatch("plan_cuts_args", 1).dispatch_indirect("plan_cuts", "lattice_dispatch", DISPATCH_PLAN_CUTS);
-    r.dispatch("plan_parts_args", 1).dispatch_indirect("plan_parts", "lattice_dispatch", DISPATCH_PLAN_PARTS);
+    if defers_parts(panorama) {
+        r.dispatch("plan_parts_args", 1).dispatch_indirect("plan_parts", "lattice_dispatch", DISPATCH_PLAN_PARTS);
+    }
+}
+
+/// Whether `plan_cuts` leaves the parts of its bands to `plan_parts`: on the sphere, whose
+/// quadrants near a pole have many bands (on the cylinder, a few: it plans them itself).
+pub fn defers_parts(panorama: PanoramaKind) -> bool {
+    panorama == PanoramaKind::Equirect
 }
 
 /// The work items `lattice` appended: `lattice_nodes`, then `lattice_triangles` (which reads
@@ -224,12 +232,12 @@ pub fn active_cuts(triangles: u32) -> Recording {
 /// One step of a chunked schedule: `entry` (`plan`, with `plan_cuts` and `plan_parts` after it,
 /// or `lattice`, with its work items' passes) over `count` invocations, then `finalize`; the counters of this run cleared first (the
 /// frame's cuts kept).
-pub fn pass_run(entry: &'static str, count: u32) -> Recording {
+pub fn pass_run(entry: &'static str, count: u32, panorama: PanoramaKind) -> Recording {
     let mut r = Recording::default();
     r.clear("counters", Some(SubdivideCounters::RUN_BYTES));
     r.pass(entry, None).dispatch(entry, count);
     if entry == "plan" {
-        cut_and_plan_parts(&mut r);
+        cut_and_plan_parts(&mut r, panorama);
     } else {
         lattice_work(&mut r);
     }

@@ -75,10 +75,14 @@ impl SubdivideStage {
                 (PanoramaKind::Equirect, false) => &[ROWS_OFF],
                 (PanoramaKind::Equirect, true) => &[],
             };
+            // The entry points this panorama's schedules dispatch (every schedule's are the usual
+            // frame's).
+            let used: Vec<&'static str> = one_submission(1, panorama, false).entries().collect();
             let pipelines = std::thread::scope(|scope| {
                 let builds: Vec<_> = SUBDIVIDE
                     .entry_points
                     .iter()
+                    .filter(|e| used.contains(&e.name))
                     .map(|e| {
                         let build = move || self.stage.compute_standing_in(gpu, e.name, &constants, stand_ins);
                         (e.name, scope.spawn(build))
@@ -152,7 +156,7 @@ impl SubdivideStage {
     ) {
         let params = SubdivideParams { first_piece: 0, piece_count: PIECES_FROM_COUNTER, ..*params };
         gpu.queue.write_buffer(uniform, 0, bytemuck::bytes_of(&params));
-        let recording = one_submission(params.triangle_count, timestamps.is_some());
+        let recording = one_submission(params.triangle_count, panorama, timestamps.is_some());
         self.replay(gpu, enc, &recording, &FrameBuffers { uniform, scene, b }, (panorama, &params), timestamps);
     }
 
