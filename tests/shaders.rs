@@ -237,26 +237,31 @@ fn shared_modules_declare_no_entry_points_and_only_binding_modules_declare_bindi
 
 #[test]
 fn the_subdivisions_recordings_name_its_entry_points_and_bindings() {
-    use twister::core::projection::PanoramaKind;
     use twister::encoding::recording::Command;
-    use twister::encoding::subdivide::{active_cuts, one_submission, pass_run};
+    use twister::encoding::subdivide::{active_cuts, one_submission, pass_run, Passes};
     use twister::shader::SUBDIVIDE;
     let entries: Vec<&str> = SUBDIVIDE.entry_points.iter().map(|e| e.name).collect();
     let bound = |name: &str| SUBDIVIDE.bindings.iter().any(|b| b.name == name);
-    let usual = one_submission(1000, PanoramaKind::Equirect, true);
-    // The usual frame dispatches every entry point, in the order the passes depend on.
+    let all = Passes { parts: true, rows: true };
+    let usual = one_submission(1000, all, true);
+    // The usual frame of the sphere under an adaptive rule dispatches every entry point, in the
+    // order the passes depend on.
     let order: Vec<&str> = usual.entries().collect();
+    assert_eq!(order, entries);
     let expected = [
         ["active_cuts", "ring_cuts", "plan", "plan_cuts_args", "plan_cuts", "plan_parts_args", "plan_parts"].as_slice(),
-        &["lattice_args", "lattice", "lattice_work_args", "lattice_nodes", "lattice_triangles", "finalize"],
+        &["lattice_args", "lattice", "lattice_rows_args", "lattice_rows", "lattice_rows_plan"],
+        &["lattice_work_args", "lattice_nodes", "lattice_triangles", "finalize"],
     ];
     assert_eq!(order, expected.concat());
-    // The cylinder's leaves out `plan_parts` (its `plan_cuts` plans its few bands itself).
-    let cylinder: Vec<&str> = one_submission(7, PanoramaKind::Cylinder, false).entries().collect();
-    let deferred: Vec<&str> = order.iter().copied().filter(|e| !e.starts_with("plan_parts")).collect();
-    assert_eq!(cylinder, deferred);
-    let runs = [PanoramaKind::Cylinder, PanoramaKind::Equirect]
-        .map(|p| [one_submission(7, p, false), pass_run("plan", 7, p), pass_run("lattice", 7, p)]);
+    // The cylinder's leaves out `plan_parts` (its `plan_cuts` plans its few bands itself), and
+    // the frames without rows their passes.
+    let cylinder: Vec<&str> = one_submission(7, Passes { parts: false, rows: false }, false).entries().collect();
+    let optional = ["plan_parts_args", "plan_parts", "lattice_rows_args", "lattice_rows", "lattice_rows_plan"];
+    let always: Vec<&str> = order.iter().copied().filter(|e| !optional.contains(e)).collect();
+    assert_eq!(cylinder, always);
+    let some = [Passes { parts: false, rows: false }, Passes { parts: true, rows: false }, all];
+    let runs = some.map(|p| [one_submission(7, p, false), pass_run("plan", 7, p), pass_run("lattice", 7, p)]);
     for recording in [usual, active_cuts(7)].into_iter().chain(runs.into_iter().flatten()) {
         let mut in_pass = false;
         for command in &recording.commands {

@@ -71,3 +71,4 @@ fn band_cell(cell: u32, part: ptr<function, PartPlan>) -> array<vec3<u32>, 3> {
 }
 
 const ROWS_SHAPE: u32 = 5u; // `strip_base` of a piece drawn in rows (`subdivide_rows`)
+const ROWS_PENDING: u32 = 6u; // ... of one whose rows `lattice_rows` measures

@@ -14,10 +14,11 @@
 @group(0) @binding(6) var<storage, read_write> draw_args: DrawIndexedIndirectArgs;
 // Workgroup counts of the `lattice` dispatch (0–2), written by `lattice_args` from the piece
 // counter, of the `plan_cuts` dispatch (3–5), written by `plan_cuts_args`, of the `plan_parts`
-// dispatch (6–8), written by `plan_parts_args`, and of `lattice_nodes` (9–11) and
-// `lattice_triangles` (12–14), written by `lattice_work_args` (`DISPATCH_*` in
+// dispatch (6–8), written by `plan_parts_args`, of `lattice_nodes` (9–11) and
+// `lattice_triangles` (12–14), written by `lattice_work_args`, and of `lattice_rows` and
+// `lattice_rows_plan` (15–17), written by `lattice_rows_args` (`DISPATCH_*` in
 // src/encoding/subdivide.rs: their byte offsets).
-@group(0) @binding(7) var<storage, read_write> lattice_dispatch: array<u32, 15>;
+@group(0) @binding(7) var<storage, read_write> lattice_dispatch: array<u32, 18>;
 // Per object: the factor its L is multiplied by (the visual-field level of detail relaxes the
 // subdivision away from the gaze; 1 without it). CPU twin: `Subdivider::edge_px`.
 @group(0) @binding(8) var<storage, read> object_edge_scale: array<f32>;
@@ -43,3 +44,7 @@
 // the output's nodes: each item has at least one node's worth, see `work_items` in lattice.rs).
 @group(0) @binding(15) var<storage, read_write> piece_work: array<PieceWork>;
 @group(0) @binding(16) var<storage, read_write> lattice_work: array<vec4<u32>>;
+// The bands of the pieces whose rows `lattice_rows` measures, (piece << 5) | band, in the
+// output's index buffer (`out_indices`, written only later by `lattice_triangles`): a piece of
+// R rows has at least R + 1 nodes, so where the output fits, so do they.
+@group(0) @binding(17) var<storage, read_write> row_items: array<u32>;

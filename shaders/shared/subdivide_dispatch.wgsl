@@ -25,11 +25,29 @@ fn listed_cut(i: u32, listed: vec2<u32>) -> u32 {
     return cut_list[arrayLength(&cut_list) - 1u - (i - listed.x)];
 }
 
+// The pieces `lattice` and its rows' passes run over: a range's, or as many as were counted.
+fn pieces_planned() -> u32 {
+    if (params.piece_count == PIECES_FROM_COUNTER) {
+        return min(atomicLoad(&counters.pieces), params.piece_capacity);
+    }
+    return params.piece_count;
+}
+
 // The work items `lattice` appended: (node items, triangle items), within `lattice_work`'s room
 // (`work_items` in src/cpu/subdivide/passes.rs).
 fn work_items() -> vec2<u32> {
     let len = params.triangle_capacity;
     return vec2<u32>(min(atomicLoad(&counters.node_items), len), min(atomicLoad(&counters.triangle_items), len));
+}
+
+// Room for `lattice`'s row items: the output's indices, 3 per output unit.
+fn row_item_room() -> u32 {
+    return 3u * params.triangle_capacity;
+}
+
+// The row items `lattice` appended, within their room.
+fn row_item_count() -> u32 {
+    return min(atomicLoad(&counters.row_items), row_item_room());
 }
 
 // Invocations of `plan_cuts` per listed triangle: one per quadrant on the sphere, whose bands reach

@@ -403,8 +403,9 @@ fn piece_corners(piece: Piece, part: ptr<function, PartPlan>, piece_state: ptr<f
     return loc;
 }
 
-// A piece of the pre-split: its corners, each edge's count, lattice, strip or rows. Nothing
-// where its snapped corners coincide (no area) or it lies wholly off screen.
+// A piece of the pre-split: its corners, each edge's count, lattice or strip, or rows to be
+// measured (ROWS_PENDING: `lattice_rows`, then `lattice_rows_plan` chooses between them and the
+// lattice). Nothing where its snapped corners coincide (no area) or it lies wholly off screen.
 fn lattice_shape(piece: Piece, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> PieceShape {
     let loc = piece_corners(piece, part, piece_state);
     if (same((*piece_state).corner[0].position, (*piece_state).corner[1].position) || same((*piece_state).corner[1].position, (*piece_state).corner[2].position)
@@ -424,13 +425,8 @@ fn lattice_shape(piece: Piece, tri: ptr<function, InputTriangle>, part: ptr<func
         (*piece_state).strip_n = vec2<u32>((*piece_state).counts[((*piece_state).strip_base + 1u) % 3u], (*piece_state).counts[((*piece_state).strip_base + 2u) % 3u]);
         candidates = (*piece_state).strip_n.x + (*piece_state).strip_n.y - 1u;
         node_count = (*piece_state).strip_n.x + (*piece_state).strip_n.y + 1u;
-    } else {
-        let rows = plan_rows(tri, part, piece_state);
-        if (rows.x < candidates) {
-            (*piece_state).strip_base = ROWS_SHAPE;
-            candidates = rows.x;
-            node_count = rows.y;
-        }
+    } else if (rows_possible(piece_state)) {
+        (*piece_state).strip_base = ROWS_PENDING; // the lattice's figures until its rows are measured
     }
     let theta_c = azimuth(((*piece_state).corner[0].position + (*piece_state).corner[1].position + (*piece_state).corner[2].position) / 3.0);
     return PieceShape(m, candidates, node_count, theta_c);

@@ -41,31 +41,54 @@ fn band_parts(b: u32, cap: u32, tri: ptr<function, InputTriangle>, part: ptr<fun
     return cap;
 }
 
-// On the sphere, under an adaptive rule, the piece's rows: their widths in `row_w`, and
-// (candidate triangles, nodes); (u32 max, 0) where the piece has fewer than two rows, or another
-// panorama or rule.
-fn plan_rows(tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> vec2<u32> {
+// Whether the piece may be drawn in rows — on the sphere, under an adaptive rule, two rows or
+// more (at most PIECE_DIVISIONS) — and then its rows' base and sides in `row_base` and `strip_n`
+// (`Subdivider::rows_base`).
+fn rows_possible(piece_state: ptr<function, PieceState>) -> bool {
     let counts = (*piece_state).counts;
     let base = band_base(counts);
     let sides = vec2<u32>(counts[(base + 2u) % 3u], counts[(base + 1u) % 3u]);
     let r = max(sides.x, sides.y);
-    if (!is_adaptive() || !is_sphere(params.projection) || r < 2u) {
-        return vec2<u32>(0xffffffffu, 0u);
+    if (!is_adaptive() || !is_sphere(params.projection) || r < 2u || r > PIECE_DIVISIONS) {
+        return false;
     }
     (*piece_state).row_base = base;
     (*piece_state).strip_n = sides;
-    let cap = clamp(2u * params.max_div, 1u, PIECE_DIVISIONS);
-    // Each band's need first (one call site of `band_parts`), then each row's own.
-    var need: array<u32, 32>;
-    for (var b = 0u; b < r; b++) {
-        need[b] = band_parts(b, cap, tri, part, piece_state);
+    return true;
+}
+
+// The widest a row may be: 2·N_max, within 1 and PIECE_DIVISIONS.
+fn row_cap() -> u32 {
+    return clamp(2u * params.max_div, 1u, PIECE_DIVISIONS);
+}
+
+// Band b's measures (one `lattice_rows` invocation; `Subdivider::row_measures`): the parts
+// across it its zipper's diagonals need, | the parts row b needs itself << 8 (0 for the base row).
+fn row_measures(b: u32, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> u32 {
+    let need = band_parts(b, row_cap(), tri, part, piece_state);
+    if (b == 0u) {
+        return need;
     }
-    (*piece_state).row_w[0] = counts[base];
+    let left = row_end(b, false, part, piece_state).position;
+    let right = row_end(b, true, part, piece_state).position;
+    let own = min(min(edge_divisions(left, right, tri), 2u * params.max_div), PIECE_DIVISIONS);
+    return need | (own << 8u);
+}
+
+// The piece's rows from its bands' measures in `row_w` (`lattice_rows_plan`;
+// `Subdivider::rows_from_measures`): their widths in `row_w`, and (candidate triangles, nodes).
+fn rows_from_measures(piece_state: ptr<function, PieceState>) -> vec2<u32> {
+    let counts = (*piece_state).counts;
+    let r = max((*piece_state).strip_n.x, (*piece_state).strip_n.y);
+    // Row k's width from its own measure and its two bands' needs, in place: row k − 1's width
+    // is written before row k is read, so the band below's need is kept aside.
+    var below = (*piece_state).row_w[0] & 0xffu;
+    (*piece_state).row_w[0] = counts[(*piece_state).row_base];
     for (var row = 1u; row < r; row++) {
-        let left = row_end(row, false, part, piece_state).position;
-        let right = row_end(row, true, part, piece_state).position;
-        let own = min(min(edge_divisions(left, right, tri), 2u * params.max_div), PIECE_DIVISIONS);
-        (*piece_state).row_w[row] = clamp(max(max(own, need[row - 1u]), need[row]), 1u, cap);
+        let measures = (*piece_state).row_w[row];
+        let need = max(max(measures >> 8u, below), measures & 0xffu);
+        below = measures & 0xffu;
+        (*piece_state).row_w[row] = clamp(need, 1u, row_cap());
     }
     (*piece_state).row_w[r] = 0u;
     var candidates = 0u;

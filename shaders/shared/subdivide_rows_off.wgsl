@@ -4,8 +4,16 @@
 
 #import subdivide_state
 
-// No rows: (u32 max, 0), as `plan_rows` says for a piece without them.
-fn plan_rows(tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> vec2<u32> {
+// No rows.
+fn rows_possible(piece_state: ptr<function, PieceState>) -> bool {
+    return false;
+}
+
+fn row_measures(b: u32, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> u32 {
+    return 0u;
+}
+
+fn rows_from_measures(piece_state: ptr<function, PieceState>) -> vec2<u32> {
     return vec2<u32>(0xffffffffu, 0u);
 }
 

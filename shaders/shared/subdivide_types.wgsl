@@ -50,11 +50,11 @@ struct Counters {
     parts: atomic<u32>,         // part records `plan_cuts` appended for `plan_parts`
     node_items: atomic<u32>,    // work items `lattice` appended for `lattice_nodes` (front of `lattice_work`)
     triangle_items: atomic<u32>, // ... and for `lattice_triangles` (its back)
+    row_items: atomic<u32>,     // bands of pieces whose rows `lattice_rows` measures (`row_items`)
     // The frame's cuts around the axis (`AxisCuts` in axis.rs): bit 0 the quadrant cuts and the
     // square, bit k the diamond c_k; bits 0–31 and 32–63. Kept across the chunks of a frame.
     cuts_low: atomic<u32>,
     cuts_high: atomic<u32>,
-    _pad: u32,
 }
 
 struct DrawIndexedIndirectArgs {
@@ -79,10 +79,11 @@ struct Piece {
 }
 
 // What `lattice` planned for a piece (at the piece's index), which its work items read: its
-// shape (`strip_base`: a sliver's strip base 0–2, the lattice 3, QUAD_STRIP, ROWS_SHAPE), level
-// m, nodes, candidate triangles, seam copies (0: nothing drawn) and their reference azimuths, its
-// first output node, its edge counts (8 bits each; rows' base in bits 24–31), a strip's, quad's
-// or rows' sides' counts (x | y << 16), rows' widths (8 bits each, four a word).
+// shape (`strip_base`: a sliver's strip base 0–2, the lattice 3, QUAD_STRIP, ROWS_SHAPE, or
+// ROWS_PENDING while `lattice_rows` measures its rows), level m, nodes, candidate triangles, seam
+// copies (0: nothing drawn) and their reference azimuths, its first output node, its edge counts
+// (8 bits each; rows' base in bits 24–31), a strip's, quad's or rows' sides' counts
+// (x | y << 16), rows' widths (while pending: each band's measures, `row_measures`).
 struct PieceWork {
     shape: u32,
     m: u32,
@@ -93,7 +94,7 @@ struct PieceWork {
     counts: u32,
     strip_n: u32,
     refs: vec4<f32>,
-    row_w: array<u32, 9>,
+    row_w: array<u32, 33>,
     _pad: array<u32, 3>,
 }
 

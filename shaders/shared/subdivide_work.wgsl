@@ -12,6 +12,7 @@
 #import subdivide_lattice
 #import subdivide_bands
 #import subdivide_rows
+#import subdivide_dispatch
 
 // Node slots or candidate triangles one item of a piece drawn `copies` times covers.
 fn chunk_of(copies: u32) -> u32 {
@@ -21,11 +22,6 @@ fn chunk_of(copies: u32) -> u32 {
 // Room in `lattice_work`: as many items as output nodes (a piece's items are fewer than its nodes).
 fn work_capacity() -> u32 {
     return params.triangle_capacity;
-}
-
-// Row k's parts from a piece's work (`row_w`: 8 bits each, four a word).
-fn work_row_width(work: PieceWork, k: u32) -> u32 {
-    return (work.row_w[k / 4u] >> (8u * (k % 4u))) & 0xffu;
 }
 
 // The piece at `index` (its shape in `piece_state`, its seam copies): its work written, its
@@ -44,9 +40,7 @@ fn plan_work(index: u32, shape: PieceShape, seam: SeamCopies, piece_state: ptr<f
     work.strip_n = (*piece_state).strip_n.x | ((*piece_state).strip_n.y << 16u);
     work.refs = vec4<f32>(seam.refs[0], seam.refs[1], seam.refs[2], 0.0);
     if (work.shape == ROWS_SHAPE) {
-        for (var k = 0u; k < 33u; k++) {
-            work.row_w[k / 4u] |= min((*piece_state).row_w[k], 255u) << (8u * (k % 4u));
-        }
+        work.row_w = (*piece_state).row_w;
     }
     work.first_node = atomicAdd(&counters.nodes, copies * shape.node_count);
     piece_work[index] = work;
@@ -79,6 +73,26 @@ fn plan_work(index: u32, shape: PieceShape, seam: SeamCopies, piece_state: ptr<f
     }
 }
 
+// A piece whose rows `lattice_rows` measures: its plan so far (counts, rows' base and sides, the
+// lattice's figures), and a row item per band (`row_items`), counted always, written where they fit.
+fn plan_pending(index: u32, shape: PieceShape, piece_state: ptr<function, PieceState>) {
+    var work: PieceWork;
+    work.shape = ROWS_PENDING;
+    work.m = shape.m;
+    work.node_count = shape.node_count;
+    work.candidates = shape.candidates;
+    work.counts = (*piece_state).counts[0] | ((*piece_state).counts[1] << 8u) | ((*piece_state).counts[2] << 16u) | ((*piece_state).row_base << 24u);
+    work.strip_n = (*piece_state).strip_n.x | ((*piece_state).strip_n.y << 16u);
+    piece_work[index] = work;
+    let r = max((*piece_state).strip_n.x, (*piece_state).strip_n.y);
+    let base = atomicAdd(&counters.row_items, r);
+    for (var b = 0u; b < r; b++) {
+        if (base + b < row_item_room()) {
+            row_items[base + b] = (index << 5u) | b; // b < r ≤ PIECE_DIVISIONS = 32
+        }
+    }
+}
+
 // A work item's piece reloaded as `lattice` left it: its part, corners, edges and counts, its
 // shape (and a quad's rails, rows' widths) from its work.
 fn load_work(index: u32, work: PieceWork, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
@@ -95,10 +109,8 @@ fn load_work(index: u32, work: PieceWork, part: ptr<function, PartPlan>, piece_s
     (*piece_state).strip_base = work.shape;
     (*piece_state).strip_n = vec2<u32>(work.strip_n & 0xffffu, work.strip_n >> 16u);
     (*piece_state).row_base = work.counts >> 24u;
-    if (work.shape == ROWS_SHAPE) {
-        for (var k = 0u; k < 33u; k++) {
-            (*piece_state).row_w[k] = work_row_width(work, k);
-        }
+    if (work.shape == ROWS_SHAPE || work.shape == ROWS_PENDING) {
+        (*piece_state).row_w = work.row_w;
     }
 }
 

@@ -2,8 +2,9 @@
 // corners from the record; the piece's shape: the regular lattice of level m = max(counts),
 // boundary nodes snapped to each edge's nodes, or a sliver's strip along its long edges (the
 // error split on the cylinder), a band quad's strip between its rails (corner 3 read from the
-// next record), rows (the sphere); its seam copies (again a turn away where its nodes' u range
-// crosses ±π). It writes no output: its plan (`piece_work`), its nodes' room, and its work items
+// next record), or rows (the sphere: their measures are left to `lattice_rows`, the choice to
+// `lattice_rows_plan`); its seam copies (again a turn away where its nodes' u range crosses ±π).
+// It writes no output: its plan (`piece_work`), its nodes' room, and its work items
 // (`plan_work`), which `lattice_nodes` and `lattice_triangles` then run, at most LATTICE_CHUNK
 // outputs each. CPU twin: `CpuSubdivision::lattice`.
 
@@ -29,11 +30,7 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     var part: PartPlan;
     var piece_state: PieceState;
     let local = invocation_index(gid, groups);
-    var piece_count = params.piece_count;
-    if (piece_count == PIECES_FROM_COUNTER) {
-        piece_count = min(atomicLoad(&counters.pieces), params.piece_capacity);
-    }
-    if (local >= piece_count) {
+    if (local >= pieces_planned()) {
         return;
     }
     let index = params.first_piece + local;
@@ -50,6 +47,10 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         shape = lattice_shape(piece, &tri, &part, &piece_state);
     }
     if (shape.candidates == 0u) {
+        return;
+    }
+    if (piece_state.strip_base == ROWS_PENDING) {
+        plan_pending(index, shape, &piece_state); // planned by `lattice_rows_plan`
         return;
     }
     plan_work(index, shape, seam_copies(shape, &part, &piece_state), &piece_state);

@@ -18,7 +18,7 @@ use crate::core::settings::RenderSettings;
 use crate::encoding::constants::PIECES_FROM_COUNTER;
 use crate::encoding::recording::Recording;
 use crate::encoding::subdivide::{
-    active_cuts, dispatched, one_submission, pass_run, subdivide_params, AxisCuts, SubdivideOutput,
+    active_cuts, dispatched, one_submission, pass_run, subdivide_params, AxisCuts, Passes, SubdivideOutput,
 };
 use crate::encoding::types::{DrawVertex, Piece, PieceWork, SubdivideCounters, SubdivideParams};
 use crate::error::{Error, Result};
@@ -249,7 +249,7 @@ pub fn run_one_submission<E: SubdivisionEngine>(
     let mut params = subdivide_params(settings, 0, triangles);
     (params.piece_capacity, params.triangle_capacity) = (capacity.pieces, capacity.triangles);
     (params.first_piece, params.piece_count) = (0, PIECES_FROM_COUNTER);
-    let recording = one_submission(triangles, settings.projection().panorama, false);
+    let recording = one_submission(triangles, Passes::of_settings(settings), false);
     let mut totals = RunTotals::default();
     let counters = replay_counted(engine, &recording, &params, settings, &mut totals)?;
     if counters.overflowed(capacity.pieces, capacity.triangles) {
@@ -290,7 +290,7 @@ pub fn run_chunked<E: SubdivisionEngine>(
         params.triangle_capacity = capacity.triangles;
         let planned = replay_counted(
             engine,
-            &pass_run("plan", count, settings.projection().panorama),
+            &pass_run("plan", count, Passes::of_settings(settings)),
             &params,
             settings,
             &mut totals,
@@ -334,7 +334,7 @@ fn lattice_ranges<E: SubdivisionEngine>(
         params.triangle_capacity = capacity.triangles.min(budget.triangles);
         let done = replay_counted(
             engine,
-            &pass_run("lattice", count, settings.projection().panorama),
+            &pass_run("lattice", count, Passes::of_settings(settings)),
             params,
             settings,
             totals,

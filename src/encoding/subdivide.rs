@@ -2,7 +2,7 @@
 //! axis it reports, and its output as both the GPU (read back) and the CPU twin give it.
 
 use crate::core::projection::{PanoramaKind, Projection};
-use crate::core::settings::RenderSettings;
+use crate::core::settings::{RenderSettings, SplitRule};
 use crate::encoding::constants::{AXIS_CLEARANCE_MAX, AXIS_CLEARANCE_MIN};
 use crate::encoding::recording::{Command, Recording};
 use crate::encoding::types::{DrawVertex, SubdivideCounters, SubdivideParams};
@@ -148,6 +148,9 @@ pub fn dispatched(
             Command::DispatchIndirect { entry: "lattice_nodes", .. } => {
                 Some(("lattice_nodes", counters.node_items.min(params.triangle_capacity) as u64))
             }
+            Command::DispatchIndirect { entry: entry @ ("lattice_rows" | "lattice_rows_plan"), .. } => {
+                Some((entry, counters.row_items.min(3 * params.triangle_capacity) as u64))
+            }
             Command::DispatchIndirect { entry: "lattice_triangles", .. } => {
                 Some(("lattice_triangles", counters.triangle_items.min(params.triangle_capacity) as u64))
             }
@@ -159,14 +162,16 @@ pub fn dispatched(
 
 /// Byte offsets in `lattice_dispatch` of the indirect dispatches' workgroup counts: `lattice`
 /// (written by `lattice_args`), `plan_cuts` (`plan_cuts_args`), `plan_parts` (`plan_parts_args`),
-/// `lattice_nodes` and `lattice_triangles` (`lattice_work_args`).
+/// `lattice_nodes` and `lattice_triangles` (`lattice_work_args`), `lattice_rows` and
+/// `lattice_rows_plan` (`lattice_rows_args`).
 pub const DISPATCH_LATTICE: u64 = 0;
 pub const DISPATCH_PLAN_CUTS: u64 = 12;
 pub const DISPATCH_PLAN_PARTS: u64 = 24;
 pub const DISPATCH_LATTICE_NODES: u64 = 36;
 pub const DISPATCH_LATTICE_TRIANGLES: u64 = 48;
+pub const DISPATCH_LATTICE_ROWS: u64 = 60;
 /// Words of `lattice_dispatch`.
-pub const DISPATCH_WORDS: usize = 15;
+pub const DISPATCH_WORDS: usize = 18;
 
 /// Timestamp query indices of the one-submission schedule's passes (each pass's begin; its end
 /// is the next index): `plan` (with the cuts), `plan_cuts`, `lattice`.
@@ -182,39 +187,63 @@ pub const LATTICE_TIMESTAMP: u32 = 4;
 /// `lattice_triangles` over the work items `lattice` appended, and `finalize` (the draw's
 /// arguments).
 /// `timed`: each pass writes its timestamps.
-pub fn one_submission(triangles: u32, panorama: PanoramaKind, timed: bool) -> Recording {
+pub fn one_submission(triangles: u32, passes: Passes, timed: bool) -> Recording {
     let stamp = |index: u32| timed.then_some(index);
     let mut r = Recording::default();
     r.clear("counters", None).clear("cut_edges", None);
     r.pass("plan", stamp(PLAN_TIMESTAMP));
     r.dispatch("active_cuts", triangles).dispatch("ring_cuts", triangles).dispatch("plan", triangles);
     r.pass("plan_cuts", stamp(PLAN_CUTS_TIMESTAMP));
-    cut_and_plan_parts(&mut r, panorama);
+    cut_and_plan_parts(&mut r, passes);
     r.pass("lattice", stamp(LATTICE_TIMESTAMP));
     r.dispatch("lattice_args", 1).dispatch_indirect("lattice", "lattice_dispatch", DISPATCH_LATTICE);
-    lattice_work(&mut r);
+    lattice_work(&mut r, passes);
     r.dispatch("finalize", 1);
     r
 }
 
 /// `plan_cuts` over the triangles `plan` listed, then on the sphere `plan_parts` over the parts
 /// it left (each after its one-thread setup pass).
-fn cut_and_plan_parts(r: &mut Recording, panorama: PanoramaKind) {
+fn cut_and_plan_parts(r: &mut Recording, passes: Passes) {
     r.dispatch("plan_cuts_args", 1).dispatch_indirect("plan_cuts", "lattice_dispatch", DISPATCH_PLAN_CUTS);
-    if defers_parts(panorama) {
+    if passes.parts {
         r.dispatch("plan_parts_args", 1).dispatch_indirect("plan_parts", "lattice_dispatch", DISPATCH_PLAN_PARTS);
     }
 }
 
-/// Whether `plan_cuts` leaves the parts of its bands to `plan_parts`: on the sphere, whose
-/// quadrants near a pole have many bands (on the cylinder, a few: it plans them itself).
-pub fn defers_parts(panorama: PanoramaKind) -> bool {
-    panorama == PanoramaKind::Equirect
+/// The passes a frame's schedules dispatch besides those every frame has.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Passes {
+    /// `plan_parts`: `plan_cuts` leaves the parts of its bands to it — on the sphere, whose
+    /// quadrants near a pole have many bands (on the cylinder, a few: it plans them itself).
+    pub parts: bool,
+    /// `lattice_rows` and `lattice_rows_plan`: pieces may be drawn in rows (the sphere, under an
+    /// adaptive rule).
+    pub rows: bool,
 }
 
-/// The work items `lattice` appended: `lattice_nodes`, then `lattice_triangles` (which reads
-/// the nodes), each after the setup pass that counts them.
-fn lattice_work(r: &mut Recording) {
+impl Passes {
+    /// A frame's: its panorama and its split rule (`SubdivideParams::method`).
+    pub fn of(panorama: PanoramaKind, method: u32) -> Passes {
+        let sphere = panorama == PanoramaKind::Equirect;
+        Passes { parts: sphere, rows: sphere && SplitRule::is_adaptive(method) }
+    }
+
+    /// The passes of a frame drawn with `settings`.
+    pub fn of_settings(settings: &RenderSettings) -> Passes {
+        Passes::of(settings.projection().panorama, settings.subdivision.method.split_rule().0 as u32)
+    }
+}
+
+/// What follows `lattice`: where pieces may be drawn in rows, `lattice_rows` over the bands it
+/// listed and `lattice_rows_plan`; then its work items, `lattice_nodes`, then `lattice_triangles`
+/// (which reads the nodes), each after the setup pass that counts them.
+fn lattice_work(r: &mut Recording, passes: Passes) {
+    if passes.rows {
+        r.dispatch("lattice_rows_args", 1);
+        r.dispatch_indirect("lattice_rows", "lattice_dispatch", DISPATCH_LATTICE_ROWS);
+        r.dispatch_indirect("lattice_rows_plan", "lattice_dispatch", DISPATCH_LATTICE_ROWS);
+    }
     r.dispatch("lattice_work_args", 1);
     r.dispatch_indirect("lattice_nodes", "lattice_dispatch", DISPATCH_LATTICE_NODES);
     r.dispatch_indirect("lattice_triangles", "lattice_dispatch", DISPATCH_LATTICE_TRIANGLES);
@@ -232,14 +261,14 @@ pub fn active_cuts(triangles: u32) -> Recording {
 /// One step of a chunked schedule: `entry` (`plan`, with `plan_cuts` and `plan_parts` after it,
 /// or `lattice`, with its work items' passes) over `count` invocations, then `finalize`; the counters of this run cleared first (the
 /// frame's cuts kept).
-pub fn pass_run(entry: &'static str, count: u32, panorama: PanoramaKind) -> Recording {
+pub fn pass_run(entry: &'static str, count: u32, passes: Passes) -> Recording {
     let mut r = Recording::default();
     r.clear("counters", Some(SubdivideCounters::RUN_BYTES));
     r.pass(entry, None).dispatch(entry, count);
     if entry == "plan" {
-        cut_and_plan_parts(&mut r, panorama);
+        cut_and_plan_parts(&mut r, passes);
     } else {
-        lattice_work(&mut r);
+        lattice_work(&mut r, passes);
     }
     r.dispatch("finalize", 1);
     r

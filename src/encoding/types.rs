@@ -149,17 +149,17 @@ pub struct SubdivideCounters {
     pub node_items: u32,
     /// ... and for `lattice_triangles` (from its back).
     pub triangle_items: u32,
+    /// Bands of pieces whose rows `lattice_rows` measures (`row_items`).
+    pub row_items: u32,
     /// The frame's cuts around the axis (`AxisCuts`), bits 0–31 and 32–63.
     pub cuts_low: u32,
     pub cuts_high: u32,
-    /// Keeps the size a multiple of 8 (the timestamps read back after the counters are u64s).
-    pub _pad: u32,
 }
 
 impl SubdivideCounters {
     /// Bytes of the counters that each `plan` or `lattice` run starts from zero; the cuts after
     /// them are set once per frame by `active_cuts`.
-    pub const RUN_BYTES: u64 = 44;
+    pub const RUN_BYTES: u64 = 48;
 
     /// What the output buffers must hold, in their unit (a triangle's indices and a node each):
     /// the larger of the triangle and node counts.
@@ -296,10 +296,10 @@ pub struct Piece {
 /// `PieceWork` in shaders/shared/subdivide_types.wgsl: what `lattice` planned for a piece (at
 /// the piece's index), which its work items read (`lattice_nodes`, `lattice_triangles`).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct PieceWork {
     /// How it is drawn: a sliver's strip (its base edge 0–2), the lattice (3), a band quad's
-    /// strip (`QUAD_STRIP`), rows (`ROWS_SHAPE`).
+    /// strip (`QUAD_STRIP`), rows (`ROWS_SHAPE`), or `ROWS_PENDING` while its rows are measured.
     pub shape: u32,
     /// Its lattice level (the largest edge count).
     pub m: u32,
@@ -316,9 +316,16 @@ pub struct PieceWork {
     pub strip_n: u32,
     /// Each copy's reference azimuth (`theta_ref`; x, y, z).
     pub refs: [f32; 4],
-    /// Rows: each row's parts, 8 bits each, four rows a word (33 rows at most).
-    pub row_w: [u32; 9],
+    /// Rows: each row's parts (33 rows at most); while `lattice_rows` measures them, each
+    /// band's measures (`row_measures`).
+    pub row_w: [u32; 33],
     pub _pad: [u32; 3],
+}
+
+impl Default for PieceWork {
+    fn default() -> Self {
+        bytemuck::Zeroable::zeroed()
+    }
 }
 
 /// A Rust struct's layout, to be checked against its WGSL twin.
@@ -443,7 +450,7 @@ pub const LAYOUTS: &[StructLayout] = &[
         view, projection, axis_clearance, triangle_count, first_triangle, method, fixed_n, edge_px, max_div,
         piece_capacity, triangle_capacity, first_piece, piece_count, measure_edges, vertical_limit, max_error_px, _pad1, _pad2
     }),
-    layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, nodes, cut_wide, max_pieces, max_output, parts, node_items, triangle_items, cuts_low, cuts_high, _pad }),
+    layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, nodes, cut_wide, max_pieces, max_output, parts, node_items, triangle_items, row_items, cuts_low, cuts_high }),
     layout!("Piece" => Piece { triangle, cell, counts01, count2_level, corner, bary1, bary2 }),
     layout!("PieceWork" => PieceWork { shape, m, node_count, candidates, copies, first_node, counts, strip_n, refs, row_w, _pad }),
     layout!("DrawIndexedIndirectArgs" => DrawIndexedIndirectArgs { index_count, instance_count, first_index, base_vertex, first_instance }),

@@ -11,11 +11,11 @@
 use std::sync::OnceLock;
 
 use crate::core::projection::PanoramaKind;
-use crate::core::settings::{RenderSettings, SplitRule};
+use crate::core::settings::RenderSettings;
 use crate::encoding::constants::PIECES_FROM_COUNTER;
 use crate::encoding::recording::{Command, Recording};
 use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine, INDICES_SIZE, NODE_SIZE};
-use crate::encoding::subdivide::{one_submission, SubdivideOutput};
+use crate::encoding::subdivide::{one_submission, Passes, SubdivideOutput};
 use crate::encoding::types::{DrawVertex, SubdivideCounters, SubdivideParams};
 use crate::error::Result;
 use crate::gpu::device::Gpu;
@@ -65,7 +65,8 @@ impl SubdivideStage {
             PanoramaKind::Cylinder => (0, 1.0),
             PanoramaKind::Equirect => (1, 2.0),
         };
-        let rows = SplitRule::is_adaptive(params.method) && panorama == PanoramaKind::Equirect;
+        let passes = Passes::of(panorama, params.method);
+        let rows = passes.rows;
         self.variants[2 * k + rows as usize].get_or_init(|| {
             // Built side by side: the driver's compiling of the large passes (`plan_cuts`,
             // `lattice`) is most of a fresh process's time.
@@ -75,9 +76,9 @@ impl SubdivideStage {
                 (PanoramaKind::Equirect, false) => &[ROWS_OFF],
                 (PanoramaKind::Equirect, true) => &[],
             };
-            // The entry points this panorama's schedules dispatch (every schedule's are the usual
+            // The entry points this frame's schedules dispatch (every schedule's are the usual
             // frame's).
-            let used: Vec<&'static str> = one_submission(1, panorama, false).entries().collect();
+            let used: Vec<&'static str> = one_submission(1, passes, false).entries().collect();
             let pipelines = std::thread::scope(|scope| {
                 let builds: Vec<_> = SUBDIVIDE
                     .entry_points
@@ -156,7 +157,8 @@ impl SubdivideStage {
     ) {
         let params = SubdivideParams { first_piece: 0, piece_count: PIECES_FROM_COUNTER, ..*params };
         gpu.queue.write_buffer(uniform, 0, bytemuck::bytes_of(&params));
-        let recording = one_submission(params.triangle_count, panorama, timestamps.is_some());
+        let recording =
+            one_submission(params.triangle_count, Passes::of(panorama, params.method), timestamps.is_some());
         self.replay(gpu, enc, &recording, &FrameBuffers { uniform, scene, b }, (panorama, &params), timestamps);
     }
 
@@ -265,7 +267,7 @@ impl FrameBuffers<'_> {
             "lattice_dispatch" => &b.lattice_dispatch,
             "object_edge_scale" => &scene.object_edge_scale,
             "cut_list" => &b.cut_list,
-            "out_indices" => &b.indices,
+            "out_indices" | "row_items" => &b.indices,
             "triangle_edges" => &scene.triangle_edges,
             "cut_edges" | "edge_marks_read" => &b.cut_edges,
             other => panic!("the subdivide stage binds no buffer {other}"),

@@ -12,7 +12,7 @@ use crate::core::settings::RenderSettings;
 use crate::encoding::params::raster_params;
 use crate::encoding::recording::Recording;
 use crate::encoding::schedule::{run_chunked, Capacities, FramePlan, SubdivisionEngine};
-use crate::encoding::subdivide::{dispatched, one_submission, subdivide_params};
+use crate::encoding::subdivide::{dispatched, one_submission, subdivide_params, Passes};
 use crate::encoding::types::{SubdivideCounters, SubdivideParams};
 use crate::error::Result;
 use crate::gpu::device::Gpu;
@@ -94,8 +94,12 @@ impl Method for SubdividedMethod {
                     None => stats.timing = Timing::WallOneSubmission,
                 }
                 stats.pieces = counters.pieces as u64;
-                stats.subdivide_invocations =
-                    dispatched(&one_submission(n, p.panorama, false), &params, &counters, p.panorama);
+                stats.subdivide_invocations = dispatched(
+                    &one_submission(n, Passes::of(p.panorama, params.method), false),
+                    &params,
+                    &counters,
+                    p.panorama,
+                );
                 stats.max_pieces_per_invocation = counters.max_pieces;
                 stats.max_output_per_invocation = counters.max_output;
                 stats.triangles_out = counters.triangles as u64;

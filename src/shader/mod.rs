@@ -249,8 +249,33 @@ pub const SUBDIVIDE: Stage = Stage {
         ),
         pass(
             "lattice",
-            &["params", "vertices", "indices", "pieces", "counters", "object_edge_scale", "piece_work", "lattice_work"],
+            &[
+                "params",
+                "vertices",
+                "indices",
+                "pieces",
+                "counters",
+                "object_edge_scale",
+                "piece_work",
+                "lattice_work",
+                "row_items",
+            ],
             include_str!("../../shaders/subdivide/lattice.wgsl"),
+        ),
+        pass(
+            "lattice_rows_args",
+            &["params", "counters", "lattice_dispatch"],
+            include_str!("../../shaders/subdivide/lattice_rows_args.wgsl"),
+        ),
+        pass(
+            "lattice_rows",
+            &["params", "vertices", "indices", "pieces", "counters", "object_edge_scale", "piece_work", "row_items"],
+            include_str!("../../shaders/subdivide/lattice_rows.wgsl"),
+        ),
+        pass(
+            "lattice_rows_plan",
+            &["params", "pieces", "counters", "piece_work", "lattice_work", "row_items"],
+            include_str!("../../shaders/subdivide/lattice_rows_plan.wgsl"),
         ),
         pass(
             "lattice_work_args",
@@ -297,6 +322,7 @@ pub const SUBDIVIDE: Stage = Stage {
         bind(0, 14, "parts", StorageReadWrite),
         bind(0, 15, "piece_work", StorageReadWrite),
         bind(0, 16, "lattice_work", StorageReadWrite),
+        bind(0, 17, "row_items", StorageReadWrite),
     ],
 };
 

@@ -103,7 +103,7 @@
 use glam::{Vec2, Vec3, Vec4};
 use std::f32::consts::{PI, TAU};
 
-use crate::core::projection::{azimuth, wrap_angle, Eye, PanoramaKind, Projection};
+use crate::core::projection::{azimuth, wrap_angle, PanoramaKind, Projection};
 use crate::core::scene::{pack_tangent, SceneVertex};
 use crate::core::settings::SplitRule;
 use crate::encoding::constants::{SEAM_MARGIN, STRIP_BASE_ERROR, STRIP_MIN_DIVISIONS};
@@ -115,6 +115,7 @@ mod edges;
 mod frame_cuts;
 mod lattice;
 pub mod passes;
+mod piece;
 mod quad;
 mod rows;
 mod work;
@@ -130,7 +131,7 @@ pub use lattice::{
     boundary_edge, lattice_triangles, macro_cell, node_slot, quad_strip_node_count, quad_strip_triangles, slot_node,
     snap, strip_node_count, strip_triangles,
 };
-use lattice::{lattice_node, lattice_slots, strip_node, strip_slots, weighted};
+use piece::{PieceGeometry, Shape};
 pub use rows::{band_cell, PartSplit, Rows};
 pub use work::{chunk_of, PiecePlan};
 
@@ -218,115 +219,6 @@ impl<'a> Subdivider<'a> {
         }
         out.vertices = expand(&out.nodes, &out.indices);
         out
-    }
-
-    /// Where macro node (a, b, c)/K lies: nodes on an original edge snap to its fine nodes, and
-    /// may land on a triangle corner.
-    fn macro_location(&self, n: [u32; 3], k: u32, abc: [u32; 3]) -> Location {
-        let Some((e, idx)) = boundary_edge(abc) else {
-            return Location::Interior(abc);
-        };
-        Location::on_edge(e, snap(idx, n[e], k), n)
-    }
-
-    fn macro_node(&self, part: &[Node; 3], n: [u32; 3], k: u32, loc: Location) -> Node {
-        match loc {
-            Location::Corner(i) => part[i],
-            Location::OnEdge(e, j) => edge_point(part[e], part[(e + 1) % 3], j, n[e]),
-            Location::Interior([a, b, c]) => {
-                let w = Vec3::new(a as f32, b as f32, c as f32) / k as f32;
-                weighted(part, w)
-            }
-        }
-    }
-
-    /// `lattice`: plans piece `cell` of a part (a macro cell, or a band's half): its shape, its
-    /// nodes once per seam copy, its candidate triangles. None where it draws nothing.
-    fn lattice(&self, tri: &Triangle, part: &[Node; 3], split: PartSplit, cell: u32) -> Option<(PiecePlan, Shape)> {
-        let PartSplit { n, k, .. } = split;
-        let loc = if split.bands {
-            band_cell(n, self.params.max_div, cell).map(|(e, j)| Location::on_edge(e, j, n))
-        } else {
-            macro_cell(k, cell).map(|c| self.macro_location(n, k, c))
-        };
-        let q = loc.map(|l| self.macro_node(part, n, k, l));
-        if q[0].position == q[1].position || q[1].position == q[2].position || q[2].position == q[0].position {
-            return None; // snapped corners coincide: no area
-        }
-        if self.off_screen_vertically(q.map(|n| n.position)) {
-            return None; // every sub-triangle would be culled
-        }
-        // Each piece edge: on an original edge (that edge's fine nodes, by global index) or interior.
-        let mut edges = [PieceEdge::default(); 3];
-        for e in 0..3 {
-            let (s, t) = (loc[e], loc[(e + 1) % 3]);
-            edges[e] = (0..3)
-                .find_map(|oe| match (s.index_on(oe, n), t.index_on(oe, n)) {
-                    (Some(from), Some(to)) => {
-                        Some(PieceEdge { original: Some(oe), from, to, count: from.abs_diff(to) })
-                    }
-                    _ => None,
-                })
-                .unwrap_or(PieceEdge {
-                    original: None,
-                    from: 0,
-                    to: 0,
-                    count: self.interior_divisions(q[e].position, q[(e + 1) % 3].position, self.limits(tri.object), k),
-                });
-        }
-        let counts = edges.map(|e| e.count);
-        let node_on_edge = |e: usize, m: u32| -> Node {
-            // m-th node from piece corner e towards corner e+1.
-            let pe = edges[e];
-            match pe.original {
-                Some(oe) => {
-                    let j = if pe.to >= pe.from { pe.from + m } else { pe.from - m };
-                    edge_point(part[oe], part[(oe + 1) % 3], j, n[oe])
-                }
-                None => edge_point(q[e], q[(e + 1) % 3], m, pe.count),
-            }
-        };
-        // The lattice of level m, a sliver's strip or rows: its nodes and candidate triangles.
-        let shape = self.piece_shape(counts, &q, self.limits(tri.object), k, &node_on_edge);
-        let nodes = shape.nodes(counts, &q, &node_on_edge);
-        let theta_c = azimuth((q[0].position + q[1].position + q[2].position) / 3.0);
-        let u_range = if self.projection.panorama == PanoramaKind::Equirect {
-            let (mut u_min, mut u_max) = (f32::INFINITY, f32::NEG_INFINITY);
-            for n in &nodes {
-                let theta = theta_c + wrap_angle(azimuth(n.position) - theta_c);
-                for eye in Eye::BOTH {
-                    let u = self.projection.project_with_azimuth(n.position, theta, eye).u;
-                    u_min = u_min.min(u);
-                    u_max = u_max.max(u);
-                }
-            }
-            (u_min, u_max)
-        } else {
-            self.piece_u_range(&q, theta_c)
-        };
-        let plan = self.piece_plan(tri, &nodes, shape.slots(counts), theta_c, u_range);
-        Some((plan, shape))
-    }
-
-    /// How a piece is triangulated: a sliver's strip on the cylinder ([`Subdivider::strip_base`]),
-    /// else under an adaptive rule its rows ([`Rows`]) where they make fewer candidate triangles
-    /// than the regular lattice of level m = max(counts), else that lattice.
-    fn piece_shape(
-        &self,
-        counts: [u32; 3],
-        q: &[Node; 3],
-        limits: Limits,
-        k: u32,
-        node_on_edge: &dyn Fn(usize, u32) -> Node,
-    ) -> Shape {
-        let m = counts[0].max(counts[1]).max(counts[2]);
-        if let Some(base) = self.strip_base(counts, q, limits) {
-            return Shape::Strip(base);
-        }
-        match self.rows(counts, limits, k, node_on_edge) {
-            Some(rows) if rows.candidates() < m * m => Shape::Rows(rows),
-            _ => Shape::Lattice(m),
-        }
     }
 
     /// A piece's plan: its nodes once per seam copy, every node unwrapped towards the piece's
@@ -438,77 +330,6 @@ impl<'a> Subdivider<'a> {
         }
         longest
     }
-}
-
-/// Where a macro node lies. Original edge e runs from corner e to corner e + 1.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Location {
-    Corner(usize),
-    /// Fine node j (0 < j < n_e) of original edge e, counted from its start.
-    OnEdge(usize, u32),
-    Interior([u32; 3]),
-}
-
-impl Location {
-    /// Fine node j of original edge e (0 ≤ j ≤ n_e): a corner at either end.
-    fn on_edge(e: usize, j: u32, n: [u32; 3]) -> Location {
-        if j == 0 {
-            Location::Corner(e)
-        } else if j == n[e] {
-            Location::Corner((e + 1) % 3)
-        } else {
-            Location::OnEdge(e, j)
-        }
-    }
-
-    /// The node's fine index along original edge `oe` from its start, if it lies on that edge.
-    fn index_on(self, oe: usize, n: [u32; 3]) -> Option<u32> {
-        match self {
-            Location::Corner(c) if c == oe => Some(0),
-            Location::Corner(c) if c == (oe + 1) % 3 => Some(n[oe]),
-            Location::OnEdge(e, j) if e == oe => Some(j),
-            _ => None,
-        }
-    }
-}
-
-/// How a piece is triangulated (`piece_shape`).
-enum Shape {
-    Lattice(u32),
-    Strip(usize),
-    Rows(Rows),
-}
-
-impl Shape {
-    /// Its candidate triangles, as their corners' slots.
-    fn slots(&self, counts: [u32; 3]) -> Vec<[u32; 3]> {
-        match self {
-            Shape::Lattice(m) => lattice_slots(*m),
-            Shape::Strip(base) => strip_slots(counts, *base),
-            Shape::Rows(rows) => rows.slots(),
-        }
-    }
-
-    /// Its nodes in slot order.
-    fn nodes(&self, counts: [u32; 3], q: &[Node; 3], node_on_edge: &dyn Fn(usize, u32) -> Node) -> Vec<Node> {
-        match self {
-            Shape::Lattice(m) => (0..(m + 1) * (m + 2) / 2)
-                .map(|k| lattice_node(counts, q, node_on_edge, *m, slot_node(k, *m)))
-                .collect(),
-            Shape::Strip(base) => {
-                (0..strip_node_count(counts, *base)).map(|k| strip_node(counts, *base, node_on_edge, k)).collect()
-            }
-            Shape::Rows(rows) => rows.nodes(node_on_edge),
-        }
-    }
-}
-
-#[derive(Clone, Copy, Debug, Default)]
-struct PieceEdge {
-    original: Option<usize>,
-    from: u32,
-    to: u32,
-    count: u32,
 }
 
 fn draw_vertex(tri: &Triangle, n: Node, theta_ref: f32) -> DrawVertex {

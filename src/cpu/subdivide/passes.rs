@@ -16,7 +16,7 @@ use glam::Vec3;
 
 use super::{
     band_limit, edge_split_parts, fan, one_part, quadrant_polygons, triangle_cuts, FrameCuts, Node, PartSplit,
-    PiecePlan, SubdivideOutput, Subdivider, Triangle,
+    PieceGeometry, PiecePlan, SubdivideOutput, Subdivider, Triangle,
 };
 use crate::core::projection::PanoramaKind;
 use crate::core::scene::SceneVertex;
@@ -25,8 +25,8 @@ use crate::encoding::constants::{BANDS, PIECES_FROM_COUNTER, QUAD_HEAD, QUAD_TAI
 use crate::encoding::recording::{Command, Recording};
 use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine};
 use crate::encoding::subdivide::{
-    plan_cuts_split, DISPATCH_LATTICE, DISPATCH_LATTICE_NODES, DISPATCH_LATTICE_TRIANGLES, DISPATCH_PLAN_CUTS,
-    DISPATCH_PLAN_PARTS, DISPATCH_WORDS,
+    plan_cuts_split, DISPATCH_LATTICE, DISPATCH_LATTICE_NODES, DISPATCH_LATTICE_ROWS, DISPATCH_LATTICE_TRIANGLES,
+    DISPATCH_PLAN_CUTS, DISPATCH_PLAN_PARTS, DISPATCH_WORDS,
 };
 use crate::encoding::types::{DrawIndexedIndirectArgs, DrawVertex, Piece, SubdivideCounters, SubdivideParams};
 use crate::error::Result;
@@ -65,6 +65,12 @@ pub struct CpuSubdivision<'s> {
     /// What `lattice` planned for each piece, by the piece's index: its first output node and
     /// its plan (`piece_work`).
     piece_work: HashMap<u32, (u32, PiecePlan)>,
+    /// The pieces whose rows `lattice_rows` measures, by index: their triangle, placement and
+    /// each band's measures so far.
+    pending_rows: HashMap<u32, PendingRows>,
+    /// The bands of pieces whose rows `lattice_rows` measures: (piece << 5) | band (the GPU's
+    /// share `out_indices`' room, 3 per output unit).
+    row_items: Vec<u32>,
     /// `lattice`'s work items: [piece, first slot or candidate, 0, 0] (the twin needs no walk).
     lattice_work: Vec<[u32; 4]>,
     /// The most nodes or candidate triangles one piece has (seam copies included): the most a
@@ -76,6 +82,9 @@ pub struct CpuSubdivision<'s> {
     pub nodes: Vec<DrawVertex>,
     pub taken_indices: Vec<u32>,
 }
+
+/// A piece whose rows `lattice_rows` measures: its triangle, its placement, each band's measures.
+type PendingRows = (Triangle, PieceGeometry, Vec<(u32, u32)>);
 
 /// A part's corner from a piece record.
 fn record_corner(piece: &Piece, i: usize) -> Node {
@@ -108,6 +117,8 @@ impl<'s> CpuSubdivision<'s> {
             out_nodes: vec![DrawVertex::default(); 1],
             out_indices: vec![0; 3],
             piece_work: HashMap::new(),
+            pending_rows: HashMap::new(),
+            row_items: vec![0; 3],
             lattice_work: vec![[0; 4]; 1],
             max_piece_output: 0,
             lattice_dispatch: [0; DISPATCH_WORDS],
@@ -146,6 +157,9 @@ impl<'s> CpuSubdivision<'s> {
             "plan_parts" => all.for_each(|i| self.plan_parts(sub, i)),
             "lattice_args" => self.lattice_args(sub),
             "lattice" => all.for_each(|i| self.lattice(sub, i)),
+            "lattice_rows_args" => self.lattice_rows_args(sub),
+            "lattice_rows" => all.for_each(|i| self.lattice_rows(sub, i)),
+            "lattice_rows_plan" => all.for_each(|i| self.lattice_rows_plan(sub, i)),
             "lattice_work_args" => self.lattice_work_args(sub),
             "lattice_nodes" => all.for_each(|i| self.lattice_nodes(sub, i)),
             "lattice_triangles" => all.for_each(|i| self.lattice_triangles(sub, i)),
@@ -300,15 +314,20 @@ impl<'s> CpuSubdivision<'s> {
         self.lattice_dispatch[at..at + 3].copy_from_slice(&[groups.min(65535), groups.div_ceil(65535), 1]);
     }
 
+    /// The pieces `lattice` runs over: a range's, or as many as were counted.
+    fn pieces_planned(&self, params: &SubdivideParams) -> u32 {
+        match params.piece_count {
+            PIECES_FROM_COUNTER => self.counters.pieces.min(params.piece_capacity),
+            count => count,
+        }
+    }
+
     /// One piece record: its lattice (or a band quad's strip, from its two records) planned, its
-    /// nodes allocated, its work items appended (`plan_work`).
+    /// nodes allocated, its work items appended (`plan_work`) — or, where its rows are to be
+    /// measured, left to `lattice_rows` and `lattice_rows_plan`.
     fn lattice(&mut self, sub: &Subdivider, local: u32) {
         let params = sub.params;
-        let mut piece_count = params.piece_count;
-        if piece_count == PIECES_FROM_COUNTER {
-            piece_count = self.counters.pieces.min(params.piece_capacity);
-        }
-        if local >= piece_count {
+        if local >= self.pieces_planned(params) {
             return;
         }
         let index = params.first_piece + local;
@@ -319,16 +338,75 @@ impl<'s> CpuSubdivision<'s> {
         let tri = sub.load(self.scene.0, self.scene.1, piece.triangle as usize);
         let corners = [0, 1, 2].map(|i| record_corner(&piece, i));
         let (n0, n1) = (piece.counts01 & 0xffff, piece.counts01 >> 16);
-        let plan = if piece.count2_level & QUAD_HEAD != 0 {
+        if piece.count2_level & QUAD_HEAD != 0 {
             let last = record_corner(&self.pieces[index as usize + 1], 0);
-            sub.quad_lattice(&tri, &[corners[0], corners[1], corners[2], last], [n0, n1])
-        } else {
-            let n = [n0, n1, piece.count2_level & 0xffff];
-            let k = (piece.count2_level >> 16) & 0x1fff;
-            let bands = piece.count2_level & BANDS != 0;
-            sub.lattice(&tri, &corners, PartSplit { n, k, bands }, piece.cell).map(|(plan, _)| plan)
-        };
-        let Some(plan) = plan else { return };
+            if let Some(plan) = sub.quad_lattice(&tri, &[corners[0], corners[1], corners[2], last], [n0, n1]) {
+                self.plan_work(params, index, plan);
+            }
+            return;
+        }
+        let n = [n0, n1, piece.count2_level & 0xffff];
+        let k = (piece.count2_level >> 16) & 0x1fff;
+        let bands = piece.count2_level & BANDS != 0;
+        let Some(g) = sub.piece_geometry(&tri, &corners, PartSplit { n, k, bands }, piece.cell) else { return };
+        match sub.unmeasured_shape(&g) {
+            Some(shape) => {
+                let plan = sub.shaped_plan(&tri, &g, &shape);
+                self.plan_work(params, index, plan);
+            }
+            None => {
+                // A row item per band, counted always, written where they fit (`plan_pending`).
+                let r = sub.row_count(&g);
+                for b in 0..r {
+                    let slot = self.counters.row_items;
+                    self.counters.row_items += 1;
+                    if slot < 3 * params.triangle_capacity {
+                        self.row_items[slot as usize] = index << 5 | b;
+                    }
+                }
+                self.pending_rows.insert(index, (tri, g, vec![(0, 0); r as usize]));
+            }
+        }
+    }
+
+    /// The row items `lattice` appended, within their room.
+    fn row_item_count(&self, params: &SubdivideParams) -> u32 {
+        self.counters.row_items.min(3 * params.triangle_capacity)
+    }
+
+    fn lattice_rows_args(&mut self, sub: &Subdivider) {
+        let groups = self.row_item_count(sub.params).div_ceil(64);
+        let at = DISPATCH_LATTICE_ROWS as usize / 4;
+        self.lattice_dispatch[at..at + 3].copy_from_slice(&[groups.min(65535), groups.div_ceil(65535), 1]);
+    }
+
+    /// A row item: band b of a piece whose rows are to be measured, measured.
+    fn lattice_rows(&mut self, sub: &Subdivider, local: u32) {
+        if local >= self.row_item_count(sub.params) {
+            return;
+        }
+        let item = self.row_items[local as usize];
+        let (index, b) = (item >> 5, item & 31);
+        if let Some((_, g, measures)) = self.pending_rows.get_mut(&index) {
+            measures[b as usize] = sub.row_measure(g, b);
+        }
+    }
+
+    /// Band 0's row item of a piece whose rows were measured: rows or the lattice, planned as
+    /// `lattice` plans the others.
+    fn lattice_rows_plan(&mut self, sub: &Subdivider, local: u32) {
+        if local >= self.row_item_count(sub.params) || self.row_items[local as usize] & 31 != 0 {
+            return;
+        }
+        let index = self.row_items[local as usize] >> 5;
+        if let Some((tri, g, measures)) = self.pending_rows.remove(&index) {
+            let plan = sub.shaped_plan(&tri, &g, &sub.rows_or_lattice(&g, &measures));
+            self.plan_work(sub.params, index, plan);
+        }
+    }
+
+    /// A planned piece's work: its nodes allocated, its work items appended.
+    fn plan_work(&mut self, params: &SubdivideParams, index: u32, plan: PiecePlan) {
         let first_node = self.counters.nodes;
         self.counters.nodes += plan.copies * plan.node_count;
         let len = params.triangle_capacity;
@@ -490,6 +568,7 @@ impl SubdivisionEngine for CpuSubdivision<'_> {
             self.out_nodes.resize(want.triangles as usize, DrawVertex::default());
             self.out_indices.resize(3 * want.triangles as usize, 0);
             self.lattice_work.resize(want.triangles as usize, [0; 4]);
+            self.row_items.resize(3 * want.triangles as usize, 0);
         }
         Capacities { pieces: self.pieces.len() as u32, triangles: self.out_nodes.len() as u32 }
     }

@@ -217,31 +217,54 @@ impl Rows {
 }
 
 impl Subdivider<'_> {
-    /// On the sphere, under an adaptive rule, a piece's rows (`piece_shape` keeps them where they
-    /// make fewer candidate triangles than the lattice): the base row in its edge's parts, the apex's none,
-    /// each other row in as many as it needs itself (the interior rule) and as its two bands'
-    /// diagonals need ([`Subdivider::band_parts`]), at least one and at most 2·N_max. None with
-    /// fewer than two rows.
-    pub(super) fn rows(
+    /// Where a piece may be drawn in rows — on the sphere, under an adaptive rule, with two rows
+    /// or more — its base edge and its sides' counts (left, right); None elsewhere
+    /// (`rows_possible` in the WGSL).
+    pub(super) fn rows_base(&self, counts: [u32; 3]) -> Option<(usize, [u32; 2])> {
+        let (base, r) = Rows::base_of(counts);
+        let possible = SplitRule::is_adaptive(self.params.method)
+            && self.projection.panorama == PanoramaKind::Equirect
+            && (2..=PIECE_DIVISIONS).contains(&r);
+        possible.then(|| (base, sides_of(counts, base)))
+    }
+
+    /// The widest a row may be: 2·N_max, within 1 and `PIECE_DIVISIONS`.
+    fn row_cap(&self) -> u32 {
+        self.params.max_div.saturating_mul(2).clamp(1, PIECE_DIVISIONS)
+    }
+
+    /// Band b's measures (`row_measures` in the WGSL, one `lattice_rows` invocation): the parts
+    /// across band b (rows b and b + 1) its zipper's diagonals need ([`Subdivider::band_parts`]),
+    /// and the parts row b needs itself (the interior rule; 0 for the base row, whose parts are
+    /// its edge's).
+    pub(super) fn row_measures(
         &self,
         counts: [u32; 3],
+        b: u32,
         limits: Limits,
         k: u32,
         node_on_edge: &dyn Fn(usize, u32) -> Node,
-    ) -> Option<Rows> {
-        let (base, r) = Rows::base_of(counts);
-        if !SplitRule::is_adaptive(self.params.method) || self.projection.panorama != PanoramaKind::Equirect || r < 2 {
-            return None;
+    ) -> (u32, u32) {
+        let (base, sides) = self.rows_base(counts).expect("a piece with rows");
+        let need = self.band_parts(base, sides, b, limits, self.row_cap(), node_on_edge);
+        if b == 0 {
+            return (need, 0);
         }
-        let sides = sides_of(counts, base);
-        let cap = self.params.max_div.saturating_mul(2).clamp(1, PIECE_DIVISIONS);
-        // Each band's need first, then each row's own (as the WGSL does).
-        let need: Vec<u32> = (0..r).map(|b| self.band_parts(base, sides, b, limits, cap, node_on_edge)).collect();
+        let [left, right] = Rows::row_ends(base, sides, b, node_on_edge);
+        (need, self.interior_divisions(left.position, right.position, limits, k))
+    }
+
+    /// A piece's rows from its bands' measures (`rows_from_measures` in the WGSL): the base row
+    /// in its edge's parts, the apex's none, each other row in as many as it needs itself and
+    /// as its two bands' diagonals need, at least one and at most 2·N_max. None where the piece
+    /// has no rows ([`Subdivider::rows_base`]).
+    pub(super) fn rows_from_measures(&self, counts: [u32; 3], measures: &[(u32, u32)]) -> Option<Rows> {
+        let (base, sides) = self.rows_base(counts)?;
+        let r = sides[0].max(sides[1]) as usize;
         let mut widths = vec![counts[base]];
         for row in 1..r {
-            let [left, right] = Rows::row_ends(base, sides, row, node_on_edge);
-            let own = self.interior_divisions(left.position, right.position, limits, k);
-            widths.push(own.max(need[row as usize - 1]).max(need[row as usize]).clamp(1, cap));
+            let need = measures[row].1.max(measures[row - 1].0).max(measures[row].0);
+            widths.push(need.clamp(1, self.row_cap()));
         }
         widths.push(0);
         Some(Rows { base, sides, widths })

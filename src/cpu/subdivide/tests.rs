@@ -1,6 +1,7 @@
 //! Tests of the `subdivide` twin: lattice conformity, closed meshes, pre-split, seam, axis.
 
 use super::lattice::quad_strip_node;
+use super::lattice::strip_node;
 use super::*;
 use crate::core::projection::{Eye, Vertical};
 use crate::core::settings::{Method, RenderSettings, Split, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV};
@@ -671,6 +672,11 @@ fn the_passes_replaying_every_schedule_make_the_twins_triangles() {
                 assert_eq!((out.pieces, out.cuts), (direct.pieces, direct.cuts), "{what}");
                 assert_eq!(out.max_output, direct.max_output, "{what}: the largest output of one lattice invocation");
                 assert!(out.max_pieces >= 1 && out.max_output >= 1, "{what}: the balance counters");
+                assert!(
+                    out.max_output <= crate::encoding::constants::LATTICE_CHUNK,
+                    "{what}: one invocation wrote {} nodes or triangles",
+                    out.max_output
+                );
                 assert_eq!(out.nodes.len(), direct.nodes.len(), "{what}");
                 assert!(sorted(&out) == sorted(&direct), "{what}: not the twin's triangles");
             }

@@ -1,0 +1,16 @@
+// The `lattice_rows_args` setup pass of the `subdivide` stage (one thread; the sphere, adaptive
+// rules): the indirect dispatch of `lattice_rows` and `lattice_rows_plan`, one invocation per row
+// item `lattice` appended. CPU twin: `CpuSubdivision::lattice_rows_args`.
+
+#import constants
+#import subdivide_types
+#import subdivide_bindings
+#import subdivide_dispatch
+
+@compute @workgroup_size(1)
+fn lattice_rows_args() {
+    let groups = (row_item_count() + 63u) / 64u;
+    lattice_dispatch[15] = min(groups, 65535u);
+    lattice_dispatch[16] = (groups + 65534u) / 65535u;
+    lattice_dispatch[17] = 1u;
+}

@@ -1,0 +1,44 @@
+// The `lattice_rows_plan` pass of the `subdivide` stage (the sphere, adaptive rules), after
+// `lattice_rows`: over the row items, band 0's invocation of each piece whose rows were measured gets
+// its rows' widths from the measures (`rows_from_measures`), is drawn in rows where they make
+// fewer candidate triangles than its lattice, and is planned as `lattice` plans the others: its
+// seam copies, its nodes' room, its work items. CPU twin: `CpuSubdivision::lattice_rows_plan`.
+
+#import projection
+#import constants
+#import scene
+#import subdivide_types
+#import subdivide_bindings
+#import subdivide_state
+#import subdivide_edges
+#import subdivide_frame_cuts
+#import subdivide_axis
+#import subdivide_quad
+#import subdivide_lattice
+#import subdivide_bands
+#import subdivide_rows
+#import subdivide_work
+#import subdivide_dispatch
+
+@compute @workgroup_size(64)
+fn lattice_rows_plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    var part: PartPlan;
+    var piece_state: PieceState;
+    let local = invocation_index(gid, groups);
+    if (local >= row_item_count() || (row_items[local] & 31u) != 0u) {
+        return;
+    }
+    let index = row_items[local] >> 5u;
+    let work = piece_work[index];
+    load_work(index, work, &part, &piece_state);
+    let rows = rows_from_measures(&piece_state);
+    let c = piece_state.corner;
+    var shape = PieceShape(work.m, work.candidates, work.node_count, azimuth((c[0].position + c[1].position + c[2].position) / 3.0));
+    piece_state.strip_base = 3u;
+    if (rows.x < shape.candidates) {
+        piece_state.strip_base = ROWS_SHAPE;
+        shape.candidates = rows.x;
+        shape.node_count = rows.y;
+    }
+    plan_work(index, shape, seam_copies(shape, &part, &piece_state), &piece_state);
+}
