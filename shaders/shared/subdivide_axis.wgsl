@@ -448,6 +448,17 @@ fn plan_apex_part(t: u32, apex: Node, i: u32, tri: ptr<function, InputTriangle>,
     (*part).corner[1] = (*clip).pool[i];
     (*part).corner[2] = (*clip).pool[(i + 1u) % (*clip).poly_count];
     if (!off_screen_vertically((*part).corner[0].position, (*part).corner[1].position, (*part).corner[2].position)) {
+        plan_cut_part(t, tri, part);
+    }
+}
+
+// A part `plan_cuts` cut: on the sphere appended for `plan_parts` (a quadrant near a pole has
+// many bands, a triangle beside it several parts: planning them here made the frame's longest
+// threads), on the cylinder planned here (`Passes::parts`).
+fn plan_cut_part(t: u32, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>) {
+    if (is_sphere(params.projection)) {
+        append_part(t, part);
+    } else {
         plan_part(tri, part);
         append_pieces(t, part);
     }
@@ -479,8 +490,7 @@ fn plan_edge_split(t: u32, tri: ptr<function, InputTriangle>, part: ptr<function
     }
     if (crossed == 0u) {
         (*part).corner = corners;
-        plan_part(tri, part);
-        append_pieces(t, part);
+        plan_cut_part(t, tri, part);
     } else if (crossed == 1u) {
         for (var i = 0u; i < chain.z; i++) {
             plan_apex_part(t, corners[(chain.x + 2u) % 3u], chain.y + i, tri, part, clip);
@@ -549,7 +559,7 @@ fn plan_band(t: u32, tri: ptr<function, InputTriangle>, part: ptr<function, Part
             (*part).corner[1] = poly_node(i, clip);
             (*part).corner[2] = poly_node(i + 1u, clip);
             if (sphere) {
-                append_part(t, part);
+                append_part(t, part); // `plan_cut_part`: the counts are left to `plan_parts`
             } else {
                 let e = fan_edges(i, clip);
                 (*part).n[0] = (*clip).poly_n[e.x];

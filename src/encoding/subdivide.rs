@@ -89,9 +89,13 @@ pub struct SubdivideOutput {
     /// triangles one work item of `lattice_nodes` or `lattice_triangles` wrote.
     pub max_pieces: u32,
     pub max_output: u32,
-    /// The most nodes or candidate triangles one piece has, seam copies included (the twin's,
-    /// for the twin test's slack; 0 from the GPU).
+    /// The most nodes or candidate triangles one piece has, seam copies included (a measure of
+    /// its own flipped re-triangulates it) ...
     pub max_piece_output: u32,
+    /// ... and one part has, its pieces' and seam copies included:
+    /// what a count flipped on one of its edges changes, the part planned again whole (the
+    /// twin's, for the twin test's slack; 0 from the GPU).
+    pub max_part_output: u32,
 }
 
 /// Indexed triangles as three vertices each.
@@ -211,11 +215,17 @@ fn cut_and_plan_parts(r: &mut Recording, passes: Passes) {
     }
 }
 
+/// Whether `plan_cuts` leaves the parts it cuts to `plan_parts`: on the sphere (a quadrant
+/// near a pole has many bands, which one invocation planned in turn); on the cylinder, with a
+/// few, it plans them itself (`plan_cut_part` in the WGSL).
+pub fn defers_parts(panorama: PanoramaKind) -> bool {
+    panorama == PanoramaKind::Equirect
+}
+
 /// The passes a frame's schedules dispatch besides those every frame has.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Passes {
-    /// `plan_parts`: `plan_cuts` leaves the parts of its bands to it — on the sphere, whose
-    /// quadrants near a pole have many bands (on the cylinder, a few: it plans them itself).
+    /// `plan_parts`: `plan_cuts` leaves the parts it cuts to it ([`defers_parts`]).
     pub parts: bool,
     /// `lattice_rows` and `lattice_rows_plan`: pieces may be drawn in rows (the sphere, under an
     /// adaptive rule).
@@ -226,7 +236,7 @@ impl Passes {
     /// A frame's: its panorama and its split rule (`SubdivideParams::method`).
     pub fn of(panorama: PanoramaKind, method: u32) -> Passes {
         let sphere = panorama == PanoramaKind::Equirect;
-        Passes { parts: sphere, rows: sphere && SplitRule::is_adaptive(method) }
+        Passes { parts: defers_parts(panorama), rows: sphere && SplitRule::is_adaptive(method) }
     }
 
     /// The passes of a frame drawn with `settings`.

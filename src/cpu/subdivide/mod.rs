@@ -192,6 +192,7 @@ impl<'a> Subdivider<'a> {
                     out.pieces += 2; // the GPU's two records of a quad
                     if let Some(plan) = self.quad_lattice(&tri, &corners, rails) {
                         out.quads += 1;
+                        out.max_part_output = out.max_part_output.max(plan.output());
                         out.max_piece_output = out.max_piece_output.max(plan.output());
                         self.emit(&plan, &mut out);
                     }
@@ -204,16 +205,19 @@ impl<'a> Subdivider<'a> {
                         continue;
                     }
                     let split = self.plan(&tri, &part);
+                    let mut part_output = 0;
                     for cell in 0..split.pieces(self.params.max_div) {
                         out.pieces += 1;
                         out.bands += split.bands as u32;
                         if let Some((plan, shape)) = self.lattice(&tri, &part, split, cell) {
                             out.strips += matches!(shape, Shape::Strip(_)) as u32;
                             out.rows += matches!(shape, Shape::Rows(_)) as u32;
+                            part_output += plan.output();
                             out.max_piece_output = out.max_piece_output.max(plan.output());
                             self.emit(&plan, &mut out);
                         }
                     }
+                    out.max_part_output = out.max_part_output.max(part_output);
                 }
             }
         }

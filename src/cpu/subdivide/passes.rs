@@ -18,15 +18,14 @@ use super::{
     band_limit, edge_split_parts, fan, one_part, quadrant_polygons, triangle_cuts, FrameCuts, Node, PartSplit,
     PieceGeometry, PiecePlan, SubdivideOutput, Subdivider, Triangle,
 };
-use crate::core::projection::PanoramaKind;
 use crate::core::scene::SceneVertex;
 use crate::core::settings::RenderSettings;
 use crate::encoding::constants::{BANDS, PIECES_FROM_COUNTER, QUAD_HEAD, QUAD_TAIL};
 use crate::encoding::recording::{Command, Recording};
 use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine};
 use crate::encoding::subdivide::{
-    plan_cuts_split, DISPATCH_LATTICE, DISPATCH_LATTICE_NODES, DISPATCH_LATTICE_ROWS, DISPATCH_LATTICE_TRIANGLES,
-    DISPATCH_PLAN_CUTS, DISPATCH_PLAN_PARTS, DISPATCH_WORDS,
+    defers_parts, plan_cuts_split, DISPATCH_LATTICE, DISPATCH_LATTICE_NODES, DISPATCH_LATTICE_ROWS,
+    DISPATCH_LATTICE_TRIANGLES, DISPATCH_PLAN_CUTS, DISPATCH_PLAN_PARTS, DISPATCH_WORDS,
 };
 use crate::encoding::types::{DrawIndexedIndirectArgs, DrawVertex, Piece, SubdivideCounters, SubdivideParams};
 use crate::error::Result;
@@ -42,8 +41,9 @@ pub fn run_scheduled(
 ) -> Result<SubdivideOutput> {
     let mut engine = CpuSubdivision::new(vertices, indices, &[]);
     let totals = run_schedule(&mut engine, settings, (indices.len() / 3) as u32, schedule, budget)?;
+    let max_part_output = engine.part_output.values().copied().max().unwrap_or(0);
     let max_piece_output = engine.max_piece_output;
-    Ok(SubdivideOutput { max_piece_output, ..totals.output(engine.nodes, engine.taken_indices) })
+    Ok(SubdivideOutput { max_piece_output, max_part_output, ..totals.output(engine.nodes, engine.taken_indices) })
 }
 
 /// The stage's buffers on the CPU, and what [`SubdivisionEngine::take`] kept.
@@ -73,9 +73,12 @@ pub struct CpuSubdivision<'s> {
     row_items: Vec<u32>,
     /// `lattice`'s work items: [piece, first slot or candidate, 0, 0] (the twin needs no walk).
     lattice_work: Vec<[u32; 4]>,
-    /// The most nodes or candidate triangles one piece has (seam copies included): the most a
-    /// piece's output changes when one of its measures flips (the twin test's slack).
-    pub max_piece_output: u32,
+    /// Each part's nodes or candidate triangles (seam copies included), by its record's bits:
+    /// the most a part's output changes when one of its edges' counts flips (it is planned
+    /// again whole; the twin test's slack).
+    part_output: HashMap<Vec<u32>, u32>,
+    /// The most one piece has (a flipped measure of its own re-triangulates it).
+    max_piece_output: u32,
     lattice_dispatch: [u32; DISPATCH_WORDS],
     pub draw_args: DrawIndexedIndirectArgs,
     /// Every taken range's nodes, and its triangles' indices into them.
@@ -120,6 +123,7 @@ impl<'s> CpuSubdivision<'s> {
             pending_rows: HashMap::new(),
             row_items: vec![0; 3],
             lattice_work: vec![[0; 4]; 1],
+            part_output: HashMap::new(),
             max_piece_output: 0,
             lattice_dispatch: [0; DISPATCH_WORDS],
             draw_args: DrawIndexedIndirectArgs::default(),
@@ -276,14 +280,14 @@ impl<'s> CpuSubdivision<'s> {
             if local % split == 0 {
                 let shared = [0, 1, 2].map(|e| self.frame.is_cut_edge(t as usize, e));
                 for part in edge_split_parts(tri.position, shared, rho, cuts) {
-                    self.plan_polygon(sub, &tri, t, &part, false);
+                    self.plan_polygon(sub, &tri, t, &part);
                 }
             }
         } else {
             let quadrants = if split == 4 { (local % 4) as usize..(local % 4) as usize + 1 } else { 0..4 };
             for q in quadrants {
                 for poly in quadrant_polygons(tri.position, rho, cuts, q) {
-                    self.plan_polygon(sub, &tri, t, &poly, sub.projection.panorama == PanoramaKind::Equirect);
+                    self.plan_polygon(sub, &tri, t, &poly);
                 }
             }
         }
@@ -425,6 +429,9 @@ impl<'s> CpuSubdivision<'s> {
             }
         }
         self.max_piece_output = self.max_piece_output.max(plan.output());
+        // The part's record: the piece's without its cell.
+        let part = Piece { cell: 0, ..self.pieces[index as usize] };
+        *self.part_output.entry(bytemuck::cast_slice(&[part]).to_vec()).or_default() += plan.output();
         self.piece_work.insert(index, (first_node, plan));
     }
 
@@ -511,8 +518,9 @@ impl<'s> CpuSubdivision<'s> {
     // ---- what the passes share ----
 
     /// A polygon `plan_cuts` cut from triangle t: a band quad's two records, or its fan's parts
-    /// on screen, planned, or with `deferred` (the sphere's bands) appended for `plan_parts`.
-    fn plan_polygon(&mut self, sub: &Subdivider, tri: &Triangle, t: u32, poly: &[Node], deferred: bool) {
+    /// on screen, planned, or on the sphere appended for `plan_parts` (`plan_cut_part`).
+    fn plan_polygon(&mut self, sub: &Subdivider, tri: &Triangle, t: u32, poly: &[Node]) {
+        let deferred = defers_parts(sub.projection.panorama);
         if let Some((c, rails)) = sub.quad_strip(tri, poly) {
             let head = record(t, rails[0] | rails[1] << 16, QUAD_HEAD, [c[0], c[1], c[2]]);
             let tail = record(t, head.counts01, QUAD_TAIL, [c[3], c[1], c[2]]);
