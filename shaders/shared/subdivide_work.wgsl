@@ -14,6 +14,11 @@
 #import subdivide_rows
 #import subdivide_dispatch
 
+// Whether the frame measures rows (the sphere, an adaptive rule: `Passes::rows`).
+fn measures_rows() -> bool {
+    return is_adaptive() && is_sphere(params.projection);
+}
+
 // Node slots or candidate triangles one item of a piece drawn `copies` times covers.
 fn chunk_of(copies: u32) -> u32 {
     return LATTICE_CHUNK / copies;
@@ -24,11 +29,15 @@ fn work_capacity() -> u32 {
     return params.triangle_capacity;
 }
 
-// The piece at `index` (its shape in `piece_state`, its seam copies): its work written, its
-// nodes allocated, and its work items appended: node items from the front of `lattice_work`,
-// triangle items from its back, each triangle item with the walk (strip, quad, rows) at its first
-// candidate. Counted always, written only where they fit.
-fn plan_work(index: u32, shape: PieceShape, seam: SeamCopies, piece_state: ptr<function, PieceState>) {
+// The piece at `index` (its shape in `piece_state`, its seam copies): its nodes allocated; a
+// piece of one item's worth (at most LATTICE_CHUNK / copies nodes and candidates: every `vertex`
+// piece, most small ones) written here, as its items would be — except in frames that measure
+// rows, whose row items lie in the output's index buffer until `lattice_rows_plan` —; a larger
+// one's work written and
+// its work items appended: node items from the front of `lattice_work`, triangle items from its
+// back, each triangle item with the walk (strip, quad, rows) at its first candidate. Counted
+// always, written only where they fit.
+fn plan_work(index: u32, shape: PieceShape, seam: SeamCopies, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
     let copies = seam.copies;
     var work: PieceWork;
     work.shape = (*piece_state).strip_base;
@@ -43,8 +52,15 @@ fn plan_work(index: u32, shape: PieceShape, seam: SeamCopies, piece_state: ptr<f
         work.row_w = (*piece_state).row_w;
     }
     work.first_node = atomicAdd(&counters.nodes, copies * shape.node_count);
-    piece_work[index] = work;
     let chunk = chunk_of(copies);
+    if (shape.node_count <= chunk && shape.candidates <= chunk && !measures_rows()) {
+        if (work.first_node + copies * shape.node_count <= params.triangle_capacity) {
+            write_nodes(0u, work, tri, part, piece_state);
+            write_triangles(vec4<u32>(index, 0u, 0u, 0u), work, piece_state);
+        }
+        return;
+    }
+    piece_work[index] = work;
     let len = work_capacity();
     let node_items = (shape.node_count + chunk - 1u) / chunk;
     let at = atomicAdd(&counters.node_items, node_items);

@@ -4,9 +4,10 @@
 // error split on the cylinder), a band quad's strip between its rails (corner 3 read from the
 // next record), or rows (the sphere: their measures are left to `lattice_rows`, the choice to
 // `lattice_rows_plan`); its seam copies (again a turn away where its nodes' u range crosses ±π).
-// It writes no output: its plan (`piece_work`), its nodes' room, and its work items
-// (`plan_work`), which `lattice_nodes` and `lattice_triangles` then run, at most LATTICE_CHUNK
-// outputs each. CPU twin: `CpuSubdivision::lattice`.
+// A piece of one work item's worth it writes itself; for a larger one it writes its plan
+// (`piece_work`), its nodes' room and its work items (`plan_work`), which `lattice_nodes` and
+// `lattice_triangles` then run, at most LATTICE_CHUNK outputs each. CPU twin:
+// `CpuSubdivision::lattice`.
 
 #import projection
 #import constants
@@ -53,5 +54,5 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         plan_pending(index, shape, &piece_state); // planned by `lattice_rows_plan`
         return;
     }
-    plan_work(index, shape, seam_copies(shape, &part, &piece_state), &piece_state);
+    plan_work(index, shape, seam_copies(shape, &part, &piece_state), &tri, &part, &piece_state);
 }

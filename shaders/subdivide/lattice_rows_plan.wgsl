@@ -22,6 +22,7 @@
 
 @compute @workgroup_size(64)
 fn lattice_rows_plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    var tri: InputTriangle;
     var part: PartPlan;
     var piece_state: PieceState;
     let local = invocation_index(gid, groups);
@@ -30,6 +31,7 @@ fn lattice_rows_plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
     }
     let index = row_items[local] >> 5u;
     let work = piece_work[index];
+    load_triangle(pieces[index].triangle, &tri);
     load_work(index, work, &part, &piece_state);
     let rows = rows_from_measures(&piece_state);
     let c = piece_state.corner;
@@ -40,5 +42,5 @@ fn lattice_rows_plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
         shape.candidates = rows.x;
         shape.node_count = rows.y;
     }
-    plan_work(index, shape, seam_copies(shape, &part, &piece_state), &piece_state);
+    plan_work(index, shape, seam_copies(shape, &part, &piece_state), &tri, &part, &piece_state);
 }

@@ -11,12 +11,13 @@
 //! GPU's (whose appends race); both are compared as sets.
 
 use std::collections::HashMap;
+use std::rc::Rc;
 
 use glam::Vec3;
 
 use super::{
-    band_limit, edge_split_parts, fan, one_part, quadrant_polygons, triangle_cuts, FrameCuts, Node, PartSplit,
-    PieceGeometry, PiecePlan, SubdivideOutput, Subdivider, Triangle,
+    band_limit, chunk_of, edge_split_parts, fan, one_part, quadrant_polygons, triangle_cuts, FrameCuts, Node,
+    PartSplit, PieceGeometry, PiecePlan, SubdivideOutput, Subdivider, Triangle,
 };
 use crate::core::scene::SceneVertex;
 use crate::core::settings::RenderSettings;
@@ -24,7 +25,7 @@ use crate::encoding::constants::{BANDS, PIECES_FROM_COUNTER, QUAD_HEAD, QUAD_TAI
 use crate::encoding::recording::{Command, Recording};
 use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine};
 use crate::encoding::subdivide::{
-    defers_parts, plan_cuts_split, DISPATCH_LATTICE, DISPATCH_LATTICE_NODES, DISPATCH_LATTICE_ROWS,
+    defers_parts, plan_cuts_split, Passes, DISPATCH_LATTICE, DISPATCH_LATTICE_NODES, DISPATCH_LATTICE_ROWS,
     DISPATCH_LATTICE_TRIANGLES, DISPATCH_PLAN_CUTS, DISPATCH_PLAN_PARTS, DISPATCH_WORDS,
 };
 use crate::encoding::types::{DrawIndexedIndirectArgs, DrawVertex, Piece, SubdivideCounters, SubdivideParams};
@@ -64,7 +65,7 @@ pub struct CpuSubdivision<'s> {
     out_indices: Vec<u32>,
     /// What `lattice` planned for each piece, by the piece's index: its first output node and
     /// its plan (`piece_work`).
-    piece_work: HashMap<u32, (u32, PiecePlan)>,
+    piece_work: HashMap<u32, Rc<(u32, PiecePlan)>>,
     /// The pieces whose rows `lattice_rows` measures, by index: their triangle, placement and
     /// each band's measures so far.
     pending_rows: HashMap<u32, PendingRows>,
@@ -345,7 +346,7 @@ impl<'s> CpuSubdivision<'s> {
         if piece.count2_level & QUAD_HEAD != 0 {
             let last = record_corner(&self.pieces[index as usize + 1], 0);
             if let Some(plan) = sub.quad_lattice(&tri, &[corners[0], corners[1], corners[2], last], [n0, n1]) {
-                self.plan_work(params, index, plan);
+                self.plan_work(sub, index, plan);
             }
             return;
         }
@@ -356,7 +357,7 @@ impl<'s> CpuSubdivision<'s> {
         match sub.unmeasured_shape(&g) {
             Some(shape) => {
                 let plan = sub.shaped_plan(&tri, &g, &shape);
-                self.plan_work(params, index, plan);
+                self.plan_work(sub, index, plan);
             }
             None => {
                 // A row item per band, counted always, written where they fit (`plan_pending`).
@@ -405,14 +406,32 @@ impl<'s> CpuSubdivision<'s> {
         let index = self.row_items[local as usize] >> 5;
         if let Some((tri, g, measures)) = self.pending_rows.remove(&index) {
             let plan = sub.shaped_plan(&tri, &g, &sub.rows_or_lattice(&g, &measures));
-            self.plan_work(sub.params, index, plan);
+            self.plan_work(sub, index, plan);
         }
     }
 
-    /// A planned piece's work: its nodes allocated, its work items appended.
-    fn plan_work(&mut self, params: &SubdivideParams, index: u32, plan: PiecePlan) {
+    /// A planned piece's work: its nodes allocated; a piece of one item's worth written here,
+    /// as its items would be; a larger one's work items appended (`plan_work`).
+    fn plan_work(&mut self, sub: &Subdivider, index: u32, plan: PiecePlan) {
+        let params = sub.params;
         let first_node = self.counters.nodes;
         self.counters.nodes += plan.copies * plan.node_count;
+        self.max_piece_output = self.max_piece_output.max(plan.output());
+        // The part's record: the piece's without its cell.
+        let part = Piece { cell: 0, ..self.pieces[index as usize] };
+        *self.part_output.entry(bytemuck::cast_slice(&[part]).to_vec()).or_default() += plan.output();
+        let work = Rc::new((first_node, plan));
+        let plan = &work.1;
+        let chunk = chunk_of(plan.copies);
+        // Not in frames that measure rows: their row items lie in the output's index buffer.
+        let rows = Passes::of(sub.projection.panorama, params.method).rows;
+        if plan.node_count <= chunk && plan.candidates.len() as u32 <= chunk && !rows {
+            if first_node + plan.copies * plan.node_count <= params.triangle_capacity {
+                self.write_nodes(&work, 0);
+                self.write_triangles(sub, &work, 0);
+            }
+            return;
+        }
         let len = params.triangle_capacity;
         for start in plan.node_items() {
             let slot = self.counters.node_items;
@@ -428,11 +447,7 @@ impl<'s> CpuSubdivision<'s> {
                 self.lattice_work[(len - 1 - slot) as usize] = [index, start, 0, 0];
             }
         }
-        self.max_piece_output = self.max_piece_output.max(plan.output());
-        // The part's record: the piece's without its cell.
-        let part = Piece { cell: 0, ..self.pieces[index as usize] };
-        *self.part_output.entry(bytemuck::cast_slice(&[part]).to_vec()).or_default() += plan.output();
-        self.piece_work.insert(index, (first_node, plan));
+        self.piece_work.insert(index, work);
     }
 
     /// The work items `lattice` appended: (node items, triangle items) within `lattice_work`.
@@ -457,15 +472,8 @@ impl<'s> CpuSubdivision<'s> {
             return;
         }
         let [index, start, ..] = self.lattice_work[local as usize];
-        let (first_node, plan) = &self.piece_work[&index];
-        let range = plan.node_range(start);
-        for c in 0..plan.copies {
-            for k in range.clone() {
-                let (to, from) = (first_node + c * plan.node_count + k, c * plan.node_count + k);
-                self.out_nodes[to as usize] = plan.nodes[from as usize];
-            }
-        }
-        self.counters.max_output = self.counters.max_output.max(range.len() as u32 * plan.copies);
+        let work = Rc::clone(&self.piece_work[&index]);
+        self.write_nodes(&work, start);
     }
 
     /// A triangle item: its piece's candidates in it that are drawn (their corners read from the
@@ -477,7 +485,26 @@ impl<'s> CpuSubdivision<'s> {
             return;
         }
         let [index, start, ..] = self.lattice_work[(len - 1 - local) as usize];
-        let (first_node, plan) = &self.piece_work[&index];
+        let work = Rc::clone(&self.piece_work[&index]);
+        self.write_triangles(sub, &work, start);
+    }
+
+    /// The nodes of a piece's node item at slot `start`, once per seam copy (`write_nodes`).
+    fn write_nodes(&mut self, (first_node, plan): &(u32, PiecePlan), start: u32) {
+        let range = plan.node_range(start);
+        for c in 0..plan.copies {
+            for k in range.clone() {
+                let (to, from) = (first_node + c * plan.node_count + k, c * plan.node_count + k);
+                self.out_nodes[to as usize] = plan.nodes[from as usize];
+            }
+        }
+        self.counters.max_output = self.counters.max_output.max(range.len() as u32 * plan.copies);
+    }
+
+    /// The drawn triangles of a piece's triangle item at candidate `start`, their corners read
+    /// from the nodes written, appended once per seam copy (`write_triangles`).
+    fn write_triangles(&mut self, sub: &Subdivider, (first_node, plan): &(u32, PiecePlan), start: u32) {
+        let len = sub.params.triangle_capacity;
         let node = |k: u32| Vec3::from(self.out_nodes[(first_node + k) as usize].position);
         let drawn = plan.drawn(sub, start, node);
         if drawn.is_empty() {
@@ -490,7 +517,7 @@ impl<'s> CpuSubdivision<'s> {
         if first_triangle + total > len {
             return; // counted, never written
         }
-        if params.measure_edges != 0 {
+        if sub.params.measure_edges != 0 {
             for t in &drawn {
                 let edge = sub.visible_edge_px(t.map(node));
                 self.counters.max_edge_bits = f32::from_bits(self.counters.max_edge_bits).max(edge).to_bits();
