@@ -13,6 +13,7 @@
 #import subdivide_bands
 #import subdivide_rows
 #import subdivide_dispatch
+#import subdivide_in_place
 
 // Whether the frame measures rows (the sphere, an adaptive rule: `Passes::rows`).
 fn measures_rows() -> bool {
@@ -54,10 +55,7 @@ fn plan_work(index: u32, shape: PieceShape, seam: SeamCopies, tri: ptr<function,
     work.first_node = atomicAdd(&counters.nodes, copies * shape.node_count);
     let chunk = chunk_of(copies);
     if (shape.node_count <= chunk && shape.candidates <= chunk && !measures_rows()) {
-        if (work.first_node + copies * shape.node_count <= params.triangle_capacity) {
-            write_nodes(0u, work, tri, part, piece_state);
-            write_triangles(vec4<u32>(index, 0u, 0u, 0u), work, piece_state);
-        }
+        write_in_place(index, work, tri, part, piece_state);
         return;
     }
     piece_work[index] = work;

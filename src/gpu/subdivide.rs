@@ -23,7 +23,7 @@ use crate::gpu::frame_plan::SubdivisionBuffers;
 use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
 use crate::gpu::timestamps::{self as stamp, Timestamps};
-use crate::shader::{StandIn, ROWS_OFF, SPHERE_OFF, SUBDIVIDE};
+use crate::shader::{StandIn, IN_PLACE_OFF, ROWS_OFF, SPHERE_OFF, SUBDIVIDE};
 
 pub(crate) const COUNTERS_SIZE: u64 = std::mem::size_of::<SubdivideCounters>() as u64;
 // The frame's timestamps are read back as u64s right after the counters.
@@ -74,7 +74,7 @@ impl SubdivideStage {
             let stand_ins: &[StandIn] = match (panorama, rows) {
                 (PanoramaKind::Cylinder, _) => &[ROWS_OFF, SPHERE_OFF],
                 (PanoramaKind::Equirect, false) => &[ROWS_OFF],
-                (PanoramaKind::Equirect, true) => &[],
+                (PanoramaKind::Equirect, true) => &[IN_PLACE_OFF],
             };
             // The entry points this frame's schedules dispatch (every schedule's are the usual
             // frame's).
