@@ -11,6 +11,15 @@ fn invocation_index(gid: vec3<u32>, groups: vec3<u32>) -> u32 {
     return gid.x + gid.y * groups.x * 64u;
 }
 
+// An indirect dispatch's workgroup counts at word `at` of `lattice_dispatch`, for `invocations`
+// in workgroups of 64 spread over two dimensions (`set_dispatch` in src/cpu/subdivide/passes.rs).
+fn set_dispatch(at: u32, invocations: u32) {
+    let groups = (invocations + 63u) / 64u;
+    lattice_dispatch[at] = min(groups, 65535u);
+    lattice_dispatch[at + 1u] = (groups + 65534u) / 65535u;
+    lattice_dispatch[at + 2u] = 1u;
+}
+
 // The triangles `plan` listed, and the i-th of them: the narrow ones from the front of
 // `cut_list`, then the wide ones from its back.
 fn listed_cuts() -> vec2<u32> {

@@ -4,11 +4,9 @@
 #import constants
 #import subdivide_types
 #import subdivide_bindings
+#import subdivide_dispatch
 
 @compute @workgroup_size(1)
 fn lattice_args() {
-    let groups = (min(atomicLoad(&counters.pieces), params.piece_capacity) + 63u) / 64u;
-    lattice_dispatch[0] = min(groups, 65535u);
-    lattice_dispatch[1] = (groups + 65534u) / 65535u;
-    lattice_dispatch[2] = 1u;
+    set_dispatch(0u, min(atomicLoad(&counters.pieces), params.piece_capacity));
 }

@@ -9,8 +9,5 @@
 
 @compute @workgroup_size(1)
 fn lattice_rows_args() {
-    let groups = (row_item_count() + 63u) / 64u;
-    lattice_dispatch[15] = min(groups, 65535u);
-    lattice_dispatch[16] = (groups + 65534u) / 65535u;
-    lattice_dispatch[17] = 1u;
+    set_dispatch(15u, row_item_count());
 }

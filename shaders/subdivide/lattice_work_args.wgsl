@@ -10,10 +10,6 @@
 @compute @workgroup_size(1)
 fn lattice_work_args() {
     let items = work_items();
-    for (var i = 0u; i < 2u; i++) {
-        let groups = (items[i] + 63u) / 64u;
-        lattice_dispatch[9u + 3u * i] = min(groups, 65535u);
-        lattice_dispatch[10u + 3u * i] = (groups + 65534u) / 65535u;
-        lattice_dispatch[11u + 3u * i] = 1u;
-    }
+    set_dispatch(9u, items.x);
+    set_dispatch(12u, items.y);
 }

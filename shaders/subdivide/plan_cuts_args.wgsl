@@ -9,8 +9,5 @@
 @compute @workgroup_size(1)
 fn plan_cuts_args() {
     let listed = listed_cuts();
-    let groups = (plan_cuts_split() * min(listed.x + listed.y, arrayLength(&cut_list)) + 63u) / 64u;
-    lattice_dispatch[3] = min(groups, 65535u);
-    lattice_dispatch[4] = (groups + 65534u) / 65535u;
-    lattice_dispatch[5] = 1u;
+    set_dispatch(3u, plan_cuts_split() * min(listed.x + listed.y, arrayLength(&cut_list)));
 }

@@ -4,11 +4,9 @@
 #import constants
 #import subdivide_types
 #import subdivide_bindings
+#import subdivide_dispatch
 
 @compute @workgroup_size(1)
 fn plan_parts_args() {
-    let groups = (min(atomicLoad(&counters.parts), params.piece_capacity) + 63u) / 64u;
-    lattice_dispatch[6] = min(groups, 65535u);
-    lattice_dispatch[7] = (groups + 65534u) / 65535u;
-    lattice_dispatch[8] = 1u;
+    set_dispatch(6u, min(atomicLoad(&counters.parts), params.piece_capacity));
 }

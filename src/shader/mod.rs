@@ -210,6 +210,22 @@ const CUTTING: &[&str] = &[
     "parts",
 ];
 
+/// What `lattice` and `lattice_rows_plan` read and write: they plan pieces, append row items
+/// and work items, and write small pieces' output in place.
+const PIECE_PLANNING: &[&str] = &[
+    "params",
+    "vertices",
+    "indices",
+    "pieces",
+    "counters",
+    "object_edge_scale",
+    "piece_work",
+    "lattice_work",
+    "row_items",
+    "out_nodes",
+    "out_indices",
+];
+
 pub const SUBDIVIDE: Stage = Stage {
     name: "subdivide",
     source: None,
@@ -247,23 +263,7 @@ pub const SUBDIVIDE: Stage = Stage {
             &["params", "counters", "lattice_dispatch"],
             include_str!("../../shaders/subdivide/lattice_args.wgsl"),
         ),
-        pass(
-            "lattice",
-            &[
-                "params",
-                "vertices",
-                "indices",
-                "pieces",
-                "counters",
-                "object_edge_scale",
-                "piece_work",
-                "lattice_work",
-                "row_items",
-                "out_nodes",
-                "out_indices",
-            ],
-            include_str!("../../shaders/subdivide/lattice.wgsl"),
-        ),
+        pass("lattice", PIECE_PLANNING, include_str!("../../shaders/subdivide/lattice.wgsl")),
         pass(
             "lattice_rows_args",
             &["params", "counters", "lattice_dispatch"],
@@ -274,23 +274,7 @@ pub const SUBDIVIDE: Stage = Stage {
             &["params", "vertices", "indices", "pieces", "counters", "object_edge_scale", "piece_work", "row_items"],
             include_str!("../../shaders/subdivide/lattice_rows.wgsl"),
         ),
-        pass(
-            "lattice_rows_plan",
-            &[
-                "params",
-                "vertices",
-                "indices",
-                "pieces",
-                "counters",
-                "object_edge_scale",
-                "piece_work",
-                "lattice_work",
-                "row_items",
-                "out_nodes",
-                "out_indices",
-            ],
-            include_str!("../../shaders/subdivide/lattice_rows_plan.wgsl"),
-        ),
+        pass("lattice_rows_plan", PIECE_PLANNING, include_str!("../../shaders/subdivide/lattice_rows_plan.wgsl")),
         pass(
             "lattice_work_args",
             &["params", "counters", "lattice_dispatch"],

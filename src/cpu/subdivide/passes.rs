@@ -173,6 +173,14 @@ impl<'s> CpuSubdivision<'s> {
         }
     }
 
+    /// An indirect dispatch's workgroup counts at byte `offset` of `lattice_dispatch`, for
+    /// `invocations` in workgroups of 64 spread over two dimensions (`set_dispatch`).
+    fn set_dispatch(&mut self, offset: u64, invocations: u32) {
+        let groups = invocations.div_ceil(64);
+        let at = offset as usize / 4;
+        self.lattice_dispatch[at..at + 3].copy_from_slice(&[groups.min(65535), groups.div_ceil(65535), 1]);
+    }
+
     // ---- the entry points ----
 
     /// Over every triangle of the scene: the cuts it asks for, OR-ed into the counters; its
@@ -258,9 +266,7 @@ impl<'s> CpuSubdivision<'s> {
     fn plan_cuts_args(&mut self, sub: &Subdivider) {
         let (narrow, wide) = self.listed_cuts();
         let listed = (narrow + wide).min(self.cut_list.len() as u32);
-        let groups = (plan_cuts_split(sub.projection.panorama) * listed).div_ceil(64);
-        let at = DISPATCH_PLAN_CUTS as usize / 4;
-        self.lattice_dispatch[at..at + 3].copy_from_slice(&[groups.min(65535), groups.div_ceil(65535), 1]);
+        self.set_dispatch(DISPATCH_PLAN_CUTS, plan_cuts_split(sub.projection.panorama) * listed);
     }
 
     /// A listed triangle: a narrow one cut at its marked edges' crossings, a wide one's parts
@@ -297,9 +303,7 @@ impl<'s> CpuSubdivision<'s> {
     }
 
     fn plan_parts_args(&mut self, sub: &Subdivider) {
-        let groups = self.counters.parts.min(sub.params.piece_capacity).div_ceil(64);
-        let at = DISPATCH_PLAN_PARTS as usize / 4;
-        self.lattice_dispatch[at..at + 3].copy_from_slice(&[groups.min(65535), groups.div_ceil(65535), 1]);
+        self.set_dispatch(DISPATCH_PLAN_PARTS, self.counters.parts.min(sub.params.piece_capacity));
     }
 
     /// A part `plan_cuts` cut: planned, its pieces appended.
@@ -314,9 +318,7 @@ impl<'s> CpuSubdivision<'s> {
     }
 
     fn lattice_args(&mut self, sub: &Subdivider) {
-        let groups = self.counters.pieces.min(sub.params.piece_capacity).div_ceil(64);
-        let at = DISPATCH_LATTICE as usize / 4;
-        self.lattice_dispatch[at..at + 3].copy_from_slice(&[groups.min(65535), groups.div_ceil(65535), 1]);
+        self.set_dispatch(DISPATCH_LATTICE, self.counters.pieces.min(sub.params.piece_capacity));
     }
 
     /// The pieces `lattice` runs over: a range's, or as many as were counted.
@@ -380,9 +382,7 @@ impl<'s> CpuSubdivision<'s> {
     }
 
     fn lattice_rows_args(&mut self, sub: &Subdivider) {
-        let groups = self.row_item_count(sub.params).div_ceil(64);
-        let at = DISPATCH_LATTICE_ROWS as usize / 4;
-        self.lattice_dispatch[at..at + 3].copy_from_slice(&[groups.min(65535), groups.div_ceil(65535), 1]);
+        self.set_dispatch(DISPATCH_LATTICE_ROWS, self.row_item_count(sub.params));
     }
 
     /// A row item: band b of a piece whose rows are to be measured, measured.
@@ -458,11 +458,8 @@ impl<'s> CpuSubdivision<'s> {
 
     fn lattice_work_args(&mut self, sub: &Subdivider) {
         let (nodes, triangles) = self.work_items(sub.params);
-        for (items, offset) in [(nodes, DISPATCH_LATTICE_NODES), (triangles, DISPATCH_LATTICE_TRIANGLES)] {
-            let groups = items.div_ceil(64);
-            let at = offset as usize / 4;
-            self.lattice_dispatch[at..at + 3].copy_from_slice(&[groups.min(65535), groups.div_ceil(65535), 1]);
-        }
+        self.set_dispatch(DISPATCH_LATTICE_NODES, nodes);
+        self.set_dispatch(DISPATCH_LATTICE_TRIANGLES, triangles);
     }
 
     /// A node item: its piece's nodes in its slots, once per seam copy.
