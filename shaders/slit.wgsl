@@ -88,6 +88,11 @@ fn fs_main(in: VertexOut, @builtin(front_facing) front_facing: bool) -> Fragment
 }
 
 @fragment
+fn fs_coverage(in: VertexOut, @builtin(front_facing) front_facing: bool) -> FragmentCoverage {
+    return fragment_coverage(in, front_facing, fragment_view(in.eye));
+}
+
+@fragment
 fn fs_error(in: VertexOut, @builtin(front_facing) front_facing: bool) -> FragmentOut {
     return measured(in, front_facing, fragment_view(in.eye));
 }

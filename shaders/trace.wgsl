@@ -1,6 +1,6 @@
-// The `trace` stage (compute): ray tracing (seed 000), one primary ray per pixel and eye from
-// the pixel's eye point (`pixel_ray` of surface.wgsl: the cylinder's exact vertical model, or the
-// sphere with its convergence and pole merge), the closest hit through the scene's BVH
+// The `trace` stage (compute): ray tracing (seed 000), a primary ray per sample of each pixel
+// (`--samples`; one: the pixel's centre) and eye from its eye point (`pixel_ray` of
+// surface.wgsl: the cylinder's exact vertical model, or the sphere with its convergence and pole merge), the closest hit through the scene's BVH
 // (src/core/bvh.rs), shaded with the rasterizer's materials and headlight (surface.wgsl), or a
 // point light with shadow rays; mirror and refraction rays (the material's optics) to
 // `reflect_max` bounces, depth first.
@@ -44,7 +44,7 @@ struct TraceParams {
     lod_min_share: f32, // N_min / N_max of eq. 10
     original_root: u32, // where rays that meet every original start (SceneBvh::original_root)
     original_level: f32, // rays above this visual level do (SceneBvh::original_level)
-    _pad2: u32,
+    samples: u32,       // rays per pixel (`sample_position`)
 }
 
 // count = 0: inner (children first, first + 1); count & OBJECT_LEAF: an object, its chain's
@@ -99,19 +99,34 @@ fn enter_box(n: BvhNode, origin: vec3<f32>, inv: vec3<f32>, limit: f32) -> f32 {
     return select(FAR, near, near <= far);
 }
 
-// The footprint in texture units of a ray cone `width` metres wide meeting `triangle` along the
-// unit direction `dir`: width / |cos incidence| (at most 20×) × √(uv area / world area).
-fn texture_footprint(triangle: u32, dir: vec3<f32>, width: f32) -> f32 {
+// The footprint of a ray cone `width` metres wide meeting `triangle` along the unit direction
+// `dir`: the ellipse the cone draws on the triangle's plane, as its two axes in texture units
+// (the derivatives the sampler takes, columns): along the ray's trace on the plane width / |cos
+// incidence| (at most 20×), across it width; each world vector in the plane mapped to texture
+// units through the triangle's corners.
+fn texture_footprint(triangle: u32, dir: vec3<f32>, width: f32) -> mat2x2<f32> {
     let a = vertices[indices[3u * triangle]];
     let b = vertices[indices[3u * triangle + 1u]];
     let c = vertices[indices[3u * triangle + 2u]];
-    let n = cross(b.position - a.position, c.position - a.position);
+    let e1 = b.position - a.position;
+    let e2 = c.position - a.position;
+    let n = cross(e1, e2);
     let world = max(length(n), 1e-30);
+    let normal = n / world;
+    let cos_i = max(abs(dot(normal, dir)), 0.05);
+    var along = dir - normal * dot(normal, dir);
+    if (dot(along, along) < 1e-12) {
+        along = e1;
+    }
+    along = normalize(along);
+    let major = along * (width / cos_i);
+    let minor = cross(normal, along) * width;
+    // w = s·e1 + t·e2 in the plane: s = w·(e2 × n̂)/|n|, t = w·(n̂ × e1)/|n|.
+    let to_s = cross(e2, normal) / world;
+    let to_t = cross(normal, e1) / world;
     let d1 = b.uv - a.uv;
     let d2 = c.uv - a.uv;
-    let uv = abs(d1.x * d2.y - d1.y * d2.x);
-    let cos_i = max(abs(dot(n, dir)) / world, 0.05);
-    return width / cos_i * sqrt(uv / world);
+    return mat2x2<f32>(dot(major, to_s) * d1 + dot(major, to_t) * d2, dot(minor, to_s) * d1 + dot(minor, to_t) * d2);
 }
 
 // Whether a candidate hit's material keeps it (the fragment stage's discard), its texture
@@ -131,7 +146,7 @@ fn keeps(triangle: u32, b1: f32, b2: f32, front: bool, frag_xy: vec2<f32>, dir: 
     let color = b0 * a.color + b1 * b.color + b2 * c.color;
     let uv = b0 * a.uv + b1 * b.uv + b2 * c.uv;
     let f = texture_footprint(triangle, dir, width);
-    return surface_color(a.material, color, uv, vec2<f32>(f, 0.0), vec2<f32>(0.0, f), frag_xy, front).a >= 0.0;
+    return surface_color(a.material, color, uv, f[0], f[1], frag_xy, front).a >= 0.0;
 }
 
 // The level of an object's chain (levels first .. first + count, the original first) that a ray
@@ -321,7 +336,7 @@ fn shade_hit(hit: Hit, dir: vec3<f32>, p: vec3<f32>, view_position: vec3<f32>, f
     // transpose rotates back).
     let rotation = mat3x3<f32>(params.to_scene[0].xyz, params.to_scene[1].xyz, params.to_scene[2].xyz);
     let f = texture_footprint(hit.triangle, dir, width);
-    let surface = surface_color(a.material, color, uv, vec2<f32>(f, 0.0), vec2<f32>(0.0, f), frag_xy, hit.front);
+    let surface = surface_color(a.material, color, uv, f[0], f[1], frag_xy, hit.front);
     let facing = select(n, -n, dot(n, dir) > 0.0);
     var own = 1.0;
     var out: Shaded;
@@ -354,7 +369,7 @@ fn shade_hit(hit: Hit, dir: vec3<f32>, p: vec3<f32>, view_position: vec3<f32>, f
         // (what the drawing stages' screen derivatives give, as sub-triangles keep the
         // triangle's plane and texture mapping).
         let t = b0 * unpack_tangent(a.tangent) + hit.b1 * unpack_tangent(b.tangent) + hit.b2 * unpack_tangent(c.tangent);
-        let maps = surface_maps(a.material, uv, vec2<f32>(f, 0.0), vec2<f32>(0.0, f), back * (b.position - a.position),
+        let maps = surface_maps(a.material, uv, f[0], f[1], back * (b.position - a.position),
                                 back * (c.position - a.position), b.uv - a.uv, c.uv - a.uv, vec4<f32>(back * t.xyz, t.w));
         let v = -(back * dir);
         out.shadowed = select(0u, min(lighting.count, MAX_SHADOWED_LIGHTS), lighting.shadows != 0u);
@@ -424,10 +439,10 @@ fn write_background(slot: u32) {
     out_distance[slot] = 0x7f800000u;
 }
 
-// One pixel of one eye (gid.z): its primary ray, then the mirror, refraction and shadow rays it
-// leads to, from a stack of tasks. Seed 000's level of detail: rays outside the visual field
-// are not traced (background), and a ray's bounces are level × Reflect_max (eq. 9, rounded);
-// its rays meet each object at the level of detail eq. 10 gives (level 1: the original).
+// One pixel of one eye (gid.z): `params.samples` rays through stratified points of the pixel
+// (`sample_position`; one sample: its centre), each with the mirror, refraction and shadow rays
+// it leads to; the pixel shows the average of their tone-mapped colours in linear light. The
+// outputs that are not averaged (error, object, distance) are those of the centre's ray.
 @compute @workgroup_size(8, 8, 1)
 fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     let proj = params.projection;
@@ -436,12 +451,110 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let eye_sign = select(-1.0, 1.0, gid.z == 1u);
     let slot = (gid.z * u32(proj.height) + gid.y) * params.row_texels + gid.x;
-    let frag_xy = vec2<f32>(gid.xy) + 0.5;
+    let n = params.samples;
+    var rays = 0u;
+    var tests = 0u;
+    if (n > 1u) {
+        let centre = write_centre(slot, eye_sign, vec2<f32>(gid.xy) + 0.5);
+        rays += centre.x;
+        tests += centre.y;
+    }
+    var sum = vec3<f32>(0.0);
+    var plain = 0u;
+    for (var i = 0u; i < n; i++) {
+        let s = trace_sample(slot, eye_sign, vec2<f32>(gid.xy) + sample_position(n, i), n == 1u);
+        sum += s.color;
+        plain += u32(s.plain);
+        rays += s.rays;
+        tests += s.tests;
+    }
+    // Counted per group of 64 pixels (a wrapping slot), so that no 32-bit counter overflows.
+    let count_slot = (((gid.z * u32(proj.height) + gid.y) * u32(proj.width) + gid.x) / 64u) % TRACE_COUNT_SLOTS;
+    atomicAdd(&counts[2u * count_slot], rays);
+    atomicAdd(&counts[2u * count_slot + 1u], tests);
+    // A pixel all background keeps the background's display value exactly.
+    out_color[slot] = select(pack_display(linear_to_srgb(sum / f32(n))), pack_display(params.background.rgb), plain == n);
+}
+
+// Where sample i of n lies in its pixel (0..1 from the pixel's corner): the standard sample
+// positions of Vulkan and Direct3D for 1, 2, 4, 8 and 16 samples (in 16ths of a pixel; one
+// sample: the centre), 32 as the 8 pattern in each quarter of the pixel. `sample_position` in
+// src/core/sampling.rs.
+fn sample_position(n: u32, i: u32) -> vec2<f32> {
+    var p2 = array<vec2<f32>, 2>(vec2<f32>(12.0, 12.0), vec2<f32>(4.0, 4.0));
+    var p4 = array<vec2<f32>, 4>(vec2<f32>(6.0, 2.0), vec2<f32>(14.0, 6.0), vec2<f32>(2.0, 10.0), vec2<f32>(10.0, 14.0));
+    var p8 = array<vec2<f32>, 8>(vec2<f32>(9.0, 5.0), vec2<f32>(7.0, 11.0), vec2<f32>(13.0, 9.0), vec2<f32>(5.0, 3.0),
+                                 vec2<f32>(3.0, 13.0), vec2<f32>(1.0, 7.0), vec2<f32>(11.0, 15.0), vec2<f32>(15.0, 1.0));
+    var p16 = array<vec2<f32>, 16>(vec2<f32>(9.0, 9.0), vec2<f32>(7.0, 5.0), vec2<f32>(5.0, 10.0), vec2<f32>(12.0, 7.0),
+                                   vec2<f32>(3.0, 6.0), vec2<f32>(10.0, 13.0), vec2<f32>(13.0, 11.0), vec2<f32>(11.0, 3.0),
+                                   vec2<f32>(6.0, 14.0), vec2<f32>(8.0, 1.0), vec2<f32>(4.0, 2.0), vec2<f32>(2.0, 12.0),
+                                   vec2<f32>(0.0, 8.0), vec2<f32>(15.0, 4.0), vec2<f32>(14.0, 15.0), vec2<f32>(1.0, 0.0));
+    switch n {
+        case 2u: { return p2[i] / 16.0; }
+        case 4u: { return p4[i] / 16.0; }
+        case 8u: { return p8[i] / 16.0; }
+        case 16u: { return p16[i] / 16.0; }
+        case 32u: {
+            let quarter = vec2<f32>(f32(i & 1u), f32((i >> 1u) & 1u));
+            return (quarter + p8[i >> 2u] / 16.0) * 0.5;
+        }
+        default: { return vec2<f32>(0.5); }
+    }
+}
+
+// The outputs at a pixel's centre (error, object, distance) from its primary ray alone, for
+// frames of several samples; the rays traced and ray–triangle tests made.
+fn write_centre(slot: u32, eye_sign: f32, frag_xy: vec2<f32>) -> vec2<u32> {
+    let ray = pixel_ray(params.projection, eye_sign, frag_xy);
+    write_background(slot);
+    var level = 1.0;
+    if (params.gaze_forward.w > 0.0) {
+        level = visual_level(ray.dir);
+        if (level <= 0.0) {
+            return vec2<u32>(0u);
+        }
+    }
+    let spread = pixel_spread(params.projection, frag_xy);
+    let hit = closest_hit((params.to_scene * vec4<f32>(ray.origin, 1.0)).xyz, (params.to_scene * vec4<f32>(ray.dir, 0.0)).xyz,
+                          frag_xy, FAR, level, vec2<f32>(0.0, spread));
+    if (hit.triangle != NO_HIT) {
+        write_primary(slot, eye_sign, ray, hit, frag_xy);
+    }
+    return vec2<u32>(1u, hit.tests);
+}
+
+// The error, object and distance outputs of a primary ray's hit.
+fn write_primary(slot: u32, eye_sign: f32, ray: Ray, hit: Hit, frag_xy: vec2<f32>) {
+    let view_position = ray.origin + hit.t * ray.dir;
+    out_error[slot] = bitcast<u32>(pixel_error(params.projection, eye_sign, view_position, frag_xy, params.error_angle != 0u));
+    out_object[slot] = vertices[indices[3u * hit.triangle]].object + 1u;
+    out_distance[slot] = bitcast<u32>(hit.t);
+}
+
+// A traced sample: its colour as the pixel shows it (tone mapped, linear light), whether that is
+// the plain background, and the rays and ray–triangle tests it took.
+struct Sample {
+    color: vec3<f32>,
+    plain: bool,
+    rays: u32,
+    tests: u32,
+}
+
+// One sample's primary ray through `frag_xy`, then the mirror, refraction and shadow rays it
+// leads to, from a stack of tasks. Seed 000's level of detail: rays outside the visual field
+// are not traced (background), and a ray's bounces are level × Reflect_max (eq. 9, rounded);
+// its rays meet each object at the level of detail eq. 10 gives (level 1: the original). With
+// `centre`, the primary ray also writes the error, object and distance outputs.
+fn trace_sample(slot: u32, eye_sign: f32, frag_xy: vec2<f32>, centre: bool) -> Sample {
+    let proj = params.projection;
     let ray = pixel_ray(proj, eye_sign, frag_xy);
     let background = srgb_to_linear(params.background.rgb);
     // The scene frame's origin of the viewer frame and the rotation back, for the headlight.
     let to_view = transpose(mat3x3<f32>(params.to_scene[0].xyz, params.to_scene[1].xyz, params.to_scene[2].xyz));
     let viewer = params.to_scene[3].xyz;
+    if (centre) {
+        write_background(slot);
+    }
     var pending: array<Task, TRACE_PENDING>;
     var count = 0u;
     var color = vec3<f32>(0.0);
@@ -450,8 +563,7 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (params.gaze_forward.w > 0.0) {
         level = visual_level(ray.dir);
         if (level <= 0.0) {
-            write_background(slot);
-            return;
+            return Sample(background, true, 0u, 0u);
         }
         reflect_max = u32(floor(level * f32(params.reflect_max) + 0.5));
     }
@@ -462,7 +574,6 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
                     vec2<f32>(0.0, spread));
     var rays = 0u;
     var tests = 0u;
-    var missed = false;
     loop {
         let hit = closest_hit(task.origin, task.dir, frag_xy, task.limit, level, task.cone);
         rays += 1u;
@@ -473,20 +584,19 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
             }
         } else if (hit.triangle == NO_HIT) {
             if (task.kind == PRIMARY) {
-                missed = true;
-                break;
+                // The background, or the environment seen where it lights the scene.
+                if (environment_lit() && lighting.env_background != 0u) {
+                    return Sample(tonemap(env_level(0u, env_st(env_direction(ray.dir)))), false, rays, tests);
+                }
+                return Sample(background, true, rays, tests);
             }
             // A mirrored or refracted ray that leaves the scene brings the environment's light.
             color += task.weight
                 * select(background, env_level(0u, env_st(env_direction(to_view * task.dir))), environment_lit());
         } else {
             let p = task.origin + hit.t * task.dir;
-            if (task.kind == PRIMARY) {
-                // The primary hit gives the error, object and distance outputs.
-                let view_position = ray.origin + hit.t * ray.dir;
-                out_error[slot] = bitcast<u32>(pixel_error(proj, eye_sign, view_position, frag_xy, params.error_angle != 0u));
-                out_object[slot] = vertices[indices[3u * hit.triangle]].object + 1u;
-                out_distance[slot] = bitcast<u32>(hit.t);
+            if (task.kind == PRIMARY && centre) {
+                write_primary(slot, eye_sign, ray, hit, frag_xy);
             }
             // The cone's width here; mirrored and refracted rays go on growing from it, shadow
             // rays keep it (they converge on a point light).
@@ -505,30 +615,11 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
         count -= 1u;
         task = pending[count];
     }
-    finish_pixel(gid, slot, rays, tests, missed, color, ray.dir);
-}
-
-// Writes a traced pixel's colour (tone mapped once its light is summed; the background or the
-// environment where the primary ray missed) and counts its rays and triangle tests.
-fn finish_pixel(gid: vec3<u32>, slot: u32, rays: u32, tests: u32, missed: bool, color_in: vec3<f32>,
-                primary_dir: vec3<f32>) {
-    let proj = params.projection;
-    var color = color_in;
-    // Counted per group of 64 pixels (a wrapping slot), so that no 32-bit counter overflows.
-    let count_slot = (((gid.z * u32(proj.height) + gid.y) * u32(proj.width) + gid.x) / 64u) % TRACE_COUNT_SLOTS;
-    atomicAdd(&counts[2u * count_slot], rays);
-    atomicAdd(&counts[2u * count_slot + 1u], tests);
-    if (missed) {
-        write_background(slot);
-        if (environment_lit() && lighting.env_background != 0u) {
-            out_color[slot] = pack_display(linear_to_srgb(tonemap(env_level(0u, env_st(env_direction(primary_dir))))));
-        }
-        return;
-    }
+    // Tone mapped once the pixel's light is summed.
     if (MATERIALS && lighting.pbr != 0u && params.light.w <= 0.0) {
         color = tonemap(color);
     }
-    out_color[slot] = pack_display(linear_to_srgb(color));
+    return Sample(color, false, rays, tests);
 }
 
 // The mirrored and refracted rays a hit sends on (its bounces left), onto the task stack.

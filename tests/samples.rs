@@ -8,7 +8,7 @@ mod common;
 use glam::Vec3;
 use twister::core::color::srgb_to_linear;
 use twister::core::material::Material;
-use twister::core::projection::{Eye, PanoramaKind, Projection};
+use twister::core::projection::{Eye, PanoramaKind, Projection, Vertical};
 use twister::core::scene::SceneVertex;
 use twister::core::settings::Method;
 use twister::{RenderSettings, Scene};
@@ -35,12 +35,19 @@ fn wall(left: f32) -> Scene {
 /// (mean, worst) of |measured − exact| coverage of the edge's pixel, where measured is the
 /// pixel's linear value over the wall's inside (two columns on), exact the share of the pixel
 /// right of the edge.
-fn coverage_error(panorama: PanoramaKind, samples: u32) -> (f64, f64) {
+fn coverage_error(panorama: PanoramaKind, method: Method, samples: u32) -> (f64, f64) {
     let projection = match panorama {
-        PanoramaKind::Cylinder => Projection { width: 256, height: 64, ..Projection::default() },
+        // The ray tracer takes the cylinder's exact vertical model only.
+        PanoramaKind::Cylinder => {
+            Projection { width: 256, height: 64, vertical: Vertical::Exact, ..Projection::default() }
+        }
         PanoramaKind::Equirect => Projection::equirect(256),
     };
-    let settings = RenderSettings::new(projection).with_ambient(0.0).with_background([0.0; 3]).with_samples(samples);
+    let settings = RenderSettings::new(projection)
+        .with_method(method)
+        .with_ambient(0.0)
+        .with_background([0.0; 3])
+        .with_samples(samples);
     let (mut sum, mut worst, mut n) = (0.0f64, 0.0f64, 0);
     for k in 0..12 {
         let left = -0.4 + 0.0137 * k as f32;
@@ -66,14 +73,19 @@ fn coverage_error(panorama: PanoramaKind, samples: u32) -> (f64, f64) {
     (sum / n as f64, worst)
 }
 
+/// The projection methods multisample, the ray tracer traces a ray per sample position: both
+/// count the share of an edge's pixel the surface covers.
 #[test]
 fn a_pixel_shows_the_share_of_it_a_surface_covers() {
-    for panorama in [PanoramaKind::Cylinder, PanoramaKind::Equirect] {
-        let (mean1, _) = coverage_error(panorama, 1);
-        let (mean4, worst4) = coverage_error(panorama, 4);
-        let (mean16, worst16) = coverage_error(panorama, 16);
+    let cases = [PanoramaKind::Cylinder, PanoramaKind::Equirect]
+        .into_iter()
+        .flat_map(|p| [(p, Method::Adaptive(Default::default())), (p, Method::Trace)]);
+    for (panorama, method) in cases {
+        let (mean1, _) = coverage_error(panorama, method, 1);
+        let (mean4, worst4) = coverage_error(panorama, method, 4);
+        let (mean16, worst16) = coverage_error(panorama, method, 16);
         eprintln!(
-            "{panorama:?}: coverage error, 1 sample mean {mean1:.3}; 4 samples mean {mean4:.3}, worst {worst4:.3}; \
+            "{panorama:?}, {method:?}: coverage error, 1 sample mean {mean1:.3}; 4 samples mean {mean4:.3}, worst {worst4:.3}; \
              16 mean {mean16:.3}, worst {worst16:.3}"
         );
         // One sample: the pixel is all or nothing (the mean error of an edge at a uniform
@@ -81,9 +93,11 @@ fn a_pixel_shows_the_share_of_it_a_surface_covers() {
         // pixel count the share to within 1/8 (mean 1/16), plus the sRGB target's rounding.
         // Sixteen (four per pixel of a 2×2 larger image where the adapter has no 16): eight
         // columns, within 1/16 (mean 1/32).
-        assert!(mean1 > 0.15, "{panorama:?}: one sample, mean {mean1}");
-        assert!(worst4 <= 0.13 && mean4 <= 0.08, "{panorama:?}: four samples, mean {mean4}, worst {worst4}");
-        assert!(worst16 <= 0.07 && mean16 <= 0.05, "{panorama:?}: sixteen samples, mean {mean16}, worst {worst16}");
+        // The ray tracer's sixteen are the standard 16 pattern: sixteen columns, within 1/32.
+        let what = format!("{panorama:?}, {method:?}");
+        assert!(mean1 > 0.15, "{what}: one sample, mean {mean1}");
+        assert!(worst4 <= 0.13 && mean4 <= 0.08, "{what}: four samples, mean {mean4}, worst {worst4}");
+        assert!(worst16 <= 0.07 && mean16 <= 0.05, "{what}: sixteen samples, mean {mean16}, worst {worst16}");
     }
 }
 
@@ -160,12 +174,15 @@ fn samples_beyond_the_adapter_need_an_image_it_can_draw() {
     assert!(err.contains("shading.samples") && err.contains("larger image"), "{err}");
 }
 
+/// Bad sample counts and anisotropies: one error line naming the option, nothing written.
 #[test]
 fn bad_sample_counts_are_one_clear_line() {
     for (args, says) in [
         (&["--samples", "3"][..], "must be 1, 2, 4, 8, 16 or 32"),
-        (&["--samples", "4", "--method", "trace"][..], "one ray per pixel"),
         (&["--samples", "99999999999"][..], "--samples"),
+        (&["--anisotropy", "0"][..], "must be 1 to 16"),
+        (&["--anisotropy", "17"][..], "must be 1 to 16"),
+        (&["--anisotropy", "-1"][..], "--anisotropy"),
     ] {
         let dir = common::TempDir::new(format!("twister-samples-{}", std::process::id()));
         let o = common::twister()
@@ -176,8 +193,123 @@ fn bad_sample_counts_are_one_clear_line() {
             .expect("runs");
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(!o.status.success(), "{args:?} succeeded");
-        assert!(err.contains("--samples") && err.contains(says), "{args:?}: {err}");
+        assert!(err.contains(args[0]) && err.contains(says), "{args:?}: {err}");
         assert_eq!(err.lines().filter(|l| l.starts_with("error")).count(), 1, "{args:?}: one error line: {err}");
         assert!(std::fs::read_dir(&*dir).map_or(true, |mut d| d.next().is_none()), "{args:?} wrote output");
+    }
+}
+
+/// `wall(left)` with its alpha: BLEND with the vertex colours' alpha `alpha`, or MASK (cutoff
+/// 1/2) with a texture of two texels, alpha 0 then 1, filtered linearly across the wall: the
+/// cutoff's line runs down the wall's middle, 2 m right of `left`.
+fn alpha_wall(left: f32, mode: twister::core::material::AlphaMode, alpha: f32) -> Scene {
+    use twister::core::material::{AlphaMode, Filter, Wrap};
+    let mut scene = wall(left);
+    scene.vertices.iter_mut().for_each(|v| v.color[3] = alpha);
+    let m = &mut scene.materials[0];
+    m.alpha_mode = mode as u32;
+    if mode == AlphaMode::Mask {
+        m.alpha_cutoff = 0.5;
+        scene.textures.push(twister::core::texture::Texture {
+            name: "alpha edge".into(),
+            width: 2,
+            height: 1,
+            rgba: vec![255, 255, 255, 0, 255, 255, 255, 255],
+        });
+        m.texture = 0;
+        (m.mag_filter, m.min_filter) = (Filter::Linear as u32, Filter::Linear as u32);
+        (m.wrap_u, m.wrap_v) = (Wrap::ClampToEdge as u32, Wrap::ClampToEdge as u32);
+        for v in &mut scene.vertices {
+            v.uv = [(v.position[0] - left) / 4.0, 0.5];
+        }
+    }
+    scene
+}
+
+/// Alpha to coverage: with several samples a BLEND surface covers the share of each pixel its
+/// alpha gives (not a dither of whole pixels), and a MASK texture's cutoff line is an edge that
+/// covers its share of the pixels it crosses, as a triangle's edge does; with one sample both
+/// stay all or nothing per pixel.
+#[test]
+fn alpha_covers_its_share_of_each_pixel() {
+    alpha_coverage(Method::Adaptive(Default::default()));
+    alpha_coverage(Method::Trace);
+}
+
+/// `alpha_covers_its_share_of_each_pixel` drawn by `method` (the ray tracer: a ray per sample,
+/// each with its own alpha test and screen-door threshold).
+fn alpha_coverage(method: Method) {
+    use twister::core::material::AlphaMode;
+    let projection = Projection { width: 256, height: 64, vertical: Vertical::Exact, ..Projection::default() };
+    let settings = RenderSettings::new(projection).with_method(method).with_ambient(0.0).with_background([0.0; 3]);
+    let linear = |image: &twister::EyeImage, x: u32, y: u32| srgb_to_linear(image.pixel(x, y)[0] as f32 / 255.0) as f64;
+    // BLEND: every pixel inside the wall, rows about the horizon, over the opaque wall's value.
+    let opaque = linear(&common::render(&wall(-0.35), &settings).left, projection.width / 2, projection.height / 2);
+    for alpha in [0.3f32, 0.5, 0.8] {
+        let scene = alpha_wall(-0.35, AlphaMode::Blend, alpha);
+        for samples in [1u32, 4, 16] {
+            let frame = common::render(&scene, &settings.with_samples(samples));
+            let (a, b) = (
+                projection.project(Vec3::new(0.0, 0.0, -2.0), Eye::Left).unwrap(),
+                projection.project(Vec3::new(3.0, 0.0, -2.0), Eye::Left).unwrap(),
+            );
+            let (x0, x1) = (projection.to_pixel(a.u, a.v)[0] as u32, projection.to_pixel(b.u, b.v)[0] as u32);
+            let middle = projection.height / 2;
+            let values: Vec<f64> = (middle - 4..middle + 4)
+                .flat_map(|y| (x0..x1).map(move |x| (x, y)))
+                .map(|(x, y)| linear(&frame.left, x, y) / opaque)
+                .collect();
+            let mean = values.iter().sum::<f64>() / values.len() as f64;
+            let worst = values.iter().map(|v| (v - alpha as f64).abs()).fold(0.0, f64::max);
+            eprintln!(
+                "{method:?}: BLEND alpha {alpha}, {samples} samples: mean {mean:.3}, worst pixel off by {worst:.3}"
+            );
+            // One sample: the screen door's 4×4 thresholds (k + 1/2)/16 over rows 8 high.
+            let within = if samples == 1 { 1.0 / 16.0 } else { 0.03 };
+            assert!((mean - alpha as f64).abs() < within, "alpha {alpha}, {samples} samples: mean {mean}");
+            if samples == 1 {
+                assert!(worst > 0.19, "alpha {alpha}, one sample: a dither of whole pixels ({worst})");
+            } else {
+                assert!(
+                    worst <= 1.0 / samples as f64 + 0.01,
+                    "alpha {alpha}, {samples} samples: a pixel off by {worst}"
+                );
+            }
+        }
+    }
+    // MASK: the cutoff's line at 12 fractions of a pixel, both eyes, six rows. The texture lies
+    // where the subdivision puts it (within τ), so τ is small here.
+    let mask_settings = settings.with_max_error_px(0.02);
+    for samples in [1u32, 4] {
+        let (mut sum, mut n) = (0.0, 0);
+        for k in 0..12 {
+            let left = -2.4 + 0.0137 * k as f32;
+            let frame = common::render(&alpha_wall(left, AlphaMode::Mask, 1.0), &mask_settings.with_samples(samples));
+            for (eye, image) in [(Eye::Left, &frame.left), (Eye::Right, &frame.right)] {
+                let p = projection.project(Vec3::new(left + 2.0, 0.0, -2.0), eye).expect("seen");
+                let x = projection.to_pixel(p.u, p.v)[0];
+                let column = x.floor() as u32;
+                let exact = (column as f32 + 1.0 - x) as f64;
+                let middle = projection.height / 2;
+                for row in middle - 3..middle + 3 {
+                    let inside = linear(image, column + 2, row);
+                    let row_values: Vec<f64> =
+                        (column - 4..column + 5).map(|c| (linear(image, c, row) * 100.0).round()).collect();
+                    assert!(
+                        inside > 0.5 && linear(image, column - 2, row) < 1e-3,
+                        "the mask's two sides {x} {row_values:?}"
+                    );
+                    sum += (linear(image, column, row) / inside - exact).abs();
+                    n += 1;
+                }
+            }
+        }
+        let mean = sum / n as f64;
+        eprintln!("{method:?}: MASK edge, {samples} samples: mean |coverage − exact share| {mean:.3}");
+        if samples == 1 {
+            assert!(mean > 0.15, "one sample: all or nothing ({mean})");
+        } else {
+            assert!(mean < 0.13, "{samples} samples: mean {mean}");
+        }
     }
 }

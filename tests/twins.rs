@@ -89,7 +89,10 @@ fn twin_of(stage: &str) -> Option<TwinCheck> {
 #[test]
 fn every_registered_stage_matches_its_cpu_twin() {
     let mut differ = Vec::new();
-    for stage in STAGES {
+    // TWISTER_TWINS=slit,trace checks only those stages (while working on them); all by default.
+    let only = std::env::var("TWISTER_TWINS").ok();
+    let chosen = |name: &str| only.as_deref().is_none_or(|o| o.split(',').any(|s| s == name));
+    for stage in STAGES.iter().filter(|s| chosen(s.name)) {
         let run = twin_of(stage.name).unwrap_or_else(|| {
             panic!("stage {} has no twin check: implement Twin for it in tests/twins.rs", stage.name)
         });
@@ -316,6 +319,9 @@ fn raster_look_cases() -> Vec<(String, RasterCase)> {
     panels.environment = Some(common::studio(false));
     let settings = RenderSettings::new(Projection { width: 480, height: 120, ..Projection::default() });
     out.push(("mapped panels".into(), (panels.clone(), settings, None)));
+    // Anisotropic filtering: a striped floor at grazing angles, 16 probes, on the sphere.
+    let floor = RenderSettings::new(Projection::equirect(192)).with_ambient(1.0).with_anisotropy(16);
+    out.push(("striped floor, anisotropy 16".into(), (common::striped_floor(), floor, None)));
     out.push(("mapped panels with glTF tangents".into(), (common::with_tangents(panels), settings, None)));
     // Shadow maps: a ball and a masked screen over a floor under a spot light.
     let shadows = common::ball_over_floor(twister::core::light::LightKind::Spot, true);
@@ -515,6 +521,27 @@ impl Twin for Trace {
                     builtin::builtin_scene("builtin:box-room", &cylinder).unwrap(),
                     RenderSettings::new(cylinder).with_method(Method::Trace),
                 ),
+            ),
+            (
+                "4 rays per pixel: a mirror and a glass, visual-field level of detail".into(),
+                (
+                    optics_demo(),
+                    RenderSettings::new(cylinder)
+                        .with_method(Method::Trace)
+                        .with_samples(4)
+                        .with_trace_gaze(Some(twister::core::visual_field::Gaze::new(30.0, 5.0))),
+                ),
+            ),
+            (
+                "a striped floor, anisotropy 16 (the ray cone's ellipse)".into(),
+                (
+                    common::striped_floor(),
+                    RenderSettings::new(sphere).with_method(Method::Trace).with_ambient(1.0).with_anisotropy(16),
+                ),
+            ),
+            (
+                "8 rays per pixel: the studio as background and in a mirror, on the sphere".into(),
+                (mirror_in_studio(), RenderSettings::new(sphere).with_method(Method::Trace).with_samples(8)),
             ),
         ]
     }

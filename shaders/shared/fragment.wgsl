@@ -2,7 +2,7 @@
 // their varyings, the output targets and what each fragment entry point computes, taking the
 // surface colour, shading and display-position error from surface.wgsl (the sRGB colour target
 // encodes the linear colour). No bindings and no entry points: each stage declares its
-// `fs_main`, `fs_error`, `fs_position` and `fs_background`, passing the drawn eye's
+// `fs_main`, `fs_coverage`, `fs_error`, `fs_position` and `fs_background`, passing the drawn eye's
 // `FragmentView`. CPU twins: src/cpu/fragment/ (sampling, shading, error).
 
 #import projection
@@ -70,6 +70,38 @@ struct VertexOut {
     @location(6) @interpolate(flat) eye: u32,
     // glTF's tangent (viewer frame xyz, bitangent sign w), zero where none.
     @location(7) tangent: vec4<f32>,
+}
+
+// Samples per pixel of the multisampled colour's pipelines that take alpha to coverage
+// (`fs_coverage`).
+override SAMPLES: u32 = 1u;
+
+// The colour outputs and the samples of the pixel the fragment covers (`fs_coverage`).
+struct FragmentCoverage {
+    @location(0) color: vec4<f32>,
+    @location(5) hdr: vec4<f32>,
+    @builtin(sample_mask) mask: u32,
+}
+
+// The shaded colour with alpha to coverage (`fs_coverage`, the multisampled colour of scenes
+// whose materials may discard): a MASK or BLEND fragment covers the share of its pixel's samples
+// its alpha gives (`coverage_mask`) instead of all or none.
+fn fragment_coverage(in: VertexOut, front_facing: bool, params: FragmentView) -> FragmentCoverage {
+    // Derivatives first, in uniform control flow.
+    let duv_dx = dpdx(in.uv);
+    let duv_dy = dpdy(in.uv);
+    let dp_dx = dpdxFine(in.view_position);
+    let dp_dy = dpdyFine(in.view_position);
+    let c = surface_rgba(in.material, in.color, in.uv, duv_dx, duv_dy, front_facing);
+    let alpha_width = mask_alpha_width(in.material, in.color.a, in.uv, duv_dx, duv_dy);
+    let mask = coverage_mask(in.material, c.a, alpha_width, in.clip.xy, SAMPLES);
+    if (mask == 0u) {
+        discard;
+    }
+    let shaded = shade_surface(in.material, params.ambient, params.projection, params.eye_sign, in.clip.xy,
+                               in.view_position, in.normal, in.tangent, vec4<f32>(c.rgb, max(c.a, 0.0)), in.uv,
+                               duv_dx, duv_dy, dp_dx, dp_dy);
+    return FragmentCoverage(shaded.display, shaded.linear, mask);
 }
 
 // The shaded colour (`fs_main`).

@@ -13,18 +13,21 @@
 #import pixel_error
 
 // Screen-door threshold of a pixel for BLEND materials: a 4×4 ordered-dither (Bayer) matrix,
-// so a surface of opacity a covers about a of the pixels, independently of drawing order.
+// so a surface of opacity a covers about a of the pixels, independently of drawing order; a
+// point off the pixel's centre (a traced sample) shifts it by its offset along x, so that the
+// standard sample positions of one pixel get thresholds evenly spaced over 0..1 (a pixel of N
+// traced samples shows the share a of them).
 fn blend_threshold(frag_xy: vec2<f32>) -> f32 {
     var bayer = array<f32, 16>(0.0, 8.0, 2.0, 10.0, 12.0, 4.0, 14.0, 6.0, 3.0, 11.0, 1.0, 9.0, 15.0, 7.0, 13.0, 5.0);
     let x = u32(frag_xy.x) % 4u;
     let y = u32(frag_xy.y) % 4u;
-    return (bayer[4u * y + x] + 0.5) / 16.0;
+    return fract((bayer[4u * y + x] + 0.5) / 16.0 + 0.5 + fract(frag_xy.x) - 1.0);
 }
 
-// The linear surface colour of a fragment; alpha < 0 where it is discarded (a single-sided
-// face seen from behind, alpha below the MASK cutoff, a BLEND fragment the screen door leaves out).
-fn surface_color(material: u32, color: vec4<f32>, uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>,
-                 frag_xy: vec2<f32>, front_facing: bool) -> vec4<f32> {
+// The linear surface colour of a fragment before its alpha test; alpha −1 for a single-sided
+// face seen from behind.
+fn surface_rgba(material: u32, color: vec4<f32>, uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>,
+                front_facing: bool) -> vec4<f32> {
     if (!MATERIALS) {
         return color;
     }
@@ -37,12 +40,72 @@ fn surface_color(material: u32, color: vec4<f32>, uv: vec2<f32>, duv_dx: vec2<f3
         let m = materials[index];
         c *= sample_texture(m, uv, duv_dx, duv_dy);
     }
-    let m = materials[index];
+    return c;
+}
+
+// The linear surface colour of a fragment; alpha < 0 where it is discarded (a single-sided
+// face seen from behind, alpha below the MASK cutoff, a BLEND fragment the screen door leaves out).
+fn surface_color(material: u32, color: vec4<f32>, uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>,
+                 frag_xy: vec2<f32>, front_facing: bool) -> vec4<f32> {
+    let c = surface_rgba(material, color, uv, duv_dx, duv_dy, front_facing);
+    if (!MATERIALS || c.a < 0.0) {
+        return c;
+    }
+    let m = materials[min(material, arrayLength(&materials) - 1u)];
     if ((m.alpha_mode == ALPHA_MASK && c.a < m.alpha_cutoff)
         || (m.alpha_mode == ALPHA_BLEND && c.a <= blend_threshold(frag_xy))) {
         return vec4<f32>(-1.0);
     }
     return vec4<f32>(c.rgb, max(c.a, 0.0));
+}
+
+// How much a MASK material's alpha changes over one pixel: |α(uv + ∂uv/∂x) − α(uv)| + |α(uv +
+// ∂uv/∂y) − α(uv)| of its texture (× the vertex alpha), as fwidth would give it but from the
+// texture itself, the same on every adapter and in the CPU twin; 0 for other materials.
+fn mask_alpha_width(material: u32, vertex_alpha: f32, uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>) -> f32 {
+    if (!MATERIALS) {
+        return 0.0;
+    }
+    let m = materials[min(material, arrayLength(&materials) - 1u)];
+    if (m.alpha_mode != ALPHA_MASK || m.texture == NO_TEXTURE || m.mip_count == 0u) {
+        return 0.0;
+    }
+    let a = sample_texture(m, uv, duv_dx, duv_dy).a;
+    let ax = sample_texture(m, uv + duv_dx, duv_dx, duv_dy).a;
+    let ay = sample_texture(m, uv + duv_dy, duv_dx, duv_dy).a;
+    return abs(vertex_alpha) * (abs(ax - a) + abs(ay - a));
+}
+
+// Alpha to coverage: which of its pixel's `n` samples (n > 1) a fragment of `alpha` covers
+// (`alpha_width`: how much alpha changes over a pixel, `mask_alpha_width`). Opaque: all; a single-sided face
+// seen from behind: none; MASK: the alpha sharpened about its cutoff over one pixel's change,
+// clamp((alpha − cutoff) / alpha_width + 1/2, 0, 1), so that the cutoff's line through the
+// texture is an edge covering its share of the pixel; BLEND: alpha itself. k = ⌊share·n +
+// threshold⌋ samples (the pixel's screen-door threshold dithers the rounding, so a 4×4 block of
+// pixels covers the share within 1/(16n)), consecutive from a sample the threshold picks (a
+// surface behind another of the same alpha shows through the samples it leaves).
+fn coverage_mask(material: u32, alpha: f32, alpha_width: f32, frag_xy: vec2<f32>, n: u32) -> u32 {
+    let all = 0xffffffffu >> (32u - n);
+    if (!MATERIALS) {
+        return all;
+    }
+    if (alpha < 0.0) {
+        return 0u;
+    }
+    let m = materials[min(material, arrayLength(&materials) - 1u)];
+    var share = 1.0;
+    if (m.alpha_mode == ALPHA_MASK) {
+        share = clamp((alpha - m.alpha_cutoff) / max(alpha_width, 1e-4) + 0.5, 0.0, 1.0);
+    } else if (m.alpha_mode == ALPHA_BLEND) {
+        share = clamp(alpha, 0.0, 1.0);
+    } else {
+        return all;
+    }
+    let threshold = blend_threshold(frag_xy);
+    let k = min(u32(floor(share * f32(n) + threshold)), n);
+    let run = select(0u, 0xffffffffu >> (32u - max(k, 1u)), k > 0u);
+    let start = u32(threshold * 16.0) % n;
+    return ((run << start) | (run >> ((n - start) % n))) & all;
 }
 
 // Linear colour × (ambient + (1 − ambient)·|n·l|), the light at the viewer, two-sided. The

@@ -97,6 +97,10 @@ struct Lighting {
     env_background: u32,
     env_lut: u32,
     shadows: u32,
+    anisotropy: u32,    // the most probes a texture sample takes along its footprint (`--anisotropy`)
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
     env_rotation: array<vec4<f32>, 3>,
     env_sh: array<vec4<f32>, 9>,
     env_levels: array<vec4<u32>, ENV_LEVELS>,

@@ -70,11 +70,16 @@ pub struct ViewArgs {
     pub method: Method,
     /// Samples per pixel of the colour image: 1, 2, 4, 8, 16 or 32 (multisampling, averaged in
     /// linear light after tone mapping; the projection methods and slit:W; counts the adapter
-    /// lacks are made up by a larger image). Depth, --hdr and the error pass stay one sample at
-    /// each pixel's centre.
-    /// [default: 4 for render (1 with trace); 1 for bench and error, the paper's geometry]
+    /// lacks are made up by a larger image; trace: a ray through each sample position). Depth,
+    /// --hdr and the error pass stay one sample at each pixel's centre.
+    /// [default: 4 for render; 1 for bench and error, the paper's geometry]
     #[arg(long)]
     pub samples: Option<u32>,
+    /// Anisotropic texture filtering: the most probes a texture sample takes along its
+    /// footprint's longer axis, 1 to 16 (1: isotropic, trilinear from the longest axis).
+    /// [default: 16 for render; 1 for bench and error]
+    #[arg(long)]
+    pub anisotropy: Option<u32>,
     /// What splits an adaptive edge: error (its projected error, --max-error-px) or length (its
     /// projected length, --edge-px: the paper's eq. 5) [default: error].
     #[arg(long, value_enum)]
@@ -339,7 +344,8 @@ impl ViewArgs {
             .with_shadow_map_size(self.shadow_map_size)
             .with_environment_yaw_deg(self.environment_yaw)
             .with_tonemap(self.tonemap)
-            .with_samples(self.samples.unwrap_or(1));
+            .with_samples(self.samples.unwrap_or(1))
+            .with_anisotropy(self.anisotropy.unwrap_or(1));
         settings.validate()?;
         Ok(settings)
     }

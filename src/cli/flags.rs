@@ -26,6 +26,7 @@ pub const FLAGS: &[(&str, &str)] = &[
     ("shading.shadow_map_size", "--shadow-map-size"),
     ("shading.hdr", "--hdr"),
     ("shading.samples", "--samples"),
+    ("shading.anisotropy", "--anisotropy"),
     ("lod.p2/p3", "--lod-p2/--lod-p3"),
     ("lod.d_inf", "--lod-dinf"),
     ("environment", "--environment"),

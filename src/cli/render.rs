@@ -21,12 +21,11 @@ pub fn render_settings(args: &RenderArgs) -> Result<twister::RenderSettings> {
         .with_measure_edges(args.stats.is_some())
         .with_depth(args.depth)
         .with_hdr(args.hdr);
-    // Four samples unless asked otherwise; one for the ray tracer (a ray per pixel).
-    let samples = args.view.samples.unwrap_or(match settings.subdivision.method {
-        twister::core::settings::Method::Trace => 1,
-        _ => DEFAULT_SAMPLES,
-    });
-    let settings = settings.with_samples(samples);
+    // Four samples unless asked otherwise (the ray tracer: four rays per pixel), textures
+    // filtered with the most anisotropy.
+    let settings = settings
+        .with_samples(args.view.samples.unwrap_or(DEFAULT_SAMPLES))
+        .with_anisotropy(args.view.anisotropy.unwrap_or(twister::core::settings::MAX_ANISOTROPY));
     settings.validate()?;
     Ok(settings)
 }

@@ -143,7 +143,7 @@ impl Tonemap {
     }
 }
 
-/// `Lighting` in shaders/shared/surface.wgsl (a uniform): the frame's lighting. 320 bytes.
+/// `Lighting` in shaders/shared/surface_bindings.wgsl (a uniform): the frame's lighting. 336 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct LightingParams {
@@ -163,6 +163,12 @@ pub struct LightingParams {
     pub env_lut: u32,
     /// 1: the scene's lights cast shadows (the ray tracer's shadow rays; `--no-shadows`: 0).
     pub shadows: u32,
+    /// The most probes a texture sample takes along its footprint's longer axis
+    /// (`ShadingSettings::anisotropy`; 0 or 1: isotropic).
+    pub anisotropy: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    pub _pad2: u32,
     /// Viewer frame → environment (scene) frame: the columns of the rotation (w unused).
     pub env_rotation: [[f32; 4]; 3],
     /// E(n)/π as spherical-harmonic coefficients (rgb, w unused).

@@ -17,6 +17,7 @@ pub mod load;
 pub mod lod;
 pub mod material;
 pub mod projection;
+pub mod sampling;
 pub mod scene;
 pub mod settings;
 pub mod shadow;

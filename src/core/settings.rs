@@ -189,12 +189,22 @@ pub struct ShadingSettings {
     /// of the same frame (`--hdr`: [`Frame::hdr`](crate::core::frame::Frame::hdr); the
     /// projection methods only).
     pub hdr: bool,
-    /// Samples per pixel of the display colour (`--samples`: 1, 2, 4, 8, 16 or 32; the
-    /// projection methods and slits): each pixel shows the average of its samples' tone-mapped
-    /// linear colours (multisampling, resolved in linear light). The other outputs (the error
+    /// Samples per pixel of the display colour (`--samples`: 1, 2, 4, 8, 16 or 32): each pixel
+    /// shows the average of its samples' tone-mapped linear colours (the projection methods and
+    /// slits multisample, resolved in linear light; the ray tracer traces a ray through each of
+    /// [`sample_position`](crate::core::sampling::sample_position)). The other outputs (the error
     /// pass's targets, depth, the linear HDR colour) stay one sample at the pixel's centre.
     pub samples: u32,
+    /// The most probes a texture sample takes along its footprint's longer axis (`--anisotropy`,
+    /// 1..=16; 1: isotropic, the longest axis picks the mip level): anisotropic filtering, in the
+    /// drawing stages (the footprint from the screen derivatives) and the ray tracer (the ray
+    /// cone's ellipse on the surface).
+    pub anisotropy: u32,
 }
+
+/// The most probes `--anisotropy` takes (the usual hardware limit; twister filters by hand, so
+/// every adapter has it).
+pub const MAX_ANISOTROPY: u32 = 16;
 
 /// The sample counts `--samples` takes.
 pub const SAMPLE_COUNTS: [u32; 6] = [1, 2, 4, 8, 16, 32];
@@ -310,6 +320,7 @@ impl RenderSettings {
         let tonemap = s.tonemap;
         crate::core::light::LightingParams {
             shadows: s.shadows as u32,
+            anisotropy: s.anisotropy,
             ..crate::core::light::LightingParams::of(s.lighting, scene, environment, s.exposure_ev, tonemap)
         }
     }
@@ -356,6 +367,7 @@ impl Default for ShadingSettings {
             tonemap: Default::default(),
             hdr: false,
             samples: 1,
+            anisotropy: 1,
             shadows: true,
             shadow_map_size: crate::core::shadow::DEFAULT_SHADOW_MAP_SIZE,
             environment_yaw_deg: 0.0,
@@ -397,6 +409,7 @@ builders! {
     with_tonemap: crate::core::light::Tonemap => shading.tonemap,
     with_hdr: bool => shading.hdr,
     with_samples: u32 => shading.samples,
+    with_anisotropy: u32 => shading.anisotropy,
     with_shadows: bool => shading.shadows,
     with_shadow_map_size: u32 => shading.shadow_map_size,
     with_environment_yaw_deg: f32 => shading.environment_yaw_deg,
@@ -486,10 +499,10 @@ impl RenderSettings {
         if !SAMPLE_COUNTS.contains(&samples) {
             return Err(Error::setting("shading.samples", format!("must be 1, 2, 4, 8, 16 or 32, got {samples}")));
         }
-        if samples > 1 && self.subdivision.method == Method::Trace {
+        if !(1..=MAX_ANISOTROPY).contains(&self.shading.anisotropy) {
             return Err(Error::setting(
-                "shading.samples",
-                format!("the ray tracer draws one ray per pixel; {samples} samples are for the other methods"),
+                "shading.anisotropy",
+                format!("must be 1 to {MAX_ANISOTROPY} probes, got {}", self.shading.anisotropy),
             ));
         }
         if !(self.shading.exposure_ev.is_finite() && self.shading.exposure_ev.abs() <= 64.0) {

@@ -215,25 +215,34 @@ fn rasterize_clipped(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: [u32;
             if !(z < img.depth[i]) || !(z >= 0.0) {
                 continue;
             }
-            // Perspective-correct weights here (and one pixel right and down, for the
-            // derivatives of uv).
+            // Perspective-correct weights here, and the derivatives as the GPU takes them over
+            // its 2×2 quad of pixels: fine (the difference across the quad in this pixel's row
+            // for x, in its column for y; lavapipe's dpdx is fine too), from points outside the
+            // triangle where the quad reaches beyond it, as helper invocations do.
             let pw = perspective(b);
             let mix3 = |f: &dyn Fn(&ClipVertex) -> Vec3| (0..3).map(|k| pw[k] * f(&tri[k])).sum::<Vec3>();
-            let uv_at = |w: [f32; 3]| (0..3).map(|k| w[k] * tri[k].uv).sum::<Vec2>();
-            let uv = uv_at(pw);
-            let position_at = |w: [f32; 3]| (0..3).map(|k| w[k] * tri[k].view_position).sum::<Vec3>();
+            let uv_at = |x: f32, y: f32| {
+                let w = perspective(barycentric(x, y));
+                (0..3).map(|k| w[k] * tri[k].uv).sum::<Vec2>()
+            };
+            let uv = (0..3).map(|k| pw[k] * tri[k].uv).sum::<Vec2>();
+            let position_at = |x: f32, y: f32| {
+                let w = perspective(barycentric(x, y));
+                (0..3).map(|k| w[k] * tri[k].view_position).sum::<Vec3>()
+            };
             let view_position = mix3(&|v| v.view_position);
+            let (qx, qy) = ((x & !1) as f32 + 0.5, (y & !1) as f32 + 0.5);
             let input = FragmentIn {
                 view_position,
-                dp_dx: position_at(perspective(barycentric(px + 1.0, py))) - view_position,
-                dp_dy: position_at(perspective(barycentric(px, py + 1.0))) - view_position,
+                dp_dx: position_at(qx + 1.0, py) - position_at(qx, py),
+                dp_dy: position_at(px, qy + 1.0) - position_at(px, qy),
                 normal: mix3(&|v| v.normal),
                 surface: Surface {
                     material: tri[0].material,
                     color: (0..3).map(|k| pw[k] * tri[k].color).sum::<Vec4>(),
                     uv,
-                    duv_dx: uv_at(perspective(barycentric(px + 1.0, py))) - uv,
-                    duv_dy: uv_at(perspective(barycentric(px, py + 1.0))) - uv,
+                    duv_dx: uv_at(qx + 1.0, py) - uv_at(qx, py),
+                    duv_dy: uv_at(px, qy + 1.0) - uv_at(px, qy),
                     frag_xy: Vec2::new(px, py),
                     // Counter-clockwise in normalized device coordinates (y up) is clockwise
                     // on the pixel grid (y down): negative `area`.

@@ -1,5 +1,5 @@
-//! The `trace` stage, CPU twin of `shaders/trace.wgsl`: ray tracing (seed 000), one primary ray
-//! per pixel and eye from the pixel's eye point ([`pixel_ray`]: the cylinder's exact vertical
+//! The `trace` stage, CPU twin of `shaders/trace.wgsl`: ray tracing (seed 000), a primary ray
+//! per sample of each pixel (`--samples`, the pixel's centre for one) and eye from its eye point ([`pixel_ray`]: the cylinder's exact vertical
 //! model, or the sphere), the closest hit through the scene's BVH ([`SceneBvh`]), shaded with
 //! the rasterizer's materials and headlight, or a point light with shadow rays; mirror and
 //! refraction rays to `reflect_max` bounces, depth first. The same traversal as the WGSL (nearer
@@ -16,6 +16,7 @@ use crate::core::light::tonemap;
 use crate::core::light::LightKind;
 use crate::core::material::AlphaMode;
 use crate::core::projection::{Eye, Projection};
+use crate::core::sampling::sample_position;
 use crate::core::scene::{unpack_tangent, SceneVertex};
 use crate::core::texture::MaterialTable;
 use crate::core::visual_field::Gaze;
@@ -269,21 +270,33 @@ impl<'a> Tracer<'a> {
         &materials[(self.corners(tri)[0].material as usize).min(materials.len() - 1)]
     }
 
-    /// The footprint in texture units of a ray cone `width` wide meeting `tri` along `dir`
-    /// (`texture_footprint`).
-    fn footprint(&self, tri: u32, dir: Vec3, width: f32) -> f32 {
+    /// The footprint of a ray cone `width` wide meeting `tri` along `dir` (`texture_footprint`):
+    /// the ellipse it draws on the triangle's plane as its two axes in texture units, along the
+    /// ray's trace (width / |cos incidence|, at most 20×) and across it (width).
+    fn footprint(&self, tri: u32, dir: Vec3, width: f32) -> (Vec2, Vec2) {
         let [a, b, c] = self.corners(tri);
-        let n =
-            (Vec3::from(b.position) - Vec3::from(a.position)).cross(Vec3::from(c.position) - Vec3::from(a.position));
+        let (e1, e2) =
+            (Vec3::from(b.position) - Vec3::from(a.position), Vec3::from(c.position) - Vec3::from(a.position));
+        let n = e1.cross(e2);
         let world = n.length().max(1e-30);
+        let normal = n / world;
+        let cos_i = normal.dot(dir).abs().max(0.05);
+        let mut along = dir - normal * normal.dot(dir);
+        if along.dot(along) < 1e-12 {
+            along = e1;
+        }
+        let along = along.normalize();
+        let (major, minor) = (along * (width / cos_i), normal.cross(along) * width);
+        // w = s·e1 + t·e2 in the plane: s = w·(e2 × n̂)/|n|, t = w·(n̂ × e1)/|n|.
+        let (to_s, to_t) = (e2.cross(normal) / world, normal.cross(e1) / world);
         let (d1, d2) = (Vec2::from(b.uv) - Vec2::from(a.uv), Vec2::from(c.uv) - Vec2::from(a.uv));
-        let uv = (d1.x * d2.y - d1.y * d2.x).abs();
-        let cos_i = (n.dot(dir).abs() / world).max(0.05);
-        width / cos_i * (uv / world).sqrt()
+        let to_uv = |w: Vec3| w.dot(to_s) * d1 + w.dot(to_t) * d2;
+        (to_uv(major), to_uv(minor))
     }
 
-    /// The surface at barycentrics (b1, b2) of `tri`, its texture footprint `f`.
-    fn surface(&self, tri: u32, b1: f32, b2: f32, front: bool, frag_xy: Vec2, f: f32) -> Surface {
+    /// The surface at barycentrics (b1, b2) of `tri`, its texture footprint `f` (the ellipse's
+    /// axes).
+    fn surface(&self, tri: u32, b1: f32, b2: f32, front: bool, frag_xy: Vec2, f: (Vec2, Vec2)) -> Surface {
         let [a, b, c] = self.corners(tri);
         let b0 = 1.0 - b1 - b2;
         let mix4 = |x: [f32; 4], y: [f32; 4], z: [f32; 4]| b0 * Vec4::from(x) + b1 * Vec4::from(y) + b2 * Vec4::from(z);
@@ -292,8 +305,8 @@ impl<'a> Tracer<'a> {
             material: a.material,
             color: mix4(a.color, b.color, c.color),
             uv: mix2(a.uv, b.uv, c.uv),
-            duv_dx: Vec2::new(f, 0.0),
-            duv_dy: Vec2::new(0.0, f),
+            duv_dx: f.0,
+            duv_dy: f.1,
             frag_xy,
             front_facing: front,
             tangent: b0 * unpack_tangent(a.tangent) + b1 * unpack_tangent(b.tangent) + b2 * unpack_tangent(c.tangent),
@@ -441,51 +454,102 @@ impl<'a> Tracer<'a> {
         lit
     }
 
-    /// Traces the pixel (x, y) of `eye` into `img`: its primary ray, then its mirror and
-    /// refraction rays depth first (as the WGSL).
+    /// Traces the pixel (x, y) of `eye` into `img` as the WGSL: `samples` rays through the
+    /// pixel's sample positions ([`sample_position`]; one: the centre), the average of their
+    /// tone-mapped colours in linear light, a pixel all plain background exactly the background;
+    /// the error, object and distance outputs from the centre's ray.
     fn trace_pixel(&self, eye: Eye, x: u32, y: u32, img: &mut RasterImage) {
-        let (params, table, projection) = (self.params, self.table, &self.projection);
-        let frag_xy = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-        let keeps = |tri, b1, b2, front, dir, width| self.keeps(frag_xy, tri, b1, b2, front, dir, width);
-        // The pixel's angular size: the cone's growth per metre.
-        let spread = pixel_spread(projection, frag_xy);
-        let (origin_v, dir_v) = pixel_ray(projection, eye, frag_xy);
-        // Seed 000's level of detail: untraced outside the visual field, level × Reflect_max
-        // bounces (eq. 9, rounded). Its rays meet each object at the level of detail eq. 10
-        // gives (level 1: the original).
+        let n = self.params.samples.max(1);
+        let corner = Vec2::new(x as f32, y as f32);
+        let i = (y * self.projection.width + x) as usize;
+        if n > 1 {
+            self.write_centre(eye, corner + 0.5, i, img);
+        }
+        let (mut sum, mut plain) = (Vec3::ZERO, 0);
+        for k in 0..n {
+            let (color, is_plain) =
+                self.trace_sample(eye, corner + sample_position(n, k), (n == 1).then_some((i, &mut *img)));
+            sum += color;
+            plain += is_plain as u32;
+        }
+        if plain < n {
+            img.rgba[4 * i..4 * i + 4].copy_from_slice(&display_bytes(sum / n as f32));
+        }
+    }
+
+    /// The primary ray through `frag_xy` and its visual level and bounces (seed 000's level of
+    /// detail: None outside the visual field, else level × Reflect_max bounces, eq. 9, rounded;
+    /// its rays meet each object at the level of detail eq. 10 gives, level 1 the original),
+    /// in the viewer's frame and the scene's.
+    fn primary(&self, eye: Eye, frag_xy: Vec2) -> Option<(Vec3, Vec3, TracedRay, u32)> {
+        let params = self.params;
+        let (origin_v, dir_v) = pixel_ray(&self.projection, eye, frag_xy);
         let (level, reflect_max) = match self.gaze {
             None => (1.0, params.reflect_max),
             Some(g) => {
                 let level = g.position(dir_v).level();
                 if level <= 0.0 {
-                    return;
+                    return None;
                 }
                 (level, (level * params.reflect_max as f32 + 0.5).floor() as u32)
             }
         };
-        let origin = self.to_scene.transform_point3(origin_v);
-        let dir = self.to_scene.transform_vector3(dir_v);
-        self.rays.set(self.rays.get() + 1);
-        let primary = TracedRay { origin, dir, limit: FAR, level, cone: Vec2::new(0.0, spread) };
-        let Some(hit) = closest_hit(&self.traced, &primary, &keeps, &self.tests) else {
-            if self.environment_lit && table.lighting.env_background != 0 {
-                let i = 4 * (y * projection.width + x) as usize;
-                let c = tonemap(env_level(table, 0, env_st(env_direction(table, dir_v))), &table.lighting);
-                img.rgba[i..i + 4].copy_from_slice(&display_bytes(c));
-            }
-            return;
+        // The pixel's angular size: the cone's growth per metre.
+        let spread = pixel_spread(&self.projection, frag_xy);
+        let ray = TracedRay {
+            origin: self.to_scene.transform_point3(origin_v),
+            dir: self.to_scene.transform_vector3(dir_v),
+            limit: FAR,
+            level,
+            cone: Vec2::new(0.0, spread),
         };
-        let i = (y * projection.width + x) as usize;
-        let view_position = origin_v + hit.t * dir_v;
-        img.error[i] = pixel_error(projection, eye, view_position, frag_xy, params.error_angle != 0);
+        Some((origin_v, dir_v, ray, reflect_max))
+    }
+
+    /// The error, object and distance outputs of the centre's ray alone (frames of several
+    /// samples).
+    fn write_centre(&self, eye: Eye, frag_xy: Vec2, i: usize, img: &mut RasterImage) {
+        let keeps = |tri, b1, b2, front, dir, width| self.keeps(frag_xy, tri, b1, b2, front, dir, width);
+        let Some((origin_v, dir_v, ray, _)) = self.primary(eye, frag_xy) else { return };
+        self.rays.set(self.rays.get() + 1);
+        if let Some(hit) = closest_hit(&self.traced, &ray, &keeps, &self.tests) {
+            self.write_primary(eye, frag_xy, origin_v + hit.t * dir_v, &hit, i, img);
+        }
+    }
+
+    /// The outputs of a primary ray's hit at `view_position`.
+    fn write_primary(&self, eye: Eye, frag_xy: Vec2, view_position: Vec3, hit: &Hit, i: usize, img: &mut RasterImage) {
+        img.error[i] = pixel_error(&self.projection, eye, view_position, frag_xy, self.params.error_angle != 0);
         img.object[i] = self.corners(hit.triangle)[0].object + 1;
         img.distance[i] = hit.t;
         img.depth[i] = hit.t;
-        let mut color = self.gather(origin, dir, hit, frag_xy, spread, level, reflect_max, &keeps);
-        if table.lighting.pbr != 0 && self.light.is_none() {
-            color = tonemap(color, &table.lighting);
+    }
+
+    /// One sample: its primary ray through `frag_xy`, then its mirror and refraction rays depth
+    /// first (as the WGSL); its tone-mapped linear colour and whether that is the plain
+    /// background. With `centre` (pixel index and image) the primary hit's outputs are written.
+    fn trace_sample(&self, eye: Eye, frag_xy: Vec2, centre: Option<(usize, &mut RasterImage)>) -> (Vec3, bool) {
+        let table = self.table;
+        let keeps = |tri, b1, b2, front, dir, width| self.keeps(frag_xy, tri, b1, b2, front, dir, width);
+        let Some((origin_v, dir_v, primary, reflect_max)) = self.primary(eye, frag_xy) else {
+            return (self.background, true);
+        };
+        self.rays.set(self.rays.get() + 1);
+        let Some(hit) = closest_hit(&self.traced, &primary, &keeps, &self.tests) else {
+            if self.environment_lit && table.lighting.env_background != 0 {
+                return (tonemap(env_level(table, 0, env_st(env_direction(table, dir_v))), &table.lighting), false);
+            }
+            return (self.background, true);
+        };
+        if let Some((i, img)) = centre {
+            self.write_primary(eye, frag_xy, origin_v + hit.t * dir_v, &hit, i, img);
         }
-        img.rgba[4 * i..4 * i + 4].copy_from_slice(&display_bytes(color));
+        let (level, spread) = (primary.level, primary.cone.y);
+        let color = self.gather(primary.origin, primary.dir, hit, frag_xy, spread, level, reflect_max, &keeps);
+        if table.lighting.pbr != 0 && self.light.is_none() {
+            return (tonemap(color, &table.lighting), false);
+        }
+        (color, false)
     }
 
     /// The light a primary ray gathers from its first hit and the mirror and refraction rays

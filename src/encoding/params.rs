@@ -36,6 +36,6 @@ pub fn trace_params(settings: &RenderSettings, row_texels: u32) -> TraceParams {
         // Set from the scene's BVH where it is bound (`SceneBvh::original_root`, `original_level`).
         original_root: 0,
         original_level: -1.0,
-        _pad2: 0,
+        samples: settings.shading.samples,
     }
 }

@@ -378,7 +378,8 @@ pub struct TraceParams {
     /// the visual level above which they do (`SceneBvh::original_level`).
     pub original_root: u32,
     pub original_level: f32,
-    pub _pad2: u32,
+    /// Rays per pixel, through `core::sampling::sample_position` (`ShadingSettings::samples`).
+    pub samples: u32,
 }
 
 /// `ShadowParams` in shaders/shadow.wgsl: one shadow map's projection, scene frame → the
@@ -457,7 +458,7 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("RasterParams" => RasterParams { projection, eye_sign, ambient, shift_px, error_angle, _pad0, _pad1, _pad2 }),
     layout!("SlitParams" => SlitParams { view, projection, eye_sign, ambient, near, error_angle }),
     layout!("SlitCamera" => SlitCamera { origin_sx, right_cx, up_cy, forward_sy }),
-    layout!("TraceParams" => TraceParams { to_scene, projection, background, light, gaze_forward, gaze_right, gaze_up, ambient, error_angle, row_texels, reflect_max, lod_min_share, original_root, original_level, _pad2 }),
+    layout!("TraceParams" => TraceParams { to_scene, projection, background, light, gaze_forward, gaze_right, gaze_up, ambient, error_angle, row_texels, reflect_max, lod_min_share, original_root, original_level, samples }),
     layout!("BvhNode" => BvhNode { min, first, max, count }),
     layout!("BvhLevel" => BvhLevel { root, triangles }),
     layout!("Light" => GpuLight { position, kind, direction, range, color, inner_cos, outer_cos, shadow_map, _pad1, _pad2 }),
@@ -467,7 +468,7 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("SkinInstance" => SkinInstance { matrix, normal_matrix, first_joint, joint_count, first_weight, weight_count, mirror, _pad0, _pad1, _pad2 }),
     layout!("SkinParams" => SkinParams { count, _pad0, _pad1, _pad2 }),
     layout!("Lighting" => LightingParams {
-        count, pbr, exposure, tonemap, environment, env_background, env_lut, shadows, env_rotation, env_sh, env_levels
+        count, pbr, exposure, tonemap, environment, env_background, env_lut, shadows, anisotropy, _pad0, _pad1, _pad2, env_rotation, env_sh, env_levels
     }),
     layout!("ProjectParams" => ProjectParams { projection, eye_sign, count, _pad }),
     layout!("Material" => Material {

@@ -217,6 +217,10 @@ fn draw_pipeline(
     let buffers = [Some(layout)];
     let targets = color_targets(gpu, outputs, hdr, background);
     let mut constants = look_constants(look, lit);
+    let coverage = samples > 1 && !background && matches!(look, Look::Materials | Look::Culled);
+    if coverage {
+        constants.push(("SAMPLES", samples as f64));
+    }
     let multiview_mask = match layers {
         Layers::Both => std::num::NonZeroU32::new(0b11),
         Layers::Eye(k) => {
@@ -253,6 +257,8 @@ fn draw_pipeline(
             module: stage.module(gpu, None),
             entry_point: Some(match (background, outputs) {
                 (true, _) => "fs_background",
+                // Alpha to coverage where the multisampled colour's materials may discard.
+                (_, 1) if coverage => "fs_coverage",
                 (_, 1) => "fs_main",
                 (_, 4) => "fs_error",
                 _ => "fs_position",

@@ -90,7 +90,8 @@ impl Renderer {
         self.check_size(settings)?;
         let n = settings.shading.samples;
         let counts = crate::gpu::targets::sample_counts(&self.gpu);
-        if counts.contains(&n) {
+        // The ray tracer traces any count itself (a ray per sample).
+        if counts.contains(&n) || settings.subdivision.method == MethodName::Trace {
             return self.render_direct(scene, settings);
         }
         self.render_larger(scene, settings, &counts)
@@ -171,6 +172,9 @@ impl Renderer {
             frame.stats.samples = n;
             frame.stats.sampling = match crate::gpu::targets::Samples::passes(settings).as_slice() {
                 [_] if n == 1 => "1 sample at each pixel's centre".to_string(),
+                _ if settings.subdivision.method == MethodName::Trace => {
+                    format!("{n} rays per pixel at the standard sample positions; error, object and distance of the centre's ray")
+                }
                 [_] => format!("multisampled {n} (a pass per eye)"),
                 _ => format!("multisampled {n} (a pass per eye), depth, error and linear colour at the centres"),
             };

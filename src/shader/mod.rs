@@ -331,6 +331,7 @@ pub const RASTER: Stage = Stage {
     entry_points: &[
         entry("vs_main", &["params"]),
         entry("fs_main", SHADING),
+        entry("fs_coverage", SHADING),
         entry("fs_error", SHADING),
         entry("fs_position", SHADING),
         entry("vs_background", &[]),
@@ -346,6 +347,7 @@ pub const SLIT: Stage = Stage {
     entry_points: &[
         entry("vs_main", &["params", "cameras"]),
         entry("fs_main", SHADING),
+        entry("fs_coverage", SHADING),
         entry("fs_error", SHADING),
         entry("fs_position", SHADING),
         entry("vs_background", &[]),
@@ -399,7 +401,7 @@ pub const SHADOW: Stage = Stage {
     name: "shadow",
     source: Some(include_str!("../../shaders/shadow.wgsl")),
     kind: StageKind::Draw,
-    entry_points: &[entry("vs_main", &["params"]), entry("fs_mask", &["materials", "mips", "texels"])],
+    entry_points: &[entry("vs_main", &["params"]), entry("fs_mask", &["materials", "mips", "texels", "lighting"])],
     bindings: with_material_table![bind(0, 0, "params", Uniform),],
 };
 

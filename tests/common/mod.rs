@@ -135,6 +135,45 @@ pub fn checker_floor() -> twister::Scene {
     scene
 }
 
+/// A floor 1 m below the viewer, 60 m square, striped along x: a 64×64 texture of white and
+/// black columns 2 texels wide (period 4), one repeat per `STRIPE_REPEAT_M` metres, filtered
+/// linearly between linear mip levels. Seen at grazing angles the texture's footprint is long
+/// along the view and narrow across it: what anisotropic filtering is for.
+pub fn striped_floor() -> twister::Scene {
+    use twister::core::material::{Filter, Material, Mipmap};
+    use twister::core::scene::SceneVertex;
+    use twister::core::texture::Texture;
+    let mut scene = twister::Scene::new("striped floor");
+    let rgba = (0..64u32 * 64).flat_map(|i| if stripe_is_white(i % 64) { [255; 4] } else { [0, 0, 0, 255] }).collect();
+    scene.textures.push(Texture { name: "stripes".into(), width: 64, height: 64, rgba });
+    scene.materials.push(Material {
+        texture: 0,
+        min_filter: Filter::Linear as u32,
+        mag_filter: Filter::Linear as u32,
+        mipmap: Mipmap::Linear as u32,
+        ..Default::default()
+    });
+    let corner = |x: f32, z: f32| SceneVertex {
+        position: [x, -1.0, z],
+        normal: [0.0, 1.0, 0.0],
+        color: [1.0; 4],
+        uv: [x / STRIPE_REPEAT_M, z / STRIPE_REPEAT_M],
+        material: 1,
+        ..Default::default()
+    };
+    let v = [corner(-30.0, 30.0), corner(30.0, 30.0), corner(30.0, -30.0), corner(-30.0, -30.0)];
+    scene.add_mesh("floor", &v, &[0, 1, 2, 0, 2, 3]);
+    scene
+}
+
+/// Metres per repeat of `striped_floor`'s texture.
+pub const STRIPE_REPEAT_M: f32 = 5.0;
+
+/// Whether texel column `x` of `striped_floor`'s texture is white.
+pub fn stripe_is_white(x: u32) -> bool {
+    (x / 2) % 2 == 0
+}
+
 /// Three spheres ahead — a rough white dielectric, a gold metal, an emissive one — under a point
 /// light with a range, a spot light and a directional light (`KHR_lights_punctual`): the glTF BRDF.
 pub fn lit_spheres() -> twister::Scene {

@@ -42,6 +42,13 @@ impl Twin for Slit {
         let shadows = common::ball_over_floor(twister::core::light::LightKind::Directional, true);
         let settings = RenderSettings::new(projection).with_method(Method::Slit(4)).with_shadow_map_size(512);
         cases.push(("ball and screen, directional light's shadow map".into(), (shadows, settings)));
+        cases.push((
+            "striped floor, anisotropy 16".into(),
+            (
+                common::striped_floor(),
+                RenderSettings::new(projection).with_method(Method::Slit(4)).with_ambient(1.0).with_anisotropy(16),
+            ),
+        ));
         let mut studio = common::lit_spheres();
         studio.environment = Some(common::studio(true));
         cases.push((

@@ -272,12 +272,53 @@ pub fn mapped_normal(n: Vec3, s: &SurfaceMaps) -> Vec3 {
 
 // ---- Image-based lighting (`core::environment`; surface.wgsl's twins) ----
 
-/// Screen-door threshold of a pixel for BLEND materials: a 4×4 ordered-dither (Bayer) matrix,
-/// so a surface of opacity a covers about a of the pixels, independently of drawing order.
+/// Screen-door threshold of a pixel for BLEND materials (`blend_threshold` in surface.wgsl): a
+/// 4×4 ordered-dither (Bayer) matrix, shifted by a point's offset from the pixel's centre along x
+/// (a traced sample's), so that the standard sample positions of one pixel get thresholds evenly
+/// spaced over 0..1.
 pub fn blend_threshold(frag_xy: Vec2) -> f32 {
     const BAYER: [f32; 16] = [0.0, 8.0, 2.0, 10.0, 12.0, 4.0, 14.0, 6.0, 3.0, 11.0, 1.0, 9.0, 15.0, 7.0, 13.0, 5.0];
     let (x, y) = (frag_xy.x as u32 % 4, frag_xy.y as u32 % 4);
-    (BAYER[(4 * y + x) as usize] + 0.5) / 16.0
+    let t = (BAYER[(4 * y + x) as usize] + 0.5) / 16.0 + 0.5 + frag_xy.x.fract() - 1.0;
+    t - t.floor()
+}
+
+/// How much a MASK material's alpha changes over one pixel (`mask_alpha_width` in surface.wgsl):
+/// |α(uv + ∂uv/∂x) − α(uv)| + |α(uv + ∂uv/∂y) − α(uv)| of its texture × the vertex alpha; 0 for
+/// other materials.
+pub fn mask_alpha_width(table: &MaterialTable, s: &Surface) -> f32 {
+    let m = &table.materials[(s.material as usize).min(table.materials.len() - 1)];
+    if m.alpha_mode != AlphaMode::Mask as u32 || m.texture == NO_TEXTURE || m.mip_count == 0 {
+        return 0.0;
+    }
+    let alpha = |uv: Vec2| sample_texture(table, m, uv, s.duv_dx, s.duv_dy).w;
+    let a = alpha(s.uv);
+    s.color.w.abs() * ((alpha(s.uv + s.duv_dx) - a).abs() + (alpha(s.uv + s.duv_dy) - a).abs())
+}
+
+/// Alpha to coverage (`coverage_mask` in surface.wgsl): which of its pixel's `n` samples (n > 1)
+/// a fragment of `alpha` covers, `alpha_width` the change of alpha over a pixel. Opaque: all;
+/// a face culled: none; MASK: the alpha sharpened about its cutoff, clamp((alpha − cutoff) /
+/// alpha_width + 1/2, 0, 1); BLEND: alpha. k = ⌊share·n + threshold⌋ consecutive samples from
+/// the one the pixel's threshold picks.
+pub fn coverage_mask(table: &MaterialTable, material: u32, alpha: f32, alpha_width: f32, frag_xy: Vec2, n: u32) -> u32 {
+    let all = u32::MAX >> (32 - n);
+    if alpha < 0.0 {
+        return 0;
+    }
+    let m = &table.materials[(material as usize).min(table.materials.len() - 1)];
+    let share = if m.alpha_mode == AlphaMode::Mask as u32 {
+        ((alpha - m.alpha_cutoff) / alpha_width.max(1e-4) + 0.5).clamp(0.0, 1.0)
+    } else if m.alpha_mode == AlphaMode::Blend as u32 {
+        alpha.clamp(0.0, 1.0)
+    } else {
+        return all;
+    };
+    let threshold = blend_threshold(frag_xy);
+    let k = ((share * n as f32 + threshold).floor() as u32).min(n);
+    let run = if k == 0 { 0 } else { u32::MAX >> (32 - k) };
+    let start = (threshold * 16.0) as u32 % n;
+    ((run << start) | (run >> ((n - start) % n))) & all
 }
 
 /// A surface fragment before shading.
@@ -320,6 +361,38 @@ mod tests {
     use crate::core::color::{linear_to_srgb, srgb_to_linear};
     use crate::core::material::{Filter, Material, Mipmap, Wrap};
     use crate::core::texture::Texture;
+
+    /// Alpha to coverage against the closed form: over a 4×4 block of pixels (every screen-door
+    /// threshold once) a BLEND fragment of alpha a covers a·n·16 samples within one, each pixel
+    /// within one sample of a·n; opaque covers all, a culled face none; a MASK fragment's share
+    /// is its alpha's distance beyond the cutoff over its width, plus one half.
+    #[test]
+    fn coverage_masks_cover_the_share_alpha_gives() {
+        let mut t = table(Material { alpha_mode: AlphaMode::Blend as u32, ..Default::default() });
+        for n in [2u32, 4, 8, 16, 32] {
+            let all = if n == 32 { u32::MAX } else { (1 << n) - 1 };
+            for a in [0.0f32, 0.1, 0.3, 0.5, 0.77, 1.0] {
+                let masks: Vec<u32> = (0..16)
+                    .map(|i| coverage_mask(&t, 1, a, 0.0, Vec2::new((i % 4) as f32 + 0.5, (i / 4) as f32 + 0.5), n))
+                    .collect();
+                assert!(masks.iter().all(|m| m & !all == 0), "{n} {a}: {masks:?}");
+                let total: u32 = masks.iter().map(|m| m.count_ones()).sum();
+                assert!((total as f32 - a * n as f32 * 16.0).abs() <= 1.0, "{n} samples, alpha {a}: {total}");
+                for m in &masks {
+                    assert!((m.count_ones() as f32 - a * n as f32).abs() < 1.0, "{n} {a}: {m:b}");
+                }
+            }
+            assert_eq!(coverage_mask(&t, 1, -1.0, 0.0, Vec2::splat(0.5), n), 0, "a culled face");
+        }
+        t.materials[1].alpha_mode = AlphaMode::Opaque as u32;
+        assert_eq!(coverage_mask(&t, 1, 0.2, 0.0, Vec2::splat(0.5), 4), 0b1111);
+        t.materials[1].alpha_mode = AlphaMode::Mask as u32;
+        t.materials[1].alpha_cutoff = 0.5;
+        // Share 0.5 + (0.55 − 0.5)/0.2 = 0.75 of 4 samples: 3 (or 4 where the threshold rounds up).
+        let k = coverage_mask(&t, 1, 0.55, 0.2, Vec2::splat(0.5), 4).count_ones();
+        assert!(k == 3 || k == 4, "{k}");
+        assert_eq!(coverage_mask(&t, 1, 0.3, 0.05, Vec2::splat(0.5), 4), 0, "well below the cutoff");
+    }
 
     #[test]
     fn srgb_round_trips_every_byte() {

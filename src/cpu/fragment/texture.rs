@@ -54,12 +54,22 @@ fn sample_level(table: &MaterialTable, m: &Material, first_mip: u32, level: u32,
     sum
 }
 
-/// Samples a material's base colour texture at `uv` with the screen-space derivatives of uv:
-/// level of detail λ = log2 of the longest footprint in level-0 texels; λ ≤ 0 magnifies
-/// (magnification filter, level 0), else the minification filter on level 0 (no mipmaps), the
-/// nearest level, or a blend of the two nearest.
+/// Samples a material's base colour texture at `uv` with the screen-space derivatives of uv,
+/// anisotropically (EXT_texture_filter_anisotropic's reference): P_max and P_min the longer and
+/// shorter footprint axis in level-0 texels, N = min(⌈P_max / P_min⌉, `lighting.anisotropy`)
+/// probes spaced evenly along the longer axis, each at level of detail λ = log2(P_max / N) (one
+/// probe: isotropic, the longest axis); λ ≤ 0 magnifies (magnification filter, level 0), else the
+/// minification filter on level 0 (no mipmaps), the nearest level, or a blend of the two nearest.
 pub fn sample_texture(table: &MaterialTable, m: &Material, uv: Vec2, duv_dx: Vec2, duv_dy: Vec2) -> Vec4 {
     sample_levels(table, m, m.first_mip, m.mip_count, uv, duv_dx, duv_dy)
+}
+
+/// The number of probes along the footprint's longer axis (1 ..= `anisotropy`).
+pub fn anisotropic_probes(anisotropy: u32, p_max: f32, p_min: f32) -> u32 {
+    if anisotropy <= 1 || !(p_max > p_min) {
+        return 1;
+    }
+    (p_max / p_min.max(p_max / 16.0)).ceil().clamp(1.0, anisotropy as f32) as u32
 }
 
 /// The same for the texture whose mip chain starts at `first_mip` (a material's maps), with the
@@ -75,7 +85,11 @@ pub fn sample_levels(
 ) -> Vec4 {
     let top = &table.mips[first_mip as usize];
     let size = Vec2::new(top.width as f32, top.height as f32);
-    let lambda = (duv_dx * size).length().max((duv_dy * size).length()).log2();
+    let (px, py) = ((duv_dx * size).length(), (duv_dy * size).length());
+    let p_max = px.max(py);
+    let probes = anisotropic_probes(table.lighting.anisotropy, p_max, px.min(py));
+    let axis = if px >= py { duv_dx } else { duv_dy };
+    let lambda = (p_max / probes as f32).log2();
     let last = (mip_count - 1) as f32;
     // (first level, second level, weight of the second, filter)
     let (l0, l1, t, filter) = if !(lambda > 0.0) {
@@ -90,11 +104,14 @@ pub fn sample_levels(
         (l.floor(), (l.floor() + 1.0).min(last), l - l.floor(), m.min_filter)
     };
     let mut out = Vec4::ZERO;
-    for (k, level) in [l0, l1].into_iter().enumerate() {
-        let weight = if k == 0 { 1.0 - t } else { t };
-        if weight > 0.0 {
-            out += weight * sample_level(table, m, first_mip, level as u32, uv, filter);
+    for probe in 0..probes {
+        let at = if probes > 1 { uv + axis * ((probe as f32 + 0.5) / probes as f32 - 0.5) } else { uv };
+        for (k, level) in [l0, l1].into_iter().enumerate() {
+            let weight = if k == 0 { 1.0 - t } else { t };
+            if weight > 0.0 {
+                out += weight * sample_level(table, m, first_mip, level as u32, at, filter);
+            }
         }
     }
-    out
+    out / probes as f32
 }
