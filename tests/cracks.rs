@@ -7,6 +7,7 @@ mod common;
 
 use glam::Vec3;
 use twister::core::builtin;
+use twister::core::projection::Vertical;
 use twister::core::settings::{Method, Split};
 use twister::EyeImage;
 use twister::{Projection, RenderSettings, Scene};
@@ -263,7 +264,7 @@ fn triangles_reaching_into_the_eye_circle_are_drawn_whole() {
     assert!(checked > 10_000, "only {checked} points checked");
 }
 
-/// Surround scenes at four samples per pixel, both panoramas: a crack narrower than a pixel
+/// Surround scenes at several samples per pixel, both panoramas: a crack narrower than a pixel
 /// would show as partial coverage of the background, which one sample at the centre can miss.
 /// The oracle: the same frame on a black and on a white background is the same image, pixel for
 /// pixel (any background a sample sees changes its pixel).
@@ -277,13 +278,26 @@ fn surround_scenes_let_no_sample_see_the_background() {
     ];
     let r = common::renderer();
     for (what, scene, viewer) in &scenes {
-        let gs = twister::GpuScene::upload(&r.gpu, scene).unwrap();
-        for (panorama, width, height) in
-            [(PanoramaKind::Cylinder, 320, 80), (PanoramaKind::Cylinder, 192, 192), (PanoramaKind::Equirect, 256, 128)]
-        {
-            for method in [Method::Vertex, Method::Fixed(7), Method::Adaptive(Split::Error)] {
-                let projection = Projection { width, height, panorama, ..Projection::default() };
-                let settings = RenderSettings::new(projection).with_viewer(*viewer).with_method(method).with_samples(4);
+        let gs = twister::GpuScene::upload(&r.gpu, scene).unwrap().with_bvh(&r.gpu, scene).unwrap();
+        // Every method at 4 samples (the adapter's own), the adaptive one also at 2 and 16 (made
+        // up by a larger image where the adapter lacks them), the ray tracer at 4 rays a pixel.
+        let runs = [Method::Vertex, Method::Fixed(7), Method::Adaptive(Split::Error)]
+            .map(|m| (m, 4))
+            .into_iter()
+            .chain([(Method::Adaptive(Split::Error), 2), (Method::Adaptive(Split::Error), 16), (Method::Trace, 4)]);
+        let sizes =
+            [(PanoramaKind::Cylinder, 320, 80), (PanoramaKind::Cylinder, 192, 192), (PanoramaKind::Equirect, 256, 128)];
+        let runs: Vec<_> = runs.flat_map(|run| sizes.map(|size| (run, size))).collect();
+        for ((method, samples), (panorama, width, height)) in runs {
+            // One size each for the extra counts and the ray tracer (exact vertical model only).
+            if (samples != 4 || method == Method::Trace) && width == 192 {
+                continue;
+            }
+            {
+                let vertical = if method == Method::Trace { Vertical::Exact } else { Vertical::Paper };
+                let projection = Projection { width, height, panorama, vertical, ..Projection::default() };
+                let settings =
+                    RenderSettings::new(projection).with_viewer(*viewer).with_method(method).with_samples(samples);
                 let black = r.render(&gs, &settings.with_background([0.0; 3])).unwrap();
                 let white = r.render(&gs, &settings.with_background([1.0; 3])).unwrap();
                 for eye in twister::Eye::BOTH {
@@ -294,7 +308,7 @@ fn surround_scenes_let_no_sample_see_the_background() {
                         .collect();
                     assert!(
                         seen.is_empty(),
-                        "{what}, {panorama:?} {width}x{height} {} {eye:?}: {} pixels see the background, e.g. {:?}",
+                        "{what}, {panorama:?} {width}x{height} {} at {samples} samples {eye:?}: {} pixels see the background, e.g. {:?}",
                         method.name(),
                         seen.len(),
                         &seen[..seen.len().min(5)]

@@ -21,6 +21,7 @@ use rand::{Rng, SeedableRng};
 use twister::core::builtin;
 use twister::core::light::Tonemap;
 use twister::core::settings::{Method, Split};
+use twister::cpu::multisample::raster_multisampled;
 use twister::cpu::raster::raster;
 use twister::cpu::reduce_error::reduce_error;
 use twister::cpu::subdivide::subdivide;
@@ -293,6 +294,36 @@ fn raster_geometry_cases() -> Vec<(String, RasterCase)> {
     out
 }
 
+/// The raster twin's multisampled cases (4 samples, which every adapter draws itself): the
+/// coverage of edges and the resolve, alpha to coverage for MASK and BLEND materials.
+fn raster_sample_cases() -> Vec<(String, RasterCase)> {
+    let projection = Projection { width: 400, height: 100, vertical: Vertical::Exact, ..Projection::default() };
+    let settings = RenderSettings::new(projection).with_samples(4);
+    let mut blended = builtin::demo();
+    blended.materials.push(twister::core::material::Material {
+        alpha_mode: twister::core::material::AlphaMode::Blend as u32,
+        ..Default::default()
+    });
+    let blend = blended.materials.len() as u32;
+    for v in blended.vertices.iter_mut().filter(|v| v.object == 1 || v.object == 2) {
+        v.material = blend;
+        v.color[3] = if v.object == 1 { 0.5 } else { 0.3 };
+    }
+    let screen = common::ball_over_floor(twister::core::light::LightKind::Spot, true);
+    vec![
+        ("demo, 4 samples".into(), (builtin::demo(), settings, None)),
+        ("demo with two BLEND objects, 4 samples".into(), (blended, settings, None)),
+        (
+            "ball and MASK screen, 4 samples: alpha to coverage".into(),
+            (screen, settings.with_shadow_map_size(512), None),
+        ),
+        (
+            "demo on the sphere, 4 samples".into(),
+            (builtin::demo(), RenderSettings::new(Projection::equirect(256)).with_samples(4), None),
+        ),
+    ]
+}
+
 /// The raster twin's look cases: image-based lighting, every glTF map, shadow maps, the BRDF
 /// under each light kind and tone mapping.
 fn raster_look_cases() -> Vec<(String, RasterCase)> {
@@ -353,6 +384,7 @@ impl Twin for Raster {
     fn cases() -> Vec<(String, Self::Case)> {
         let mut out = raster_geometry_cases();
         out.extend(raster_look_cases());
+        out.extend(raster_sample_cases());
         out
     }
     fn gpu(_: &Renderer, (scene, settings, tolerance): &Self::Case) -> Self::Output {
@@ -362,8 +394,17 @@ impl Twin for Raster {
         let params = subdivide_params(settings, 0, scene.triangle_count() as u32);
         let tris = subdivide(&params, &scene.vertices, &scene.indices).vertices;
         let table = lit_table(scene, settings);
-        let eyes = raster(&raster_params(settings), &tris, &table, settings.shading.background)
+        let (background, samples) = (settings.shading.background, settings.shading.samples);
+        let mut eyes = raster(&raster_params(settings), &tris, &table, background)
             .map(|img| (img.rgba, img.error, img.object, img.distance));
+        // Several samples: the colour is the multisampled pass's, resolved; the rest stays the
+        // one-sample pass's, at the pixels' centres.
+        if samples > 1 {
+            let resolved = raster_multisampled(&raster_params(settings), &tris, &table, background, samples);
+            for (eye, rgba) in eyes.iter_mut().zip(resolved) {
+                eye.0 = rgba;
+            }
+        }
         (eyes, *tolerance)
     }
     fn compare((gpu, tolerance): &Self::Output, (cpu, _): &Self::Output) -> Result<(), String> {

@@ -6,10 +6,14 @@ set -euo pipefail
 cd "$(dirname "$0")/../.."
 work=$(mktemp -d)
 cargo run -q --release --example cycles_reference -- export "$work"
-render() { blender -b -P scripts/cycles/render_cycles.py -- "$work/demo.obj" "$work/$1" 512 "$2" "$3" "$4" >/dev/null; }
+render() { blender -b -P scripts/cycles/render_cycles.py -- "$work/demo.obj" "$work/$1" 512 "$2" "$3" "$4" "${5:-centre}" >/dev/null; }
 render parallel parallel 60 75
 render converge2m 2.0 60 75
 render no_pole_merge parallel off off
+# The anti-aliasing reference: a one-pixel box filter, kept as rendered (not snapped).
+render parallel_box parallel 60 75 box
+cp "$work/parallel_box_L.png" tests/data/cycles/demo_parallel_box_L.png
+cp "$work/parallel_box_R.png" tests/data/cycles/demo_parallel_box_R.png
 for case in "parallel parallel" "converge2m 2.0" "no_pole_merge parallel off"; do
     set -- $case
     cargo run -q --release --example cycles_reference -- snap "$work/$1" "tests/data/cycles/demo_$1"

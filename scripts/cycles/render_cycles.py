@@ -2,8 +2,11 @@
 spherical stereo (equirectangular, both eyes) as flat, unlit colours, so that twister's
 full-sphere panorama can be checked against Cycles pixel for pixel.
 
-blender -b -P scripts/cycles/render_cycles.py -- SCENE.obj OUT_PREFIX WIDTH CONVERGENCE POLE_FROM POLE_TO
+blender -b -P scripts/cycles/render_cycles.py -- SCENE.obj OUT_PREFIX WIDTH CONVERGENCE POLE_FROM POLE_TO [FILTER]
     CONVERGENCE: `parallel` or a distance in metres; POLE_FROM/POLE_TO in degrees (`off` for no merge)
+    FILTER: `centre` (default: 64 rays at each pixel's centre, no anti-aliasing, for the boundary
+    checks) or `box` (1024 rays spread evenly over the pixel, a one-pixel box filter: each pixel
+    the share of it each surface covers, for the anti-aliasing checks)
 
 Writes OUT_PREFIX_L.png and OUT_PREFIX_R.png (WIDTH × WIDTH/2 each).
 
@@ -18,6 +21,7 @@ import bpy
 
 argv = sys.argv[sys.argv.index("--") + 1:]
 obj_path, out_prefix, width, convergence, pole_from, pole_to = argv[:6]
+pixel_filter = argv[6] if len(argv) > 6 else "centre"
 width = int(width)
 
 bpy.ops.wm.read_factory_settings(use_empty=True)
@@ -71,9 +75,16 @@ scene.camera = cam
 
 scene.render.engine = "CYCLES"
 scene.cycles.device = "CPU"
-scene.cycles.samples = 64
 scene.cycles.use_denoising = False
-scene.cycles.filter_width = 0.01  # no reconstruction blur: each pixel averages its own area
+if pixel_filter == "box":
+    # Rays spread uniformly over the pixel: its value is the mean over its area.
+    scene.cycles.samples = 1024
+    scene.cycles.pixel_filter_type = "BOX"
+    scene.cycles.filter_width = 1.0
+else:
+    # Rays at the pixel's centre: no anti-aliasing (the boundary checks snap colours).
+    scene.cycles.samples = 64
+    scene.cycles.filter_width = 0.01
 scene.cycles.max_bounces = 0
 scene.render.resolution_x = width
 scene.render.resolution_y = width // 2

@@ -5,6 +5,7 @@
 //! |---|---|
 //! | [`subdivide`] | `shaders/subdivide/*.wgsl`, one file per pass (`active_cuts`, `ring_cuts`, `plan`, `plan_cuts_args`, `plan_cuts`, `lattice_args`, `lattice`, `finalize`: `subdivide::passes`), and `shaders/shared/subdivide_*.wgsl` |
 //! | [`raster`] | `shaders/raster.wgsl` |
+//! | [`multisample`] | the drawing stages' multisampled colour (`fs_main`, `fs_coverage`) and its resolve |
 //! | [`slit`] | `shaders/slit.wgsl` |
 //! | [`trace`] | `shaders/trace.wgsl` |
 //! | [`shadow`] | `shaders/shadow.wgsl` |
@@ -14,6 +15,7 @@
 //! | [`project_points`] | `shaders/project_points.wgsl` |
 
 pub mod fragment;
+pub mod multisample;
 pub mod project_points;
 pub mod raster;
 pub mod reduce_error;

@@ -160,7 +160,14 @@ pub fn fragment(
 /// Rasterizes one triangle into `img`, within the scissor rectangle [columns start, end, rows
 /// start, end).
 pub fn rasterize(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: [u32; 4], fragment: &FragmentFn) {
-    // Clip against the near plane z ≥ 0 in clip space (w = 1 triangles never need it).
+    for t in near_clipped(tri) {
+        rasterize_clipped(img, t, scissor, fragment);
+    }
+}
+
+/// A triangle clipped against the near plane z ≥ 0 in clip space: none, one or two triangles
+/// (w = 1 triangles never need it).
+pub(crate) fn near_clipped(tri: [ClipVertex; 3]) -> Vec<[ClipVertex; 3]> {
     let mut poly: Vec<ClipVertex> = Vec::with_capacity(4);
     for i in 0..3 {
         let (a, b) = (&tri[i], &tri[(i + 1) % 3]);
@@ -171,86 +178,115 @@ pub fn rasterize(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: [u32; 4],
             poly.push(ClipVertex::lerp(a, b, a.clip.z / (a.clip.z - b.clip.z)));
         }
     }
-    for i in 1..poly.len().saturating_sub(1) {
-        rasterize_clipped(img, [poly[0], poly[i], poly[i + 1]], scissor, fragment);
+    (1..poly.len().saturating_sub(1)).map(|i| [poly[0], poly[i], poly[i + 1]]).collect()
+}
+
+/// A clipped triangle on the pixel grid: its corners in pixels, its signed area, and the
+/// pixels of its bounding box within a scissor rectangle.
+pub(crate) struct ScreenTriangle {
+    pub tri: [ClipVertex; 3],
+    s: [[f32; 2]; 3],
+    area: f32,
+    /// Columns and rows of its bounding box within the scissor, [start, end).
+    pub columns: std::ops::Range<i64>,
+    pub rows: std::ops::Range<i64>,
+}
+
+impl ScreenTriangle {
+    /// The triangle on a `width` × `height` grid within `scissor` [columns start, end, rows
+    /// start, end); None if it is degenerate or has a corner at or behind the eye.
+    pub fn new(tri: [ClipVertex; 3], width: u32, height: u32, scissor: [u32; 4]) -> Option<ScreenTriangle> {
+        if tri.iter().any(|v| !v.clip.is_finite() || v.clip.w <= 0.0) {
+            return None;
+        }
+        let (w, h) = (width as f32, height as f32);
+        let s = tri.map(|v| [(v.clip.x / v.clip.w + 1.0) * 0.5 * w, (1.0 - v.clip.y / v.clip.w) * 0.5 * h]);
+        let area = (s[1][0] - s[0][0]) * (s[2][1] - s[0][1]) - (s[2][0] - s[0][0]) * (s[1][1] - s[0][1]);
+        if area == 0.0 {
+            return None;
+        }
+        let min_x = s.iter().map(|p| p[0]).fold(f32::MAX, f32::min).floor().max(scissor[0] as f32) as i64;
+        let max_x = s.iter().map(|p| p[0]).fold(f32::MIN, f32::max).ceil().min(scissor[1].min(width) as f32) as i64;
+        let min_y = s.iter().map(|p| p[1]).fold(f32::MAX, f32::min).floor().max(scissor[2] as f32) as i64;
+        let max_y = s.iter().map(|p| p[1]).fold(f32::MIN, f32::max).ceil().min(scissor[3].min(height) as f32) as i64;
+        Some(ScreenTriangle { tri, s, area, columns: min_x..max_x, rows: min_y..max_y })
+    }
+
+    /// Screen-space barycentric weights of a point.
+    pub fn barycentric(&self, qx: f32, qy: f32) -> [f32; 3] {
+        let s = &self.s;
+        let edge = |a: [f32; 2], b: [f32; 2]| (b[0] - a[0]) * (qy - a[1]) - (b[1] - a[1]) * (qx - a[0]);
+        [edge(s[1], s[2]) / self.area, edge(s[2], s[0]) / self.area, edge(s[0], s[1]) / self.area]
+    }
+
+    /// The depth at barycentrics `b` (interpolated linearly on the screen, as GPUs do), if the
+    /// point is inside the triangle.
+    pub fn covers(&self, b: [f32; 3]) -> Option<f32> {
+        if b.iter().any(|&x| x < 0.0) {
+            return None;
+        }
+        Some((0..3).map(|k| b[k] * self.tri[k].clip.z / self.tri[k].clip.w).sum::<f32>())
+    }
+
+    /// Perspective-correct weights from screen-space ones.
+    fn perspective(&self, b: [f32; 3]) -> [f32; 3] {
+        let pw = [0, 1, 2].map(|k| b[k] / self.tri[k].clip.w);
+        let sum: f32 = pw.iter().sum();
+        pw.map(|w| w / sum)
+    }
+
+    /// The fragment of pixel (x, y), its attributes at the pixel's centre (inside the triangle
+    /// or not, as a GPU interpolates them for a pixel some of whose samples it covers), and the
+    /// derivatives as the GPU takes them over its 2×2 quad of pixels: fine (the difference
+    /// across the quad in this pixel's row for x, in its column for y; lavapipe's dpdx is fine
+    /// too), from points outside the triangle where the quad reaches beyond it, as helper
+    /// invocations do.
+    pub fn fragment_input(&self, x: i64, y: i64) -> FragmentIn {
+        let tri = &self.tri;
+        let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
+        let pw = self.perspective(self.barycentric(px, py));
+        let mix3 = |f: &dyn Fn(&ClipVertex) -> Vec3| (0..3).map(|k| pw[k] * f(&tri[k])).sum::<Vec3>();
+        let uv_at = |x: f32, y: f32| {
+            let w = self.perspective(self.barycentric(x, y));
+            (0..3).map(|k| w[k] * tri[k].uv).sum::<Vec2>()
+        };
+        let position_at = |x: f32, y: f32| {
+            let w = self.perspective(self.barycentric(x, y));
+            (0..3).map(|k| w[k] * tri[k].view_position).sum::<Vec3>()
+        };
+        let (qx, qy) = ((x & !1) as f32 + 0.5, (y & !1) as f32 + 0.5);
+        FragmentIn {
+            view_position: mix3(&|v| v.view_position),
+            dp_dx: position_at(qx + 1.0, py) - position_at(qx, py),
+            dp_dy: position_at(px, qy + 1.0) - position_at(px, qy),
+            normal: mix3(&|v| v.normal),
+            surface: Surface {
+                material: tri[0].material,
+                color: (0..3).map(|k| pw[k] * tri[k].color).sum::<Vec4>(),
+                uv: (0..3).map(|k| pw[k] * tri[k].uv).sum::<Vec2>(),
+                duv_dx: uv_at(qx + 1.0, py) - uv_at(qx, py),
+                duv_dy: uv_at(px, qy + 1.0) - uv_at(px, qy),
+                frag_xy: Vec2::new(px, py),
+                // Counter-clockwise in normalized device coordinates (y up) is clockwise on the
+                // pixel grid (y down): negative `area`.
+                front_facing: self.area < 0.0,
+                tangent: (0..3).map(|k| pw[k] * tri[k].tangent).sum::<Vec4>(),
+            },
+        }
     }
 }
 
 fn rasterize_clipped(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: [u32; 4], fragment: &FragmentFn) {
-    let (w, h) = (img.width, img.height);
-    if tri.iter().any(|v| !v.clip.is_finite() || v.clip.w <= 0.0) {
-        return;
-    }
-    let s: Vec<[f32; 2]> = tri
-        .iter()
-        .map(|v| [(v.clip.x / v.clip.w + 1.0) * 0.5 * w as f32, (1.0 - v.clip.y / v.clip.w) * 0.5 * h as f32])
-        .collect();
-    let area = (s[1][0] - s[0][0]) * (s[2][1] - s[0][1]) - (s[2][0] - s[0][0]) * (s[1][1] - s[0][1]);
-    if area == 0.0 {
-        return;
-    }
-    let min_x = s.iter().map(|p| p[0]).fold(f32::MAX, f32::min).floor().max(scissor[0] as f32) as i64;
-    let max_x = s.iter().map(|p| p[0]).fold(f32::MIN, f32::max).ceil().min(scissor[1].min(w) as f32) as i64;
-    let min_y = s.iter().map(|p| p[1]).fold(f32::MAX, f32::min).floor().max(scissor[2] as f32) as i64;
-    let max_y = s.iter().map(|p| p[1]).fold(f32::MIN, f32::max).ceil().min(scissor[3].min(h) as f32) as i64;
-    // Screen-space barycentric weights of a point, and their perspective-correct form.
-    let barycentric = |qx: f32, qy: f32| {
-        let edge = |a: [f32; 2], b: [f32; 2]| (b[0] - a[0]) * (qy - a[1]) - (b[1] - a[1]) * (qx - a[0]);
-        [edge(s[1], s[2]) / area, edge(s[2], s[0]) / area, edge(s[0], s[1]) / area]
-    };
-    let perspective = |b: [f32; 3]| {
-        let pw = [0, 1, 2].map(|k| b[k] / tri[k].clip.w);
-        let sum: f32 = pw.iter().sum();
-        pw.map(|w| w / sum)
-    };
-    for y in min_y..max_y {
-        for x in min_x..max_x {
-            let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
-            let b = barycentric(px, py);
-            if b.iter().any(|&x| x < 0.0) {
-                continue;
-            }
-            let z = (0..3).map(|k| b[k] * tri[k].clip.z / tri[k].clip.w).sum::<f32>();
+    let w = img.width;
+    let Some(t) = ScreenTriangle::new(tri, img.width, img.height, scissor) else { return };
+    for y in t.rows.clone() {
+        for x in t.columns.clone() {
+            let Some(z) = t.covers(t.barycentric(x as f32 + 0.5, y as f32 + 0.5)) else { continue };
             let i = (y as u32 * w + x as u32) as usize;
             if !(z < img.depth[i]) || !(z >= 0.0) {
                 continue;
             }
-            // Perspective-correct weights here, and the derivatives as the GPU takes them over
-            // its 2×2 quad of pixels: fine (the difference across the quad in this pixel's row
-            // for x, in its column for y; lavapipe's dpdx is fine too), from points outside the
-            // triangle where the quad reaches beyond it, as helper invocations do.
-            let pw = perspective(b);
-            let mix3 = |f: &dyn Fn(&ClipVertex) -> Vec3| (0..3).map(|k| pw[k] * f(&tri[k])).sum::<Vec3>();
-            let uv_at = |x: f32, y: f32| {
-                let w = perspective(barycentric(x, y));
-                (0..3).map(|k| w[k] * tri[k].uv).sum::<Vec2>()
-            };
-            let uv = (0..3).map(|k| pw[k] * tri[k].uv).sum::<Vec2>();
-            let position_at = |x: f32, y: f32| {
-                let w = perspective(barycentric(x, y));
-                (0..3).map(|k| w[k] * tri[k].view_position).sum::<Vec3>()
-            };
-            let view_position = mix3(&|v| v.view_position);
-            let (qx, qy) = ((x & !1) as f32 + 0.5, (y & !1) as f32 + 0.5);
-            let input = FragmentIn {
-                view_position,
-                dp_dx: position_at(qx + 1.0, py) - position_at(qx, py),
-                dp_dy: position_at(px, qy + 1.0) - position_at(px, qy),
-                normal: mix3(&|v| v.normal),
-                surface: Surface {
-                    material: tri[0].material,
-                    color: (0..3).map(|k| pw[k] * tri[k].color).sum::<Vec4>(),
-                    uv,
-                    duv_dx: uv_at(qx + 1.0, py) - uv_at(qx, py),
-                    duv_dy: uv_at(px, qy + 1.0) - uv_at(px, qy),
-                    frag_xy: Vec2::new(px, py),
-                    // Counter-clockwise in normalized device coordinates (y up) is clockwise
-                    // on the pixel grid (y down): negative `area`.
-                    front_facing: area < 0.0,
-                    tangent: (0..3).map(|k| pw[k] * tri[k].tangent).sum::<Vec4>(),
-                },
-            };
-            let Some(out) = fragment(&input) else {
+            let Some(out) = fragment(&t.fragment_input(x, y)) else {
                 continue;
             };
             img.depth[i] = z;
@@ -279,22 +315,27 @@ pub fn raster(
     }
     for tri in vertices.chunks_exact(3) {
         for ((eye_params, eye), img) in params.iter().zip(Eye::BOTH).zip(images.iter_mut()) {
-            let cv = [0, 1, 2].map(|k| ClipVertex {
-                clip: raster_vertex(eye_params, &tri[k]),
-                view_position: Vec3::from(tri[k].position),
-                normal: Vec3::from(tri[k].normal),
-                tangent: unpack_tangent(tri[k].tangent),
-                color: Vec4::from(tri[k].color),
-                uv: Vec2::from(tri[k].uv),
-                object: tri[k].object,
-                material: tri[k].material,
-            });
+            let cv = clip_vertices(eye_params, tri);
             let fragment =
                 |f: &FragmentIn| fragment(table, eye_params.ambient, &projection, eye, eye_params.error_angle != 0, f);
             rasterize(img, cv, [0, projection.width, 0, projection.height], &fragment);
         }
     }
     images
+}
+
+/// A subdivided triangle's corners as the raster stage's vertex shader gives them for one eye.
+pub(crate) fn clip_vertices(params: &RasterParams, tri: &[DrawVertex]) -> [ClipVertex; 3] {
+    [0, 1, 2].map(|k| ClipVertex {
+        clip: raster_vertex(params, &tri[k]),
+        view_position: Vec3::from(tri[k].position),
+        normal: Vec3::from(tri[k].normal),
+        tangent: unpack_tangent(tri[k].tangent),
+        color: Vec4::from(tri[k].color),
+        uv: Vec2::from(tri[k].uv),
+        object: tri[k].object,
+        material: tri[k].material,
+    })
 }
 
 /// Paints the environment into an image's background (the background triangle drawn first).

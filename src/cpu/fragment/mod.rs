@@ -339,6 +339,19 @@ pub struct Surface {
 /// The linear surface colour of a fragment, or None where it is discarded (a single-sided face
 /// seen from behind, alpha below the MASK cutoff, a BLEND fragment the screen door leaves out).
 pub fn surface_color(table: &MaterialTable, s: &Surface) -> Option<Vec4> {
+    let c = surface_rgba(table, s)?;
+    let m = &table.materials[(s.material as usize).min(table.materials.len() - 1)];
+    if (m.alpha_mode == AlphaMode::Mask as u32 && c.w < m.alpha_cutoff)
+        || (m.alpha_mode == AlphaMode::Blend as u32 && c.w <= blend_threshold(s.frag_xy))
+    {
+        return None;
+    }
+    Some(c)
+}
+
+/// The linear surface colour of a fragment before its alpha test (`surface_rgba` in
+/// surface.wgsl); None for a single-sided face seen from behind.
+pub fn surface_rgba(table: &MaterialTable, s: &Surface) -> Option<Vec4> {
     let m = &table.materials[(s.material as usize).min(table.materials.len() - 1)];
     if m.double_sided == 0 && !s.front_facing {
         return None;
@@ -346,11 +359,6 @@ pub fn surface_color(table: &MaterialTable, s: &Surface) -> Option<Vec4> {
     let mut c = s.color;
     if m.texture != NO_TEXTURE && m.mip_count > 0 {
         c *= sample_texture(table, m, s.uv, s.duv_dx, s.duv_dy);
-    }
-    if (m.alpha_mode == AlphaMode::Mask as u32 && c.w < m.alpha_cutoff)
-        || (m.alpha_mode == AlphaMode::Blend as u32 && c.w <= blend_threshold(s.frag_xy))
-    {
-        return None;
     }
     Some(c)
 }
