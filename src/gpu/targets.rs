@@ -74,14 +74,16 @@ impl Samples {
     }
 }
 
-/// Per eye a colour and a depth target of N samples (single-layer: wgpu has no multisampled
-/// array textures), resolved into a single-layer target of the eye's and copied into its layer
-/// of the frame's colour target ([`Targets::copy_resolved`]; lavapipe resolved a pass into a
-/// layer view of the 2-layer target always into layer 0).
+/// A colour and a depth target of N samples (single-layer: wgpu has no multisampled array
+/// textures), which the eyes' passes take in turn (one eye's samples are resolved at the end of
+/// its pass, so the next pass may clear them: half the memory of a pair), each pass resolved into
+/// a single-layer target of its eye's and copied into its layer of the frame's colour target
+/// ([`Targets::copy_resolved`]; lavapipe resolved a pass into a layer view of the 2-layer target
+/// always into layer 0).
 pub struct Multisampled {
     pub samples: u32,
-    color: [wgpu::Texture; 2],
-    depth: [wgpu::Texture; 2],
+    color: wgpu::Texture,
+    depth: wgpu::Texture,
     resolved: [wgpu::Texture; 2],
 }
 
@@ -139,10 +141,8 @@ impl Targets {
             hdr,
             multisampled: (samples > 1).then(|| Multisampled {
                 samples,
-                color: ["left", "right"]
-                    .map(|e| texture(COLOR_FORMAT, depth, &format!("{e} colour samples"), 1, samples)),
-                depth: ["left", "right"]
-                    .map(|e| texture(DEPTH_FORMAT, depth, &format!("{e} depth samples"), 1, samples)),
+                color: texture(COLOR_FORMAT, depth, "colour samples", 1, samples),
+                depth: texture(DEPTH_FORMAT, depth, "depth samples", 1, samples),
                 resolved: ["left", "right"].map(|e| {
                     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
                     texture(COLOR_FORMAT, usage, &format!("{e} colour resolved"), 1, 1)
@@ -227,8 +227,8 @@ impl Targets {
         };
         let ms = self.multisampled.as_ref().expect("the targets were made with the frame's samples");
         let resolve = ms.resolved[k].create_view(&Default::default());
-        let color = ms.color[k].create_view(&Default::default());
-        let depth = ms.depth[k].create_view(&Default::default());
+        let color = ms.color.create_view(&Default::default());
+        let depth = ms.depth.create_view(&Default::default());
         let attachments = [attachment(&color, Some(&resolve), background_clear(settings), clear)];
         let label = if k == 0 { "left eye's samples" } else { "right eye's samples" };
         begin(enc, label, &attachments, &depth, clear, timestamp_writes, None)
