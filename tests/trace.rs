@@ -1,14 +1,21 @@
 //! The ray tracer (`--method trace`) against the independent reference, the slit renderer at one
 //! column per slit (`slit:1`, the exact vertical model, to which it converges): the same surface
 //! on ≥ 99.9 % of the covered pixels, and where they differ (boundaries), the other render shows
-//! the same surface within 1 px.
+//! the same surface within 1 px. And the CPU twin's traversal against brute force.
 
 mod common;
 
-use glam::Mat4;
+use std::cell::Cell;
+
+use glam::{Mat4, Vec2, Vec3};
 use twister::core::builtin;
+use twister::core::builtin::sphere_scene;
+use twister::core::bvh::{BvhLevel, SceneBvh};
 use twister::core::load::load_scene;
+use twister::core::lod::LodChain;
+use twister::core::scene::SceneVertex;
 use twister::core::settings::Method;
+use twister::cpu::trace::{closest_hit, TracedRay, TracedScene};
 use twister::{Eye, Frame, GpuScene, Projection, RenderSettings, Scene, Vertical};
 
 fn render(scene: &Scene, settings: &RenderSettings) -> Frame {
@@ -131,7 +138,6 @@ fn trace_refuses_the_paper_model_and_a_scene_without_its_bvh() {
 
 // ---- optics: a mirror sphere and a glass sphere against analytic rays ----
 
-use glam::{Vec2, Vec3};
 use twister::core::color::linear_to_srgb;
 use twister::core::material::Material;
 use twister::cpu::fragment::pixel_ray;
@@ -559,4 +565,83 @@ fn the_ray_tracer_filters_textures_as_the_rasterizer_does() {
     assert!(n > 10_000 && far_n > 1000, "{n} floor pixels, {far_n} far");
     // Sampled at level 0 (no cones) the floor differs by 18 levels on average, 22 beyond 8 m.
     assert!(mean < 8.0 && far_mean < 3.0, "mean {mean:.2}, far {far_mean:.2} levels");
+}
+
+// ---- the twin's traversal (CPU only) ----
+
+/// The nearest hit of a ray among `triangles` by testing every one (Möller–Trumbore).
+fn brute_force(vertices: &[SceneVertex], triangles: &[u32], origin: Vec3, dir: Vec3) -> Option<f32> {
+    let mut best: Option<f32> = None;
+    for t in triangles.chunks_exact(3) {
+        let p = |k: usize| Vec3::from(vertices[t[k] as usize].position);
+        let (e1, e2) = (p(1) - p(0), p(2) - p(0));
+        let q = dir.cross(e2);
+        let det = e1.dot(q);
+        if det.abs() < 1e-12 {
+            continue;
+        }
+        let s = origin - p(0);
+        let b1 = s.dot(q) / det;
+        let r = s.cross(e1);
+        let b2 = dir.dot(r) / det;
+        let d = e2.dot(r) / det;
+        if b1 >= 0.0 && b2 >= 0.0 && b1 + b2 <= 1.0 && d > 0.0 && best.is_none_or(|b| d < b) {
+            best = Some(d);
+        }
+    }
+    best
+}
+
+/// Through the two-level BVH, a ray of visual level λ meets each object at the chain level
+/// eq. 10 picks: its hit is the brute-force nearest hit among those levels' triangles.
+#[test]
+fn closest_hit_meets_each_object_at_the_level_eq_10_picks() {
+    let mut scene = Scene::new("spheres");
+    for (k, z) in [-2.0f32, -3.0, -4.0].into_iter().enumerate() {
+        let s = sphere_scene(2400, Vec3::new(0.3 * k as f32, 0.1 * k as f32, z), 0.6, "s");
+        scene.add_mesh(format!("s{k}"), &s.vertices, &s.indices);
+    }
+    let chain = LodChain::build(&scene, 0.08);
+    let bvh = SceneBvh::build(&scene.vertices, &chain.levels);
+    let traced = TracedScene { bvh: &bvh, vertices: &scene.vertices, min_share: 0.08 };
+    let tests = Cell::new(0);
+    let mut checked = [0usize; 2];
+    for i in 0..600 {
+        let level = (i % 11) as f32 / 10.0;
+        let a = i as f32 * 0.618;
+        let dir = Vec3::new(0.25 * a.sin(), 0.25 * (1.7 * a).cos(), -1.0).normalize();
+        let origin = Vec3::new(0.05 * (i % 3) as f32, 0.0, 0.0);
+        let picked: Vec<u32> = chain
+            .levels
+            .iter()
+            .map(|object| {
+                let counts: Vec<BvhLevel> =
+                    object.iter().map(|l| BvhLevel { root: 0, triangles: (l.len() / 3) as u32 }).collect();
+                object[SceneBvh::pick_level(&counts, level, 0.08)].clone()
+            })
+            .collect::<Vec<_>>()
+            .concat();
+        let want = brute_force(&scene.vertices, &picked, origin, dir);
+        let got = closest_hit(
+            &traced,
+            &TracedRay { origin, dir, limit: f32::MAX, level, cone: Vec2::ZERO },
+            &|_, _, _, _, _, _| true,
+            &tests,
+        )
+        .map(|h| h.t);
+        match (want, got) {
+            (Some(w), Some(g)) => assert!((w - g).abs() < 1e-4 * w, "ray {i}, level {level}: {g} vs {w}"),
+            (None, None) => {}
+            _ => panic!("ray {i}, level {level}: {got:?} vs brute force {want:?}"),
+        }
+        checked[want.is_some() as usize] += 1;
+    }
+    assert!(checked[1] > 300 && checked[0] > 20, "{checked:?}");
+    // A coarse level is a different surface: the same ray may hit at another distance.
+    let ray = |level| {
+        let dir = Vec3::new(0.1, 0.05, -1.0).normalize();
+        let ray = TracedRay { origin: Vec3::ZERO, dir, limit: f32::MAX, level, cone: Vec2::ZERO };
+        closest_hit(&traced, &ray, &|_, _, _, _, _, _| true, &tests)
+    };
+    assert_ne!(ray(1.0).map(|h| h.triangle), ray(0.0).map(|h| h.triangle));
 }
