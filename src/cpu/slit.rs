@@ -63,12 +63,41 @@ pub fn slit(
 ) -> RasterImage {
     let projection = Projection::from(&params.projection);
     let eye = if params.eye_sign > 0.0 { Eye::Right } else { Eye::Left };
-    let view = Mat4::from_cols_array_2d(&params.view);
     let mut img = RasterImage::new(projection.width, projection.height, background);
     if crate::cpu::fragment::shows_environment(table) {
         crate::cpu::raster::fill_background(&mut img, table, &projection, eye);
     }
     let fragment = |f: &FragmentIn| fragment(table, params.ambient, &projection, eye, params.error_angle != 0, f);
+    slit_triangles(params, slits, scene, |tri, scissor| rasterize(&mut img, tri, scissor, &fragment));
+    img
+}
+
+/// The slit stage's multisampled colour pass on the CPU for one eye (`samples` per pixel),
+/// resolved (RGBA8; `cpu::multisample`).
+pub fn slit_multisampled(
+    params: &SlitParams,
+    slits: &[Slit],
+    scene: &Scene,
+    table: &MaterialTable,
+    background: [f32; 3],
+    samples: u32,
+) -> Vec<u8> {
+    use crate::cpu::multisample::{coverage_fragment, MultisampledImage};
+    let projection = Projection::from(&params.projection);
+    let eye = if params.eye_sign > 0.0 { Eye::Right } else { Eye::Left };
+    let mut img = MultisampledImage::new(projection.width, projection.height, samples, background);
+    if crate::cpu::fragment::shows_environment(table) {
+        img.fill_background(table, &projection, eye);
+    }
+    let fragment = |f: &FragmentIn| coverage_fragment(table, params.ambient, &projection, eye, samples, f);
+    slit_triangles(params, slits, scene, |tri, scissor| img.rasterize(tri, scissor, &fragment));
+    img.resolve()
+}
+
+/// Each triangle each slit draws (the objects whose bounding sphere its camera may see), as the
+/// slit's camera puts it, with the slit's scissor rectangle.
+fn slit_triangles(params: &SlitParams, slits: &[Slit], scene: &Scene, mut draw: impl FnMut([ClipVertex; 3], [u32; 4])) {
+    let view = Mat4::from_cols_array_2d(&params.view);
     let spheres = object_spheres(scene);
     for slit in slits {
         for (o, &(center, radius)) in scene.objects.iter().zip(&spheres) {
@@ -93,10 +122,8 @@ pub fn slit(
                         material: v.material,
                     }
                 });
-                let scissor = [slit.first_column, slit.end_column, slit.first_row, slit.end_row];
-                rasterize(&mut img, cv, scissor, &fragment);
+                draw(cv, [slit.first_column, slit.end_column, slit.first_row, slit.end_row]);
             }
         }
     }
-    img
 }

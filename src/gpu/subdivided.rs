@@ -111,6 +111,8 @@ impl Method for SubdividedMethod {
             plan = plan.after_overflow(budget);
         }
         let FramePlan::Chunked { mut want, budget } = plan else { unreachable!("a one-submission frame returned") };
+        // Each chunk's pass loads what the eye's earlier chunks drew: no samples shared by the eyes.
+        res.targets.as_mut().expect("made").give_each_eye_its_samples(gpu);
         self.render_chunked(gpu, res, scene, settings, &mut want, budget, &mut stats)?;
         stats.ms_frame = stats.ms_subdivide.unwrap_or(0.0) + stats.ms_raster.unwrap_or(0.0);
         stats.timing = Timing::WallPerPass;

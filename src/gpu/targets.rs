@@ -76,15 +76,23 @@ impl Samples {
 
 /// A colour and a depth target of N samples (single-layer: wgpu has no multisampled array
 /// textures), which the eyes' passes take in turn (one eye's samples are resolved at the end of
-/// its pass, so the next pass may clear them: half the memory of a pair), each pass resolved into
-/// a single-layer target of its eye's and copied into its layer of the frame's colour target
-/// ([`Targets::copy_resolved`]; lavapipe resolved a pass into a layer view of the 2-layer target
-/// always into layer 0).
+/// its pass, so the next pass may clear them: half the memory of a pair), or one pair per eye
+/// (`per_eye`: a frame drawn in chunks, whose later passes load what the eye's earlier ones
+/// drew); each pass resolved into a single-layer target of its eye's and copied into its layer of
+/// the frame's colour target ([`Targets::copy_resolved`]; lavapipe resolved a pass into a layer
+/// view of the 2-layer target always into layer 0).
 pub struct Multisampled {
     pub samples: u32,
-    color: wgpu::Texture,
-    depth: wgpu::Texture,
+    color: Vec<wgpu::Texture>,
+    depth: Vec<wgpu::Texture>,
     resolved: [wgpu::Texture; 2],
+}
+
+impl Multisampled {
+    /// Whether each eye has its own samples.
+    pub fn per_eye(&self) -> bool {
+        self.color.len() == 2
+    }
 }
 
 pub struct Targets {
@@ -141,8 +149,8 @@ impl Targets {
             hdr,
             multisampled: (samples > 1).then(|| Multisampled {
                 samples,
-                color: texture(COLOR_FORMAT, depth, "colour samples", 1, samples),
-                depth: texture(DEPTH_FORMAT, depth, "depth samples", 1, samples),
+                color: vec![texture(COLOR_FORMAT, depth, "colour samples", 1, samples)],
+                depth: vec![texture(DEPTH_FORMAT, depth, "depth samples", 1, samples)],
                 resolved: ["left", "right"].map(|e| {
                     let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
                     texture(COLOR_FORMAT, usage, &format!("{e} colour resolved"), 1, 1)
@@ -150,6 +158,31 @@ impl Targets {
             }),
             error_target: gpu.error_target,
         }
+    }
+
+    /// Gives the right eye multisampled targets of its own (the left keeps the ones the eyes
+    /// shared), for a frame drawn in chunks: its later passes load what each eye's earlier ones
+    /// drew.
+    pub fn give_each_eye_its_samples(&mut self, gpu: &Gpu) {
+        let (width, height) = (self.width, self.height);
+        let Some(ms) = self.multisampled.as_mut().filter(|m| !m.per_eye()) else { return };
+        let size = wgpu::Extent3d { width, height, depth_or_array_layers: 1 };
+        let texture = |format, label: &str| {
+            gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size,
+                mip_level_count: 1,
+                sample_count: ms.samples,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+                view_formats: &[],
+            })
+        };
+        let (color, depth) =
+            (texture(COLOR_FORMAT, "right colour samples"), texture(DEPTH_FORMAT, "right depth samples"));
+        ms.color.push(color);
+        ms.depth.push(depth);
     }
 
     /// Begins a render pass drawing `layers`, clearing their targets first if `clear`
@@ -227,8 +260,8 @@ impl Targets {
         };
         let ms = self.multisampled.as_ref().expect("the targets were made with the frame's samples");
         let resolve = ms.resolved[k].create_view(&Default::default());
-        let color = ms.color.create_view(&Default::default());
-        let depth = ms.depth.create_view(&Default::default());
+        let color = ms.color[k % ms.color.len()].create_view(&Default::default());
+        let depth = ms.depth[k % ms.depth.len()].create_view(&Default::default());
         let attachments = [attachment(&color, Some(&resolve), background_clear(settings), clear)];
         let label = if k == 0 { "left eye's samples" } else { "right eye's samples" };
         begin(enc, label, &attachments, &depth, clear, timestamp_writes, None)

@@ -3,7 +3,7 @@
 
 use twister::core::builtin;
 use twister::core::settings::Method;
-use twister::cpu::slit::slit;
+use twister::cpu::slit::{slit, slit_multisampled};
 use twister::encoding::slits::{slit_params, slits};
 use twister::{Eye, Projection, RenderSettings, Renderer, Scene, Vertical};
 
@@ -49,6 +49,16 @@ impl Twin for Slit {
                 RenderSettings::new(projection).with_method(Method::Slit(4)).with_ambient(1.0).with_anisotropy(16),
             ),
         ));
+        cases.push((
+            "demo slit:4, 4 samples".into(),
+            (builtin::demo(), RenderSettings::new(projection).with_method(Method::Slit(4)).with_samples(4)),
+        ));
+        let screen = common::ball_over_floor(twister::core::light::LightKind::Directional, true);
+        let settings = RenderSettings::new(projection).with_method(Method::Slit(4)).with_shadow_map_size(512);
+        cases.push((
+            "ball and MASK screen slit:4, 4 samples: alpha to coverage".into(),
+            (screen, settings.with_samples(4)),
+        ));
         let mut studio = common::lit_spheres();
         studio.environment = Some(common::studio(true));
         cases.push((
@@ -64,10 +74,16 @@ impl Twin for Slit {
         let Method::Slit(w) = settings.subdivision.method else { unreachable!() };
         let p = settings.projection();
         let table = lit_table(scene, settings);
+        let (background, samples) = (settings.shading.background, settings.shading.samples);
         Eye::BOTH.map(|eye| {
             let params = slit_params(p, settings.view(), eye, settings.shading.ambient, settings.measure.error_angle);
-            let img = slit(&params, &slits(p, eye, w), scene, &table, settings.shading.background);
-            (img.rgba, img.error, img.object, img.distance)
+            let img = slit(&params, &slits(p, eye, w), scene, &table, background);
+            // Several samples: the multisampled pass's colour, the rest at the pixels' centres.
+            let rgba = match samples {
+                1 => img.rgba,
+                n => slit_multisampled(&params, &slits(p, eye, w), scene, &table, background, n),
+            };
+            (rgba, img.error, img.object, img.distance)
         })
     }
     fn compare(gpu: &Self::Output, cpu: &Self::Output) -> Result<(), String> {
