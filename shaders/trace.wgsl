@@ -455,14 +455,16 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     var rays = 0u;
     var tests = 0u;
     if (n > 1u) {
-        let centre = write_centre(slot, eye_sign, vec2<f32>(gid.xy) + 0.5);
-        rays += centre.x;
-        tests += centre.y;
+        // The centre's ray for the outputs alone (one sample is the centre's itself).
+        let centre = trace_sample(slot, eye_sign, vec2<f32>(gid.xy) + 0.5, SAMPLE_OUTPUTS);
+        rays += centre.rays;
+        tests += centre.tests;
     }
     var sum = vec3<f32>(0.0);
     var plain = 0u;
     for (var i = 0u; i < n; i++) {
-        let s = trace_sample(slot, eye_sign, vec2<f32>(gid.xy) + sample_position(n, i), n == 1u);
+        let s = trace_sample(slot, eye_sign, vec2<f32>(gid.xy) + sample_position(n, i),
+                             select(SAMPLE_COLOUR, SAMPLE_BOTH, n == 1u));
         sum += s.color;
         plain += u32(s.plain);
         rays += s.rays;
@@ -478,17 +480,14 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
 
 // Where sample i of n lies in its pixel (0..1 from the pixel's corner): the standard sample
 // positions of Vulkan and Direct3D for 1, 2, 4, 8 and 16 samples (in 16ths of a pixel; one
-// sample: the centre), 32 as the 8 pattern in each quarter of the pixel. `sample_position` in
-// src/core/sampling.rs.
+// sample: the centre; `SAMPLES_N`, generated from src/core/sampling.rs), 32 as the 8 pattern in
+// each quarter of the pixel. `sample_position` in src/core/sampling.rs.
 fn sample_position(n: u32, i: u32) -> vec2<f32> {
-    var p2 = array<vec2<f32>, 2>(vec2<f32>(12.0, 12.0), vec2<f32>(4.0, 4.0));
-    var p4 = array<vec2<f32>, 4>(vec2<f32>(6.0, 2.0), vec2<f32>(14.0, 6.0), vec2<f32>(2.0, 10.0), vec2<f32>(10.0, 14.0));
-    var p8 = array<vec2<f32>, 8>(vec2<f32>(9.0, 5.0), vec2<f32>(7.0, 11.0), vec2<f32>(13.0, 9.0), vec2<f32>(5.0, 3.0),
-                                 vec2<f32>(3.0, 13.0), vec2<f32>(1.0, 7.0), vec2<f32>(11.0, 15.0), vec2<f32>(15.0, 1.0));
-    var p16 = array<vec2<f32>, 16>(vec2<f32>(9.0, 9.0), vec2<f32>(7.0, 5.0), vec2<f32>(5.0, 10.0), vec2<f32>(12.0, 7.0),
-                                   vec2<f32>(3.0, 6.0), vec2<f32>(10.0, 13.0), vec2<f32>(13.0, 11.0), vec2<f32>(11.0, 3.0),
-                                   vec2<f32>(6.0, 14.0), vec2<f32>(8.0, 1.0), vec2<f32>(4.0, 2.0), vec2<f32>(2.0, 12.0),
-                                   vec2<f32>(0.0, 8.0), vec2<f32>(15.0, 4.0), vec2<f32>(14.0, 15.0), vec2<f32>(1.0, 0.0));
+    // The generated tables (`constants`), copied to be indexed at run time.
+    var p2 = SAMPLES_2;
+    var p4 = SAMPLES_4;
+    var p8 = SAMPLES_8;
+    var p16 = SAMPLES_16;
     switch n {
         case 2u: { return p2[i] / 16.0; }
         case 4u: { return p4[i] / 16.0; }
@@ -502,27 +501,6 @@ fn sample_position(n: u32, i: u32) -> vec2<f32> {
     }
 }
 
-// The outputs at a pixel's centre (error, object, distance) from its primary ray alone, for
-// frames of several samples; the rays traced and ray–triangle tests made.
-fn write_centre(slot: u32, eye_sign: f32, frag_xy: vec2<f32>) -> vec2<u32> {
-    let ray = pixel_ray(params.projection, eye_sign, frag_xy);
-    write_background(slot);
-    var level = 1.0;
-    if (params.gaze_forward.w > 0.0) {
-        level = visual_level(ray.dir);
-        if (level <= 0.0) {
-            return vec2<u32>(0u);
-        }
-    }
-    let spread = pixel_spread(params.projection, frag_xy);
-    let hit = closest_hit((params.to_scene * vec4<f32>(ray.origin, 1.0)).xyz, (params.to_scene * vec4<f32>(ray.dir, 0.0)).xyz,
-                          frag_xy, FAR, level, vec2<f32>(0.0, spread));
-    if (hit.triangle != NO_HIT) {
-        write_primary(slot, eye_sign, ray, hit, frag_xy);
-    }
-    return vec2<u32>(1u, hit.tests);
-}
-
 // The error, object and distance outputs of a primary ray's hit.
 fn write_primary(slot: u32, eye_sign: f32, ray: Ray, hit: Hit, frag_xy: vec2<f32>) {
     let view_position = ray.origin + hit.t * ray.dir;
@@ -530,6 +508,13 @@ fn write_primary(slot: u32, eye_sign: f32, ray: Ray, hit: Hit, frag_xy: vec2<f32
     out_object[slot] = vertices[indices[3u * hit.triangle]].object + 1u;
     out_distance[slot] = bitcast<u32>(hit.t);
 }
+
+// What `trace_sample` makes of its ray: its colour, its colour and the pixel's outputs (one
+// sample, the centre's), or the outputs alone (the centre's ray beside several samples: its
+// primary hit only).
+const SAMPLE_COLOUR: u32 = 0u;
+const SAMPLE_BOTH: u32 = 1u;
+const SAMPLE_OUTPUTS: u32 = 2u;
 
 // A traced sample: its colour as the pixel shows it (tone mapped, linear light), whether that is
 // the plain background, and the rays and ray–triangle tests it took.
@@ -543,15 +528,18 @@ struct Sample {
 // One sample's primary ray through `frag_xy`, then the mirror, refraction and shadow rays it
 // leads to, from a stack of tasks. Seed 000's level of detail: rays outside the visual field
 // are not traced (background), and a ray's bounces are level × Reflect_max (eq. 9, rounded);
-// its rays meet each object at the level of detail eq. 10 gives (level 1: the original). With
-// `centre`, the primary ray also writes the error, object and distance outputs.
-fn trace_sample(slot: u32, eye_sign: f32, frag_xy: vec2<f32>, centre: bool) -> Sample {
+// its rays meet each object at the level of detail eq. 10 gives (level 1: the original). The
+// primary ray writes the error, object and distance outputs unless `mode` is SAMPLE_COLOUR, and
+// with SAMPLE_OUTPUTS nothing more is traced. One call of `closest_hit` traces every ray (lavapipe
+// runs a shader with several inlined copies of the traversal markedly slower).
+fn trace_sample(slot: u32, eye_sign: f32, frag_xy: vec2<f32>, mode: u32) -> Sample {
     let proj = params.projection;
     let ray = pixel_ray(proj, eye_sign, frag_xy);
     let background = srgb_to_linear(params.background.rgb);
     // The scene frame's origin of the viewer frame and the rotation back, for the headlight.
     let to_view = transpose(mat3x3<f32>(params.to_scene[0].xyz, params.to_scene[1].xyz, params.to_scene[2].xyz));
     let viewer = params.to_scene[3].xyz;
+    let centre = mode != SAMPLE_COLOUR;
     if (centre) {
         write_background(slot);
     }
@@ -597,6 +585,9 @@ fn trace_sample(slot: u32, eye_sign: f32, frag_xy: vec2<f32>, centre: bool) -> S
             let p = task.origin + hit.t * task.dir;
             if (task.kind == PRIMARY && centre) {
                 write_primary(slot, eye_sign, ray, hit, frag_xy);
+                if (mode == SAMPLE_OUTPUTS) {
+                    return Sample(vec3<f32>(0.0), false, rays, tests);
+                }
             }
             // The cone's width here; mirrored and refracted rays go on growing from it, shadow
             // rays keep it (they converge on a point light).

@@ -93,7 +93,7 @@ fn fragment_coverage(in: VertexOut, front_facing: bool, params: FragmentView) ->
     let dp_dx = dpdxFine(in.view_position);
     let dp_dy = dpdyFine(in.view_position);
     let c = surface_rgba(in.material, in.color, in.uv, duv_dx, duv_dy, front_facing);
-    let alpha_width = mask_alpha_width(in.material, in.color.a, in.uv, duv_dx, duv_dy);
+    let alpha_width = mask_alpha_width(in.material, in.color.a, c.a, in.uv, duv_dx, duv_dy);
     let mask = coverage_mask(in.material, c.a, alpha_width, in.clip.xy, SAMPLES);
     if (mask == 0u) {
         discard;

@@ -59,10 +59,12 @@ fn surface_color(material: u32, color: vec4<f32>, uv: vec2<f32>, duv_dx: vec2<f3
     return vec4<f32>(c.rgb, max(c.a, 0.0));
 }
 
-// How much a MASK material's alpha changes over one pixel: |α(uv + ∂uv/∂x) − α(uv)| + |α(uv +
-// ∂uv/∂y) − α(uv)| of its texture (× the vertex alpha), as fwidth would give it but from the
-// texture itself, the same on every adapter and in the CPU twin; 0 for other materials.
-fn mask_alpha_width(material: u32, vertex_alpha: f32, uv: vec2<f32>, duv_dx: vec2<f32>, duv_dy: vec2<f32>) -> f32 {
+// How much a MASK material's alpha changes over one pixel: |a·α(uv + ∂uv/∂x) − alpha| + |a·α(uv +
+// ∂uv/∂y) − alpha| of its texture α (a the vertex alpha, `alpha` the fragment's, a·α(uv)), as
+// fwidth would give it but from the texture itself, the same on every adapter and in the CPU
+// twin; 0 for other materials.
+fn mask_alpha_width(material: u32, vertex_alpha: f32, alpha: f32, uv: vec2<f32>, duv_dx: vec2<f32>,
+                    duv_dy: vec2<f32>) -> f32 {
     if (!MATERIALS) {
         return 0.0;
     }
@@ -70,10 +72,9 @@ fn mask_alpha_width(material: u32, vertex_alpha: f32, uv: vec2<f32>, duv_dx: vec
     if (m.alpha_mode != ALPHA_MASK || m.texture == NO_TEXTURE || m.mip_count == 0u) {
         return 0.0;
     }
-    let a = sample_texture(m, uv, duv_dx, duv_dy).a;
-    let ax = sample_texture(m, uv + duv_dx, duv_dx, duv_dy).a;
-    let ay = sample_texture(m, uv + duv_dy, duv_dx, duv_dy).a;
-    return abs(vertex_alpha) * (abs(ax - a) + abs(ay - a));
+    let ax = vertex_alpha * sample_texture(m, uv + duv_dx, duv_dx, duv_dy).a;
+    let ay = vertex_alpha * sample_texture(m, uv + duv_dy, duv_dx, duv_dy).a;
+    return abs(ax - alpha) + abs(ay - alpha);
 }
 
 // Alpha to coverage: which of its pixel's `n` samples (n > 1) a fragment of `alpha` covers

@@ -6,7 +6,7 @@
 use glam::Vec2;
 
 /// The standard positions, in 16ths of a pixel from its corner (Vulkan's
-/// `standardSampleLocations`).
+/// `standardSampleLocations`), by count ([`STANDARD_POSITIONS`]).
 const TWO: [[f32; 2]; 2] = [[12.0, 12.0], [4.0, 4.0]];
 const FOUR: [[f32; 2]; 4] = [[6.0, 2.0], [14.0, 6.0], [2.0, 10.0], [10.0, 14.0]];
 const EIGHT: [[f32; 2]; 8] =
@@ -29,6 +29,10 @@ const SIXTEEN: [[f32; 2]; 16] = [
     [14.0, 15.0],
     [1.0, 0.0],
 ];
+
+/// Each count's standard positions: the tables `sample_position` reads, also generated into the
+/// WGSL `constants` module as `SAMPLES_2` … `SAMPLES_16` (src/encoding/constants.rs).
+pub const STANDARD_POSITIONS: [(u32, &[[f32; 2]]); 4] = [(2, &TWO), (4, &FOUR), (8, &EIGHT), (16, &SIXTEEN)];
 
 /// Where sample `i` of `n` lies in its pixel (0..1 from the pixel's corner); any other `n`: the
 /// centre.

@@ -116,7 +116,7 @@ pub fn coverage_fragment(
 ) -> Option<([u8; 4], u32)> {
     let c = surface_rgba(table, &f.surface);
     let alpha = c.map_or(-1.0, |c| c.w);
-    let width = mask_alpha_width(table, &f.surface);
+    let width = mask_alpha_width(table, &f.surface, alpha);
     let mask = coverage_mask(table, f.surface.material, alpha, width, f.surface.frag_xy, samples);
     let c = c.filter(|_| mask != 0)?;
     let color = Vec4::new(c.x, c.y, c.z, c.w.max(0.0));

@@ -463,12 +463,13 @@ impl<'a> Tracer<'a> {
         let corner = Vec2::new(x as f32, y as f32);
         let i = (y * self.projection.width + x) as usize;
         if n > 1 {
-            self.write_centre(eye, corner + 0.5, i, img);
+            // The centre's ray for the outputs alone (one sample is the centre's itself).
+            self.trace_sample(eye, corner + 0.5, Some((i, &mut *img)), false);
         }
         let (mut sum, mut plain) = (Vec3::ZERO, 0);
         for k in 0..n {
             let (color, is_plain) =
-                self.trace_sample(eye, corner + sample_position(n, k), (n == 1).then_some((i, &mut *img)));
+                self.trace_sample(eye, corner + sample_position(n, k), (n == 1).then_some((i, &mut *img)), true);
             sum += color;
             plain += is_plain as u32;
         }
@@ -506,17 +507,6 @@ impl<'a> Tracer<'a> {
         Some((origin_v, dir_v, ray, reflect_max))
     }
 
-    /// The error, object and distance outputs of the centre's ray alone (frames of several
-    /// samples).
-    fn write_centre(&self, eye: Eye, frag_xy: Vec2, i: usize, img: &mut RasterImage) {
-        let keeps = |tri, b1, b2, front, dir, width| self.keeps(frag_xy, tri, b1, b2, front, dir, width);
-        let Some((origin_v, dir_v, ray, _)) = self.primary(eye, frag_xy) else { return };
-        self.rays.set(self.rays.get() + 1);
-        if let Some(hit) = closest_hit(&self.traced, &ray, &keeps, &self.tests) {
-            self.write_primary(eye, frag_xy, origin_v + hit.t * dir_v, &hit, i, img);
-        }
-    }
-
     /// The outputs of a primary ray's hit at `view_position`.
     fn write_primary(&self, eye: Eye, frag_xy: Vec2, view_position: Vec3, hit: &Hit, i: usize, img: &mut RasterImage) {
         img.error[i] = pixel_error(&self.projection, eye, view_position, frag_xy, self.params.error_angle != 0);
@@ -527,8 +517,15 @@ impl<'a> Tracer<'a> {
 
     /// One sample: its primary ray through `frag_xy`, then its mirror and refraction rays depth
     /// first (as the WGSL); its tone-mapped linear colour and whether that is the plain
-    /// background. With `centre` (pixel index and image) the primary hit's outputs are written.
-    fn trace_sample(&self, eye: Eye, frag_xy: Vec2, centre: Option<(usize, &mut RasterImage)>) -> (Vec3, bool) {
+    /// background. With `centre` (pixel index and image) the primary hit's outputs are written;
+    /// without `shade` nothing more is traced (the centre's ray beside several samples).
+    fn trace_sample(
+        &self,
+        eye: Eye,
+        frag_xy: Vec2,
+        centre: Option<(usize, &mut RasterImage)>,
+        shade: bool,
+    ) -> (Vec3, bool) {
         let table = self.table;
         let keeps = |tri, b1, b2, front, dir, width| self.keeps(frag_xy, tri, b1, b2, front, dir, width);
         let Some((origin_v, dir_v, primary, reflect_max)) = self.primary(eye, frag_xy) else {
@@ -543,6 +540,9 @@ impl<'a> Tracer<'a> {
         };
         if let Some((i, img)) = centre {
             self.write_primary(eye, frag_xy, origin_v + hit.t * dir_v, &hit, i, img);
+        }
+        if !shade {
+            return (Vec3::ZERO, false);
         }
         let (level, spread) = (primary.level, primary.cone.y);
         let color = self.gather(primary.origin, primary.dir, hit, frag_xy, spread, level, reflect_max, &keeps);

@@ -208,5 +208,10 @@ pub fn wgsl() -> String {
             Value::U32(x) => s += &format!("const {name}: u32 = {x}u;\n"),
         }
     }
+    // The standard sample positions (16ths of a pixel), for the ray tracer's samples.
+    for (n, table) in crate::core::sampling::STANDARD_POSITIONS {
+        let items: Vec<String> = table.iter().map(|[x, y]| format!("vec2<f32>({x:?}, {y:?})")).collect();
+        s += &format!("const SAMPLES_{n}: array<vec2<f32>, {n}> = array<vec2<f32>, {n}>({});\n", items.join(", "));
+    }
     s
 }

@@ -103,36 +103,11 @@ pub fn read_exr(path: &std::path::Path) -> (usize, usize, Vec<f32>) {
 /// average it to grey.
 #[allow(dead_code)]
 pub fn checker_floor() -> twister::Scene {
-    use twister::core::material::{Filter, Material, Mipmap};
-    use twister::core::scene::SceneVertex;
-    use twister::core::texture::Texture;
-    let mut scene = twister::Scene::new("checker floor");
     let rgba =
         (0..64u32 * 64).flat_map(|i| if (i % 64 + i / 64) % 2 == 0 { [255; 4] } else { [0, 0, 0, 255] }).collect();
-    scene.textures.push(Texture { name: "checker".into(), width: 64, height: 64, rgba });
-    scene.materials.push(Material {
-        texture: 0,
-        min_filter: Filter::Linear as u32,
-        mag_filter: Filter::Linear as u32,
-        mipmap: Mipmap::Linear as u32,
-        ..Default::default()
-    });
-    let corner = |x: f32, z: f32, u: f32, v: f32| SceneVertex {
-        position: [x, -1.0, z],
-        normal: [0.0, 1.0, 0.0],
-        color: [1.0; 4],
-        uv: [u, v],
-        material: 1,
-        ..Default::default()
-    };
-    let v = [
-        corner(-20.0, 0.5, 0.0, 0.0),
-        corner(20.0, 0.5, 20.0, 0.0),
-        corner(20.0, -40.0, 20.0, 20.0),
-        corner(-20.0, -40.0, 0.0, 20.0),
-    ];
-    scene.add_mesh("floor", &v, &[0, 1, 2, 0, 2, 3]);
-    scene
+    let corners =
+        [[-20.0, 0.5, 0.0, 0.0], [20.0, 0.5, 20.0, 0.0], [20.0, -40.0, 20.0, 20.0], [-20.0, -40.0, 0.0, 20.0]];
+    textured_floor("checker", rgba, corners)
 }
 
 /// A floor 1 m below the viewer, 60 m square, striped along x: a 64×64 texture of white and
@@ -140,12 +115,20 @@ pub fn checker_floor() -> twister::Scene {
 /// linearly between linear mip levels. Seen at grazing angles the texture's footprint is long
 /// along the view and narrow across it: what anisotropic filtering is for.
 pub fn striped_floor() -> twister::Scene {
+    let rgba = (0..64u32 * 64).flat_map(|i| if stripe_is_white(i % 64) { [255; 4] } else { [0, 0, 0, 255] }).collect();
+    let corners = [[-30.0, 30.0], [30.0, 30.0], [30.0, -30.0], [-30.0, -30.0]]
+        .map(|[x, z]| [x, z, x / STRIPE_REPEAT_M, z / STRIPE_REPEAT_M]);
+    textured_floor("stripes", rgba, corners)
+}
+
+/// A floor quad 1 m below the viewer, white, its corners (x, z, u, v) in order, with a 64×64
+/// texture (`rgba`) filtered linearly between linear mip levels.
+fn textured_floor(name: &str, rgba: Vec<u8>, corners: [[f32; 4]; 4]) -> twister::Scene {
     use twister::core::material::{Filter, Material, Mipmap};
     use twister::core::scene::SceneVertex;
     use twister::core::texture::Texture;
-    let mut scene = twister::Scene::new("striped floor");
-    let rgba = (0..64u32 * 64).flat_map(|i| if stripe_is_white(i % 64) { [255; 4] } else { [0, 0, 0, 255] }).collect();
-    scene.textures.push(Texture { name: "stripes".into(), width: 64, height: 64, rgba });
+    let mut scene = twister::Scene::new(format!("{name} floor"));
+    scene.textures.push(Texture { name: name.into(), width: 64, height: 64, rgba });
     scene.materials.push(Material {
         texture: 0,
         min_filter: Filter::Linear as u32,
@@ -153,15 +136,14 @@ pub fn striped_floor() -> twister::Scene {
         mipmap: Mipmap::Linear as u32,
         ..Default::default()
     });
-    let corner = |x: f32, z: f32| SceneVertex {
+    let v = corners.map(|[x, z, u, v]| SceneVertex {
         position: [x, -1.0, z],
         normal: [0.0, 1.0, 0.0],
         color: [1.0; 4],
-        uv: [x / STRIPE_REPEAT_M, z / STRIPE_REPEAT_M],
+        uv: [u, v],
         material: 1,
         ..Default::default()
-    };
-    let v = [corner(-30.0, 30.0), corner(30.0, 30.0), corner(30.0, -30.0), corner(-30.0, -30.0)];
+    });
     scene.add_mesh("floor", &v, &[0, 1, 2, 0, 2, 3]);
     scene
 }

@@ -284,16 +284,15 @@ pub fn blend_threshold(frag_xy: Vec2) -> f32 {
 }
 
 /// How much a MASK material's alpha changes over one pixel (`mask_alpha_width` in surface.wgsl):
-/// |α(uv + ∂uv/∂x) − α(uv)| + |α(uv + ∂uv/∂y) − α(uv)| of its texture × the vertex alpha; 0 for
-/// other materials.
-pub fn mask_alpha_width(table: &MaterialTable, s: &Surface) -> f32 {
+/// |a·α(uv + ∂uv/∂x) − alpha| + |a·α(uv + ∂uv/∂y) − alpha| of its texture α, a the vertex alpha,
+/// `alpha` the fragment's (a·α(uv)); 0 for other materials.
+pub fn mask_alpha_width(table: &MaterialTable, s: &Surface, alpha: f32) -> f32 {
     let m = &table.materials[(s.material as usize).min(table.materials.len() - 1)];
     if m.alpha_mode != AlphaMode::Mask as u32 || m.texture == NO_TEXTURE || m.mip_count == 0 {
         return 0.0;
     }
-    let alpha = |uv: Vec2| sample_texture(table, m, uv, s.duv_dx, s.duv_dy).w;
-    let a = alpha(s.uv);
-    s.color.w.abs() * ((alpha(s.uv + s.duv_dx) - a).abs() + (alpha(s.uv + s.duv_dy) - a).abs())
+    let at = |uv: Vec2| s.color.w * sample_texture(table, m, uv, s.duv_dx, s.duv_dy).w;
+    (at(s.uv + s.duv_dx) - alpha).abs() + (at(s.uv + s.duv_dy) - alpha).abs()
 }
 
 /// Alpha to coverage (`coverage_mask` in surface.wgsl): which of its pixel's `n` samples (n > 1)
