@@ -28,8 +28,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let renderer = Renderer::new(Gpu::new()?)?;
     let gpu_scene = GpuScene::upload(&renderer.gpu, &scene)?;
     let frame = renderer.render(&gpu_scene, &settings)?;
-    for path in write_images(out.as_ref(), &layout_images(&frame, Layout::Twister, twister::output::ImageFormat::Png))?
-    {
+    for path in write_images(
+        out.as_ref(),
+        &layout_images(
+            &frame,
+            Layout::Twister,
+            twister::output::ImageFormat::Png,
+            twister::core::projection::PanoramaKind::Cylinder,
+        ),
+    )? {
         println!("{}", path.display());
     }
     Ok(())

@@ -16,9 +16,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let renderer = Renderer::new(Gpu::new()?)?;
     let gpu_scene = GpuScene::upload(&renderer.gpu, &scene)?;
     let frame = renderer.render(&gpu_scene, &settings)?;
-    for path in
-        write_images(out.as_ref(), &layout_images(&frame, Layout::TopBottom, twister::output::ImageFormat::Png))?
-    {
+    let panorama = settings.view.projection.panorama;
+    let images = layout_images(&frame, Layout::TopBottom, twister::output::ImageFormat::Png, panorama);
+    for path in write_images(out.as_ref(), &images)? {
         println!("{}", path.display());
     }
     eprintln!(

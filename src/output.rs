@@ -40,6 +40,7 @@ impl Layout {
         match panorama {
             PanoramaKind::Cylinder => Layout::Eyes,
             PanoramaKind::Equirect => Layout::TopBottom,
+            PanoramaKind::Vr180 => Layout::SideBySide,
         }
     }
 }
@@ -101,13 +102,15 @@ fn side_by_side<T: Copy>(left: &[T], right: &[T], width: usize, per_texel: usize
         .collect()
 }
 
-/// The file names of a layout, in the order of [`layout_images`].
-pub fn layout_names(layout: Layout, format: ImageFormat) -> Vec<String> {
+/// The file names of a layout, in the order of [`layout_images`]. The combined layouts carry
+/// the tags VR players detect: `_360` or `_180` for the panorama, then `_TB` or `_LR`.
+pub fn layout_names(layout: Layout, format: ImageFormat, panorama: PanoramaKind) -> Vec<String> {
     let ext = format.extension();
+    let tag = panorama.player_tag().map_or(String::new(), |t| format!("_{t}"));
     match layout {
         Layout::Eyes => vec![format!("left.{ext}"), format!("right.{ext}")],
-        Layout::TopBottom => vec![format!("stereo_TB.{ext}")],
-        Layout::SideBySide => vec![format!("stereo_LR.{ext}")],
+        Layout::TopBottom => vec![format!("stereo{tag}_TB.{ext}")],
+        Layout::SideBySide => vec![format!("stereo{tag}_LR.{ext}")],
         Layout::Twister => ["left", "right"]
             .iter()
             .flat_map(|eye| [format!("{eye}_front.{ext}"), format!("{eye}_back.{ext}")])
@@ -116,8 +119,13 @@ pub fn layout_names(layout: Layout, format: ImageFormat) -> Vec<String> {
 }
 
 /// The images of a layout, with their file names.
-pub fn layout_images(frame: &Frame, layout: Layout, format: ImageFormat) -> Vec<(String, EyeImage)> {
-    let names = layout_names(layout, format);
+pub fn layout_images(
+    frame: &Frame,
+    layout: Layout,
+    format: ImageFormat,
+    panorama: PanoramaKind,
+) -> Vec<(String, EyeImage)> {
+    let names = layout_names(layout, format, panorama);
     let (w, h) = (frame.left.width, frame.left.height);
     let images = match layout {
         Layout::Eyes => vec![frame.left.clone(), frame.right.clone()],
@@ -181,10 +189,17 @@ pub fn depth_names(layout: Layout) -> Vec<String> {
     }
 }
 
-/// Google's photo-sphere XMP (GPano) for an equirectangular panorama of `width` × `height`
-/// pixels per eye, the whole sphere (no crop): what Google Photos, Facebook, Kuula and most VR
-/// photo viewers read to show an image as a sphere.
-pub fn gpano_xmp(width: u32, height: u32) -> String {
+/// Google's photo-sphere XMP (GPano) for an equirectangular image of `width` × `height` pixels
+/// per eye: what Google Photos, Facebook, Kuula and most VR photo viewers read to show an image
+/// as a sphere. The full sphere is the whole panorama; VR180's image is its front half, cropped
+/// from a panorama twice as wide ([`gpano_xmp_cropped`]).
+pub fn gpano_xmp(panorama: PanoramaKind, width: u32, height: u32) -> String {
+    let full_width = (width as f32 / panorama.turn_share()).round() as u32;
+    gpano_xmp_cropped([width, height], [full_width, height], [(full_width - width) / 2, 0])
+}
+
+/// GPano for an image of `cropped` pixels at `left_top` in a full panorama of `full` pixels.
+pub fn gpano_xmp_cropped(cropped: [u32; 2], full: [u32; 2], left_top: [u32; 2]) -> String {
     format!(
         concat!(
             "<?xpacket begin=\"\u{feff}\" id=\"W5M0MpCehiHzreSzNTczkc9d\"?>\n",
@@ -195,17 +210,21 @@ pub fn gpano_xmp(width: u32, height: u32) -> String {
             "   <GPano:UsePanoramaViewer>True</GPano:UsePanoramaViewer>\n",
             "   <GPano:CroppedAreaImageWidthPixels>{w}</GPano:CroppedAreaImageWidthPixels>\n",
             "   <GPano:CroppedAreaImageHeightPixels>{h}</GPano:CroppedAreaImageHeightPixels>\n",
-            "   <GPano:FullPanoWidthPixels>{w}</GPano:FullPanoWidthPixels>\n",
-            "   <GPano:FullPanoHeightPixels>{h}</GPano:FullPanoHeightPixels>\n",
-            "   <GPano:CroppedAreaLeftPixels>0</GPano:CroppedAreaLeftPixels>\n",
-            "   <GPano:CroppedAreaTopPixels>0</GPano:CroppedAreaTopPixels>\n",
+            "   <GPano:FullPanoWidthPixels>{fw}</GPano:FullPanoWidthPixels>\n",
+            "   <GPano:FullPanoHeightPixels>{fh}</GPano:FullPanoHeightPixels>\n",
+            "   <GPano:CroppedAreaLeftPixels>{left}</GPano:CroppedAreaLeftPixels>\n",
+            "   <GPano:CroppedAreaTopPixels>{top}</GPano:CroppedAreaTopPixels>\n",
             "  </rdf:Description>\n",
             " </rdf:RDF>\n",
             "</x:xmpmeta>\n",
             "<?xpacket end=\"w\"?>"
         ),
-        w = width,
-        h = height
+        w = cropped[0],
+        h = cropped[1],
+        fw = full[0],
+        fh = full[1],
+        left = left_top[0],
+        top = left_top[1],
     )
 }
 
@@ -484,8 +503,11 @@ mod tests {
         };
         for layout in [Layout::Eyes, Layout::TopBottom, Layout::SideBySide, Layout::Twister] {
             for format in [ImageFormat::Png, ImageFormat::Jpg] {
-                let names: Vec<String> = layout_images(&frame, layout, format).into_iter().map(|(n, _)| n).collect();
-                assert_eq!(names, layout_names(layout, format));
+                for panorama in [PanoramaKind::Cylinder, PanoramaKind::Equirect, PanoramaKind::Vr180] {
+                    let images = layout_images(&frame, layout, format, panorama);
+                    let names: Vec<String> = images.into_iter().map(|(n, _)| n).collect();
+                    assert_eq!(names, layout_names(layout, format, panorama));
+                }
             }
         }
     }

@@ -5,14 +5,24 @@
 //! - `st3d` (full box): stereo mode, 0 mono, 1 top-bottom (left eye on top), 2 left-right;
 //! - `sv3d` (container): `svhd` (full box: the metadata source, a NUL-terminated string) and
 //!   `proj` (container): `prhd` (full box: pose yaw, pitch, roll as 16.16 fixed point, all 0)
-//!   and `equi` (full box: the projection bounds top, bottom, left, right, all 0: the whole
-//!   sphere).
+//!   and `equi` (full box: the projection bounds top, bottom, left, right as 0.32 fixed-point
+//!   fractions cropped off each side: all 0 for the whole sphere, left = right = ¼ for VR180's
+//!   front half).
 //!
-//! Every box around the sample entry (`stsd`, `stbl`, `minf`, `mdia`, `trak`, `moov`) grows by
-//! the bytes added; where `moov` comes before the media data (`faststart`), every chunk offset
-//! (`stco`, `co64`) moves by the same amount.
+//! and, for players that read only the first version, Spherical Video V1's `uuid` box (UUID
+//! ffcc8263-f855-4a93-8814-587a02521fdd) at the end of the video track, holding the
+//! GSpherical XML ([`spherical_v1_xml`]): projection, stereo mode, and the crop in pixels.
+//!
+//! Every box around what is added (`stsd`, `stbl`, `minf`, `mdia`, `trak`, `moov`) grows by the
+//! bytes added inside it; where `moov` comes before the media data (`faststart`), every chunk
+//! offset (`stco`, `co64`) moves by the bytes added in all.
 
+use crate::core::projection::PanoramaKind;
 use crate::error::{Error, Result};
+
+/// Spherical Video V1's box type: `uuid` with this UUID.
+pub const SPHERICAL_V1_UUID: [u8; 16] =
+    [0xff, 0xcc, 0x82, 0x63, 0xf8, 0x55, 0x4a, 0x93, 0x88, 0x14, 0x58, 0x7a, 0x02, 0x52, 0x1f, 0xdd];
 
 /// How the two eyes share a frame (`st3d`'s stereo mode).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -72,21 +82,81 @@ fn container(kind: &[u8; 4], children: &[Vec<u8>]) -> Vec<u8> {
     out
 }
 
-/// The `st3d` and, for an equirectangular panorama, `sv3d` boxes.
-pub fn spherical_boxes(stereo: StereoMode, equirect: bool) -> Vec<u8> {
+/// `equi`'s bounds for a panorama (top, bottom, left, right: the share of the full sphere's
+/// width or height cropped off that side, 0.32 fixed point).
+pub fn equi_bounds(panorama: PanoramaKind) -> [u32; 4] {
+    let side = (1.0 - panorama.turn_share() as f64) / 2.0;
+    let side = (side * 4294967296.0).round() as u32;
+    [0, 0, side, side]
+}
+
+/// The `st3d` and, for an equirectangular panorama (the sphere, VR180), `sv3d` boxes.
+pub fn spherical_boxes(stereo: StereoMode, panorama: PanoramaKind) -> Vec<u8> {
     let mut out = full_box(b"st3d", &[stereo as u8]);
-    if equirect {
+    if panorama.is_sphere() {
         let svhd = full_box(b"svhd", b"twister\0");
         let prhd = full_box(b"prhd", &[0; 12]);
-        let equi = full_box(b"equi", &[0; 16]);
+        let bounds: Vec<u8> = equi_bounds(panorama).iter().flat_map(|b| b.to_be_bytes()).collect();
+        let equi = full_box(b"equi", &bounds);
         out.extend(container(b"sv3d", &[svhd, container(b"proj", &[prhd, equi])]));
     }
     out
 }
 
+/// Spherical Video V1's XML for an equirectangular panorama of `eye` pixels per eye.
+pub fn spherical_v1_xml(stereo: StereoMode, panorama: PanoramaKind, eye: [u32; 2]) -> String {
+    let full_width = (eye[0] as f64 / panorama.turn_share() as f64).round() as u32;
+    let mode = match stereo {
+        StereoMode::Mono => "mono",
+        StereoMode::TopBottom => "top-bottom",
+        StereoMode::LeftRight => "left-right",
+    };
+    let tags = [
+        ("Spherical", "true".to_string()),
+        ("Stitched", "true".to_string()),
+        ("StitchingSoftware", "twister".to_string()),
+        ("ProjectionType", "equirectangular".to_string()),
+        ("StereoMode", mode.to_string()),
+        ("CroppedAreaImageWidthPixels", eye[0].to_string()),
+        ("CroppedAreaImageHeightPixels", eye[1].to_string()),
+        ("FullPanoWidthPixels", full_width.to_string()),
+        ("FullPanoHeightPixels", eye[1].to_string()),
+        ("CroppedAreaLeftPixels", ((full_width - eye[0]) / 2).to_string()),
+        ("CroppedAreaTopPixels", "0".to_string()),
+    ];
+    let body: String = tags.iter().map(|(k, v)| format!("<GSpherical:{k}>{v}</GSpherical:{k}>")).collect();
+    format!(
+        "<?xml version=\"1.0\"?><rdf:SphericalVideo xmlns:rdf=\"http://www.w3.org/1999/02/22-rdf-syntax-ns#\" \
+         xmlns:GSpherical=\"http://ns.google.com/videos/1.0/spherical/\">{body}</rdf:SphericalVideo>"
+    )
+}
+
+/// The V1 `uuid` box holding `xml`.
+fn spherical_v1_box(xml: &str) -> Vec<u8> {
+    let mut body = SPHERICAL_V1_UUID.to_vec();
+    body.extend(xml.as_bytes());
+    container(b"uuid", &[body])
+}
+
+/// The XML of every Spherical Video V1 box in the file's tracks (tests, checks).
+pub fn find_spherical_v1(data: &[u8]) -> Vec<String> {
+    find_boxes(data, &["moov", "trak", "uuid"])
+        .into_iter()
+        .filter(|b| b.starts_with(&SPHERICAL_V1_UUID))
+        .map(|b| String::from_utf8_lossy(&b[16..]).into_owned())
+        .collect()
+}
+
 /// `mp4` (named `name` in errors) with the spherical boxes added to its video track's first
-/// sample entry.
-pub fn with_spherical_metadata(mp4: &[u8], name: &str, stereo: StereoMode, equirect: bool) -> Result<Vec<u8>> {
+/// sample entry, and for an equirectangular panorama of `eye` pixels per eye the V1 box at the
+/// end of that track.
+pub fn with_spherical_metadata(
+    mp4: &[u8],
+    name: &str,
+    stereo: StereoMode,
+    panorama: PanoramaKind,
+    eye: [u32; 2],
+) -> Result<Vec<u8>> {
     let bad = |what: &str| Error::output(name, format!("cannot add the spherical metadata: {what}"));
     let top = boxes(mp4, 0, mp4.len()).ok_or_else(|| bad("not an MP4 file"))?;
     let moov = *top.iter().find(|b| &b.kind == b"moov").ok_or_else(|| bad("no moov box"))?;
@@ -109,14 +179,19 @@ pub fn with_spherical_metadata(mp4: &[u8], name: &str, stereo: StereoMode, equir
     // stsd: full box header, entry count, then sample entries; the first is the video's.
     let entries = boxes(mp4, stsd.start + stsd.header + 8, stsd.end).ok_or_else(|| bad("a broken stsd box"))?;
     let entry = *entries.first().ok_or_else(|| bad("no sample entry"))?;
-    let added = spherical_boxes(stereo, equirect);
-    let grow = added.len();
+    let added = spherical_boxes(stereo, panorama);
+    let v1 = if panorama.is_sphere() { spherical_v1_box(&spherical_v1_xml(stereo, panorama, eye)) } else { vec![] };
+    let grow = added.len() + v1.len();
     let mut out = Vec::with_capacity(mp4.len() + grow);
     out.extend_from_slice(&mp4[..entry.end]);
     out.extend_from_slice(&added);
-    out.extend_from_slice(&mp4[entry.end..]);
-    // Every box holding the entry grows (32-bit sizes; a 64-bit one keeps its place).
+    out.extend_from_slice(&mp4[entry.end..trak.end]);
+    out.extend_from_slice(&v1);
+    out.extend_from_slice(&mp4[trak.end..]);
+    // Every box holding what was added grows (32-bit sizes; a 64-bit one keeps its place; every
+    // size field lies before the first insertion, so none has moved).
     for b in [moov, trak, mdia, minf, stbl, stsd, entry] {
+        let grow = if b.start <= trak.start { grow } else { added.len() };
         let field = if b.header == 16 { b.start + 8 } else { b.start };
         if b.header == 16 {
             let size = u64::from_be_bytes(out[field..field + 8].try_into().expect("8 bytes")) + grow as u64;

@@ -294,7 +294,8 @@ fn a_video_carries_the_spherical_metadata() {
     if !common::assets_present() {
         return;
     }
-    use twister::video::{find_boxes, with_spherical_metadata, StereoMode};
+    use twister::core::projection::PanoramaKind;
+    use twister::video::{find_boxes, find_spherical_v1, with_spherical_metadata, StereoMode};
     let root = common::TempDir::new(format!("twister-video-{}", std::process::id()));
     let video = root.join("cube.mp4");
     let scene = common::asset("gltf/AnimatedCube/glTF/AnimatedCube.gltf");
@@ -337,11 +338,45 @@ fn a_video_carries_the_spherical_metadata() {
         .status()
         .unwrap();
     assert!(status.success());
-    let tagged = with_spherical_metadata(&std::fs::read(&fast).unwrap(), "fast", StereoMode::LeftRight, true).unwrap();
+    // Re-tagged as VR180 side by side: equi's bounds crop a quarter off each side, and the V1
+    // XML gives the same crop in pixels.
+    let v1 = find_spherical_v1(&mp4);
+    assert_eq!(v1.len(), 1, "the sphere's video carries one V1 box");
+    assert!(
+        v1[0].contains("<GSpherical:StereoMode>top-bottom<") && v1[0].contains("<GSpherical:FullPanoWidthPixels>128<")
+    );
+    let eye = [64, 64];
+    let tagged = with_spherical_metadata(
+        &std::fs::read(&fast).unwrap(),
+        "fast",
+        StereoMode::LeftRight,
+        PanoramaKind::Vr180,
+        eye,
+    )
+    .unwrap();
     std::fs::write(&fast, &tagged).unwrap();
+    let equi = find_boxes(&tagged, &[&entry[..], &["sv3d", "proj", "equi"]].concat());
+    let bounds: Vec<u32> = equi[0][4..20].chunks(4).map(|b| u32::from_be_bytes(b.try_into().unwrap())).collect();
+    assert_eq!(bounds, [0, 0, 1 << 30, 1 << 30], "top, bottom, left, right");
+    let v1 = find_spherical_v1(&tagged);
+    assert_eq!(v1.len(), 1);
+    for tag in [
+        "StereoMode>left-right<",
+        "CroppedAreaImageWidthPixels>64<",
+        "FullPanoWidthPixels>128<",
+        "CroppedAreaLeftPixels>32<",
+    ] {
+        assert!(v1[0].contains(tag), "{tag}: {}", v1[0]);
+    }
     let stream = probe(&fast);
     assert_eq!(stream["nb_read_frames"], "12", "every frame still decodes");
-    assert!(stream["side_data_list"].to_string().contains("side by side"), "{}", stream["side_data_list"]);
+    let side = stream["side_data_list"].to_string();
+    assert!(side.contains("side by side") && side.contains("tiled equirectangular"), "{side}");
+    // ffprobe gives the bounds in pixels of a full panorama twice the frame's width (rounded its
+    // own way): a quarter of that, the frame's half, off each side.
+    let mapping = stream["side_data_list"].as_array().unwrap().iter().find(|d| d["bound_left"].is_u64()).unwrap();
+    let (l, r) = (mapping["bound_left"].as_u64().unwrap(), mapping["bound_right"].as_u64().unwrap());
+    assert!(l + r == 128 && l.abs_diff(64) <= 2, "{side}");
     // No ffmpeg: one line.
     let out = common::twister()
         .args(["render", scene.to_str().unwrap(), "--frames", "0..1", "--layout", "top-bottom", "--video"])

@@ -285,15 +285,20 @@ fn surround_scenes_let_no_sample_see_the_background() {
             .map(|m| (m, 4))
             .into_iter()
             .chain([(Method::Adaptive(Split::Error), 2), (Method::Adaptive(Split::Error), 16), (Method::Trace, 4)]);
-        let sizes =
-            [(PanoramaKind::Cylinder, 320, 80), (PanoramaKind::Cylinder, 192, 192), (PanoramaKind::Equirect, 256, 128)];
+        let sizes = [
+            (PanoramaKind::Cylinder, 320, 80),
+            (PanoramaKind::Cylinder, 192, 192),
+            (PanoramaKind::Equirect, 256, 128),
+            (PanoramaKind::Vr180, 128, 128),
+        ];
         let runs: Vec<_> = runs.flat_map(|run| sizes.map(|size| (run, size))).collect();
         for ((method, samples), (panorama, width, height)) in runs {
             // One size each for the extra counts (2: the cylinder, 16: the sphere) and the ray
             // tracer (the sphere; the exact vertical model only).
             let extra = samples != 4 || method == Method::Trace;
             let sphere = panorama == PanoramaKind::Equirect;
-            if extra && (width == 192 || (samples == 2 && sphere) || (samples != 2 && !sphere)) {
+            let vr180 = panorama == PanoramaKind::Vr180;
+            if extra && (width == 192 || vr180 || (samples == 2 && sphere) || (samples != 2 && !sphere)) {
                 continue;
             }
             {

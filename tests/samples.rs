@@ -42,6 +42,7 @@ fn coverage_error(panorama: PanoramaKind, method: Method, samples: u32) -> (f64,
             Projection { width: 256, height: 64, vertical: Vertical::Exact, ..Projection::default() }
         }
         PanoramaKind::Equirect => Projection::equirect(256),
+        PanoramaKind::Vr180 => Projection::vr180(128),
     };
     let settings = RenderSettings::new(projection)
         .with_method(method)

@@ -104,6 +104,80 @@ fn spheres_land_where_the_formulas_put_them_at_every_latitude_and_across_the_sea
     }
 }
 
+/// VR180: the closed demo room fills both eyes' front halves (no background pixel), and small
+/// spheres land where the format puts them: x = (λ/π + ½)·W, y = (½ − φ/π)·W with λ, φ as above
+/// (a sphere 45° up straight ahead at (W/2, W/4)); one behind the viewer shows in no pixel.
+#[test]
+fn vr180_shows_the_front_half_closed_with_spheres_where_the_format_puts_them() {
+    let black = [0.0; 3];
+    for method in [Method::Adaptive(Split::Error), Method::Vertex] {
+        let settings = RenderSettings::new(Projection::vr180(256)).with_method(method).with_background(black);
+        let frame = common::render(&builtin::demo(), &settings);
+        for eye in Eye::BOTH {
+            assert_eq!((frame.eye(eye).width, frame.eye(eye).height), (256, 256));
+            let holes = common::pixels_where(frame.eye(eye), |p| common::is_background(p, black));
+            assert!(
+                holes.is_empty(),
+                "{} {eye:?}: {} background pixels, e.g. {:?}",
+                method.name(),
+                holes.len(),
+                &holes[..holes.len().min(5)]
+            );
+        }
+    }
+    let (de, width) = (0.032f32, 512u32);
+    let mut scene = Scene::new("probes");
+    let mut centres = Vec::new();
+    for (lon, lat, distance) in [
+        (0.0f32, 45.0f32, 3.0f32),
+        (0.0, 0.0, 1.0),
+        (-60.0, 0.0, 3.0),
+        (60.0, -45.0, 10.0),
+        (80.0, 30.0, 2.0),
+        (-30.0, 80.0, 3.0),
+        (170.0, 0.0, 3.0),
+    ] {
+        let (lat_r, lon_r) = (lat.to_radians(), lon.to_radians());
+        let centre = distance * Vec3::new(lat_r.cos() * lon_r.sin(), lat_r.sin(), -lat_r.cos() * lon_r.cos());
+        let (v, i) = builtin::uv_sphere(centre, 0.012 * distance, 24, 13, [0.9, 0.2, 0.2, 1.0]);
+        scene.add_mesh(format!("probe {lon} {lat}"), &v, &i);
+        centres.push(centre);
+    }
+    let frame = common::render(&scene, &RenderSettings::new(Projection::vr180(width)).with_measure_error(true));
+    let m = frame.measurement.as_ref().unwrap();
+    for (object, centre) in centres.iter().enumerate() {
+        let r = (centre.x * centre.x + centre.z * centre.z).sqrt();
+        let theta = centre.x.atan2(-centre.z);
+        let altitude = centre.y.atan2(r).abs().to_degrees();
+        for (k, eye) in Eye::BOTH.into_iter().enumerate() {
+            let (lon, lat) = if altitude < 59.0 {
+                (theta - eye.sign() * (de / r).asin(), centre.y.atan2((r * r - de * de).sqrt()))
+            } else {
+                (theta, centre.y.atan2(r))
+            };
+            let pixels: Vec<(f32, f32)> = (m.object[k].iter().enumerate())
+                .filter(|(_, &id)| id == object as u32 + 1)
+                .map(|(p, _)| ((p as u32 % width) as f32 + 0.5, (p as u32 / width) as f32 + 0.5))
+                .collect();
+            if lon.abs() > std::f32::consts::FRAC_PI_2 {
+                assert!(pixels.is_empty(), "{centre} behind the viewer shows in {} pixels", pixels.len());
+                continue;
+            }
+            let want =
+                ((lon / std::f32::consts::PI + 0.5) * width as f32, (0.5 - lat / std::f32::consts::PI) * width as f32);
+            let n = pixels.len() as f32;
+            assert!(n >= 4.0, "{centre} {eye:?}: only {n} pixels");
+            let (x, y) = pixels.iter().fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
+            assert!(
+                ((x - want.0) * lat.cos()).abs() < 0.35 && (y - want.1).abs() < 0.35,
+                "{centre} {eye:?}: centroid ({x:.2}, {y:.2}), want ({:.2}, {:.2})",
+                want.0,
+                want.1
+            );
+        }
+    }
+}
+
 /// Reads a PNG's iTXt chunk `XML:com.adobe.xmp`, or a JPEG's XMP APP1 segment.
 fn xmp_of(path: &std::path::Path) -> String {
     let bytes = std::fs::read(path).unwrap();
@@ -144,13 +218,17 @@ fn gpano(xmp: &str) -> std::collections::HashMap<String, String> {
 #[test]
 fn sphere_images_carry_photo_sphere_metadata_in_png_and_jpeg_and_players_names() {
     let out = tmp("metadata");
-    for (format, layout, file, size) in [
-        ("png", None, "stereo_TB.png", (256, 256)),
-        ("jpg", Some("side-by-side"), "stereo_LR.jpg", (512, 128)),
-        ("png", Some("eyes"), "left.png", (256, 128)),
+    // (panorama, format, layout, file, its size, the eye's crop and left edge in the full panorama)
+    for (panorama, format, layout, file, size, crop, full, left) in [
+        ("equirect", "png", None, "stereo_360_TB.png", (256, 256), ("256", "128"), ("256", "128"), "0"),
+        ("equirect", "jpg", Some("side-by-side"), "stereo_360_LR.jpg", (512, 128), ("256", "128"), ("256", "128"), "0"),
+        ("equirect", "png", Some("eyes"), "left.png", (256, 128), ("256", "128"), ("256", "128"), "0"),
+        // VR180: the front half of a sphere twice as wide, side by side by default.
+        ("vr180", "png", None, "stereo_180_LR.png", (512, 256), ("256", "256"), ("512", "256"), "128"),
+        ("vr180", "jpg", Some("top-bottom"), "stereo_180_TB.jpg", (256, 512), ("256", "256"), ("512", "256"), "128"),
     ] {
         let mut cmd = common::twister();
-        cmd.args(["render", "builtin:demo", "--panorama", "equirect", "--width", "256", "--method", "vertex"]);
+        cmd.args(["render", "builtin:demo", "--panorama", panorama, "--width", "256", "--method", "vertex"]);
         cmd.args(["--format", format, "--out"]).arg(&out);
         if let Some(l) = layout {
             cmd.args(["--layout", l]);
@@ -162,12 +240,13 @@ fn sphere_images_carry_photo_sphere_metadata_in_png_and_jpeg_and_players_names()
         let g = gpano(&xmp_of(&path));
         assert_eq!(g["ProjectionType"], "equirectangular", "{file}: {g:?}");
         assert_eq!(g["UsePanoramaViewer"], "True");
-        assert_eq!((g["FullPanoWidthPixels"].as_str(), g["FullPanoHeightPixels"].as_str()), ("256", "128"));
+        assert_eq!((g["FullPanoWidthPixels"].as_str(), g["FullPanoHeightPixels"].as_str()), full, "{file}");
         assert_eq!(
             (g["CroppedAreaImageWidthPixels"].as_str(), g["CroppedAreaImageHeightPixels"].as_str()),
-            ("256", "128")
+            crop,
+            "{file}"
         );
-        assert_eq!((g["CroppedAreaLeftPixels"].as_str(), g["CroppedAreaTopPixels"].as_str()), ("0", "0"));
+        assert_eq!((g["CroppedAreaLeftPixels"].as_str(), g["CroppedAreaTopPixels"].as_str()), (left, "0"), "{file}");
     }
     // The cylinder is no photo sphere: no GPano.
     let o = common::twister()
@@ -190,7 +269,7 @@ fn sphere_images_carry_photo_sphere_metadata_in_png_and_jpeg_and_players_names()
 fn pixel_eye_ray(projection: &Projection, eye: Eye, x: usize, y: usize) -> (Vec3, Vec3) {
     let (u, v) = projection.pixel_to_screen(x as f32, y as f32);
     let s = eye.sign();
-    if projection.panorama == PanoramaKind::Equirect {
+    if projection.panorama.is_sphere() {
         let d = Vec3::new(v.cos() * u.sin(), v.sin(), -v.cos() * u.cos());
         let side = d.cross(Vec3::Y).normalize();
         let fade = projection.pole_fade(v.abs());

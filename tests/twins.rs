@@ -146,6 +146,10 @@ impl Twin for ProjectPoints {
                 out.push((format!("sphere {convergence:?} {pole_merge:?} {eye:?}"), (p, eye, sphere_points.clone())));
             }
         }
+        // VR180: the same points, half of them behind (outside the image).
+        for eye in Eye::BOTH {
+            out.push((format!("vr180 {eye:?}"), (Projection::vr180(2048), eye, sphere_points.clone())));
+        }
         out
     }
     fn gpu(r: &Renderer, (p, eye, points): &Self::Case) -> Self::Output {
@@ -171,7 +175,7 @@ impl Twin for ProjectPoints {
             let tolerance = if near_image { 1e-3 } else { 1e-6 * c[1].abs() };
             // On the sphere, columns near the poles are short: compare the distance they make.
             let (_, lat) = p.pixel_to_screen(c[0], c[1]);
-            let squeeze = if p.panorama == twister::core::projection::PanoramaKind::Equirect { lat.cos() } else { 1.0 };
+            let squeeze = if p.panorama.is_sphere() { lat.cos() } else { 1.0 };
             if !(p.wrapped_dx(g[0], c[0]) * squeeze < 1e-3 && (g[1] - c[1]).abs() < tolerance) {
                 return Err(format!("point {i}: GPU {g:?}, CPU {c:?}"));
             }
@@ -265,6 +269,7 @@ fn raster_geometry_cases() -> Vec<(String, RasterCase)> {
     // The full sphere, with the error in pixels and as an angle (arcminutes).
     let sphere = Projection::equirect(320);
     out.push(("demo on the sphere".into(), (builtin::demo(), RenderSettings::new(sphere), None)));
+    out.push(("demo on VR180".into(), (builtin::demo(), RenderSettings::new(Projection::vr180(160)), None)));
     // A triangle 2 m ahead reaching ±60° across and 50° up and down.
     let mut triangle = Scene::new("big triangle");
     let corner = |p: [f32; 3]| twister::core::scene::SceneVertex {

@@ -7,7 +7,7 @@
 
 // The screen point (u, v) at image position (x, y) (`Projection::pixel_to_screen`).
 fn from_pixel(proj: Projection, xy: vec2<f32>) -> vec2<f32> {
-    return vec2<f32>((xy.x / proj.width - 0.5) * TAU, (0.5 * proj.height - xy.y) / proj.pixels_per_v);
+    return vec2<f32>((xy.x - 0.5 * proj.width) / proj.turn_px * TAU, (0.5 * proj.height - xy.y) / proj.pixels_per_v);
 }
 
 // The unit direction, seen from the centre, of screen point (u, v): on the cylinder the screen
@@ -20,14 +20,14 @@ fn screen_direction(proj: Projection, uv: vec2<f32>) -> vec3<f32> {
 }
 
 // The angle a pixel spans, radians (`pixel_spread` in fragment.rs): the larger of its width
-// (2π/W, on the sphere × cos latitude) and its height (on the cylinder 1/(pixels_per_v·R_T) seen
+// (2π/turn_px, on the sphere × cos latitude) and its height (on the cylinder 1/(pixels_per_v·R_T) seen
 // from the eyes, about R_T away; on the sphere 1/pixels_per_v).
 fn pixel_spread(proj: Projection, frag_xy: vec2<f32>) -> f32 {
     let uv = from_pixel(proj, frag_xy);
     if (is_sphere(proj)) {
-        return max(TAU / proj.width * cos(uv.y), 1.0 / proj.pixels_per_v);
+        return max(TAU / proj.turn_px * cos(uv.y), 1.0 / proj.pixels_per_v);
     }
-    return max(TAU / proj.width, 1.0 / (proj.pixels_per_v * proj.screen_radius));
+    return max(TAU / proj.turn_px, 1.0 / (proj.pixels_per_v * proj.screen_radius));
 }
 
 // The display-position error of surface point p drawn at pixel centre `frag_xy` for this eye: the
@@ -46,7 +46,7 @@ fn pixel_error(proj: Projection, eye_sign: f32, p: vec3<f32>, frag_xy: vec2<f32>
     }
     let ideal = to_pixel(proj, uvd.x, uvd.y);
     var dx = abs(ideal.x - frag_xy.x);
-    dx = min(dx, proj.width - dx);
+    dx = min(dx, proj.turn_px - dx);
     return length(vec2<f32>(dx, ideal.y - frag_xy.y));
 }
 

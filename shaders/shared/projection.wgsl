@@ -26,21 +26,21 @@ struct Projection {
     acos_eye_screen: f32,  // acos(d_e / R_T)
     vertical_exact: u32,   // 0: paper model, 1: exact model
     pixels_per_v: f32,     // W / (2π·R_T) (cylinder: v in metres), H/π (sphere: v in radians)
-    panorama: u32,         // PANORAMA_CYLINDER or PANORAMA_EQUIRECT (generated constants)
+    panorama: u32,         // PANORAMA_CYLINDER, PANORAMA_EQUIRECT or PANORAMA_VR180 (generated constants)
     convergence: f32,      // sphere: rays converge on this radius, metres; 0: parallel
     pole_from: f32,        // sphere: pole merge, radians of altitude; pole_to 0: off
     pole_to: f32,
-    _pad: f32,
+    turn_px: f32,          // pixels per full turn of azimuth: the width, 2W for VR180 (its width spans π)
 }
 
-// The panoramas a pipeline can draw (bit 0 the cylinder, bit 1 the sphere). The subdivide stage's
+// The panoramas a pipeline can draw (bit 0 the cylinder, bit 1 the sphere: equirect or VR180). The subdivide stage's
 // pipelines are built for one panorama each, so the other's code is compiled out: on lavapipe a
 // shader that merely contains the sphere's projection (inlined at every sample of an edge) ran
 // the cylinder's subdivision three times slower.
 override PANORAMAS: u32 = 3u;
 
 fn is_sphere(proj: Projection) -> bool {
-    return (PANORAMAS & 2u) != 0u && ((PANORAMAS & 1u) == 0u || proj.panorama == PANORAMA_EQUIRECT);
+    return (PANORAMAS & 2u) != 0u && ((PANORAMAS & 1u) == 0u || proj.panorama != PANORAMA_CYLINDER);
 }
 
 // atan2 and acos accurate to about 1e-7 rad. Drivers' built-ins may be far less precise (lavapipe's
@@ -151,19 +151,20 @@ fn project_with_azimuth(proj: Projection, p: vec3<f32>, theta: f32, eye_sign: f3
     return vec3<f32>(theta + eye_sign * eye_shift(proj, r), screen_height(proj, p.y, r), r);
 }
 
-// Continuous image coordinates (x right, y down) of a screen point, u wrapped into the image.
+// Continuous image coordinates (x right, y down) of a screen point, u wrapped into [−π, π)
+// (VR180: |u| > π/2 falls outside the image).
 fn to_pixel(proj: Projection, u: f32, v: f32) -> vec2<f32> {
-    let x = (wrap_angle(u) / TAU + 0.5) * proj.width;
+    let x = wrap_angle(u) / TAU * proj.turn_px + 0.5 * proj.width;
     let y = 0.5 * proj.height - v * proj.pixels_per_v;
     return vec2<f32>(x, y);
 }
 
 // Clip-space position of a projected point. u is NOT wrapped: the pre-pass places seam copies
-// at u ± 2π and the rasterizer clips them. w = 1, so attributes interpolate linearly on the
+// at u ± 2π and the rasterizer clips them (and VR180's |u| > π/2). w = 1, so attributes interpolate linearly on the
 // screen as in the paper; depth r maps monotonically into (0, 1) as r / (r + 1).
 // y is kept within GUARD_BAND_PX of the image (constants.rs says why).
 fn to_clip(proj: Projection, uvd: vec3<f32>) -> vec4<f32> {
-    let x = uvd.x / PI;
+    let x = uvd.x * proj.turn_px / (PI * proj.width);
     let y_limit = 1.0 + GUARD_BAND_PX / (0.5 * proj.height);
     var y = clamp(uvd.y * proj.pixels_per_v / (0.5 * proj.height), -y_limit, y_limit);
     // The sphere: a vertex beyond the centre of the first (last) row, where every longitude

@@ -38,7 +38,7 @@ fn edge_point(a: Node, b: Node, j: u32, n: u32) -> Node {
 // Image position in pixels (x not wrapped) of a viewer-frame point for one eye sign.
 fn pixel(p: vec3<f32>, eye_sign: f32) -> vec2<f32> {
     let q = project_with_azimuth(params.projection, p, azimuth(p), eye_sign);
-    return vec2<f32>(q.x * params.projection.width / TAU, q.y * params.projection.pixels_per_v);
+    return vec2<f32>(q.x * params.projection.turn_px / TAU, q.y * params.projection.pixels_per_v);
 }
 
 // What the split rules read of the straight edge ab (`Subdivider::edge_profile`): sampled at
@@ -60,7 +60,7 @@ fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
         hi = a;
     }
     let clamp_v = 1.5 * params.projection.height;
-    let width = params.projection.width;
+    let width = params.projection.turn_px; // a full turn in pixels: x wraps at it
     var length_px = 0.0;
     var longest = 0.0;
     var nearest = 1e30;

@@ -207,7 +207,7 @@ fn draw_vertex(n: Node, theta_ref: f32, tri: ptr<function, InputTriangle>) -> Dr
 
 fn visible_edge_px(p: array<vec3<f32>, 3>) -> f32 {
     let half_h = 0.5 * params.projection.height;
-    let width = params.projection.width;
+    let width = params.projection.turn_px; // a full turn in pixels: x wraps at it
     var longest = 0.0;
     for (var s = 0u; s < 2u; s++) {
         let eye_sign = select(-1.0, 1.0, s == 1u);

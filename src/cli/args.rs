@@ -20,15 +20,16 @@ use twister::{Projection, RenderSettings, Vertical};
 
 #[derive(Args)]
 pub struct ViewArgs {
-    /// The panorama: cylinder (the TWISTER display) or equirect (the full sphere, 360° × 180°
-    /// per eye: omni-directional stereo as VR players, 360° video and Blender use).
-    /// [default: cylinder; equirect with --preset]
+    /// The panorama: cylinder (the TWISTER display), equirect (the full sphere, 360° × 180°
+    /// per eye: omni-directional stereo as VR players, 360° video and Blender use) or vr180
+    /// (its front half, 180° × 180° per eye). [default: cylinder; equirect with --preset]
     #[arg(long, value_enum)]
     pub panorama: Option<PanoramaKind>,
-    /// Image width per eye in pixels (the full 360°) [default: 3168; equirect 4096].
+    /// Image width per eye in pixels (the full 360°; vr180: 180°) [default: 3168; equirect and
+    /// vr180 4096].
     #[arg(long)]
     pub width: Option<u32>,
-    /// Image height per eye in pixels [default: 600; equirect: width/2].
+    /// Image height per eye in pixels [default: 600; equirect: width/2; vr180: width].
     #[arg(long)]
     pub height: Option<u32>,
     /// Size preset of the full sphere (implies --panorama equirect): vr4k (4096×4096 top-bottom:
@@ -279,7 +280,7 @@ impl ViewArgs {
     /// viewer of `camera[:N]` is placed with the scene, by `cli::scene::prepare`).
     pub fn settings(&self, methods: &[Method]) -> Result<RenderSettings> {
         let panorama = match (self.panorama, self.preset) {
-            (Some(PanoramaKind::Cylinder), Some(_)) => {
+            (Some(PanoramaKind::Cylinder | PanoramaKind::Vr180), Some(_)) => {
                 return Err(Error::option("--preset", "sizes the full sphere: use it with --panorama equirect"))
             }
             (Some(p), _) => p,
@@ -288,10 +289,10 @@ impl ViewArgs {
         };
         if panorama == PanoramaKind::Cylinder {
             if self.convergence.is_some() {
-                return Err(Error::option("--convergence", "needs --panorama equirect"));
+                return Err(Error::option("--convergence", "needs --panorama equirect or vr180"));
             }
             if self.pole_merge.is_some() {
-                return Err(Error::option("--pole-merge", "needs --panorama equirect"));
+                return Err(Error::option("--pole-merge", "needs --panorama equirect or vr180"));
             }
         }
         let (width, height) = match (panorama, self.preset) {
@@ -300,6 +301,10 @@ impl ViewArgs {
             (PanoramaKind::Equirect, None) => {
                 let width = self.width.unwrap_or(4096);
                 (width, self.height.unwrap_or(width / 2))
+            }
+            (PanoramaKind::Vr180, None) => {
+                let width = self.width.unwrap_or(4096);
+                (width, self.height.unwrap_or(width))
             }
         };
         let projection = Projection {
@@ -447,9 +452,10 @@ pub struct RenderArgs {
     pub out: PathBuf,
     #[command(flatten)]
     pub view: ViewArgs,
-    /// Output layout: eyes (left.png, right.png), top-bottom (stereo_TB.png, left eye on top),
-    /// side-by-side (stereo_LR.png, left eye on the left), twister (four W/2×H images)
-    /// [default: eyes; top-bottom for --panorama equirect].
+    /// Output layout: eyes (left.png, right.png), top-bottom (stereo_TB.png, left eye on top;
+    /// the sphere's stereo_360_TB.png), side-by-side (stereo_LR.png, left eye on the left;
+    /// vr180's stereo_180_LR.png), twister (four W/2×H images, the cylinder)
+    /// [default: eyes; top-bottom for equirect; side-by-side for vr180].
     #[arg(long, value_enum)]
     pub layout: Option<Layout>,
     /// Image format: png or jpg (full-sphere images carry GPano XMP metadata in both).

@@ -86,7 +86,7 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
     });
     // On the sphere, pixels shrink towards the poles: the error is also measured as an angle
     // (seen from the centre), by a second render whose error pass writes arcminutes.
-    if settings.view.projection.panorama == twister::core::projection::PanoramaKind::Equirect {
+    if settings.view.projection.panorama.is_sphere() {
         let angular = renderer.render(gpu_scene, &settings.with_error_angle(true))?;
         add_angles(&mut json, &angular.measurement.as_ref().expect("rendered with the error pass").stats);
     }

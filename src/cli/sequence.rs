@@ -20,7 +20,6 @@ use crate::render::render_settings;
 use crate::scene::{open_renderer, prepare, Prepared};
 use crate::writer::{frame_name, FrameRecord, FrameWriter};
 use twister::core::lod::{LodChain, LodParams, LodSelection};
-use twister::core::projection::PanoramaKind;
 use twister::core::settings::Method;
 use twister::core::timeline::Timeline;
 use twister::core::visual_field::GazePath;
@@ -135,7 +134,6 @@ impl Sequence<'_> {
 pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32)) -> Result<()> {
     let settings = render_settings(args)?;
     check_sequence_options(args)?;
-    let panorama = settings.projection().panorama;
     let writer = FrameWriter::new(args, &settings, true)?;
     let stereo = video_stereo(args, &writer)?;
     let frames = match args.shard {
@@ -204,7 +202,7 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32)) -> Result<(
     );
     if let Some(video) = &args.video {
         let name = frame_name(0, &writer.image_names()[0]).replacen("000000", "%06d", 1);
-        encode_video(video, &args.out.join(name), first, last - first + 1, args.fps, stereo, panorama)?;
+        encode_video(video, &args.out.join(name), first, last - first + 1, args.fps, stereo, settings.projection())?;
         println!("{}", video.display());
     }
     Ok(())
@@ -349,7 +347,7 @@ fn encode_video(
     count: u32,
     fps: f32,
     stereo: twister::video::StereoMode,
-    panorama: PanoramaKind,
+    projection: &twister::Projection,
 ) -> Result<()> {
     let missing = (first..first + count)
         .find(|f| !PathBuf::from(pattern.to_string_lossy().replace("%06d", &format!("{f:06}"))).exists());
@@ -376,6 +374,12 @@ fn encode_video(
     }
     let encoded = encoded.map_err(|e| Error::output(video, format!("ffmpeg wrote nothing readable: {e}")))?;
     let name = video.display().to_string();
-    let bytes = twister::video::with_spherical_metadata(&encoded, &name, stereo, panorama == PanoramaKind::Equirect)?;
+    let bytes = twister::video::with_spherical_metadata(
+        &encoded,
+        &name,
+        stereo,
+        projection.panorama,
+        [projection.width, projection.height],
+    )?;
     write_all(&[twister::output::OutputFile { path: video.to_path_buf(), bytes }])
 }

@@ -23,6 +23,8 @@ const HDR_NAMES: [&str; 2] = ["left_hdr.exr", "right_hdr.exr"];
 pub struct FrameWriter {
     out: PathBuf,
     layout: Layout,
+    /// The panorama drawn: its tag goes into the combined layouts' names.
+    panorama: PanoramaKind,
     /// The images' format and how they are encoded.
     encoding: Encoding,
     depth: bool,
@@ -37,14 +39,24 @@ impl FrameWriter {
             return Err(Error::option("--quality", "needs --format jpg"));
         }
         let projection = settings.projection();
-        let sphere = projection.panorama == PanoramaKind::Equirect;
+        let sphere = projection.panorama.is_sphere();
+        if args.layout == Some(Layout::Twister) && !projection.panorama.wraps() {
+            return Err(Error::option(
+                "--layout",
+                format!(
+                    "twister splits a panorama that goes all around; --panorama {} spans 180°",
+                    projection.panorama.name()
+                ),
+            ));
+        }
         Ok(FrameWriter {
             out: args.out.clone(),
             layout: args.layout.unwrap_or(Layout::default_for(projection.panorama)),
+            panorama: projection.panorama,
             encoding: Encoding {
                 format: args.format,
                 quality: args.quality.unwrap_or(90),
-                xmp: sphere.then(|| gpano_xmp(projection.width, projection.height)),
+                xmp: sphere.then(|| gpano_xmp(projection.panorama, projection.width, projection.height)),
                 fast,
             },
             depth: args.depth,
@@ -58,7 +70,7 @@ impl FrameWriter {
 
     /// The layout's image names (`left.png`, `stereo_TB.png`, …).
     pub fn image_names(&self) -> Vec<String> {
-        layout_names(self.layout, self.encoding.format)
+        layout_names(self.layout, self.encoding.format, self.panorama)
     }
 
     /// Where a file of a frame goes: as named for a still, numbered for frame `k` of a sequence.
@@ -85,7 +97,7 @@ impl FrameWriter {
     /// frame holds them.
     pub fn files(&self, rendered: &Frame, frame: Option<u32>) -> Result<Vec<OutputFile>> {
         // The images are encoded side by side (a still's two eyes: half the wait on two cores).
-        let images = layout_images(rendered, self.layout, self.encoding.format);
+        let images = layout_images(rendered, self.layout, self.encoding.format, self.panorama);
         let mut files = std::thread::scope(|scope| {
             let encoders: Vec<_> = images
                 .iter()

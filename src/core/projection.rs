@@ -79,7 +79,7 @@ pub struct Projection {
     pub screen_radius: f32,
     /// d_e: radius of the circle the eyes move on, metres (half the interocular distance).
     pub eye_radius: f32,
-    /// Image width in pixels (covers the full 2π of azimuth).
+    /// Image width in pixels (covers the full 2π of azimuth; VR180: π, see [`Projection::turn_px`]).
     pub width: u32,
     /// Image height in pixels.
     pub height: u32,
@@ -116,6 +116,12 @@ impl Projection {
     /// pole merge.
     pub fn equirect(width: u32) -> Projection {
         Projection { panorama: PanoramaKind::Equirect, width, height: width / 2, ..Projection::default() }
+    }
+
+    /// VR180: the sphere's front half, `width` × `width` pixels per eye, parallel rays, Blender's
+    /// pole merge.
+    pub fn vr180(width: u32) -> Projection {
+        Projection { panorama: PanoramaKind::Vr180, width, height: width, ..Projection::default() }
     }
 }
 
@@ -224,27 +230,20 @@ impl Projection {
         if !p.is_finite() {
             return None;
         }
-        match self.panorama {
-            PanoramaKind::Cylinder if !(r > self.eye_radius) => None,
-            PanoramaKind::Equirect if !self.sphere_sees(p) => None,
-            _ => Some(self.project_with_azimuth(p, azimuth(p), eye)),
-        }
+        let seen = if self.panorama.is_sphere() { self.sphere_sees(p) } else { r > self.eye_radius };
+        seen.then(|| self.project_with_azimuth(p, azimuth(p), eye))
     }
 
     /// Like [`project`](Self::project) but with θ given (already unwrapped by the caller).
     /// Points no eye sees are drawn with the offset clamped (they stay finite).
     pub fn project_with_azimuth(&self, p: Vec3, theta: f32, eye: Eye) -> Projected {
         let r = horizontal_radius(p);
-        match self.panorama {
-            PanoramaKind::Cylinder => {
-                Projected { u: theta + eye.sign() * self.eye_shift(r), v: self.screen_height(p.y, r), depth: r }
-            }
-            PanoramaKind::Equirect => {
-                let d = self.sphere_eye_offset(r, p.y);
-                let (lon, lat, depth) = self.sphere_at_offset(r, p.y, theta, eye.sign(), d);
-                Projected { u: lon, v: lat, depth }
-            }
+        if self.panorama.is_sphere() {
+            let d = self.sphere_eye_offset(r, p.y);
+            let (lon, lat, depth) = self.sphere_at_offset(r, p.y, theta, eye.sign(), d);
+            return Projected { u: lon, v: lat, depth };
         }
+        Projected { u: theta + eye.sign() * self.eye_shift(r), v: self.screen_height(p.y, r), depth: r }
     }
 
     /// Pixels per metre of screen (square pixels): W / (2π·R_T). The cylinder only.
@@ -255,28 +254,37 @@ impl Projection {
     /// Pixels per unit of v: per metre of screen height (the cylinder), per radian of latitude
     /// (the sphere: H/π).
     pub fn pixels_per_v(&self) -> f32 {
-        match self.panorama {
-            PanoramaKind::Cylinder => self.pixels_per_metre(),
-            PanoramaKind::Equirect => self.height as f32 / std::f32::consts::PI,
+        if self.panorama.is_sphere() {
+            self.height as f32 / std::f32::consts::PI
+        } else {
+            self.pixels_per_metre()
         }
     }
 
-    /// Pixels per radian of azimuth: W / 2π.
+    /// Pixels per full turn of azimuth (2π): the width, or twice it for VR180 (whose width
+    /// spans π). `turn_px` in projection.wgsl.
+    pub fn turn_px(&self) -> f32 {
+        self.width as f32 / self.panorama.turn_share()
+    }
+
+    /// Pixels per radian of azimuth: W / 2π (VR180: W / π).
     pub fn pixels_per_radian(&self) -> f32 {
-        self.width as f32 / std::f32::consts::TAU
+        self.turn_px() / std::f32::consts::TAU
     }
 
     /// Continuous image coordinates (x right, y down, pixel centres at +0.5) of a screen point;
-    /// `u` is wrapped into the image.
+    /// `u` is wrapped into [−π, π), azimuth 0 at the image's centre column (VR180: |u| > π/2
+    /// falls outside the image).
     pub fn to_pixel(&self, u: f32, v: f32) -> [f32; 2] {
-        let x = (wrap_angle(u) / std::f32::consts::TAU + 0.5) * self.width as f32;
+        let x = wrap_angle(u) / std::f32::consts::TAU * self.turn_px() + 0.5 * self.width as f32;
         let y = 0.5 * self.height as f32 - v * self.pixels_per_v();
         [x, y]
     }
 
-    /// The screen point (u ∈ [−π, π), v) at the centre of pixel (column, row).
+    /// The screen point (u, v) at the centre of pixel (column, row); u ∈ [−π, π) (VR180:
+    /// [−π/2, π/2)).
     pub fn pixel_to_screen(&self, column: f32, row: f32) -> (f32, f32) {
-        let u = ((column + 0.5) / self.width as f32 - 0.5) * std::f32::consts::TAU;
+        let u = (column + 0.5 - 0.5 * self.width as f32) / self.turn_px() * std::f32::consts::TAU;
         let v = (0.5 * self.height as f32 - (row + 0.5)) / self.pixels_per_v();
         (u, v)
     }
@@ -285,9 +293,10 @@ impl Projection {
     /// the cylinder's half height over R_T (v = R_T·y/r); on the sphere tan 30° (about the
     /// cylinder's default view).
     pub fn fill_tan(&self) -> f32 {
-        match self.panorama {
-            PanoramaKind::Cylinder => self.half_height_m() / self.screen_radius,
-            PanoramaKind::Equirect => 30f32.to_radians().tan(),
+        if self.panorama.is_sphere() {
+            30f32.to_radians().tan()
+        } else {
+            self.half_height_m() / self.screen_radius
         }
     }
 
@@ -295,13 +304,11 @@ impl Projection {
     /// screen point (R_T sin u, v, −R_T cos u), on the sphere longitude u, latitude v.
     /// `screen_direction` in fragment.wgsl.
     pub fn screen_direction(&self, u: f32, v: f32) -> Vec3 {
-        match self.panorama {
-            PanoramaKind::Equirect => Vec3::new(v.cos() * u.sin(), v.sin(), -v.cos() * u.cos()),
-            PanoramaKind::Cylinder => {
-                let rt = self.screen_radius;
-                Vec3::new(rt * u.sin(), v, -rt * u.cos()).normalize()
-            }
+        if self.panorama.is_sphere() {
+            return Vec3::new(v.cos() * u.sin(), v.sin(), -v.cos() * u.cos());
         }
+        let rt = self.screen_radius;
+        Vec3::new(rt * u.sin(), v, -rt * u.cos()).normalize()
     }
 
     /// The slope k such that a point with |y| > k·r shows in no pixel row: above the top of the
@@ -311,13 +318,11 @@ impl Projection {
     /// vertical models; on the sphere the latitude atan2(y, √(r² − e²)) ≥ atan(y/r), so
     /// k = 1/tan(π/2H) is safe for every eye offset.
     pub fn vertical_limit(&self) -> f32 {
-        match self.panorama {
-            PanoramaKind::Equirect => 1.0 / (0.5 * std::f32::consts::PI / self.height as f32).tan(),
-            PanoramaKind::Cylinder => {
-                let (rt, de) = (self.screen_radius, self.eye_radius);
-                self.half_height_m() / (rt * (1.0 - (de / rt) * (de / rt)).sqrt())
-            }
+        if self.panorama.is_sphere() {
+            return 1.0 / (0.5 * std::f32::consts::PI / self.height as f32).tan();
         }
+        let (rt, de) = (self.screen_radius, self.eye_radius);
+        self.half_height_m() / (rt * (1.0 - (de / rt) * (de / rt)).sqrt())
     }
 
     /// Half the screen height in metres (the cylinder).
@@ -325,9 +330,10 @@ impl Projection {
         0.5 * self.height as f32 / self.pixels_per_metre()
     }
 
-    /// The horizontal distance in pixels between two image x coordinates, wrapping around.
+    /// The horizontal distance in pixels between two image x coordinates, wrapping around the
+    /// full turn (VR180: a turn is twice the width, so no two pixels of its image wrap).
     pub fn wrapped_dx(&self, a: f32, b: f32) -> f32 {
-        let w = self.width as f32;
+        let w = self.turn_px();
         let d = (a - b).rem_euclid(w);
         d.min(w - d)
     }
@@ -343,6 +349,9 @@ pub enum PanoramaKind {
     /// The full sphere, equirectangular omni-directional stereo (Google ODS, Cycles' spherical
     /// stereo): 360° × 180° per eye.
     Equirect,
+    /// VR180: the sphere's front half, equirectangular 180° × 180° per eye (W = H), the same eye
+    /// model as `Equirect`; longitudes beyond ±90° fall outside the image.
+    Vr180,
 }
 
 impl PanoramaKind {
@@ -350,7 +359,37 @@ impl PanoramaKind {
         match self {
             PanoramaKind::Cylinder => "cylinder",
             PanoramaKind::Equirect => "equirect",
+            PanoramaKind::Vr180 => "vr180",
         }
+    }
+
+    /// Whether the panorama is (part of) the full sphere's equirectangular ODS: longitude u,
+    /// latitude v, the eye model of `core::sphere`.
+    pub const fn is_sphere(self) -> bool {
+        matches!(self, PanoramaKind::Equirect | PanoramaKind::Vr180)
+    }
+
+    /// The share of a full turn of azimuth that the image's width spans: 1, or ½ for VR180.
+    pub const fn turn_share(self) -> f32 {
+        match self {
+            PanoramaKind::Vr180 => 0.5,
+            _ => 1.0,
+        }
+    }
+
+    /// The tag VR players detect in a file name (`_360`, `_180`); None for the cylinder, which is
+    /// no player format.
+    pub const fn player_tag(self) -> Option<&'static str> {
+        match self {
+            PanoramaKind::Cylinder => None,
+            PanoramaKind::Equirect => Some("360"),
+            PanoramaKind::Vr180 => Some("180"),
+        }
+    }
+
+    /// Whether the image's width is the whole turn (its left and right edges meet).
+    pub const fn wraps(self) -> bool {
+        !matches!(self, PanoramaKind::Vr180)
     }
 
     /// Its code in the WGSL projection uniform (`PANORAMA_CYLINDER`, `PANORAMA_EQUIRECT`).
@@ -358,12 +397,13 @@ impl PanoramaKind {
         match self {
             PanoramaKind::Cylinder => 0,
             PanoramaKind::Equirect => 1,
+            PanoramaKind::Vr180 => 2,
         }
     }
 
     /// The panorama of a code; None for a code no panorama has.
     pub fn from_code(code: u32) -> Option<PanoramaKind> {
-        [PanoramaKind::Cylinder, PanoramaKind::Equirect].into_iter().find(|p| p.code() == code)
+        [PanoramaKind::Cylinder, PanoramaKind::Equirect, PanoramaKind::Vr180].into_iter().find(|p| p.code() == code)
     }
 }
 
@@ -401,9 +441,8 @@ impl Panorama for Projection {
     ///
     /// The sphere: the point at distance `depth` along the pixel's ray ([`Projection::sphere_ray`]).
     fn unproject_pixel(&self, [x, y]: [f32; 2], r: f32, eye: Eye) -> Vec3 {
-        let u = (x / self.width as f32 - 0.5) * std::f32::consts::TAU;
-        let v = (0.5 * self.height as f32 - y) / self.pixels_per_v();
-        if self.panorama == PanoramaKind::Equirect {
+        let (u, v) = self.pixel_to_screen(x - 0.5, y - 0.5);
+        if self.panorama.is_sphere() {
             let (origin, ray) = self.sphere_ray(u, v, eye);
             return origin + r * ray;
         }
@@ -426,16 +465,14 @@ impl Panorama for Projection {
 /// model's ray; the paper model has no single ray per pixel and uses the same.
 pub fn pixel_ray(projection: &Projection, eye: Eye, frag_xy: Vec2) -> (Vec3, Vec3) {
     let (u, v) = projection.pixel_to_screen(frag_xy.x - 0.5, frag_xy.y - 0.5);
-    match projection.panorama {
-        PanoramaKind::Equirect => projection.sphere_ray(u, v, eye),
-        PanoramaKind::Cylinder => {
-            let (rt, de) = (projection.screen_radius, projection.eye_radius);
-            let phi = u - eye.sign() * (de / rt).asin();
-            let origin = eye.sign() * de * Vec3::new(phi.cos(), 0.0, phi.sin());
-            let screen = Vec3::new(rt * u.sin(), v, -rt * u.cos());
-            (origin, (screen - origin).normalize())
-        }
+    if projection.panorama.is_sphere() {
+        return projection.sphere_ray(u, v, eye);
     }
+    let (rt, de) = (projection.screen_radius, projection.eye_radius);
+    let phi = u - eye.sign() * (de / rt).asin();
+    let origin = eye.sign() * de * Vec3::new(phi.cos(), 0.0, phi.sin());
+    let screen = Vec3::new(rt * u.sin(), v, -rt * u.cos());
+    (origin, (screen - origin).normalize())
 }
 
 /// The points the pixels' rays meet at `distances` (per eye, +∞: none → NaN), viewer frame:

@@ -301,6 +301,50 @@ mod tests {
         assert!(compared > 20_000, "{compared} points compared");
     }
 
+    /// VR180: the same rays, drawn on the front half's image (x = (λ/π + ½)·W, y = (½ − φ/π)·H,
+    /// written here from the format, not from `to_pixel`); points behind fall outside the image;
+    /// the inverse takes pixels back to points.
+    #[test]
+    fn vr180_draws_the_spheres_rays_on_the_front_half() {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(18);
+        let proj = Projection::vr180(2048);
+        assert_eq!((proj.kind(), proj.size()), (PanoramaKind::Vr180, [2048, 2048]));
+        let (w, h) = (2048.0, 2048.0);
+        let (mut inside, mut behind) = (0, 0);
+        for _ in 0..3000 {
+            let (a, b): (f64, f64) = (rng.random_range(-1.0..1.0), rng.random_range(-PI..PI));
+            let dist: f64 = 10f64.powf(rng.random_range(-0.5..1.5));
+            let hz = (1.0 - a * a).sqrt();
+            let p = [dist * hz * b.sin(), dist * a, -dist * hz * b.cos()];
+            let pf = Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32);
+            for eye in Eye::BOTH {
+                let pole = Some(DEFAULT_POLE_MERGE).map(|(f, t)| ((f as f64).to_radians(), (t as f64).to_radians()));
+                let (Some((lon, lat, t)), Some((q, depth))) =
+                    (brute_force_sphere(p, eye.sign() as f64, 0.032, None, pole), proj.project_pixel(pf, eye))
+                else {
+                    let r = (p[0] * p[0] + p[2] * p[2]).sqrt();
+                    assert!(r < 0.05, "{eye:?} {p:?}");
+                    continue;
+                };
+                let x = (lon / PI + 0.5) * w;
+                let y = (0.5 - lat / PI) * h;
+                if lon.abs() > PI / 2.0 + 1e-3 {
+                    assert!(q[0] < 0.0 || q[0] > w as f32, "{eye:?} {p:?} behind, drawn at {q:?}");
+                    behind += 1;
+                    continue;
+                }
+                let dx = (q[0] as f64 - x).abs() * lat.cos().max(1e-3);
+                assert!(dx < 1e-3 && (q[1] as f64 - y).abs() < 1e-3, "{eye:?} {p:?}: {q:?} vs ({x}, {y})");
+                assert!((depth as f64 - t).abs() < 1e-5 * (1.0 + t));
+                inside += 1;
+                // The inverse.
+                let back = proj.unproject_pixel(q, depth, eye);
+                assert!((back - pf).length() < 1e-4 * (1.0 + dist as f32), "{p:?} → {q:?} → {back}");
+            }
+        }
+        assert!(inside > 2500 && behind > 2500, "{inside} in front, {behind} behind");
+    }
+
     #[test]
     fn on_the_sphere_the_right_eye_stands_right_and_converging_rays_cross_at_the_convergence_sphere() {
         let ahead = |d: f32, proj: &Projection| {

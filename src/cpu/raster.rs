@@ -10,7 +10,7 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::core::projection::{azimuth, Eye, PanoramaKind, Projection};
+use crate::core::projection::{azimuth, Eye, Projection};
 use crate::core::scene::unpack_tangent;
 use crate::core::texture::MaterialTable;
 use crate::cpu::fragment::{
@@ -34,11 +34,12 @@ pub fn raster_vertex(params: &RasterParams, v: &DrawVertex) -> Vec4 {
     let y_limit = 1.0 + GUARD_BAND_PX / half_height;
     let mut y = (q.v * projection.pixels_per_v() / half_height).clamp(-y_limit, y_limit);
     // The sphere: beyond the centre of the first (last) row, on the image's edge (the pole).
-    if projection.panorama == PanoramaKind::Equirect && y.abs() > 1.0 - 1.0 / projection.height as f32 {
+    if projection.panorama.is_sphere() && y.abs() > 1.0 - 1.0 / projection.height as f32 {
         y = y.signum();
     }
     Vec4::new(
-        q.u / std::f32::consts::PI + 2.0 * params.shift_px[0] / projection.width as f32,
+        q.u * projection.turn_px() / (std::f32::consts::PI * projection.width as f32)
+            + 2.0 * params.shift_px[0] / projection.width as f32,
         y - 2.0 * params.shift_px[1] / projection.height as f32,
         (q.depth / (q.depth + 1.0)).min(crate::encoding::constants::MAX_DEPTH),
         1.0,

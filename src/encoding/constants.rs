@@ -164,6 +164,7 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("BINS", U32(BINS)),
         ("PANORAMA_CYLINDER", U32(PanoramaKind::Cylinder.code())),
         ("PANORAMA_EQUIRECT", U32(PanoramaKind::Equirect.code())),
+        ("PANORAMA_VR180", U32(PanoramaKind::Vr180.code())),
         ("NO_TEXTURE", U32(NO_TEXTURE)),
         ("WRAP_REPEAT", U32(Wrap::Repeat as u32)),
         ("WRAP_CLAMP", U32(Wrap::ClampToEdge as u32)),

@@ -4,7 +4,7 @@
 
 use glam::{Mat4, Vec2, Vec3};
 
-use crate::core::projection::{Eye, PanoramaKind, Projection};
+use crate::core::projection::{Eye, Projection};
 use crate::encoding::types::{SlitCamera, SlitParams};
 
 /// Distance of the slit cameras' near plane, metres.
@@ -48,47 +48,44 @@ pub fn slits(projection: &Projection, eye: Eye, width: u32) -> Vec<Slit> {
     let (w_img, h_img) = (projection.width, projection.height);
     let column_ranges = (0..w_img.div_ceil(width)).map(move |k| (k * width, ((k + 1) * width).min(w_img)));
     let ndc_x = |c: f32| 2.0 * c / w_img as f32 - 1.0;
-    match projection.panorama {
-        PanoramaKind::Cylinder => {
-            let (rt, de) = (projection.screen_radius, projection.eye_radius);
-            let offset = (de / rt).asin();
-            let focal_y_clip = (rt * rt - de * de).sqrt() * projection.pixels_per_metre() / (0.5 * h_img as f32);
-            column_ranges
-                .map(|(c0, c1)| {
-                    let centre = 0.5 * (c0 + c1) as f32;
-                    let u_c = (centre / w_img as f32 - 0.5) * std::f32::consts::TAU;
-                    let phi = u_c - eye.sign() * offset;
-                    let (s, c) = phi.sin_cos();
-                    let right = Vec3::new(c, 0.0, s);
-                    let forward = Vec3::new(s, 0.0, -c);
-                    let origin = eye.sign() * de * right;
-                    let scale = Vec2::new(1.0 / std::f32::consts::PI, focal_y_clip);
-                    let camera = camera(origin, right, Vec3::Y, forward, Vec2::new(ndc_x(centre), 0.0), scale);
-                    Slit { first_column: c0, end_column: c1, first_row: 0, end_row: h_img, camera }
-                })
-                .collect()
-        }
-        PanoramaKind::Equirect => {
-            let mut out = Vec::new();
-            for (c0, c1) in column_ranges {
-                for r0 in (0..h_img).step_by(width as usize) {
-                    let r1 = (r0 + width).min(h_img);
-                    let (cx, cy) = (0.5 * (c0 + c1) as f32, 0.5 * (r0 + r1) as f32);
-                    let (lon, lat) = projection.pixel_to_screen(cx - 0.5, cy - 0.5);
-                    let (origin, forward) = projection.sphere_ray(lon, lat, eye);
-                    let right = Vec3::new(lon.cos(), 0.0, lon.sin());
-                    let up = right.cross(forward).normalize();
-                    let right = forward.cross(up).normalize();
-                    let scale =
-                        Vec2::new(1.0 / (std::f32::consts::PI * lat.cos().max(1e-6)), 2.0 / std::f32::consts::PI);
-                    let centre = Vec2::new(ndc_x(cx), 1.0 - 2.0 * cy / h_img as f32);
-                    let camera = camera(origin, right, up, forward, centre, scale);
-                    out.push(Slit { first_column: c0, end_column: c1, first_row: r0, end_row: r1, camera });
-                }
+    // Clip-space x per radian of azimuth: 2/W pixels⁻¹ × W/2π (VR180: W/π) pixels per radian.
+    let clip_per_radian = 2.0 * projection.pixels_per_radian() / w_img as f32;
+    if projection.panorama.is_sphere() {
+        let mut out = Vec::new();
+        for (c0, c1) in column_ranges {
+            for r0 in (0..h_img).step_by(width as usize) {
+                let r1 = (r0 + width).min(h_img);
+                let (cx, cy) = (0.5 * (c0 + c1) as f32, 0.5 * (r0 + r1) as f32);
+                let (lon, lat) = projection.pixel_to_screen(cx - 0.5, cy - 0.5);
+                let (origin, forward) = projection.sphere_ray(lon, lat, eye);
+                let right = Vec3::new(lon.cos(), 0.0, lon.sin());
+                let up = right.cross(forward).normalize();
+                let right = forward.cross(up).normalize();
+                let scale = Vec2::new(clip_per_radian / lat.cos().max(1e-6), 2.0 / std::f32::consts::PI);
+                let centre = Vec2::new(ndc_x(cx), 1.0 - 2.0 * cy / h_img as f32);
+                let camera = camera(origin, right, up, forward, centre, scale);
+                out.push(Slit { first_column: c0, end_column: c1, first_row: r0, end_row: r1, camera });
             }
-            out
         }
+        return out;
     }
+    let (rt, de) = (projection.screen_radius, projection.eye_radius);
+    let offset = (de / rt).asin();
+    let focal_y_clip = (rt * rt - de * de).sqrt() * projection.pixels_per_metre() / (0.5 * h_img as f32);
+    column_ranges
+        .map(|(c0, c1)| {
+            let centre = 0.5 * (c0 + c1) as f32;
+            let (u_c, _) = projection.pixel_to_screen(centre - 0.5, 0.0);
+            let phi = u_c - eye.sign() * offset;
+            let (s, c) = phi.sin_cos();
+            let right = Vec3::new(c, 0.0, s);
+            let forward = Vec3::new(s, 0.0, -c);
+            let origin = eye.sign() * de * right;
+            let scale = Vec2::new(clip_per_radian, focal_y_clip);
+            let camera = camera(origin, right, Vec3::Y, forward, Vec2::new(ndc_x(centre), 0.0), scale);
+            Slit { first_column: c0, end_column: c1, first_row: 0, end_row: h_img, camera }
+        })
+        .collect()
 }
 
 /// A viewer-frame point in a slit camera's coordinates (x_c right, y_c up, z_c forward).

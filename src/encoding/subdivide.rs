@@ -46,7 +46,7 @@ pub fn subdivide_params(settings: &RenderSettings, first_triangle: u32, triangle
 /// colatitudes below ρ/h for a surface h above or below the eyes) is smaller than half a pixel
 /// row unless h < 2ρ·H/π (1.3 cm at 4096×2048).
 pub fn axis_clearance(projection: &Projection) -> f32 {
-    if projection.panorama == PanoramaKind::Equirect && projection.pole_merge.is_some() {
+    if projection.panorama.is_sphere() && projection.pole_merge.is_some() {
         return AXIS_CLEARANCE_MIN;
     }
     let rt = projection.screen_radius;
@@ -121,9 +121,10 @@ impl SubdivideOutput {
 /// reach 10⁻⁵ m from the axis: one quadrant's keep an invocation within lavapipe's loop budget),
 /// one per triangle on the cylinder (`plan_cuts_split` in the WGSL).
 pub fn plan_cuts_split(panorama: PanoramaKind) -> u32 {
-    match panorama {
-        PanoramaKind::Equirect => 4,
-        PanoramaKind::Cylinder => 1,
+    if panorama.is_sphere() {
+        4
+    } else {
+        1
     }
 }
 
@@ -219,7 +220,7 @@ fn cut_and_plan_parts(r: &mut Recording, passes: Passes) {
 /// near a pole has many bands, which one invocation planned in turn); on the cylinder, with a
 /// few, it plans them itself (`plan_cut_part` in the WGSL).
 pub fn defers_parts(panorama: PanoramaKind) -> bool {
-    panorama == PanoramaKind::Equirect
+    panorama.is_sphere()
 }
 
 /// The passes a frame's schedules dispatch besides those every frame has.
@@ -235,7 +236,7 @@ pub struct Passes {
 impl Passes {
     /// A frame's: its panorama and its split rule (`SubdivideParams::method`).
     pub fn of(panorama: PanoramaKind, method: u32) -> Passes {
-        let sphere = panorama == PanoramaKind::Equirect;
+        let sphere = panorama.is_sphere();
         Passes { parts: defers_parts(panorama), rows: sphere && SplitRule::is_adaptive(method) }
     }
 

@@ -43,14 +43,15 @@ pub struct ProjectionUniform {
     pub vertical_exact: u32,
     /// Pixels per unit of v (metres of screen, or radians of latitude).
     pub pixels_per_v: f32,
-    /// 0 the cylinder, 1 the sphere (`PanoramaKind`).
+    /// 0 the cylinder, 1 the sphere, 2 VR180 (`PanoramaKind::code`).
     pub panorama: u32,
     /// The sphere's convergence distance, metres; 0: parallel rays.
     pub convergence: f32,
     /// The sphere's pole merge, radians of altitude; `pole_to` 0: off (as in Cycles).
     pub pole_from: f32,
     pub pole_to: f32,
-    pub _pad: f32,
+    /// Pixels per full turn of azimuth (`Projection::turn_px`): the width, or 2W for VR180.
+    pub turn_px: f32,
 }
 
 impl From<&ProjectionUniform> for Projection {
@@ -83,7 +84,7 @@ impl From<&Projection> for ProjectionUniform {
             convergence: p.convergence.unwrap_or(0.0),
             pole_from,
             pole_to,
-            _pad: 0.0,
+            turn_px: p.turn_px(),
         }
     }
 }
@@ -445,7 +446,7 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("DrawVertex" => DrawVertex { position, theta_ref, normal, material, color, uv, object, tangent }),
     layout!("Projection" => ProjectionUniform {
         screen_radius, eye_radius, width, height, acos_eye_screen, vertical_exact, pixels_per_v, panorama,
-        convergence, pole_from, pole_to, _pad
+        convergence, pole_from, pole_to, turn_px
     }),
     layout!("SubdivideParams" => SubdivideParams {
         view, projection, axis_clearance, triangle_count, first_triangle, method, fixed_n, edge_px, max_div,

@@ -61,20 +61,17 @@ impl SubdivideStage {
     /// The pipelines for a panorama and a frame's split rule (`params.method`): rows on the
     /// sphere under the adaptive rules only.
     fn variant(&self, gpu: &Gpu, panorama: PanoramaKind, params: &SubdivideParams) -> &Variant {
-        let (k, bits) = match panorama {
-            PanoramaKind::Cylinder => (0, 1.0),
-            PanoramaKind::Equirect => (1, 2.0),
-        };
+        let (k, bits) = if panorama.is_sphere() { (1, 2.0) } else { (0, 1.0) };
         let passes = Passes::of(panorama, params.method);
         let rows = passes.rows;
         self.variants[2 * k + rows as usize].get_or_init(|| {
             // Built side by side: the driver's compiling of the large passes (`plan_cuts`,
             // `lattice`) is most of a fresh process's time.
             let constants = [("PANORAMAS", bits)];
-            let stand_ins: &[StandIn] = match (panorama, rows) {
-                (PanoramaKind::Cylinder, _) => &[ROWS_OFF, SPHERE_OFF],
-                (PanoramaKind::Equirect, false) => &[ROWS_OFF],
-                (PanoramaKind::Equirect, true) => &[IN_PLACE_OFF],
+            let stand_ins: &[StandIn] = match (panorama.is_sphere(), rows) {
+                (false, _) => &[ROWS_OFF, SPHERE_OFF],
+                (true, false) => &[ROWS_OFF],
+                (true, true) => &[IN_PLACE_OFF],
             };
             // The entry points this frame's schedules dispatch (every schedule's are the usual
             // frame's).

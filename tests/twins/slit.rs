@@ -33,6 +33,10 @@ impl Twin for Slit {
             ));
         }
         cases.push((
+            "demo on VR180 slit:4".into(),
+            (builtin::demo(), RenderSettings::new(Projection::vr180(96)).with_method(Method::Slit(4))),
+        ));
+        cases.push((
             "lit spheres slit:4".into(),
             (
                 common::lit_spheres(),

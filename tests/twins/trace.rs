@@ -96,6 +96,10 @@ impl Twin for Trace {
                 (builtin::demo(), RenderSettings::new(sphere).with_method(Method::Trace)),
             ),
             (
+                "demo on VR180".into(),
+                (builtin::demo(), RenderSettings::new(Projection::vr180(96)).with_method(Method::Trace)),
+            ),
+            (
                 "demo with a mirror and a glass object".into(),
                 (optics_demo(), RenderSettings::new(cylinder).with_method(Method::Trace)),
             ),

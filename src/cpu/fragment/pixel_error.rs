@@ -4,18 +4,19 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::core::projection::{pixel_ray, Eye, PanoramaKind, Projection};
+use crate::core::projection::{pixel_ray, Eye, Projection};
 
 /// The angle a pixel spans, radians (`pixel_spread` in surface.wgsl): the larger of its width
-/// (2π/W, on the sphere × cos latitude) and its height (on the cylinder 1/(pixels_per_v·R_T),
+/// (2π/turn_px, on the sphere × cos latitude) and its height (on the cylinder 1/(pixels_per_v·R_T),
 /// seen from the eyes about R_T away; on the sphere 1/pixels_per_v). A ray cone grows by this
 /// much per metre.
 pub fn pixel_spread(projection: &Projection, frag_xy: Vec2) -> f32 {
     let (_, v) = projection.pixel_to_screen(frag_xy.x - 0.5, frag_xy.y - 0.5);
-    let across = std::f32::consts::TAU / projection.width as f32;
-    match projection.panorama {
-        PanoramaKind::Equirect => (across * v.cos()).max(1.0 / projection.pixels_per_v()),
-        PanoramaKind::Cylinder => across.max(1.0 / (projection.pixels_per_v() * projection.screen_radius)),
+    let across = std::f32::consts::TAU / projection.turn_px();
+    if projection.panorama.is_sphere() {
+        (across * v.cos()).max(1.0 / projection.pixels_per_v())
+    } else {
+        across.max(1.0 / (projection.pixels_per_v() * projection.screen_radius))
     }
 }
 

@@ -6,7 +6,7 @@
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use super::{snap_to_cut_planes, Node, PartSplit, Subdivider, Triangle};
-use crate::core::projection::{azimuth, horizontal_radius, Eye, PanoramaKind, Vertical};
+use crate::core::projection::{azimuth, horizontal_radius, Eye, Vertical};
 use crate::core::scene::{unpack_tangent, SceneVertex};
 use crate::core::settings::SplitRule;
 use crate::encoding::constants::{
@@ -90,7 +90,7 @@ impl Subdivider<'_> {
     pub fn edge_profile(&self, a: Vec3, b: Vec3, segments: u32) -> EdgeProfile {
         let (lo, hi) = if lex_less(b, a) { (b, a) } else { (a, b) };
         let clamp_v = 1.5 * self.projection.height as f32;
-        let width = self.projection.width as f32;
+        let width = self.projection.turn_px(); // a full turn in pixels: x wraps at it
         let (mut length, mut longest, mut nearest, mut bend) = (0.0f32, 0.0f32, f32::INFINITY, 0.0f32);
         for eye_sign in [-1.0f32, 1.0] {
             let mut total = 0.0;
@@ -122,8 +122,7 @@ impl Subdivider<'_> {
         }
         // Near the eye circle, which the paper model and the sphere show on screen (α and the
         // longitude ∝ √(r − d_e)), no stretch is allowed (the exact model puts it at v = ±∞).
-        let shows_ring =
-            self.projection.vertical == Vertical::Paper || self.projection.panorama == PanoramaKind::Equirect;
+        let shows_ring = self.projection.vertical == Vertical::Paper || self.projection.panorama.is_sphere();
         let ring = shows_ring && nearest < 2.0 * self.projection.eye_radius;
         let stretch = if ring { 1.0 } else { MAX_STRETCH };
         EdgeProfile { length_px: length.max(segments as f32 * longest / stretch), bend_px: bend, ring }

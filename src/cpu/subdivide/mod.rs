@@ -103,7 +103,7 @@
 use glam::{Vec2, Vec3, Vec4};
 use std::f32::consts::{PI, TAU};
 
-use crate::core::projection::{azimuth, wrap_angle, PanoramaKind, Projection};
+use crate::core::projection::{azimuth, wrap_angle, Projection};
 use crate::core::scene::{pack_tangent, SceneVertex};
 use crate::core::settings::SplitRule;
 use crate::encoding::constants::{SEAM_MARGIN, STRIP_BASE_ERROR, STRIP_MIN_DIVISIONS};
@@ -307,7 +307,7 @@ impl<'a> Subdivider<'a> {
     /// tell (random slivers around the axis reached p99 1.9 px at τ = 1 px, 1.3 with the lattice).
     fn strip_base(&self, counts: [u32; 3], q: &[Node; 3], limits: Limits) -> Option<usize> {
         if self.params.method != SplitRule::AdaptiveError as u32
-            || self.projection.panorama == PanoramaKind::Equirect
+            || self.projection.panorama.is_sphere()
             || counts.iter().max() < Some(&STRIP_MIN_DIVISIONS)
         {
             return None;
@@ -320,7 +320,7 @@ impl<'a> Subdivider<'a> {
     /// Longest chord, in pixels, of a triangle's edges with an end on the screen rows.
     fn visible_edge_px(&self, p: [Vec3; 3]) -> f32 {
         let half_h = 0.5 * self.projection.height as f32;
-        let width = self.projection.width as f32;
+        let width = self.projection.turn_px(); // a full turn in pixels: x wraps at it
         let mut longest = 0.0f32;
         for eye_sign in [-1.0f32, 1.0] {
             let q = p.map(|x| self.pixel(x, eye_sign));

@@ -10,7 +10,7 @@ use super::{
     band_cell, boundary_edge, edge_point, macro_cell, slot_node, snap, strip_node_count, Node, PartSplit, PiecePlan,
     Rows, Subdivider, Triangle,
 };
-use crate::core::projection::{azimuth, wrap_angle, Eye, PanoramaKind};
+use crate::core::projection::{azimuth, wrap_angle, Eye};
 use glam::Vec3;
 
 /// Where a macro node lies. Original edge e runs from corner e to corner e + 1.
@@ -241,7 +241,7 @@ impl Subdivider<'_> {
         let q = &g.q;
         let nodes = shape.nodes(g);
         let theta_c = azimuth((q[0].position + q[1].position + q[2].position) / 3.0);
-        let u_range = if self.projection.panorama == PanoramaKind::Equirect {
+        let u_range = if self.projection.panorama.is_sphere() {
             let (mut u_min, mut u_max) = (f32::INFINITY, f32::NEG_INFINITY);
             for n in &nodes {
                 let theta = theta_c + wrap_angle(azimuth(n.position) - theta_c);

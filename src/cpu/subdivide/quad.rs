@@ -8,7 +8,7 @@ use glam::Vec3;
 
 use super::lattice::{quad_strip_node, quad_strip_node_count, quad_strip_rungs, quad_strip_slots};
 use super::{parts_for_bend, Node, PiecePlan, Subdivider, Triangle};
-use crate::core::projection::{azimuth, PanoramaKind};
+use crate::core::projection::azimuth;
 use crate::core::settings::SplitRule;
 use crate::encoding::constants::{PIECE_DIVISIONS, QUAD_MIN_DIVISIONS, QUAD_RUNG_ERROR};
 
@@ -25,7 +25,7 @@ impl Subdivider<'_> {
     /// the WGSL).
     pub(super) fn quad_strip(&self, tri: &Triangle, poly: &[Node]) -> Option<([Node; 4], [u32; 2])> {
         if self.params.method != SplitRule::AdaptiveError as u32
-            || self.projection.panorama == PanoramaKind::Equirect
+            || self.projection.panorama.is_sphere()
             || poly.len() != 4
         {
             return None;

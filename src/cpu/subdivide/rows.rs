@@ -12,7 +12,6 @@
 use super::edges::Limits;
 use super::lattice::{collapsed, with_nodes};
 use super::{edge_point, Node, Subdivider};
-use crate::core::projection::PanoramaKind;
 use crate::core::settings::SplitRule;
 use crate::encoding::constants::PIECE_DIVISIONS;
 
@@ -223,7 +222,7 @@ impl Subdivider<'_> {
     pub(super) fn rows_base(&self, counts: [u32; 3]) -> Option<(usize, [u32; 2])> {
         let (base, r) = Rows::base_of(counts);
         let possible = SplitRule::is_adaptive(self.params.method)
-            && self.projection.panorama == PanoramaKind::Equirect
+            && self.projection.panorama.is_sphere()
             && (2..=PIECE_DIVISIONS).contains(&r);
         possible.then(|| (base, sides_of(counts, base)))
     }
