@@ -6,10 +6,13 @@ set -euo pipefail
 cd "$(dirname "$0")/../.."
 work=$(mktemp -d)
 cargo run -q --release --example cycles_reference -- export "$work"
-render() { blender -b -P scripts/cycles/render_cycles.py -- "$work/demo.obj" "$work/$1" 512 "$2" "$3" "$4" "${5:-centre}" >/dev/null; }
+render() { blender -b -P scripts/cycles/render_cycles.py -- "$work/demo.obj" "$work/$1" "${6:-512}" "$2" "$3" "$4" "${5:-centre}" "${7:-equirect}" >/dev/null; }
 render parallel parallel 60 75
 render converge2m 2.0 60 75
 render no_pole_merge parallel off off
+# VR180: the front half, 256 × 256 per eye (tests/cycles.rs compares it).
+render vr180 parallel 60 75 centre 256 vr180
+cargo run -q --release --example cycles_reference -- snap "$work/vr180" tests/data/cycles/demo_vr180
 # The anti-aliasing reference: a one-pixel box filter, kept as rendered (not snapped).
 render parallel_box parallel 60 75 box
 cp "$work/parallel_box_L.png" tests/data/cycles/demo_parallel_box_L.png

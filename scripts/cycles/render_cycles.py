@@ -2,13 +2,15 @@
 spherical stereo (equirectangular, both eyes) as flat, unlit colours, so that twister's
 full-sphere panorama can be checked against Cycles pixel for pixel.
 
-blender -b -P scripts/cycles/render_cycles.py -- SCENE.obj OUT_PREFIX WIDTH CONVERGENCE POLE_FROM POLE_TO [FILTER]
+blender -b -P scripts/cycles/render_cycles.py -- SCENE.obj OUT_PREFIX WIDTH CONVERGENCE POLE_FROM POLE_TO [FILTER [PANORAMA]]
     CONVERGENCE: `parallel` or a distance in metres; POLE_FROM/POLE_TO in degrees (`off` for no merge)
     FILTER: `centre` (default: 64 rays at each pixel's centre, no anti-aliasing, for the boundary
     checks) or `box` (1024 rays spread evenly over the pixel, a one-pixel box filter: each pixel
     the share of it each surface covers, for the anti-aliasing checks)
+    PANORAMA: `equirect` (default: 360° × 180°, WIDTH × WIDTH/2) or `vr180` (longitudes ±90°,
+    WIDTH × WIDTH)
 
-Writes OUT_PREFIX_L.png and OUT_PREFIX_R.png (WIDTH × WIDTH/2 each).
+Writes OUT_PREFIX_L.png and OUT_PREFIX_R.png.
 
 The scene is in twister's frame (+y up, −z ahead); the importer turns it into Blender's (+z up,
 +y ahead): forward −Z, up Y. The camera stands at the origin looking along +y (rotation 90°
@@ -22,6 +24,7 @@ import bpy
 argv = sys.argv[sys.argv.index("--") + 1:]
 obj_path, out_prefix, width, convergence, pole_from, pole_to = argv[:6]
 pixel_filter = argv[6] if len(argv) > 6 else "centre"
+panorama = argv[7] if len(argv) > 7 else "equirect"
 width = int(width)
 
 bpy.ops.wm.read_factory_settings(use_empty=True)
@@ -53,6 +56,12 @@ if hasattr(cam_data, "panorama_type"):
     cam_data.panorama_type = "EQUIRECTANGULAR"
 else:
     cam_data.cycles.panorama_type = "EQUIRECTANGULAR"
+if panorama == "vr180":
+    # The front half: Cycles' equirectangular camera's longitude range (Blender 3.x keeps it
+    # in the Cycles settings, 4.x on the camera).
+    settings = cam_data if hasattr(cam_data, "longitude_min") else cam_data.cycles
+    settings.longitude_min = -math.pi / 2
+    settings.longitude_max = math.pi / 2
 stereo = cam_data.stereo
 stereo.interocular_distance = 0.064
 if convergence == "parallel":
@@ -87,7 +96,7 @@ else:
     scene.cycles.filter_width = 0.01
 scene.cycles.max_bounces = 0
 scene.render.resolution_x = width
-scene.render.resolution_y = width // 2
+scene.render.resolution_y = width if panorama == "vr180" else width // 2
 scene.render.resolution_percentage = 100
 scene.view_settings.view_transform = "Standard"
 scene.view_settings.look = "None"
