@@ -548,6 +548,9 @@ fn trace_sample(slot: u32, eye_sign: f32, frag_xy: vec2<f32>, mode: u32) -> Samp
     var color = vec3<f32>(0.0);
     var reflect_max = params.reflect_max;
     var level = 1.0;
+    if (!shows_pixel(proj, frag_xy)) {
+        return Sample(background, true, 0u, 0u); // outside the fisheye's circle
+    }
     if (params.gaze_forward.w > 0.0) {
         level = visual_level(ray.dir);
         if (level <= 0.0) {

@@ -41,6 +41,7 @@ impl Layout {
             PanoramaKind::Cylinder => Layout::Eyes,
             PanoramaKind::Equirect => Layout::TopBottom,
             PanoramaKind::Vr180 => Layout::SideBySide,
+            PanoramaKind::Fisheye => Layout::Eyes,
         }
     }
 }
@@ -503,7 +504,9 @@ mod tests {
         };
         for layout in [Layout::Eyes, Layout::TopBottom, Layout::SideBySide, Layout::Twister] {
             for format in [ImageFormat::Png, ImageFormat::Jpg] {
-                for panorama in [PanoramaKind::Cylinder, PanoramaKind::Equirect, PanoramaKind::Vr180] {
+                for panorama in
+                    [PanoramaKind::Cylinder, PanoramaKind::Equirect, PanoramaKind::Vr180, PanoramaKind::Fisheye]
+                {
                     let images = layout_images(&frame, layout, format, panorama);
                     let names: Vec<String> = images.into_iter().map(|(n, _)| n).collect();
                     assert_eq!(names, layout_names(layout, format, panorama));

@@ -90,10 +90,11 @@ pub fn equi_bounds(panorama: PanoramaKind) -> [u32; 4] {
     [0, 0, side, side]
 }
 
-/// The `st3d` and, for an equirectangular panorama (the sphere, VR180), `sv3d` boxes.
+/// The `st3d` and, for an equirectangular panorama (the sphere, VR180), `sv3d` boxes (the
+/// fisheye's projection has no `sv3d` type: `st3d` alone).
 pub fn spherical_boxes(stereo: StereoMode, panorama: PanoramaKind) -> Vec<u8> {
     let mut out = full_box(b"st3d", &[stereo as u8]);
-    if panorama.is_sphere() {
+    if panorama.is_equirectangular() {
         let svhd = full_box(b"svhd", b"twister\0");
         let prhd = full_box(b"prhd", &[0; 12]);
         let bounds: Vec<u8> = equi_bounds(panorama).iter().flat_map(|b| b.to_be_bytes()).collect();
@@ -180,7 +181,8 @@ pub fn with_spherical_metadata(
     let entries = boxes(mp4, stsd.start + stsd.header + 8, stsd.end).ok_or_else(|| bad("a broken stsd box"))?;
     let entry = *entries.first().ok_or_else(|| bad("no sample entry"))?;
     let added = spherical_boxes(stereo, panorama);
-    let v1 = if panorama.is_sphere() { spherical_v1_box(&spherical_v1_xml(stereo, panorama, eye)) } else { vec![] };
+    let v1 =
+        if panorama.is_equirectangular() { spherical_v1_box(&spherical_v1_xml(stereo, panorama, eye)) } else { vec![] };
     let grow = added.len() + v1.len();
     let mut out = Vec::with_capacity(mp4.len() + grow);
     out.extend_from_slice(&mp4[..entry.end]);

@@ -154,6 +154,17 @@ fn bad_arguments_are_clear_errors() {
         (&["render", "--quality", "50"], "--quality: needs --format jpg"),
         (&["render", "--format", "jpg", "--quality", "0"], "--quality"),
         (&["render", "--format", "gif"], "--format"),
+        // VR180 and the fisheye (issue 34).
+        (&["render", "--panorama", "vr180", "--layout", "twister"], "--layout: twister splits a panorama"),
+        (&["render", "--panorama", "vr180", "--preset", "vr4k"], "--preset"),
+        (&["render", "--fov", "200"], "--fov: needs --panorama fisheye"),
+        (&["render", "--panorama", "equirect", "--dome-tilt", "10"], "--dome-tilt: needs --panorama fisheye"),
+        (&["render", "--panorama", "fisheye", "--fov", "0"], "--fov: must be a field of view"),
+        (&["render", "--panorama", "fisheye", "--fov", "361"], "--fov: must be a field of view"),
+        (&["render", "--panorama", "fisheye", "--fov", "nan"], "--fov"),
+        (&["render", "--panorama", "fisheye", "--dome-tilt", "95"], "--dome-tilt: must be degrees between -90 and 90"),
+        (&["render", "--panorama", "fisheye", "--fov", "350", "--dome-tilt", "10"], "--dome-tilt: a tilted dome"),
+        (&["render", "--panorama", "fisheye", "--method", "slit:4"], "--method: slit:4"),
     ];
     for (args, needle) in cases {
         let o = twister().args(*args).args(["--out", "/nonexistent/never"]).output().unwrap();

@@ -33,6 +33,7 @@ fn projection(panorama: PanoramaKind, scale: u32) -> Projection {
         PanoramaKind::Cylinder => Projection { width: 512 * scale, height: 128 * scale, ..Projection::default() },
         PanoramaKind::Equirect => Projection::equirect(512 * scale),
         PanoramaKind::Vr180 => Projection::vr180(256 * scale),
+        PanoramaKind::Fisheye => Projection::fisheye(256 * scale),
     }
 }
 

@@ -125,17 +125,31 @@ fn vr180_shows_the_front_half_closed_with_spheres_where_the_format_puts_them() {
             );
         }
     }
-    let (de, width) = (0.032f32, 512u32);
+    probes_land_where_the_format_puts_them(Projection::vr180(512), |lon, lat| {
+        let w = 512.0;
+        (lon.abs() <= std::f32::consts::FRAC_PI_2)
+            .then(|| ((lon / std::f32::consts::PI + 0.5) * w, (0.5 - lat / std::f32::consts::PI) * w, lat.cos()))
+    });
+}
+
+/// Small spheres around the viewer (one behind): the centroid of each one's pixels lies where the
+/// panorama's format puts the sphere's eye ray (`want(λ, φ)`: the image position and the factor
+/// its x error is weighed by; None where the image does not show it). λ and φ come from the
+/// geometry alone, as in `spheres_land_where_the_formulas_put_them…`.
+fn probes_land_where_the_format_puts_them(projection: Projection, want: impl Fn(f32, f32) -> Option<(f32, f32, f32)>) {
+    let de = 0.032f32;
+    let width = projection.width;
     let mut scene = Scene::new("probes");
     let mut centres = Vec::new();
     for (lon, lat, distance) in [
         (0.0f32, 45.0f32, 3.0f32),
-        (0.0, 0.0, 1.0),
-        (-60.0, 0.0, 3.0),
+        (0.0, 8.0, 1.0),
+        (-60.0, 8.0, 3.0),
         (60.0, -45.0, 10.0),
         (80.0, 30.0, 2.0),
         (-30.0, 80.0, 3.0),
-        (170.0, 0.0, 3.0),
+        (170.0, -10.0, 3.0),
+        (120.0, 50.0, 4.0),
     ] {
         let (lat_r, lon_r) = (lat.to_radians(), lon.to_radians());
         let centre = distance * Vec3::new(lat_r.cos() * lon_r.sin(), lat_r.sin(), -lat_r.cos() * lon_r.cos());
@@ -143,8 +157,9 @@ fn vr180_shows_the_front_half_closed_with_spheres_where_the_format_puts_them() {
         scene.add_mesh(format!("probe {lon} {lat}"), &v, &i);
         centres.push(centre);
     }
-    let frame = common::render(&scene, &RenderSettings::new(Projection::vr180(width)).with_measure_error(true));
+    let frame = common::render(&scene, &RenderSettings::new(projection).with_measure_error(true));
     let m = frame.measurement.as_ref().unwrap();
+    let mut seen = 0;
     for (object, centre) in centres.iter().enumerate() {
         let r = (centre.x * centre.x + centre.z * centre.z).sqrt();
         let theta = centre.x.atan2(-centre.z);
@@ -159,22 +174,66 @@ fn vr180_shows_the_front_half_closed_with_spheres_where_the_format_puts_them() {
                 .filter(|(_, &id)| id == object as u32 + 1)
                 .map(|(p, _)| ((p as u32 % width) as f32 + 0.5, (p as u32 / width) as f32 + 0.5))
                 .collect();
-            if lon.abs() > std::f32::consts::FRAC_PI_2 {
-                assert!(pixels.is_empty(), "{centre} behind the viewer shows in {} pixels", pixels.len());
+            let Some((want_x, want_y, squeeze)) = want(lon, lat) else {
+                assert!(pixels.is_empty(), "{centre} outside the image shows in {} pixels", pixels.len());
                 continue;
-            }
-            let want =
-                ((lon / std::f32::consts::PI + 0.5) * width as f32, (0.5 - lat / std::f32::consts::PI) * width as f32);
+            };
             let n = pixels.len() as f32;
             assert!(n >= 4.0, "{centre} {eye:?}: only {n} pixels");
             let (x, y) = pixels.iter().fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
             assert!(
-                ((x - want.0) * lat.cos()).abs() < 0.35 && (y - want.1).abs() < 0.35,
-                "{centre} {eye:?}: centroid ({x:.2}, {y:.2}), want ({:.2}, {:.2})",
-                want.0,
-                want.1
+                ((x - want_x) * squeeze).abs() < 0.35 && (y - want_y).abs() < 0.35,
+                "{centre} {eye:?}: centroid ({x:.2}, {y:.2}), want ({want_x:.2}, {want_y:.2})"
             );
+            seen += 1;
         }
+    }
+    assert!(seen >= 8, "{seen} probes seen");
+}
+
+/// The fulldome master: the closed demo room fills the circle (no background pixel inside it,
+/// the background colour outside), and small spheres land where an equidistant dome puts them:
+/// the ray's direction turned into the dome's frame (the front raised by the tilt), x = W/2 +
+/// ρ·sin α, y = W/2 + ρ·cos α with ρ = (W/2)·ψ/(FOV/2), ψ its angle from the dome's axis and α its
+/// azimuth about it (0 ahead, at the bottom). A sphere 45° up straight ahead sits at (W/2, 3W/4)
+/// in the 180° dome (`core::fisheye` checks that exactly, mono).
+#[test]
+fn the_fisheye_fills_its_circle_with_spheres_where_the_dome_puts_them() {
+    let black = [0.0; 3];
+    let dome = Projection { fov: 240.0, dome_tilt: 20.0, ..Projection::fisheye(192) };
+    let frame = common::render(&builtin::demo(), &RenderSettings::new(dome).with_background(black));
+    for eye in Eye::BOTH {
+        let img = frame.eye(eye);
+        let inside = |x: u32, y: u32| dome.shows_pixel(x as f32 + 0.5, y as f32 + 0.5);
+        let holes: Vec<(u32, u32)> = common::pixels_where(img, |p| common::is_background(p, black))
+            .into_iter()
+            .filter(|&(x, y)| inside(x, y))
+            .collect();
+        assert!(
+            holes.is_empty(),
+            "{eye:?}: {} background pixels inside the circle, e.g. {:?}",
+            holes.len(),
+            &holes[..holes.len().min(5)]
+        );
+        let outside = (0..192).flat_map(|y| (0..192).map(move |x| (x, y))).filter(|&(x, y)| !inside(x, y));
+        assert!(
+            outside.into_iter().all(|(x, y)| img.pixel(x, y)[..3] == [0, 0, 0]),
+            "outside the circle: the background"
+        );
+    }
+    for (fov, tilt) in [(180.0f32, 0.0f32), (240.0, 20.0)] {
+        let w = 512.0;
+        let dome = Projection { fov, dome_tilt: tilt, ..Projection::fisheye(512) };
+        probes_land_where_the_format_puts_them(dome, move |lon, lat| {
+            let d = Vec3::new(lat.cos() * lon.sin(), lat.sin(), -lat.cos() * lon.cos());
+            // Into the dome's frame: turn about x so that its axis becomes +y.
+            let t = -tilt.to_radians();
+            let d = Vec3::new(d.x, t.cos() * d.y - t.sin() * d.z, t.sin() * d.y + t.cos() * d.z);
+            let psi = d.y.clamp(-1.0, 1.0).acos();
+            let alpha = d.x.atan2(-d.z);
+            let rho = 0.5 * w * psi / (0.5 * fov.to_radians());
+            (rho < 0.5 * w - 2.0).then(|| (0.5 * w + rho * alpha.sin(), 0.5 * w + rho * alpha.cos(), 1.0))
+        });
     }
 }
 
@@ -256,6 +315,18 @@ fn sphere_images_carry_photo_sphere_metadata_in_png_and_jpeg_and_players_names()
         .unwrap();
     assert!(o.status.success());
     let decoder = png::Decoder::new(std::io::Cursor::new(std::fs::read(out.join("left.png")).unwrap()));
+    assert!(decoder.read_info().unwrap().info().utf8_text.is_empty());
+    // Nor is the fisheye (GPano has no fisheye type); its combined layouts carry `_fisheye`.
+    let o = common::twister()
+        .args(["render", "builtin:demo", "--panorama", "fisheye", "--width", "64", "--method", "vertex"])
+        .args(["--layout", "side-by-side", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let file = out.join("stereo_fisheye_LR.png");
+    assert_eq!(image::image_dimensions(&file).unwrap(), (128, 64));
+    let decoder = png::Decoder::new(std::io::Cursor::new(std::fs::read(file).unwrap()));
     assert!(decoder.read_info().unwrap().info().utf8_text.is_empty());
     let _ = std::fs::remove_dir_all(&out);
 }

@@ -13,6 +13,9 @@ render no_pole_merge parallel off off
 # VR180: the front half, 256 × 256 per eye (tests/cycles.rs compares it).
 render vr180 parallel 60 75 centre 256 vr180
 cargo run -q --release --example cycles_reference -- snap "$work/vr180" tests/data/cycles/demo_vr180
+# The fulldome master: an equidistant fisheye of 200°, mono, 256 × 256.
+render fisheye200 mono 60 75 centre 256 fisheye:200
+cargo run -q --release --example cycles_reference -- snap "$work/fisheye200" tests/data/cycles/demo_fisheye200
 # The anti-aliasing reference: a one-pixel box filter, kept as rendered (not snapped).
 render parallel_box parallel 60 75 box
 cp "$work/parallel_box_L.png" tests/data/cycles/demo_parallel_box_L.png

@@ -3,12 +3,13 @@ spherical stereo (equirectangular, both eyes) as flat, unlit colours, so that tw
 full-sphere panorama can be checked against Cycles pixel for pixel.
 
 blender -b -P scripts/cycles/render_cycles.py -- SCENE.obj OUT_PREFIX WIDTH CONVERGENCE POLE_FROM POLE_TO [FILTER [PANORAMA]]
-    CONVERGENCE: `parallel` or a distance in metres; POLE_FROM/POLE_TO in degrees (`off` for no merge)
+    CONVERGENCE: `parallel`, `mono` (no eye offset) or a distance in metres; POLE_FROM/POLE_TO in degrees (`off` for no merge)
     FILTER: `centre` (default: 64 rays at each pixel's centre, no anti-aliasing, for the boundary
     checks) or `box` (1024 rays spread evenly over the pixel, a one-pixel box filter: each pixel
     the share of it each surface covers, for the anti-aliasing checks)
-    PANORAMA: `equirect` (default: 360° × 180°, WIDTH × WIDTH/2) or `vr180` (longitudes ±90°,
-    WIDTH × WIDTH)
+    PANORAMA: `equirect` (default: 360° × 180°, WIDTH × WIDTH/2), `vr180` (longitudes ±90°,
+    WIDTH × WIDTH) or `fisheye:FOV` (equidistant, FOV degrees, WIDTH × WIDTH, looking up with the
+    front at the bottom: the fulldome master)
 
 Writes OUT_PREFIX_L.png and OUT_PREFIX_R.png.
 
@@ -52,10 +53,12 @@ scene.world = world
 
 cam_data = bpy.data.cameras.new("ods")
 cam_data.type = "PANO"
-if hasattr(cam_data, "panorama_type"):
-    cam_data.panorama_type = "EQUIRECTANGULAR"
+pano = cam_data if hasattr(cam_data, "panorama_type") else cam_data.cycles
+if panorama.startswith("fisheye"):
+    pano.panorama_type = "FISHEYE_EQUIDISTANT"
+    pano.fisheye_fov = math.radians(float(panorama.split(":")[1]))
 else:
-    cam_data.cycles.panorama_type = "EQUIRECTANGULAR"
+    pano.panorama_type = "EQUIRECTANGULAR"
 if panorama == "vr180":
     # The front half: Cycles' equirectangular camera's longitude range (Blender 3.x keeps it
     # in the Cycles settings, 4.x on the camera).
@@ -63,8 +66,10 @@ if panorama == "vr180":
     settings.longitude_min = -math.pi / 2
     settings.longitude_max = math.pi / 2
 stereo = cam_data.stereo
-stereo.interocular_distance = 0.064
-if convergence == "parallel":
+# `mono`: both eyes at the centre (Cycles' spherical stereo turns the eye circle with the camera's
+# own up axis, so a dome camera looking up would put it upright: twister keeps it level).
+stereo.interocular_distance = 0.0 if convergence == "mono" else 0.064
+if convergence in ("parallel", "mono"):
     stereo.convergence_mode = "PARALLEL"
 else:
     stereo.convergence_mode = "OFFAXIS"
@@ -79,7 +84,8 @@ else:
 cam = bpy.data.objects.new("ods", cam_data)
 scene.collection.objects.link(cam)
 cam.location = (0, 0, 0)
-cam.rotation_euler = (math.pi / 2, 0, 0)
+# Looking ahead (+y) for the equirect; up (+z) with the image's top towards the back for the dome.
+cam.rotation_euler = (math.pi, 0, 0) if panorama.startswith("fisheye") else (math.pi / 2, 0, 0)
 scene.camera = cam
 
 scene.render.engine = "CYCLES"
@@ -96,7 +102,7 @@ else:
     scene.cycles.filter_width = 0.01
 scene.cycles.max_bounces = 0
 scene.render.resolution_x = width
-scene.render.resolution_y = width if panorama == "vr180" else width // 2
+scene.render.resolution_y = width // 2 if panorama == "equirect" else width
 scene.render.resolution_percentage = 100
 scene.view_settings.view_transform = "Standard"
 scene.view_settings.look = "None"

@@ -92,6 +92,9 @@ fn fragment_coverage(in: VertexOut, front_facing: bool, params: FragmentView) ->
     let duv_dy = dpdy(in.uv);
     let dp_dx = dpdxFine(in.view_position);
     let dp_dy = dpdyFine(in.view_position);
+    if (!shows_pixel(params.projection, in.clip.xy)) {
+        discard; // outside the fisheye's circle
+    }
     let c = surface_rgba(in.material, in.color, in.uv, duv_dx, duv_dy, front_facing);
     let alpha_width = mask_alpha_width(in.material, in.color.a, c.a, in.uv, duv_dx, duv_dy);
     let mask = coverage_mask(in.material, c.a, alpha_width, in.clip.xy, SAMPLES);
@@ -111,6 +114,9 @@ fn fragment_color(in: VertexOut, front_facing: bool, params: FragmentView) -> Fr
     let duv_dy = dpdy(in.uv);
     let dp_dx = dpdxFine(in.view_position);
     let dp_dy = dpdyFine(in.view_position);
+    if (!shows_pixel(params.projection, in.clip.xy)) {
+        discard; // outside the fisheye's circle
+    }
     let c = surface_color(in.material, in.color, in.uv, duv_dx, duv_dy, in.clip.xy, front_facing);
     if (MATERIALS && DISCARDS && c.a < 0.0) {
         discard;
@@ -146,6 +152,9 @@ fn measured(in: VertexOut, front_facing: bool, params: FragmentView) -> Fragment
     // and the normal map's tangent frame).
     let dp_dx = dpdxFine(in.view_position);
     let dp_dy = dpdyFine(in.view_position);
+    if (!shows_pixel(params.projection, in.clip.xy)) {
+        discard; // outside the fisheye's circle
+    }
     let c = surface_color(in.material, in.color, in.uv, duv_dx, duv_dy, in.clip.xy, front_facing);
     if (MATERIALS && DISCARDS && c.a < 0.0) {
         discard;
@@ -172,6 +181,9 @@ fn background_vertex(i: u32, eye: u32) -> BackgroundOut {
 // The environment's radiance along the pixel's own ray, tone mapped, and linear
 // (`fs_background`).
 fn background_color(params: FragmentView, frag_xy: vec2<f32>) -> FragmentColor {
+    if (!shows_pixel(params.projection, frag_xy)) {
+        discard; // outside the fisheye's circle: the background colour
+    }
     let ray = pixel_ray(params.projection, params.eye_sign, frag_xy);
     let linear = exposed(env_level(0u, env_st(env_direction(ray.dir))));
     return FragmentColor(vec4<f32>(tone(linear), 1.0), vec4<f32>(linear, 1.0));

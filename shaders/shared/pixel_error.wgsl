@@ -7,6 +7,9 @@
 
 // The screen point (u, v) at image position (x, y) (`Projection::pixel_to_screen`).
 fn from_pixel(proj: Projection, xy: vec2<f32>) -> vec2<f32> {
+    if (is_fisheye(proj)) {
+        return fisheye_direction(proj, xy);
+    }
     return vec2<f32>((xy.x - 0.5 * proj.width) / proj.turn_px * TAU, (0.5 * proj.height - xy.y) / proj.pixels_per_v);
 }
 
@@ -23,6 +26,9 @@ fn screen_direction(proj: Projection, uv: vec2<f32>) -> vec3<f32> {
 // (2π/turn_px, on the sphere × cos latitude) and its height (on the cylinder 1/(pixels_per_v·R_T) seen
 // from the eyes, about R_T away; on the sphere 1/pixels_per_v).
 fn pixel_spread(proj: Projection, frag_xy: vec2<f32>) -> f32 {
+    if (is_fisheye(proj)) {
+        return 1.0 / fisheye_scale(proj);
+    }
     let uv = from_pixel(proj, frag_xy);
     if (is_sphere(proj)) {
         return max(TAU / proj.turn_px * cos(uv.y), 1.0 / proj.pixels_per_v);
@@ -46,7 +52,9 @@ fn pixel_error(proj: Projection, eye_sign: f32, p: vec3<f32>, frag_xy: vec2<f32>
     }
     let ideal = to_pixel(proj, uvd.x, uvd.y);
     var dx = abs(ideal.x - frag_xy.x);
-    dx = min(dx, proj.turn_px - dx);
+    if (!is_fisheye(proj)) {
+        dx = min(dx, proj.turn_px - dx);
+    }
     return length(vec2<f32>(dx, ideal.y - frag_xy.y));
 }
 

@@ -31,6 +31,10 @@ struct Projection {
     pole_from: f32,        // sphere: pole merge, radians of altitude; pole_to 0: off
     pole_to: f32,
     turn_px: f32,          // pixels per full turn of azimuth: the width, 2W for VR180 (its width spans π)
+    fov: f32,              // fisheye: the field of view inscribed in the image, degrees
+    dome_tilt: f32,        // fisheye: the dome's front raised by this, degrees
+    _pad0: f32,
+    _pad1: f32,
 }
 
 // The panoramas a pipeline can draw (bit 0 the cylinder, bit 1 the sphere: equirect or VR180). The subdivide stage's
@@ -151,9 +155,67 @@ fn project_with_azimuth(proj: Projection, p: vec3<f32>, theta: f32, eye_sign: f3
     return vec3<f32>(theta + eye_sign * eye_shift(proj, r), screen_height(proj, p.y, r), r);
 }
 
+// ---- the fisheye (`core::fisheye`): the sphere's rays in an equidistant azimuthal image ----
+
+fn is_fisheye(proj: Projection) -> bool {
+    return (PANORAMAS & 2u) != 0u && proj.panorama == PANORAMA_FISHEYE;
+}
+
+// k: pixels per radian from the dome's axis.
+fn fisheye_scale(proj: Projection) -> f32 {
+    return proj.width / radians(proj.fov);
+}
+
+// The image position of the ray of longitude u, latitude v (`Projection::fisheye_pixel`).
+fn fisheye_pixel(proj: Projection, u: f32, v: f32) -> vec2<f32> {
+    let d = vec3<f32>(cos(v) * sin(u), sin(v), -cos(v) * cos(u));
+    let t = radians(proj.dome_tilt);
+    let a = d.x;
+    let b = d.y * sin(t) - d.z * cos(t);
+    let c = d.y * cos(t) + d.z * sin(t);
+    let h = sqrt(a * a + b * b);
+    var ratio = 1.0;
+    if (h > 0.0) {
+        ratio = precise_atan2(h, c) / h;
+    }
+    let k = fisheye_scale(proj);
+    return vec2<f32>(0.5 * proj.width + k * ratio * a, 0.5 * proj.height + k * ratio * b);
+}
+
+// The longitude and latitude of the ray shown at image position xy
+// (`Projection::fisheye_direction_at`).
+fn fisheye_direction(proj: Projection, xy: vec2<f32>) -> vec2<f32> {
+    let dxy = xy - 0.5 * vec2<f32>(proj.width, proj.height);
+    let k = fisheye_scale(proj);
+    let rho = length(dxy);
+    let psi = rho / k;
+    var s = 1.0 / k;
+    if (rho > 0.0) {
+        s = sin(psi) / rho;
+    }
+    let t = radians(proj.dome_tilt);
+    let axis = vec3<f32>(0.0, cos(t), sin(t));
+    let front = vec3<f32>(0.0, sin(t), -cos(t));
+    let d = vec3<f32>(s * dxy.x, 0.0, 0.0) + s * dxy.y * front + cos(psi) * axis;
+    return vec2<f32>(precise_atan2(d.x, -d.z), precise_atan2(d.y, sqrt(d.x * d.x + d.z * d.z)));
+}
+
+// Whether image position xy shows the scene: inside the fisheye's circle; everywhere elsewhere
+// (`Projection::shows_pixel`).
+fn shows_pixel(proj: Projection, xy: vec2<f32>) -> bool {
+    if (!is_fisheye(proj)) {
+        return true;
+    }
+    let d = xy - 0.5 * vec2<f32>(proj.width, proj.height);
+    return dot(d, d) <= 0.25 * proj.width * proj.width;
+}
+
 // Continuous image coordinates (x right, y down) of a screen point, u wrapped into [−π, π)
-// (VR180: |u| > π/2 falls outside the image).
+// (VR180: |u| > π/2 falls outside the image; the fisheye: its own map).
 fn to_pixel(proj: Projection, u: f32, v: f32) -> vec2<f32> {
+    if (is_fisheye(proj)) {
+        return fisheye_pixel(proj, u, v);
+    }
     let x = wrap_angle(u) / TAU * proj.turn_px + 0.5 * proj.width;
     let y = 0.5 * proj.height - v * proj.pixels_per_v;
     return vec2<f32>(x, y);
@@ -164,6 +226,11 @@ fn to_pixel(proj: Projection, u: f32, v: f32) -> vec2<f32> {
 // screen as in the paper; depth r maps monotonically into (0, 1) as r / (r + 1).
 // y is kept within GUARD_BAND_PX of the image (constants.rs says why).
 fn to_clip(proj: Projection, uvd: vec3<f32>) -> vec4<f32> {
+    let z = min(uvd.z / (uvd.z + 1.0), MAX_DEPTH);
+    if (is_fisheye(proj)) {
+        let xy = fisheye_pixel(proj, uvd.x, uvd.y);
+        return vec4<f32>(2.0 * xy.x / proj.width - 1.0, 1.0 - 2.0 * xy.y / proj.height, z, 1.0);
+    }
     let x = uvd.x * proj.turn_px / (PI * proj.width);
     let y_limit = 1.0 + GUARD_BAND_PX / (0.5 * proj.height);
     var y = clamp(uvd.y * proj.pixels_per_v / (0.5 * proj.height), -y_limit, y_limit);
@@ -174,6 +241,5 @@ fn to_clip(proj: Projection, uvd: vec3<f32>) -> vec4<f32> {
     if (is_sphere(proj) && abs(y) > 1.0 - 1.0 / proj.height) {
         y = sign(y);
     }
-    let z = min(uvd.z / (uvd.z + 1.0), MAX_DEPTH);
     return vec4<f32>(x, y, z, 1.0);
 }

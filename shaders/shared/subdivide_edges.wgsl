@@ -38,6 +38,9 @@ fn edge_point(a: Node, b: Node, j: u32, n: u32) -> Node {
 // Image position in pixels (x not wrapped) of a viewer-frame point for one eye sign.
 fn pixel(p: vec3<f32>, eye_sign: f32) -> vec2<f32> {
     let q = project_with_azimuth(params.projection, p, azimuth(p), eye_sign);
+    if (is_fisheye(params.projection)) {
+        return fisheye_pixel(params.projection, q.x, q.y) - 0.5 * vec2<f32>(params.projection.width, params.projection.height);
+    }
     return vec2<f32>(q.x * params.projection.turn_px / TAU, q.y * params.projection.pixels_per_v);
 }
 
@@ -149,7 +152,20 @@ fn off_screen_vertically(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> bool {
     let k = params.vertical_limit;
     let r = vec3<f32>(horizontal_radius(p0), horizontal_radius(p1), horizontal_radius(p2));
     let y = vec3<f32>(p0.y, p1.y, p2.y);
-    return all(y > k * r) || all(y < -k * r);
+    return all(y > k * r) || all(y < -k * r) || around_dome_antipode(p0, p1, p2);
+}
+
+// Whether a triangle lies wholly in the cone around the point opposite the fisheye's axis
+// (`Projection::around_dome_antipode`): there the image folds onto a ring.
+fn around_dome_antipode(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> bool {
+    let beta = min(180.0 - 0.5 * params.projection.fov - 10.0, 90.0);
+    if (!is_fisheye(params.projection) || beta <= 0.0) {
+        return false;
+    }
+    let c = cos(radians(beta));
+    let t = radians(params.projection.dome_tilt);
+    let axis = vec3<f32>(0.0, cos(t), sin(t));
+    return dot(p0, axis) < -c * length(p0) && dot(p1, axis) < -c * length(p1) && dot(p2, axis) < -c * length(p2);
 }
 
 // The corners of input triangle t in the viewer frame, snapped to the cut planes.

@@ -21,8 +21,10 @@ use twister::{Projection, RenderSettings, Vertical};
 #[derive(Args)]
 pub struct ViewArgs {
     /// The panorama: cylinder (the TWISTER display), equirect (the full sphere, 360° × 180°
-    /// per eye: omni-directional stereo as VR players, 360° video and Blender use) or vr180
-    /// (its front half, 180° × 180° per eye). [default: cylinder; equirect with --preset]
+    /// per eye: omni-directional stereo as VR players, 360° video and Blender use), vr180
+    /// (its front half, 180° × 180° per eye) or fisheye (the fulldome master: W × W,
+    /// equidistant, the zenith at the centre and the front at the bottom; --fov, --dome-tilt;
+    /// mono with --eye-radius 0). [default: cylinder; equirect with --preset]
     #[arg(long, value_enum)]
     pub panorama: Option<PanoramaKind>,
     /// Image width per eye in pixels (the full 360°; vr180: 180°) [default: 3168; equirect and
@@ -45,6 +47,13 @@ pub struct ViewArgs {
     /// poles (Blender's pole merge), or off [default: 60,75].
     #[arg(long, value_parser = parse_pole_merge)]
     pub pole_merge: Option<PoleMerge>,
+    /// fisheye: the field of view inscribed in the square image, degrees, 0 < FOV ≤ 360
+    /// [default: 180].
+    #[arg(long, allow_hyphen_values = true)]
+    pub fov: Option<f32>,
+    /// fisheye: the dome's front raised by DEG degrees (a tilted dome), -90..90 [default: 0].
+    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    pub dome_tilt: Option<f32>,
     /// R_T: radius of the display cylinder, metres.
     #[arg(long, default_value_t = 1.0)]
     pub screen_radius: f32,
@@ -280,7 +289,7 @@ impl ViewArgs {
     /// viewer of `camera[:N]` is placed with the scene, by `cli::scene::prepare`).
     pub fn settings(&self, methods: &[Method]) -> Result<RenderSettings> {
         let panorama = match (self.panorama, self.preset) {
-            (Some(PanoramaKind::Cylinder | PanoramaKind::Vr180), Some(_)) => {
+            (Some(PanoramaKind::Cylinder | PanoramaKind::Vr180 | PanoramaKind::Fisheye), Some(_)) => {
                 return Err(Error::option("--preset", "sizes the full sphere: use it with --panorama equirect"))
             }
             (Some(p), _) => p,
@@ -302,11 +311,19 @@ impl ViewArgs {
                 let width = self.width.unwrap_or(4096);
                 (width, self.height.unwrap_or(width / 2))
             }
-            (PanoramaKind::Vr180, None) => {
+            (PanoramaKind::Vr180 | PanoramaKind::Fisheye, None) => {
                 let width = self.width.unwrap_or(4096);
                 (width, self.height.unwrap_or(width))
             }
         };
+        if panorama != PanoramaKind::Fisheye {
+            if self.fov.is_some() {
+                return Err(Error::option("--fov", "needs --panorama fisheye"));
+            }
+            if self.dome_tilt.is_some() {
+                return Err(Error::option("--dome-tilt", "needs --panorama fisheye"));
+            }
+        }
         let projection = Projection {
             screen_radius: self.screen_radius,
             eye_radius: self.eye_radius,
@@ -316,6 +333,8 @@ impl ViewArgs {
             panorama,
             convergence: self.convergence.and_then(|c| c.0),
             pole_merge: self.pole_merge.map_or(Some(DEFAULT_POLE_MERGE), |p| p.0),
+            fov: self.fov.unwrap_or(180.0),
+            dome_tilt: self.dome_tilt.unwrap_or(0.0),
         };
         projection.validate()?;
         if !self.yaw.is_finite() {

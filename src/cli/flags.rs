@@ -10,6 +10,8 @@ pub const FLAGS: &[(&str, &str)] = &[
     ("view.projection.eye_radius", "--eye-radius"),
     ("view.projection.convergence", "--convergence"),
     ("view.projection.pole_merge", "--pole-merge"),
+    ("view.projection.fov", "--fov"),
+    ("view.projection.dome_tilt", "--dome-tilt"),
     ("view.projection.width/height", "--width/--height"),
     ("view.projection.vertical", "--vertical"),
     ("view.viewer", "--viewer"),

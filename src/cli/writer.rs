@@ -39,7 +39,7 @@ impl FrameWriter {
             return Err(Error::option("--quality", "needs --format jpg"));
         }
         let projection = settings.projection();
-        let sphere = projection.panorama.is_sphere();
+        let sphere = projection.panorama.is_equirectangular();
         if args.layout == Some(Layout::Twister) && !projection.panorama.wraps() {
             return Err(Error::option(
                 "--layout",

@@ -11,6 +11,7 @@ pub mod compare;
 pub mod disk_cache;
 pub mod environment;
 pub mod environment_cache;
+pub mod fisheye;
 pub mod frame;
 pub mod light;
 pub mod load;

@@ -26,7 +26,8 @@
 //! Pixels: u ∈ [−π, π) spans the image width with θ = 0 at the centre column; pixels are square,
 //! one pixel = 2π·R_T/W metres of screen; v = 0 is the middle row, +y is up in the image.
 //!
-//! The full sphere's eye model and its forward map are in `core::sphere`.
+//! The full sphere's eye model and its forward map are in `core::sphere`; the fisheye's image map
+//! in `core::fisheye`.
 //!
 //! The WGSL twin of this module is `shaders/shared/projection.wgsl`; both must stay in step.
 
@@ -90,6 +91,11 @@ pub struct Projection {
     pub convergence: Option<f32>,
     /// The full sphere: the eye offset fades out between these altitudes, degrees; None: off.
     pub pole_merge: Option<(f32, f32)>,
+    /// The fisheye: the field of view inscribed in the square image, degrees (180: the dome's
+    /// hemisphere).
+    pub fov: f32,
+    /// The fisheye: the dome's front raised by this many degrees (its axis tilted back).
+    pub dome_tilt: f32,
 }
 
 /// The pole merge Blender uses by default (degrees of altitude).
@@ -107,6 +113,8 @@ impl Default for Projection {
             panorama: PanoramaKind::Cylinder,
             convergence: None,
             pole_merge: Some(DEFAULT_POLE_MERGE),
+            fov: 180.0,
+            dome_tilt: 0.0,
         }
     }
 }
@@ -116,6 +124,11 @@ impl Projection {
     /// pole merge.
     pub fn equirect(width: u32) -> Projection {
         Projection { panorama: PanoramaKind::Equirect, width, height: width / 2, ..Projection::default() }
+    }
+
+    /// The fulldome master: `width` × `width` pixels per eye, the zenith at the centre, 180°.
+    pub fn fisheye(width: u32) -> Projection {
+        Projection { panorama: PanoramaKind::Fisheye, width, height: width, ..Projection::default() }
     }
 
     /// VR180: the sphere's front half, `width` × `width` pixels per eye, parallel rays, Blender's
@@ -187,6 +200,30 @@ impl Projection {
                 ));
             }
         }
+        if self.panorama == PanoramaKind::Fisheye {
+            if !(self.fov.is_finite() && self.fov > 0.0 && self.fov <= 360.0) {
+                return Err(Error::setting(
+                    "view.projection.fov",
+                    format!("must be a field of view in degrees, 0 < FOV ≤ 360, got {}", self.fov),
+                ));
+            }
+            if !(self.dome_tilt.is_finite() && self.dome_tilt.abs() <= 90.0) {
+                return Err(Error::setting(
+                    "view.projection.dome_tilt",
+                    format!("must be degrees between -90 and 90, got {}", self.dome_tilt),
+                ));
+            }
+            if self.dome_tilt != 0.0 && self.dome_antipode_cone().is_none() {
+                return Err(Error::setting(
+                    "view.projection.dome_tilt",
+                    format!(
+                        "a tilted dome takes a field of view below 340°, got {}: the point opposite its axis \
+                         then lies within 10° of the image's rim",
+                        self.fov
+                    ),
+                ));
+            }
+        }
         if self.width < 2 || self.height < 2 || self.width > MAX_IMAGE_SIDE || self.height > MAX_IMAGE_SIDE {
             return Err(Error::setting(
                 "view.projection.width/height",
@@ -254,16 +291,20 @@ impl Projection {
     /// Pixels per unit of v: per metre of screen height (the cylinder), per radian of latitude
     /// (the sphere: H/π).
     pub fn pixels_per_v(&self) -> f32 {
-        if self.panorama.is_sphere() {
-            self.height as f32 / std::f32::consts::PI
-        } else {
-            self.pixels_per_metre()
+        match self.panorama {
+            PanoramaKind::Fisheye => self.fisheye_pixels_per_radian(),
+            p if p.is_sphere() => self.height as f32 / std::f32::consts::PI,
+            _ => self.pixels_per_metre(),
         }
     }
 
     /// Pixels per full turn of azimuth (2π): the width, or twice it for VR180 (whose width
-    /// spans π). `turn_px` in projection.wgsl.
+    /// spans π); the fisheye, whose image has no seam, f32::MAX (x never wraps). `turn_px` in
+    /// projection.wgsl.
     pub fn turn_px(&self) -> f32 {
+        if self.panorama == PanoramaKind::Fisheye {
+            return f32::MAX;
+        }
         self.width as f32 / self.panorama.turn_share()
     }
 
@@ -276,6 +317,9 @@ impl Projection {
     /// `u` is wrapped into [−π, π), azimuth 0 at the image's centre column (VR180: |u| > π/2
     /// falls outside the image).
     pub fn to_pixel(&self, u: f32, v: f32) -> [f32; 2] {
+        if self.panorama == PanoramaKind::Fisheye {
+            return self.fisheye_pixel(u, v);
+        }
         let x = wrap_angle(u) / std::f32::consts::TAU * self.turn_px() + 0.5 * self.width as f32;
         let y = 0.5 * self.height as f32 - v * self.pixels_per_v();
         [x, y]
@@ -284,6 +328,9 @@ impl Projection {
     /// The screen point (u, v) at the centre of pixel (column, row); u ∈ [−π, π) (VR180:
     /// [−π/2, π/2)).
     pub fn pixel_to_screen(&self, column: f32, row: f32) -> (f32, f32) {
+        if self.panorama == PanoramaKind::Fisheye {
+            return self.fisheye_direction_at(column + 0.5, row + 0.5);
+        }
         let u = (column + 0.5 - 0.5 * self.width as f32) / self.turn_px() * std::f32::consts::TAU;
         let v = (0.5 * self.height as f32 - (row + 0.5)) / self.pixels_per_v();
         (u, v)
@@ -318,6 +365,9 @@ impl Projection {
     /// vertical models; on the sphere the latitude atan2(y, √(r² − e²)) ≥ atan(y/r), so
     /// k = 1/tan(π/2H) is safe for every eye offset.
     pub fn vertical_limit(&self) -> f32 {
+        if self.panorama == PanoramaKind::Fisheye {
+            return f32::MAX; // the dome shows every altitude its field of view reaches
+        }
         if self.panorama.is_sphere() {
             return 1.0 / (0.5 * std::f32::consts::PI / self.height as f32).tan();
         }
@@ -331,8 +381,12 @@ impl Projection {
     }
 
     /// The horizontal distance in pixels between two image x coordinates, wrapping around the
-    /// full turn (VR180: a turn is twice the width, so no two pixels of its image wrap).
+    /// full turn (VR180: a turn is twice the width, so no two pixels of its image wrap; the
+    /// fisheye: no wrap).
     pub fn wrapped_dx(&self, a: f32, b: f32) -> f32 {
+        if self.panorama == PanoramaKind::Fisheye {
+            return (a - b).abs();
+        }
         let w = self.turn_px();
         let d = (a - b).rem_euclid(w);
         d.min(w - d)
@@ -352,6 +406,9 @@ pub enum PanoramaKind {
     /// VR180: the sphere's front half, equirectangular 180° × 180° per eye (W = H), the same eye
     /// model as `Equirect`; longitudes beyond ±90° fall outside the image.
     Vr180,
+    /// The fulldome master: the sphere's eye rays drawn in an equidistant azimuthal (fisheye)
+    /// image, W × W, the dome's axis at the centre (`core::fisheye`).
+    Fisheye,
 }
 
 impl PanoramaKind {
@@ -360,12 +417,19 @@ impl PanoramaKind {
             PanoramaKind::Cylinder => "cylinder",
             PanoramaKind::Equirect => "equirect",
             PanoramaKind::Vr180 => "vr180",
+            PanoramaKind::Fisheye => "fisheye",
         }
     }
 
     /// Whether the panorama is (part of) the full sphere's equirectangular ODS: longitude u,
     /// latitude v, the eye model of `core::sphere`.
     pub const fn is_sphere(self) -> bool {
+        matches!(self, PanoramaKind::Equirect | PanoramaKind::Vr180 | PanoramaKind::Fisheye)
+    }
+
+    /// Whether the image is equirectangular (the sphere, VR180): what GPano and `sv3d`/`equi`
+    /// describe.
+    pub const fn is_equirectangular(self) -> bool {
         matches!(self, PanoramaKind::Equirect | PanoramaKind::Vr180)
     }
 
@@ -384,12 +448,13 @@ impl PanoramaKind {
             PanoramaKind::Cylinder => None,
             PanoramaKind::Equirect => Some("360"),
             PanoramaKind::Vr180 => Some("180"),
+            PanoramaKind::Fisheye => Some("fisheye"),
         }
     }
 
     /// Whether the image's width is the whole turn (its left and right edges meet).
     pub const fn wraps(self) -> bool {
-        !matches!(self, PanoramaKind::Vr180)
+        !matches!(self, PanoramaKind::Vr180 | PanoramaKind::Fisheye)
     }
 
     /// Its code in the WGSL projection uniform (`PANORAMA_CYLINDER`, `PANORAMA_EQUIRECT`).
@@ -398,12 +463,15 @@ impl PanoramaKind {
             PanoramaKind::Cylinder => 0,
             PanoramaKind::Equirect => 1,
             PanoramaKind::Vr180 => 2,
+            PanoramaKind::Fisheye => 3,
         }
     }
 
     /// The panorama of a code; None for a code no panorama has.
     pub fn from_code(code: u32) -> Option<PanoramaKind> {
-        [PanoramaKind::Cylinder, PanoramaKind::Equirect, PanoramaKind::Vr180].into_iter().find(|p| p.code() == code)
+        [PanoramaKind::Cylinder, PanoramaKind::Equirect, PanoramaKind::Vr180, PanoramaKind::Fisheye]
+            .into_iter()
+            .find(|p| p.code() == code)
     }
 }
 

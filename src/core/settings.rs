@@ -463,6 +463,12 @@ impl RenderSettings {
             return Err(Error::setting("subdivision.max_div", format!("must be between 1 and 64, got {}", s.max_div)));
         }
         if let Method::Slit(w) = s.method {
+            if self.view.projection.panorama == PanoramaKind::Fisheye {
+                return Err(Error::setting(
+                    "subdivision.method",
+                    format!("slit:{w} pastes the cylinder's, the sphere's and VR180's slits; the fisheye has none yet: use trace as the reference"),
+                ));
+            }
             if w > self.view.projection.width {
                 return Err(Error::setting(
                     "subdivision.method",

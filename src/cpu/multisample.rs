@@ -45,6 +45,9 @@ impl MultisampledImage {
         let n = self.samples as usize;
         for y in 0..self.height {
             for x in 0..self.width {
+                if !projection.shows_pixel(x as f32 + 0.5, y as f32 + 0.5) {
+                    continue; // outside the fisheye's circle: the background colour
+                }
                 let c = background_color(table, projection, eye, Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
                 let i = (y * self.width + x) as usize;
                 self.rgba[n * i..n * (i + 1)].fill(c);
@@ -114,6 +117,9 @@ pub fn coverage_fragment(
     samples: u32,
     f: &FragmentIn,
 ) -> Option<([u8; 4], u32)> {
+    if !projection.shows_pixel(f.surface.frag_xy.x, f.surface.frag_xy.y) {
+        return None; // outside the fisheye's circle
+    }
     let c = surface_rgba(table, &f.surface);
     let alpha = c.map_or(-1.0, |c| c.w);
     let width = mask_alpha_width(table, &f.surface, alpha);

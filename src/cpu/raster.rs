@@ -10,7 +10,7 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::core::projection::{azimuth, Eye, Projection};
+use crate::core::projection::{azimuth, Eye, PanoramaKind, Projection};
 use crate::core::scene::unpack_tangent;
 use crate::core::texture::MaterialTable;
 use crate::cpu::fragment::{
@@ -30,6 +30,22 @@ pub fn raster_vertex(params: &RasterParams, v: &DrawVertex) -> Vec4 {
     let theta = theta0 + std::f32::consts::TAU * ((v.theta_ref - theta0) / std::f32::consts::TAU + 0.5).floor();
     let eye = if params.eye_sign > 0.0 { Eye::Right } else { Eye::Left };
     let q = projection.project_with_azimuth(p, theta, eye);
+    let depth = (q.depth / (q.depth + 1.0)).min(crate::encoding::constants::MAX_DEPTH);
+    if projection.panorama == PanoramaKind::Fisheye {
+        // The fisheye has no seam: a seam copy (its reference a turn away) would draw its
+        // triangle twice, so it collapses to a point outside the image.
+        if v.theta_ref.abs() > std::f32::consts::PI {
+            return Vec4::new(-4.0, -4.0, depth, 1.0);
+        }
+        let [x, y] = projection.fisheye_pixel(q.u, q.v);
+        let (w, h) = (projection.width as f32, projection.height as f32);
+        return Vec4::new(
+            2.0 * (x + params.shift_px[0]) / w - 1.0,
+            1.0 - 2.0 * (y + params.shift_px[1]) / h,
+            depth,
+            1.0,
+        );
+    }
     let half_height = 0.5 * projection.height as f32;
     let y_limit = 1.0 + GUARD_BAND_PX / half_height;
     let mut y = (q.v * projection.pixels_per_v() / half_height).clamp(-y_limit, y_limit);
@@ -41,7 +57,7 @@ pub fn raster_vertex(params: &RasterParams, v: &DrawVertex) -> Vec4 {
         q.u * projection.turn_px() / (std::f32::consts::PI * projection.width as f32)
             + 2.0 * params.shift_px[0] / projection.width as f32,
         y - 2.0 * params.shift_px[1] / projection.height as f32,
-        (q.depth / (q.depth + 1.0)).min(crate::encoding::constants::MAX_DEPTH),
+        depth,
         1.0,
     )
 }
@@ -138,8 +154,11 @@ pub fn fragment(
     error_angle: bool,
     f: &FragmentIn,
 ) -> Option<FragmentOut> {
-    let color = surface_color(table, &f.surface)?;
     let frag_xy = f.surface.frag_xy;
+    if !projection.shows_pixel(frag_xy.x, frag_xy.y) {
+        return None; // outside the fisheye's circle
+    }
+    let color = surface_color(table, &f.surface)?;
     Some(FragmentOut {
         rgba: shade_surface(
             table,
@@ -343,6 +362,9 @@ pub(crate) fn clip_vertices(params: &RasterParams, tri: &[DrawVertex]) -> [ClipV
 pub fn fill_background(img: &mut RasterImage, table: &MaterialTable, projection: &Projection, eye: Eye) {
     for y in 0..img.height {
         for x in 0..img.width {
+            if !projection.shows_pixel(x as f32 + 0.5, y as f32 + 0.5) {
+                continue; // outside the fisheye's circle: the background colour
+            }
             let i = 4 * (y * img.width + x) as usize;
             let c = background_color(table, projection, eye, Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
             img.rgba[i..i + 4].copy_from_slice(&c);

@@ -484,6 +484,9 @@ impl<'a> Tracer<'a> {
     /// in the viewer's frame and the scene's.
     fn primary(&self, eye: Eye, frag_xy: Vec2) -> Option<(Vec3, Vec3, TracedRay, u32)> {
         let params = self.params;
+        if !self.projection.shows_pixel(frag_xy.x, frag_xy.y) {
+            return None; // outside the fisheye's circle
+        }
         let (origin_v, dir_v) = pixel_ray(&self.projection, eye, frag_xy);
         let (level, reflect_max) = match self.gaze {
             None => (1.0, params.reflect_max),

@@ -165,6 +165,7 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("PANORAMA_CYLINDER", U32(PanoramaKind::Cylinder.code())),
         ("PANORAMA_EQUIRECT", U32(PanoramaKind::Equirect.code())),
         ("PANORAMA_VR180", U32(PanoramaKind::Vr180.code())),
+        ("PANORAMA_FISHEYE", U32(PanoramaKind::Fisheye.code())),
         ("NO_TEXTURE", U32(NO_TEXTURE)),
         ("WRAP_REPEAT", U32(Wrap::Repeat as u32)),
         ("WRAP_CLAMP", U32(Wrap::ClampToEdge as u32)),

@@ -31,7 +31,7 @@ pub struct DrawVertex {
     pub tangent: u32,
 }
 
-/// `Projection` in shaders/shared/projection.wgsl. 48 bytes.
+/// `Projection` in shaders/shared/projection.wgsl. 64 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct ProjectionUniform {
@@ -43,7 +43,7 @@ pub struct ProjectionUniform {
     pub vertical_exact: u32,
     /// Pixels per unit of v (metres of screen, or radians of latitude).
     pub pixels_per_v: f32,
-    /// 0 the cylinder, 1 the sphere, 2 VR180 (`PanoramaKind::code`).
+    /// 0 the cylinder, 1 the sphere, 2 VR180, 3 the fisheye (`PanoramaKind::code`).
     pub panorama: u32,
     /// The sphere's convergence distance, metres; 0: parallel rays.
     pub convergence: f32,
@@ -52,6 +52,11 @@ pub struct ProjectionUniform {
     pub pole_to: f32,
     /// Pixels per full turn of azimuth (`Projection::turn_px`): the width, or 2W for VR180.
     pub turn_px: f32,
+    /// The fisheye's field of view and dome tilt, degrees (`Projection::fov`, `dome_tilt`).
+    pub fov: f32,
+    pub dome_tilt: f32,
+    pub _pad0: f32,
+    pub _pad1: f32,
 }
 
 impl From<&ProjectionUniform> for Projection {
@@ -65,6 +70,8 @@ impl From<&ProjectionUniform> for Projection {
             panorama: PanoramaKind::from_code(p.panorama).unwrap_or_default(),
             convergence: (p.convergence > 0.0).then_some(p.convergence),
             pole_merge: (p.pole_to > 0.0).then(|| (p.pole_from.to_degrees(), p.pole_to.to_degrees())),
+            fov: p.fov,
+            dome_tilt: p.dome_tilt,
         }
     }
 }
@@ -85,11 +92,15 @@ impl From<&Projection> for ProjectionUniform {
             pole_from,
             pole_to,
             turn_px: p.turn_px(),
+            fov: p.fov,
+            dome_tilt: p.dome_tilt,
+            _pad0: 0.0,
+            _pad1: 0.0,
         }
     }
 }
 
-/// `SubdivideParams` in shaders/shared/subdivide_types.wgsl. 176 bytes.
+/// `SubdivideParams` in shaders/shared/subdivide_types.wgsl. 192 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct SubdivideParams {
@@ -185,7 +196,7 @@ impl SubdivideCounters {
     }
 }
 
-/// `RasterParams` in shaders/raster.wgsl. 80 bytes.
+/// `RasterParams` in shaders/raster.wgsl. 96 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct RasterParams {
@@ -231,7 +242,7 @@ pub struct ReduceParams {
     pub _pad2: u32,
 }
 
-/// `SlitParams` in shaders/slit.wgsl. 128 bytes.
+/// `SlitParams` in shaders/slit.wgsl. 144 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct SlitParams {
@@ -351,7 +362,7 @@ macro_rules! layout {
     };
 }
 
-/// `TraceParams` in shaders/trace.wgsl. 224 bytes.
+/// `TraceParams` in shaders/trace.wgsl. 240 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct TraceParams {
@@ -446,7 +457,7 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("DrawVertex" => DrawVertex { position, theta_ref, normal, material, color, uv, object, tangent }),
     layout!("Projection" => ProjectionUniform {
         screen_radius, eye_radius, width, height, acos_eye_screen, vertical_exact, pixels_per_v, panorama,
-        convergence, pole_from, pole_to, turn_px
+        convergence, pole_from, pole_to, turn_px, fov, dome_tilt, _pad0, _pad1
     }),
     layout!("SubdivideParams" => SubdivideParams {
         view, projection, axis_clearance, triangle_count, first_triangle, method, fixed_n, edge_px, max_div,

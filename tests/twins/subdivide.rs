@@ -105,6 +105,8 @@ fn subdivide_cases() -> Vec<(Scene, RenderSettings)> {
         (random_triangle_scene(7, 200), RenderSettings::new(Projection::equirect(256)).with_method(Method::Fixed(3))),
         // VR180: the sphere's front half (the back's pieces land beyond the image's sides).
         (builtin::demo(), RenderSettings::new(Projection::vr180(192))),
+        // The fisheye: its own image's edge lengths, the cone around the tilted dome's antipode.
+        (builtin::demo(), RenderSettings::new(Projection { fov: 240.0, dome_tilt: 20.0, ..Projection::fisheye(192) })),
         // Rows (the sphere, adaptive rules): random triangles, the box room (long thin parts in
         // bands), eq. 5, a viewer off the axis.
         (random_triangle_scene(9, 200), RenderSettings::new(Projection::equirect(320))),

@@ -96,6 +96,14 @@ impl Twin for Trace {
                 (builtin::demo(), RenderSettings::new(sphere).with_method(Method::Trace)),
             ),
             (
+                "demo on a 200° fisheye".into(),
+                (
+                    builtin::demo(),
+                    RenderSettings::new(Projection { fov: 200.0, ..Projection::fisheye(96) })
+                        .with_method(Method::Trace),
+                ),
+            ),
+            (
                 "demo on VR180".into(),
                 (builtin::demo(), RenderSettings::new(Projection::vr180(96)).with_method(Method::Trace)),
             ),

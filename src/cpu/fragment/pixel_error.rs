@@ -4,13 +4,16 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::core::projection::{pixel_ray, Eye, Projection};
+use crate::core::projection::{pixel_ray, Eye, PanoramaKind, Projection};
 
 /// The angle a pixel spans, radians (`pixel_spread` in surface.wgsl): the larger of its width
 /// (2π/turn_px, on the sphere × cos latitude) and its height (on the cylinder 1/(pixels_per_v·R_T),
 /// seen from the eyes about R_T away; on the sphere 1/pixels_per_v). A ray cone grows by this
 /// much per metre.
 pub fn pixel_spread(projection: &Projection, frag_xy: Vec2) -> f32 {
+    if projection.panorama == PanoramaKind::Fisheye {
+        return 1.0 / projection.fisheye_pixels_per_radian();
+    }
     let (_, v) = projection.pixel_to_screen(frag_xy.x - 0.5, frag_xy.y - 0.5);
     let across = std::f32::consts::TAU / projection.turn_px();
     if projection.panorama.is_sphere() {

@@ -6,7 +6,7 @@
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use super::{snap_to_cut_planes, Node, PartSplit, Subdivider, Triangle};
-use crate::core::projection::{azimuth, horizontal_radius, Eye, Vertical};
+use crate::core::projection::{azimuth, horizontal_radius, Eye, PanoramaKind, Vertical};
 use crate::core::scene::{unpack_tangent, SceneVertex};
 use crate::core::settings::SplitRule;
 use crate::encoding::constants::{
@@ -66,7 +66,13 @@ impl Subdivider<'_> {
     pub(super) fn pixel(&self, p: Vec3, eye_sign: f32) -> Vec2 {
         let eye = if eye_sign > 0.0 { Eye::Right } else { Eye::Left };
         let q = self.projection.project_with_azimuth(p, azimuth(p), eye);
-        Vec2::new(q.u * self.projection.pixels_per_radian(), q.v * self.projection.pixels_per_v())
+        let proj = &self.projection;
+        if proj.panorama == PanoramaKind::Fisheye {
+            // Its own image, centred (no seam: x never wraps).
+            let [x, y] = proj.fisheye_pixel(q.u, q.v);
+            return Vec2::new(x - 0.5 * proj.width as f32, y - 0.5 * proj.height as f32);
+        }
+        Vec2::new(q.u * proj.pixels_per_radian(), q.v * proj.pixels_per_v())
     }
 
     /// What the split rules read of the straight edge ab, projected and sampled as a polyline
@@ -234,7 +240,7 @@ impl Subdivider<'_> {
         let k = self.vertical_limit();
         let above = p.iter().all(|q| q.y > k * horizontal_radius(*q));
         let below = p.iter().all(|q| q.y < -k * horizontal_radius(*q));
-        above || below
+        above || below || self.projection.around_dome_antipode(p)
     }
 
     /// `plan`: the macro-lattice level K of a part (K² pieces) and its edge counts.
