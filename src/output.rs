@@ -94,6 +94,19 @@ pub fn columns(img: &EyeImage, start: u32, width: u32) -> EyeImage {
     EyeImage { width, height: img.height, rgba }
 }
 
+/// The image with every pixel outside the projection's image (the fisheye's circle) transparent
+/// (RGBA 0, 0, 0, 0): `--alpha`.
+pub fn transparent_outside(img: &EyeImage, projection: &crate::core::projection::Projection) -> EyeImage {
+    let mut out = img.clone();
+    for (i, px) in out.rgba.chunks_exact_mut(4).enumerate() {
+        let (x, y) = ((i as u32 % img.width) as f32 + 0.5, (i as u32 / img.width) as f32 + 0.5);
+        if !projection.shows_pixel(x, y) {
+            px.copy_from_slice(&[0; 4]);
+        }
+    }
+    out
+}
+
 /// The two eyes side by side, left on the left (4-byte texels, rows of `width`).
 fn side_by_side<T: Copy>(left: &[T], right: &[T], width: usize, per_texel: usize) -> Vec<T> {
     left.chunks(width * per_texel)

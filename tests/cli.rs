@@ -165,6 +165,8 @@ fn bad_arguments_are_clear_errors() {
         (&["render", "--panorama", "fisheye", "--dome-tilt", "95"], "--dome-tilt: must be degrees between -90 and 90"),
         (&["render", "--panorama", "fisheye", "--fov", "350", "--dome-tilt", "10"], "--dome-tilt: a tilted dome"),
         (&["render", "--panorama", "fisheye", "--method", "slit:4"], "--method: slit:4"),
+        (&["render", "--alpha"], "--alpha: needs --panorama fisheye"),
+        (&["render", "--panorama", "fisheye", "--alpha", "--format", "jpg"], "--alpha: needs --format png"),
     ];
     for (args, needle) in cases {
         let o = twister().args(*args).args(["--out", "/nonexistent/never"]).output().unwrap();

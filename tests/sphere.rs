@@ -326,8 +326,23 @@ fn sphere_images_carry_photo_sphere_metadata_in_png_and_jpeg_and_players_names()
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let file = out.join("stereo_fisheye_LR.png");
     assert_eq!(image::image_dimensions(&file).unwrap(), (128, 64));
-    let decoder = png::Decoder::new(std::io::Cursor::new(std::fs::read(file).unwrap()));
+    let decoder = png::Decoder::new(std::io::Cursor::new(std::fs::read(&file).unwrap()));
     assert!(decoder.read_info().unwrap().info().utf8_text.is_empty());
+    let opaque = image::open(&file).unwrap().to_rgba8();
+    // --alpha: the circle's outside transparent, its inside as before.
+    let o = common::twister()
+        .args(["render", "builtin:demo", "--panorama", "fisheye", "--width", "64", "--method", "vertex"])
+        .args(["--layout", "side-by-side", "--alpha", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let clear = image::open(&file).unwrap().to_rgba8();
+    let dome = Projection::fisheye(64);
+    for (x, y, p) in clear.enumerate_pixels() {
+        let inside = dome.shows_pixel((x % 64) as f32 + 0.5, y as f32 + 0.5);
+        assert_eq!(p.0, if inside { opaque.get_pixel(x, y).0 } else { [0; 4] }, "({x}, {y})");
+    }
     let _ = std::fs::remove_dir_all(&out);
 }
 

@@ -493,6 +493,9 @@ pub struct RenderArgs {
     /// target beside the display colour, in the same frame; the projection methods only.
     #[arg(long)]
     pub hdr: bool,
+    /// fisheye: outside the circle transparent (alpha 0) instead of the background colour; PNG.
+    #[arg(long)]
+    pub alpha: bool,
     /// Background colour R,G,B, each 0–255.
     #[arg(long, value_parser = parse_rgb, default_value = "26,26,31")]
     pub background: [f32; 3],

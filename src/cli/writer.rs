@@ -9,8 +9,8 @@ use serde::Serialize;
 use twister::core::projection::PanoramaKind;
 use twister::error::{Error, Result};
 use twister::output::{
-    depth_images, depth_names, exr_file, gpano_xmp, hdr_exr_file, image_file, layout_images, layout_names, Encoding,
-    ImageFormat, Layout, OutputFile,
+    depth_images, depth_names, exr_file, gpano_xmp, hdr_exr_file, image_file, layout_images, layout_names,
+    transparent_outside, Encoding, ImageFormat, Layout, OutputFile,
 };
 use twister::{Frame, RenderSettings};
 
@@ -29,6 +29,8 @@ pub struct FrameWriter {
     encoding: Encoding,
     depth: bool,
     hdr: bool,
+    /// The fisheye with `--alpha`: its projection, whose circle's outside is made transparent.
+    transparent_outside: Option<twister::Projection>,
 }
 
 impl FrameWriter {
@@ -40,6 +42,12 @@ impl FrameWriter {
         }
         let projection = settings.projection();
         let sphere = projection.panorama.is_equirectangular();
+        if args.alpha && projection.panorama != PanoramaKind::Fisheye {
+            return Err(Error::option("--alpha", "needs --panorama fisheye (the outside of its circle)"));
+        }
+        if args.alpha && args.format != ImageFormat::Png {
+            return Err(Error::option("--alpha", "needs --format png (JPEG has no alpha)"));
+        }
         if args.layout == Some(Layout::Twister) && !projection.panorama.wraps() {
             return Err(Error::option(
                 "--layout",
@@ -61,6 +69,7 @@ impl FrameWriter {
             },
             depth: args.depth,
             hdr: args.hdr,
+            transparent_outside: args.alpha.then_some(*projection),
         })
     }
 
@@ -97,7 +106,22 @@ impl FrameWriter {
     /// frame holds them.
     pub fn files(&self, rendered: &Frame, frame: Option<u32>) -> Result<Vec<OutputFile>> {
         // The images are encoded side by side (a still's two eyes: half the wait on two cores).
-        let images = layout_images(rendered, self.layout, self.encoding.format, self.panorama);
+        let images = match &self.transparent_outside {
+            None => layout_images(rendered, self.layout, self.encoding.format, self.panorama),
+            Some(projection) => {
+                let [left, right] = [&rendered.left, &rendered.right].map(|img| transparent_outside(img, projection));
+                let eyes = Frame {
+                    left,
+                    right,
+                    stats: Default::default(),
+                    measurement: None,
+                    depth: None,
+                    positions: None,
+                    hdr: None,
+                };
+                layout_images(&eyes, self.layout, self.encoding.format, self.panorama)
+            }
+        };
         let mut files = std::thread::scope(|scope| {
             let encoders: Vec<_> = images
                 .iter()
