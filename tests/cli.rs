@@ -166,6 +166,14 @@ fn bad_arguments_are_clear_errors() {
         (&["render", "--panorama", "fisheye", "--fov", "350", "--dome-tilt", "10"], "--dome-tilt: a tilted dome"),
         (&["render", "--panorama", "fisheye", "--method", "slit:4"], "--method: slit:4"),
         (&["render", "--alpha"], "--alpha: needs --panorama fisheye"),
+        // A tracked head (issue 34).
+        (&["render", "--head", "0.98,0,0"], "--head: the eyes reach the screen"),
+        (&["render", "--head", "0,0,0", "--panorama", "equirect"], "--head: a tracked head looks at the cylinder"),
+        (&["render", "--head", "0,0,0", "--viewer", "camera"], "--head: needs the display's centre"),
+        (&["render", "--head", "0,0,0", "--vertical", "paper"], "--vertical: a tracked head"),
+        (&["render", "--head", "0,0,0", "--method", "slit:4"], "--method: slit:4 pastes the slits of eyes"),
+        (&["render", "--head", "0,0"], "--head"),
+        (&["render", "--head", "0,0,nan"], "--head"),
         (&["render", "--panorama", "fisheye", "--alpha", "--format", "jpg"], "--alpha: needs --format png"),
     ];
     for (args, needle) in cases {

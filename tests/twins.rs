@@ -149,6 +149,9 @@ impl Twin for ProjectPoints {
         // VR180: the same points, half of them behind (outside the image).
         for eye in Eye::BOTH {
             out.push((format!("vr180 {eye:?}"), (Projection::vr180(2048), eye, sphere_points.clone())));
+            let head = twister::core::head::Head { offset: [0.3, 0.1, -0.2], turn: 0.35 };
+            let tracked = Projection { vertical: Vertical::Exact, head: Some(head), ..Projection::default() };
+            out.push((format!("a tracked head {eye:?}"), (tracked, eye, points.clone())));
             let dome = Projection { fov: 240.0, dome_tilt: 20.0, ..Projection::fisheye(2048) };
             out.push((format!("fisheye 240° tilted 20° {eye:?}"), (dome, eye, sphere_points.clone())));
         }
@@ -279,6 +282,10 @@ fn raster_geometry_cases() -> Vec<(String, RasterCase)> {
     let sphere = Projection::equirect(320);
     out.push(("demo on the sphere".into(), (builtin::demo(), RenderSettings::new(sphere), None)));
     out.push(("demo on VR180".into(), (builtin::demo(), RenderSettings::new(Projection::vr180(160)), None)));
+    let head = twister::core::head::Head { offset: [0.3, 0.1, -0.2], turn: 0.35 };
+    let tracked =
+        Projection { width: 400, height: 100, vertical: Vertical::Exact, head: Some(head), ..Projection::default() };
+    out.push(("demo seen by a tracked head".into(), (builtin::demo(), RenderSettings::new(tracked), None)));
     let dome = Projection { fov: 240.0, dome_tilt: 20.0, ..Projection::fisheye(160) };
     out.push(("demo on a tilted 240° fisheye".into(), (builtin::demo(), RenderSettings::new(dome), None)));
     // A triangle 2 m ahead reaching ±60° across and 50° up and down.

@@ -19,6 +19,9 @@ fn screen_direction(proj: Projection, uv: vec2<f32>) -> vec3<f32> {
     if (is_sphere(proj)) {
         return vec3<f32>(cos(uv.y) * sin(uv.x), sin(uv.y), -cos(uv.y) * cos(uv.x));
     }
+    if (proj.head_on != 0.0) {
+        return normalize(head_screen_point(proj, uv.x, uv.y));
+    }
     return normalize(vec3<f32>(proj.screen_radius * sin(uv.x), uv.y, -proj.screen_radius * cos(uv.x)));
 }
 
@@ -75,6 +78,10 @@ fn pixel_ray(proj: Projection, eye_sign: f32, frag_xy: vec2<f32>) -> Ray {
             return Ray(origin, normalize(proj.convergence * d - origin));
         }
         return Ray(origin, d);
+    }
+    if (proj.head_on != 0.0) {
+        let origin = vec3<f32>(eye_sign * proj.eye_radius, 0.0, 0.0);
+        return Ray(origin, normalize(head_screen_point(proj, uv.x, uv.y) - origin));
     }
     let phi = uv.x - eye_sign * precise_asin(proj.eye_radius / proj.screen_radius);
     let origin = eye_sign * proj.eye_radius * vec3<f32>(cos(phi), 0.0, sin(phi));

@@ -33,8 +33,10 @@ struct Projection {
     turn_px: f32,          // pixels per full turn of azimuth: the width, 2W for VR180 (its width spans π)
     fov: f32,              // fisheye: the field of view inscribed in the image, degrees
     dome_tilt: f32,        // fisheye: the dome's front raised by this, degrees
+    head_on: f32,          // the cylinder's tracked head (`core::head`): 1 on, 0 off
+    head_turn: f32,        // γ: head frame → display frame turn, radians
+    head_offset: vec3<f32>, // O: the head in the display's frame, metres
     _pad0: f32,
-    _pad1: f32,
 }
 
 // The panoramas a pipeline can draw (bit 0 the cylinder, bit 1 the sphere: equirect or VR180). The subdivide stage's
@@ -152,7 +154,45 @@ fn project_with_azimuth(proj: Projection, p: vec3<f32>, theta: f32, eye_sign: f3
     if (is_sphere(proj)) {
         return sphere_at_offset(proj, r, p.y, theta, eye_sign, sphere_eye_offset(proj, r, p.y));
     }
+    if (proj.head_on != 0.0) {
+        return head_project(proj, p, theta, eye_sign);
+    }
     return vec3<f32>(theta + eye_sign * eye_shift(proj, r), screen_height(proj, p.y, r), r);
+}
+
+// ---- the cylinder seen by a tracked head (`core::head`) ----
+
+// Head frame → display frame (the turn γ about y).
+fn head_to_display(proj: Projection, v: vec3<f32>) -> vec3<f32> {
+    let c = cos(proj.head_turn);
+    let s = sin(proj.head_turn);
+    return vec3<f32>(c * v.x + s * v.z, v.y, -s * v.x + c * v.z);
+}
+
+fn display_to_head(proj: Projection, v: vec3<f32>) -> vec3<f32> {
+    let c = cos(proj.head_turn);
+    let s = sin(proj.head_turn);
+    return vec3<f32>(c * v.x - s * v.z, v.y, s * v.x + c * v.z);
+}
+
+// u (unwrapped about θ), v and depth where the line from the eye through p meets the screen.
+fn head_project(proj: Projection, p: vec3<f32>, theta: f32, eye_sign: f32) -> vec3<f32> {
+    let e_head = vec3<f32>(eye_sign * proj.eye_radius, 0.0, 0.0);
+    let e = head_to_display(proj, e_head) + proj.head_offset;
+    let d = head_to_display(proj, p - e_head);
+    let a = d.x * d.x + d.z * d.z;
+    let b = 2.0 * (e.x * d.x + e.z * d.z);
+    let c = e.x * e.x + e.z * e.z - proj.screen_radius * proj.screen_radius;
+    let t = (-b + sqrt(max(b * b - 4.0 * a * c, 0.0))) / max(2.0 * a, 1e-30);
+    let hit = e + t * d;
+    let u = theta - proj.head_turn + wrap_angle(azimuth(hit) - theta + proj.head_turn);
+    return vec3<f32>(u, hit.y, length(p - e_head));
+}
+
+// The screen point of (u, v) in the head's frame.
+fn head_screen_point(proj: Projection, u: f32, v: f32) -> vec3<f32> {
+    let s = vec3<f32>(proj.screen_radius * sin(u), v, -proj.screen_radius * cos(u));
+    return display_to_head(proj, s - proj.head_offset);
 }
 
 // ---- the fisheye (`core::fisheye`): the sphere's rays in an equidistant azimuthal image ----

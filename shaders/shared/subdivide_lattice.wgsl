@@ -356,7 +356,16 @@ fn piece_u_range(q: array<Node, 3>, theta_c: f32) -> vec2<f32> {
         let t = clamp(-dot(a, ab) / max(dot(ab, ab), 1e-30), 0.0, 1.0);
         r_min = min(r_min, length(a + t * ab));
     }
-    let alpha = max(abs(eye_shift(params.projection, r_min)), abs(eye_shift(params.projection, r_max)));
+    let proj = params.projection;
+    if (proj.head_on != 0.0) {
+        // A tracked head: u = θ − γ, moved by the eye's offset seen from the point and by the
+        // eye's distance from the display's axis seen from the screen (`core::head`).
+        let reach = length(proj.head_offset.xz) + proj.eye_radius;
+        let bound = precise_asin(min(proj.eye_radius / max(r_min, 1e-30), 1.0))
+            + precise_asin(min(reach / proj.screen_radius, 1.0));
+        return vec2<f32>(theta_min - proj.head_turn - bound, theta_max - proj.head_turn + bound);
+    }
+    let alpha = max(abs(eye_shift(proj, r_min)), abs(eye_shift(proj, r_max)));
     return vec2<f32>(theta_min - alpha, theta_max + alpha);
 }
 

@@ -8,6 +8,7 @@ use glam::Vec3;
 use twister::core::environment::PreparedEnvironment;
 use twister::core::light::{LightingMode, Tonemap};
 
+use twister::core::head::Head;
 use twister::core::lod::LodParams;
 use twister::core::projection::{PanoramaKind, DEFAULT_POLE_MERGE};
 use twister::core::settings::{
@@ -71,6 +72,11 @@ pub struct ViewArgs {
     /// Turn of the view about the vertical axis, degrees; positive turns left.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub yaw: f32,
+    /// cylinder: a tracked head at X,Y,Z (scene units, the point midway between the eyes) facing
+    /// YAW degrees (as --yaw; default --yaw), away from the display's centre (--viewer): each
+    /// point is drawn where the line from an eye meets the screen (the exact model).
+    #[arg(long, value_parser = parse_head, value_name = "X,Y,Z[,YAW]", allow_hyphen_values = true)]
+    pub head: Option<(Vec3, Option<f32>)>,
     /// Metres per scene unit: the scene (and --viewer, given in scene units) is scaled by it.
     #[arg(long, default_value_t = 1.0)]
     pub scale: f32,
@@ -251,6 +257,16 @@ pub fn parse_viewer(s: &str) -> std::result::Result<Viewer, String> {
     }
 }
 
+pub fn parse_head(s: &str) -> std::result::Result<(Vec3, Option<f32>), String> {
+    let v: Vec<f32> =
+        s.split(',').map(|x| x.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|e| format!("'{s}': {e}"))?;
+    match v[..] {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok((Vec3::new(x, y, z), None)),
+        [x, y, z, yaw] if v.iter().all(|c| c.is_finite()) => Ok((Vec3::new(x, y, z), Some(yaw))),
+        _ => Err(format!("'{s}': expected finite numbers x,y,z or x,y,z,yaw")),
+    }
+}
+
 pub fn parse_vec3(s: &str) -> std::result::Result<Vec3, String> {
     let v: Vec<f32> =
         s.split(',').map(|x| x.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|e| format!("'{s}': {e}"))?;
@@ -335,6 +351,15 @@ impl ViewArgs {
             pole_merge: self.pole_merge.map_or(Some(DEFAULT_POLE_MERGE), |p| p.0),
             fov: self.fov.unwrap_or(180.0),
             dome_tilt: self.dome_tilt.unwrap_or(0.0),
+            head: match (self.head, self.viewer) {
+                (None, _) => None,
+                (Some(_), Viewer::Camera(_)) => {
+                    return Err(Error::option("--head", "needs the display's centre as --viewer x,y,z"))
+                }
+                (Some((at, yaw)), Viewer::At(viewer)) => {
+                    Some(Head::relative(at * self.scale, yaw.unwrap_or(self.yaw), viewer * self.scale, self.yaw))
+                }
+            },
         };
         projection.validate()?;
         if !self.yaw.is_finite() {
@@ -380,6 +405,8 @@ impl ViewArgs {
     fn vertical_for(&self, panorama: PanoramaKind, methods: &[Method]) -> Vertical {
         match self.vertical {
             Some(vertical) => vertical,
+            // A tracked head's line from the eye to the screen is the exact model.
+            None if self.head.is_some() => Vertical::Exact,
             None if panorama == PanoramaKind::Cylinder && methods.contains(&Method::Trace) => {
                 eprintln!(
                     "note: trace follows each pixel's ray, which the paper's vertical model (v = R_T·y/r) does not \

@@ -11,6 +11,7 @@ pub const FLAGS: &[(&str, &str)] = &[
     ("view.projection.convergence", "--convergence"),
     ("view.projection.pole_merge", "--pole-merge"),
     ("view.projection.fov", "--fov"),
+    ("view.projection.head", "--head"),
     ("view.projection.dome_tilt", "--dome-tilt"),
     ("view.projection.width/height", "--width/--height"),
     ("view.projection.vertical", "--vertical"),

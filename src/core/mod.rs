@@ -13,6 +13,7 @@ pub mod environment;
 pub mod environment_cache;
 pub mod fisheye;
 pub mod frame;
+pub mod head;
 pub mod light;
 pub mod load;
 pub mod lod;

@@ -33,6 +33,7 @@
 
 use glam::{Vec2, Vec3};
 
+use crate::core::head::Head;
 use crate::error::{Error, Result};
 
 /// The vertical model: how the screen height `v` of a point is computed.
@@ -96,6 +97,9 @@ pub struct Projection {
     pub fov: f32,
     /// The fisheye: the dome's front raised by this many degrees (its axis tilted back).
     pub dome_tilt: f32,
+    /// The cylinder: a tracked head away from the display's centre (`core::head`); None: the
+    /// paper's eyes on the circle about the centre.
+    pub head: Option<Head>,
 }
 
 /// The pole merge Blender uses by default (degrees of altitude).
@@ -115,6 +119,7 @@ impl Default for Projection {
             pole_merge: Some(DEFAULT_POLE_MERGE),
             fov: 180.0,
             dome_tilt: 0.0,
+            head: None,
         }
     }
 }
@@ -200,6 +205,38 @@ impl Projection {
                 ));
             }
         }
+        if let Some(head) = &self.head {
+            let [x, y, z] = head.offset;
+            if self.panorama != PanoramaKind::Cylinder {
+                return Err(Error::setting(
+                    "view.projection.head",
+                    "a tracked head looks at the cylinder (--panorama cylinder)",
+                ));
+            }
+            if !(head.offset.iter().all(|c| c.is_finite()) && head.turn.is_finite()) {
+                return Err(Error::setting("view.projection.head", format!("must be finite, got {head:?}")));
+            }
+            let reach = (x * x + z * z).sqrt() + self.eye_radius;
+            if reach >= self.screen_radius {
+                return Err(Error::setting(
+                    "view.projection.head",
+                    format!(
+                        "the eyes reach the screen: the head is {:.3} m from the display's axis, plus the eye radius {} \
+                         makes {reach:.3} m, not within the screen radius {}",
+                        (x * x + z * z).sqrt(),
+                        self.eye_radius,
+                        self.screen_radius
+                    ),
+                ));
+            }
+            let _ = y;
+            if self.vertical == Vertical::Paper {
+                return Err(Error::setting(
+                    "view.projection.vertical",
+                    "a tracked head draws each point where the line from the eye meets the screen: the exact model",
+                ));
+            }
+        }
         if self.panorama == PanoramaKind::Fisheye {
             if !(self.fov.is_finite() && self.fov > 0.0 && self.fov <= 360.0) {
                 return Err(Error::setting(
@@ -280,6 +317,9 @@ impl Projection {
             let (lon, lat, depth) = self.sphere_at_offset(r, p.y, theta, eye.sign(), d);
             return Projected { u: lon, v: lat, depth };
         }
+        if let Some(head) = &self.head {
+            return self.head_project(head, p, theta, eye);
+        }
         Projected { u: theta + eye.sign() * self.eye_shift(r), v: self.screen_height(p.y, r), depth: r }
     }
 
@@ -354,6 +394,9 @@ impl Projection {
         if self.panorama.is_sphere() {
             return Vec3::new(v.cos() * u.sin(), v.sin(), -v.cos() * u.cos());
         }
+        if let Some(head) = &self.head {
+            return self.head_screen_point(head, u, v).normalize();
+        }
         let rt = self.screen_radius;
         Vec3::new(rt * u.sin(), v, -rt * u.cos()).normalize()
     }
@@ -372,6 +415,12 @@ impl Projection {
             return 1.0 / (0.5 * std::f32::consts::PI / self.height as f32).tan();
         }
         let (rt, de) = (self.screen_radius, self.eye_radius);
+        if let Some(head) = &self.head {
+            // From an eye, the screen's rows rise at most to its edge's height over its nearest
+            // distance from the eye.
+            let [x, y, z] = head.offset;
+            return (self.half_height_m() + y.abs()) / (rt - (x * x + z * z).sqrt() - de);
+        }
         self.half_height_m() / (rt * (1.0 - (de / rt) * (de / rt)).sqrt())
     }
 
@@ -514,6 +563,11 @@ impl Panorama for Projection {
             let (origin, ray) = self.sphere_ray(u, v, eye);
             return origin + r * ray;
         }
+        if self.head.is_some() {
+            // The depth is the distance from the eye along the pixel's ray.
+            let (origin, ray) = pixel_ray(self, eye, Vec2::new(x, y));
+            return origin + r * ray;
+        }
         let theta = u - eye.sign() * self.eye_shift(r);
         let height = match self.vertical {
             Vertical::Paper => v * r / self.screen_radius,
@@ -535,6 +589,10 @@ pub fn pixel_ray(projection: &Projection, eye: Eye, frag_xy: Vec2) -> (Vec3, Vec
     let (u, v) = projection.pixel_to_screen(frag_xy.x - 0.5, frag_xy.y - 0.5);
     if projection.panorama.is_sphere() {
         return projection.sphere_ray(u, v, eye);
+    }
+    if let Some(head) = &projection.head {
+        let origin = projection.head_eye(eye);
+        return (origin, (projection.head_screen_point(head, u, v) - origin).normalize());
     }
     let (rt, de) = (projection.screen_radius, projection.eye_radius);
     let phi = u - eye.sign() * (de / rt).asin();

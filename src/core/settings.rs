@@ -434,7 +434,13 @@ impl RenderSettings {
 
     /// World → viewer frame: translate the viewer to the origin, then undo the yaw.
     pub fn view(&self) -> Mat4 {
-        Mat4::from_rotation_y(-self.view.yaw_deg.to_radians()) * Mat4::from_translation(-self.view.viewer)
+        let display =
+            Mat4::from_rotation_y(-self.view.yaw_deg.to_radians()) * Mat4::from_translation(-self.view.viewer);
+        // A tracked head: the frame drawn is the head's (`core::head`).
+        match &self.view.projection.head {
+            Some(head) => head.to_head() * display,
+            None => display,
+        }
     }
 
     pub fn validate(&self) -> Result<()> {
@@ -463,6 +469,12 @@ impl RenderSettings {
             return Err(Error::setting("subdivision.max_div", format!("must be between 1 and 64, got {}", s.max_div)));
         }
         if let Method::Slit(w) = s.method {
+            if self.view.projection.head.is_some() {
+                return Err(Error::setting(
+                    "subdivision.method",
+                    format!("slit:{w} pastes the slits of eyes on the circle about the display's centre; a tracked head has fixed eyes: use trace as the reference"),
+                ));
+            }
             if self.view.projection.panorama == PanoramaKind::Fisheye {
                 return Err(Error::setting(
                     "subdivision.method",

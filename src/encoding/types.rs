@@ -31,7 +31,7 @@ pub struct DrawVertex {
     pub tangent: u32,
 }
 
-/// `Projection` in shaders/shared/projection.wgsl. 64 bytes.
+/// `Projection` in shaders/shared/projection.wgsl. 80 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct ProjectionUniform {
@@ -55,8 +55,12 @@ pub struct ProjectionUniform {
     /// The fisheye's field of view and dome tilt, degrees (`Projection::fov`, `dome_tilt`).
     pub fov: f32,
     pub dome_tilt: f32,
+    /// The cylinder's tracked head (`core::head`): 1 on, 0 off; its turn γ (radians) and its
+    /// position O in the display's frame (metres).
+    pub head_on: f32,
+    pub head_turn: f32,
+    pub head_offset: [f32; 3],
     pub _pad0: f32,
-    pub _pad1: f32,
 }
 
 impl From<&ProjectionUniform> for Projection {
@@ -72,6 +76,7 @@ impl From<&ProjectionUniform> for Projection {
             pole_merge: (p.pole_to > 0.0).then(|| (p.pole_from.to_degrees(), p.pole_to.to_degrees())),
             fov: p.fov,
             dome_tilt: p.dome_tilt,
+            head: (p.head_on != 0.0).then_some(crate::core::head::Head { offset: p.head_offset, turn: p.head_turn }),
         }
     }
 }
@@ -94,13 +99,15 @@ impl From<&Projection> for ProjectionUniform {
             turn_px: p.turn_px(),
             fov: p.fov,
             dome_tilt: p.dome_tilt,
+            head_on: p.head.is_some() as u32 as f32,
+            head_turn: p.head.map_or(0.0, |h| h.turn),
+            head_offset: p.head.map_or([0.0; 3], |h| h.offset),
             _pad0: 0.0,
-            _pad1: 0.0,
         }
     }
 }
 
-/// `SubdivideParams` in shaders/shared/subdivide_types.wgsl. 192 bytes.
+/// `SubdivideParams` in shaders/shared/subdivide_types.wgsl. 208 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct SubdivideParams {
@@ -196,7 +203,7 @@ impl SubdivideCounters {
     }
 }
 
-/// `RasterParams` in shaders/raster.wgsl. 96 bytes.
+/// `RasterParams` in shaders/raster.wgsl. 112 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct RasterParams {
@@ -242,7 +249,7 @@ pub struct ReduceParams {
     pub _pad2: u32,
 }
 
-/// `SlitParams` in shaders/slit.wgsl. 144 bytes.
+/// `SlitParams` in shaders/slit.wgsl. 160 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct SlitParams {
@@ -362,7 +369,7 @@ macro_rules! layout {
     };
 }
 
-/// `TraceParams` in shaders/trace.wgsl. 240 bytes.
+/// `TraceParams` in shaders/trace.wgsl. 256 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct TraceParams {
@@ -457,7 +464,7 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("DrawVertex" => DrawVertex { position, theta_ref, normal, material, color, uv, object, tangent }),
     layout!("Projection" => ProjectionUniform {
         screen_radius, eye_radius, width, height, acos_eye_screen, vertical_exact, pixels_per_v, panorama,
-        convergence, pole_from, pole_to, turn_px, fov, dome_tilt, _pad0, _pad1
+        convergence, pole_from, pole_to, turn_px, fov, dome_tilt, head_on, head_turn, head_offset, _pad0
     }),
     layout!("SubdivideParams" => SubdivideParams {
         view, projection, axis_clearance, triangle_count, first_triangle, method, fixed_n, edge_px, max_div,

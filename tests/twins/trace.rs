@@ -96,6 +96,17 @@ impl Twin for Trace {
                 (builtin::demo(), RenderSettings::new(sphere).with_method(Method::Trace)),
             ),
             (
+                "demo seen by a tracked head".into(),
+                (
+                    builtin::demo(),
+                    RenderSettings::new(Projection {
+                        head: Some(twister::core::head::Head { offset: [0.3, 0.1, -0.2], turn: 0.35 }),
+                        ..cylinder
+                    })
+                    .with_method(Method::Trace),
+                ),
+            ),
+            (
                 "demo on a 200° fisheye".into(),
                 (
                     builtin::demo(),

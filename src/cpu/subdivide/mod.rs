@@ -295,7 +295,16 @@ impl<'a> Subdivider<'a> {
             let t = (-a.dot(ab) / ab.dot(ab).max(1e-30)).clamp(0.0, 1.0);
             r_min = r_min.min((a + t * ab).length());
         }
-        let alpha = self.projection.eye_shift(r_min).abs().max(self.projection.eye_shift(r_max).abs());
+        let proj = &self.projection;
+        if let Some(head) = &proj.head {
+            // A tracked head: u = θ − γ, moved by the eye's offset seen from the point and by
+            // the eye's distance from the display's axis seen from the screen (`core::head`).
+            let reach = Vec2::new(head.offset[0], head.offset[2]).length() + proj.eye_radius;
+            let bound =
+                (proj.eye_radius / r_min.max(1e-30)).min(1.0).asin() + (reach / proj.screen_radius).min(1.0).asin();
+            return (theta_min - head.turn - bound, theta_max - head.turn + bound);
+        }
+        let alpha = proj.eye_shift(r_min).abs().max(proj.eye_shift(r_max).abs());
         (theta_min - alpha, theta_max + alpha)
     }
 
