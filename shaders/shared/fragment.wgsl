@@ -92,7 +92,7 @@ fn fragment_coverage(in: VertexOut, front_facing: bool, params: FragmentView) ->
     let duv_dy = dpdy(in.uv);
     let dp_dx = dpdxFine(in.view_position);
     let dp_dy = dpdyFine(in.view_position);
-    if (!shows_pixel(params.projection, in.clip.xy)) {
+    if (CIRCLE && !shows_pixel(params.projection, in.clip.xy)) {
         discard; // outside the fisheye's circle
     }
     let c = surface_rgba(in.material, in.color, in.uv, duv_dx, duv_dy, front_facing);
@@ -114,7 +114,7 @@ fn fragment_color(in: VertexOut, front_facing: bool, params: FragmentView) -> Fr
     let duv_dy = dpdy(in.uv);
     let dp_dx = dpdxFine(in.view_position);
     let dp_dy = dpdyFine(in.view_position);
-    if (!shows_pixel(params.projection, in.clip.xy)) {
+    if (CIRCLE && !shows_pixel(params.projection, in.clip.xy)) {
         discard; // outside the fisheye's circle
     }
     let c = surface_color(in.material, in.color, in.uv, duv_dx, duv_dy, in.clip.xy, front_facing);
@@ -152,7 +152,7 @@ fn measured(in: VertexOut, front_facing: bool, params: FragmentView) -> Fragment
     // and the normal map's tangent frame).
     let dp_dx = dpdxFine(in.view_position);
     let dp_dy = dpdyFine(in.view_position);
-    if (!shows_pixel(params.projection, in.clip.xy)) {
+    if (CIRCLE && !shows_pixel(params.projection, in.clip.xy)) {
         discard; // outside the fisheye's circle
     }
     let c = surface_color(in.material, in.color, in.uv, duv_dx, duv_dy, in.clip.xy, front_facing);
@@ -181,7 +181,7 @@ fn background_vertex(i: u32, eye: u32) -> BackgroundOut {
 // The environment's radiance along the pixel's own ray, tone mapped, and linear
 // (`fs_background`).
 fn background_color(params: FragmentView, frag_xy: vec2<f32>) -> FragmentColor {
-    if (!shows_pixel(params.projection, frag_xy)) {
+    if (CIRCLE && !shows_pixel(params.projection, frag_xy)) {
         discard; // outside the fisheye's circle: the background colour
     }
     let ray = pixel_ray(params.projection, params.eye_sign, frag_xy);

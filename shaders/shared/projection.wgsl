@@ -13,6 +13,8 @@
 
 #import constants
 #import projection_sphere
+#import projection_fisheye
+#import projection_head
 
 const PI: f32 = 3.14159265358979;
 const TAU: f32 = 6.28318530717959;
@@ -39,11 +41,12 @@ struct Projection {
     _pad0: f32,
 }
 
-// The panoramas a pipeline can draw (bit 0 the cylinder, bit 1 the sphere: equirect or VR180). The subdivide stage's
-// pipelines are built for one panorama each, so the other's code is compiled out: on lavapipe a
+// The panoramas a pipeline can draw (bit 0 the cylinder, bit 1 the sphere: equirect, VR180 or
+// the fisheye, bit 2 the fisheye's image). The subdivide stage's and the drawing stages'
+// pipelines are built for one panorama each, so the others' code is compiled out: on lavapipe a
 // shader that merely contains the sphere's projection (inlined at every sample of an edge) ran
 // the cylinder's subdivision three times slower.
-override PANORAMAS: u32 = 3u;
+override PANORAMAS: u32 = 7u;
 
 fn is_sphere(proj: Projection) -> bool {
     return (PANORAMAS & 2u) != 0u && ((PANORAMAS & 1u) == 0u || proj.panorama != PANORAMA_CYLINDER);
@@ -158,96 +161,6 @@ fn project_with_azimuth(proj: Projection, p: vec3<f32>, theta: f32, eye_sign: f3
         return head_project(proj, p, theta, eye_sign);
     }
     return vec3<f32>(theta + eye_sign * eye_shift(proj, r), screen_height(proj, p.y, r), r);
-}
-
-// ---- the cylinder seen by a tracked head (`core::head`) ----
-
-// Head frame → display frame (the turn γ about y).
-fn head_to_display(proj: Projection, v: vec3<f32>) -> vec3<f32> {
-    let c = cos(proj.head_turn);
-    let s = sin(proj.head_turn);
-    return vec3<f32>(c * v.x + s * v.z, v.y, -s * v.x + c * v.z);
-}
-
-fn display_to_head(proj: Projection, v: vec3<f32>) -> vec3<f32> {
-    let c = cos(proj.head_turn);
-    let s = sin(proj.head_turn);
-    return vec3<f32>(c * v.x - s * v.z, v.y, s * v.x + c * v.z);
-}
-
-// u (unwrapped about θ), v and depth where the line from the eye through p meets the screen.
-fn head_project(proj: Projection, p: vec3<f32>, theta: f32, eye_sign: f32) -> vec3<f32> {
-    let e_head = vec3<f32>(eye_sign * proj.eye_radius, 0.0, 0.0);
-    let e = head_to_display(proj, e_head) + proj.head_offset;
-    let d = head_to_display(proj, p - e_head);
-    let a = d.x * d.x + d.z * d.z;
-    let b = 2.0 * (e.x * d.x + e.z * d.z);
-    let c = e.x * e.x + e.z * e.z - proj.screen_radius * proj.screen_radius;
-    let t = (-b + sqrt(max(b * b - 4.0 * a * c, 0.0))) / max(2.0 * a, 1e-30);
-    let hit = e + t * d;
-    let u = theta - proj.head_turn + wrap_angle(azimuth(hit) - theta + proj.head_turn);
-    return vec3<f32>(u, hit.y, length(p - e_head));
-}
-
-// The screen point of (u, v) in the head's frame.
-fn head_screen_point(proj: Projection, u: f32, v: f32) -> vec3<f32> {
-    let s = vec3<f32>(proj.screen_radius * sin(u), v, -proj.screen_radius * cos(u));
-    return display_to_head(proj, s - proj.head_offset);
-}
-
-// ---- the fisheye (`core::fisheye`): the sphere's rays in an equidistant azimuthal image ----
-
-fn is_fisheye(proj: Projection) -> bool {
-    return (PANORAMAS & 2u) != 0u && proj.panorama == PANORAMA_FISHEYE;
-}
-
-// k: pixels per radian from the dome's axis.
-fn fisheye_scale(proj: Projection) -> f32 {
-    return proj.width / radians(proj.fov);
-}
-
-// The image position of the ray of longitude u, latitude v (`Projection::fisheye_pixel`).
-fn fisheye_pixel(proj: Projection, u: f32, v: f32) -> vec2<f32> {
-    let d = vec3<f32>(cos(v) * sin(u), sin(v), -cos(v) * cos(u));
-    let t = radians(proj.dome_tilt);
-    let a = d.x;
-    let b = d.y * sin(t) - d.z * cos(t);
-    let c = d.y * cos(t) + d.z * sin(t);
-    let h = sqrt(a * a + b * b);
-    var ratio = 1.0;
-    if (h > 0.0) {
-        ratio = precise_atan2(h, c) / h;
-    }
-    let k = fisheye_scale(proj);
-    return vec2<f32>(0.5 * proj.width + k * ratio * a, 0.5 * proj.height + k * ratio * b);
-}
-
-// The longitude and latitude of the ray shown at image position xy
-// (`Projection::fisheye_direction_at`).
-fn fisheye_direction(proj: Projection, xy: vec2<f32>) -> vec2<f32> {
-    let dxy = xy - 0.5 * vec2<f32>(proj.width, proj.height);
-    let k = fisheye_scale(proj);
-    let rho = length(dxy);
-    let psi = rho / k;
-    var s = 1.0 / k;
-    if (rho > 0.0) {
-        s = sin(psi) / rho;
-    }
-    let t = radians(proj.dome_tilt);
-    let axis = vec3<f32>(0.0, cos(t), sin(t));
-    let front = vec3<f32>(0.0, sin(t), -cos(t));
-    let d = vec3<f32>(s * dxy.x, 0.0, 0.0) + s * dxy.y * front + cos(psi) * axis;
-    return vec2<f32>(precise_atan2(d.x, -d.z), precise_atan2(d.y, sqrt(d.x * d.x + d.z * d.z)));
-}
-
-// Whether image position xy shows the scene: inside the fisheye's circle; everywhere elsewhere
-// (`Projection::shows_pixel`).
-fn shows_pixel(proj: Projection, xy: vec2<f32>) -> bool {
-    if (!is_fisheye(proj)) {
-        return true;
-    }
-    let d = xy - 0.5 * vec2<f32>(proj.width, proj.height);
-    return dot(d, d) <= 0.25 * proj.width * proj.width;
 }
 
 // Continuous image coordinates (x right, y down) of a screen point, u wrapped into [−π, π)

@@ -17,6 +17,10 @@ override MATERIALS: bool = true;
 // fragment entry points leave `discard` out and the rasterizer may test depth before shading.
 override DISCARDS: bool = true;
 
+// true: the fisheye, whose fragments outside its circle are discarded (fragment.wgsl); false
+// compiles that test out, keeping early depth testing for the other panoramas.
+override CIRCLE: bool = true;
+
 // Parts of the glTF look a pipeline compiles in (src/gpu/draw.rs, `Lit`): the BRDF at all, the
 // environment's image-based lighting, the texture maps. lavapipe runs every branch under a mask,
 // so a part a frame does not use is left out rather than skipped. The ray tracer keeps all

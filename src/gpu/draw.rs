@@ -96,6 +96,10 @@ pub(crate) struct Lit {
     pub maps: bool,
     /// The shadow maps' look-up (`SHADOW_MAPS`).
     pub shadows: bool,
+    /// The panorama drawn (`PANORAMAS` in projection.wgsl: the others' code compiled out); the
+    /// fisheye's also discards fragments outside its circle (`CIRCLE`; compiled out elsewhere,
+    /// which keeps early depth testing).
+    pub panoramas: u32,
 }
 
 impl Lit {
@@ -107,6 +111,7 @@ impl Lit {
             environment: pbr && scene.environment.is_some(),
             maps: pbr && scene.has_maps,
             shadows: scene.shadow_maps(settings),
+            panoramas: panorama_bits(settings.projection().panorama),
         }
     }
 }
@@ -207,7 +212,7 @@ fn draw_pipeline(
     // None: the background triangle (no vertex buffer; colour only; behind everything).
     let background = look.is_none();
     let (look, lit) =
-        look.unwrap_or((Look::Materials, Lit { pbr: true, environment: true, maps: false, shadows: false }));
+        look.unwrap_or((Look::Materials, Lit { pbr: true, environment: true, maps: false, shadows: false, panoramas: 7 }));
     let (stride, attributes) = vertex_layout(kind);
     let layout = wgpu::VertexBufferLayout {
         array_stride: stride as u64,
@@ -303,7 +308,19 @@ fn look_constants(look: Look, lit: Lit) -> Vec<(&'static str, f64)> {
         ("ENVIRONMENT", lit.environment as u32 as f64),
         ("MAPS", lit.maps as u32 as f64),
         ("SHADOW_MAPS", lit.shadows as u32 as f64),
+        ("CIRCLE", (lit.panoramas & 4 != 0) as u32 as f64),
+        ("PANORAMAS", lit.panoramas as f64),
     ]
+}
+
+/// `PANORAMAS` for a panorama (projection.wgsl): 1 the cylinder, 2 the sphere and VR180, 6 the
+/// fisheye (the sphere's eye model in its own image).
+pub(crate) fn panorama_bits(panorama: crate::core::projection::PanoramaKind) -> u32 {
+    match panorama {
+        crate::core::projection::PanoramaKind::Fisheye => 6,
+        p if p.is_sphere() => 2,
+        _ => 1,
+    }
 }
 
 /// A drawing stage's vertex buffer: its stride and attributes. Raster: the subdivided

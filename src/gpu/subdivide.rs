@@ -23,7 +23,7 @@ use crate::gpu::frame_plan::SubdivisionBuffers;
 use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
 use crate::gpu::timestamps::{self as stamp, Timestamps};
-use crate::shader::{StandIn, IN_PLACE_OFF, ROWS_OFF, SPHERE_OFF, SUBDIVIDE};
+use crate::shader::{StandIn, FISHEYE_OFF, HEAD_OFF, IN_PLACE_OFF, ROWS_OFF, SPHERE_OFF, SUBDIVIDE};
 
 pub(crate) const COUNTERS_SIZE: u64 = std::mem::size_of::<SubdivideCounters>() as u64;
 // The frame's timestamps are read back as u64s right after the counters.
@@ -49,7 +49,7 @@ impl Variant {
 /// (`subdivide_rows_off`): lavapipe builds a pipeline about twice as long with the code merely in it).
 pub(crate) struct SubdivideStage {
     stage: GpuStage,
-    variants: [OnceLock<Variant>; 4],
+    variants: [OnceLock<Variant>; 8],
 }
 
 impl SubdivideStage {
@@ -58,20 +58,30 @@ impl SubdivideStage {
         SubdivideStage { stage: GpuStage::new(gpu, &SUBDIVIDE), variants: Default::default() }
     }
 
-    /// The pipelines for a panorama and a frame's split rule (`params.method`): rows on the
-    /// sphere under the adaptive rules only.
+    /// The pipelines for a panorama (the cylinder with or without a tracked head, the sphere
+    /// and VR180, the fisheye) and a frame's split rule (`params.method`): rows on the sphere
+    /// under the adaptive rules only. Each leaves out the other panoramas' projection code.
     fn variant(&self, gpu: &Gpu, panorama: PanoramaKind, params: &SubdivideParams) -> &Variant {
-        let (k, bits) = if panorama.is_sphere() { (1, 2.0) } else { (0, 1.0) };
+        let head = params.projection.head_on != 0.0;
+        let (k, bits) = match panorama {
+            PanoramaKind::Fisheye => (3, 6.0),
+            p if p.is_sphere() => (2, 2.0),
+            _ if head => (1, 1.0),
+            _ => (0, 1.0),
+        };
         let passes = Passes::of(panorama, params.method);
         let rows = passes.rows;
         self.variants[2 * k + rows as usize].get_or_init(|| {
             // Built side by side: the driver's compiling of the large passes (`plan_cuts`,
             // `lattice`) is most of a fresh process's time.
             let constants = [("PANORAMAS", bits)];
-            let stand_ins: &[StandIn] = match (panorama.is_sphere(), rows) {
-                (false, _) => &[ROWS_OFF, SPHERE_OFF],
-                (true, false) => &[ROWS_OFF],
-                (true, true) => &[IN_PLACE_OFF],
+            let stand_ins: &[StandIn] = match (k, rows) {
+                (0, _) => &[ROWS_OFF, SPHERE_OFF, FISHEYE_OFF, HEAD_OFF],
+                (1, _) => &[ROWS_OFF, SPHERE_OFF, FISHEYE_OFF],
+                (2, false) => &[ROWS_OFF, FISHEYE_OFF, HEAD_OFF],
+                (2, true) => &[IN_PLACE_OFF, FISHEYE_OFF, HEAD_OFF],
+                (_, false) => &[ROWS_OFF, HEAD_OFF],
+                (_, true) => &[IN_PLACE_OFF, HEAD_OFF],
             };
             // The entry points this frame's schedules dispatch (every schedule's are the usual
             // frame's).

@@ -458,6 +458,10 @@ pub const SHARED: &[(&str, &str)] = &[
     ("projection", include_str!("../../shaders/shared/projection.wgsl")),
     ("projection_sphere", include_str!("../../shaders/shared/projection_sphere.wgsl")),
     ("projection_sphere_off", include_str!("../../shaders/shared/projection_sphere_off.wgsl")),
+    ("projection_fisheye", include_str!("../../shaders/shared/projection_fisheye.wgsl")),
+    ("projection_fisheye_off", include_str!("../../shaders/shared/projection_fisheye_off.wgsl")),
+    ("projection_head", include_str!("../../shaders/shared/projection_head.wgsl")),
+    ("projection_head_off", include_str!("../../shaders/shared/projection_head_off.wgsl")),
     ("scene", include_str!("../../shaders/shared/scene.wgsl")),
     ("subdivide_types", include_str!("../../shaders/shared/subdivide_types.wgsl")),
     ("subdivide_bindings", include_str!("../../shaders/shared/subdivide_bindings.wgsl")),
@@ -489,7 +493,7 @@ pub const SHARED: &[(&str, &str)] = &[
 pub type StandIn = (&'static str, &'static str);
 
 /// Every stand-in (the naga test validates each file composed with each one).
-pub const STAND_INS: &[StandIn] = &[ROWS_OFF, SPHERE_OFF, IN_PLACE_OFF];
+pub const STAND_INS: &[StandIn] = &[ROWS_OFF, SPHERE_OFF, IN_PLACE_OFF, FISHEYE_OFF, HEAD_OFF];
 
 /// `subdivide_rows` left out: the `lattice` pipeline of the frames that never draw rows.
 pub const ROWS_OFF: StandIn = ("subdivide_rows", "subdivide_rows_off");
@@ -499,6 +503,12 @@ pub const IN_PLACE_OFF: StandIn = ("subdivide_in_place", "subdivide_in_place_off
 
 /// `projection_sphere` left out: the subdivide stage's pipelines for the cylinder.
 pub const SPHERE_OFF: StandIn = ("projection_sphere", "projection_sphere_off");
+
+/// `projection_fisheye` left out: the subdivide stage's pipelines for the other panoramas.
+pub const FISHEYE_OFF: StandIn = ("projection_fisheye", "projection_fisheye_off");
+
+/// `projection_head` left out: the subdivide stage's pipelines for frames without a tracked head.
+pub const HEAD_OFF: StandIn = ("projection_head", "projection_head_off");
 
 /// How the error target is written: as f32 (R32Float) or as its bits (R32Uint), for adapters
 /// that cannot render to R32Float.
