@@ -560,3 +560,51 @@ fn a_viewer_path_moves_the_viewer_through_a_still_scene() {
     }
     std::fs::remove_dir_all(&root).unwrap();
 }
+
+/// `--head-path`: a tracked head moves before the cylinder as the CSV says — frame 1 of 0–1 at
+/// 1 fps is pixel for pixel the still with `--head` at the last row, frame 0 the first; the
+/// path's misuses are one line each.
+#[test]
+fn a_head_path_moves_the_tracked_head() {
+    let root = common::TempDir::new(format!("twister-head-{}", std::process::id()));
+    std::fs::create_dir_all(&root).unwrap();
+    let path = root.join("head.csv");
+    std::fs::write(&path, "# time, x, y, z, yaw\n0,0,0,0,0\n1,0.3,0.1,-0.2,20\n").unwrap();
+    let small = ["--width", "256", "--height", "64", "--method", "vertex"];
+    let run =
+        |extra: &[&str]| common::twister().args(["render", "builtin:demo"]).args(small).args(extra).output().unwrap();
+    let seq = root.join("seq");
+    let out =
+        run(&["--head-path", path.to_str().unwrap(), "--frames", "0..1", "--fps", "1", "--out", seq.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    for (k, head) in [(0, "0,0,0"), (1, "0.3,0.1,-0.2,20")] {
+        let still = root.join(format!("still{k}"));
+        let out = run(&["--head", head, "--out", still.to_str().unwrap()]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        for eye in ["left", "right"] {
+            let a = image::open(seq.join(format!("frame_{k:06}_{eye}.png"))).unwrap();
+            let b = image::open(still.join(format!("{eye}.png"))).unwrap();
+            assert!(a == b, "frame {k} ({eye}) is not the still with --head {head}");
+        }
+    }
+    let p = path.to_str().unwrap();
+    for (extra, needle) in [
+        (&["--head-path", p][..], "--head-path: belongs to a sequence"),
+        (&["--head-path", p, "--frames", "0..1", "--head", "0,0,0"], "--head-path: moves the head itself"),
+        (
+            &["--head-path", p, "--frames", "0..1", "--panorama", "equirect"],
+            "--head-path: a tracked head looks at the cylinder",
+        ),
+        (&["--head-path", p, "--frames", "0..1", "--vertical", "paper"], "--head-path: a tracked head draws"),
+    ] {
+        let out = run(&[extra, &["--out", root.join("bad").to_str().unwrap()]].concat());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && err.contains(needle) && err.lines().count() == 1, "{extra:?}: {err}");
+    }
+    // A row that puts the eyes on the screen: one line naming the option.
+    std::fs::write(&path, "0,0,0,0\n1,0.99,0,0\n").unwrap();
+    let out = run(&["--head-path", p, "--frames", "0..1", "--fps", "1", "--out", root.join("far").to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("the eyes reach the screen"), "{err}");
+    std::fs::remove_dir_all(&root).unwrap();
+}

@@ -125,8 +125,8 @@ fn vr180_shows_the_front_half_closed_with_spheres_where_the_format_puts_them() {
             );
         }
     }
-    probes_land_where_the_format_puts_them(Projection::vr180(512), |lon, lat| {
-        let w = 512.0;
+    probes_land_where_the_format_puts_them(Projection::vr180(384), |lon, lat| {
+        let w = 384.0;
         (lon.abs() <= std::f32::consts::FRAC_PI_2)
             .then(|| ((lon / std::f32::consts::PI + 0.5) * w, (0.5 - lat / std::f32::consts::PI) * w, lat.cos()))
     });

@@ -565,6 +565,11 @@ pub struct RenderArgs {
     /// in scene units as --viewer; degrees added to --yaw), blended linearly between rows.
     #[arg(long, value_name = "FILE.csv")]
     pub viewer_path: Option<PathBuf>,
+    /// With --frames, the cylinder: the tracked head over time, a CSV of time,x,y,z[,yaw] rows
+    /// (seconds; the head in scene units as --head; its yaw in degrees, default --yaw), blended
+    /// linearly between rows.
+    #[arg(long, value_name = "FILE.csv")]
+    pub head_path: Option<PathBuf>,
     /// How --shard splits the frames.
     #[arg(long, value_enum, default_value_t = ShardMode::Interleave)]
     pub shard_mode: ShardMode,

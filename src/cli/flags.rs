@@ -36,6 +36,7 @@ pub const FLAGS: &[(&str, &str)] = &[
     ("fit", "--fit"),
     ("gaze_path", "--gaze-path"),
     ("viewer_path", "--viewer-path"),
+    ("head_path", "--head-path"),
 ];
 
 /// The option that sets `setting`, if the command line has one.

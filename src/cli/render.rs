@@ -38,6 +38,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         (args.video.is_some(), "--video"),
         (args.gaze_path.is_some(), "--gaze-path"),
         (args.viewer_path.is_some(), "--viewer-path"),
+        (args.head_path.is_some(), "--head-path"),
     ] {
         if given {
             return Err(Error::option(option, "belongs to a sequence: use it with --frames A..B"));

@@ -20,6 +20,7 @@ use crate::render::render_settings;
 use crate::scene::{open_renderer, prepare, Prepared};
 use crate::writer::{frame_name, FrameRecord, FrameWriter};
 use twister::core::lod::{LodChain, LodParams, LodSelection};
+use twister::core::projection::PanoramaKind;
 use twister::core::settings::Method;
 use twister::core::timeline::Timeline;
 use twister::core::visual_field::GazePath;
@@ -70,6 +71,8 @@ struct Sequence<'a> {
     base_yaw: f32,
     clip: Option<usize>,
     viewer_path: Option<Timeline>,
+    /// `--head-path`: the tracked head over time.
+    head_path: Option<Timeline>,
     camera: Option<usize>,
     tracked: Option<Tracked<'a>>,
 }
@@ -113,8 +116,26 @@ impl Sequence<'_> {
         }
     }
 
-    /// The frame's settings: the base's, with the viewer the path or the posed camera puts.
+    /// The frame's settings: the base's, with the viewer the path or the posed camera puts, and
+    /// the tracked head the head path puts.
     fn frame_settings(&self, time: f32) -> twister::RenderSettings {
+        let settings = self.viewer_settings(time);
+        let Some(path) = &self.head_path else { return settings };
+        let v = path.at(time);
+        let scale = self.args.view.scale;
+        let head = twister::core::head::Head::relative(
+            Vec3::new(v[0], v[1], v[2]) * scale,
+            v.get(3).copied().unwrap_or(self.base_yaw),
+            settings.view.viewer,
+            settings.view.yaw_deg,
+        );
+        let projection =
+            twister::Projection { head: Some(head), vertical: twister::Vertical::Exact, ..*settings.projection() };
+        settings.with_projection(projection)
+    }
+
+    /// The frame's settings without the head path's head.
+    fn viewer_settings(&self, time: f32) -> twister::RenderSettings {
         let base = self.base;
         if let Some(cam) = self.camera.and_then(|n| self.prepared.scene.cameras.get(n)) {
             return base.with_viewer(Vec3::from(cam.position)).with_yaw_deg(self.base_yaw + cam.yaw_deg);
@@ -143,6 +164,7 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32)) -> Result<(
     let gaze_path = args.gaze_path.as_deref().map(GazePath::read).transpose()?;
     let lod = args.view.lod()?;
     let viewer_path = read_viewer_path(args)?;
+    let head_path = read_head_path(args, &settings)?;
     if gaze_path.is_some() && lod.is_none() {
         return Err(Error::option("--gaze-path", "steers the level of detail: use it with --lod visual-field"));
     }
@@ -166,7 +188,7 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32)) -> Result<(
     };
     let base = prepared.settings;
     let mut sequence =
-        Sequence { args, renderer: &renderer, prepared, base, base_yaw, clip, viewer_path, camera, tracked };
+        Sequence { args, renderer: &renderer, prepared, base, base_yaw, clip, viewer_path, head_path, camera, tracked };
     let todo: Vec<u32> =
         frames.into_iter().filter(|&f| !(args.resume && writer.paths(Some(f)).iter().all(|p| p.exists()))).collect();
     let stats = open_stats(args)?;
@@ -293,6 +315,32 @@ fn read_viewer_path(args: &RenderArgs) -> Result<Option<Timeline>> {
         })?)),
         None => Ok(None),
     }
+}
+
+/// `--head-path`, read and checked: the cylinder, the display's centre given as a place, no
+/// fixed `--head`, the exact model.
+fn read_head_path(args: &RenderArgs, settings: &twister::RenderSettings) -> Result<Option<Timeline>> {
+    let Some(path) = &args.head_path else { return Ok(None) };
+    let why = if args.view.head.is_some() {
+        Some("moves the head itself: leave out --head")
+    } else if matches!(args.view.viewer, Viewer::Camera(_)) {
+        Some("needs the display's centre as --viewer x,y,z")
+    } else if settings.projection().panorama != PanoramaKind::Cylinder {
+        Some("a tracked head looks at the cylinder: use it with --panorama cylinder")
+    } else if args.view.vertical == Some(twister::Vertical::Paper) {
+        Some("a tracked head draws each point where the line from the eye meets the screen: leave out --vertical paper")
+    } else if settings.subdivision.method.name().starts_with("slit") {
+        Some("slit pastes the slits of eyes on the circle about the display's centre: use trace as the reference")
+    } else {
+        None
+    };
+    if let Some(why) = why {
+        return Err(Error::option("--head-path", why));
+    }
+    Ok(Some(Timeline::read(path, "head_path", (3, 4), "time,x,y,z[,yaw]", |v| {
+        let max = twister::core::scene::MAX_COORDINATE;
+        (v[..3].iter().any(|c| c.abs() > max)).then(|| format!("coordinates within ±{max:e}"))
+    })?))
 }
 
 /// The animation a sequence plays: `--animation` by name or index, else the file's first.

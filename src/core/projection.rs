@@ -208,10 +208,7 @@ impl Projection {
         if let Some(head) = &self.head {
             let [x, y, z] = head.offset;
             if self.panorama != PanoramaKind::Cylinder {
-                return Err(Error::setting(
-                    "view.projection.head",
-                    "a tracked head looks at the cylinder (--panorama cylinder)",
-                ));
+                return Err(Error::setting("view.projection.head", "a tracked head looks at the cylinder panorama"));
             }
             if !(head.offset.iter().all(|c| c.is_finite()) && head.turn.is_finite()) {
                 return Err(Error::setting("view.projection.head", format!("must be finite, got {head:?}")));

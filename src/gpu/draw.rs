@@ -211,8 +211,8 @@ fn draw_pipeline(
 ) -> wgpu::RenderPipeline {
     // None: the background triangle (no vertex buffer; colour only; behind everything).
     let background = look.is_none();
-    let (look, lit) =
-        look.unwrap_or((Look::Materials, Lit { pbr: true, environment: true, maps: false, shadows: false, panoramas: 7 }));
+    let (look, lit) = look
+        .unwrap_or((Look::Materials, Lit { pbr: true, environment: true, maps: false, shadows: false, panoramas: 7 }));
     let (stride, attributes) = vertex_layout(kind);
     let layout = wgpu::VertexBufferLayout {
         array_stride: stride as u64,
