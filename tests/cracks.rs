@@ -309,6 +309,11 @@ fn surround_scenes_let_no_sample_see_the_background() {
             if panorama == PanoramaKind::Fisheye && !matches!(method, Method::Adaptive(_)) {
                 continue;
             }
+            // VR180 is the sphere's front half, whose every method the sphere's size checks:
+            // the adaptive rule here, for its own image's edges.
+            if panorama == PanoramaKind::Vr180 && !matches!(method, Method::Adaptive(_)) {
+                continue;
+            }
             {
                 let vertical = if method == Method::Trace { Vertical::Exact } else { Vertical::Paper };
                 // The fisheye at 240°, tilted: the floor's antipode cone inside the circle's reach.

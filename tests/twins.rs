@@ -281,12 +281,12 @@ fn raster_geometry_cases() -> Vec<(String, RasterCase)> {
     // The full sphere, with the error in pixels and as an angle (arcminutes).
     let sphere = Projection::equirect(320);
     out.push(("demo on the sphere".into(), (builtin::demo(), RenderSettings::new(sphere), None)));
-    out.push(("demo on VR180".into(), (builtin::demo(), RenderSettings::new(Projection::vr180(160)), None)));
+    out.push(("demo on VR180".into(), (builtin::demo(), RenderSettings::new(Projection::vr180(128)), None)));
     let head = twister::core::head::Head { offset: [0.3, 0.1, -0.2], turn: 0.35 };
     let tracked =
-        Projection { width: 400, height: 100, vertical: Vertical::Exact, head: Some(head), ..Projection::default() };
+        Projection { width: 256, height: 64, vertical: Vertical::Exact, head: Some(head), ..Projection::default() };
     out.push(("demo seen by a tracked head".into(), (builtin::demo(), RenderSettings::new(tracked), None)));
-    let dome = Projection { fov: 240.0, dome_tilt: 20.0, ..Projection::fisheye(160) };
+    let dome = Projection { fov: 240.0, dome_tilt: 20.0, ..Projection::fisheye(128) };
     out.push(("demo on a tilted 240° fisheye".into(), (builtin::demo(), RenderSettings::new(dome), None)));
     // A triangle 2 m ahead reaching ±60° across and 50° up and down.
     let mut triangle = Scene::new("big triangle");

@@ -28,11 +28,11 @@ pub struct ViewArgs {
     /// mono with --eye-radius 0). [default: cylinder; equirect with --preset]
     #[arg(long, value_enum)]
     pub panorama: Option<PanoramaKind>,
-    /// Image width per eye in pixels (the full 360°; vr180: 180°) [default: 3168; equirect and
-    /// vr180 4096].
+    /// Image width per eye in pixels (the full 360°; vr180: 180°; fisheye: --fov) [default: 3168;
+    /// equirect, vr180 and fisheye 4096].
     #[arg(long)]
     pub width: Option<u32>,
-    /// Image height per eye in pixels [default: 600; equirect: width/2; vr180: width].
+    /// Image height per eye in pixels [default: 600; equirect: width/2; vr180, fisheye: width].
     #[arg(long)]
     pub height: Option<u32>,
     /// Size preset of the full sphere (implies --panorama equirect): vr4k (4096×4096 top-bottom:

@@ -24,17 +24,8 @@
 
 use glam::{Mat3, Vec3};
 
+pub use crate::core::projection::Head;
 use crate::core::projection::{azimuth, wrap_angle, Eye, Projected, Projection};
-
-/// Where the head is, seen from the display: its position O in the display's frame (metres;
-/// the display's centre is the origin, its front −z) and the turn γ (radians) that takes the
-/// head's frame into the display's (a direction at azimuth θ about the head lies at θ − γ about
-/// the display).
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
-pub struct Head {
-    pub offset: [f32; 3],
-    pub turn: f32,
-}
 
 impl Head {
     /// The head at `position` (scene units × `scale` = metres, scene frame) facing `yaw_deg`,
@@ -88,8 +79,7 @@ impl Projection {
 
 #[cfg(test)]
 mod tests {
-    use super::Head;
-    use crate::core::projection::{pixel_ray, Eye, Panorama, Projection, Vertical};
+    use crate::core::projection::{pixel_ray, Eye, Head, Panorama, Projection, Vertical};
     use glam::{Vec2, Vec3};
     use rand::{Rng, SeedableRng};
 

@@ -33,7 +33,6 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::core::head::Head;
 use crate::error::{Error, Result};
 
 /// The vertical model: how the screen height `v` of a point is computed.
@@ -100,6 +99,17 @@ pub struct Projection {
     /// The cylinder: a tracked head away from the display's centre (`core::head`); None: the
     /// paper's eyes on the circle about the centre.
     pub head: Option<Head>,
+}
+
+/// A tracked head before the cylinder (`core::head`, which has its maths): where the head is,
+/// seen from the display: its position O in the display's frame (metres;
+/// the display's centre is the origin, its front −z) and the turn γ (radians) that takes the
+/// head's frame into the display's (a direction at azimuth θ about the head lies at θ − γ about
+/// the display).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Head {
+    pub offset: [f32; 3],
+    pub turn: f32,
 }
 
 /// The pole merge Blender uses by default (degrees of altitude).

@@ -104,20 +104,20 @@ fn subdivide_cases() -> Vec<(Scene, RenderSettings)> {
         ),
         (random_triangle_scene(7, 200), RenderSettings::new(Projection::equirect(256)).with_method(Method::Fixed(3))),
         // VR180: the sphere's front half (the back's pieces land beyond the image's sides).
-        (builtin::demo(), RenderSettings::new(Projection::vr180(192))),
+        (builtin::demo(), RenderSettings::new(Projection::vr180(128))),
         // A tracked head off the display's centre: its seam copies, its vertical limit.
         (
             builtin::demo(),
             RenderSettings::new(Projection {
-                width: 400,
-                height: 100,
+                width: 256,
+                height: 64,
                 vertical: Vertical::Exact,
                 head: Some(twister::core::head::Head { offset: [-0.5, -0.2, 0.4], turn: -1.0 }),
                 ..Projection::default()
             }),
         ),
         // The fisheye: its own image's edge lengths, the cone around the tilted dome's antipode.
-        (builtin::demo(), RenderSettings::new(Projection { fov: 240.0, dome_tilt: 20.0, ..Projection::fisheye(192) })),
+        (builtin::demo(), RenderSettings::new(Projection { fov: 240.0, dome_tilt: 20.0, ..Projection::fisheye(128) })),
         // Rows (the sphere, adaptive rules): random triangles, the box room (long thin parts in
         // bands), eq. 5, a viewer off the axis.
         (random_triangle_scene(9, 200), RenderSettings::new(Projection::equirect(320))),
