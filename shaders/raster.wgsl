@@ -56,11 +56,6 @@ fn vs_main(in: VertexIn, eye_in: EyeIn) -> VertexOut {
     out.clip = to_clip(params.projection, uvd);
     out.clip.x += 2.0 * params.shift_px.x / params.projection.width;
     out.clip.y -= 2.0 * params.shift_px.y / params.projection.height;
-    // The fisheye has no seam: a seam copy (its reference a turn away) would draw its triangle
-    // twice, so it collapses to a point outside the image (`raster_vertex` in cpu/raster.rs).
-    if (is_fisheye(params.projection) && abs(in.theta_ref) > PI) {
-        out.clip = vec4<f32>(-4.0, -4.0, out.clip.z, 1.0);
-    }
     out.view_position = in.position;
     out.normal = in.normal;
     out.tangent = unpack_tangent(in.tangent);

@@ -264,6 +264,30 @@ fn triangles_reaching_into_the_eye_circle_are_drawn_whole() {
     assert!(checked > 10_000, "only {checked} points checked");
 }
 
+/// Per eye, the pixels the image shows (inside the fisheye's circle) that differ between the frame
+/// drawn on a black and on a white background: where a sample sees the background.
+fn background_seen(
+    r: &twister::Renderer,
+    gs: &twister::GpuScene,
+    settings: &RenderSettings,
+) -> Vec<(twister::Eye, Vec<(u32, u32)>)> {
+    let black = r.render(gs, &settings.with_background([0.0; 3])).unwrap();
+    let white = r.render(gs, &settings.with_background([1.0; 3])).unwrap();
+    let projection = settings.projection();
+    twister::Eye::BOTH
+        .into_iter()
+        .map(|eye| {
+            let (a, b) = (black.eye(eye), white.eye(eye));
+            let seen = (0..a.height)
+                .flat_map(|y| (0..a.width).map(move |x| (x, y)))
+                .filter(|&(x, y)| projection.shows_pixel(x as f32 + 0.5, y as f32 + 0.5))
+                .filter(|&(x, y)| a.pixel(x, y) != b.pixel(x, y))
+                .collect();
+            (eye, seen)
+        })
+        .collect()
+}
+
 /// Surround scenes at several samples per pixel, both panoramas: a crack narrower than a pixel
 /// would show as partial coverage of the background, which one sample at the centre can miss.
 /// The oracle: the same frame on a black and on a white background is the same image, pixel for
@@ -322,15 +346,7 @@ fn surround_scenes_let_no_sample_see_the_background() {
                     Projection { width, height, panorama, vertical, fov, dome_tilt, ..Projection::default() };
                 let settings =
                     RenderSettings::new(projection).with_viewer(*viewer).with_method(method).with_samples(samples);
-                let black = r.render(&gs, &settings.with_background([0.0; 3])).unwrap();
-                let white = r.render(&gs, &settings.with_background([1.0; 3])).unwrap();
-                for eye in twister::Eye::BOTH {
-                    let (a, b) = (black.eye(eye), white.eye(eye));
-                    let seen: Vec<(u32, u32)> = (0..a.height)
-                        .flat_map(|y| (0..a.width).map(move |x| (x, y)))
-                        .filter(|&(x, y)| projection.shows_pixel(x as f32 + 0.5, y as f32 + 0.5))
-                        .filter(|&(x, y)| a.pixel(x, y) != b.pixel(x, y))
-                        .collect();
+                for (eye, seen) in background_seen(r, &gs, &settings) {
                     assert!(
                         seen.is_empty(),
                         "{what}, {panorama:?} {width}x{height} {} at {samples} samples {eye:?}: {} pixels see the background, e.g. {:?}",
@@ -375,14 +391,7 @@ fn a_tracked_head_sees_closed_rooms_whole() {
                 ..Projection::default()
             };
             let settings = RenderSettings::new(projection).with_method(method).with_samples(samples);
-            let black = r.render(&gs, &settings.with_background([0.0; 3])).unwrap();
-            let white = r.render(&gs, &settings.with_background([1.0; 3])).unwrap();
-            for eye in twister::Eye::BOTH {
-                let (a, b) = (black.eye(eye), white.eye(eye));
-                let seen: Vec<(u32, u32)> = (0..a.height)
-                    .flat_map(|y| (0..a.width).map(move |x| (x, y)))
-                    .filter(|&(x, y)| a.pixel(x, y) != b.pixel(x, y))
-                    .collect();
+            for (eye, seen) in background_seen(r, &gs, &settings) {
                 assert!(
                     seen.is_empty(),
                     "{what}, {head:?} {} {eye:?}: {} pixels see the background, e.g. {:?}",

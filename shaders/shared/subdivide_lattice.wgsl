@@ -504,6 +504,10 @@ fn seam_copies(shape: PieceShape, part: ptr<function, PartPlan>, piece_state: pt
         u_range = piece_u_range((*piece_state).corner, theta_c);
     }
     var seam = SeamCopies(array<f32, 3>(theta_c, 0.0, 0.0), 1u);
+    // The fisheye's image has no seam (a copy would draw its piece twice over the original).
+    if (is_fisheye(params.projection)) {
+        return seam;
+    }
     if (u_range.y > PI - SEAM_MARGIN) {
         seam.refs[seam.copies] = theta_c - TAU;
         seam.copies += 1u;

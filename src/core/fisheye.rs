@@ -19,9 +19,39 @@
 
 use glam::Vec3;
 
-use crate::core::projection::Projection;
+use crate::core::projection::{PanoramaKind, Projection};
+use crate::error::{Error, Result};
 
 impl Projection {
+    /// The fisheye's settings: its field of view, its tilt, and a tilted dome's antipode off the rim.
+    pub(crate) fn validate_fisheye(&self) -> Result<()> {
+        if self.panorama == PanoramaKind::Fisheye {
+            if !(self.fov.is_finite() && self.fov > 0.0 && self.fov <= 360.0) {
+                return Err(Error::setting(
+                    "view.projection.fov",
+                    format!("must be a field of view in degrees, 0 < FOV ≤ 360, got {}", self.fov),
+                ));
+            }
+            if !(self.dome_tilt.is_finite() && self.dome_tilt.abs() <= 90.0) {
+                return Err(Error::setting(
+                    "view.projection.dome_tilt",
+                    format!("must be degrees between -90 and 90, got {}", self.dome_tilt),
+                ));
+            }
+            if self.dome_tilt != 0.0 && self.dome_antipode_cone().is_none() {
+                return Err(Error::setting(
+                    "view.projection.dome_tilt",
+                    format!(
+                        "a tilted dome takes a field of view below 340°, got {}: the point opposite its axis \
+                         then lies within 10° of the image's rim",
+                        self.fov
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// k: pixels per radian from the dome's axis, W / FOV.
     pub fn fisheye_pixels_per_radian(&self) -> f32 {
         self.width as f32 / self.fov.to_radians()

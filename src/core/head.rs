@@ -25,7 +25,8 @@
 use glam::{Mat3, Vec3};
 
 pub use crate::core::projection::Head;
-use crate::core::projection::{azimuth, wrap_angle, Eye, Projected, Projection};
+use crate::core::projection::{azimuth, wrap_angle, Eye, PanoramaKind, Projected, Projection, Vertical};
+use crate::error::{Error, Result};
 
 impl Head {
     /// The head at `position` (scene units × `scale` = metres, scene frame) facing `yaw_deg`,
@@ -48,6 +49,40 @@ impl Head {
 }
 
 impl Projection {
+    /// The tracked head's settings: the cylinder, finite, the eyes within the screen, the exact model.
+    pub(crate) fn validate_head(&self) -> Result<()> {
+        if let Some(head) = &self.head {
+            let [x, y, z] = head.offset;
+            if self.panorama != PanoramaKind::Cylinder {
+                return Err(Error::setting("view.projection.head", "a tracked head looks at the cylinder panorama"));
+            }
+            if !(head.offset.iter().all(|c| c.is_finite()) && head.turn.is_finite()) {
+                return Err(Error::setting("view.projection.head", format!("must be finite, got {head:?}")));
+            }
+            let reach = (x * x + z * z).sqrt() + self.eye_radius;
+            if reach >= self.screen_radius {
+                return Err(Error::setting(
+                    "view.projection.head",
+                    format!(
+                        "the eyes reach the screen: the head is {:.3} m from the display's axis, plus the eye radius {} \
+                         makes {reach:.3} m, not within the screen radius {}",
+                        (x * x + z * z).sqrt(),
+                        self.eye_radius,
+                        self.screen_radius
+                    ),
+                ));
+            }
+            let _ = y;
+            if self.vertical == Vertical::Paper {
+                return Err(Error::setting(
+                    "view.projection.vertical",
+                    "a tracked head draws each point where the line from the eye meets the screen: the exact model",
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// The eye's position in the head's frame.
     pub fn head_eye(&self, eye: Eye) -> Vec3 {
         Vec3::new(eye.sign() * self.eye_radius, 0.0, 0.0)

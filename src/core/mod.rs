@@ -18,6 +18,7 @@ pub mod light;
 pub mod load;
 pub mod lod;
 pub mod material;
+pub mod panorama;
 pub mod projection;
 pub mod sampling;
 pub mod scene;

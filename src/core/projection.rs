@@ -33,6 +33,7 @@
 
 use glam::{Vec2, Vec3};
 
+pub use crate::core::panorama::PanoramaKind;
 use crate::error::{Error, Result};
 
 /// The vertical model: how the screen height `v` of a point is computed.
@@ -215,59 +216,8 @@ impl Projection {
                 ));
             }
         }
-        if let Some(head) = &self.head {
-            let [x, y, z] = head.offset;
-            if self.panorama != PanoramaKind::Cylinder {
-                return Err(Error::setting("view.projection.head", "a tracked head looks at the cylinder panorama"));
-            }
-            if !(head.offset.iter().all(|c| c.is_finite()) && head.turn.is_finite()) {
-                return Err(Error::setting("view.projection.head", format!("must be finite, got {head:?}")));
-            }
-            let reach = (x * x + z * z).sqrt() + self.eye_radius;
-            if reach >= self.screen_radius {
-                return Err(Error::setting(
-                    "view.projection.head",
-                    format!(
-                        "the eyes reach the screen: the head is {:.3} m from the display's axis, plus the eye radius {} \
-                         makes {reach:.3} m, not within the screen radius {}",
-                        (x * x + z * z).sqrt(),
-                        self.eye_radius,
-                        self.screen_radius
-                    ),
-                ));
-            }
-            let _ = y;
-            if self.vertical == Vertical::Paper {
-                return Err(Error::setting(
-                    "view.projection.vertical",
-                    "a tracked head draws each point where the line from the eye meets the screen: the exact model",
-                ));
-            }
-        }
-        if self.panorama == PanoramaKind::Fisheye {
-            if !(self.fov.is_finite() && self.fov > 0.0 && self.fov <= 360.0) {
-                return Err(Error::setting(
-                    "view.projection.fov",
-                    format!("must be a field of view in degrees, 0 < FOV ≤ 360, got {}", self.fov),
-                ));
-            }
-            if !(self.dome_tilt.is_finite() && self.dome_tilt.abs() <= 90.0) {
-                return Err(Error::setting(
-                    "view.projection.dome_tilt",
-                    format!("must be degrees between -90 and 90, got {}", self.dome_tilt),
-                ));
-            }
-            if self.dome_tilt != 0.0 && self.dome_antipode_cone().is_none() {
-                return Err(Error::setting(
-                    "view.projection.dome_tilt",
-                    format!(
-                        "a tilted dome takes a field of view below 340°, got {}: the point opposite its axis \
-                         then lies within 10° of the image's rim",
-                        self.fov
-                    ),
-                ));
-            }
-        }
+        self.validate_head()?;
+        self.validate_fisheye()?;
         if self.width < 2 || self.height < 2 || self.width > MAX_IMAGE_SIDE || self.height > MAX_IMAGE_SIDE {
             return Err(Error::setting(
                 "view.projection.width/height",
@@ -446,88 +396,6 @@ impl Projection {
         let w = self.turn_px();
         let d = (a - b).rem_euclid(w);
         d.min(w - d)
-    }
-}
-
-/// The panoramas twister renders (`--panorama`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, clap::ValueEnum)]
-#[serde(rename_all = "kebab-case")]
-pub enum PanoramaKind {
-    /// The TWISTER display's cylinder: concentric mosaics, seed 002 eq. 1–4.
-    #[default]
-    Cylinder,
-    /// The full sphere, equirectangular omni-directional stereo (Google ODS, Cycles' spherical
-    /// stereo): 360° × 180° per eye.
-    Equirect,
-    /// VR180: the sphere's front half, equirectangular 180° × 180° per eye (W = H), the same eye
-    /// model as `Equirect`; longitudes beyond ±90° fall outside the image.
-    Vr180,
-    /// The fulldome master: the sphere's eye rays drawn in an equidistant azimuthal (fisheye)
-    /// image, W × W, the dome's axis at the centre (`core::fisheye`).
-    Fisheye,
-}
-
-impl PanoramaKind {
-    pub fn name(self) -> &'static str {
-        match self {
-            PanoramaKind::Cylinder => "cylinder",
-            PanoramaKind::Equirect => "equirect",
-            PanoramaKind::Vr180 => "vr180",
-            PanoramaKind::Fisheye => "fisheye",
-        }
-    }
-
-    /// Whether the panorama is (part of) the full sphere's equirectangular ODS: longitude u,
-    /// latitude v, the eye model of `core::sphere`.
-    pub const fn is_sphere(self) -> bool {
-        matches!(self, PanoramaKind::Equirect | PanoramaKind::Vr180 | PanoramaKind::Fisheye)
-    }
-
-    /// Whether the image is equirectangular (the sphere, VR180): what GPano and `sv3d`/`equi`
-    /// describe.
-    pub const fn is_equirectangular(self) -> bool {
-        matches!(self, PanoramaKind::Equirect | PanoramaKind::Vr180)
-    }
-
-    /// The share of a full turn of azimuth that the image's width spans: 1, or ½ for VR180.
-    pub const fn turn_share(self) -> f32 {
-        match self {
-            PanoramaKind::Vr180 => 0.5,
-            _ => 1.0,
-        }
-    }
-
-    /// The tag VR players detect in a file name (`_360`, `_180`); None for the cylinder, which is
-    /// no player format.
-    pub const fn player_tag(self) -> Option<&'static str> {
-        match self {
-            PanoramaKind::Cylinder => None,
-            PanoramaKind::Equirect => Some("360"),
-            PanoramaKind::Vr180 => Some("180"),
-            PanoramaKind::Fisheye => Some("fisheye"),
-        }
-    }
-
-    /// Whether the image's width is the whole turn (its left and right edges meet).
-    pub const fn wraps(self) -> bool {
-        !matches!(self, PanoramaKind::Vr180 | PanoramaKind::Fisheye)
-    }
-
-    /// Its code in the WGSL projection uniform (`PANORAMA_CYLINDER`, `PANORAMA_EQUIRECT`).
-    pub const fn code(self) -> u32 {
-        match self {
-            PanoramaKind::Cylinder => 0,
-            PanoramaKind::Equirect => 1,
-            PanoramaKind::Vr180 => 2,
-            PanoramaKind::Fisheye => 3,
-        }
-    }
-
-    /// The panorama of a code; None for a code no panorama has.
-    pub fn from_code(code: u32) -> Option<PanoramaKind> {
-        [PanoramaKind::Cylinder, PanoramaKind::Equirect, PanoramaKind::Vr180, PanoramaKind::Fisheye]
-            .into_iter()
-            .find(|p| p.code() == code)
     }
 }
 

@@ -32,11 +32,6 @@ pub fn raster_vertex(params: &RasterParams, v: &DrawVertex) -> Vec4 {
     let q = projection.project_with_azimuth(p, theta, eye);
     let depth = (q.depth / (q.depth + 1.0)).min(crate::encoding::constants::MAX_DEPTH);
     if projection.panorama == PanoramaKind::Fisheye {
-        // The fisheye has no seam: a seam copy (its reference a turn away) would draw its
-        // triangle twice, so it collapses to a point outside the image.
-        if v.theta_ref.abs() > std::f32::consts::PI {
-            return Vec4::new(-4.0, -4.0, depth, 1.0);
-        }
         let [x, y] = projection.fisheye_pixel(q.u, q.v);
         let (w, h) = (projection.width as f32, projection.height as f32);
         return Vec4::new(

@@ -103,7 +103,7 @@
 use glam::{Vec2, Vec3, Vec4};
 use std::f32::consts::{PI, TAU};
 
-use crate::core::projection::{azimuth, wrap_angle, Projection};
+use crate::core::projection::{azimuth, wrap_angle, PanoramaKind, Projection};
 use crate::core::scene::{pack_tangent, SceneVertex};
 use crate::core::settings::SplitRule;
 use crate::encoding::constants::{SEAM_MARGIN, STRIP_BASE_ERROR, STRIP_MIN_DIVISIONS};
@@ -238,11 +238,13 @@ impl<'a> Subdivider<'a> {
     ) -> PiecePlan {
         let mut refs = vec![theta_c];
         // Conservative by SEAM_MARGIN: a vertex exactly on the seam (θ = π, r = R_T) is a tie
-        // that rounding could break either way; an extra copy is clipped by the rasterizer.
-        if u_max > PI - SEAM_MARGIN {
+        // that rounding could break either way; an extra copy is clipped by the rasterizer. The
+        // fisheye's image has no seam (a copy would draw its piece twice over the original).
+        let seam = self.projection.panorama != PanoramaKind::Fisheye;
+        if seam && u_max > PI - SEAM_MARGIN {
             refs.push(theta_c - TAU);
         }
-        if u_min < -PI + SEAM_MARGIN {
+        if seam && u_min < -PI + SEAM_MARGIN {
             refs.push(theta_c + TAU);
         }
         let nodes: Vec<DrawVertex> =

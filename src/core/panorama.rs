@@ -1,0 +1,86 @@
+//! The panoramas twister renders (`--panorama`): which image each is, its code in the WGSL
+//! projection uniform and the facts about its image the rest of the pipeline asks (the sphere's
+//! eye model or the cylinder's, the azimuth its width spans, the name players detect). The maps
+//! themselves are `core::projection` (the cylinder), `core::sphere`, `core::fisheye`.
+
+/// The panoramas twister renders (`--panorama`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum PanoramaKind {
+    /// The TWISTER display's cylinder: concentric mosaics, seed 002 eq. 1–4.
+    #[default]
+    Cylinder,
+    /// The full sphere, equirectangular omni-directional stereo (Google ODS, Cycles' spherical
+    /// stereo): 360° × 180° per eye.
+    Equirect,
+    /// VR180: the sphere's front half, equirectangular 180° × 180° per eye (W = H), the same eye
+    /// model as `Equirect`; longitudes beyond ±90° fall outside the image.
+    Vr180,
+    /// The fulldome master: the sphere's eye rays drawn in an equidistant azimuthal (fisheye)
+    /// image, W × W, the dome's axis at the centre (`core::fisheye`).
+    Fisheye,
+}
+
+impl PanoramaKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            PanoramaKind::Cylinder => "cylinder",
+            PanoramaKind::Equirect => "equirect",
+            PanoramaKind::Vr180 => "vr180",
+            PanoramaKind::Fisheye => "fisheye",
+        }
+    }
+
+    /// Whether the panorama is (part of) the full sphere's equirectangular ODS: longitude u,
+    /// latitude v, the eye model of `core::sphere`.
+    pub const fn is_sphere(self) -> bool {
+        matches!(self, PanoramaKind::Equirect | PanoramaKind::Vr180 | PanoramaKind::Fisheye)
+    }
+
+    /// Whether the image is equirectangular (the sphere, VR180): what GPano and `sv3d`/`equi`
+    /// describe.
+    pub const fn is_equirectangular(self) -> bool {
+        matches!(self, PanoramaKind::Equirect | PanoramaKind::Vr180)
+    }
+
+    /// The share of a full turn of azimuth that the image's width spans: 1, or ½ for VR180.
+    pub const fn turn_share(self) -> f32 {
+        match self {
+            PanoramaKind::Vr180 => 0.5,
+            _ => 1.0,
+        }
+    }
+
+    /// The tag VR players detect in a file name (`_360`, `_180`); None for the cylinder, which is
+    /// no player format.
+    pub const fn player_tag(self) -> Option<&'static str> {
+        match self {
+            PanoramaKind::Cylinder => None,
+            PanoramaKind::Equirect => Some("360"),
+            PanoramaKind::Vr180 => Some("180"),
+            PanoramaKind::Fisheye => Some("fisheye"),
+        }
+    }
+
+    /// Whether the image's width is the whole turn (its left and right edges meet).
+    pub const fn wraps(self) -> bool {
+        !matches!(self, PanoramaKind::Vr180 | PanoramaKind::Fisheye)
+    }
+
+    /// Its code in the WGSL projection uniform (`PANORAMA_CYLINDER`, `PANORAMA_EQUIRECT`).
+    pub const fn code(self) -> u32 {
+        match self {
+            PanoramaKind::Cylinder => 0,
+            PanoramaKind::Equirect => 1,
+            PanoramaKind::Vr180 => 2,
+            PanoramaKind::Fisheye => 3,
+        }
+    }
+
+    /// The panorama of a code; None for a code no panorama has.
+    pub fn from_code(code: u32) -> Option<PanoramaKind> {
+        [PanoramaKind::Cylinder, PanoramaKind::Equirect, PanoramaKind::Vr180, PanoramaKind::Fisheye]
+            .into_iter()
+            .find(|p| p.code() == code)
+    }
+}
