@@ -31,6 +31,11 @@ pub enum Layout {
     TopBottom,
     SideBySide,
     Twister,
+    /// The cubemap's twelve faces in one strip, the left eye's six then the right eye's, each
+    /// eye's in the grid's order (right, left, up, down, front, back): Meta's 360 photo format.
+    #[value(name = "12x1")]
+    #[serde(rename = "12x1")]
+    Strip12,
 }
 
 impl Layout {
@@ -42,6 +47,7 @@ impl Layout {
             PanoramaKind::Equirect => Layout::TopBottom,
             PanoramaKind::Vr180 => Layout::SideBySide,
             PanoramaKind::Fisheye => Layout::Eyes,
+            PanoramaKind::Cubemap => Layout::TopBottom,
         }
     }
 }
@@ -116,6 +122,24 @@ fn side_by_side<T: Copy>(left: &[T], right: &[T], width: usize, per_texel: usize
         .collect()
 }
 
+/// Both eyes' cubemap grids (3×2 faces, rows of `width` texels of `per_texel` values) as one
+/// strip of their twelve faces: the left eye's six, then the right eye's, each in the grid's
+/// order.
+fn strip12<T: Copy>(left: &[T], right: &[T], width: usize, per_texel: usize) -> Vec<T> {
+    let face = width / 3;
+    let row_len = width * per_texel;
+    let cells: Vec<(&[T], usize, usize)> =
+        [left, right].iter().flat_map(|img| (0..6).map(move |k| (*img, k % 3, k / 3))).collect();
+    let mut out = Vec::with_capacity(12 * face * face * per_texel);
+    for y in 0..face {
+        for &(img, col, row) in &cells {
+            let start = (row * face + y) * row_len + col * face * per_texel;
+            out.extend_from_slice(&img[start..start + face * per_texel]);
+        }
+    }
+    out
+}
+
 /// The file names of a layout, in the order of [`layout_images`]. The combined layouts carry
 /// the tags VR players detect: `_360` or `_180` for the panorama, then `_TB` or `_LR`.
 pub fn layout_names(layout: Layout, format: ImageFormat, panorama: PanoramaKind) -> Vec<String> {
@@ -129,6 +153,7 @@ pub fn layout_names(layout: Layout, format: ImageFormat, panorama: PanoramaKind)
             .iter()
             .flat_map(|eye| [format!("{eye}_front.{ext}"), format!("{eye}_back.{ext}")])
             .collect(),
+        Layout::Strip12 => vec![format!("stereo{tag}_12x1.{ext}")],
     }
 }
 
@@ -162,6 +187,13 @@ pub fn layout_images(
                 .flat_map(|img| [columns(img, quarter, half), columns(img, quarter + half, w - half)])
                 .collect()
         }
+        Layout::Strip12 => {
+            vec![EyeImage {
+                width: 4 * w,
+                height: h / 2,
+                rgba: strip12(&frame.left.rgba, &frame.right.rgba, w as usize, 4),
+            }]
+        }
     };
     names.into_iter().zip(images).collect()
 }
@@ -190,6 +222,9 @@ pub fn depth_images(frame: &Frame, layout: Layout) -> Option<Vec<(String, DepthI
         Layout::SideBySide => {
             vec![DepthImage { width: 2 * w, height: h, values: side_by_side(left, right, w as usize, 1) }]
         }
+        Layout::Strip12 => {
+            vec![DepthImage { width: 4 * w, height: h / 2, values: strip12(left, right, w as usize, 1) }]
+        }
     };
     Some(depth_names(layout).into_iter().zip(images).collect())
 }
@@ -200,6 +235,7 @@ pub fn depth_names(layout: Layout) -> Vec<String> {
         Layout::Eyes | Layout::Twister => vec!["left_depth.exr".into(), "right_depth.exr".into()],
         Layout::TopBottom => vec!["depth_TB.exr".into()],
         Layout::SideBySide => vec!["depth_LR.exr".into()],
+        Layout::Strip12 => vec!["depth_12x1.exr".into()],
     }
 }
 
@@ -505,7 +541,7 @@ mod tests {
 
     #[test]
     fn layout_names_are_the_names_of_the_layout_images() {
-        let eye = EyeImage { width: 8, height: 2, rgba: vec![0; 64] };
+        let eye = EyeImage { width: 6, height: 4, rgba: vec![0; 96] };
         let frame = Frame {
             left: eye.clone(),
             right: eye,
@@ -515,17 +551,57 @@ mod tests {
             positions: None,
             hdr: None,
         };
-        for layout in [Layout::Eyes, Layout::TopBottom, Layout::SideBySide, Layout::Twister] {
+        for layout in [Layout::Eyes, Layout::TopBottom, Layout::SideBySide, Layout::Twister, Layout::Strip12] {
             for format in [ImageFormat::Png, ImageFormat::Jpg] {
-                for panorama in
-                    [PanoramaKind::Cylinder, PanoramaKind::Equirect, PanoramaKind::Vr180, PanoramaKind::Fisheye]
-                {
+                for panorama in PanoramaKind::ALL {
                     let images = layout_images(&frame, layout, format, panorama);
                     let names: Vec<String> = images.into_iter().map(|(n, _)| n).collect();
                     assert_eq!(names, layout_names(layout, format, panorama));
                 }
             }
         }
+    }
+
+    /// The 12×1 strip holds each eye's faces, cut from its grid by their cells (right, left, up /
+    /// down, front, back), the left eye's first, every pixel in place.
+    #[test]
+    fn the_strip_of_twelve_faces_cuts_each_eyes_grid_in_the_grids_order() {
+        let face = 3u32;
+        let (w, h) = (3 * face, 2 * face);
+        // Each pixel holds its eye, its face (from its cell) and its place in the face.
+        let grid = |eye: u8| {
+            let rgba = (0..w * h)
+                .flat_map(|i| {
+                    let (x, y) = (i % w, i / w);
+                    let f = (3 * (y / face) + x / face) as u8;
+                    [eye, f, (x % face) as u8, (y % face) as u8]
+                })
+                .collect();
+            EyeImage { width: w, height: h, rgba }
+        };
+        let frame = Frame {
+            left: grid(0),
+            right: grid(1),
+            stats: Default::default(),
+            measurement: None,
+            depth: Some([(0..w * h).map(|i| i as f32).collect(), (0..w * h).map(|i| -(i as f32)).collect()]),
+            positions: None,
+            hdr: None,
+        };
+        let images = layout_images(&frame, Layout::Strip12, ImageFormat::Png, PanoramaKind::Cubemap);
+        assert_eq!(images.len(), 1);
+        let (name, strip) = &images[0];
+        assert_eq!((name.as_str(), strip.width, strip.height), ("stereo_cubemap_12x1.png", 12 * face, face));
+        for (i, px) in strip.rgba.chunks_exact(4).enumerate() {
+            let (x, y) = (i as u32 % strip.width, i as u32 / strip.width);
+            let k = x / face;
+            assert_eq!(px, [(k / 6) as u8, (k % 6) as u8, (x % face) as u8, y as u8], "strip pixel ({x}, {y})");
+        }
+        let depth = depth_images(&frame, Layout::Strip12).unwrap();
+        assert_eq!(depth[0].0, "depth_12x1.exr");
+        // The right eye's down face (its fourth: cell (0, 1)), second row, first column.
+        let at = depth[0].1.values[(face * 12 + 9 * face) as usize];
+        assert_eq!(at, -(((face + 1) * w) as f32));
     }
 
     #[test]

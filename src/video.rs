@@ -90,17 +90,22 @@ pub fn equi_bounds(panorama: PanoramaKind) -> [u32; 4] {
     [0, 0, side, side]
 }
 
-/// The `st3d` and, for an equirectangular panorama (the sphere, VR180), `sv3d` boxes (the
-/// fisheye's projection has no `sv3d` type: `st3d` alone).
+/// The `st3d` and, for an equirectangular panorama (the sphere, VR180) or the cubemap, `sv3d`
+/// boxes: `equi` with its bounds, or `cbmp` layout 0 (the 3×2 grid, no padding). The fisheye's
+/// projection has no `sv3d` type: `st3d` alone.
 pub fn spherical_boxes(stereo: StereoMode, panorama: PanoramaKind) -> Vec<u8> {
     let mut out = full_box(b"st3d", &[stereo as u8]);
-    if panorama.is_equirectangular() {
-        let svhd = full_box(b"svhd", b"twister\0");
-        let prhd = full_box(b"prhd", &[0; 12]);
+    let projection = if panorama.is_equirectangular() {
         let bounds: Vec<u8> = equi_bounds(panorama).iter().flat_map(|b| b.to_be_bytes()).collect();
-        let equi = full_box(b"equi", &bounds);
-        out.extend(container(b"sv3d", &[svhd, container(b"proj", &[prhd, equi])]));
-    }
+        full_box(b"equi", &bounds)
+    } else if panorama == PanoramaKind::Cubemap {
+        full_box(b"cbmp", &[0; 8])
+    } else {
+        return out;
+    };
+    let svhd = full_box(b"svhd", b"twister\0");
+    let prhd = full_box(b"prhd", &[0; 12]);
+    out.extend(container(b"sv3d", &[svhd, container(b"proj", &[prhd, projection])]));
     out
 }
 

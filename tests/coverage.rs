@@ -34,6 +34,7 @@ fn projection(panorama: PanoramaKind, scale: u32) -> Projection {
         PanoramaKind::Equirect => Projection::equirect(512 * scale),
         PanoramaKind::Vr180 => Projection::vr180(256 * scale),
         PanoramaKind::Fisheye => Projection::fisheye(256 * scale),
+        PanoramaKind::Cubemap => Projection::cubemap(384 * scale),
     }
 }
 

@@ -154,6 +154,7 @@ impl Twin for ProjectPoints {
             out.push((format!("a tracked head {eye:?}"), (tracked, eye, points.clone())));
             let dome = Projection { fov: 240.0, dome_tilt: 20.0, ..Projection::fisheye(2048) };
             out.push((format!("fisheye 240° tilted 20° {eye:?}"), (dome, eye, sphere_points.clone())));
+            out.push((format!("cubemap {eye:?}"), (Projection::cubemap(3 * 1024), eye, sphere_points.clone())));
         }
         out
     }
@@ -186,7 +187,7 @@ impl Twin for ProjectPoints {
             };
             // On the sphere, columns near the poles are short: compare the distance they make.
             let (_, lat) = p.pixel_to_screen(c[0], c[1]);
-            let equirect = p.panorama.is_sphere() && p.panorama != twister::core::projection::PanoramaKind::Fisheye;
+            let equirect = p.panorama.is_equirectangular();
             let squeeze = if equirect { lat.cos() } else { 1.0 };
             if !(p.wrapped_dx(g[0], c[0]) * squeeze < tolerance.max(1e-3) && (g[1] - c[1]).abs() < tolerance) {
                 return Err(format!("point {i}: GPU {g:?}, CPU {c:?}"));
@@ -288,6 +289,7 @@ fn raster_geometry_cases() -> Vec<(String, RasterCase)> {
     out.push(("demo seen by a tracked head".into(), (builtin::demo(), RenderSettings::new(tracked), None)));
     let dome = Projection { fov: 240.0, dome_tilt: 20.0, ..Projection::fisheye(128) };
     out.push(("demo on a tilted 240° fisheye".into(), (builtin::demo(), RenderSettings::new(dome), None)));
+    out.push(("demo on the cubemap".into(), (builtin::demo(), RenderSettings::new(Projection::cubemap(192)), None)));
     // A triangle 2 m ahead reaching ±60° across and 50° up and down.
     let mut triangle = Scene::new("big triangle");
     let corner = |p: [f32; 3]| twister::core::scene::SceneVertex {

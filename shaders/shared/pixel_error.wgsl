@@ -10,6 +10,9 @@ fn from_pixel(proj: Projection, xy: vec2<f32>) -> vec2<f32> {
     if (is_fisheye(proj)) {
         return fisheye_direction(proj, xy);
     }
+    if (is_cubemap(proj)) {
+        return cube_direction(proj, xy);
+    }
     return vec2<f32>((xy.x - 0.5 * proj.width) / proj.turn_px * TAU, (0.5 * proj.height - xy.y) / proj.pixels_per_v);
 }
 
@@ -32,6 +35,9 @@ fn pixel_spread(proj: Projection, frag_xy: vec2<f32>) -> f32 {
     if (is_fisheye(proj)) {
         return 1.0 / fisheye_scale(proj);
     }
+    if (is_cubemap(proj)) {
+        return 1.0 / proj.pixels_per_v; // a face's centre, where its pixels span the most
+    }
     let uv = from_pixel(proj, frag_xy);
     if (is_sphere(proj)) {
         return max(TAU / proj.turn_px * cos(uv.y), 1.0 / proj.pixels_per_v);
@@ -52,6 +58,14 @@ fn pixel_error(proj: Projection, eye_sign: f32, p: vec3<f32>, frag_xy: vec2<f32>
         let a = screen_direction(proj, uvd.xy);
         let b = screen_direction(proj, from_pixel(proj, frag_xy));
         return precise_atan2(length(cross(a, b)), dot(a, b)) * (180.0 * 60.0 / PI);
+    }
+    if (is_cubemap(proj)) {
+        // On the pixel's own face (a point drawn across a face's edge belongs beyond it there).
+        let near = cube_pixel_near(proj, uvd.x, uvd.y, frag_xy);
+        if (near.z <= 0.0) {
+            return 1e9;
+        }
+        return length(near.xy - frag_xy);
     }
     let ideal = to_pixel(proj, uvd.x, uvd.y);
     var dx = abs(ideal.x - frag_xy.x);

@@ -15,11 +15,12 @@
 #import projection_sphere
 #import projection_fisheye
 #import projection_head
+#import projection_cubemap
 
 const PI: f32 = 3.14159265358979;
 const TAU: f32 = 6.28318530717959;
 
-// Mirrors `ProjectionUniform` in src/shader/types.rs (48 bytes).
+// Mirrors `ProjectionUniform` in src/encoding/types.rs (80 bytes).
 struct Projection {
     screen_radius: f32,    // R_T, metres
     eye_radius: f32,       // d_e, metres
@@ -38,15 +39,15 @@ struct Projection {
     head_on: f32,          // the cylinder's tracked head (`core::head`): 1 on, 0 off
     head_turn: f32,        // γ: head frame → display frame turn, radians
     head_offset: vec3<f32>, // O: the head in the display's frame, metres
-    _pad0: f32,
+    face: u32,             // the cubemap: the face this draw projects into (0 elsewhere)
 }
 
-// The panoramas a pipeline can draw (bit 0 the cylinder, bit 1 the sphere: equirect, VR180 or
-// the fisheye, bit 2 the fisheye's image). The subdivide stage's and the drawing stages'
+// The panoramas a pipeline can draw (bit 0 the cylinder, bit 1 the sphere: equirect, VR180, the
+// fisheye or the cubemap, bit 2 the fisheye's image, bit 3 the cubemap's). The subdivide stage's and the drawing stages'
 // pipelines are built for one panorama each, so the others' code is compiled out: on lavapipe a
 // shader that merely contains the sphere's projection (inlined at every sample of an edge) ran
 // the cylinder's subdivision three times slower.
-override PANORAMAS: u32 = 7u;
+override PANORAMAS: u32 = 15u;
 
 fn is_sphere(proj: Projection) -> bool {
     return (PANORAMAS & 2u) != 0u && ((PANORAMAS & 1u) == 0u || proj.panorama != PANORAMA_CYLINDER);
@@ -169,6 +170,9 @@ fn to_pixel(proj: Projection, u: f32, v: f32) -> vec2<f32> {
     if (is_fisheye(proj)) {
         return fisheye_pixel(proj, u, v);
     }
+    if (is_cubemap(proj)) {
+        return cube_pixel(proj, u, v);
+    }
     let x = wrap_angle(u) / TAU * proj.turn_px + 0.5 * proj.width;
     let y = 0.5 * proj.height - v * proj.pixels_per_v;
     return vec2<f32>(x, y);
@@ -183,6 +187,9 @@ fn to_clip(proj: Projection, uvd: vec3<f32>) -> vec4<f32> {
     if (is_fisheye(proj)) {
         let xy = fisheye_pixel(proj, uvd.x, uvd.y);
         return vec4<f32>(2.0 * xy.x / proj.width - 1.0, 1.0 - 2.0 * xy.y / proj.height, z, 1.0);
+    }
+    if (is_cubemap(proj)) {
+        return cube_clip(proj, uvd.x, uvd.y, z);
     }
     let x = uvd.x * proj.turn_px / (PI * proj.width);
     let y_limit = 1.0 + GUARD_BAND_PX / (0.5 * proj.height);

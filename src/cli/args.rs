@@ -23,16 +23,18 @@ use twister::{Projection, RenderSettings, Vertical};
 pub struct ViewArgs {
     /// The panorama: cylinder (the TWISTER display), equirect (the full sphere, 360° × 180°
     /// per eye: omni-directional stereo as VR players, 360° video and Blender use), vr180
-    /// (its front half, 180° × 180° per eye) or fisheye (the fulldome master: W × W,
+    /// (its front half, 180° × 180° per eye), fisheye (the fulldome master: W × W,
     /// equidistant, the zenith at the centre and the front at the bottom; --fov, --dome-tilt;
-    /// mono with --eye-radius 0). [default: cylinder; equirect with --preset]
+    /// mono with --eye-radius 0) or cubemap (six 90° faces per eye in YouTube's 3×2 grid: right,
+    /// left, up / down, front, back). [default: cylinder; equirect with --preset]
     #[arg(long, value_enum)]
     pub panorama: Option<PanoramaKind>,
-    /// Image width per eye in pixels (the full 360°; vr180: 180°; fisheye: --fov) [default: 3168;
-    /// equirect, vr180 and fisheye 4096].
+    /// Image width per eye in pixels (the full 360°; vr180: 180°; fisheye: --fov; cubemap: three
+    /// faces) [default: 3168; equirect, vr180 and fisheye 4096; cubemap 3072].
     #[arg(long)]
     pub width: Option<u32>,
-    /// Image height per eye in pixels [default: 600; equirect: width/2; vr180, fisheye: width].
+    /// Image height per eye in pixels [default: 600; equirect: width/2; vr180, fisheye: width;
+    /// cubemap: 2·width/3].
     #[arg(long)]
     pub height: Option<u32>,
     /// Size preset of the full sphere (implies --panorama equirect): vr4k (4096×4096 top-bottom:
@@ -305,7 +307,7 @@ impl ViewArgs {
     /// viewer of `camera[:N]` is placed with the scene, by `cli::scene::prepare`).
     pub fn settings(&self, methods: &[Method]) -> Result<RenderSettings> {
         let panorama = match (self.panorama, self.preset) {
-            (Some(PanoramaKind::Cylinder | PanoramaKind::Vr180 | PanoramaKind::Fisheye), Some(_)) => {
+            (Some(p), Some(_)) if p != PanoramaKind::Equirect => {
                 return Err(Error::option("--preset", "sizes the full sphere: use it with --panorama equirect"))
             }
             (Some(p), _) => p,
@@ -330,6 +332,11 @@ impl ViewArgs {
             (PanoramaKind::Vr180 | PanoramaKind::Fisheye, None) => {
                 let width = self.width.unwrap_or(4096);
                 (width, self.height.unwrap_or(width))
+            }
+            // Faces of 1024: the default sphere's resolution (4096 pixels a turn) at their centres.
+            (PanoramaKind::Cubemap, None) => {
+                let width = self.width.unwrap_or(3072);
+                (width, self.height.unwrap_or(2 * width / 3))
             }
         };
         if panorama != PanoramaKind::Fisheye {
@@ -500,8 +507,9 @@ pub struct RenderArgs {
     pub view: ViewArgs,
     /// Output layout: eyes (left.png, right.png), top-bottom (stereo_TB.png, left eye on top;
     /// the sphere's stereo_360_TB.png), side-by-side (stereo_LR.png, left eye on the left;
-    /// vr180's stereo_180_LR.png), twister (four W/2×H images, the cylinder)
-    /// [default: eyes; top-bottom for equirect; side-by-side for vr180].
+    /// vr180's stereo_180_LR.png), twister (four W/2×H images, the cylinder), 12x1 (the
+    /// cubemap's twelve faces in one strip, left eye's first: stereo_cubemap_12x1.png)
+    /// [default: eyes; top-bottom for equirect and cubemap; side-by-side for vr180].
     #[arg(long, value_enum)]
     pub layout: Option<Layout>,
     /// Image format: png or jpg (full-sphere images carry GPano XMP metadata in both).

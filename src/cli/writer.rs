@@ -57,6 +57,9 @@ impl FrameWriter {
                 ),
             ));
         }
+        if args.layout == Some(Layout::Strip12) && projection.panorama != PanoramaKind::Cubemap {
+            return Err(Error::option("--layout", "12x1 lays out a cubemap's faces: use it with --panorama cubemap"));
+        }
         Ok(FrameWriter {
             out: args.out.clone(),
             layout: args.layout.unwrap_or(Layout::default_for(projection.panorama)),

@@ -8,6 +8,7 @@ pub mod builtin;
 pub mod bvh;
 pub mod color;
 pub mod compare;
+pub mod cubemap;
 pub mod disk_cache;
 pub mod environment;
 pub mod environment_cache;

@@ -1,7 +1,8 @@
 //! The panoramas twister renders (`--panorama`): which image each is, its code in the WGSL
 //! projection uniform and the facts about its image the rest of the pipeline asks (the sphere's
 //! eye model or the cylinder's, the azimuth its width spans, the name players detect). The maps
-//! themselves are `core::projection` (the cylinder), `core::sphere`, `core::fisheye`.
+//! themselves are `core::projection` (the cylinder), `core::sphere`, `core::fisheye`,
+//! `core::cubemap`.
 
 /// The panoramas twister renders (`--panorama`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, clap::ValueEnum)]
@@ -19,22 +20,34 @@ pub enum PanoramaKind {
     /// The fulldome master: the sphere's eye rays drawn in an equidistant azimuthal (fisheye)
     /// image, W × W, the dome's axis at the centre (`core::fisheye`).
     Fisheye,
+    /// The stereo cubemap: the sphere's eye rays on the six 90° faces of a cube, one eye's
+    /// image the 3×2 grid of YouTube's layout (`core::cubemap`).
+    Cubemap,
 }
 
 impl PanoramaKind {
+    pub const ALL: [PanoramaKind; 5] = [
+        PanoramaKind::Cylinder,
+        PanoramaKind::Equirect,
+        PanoramaKind::Vr180,
+        PanoramaKind::Fisheye,
+        PanoramaKind::Cubemap,
+    ];
+
     pub fn name(self) -> &'static str {
         match self {
             PanoramaKind::Cylinder => "cylinder",
             PanoramaKind::Equirect => "equirect",
             PanoramaKind::Vr180 => "vr180",
             PanoramaKind::Fisheye => "fisheye",
+            PanoramaKind::Cubemap => "cubemap",
         }
     }
 
     /// Whether the panorama is (part of) the full sphere's equirectangular ODS: longitude u,
     /// latitude v, the eye model of `core::sphere`.
     pub const fn is_sphere(self) -> bool {
-        matches!(self, PanoramaKind::Equirect | PanoramaKind::Vr180 | PanoramaKind::Fisheye)
+        matches!(self, PanoramaKind::Equirect | PanoramaKind::Vr180 | PanoramaKind::Fisheye | PanoramaKind::Cubemap)
     }
 
     /// Whether the image is equirectangular (the sphere, VR180): what GPano and `sv3d`/`equi`
@@ -59,12 +72,13 @@ impl PanoramaKind {
             PanoramaKind::Equirect => Some("360"),
             PanoramaKind::Vr180 => Some("180"),
             PanoramaKind::Fisheye => Some("fisheye"),
+            PanoramaKind::Cubemap => Some("cubemap"),
         }
     }
 
     /// Whether the image's width is the whole turn (its left and right edges meet).
     pub const fn wraps(self) -> bool {
-        !matches!(self, PanoramaKind::Vr180 | PanoramaKind::Fisheye)
+        !matches!(self, PanoramaKind::Vr180 | PanoramaKind::Fisheye | PanoramaKind::Cubemap)
     }
 
     /// Its code in the WGSL projection uniform (`PANORAMA_CYLINDER`, `PANORAMA_EQUIRECT`).
@@ -74,13 +88,12 @@ impl PanoramaKind {
             PanoramaKind::Equirect => 1,
             PanoramaKind::Vr180 => 2,
             PanoramaKind::Fisheye => 3,
+            PanoramaKind::Cubemap => 4,
         }
     }
 
     /// The panorama of a code; None for a code no panorama has.
     pub fn from_code(code: u32) -> Option<PanoramaKind> {
-        [PanoramaKind::Cylinder, PanoramaKind::Equirect, PanoramaKind::Vr180, PanoramaKind::Fisheye]
-            .into_iter()
-            .find(|p| p.code() == code)
+        PanoramaKind::ALL.into_iter().find(|p| p.code() == code)
     }
 }

@@ -218,6 +218,7 @@ impl Projection {
         }
         self.validate_head()?;
         self.validate_fisheye()?;
+        self.validate_cubemap()?;
         if self.width < 2 || self.height < 2 || self.width > MAX_IMAGE_SIDE || self.height > MAX_IMAGE_SIDE {
             return Err(Error::setting(
                 "view.projection.width/height",
@@ -290,16 +291,18 @@ impl Projection {
     pub fn pixels_per_v(&self) -> f32 {
         match self.panorama {
             PanoramaKind::Fisheye => self.fisheye_pixels_per_radian(),
+            // A face's centre: F/2 pixels per radian (its least).
+            PanoramaKind::Cubemap => 0.5 * self.cube_face_px(),
             p if p.is_sphere() => self.height as f32 / std::f32::consts::PI,
             _ => self.pixels_per_metre(),
         }
     }
 
     /// Pixels per full turn of azimuth (2π): the width, or twice it for VR180 (whose width
-    /// spans π); the fisheye, whose image has no seam, f32::MAX (x never wraps). `turn_px` in
-    /// projection.wgsl.
+    /// spans π); the fisheye and the cubemap, whose images have no seam, f32::MAX (x never
+    /// wraps). `turn_px` in projection.wgsl.
     pub fn turn_px(&self) -> f32 {
-        if self.panorama == PanoramaKind::Fisheye {
+        if matches!(self.panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap) {
             return f32::MAX;
         }
         self.width as f32 / self.panorama.turn_share()
@@ -317,6 +320,9 @@ impl Projection {
         if self.panorama == PanoramaKind::Fisheye {
             return self.fisheye_pixel(u, v);
         }
+        if self.panorama == PanoramaKind::Cubemap {
+            return self.cube_pixel(u, v);
+        }
         let x = wrap_angle(u) / std::f32::consts::TAU * self.turn_px() + 0.5 * self.width as f32;
         let y = 0.5 * self.height as f32 - v * self.pixels_per_v();
         [x, y]
@@ -327,6 +333,10 @@ impl Projection {
     pub fn pixel_to_screen(&self, column: f32, row: f32) -> (f32, f32) {
         if self.panorama == PanoramaKind::Fisheye {
             return self.fisheye_direction_at(column + 0.5, row + 0.5);
+        }
+        if self.panorama == PanoramaKind::Cubemap {
+            let d = self.cube_direction_at(column + 0.5, row + 0.5);
+            return (d.x.atan2(-d.z), d.y.atan2((d.x * d.x + d.z * d.z).sqrt()));
         }
         let u = (column + 0.5 - 0.5 * self.width as f32) / self.turn_px() * std::f32::consts::TAU;
         let v = (0.5 * self.height as f32 - (row + 0.5)) / self.pixels_per_v();
@@ -365,8 +375,8 @@ impl Projection {
     /// vertical models; on the sphere the latitude atan2(y, √(r² − e²)) ≥ atan(y/r), so
     /// k = 1/tan(π/2H) is safe for every eye offset.
     pub fn vertical_limit(&self) -> f32 {
-        if self.panorama == PanoramaKind::Fisheye {
-            return f32::MAX; // the dome shows every altitude its field of view reaches
+        if matches!(self.panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap) {
+            return f32::MAX; // the dome shows every altitude its field of view reaches; the cube all
         }
         if self.panorama.is_sphere() {
             return 1.0 / (0.5 * std::f32::consts::PI / self.height as f32).tan();
@@ -388,9 +398,9 @@ impl Projection {
 
     /// The horizontal distance in pixels between two image x coordinates, wrapping around the
     /// full turn (VR180: a turn is twice the width, so no two pixels of its image wrap; the
-    /// fisheye: no wrap).
+    /// fisheye and the cubemap: no wrap).
     pub fn wrapped_dx(&self, a: f32, b: f32) -> f32 {
-        if self.panorama == PanoramaKind::Fisheye {
+        if matches!(self.panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap) {
             return (a - b).abs();
         }
         let w = self.turn_px();

@@ -475,10 +475,14 @@ impl RenderSettings {
                     format!("slit:{w} pastes the slits of eyes on the circle about the display's centre; a tracked head has fixed eyes: use trace as the reference"),
                 ));
             }
-            if self.view.projection.panorama == PanoramaKind::Fisheye {
+            let panorama = self.view.projection.panorama;
+            if matches!(panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap) {
                 return Err(Error::setting(
                     "subdivision.method",
-                    format!("slit:{w} pastes the cylinder's, the sphere's and VR180's slits; the fisheye has none yet: use trace as the reference"),
+                    format!(
+                        "slit:{w} pastes the cylinder's, the sphere's and VR180's slits; the {} has none yet: use trace as the reference",
+                        panorama.name()
+                    ),
                 ));
             }
             if w > self.view.projection.width {

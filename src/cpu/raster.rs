@@ -31,6 +31,9 @@ pub fn raster_vertex(params: &RasterParams, v: &DrawVertex) -> Vec4 {
     let eye = if params.eye_sign > 0.0 { Eye::Right } else { Eye::Left };
     let q = projection.project_with_azimuth(p, theta, eye);
     let depth = (q.depth / (q.depth + 1.0)).min(crate::encoding::constants::MAX_DEPTH);
+    if projection.panorama == PanoramaKind::Cubemap {
+        return projection.cube_clip(crate::core::cubemap::direction(q.u, q.v), depth, params.projection.face as usize);
+    }
     if projection.panorama == PanoramaKind::Fisheye {
         let [x, y] = projection.fisheye_pixel(q.u, q.v);
         let (w, h) = (projection.width as f32, projection.height as f32);
@@ -175,23 +178,48 @@ pub fn fragment(
 /// Rasterizes one triangle into `img`, within the scissor rectangle [columns start, end, rows
 /// start, end).
 pub fn rasterize(img: &mut RasterImage, tri: [ClipVertex; 3], scissor: [u32; 4], fragment: &FragmentFn) {
-    for t in near_clipped(tri) {
+    rasterize_within(img, tri, &[NEAR_PLANE], scissor, fragment);
+}
+
+/// Rasterizes one triangle into `img` clipped against `planes` (clip space, `plane · clip ≥ 0`
+/// inside), within the scissor rectangle.
+pub fn rasterize_within(
+    img: &mut RasterImage,
+    tri: [ClipVertex; 3],
+    planes: &[Vec4],
+    scissor: [u32; 4],
+    fragment: &FragmentFn,
+) {
+    for t in clipped(tri, planes) {
         rasterize_clipped(img, t, scissor, fragment);
     }
 }
 
-/// A triangle clipped against the near plane z ≥ 0 in clip space: none, one or two triangles
-/// (w = 1 triangles never need it).
+/// The near plane z ≥ 0 (w = 1 triangles never cross it).
+pub(crate) const NEAR_PLANE: Vec4 = Vec4::new(0.0, 0.0, 1.0, 0.0);
+
+/// A triangle clipped against the near plane z ≥ 0 in clip space: none, one or two triangles.
 pub(crate) fn near_clipped(tri: [ClipVertex; 3]) -> Vec<[ClipVertex; 3]> {
-    let mut poly: Vec<ClipVertex> = Vec::with_capacity(4);
-    for i in 0..3 {
-        let (a, b) = (&tri[i], &tri[(i + 1) % 3]);
-        if a.clip.z >= 0.0 {
-            poly.push(*a);
+    clipped(tri, &[NEAR_PLANE])
+}
+
+/// A triangle clipped against planes in clip space (`plane · clip ≥ 0` inside), as a fan of
+/// triangles.
+pub(crate) fn clipped(tri: [ClipVertex; 3], planes: &[Vec4]) -> Vec<[ClipVertex; 3]> {
+    let mut poly: Vec<ClipVertex> = tri.to_vec();
+    for plane in planes {
+        let mut next = Vec::with_capacity(poly.len() + 1);
+        for i in 0..poly.len() {
+            let (a, b) = (&poly[i], &poly[(i + 1) % poly.len()]);
+            let (da, db) = (plane.dot(a.clip), plane.dot(b.clip));
+            if da >= 0.0 {
+                next.push(*a);
+            }
+            if (da >= 0.0) != (db >= 0.0) {
+                next.push(ClipVertex::lerp(a, b, da / (da - db)));
+            }
         }
-        if (a.clip.z >= 0.0) != (b.clip.z >= 0.0) {
-            poly.push(ClipVertex::lerp(a, b, a.clip.z / (a.clip.z - b.clip.z)));
-        }
+        poly = next;
     }
     (1..poly.len().saturating_sub(1)).map(|i| [poly[0], poly[i], poly[i + 1]]).collect()
 }
@@ -328,12 +356,25 @@ pub fn raster(
             fill_background(img, table, &projection, eye);
         }
     }
-    for tri in vertices.chunks_exact(3) {
-        for ((eye_params, eye), img) in params.iter().zip(Eye::BOTH).zip(images.iter_mut()) {
-            let cv = clip_vertices(eye_params, tri);
-            let fragment =
-                |f: &FragmentIn| fragment(table, eye_params.ambient, &projection, eye, eye_params.error_angle != 0, f);
-            rasterize(img, cv, [0, projection.width, 0, projection.height], &fragment);
+    // One draw, or the cubemap's six, each face's clipped to its square (the GPU's scissor).
+    let draws: Vec<(Option<usize>, Vec<Vec4>)> = if projection.panorama == PanoramaKind::Cubemap {
+        (0..6).map(|f| (Some(f), [&[NEAR_PLANE][..], &projection.cube_face_planes(f)].concat())).collect()
+    } else {
+        vec![(None, vec![NEAR_PLANE])]
+    };
+    for (face, planes) in &draws {
+        let params = params.map(|p| RasterParams {
+            projection: crate::encoding::types::ProjectionUniform { face: face.unwrap_or(0) as u32, ..p.projection },
+            ..p
+        });
+        for tri in vertices.chunks_exact(3) {
+            for ((eye_params, eye), img) in params.iter().zip(Eye::BOTH).zip(images.iter_mut()) {
+                let cv = clip_vertices(eye_params, tri);
+                let fragment = |f: &FragmentIn| {
+                    fragment(table, eye_params.ambient, &projection, eye, eye_params.error_angle != 0, f)
+                };
+                rasterize_within(img, cv, planes, [0, projection.width, 0, projection.height], &fragment);
+            }
         }
     }
     images

@@ -11,11 +11,14 @@ use crate::encoding::types::{DrawVertex, SubdivideCounters, SubdivideParams};
 /// ranges are left for the caller, 0).
 pub fn subdivide_params(settings: &RenderSettings, first_triangle: u32, triangle_count: u32) -> SubdivideParams {
     let projection = settings.projection();
+    // The image the subdivision measures edges on (the cubemap: the sphere at its faces'
+    // resolution; `Projection::measured`).
+    let measured = projection.measured();
     let sub = &settings.subdivision;
     let (rule, fixed_n) = sub.method.split_rule();
     SubdivideParams {
         view: settings.view().to_cols_array_2d(),
-        projection: projection.into(),
+        projection: (&measured).into(),
         axis_clearance: axis_clearance(projection),
         triangle_count,
         first_triangle,

@@ -60,7 +60,9 @@ pub struct ProjectionUniform {
     pub head_on: f32,
     pub head_turn: f32,
     pub head_offset: [f32; 3],
-    pub _pad0: f32,
+    /// The cubemap: the face a draw projects into (`core::cubemap::CUBE_FACES`); set per face
+    /// draw by the raster stage, 0 elsewhere.
+    pub face: u32,
 }
 
 impl From<&ProjectionUniform> for Projection {
@@ -102,7 +104,7 @@ impl From<&Projection> for ProjectionUniform {
             head_on: p.head.is_some() as u32 as f32,
             head_turn: p.head.map_or(0.0, |h| h.turn),
             head_offset: p.head.map_or([0.0; 3], |h| h.offset),
-            _pad0: 0.0,
+            face: 0,
         }
     }
 }
@@ -464,7 +466,7 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("DrawVertex" => DrawVertex { position, theta_ref, normal, material, color, uv, object, tangent }),
     layout!("Projection" => ProjectionUniform {
         screen_radius, eye_radius, width, height, acos_eye_screen, vertical_exact, pixels_per_v, panorama,
-        convergence, pole_from, pole_to, turn_px, fov, dome_tilt, head_on, head_turn, head_offset, _pad0
+        convergence, pole_from, pole_to, turn_px, fov, dome_tilt, head_on, head_turn, head_offset, face
     }),
     layout!("SubdivideParams" => SubdivideParams {
         view, projection, axis_clearance, triangle_count, first_triangle, method, fixed_n, edge_px, max_div,

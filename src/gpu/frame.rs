@@ -22,7 +22,8 @@ pub(crate) struct FrameResources {
     pub targets: Option<Targets>,
     pub timestamps: Option<Timestamps>,
     pub subdivide_params: wgpu::Buffer,
-    /// Both eyes' (left, right), as the raster stage's `array<RasterParams, 2>`.
+    /// Both eyes' (left, right), as the raster stage's `array<RasterParams, 2>`; the cubemap's
+    /// six face draws each at its own offset ([`raster_params_stride`]).
     pub raster_params: wgpu::Buffer,
     pub slit_params: [wgpu::Buffer; 2],
     /// Counters and timestamps of a one-submission frame.
@@ -32,6 +33,13 @@ pub(crate) struct FrameResources {
     /// error, object and distance buffers), and its counters of rays and triangle tests.
     pub trace_outputs: Option<(u32, u32, [wgpu::Buffer; 4])>,
     pub trace_counts: Option<wgpu::Buffer>,
+}
+
+/// The distance between the raster parameters of the cubemap's face draws in their buffer: a
+/// `[RasterParams; 2]` rounded up to the adapter's uniform offset alignment.
+pub(crate) fn raster_params_stride(gpu: &Gpu) -> u64 {
+    let size = std::mem::size_of::<[crate::encoding::types::RasterParams; 2]>() as u64;
+    size.next_multiple_of(gpu.limits.min_uniform_buffer_offset_alignment.max(1) as u64)
 }
 
 impl FrameResources {

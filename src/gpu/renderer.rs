@@ -16,7 +16,7 @@ use crate::core::scene::Scene;
 use crate::core::settings::{Method as MethodName, RenderSettings};
 use crate::encoding::schedule::Schedule;
 use crate::encoding::subdivide::SubdivideOutput;
-use crate::encoding::types::{RasterParams, SlitParams, SubdivideParams, TraceParams};
+use crate::encoding::types::{SlitParams, SubdivideParams, TraceParams};
 use crate::error::{Error, Result};
 use crate::gpu::device::Gpu;
 use crate::gpu::frame::{FrameEnd, FrameResources, Method, STAGING_SIZE};
@@ -54,7 +54,12 @@ impl Renderer {
                 targets: None,
                 timestamps: Timestamps::new(&gpu),
                 subdivide_params: gpu.uniform_buffer::<SubdivideParams>("subdivide params"),
-                raster_params: gpu.uniform_buffer::<[RasterParams; 2]>("raster params"),
+                raster_params: gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("raster params"),
+                    size: crate::gpu::frame::raster_params_stride(&gpu) * crate::core::cubemap::CUBE_FACES.len() as u64,
+                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                }),
                 slit_params: Eye::BOTH.map(|e| gpu.uniform_buffer::<SlitParams>(&format!("{} slit params", e.name()))),
                 staging: gpu.device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("frame readback"),

@@ -13,7 +13,7 @@ use crate::encoding::params::raster_params;
 use crate::encoding::recording::Recording;
 use crate::encoding::schedule::{run_chunked, Capacities, FramePlan, SubdivisionEngine};
 use crate::encoding::subdivide::{dispatched, one_submission, subdivide_params, Passes};
-use crate::encoding::types::{SubdivideCounters, SubdivideParams};
+use crate::encoding::types::{ProjectionUniform, RasterParams, SubdivideCounters, SubdivideParams};
 use crate::error::Result;
 use crate::gpu::device::Gpu;
 use crate::gpu::draw::{DrawPipelines, DrawStage};
@@ -191,9 +191,8 @@ impl SubdividedMethod {
         timestamps: Option<(&wgpu::QuerySet, u32, u32)>,
     ) {
         let materials = self.raster.material_bind_group(gpu, scene);
-        let uniform = &res.raster_params;
-        gpu.queue.write_buffer(uniform, 0, bytemuck::cast_slice(&raster_params(settings)));
-        let bind_group = self.raster.stage.bind_group(gpu, None, 0, &[uniform]);
+        // One draw, or the cubemap's six: each face's parameters, and its square as the scissor.
+        let draws = face_draws(gpu, &self.raster.stage, &res.raster_params, settings);
         // Every output at the pixels' centres, then (or only) the multisampled colour.
         let passes: Vec<(Samples, Layers)> = Samples::passes(settings)
             .into_iter()
@@ -203,7 +202,7 @@ impl SubdividedMethod {
             let pipeline = self.raster.get(gpu, scene, settings, layers, samples);
             let writes = stamp::first_and_last(timestamps, k, passes.len());
             let mut pass = targets.begin_samples_pass(enc, samples, layers, settings, clear, writes);
-            pass.set_bind_group(0, &bind_group, &[]);
+            pass.set_bind_group(0, &draws[0].0, &[]);
             pass.set_bind_group(1, &materials, &[]);
             if clear && scene.shows_environment(settings) {
                 pass.set_pipeline(&self.raster.background(gpu, settings, layers, samples));
@@ -212,7 +211,13 @@ impl SubdividedMethod {
             pass.set_pipeline(&pipeline);
             pass.set_vertex_buffer(0, buffers.nodes.slice(..));
             pass.set_index_buffer(buffers.indices.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed_indirect(&buffers.draw_args, 0);
+            for (bind_group, scissor) in &draws {
+                pass.set_bind_group(0, bind_group, &[]);
+                if let Some([x, y, side]) = *scissor {
+                    pass.set_scissor_rect(x, y, side, side);
+                }
+                pass.draw_indexed_indirect(&buffers.draw_args, 0);
+            }
         }
         targets.copy_resolved(enc);
     }
@@ -247,6 +252,41 @@ impl SubdividedMethod {
         stats.ms_raster = Some(engine.clock.raster);
         Ok(())
     }
+}
+
+/// The raster stage's draws of a frame: its parameters' bind group, and for the cubemap one draw
+/// per face, each projecting into its face (`face` in the projection uniform) and kept to the
+/// face's square by the scissor (`core::cubemap`: w = D·n clips what lies behind the face).
+fn face_draws(
+    gpu: &Gpu,
+    stage: &crate::gpu::stages::GpuStage,
+    uniform: &wgpu::Buffer,
+    settings: &RenderSettings,
+) -> Vec<(wgpu::BindGroup, Option<[u32; 3]>)> {
+    let params = raster_params(settings);
+    let size = std::mem::size_of_val(&params) as u64;
+    let stride = crate::gpu::frame::raster_params_stride(gpu);
+    let projection = settings.projection();
+    let faces: Vec<Option<u32>> = if projection.panorama == crate::core::projection::PanoramaKind::Cubemap {
+        (0..crate::core::cubemap::CUBE_FACES.len() as u32).map(Some).collect()
+    } else {
+        vec![None]
+    };
+    faces
+        .into_iter()
+        .enumerate()
+        .map(|(k, face)| {
+            let offset = k as u64 * stride;
+            let face_params = params.map(|p| RasterParams {
+                projection: ProjectionUniform { face: face.unwrap_or(0), ..p.projection },
+                ..p
+            });
+            gpu.queue.write_buffer(uniform, offset, bytemuck::cast_slice(&face_params));
+            let binding = wgpu::BufferBinding { buffer: uniform, offset, size: wgpu::BufferSize::new(size) };
+            let bind_group = stage.bind_group_ranges(gpu, None, 0, &[binding]);
+            (bind_group, face.map(|f| projection.cube_face_rect(f as usize)))
+        })
+        .collect()
 }
 
 /// The chunked frame's engine: submits each recording, draws each range's output into the

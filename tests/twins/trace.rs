@@ -119,6 +119,10 @@ impl Twin for Trace {
                 (builtin::demo(), RenderSettings::new(Projection::vr180(96)).with_method(Method::Trace)),
             ),
             (
+                "demo on the cubemap".into(),
+                (builtin::demo(), RenderSettings::new(Projection::cubemap(96)).with_method(Method::Trace)),
+            ),
+            (
                 "demo with a mirror and a glass object".into(),
                 (optics_demo(), RenderSettings::new(cylinder).with_method(Method::Trace)),
             ),

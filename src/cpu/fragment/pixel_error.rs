@@ -14,6 +14,9 @@ pub fn pixel_spread(projection: &Projection, frag_xy: Vec2) -> f32 {
     if projection.panorama == PanoramaKind::Fisheye {
         return 1.0 / projection.fisheye_pixels_per_radian();
     }
+    if projection.panorama == PanoramaKind::Cubemap {
+        return 1.0 / projection.pixels_per_v(); // a face's centre, where its pixels span the most
+    }
     let (_, v) = projection.pixel_to_screen(frag_xy.x - 0.5, frag_xy.y - 0.5);
     let across = std::f32::consts::TAU / projection.turn_px();
     if projection.panorama.is_sphere() {
@@ -35,6 +38,14 @@ pub fn pixel_error(projection: &Projection, eye: Eye, p: Vec3, frag_xy: Vec2, an
             let (u, v) = projection.pixel_to_screen(frag_xy.x - 0.5, frag_xy.y - 0.5);
             let b = projection.screen_direction(u, v);
             a.cross(b).length().atan2(a.dot(b)).to_degrees() * 60.0
+        }
+        Some(q) if projection.panorama == PanoramaKind::Cubemap => {
+            // On the pixel's own face (a point drawn across a face's edge belongs beyond it there).
+            let face = projection.cube_face_at(frag_xy.x, frag_xy.y);
+            match projection.cube_pixel_on_face(crate::core::cubemap::direction(q.u, q.v), face) {
+                Some([x, y]) => Vec2::new(x - frag_xy.x, y - frag_xy.y).length(),
+                None => 1e9,
+            }
         }
         Some(q) => {
             let [x, y] = projection.to_pixel(q.u, q.v);

@@ -1,0 +1,318 @@
+//! The stereo cubemap (`--panorama cubemap`): the full sphere's eye rays (`core::sphere`, the
+//! same ODS eye model: a point is first projected to the longitude λ and latitude φ of the eye
+//! ray that reaches it, from that eye's point on the eye circle) drawn on the six faces of a cube,
+//! each face a 90° gnomonic image of those rays' directions:
+//!
+//! ```text
+//!   D = (cos φ sin λ, sin φ, −cos φ cos λ)      the ray's direction
+//!   face f: normal n, right r, up u             (the table below)
+//!   x = col·F + (1 + D·r / D·n)·F/2             F = W/3, the face's side in pixels
+//!   y = row·F + (1 − D·u / D·n)·F/2
+//! ```
+//!
+//! One eye's image is the 3×2 grid of YouTube's cubemap layout (Spherical Video V2, `cbmp`
+//! layout 0): right, left, up in the top row, down, front, back in the bottom row; the right,
+//! left, front and back faces upright, the up face's top towards the front (−z), the down face's
+//! top towards the back (+z). Each face is the image a camera at the centre looking along its
+//! normal would take, not mirrored: r = n × u.
+//!
+//! Exact ODS: every pixel shows the ray of its own direction from its eye's point, so the edges
+//! of the scene are curved on a face wherever the eyes' offset matters (near things), and the
+//! adaptive subdivision splits them; what a triangle covers beyond a face's edge is drawn on the
+//! neighbouring face (the raster stage draws the subdivided triangles once per face, clipped to
+//! it). The subdivision measures edges on the sphere at the faces' resolution
+//! ([`Projection::measured`]).
+//!
+//! The WGSL twin is `shaders/shared/projection_cubemap.wgsl`.
+
+use glam::{Vec3, Vec4};
+
+use crate::core::projection::{PanoramaKind, Projection};
+use crate::error::{Error, Result};
+
+/// One face of the cube: its name, where it sits in an eye's 3×2 grid, and its camera's axes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CubeFace {
+    pub name: &'static str,
+    /// Column and row in the grid.
+    pub cell: [u32; 2],
+    /// The direction its centre shows, its image's right and its image's up.
+    pub normal: Vec3,
+    pub right: Vec3,
+    pub up: Vec3,
+}
+
+const fn face(name: &'static str, cell: [u32; 2], normal: Vec3, right: Vec3, up: Vec3) -> CubeFace {
+    CubeFace { name, cell, normal, right, up }
+}
+
+/// The six faces in the grid's order (row by row): right, left, up / down, front, back.
+pub const CUBE_FACES: [CubeFace; 6] = [
+    face("right", [0, 0], Vec3::X, Vec3::Z, Vec3::Y),
+    face("left", [1, 0], Vec3::NEG_X, Vec3::NEG_Z, Vec3::Y),
+    face("up", [2, 0], Vec3::Y, Vec3::NEG_X, Vec3::NEG_Z),
+    face("down", [0, 1], Vec3::NEG_Y, Vec3::NEG_X, Vec3::Z),
+    face("front", [1, 1], Vec3::NEG_Z, Vec3::X, Vec3::Y),
+    face("back", [2, 1], Vec3::Z, Vec3::NEG_X, Vec3::Y),
+];
+
+/// The unit direction of longitude `lon`, latitude `lat`.
+pub fn direction(lon: f32, lat: f32) -> Vec3 {
+    Vec3::new(lat.cos() * lon.sin(), lat.sin(), -lat.cos() * lon.cos())
+}
+
+/// The face a direction falls on: the one whose normal it is closest to (ties to the earlier
+/// face). `cube_face_of` in projection_cubemap.wgsl.
+pub fn cube_face_of(d: Vec3) -> usize {
+    let a = d.abs();
+    if a.x >= a.y && a.x >= a.z {
+        if d.x >= 0.0 {
+            0
+        } else {
+            1
+        }
+    } else if a.y >= a.z {
+        if d.y >= 0.0 {
+            2
+        } else {
+            3
+        }
+    } else if d.z < 0.0 {
+        4
+    } else {
+        5
+    }
+}
+
+impl Projection {
+    /// The stereo cubemap: one eye's 3×2 grid of faces `width`/3 pixels square, parallel rays,
+    /// Blender's pole merge.
+    pub fn cubemap(width: u32) -> Projection {
+        Projection { panorama: PanoramaKind::Cubemap, width, height: 2 * width / 3, ..Projection::default() }
+    }
+
+    /// The cubemap's grid: a width of three faces and a height of two.
+    pub(crate) fn validate_cubemap(&self) -> Result<()> {
+        if self.panorama == PanoramaKind::Cubemap && (self.width % 3 != 0 || 3 * self.height != 2 * self.width) {
+            return Err(Error::setting(
+                "view.projection.width/height",
+                format!(
+                    "a cubemap is a 3x2 grid of square faces: the width a multiple of 3 and the height 2/3 of it \
+                     (e.g. 1536x1024), got {}x{}",
+                    self.width, self.height
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// F: a face's side in pixels, W / 3.
+    pub fn cube_face_px(&self) -> f32 {
+        self.width as f32 / 3.0
+    }
+
+    /// The image position of direction `d` on face `f`, beyond the face's edges where `d` lies
+    /// outside it; None where `d` points away from the face (D·n ≤ 0).
+    pub fn cube_pixel_on_face(&self, d: Vec3, f: usize) -> Option<[f32; 2]> {
+        let face = &CUBE_FACES[f];
+        let w = d.dot(face.normal);
+        if w <= 0.0 {
+            return None;
+        }
+        let s = self.cube_face_px();
+        let [col, row] = face.cell.map(|c| c as f32);
+        Some([s * (col + 0.5 * (1.0 + d.dot(face.right) / w)), s * (row + 0.5 * (1.0 - d.dot(face.up) / w))])
+    }
+
+    /// The image position (x right, y down, pixel centres at +0.5) of the ray of longitude
+    /// `lon`, latitude `lat`: on the face it falls on.
+    pub fn cube_pixel(&self, lon: f32, lat: f32) -> [f32; 2] {
+        let d = direction(lon, lat);
+        self.cube_pixel_on_face(d, cube_face_of(d)).unwrap_or([f32::NAN; 2])
+    }
+
+    /// The face whose square holds image position (x, y) (the nearest face for a position
+    /// outside the grid).
+    pub fn cube_face_at(&self, x: f32, y: f32) -> usize {
+        let s = self.cube_face_px();
+        let col = (x / s).floor().clamp(0.0, 2.0) as usize;
+        let row = (y / s).floor().clamp(0.0, 1.0) as usize;
+        3 * row + col
+    }
+
+    /// The unit direction the cubemap shows at image position (x, y) (beyond a face's edge, the
+    /// same face's plane goes on).
+    pub fn cube_direction_at(&self, x: f32, y: f32) -> Vec3 {
+        let face = &CUBE_FACES[self.cube_face_at(x, y)];
+        let s = self.cube_face_px();
+        let [col, row] = face.cell.map(|c| c as f32);
+        let a = 2.0 * (x / s - col) - 1.0;
+        let b = 1.0 - 2.0 * (y / s - row);
+        (face.normal + a * face.right + b * face.up).normalize()
+    }
+
+    /// The clip-space position on the whole grid of direction `d` (any length) at depth `z`
+    /// (0..1) for the draw of face `f`: w = D·n, so that the rasterizer's perspective divide is
+    /// the face's gnomonic map and its clipping keeps what lies in front of the face; the draw's
+    /// scissor (the face's square) keeps the face. Linear in D: the great circle between two
+    /// directions is the straight line between their images on every face.
+    pub fn cube_clip(&self, d: Vec3, z: f32, f: usize) -> Vec4 {
+        let face = &CUBE_FACES[f];
+        let w = d.dot(face.normal);
+        let [col, row] = face.cell.map(|c| c as f32);
+        // Pixel x = F·(col + (1 + X/w)/2) over a width of 3F; pixel y = F·(row + (1 − Y/w)/2)
+        // over a height of 2F; NDC x = 2x/W − 1, NDC y = 1 − 2y/H.
+        Vec4::new(
+            ((2.0 * col + 1.0) / 3.0 - 1.0) * w + d.dot(face.right) / 3.0,
+            (0.5 - row) * w + 0.5 * d.dot(face.up),
+            z * w,
+            w,
+        )
+    }
+
+    /// The planes (in clip space, `plane · clip ≥ 0` inside) of face `f`'s square on the grid:
+    /// what the GPU's scissor keeps of a draw of that face, for the CPU twin's clipping.
+    pub fn cube_face_planes(&self, f: usize) -> [Vec4; 4] {
+        let [col, row] = CUBE_FACES[f].cell.map(|c| c as f32);
+        let (x0, x1) = (2.0 * col / 3.0 - 1.0, 2.0 * (col + 1.0) / 3.0 - 1.0);
+        let (y0, y1) = (-row, 1.0 - row);
+        [
+            Vec4::new(1.0, 0.0, 0.0, -x0),
+            Vec4::new(-1.0, 0.0, 0.0, x1),
+            Vec4::new(0.0, 1.0, 0.0, -y0),
+            Vec4::new(0.0, -1.0, 0.0, y1),
+        ]
+    }
+
+    /// Face `f`'s square on the grid: [x, y, side] in pixels (the draw's scissor).
+    pub fn cube_face_rect(&self, f: usize) -> [u32; 3] {
+        let s = self.width / 3;
+        let [col, row] = CUBE_FACES[f].cell;
+        [col * s, row * s, s]
+    }
+
+    /// The equirectangular image the subdivision measures a cubemap's edges on: the sphere with
+    /// the faces' angular resolution at their centres (a turn of 4F pixels), the same eye model.
+    /// A face magnifies its edges up to twice that (sec²45° at the middle of its sides), where
+    /// `--edge-px` is then met within a factor of two; the other panoramas measure themselves.
+    pub fn measured(&self) -> Projection {
+        if self.panorama != PanoramaKind::Cubemap {
+            return *self;
+        }
+        let f = self.width / 3;
+        Projection { panorama: PanoramaKind::Equirect, width: 4 * f, height: 2 * f, ..*self }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::core::projection::{Eye, Panorama};
+    use rand::{Rng, SeedableRng};
+
+    /// A face pixel's direction from the layout's definition (Spherical Video V2's `cbmp` layout
+    /// 0, written out here without the face table): the centre of each cell, its right and up.
+    fn layout_direction(cell: [u32; 2], a: f64, b: f64) -> [f64; 3] {
+        // (centre, image right, image up) per cell, from the layout's words.
+        let (n, r, u): ([f64; 3], [f64; 3], [f64; 3]) = match cell {
+            [0, 0] => ([1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]), // right: its right is behind
+            [1, 0] => ([-1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]), // left: its right ahead
+            [2, 0] => ([0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, -1.0]), // up: its top forwards
+            [0, 1] => ([0.0, -1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]), // down: its top back
+            [1, 1] => ([0.0, 0.0, -1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]), // front
+            _ => ([0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]),     // back
+        };
+        let d: Vec<f64> = (0..3).map(|i| n[i] + a * r[i] + b * u[i]).collect();
+        let l = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        [d[0] / l, d[1] / l, d[2] / l]
+    }
+
+    /// The forward map against each pixel's ray built from the layout's definition: the pixel
+    /// `project_pixel` gives a point has the ray (that direction, from the eye point the sphere's
+    /// model gives it) that passes through the point, within 10⁻³ px; and the inverse.
+    #[test]
+    fn the_cubemap_draws_each_point_where_its_pixels_ray_meets_it() {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(34);
+        let proj = Projection::cubemap(3 * 512);
+        proj.validate().unwrap();
+        let s = proj.cube_face_px() as f64;
+        let mut faces = [0; 6];
+        for _ in 0..3000 {
+            let (a, b): (f32, f32) =
+                (rng.random_range(-1.0..1.0), rng.random_range(-std::f32::consts::PI..std::f32::consts::PI));
+            let dist = 10f32.powf(rng.random_range(-0.5..1.5));
+            let h = (1.0 - a * a).sqrt();
+            let p = dist * Vec3::new(h * b.sin(), a, -h * b.cos());
+            for eye in Eye::BOTH {
+                let Some(([x, y], depth)) = proj.project_pixel(p, eye) else { continue };
+                assert!((0.0..=proj.width as f32).contains(&x) && (0.0..=proj.height as f32).contains(&y));
+                let cell = [(x as f64 / s).floor().min(2.0) as u32, (y as f64 / s).floor().min(1.0) as u32];
+                faces[(3 * cell[1] + cell[0]) as usize] += 1;
+                let (fa, fb) =
+                    (2.0 * (x as f64 / s - cell[0] as f64) - 1.0, 1.0 - 2.0 * (y as f64 / s - cell[1] as f64));
+                let d = layout_direction(cell, fa, fb);
+                let d = Vec3::new(d[0] as f32, d[1] as f32, d[2] as f32);
+                let (lon, lat) = (d.x.atan2(-d.z), d.y.atan2((d.x * d.x + d.z * d.z).sqrt()));
+                let (origin, dir) = proj.sphere_ray(lon, lat, eye);
+                let to_p = p - origin;
+                let miss = (to_p - to_p.dot(dir) * dir).length();
+                // A thousandth of a pixel at this distance (a pixel spans at most 2/F radians).
+                let px = to_p.length() * 2.0 / s as f32;
+                assert!(miss < 1e-3 * px + 1e-6, "{eye:?} {p}: misses by {} px", miss / px);
+                assert!((depth - to_p.length()).abs() < 1e-4 * depth);
+                let back = proj.unproject_pixel([x, y], depth, eye);
+                assert!((back - p).length() < 1e-3 * dist, "{p} → ({x}, {y}) → {back}");
+            }
+        }
+        assert!(faces.iter().all(|&n| n > 300), "every face compared: {faces:?}");
+    }
+
+    /// The clip positions of the face draws are the face's map after the divide, and points
+    /// beyond a face's edge continue its plane (so the scissor cuts a triangle at the edge where
+    /// the neighbour's draw starts it).
+    #[test]
+    fn the_face_draws_divide_to_the_faces_map_and_meet_at_the_edges() {
+        let proj = Projection::cubemap(300);
+        let (w, h) = (proj.width as f32, proj.height as f32);
+        let mut rng = rand::rngs::StdRng::seed_from_u64(5);
+        for _ in 0..500 {
+            let d = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+            for f in 0..6 {
+                let c = proj.cube_clip(d, 0.5, f);
+                match proj.cube_pixel_on_face(d, f) {
+                    Some([x, y]) => {
+                        let got = [(c.x / c.w + 1.0) * 0.5 * w, (1.0 - c.y / c.w) * 0.5 * h];
+                        // Relative to the distance from the face's centre (f32 near D·n = 0).
+                        let tol = 1e-5 * (1.0 + x.abs() + y.abs());
+                        assert!((got[0] - x).abs() < tol && (got[1] - y).abs() < tol, "{d} face {f}");
+                        let inside = proj.cube_face_planes(f).iter().all(|p| p.dot(c) >= 0.0);
+                        let [x0, y0, s] = proj.cube_face_rect(f).map(|v| v as f32);
+                        let in_rect = (x0..=x0 + s).contains(&x) && (y0..=y0 + s).contains(&y);
+                        assert_eq!(inside, in_rect, "{d} face {f}: ({x}, {y})");
+                        if in_rect && cube_face_of(d) == f {
+                            assert_eq!(proj.cube_face_at(x, y), f);
+                            assert!((proj.cube_direction_at(x, y) - d.normalize()).length() < 1e-5);
+                        }
+                    }
+                    None => assert!(c.w <= 0.0),
+                }
+            }
+        }
+        // The middle of the front face's top edge is the middle of the up face's bottom edge
+        // turned: 45° up straight ahead.
+        let up45 = Vec3::new(0.0, 1.0, -1.0);
+        let front = proj.cube_pixel_on_face(up45, 4).unwrap();
+        let up = proj.cube_pixel_on_face(up45, 2).unwrap();
+        assert!((front[0] - 150.0).abs() < 1e-4 && (front[1] - 100.0).abs() < 1e-4, "{front:?}");
+        assert!((up[0] - 250.0).abs() < 1e-4 && up[1].abs() < 1e-4, "the up face's top is forwards: {up:?}");
+    }
+
+    #[test]
+    fn a_grid_that_is_not_three_by_two_squares_is_refused() {
+        for (w, h) in [(400, 266), (300, 300), (301, 200)] {
+            let e = Projection { width: w, height: h, ..Projection::cubemap(300) }.validate().unwrap_err().to_string();
+            assert!(e.contains("3x2 grid") && e.contains(&format!("{w}x{h}")), "{e}");
+        }
+        Projection::cubemap(300).validate().unwrap();
+    }
+}
