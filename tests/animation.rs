@@ -377,6 +377,31 @@ fn a_video_carries_the_spherical_metadata() {
     let mapping = stream["side_data_list"].as_array().unwrap().iter().find(|d| d["bound_left"].is_u64()).unwrap();
     let (l, r) = (mapping["bound_left"].as_u64().unwrap(), mapping["bound_right"].as_u64().unwrap());
     assert!(l + r == 128 && l.abs_diff(64) <= 2, "{side}");
+    // Re-tagged as a stereo cubemap (top-bottom): `cbmp` layout 0 (the 3×2 grid), no padding, and
+    // no V1 box (V1 describes equirectangular images only); ffprobe reads a cubemap.
+    let cube = root.join("cube-map.mp4");
+    let status = Command::new("ffmpeg")
+        .args(["-y", "-loglevel", "error", "-i"])
+        .arg(&video)
+        .args(["-c", "copy"])
+        .arg(&cube)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let untagged = std::fs::read(&cube).unwrap();
+    assert!(find_boxes(&untagged, &[&entry[..], &["sv3d"]].concat()).is_empty(), "ffmpeg writes no sv3d of its own");
+    let tagged =
+        with_spherical_metadata(&untagged, "cube", StereoMode::TopBottom, PanoramaKind::Cubemap, [96, 64]).unwrap();
+    std::fs::write(&cube, &tagged).unwrap();
+    let cbmp = find_boxes(&tagged, &[&entry[..], &["sv3d", "proj", "cbmp"]].concat());
+    assert_eq!(cbmp.len(), 1);
+    assert_eq!(&cbmp[0][4..12], &[0; 8], "layout 0, padding 0");
+    assert!(find_boxes(&tagged, &[&entry[..], &["sv3d", "proj", "equi"]].concat()).is_empty());
+    assert!(find_spherical_v1(&tagged).is_empty());
+    let stream = probe(&cube);
+    assert_eq!(stream["nb_read_frames"], "12", "every frame still decodes");
+    let side = stream["side_data_list"].to_string();
+    assert!(side.contains("top and bottom") && side.contains("cubemap"), "{side}");
     // No ffmpeg: one line.
     let out = common::twister()
         .args(["render", scene.to_str().unwrap(), "--frames", "0..1", "--layout", "top-bottom", "--video"])

@@ -84,6 +84,38 @@ fn render_writes_every_layout_and_stats() {
     assert_eq!(json["triangles_in"], 100);
     assert_eq!(json["width"], 320);
     assert!(json["triangles_drawn"].as_u64().unwrap() >= 100);
+    // The cubemap: top-bottom by default (stereo_cubemap_TB.png); 12x1 cuts each eye's 3×2 grid
+    // into one strip of twelve faces, the left eye's six first.
+    let cube = ["--panorama", "cubemap", "--width", "96"];
+    let run = |layout: &str, dir: &Path, extra: &[&str]| {
+        let o = twister()
+            .args(["render", "builtin:sphere100", "--layout", layout, "--out"])
+            .arg(dir)
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{layout}: {}", String::from_utf8_lossy(&o.stderr));
+    };
+    run("eyes", &out.join("cube-eyes"), &cube);
+    let cube_eyes = ["left", "right"].map(|e| image::open(out.join(format!("cube-eyes/{e}.png"))).unwrap().to_rgba8());
+    assert_eq!(cube_eyes[0].dimensions(), (96, 64));
+    run("12x1", &out.join("strip"), &cube);
+    let strip = image::open(out.join("strip/stereo_cubemap_12x1.png")).unwrap().to_rgba8();
+    assert_eq!(strip.dimensions(), (384, 32));
+    for k in 0..12u32 {
+        let (eye, face) = (&cube_eyes[(k / 6) as usize], k % 6);
+        for (x, y) in [(0, 0), (13, 21), (31, 31)] {
+            assert_eq!(
+                strip.get_pixel(32 * k + x, y),
+                eye.get_pixel(32 * (face % 3) + x, 32 * (face / 3) + y),
+                "face {k}"
+            );
+        }
+    }
+    let o =
+        twister().args(["render", "builtin:sphere100", "--out"]).arg(out.join("cube-tb")).args(cube).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(png_size(&out.join("cube-tb/stereo_cubemap_TB.png")), (96, 128));
     let _ = std::fs::remove_dir_all(&out);
 }
 
@@ -175,6 +207,13 @@ fn bad_arguments_are_clear_errors() {
         (&["render", "--head", "0,0"], "--head"),
         (&["render", "--head", "0,0,nan"], "--head"),
         (&["render", "--panorama", "fisheye", "--alpha", "--format", "jpg"], "--alpha: needs --format png"),
+        // The stereo cubemap (issue 34).
+        (&["render", "--panorama", "cubemap", "--width", "100"], "--width/--height: a cubemap is a 3x2 grid"),
+        (&["render", "--panorama", "cubemap", "--width", "300", "--height", "300"], "3x2 grid"),
+        (&["render", "--panorama", "cubemap", "--method", "slit:4"], "--method: slit:4"),
+        (&["render", "--panorama", "cubemap", "--preset", "vr4k"], "--preset"),
+        (&["render", "--layout", "12x1"], "--layout: 12x1 lays out a cubemap's faces"),
+        (&["render", "--panorama", "cubemap", "--layout", "twister"], "--layout: twister"),
     ];
     for (args, needle) in cases {
         let o = twister().args(*args).args(["--out", "/nonexistent/never"]).output().unwrap();

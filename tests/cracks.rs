@@ -315,6 +315,7 @@ fn surround_scenes_let_no_sample_see_the_background() {
             (PanoramaKind::Equirect, 256, 128),
             (PanoramaKind::Vr180, 128, 128),
             (PanoramaKind::Fisheye, 128, 128),
+            (PanoramaKind::Cubemap, 192, 128),
         ];
         let runs: Vec<_> = runs.flat_map(|run| sizes.map(|size| (run, size))).collect();
         for ((method, samples), (panorama, width, height)) in runs {
@@ -322,7 +323,7 @@ fn surround_scenes_let_no_sample_see_the_background() {
             // tracer (the sphere; the exact vertical model only).
             let extra = samples != 4 || method == Method::Trace;
             let sphere = panorama == PanoramaKind::Equirect;
-            let vr180 = matches!(panorama, PanoramaKind::Vr180 | PanoramaKind::Fisheye);
+            let vr180 = matches!(panorama, PanoramaKind::Vr180 | PanoramaKind::Fisheye | PanoramaKind::Cubemap);
             if extra && (width == 192 || vr180 || (samples == 2 && sphere) || (samples != 2 && !sphere)) {
                 continue;
             }

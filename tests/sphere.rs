@@ -134,8 +134,9 @@ fn vr180_shows_the_front_half_closed_with_spheres_where_the_format_puts_them() {
 
 /// Small spheres around the viewer (one behind): the centroid of each one's pixels lies where the
 /// panorama's format puts the sphere's eye ray (`want(λ, φ)`: the image position and the factor
-/// its x error is weighed by; None where the image does not show it). λ and φ come from the
-/// geometry alone, as in `spheres_land_where_the_formulas_put_them…`.
+/// its x error is weighed by, NaN where the sphere straddles an edge of the format's and is not
+/// compared; None where the image does not show it). λ and φ come from the geometry alone, as in
+/// `spheres_land_where_the_formulas_put_them…`.
 fn probes_land_where_the_format_puts_them(projection: Projection, want: impl Fn(f32, f32) -> Option<(f32, f32, f32)>) {
     let de = 0.032f32;
     let width = projection.width;
@@ -178,6 +179,9 @@ fn probes_land_where_the_format_puts_them(projection: Projection, want: impl Fn(
                 assert!(pixels.is_empty(), "{centre} outside the image shows in {} pixels", pixels.len());
                 continue;
             };
+            if squeeze.is_nan() {
+                continue;
+            }
             let n = pixels.len() as f32;
             assert!(n >= 4.0, "{centre} {eye:?}: only {n} pixels");
             let (x, y) = pixels.iter().fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
@@ -235,6 +239,47 @@ fn the_fisheye_fills_its_circle_with_spheres_where_the_dome_puts_them() {
             (rho < 0.5 * w - 2.0).then(|| (0.5 * w + rho * alpha.sin(), 0.5 * w + rho * alpha.cos(), 1.0))
         });
     }
+}
+
+/// The stereo cubemap: the closed demo room leaves no face's pixel to the background (no seam
+/// between faces), and small spheres land where the cube's layout puts them, written out from
+/// its definition (YouTube's 3×2 grid: right, left, up / down, front, back; the up face's top
+/// forwards, the down face's top to the back): the face whose axis the ray's direction is
+/// nearest, x = F·(col + (1 + a)/2), y = F·(row + (1 − b)/2) with (a, b) the direction's
+/// coordinates along the face's right and up over its depth along the face's axis.
+#[test]
+fn the_cubemap_fills_its_faces_with_spheres_where_the_layout_puts_them() {
+    let black = [0.0; 3];
+    let cube = Projection::cubemap(3 * 64);
+    let frame = common::render(&builtin::demo(), &RenderSettings::new(cube).with_background(black));
+    for eye in Eye::BOTH {
+        let holes = common::pixels_where(frame.eye(eye), |p| common::is_background(p, black));
+        assert!(
+            holes.is_empty(),
+            "{eye:?}: {} background pixels, e.g. {:?}",
+            holes.len(),
+            &holes[..holes.len().min(5)]
+        );
+    }
+    let f = 384.0f32;
+    probes_land_where_the_format_puts_them(Projection::cubemap(3 * 384), move |lon, lat| {
+        let d = [lat.cos() * lon.sin(), lat.sin(), -lat.cos() * lon.cos()];
+        // (cell, axis index and sign, right, up) per face, from the layout's words.
+        let (cell, depth, a, b) = match (0..3).max_by(|&i, &j| d[i].abs().total_cmp(&d[j].abs())).unwrap() {
+            0 if d[0] > 0.0 => ((0.0, 0.0), d[0], d[2], d[1]), // right: its right behind
+            0 => ((1.0, 0.0), -d[0], -d[2], d[1]),             // left: its right ahead
+            1 if d[1] > 0.0 => ((2.0, 0.0), d[1], -d[0], -d[2]), // up: its top ahead
+            1 => ((0.0, 1.0), -d[1], -d[0], d[2]),             // down: its top behind
+            _ if d[2] < 0.0 => ((1.0, 1.0), -d[2], d[0], d[1]), // front
+            _ => ((2.0, 1.0), d[2], -d[0], d[1]),              // back
+        };
+        let (a, b) = (a / depth, b / depth);
+        // Within about 3° of a face's edge (the probes reach 0.7° from their centres) a sphere
+        // may straddle two faces: not compared.
+        let straddles = a.abs().max(b.abs()) > 0.9;
+        let squeeze = if straddles { f32::NAN } else { 1.0 };
+        Some((f * (cell.0 + 0.5 * (1.0 + a)), f * (cell.1 + 0.5 * (1.0 - b)), squeeze))
+    });
 }
 
 /// Reads a PNG's iTXt chunk `XML:com.adobe.xmp`, or a JPEG's XMP APP1 segment.
