@@ -48,6 +48,7 @@ impl Layout {
             PanoramaKind::Vr180 => Layout::SideBySide,
             PanoramaKind::Fisheye => Layout::Eyes,
             PanoramaKind::Cubemap => Layout::TopBottom,
+            PanoramaKind::Cave => Layout::Eyes,
         }
     }
 }

@@ -35,6 +35,7 @@ fn projection(panorama: PanoramaKind, scale: u32) -> Projection {
         PanoramaKind::Vr180 => Projection::vr180(256 * scale),
         PanoramaKind::Fisheye => Projection::fisheye(256 * scale),
         PanoramaKind::Cubemap => Projection::cubemap(384 * scale),
+        PanoramaKind::Cave => unreachable!("the CAVE is not measured here"),
     }
 }
 

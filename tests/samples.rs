@@ -45,6 +45,7 @@ fn coverage_error(panorama: PanoramaKind, method: Method, samples: u32) -> (f64,
         PanoramaKind::Vr180 => Projection::vr180(128),
         PanoramaKind::Fisheye => Projection::fisheye(128),
         PanoramaKind::Cubemap => Projection::cubemap(192),
+        PanoramaKind::Cave => unreachable!("the CAVE is not sampled here"),
     };
     let settings = RenderSettings::new(projection)
         .with_method(method)

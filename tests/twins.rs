@@ -155,6 +155,18 @@ impl Twin for ProjectPoints {
             let dome = Projection { fov: 240.0, dome_tilt: 20.0, ..Projection::fisheye(2048) };
             out.push((format!("fisheye 240° tilted 20° {eye:?}"), (dome, eye, sphere_points.clone())));
             out.push((format!("cubemap {eye:?}"), (Projection::cubemap(3 * 1024), eye, sphere_points.clone())));
+            // The CAVE: points seen through the wall and around it, before and beyond it.
+            let cave = common::cave(0, 2048, Vec3::new(0.2, 0.1, 0.3), 25.0);
+            let [corner, right, up] = cave.cave_wall();
+            let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+            let through: Vec<Vec3> = (0..5000)
+                .map(|_| {
+                    let (a, b, t) =
+                        (rng.random_range(-0.2..1.2), rng.random_range(-0.2..1.2), rng.random_range(0.2..5.0));
+                    t * (corner + a * right + b * up)
+                })
+                .collect();
+            out.push((format!("a CAVE's front wall {eye:?}"), (cave, eye, through)));
         }
         out
     }

@@ -13,12 +13,18 @@ fn from_pixel(proj: Projection, xy: vec2<f32>) -> vec2<f32> {
     if (is_cubemap(proj)) {
         return cube_direction(proj, xy);
     }
+    if (is_cave(proj)) {
+        return xy;
+    }
     return vec2<f32>((xy.x - 0.5 * proj.width) / proj.turn_px * TAU, (0.5 * proj.height - xy.y) / proj.pixels_per_v);
 }
 
 // The unit direction, seen from the centre, of screen point (u, v): on the cylinder the screen
 // point (R_T sin u, v, −R_T cos u), on the sphere longitude u, latitude v.
 fn screen_direction(proj: Projection, uv: vec2<f32>) -> vec3<f32> {
+    if (is_cave(proj)) {
+        return normalize(cave_point(proj, uv)); // the wall's point, seen from the head
+    }
     if (is_sphere(proj)) {
         return vec3<f32>(cos(uv.y) * sin(uv.x), sin(uv.y), -cos(uv.y) * cos(uv.x));
     }
@@ -38,6 +44,9 @@ fn pixel_spread(proj: Projection, frag_xy: vec2<f32>) -> f32 {
     if (is_cubemap(proj)) {
         return 1.0 / proj.pixels_per_v; // a face's centre, where its pixels span the most
     }
+    if (is_cave(proj)) {
+        return cave_spread(proj);
+    }
     let uv = from_pixel(proj, frag_xy);
     if (is_sphere(proj)) {
         return max(TAU / proj.turn_px * cos(uv.y), 1.0 / proj.pixels_per_v);
@@ -54,6 +63,9 @@ fn pixel_error(proj: Projection, eye_sign: f32, p: vec3<f32>, frag_xy: vec2<f32>
         return -1.0;
     }
     let uvd = project_with_azimuth(proj, p, azimuth(p), eye_sign);
+    if (is_cave(proj) && uvd.z < 0.0) {
+        return -1.0; // behind this eye's plane
+    }
     if (angle) {
         let a = screen_direction(proj, uvd.xy);
         let b = screen_direction(proj, from_pixel(proj, frag_xy));
@@ -85,6 +97,10 @@ struct Ray {
 // the pixel's column (viewing direction φ = u − s·asin(d_e/R_T)) through the pixel's screen point.
 fn pixel_ray(proj: Projection, eye_sign: f32, frag_xy: vec2<f32>) -> Ray {
     let uv = from_pixel(proj, frag_xy);
+    if (is_cave(proj)) {
+        let origin = vec3<f32>(eye_sign * proj.eye_radius, 0.0, 0.0);
+        return Ray(origin, normalize(cave_point(proj, uv) - origin));
+    }
     if (is_sphere(proj)) {
         let d = vec3<f32>(cos(uv.y) * sin(uv.x), sin(uv.y), -cos(uv.y) * cos(uv.x));
         let origin = eye_sign * pole_fade(proj, abs(uv.y)) * proj.eye_radius * vec3<f32>(cos(uv.x), 0.0, sin(uv.x));

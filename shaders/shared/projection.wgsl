@@ -16,11 +16,12 @@
 #import projection_fisheye
 #import projection_head
 #import projection_cubemap
+#import projection_cave
 
 const PI: f32 = 3.14159265358979;
 const TAU: f32 = 6.28318530717959;
 
-// Mirrors `ProjectionUniform` in src/encoding/types.rs (80 bytes).
+// Mirrors `ProjectionUniform` in src/encoding/types.rs (128 bytes).
 struct Projection {
     screen_radius: f32,    // R_T, metres
     eye_radius: f32,       // d_e, metres
@@ -40,14 +41,21 @@ struct Projection {
     head_turn: f32,        // γ: head frame → display frame turn, radians
     head_offset: vec3<f32>, // O: the head in the display's frame, metres
     face: u32,             // the cubemap: the face this draw projects into (0 elsewhere)
+    wall_corner: vec3<f32>, // the CAVE: its wall in the display's frame (`core::cave`), metres
+    wall_on: f32,
+    wall_right: vec3<f32>,
+    _pad1: f32,
+    wall_up: vec3<f32>,
+    _pad2: f32,
 }
 
 // The panoramas a pipeline can draw (bit 0 the cylinder, bit 1 the sphere: equirect, VR180, the
-// fisheye or the cubemap, bit 2 the fisheye's image, bit 3 the cubemap's). The subdivide stage's and the drawing stages'
-// pipelines are built for one panorama each, so the others' code is compiled out: on lavapipe a
+// fisheye or the cubemap, bit 2 the fisheye's image, bit 3 the cubemap's, bit 4 the CAVE). The
+// subdivide stage's and the drawing stages' pipelines are built for one panorama each, so the
+// others' code is compiled out: on lavapipe a
 // shader that merely contains the sphere's projection (inlined at every sample of an edge) ran
 // the cylinder's subdivision three times slower.
-override PANORAMAS: u32 = 15u;
+override PANORAMAS: u32 = 31u;
 
 fn is_sphere(proj: Projection) -> bool {
     return (PANORAMAS & 2u) != 0u && ((PANORAMAS & 1u) == 0u || proj.panorama != PANORAMA_CYLINDER);
@@ -143,6 +151,9 @@ fn pole_fade(proj: Projection, a: f32) -> f32 {
 // Whether an eye sees the point (`Projection::project` is Some): the cylinder r > d_e; the sphere
 // r > |e| at the point's offset (a point on the axis only where the offset has faded to 0).
 fn sees(proj: Projection, p: vec3<f32>) -> bool {
+    if (is_cave(proj)) {
+        return cave_sees(proj, p);
+    }
     let r = horizontal_radius(p);
     if (!is_sphere(proj)) {
         return r > proj.eye_radius;
@@ -154,6 +165,9 @@ fn sees(proj: Projection, p: vec3<f32>) -> bool {
 // (u, v, depth) of a viewer-frame point whose azimuth θ the caller has already unwrapped:
 // (u, v) are (θ ± α, screen height) on the cylinder, (longitude, latitude) on the sphere.
 fn project_with_azimuth(proj: Projection, p: vec3<f32>, theta: f32, eye_sign: f32) -> vec3<f32> {
+    if (is_cave(proj)) {
+        return cave_project(proj, p, eye_sign);
+    }
     let r = horizontal_radius(p);
     if (is_sphere(proj)) {
         return sphere_at_offset(proj, r, p.y, theta, eye_sign, sphere_eye_offset(proj, r, p.y));
@@ -172,6 +186,9 @@ fn to_pixel(proj: Projection, u: f32, v: f32) -> vec2<f32> {
     }
     if (is_cubemap(proj)) {
         return cube_pixel(proj, u, v);
+    }
+    if (is_cave(proj)) {
+        return vec2<f32>(u, v); // the CAVE's (u, v) are its image position
     }
     let x = wrap_angle(u) / TAU * proj.turn_px + 0.5 * proj.width;
     let y = 0.5 * proj.height - v * proj.pixels_per_v;

@@ -8,6 +8,7 @@ use glam::Vec3;
 use twister::core::environment::PreparedEnvironment;
 use twister::core::light::{LightingMode, Tonemap};
 
+use twister::core::cave::NamedWall;
 use twister::core::head::Head;
 use twister::core::lod::LodParams;
 use twister::core::projection::{PanoramaKind, DEFAULT_POLE_MERGE};
@@ -19,14 +20,15 @@ use twister::error::{Error, Result};
 use twister::output::{ImageFormat, Layout};
 use twister::{Projection, RenderSettings, Vertical};
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 pub struct ViewArgs {
     /// The panorama: cylinder (the TWISTER display), equirect (the full sphere, 360° × 180°
     /// per eye: omni-directional stereo as VR players, 360° video and Blender use), vr180
     /// (its front half, 180° × 180° per eye), fisheye (the fulldome master: W × W,
     /// equidistant, the zenith at the centre and the front at the bottom; --fov, --dome-tilt;
-    /// mono with --eye-radius 0) or cubemap (six 90° faces per eye in YouTube's 3×2 grid: right,
-    /// left, up / down, front, back). [default: cylinder; equirect with --preset]
+    /// mono with --eye-radius 0), cubemap (six 90° faces per eye in YouTube's 3×2 grid: right,
+    /// left, up / down, front, back) or cave (CAVE walls: --cave, --head). [default: cylinder;
+    /// equirect with --preset]
     #[arg(long, value_enum)]
     pub panorama: Option<PanoramaKind>,
     /// Image width per eye in pixels (the full 360°; vr180: 180°; fisheye: --fov; cubemap: three
@@ -74,11 +76,18 @@ pub struct ViewArgs {
     /// Turn of the view about the vertical axis, degrees; positive turns left.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub yaw: f32,
-    /// cylinder: a tracked head at X,Y,Z (scene units, the point midway between the eyes) facing
-    /// YAW degrees (as --yaw; default --yaw), away from the display's centre (--viewer): each
-    /// point is drawn where the line from an eye meets the screen (the exact model).
+    /// cylinder and cave: a tracked head at X,Y,Z (scene units, the point midway between the
+    /// eyes) facing YAW degrees (as --yaw; default --yaw), away from the display's centre
+    /// (--viewer): each point is drawn where the line from an eye meets the screen (the cylinder:
+    /// the exact model) or the CAVE's wall.
     #[arg(long, value_parser = parse_head, value_name = "X,Y,Z[,YAW]", allow_hyphen_values = true)]
     pub head: Option<(Vec3, Option<f32>)>,
+    /// cave: the CAVE's walls, a JSON file {"walls": [{"name", "lower_left", "lower_right",
+    /// "upper_left", "pixels": [W, H]}]}: each a rectangle in the scene (scene units, seen from
+    /// the room: lower right to the right of lower left), drawn per eye as `NAME_left.png`,
+    /// `NAME_right.png`.
+    #[arg(long, value_name = "FILE.json")]
+    pub cave: Option<PathBuf>,
     /// Metres per scene unit: the scene (and --viewer, given in scene units) is scaled by it.
     #[arg(long, default_value_t = 1.0)]
     pub scale: f32,
@@ -322,7 +331,9 @@ impl ViewArgs {
                 return Err(Error::option("--pole-merge", "needs --panorama equirect or vr180"));
             }
         }
+        let walls = self.cave_file(panorama)?;
         let (width, height) = match (panorama, self.preset) {
+            (PanoramaKind::Cave, _) => (walls[0].pixels[0], walls[0].pixels[1]),
             (_, Some(preset)) => (preset.width(), preset.width() / 2),
             (PanoramaKind::Cylinder, None) => (self.width.unwrap_or(3168), self.height.unwrap_or(600)),
             (PanoramaKind::Equirect, None) => {
@@ -358,6 +369,7 @@ impl ViewArgs {
             pole_merge: self.pole_merge.map_or(Some(DEFAULT_POLE_MERGE), |p| p.0),
             fov: self.fov.unwrap_or(180.0),
             dome_tilt: self.dome_tilt.unwrap_or(0.0),
+            wall: None,
             head: match (self.head, self.viewer) {
                 (None, _) => None,
                 (Some(_), Viewer::Camera(_)) => {
@@ -367,6 +379,12 @@ impl ViewArgs {
                     Some(Head::relative(at * self.scale, yaw.unwrap_or(self.yaw), viewer * self.scale, self.yaw))
                 }
             },
+        };
+        let projection = match walls.first() {
+            Some(wall) => {
+                Projection { wall: Some(wall.in_display(self.scale, self.viewer_m(), self.yaw)), ..projection }
+            }
+            None => projection,
         };
         projection.validate()?;
         if !self.yaw.is_finite() {
@@ -404,6 +422,57 @@ impl ViewArgs {
             .with_anisotropy(self.anisotropy.unwrap_or(1));
         settings.validate()?;
         Ok(settings)
+    }
+
+    /// `--cave`'s walls, read and checked, for the CAVE panorama (none for the others, which
+    /// refuse `--cave`); the CAVE's conditions: its head, no --width/--height, the display's
+    /// centre a place.
+    pub fn cave_file(&self, panorama: PanoramaKind) -> Result<Vec<NamedWall>> {
+        if panorama != PanoramaKind::Cave {
+            if self.cave.is_some() {
+                return Err(Error::option("--cave", "gives the walls of --panorama cave"));
+            }
+            return Ok(Vec::new());
+        }
+        let Some(path) = &self.cave else {
+            return Err(Error::option("--cave", "--panorama cave draws the walls of a --cave FILE.json"));
+        };
+        if self.width.is_some() || self.height.is_some() {
+            return Err(Error::option("--width/--height", "a CAVE's walls give their own pixels (--cave)"));
+        }
+        if matches!(self.viewer, Viewer::Camera(_)) {
+            return Err(Error::option("--viewer", "a CAVE's walls and head are in the scene: give --viewer x,y,z"));
+        }
+        twister::core::cave::read_cave(path).map_err(crate::flags::for_user)
+    }
+
+    /// `--viewer` in metres (a camera's place: the origin until the scene is prepared).
+    fn viewer_m(&self) -> Vec3 {
+        match self.viewer {
+            Viewer::At(p) => p * self.scale,
+            Viewer::Camera(_) => Vec3::ZERO,
+        }
+    }
+
+    /// Each wall of `--cave` drawn with `settings` (which draw the first): its name and its
+    /// projection, checked.
+    pub fn cave_walls(&self, settings: &RenderSettings) -> Result<Vec<(String, Projection)>> {
+        let walls = self.cave_file(settings.projection().panorama)?;
+        walls
+            .iter()
+            .map(|w| {
+                let wall = w.in_display(self.scale, settings.view.viewer, settings.view.yaw_deg);
+                let projection =
+                    Projection { width: w.pixels[0], height: w.pixels[1], wall: Some(wall), ..*settings.projection() };
+                projection.validate().map_err(|e| match crate::flags::for_user(e) {
+                    Error::Option { option, message } => {
+                        Error::Option { option, message: format!("wall {:?}: {message}", w.name) }
+                    }
+                    other => other,
+                })?;
+                Ok((w.name.clone(), projection))
+            })
+            .collect()
     }
 
     /// The vertical model: as given, else the paper's, except where `trace` draws the cylinder:

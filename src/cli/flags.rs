@@ -37,6 +37,8 @@ pub const FLAGS: &[(&str, &str)] = &[
     ("gaze_path", "--gaze-path"),
     ("viewer_path", "--viewer-path"),
     ("head_path", "--head-path"),
+    ("cave", "--cave"),
+    ("view.projection.wall", "--cave"),
 ];
 
 /// The option that sets `setting`, if the command line has one.

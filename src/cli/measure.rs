@@ -42,9 +42,6 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
     if let Some(max) = args.heatmap_max.filter(|m| !(m.is_finite() && *m > 0.0)) {
         return Err(Error::option("--heatmap-max", format!("must be a positive number of pixels, got {max}")));
     }
-    if let Some(path) = &args.heatmap {
-        twister::output::check_outputs(&[path.as_path()])?;
-    }
     // With --against, both frames also measure depth (the distance differences); against the ray
     // tracer, also the surface points (where the traced image shows what was drawn).
     let drawn: Vec<Method> = std::iter::once(args.view.method).chain(args.against).collect();
@@ -54,54 +51,88 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
         .with_measure_error(true)
         .with_depth(args.against.is_some())
         .with_positions(args.against == Some(Method::Trace));
+    // One view, or a CAVE's walls, each measured (its heatmap named by the wall).
+    let walls = args.view.cave_walls(&settings)?;
+    let views: Vec<(Option<String>, Option<twister::Projection>)> = if walls.is_empty() {
+        vec![(None, None)]
+    } else {
+        walls.into_iter().map(|(name, p)| (Some(name), Some(p))).collect()
+    };
+    let heatmap = |wall: &Option<String>| {
+        args.heatmap.as_ref().map(|path| match wall {
+            Some(wall) => {
+                path.with_file_name(format!("{wall}_{}", path.file_name().unwrap_or_default().to_string_lossy()))
+            }
+            None => path.clone(),
+        })
+    };
+    let heatmaps: Vec<std::path::PathBuf> = views.iter().filter_map(|(wall, _)| heatmap(wall)).collect();
+    twister::output::check_outputs(&heatmaps.iter().map(|p| p.as_path()).collect::<Vec<_>>())?;
     let (renderer, adapter) = open_renderer()?;
     let methods: Vec<Method> = std::iter::once(settings.subdivision.method).chain(args.against).collect();
     let prepared = prepare(&renderer, &args.scene, args.fit, &args.view, settings, false, &methods)?;
-    let settings = prepared.settings;
     let gpu_scene = &prepared.gpu_scene;
-    let frame = renderer.render(gpu_scene, &settings)?;
-    let measured = frame.measurement.as_ref().expect("rendered with the error pass");
-    let e = &measured.stats;
-    let s = &frame.stats;
-    let mut json = serde_json::json!({
-        "scene": args.scene,
-        "method": settings.subdivision.method.name(),
-        "vertical": settings.view.projection.vertical,
-        "width": settings.view.projection.width,
-        "height": settings.view.projection.height,
-        "mean_px": e.mean,
-        "std_px": e.std_dev,
-        "p50_px": e.p50,
-        "p90_px": e.p90,
-        "p99_px": e.p99,
-        "max_px": e.max,
-        "pixels": e.count,
-        "lod": lod_stats(&prepared.selection),
-        "triangles_in": s.triangles_in,
-        "triangles_out": s.triangles_out,
-        "ms_render": s.ms_frame,
-        "timing": s.timing,
-        "ms_total": s.ms_total,
-        "adapter": adapter,
-    });
-    // On the sphere, pixels shrink towards the poles: the error is also measured as an angle
-    // (seen from the centre), by a second render whose error pass writes arcminutes.
-    if settings.view.projection.panorama.is_sphere() {
-        let angular = renderer.render(gpu_scene, &settings.with_error_angle(true))?;
-        add_angles(&mut json, &angular.measurement.as_ref().expect("rendered with the error pass").stats);
-    }
-    if let Some(method) = args.against {
-        let reference = renderer.render(gpu_scene, &settings.with_method(method))?;
-        add_comparison(&mut json, method, &twister::core::compare::compare(&frame, &reference)?);
-    }
-    if let Some(path) = &args.heatmap {
-        let max = args.heatmap_max.unwrap_or_else(|| crate::heatmap::nice_max(e.p99));
-        write_heatmap(path, &measured.error, settings.projection(), max)?;
-    }
-    if args.json {
-        println!("{}", serde_json::to_string(&json).unwrap());
-    } else {
-        print_summary(&args.scene, &settings, &json, e, s);
+    for (wall, projection) in &views {
+        let settings = match projection {
+            Some(p) => prepared.settings.with_projection(twister::Projection {
+                width: p.width,
+                height: p.height,
+                wall: p.wall,
+                ..*prepared.settings.projection()
+            }),
+            None => prepared.settings,
+        };
+        let frame = renderer.render(gpu_scene, &settings)?;
+        let measured = frame.measurement.as_ref().expect("rendered with the error pass");
+        let e = &measured.stats;
+        let s = &frame.stats;
+        let mut json = serde_json::json!({
+            "scene": args.scene,
+            "method": settings.subdivision.method.name(),
+            "vertical": settings.view.projection.vertical,
+            "width": settings.view.projection.width,
+            "height": settings.view.projection.height,
+            "mean_px": e.mean,
+            "std_px": e.std_dev,
+            "p50_px": e.p50,
+            "p90_px": e.p90,
+            "p99_px": e.p99,
+            "max_px": e.max,
+            "pixels": e.count,
+            "lod": lod_stats(&prepared.selection),
+            "triangles_in": s.triangles_in,
+            "triangles_out": s.triangles_out,
+            "ms_render": s.ms_frame,
+            "timing": s.timing,
+            "ms_total": s.ms_total,
+            "adapter": adapter,
+        });
+        if let Some(wall) = wall {
+            json["wall"] = serde_json::json!(wall);
+        }
+        // On the sphere, pixels shrink towards the poles: the error is also measured as an angle
+        // (seen from the centre), by a second render whose error pass writes arcminutes.
+        if settings.view.projection.panorama.is_sphere() {
+            let angular = renderer.render(gpu_scene, &settings.with_error_angle(true))?;
+            add_angles(&mut json, &angular.measurement.as_ref().expect("rendered with the error pass").stats);
+        }
+        if let Some(method) = args.against {
+            let reference = renderer.render(gpu_scene, &settings.with_method(method))?;
+            add_comparison(&mut json, method, &twister::core::compare::compare(&frame, &reference)?);
+        }
+        if let Some(path) = heatmap(wall) {
+            let max = args.heatmap_max.unwrap_or_else(|| crate::heatmap::nice_max(e.p99));
+            write_heatmap(&path, &measured.error, settings.projection(), max)?;
+        }
+        if args.json {
+            println!("{}", serde_json::to_string(&json).unwrap());
+        } else {
+            let scene = match wall {
+                Some(wall) => format!("{} wall {wall}", args.scene),
+                None => args.scene.clone(),
+            };
+            print_summary(&scene, &settings, &json, e, s);
+        }
     }
     Ok(())
 }

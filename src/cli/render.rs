@@ -14,8 +14,12 @@ pub const DEFAULT_SAMPLES: u32 = 4;
 /// The render settings `args` ask for, with the outputs' measures (depth, edge lengths for the
 /// statistics, the linear colour) and the background, checked as a whole; then only read.
 pub fn render_settings(args: &RenderArgs) -> Result<twister::RenderSettings> {
-    let settings = args
-        .view
+    // A CAVE sequence's head path: the base settings see the head where it starts.
+    let view = match crate::sequence::cave_head_start(args)? {
+        Some(head) => &crate::args::ViewArgs { head: Some(head), ..args.view.clone() },
+        None => &args.view,
+    };
+    let settings = view
         .settings(&[args.view.method])?
         .with_background(args.background)
         .with_measure_edges(args.stats.is_some())
@@ -49,38 +53,65 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     if args.lod_overlay && args.view.lod == LodMode::Off {
         return Err(Error::option("--lod-overlay", "needs --lod visual-field"));
     }
+    // One view, or a CAVE's walls: each its projection and its writer (files named by wall).
+    let walls = args.view.cave_walls(&settings)?;
+    let views: Vec<(Option<twister::Projection>, FrameWriter)> = if walls.is_empty() {
+        vec![(None, writer)]
+    } else {
+        walls.into_iter().map(|(name, p)| (Some(p), writer.for_wall(Some(name)))).collect()
+    };
     // Every output is checked before anything is rendered, and all are written together.
-    let image_paths = writer.paths(None);
+    let image_paths: Vec<std::path::PathBuf> = views.iter().flat_map(|(_, w)| w.paths(None)).collect();
     let mut all_paths: Vec<&std::path::Path> = image_paths.iter().map(|p| p.as_path()).collect();
     all_paths.extend(args.stats.as_deref());
     check_outputs(&all_paths)?;
     let (renderer, adapter) = open_renderer()?;
     let method = [settings.subdivision.method];
     let prepared = prepare(&renderer, &args.scene, args.fit, &args.view, settings, args.lod_overlay, &method)?;
-    let settings = prepared.settings;
-    let mut frame = renderer.render(&prepared.gpu_scene, &settings)?;
-    if let (true, Some(gaze)) = (args.lod_overlay, &prepared.gaze) {
-        for img in [&mut frame.left, &mut frame.right] {
-            twister::core::lod::draw_field_boundaries(img, settings.projection(), gaze);
+    let mut files = Vec::new();
+    let mut records = Vec::new();
+    for (wall, writer) in &views {
+        let settings = match wall {
+            Some(p) => prepared.settings.with_projection(twister::Projection {
+                width: p.width,
+                height: p.height,
+                wall: p.wall,
+                ..*prepared.settings.projection()
+            }),
+            None => prepared.settings,
+        };
+        let mut frame = renderer.render(&prepared.gpu_scene, &settings)?;
+        if let (true, Some(gaze)) = (args.lod_overlay, &prepared.gaze) {
+            for img in [&mut frame.left, &mut frame.right] {
+                twister::core::lod::draw_field_boundaries(img, settings.projection(), gaze);
+            }
+        }
+        let t = std::time::Instant::now();
+        files.extend(writer.files(&frame, None)?);
+        // Encoding: the writing itself is a rename.
+        let ms_write = t.elapsed().as_secs_f64() * 1e3;
+        if args.stats.is_some() {
+            let lod = lod_stats(&prepared.selection);
+            let record = FrameRecord {
+                ms_write,
+                ms_total: frame.stats.ms_total + ms_write,
+                ..FrameRecord::new(&args.scene, &settings, &frame, writer, &adapter, lod)
+            };
+            records.push(serde_json::to_value(&record).expect("JSON of plain values"));
         }
     }
-    let t = std::time::Instant::now();
-    let mut files = writer.files(&frame, None)?;
-    // Encoding: the writing itself is a rename.
-    let ms_write = t.elapsed().as_secs_f64() * 1e3;
+    let written = files.len();
     if let Some(path) = &args.stats {
-        let lod = lod_stats(&prepared.selection);
-        let record = FrameRecord {
-            ms_write,
-            ms_total: frame.stats.ms_total + ms_write,
-            ..FrameRecord::new(&args.scene, &settings, &frame, &writer, &adapter, lod)
-        };
-        let text = serde_json::to_string_pretty(&record).expect("JSON of plain values");
+        // One object; a CAVE's walls: one per wall, in an array.
+        let value = if records.len() == 1 { records.remove(0) } else { serde_json::Value::Array(records) };
+        let text = serde_json::to_string_pretty(&value).expect("JSON of plain values");
         files.push(OutputFile { path: path.clone(), bytes: text.into_bytes() });
     }
     write_all(&files)?;
-    for f in files.iter().take(image_paths.len()) {
-        println!("{}", f.path.display());
+    for f in files.iter().take(written) {
+        if image_paths.contains(&f.path) {
+            println!("{}", f.path.display());
+        }
     }
     Ok(())
 }

@@ -44,6 +44,8 @@ pub fn shard_frames(first: u32, last: u32, (i, n): (u32, u32), mode: ShardMode) 
 /// the frame, the settings it was drawn with and its level-of-detail selection.
 struct Drawn {
     frame: u32,
+    /// The view drawn: a CAVE's wall (its writer), or 0.
+    view: usize,
     time: f32,
     ms_pose: f64,
     rendered: twister::Frame,
@@ -75,11 +77,14 @@ struct Sequence<'a> {
     head_path: Option<Timeline>,
     camera: Option<usize>,
     tracked: Option<Tracked<'a>>,
+    /// A CAVE's walls (their projections; `ViewArgs::cave_walls`), or none: one view.
+    walls: Vec<twister::Projection>,
 }
 
 impl Sequence<'_> {
-    /// Poses the scene at frame `frame`, places the viewer, selects the level of detail, draws.
-    fn draw(&mut self, frame: u32) -> Result<Drawn> {
+    /// Poses the scene at frame `frame`, places the viewer, selects the level of detail, draws
+    /// each view (a CAVE's walls, or the one panorama).
+    fn draw(&mut self, frame: u32) -> Result<Vec<Drawn>> {
         let time = frame as f32 / self.args.fps;
         let t = std::time::Instant::now();
         self.pose(time)?;
@@ -91,8 +96,22 @@ impl Sequence<'_> {
             selected = Some(selection);
         }
         let ms_pose = t.elapsed().as_secs_f64() * 1e3;
-        let rendered = self.renderer.render(&self.prepared.gpu_scene, &settings)?;
-        Ok(Drawn { frame, time, ms_pose, rendered, settings, selected })
+        if self.walls.is_empty() {
+            let rendered = self.renderer.render(&self.prepared.gpu_scene, &settings)?;
+            return Ok(vec![Drawn { frame, view: 0, time, ms_pose, rendered, settings, selected }]);
+        }
+        let mut drawn = Vec::with_capacity(self.walls.len());
+        for (view, wall) in self.walls.iter().enumerate() {
+            let settings = settings.with_projection(twister::Projection {
+                width: wall.width,
+                height: wall.height,
+                wall: wall.wall,
+                ..*settings.projection()
+            });
+            let rendered = self.renderer.render(&self.prepared.gpu_scene, &settings)?;
+            drawn.push(Drawn { frame, view, time, ms_pose, rendered, settings, selected: selected.clone() });
+        }
+        Ok(drawn)
     }
 
     /// Poses an animated scene at `time`.
@@ -157,6 +176,17 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32)) -> Result<(
     check_sequence_options(args)?;
     let writer = FrameWriter::new(args, &settings, true)?;
     let stereo = video_stereo(args, &writer)?;
+    // A CAVE: each wall its projection and its writer (files named by wall).
+    let walls = args.view.cave_walls(&settings)?;
+    if !walls.is_empty() && args.video.is_some() {
+        return Err(Error::option("--video", "encodes one panorama: a CAVE's walls are images apart"));
+    }
+    let writers: Vec<FrameWriter> = if walls.is_empty() {
+        vec![writer.clone()]
+    } else {
+        walls.iter().map(|(name, _)| writer.for_wall(Some(name.clone()))).collect()
+    };
+    let walls: Vec<twister::Projection> = walls.into_iter().map(|(_, p)| p).collect();
     let frames = match args.shard {
         Some(shard) => shard_frames(first, last, shard, args.shard_mode),
         None => (first..=last).collect(),
@@ -187,10 +217,21 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32)) -> Result<(
         Viewer::At(_) => None,
     };
     let base = prepared.settings;
-    let mut sequence =
-        Sequence { args, renderer: &renderer, prepared, base, base_yaw, clip, viewer_path, head_path, camera, tracked };
-    let todo: Vec<u32> =
-        frames.into_iter().filter(|&f| !(args.resume && writer.paths(Some(f)).iter().all(|p| p.exists()))).collect();
+    let mut sequence = Sequence {
+        args,
+        renderer: &renderer,
+        prepared,
+        base,
+        base_yaw,
+        clip,
+        viewer_path,
+        head_path,
+        camera,
+        tracked,
+        walls,
+    };
+    let complete = |f: u32| writers.iter().all(|w| w.paths(Some(f)).iter().all(|p| p.exists()));
+    let todo: Vec<u32> = frames.into_iter().filter(|&f| !(args.resume && complete(f))).collect();
     let stats = open_stats(args)?;
     let progress = indicatif::ProgressBar::new(todo.len() as u64).with_style(
         indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames, {per_sec}, ETA {eta}")
@@ -201,11 +242,13 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32)) -> Result<(
     // flight: bounded memory).
     let (send, receive) = std::sync::mpsc::sync_channel::<Drawn>(1);
     std::thread::scope(|scope| -> Result<()> {
-        let writing = scope.spawn(|| write_frames(receive, args, &writer, stats, &progress, &adapter));
+        let writing = scope.spawn(|| write_frames(receive, args, &writers, stats, &progress, &adapter));
         let drawn = (|| -> Result<()> {
             for &frame in &todo {
-                if send.send(sequence.draw(frame)?).is_err() {
-                    break; // the writer stopped: its error is reported below
+                for drawn in sequence.draw(frame)? {
+                    if send.send(drawn).is_err() {
+                        return Ok(()); // the writer stopped: its error is reported below
+                    }
                 }
             }
             Ok(())
@@ -235,12 +278,13 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32)) -> Result<(
 fn write_frames(
     receive: std::sync::mpsc::Receiver<Drawn>,
     args: &RenderArgs,
-    writer: &FrameWriter,
+    writers: &[FrameWriter],
     mut stats: Option<std::fs::File>,
     progress: &indicatif::ProgressBar,
     adapter: &str,
 ) -> Result<()> {
     for drawn in receive {
+        let writer = &writers[drawn.view];
         let t = std::time::Instant::now();
         let files = writer.files(&drawn.rendered, Some(drawn.frame))?;
         write_all(&files)?;
@@ -258,7 +302,9 @@ fn write_frames(
             let line = serde_json::to_string(&record).expect("JSON of plain values");
             writeln!(file, "{line}").map_err(|e| Error::output(path, format!("cannot write: {e}")))?;
         }
-        progress.inc(1);
+        if drawn.view + 1 == writers.len() {
+            progress.inc(1);
+        }
     }
     Ok(())
 }
@@ -325,8 +371,8 @@ fn read_head_path(args: &RenderArgs, settings: &twister::RenderSettings) -> Resu
         Some("moves the head itself: leave out --head")
     } else if matches!(args.view.viewer, Viewer::Camera(_)) {
         Some("needs the display's centre as --viewer x,y,z")
-    } else if settings.projection().panorama != PanoramaKind::Cylinder {
-        Some("a tracked head looks at the cylinder: use it with --panorama cylinder")
+    } else if !matches!(settings.projection().panorama, PanoramaKind::Cylinder | PanoramaKind::Cave) {
+        Some("a tracked head looks at the cylinder or CAVE walls: use it with --panorama cylinder or cave")
     } else if args.view.vertical == Some(twister::Vertical::Paper) {
         Some("a tracked head draws each point where the line from the eye meets the screen: leave out --vertical paper")
     } else if settings.subdivision.method.name().starts_with("slit") {
@@ -337,10 +383,27 @@ fn read_head_path(args: &RenderArgs, settings: &twister::RenderSettings) -> Resu
     if let Some(why) = why {
         return Err(Error::option("--head-path", why));
     }
-    Ok(Some(Timeline::read(path, "head_path", (3, 4), "time,x,y,z[,yaw]", |v| {
+    Ok(Some(read_head_timeline(path)?))
+}
+
+/// The rows of a `--head-path` file, checked.
+fn read_head_timeline(path: &std::path::Path) -> Result<Timeline> {
+    Timeline::read(path, "head_path", (3, 4), "time,x,y,z[,yaw]", |v| {
         let max = twister::core::scene::MAX_COORDINATE;
         (v[..3].iter().any(|c| c.abs() > max)).then(|| format!("coordinates within ±{max:e}"))
-    })?))
+    })
+}
+
+/// The head where a CAVE sequence's `--head-path` starts (at its frame range's first time), for
+/// the base settings (each frame then puts the path's head); None unless the CAVE is drawn with
+/// a head path and no `--head`.
+pub fn cave_head_start(args: &RenderArgs) -> Result<Option<(Vec3, Option<f32>)>> {
+    let (Some(path), None, Some(PanoramaKind::Cave)) = (&args.head_path, args.view.head, args.view.panorama) else {
+        return Ok(None);
+    };
+    let first = args.frames.map_or(0, |(a, _)| a);
+    let v = read_head_timeline(path)?.at(first as f32 / args.fps);
+    Ok(Some((Vec3::new(v[0], v[1], v[2]), v.get(3).copied())))
 }
 
 /// The animation a sequence plays: `--animation` by name or index, else the file's first.

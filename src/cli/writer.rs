@@ -20,8 +20,11 @@ use crate::args::RenderArgs;
 const HDR_NAMES: [&str; 2] = ["left_hdr.exr", "right_hdr.exr"];
 
 /// How a render's frames become files.
+#[derive(Clone)]
 pub struct FrameWriter {
     out: PathBuf,
+    /// A CAVE's wall: its name prefixes every file (`front_left.png`).
+    wall: Option<String>,
     layout: Layout,
     /// The panorama drawn: its tag goes into the combined layouts' names.
     panorama: PanoramaKind,
@@ -62,6 +65,7 @@ impl FrameWriter {
         }
         Ok(FrameWriter {
             out: args.out.clone(),
+            wall: None,
             layout: args.layout.unwrap_or(Layout::default_for(projection.panorama)),
             panorama: projection.panorama,
             encoding: Encoding {
@@ -80,6 +84,11 @@ impl FrameWriter {
         self.layout
     }
 
+    /// The writer of a CAVE's wall: the same files, each name prefixed by the wall's.
+    pub fn for_wall(&self, wall: Option<String>) -> FrameWriter {
+        FrameWriter { wall, ..self.clone() }
+    }
+
     /// The layout's image names (`left.png`, `stereo_TB.png`, …).
     pub fn image_names(&self) -> Vec<String> {
         layout_names(self.layout, self.encoding.format, self.panorama)
@@ -87,6 +96,10 @@ impl FrameWriter {
 
     /// Where a file of a frame goes: as named for a still, numbered for frame `k` of a sequence.
     fn path(&self, frame: Option<u32>, name: &str) -> PathBuf {
+        let name = &match &self.wall {
+            Some(wall) => format!("{wall}_{name}"),
+            None => name.to_string(),
+        };
         self.out.join(match frame {
             Some(k) => frame_name(k, name),
             None => name.to_string(),
@@ -161,6 +174,9 @@ pub struct FrameRecord<'a> {
     pub frame: Option<u32>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub time: Option<f32>,
+    /// A CAVE's wall.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub wall: Option<String>,
     pub scene: &'a str,
     pub method: String,
     pub edge_px: f32,
@@ -223,6 +239,7 @@ impl<'a> FrameRecord<'a> {
         FrameRecord {
             frame: None,
             time: None,
+            wall: writer.wall.clone(),
             scene,
             method: sub.method.name(),
             edge_px: sub.edge_px,

@@ -53,14 +53,17 @@ impl Projection {
     pub(crate) fn validate_head(&self) -> Result<()> {
         if let Some(head) = &self.head {
             let [x, y, z] = head.offset;
-            if self.panorama != PanoramaKind::Cylinder {
-                return Err(Error::setting("view.projection.head", "a tracked head looks at the cylinder panorama"));
+            if !matches!(self.panorama, PanoramaKind::Cylinder | PanoramaKind::Cave) {
+                return Err(Error::setting(
+                    "view.projection.head",
+                    "a tracked head looks at the cylinder panorama or CAVE walls",
+                ));
             }
             if !(head.offset.iter().all(|c| c.is_finite()) && head.turn.is_finite()) {
                 return Err(Error::setting("view.projection.head", format!("must be finite, got {head:?}")));
             }
             let reach = (x * x + z * z).sqrt() + self.eye_radius;
-            if reach >= self.screen_radius {
+            if self.panorama == PanoramaKind::Cylinder && reach >= self.screen_radius {
                 return Err(Error::setting(
                     "view.projection.head",
                     format!(
@@ -73,7 +76,7 @@ impl Projection {
                 ));
             }
             let _ = y;
-            if self.vertical == Vertical::Paper {
+            if self.panorama == PanoramaKind::Cylinder && self.vertical == Vertical::Paper {
                 return Err(Error::setting(
                     "view.projection.vertical",
                     "a tracked head draws each point where the line from the eye meets the screen: the exact model",

@@ -120,6 +120,7 @@ pub struct ObjectLod {
 
 /// A frame's selection: the index list to draw (objects in the scene's order), the objects'
 /// ranges in it, and what was chosen for each.
+#[derive(Clone)]
 pub struct LodSelection {
     pub indices: Vec<u32>,
     pub objects: Vec<Object>,

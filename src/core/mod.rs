@@ -6,6 +6,7 @@ pub mod animation;
 pub mod assets;
 pub mod builtin;
 pub mod bvh;
+pub mod cave;
 pub mod color;
 pub mod compare;
 pub mod cubemap;

@@ -2,7 +2,7 @@
 //! projection uniform and the facts about its image the rest of the pipeline asks (the sphere's
 //! eye model or the cylinder's, the azimuth its width spans, the name players detect). The maps
 //! themselves are `core::projection` (the cylinder), `core::sphere`, `core::fisheye`,
-//! `core::cubemap`.
+//! `core::cubemap`, `core::cave`.
 
 /// The panoramas twister renders (`--panorama`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, clap::ValueEnum)]
@@ -23,15 +23,19 @@ pub enum PanoramaKind {
     /// The stereo cubemap: the sphere's eye rays on the six 90° faces of a cube, one eye's
     /// image the 3×2 grid of YouTube's layout (`core::cubemap`).
     Cubemap,
+    /// CAVE walls: per wall and eye, the off-axis perspective image a tracked head's eye sees
+    /// on a rectangle in the scene (`core::cave`).
+    Cave,
 }
 
 impl PanoramaKind {
-    pub const ALL: [PanoramaKind; 5] = [
+    pub const ALL: [PanoramaKind; 6] = [
         PanoramaKind::Cylinder,
         PanoramaKind::Equirect,
         PanoramaKind::Vr180,
         PanoramaKind::Fisheye,
         PanoramaKind::Cubemap,
+        PanoramaKind::Cave,
     ];
 
     pub fn name(self) -> &'static str {
@@ -41,6 +45,7 @@ impl PanoramaKind {
             PanoramaKind::Vr180 => "vr180",
             PanoramaKind::Fisheye => "fisheye",
             PanoramaKind::Cubemap => "cubemap",
+            PanoramaKind::Cave => "cave",
         }
     }
 
@@ -73,12 +78,13 @@ impl PanoramaKind {
             PanoramaKind::Vr180 => Some("180"),
             PanoramaKind::Fisheye => Some("fisheye"),
             PanoramaKind::Cubemap => Some("cubemap"),
+            PanoramaKind::Cave => None,
         }
     }
 
     /// Whether the image's width is the whole turn (its left and right edges meet).
     pub const fn wraps(self) -> bool {
-        !matches!(self, PanoramaKind::Vr180 | PanoramaKind::Fisheye | PanoramaKind::Cubemap)
+        !matches!(self, PanoramaKind::Vr180 | PanoramaKind::Fisheye | PanoramaKind::Cubemap | PanoramaKind::Cave)
     }
 
     /// Its code in the WGSL projection uniform (`PANORAMA_CYLINDER`, `PANORAMA_EQUIRECT`).
@@ -89,6 +95,7 @@ impl PanoramaKind {
             PanoramaKind::Vr180 => 2,
             PanoramaKind::Fisheye => 3,
             PanoramaKind::Cubemap => 4,
+            PanoramaKind::Cave => 5,
         }
     }
 

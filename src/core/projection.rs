@@ -100,6 +100,8 @@ pub struct Projection {
     /// The cylinder: a tracked head away from the display's centre (`core::head`); None: the
     /// paper's eyes on the circle about the centre.
     pub head: Option<Head>,
+    /// The CAVE: the wall drawn, in the display's frame (`core::cave`); None elsewhere.
+    pub wall: Option<crate::core::cave::CaveWall>,
 }
 
 /// A tracked head before the cylinder (`core::head`, which has its maths): where the head is,
@@ -131,6 +133,7 @@ impl Default for Projection {
             fov: 180.0,
             dome_tilt: 0.0,
             head: None,
+            wall: None,
         }
     }
 }
@@ -219,6 +222,7 @@ impl Projection {
         self.validate_head()?;
         self.validate_fisheye()?;
         self.validate_cubemap()?;
+        self.validate_cave()?;
         if self.width < 2 || self.height < 2 || self.width > MAX_IMAGE_SIDE || self.height > MAX_IMAGE_SIDE {
             return Err(Error::setting(
                 "view.projection.width/height",
@@ -262,6 +266,11 @@ impl Projection {
         if !p.is_finite() {
             return None;
         }
+        if self.panorama == PanoramaKind::Cave {
+            // Before both eyes' planes (as `sees` in projection.wgsl), then this eye's.
+            let seen = self.cave_sees(p).then(|| self.cave_pixel(p, eye)).flatten();
+            return seen.map(|([x, y], depth)| Projected { u: x, v: y, depth });
+        }
         let seen = if self.panorama.is_sphere() { self.sphere_sees(p) } else { r > self.eye_radius };
         seen.then(|| self.project_with_azimuth(p, azimuth(p), eye))
     }
@@ -270,6 +279,10 @@ impl Projection {
     /// Points no eye sees are drawn with the offset clamped (they stay finite).
     pub fn project_with_azimuth(&self, p: Vec3, theta: f32, eye: Eye) -> Projected {
         let r = horizontal_radius(p);
+        if self.panorama == PanoramaKind::Cave {
+            let ([x, y], depth) = self.cave_pixel(p, eye).unwrap_or(([f32::NAN; 2], f32::NAN));
+            return Projected { u: x, v: y, depth };
+        }
         if self.panorama.is_sphere() {
             let d = self.sphere_eye_offset(r, p.y);
             let (lon, lat, depth) = self.sphere_at_offset(r, p.y, theta, eye.sign(), d);
@@ -293,6 +306,8 @@ impl Projection {
             PanoramaKind::Fisheye => self.fisheye_pixels_per_radian(),
             // A face's centre: F/2 pixels per radian (its least).
             PanoramaKind::Cubemap => 0.5 * self.cube_face_px(),
+            // The CAVE: v is the image row itself.
+            PanoramaKind::Cave => 1.0,
             p if p.is_sphere() => self.height as f32 / std::f32::consts::PI,
             _ => self.pixels_per_metre(),
         }
@@ -302,7 +317,7 @@ impl Projection {
     /// spans π); the fisheye and the cubemap, whose images have no seam, f32::MAX (x never
     /// wraps). `turn_px` in projection.wgsl.
     pub fn turn_px(&self) -> f32 {
-        if matches!(self.panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap) {
+        if matches!(self.panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap | PanoramaKind::Cave) {
             return f32::MAX;
         }
         self.width as f32 / self.panorama.turn_share()
@@ -323,6 +338,9 @@ impl Projection {
         if self.panorama == PanoramaKind::Cubemap {
             return self.cube_pixel(u, v);
         }
+        if self.panorama == PanoramaKind::Cave {
+            return [u, v]; // the CAVE's (u, v) are its image position
+        }
         let x = wrap_angle(u) / std::f32::consts::TAU * self.turn_px() + 0.5 * self.width as f32;
         let y = 0.5 * self.height as f32 - v * self.pixels_per_v();
         [x, y]
@@ -333,6 +351,9 @@ impl Projection {
     pub fn pixel_to_screen(&self, column: f32, row: f32) -> (f32, f32) {
         if self.panorama == PanoramaKind::Fisheye {
             return self.fisheye_direction_at(column + 0.5, row + 0.5);
+        }
+        if self.panorama == PanoramaKind::Cave {
+            return (column + 0.5, row + 0.5);
         }
         if self.panorama == PanoramaKind::Cubemap {
             let d = self.cube_direction_at(column + 0.5, row + 0.5);
@@ -347,7 +368,7 @@ impl Projection {
     /// the cylinder's half height over R_T (v = R_T·y/r); on the sphere tan 30° (about the
     /// cylinder's default view).
     pub fn fill_tan(&self) -> f32 {
-        if self.panorama.is_sphere() {
+        if self.panorama.is_sphere() || self.panorama == PanoramaKind::Cave {
             30f32.to_radians().tan()
         } else {
             self.half_height_m() / self.screen_radius
@@ -358,6 +379,9 @@ impl Projection {
     /// screen point (R_T sin u, v, −R_T cos u), on the sphere longitude u, latitude v.
     /// `screen_direction` in fragment.wgsl.
     pub fn screen_direction(&self, u: f32, v: f32) -> Vec3 {
+        if self.panorama == PanoramaKind::Cave {
+            return self.cave_point(u, v).normalize(); // the wall's point, seen from the head
+        }
         if self.panorama.is_sphere() {
             return Vec3::new(v.cos() * u.sin(), v.sin(), -v.cos() * u.cos());
         }
@@ -375,7 +399,7 @@ impl Projection {
     /// vertical models; on the sphere the latitude atan2(y, √(r² − e²)) ≥ atan(y/r), so
     /// k = 1/tan(π/2H) is safe for every eye offset.
     pub fn vertical_limit(&self) -> f32 {
-        if matches!(self.panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap) {
+        if matches!(self.panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap | PanoramaKind::Cave) {
             return f32::MAX; // the dome shows every altitude its field of view reaches; the cube all
         }
         if self.panorama.is_sphere() {
@@ -400,7 +424,7 @@ impl Projection {
     /// full turn (VR180: a turn is twice the width, so no two pixels of its image wrap; the
     /// fisheye and the cubemap: no wrap).
     pub fn wrapped_dx(&self, a: f32, b: f32) -> f32 {
-        if matches!(self.panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap) {
+        if matches!(self.panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap | PanoramaKind::Cave) {
             return (a - b).abs();
         }
         let w = self.turn_px();
@@ -448,7 +472,7 @@ impl Panorama for Projection {
             let (origin, ray) = self.sphere_ray(u, v, eye);
             return origin + r * ray;
         }
-        if self.head.is_some() {
+        if self.head.is_some() || self.panorama == PanoramaKind::Cave {
             // The depth is the distance from the eye along the pixel's ray.
             let (origin, ray) = pixel_ray(self, eye, Vec2::new(x, y));
             return origin + r * ray;
@@ -472,6 +496,10 @@ impl Panorama for Projection {
 /// model's ray; the paper model has no single ray per pixel and uses the same.
 pub fn pixel_ray(projection: &Projection, eye: Eye, frag_xy: Vec2) -> (Vec3, Vec3) {
     let (u, v) = projection.pixel_to_screen(frag_xy.x - 0.5, frag_xy.y - 0.5);
+    if projection.panorama == PanoramaKind::Cave {
+        let origin = projection.head_eye(eye);
+        return (origin, (projection.cave_point(u, v) - origin).normalize());
+    }
     if projection.panorama.is_sphere() {
         return projection.sphere_ray(u, v, eye);
     }

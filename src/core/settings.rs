@@ -476,6 +476,12 @@ impl RenderSettings {
                 ));
             }
             let panorama = self.view.projection.panorama;
+            if panorama == PanoramaKind::Cave {
+                return Err(Error::setting(
+                    "subdivision.method",
+                    format!("slit:{w}: a CAVE wall is one perspective per eye, which every method draws exactly: use vertex, or trace as the reference"),
+                ));
+            }
             if matches!(panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap) {
                 return Err(Error::setting(
                     "subdivision.method",

@@ -167,6 +167,7 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("PANORAMA_VR180", U32(PanoramaKind::Vr180.code())),
         ("PANORAMA_FISHEYE", U32(PanoramaKind::Fisheye.code())),
         ("PANORAMA_CUBEMAP", U32(PanoramaKind::Cubemap.code())),
+        ("PANORAMA_CAVE", U32(PanoramaKind::Cave.code())),
         ("NO_TEXTURE", U32(NO_TEXTURE)),
         ("WRAP_REPEAT", U32(Wrap::Repeat as u32)),
         ("WRAP_CLAMP", U32(Wrap::ClampToEdge as u32)),

@@ -4,7 +4,7 @@
 
 use glam::{Mat4, Vec2, Vec3};
 
-use crate::core::projection::{Eye, Projection};
+use crate::core::projection::{Eye, PanoramaKind, Projection};
 use crate::encoding::types::{SlitCamera, SlitParams};
 
 /// Distance of the slit cameras' near plane, metres.
@@ -46,6 +46,15 @@ fn camera(origin: Vec3, right: Vec3, up: Vec3, forward: Vec3, centre: Vec2, scal
 /// columns on the cylinder, tiles of `width` × `width` pixels on the sphere.
 pub fn slits(projection: &Projection, eye: Eye, width: u32) -> Vec<Slit> {
     let (w_img, h_img) = (projection.width, projection.height);
+    if projection.panorama == PanoramaKind::Cave {
+        return vec![Slit {
+            first_column: 0,
+            end_column: w_img,
+            first_row: 0,
+            end_row: h_img,
+            camera: cave_camera(projection, eye),
+        }];
+    }
     let column_ranges = (0..w_img.div_ceil(width)).map(move |k| (k * width, ((k + 1) * width).min(w_img)));
     let ndc_x = |c: f32| 2.0 * c / w_img as f32 - 1.0;
     // Clip-space x per radian of azimuth: 2/W pixels⁻¹ × W/2π (VR180: W/π) pixels per radian.
@@ -86,6 +95,22 @@ pub fn slits(projection: &Projection, eye: Eye, width: u32) -> Vec<Slit> {
             Slit { first_column: c0, end_column: c1, first_row: 0, end_row: h_img, camera }
         })
         .collect()
+}
+
+/// A CAVE wall's camera for one eye (`core::cave`): at the eye, looking into the wall along its
+/// normal, its right and up the wall's; the wall's image spans the NDC square, so the pinhole's
+/// x_c/z_c maps to the wall's fraction a with NDC 2a − 1 = cx + sx·x_c/z_c, sx = 2δ/|R|, cx =
+/// −2(C − E)·R̂/|R| − 1 (δ the eye's distance to the wall's plane), and likewise up.
+fn cave_camera(projection: &Projection, eye: Eye) -> SlitCamera {
+    let [corner, right, up] = projection.cave_wall();
+    let e = projection.head_eye(eye);
+    let forward = -right.cross(up).normalize();
+    let delta = (corner - e).dot(forward);
+    let (r, u) = (right.normalize(), up.normalize());
+    let scale = Vec2::new(2.0 * delta / right.length(), 2.0 * delta / up.length());
+    let centre =
+        Vec2::new(-2.0 * (corner - e).dot(r) / right.length() - 1.0, -2.0 * (corner - e).dot(u) / up.length() - 1.0);
+    camera(e, r, u, forward, centre, scale)
 }
 
 /// A viewer-frame point in a slit camera's coordinates (x_c right, y_c up, z_c forward).

@@ -31,7 +31,7 @@ pub struct DrawVertex {
     pub tangent: u32,
 }
 
-/// `Projection` in shaders/shared/projection.wgsl. 80 bytes.
+/// `Projection` in shaders/shared/projection.wgsl. 128 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct ProjectionUniform {
@@ -63,6 +63,14 @@ pub struct ProjectionUniform {
     /// The cubemap: the face a draw projects into (`core::cubemap::CUBE_FACES`); set per face
     /// draw by the raster stage, 0 elsewhere.
     pub face: u32,
+    /// The CAVE's wall in the display's frame (`core::cave::CaveWall`): its lower left corner,
+    /// right and up edges, metres.
+    pub wall_corner: [f32; 3],
+    pub wall_on: f32,
+    pub wall_right: [f32; 3],
+    pub _pad1: f32,
+    pub wall_up: [f32; 3],
+    pub _pad2: f32,
 }
 
 impl From<&ProjectionUniform> for Projection {
@@ -79,6 +87,11 @@ impl From<&ProjectionUniform> for Projection {
             fov: p.fov,
             dome_tilt: p.dome_tilt,
             head: (p.head_on != 0.0).then_some(crate::core::head::Head { offset: p.head_offset, turn: p.head_turn }),
+            wall: (p.wall_on != 0.0).then_some(crate::core::cave::CaveWall {
+                corner: p.wall_corner,
+                right: p.wall_right,
+                up: p.wall_up,
+            }),
         }
     }
 }
@@ -105,6 +118,12 @@ impl From<&Projection> for ProjectionUniform {
             head_turn: p.head.map_or(0.0, |h| h.turn),
             head_offset: p.head.map_or([0.0; 3], |h| h.offset),
             face: 0,
+            wall_corner: p.wall.map_or([0.0; 3], |w| w.corner),
+            wall_on: p.wall.is_some() as u32 as f32,
+            wall_right: p.wall.map_or([0.0; 3], |w| w.right),
+            _pad1: 0.0,
+            wall_up: p.wall.map_or([0.0; 3], |w| w.up),
+            _pad2: 0.0,
         }
     }
 }
@@ -466,7 +485,7 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("DrawVertex" => DrawVertex { position, theta_ref, normal, material, color, uv, object, tangent }),
     layout!("Projection" => ProjectionUniform {
         screen_radius, eye_radius, width, height, acos_eye_screen, vertical_exact, pixels_per_v, panorama,
-        convergence, pole_from, pole_to, turn_px, fov, dome_tilt, head_on, head_turn, head_offset, face
+        convergence, pole_from, pole_to, turn_px, fov, dome_tilt, head_on, head_turn, head_offset, face, wall_corner, wall_on, wall_right, _pad1, wall_up, _pad2
     }),
     layout!("SubdivideParams" => SubdivideParams {
         view, projection, axis_clearance, triangle_count, first_triangle, method, fixed_n, edge_px, max_div,

@@ -167,9 +167,13 @@ impl Renderer {
                 let shadow = self.shadow.get_or_init(|| ShadowStage::new(&self.gpu));
                 shadow.draw_maps(&self.gpu, scene, settings.view(), &shadow_maps)?;
             }
+            // A CAVE wall is a perspective: every projection method draws it exactly as one
+            // pinhole camera per eye, the slit stage's (`core::cave`), with no subdivision.
+            let cave = settings.projection().panorama == crate::core::projection::PanoramaKind::Cave;
             let method: &dyn Method = match settings.subdivision.method {
-                MethodName::Slit(_) => self.slit.get_or_init(|| SlitMethod::new(&self.gpu)),
                 MethodName::Trace => &self.trace,
+                MethodName::Slit(_) => self.slit.get_or_init(|| SlitMethod::new(&self.gpu)),
+                _ if cave => self.slit.get_or_init(|| SlitMethod::new(&self.gpu)),
                 _ => self.subdivided(),
             };
             let mut frame = method.draw(&self.gpu, &self.end, &mut resources, scene, settings)?;

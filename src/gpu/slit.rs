@@ -36,8 +36,10 @@ impl Method for SlitMethod {
         scene: &GpuScene,
         settings: &RenderSettings,
     ) -> Result<Frame> {
-        let crate::core::settings::Method::Slit(width) = settings.subdivision.method else {
-            unreachable!("the slit renderer draws slit:W")
+        // slit:W, or a CAVE wall's one camera per eye (every projection method: a perspective).
+        let width = match settings.subdivision.method {
+            crate::core::settings::Method::Slit(width) => width,
+            _ => settings.projection().width,
         };
         let start = Instant::now();
         let projection = settings.projection();

@@ -464,6 +464,8 @@ pub const SHARED: &[(&str, &str)] = &[
     ("projection_head_off", include_str!("../../shaders/shared/projection_head_off.wgsl")),
     ("projection_cubemap", include_str!("../../shaders/shared/projection_cubemap.wgsl")),
     ("projection_cubemap_off", include_str!("../../shaders/shared/projection_cubemap_off.wgsl")),
+    ("projection_cave", include_str!("../../shaders/shared/projection_cave.wgsl")),
+    ("projection_cave_off", include_str!("../../shaders/shared/projection_cave_off.wgsl")),
     ("scene", include_str!("../../shaders/shared/scene.wgsl")),
     ("subdivide_types", include_str!("../../shaders/shared/subdivide_types.wgsl")),
     ("subdivide_bindings", include_str!("../../shaders/shared/subdivide_bindings.wgsl")),
@@ -495,7 +497,7 @@ pub const SHARED: &[(&str, &str)] = &[
 pub type StandIn = (&'static str, &'static str);
 
 /// Every stand-in (the naga test validates each file composed with each one).
-pub const STAND_INS: &[StandIn] = &[ROWS_OFF, SPHERE_OFF, IN_PLACE_OFF, FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF];
+pub const STAND_INS: &[StandIn] = &[ROWS_OFF, SPHERE_OFF, IN_PLACE_OFF, FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF];
 
 /// `subdivide_rows` left out: the `lattice` pipeline of the frames that never draw rows.
 pub const ROWS_OFF: StandIn = ("subdivide_rows", "subdivide_rows_off");
@@ -515,6 +517,10 @@ pub const HEAD_OFF: StandIn = ("projection_head", "projection_head_off");
 /// `projection_cubemap` left out: every subdivide stage's pipeline (it measures a cubemap on the
 /// sphere, `Projection::measured`).
 pub const CUBEMAP_OFF: StandIn = ("projection_cubemap", "projection_cubemap_off");
+
+/// `projection_cave` left out: every subdivide stage's pipeline (a CAVE wall is drawn without
+/// subdivision).
+pub const CAVE_OFF: StandIn = ("projection_cave", "projection_cave_off");
 
 /// How the error target is written: as f32 (R32Float) or as its bits (R32Uint), for adapters
 /// that cannot render to R32Float.

@@ -411,3 +411,31 @@ impl Drop for TempDir {
         let _ = std::fs::remove_dir_all(&self.0);
     }
 }
+
+/// The walls of a CAVE, a 3 m cube about the origin (floor at y = −1.5): the front, the left
+/// and the floor, `pixels` square each.
+pub fn cave_walls(pixels: u32) -> Vec<twister::core::cave::NamedWall> {
+    let wall = |name: &str, lower_left: [f32; 3], lower_right: [f32; 3], upper_left: [f32; 3]| {
+        twister::core::cave::NamedWall { name: name.into(), lower_left, lower_right, upper_left, pixels: [pixels; 2] }
+    };
+    vec![
+        wall("front", [-1.5, -1.5, -1.5], [1.5, -1.5, -1.5], [-1.5, 1.5, -1.5]),
+        wall("left", [-1.5, -1.5, 1.5], [-1.5, -1.5, -1.5], [-1.5, 1.5, 1.5]),
+        wall("floor", [-1.5, -1.5, 1.5], [1.5, -1.5, 1.5], [-1.5, -1.5, -1.5]),
+    ]
+}
+
+/// CAVE wall `k` of [`cave_walls`] seen by a head at `head` (scene = display frame) facing
+/// `yaw` degrees: its projection.
+pub fn cave(k: usize, pixels: u32, head: glam::Vec3, yaw: f32) -> twister::Projection {
+    let wall = &cave_walls(pixels)[k];
+    twister::Projection {
+        panorama: twister::core::projection::PanoramaKind::Cave,
+        width: pixels,
+        height: pixels,
+        wall: Some(wall.in_display(1.0, glam::Vec3::ZERO, 0.0)),
+        head: Some(twister::core::head::Head::relative(head, yaw, glam::Vec3::ZERO, 0.0)),
+        vertical: twister::Vertical::Exact,
+        ..twister::Projection::default()
+    }
+}

@@ -63,6 +63,9 @@ impl Twin for Slit {
             "ball and MASK screen slit:4, 4 samples: alpha to coverage".into(),
             (screen, settings.with_samples(4)),
         ));
+        // A CAVE wall: every projection method draws it as one pinhole camera per eye.
+        let cave = common::cave(1, 96, glam::Vec3::new(0.2, 0.1, 0.3), 25.0);
+        cases.push(("demo on a CAVE's left wall".into(), (builtin::demo(), RenderSettings::new(cave))));
         let mut studio = common::lit_spheres();
         studio.environment = Some(common::studio(true));
         cases.push((
@@ -75,8 +78,11 @@ impl Twin for Slit {
         frame_outputs(&measured(scene, settings))
     }
     fn cpu((scene, settings): &Self::Case) -> Self::Output {
-        let Method::Slit(w) = settings.subdivision.method else { unreachable!() };
         let p = settings.projection();
+        let w = match settings.subdivision.method {
+            Method::Slit(w) => w,
+            _ => p.width, // a CAVE wall's one camera per eye
+        };
         let table = lit_table(scene, settings);
         let (background, samples) = (settings.shading.background, settings.shading.samples);
         Eye::BOTH.map(|eye| {

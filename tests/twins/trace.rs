@@ -119,6 +119,14 @@ impl Twin for Trace {
                 (builtin::demo(), RenderSettings::new(Projection::vr180(96)).with_method(Method::Trace)),
             ),
             (
+                "demo on a CAVE's floor".into(),
+                (
+                    builtin::demo(),
+                    RenderSettings::new(common::cave(2, 64, glam::Vec3::new(0.2, 0.1, 0.3), 25.0))
+                        .with_method(Method::Trace),
+                ),
+            ),
+            (
                 "demo on the cubemap".into(),
                 (builtin::demo(), RenderSettings::new(Projection::cubemap(96)).with_method(Method::Trace)),
             ),

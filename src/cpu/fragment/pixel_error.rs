@@ -17,6 +17,11 @@ pub fn pixel_spread(projection: &Projection, frag_xy: Vec2) -> f32 {
     if projection.panorama == PanoramaKind::Cubemap {
         return 1.0 / projection.pixels_per_v(); // a face's centre, where its pixels span the most
     }
+    if projection.panorama == PanoramaKind::Cave {
+        // A pixel's width at the wall's nearest point, seen from the head.
+        let [corner, right, up] = projection.cave_wall();
+        return right.length() / projection.width as f32 / corner.dot(right.cross(up).normalize()).abs();
+    }
     let (_, v) = projection.pixel_to_screen(frag_xy.x - 0.5, frag_xy.y - 0.5);
     let across = std::f32::consts::TAU / projection.turn_px();
     if projection.panorama.is_sphere() {
