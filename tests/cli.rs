@@ -224,6 +224,90 @@ fn bad_arguments_are_clear_errors() {
     }
 }
 
+/// CAVE walls (issue 34): the outputs named by wall and eye at each wall's pixels, the
+/// statistics one record per wall, a sequence's frames per wall along a head path; each misuse
+/// one line naming the option (and the file and wall), nothing written.
+#[test]
+fn cave_walls_are_written_by_name_and_their_misuses_are_one_line() {
+    let out = tmp("cave");
+    std::fs::create_dir_all(&out).unwrap();
+    let cave = out.join("cave.json");
+    let wall = |name: &str, ll: &str, lr: &str, ul: &str, px: &str| {
+        format!(r#"{{"name": "{name}", "lower_left": {ll}, "lower_right": {lr}, "upper_left": {ul}, "pixels": {px}}}"#)
+    };
+    let front = wall("front", "[-1.5,-1.5,-1.5]", "[1.5,-1.5,-1.5]", "[-1.5,1.5,-1.5]", "[64, 48]");
+    let floor = wall("floor", "[-1.5,-1.5,1.5]", "[1.5,-1.5,1.5]", "[-1.5,-1.5,-1.5]", "[32, 32]");
+    std::fs::write(&cave, format!(r#"{{"walls": [{front}, {floor}]}}"#)).unwrap();
+    let c = cave.to_str().unwrap();
+    let stats = out.join("stats.json");
+    let o = twister()
+        .args(["render", "builtin:demo", "--panorama", "cave", "--cave", c, "--head", "0.1,0,0.2,15", "--out"])
+        .arg(out.join("still"))
+        .args(["--stats", stats.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for (name, size) in [("front", (64, 48)), ("floor", (32, 32))] {
+        for eye in ["left", "right"] {
+            assert_eq!(png_size(&out.join(format!("still/{name}_{eye}.png"))), size, "{name} {eye}");
+        }
+    }
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    let walls: Vec<(&str, u64)> =
+        json.as_array().unwrap().iter().map(|r| (r["wall"].as_str().unwrap(), r["width"].as_u64().unwrap())).collect();
+    assert_eq!(walls, [("front", 64), ("floor", 32)]);
+    // A sequence along a head path: each frame's walls.
+    let path = out.join("head.csv");
+    std::fs::write(&path, "time,x,y,z,yaw\n0,0,0,0,0\n1,0.3,0.1,0.2,30\n").unwrap();
+    let o = twister()
+        .args(["render", "builtin:demo", "--panorama", "cave", "--cave", c, "--head-path", path.to_str().unwrap()])
+        .args(["--frames", "0..1", "--out"])
+        .arg(out.join("seq"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["frame_000000_front_left.png", "frame_000001_floor_right.png"] {
+        assert!(out.join("seq").join(f).exists(), "{f}");
+    }
+    let bad = out.join("bad.json");
+    std::fs::write(&bad, r#"{"walls": [{"name": "front""#).unwrap();
+    let b = bad.to_str().unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (&["--panorama", "cave", "--head", "0,0,0"], "--cave: --panorama cave draws the walls"),
+        (&["--panorama", "cave", "--cave", "/nonexistent/cave.json", "--head", "0,0,0"], "cannot open"),
+        (&["--panorama", "cave", "--cave", b, "--head", "0,0,0"], "--cave: "),
+        (&["--cave", c], "--cave: gives the walls of --panorama cave"),
+        (&["--panorama", "cave", "--cave", c], "--head: a CAVE wall is seen by a tracked head"),
+        (&["--panorama", "cave", "--cave", c, "--head", "0,0,0", "--width", "64"], "--width/--height: a CAVE's walls"),
+        (
+            &["--panorama", "cave", "--cave", c, "--head", "0,0,0", "--method", "slit:4"],
+            "--method: slit:4: a CAVE wall",
+        ),
+        (&["--panorama", "cave", "--cave", c, "--head", "0,0,-2"], "--cave: wall \"front\": faces away"),
+        (&["--panorama", "cave", "--cave", c, "--head", "0,-1.495,0"], "--cave: wall \"floor\": the left eye is"),
+        (&["--panorama", "cave", "--cave", c, "--head", "0,0,0", "--viewer", "camera"], "--viewer: a CAVE's walls"),
+        (
+            &["--panorama", "cave", "--cave", c, "--head", "0,0,0", "--frames", "0..1", "--video", "/tmp/x.mp4"],
+            "--video",
+        ),
+    ];
+    for (args, needle) in cases {
+        let o = twister()
+            .args(["render", "builtin:demo"])
+            .args(*args)
+            .arg("--out")
+            .arg(out.join("never"))
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{args:?} succeeded");
+        assert!(err.contains(needle) && err.lines().count() == 1, "{args:?}: {err}");
+        assert!(err.contains("bad.json") || !args.contains(&b), "{err}");
+    }
+    assert!(!out.join("never").exists(), "nothing written");
+    let _ = std::fs::remove_dir_all(&out);
+}
+
 #[test]
 fn subdivision_flags_take_effect_and_are_reported() {
     let out = tmp("flags");

@@ -282,6 +282,70 @@ fn the_cubemap_fills_its_faces_with_spheres_where_the_layout_puts_them() {
     });
 }
 
+/// CAVE walls (`--panorama cave`): the closed demo room leaves no wall's pixel to the
+/// background and the error pass reads zero for every projection method (a perspective: drawn
+/// exactly with no subdivision); small spheres land where the line from the eye through their
+/// centre meets the wall, built here in the scene from the head (the eyes d_e along its right,
+/// yaw positive turning left) and the wall's corners.
+#[test]
+fn cave_walls_show_the_room_whole_and_spheres_where_the_eyes_lines_meet_them() {
+    let (head, yaw) = (Vec3::new(0.2, 0.1, 0.3), 25.0f32);
+    let black = [0.0; 3];
+    for k in 0..3 {
+        let wall = common::cave(k, 96, head, yaw);
+        for method in [Method::Vertex, Method::Adaptive(Split::Error)] {
+            let settings =
+                RenderSettings::new(wall).with_method(method).with_background(black).with_measure_error(true);
+            let frame = common::render(&builtin::demo(), &settings);
+            for eye in Eye::BOTH {
+                let holes = common::pixels_where(frame.eye(eye), |p| common::is_background(p, black));
+                assert!(
+                    holes.is_empty(),
+                    "wall {k} {eye:?}: {} background pixels, e.g. {:?}",
+                    holes.len(),
+                    &holes[..holes.len().min(5)]
+                );
+            }
+            let e = &frame.measurement.as_ref().unwrap().stats;
+            assert!(e.count > 0 && e.mean < 1e-3 && e.max < 1e-2, "wall {k} {}: {e:?}", method.name());
+        }
+    }
+    // Spheres before the front wall, seen through it from both eyes.
+    let size = 256u32;
+    let front = common::cave(0, size, head, yaw);
+    let mut scene = Scene::new("probes");
+    let centres =
+        [Vec3::new(0.0, 0.0, -1.0), Vec3::new(-0.8, 0.5, -1.2), Vec3::new(0.7, -0.9, -2.5), Vec3::new(1.2, 1.0, -4.0)];
+    for (k, &c) in centres.iter().enumerate() {
+        let (v, i) = builtin::uv_sphere(c, 0.02 * (c - head).length(), 24, 13, [0.9, 0.2, 0.2, 1.0]);
+        scene.add_mesh(format!("probe {k}"), &v, &i);
+    }
+    let frame = common::render(&scene, &RenderSettings::new(front).with_measure_error(true));
+    let m = frame.measurement.as_ref().unwrap();
+    let gamma = yaw.to_radians();
+    for (k, eye) in Eye::BOTH.into_iter().enumerate() {
+        let e = head + eye.sign() * 0.032 * Vec3::new(gamma.cos(), 0.0, -gamma.sin());
+        for (object, &c) in centres.iter().enumerate() {
+            // The front wall: z = −1.5, x and y from −1.5 to 1.5.
+            let hit = e + (-1.5 - e.z) / (c.z - e.z) * (c - e);
+            let want = ((hit.x + 1.5) / 3.0 * size as f32, (1.0 - (hit.y + 1.5) / 3.0) * size as f32);
+            let pixels: Vec<(f32, f32)> = (m.object[k].iter().enumerate())
+                .filter(|(_, &id)| id == object as u32 + 1)
+                .map(|(p, _)| ((p as u32 % size) as f32 + 0.5, (p as u32 / size) as f32 + 0.5))
+                .collect();
+            let n = pixels.len() as f32;
+            assert!(n >= 4.0, "{c} {eye:?}: only {n} pixels");
+            let (x, y) = pixels.iter().fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
+            assert!(
+                (x - want.0).abs() < 0.35 && (y - want.1).abs() < 0.35,
+                "{c} {eye:?}: centroid ({x:.2}, {y:.2}), want ({:.2}, {:.2})",
+                want.0,
+                want.1
+            );
+        }
+    }
+}
+
 /// Reads a PNG's iTXt chunk `XML:com.adobe.xmp`, or a JPEG's XMP APP1 segment.
 fn xmp_of(path: &std::path::Path) -> String {
     let bytes = std::fs::read(path).unwrap();

@@ -311,6 +311,16 @@ pub fn parse_rgb(s: &str) -> std::result::Result<[f32; 3], String> {
     }
 }
 
+/// A CAVE wall's error with the wall named.
+fn name_wall(error: Error, wall: &str) -> Error {
+    match error {
+        Error::Setting { setting: "view.projection.wall", message } => {
+            Error::Setting { setting: "view.projection.wall", message: format!("wall {wall:?}: {message}") }
+        }
+        other => other,
+    }
+}
+
 impl ViewArgs {
     /// The render settings these options give for a command that draws with `methods` (the
     /// viewer of `camera[:N]` is placed with the scene, by `cli::scene::prepare`).
@@ -386,7 +396,10 @@ impl ViewArgs {
             }
             None => projection,
         };
-        projection.validate()?;
+        projection.validate().map_err(|e| match walls.first() {
+            Some(wall) => name_wall(e, &wall.name),
+            None => e,
+        })?;
         if !self.yaw.is_finite() {
             return Err(Error::option("--yaw", "must be a finite number of degrees"));
         }
@@ -464,12 +477,7 @@ impl ViewArgs {
                 let wall = w.in_display(self.scale, settings.view.viewer, settings.view.yaw_deg);
                 let projection =
                     Projection { width: w.pixels[0], height: w.pixels[1], wall: Some(wall), ..*settings.projection() };
-                projection.validate().map_err(|e| match crate::flags::for_user(e) {
-                    Error::Option { option, message } => {
-                        Error::Option { option, message: format!("wall {:?}: {message}", w.name) }
-                    }
-                    other => other,
-                })?;
+                projection.validate().map_err(|e| crate::flags::for_user(name_wall(e, &w.name)))?;
                 Ok((w.name.clone(), projection))
             })
             .collect()

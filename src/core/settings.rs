@@ -469,6 +469,12 @@ impl RenderSettings {
             return Err(Error::setting("subdivision.max_div", format!("must be between 1 and 64, got {}", s.max_div)));
         }
         if let Method::Slit(w) = s.method {
+            if self.view.projection.panorama == PanoramaKind::Cave {
+                return Err(Error::setting(
+                    "subdivision.method",
+                    format!("slit:{w}: a CAVE wall is one perspective per eye, which every method draws exactly: use vertex, or trace as the reference"),
+                ));
+            }
             if self.view.projection.head.is_some() {
                 return Err(Error::setting(
                     "subdivision.method",
@@ -476,12 +482,6 @@ impl RenderSettings {
                 ));
             }
             let panorama = self.view.projection.panorama;
-            if panorama == PanoramaKind::Cave {
-                return Err(Error::setting(
-                    "subdivision.method",
-                    format!("slit:{w}: a CAVE wall is one perspective per eye, which every method draws exactly: use vertex, or trace as the reference"),
-                ));
-            }
             if matches!(panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap) {
                 return Err(Error::setting(
                     "subdivision.method",
