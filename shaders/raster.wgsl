@@ -53,9 +53,10 @@ fn vs_main(in: VertexIn, eye_in: EyeIn) -> VertexOut {
     let theta = theta0 + TAU * floor((in.theta_ref - theta0) / TAU + 0.5);
     let uvd = project_with_azimuth(params.projection, in.position, theta, params.eye_sign);
     var out: VertexOut;
-    out.clip = to_clip(params.projection, uvd);
-    out.clip.x += 2.0 * params.shift_px.x / params.projection.width;
-    out.clip.y -= 2.0 * params.shift_px.y / params.projection.height;
+    out.clip = frame_clip(params.projection, uvd);
+    out.clip.x += 2.0 * params.shift_px.x / params.projection.width * out.clip.w;
+    out.clip.y -= 2.0 * params.shift_px.y / params.projection.height * out.clip.w;
+    out.clip = tile_clip(params.projection, out.clip);
     out.view_position = in.position;
     out.normal = in.normal;
     out.tangent = unpack_tangent(in.tangent);

@@ -60,8 +60,8 @@ fn vs_main(in: VertexIn) -> VertexOut {
     let z_c = dot(rel, cam.forward_sy.xyz);
     var out: VertexOut;
     // Depth 1 − near/z_c, kept below 1 however far (MAX_DEPTH).
-    out.clip = vec4<f32>(cam.right_cx.w * z_c + x_c * cam.origin_sx.w, cam.up_cy.w * z_c + y_c * cam.forward_sy.w,
-                         min(z_c - params.near, z_c * MAX_DEPTH), z_c);
+    out.clip = tile_clip(params.projection, vec4<f32>(cam.right_cx.w * z_c + x_c * cam.origin_sx.w,
+                         cam.up_cy.w * z_c + y_c * cam.forward_sy.w, min(z_c - params.near, z_c * MAX_DEPTH), z_c));
     out.view_position = p;
     out.normal = (params.view * vec4<f32>(in.normal, 0.0)).xyz;
     let t = unpack_tangent(in.tangent);

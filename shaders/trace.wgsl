@@ -446,24 +446,27 @@ fn write_background(slot: u32) {
 @compute @workgroup_size(8, 8, 1)
 fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
     let proj = params.projection;
-    if (gid.x >= u32(proj.width) || gid.y >= u32(proj.height)) {
+    // This draw's image: a tile of the frame, or the frame.
+    let size = vec2<u32>(proj.tile.zw);
+    if (gid.x >= size.x || gid.y >= size.y) {
         return;
     }
+    let pixel = vec2<f32>(gid.xy) + proj.tile.xy;
     let eye_sign = select(-1.0, 1.0, gid.z == 1u);
-    let slot = (gid.z * u32(proj.height) + gid.y) * params.row_texels + gid.x;
+    let slot = (gid.z * size.y + gid.y) * params.row_texels + gid.x;
     let n = params.samples;
     var rays = 0u;
     var tests = 0u;
     if (n > 1u) {
         // The centre's ray for the outputs alone (one sample is the centre's itself).
-        let centre = trace_sample(slot, eye_sign, vec2<f32>(gid.xy) + 0.5, SAMPLE_OUTPUTS);
+        let centre = trace_sample(slot, eye_sign, pixel + 0.5, SAMPLE_OUTPUTS);
         rays += centre.rays;
         tests += centre.tests;
     }
     var sum = vec3<f32>(0.0);
     var plain = 0u;
     for (var i = 0u; i < n; i++) {
-        let s = trace_sample(slot, eye_sign, vec2<f32>(gid.xy) + sample_position(n, i),
+        let s = trace_sample(slot, eye_sign, pixel + sample_position(n, i),
                              select(SAMPLE_COLOUR, SAMPLE_BOTH, n == 1u));
         sum += s.color;
         plain += u32(s.plain);
@@ -471,7 +474,7 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
         tests += s.tests;
     }
     // Counted per group of 64 pixels (a wrapping slot), so that no 32-bit counter overflows.
-    let count_slot = (((gid.z * u32(proj.height) + gid.y) * u32(proj.width) + gid.x) / 64u) % TRACE_COUNT_SLOTS;
+    let count_slot = (((gid.z * size.y + gid.y) * size.x + gid.x) / 64u) % TRACE_COUNT_SLOTS;
     atomicAdd(&counts[2u * count_slot], rays);
     atomicAdd(&counts[2u * count_slot + 1u], tests);
     // A pixel all background keeps the background's display value exactly.

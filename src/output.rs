@@ -88,19 +88,6 @@ impl Default for Encoding {
     }
 }
 
-/// Columns [start, start + width) of an image, wrapping around the panorama.
-pub fn columns(img: &EyeImage, start: u32, width: u32) -> EyeImage {
-    let mut rgba = Vec::with_capacity((4 * width * img.height) as usize);
-    for y in 0..img.height {
-        for k in 0..width {
-            let x = (start + k) % img.width;
-            let i = 4 * (y * img.width + x) as usize;
-            rgba.extend_from_slice(&img.rgba[i..i + 4]);
-        }
-    }
-    EyeImage { width, height: img.height, rgba }
-}
-
 /// The image with every pixel outside the projection's image (the fisheye's circle) transparent
 /// (RGBA 0, 0, 0, 0): `--alpha`.
 pub fn transparent_outside(img: &EyeImage, projection: &crate::core::projection::Projection) -> EyeImage {
@@ -109,33 +96,6 @@ pub fn transparent_outside(img: &EyeImage, projection: &crate::core::projection:
         let (x, y) = ((i as u32 % img.width) as f32 + 0.5, (i as u32 / img.width) as f32 + 0.5);
         if !projection.shows_pixel(x, y) {
             px.copy_from_slice(&[0; 4]);
-        }
-    }
-    out
-}
-
-/// The two eyes side by side, left on the left (4-byte texels, rows of `width`).
-fn side_by_side<T: Copy>(left: &[T], right: &[T], width: usize, per_texel: usize) -> Vec<T> {
-    left.chunks(width * per_texel)
-        .zip(right.chunks(width * per_texel))
-        .flat_map(|(l, r)| l.iter().chain(r))
-        .copied()
-        .collect()
-}
-
-/// Both eyes' cubemap grids (3×2 faces, rows of `width` texels of `per_texel` values) as one
-/// strip of their twelve faces: the left eye's six, then the right eye's, each in the grid's
-/// order.
-fn strip12<T: Copy>(left: &[T], right: &[T], width: usize, per_texel: usize) -> Vec<T> {
-    let face = width / 3;
-    let row_len = width * per_texel;
-    let cells: Vec<(&[T], usize, usize)> =
-        [left, right].iter().flat_map(|img| (0..6).map(move |k| (*img, k % 3, k / 3))).collect();
-    let mut out = Vec::with_capacity(12 * face * face * per_texel);
-    for y in 0..face {
-        for &(img, col, row) in &cells {
-            let start = (row * face + y) * row_len + col * face * per_texel;
-            out.extend_from_slice(&img[start..start + face * per_texel]);
         }
     }
     out
@@ -158,6 +118,61 @@ pub fn layout_names(layout: Layout, format: ImageFormat, panorama: PanoramaKind)
     }
 }
 
+/// One piece of a layout image's row: the eye (0 left, 1 right), the eye image's row, its
+/// first column and how many columns.
+pub type RowPiece = (usize, u32, u32, u32);
+
+/// The sizes of a layout's images, in the order of [`layout_names`], for eyes of `w` × `h`.
+pub fn layout_sizes(layout: Layout, [w, h]: [u32; 2]) -> Vec<[u32; 2]> {
+    match layout {
+        Layout::Eyes => vec![[w, h]; 2],
+        Layout::TopBottom => vec![[w, 2 * h]],
+        Layout::SideBySide => vec![[2 * w, h]],
+        Layout::Twister => vec![[w / 2, h], [w - w / 2, h], [w / 2, h], [w - w / 2, h]],
+        Layout::Strip12 => vec![[4 * w, h / 2]],
+    }
+}
+
+/// Row `row` of image `image` of a layout, as pieces of the eyes' rows (eyes of `w` × `h`): the
+/// one recipe that both the images in memory and the streamed ones of a tiled frame follow.
+pub fn layout_row(layout: Layout, image: usize, row: u32, [w, h]: [u32; 2]) -> Vec<RowPiece> {
+    match layout {
+        Layout::Eyes => vec![(image, row, 0, w)],
+        Layout::TopBottom => vec![((row >= h) as usize, row % h, 0, w)],
+        Layout::SideBySide => vec![(0, row, 0, w), (1, row, 0, w)],
+        // Each eye's middle half (its front), then the outer halves (its back, wrapping).
+        Layout::Twister => {
+            let (eye, half) = (image / 2, w / 2);
+            let (start, width) = if image % 2 == 0 { (w / 4, half) } else { (w / 4 + half, w - half) };
+            let first = width.min(w - start);
+            let mut pieces = vec![(eye, row, start, first)];
+            if width > first {
+                pieces.push((eye, row, 0, width - first));
+            }
+            pieces
+        }
+        // The left eye's six faces, then the right eye's, each in the grid's order.
+        Layout::Strip12 => {
+            let face = w / 3;
+            (0..12).map(|k| (k / 6, (k % 6 / 3) as u32 * face + row, (k % 3) as u32 * face, face)).collect()
+        }
+    }
+}
+
+/// A layout image's texels (`per_texel` values each) from both eyes' (rows of `w`).
+fn assemble<T: Copy>(eyes: [&[T]; 2], per_texel: usize, layout: Layout, eye_size: [u32; 2], image: usize) -> Vec<T> {
+    let [iw, ih] = layout_sizes(layout, eye_size)[image];
+    let w = eye_size[0] as usize;
+    let mut out = Vec::with_capacity(iw as usize * ih as usize * per_texel);
+    for row in 0..ih {
+        for (eye, src_row, x0, n) in layout_row(layout, image, row, eye_size) {
+            let start = (src_row as usize * w + x0 as usize) * per_texel;
+            out.extend_from_slice(&eyes[eye][start..start + n as usize * per_texel]);
+        }
+    }
+    out
+}
+
 /// The images of a layout, with their file names.
 pub fn layout_images(
     frame: &Frame,
@@ -165,38 +180,16 @@ pub fn layout_images(
     format: ImageFormat,
     panorama: PanoramaKind,
 ) -> Vec<(String, EyeImage)> {
-    let names = layout_names(layout, format, panorama);
-    let (w, h) = (frame.left.width, frame.left.height);
-    let images = match layout {
-        Layout::Eyes => vec![frame.left.clone(), frame.right.clone()],
-        Layout::TopBottom => {
-            let mut rgba = frame.left.rgba.clone();
-            rgba.extend_from_slice(&frame.right.rgba);
-            vec![EyeImage { width: w, height: 2 * h, rgba }]
-        }
-        Layout::SideBySide => {
-            vec![EyeImage {
-                width: 2 * w,
-                height: h,
-                rgba: side_by_side(&frame.left.rgba, &frame.right.rgba, w as usize, 4),
-            }]
-        }
-        Layout::Twister => {
-            let (quarter, half) = (w / 4, w / 2);
-            [&frame.left, &frame.right]
-                .iter()
-                .flat_map(|img| [columns(img, quarter, half), columns(img, quarter + half, w - half)])
-                .collect()
-        }
-        Layout::Strip12 => {
-            vec![EyeImage {
-                width: 4 * w,
-                height: h / 2,
-                rgba: strip12(&frame.left.rgba, &frame.right.rgba, w as usize, 4),
-            }]
-        }
-    };
-    names.into_iter().zip(images).collect()
+    let size = [frame.left.width, frame.left.height];
+    let eyes = [frame.left.rgba.as_slice(), frame.right.rgba.as_slice()];
+    layout_names(layout, format, panorama)
+        .into_iter()
+        .zip(layout_sizes(layout, size))
+        .enumerate()
+        .map(|(k, (name, [width, height]))| {
+            (name, EyeImage { width, height, rgba: assemble(eyes, 4, layout, size, k) })
+        })
+        .collect()
 }
 
 /// A single-channel float image (depth).
@@ -208,25 +201,19 @@ pub struct DepthImage {
 }
 
 /// The depth files of a layout (see the module doc), from a frame rendered with
-/// `measure.depth`; None without depth.
+/// `measure.depth`; None without depth. The eyes apart for the layouts of several images.
 pub fn depth_images(frame: &Frame, layout: Layout) -> Option<Vec<(String, DepthImage)>> {
     let [left, right] = frame.depth.as_ref()?;
-    let (w, h) = (frame.left.width, frame.left.height);
-    let images = match layout {
-        Layout::Eyes | Layout::Twister => vec![
-            DepthImage { width: w, height: h, values: left.clone() },
-            DepthImage { width: w, height: h, values: right.clone() },
-        ],
-        Layout::TopBottom => {
-            vec![DepthImage { width: w, height: 2 * h, values: left.iter().chain(right).copied().collect() }]
-        }
-        Layout::SideBySide => {
-            vec![DepthImage { width: 2 * w, height: h, values: side_by_side(left, right, w as usize, 1) }]
-        }
-        Layout::Strip12 => {
-            vec![DepthImage { width: 4 * w, height: h / 2, values: strip12(left, right, w as usize, 1) }]
-        }
+    let size = [frame.left.width, frame.left.height];
+    let layout = match layout {
+        Layout::Twister => Layout::Eyes,
+        other => other,
     };
+    let images = layout_sizes(layout, size).into_iter().enumerate().map(|(k, [width, height])| DepthImage {
+        width,
+        height,
+        values: assemble([left.as_slice(), right.as_slice()], 1, layout, size, k),
+    });
     Some(depth_names(layout).into_iter().zip(images).collect())
 }
 
@@ -329,6 +316,109 @@ pub fn image_file(path: PathBuf, img: &EyeImage, encoding: &Encoding) -> Result<
         }
     }
     Ok(OutputFile { path, bytes })
+}
+
+/// Encodes an image of `size` into file `temp` (the output `path`, for errors) row by row as
+/// `row(y)` gives them (RGBA, top first): PNG through a stream writer, JPEG through a
+/// row-pulling baseline encoder (both hold a few rows, never the image); with the XMP packet.
+pub fn stream_image(
+    path: &Path,
+    temp: &Path,
+    [width, height]: [u32; 2],
+    encoding: &Encoding,
+    mut row: impl FnMut(u32) -> Result<Vec<u8>>,
+) -> Result<()> {
+    use std::io::Write;
+    let fail = |e: &dyn std::fmt::Display| Error::output(path, format!("cannot encode: {e}"));
+    let file = std::fs::File::create(temp).map_err(|e| Error::output(path, format!("cannot write: {e}")))?;
+    let out = std::io::BufWriter::with_capacity(1 << 20, file);
+    match encoding.format {
+        ImageFormat::Png => {
+            let mut encoder = png::Encoder::new(out, width, height);
+            encoder.set_color(png::ColorType::Rgba);
+            encoder.set_depth(png::BitDepth::Eight);
+            if encoding.fast {
+                encoder.set_compression(png::Compression::Fast);
+            }
+            if let Some(xmp) = &encoding.xmp {
+                encoder.add_itxt_chunk("XML:com.adobe.xmp".into(), xmp.clone()).map_err(|e| fail(&e))?;
+            }
+            let mut writer = encoder.write_header().map_err(|e| fail(&e))?;
+            let mut stream = writer.stream_writer().map_err(|e| fail(&e))?;
+            for y in 0..height {
+                stream.write_all(&row(y)?).map_err(|e| fail(&e))?;
+            }
+            stream.finish().map_err(|e| fail(&e))?;
+        }
+        ImageFormat::Jpg => {
+            let (w, h) = match (u16::try_from(width), u16::try_from(height)) {
+                (Ok(w), Ok(h)) => (w, h),
+                _ => {
+                    return Err(fail(&format_args!(
+                        "{width}x{height} is beyond JPEG's 65535 pixels a side: use --format png"
+                    )))
+                }
+            };
+            let mut encoder = jpeg_encoder::Encoder::new(out, encoding.quality.clamp(1, 100));
+            if let Some(xmp) = &encoding.xmp {
+                encoder.add_app_segment(1, [JPEG_XMP_NAMESPACE, xmp.as_bytes()].concat()).map_err(|e| fail(&e))?;
+            }
+            let source = RowSource {
+                width: w,
+                height: h,
+                row: std::cell::RefCell::new(&mut row),
+                last: Default::default(),
+                error: Default::default(),
+            };
+            encoder.encode_image(&source).map_err(|e| fail(&e))?;
+            if let Some(e) = source.error.into_inner() {
+                return Err(e);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Rows for the JPEG encoder, pulled as it needs them (it asks for the last row again to pad the
+/// last block row: the last row read is kept); an error is kept and reported after.
+struct RowSource<'a, F: FnMut(u32) -> Result<Vec<u8>>> {
+    width: u16,
+    height: u16,
+    row: std::cell::RefCell<&'a mut F>,
+    last: std::cell::RefCell<Option<(u16, Vec<u8>)>>,
+    error: std::cell::RefCell<Option<Error>>,
+}
+
+impl<F: FnMut(u32) -> Result<Vec<u8>>> jpeg_encoder::ImageBuffer for &RowSource<'_, F> {
+    fn get_jpeg_color_type(&self) -> jpeg_encoder::JpegColorType {
+        jpeg_encoder::JpegColorType::Ycbcr
+    }
+    fn width(&self) -> u16 {
+        self.width
+    }
+    fn height(&self) -> u16 {
+        self.height
+    }
+    fn fill_buffers(&self, y: u16, buffers: &mut [Vec<u8>; 4]) {
+        let mut last = self.last.borrow_mut();
+        if last.as_ref().is_none_or(|(at, _)| *at != y) {
+            let rgba = match (self.row.borrow_mut())(y as u32) {
+                Ok(rgba) => rgba,
+                Err(e) => {
+                    self.error.borrow_mut().get_or_insert(e);
+                    vec![0; 4 * self.width as usize]
+                }
+            };
+            *last = Some((y, rgba));
+        }
+        let (_, rgba) = last.as_ref().expect("just read");
+        for px in rgba.chunks_exact(4) {
+            let (luma, cb, cr) = jpeg_encoder::rgb_to_ycbcr(px[0], px[1], px[2]);
+            buffers[0].push(luma);
+            buffers[1].push(cb);
+            buffers[2].push(cr);
+        }
+    }
 }
 
 /// A JPEG with an XMP APP1 segment inserted after SOI and the APP0 (JFIF) segment, if any.
@@ -471,9 +561,19 @@ fn process_alive(pid: u32) -> bool {
 /// then all are moved into place; if any step fails, the files already moved are put back as
 /// they were (earlier outputs restored) and the temporaries removed.
 pub fn write_all(files: &[OutputFile]) -> Result<()> {
-    check_outputs(&files.iter().map(|f| f.path.as_path()).collect::<Vec<_>>())?;
-    for f in files {
-        if let Some(dir) = f.path.parent().filter(|p| !p.as_os_str().is_empty()) {
+    let paths: Vec<PathBuf> = files.iter().map(|f| f.path.clone()).collect();
+    write_all_with(&paths, |k, temp| {
+        std::fs::write(temp, &files[k].bytes).map_err(|e| Error::output(&files[k].path, format!("cannot write: {e}")))
+    })
+}
+
+/// Writes the files at `paths` all or none, as [`write_all`]: `write(k, temporary)` writes file
+/// k's contents into a temporary beside it (streamed, for a tiled frame's images), then all are
+/// put in place together.
+pub fn write_all_with(paths: &[PathBuf], write: impl Fn(usize, &Path) -> Result<()>) -> Result<()> {
+    check_outputs(&paths.iter().map(|p| p.as_path()).collect::<Vec<_>>())?;
+    for path in paths {
+        if let Some(dir) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir)
                 .map_err(|e| Error::output(dir, format!("cannot create the output folder: {e}")))?;
             clean_stale_temporaries(dir);
@@ -482,18 +582,18 @@ pub fn write_all(files: &[OutputFile]) -> Result<()> {
     let mut temps: Vec<PathBuf> = Vec::new();
     let mut moved: Vec<(PathBuf, Option<PathBuf>)> = Vec::new(); // (output, its previous file)
     let result = (|| {
-        for f in files {
-            let temp = side_name(&f.path, "tmp");
+        for (k, path) in paths.iter().enumerate() {
+            let temp = side_name(path, "tmp");
             temps.push(temp.clone());
-            std::fs::write(&temp, &f.bytes).map_err(|e| Error::output(&f.path, format!("cannot write: {e}")))?;
+            write(k, &temp)?;
         }
-        for (f, temp) in files.iter().zip(&temps) {
-            let old = f.path.exists().then(|| side_name(&f.path, "old"));
+        for (path, temp) in paths.iter().zip(&temps) {
+            let old = path.exists().then(|| side_name(path, "old"));
             if let Some(old) = &old {
-                std::fs::rename(&f.path, old).map_err(|e| Error::output(&f.path, format!("cannot replace: {e}")))?;
+                std::fs::rename(path, old).map_err(|e| Error::output(path, format!("cannot replace: {e}")))?;
             }
-            moved.push((f.path.clone(), old));
-            std::fs::rename(temp, &f.path).map_err(|e| Error::output(&f.path, format!("cannot write: {e}")))?;
+            moved.push((path.clone(), old));
+            std::fs::rename(temp, path).map_err(|e| Error::output(path, format!("cannot write: {e}")))?;
         }
         Ok(())
     })();

@@ -92,16 +92,16 @@ fn fragment_coverage(in: VertexOut, front_facing: bool, params: FragmentView) ->
     let duv_dy = dpdy(in.uv);
     let dp_dx = dpdxFine(in.view_position);
     let dp_dy = dpdyFine(in.view_position);
-    if (CIRCLE && !shows_pixel(params.projection, in.clip.xy)) {
+    if (CIRCLE && !shows_pixel(params.projection, frame_xy(params.projection, in.clip.xy))) {
         discard; // outside the fisheye's circle
     }
     let c = surface_rgba(in.material, in.color, in.uv, duv_dx, duv_dy, front_facing);
     let alpha_width = mask_alpha_width(in.material, in.color.a, c.a, in.uv, duv_dx, duv_dy);
-    let mask = coverage_mask(in.material, c.a, alpha_width, in.clip.xy, SAMPLES);
+    let mask = coverage_mask(in.material, c.a, alpha_width, frame_xy(params.projection, in.clip.xy), SAMPLES);
     if (mask == 0u) {
         discard;
     }
-    let shaded = shade_surface(in.material, params.ambient, params.projection, params.eye_sign, in.clip.xy,
+    let shaded = shade_surface(in.material, params.ambient, params.projection, params.eye_sign, frame_xy(params.projection, in.clip.xy),
                                in.view_position, in.normal, in.tangent, vec4<f32>(c.rgb, max(c.a, 0.0)), in.uv,
                                duv_dx, duv_dy, dp_dx, dp_dy);
     return FragmentCoverage(shaded.display, shaded.linear, mask);
@@ -114,14 +114,14 @@ fn fragment_color(in: VertexOut, front_facing: bool, params: FragmentView) -> Fr
     let duv_dy = dpdy(in.uv);
     let dp_dx = dpdxFine(in.view_position);
     let dp_dy = dpdyFine(in.view_position);
-    if (CIRCLE && !shows_pixel(params.projection, in.clip.xy)) {
+    if (CIRCLE && !shows_pixel(params.projection, frame_xy(params.projection, in.clip.xy))) {
         discard; // outside the fisheye's circle
     }
-    let c = surface_color(in.material, in.color, in.uv, duv_dx, duv_dy, in.clip.xy, front_facing);
+    let c = surface_color(in.material, in.color, in.uv, duv_dx, duv_dy, frame_xy(params.projection, in.clip.xy), front_facing);
     if (MATERIALS && DISCARDS && c.a < 0.0) {
         discard;
     }
-    let shaded = shade_surface(in.material, params.ambient, params.projection, params.eye_sign, in.clip.xy,
+    let shaded = shade_surface(in.material, params.ambient, params.projection, params.eye_sign, frame_xy(params.projection, in.clip.xy),
                                in.view_position, in.normal, in.tangent, c, in.uv, duv_dx, duv_dy, dp_dx, dp_dy);
     return FragmentColor(shaded.display, shaded.linear);
 }
@@ -152,14 +152,14 @@ fn measured(in: VertexOut, front_facing: bool, params: FragmentView) -> Fragment
     // and the normal map's tangent frame).
     let dp_dx = dpdxFine(in.view_position);
     let dp_dy = dpdyFine(in.view_position);
-    if (CIRCLE && !shows_pixel(params.projection, in.clip.xy)) {
+    if (CIRCLE && !shows_pixel(params.projection, frame_xy(params.projection, in.clip.xy))) {
         discard; // outside the fisheye's circle
     }
-    let c = surface_color(in.material, in.color, in.uv, duv_dx, duv_dy, in.clip.xy, front_facing);
+    let c = surface_color(in.material, in.color, in.uv, duv_dx, duv_dy, frame_xy(params.projection, in.clip.xy), front_facing);
     if (MATERIALS && DISCARDS && c.a < 0.0) {
         discard;
     }
-    return fragment_out(params, in.clip.xy, in.view_position, dp_dx, dp_dy, in.normal, in.tangent, c, in.object,
+    return fragment_out(params, frame_xy(params.projection, in.clip.xy), in.view_position, dp_dx, dp_dy, in.normal, in.tangent, c, in.object,
                         in.material, in.uv, duv_dx, duv_dy);
 }
 
@@ -180,7 +180,8 @@ fn background_vertex(i: u32, eye: u32) -> BackgroundOut {
 
 // The environment's radiance along the pixel's own ray, tone mapped, and linear
 // (`fs_background`).
-fn background_color(params: FragmentView, frag_xy: vec2<f32>) -> FragmentColor {
+fn background_color(params: FragmentView, image_xy: vec2<f32>) -> FragmentColor {
+    let frag_xy = frame_xy(params.projection, image_xy);
     if (CIRCLE && !shows_pixel(params.projection, frag_xy)) {
         discard; // outside the fisheye's circle: the background colour
     }

@@ -21,7 +21,7 @@
 const PI: f32 = 3.14159265358979;
 const TAU: f32 = 6.28318530717959;
 
-// Mirrors `ProjectionUniform` in src/encoding/types.rs (128 bytes).
+// Mirrors `ProjectionUniform` in src/encoding/types.rs (144 bytes).
 struct Projection {
     screen_radius: f32,    // R_T, metres
     eye_radius: f32,       // d_e, metres
@@ -47,6 +47,7 @@ struct Projection {
     _pad1: f32,
     wall_up: vec3<f32>,
     _pad2: f32,
+    tile: vec4<f32>,       // this draw's part of the frame: x, y, width, height (pixels)
 }
 
 // The panoramas a pipeline can draw (bit 0 the cylinder, bit 1 the sphere: equirect, VR180, the
@@ -195,11 +196,29 @@ fn to_pixel(proj: Projection, u: f32, v: f32) -> vec2<f32> {
     return vec2<f32>(x, y);
 }
 
+// A clip position on the whole frame as this draw's tile has it (`Projection::tile_clip`).
+fn tile_clip(proj: Projection, clip: vec4<f32>) -> vec4<f32> {
+    let frame = vec2<f32>(proj.width, proj.height);
+    let scale = frame / proj.tile.zw;
+    let shift = vec2<f32>((frame.x - 2.0 * proj.tile.x) / proj.tile.z - 1.0, 1.0 - (frame.y - 2.0 * proj.tile.y) / proj.tile.w);
+    return vec4<f32>(clip.xy * scale + clip.w * shift, clip.zw);
+}
+
+// The frame's pixel position of a position in this draw's image (a tile's, or the frame's).
+fn frame_xy(proj: Projection, xy: vec2<f32>) -> vec2<f32> {
+    return xy + proj.tile.xy;
+}
+
 // Clip-space position of a projected point. u is NOT wrapped: the pre-pass places seam copies
 // at u ± 2π and the rasterizer clips them (and VR180's |u| > π/2). w = 1, so attributes interpolate linearly on the
 // screen as in the paper; depth r maps monotonically into (0, 1) as r / (r + 1).
 // y is kept within GUARD_BAND_PX of the image (constants.rs says why).
 fn to_clip(proj: Projection, uvd: vec3<f32>) -> vec4<f32> {
+    return tile_clip(proj, frame_clip(proj, uvd));
+}
+
+// The clip position on the whole frame (`to_clip` before the tile's).
+fn frame_clip(proj: Projection, uvd: vec3<f32>) -> vec4<f32> {
     let z = min(uvd.z / (uvd.z + 1.0), MAX_DEPTH);
     if (is_fisheye(proj)) {
         let xy = fisheye_pixel(proj, uvd.x, uvd.y);

@@ -40,7 +40,8 @@ pub struct ViewArgs {
     #[arg(long)]
     pub height: Option<u32>,
     /// Size preset of the full sphere (implies --panorama equirect): vr4k (4096×4096 top-bottom:
-    /// 4096×2048 per eye), vr6k (6144×6144), vr8k (8192×8192).
+    /// 4096×2048 per eye), vr6k (6144×6144), vr8k (8192×8192), vr16k (16384×16384: drawn in
+    /// tiles where the adapter's textures are smaller, written as rows arrive).
     #[arg(long, value_enum, conflicts_with_all = ["width", "height"])]
     pub preset: Option<Preset>,
     /// equirect: parallel (every eye ray tangent to the eye circle, Google ODS, Cycles
@@ -192,6 +193,7 @@ pub enum Preset {
     Vr4k,
     Vr6k,
     Vr8k,
+    Vr16k,
 }
 
 impl Preset {
@@ -201,6 +203,7 @@ impl Preset {
             Preset::Vr4k => 4096,
             Preset::Vr6k => 6144,
             Preset::Vr8k => 8192,
+            Preset::Vr16k => 16384,
         }
     }
 }
@@ -380,6 +383,7 @@ impl ViewArgs {
             fov: self.fov.unwrap_or(180.0),
             dome_tilt: self.dome_tilt.unwrap_or(0.0),
             wall: None,
+            tile: None,
             head: match (self.head, self.viewer) {
                 (None, _) => None,
                 (Some(_), Viewer::Camera(_)) => {
@@ -608,6 +612,11 @@ pub struct RenderArgs {
     /// fisheye: outside the circle transparent (alpha 0) instead of the background colour; PNG.
     #[arg(long)]
     pub alpha: bool,
+    /// The largest tile a still is drawn in, pixels a side (at least 16): a frame larger than
+    /// this, or than the adapter draws at once, is drawn in tiles and its images are written as
+    /// rows arrive, in bounded memory (colour only: no --depth, --hdr) [default: the adapter's].
+    #[arg(long, value_name = "PIXELS")]
+    pub max_tile: Option<u32>,
     /// Background colour R,G,B, each 0–255.
     #[arg(long, value_parser = parse_rgb, default_value = "26,26,31")]
     pub background: [f32; 3],

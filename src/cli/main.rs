@@ -13,6 +13,7 @@ mod plot;
 mod render;
 mod scene;
 mod sequence;
+mod tiled;
 mod writer;
 
 use std::process::ExitCode;

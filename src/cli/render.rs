@@ -48,6 +48,9 @@ pub fn render(args: &RenderArgs) -> Result<()> {
             return Err(Error::option(option, "belongs to a sequence: use it with --frames A..B"));
         }
     }
+    if let Some(side) = args.max_tile.filter(|&s| s < 16) {
+        return Err(Error::option("--max-tile", format!("must be at least 16 pixels, got {side}")));
+    }
     let settings = render_settings(args)?;
     let writer = FrameWriter::new(args, &settings, false)?;
     if args.lod_overlay && args.view.lod == LodMode::Off {
@@ -68,18 +71,33 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     let (renderer, adapter) = open_renderer()?;
     let method = [settings.subdivision.method];
     let prepared = prepare(&renderer, &args.scene, args.fit, &args.view, settings, args.lod_overlay, &method)?;
+    let views: Vec<(twister::RenderSettings, FrameWriter)> = views
+        .into_iter()
+        .map(|(wall, writer)| {
+            let settings = match wall {
+                Some(p) => prepared.settings.with_projection(twister::Projection {
+                    width: p.width,
+                    height: p.height,
+                    wall: p.wall,
+                    ..*prepared.settings.projection()
+                }),
+                None => prepared.settings,
+            };
+            (settings, writer)
+        })
+        .collect();
+    // Larger than the adapter draws at once (or --max-tile): in tiles, streamed (`tiled`).
+    let all: Vec<twister::RenderSettings> = views.iter().map(|(s, _)| *s).collect();
+    if crate::tiled::any_tiled(&renderer, &all, args.max_tile) {
+        for path in crate::tiled::render_streamed(args, &renderer, &prepared, &views, &adapter)? {
+            println!("{}", path.display());
+        }
+        return Ok(());
+    }
     let mut files = Vec::new();
     let mut records = Vec::new();
-    for (wall, writer) in &views {
-        let settings = match wall {
-            Some(p) => prepared.settings.with_projection(twister::Projection {
-                width: p.width,
-                height: p.height,
-                wall: p.wall,
-                ..*prepared.settings.projection()
-            }),
-            None => prepared.settings,
-        };
+    for (settings, writer) in &views {
+        let settings = *settings;
         let mut frame = renderer.render(&prepared.gpu_scene, &settings)?;
         if let (true, Some(gaze)) = (args.lod_overlay, &prepared.gaze) {
             for img in [&mut frame.left, &mut frame.right] {

@@ -311,7 +311,12 @@ fn write_frames(
 
 /// The options a sequence refuses (a still's outputs) and its frame rate.
 fn check_sequence_options(args: &RenderArgs) -> Result<()> {
-    for (given, option) in [(args.depth, "--depth"), (args.hdr, "--hdr"), (args.lod_overlay, "--lod-overlay")] {
+    for (given, option) in [
+        (args.depth, "--depth"),
+        (args.hdr, "--hdr"),
+        (args.lod_overlay, "--lod-overlay"),
+        (args.max_tile.is_some(), "--max-tile"),
+    ] {
         if given {
             return Err(Error::option(option, "writes one still: leave it out with --frames"));
         }

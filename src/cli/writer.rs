@@ -118,6 +118,36 @@ impl FrameWriter {
         names.iter().map(|name| self.path(frame, name)).collect()
     }
 
+    /// Image `image` of the layout (a still's), encoded into `temp` (the output `path`) row by
+    /// row from eyes of `eye_size` whose rows `read(eye, row, first column, columns)` gives
+    /// (RGBA): a tiled frame's images, streamed (`output::stream_image`); the fisheye's outside
+    /// made transparent with `--alpha`.
+    pub fn stream_image(
+        &self,
+        image: usize,
+        path: &std::path::Path,
+        temp: &std::path::Path,
+        eye_size: [u32; 2],
+        read: &mut dyn FnMut(usize, u32, u32, u32) -> Result<Vec<u8>>,
+    ) -> Result<()> {
+        let size = twister::output::layout_sizes(self.layout, eye_size)[image];
+        twister::output::stream_image(path, temp, size, &self.encoding, |row| {
+            let mut rgba = Vec::with_capacity(4 * size[0] as usize);
+            for (eye, src_row, x0, n) in twister::output::layout_row(self.layout, image, row, eye_size) {
+                let mut piece = read(eye, src_row, x0, n)?;
+                if let Some(projection) = &self.transparent_outside {
+                    for (k, px) in piece.chunks_exact_mut(4).enumerate() {
+                        if !projection.shows_pixel((x0 + k as u32) as f32 + 0.5, src_row as f32 + 0.5) {
+                            px.copy_from_slice(&[0; 4]);
+                        }
+                    }
+                }
+                rgba.extend_from_slice(&piece);
+            }
+            Ok(rgba)
+        })
+    }
+
     /// A frame's files, encoded: the layout's images, then depth and linear colour where the
     /// frame holds them.
     pub fn files(&self, rendered: &Frame, frame: Option<u32>) -> Result<Vec<OutputFile>> {
@@ -177,6 +207,9 @@ pub struct FrameRecord<'a> {
     /// A CAVE's wall.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub wall: Option<String>,
+    /// A frame drawn in tiles: how many.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tiles: Option<u32>,
     pub scene: &'a str,
     pub method: String,
     pub edge_px: f32,
@@ -240,6 +273,7 @@ impl<'a> FrameRecord<'a> {
             frame: None,
             time: None,
             wall: writer.wall.clone(),
+            tiles: None,
             scene,
             method: sub.method.name(),
             edge_px: sub.edge_px,

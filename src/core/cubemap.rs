@@ -170,18 +170,31 @@ impl Projection {
         )
     }
 
-    /// The planes (in clip space, `plane · clip ≥ 0` inside) of face `f`'s square on the grid:
-    /// what the GPU's scissor keeps of a draw of that face, for the CPU twin's clipping.
+    /// The planes (in this draw's clip space, `plane · clip ≥ 0` inside) of face `f`'s square
+    /// on the grid: what the GPU's scissor keeps of a draw of that face, for the CPU twin's
+    /// clipping (a tile's draw: the square in the tile's NDC).
     pub fn cube_face_planes(&self, f: usize) -> [Vec4; 4] {
-        let [col, row] = CUBE_FACES[f].cell.map(|c| c as f32);
-        let (x0, x1) = (2.0 * col / 3.0 - 1.0, 2.0 * (col + 1.0) / 3.0 - 1.0);
-        let (y0, y1) = (-row, 1.0 - row);
+        let [x0, y0, s] = self.cube_face_rect(f).map(|v| v as f32);
+        let (o, [w, h]) = (self.tile_origin(), self.image_size().map(|v| v as f32));
+        let ndc_x = |px: f32| 2.0 * (px - o.x) / w - 1.0;
+        let ndc_y = |py: f32| 1.0 - 2.0 * (py - o.y) / h;
+        let (left, right, bottom, top) = (ndc_x(x0), ndc_x(x0 + s), ndc_y(y0 + s), ndc_y(y0));
         [
-            Vec4::new(1.0, 0.0, 0.0, -x0),
-            Vec4::new(-1.0, 0.0, 0.0, x1),
-            Vec4::new(0.0, 1.0, 0.0, -y0),
-            Vec4::new(0.0, -1.0, 0.0, y1),
+            Vec4::new(1.0, 0.0, 0.0, -left),
+            Vec4::new(-1.0, 0.0, 0.0, right),
+            Vec4::new(0.0, 1.0, 0.0, -bottom),
+            Vec4::new(0.0, -1.0, 0.0, top),
         ]
+    }
+
+    /// Face `f`'s square within this draw's image (a tile's, or the frame's): [x, y, width,
+    /// height] in the image's pixels, None where the tile holds none of it (the draw's scissor).
+    pub fn cube_face_scissor(&self, f: usize) -> Option<[u32; 4]> {
+        let [x0, y0, s] = self.cube_face_rect(f);
+        let [tx, ty, tw, th] = self.tile.unwrap_or([0, 0, self.width, self.height]);
+        let (left, top) = (x0.max(tx), y0.max(ty));
+        let (right, bottom) = ((x0 + s).min(tx + tw), (y0 + s).min(ty + th));
+        (left < right && top < bottom).then(|| [left - tx, top - ty, right - left, bottom - top])
     }
 
     /// Face `f`'s square on the grid: [x, y, side] in pixels (the draw's scissor).
@@ -200,7 +213,7 @@ impl Projection {
             return *self;
         }
         let f = self.width / 3;
-        Projection { panorama: PanoramaKind::Equirect, width: 4 * f, height: 2 * f, ..*self }
+        Projection { panorama: PanoramaKind::Equirect, width: 4 * f, height: 2 * f, tile: None, ..*self }
     }
 }
 

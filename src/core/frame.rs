@@ -4,7 +4,7 @@
 use crate::core::projection::Eye;
 
 /// One eye's image, tightly packed RGBA8 rows, top row first.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct EyeImage {
     pub width: u32,
     pub height: u32,
@@ -126,6 +126,33 @@ pub struct FrameStats {
     pub ms_readback: f64,
     /// Wall time from the start of `render` to its end (read-backs and error reduction included).
     pub ms_total: f64,
+}
+
+impl FrameStats {
+    /// Adds a tile's statistics to a frame's drawn in tiles: counts and times summed, the
+    /// largest of the largest.
+    pub fn add_tile(&mut self, tile: &FrameStats) {
+        self.triangles_in = tile.triangles_in;
+        self.triangles_out += tile.triangles_out;
+        self.nodes_out += tile.nodes_out;
+        self.pieces += tile.pieces;
+        self.samples = tile.samples;
+        self.sampling.clone_from(&tile.sampling);
+        self.rays_traced = tile.rays_traced.map(|r| r + self.rays_traced.unwrap_or(0));
+        self.triangle_tests = tile.triangle_tests.map(|r| r + self.triangle_tests.unwrap_or(0));
+        self.max_sub_edge_px = self.max_sub_edge_px.max(tile.max_sub_edge_px);
+        self.chunks += tile.chunks;
+        self.max_pieces_per_invocation = self.max_pieces_per_invocation.max(tile.max_pieces_per_invocation);
+        self.max_output_per_invocation = self.max_output_per_invocation.max(tile.max_output_per_invocation);
+        self.ms_frame += tile.ms_frame;
+        self.timing = tile.timing;
+        let sum = |a: Option<f64>, b: Option<f64>| b.map(|b| b + a.unwrap_or(0.0));
+        self.ms_gpu = sum(self.ms_gpu, tile.ms_gpu);
+        self.ms_subdivide = sum(self.ms_subdivide, tile.ms_subdivide);
+        self.ms_raster = sum(self.ms_raster, tile.ms_raster);
+        self.ms_readback += tile.ms_readback;
+        self.ms_total += tile.ms_total;
+    }
 }
 
 pub struct Frame {

@@ -102,6 +102,9 @@ pub struct Projection {
     pub head: Option<Head>,
     /// The CAVE: the wall drawn, in the display's frame (`core::cave`); None elsewhere.
     pub wall: Option<crate::core::cave::CaveWall>,
+    /// A frame larger than the adapter draws is drawn in tiles: this draw's [x, y, width,
+    /// height] in the frame's pixels (the maps stay the frame's); None: the whole frame.
+    pub tile: Option<[u32; 4]>,
 }
 
 /// A tracked head before the cylinder (`core::head`, which has its maths): where the head is,
@@ -134,6 +137,7 @@ impl Default for Projection {
             dome_tilt: 0.0,
             head: None,
             wall: None,
+            tile: None,
         }
     }
 }
@@ -183,8 +187,9 @@ pub fn horizontal_radius(p: Vec3) -> f32 {
     (p.x * p.x + p.z * p.z).sqrt()
 }
 
-/// The largest image side a frame may have, in pixels, whatever the adapter.
-pub const MAX_IMAGE_SIDE: u32 = 16384;
+/// The largest image side a frame may have, in pixels, whatever the adapter (frames beyond the
+/// adapter's textures are drawn in tiles): JPEG's limit.
+pub const MAX_IMAGE_SIDE: u32 = 65535;
 
 impl Projection {
     pub fn validate(&self) -> Result<()> {
@@ -223,6 +228,18 @@ impl Projection {
         self.validate_fisheye()?;
         self.validate_cubemap()?;
         self.validate_cave()?;
+        if let Some([x, y, w, h]) = self.tile {
+            let inside = w > 0
+                && h > 0
+                && x.checked_add(w).is_some_and(|e| e <= self.width)
+                && y.checked_add(h).is_some_and(|e| e <= self.height);
+            if !inside {
+                return Err(Error::setting(
+                    "view.projection.tile",
+                    format!("must lie within the {}x{} frame, got {x},{y} {w}x{h}", self.width, self.height),
+                ));
+            }
+        }
         if self.width < 2 || self.height < 2 || self.width > MAX_IMAGE_SIDE || self.height > MAX_IMAGE_SIDE {
             return Err(Error::setting(
                 "view.projection.width/height",
@@ -292,6 +309,30 @@ impl Projection {
             return self.head_project(head, p, theta, eye);
         }
         Projected { u: theta + eye.sign() * self.eye_shift(r), v: self.screen_height(p.y, r), depth: r }
+    }
+
+    /// The size of the image this draw makes: the tile's, or the frame's.
+    pub fn image_size(&self) -> [u32; 2] {
+        self.tile.map_or([self.width, self.height], |[_, _, w, h]| [w, h])
+    }
+
+    /// Where this draw's image starts in the frame, pixels.
+    pub fn tile_origin(&self) -> Vec2 {
+        self.tile.map_or(Vec2::ZERO, |[x, y, _, _]| Vec2::new(x as f32, y as f32))
+    }
+
+    /// A clip position on the whole frame as the tile's draw has it (`tile_clip` in
+    /// projection.wgsl): NDC scaled by frame/tile and shifted, linear in clip space.
+    pub fn tile_clip(&self, clip: glam::Vec4) -> glam::Vec4 {
+        let Some([x, y, w, h]) = self.tile else { return clip };
+        let (fw, fh) = (self.width as f32, self.height as f32);
+        let (x, y, w, h) = (x as f32, y as f32, w as f32, h as f32);
+        glam::Vec4::new(
+            clip.x * fw / w + clip.w * ((fw - 2.0 * x) / w - 1.0),
+            clip.y * fh / h + clip.w * (1.0 - (fh - 2.0 * y) / h),
+            clip.z,
+            clip.w,
+        )
     }
 
     /// Pixels per metre of screen (square pixels): W / (2π·R_T). The cylinder only.
@@ -526,8 +567,9 @@ pub fn ray_hit_points(projection: &Projection, distances: &[Vec<f32>; 2]) -> [Ve
                 if !t.is_finite() {
                     return [f32::NAN; 3];
                 }
-                let (x, y) = ((i as u32 % projection.width) as f32 + 0.5, (i as u32 / projection.width) as f32 + 0.5);
-                let (o, d) = pixel_ray(projection, eye, Vec2::new(x, y));
+                let w = projection.image_size()[0];
+                let (x, y) = ((i as u32 % w) as f32 + 0.5, (i as u32 / w) as f32 + 0.5);
+                let (o, d) = pixel_ray(projection, eye, Vec2::new(x, y) + projection.tile_origin());
                 (o + t * d).to_array()
             })
             .collect()

@@ -31,33 +31,32 @@ pub fn raster_vertex(params: &RasterParams, v: &DrawVertex) -> Vec4 {
     let eye = if params.eye_sign > 0.0 { Eye::Right } else { Eye::Left };
     let q = projection.project_with_azimuth(p, theta, eye);
     let depth = (q.depth / (q.depth + 1.0)).min(crate::encoding::constants::MAX_DEPTH);
+    let clip = frame_clip(&projection, q.u, q.v, depth, params.projection.face as usize);
+    // The test hook's shift, in pixels of the frame; then the tile's part of it.
+    let (w, h) = (projection.width as f32, projection.height as f32);
+    let shifted = clip + Vec4::new(2.0 * params.shift_px[0] / w, -2.0 * params.shift_px[1] / h, 0.0, 0.0) * clip.w;
+    projection.tile_clip(shifted)
+}
+
+/// The clip position on the whole frame of screen point (u, v) at depth `depth` (0..1)
+/// (`frame_clip` in projection.wgsl; the cubemap: for the draw of face `face`).
+fn frame_clip(projection: &Projection, u: f32, v: f32, depth: f32, face: usize) -> Vec4 {
     if projection.panorama == PanoramaKind::Cubemap {
-        return projection.cube_clip(crate::core::cubemap::direction(q.u, q.v), depth, params.projection.face as usize);
+        return projection.cube_clip(crate::core::cubemap::direction(u, v), depth, face);
     }
     if projection.panorama == PanoramaKind::Fisheye {
-        let [x, y] = projection.fisheye_pixel(q.u, q.v);
+        let [x, y] = projection.fisheye_pixel(u, v);
         let (w, h) = (projection.width as f32, projection.height as f32);
-        return Vec4::new(
-            2.0 * (x + params.shift_px[0]) / w - 1.0,
-            1.0 - 2.0 * (y + params.shift_px[1]) / h,
-            depth,
-            1.0,
-        );
+        return Vec4::new(2.0 * x / w - 1.0, 1.0 - 2.0 * y / h, depth, 1.0);
     }
     let half_height = 0.5 * projection.height as f32;
     let y_limit = 1.0 + GUARD_BAND_PX / half_height;
-    let mut y = (q.v * projection.pixels_per_v() / half_height).clamp(-y_limit, y_limit);
+    let mut y = (v * projection.pixels_per_v() / half_height).clamp(-y_limit, y_limit);
     // The sphere: beyond the centre of the first (last) row, on the image's edge (the pole).
     if projection.panorama.is_sphere() && y.abs() > 1.0 - 1.0 / projection.height as f32 {
         y = y.signum();
     }
-    Vec4::new(
-        q.u * projection.turn_px() / (std::f32::consts::PI * projection.width as f32)
-            + 2.0 * params.shift_px[0] / projection.width as f32,
-        y - 2.0 * params.shift_px[1] / projection.height as f32,
-        depth,
-        1.0,
-    )
+    Vec4::new(u * projection.turn_px() / (std::f32::consts::PI * projection.width as f32), y, depth, 1.0)
 }
 
 /// A vertex ready for rasterization.
@@ -350,7 +349,10 @@ pub fn raster(
     background: [f32; 3],
 ) -> [RasterImage; 2] {
     let projection = Projection::from(&params[0].projection);
-    let mut images = params.map(|_| RasterImage::new(projection.width, projection.height, background));
+    // This draw's image: a tile of the frame, or the frame (its fragments at the frame's pixels).
+    let [width, height] = projection.image_size();
+    let origin = projection.tile_origin();
+    let mut images = params.map(|_| RasterImage::new(width, height, background));
     if shows_environment(table) {
         for (img, eye) in images.iter_mut().zip(Eye::BOTH) {
             fill_background(img, table, &projection, eye);
@@ -371,9 +373,11 @@ pub fn raster(
             for ((eye_params, eye), img) in params.iter().zip(Eye::BOTH).zip(images.iter_mut()) {
                 let cv = clip_vertices(eye_params, tri);
                 let fragment = |f: &FragmentIn| {
-                    fragment(table, eye_params.ambient, &projection, eye, eye_params.error_angle != 0, f)
+                    let mut f = *f;
+                    f.surface.frag_xy += origin;
+                    fragment(table, eye_params.ambient, &projection, eye, eye_params.error_angle != 0, &f)
                 };
-                rasterize_within(img, cv, planes, [0, projection.width, 0, projection.height], &fragment);
+                rasterize_within(img, cv, planes, [0, width, 0, height], &fragment);
             }
         }
     }
@@ -398,11 +402,12 @@ pub(crate) fn clip_vertices(params: &RasterParams, tri: &[DrawVertex]) -> [ClipV
 pub fn fill_background(img: &mut RasterImage, table: &MaterialTable, projection: &Projection, eye: Eye) {
     for y in 0..img.height {
         for x in 0..img.width {
-            if !projection.shows_pixel(x as f32 + 0.5, y as f32 + 0.5) {
+            let at = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + projection.tile_origin();
+            if !projection.shows_pixel(at.x, at.y) {
                 continue; // outside the fisheye's circle: the background colour
             }
             let i = 4 * (y * img.width + x) as usize;
-            let c = background_color(table, projection, eye, Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+            let c = background_color(table, projection, eye, at);
             img.rgba[i..i + 4].copy_from_slice(&c);
         }
     }

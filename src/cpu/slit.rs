@@ -45,12 +45,13 @@ pub fn slit_vertex(params: &SlitParams, camera: &SlitCamera, p: Vec3) -> Vec4 {
     let c = camera_coordinates(camera, p);
     // Depth 1 − near/z_c, kept below 1 however far (MAX_DEPTH).
     let z = (c.z - params.near).min(c.z * crate::encoding::constants::MAX_DEPTH);
-    Vec4::new(
+    let clip = Vec4::new(
         camera.right_cx[3] * c.z + c.x * camera.origin_sx[3],
         camera.up_cy[3] * c.z + c.y * camera.forward_sy[3],
         z,
         c.z,
-    )
+    );
+    Projection::from(&params.projection).tile_clip(clip)
 }
 
 /// The slit stage on the CPU for one eye.
@@ -63,11 +64,17 @@ pub fn slit(
 ) -> RasterImage {
     let projection = Projection::from(&params.projection);
     let eye = if params.eye_sign > 0.0 { Eye::Right } else { Eye::Left };
-    let mut img = RasterImage::new(projection.width, projection.height, background);
+    let [width, height] = projection.image_size();
+    let mut img = RasterImage::new(width, height, background);
     if crate::cpu::fragment::shows_environment(table) {
         crate::cpu::raster::fill_background(&mut img, table, &projection, eye);
     }
-    let fragment = |f: &FragmentIn| fragment(table, params.ambient, &projection, eye, params.error_angle != 0, f);
+    // Fragments at the frame's pixels (a tile's draw starts at its origin).
+    let fragment = |f: &FragmentIn| {
+        let mut f = *f;
+        f.surface.frag_xy += projection.tile_origin();
+        fragment(table, params.ambient, &projection, eye, params.error_angle != 0, &f)
+    };
     slit_triangles(params, slits, scene, |tri, scissor| rasterize(&mut img, tri, scissor, &fragment));
     img
 }
@@ -122,7 +129,9 @@ fn slit_triangles(params: &SlitParams, slits: &[Slit], scene: &Scene, mut draw: 
                         material: v.material,
                     }
                 });
-                draw(cv, [slit.first_column, slit.end_column, slit.first_row, slit.end_row]);
+                if let Some([x, y, w, h]) = slit.scissor(&Projection::from(&params.projection)) {
+                    draw(cv, [x, x + w, y, y + h]);
+                }
             }
         }
     }

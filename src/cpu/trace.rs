@@ -195,9 +195,11 @@ pub fn trace(params: &TraceParams, vertices: &[SceneVertex], bvh: &SceneBvh, tab
     let [r, g, b, _] = params.background;
     let images = Eye::BOTH.map(|eye| {
         // The image's background is given in display values, as `RasterImage::new` takes it.
-        let mut img = RasterImage::new(projection.width, projection.height, [r, g, b]);
-        for y in 0..projection.height {
-            for x in 0..projection.width {
+        // This draw's image: a tile of the frame, or the frame.
+        let [w, h] = projection.image_size();
+        let mut img = RasterImage::new(w, h, [r, g, b]);
+        for y in 0..h {
+            for x in 0..w {
                 tracer.trace_pixel(eye, x, y, &mut img);
             }
         }
@@ -460,8 +462,8 @@ impl<'a> Tracer<'a> {
     /// the error, object and distance outputs from the centre's ray.
     fn trace_pixel(&self, eye: Eye, x: u32, y: u32, img: &mut RasterImage) {
         let n = self.params.samples.max(1);
-        let corner = Vec2::new(x as f32, y as f32);
-        let i = (y * self.projection.width + x) as usize;
+        let corner = Vec2::new(x as f32, y as f32) + self.projection.tile_origin();
+        let i = (y * self.projection.image_size()[0] + x) as usize;
         if n > 1 {
             // The centre's ray for the outputs alone (one sample is the centre's itself).
             self.trace_sample(eye, corner + 0.5, Some((i, &mut *img)), false);

@@ -113,6 +113,17 @@ fn cave_camera(projection: &Projection, eye: Eye) -> SlitCamera {
     camera(e, r, u, forward, centre, scale)
 }
 
+impl Slit {
+    /// The slit's pixels within this draw's image (a tile's, or the frame's): [x, y, width,
+    /// height] in the image's pixels, None where the tile holds none of them (the scissor).
+    pub fn scissor(&self, projection: &Projection) -> Option<[u32; 4]> {
+        let [tx, ty, tw, th] = projection.tile.unwrap_or([0, 0, projection.width, projection.height]);
+        let (left, top) = (self.first_column.max(tx), self.first_row.max(ty));
+        let (right, bottom) = (self.end_column.min(tx + tw), self.end_row.min(ty + th));
+        (left < right && top < bottom).then(|| [left - tx, top - ty, right - left, bottom - top])
+    }
+}
+
 /// A viewer-frame point in a slit camera's coordinates (x_c right, y_c up, z_c forward).
 pub fn camera_coordinates(camera: &SlitCamera, p: Vec3) -> Vec3 {
     let rel = p - Vec3::from_slice(&camera.origin_sx[..3]);

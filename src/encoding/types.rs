@@ -31,7 +31,7 @@ pub struct DrawVertex {
     pub tangent: u32,
 }
 
-/// `Projection` in shaders/shared/projection.wgsl. 128 bytes.
+/// `Projection` in shaders/shared/projection.wgsl. 144 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct ProjectionUniform {
@@ -71,6 +71,9 @@ pub struct ProjectionUniform {
     pub _pad1: f32,
     pub wall_up: [f32; 3],
     pub _pad2: f32,
+    /// This draw's part of the frame: x, y, width, height in pixels (`Projection::tile`; the
+    /// whole frame when not tiled).
+    pub tile: [f32; 4],
 }
 
 impl From<&ProjectionUniform> for Projection {
@@ -92,6 +95,7 @@ impl From<&ProjectionUniform> for Projection {
                 right: p.wall_right,
                 up: p.wall_up,
             }),
+            tile: (p.tile != [0.0, 0.0, p.width, p.height]).then(|| p.tile.map(|v| v as u32)),
         }
     }
 }
@@ -124,6 +128,7 @@ impl From<&Projection> for ProjectionUniform {
             _pad1: 0.0,
             wall_up: p.wall.map_or([0.0; 3], |w| w.up),
             _pad2: 0.0,
+            tile: p.tile.unwrap_or([0, 0, p.width, p.height]).map(|v| v as f32),
         }
     }
 }
@@ -485,7 +490,7 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("DrawVertex" => DrawVertex { position, theta_ref, normal, material, color, uv, object, tangent }),
     layout!("Projection" => ProjectionUniform {
         screen_radius, eye_radius, width, height, acos_eye_screen, vertical_exact, pixels_per_v, panorama,
-        convergence, pole_from, pole_to, turn_px, fov, dome_tilt, head_on, head_turn, head_offset, face, wall_corner, wall_on, wall_right, _pad1, wall_up, _pad2
+        convergence, pole_from, pole_to, turn_px, fov, dome_tilt, head_on, head_turn, head_offset, face, wall_corner, wall_on, wall_right, _pad1, wall_up, _pad2, tile
     }),
     layout!("SubdivideParams" => SubdivideParams {
         view, projection, axis_clearance, triangle_count, first_triangle, method, fixed_n, edge_px, max_div,

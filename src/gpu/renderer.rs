@@ -10,7 +10,7 @@ use std::sync::{Mutex, OnceLock};
 
 use glam::Vec3;
 
-use crate::core::frame::Frame;
+use crate::core::frame::{EyeImage, Frame};
 use crate::core::projection::{Eye, Projection};
 use crate::core::scene::Scene;
 use crate::core::settings::{Method as MethodName, RenderSettings};
@@ -28,6 +28,26 @@ use crate::gpu::slit::SlitMethod;
 use crate::gpu::subdivided::SubdividedMethod;
 use crate::gpu::timestamps::Timestamps;
 use crate::gpu::trace::TraceMethod;
+
+/// The most bytes of both eyes' colour a strip of tiles holds (`Renderer::tiles`).
+pub const STRIP_BYTES: u64 = 128 << 20;
+
+/// A frame cut into tiles: the frame's size and the tiles' (the last column and strip may be
+/// smaller), drawn strip by strip.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Tiles {
+    pub width: u32,
+    pub height: u32,
+    pub tile_w: u32,
+    pub tile_h: u32,
+}
+
+impl Tiles {
+    /// How many tiles the frame has.
+    pub fn count(&self) -> u32 {
+        self.width.div_ceil(self.tile_w) * self.height.div_ceil(self.tile_h)
+    }
+}
 
 /// The renderer: the device, each method's driver and the stages they share, and the
 /// resources kept between frames.
@@ -102,6 +122,83 @@ impl Renderer {
         self.render_larger(scene, settings, &counts)
     }
 
+    /// How a frame is cut into tiles when it is larger than the adapter draws at once (its
+    /// texture side, its read-back buffer) or than `max_tile` pixels a side: None where it is
+    /// drawn whole. Tiles are at most the texture's side (divided by the larger image a sample
+    /// count beyond the adapter's needs), and strips of them (the frame's width, the tile's
+    /// height) hold at most `STRIP_BYTES` of both eyes' colour.
+    pub fn tiles(&self, settings: &RenderSettings, max_tile: Option<u32>) -> Option<Tiles> {
+        let p = settings.projection();
+        let (kx, ky) = self.larger_factor(settings);
+        let side = (self.gpu.limits.max_texture_dimension_2d / kx.max(ky)).min(max_tile.unwrap_or(u32::MAX)).max(16);
+        let padded_row = |w: u32| (4 * w as u64 * kx as u64).div_ceil(256) * 256;
+        let fits_buffer = |w: u32, h: u32| 2 * padded_row(w) * h as u64 * ky as u64 <= self.gpu.limits.max_buffer_size;
+        if p.width <= side
+            && p.height <= side
+            && fits_buffer(p.width, p.height)
+            && max_tile.is_none_or(|m| m >= p.width.max(p.height))
+        {
+            return None;
+        }
+        let tile_w = p.width.min(side);
+        let rows_buffer = (self.gpu.limits.max_buffer_size / (2 * padded_row(tile_w) * ky as u64)).max(1);
+        let rows_strip = (STRIP_BYTES / (8 * p.width as u64)).max(1);
+        let tile_h = (p.height.min(side) as u64).min(rows_buffer).min(rows_strip).max(1) as u32;
+        Some(Tiles { width: p.width, height: p.height, tile_w, tile_h })
+    }
+
+    /// A frame in tiles ([`Renderer::tiles`]), handed on strip by strip from the top: each
+    /// strip's first row and both eyes' images of it (the frame's width, the tile's height).
+    /// The outputs at the pixels' centres (depth, error, surface points, linear colour) are not
+    /// drawn. Returns the frame's statistics, summed over the tiles.
+    pub fn render_tiled(
+        &self,
+        scene: &GpuScene,
+        settings: &RenderSettings,
+        tiles: Tiles,
+        mut strip: impl FnMut(u32, [EyeImage; 2]) -> Result<()>,
+    ) -> Result<crate::core::frame::FrameStats> {
+        let settings = settings.with_measure_error(false).with_depth(false).with_positions(false).with_hdr(false);
+        let p = *settings.projection();
+        let mut stats = crate::core::frame::FrameStats::default();
+        for y in (0..tiles.height).step_by(tiles.tile_h as usize) {
+            let h = tiles.tile_h.min(tiles.height - y);
+            let mut eyes = [0, 1].map(|_| EyeImage {
+                width: tiles.width,
+                height: h,
+                rgba: vec![0; 4 * (tiles.width * h) as usize],
+            });
+            for x in (0..tiles.width).step_by(tiles.tile_w as usize) {
+                let w = tiles.tile_w.min(tiles.width - x);
+                let tile = settings.with_projection(Projection { tile: Some([x, y, w, h]), ..p });
+                let frame = self.render(scene, &tile)?;
+                for (eye, drawn) in eyes.iter_mut().zip([&frame.left, &frame.right]) {
+                    for row in 0..h as usize {
+                        let to = 4 * (row * tiles.width as usize + x as usize);
+                        eye.rgba[to..to + 4 * w as usize]
+                            .copy_from_slice(&drawn.rgba[4 * row * w as usize..4 * (row + 1) * w as usize]);
+                    }
+                }
+                stats.add_tile(&frame.stats);
+            }
+            strip(y, eyes)?;
+        }
+        Ok(stats)
+    }
+
+    /// How many times larger (x, y) a frame is drawn for a sample count beyond the adapter's
+    /// ([`Renderer::render_larger`]); (1, 1) where the adapter draws it.
+    fn larger_factor(&self, settings: &RenderSettings) -> (u32, u32) {
+        let n = settings.shading.samples;
+        let counts = crate::gpu::targets::sample_counts(&self.gpu);
+        if counts.contains(&n) || settings.subdivision.method == MethodName::Trace {
+            return (1, 1);
+        }
+        let base = counts.iter().copied().filter(|&c| n % c == 0 && c < n).max().unwrap_or(1);
+        let cells = n / base;
+        (1u32 << cells.ilog2().div_ceil(2), 1u32 << (cells.ilog2() / 2))
+    }
+
     /// `--samples N` beyond the adapter's counts: the colour drawn at a larger size with the
     /// most samples the adapter has that divide N (kx × ky pixels per pixel, kx·ky·base = N),
     /// then box-filtered in linear light ([`EyeImage::box_filtered`]). The subdivision's L and τ
@@ -111,12 +208,14 @@ impl Renderer {
     fn render_larger(&self, scene: &GpuScene, settings: &RenderSettings, counts: &[u32]) -> Result<Frame> {
         let n = settings.shading.samples;
         let base = counts.iter().copied().filter(|&c| n % c == 0 && c < n).max().unwrap_or(1);
-        let cells = n / base;
-        let (kx, ky) = (1u32 << cells.ilog2().div_ceil(2), 1u32 << (cells.ilog2() / 2));
+        let (kx, ky) = self.larger_factor(settings);
         let p = *settings.projection();
         let (width, height) = (p.width.saturating_mul(kx), p.height.saturating_mul(ky));
-        let max = self.gpu.limits.max_texture_dimension_2d;
-        if width > max || height > max {
+        let tile = p.tile.map(|[x, y, w, h]| [x * kx, y * ky, w * kx, h * ky]);
+        let [drawn_w, drawn_h] = p.image_size().map(|v| v as u64);
+        let max = self.gpu.limits.max_texture_dimension_2d as u64;
+        if drawn_w * kx as u64 > max || drawn_h * ky as u64 > max {
+            let (width, height) = (drawn_w * kx as u64, drawn_h * ky as u64);
             return Err(Error::setting(
                 "shading.samples",
                 format!(
@@ -131,7 +230,7 @@ impl Renderer {
             m => m,
         };
         let larger = settings
-            .with_projection(Projection { width, height, ..p })
+            .with_projection(Projection { width, height, tile, ..p })
             .with_method(method)
             .with_edge_px(settings.subdivision.edge_px * k)
             .with_max_error_px(settings.subdivision.max_error_px * k)
@@ -211,18 +310,22 @@ impl Renderer {
     /// Fails with one line when the image cannot be drawn on this device.
     fn check_size(&self, settings: &RenderSettings) -> Result<()> {
         let p = settings.projection();
+        let [width, height] = p.image_size();
         let max = self.gpu.limits.max_texture_dimension_2d;
-        if p.width > max || p.height > max {
+        if width > max || height > max {
             return Err(Error::setting(
                 "view.projection.width/height",
-                format!("{}x{} is larger than this GPU's largest image, {max}x{max}", p.width, p.height),
+                format!(
+                    "{width}x{height} is larger than this GPU's largest image, {max}x{max}: draw it in tiles \
+                     (`render` does where it can)"
+                ),
             ));
         }
         // Both eyes' colour targets are read back through one buffer (rows padded to 256
         // bytes); with the error pass, each eye's error target is bound as storage (both at once
         // when they fit one binding).
-        let padded_row = (4 * p.width as u64).div_ceil(256) * 256;
-        let eyes_bytes = 2 * padded_row * p.height as u64;
+        let padded_row = (4 * width as u64).div_ceil(256) * 256;
+        let eyes_bytes = 2 * padded_row * height as u64;
         let max_buffer = self.gpu.limits.max_buffer_size;
         let (limit, what) = if settings.measure.error {
             (max_buffer.min(2 * self.gpu.max_binding()), "the error pass's buffers")
@@ -234,8 +337,8 @@ impl Renderer {
                 "view.projection.width/height",
                 format!(
                     "{}x{} needs {} MiB for {what}, more than this GPU's {} MiB: use a smaller image",
-                    p.width,
-                    p.height,
+                    width,
+                    height,
                     eyes_bytes >> 20,
                     limit >> 20
                 ),

@@ -44,7 +44,8 @@ impl Method for SlitMethod {
         let start = Instant::now();
         let projection = settings.projection();
         let (positions, samples) = (settings.measure.positions, settings.shading.samples);
-        res.targets(gpu, projection.width, projection.height, positions, false, samples);
+        let [tile_w, tile_h] = projection.image_size();
+        res.targets(gpu, tile_w, tile_h, positions, false, samples);
         let res = &*res;
         let targets = res.targets.as_ref().expect("made");
         let view = settings.view();
@@ -81,12 +82,8 @@ impl Method for SlitMethod {
             pass.set_index_buffer(scene.indices.slice(..), wgpu::IndexFormat::Uint32);
             let first_instance = (k * eye_slits[0].len()) as u32;
             for (i, slit) in eye_slits[k].iter().enumerate() {
-                pass.set_scissor_rect(
-                    slit.first_column,
-                    slit.first_row,
-                    slit.end_column - slit.first_column,
-                    slit.end_row - slit.first_row,
-                );
+                let Some([x, y, w, h]) = slit.scissor(projection) else { continue }; // outside this tile
+                pass.set_scissor_rect(x, y, w, h);
                 let instance = first_instance + i as u32;
                 for (o, &center) in scene.objects.iter().zip(&centers) {
                     if sphere_in_slit(&params, slit, center, o.radius) {

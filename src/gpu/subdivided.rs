@@ -59,7 +59,8 @@ impl Method for SubdividedMethod {
         let start = Instant::now();
         let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, ..Default::default() };
         let p = settings.projection();
-        res.targets(gpu, p.width, p.height, settings.measure.positions, settings.shading.hdr, settings.shading.samples);
+        let [tile_w, tile_h] = p.image_size();
+        res.targets(gpu, tile_w, tile_h, settings.measure.positions, settings.shading.hdr, settings.shading.samples);
         let budget = Capacities::budget(settings.subdivision.memory_mb, gpu.max_binding());
         let n = scene.triangle_count;
         let mut plan = FramePlan::first(n, res.buffers.as_ref().map(|b| b.capacity), budget);
@@ -213,8 +214,10 @@ impl SubdividedMethod {
             pass.set_index_buffer(buffers.indices.slice(..), wgpu::IndexFormat::Uint32);
             for (bind_group, scissor) in &draws {
                 pass.set_bind_group(0, bind_group, &[]);
-                if let Some([x, y, side]) = *scissor {
-                    pass.set_scissor_rect(x, y, side, side);
+                match *scissor {
+                    Some(Some([x, y, w, h])) => pass.set_scissor_rect(x, y, w, h),
+                    Some(None) => continue, // a face outside this tile
+                    None => {}
                 }
                 pass.draw_indexed_indirect(&buffers.draw_args, 0);
             }
@@ -262,7 +265,7 @@ fn face_draws(
     stage: &crate::gpu::stages::GpuStage,
     uniform: &wgpu::Buffer,
     settings: &RenderSettings,
-) -> Vec<(wgpu::BindGroup, Option<[u32; 3]>)> {
+) -> Vec<(wgpu::BindGroup, Option<Option<[u32; 4]>>)> {
     let params = raster_params(settings);
     let size = std::mem::size_of_val(&params) as u64;
     let stride = crate::gpu::frame::raster_params_stride(gpu);
@@ -284,7 +287,7 @@ fn face_draws(
             gpu.queue.write_buffer(uniform, offset, bytemuck::cast_slice(&face_params));
             let binding = wgpu::BufferBinding { buffer: uniform, offset, size: wgpu::BufferSize::new(size) };
             let bind_group = stage.bind_group_ranges(gpu, None, 0, &[binding]);
-            (bind_group, face.map(|f| projection.cube_face_rect(f as usize)))
+            (bind_group, face.map(|f| projection.cube_face_scissor(f as usize)))
         })
         .collect()
 }

@@ -76,7 +76,8 @@ impl Method for TraceMethod {
             pass.set_pipeline(&pipelines[(scene.needs_materials || scene.has_optics || scene.pbr(settings)) as usize]);
             pass.set_bind_group(0, &bind_group, &[]);
             pass.set_bind_group(1, &materials, &[]);
-            pass.dispatch_workgroups(p.width.div_ceil(8), p.height.div_ceil(8), 2);
+            let [w, h] = p.image_size();
+            pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 2);
         }
         copy_to_targets(&mut enc, outputs, targets, row_texels, p);
         let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, chunks: 1, ..Default::default() };
@@ -106,24 +107,25 @@ impl TraceMethod {
     /// counters, made anew only when the size changed. Fails with one line where an output is
     /// more than the device binds.
     fn prepare_outputs(gpu: &Gpu, res: &mut FrameResources, p: &Projection) -> Result<u32> {
-        let row_texels = p.width.div_ceil(64) * 64;
-        let bytes = 4 * row_texels as u64 * p.height as u64 * 2;
+        let [width, height] = p.image_size();
+        let row_texels = width.div_ceil(64) * 64;
+        let bytes = 4 * row_texels as u64 * height as u64 * 2;
         if bytes > gpu.max_binding() {
             return Err(Error::setting(
                 "view.projection.width/height",
                 format!(
                     "{}x{} needs {} MiB per output of the ray tracer, more than this GPU binds ({} MiB): use a smaller image",
-                    p.width,
-                    p.height,
+                    width,
+                    height,
                     bytes >> 20,
                     gpu.max_binding() >> 20
                 ),
             ));
         }
-        res.targets(gpu, p.width, p.height, false, false, 1);
-        if !res.trace_outputs.as_ref().is_some_and(|(r, h, _)| *r == row_texels && *h == p.height) {
+        res.targets(gpu, width, height, false, false, 1);
+        if !res.trace_outputs.as_ref().is_some_and(|(r, h, _)| *r == row_texels && *h == height) {
             let make = |what: &str| gpu.storage_buffer(&format!("trace {what}"), bytes, wgpu::BufferUsages::empty());
-            res.trace_outputs = Some((row_texels, p.height, ["colour", "error", "object", "distance"].map(make)));
+            res.trace_outputs = Some((row_texels, height, ["colour", "error", "object", "distance"].map(make)));
         }
         let counts_bytes = 8 * TRACE_COUNT_SLOTS as u64;
         res.trace_counts
@@ -148,11 +150,11 @@ fn copy_to_targets(
                 layout: wgpu::TexelCopyBufferLayout {
                     offset: 0,
                     bytes_per_row: Some(4 * row_texels),
-                    rows_per_image: Some(p.height),
+                    rows_per_image: Some(p.image_size()[1]),
                 },
             },
             texture.as_image_copy(),
-            wgpu::Extent3d { width: p.width, height: p.height, depth_or_array_layers: 2 },
+            wgpu::Extent3d { width: p.image_size()[0], height: p.image_size()[1], depth_or_array_layers: 2 },
         );
     }
 }
