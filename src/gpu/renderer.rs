@@ -32,6 +32,11 @@ use crate::gpu::trace::TraceMethod;
 /// The most bytes of both eyes' colour a strip of tiles holds (`Renderer::tiles`).
 pub const STRIP_BYTES: u64 = 128 << 20;
 
+/// The most bytes of both eyes' colour a frame drawn whole holds (vr8k's 256 MiB is drawn whole;
+/// vr16k's 1 GiB in strips): beyond it the targets and the image would take memory without
+/// bound (vr16k drawn whole peaked at 14 GiB on the software driver).
+pub const WHOLE_FRAME_BYTES: u64 = 512 << 20;
+
 /// A frame cut into tiles: the frame's size and the tiles' (the last column and strip may be
 /// smaller), drawn strip by strip.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -123,8 +128,8 @@ impl Renderer {
     }
 
     /// How a frame is cut into tiles when it is larger than the adapter draws at once (its
-    /// texture side, its read-back buffer) or than `max_tile` pixels a side: None where it is
-    /// drawn whole. Tiles are at most the texture's side (divided by the larger image a sample
+    /// texture side, its read-back buffer), than `max_tile` pixels a side, or than
+    /// `WHOLE_FRAME_BYTES` of colour: None where it is drawn whole. Tiles are at most the texture's side (divided by the larger image a sample
     /// count beyond the adapter's needs), and strips of them (the frame's width, the tile's
     /// height) hold at most `STRIP_BYTES` of both eyes' colour.
     pub fn tiles(&self, settings: &RenderSettings, max_tile: Option<u32>) -> Option<Tiles> {
@@ -133,7 +138,9 @@ impl Renderer {
         let side = (self.gpu.limits.max_texture_dimension_2d / kx.max(ky)).min(max_tile.unwrap_or(u32::MAX)).max(16);
         let padded_row = |w: u32| (4 * w as u64 * kx as u64).div_ceil(256) * 256;
         let fits_buffer = |w: u32, h: u32| 2 * padded_row(w) * h as u64 * ky as u64 <= self.gpu.limits.max_buffer_size;
-        if p.width <= side
+        let small = 8 * p.width as u64 * p.height as u64 <= WHOLE_FRAME_BYTES;
+        if small
+            && p.width <= side
             && p.height <= side
             && fits_buffer(p.width, p.height)
             && max_tile.is_none_or(|m| m >= p.width.max(p.height))
