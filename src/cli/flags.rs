@@ -39,6 +39,7 @@ pub const FLAGS: &[(&str, &str)] = &[
     ("head_path", "--head-path"),
     ("cave", "--cave"),
     ("view.projection.wall", "--cave"),
+    ("view.projection.tile", "--max-tile"),
 ];
 
 /// The option that sets `setting`, if the command line has one.

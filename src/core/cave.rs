@@ -21,17 +21,9 @@ use std::path::Path;
 
 use glam::{Mat3, Vec3};
 
+pub use crate::core::projection::CaveWall;
 use crate::core::projection::{Eye, Head, PanoramaKind, Projection};
 use crate::error::{Error, Result};
-
-/// A CAVE wall in the display's frame, metres: its lower left corner, and its right and up edges
-/// (full width and height).
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
-pub struct CaveWall {
-    pub corner: [f32; 3],
-    pub right: [f32; 3],
-    pub up: [f32; 3],
-}
 
 /// A wall of a `--cave` file: its name (the outputs' prefix), three corners in scene units and
 /// its size in pixels.
@@ -134,7 +126,7 @@ impl Projection {
     pub(crate) fn validate_cave(&self) -> Result<()> {
         if self.panorama != PanoramaKind::Cave {
             if self.wall.is_some() {
-                return Err(Error::setting("view.projection.wall", "a wall belongs to --panorama cave"));
+                return Err(Error::setting("view.projection.wall", "a wall belongs to the CAVE panorama"));
             }
             return Ok(());
         }

@@ -23,6 +23,9 @@ use crate::core::frame::{EyeImage, Frame};
 use crate::core::projection::PanoramaKind;
 use crate::error::{Error, Result};
 
+mod stream;
+pub use stream::stream_image;
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Layout {
@@ -316,109 +319,6 @@ pub fn image_file(path: PathBuf, img: &EyeImage, encoding: &Encoding) -> Result<
         }
     }
     Ok(OutputFile { path, bytes })
-}
-
-/// Encodes an image of `size` into file `temp` (the output `path`, for errors) row by row as
-/// `row(y)` gives them (RGBA, top first): PNG through a stream writer, JPEG through a
-/// row-pulling baseline encoder (both hold a few rows, never the image); with the XMP packet.
-pub fn stream_image(
-    path: &Path,
-    temp: &Path,
-    [width, height]: [u32; 2],
-    encoding: &Encoding,
-    mut row: impl FnMut(u32) -> Result<Vec<u8>>,
-) -> Result<()> {
-    use std::io::Write;
-    let fail = |e: &dyn std::fmt::Display| Error::output(path, format!("cannot encode: {e}"));
-    let file = std::fs::File::create(temp).map_err(|e| Error::output(path, format!("cannot write: {e}")))?;
-    let out = std::io::BufWriter::with_capacity(1 << 20, file);
-    match encoding.format {
-        ImageFormat::Png => {
-            let mut encoder = png::Encoder::new(out, width, height);
-            encoder.set_color(png::ColorType::Rgba);
-            encoder.set_depth(png::BitDepth::Eight);
-            if encoding.fast {
-                encoder.set_compression(png::Compression::Fast);
-            }
-            if let Some(xmp) = &encoding.xmp {
-                encoder.add_itxt_chunk("XML:com.adobe.xmp".into(), xmp.clone()).map_err(|e| fail(&e))?;
-            }
-            let mut writer = encoder.write_header().map_err(|e| fail(&e))?;
-            let mut stream = writer.stream_writer().map_err(|e| fail(&e))?;
-            for y in 0..height {
-                stream.write_all(&row(y)?).map_err(|e| fail(&e))?;
-            }
-            stream.finish().map_err(|e| fail(&e))?;
-        }
-        ImageFormat::Jpg => {
-            let (w, h) = match (u16::try_from(width), u16::try_from(height)) {
-                (Ok(w), Ok(h)) => (w, h),
-                _ => {
-                    return Err(fail(&format_args!(
-                        "{width}x{height} is beyond JPEG's 65535 pixels a side: use --format png"
-                    )))
-                }
-            };
-            let mut encoder = jpeg_encoder::Encoder::new(out, encoding.quality.clamp(1, 100));
-            if let Some(xmp) = &encoding.xmp {
-                encoder.add_app_segment(1, [JPEG_XMP_NAMESPACE, xmp.as_bytes()].concat()).map_err(|e| fail(&e))?;
-            }
-            let source = RowSource {
-                width: w,
-                height: h,
-                row: std::cell::RefCell::new(&mut row),
-                last: Default::default(),
-                error: Default::default(),
-            };
-            encoder.encode_image(&source).map_err(|e| fail(&e))?;
-            if let Some(e) = source.error.into_inner() {
-                return Err(e);
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Rows for the JPEG encoder, pulled as it needs them (it asks for the last row again to pad the
-/// last block row: the last row read is kept); an error is kept and reported after.
-struct RowSource<'a, F: FnMut(u32) -> Result<Vec<u8>>> {
-    width: u16,
-    height: u16,
-    row: std::cell::RefCell<&'a mut F>,
-    last: std::cell::RefCell<Option<(u16, Vec<u8>)>>,
-    error: std::cell::RefCell<Option<Error>>,
-}
-
-impl<F: FnMut(u32) -> Result<Vec<u8>>> jpeg_encoder::ImageBuffer for &RowSource<'_, F> {
-    fn get_jpeg_color_type(&self) -> jpeg_encoder::JpegColorType {
-        jpeg_encoder::JpegColorType::Ycbcr
-    }
-    fn width(&self) -> u16 {
-        self.width
-    }
-    fn height(&self) -> u16 {
-        self.height
-    }
-    fn fill_buffers(&self, y: u16, buffers: &mut [Vec<u8>; 4]) {
-        let mut last = self.last.borrow_mut();
-        if last.as_ref().is_none_or(|(at, _)| *at != y) {
-            let rgba = match (self.row.borrow_mut())(y as u32) {
-                Ok(rgba) => rgba,
-                Err(e) => {
-                    self.error.borrow_mut().get_or_insert(e);
-                    vec![0; 4 * self.width as usize]
-                }
-            };
-            *last = Some((y, rgba));
-        }
-        let (_, rgba) = last.as_ref().expect("just read");
-        for px in rgba.chunks_exact(4) {
-            let (luma, cb, cr) = jpeg_encoder::rgb_to_ycbcr(px[0], px[1], px[2]);
-            buffers[0].push(luma);
-            buffers[1].push(cb);
-            buffers[2].push(cr);
-        }
-    }
 }
 
 /// A JPEG with an XMP APP1 segment inserted after SOI and the APP0 (JFIF) segment, if any.
