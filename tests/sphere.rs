@@ -362,14 +362,14 @@ fn frames_drawn_in_tiles_are_the_frames_drawn_whole() {
     let read = |dir: &str, name: &str| image::open(out.join(dir).join(name)).unwrap().to_rgba8();
     let cases: [(&[&str], &str, f64); 5] = [
         (
-            &["--panorama", "equirect", "--width", "256", "--method", "trace", "--samples", "1"],
+            &["--panorama", "equirect", "--width", "128", "--method", "trace", "--samples", "1"],
             "stereo_360_TB.png",
             0.0,
         ),
-        (&["--panorama", "equirect", "--width", "256"], "stereo_360_TB.png", 0.01),
-        (&["--width", "320", "--height", "80", "--method", "slit:4"], "left.png", 0.01),
-        (&["--panorama", "cubemap", "--width", "192", "--samples", "1"], "stereo_cubemap_TB.png", 0.01),
-        (&["--panorama", "fisheye", "--width", "128", "--alpha"], "left.png", 0.01),
+        (&["--panorama", "equirect", "--width", "128"], "stereo_360_TB.png", 0.01),
+        (&["--width", "160", "--height", "60", "--method", "slit:4"], "left.png", 0.01),
+        (&["--panorama", "cubemap", "--width", "144", "--samples", "1"], "stereo_cubemap_TB.png", 0.01),
+        (&["--panorama", "fisheye", "--width", "96", "--alpha"], "left.png", 0.01),
     ];
     for (k, (args, name, share)) in cases.into_iter().enumerate() {
         let (whole, tiled) = (format!("whole{k}"), format!("tiled{k}"));
@@ -388,7 +388,7 @@ fn frames_drawn_in_tiles_are_the_frames_drawn_whole() {
         }
     }
     // JPEG, streamed through its encoder: the same picture, its XMP, and the tiles counted.
-    let jpeg = ["--panorama", "equirect", "--width", "256", "--format", "jpg"];
+    let jpeg = ["--panorama", "equirect", "--width", "128", "--format", "jpg"];
     run("jpeg-whole", &jpeg);
     let stats = out.join("stats.json");
     run("jpeg-tiled", &[&jpeg[..], &["--max-tile", "48", "--stats", stats.to_str().unwrap()]].concat());
@@ -401,7 +401,41 @@ fn frames_drawn_in_tiles_are_the_frames_drawn_whole() {
         .get("ProjectionType")
         .is_some_and(|t| t == "equirectangular"));
     let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
-    assert_eq!(json["tiles"], 256u32.div_ceil(48) * 128u32.div_ceil(48), "{json}");
+    assert_eq!(json["tiles"], 128u32.div_ceil(48) * 64u32.div_ceil(48), "{json}");
+    // Depth and the linear colour stream too (OpenEXR, row by row): the same values (the ray
+    // tracer's depth exactly; the rasterizer's linear colour but for tie-broken edge pixels).
+    let depth = ["--panorama", "equirect", "--width", "128", "--method", "trace", "--samples", "1", "--depth"];
+    run("depth-whole", &depth);
+    run("depth-tiled", &[&depth[..], &["--max-tile", "40"]].concat());
+    let whole = common::read_exr(&out.join("depth-whole/depth_TB.exr"));
+    assert_eq!(whole, common::read_exr(&out.join("depth-tiled/depth_TB.exr")), "depth");
+    assert!(whole.2.iter().filter(|d| d.is_finite()).count() > 1000);
+    let hdr = ["--panorama", "equirect", "--width", "128", "--samples", "1", "--hdr", "--depth"];
+    run("hdr-whole", &hdr);
+    run("hdr-tiled", &[&hdr[..], &["--max-tile", "40"]].concat());
+    let rgb = |dir: &str| {
+        exr::prelude::read_first_rgba_layer_from_file(
+            out.join(dir).join("left_hdr.exr"),
+            |size, _| vec![[0.0f32; 3]; size.width() * size.height()],
+            |px: &mut Vec<[f32; 3]>, pos, (r, g, b, _): (f32, f32, f32, f32)| px[pos.y() * 128 + pos.x()] = [r, g, b],
+        )
+        .unwrap()
+        .layer_data
+        .channel_data
+        .pixels
+    };
+    let (a, b) = (rgb("hdr-whole"), rgb("hdr-tiled"));
+    // Off by more than f32's rounding of the pixel positions a tile adds its origin to.
+    let off = |p: &[f32; 3], q: &[f32; 3]| (0..3).any(|c| (p[c] - q[c]).abs() > 1e-3 * (1.0 + p[c].abs()));
+    let differ = a.iter().zip(&b).filter(|(p, q)| off(p, q)).count();
+    assert!(a.len() == 128 * 64 && differ * 100 <= a.len(), "the linear colour: {differ} pixels differ");
+    // A sequence's frames in tiles: each frame streamed as it is drawn, the same pixels.
+    let seq = ["--panorama", "equirect", "--width", "128", "--method", "trace", "--samples", "1", "--frames", "0..1"];
+    run("seq-whole", &seq);
+    run("seq-tiled", &[&seq[..], &["--max-tile", "40"]].concat());
+    for f in ["frame_000000_360_TB.png", "frame_000001_360_TB.png"] {
+        assert_eq!(read("seq-whole", f), read("seq-tiled", f), "{f}");
+    }
     // No spool is left beside the outputs.
     let left: Vec<String> = std::fs::read_dir(out.join("jpeg-tiled"))
         .unwrap()
@@ -410,8 +444,8 @@ fn frames_drawn_in_tiles_are_the_frames_drawn_whole() {
     assert!(left.iter().all(|n| !n.ends_with(".tmp")), "{left:?}");
     for (args, needle) in [
         (&["--max-tile", "8"][..], "--max-tile: must be at least 16"),
-        (&["--max-tile", "48", "--depth"], "--depth: a frame drawn in tiles"),
-        (&["--max-tile", "48", "--frames", "0..1"], "--max-tile"),
+        (&["--max-tile", "48", "--lod-overlay"], "--lod-overlay"),
+        (&["--max-tile", "8", "--frames", "0..1"], "--max-tile: must be at least 16"),
     ] {
         let o = common::twister()
             .args(["render", "builtin:demo", "--out"])

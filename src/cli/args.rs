@@ -612,9 +612,10 @@ pub struct RenderArgs {
     /// fisheye: outside the circle transparent (alpha 0) instead of the background colour; PNG.
     #[arg(long)]
     pub alpha: bool,
-    /// The largest tile a still is drawn in, pixels a side (at least 16): a frame larger than
-    /// this, or than the adapter draws at once, is drawn in tiles and its images are written as
-    /// rows arrive, in bounded memory (colour only: no --depth, --hdr) [default: the adapter's].
+    /// The largest tile a frame is drawn in, pixels a side (at least 16): a frame larger than
+    /// this, than the adapter draws at once, or than 512 MiB of colour is drawn in tiles and its
+    /// images (and --depth, --hdr) are written as rows arrive, in bounded memory [default: the
+    /// adapter's].
     #[arg(long, value_name = "PIXELS")]
     pub max_tile: Option<u32>,
     /// Background colour R,G,B, each 0–255.

@@ -51,6 +51,8 @@ struct Drawn {
     rendered: twister::Frame,
     settings: twister::RenderSettings,
     selected: Option<LodSelection>,
+    /// A frame drawn in tiles: its images, already written (streamed); None: `rendered` holds them.
+    written: Option<Vec<PathBuf>>,
 }
 
 /// With a gaze path, each frame selects its level of detail from the whole scene: the path,
@@ -79,6 +81,8 @@ struct Sequence<'a> {
     tracked: Option<Tracked<'a>>,
     /// A CAVE's walls (their projections; `ViewArgs::cave_walls`), or none: one view.
     walls: Vec<twister::Projection>,
+    /// Each view's writer (a frame drawn in tiles is written as it is drawn).
+    writers: Vec<FrameWriter>,
 }
 
 impl Sequence<'_> {
@@ -96,20 +100,41 @@ impl Sequence<'_> {
             selected = Some(selection);
         }
         let ms_pose = t.elapsed().as_secs_f64() * 1e3;
-        if self.walls.is_empty() {
+        let views: Vec<twister::RenderSettings> = if self.walls.is_empty() {
+            vec![settings]
+        } else {
+            self.walls
+                .iter()
+                .map(|wall| {
+                    settings.with_projection(twister::Projection {
+                        width: wall.width,
+                        height: wall.height,
+                        wall: wall.wall,
+                        ..*settings.projection()
+                    })
+                })
+                .collect()
+        };
+        let mut drawn = Vec::with_capacity(views.len());
+        for (view, settings) in views.into_iter().enumerate() {
+            let selected = selected.clone();
+            // Larger than the adapter draws at once: in tiles, written now (streamed).
+            if self.renderer.tiles(&settings, self.args.max_tile).is_some() {
+                let one = [(settings, self.writers[view].clone())];
+                let (paths, stats) = crate::tiled::stream_views(
+                    self.args,
+                    self.renderer,
+                    &self.prepared.gpu_scene,
+                    &one,
+                    Some(frame),
+                    |_| None,
+                )?;
+                let rendered = crate::tiled::stats_frame(&stats[0].0);
+                drawn.push(Drawn { frame, view, time, ms_pose, rendered, settings, selected, written: Some(paths) });
+                continue;
+            }
             let rendered = self.renderer.render(&self.prepared.gpu_scene, &settings)?;
-            return Ok(vec![Drawn { frame, view: 0, time, ms_pose, rendered, settings, selected }]);
-        }
-        let mut drawn = Vec::with_capacity(self.walls.len());
-        for (view, wall) in self.walls.iter().enumerate() {
-            let settings = settings.with_projection(twister::Projection {
-                width: wall.width,
-                height: wall.height,
-                wall: wall.wall,
-                ..*settings.projection()
-            });
-            let rendered = self.renderer.render(&self.prepared.gpu_scene, &settings)?;
-            drawn.push(Drawn { frame, view, time, ms_pose, rendered, settings, selected: selected.clone() });
+            drawn.push(Drawn { frame, view, time, ms_pose, rendered, settings, selected, written: None });
         }
         Ok(drawn)
     }
@@ -172,6 +197,9 @@ impl Sequence<'_> {
 
 /// Renders the sequence `args.frames` asks for.
 pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32)) -> Result<()> {
+    if let Some(side) = args.max_tile.filter(|&s| s < 16) {
+        return Err(Error::option("--max-tile", format!("must be at least 16 pixels, got {side}")));
+    }
     let settings = render_settings(args)?;
     check_sequence_options(args)?;
     let writer = FrameWriter::new(args, &settings, true)?;
@@ -229,6 +257,7 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32)) -> Result<(
         camera,
         tracked,
         walls,
+        writers: writers.clone(),
     };
     let complete = |f: u32| writers.iter().all(|w| w.paths(Some(f)).iter().all(|p| p.exists()));
     let todo: Vec<u32> = frames.into_iter().filter(|&f| !(args.resume && complete(f))).collect();
@@ -286,8 +315,14 @@ fn write_frames(
     for drawn in receive {
         let writer = &writers[drawn.view];
         let t = std::time::Instant::now();
-        let files = writer.files(&drawn.rendered, Some(drawn.frame))?;
-        write_all(&files)?;
+        let paths: Vec<PathBuf> = match &drawn.written {
+            Some(paths) => paths.clone(),
+            None => {
+                let files = writer.files(&drawn.rendered, Some(drawn.frame))?;
+                write_all(&files)?;
+                files.into_iter().map(|f| f.path).collect()
+            }
+        };
         let ms_write = t.elapsed().as_secs_f64() * 1e3;
         if let (Some(file), Some(path)) = (stats.as_mut(), &args.stats) {
             let lod = crate::scene::lod_stats(&drawn.selected);
@@ -296,7 +331,7 @@ fn write_frames(
                 time: Some(drawn.time),
                 ms_pose: Some(drawn.ms_pose),
                 ms_write,
-                files: Some(files.iter().map(|f| f.path.display().to_string()).collect()),
+                files: Some(paths.iter().map(|p| p.display().to_string()).collect()),
                 ..FrameRecord::new(&args.scene, &drawn.settings, &drawn.rendered, writer, adapter, lod)
             };
             let line = serde_json::to_string(&record).expect("JSON of plain values");
@@ -311,12 +346,7 @@ fn write_frames(
 
 /// The options a sequence refuses (a still's outputs) and its frame rate.
 fn check_sequence_options(args: &RenderArgs) -> Result<()> {
-    for (given, option) in [
-        (args.depth, "--depth"),
-        (args.hdr, "--hdr"),
-        (args.lod_overlay, "--lod-overlay"),
-        (args.max_tile.is_some(), "--max-tile"),
-    ] {
+    for (given, option) in [(args.depth, "--depth"), (args.hdr, "--hdr"), (args.lod_overlay, "--lod-overlay")] {
         if given {
             return Err(Error::option(option, "writes one still: leave it out with --frames"));
         }

@@ -148,6 +148,40 @@ impl FrameWriter {
         })
     }
 
+    /// The depth files' names of the layout (the eyes apart for the layouts of several images).
+    pub fn depth_names(&self) -> Vec<String> {
+        depth_names(self.depth_layout())
+    }
+
+    /// The layout the depth files follow: the eyes apart for the display's four halves.
+    fn depth_layout(&self) -> Layout {
+        match self.layout {
+            Layout::Twister => Layout::Eyes,
+            other => other,
+        }
+    }
+
+    /// Depth file `file` of the layout, encoded into `temp` row by row from eyes of `eye_size`
+    /// whose rows `read(eye, row, first column, columns)` gives (metres): a tiled frame's.
+    pub fn stream_depth(
+        &self,
+        file: usize,
+        path: &std::path::Path,
+        temp: &std::path::Path,
+        eye_size: [u32; 2],
+        read: &mut (dyn FnMut(usize, u32, u32, u32) -> Result<Vec<f32>> + Send),
+    ) -> Result<()> {
+        let layout = self.depth_layout();
+        let size = twister::output::layout_sizes(layout, eye_size)[file];
+        twister::output::stream_exr(path, temp, size, 1, |row| {
+            let mut values = Vec::with_capacity(size[0] as usize);
+            for (eye, src_row, x0, n) in twister::output::layout_row(layout, file, row, eye_size) {
+                values.extend(read(eye, src_row, x0, n)?);
+            }
+            Ok(values)
+        })
+    }
+
     /// A frame's files, encoded: the layout's images, then depth and linear colour where the
     /// frame holds them.
     pub fn files(&self, rendered: &Frame, frame: Option<u32>) -> Result<Vec<OutputFile>> {

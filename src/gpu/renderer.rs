@@ -155,40 +155,56 @@ impl Renderer {
     }
 
     /// A frame in tiles ([`Renderer::tiles`]), handed on strip by strip from the top: each
-    /// strip's first row and both eyes' images of it (the frame's width, the tile's height).
-    /// The outputs at the pixels' centres (depth, error, surface points, linear colour) are not
-    /// drawn. Returns the frame's statistics, summed over the tiles.
+    /// strip's first row and its frame (the frame's width, the tile's height: both eyes' colour,
+    /// and the depth and linear colour where `settings` measure them). The error pass and the
+    /// surface points are not drawn. Returns the frame's statistics, summed over the tiles.
     pub fn render_tiled(
         &self,
         scene: &GpuScene,
         settings: &RenderSettings,
         tiles: Tiles,
-        mut strip: impl FnMut(u32, [EyeImage; 2]) -> Result<()>,
+        mut strip: impl FnMut(u32, Frame) -> Result<()>,
     ) -> Result<crate::core::frame::FrameStats> {
-        let settings = settings.with_measure_error(false).with_depth(false).with_positions(false).with_hdr(false);
+        let settings = settings.with_measure_error(false).with_positions(false);
         let p = *settings.projection();
         let mut stats = crate::core::frame::FrameStats::default();
+        let width = tiles.width as usize;
         for y in (0..tiles.height).step_by(tiles.tile_h as usize) {
             let h = tiles.tile_h.min(tiles.height - y);
-            let mut eyes = [0, 1].map(|_| EyeImage {
-                width: tiles.width,
-                height: h,
-                rgba: vec![0; 4 * (tiles.width * h) as usize],
-            });
+            let n = width * h as usize;
+            let eye = || EyeImage { width: tiles.width, height: h, rgba: vec![0; 4 * n] };
+            let mut whole = Frame {
+                left: eye(),
+                right: eye(),
+                stats: Default::default(),
+                measurement: None,
+                depth: settings.measure.depth.then(|| [vec![0.0; n], vec![0.0; n]]),
+                positions: None,
+                hdr: settings.shading.hdr.then(|| [vec![[0.0; 3]; n], vec![[0.0; 3]; n]]),
+            };
             for x in (0..tiles.width).step_by(tiles.tile_w as usize) {
-                let w = tiles.tile_w.min(tiles.width - x);
-                let tile = settings.with_projection(Projection { tile: Some([x, y, w, h]), ..p });
+                let w = tiles.tile_w.min(tiles.width - x) as usize;
+                let tile = settings.with_projection(Projection { tile: Some([x, y, w as u32, h]), ..p });
                 let frame = self.render(scene, &tile)?;
-                for (eye, drawn) in eyes.iter_mut().zip([&frame.left, &frame.right]) {
-                    for row in 0..h as usize {
-                        let to = 4 * (row * tiles.width as usize + x as usize);
-                        eye.rgba[to..to + 4 * w as usize]
-                            .copy_from_slice(&drawn.rgba[4 * row * w as usize..4 * (row + 1) * w as usize]);
+                // Row by row into the strip: each eye's colour, depth and linear colour.
+                fn place<T: Copy>(to: &mut [T], from: &[T], width: usize, x: usize, w: usize, per: usize) {
+                    for (row, src) in from.chunks_exact(w * per).enumerate() {
+                        let at = (row * width + x) * per;
+                        to[at..at + w * per].copy_from_slice(src);
                     }
+                }
+                let x = x as usize;
+                place(&mut whole.left.rgba, &frame.left.rgba, width, x, w, 4);
+                place(&mut whole.right.rgba, &frame.right.rgba, width, x, w, 4);
+                if let (Some(to), Some(from)) = (whole.depth.as_mut(), frame.depth.as_ref()) {
+                    (0..2).for_each(|k| place(&mut to[k], &from[k], width, x, w, 1));
+                }
+                if let (Some(to), Some(from)) = (whole.hdr.as_mut(), frame.hdr.as_ref()) {
+                    (0..2).for_each(|k| place(&mut to[k], &from[k], width, x, w, 1));
                 }
                 stats.add_tile(&frame.stats);
             }
-            strip(y, eyes)?;
+            strip(y, whole)?;
         }
         Ok(stats)
     }

@@ -24,7 +24,7 @@ use crate::core::projection::PanoramaKind;
 use crate::error::{Error, Result};
 
 mod stream;
-pub use stream::stream_image;
+pub use stream::{stream_exr, stream_image};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]

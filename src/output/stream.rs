@@ -109,3 +109,44 @@ impl<F: FnMut(u32) -> Result<Vec<u8>>> jpeg_encoder::ImageBuffer for &RowSource<
         }
     }
 }
+
+/// An OpenEXR image of `size` with `channels` float channels (1: `Z`, depth; 3: R, G, B, linear
+/// colour) encoded into file `temp` (the output `path`) as `row(y)` gives its rows (top first,
+/// `channels` values a pixel): uncompressed scan lines written in order, a row held at a time.
+pub fn stream_exr(
+    path: &Path,
+    temp: &Path,
+    [width, height]: [u32; 2],
+    channels: usize,
+    row: impl FnMut(u32) -> Result<Vec<f32>> + Send,
+) -> Result<()> {
+    use exr::prelude::{Image, SpecificChannels, Vec2, WritableImage};
+    // The row the encoder reads now (it asks pixel by pixel, row after row), and the first error.
+    let state = std::sync::Mutex::new((u32::MAX, Vec::<f32>::new(), row, None::<Error>));
+    let at = |p: Vec2<usize>, c: usize| -> f32 {
+        let mut s = state.lock().unwrap_or_else(|e| e.into_inner());
+        let (ref mut y, ref mut values, ref mut read, ref mut error) = *s;
+        if *y != p.y() as u32 {
+            *y = p.y() as u32;
+            *values = read(*y).unwrap_or_else(|e| {
+                error.get_or_insert(e);
+                vec![0.0; channels * width as usize]
+            });
+        }
+        values.get(p.x() * channels + c).copied().unwrap_or(0.0)
+    };
+    let size = (width as usize, height as usize);
+    let written = if channels == 1 {
+        let image =
+            Image::from_channels(size, SpecificChannels::build().with_channel("Z").with_pixel_fn(|p| (at(p, 0),)));
+        image.write().to_file(temp)
+    } else {
+        let image = Image::from_channels(size, SpecificChannels::rgb(|p| (at(p, 0), at(p, 1), at(p, 2))));
+        image.write().to_file(temp)
+    };
+    written.map_err(|e| Error::output(path, format!("cannot encode OpenEXR: {e}")))?;
+    match state.into_inner().unwrap_or_else(|e| e.into_inner()).3 {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
