@@ -139,12 +139,7 @@ pub fn stream_views(
     let mut drawn = Vec::with_capacity(views.len());
     for (k, (settings, _)) in views.iter().enumerate() {
         let p: &Projection = settings.projection();
-        let tiles = renderer.tiles(settings, args.max_tile).unwrap_or(Tiles {
-            width: p.width,
-            height: p.height,
-            tile_w: p.width,
-            tile_h: p.height,
-        });
+        let tiles = renderer.tiles(settings, args.max_tile).unwrap_or(Tiles::whole(p.width, p.height));
         let mut spool = Spool::create(&args.out, k, [p.width, p.height])?;
         let stats = renderer.render_tiled(gpu_scene, settings, tiles, |y, strip| spool.write_strip(y, &strip))?;
         drawn.push((stats, tiles));

@@ -45,12 +45,38 @@ pub struct Tiles {
     pub height: u32,
     pub tile_w: u32,
     pub tile_h: u32,
+    /// The cubemap's face side, whose squares no tile column straddles (0: none): a face's
+    /// draw then meets a tile's edge only at its own (multisampled coverage at a scissor
+    /// inside a tile differed on lavapipe).
+    pub face: u32,
 }
 
 impl Tiles {
+    /// The whole frame as one tile.
+    pub fn whole(width: u32, height: u32) -> Tiles {
+        Tiles { width, height, tile_w: width, tile_h: height, face: 0 }
+    }
+
+    /// The tile columns: (first column, width), left to right; within each face's columns
+    /// for a cubemap cut across.
+    pub fn columns(&self) -> Vec<(u32, u32)> {
+        let spans: Vec<(u32, u32)> = if self.face > 0 && self.tile_w < self.width {
+            (0..self.width / self.face).map(|k| (k * self.face, self.face)).collect()
+        } else {
+            vec![(0, self.width)]
+        };
+        let step = self.tile_w.max(1);
+        spans
+            .into_iter()
+            .flat_map(|(start, len)| {
+                (start..start + len).step_by(step as usize).map(move |x| (x, step.min(start + len - x)))
+            })
+            .collect()
+    }
+
     /// How many tiles the frame has.
     pub fn count(&self) -> u32 {
-        self.width.div_ceil(self.tile_w) * self.height.div_ceil(self.tile_h)
+        self.columns().len() as u32 * self.height.div_ceil(self.tile_h)
     }
 }
 
@@ -151,7 +177,8 @@ impl Renderer {
         let rows_buffer = (self.gpu.limits.max_buffer_size / (2 * padded_row(tile_w) * ky as u64)).max(1);
         let rows_strip = (STRIP_BYTES / (8 * p.width as u64)).max(1);
         let tile_h = (p.height.min(side) as u64).min(rows_buffer).min(rows_strip).max(1) as u32;
-        Some(Tiles { width: p.width, height: p.height, tile_w, tile_h })
+        let face = if p.panorama == crate::core::projection::PanoramaKind::Cubemap { p.width / 3 } else { 0 };
+        Some(Tiles { width: p.width, height: p.height, tile_w, tile_h, face })
     }
 
     /// A frame in tiles ([`Renderer::tiles`]), handed on strip by strip from the top: each
@@ -182,8 +209,8 @@ impl Renderer {
                 positions: None,
                 hdr: settings.shading.hdr.then(|| [vec![[0.0; 3]; n], vec![[0.0; 3]; n]]),
             };
-            for x in (0..tiles.width).step_by(tiles.tile_w as usize) {
-                let w = tiles.tile_w.min(tiles.width - x) as usize;
+            for (x, w) in tiles.columns() {
+                let w = w as usize;
                 let tile = settings.with_projection(Projection { tile: Some([x, y, w as u32, h]), ..p });
                 let frame = self.render(scene, &tile)?;
                 // Row by row into the strip: each eye's colour, depth and linear colour.
