@@ -314,6 +314,17 @@ pub fn parse_rgb(s: &str) -> std::result::Result<[f32; 3], String> {
     }
 }
 
+/// `settings` drawing CAVE wall `wall` (a projection of `ViewArgs::cave_walls`): its size and
+/// rectangle, the rest as `settings` have them (placed with the scene).
+pub fn on_wall(settings: RenderSettings, wall: &Projection) -> RenderSettings {
+    settings.with_projection(Projection {
+        width: wall.width,
+        height: wall.height,
+        wall: wall.wall,
+        ..*settings.projection()
+    })
+}
+
 /// A CAVE wall's error with the wall named.
 fn name_wall(error: Error, wall: &str) -> Error {
     match error {

@@ -75,12 +75,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         .into_iter()
         .map(|(wall, writer)| {
             let settings = match wall {
-                Some(p) => prepared.settings.with_projection(twister::Projection {
-                    width: p.width,
-                    height: p.height,
-                    wall: p.wall,
-                    ..*prepared.settings.projection()
-                }),
+                Some(wall) => crate::args::on_wall(prepared.settings, &wall),
                 None => prepared.settings,
             };
             (settings, writer)

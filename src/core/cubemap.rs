@@ -64,23 +64,11 @@ pub fn direction(lon: f32, lat: f32) -> Vec3 {
 /// The face a direction falls on: the one whose normal it is closest to (ties to the earlier
 /// face). `cube_face_of` in projection_cubemap.wgsl.
 pub fn cube_face_of(d: Vec3) -> usize {
-    let a = d.abs();
-    if a.x >= a.y && a.x >= a.z {
-        if d.x >= 0.0 {
-            0
-        } else {
-            1
-        }
-    } else if a.y >= a.z {
-        if d.y >= 0.0 {
-            2
-        } else {
-            3
-        }
-    } else if d.z < 0.0 {
-        4
-    } else {
-        5
+    // The shadow cubes' order (+x, −x, +y, −y, +z, −z) with the front (−z) before the back.
+    match crate::core::shadow::major_axis_face(d) {
+        4 => 5,
+        5 => 4,
+        k => k as usize,
     }
 }
 
@@ -251,11 +239,8 @@ mod tests {
         let s = proj.cube_face_px() as f64;
         let mut faces = [0; 6];
         for _ in 0..3000 {
-            let (a, b): (f32, f32) =
-                (rng.random_range(-1.0..1.0), rng.random_range(-std::f32::consts::PI..std::f32::consts::PI));
-            let dist = 10f32.powf(rng.random_range(-0.5..1.5));
-            let h = (1.0 - a * a).sqrt();
-            let p = dist * Vec3::new(h * b.sin(), a, -h * b.cos());
+            let p = crate::core::projection::tests::random_point(&mut rng);
+            let dist = p.length();
             for eye in Eye::BOTH {
                 let Some(([x, y], depth)) = proj.project_pixel(p, eye) else { continue };
                 assert!((0.0..=proj.width as f32).contains(&x) && (0.0..=proj.height as f32).contains(&y));

@@ -126,7 +126,7 @@ impl Projection {
 mod tests {
     use crate::core::projection::{Eye, Panorama, Projection};
     use glam::Vec3;
-    use rand::{Rng, SeedableRng};
+    use rand::SeedableRng;
 
     /// An equidistant fisheye's pixel direction (as Cycles' `fisheye_to_direction`), in f64
     /// from the format's definition, for a camera looking along the dome's axis with the image's
@@ -160,11 +160,8 @@ mod tests {
             let proj = Projection { fov, dome_tilt: tilt, ..Projection::fisheye(1024) };
             proj.validate().unwrap();
             for _ in 0..1500 {
-                let (a, b): (f32, f32) =
-                    (rng.random_range(-1.0..1.0), rng.random_range(-std::f32::consts::PI..std::f32::consts::PI));
-                let dist = 10f32.powf(rng.random_range(-0.5..1.5));
-                let h = (1.0 - a * a).sqrt();
-                let p = dist * Vec3::new(h * b.sin(), a, -h * b.cos());
+                let p = crate::core::projection::tests::random_point(&mut rng);
+                let dist = p.length();
                 for eye in Eye::BOTH {
                     let Some(([x, y], depth)) = proj.project_pixel(p, eye) else { continue };
                     let rho = ((x - 512.0).powi(2) + (y - 512.0).powi(2)).sqrt();

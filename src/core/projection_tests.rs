@@ -147,3 +147,12 @@ fn wrap_angle_is_half_open() {
     assert!((wrap_angle(3.0 * PI_F32 / 2.0) + PI_F32 / 2.0).abs() < 1e-5);
     assert!((wrap_angle(0.25) - 0.25).abs() < 1e-7);
 }
+
+/// A random point around the viewer: a direction uniform on the sphere, at a distance from
+/// 10^−0.5 to 10^1.5 m (log-uniform), for the panoramas' forward-map tests.
+pub(crate) fn random_point(rng: &mut impl Rng) -> Vec3 {
+    let (a, b): (f32, f32) = (rng.random_range(-1.0..1.0), rng.random_range(-PI_F32..PI_F32));
+    let dist = 10f32.powf(rng.random_range(-0.5..1.5));
+    let h = (1.0 - a * a).sqrt();
+    dist * Vec3::new(h * b.sin(), a, -h * b.cos())
+}

@@ -183,25 +183,21 @@ pub fn plan_shadow_maps(lights: &mut [GpuLight], count: usize, corners: &[Vec3; 
 /// The face of a cube whose light is seen from p along the unit direction `l` (towards the
 /// light): the major axis of −l (+x, −x, +y, −y, +z, −z: 0..5).
 pub fn cube_face(l: Vec3) -> u32 {
-    let d = -l;
+    major_axis_face(-l)
+}
+
+/// The major axis of `d` as a face in the order +x, −x, +y, −y, +z, −z (0..5; ties to the
+/// earlier axis), the shadow cubes' and (with ±z swapped) the stereo cubemap's.
+pub fn major_axis_face(d: Vec3) -> u32 {
     let a = d.abs();
-    if a.x >= a.y && a.x >= a.z {
-        if d.x >= 0.0 {
-            0
-        } else {
-            1
-        }
+    let axis = if a.x >= a.y && a.x >= a.z {
+        0
     } else if a.y >= a.z {
-        if d.y >= 0.0 {
-            2
-        } else {
-            3
-        }
-    } else if d.z >= 0.0 {
-        4
+        1
     } else {
-        5
-    }
+        2
+    };
+    2 * axis + (d[axis as usize] < 0.0) as u32
 }
 
 /// Where p (viewer frame) falls in a map: texel coordinates (x right, y down, texel centres at

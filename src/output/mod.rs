@@ -292,16 +292,7 @@ pub fn image_file(path: PathBuf, img: &EyeImage, encoding: &Encoding) -> Result<
     let mut bytes = Vec::new();
     match encoding.format {
         ImageFormat::Png => {
-            let mut encoder = png::Encoder::new(&mut bytes, img.width, img.height);
-            encoder.set_color(png::ColorType::Rgba);
-            encoder.set_depth(png::BitDepth::Eight);
-            if encoding.fast {
-                encoder.set_compression(png::Compression::Fast);
-            }
-            if let Some(xmp) = &encoding.xmp {
-                encoder.add_itxt_chunk("XML:com.adobe.xmp".into(), xmp.clone()).map_err(|e| fail(&e))?;
-            }
-            let mut writer = encoder.write_header().map_err(|e| fail(&e))?;
+            let mut writer = png_writer(&mut bytes, [img.width, img.height], encoding).map_err(|e| fail(&e))?;
             writer.write_image_data(&img.rgba).map_err(|e| fail(&e))?;
             writer.finish().map_err(|e| fail(&e))?;
         }
@@ -319,6 +310,25 @@ pub fn image_file(path: PathBuf, img: &EyeImage, encoding: &Encoding) -> Result<
         }
     }
     Ok(OutputFile { path, bytes })
+}
+
+/// A PNG's writer with its header written: RGBA8, deflated fast or balanced, with the XMP
+/// packet (an iTXt chunk) where the encoding has one.
+fn png_writer<W: std::io::Write>(
+    out: W,
+    [width, height]: [u32; 2],
+    encoding: &Encoding,
+) -> Result<png::Writer<W>, png::EncodingError> {
+    let mut encoder = png::Encoder::new(out, width, height);
+    encoder.set_color(png::ColorType::Rgba);
+    encoder.set_depth(png::BitDepth::Eight);
+    if encoding.fast {
+        encoder.set_compression(png::Compression::Fast);
+    }
+    if let Some(xmp) = &encoding.xmp {
+        encoder.add_itxt_chunk("XML:com.adobe.xmp".into(), xmp.clone())?;
+    }
+    encoder.write_header()
 }
 
 /// A JPEG with an XMP APP1 segment inserted after SOI and the APP0 (JFIF) segment, if any.

@@ -23,16 +23,7 @@ pub fn stream_image(
     let out = std::io::BufWriter::with_capacity(1 << 20, file);
     match encoding.format {
         ImageFormat::Png => {
-            let mut encoder = png::Encoder::new(out, width, height);
-            encoder.set_color(png::ColorType::Rgba);
-            encoder.set_depth(png::BitDepth::Eight);
-            if encoding.fast {
-                encoder.set_compression(png::Compression::Fast);
-            }
-            if let Some(xmp) = &encoding.xmp {
-                encoder.add_itxt_chunk("XML:com.adobe.xmp".into(), xmp.clone()).map_err(|e| fail(&e))?;
-            }
-            let mut writer = encoder.write_header().map_err(|e| fail(&e))?;
+            let mut writer = super::png_writer(out, [width, height], encoding).map_err(|e| fail(&e))?;
             let mut stream = writer.stream_writer().map_err(|e| fail(&e))?;
             for y in 0..height {
                 stream.write_all(&row(y)?).map_err(|e| fail(&e))?;
