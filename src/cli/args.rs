@@ -8,7 +8,6 @@ use glam::Vec3;
 use twister::core::environment::PreparedEnvironment;
 use twister::core::light::{LightingMode, Tonemap};
 
-use twister::core::cave::NamedWall;
 use twister::core::head::Head;
 use twister::core::lod::LodParams;
 use twister::core::projection::{PanoramaKind, DEFAULT_POLE_MERGE};
@@ -314,27 +313,6 @@ pub fn parse_rgb(s: &str) -> std::result::Result<[f32; 3], String> {
     }
 }
 
-/// `settings` drawing CAVE wall `wall` (a projection of `ViewArgs::cave_walls`): its size and
-/// rectangle, the rest as `settings` have them (placed with the scene).
-pub fn on_wall(settings: RenderSettings, wall: &Projection) -> RenderSettings {
-    settings.with_projection(Projection {
-        width: wall.width,
-        height: wall.height,
-        wall: wall.wall,
-        ..*settings.projection()
-    })
-}
-
-/// A CAVE wall's error with the wall named.
-fn name_wall(error: Error, wall: &str) -> Error {
-    match error {
-        Error::Setting { setting: "view.projection.wall", message } => {
-            Error::Setting { setting: "view.projection.wall", message: format!("wall {wall:?}: {message}") }
-        }
-        other => other,
-    }
-}
-
 impl ViewArgs {
     /// The render settings these options give for a command that draws with `methods` (the
     /// viewer of `camera[:N]` is placed with the scene, by `cli::scene::prepare`).
@@ -412,7 +390,7 @@ impl ViewArgs {
             None => projection,
         };
         projection.validate().map_err(|e| match walls.first() {
-            Some(wall) => name_wall(e, &wall.name),
+            Some(wall) => crate::cave::name_wall(e, &wall.name),
             None => e,
         })?;
         if !self.yaw.is_finite() {
@@ -425,10 +403,7 @@ impl ViewArgs {
             ));
         }
         let settings = RenderSettings::new(projection)
-            .with_viewer(match self.viewer {
-                Viewer::At(p) => p * self.scale,
-                Viewer::Camera(_) => Vec3::ZERO, // placed with the scene (`scene::prepare`)
-            })
+            .with_viewer(self.viewer_m())
             .with_yaw_deg(self.yaw)
             .with_method(match (self.method, self.split) {
                 (Method::Adaptive(_), Some(split)) => Method::Adaptive(split),
@@ -452,50 +427,13 @@ impl ViewArgs {
         Ok(settings)
     }
 
-    /// `--cave`'s walls, read and checked, for the CAVE panorama (none for the others, which
-    /// refuse `--cave`); the CAVE's conditions: its head, no --width/--height, the display's
-    /// centre a place.
-    pub fn cave_file(&self, panorama: PanoramaKind) -> Result<Vec<NamedWall>> {
-        if panorama != PanoramaKind::Cave {
-            if self.cave.is_some() {
-                return Err(Error::option("--cave", "gives the walls of --panorama cave"));
-            }
-            return Ok(Vec::new());
-        }
-        let Some(path) = &self.cave else {
-            return Err(Error::option("--cave", "--panorama cave draws the walls of a --cave FILE.json"));
-        };
-        if self.width.is_some() || self.height.is_some() {
-            return Err(Error::option("--width/--height", "a CAVE's walls give their own pixels (--cave)"));
-        }
-        if matches!(self.viewer, Viewer::Camera(_)) {
-            return Err(Error::option("--viewer", "a CAVE's walls and head are in the scene: give --viewer x,y,z"));
-        }
-        twister::core::cave::read_cave(path).map_err(crate::flags::for_user)
-    }
-
-    /// `--viewer` in metres (a camera's place: the origin until the scene is prepared).
-    fn viewer_m(&self) -> Vec3 {
+    /// `--viewer` in metres (a camera's place: the origin until the scene is prepared, by
+    /// `scene::prepare`).
+    pub(crate) fn viewer_m(&self) -> Vec3 {
         match self.viewer {
             Viewer::At(p) => p * self.scale,
             Viewer::Camera(_) => Vec3::ZERO,
         }
-    }
-
-    /// Each wall of `--cave` drawn with `settings` (which draw the first): its name and its
-    /// projection, checked.
-    pub fn cave_walls(&self, settings: &RenderSettings) -> Result<Vec<(String, Projection)>> {
-        let walls = self.cave_file(settings.projection().panorama)?;
-        walls
-            .iter()
-            .map(|w| {
-                let wall = w.in_display(self.scale, settings.view.viewer, settings.view.yaw_deg);
-                let projection =
-                    Projection { width: w.pixels[0], height: w.pixels[1], wall: Some(wall), ..*settings.projection() };
-                projection.validate().map_err(|e| crate::flags::for_user(name_wall(e, &w.name)))?;
-                Ok((w.name.clone(), projection))
-            })
-            .collect()
     }
 
     /// The vertical model: as given, else the paper's, except where `trace` draws the cylinder:

@@ -5,6 +5,7 @@
 
 mod args;
 mod bench;
+mod cave;
 mod flags;
 mod heatmap;
 mod info;

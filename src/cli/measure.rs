@@ -74,7 +74,7 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
     let gpu_scene = &prepared.gpu_scene;
     for (wall, projection) in &views {
         let settings = match projection {
-            Some(wall) => crate::args::on_wall(prepared.settings, wall),
+            Some(wall) => crate::cave::on_wall(prepared.settings, wall),
             None => prepared.settings,
         };
         let frame = renderer.render(gpu_scene, &settings)?;

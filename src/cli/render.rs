@@ -75,7 +75,7 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         .into_iter()
         .map(|(wall, writer)| {
             let settings = match wall {
-                Some(wall) => crate::args::on_wall(prepared.settings, &wall),
+                Some(wall) => crate::cave::on_wall(prepared.settings, &wall),
                 None => prepared.settings,
             };
             (settings, writer)

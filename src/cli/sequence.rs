@@ -103,7 +103,7 @@ impl Sequence<'_> {
         let views: Vec<twister::RenderSettings> = if self.walls.is_empty() {
             vec![settings]
         } else {
-            self.walls.iter().map(|wall| crate::args::on_wall(settings, wall)).collect()
+            self.walls.iter().map(|wall| crate::cave::on_wall(settings, wall)).collect()
         };
         let mut drawn = Vec::with_capacity(views.len());
         for (view, settings) in views.into_iter().enumerate() {

@@ -80,6 +80,15 @@ impl Tiles {
     }
 }
 
+/// Copies a tile's rows (`w` texels of `per` values) into a strip `width` texels wide at
+/// column `x`.
+fn place<T: Copy>(to: &mut [T], from: &[T], width: usize, x: usize, w: usize, per: usize) {
+    for (row, src) in from.chunks_exact(w * per).enumerate() {
+        let at = (row * width + x) * per;
+        to[at..at + w * per].copy_from_slice(src);
+    }
+}
+
 /// The renderer: the device, each method's driver and the stages they share, and the
 /// resources kept between frames.
 pub struct Renderer {
@@ -214,12 +223,6 @@ impl Renderer {
                 let tile = settings.with_projection(Projection { tile: Some([x, y, w as u32, h]), ..p });
                 let frame = self.render(scene, &tile)?;
                 // Row by row into the strip: each eye's colour, depth and linear colour.
-                fn place<T: Copy>(to: &mut [T], from: &[T], width: usize, x: usize, w: usize, per: usize) {
-                    for (row, src) in from.chunks_exact(w * per).enumerate() {
-                        let at = (row * width + x) * per;
-                        to[at..at + w * per].copy_from_slice(src);
-                    }
-                }
                 let x = x as usize;
                 place(&mut whole.left.rgba, &frame.left.rgba, width, x, w, 4);
                 place(&mut whole.right.rgba, &frame.right.rgba, width, x, w, 4);

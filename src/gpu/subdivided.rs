@@ -214,10 +214,8 @@ impl SubdividedMethod {
             pass.set_index_buffer(buffers.indices.slice(..), wgpu::IndexFormat::Uint32);
             for (bind_group, scissor) in &draws {
                 pass.set_bind_group(0, bind_group, &[]);
-                match *scissor {
-                    Some(Some([x, y, w, h])) => pass.set_scissor_rect(x, y, w, h),
-                    Some(None) => continue, // a face outside this tile
-                    None => {}
+                if let Some([x, y, w, h]) = *scissor {
+                    pass.set_scissor_rect(x, y, w, h);
                 }
                 pass.draw_indexed_indirect(&buffers.draw_args, 0);
             }
@@ -258,36 +256,37 @@ impl SubdividedMethod {
 }
 
 /// The raster stage's draws of a frame: its parameters' bind group, and for the cubemap one draw
-/// per face, each projecting into its face (`face` in the projection uniform) and kept to the
-/// face's square by the scissor (`core::cubemap`: w = D·n clips what lies behind the face).
+/// per face this draw's image holds, each projecting into its face (`face` in the projection
+/// uniform) and kept to the face's square by the scissor (`core::cubemap`: w = D·n clips what
+/// lies behind the face).
 fn face_draws(
     gpu: &Gpu,
     stage: &crate::gpu::stages::GpuStage,
     uniform: &wgpu::Buffer,
     settings: &RenderSettings,
-) -> Vec<(wgpu::BindGroup, Option<Option<[u32; 4]>>)> {
+) -> Vec<(wgpu::BindGroup, Option<[u32; 4]>)> {
     let params = raster_params(settings);
     let size = std::mem::size_of_val(&params) as u64;
     let stride = crate::gpu::frame::raster_params_stride(gpu);
     let projection = settings.projection();
-    let faces: Vec<Option<u32>> = if projection.panorama == crate::core::projection::PanoramaKind::Cubemap {
-        (0..crate::core::cubemap::CUBE_FACES.len() as u32).map(Some).collect()
+    // (face, scissor): the faces a tile holds, each with its square; or the one draw.
+    let faces: Vec<(u32, Option<[u32; 4]>)> = if projection.panorama == crate::core::projection::PanoramaKind::Cubemap {
+        (0..crate::core::cubemap::CUBE_FACES.len())
+            .filter_map(|f| projection.cube_face_scissor(f).map(|rect| (f as u32, Some(rect))))
+            .collect()
     } else {
-        vec![None]
+        vec![(0, None)]
     };
     faces
         .into_iter()
         .enumerate()
-        .map(|(k, face)| {
+        .map(|(k, (face, scissor))| {
             let offset = k as u64 * stride;
-            let face_params = params.map(|p| RasterParams {
-                projection: ProjectionUniform { face: face.unwrap_or(0), ..p.projection },
-                ..p
-            });
+            let face_params =
+                params.map(|p| RasterParams { projection: ProjectionUniform { face, ..p.projection }, ..p });
             gpu.queue.write_buffer(uniform, offset, bytemuck::cast_slice(&face_params));
             let binding = wgpu::BufferBinding { buffer: uniform, offset, size: wgpu::BufferSize::new(size) };
-            let bind_group = stage.bind_group_ranges(gpu, None, 0, &[binding]);
-            (bind_group, face.map(|f| projection.cube_face_scissor(f as usize)))
+            (stage.bind_group_ranges(gpu, None, 0, &[binding]), scissor)
         })
         .collect()
 }
