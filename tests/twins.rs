@@ -4,6 +4,8 @@
 //! fails `every_registered_stage_matches_its_cpu_twin`.
 
 mod common;
+#[path = "twins/display.rs"]
+mod display;
 #[path = "twins/shadow.rs"]
 mod shadow;
 #[path = "twins/skin.rs"]
@@ -84,6 +86,7 @@ fn twin_of(stage: &str) -> Option<TwinCheck> {
         "shadow" => check::<shadow::Shadow>,
         "skin" => check::<skin::Skin>,
         "reduce_error" => check::<ReduceError>,
+        "display" => check::<display::Display>,
         _ => return None,
     })
 }

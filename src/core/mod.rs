@@ -10,6 +10,7 @@ pub mod cave;
 pub mod color;
 pub mod compare;
 pub mod cubemap;
+pub mod display;
 pub mod disk_cache;
 pub mod environment;
 pub mod environment_cache;

@@ -14,6 +14,7 @@
 //! | [`reduce_error`] | `shaders/reduce_error.wgsl` |
 //! | [`project_points`] | `shaders/project_points.wgsl` |
 
+pub mod display;
 pub mod fragment;
 pub mod multisample;
 pub mod project_points;

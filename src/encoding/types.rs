@@ -229,6 +229,34 @@ impl SubdivideCounters {
     }
 }
 
+/// `DisplayParams` in shaders/display.wgsl (the live window's display stage; twin
+/// `cpu::display`). 224 bytes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct DisplayParams {
+    pub projection: ProjectionUniform,
+    /// `core::display::DisplayMode` as a number.
+    pub mode: u32,
+    /// Each layer's image size.
+    pub width: u32,
+    pub height: u32,
+    /// Texels per row in the buffer of texels (rows padded for the copy).
+    pub row_texels: u32,
+    /// 2: both eyes; 1: one image.
+    pub layers: u32,
+    /// 1: the target encodes sRGB itself (the stage writes linear values).
+    pub srgb_target: u32,
+    pub _pad0: u32,
+    pub _pad1: u32,
+    /// Where the image goes in the target: x, y, width, height (pixels).
+    pub area: [f32; 4],
+    /// Look-around: yaw, pitch (radians), tan of half the horizontal field of view, the far
+    /// distance (metres) of the point whose pixel each direction takes.
+    pub look: [f32; 4],
+    /// The overlay's place: x, y, width, height (pixels; width 0: none).
+    pub overlay: [f32; 4],
+}
+
 /// `RasterParams` in shaders/raster.wgsl. 112 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
@@ -501,6 +529,7 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("PieceWork" => PieceWork { shape, m, node_count, candidates, copies, first_node, counts, strip_n, refs, row_w, _pad }),
     layout!("DrawIndexedIndirectArgs" => DrawIndexedIndirectArgs { index_count, instance_count, first_index, base_vertex, first_instance }),
     layout!("RasterParams" => RasterParams { projection, eye_sign, ambient, shift_px, error_angle, _pad0, _pad1, _pad2 }),
+    layout!("DisplayParams" => DisplayParams { projection, mode, width, height, row_texels, layers, srgb_target, _pad0, _pad1, area, look, overlay }),
     layout!("SlitParams" => SlitParams { view, projection, eye_sign, ambient, near, error_angle }),
     layout!("SlitCamera" => SlitCamera { origin_sx, right_cx, up_cy, forward_sy }),
     layout!("TraceParams" => TraceParams { to_scene, projection, background, light, gaze_forward, gaze_right, gaze_up, ambient, error_angle, row_texels, reflect_max, lod_min_share, original_root, original_level, samples }),

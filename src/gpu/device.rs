@@ -72,14 +72,30 @@ impl Gpu {
     /// Opens the default adapter (respecting `WGPU_BACKEND`) with its full limits.
     pub fn new() -> Result<Gpu> {
         quiet_device_select_layer();
-        pollster::block_on(Self::new_async())
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        pollster::block_on(Self::new_async(instance, None))
     }
 
-    async fn new_async() -> Result<Gpu> {
-        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+    /// Opens an adapter that can present to a window (the live window's), with the window's
+    /// surface.
+    pub fn for_window(
+        display: Box<dyn wgpu::wgt::WgpuHasDisplayHandle>,
+        window: impl Into<wgpu::SurfaceTarget<'static>>,
+    ) -> Result<(Gpu, wgpu::Surface<'static>)> {
+        quiet_device_select_layer();
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(display));
+        let surface = instance
+            .create_surface(window)
+            .map_err(|e| Error::NoGpu(format!("cannot draw into the window: {e}")))?;
+        let gpu = pollster::block_on(Self::new_async(instance, Some(&surface)))?;
+        Ok((gpu, surface))
+    }
+
+    async fn new_async(instance: wgpu::Instance, surface: Option<&wgpu::Surface<'static>>) -> Result<Gpu> {
         let adapter = instance
             .request_adapter(&wgpu::RequestAdapterOptions {
                 power_preference: wgpu::PowerPreference::HighPerformance,
+                compatible_surface: surface,
                 ..Default::default()
             })
             .await

@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-use crate::core::frame::{Frame, FrameStats, Measurement};
+use crate::core::frame::{EyeImage, Frame, FrameStats, Measurement};
 use crate::core::settings::RenderSettings;
 use crate::error::Result;
 use crate::gpu::device::Gpu;
@@ -12,7 +12,8 @@ use crate::gpu::frame_plan::SubdivisionBuffers;
 use crate::gpu::reduce_error::ReduceStage;
 use crate::gpu::scene::GpuScene;
 use crate::gpu::subdivide::COUNTERS_SIZE;
-use crate::gpu::targets::Targets;
+use crate::gpu::display::ShownFrame;
+use crate::gpu::targets::{copy_eyes_to_buffer, Targets};
 use crate::gpu::timestamps::{self as stamp, Timestamps};
 
 /// What a renderer keeps between frames.
@@ -87,10 +88,15 @@ pub(crate) trait Method {
 }
 
 /// The end of every frame: the read-back of its targets and, with the error pass, the
-/// `reduce_error` stage (built when first needed).
+/// `reduce_error` stage (built when first needed). A frame the live window shows keeps its
+/// colour on the GPU instead (`show`): copied into a storage buffer for the display stage.
 #[derive(Default)]
 pub(crate) struct FrameEnd {
     reduce: std::sync::OnceLock<ReduceStage>,
+    /// Set while a shown frame is drawn (the renderer's frame lock is held meanwhile).
+    pub show: std::sync::atomic::AtomicBool,
+    /// The last shown frame's colour.
+    pub shown: std::sync::Mutex<Option<ShownFrame>>,
 }
 
 impl FrameEnd {
@@ -104,7 +110,15 @@ impl FrameEnd {
         start: Instant,
     ) -> Result<Frame> {
         let t = Instant::now();
-        let [left, right] = targets.read_colors(gpu)?;
+        let [left, right] = if self.show.load(std::sync::atomic::Ordering::Relaxed) {
+            let (texels, row_texels) = copy_eyes_to_buffer(gpu, &targets.color, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
+            let (width, height) = (targets.width, targets.height);
+            let shown = ShownFrame { texels, width, height, row_texels, layers: 2 };
+            *self.shown.lock().unwrap_or_else(|e| e.into_inner()) = Some(shown);
+            [0, 1].map(|_| EyeImage { width, height, rgba: Vec::new() })
+        } else {
+            targets.read_colors(gpu)?
+        };
         let hdr = if targets.hdr { Some(targets.read_hdr(gpu)?) } else { None };
         stats.ms_readback = t.elapsed().as_secs_f64() * 1e3;
         let depth = if settings.measure.depth { Some(targets.read_distances(gpu)?) } else { None };

@@ -2,6 +2,7 @@
 //! uploaded scene, render targets, timestamps, the frame plan, and the renderer that runs them.
 
 pub mod device;
+pub mod display;
 pub mod draw;
 pub mod frame;
 pub mod frame_plan;

@@ -19,6 +19,7 @@ use crate::encoding::subdivide::SubdivideOutput;
 use crate::encoding::types::{SlitParams, SubdivideParams, TraceParams};
 use crate::error::{Error, Result};
 use crate::gpu::device::Gpu;
+use crate::gpu::display::{DisplayStage, ShownFrame};
 use crate::gpu::frame::{FrameEnd, FrameResources, Method, STAGING_SIZE};
 use crate::gpu::project_points::ProjectPointsStage;
 use crate::gpu::scene::GpuScene;
@@ -100,6 +101,7 @@ pub struct Renderer {
     end: FrameEnd,
     skin: SkinStage,
     project_points: ProjectPointsStage,
+    display: OnceLock<DisplayStage>,
     resources: Mutex<FrameResources>,
 }
 
@@ -141,6 +143,7 @@ impl Renderer {
             end: FrameEnd::default(),
             skin: SkinStage::default(),
             project_points: ProjectPointsStage::default(),
+            display: OnceLock::new(),
             resources: Mutex::new(resources),
         })
     }
@@ -341,6 +344,33 @@ impl Renderer {
             };
             Ok(frame)
         })
+    }
+
+    /// Renders both eyes for the live window: the same frame as [`Renderer::render`], its
+    /// colour left on the GPU for the display stage (the images of the returned frame are
+    /// empty), or, for a sample count beyond the adapter's (box-filtered on the CPU), uploaded.
+    pub fn render_shown(&self, scene: &GpuScene, settings: &RenderSettings) -> Result<(Frame, ShownFrame)> {
+        use std::sync::atomic::Ordering::Relaxed;
+        settings.validate()?;
+        self.check_size(settings)?;
+        let counts = crate::gpu::targets::sample_counts(&self.gpu);
+        if !counts.contains(&settings.shading.samples) && settings.subdivision.method != MethodName::Trace {
+            let frame = self.render_larger(scene, settings, &counts)?;
+            let shown = ShownFrame::upload(&self.gpu, &[&frame.left, &frame.right]);
+            return Ok((frame, shown));
+        }
+        self.end.show.store(true, Relaxed);
+        let frame = self.render_direct(scene, settings);
+        self.end.show.store(false, Relaxed);
+        let shown = self.end.shown.lock().unwrap_or_else(|e| e.into_inner()).take();
+        let frame = frame?;
+        let shown = shown.ok_or_else(|| Error::Gpu("the frame's colour was not kept for the window".into()))?;
+        Ok((frame, shown))
+    }
+
+    /// The display stage (the live window's), built when first asked for.
+    pub fn display(&self) -> &DisplayStage {
+        self.display.get_or_init(|| DisplayStage::new(&self.gpu))
     }
 
     /// Poses `scene` at time t of clip `clip` (None: the rest pose) on the GPU (the skin

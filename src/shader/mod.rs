@@ -432,6 +432,14 @@ pub const PROJECT_POINTS: Stage = Stage {
     bindings: &[bind(0, 0, "params", Uniform), bind(0, 1, "points", Storage), bind(0, 2, "pixels", StorageReadWrite)],
 };
 
+pub const DISPLAY: Stage = Stage {
+    name: "display",
+    source: Some(include_str!("../../shaders/display.wgsl")),
+    kind: StageKind::Draw,
+    entry_points: &[entry("vs_main", &[]), entry("fs_main", &["params", "texels", "overlay"])],
+    bindings: &[bind(0, 0, "params", Uniform), bind(0, 1, "texels", Storage), bind(0, 2, "overlay", Storage)],
+};
+
 pub const REDUCE_ERROR: Stage = Stage {
     name: "reduce_error",
     source: Some(include_str!("../../shaders/reduce_error.wgsl")),
@@ -451,7 +459,7 @@ pub const REDUCE_ERROR: Stage = Stage {
 };
 
 /// The registry: every stage. The naga test validates and reflects each one composed.
-pub const STAGES: &[Stage] = &[SKIN, SUBDIVIDE, RASTER, SLIT, TRACE, SHADOW, PROJECT_POINTS, REDUCE_ERROR];
+pub const STAGES: &[Stage] = &[SKIN, SUBDIVIDE, RASTER, SLIT, TRACE, SHADOW, PROJECT_POINTS, REDUCE_ERROR, DISPLAY];
 
 /// The shared WGSL modules in `shaders/shared/`, by import name.
 pub const SHARED: &[(&str, &str)] = &[
