@@ -521,7 +521,7 @@ impl ViewArgs {
 }
 
 /// `twister render`'s options: the scene, the view, the outputs, and a sequence's frames.
-#[derive(Args)]
+#[derive(Args, Clone)]
 #[command(allow_negative_numbers = true)]
 pub struct RenderArgs {
     /// Scene to render: a .obj, .gltf or .glb file, or builtin:demo, builtin:box-room, builtin:cube, builtin:sphere100, builtin:sphere1024, builtin:triangle@D.

@@ -15,6 +15,7 @@ mod render;
 mod scene;
 mod sequence;
 mod tiled;
+mod view;
 mod writer;
 
 use std::process::ExitCode;
@@ -34,6 +35,9 @@ struct Cli {
 enum Command {
     /// Render a scene into the left- and right-eye panoramas.
     Render(args::RenderArgs),
+    /// Open a live window: the panoramas drawn every frame as `render` draws them; keys move the
+    /// viewer and switch the method, panorama, samples and display; F12 saves the frame.
+    View(view::ViewCmdArgs),
     /// Measure the display-position error of a method (seed 002 §4.1).
     Error(measure::ErrorArgs),
     /// Describe a scene file as JSON: triangles, objects, materials, bounds, cameras, lights, warnings,
@@ -63,6 +67,7 @@ fn main() -> ExitCode {
             Some(frames) => sequence::render_sequence(args, frames),
             None => render::render(args),
         },
+        Command::View(args) => view::view(args),
         Command::Error(args) => measure::measure(args),
         Command::Info(args) => info::info(args),
         Command::Bench(BenchCommand::Speed(args)) => bench::bench_speed(args),

@@ -432,7 +432,7 @@ pub fn cave_head_start(args: &RenderArgs) -> Result<Option<(Vec3, Option<f32>)>>
 }
 
 /// The animation a sequence plays: `--animation` by name or index, else the file's first.
-fn animation_clip(args: &RenderArgs, scene: &twister::Scene) -> Result<Option<usize>> {
+pub fn animation_clip(args: &RenderArgs, scene: &twister::Scene) -> Result<Option<usize>> {
     Ok(match (&scene.rig, &args.animation) {
         (Some(rig), Some(name)) => Some(rig.clip_index(name).ok_or_else(|| {
             let known: Vec<&str> = rig.clips.iter().map(|c| c.name.as_str()).collect();

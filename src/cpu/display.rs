@@ -94,7 +94,13 @@ impl Source<'_> {
 /// The target's pixels (RGBA bytes packed in words, as an 8-bit target stores the fragment's
 /// values: encoded again where it encodes sRGB) for a frame's `texels` (each layer `params.height` rows of
 /// `params.row_texels`) and the overlay's texels.
-pub fn display(params: &DisplayParams, projection: &Projection, texels: &[u32], overlay: &[u32], size: [u32; 2]) -> Vec<u32> {
+pub fn display(
+    params: &DisplayParams,
+    projection: &Projection,
+    texels: &[u32],
+    overlay: &[u32],
+    size: [u32; 2],
+) -> Vec<u32> {
     let source = Source { params, projection, texels };
     let mut out = Vec::with_capacity((size[0] * size[1]) as usize);
     for y in 0..size[1] {

@@ -84,9 +84,8 @@ impl Gpu {
     ) -> Result<(Gpu, wgpu::Surface<'static>)> {
         quiet_device_select_layer();
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(display));
-        let surface = instance
-            .create_surface(window)
-            .map_err(|e| Error::NoGpu(format!("cannot draw into the window: {e}")))?;
+        let surface =
+            instance.create_surface(window).map_err(|e| Error::NoGpu(format!("cannot draw into the window: {e}")))?;
         let gpu = pollster::block_on(Self::new_async(instance, Some(&surface)))?;
         Ok((gpu, surface))
     }

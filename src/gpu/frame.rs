@@ -8,11 +8,11 @@ use crate::core::frame::{EyeImage, Frame, FrameStats, Measurement};
 use crate::core::settings::RenderSettings;
 use crate::error::Result;
 use crate::gpu::device::Gpu;
+use crate::gpu::display::ShownFrame;
 use crate::gpu::frame_plan::SubdivisionBuffers;
 use crate::gpu::reduce_error::ReduceStage;
 use crate::gpu::scene::GpuScene;
 use crate::gpu::subdivide::COUNTERS_SIZE;
-use crate::gpu::display::ShownFrame;
 use crate::gpu::targets::{copy_eyes_to_buffer, Targets};
 use crate::gpu::timestamps::{self as stamp, Timestamps};
 
@@ -111,7 +111,8 @@ impl FrameEnd {
     ) -> Result<Frame> {
         let t = Instant::now();
         let [left, right] = if self.show.load(std::sync::atomic::Ordering::Relaxed) {
-            let (texels, row_texels) = copy_eyes_to_buffer(gpu, &targets.color, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
+            let (texels, row_texels) =
+                copy_eyes_to_buffer(gpu, &targets.color, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
             let (width, height) = (targets.width, targets.height);
             let shown = ShownFrame { texels, width, height, row_texels, layers: 2 };
             *self.shown.lock().unwrap_or_else(|e| e.into_inner()) = Some(shown);

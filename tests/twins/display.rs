@@ -30,8 +30,16 @@ fn case(projection: Projection, mode: DisplayMode, target: [u32; 2], overlay: bo
     let overlay_rect = overlay.then_some([5, 3, 20, 9]);
     let overlay = overlay.then(|| (0..20 * 9).map(|_| rng.random::<u32>()).collect());
     let look = Look { yaw: 0.7, pitch: -0.3, fov_deg: 100.0 };
-    let view =
-        DisplayView { mode, look, image: [w, h], layers: 2, row_texels: w, target, overlay: overlay_rect, srgb_target: srgb };
+    let view = DisplayView {
+        mode,
+        look,
+        image: [w, h],
+        layers: 2,
+        row_texels: w,
+        target,
+        overlay: overlay_rect,
+        srgb_target: srgb,
+    };
     Case { projection, view, texels, overlay }
 }
 
@@ -61,8 +69,12 @@ impl Twin for Display {
         let texels = gpu.init_buffer("texels", bytemuck::cast_slice(&c.texels), wgpu::BufferUsages::STORAGE);
         let [w, h] = c.view.image;
         let frame = ShownFrame { texels, width: w, height: h, row_texels: w, layers: 2 };
-        let overlay = c.overlay.as_ref().map(|o| gpu.init_buffer("overlay", bytemuck::cast_slice(o), wgpu::BufferUsages::STORAGE));
-        let format = if c.view.srgb_target { wgpu::TextureFormat::Rgba8UnormSrgb } else { wgpu::TextureFormat::Rgba8Unorm };
+        let overlay = c
+            .overlay
+            .as_ref()
+            .map(|o| gpu.init_buffer("overlay", bytemuck::cast_slice(o), wgpu::BufferUsages::STORAGE));
+        let format =
+            if c.view.srgb_target { wgpu::TextureFormat::Rgba8UnormSrgb } else { wgpu::TextureFormat::Rgba8Unorm };
         let [tw, th] = c.view.target;
         let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("display target"),
@@ -80,7 +92,14 @@ impl Twin for Display {
             ..Default::default()
         });
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        r.display().draw(gpu, &mut enc, DisplayTarget { view: &view, format }, &c.view.params(&c.projection), &frame, overlay.as_ref());
+        r.display().draw(
+            gpu,
+            &mut enc,
+            DisplayTarget { view: &view, format },
+            &c.view.params(&c.projection),
+            &frame,
+            overlay.as_ref(),
+        );
         gpu.queue.submit([enc.finish()]);
         let (buffer, stride) = copy_eyes_to_buffer(gpu, &texture, wgpu::BufferUsages::COPY_SRC);
         let [first, _] = unpad_eyes(&gpu.download(&buffer, buffer.size()).unwrap(), tw, th, stride);
@@ -119,7 +138,12 @@ fn the_shown_frame_is_the_rendered_frame() {
     let adaptive = RenderSettings::default().subdivision.method;
     for method in [adaptive, twister::core::settings::Method::Trace] {
         let settings = RenderSettings::default()
-            .with_projection(Projection { width: 96, height: 24, vertical: twister::Vertical::Exact, ..Projection::default() })
+            .with_projection(Projection {
+                width: 96,
+                height: 24,
+                vertical: twister::Vertical::Exact,
+                ..Projection::default()
+            })
             .with_method(method)
             .with_samples(4);
         let rendered = r.render(&gs, &settings).unwrap();
