@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The project's test command (README quick start, and what CI runs).
-# Installs Mesa's software Vulkan driver (lavapipe) when no Vulkan driver is present, and ffmpeg
-# (for `render --video`) when it is missing, then runs the whole test suite. Extra arguments go
+# Installs Mesa's software Vulkan driver (lavapipe) when no Vulkan driver is present, ffmpeg
+# (for `render --video`) and Xvfb with xdotool (for `view`'s window) when they are missing, then
+# runs the whole test suite. Extra arguments go
 # to `cargo test`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -22,6 +23,14 @@ fi
 if ! command -v ffmpeg >/dev/null 2>&1; then
     echo "No ffmpeg found: installing it (render --video encodes with it)..."
     missing+=(ffmpeg)
+fi
+# `twister view`'s tests run its window under a virtual X server, keys sent by xdotool.
+if ! command -v Xvfb >/dev/null 2>&1 || ! command -v xdotool >/dev/null 2>&1; then
+    echo "No Xvfb or xdotool found: installing them (the live window's tests)..."
+    missing+=(xvfb xauth xdotool)
+fi
+if [[ "$(ldconfig -p 2>/dev/null || true)" != *libxkbcommon-x11.so.0* ]]; then
+    missing+=(libxkbcommon-x11-0)
 fi
 if [ ${#missing[@]} -gt 0 ]; then
     sudo=""

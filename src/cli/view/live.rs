@@ -429,9 +429,15 @@ impl<'a> Live<'a> {
         let head = self.args.view.head.map_or(String::new(), |(h, yaw)| {
             format!(" head={},{},{},{}", h.x, h.y, h.z, yaw.unwrap_or(self.args.view.yaw))
         });
+        // Resident memory (Linux: /proc/self/statm's second field, pages of 4 KiB).
+        let rss = std::fs::read_to_string("/proc/self/statm")
+            .ok()
+            .and_then(|s| s.split_whitespace().nth(1).and_then(|p| p.parse::<u64>().ok()))
+            .map_or("-".to_string(), |pages| format!("{:.1}", pages as f64 * 4096.0 / (1 << 20) as f64));
         format!(
-            "frame {} viewer={},{},{} yaw={}{head} look={},{} method={} panorama={:?} samples={} show={} anim_frame={}",
+            "frame {} fps={:.2} rss_mib={rss} viewer={},{},{} yaw={}{head} look={},{} method={} panorama={:?} samples={} show={} anim_frame={}",
             self.frames,
+            self.fps,
             v.x,
             v.y,
             v.z,

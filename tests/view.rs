@@ -1,0 +1,294 @@
+//! `twister view`, the live window, as a user runs it: under a virtual X server (Xvfb) with the
+//! software driver, its screen grabbed by ffmpeg and keys sent by xdotool (scripts/test.sh
+//! installs them). The window must show exactly what `render` draws for the same settings,
+//! move the viewer as the keys and the head input say, and save the frame `render` writes,
+//! byte for byte. Without Xvfb or xdotool these tests say so and pass, except under CI.
+
+mod common;
+
+use std::io::BufRead;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use common::twister;
+
+const SIZE: [&str; 4] = ["--width", "128", "--height", "32"];
+
+fn tmp(name: &str) -> common::TempDir {
+    common::TempDir::new(format!("twister-view-{}-{name}", std::process::id()))
+}
+
+fn have(tool: &str) -> bool {
+    Command::new("sh").args(["-c", &format!("command -v {tool}")]).output().is_ok_and(|o| o.status.success())
+}
+
+/// A virtual X server on a display of its own, stopped when dropped.
+struct Xvfb {
+    child: Child,
+    display: String,
+}
+
+impl Xvfb {
+    /// None (the test does not run) where Xvfb, xdotool or ffmpeg is missing; under CI a
+    /// missing tool fails.
+    fn start(test: &str) -> Option<(std::sync::MutexGuard<'static, ()>, Xvfb)> {
+        // One window at a time: with two software-driven windows on two virtual servers at
+        // once, one of the two screens grabbed black (lavapipe's presentation, or the grab).
+        static ONE: Mutex<()> = Mutex::new(());
+        let guard = ONE.lock().unwrap_or_else(|e| e.into_inner());
+        if !(have("Xvfb") && have("xdotool") && have("ffmpeg")) {
+            assert!(std::env::var("CI").is_err(), "{test}: Xvfb, xdotool and ffmpeg are needed under CI (scripts/test.sh installs them)");
+            eprintln!("{test}: not run (no Xvfb, xdotool or ffmpeg: scripts/test.sh installs them)");
+            return None;
+        }
+        let base = 200 + (std::process::id() % 400) * 8 + test.len() as u32 % 8;
+        let n = (base..base + 64).find(|n| !Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() && !Path::new(&format!("/tmp/.X{n}-lock")).exists())?;
+        let display = format!(":{n}");
+        let child = Command::new("Xvfb")
+            .args([&display, "-screen", "0", "640x480x24", "-nolisten", "tcp"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("Xvfb starts");
+        let socket = format!("/tmp/.X11-unix/X{n}");
+        let start = Instant::now();
+        while !Path::new(&socket).exists() {
+            assert!(start.elapsed() < Duration::from_secs(20), "Xvfb {display} did not start");
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        Some((guard, Xvfb { child, display }))
+    }
+
+    /// The screen's top-left `w` × `h` pixels (RGB), grabbed by ffmpeg.
+    fn grab(&self, dir: &Path, w: u32, h: u32) -> image::RgbImage {
+        let shot = dir.join("shot.png");
+        let o = Command::new("ffmpeg")
+            .args(["-loglevel", "error", "-y", "-f", "x11grab", "-draw_mouse", "0", "-video_size", "640x480", "-i"])
+            .arg(&self.display)
+            .args(["-frames:v", "1"])
+            .arg(&shot)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "ffmpeg: {}", String::from_utf8_lossy(&o.stderr));
+        image::imageops::crop_imm(&image::open(&shot).unwrap().to_rgb8(), 0, 0, w, h).to_image()
+    }
+
+    fn xdotool(&self, args: &[&str]) {
+        let o = Command::new("xdotool").env("DISPLAY", &self.display).args(args).output().unwrap();
+        assert!(o.status.success(), "xdotool {args:?}: {}", String::from_utf8_lossy(&o.stderr));
+    }
+}
+
+impl Drop for Xvfb {
+    fn drop(&mut self) {
+        self.child.kill().ok();
+        self.child.wait().ok();
+    }
+}
+
+/// A running `twister view` and the lines it has written (`--trace-frames`, and stderr).
+struct Window {
+    child: Child,
+    lines: Arc<Mutex<Vec<String>>>,
+    errors: Arc<Mutex<Vec<String>>>,
+}
+
+impl Window {
+    fn open(x: &Xvfb, args: &[&str]) -> Window {
+        let mut child = twister()
+            .args(["view", "--overlay", "off", "--trace-frames"])
+            .args(SIZE)
+            .args(args)
+            .env("DISPLAY", &x.display)
+            .env_remove("WAYLAND_DISPLAY")
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let collect = |r: Box<dyn std::io::Read + Send>| {
+            let lines = Arc::new(Mutex::new(Vec::new()));
+            let sink = lines.clone();
+            std::thread::spawn(move || {
+                for line in std::io::BufReader::new(r).lines().map_while(|l| l.ok()) {
+                    sink.lock().unwrap().push(line);
+                }
+            });
+            lines
+        };
+        let lines = collect(Box::new(child.stdout.take().unwrap()));
+        let errors = collect(Box::new(child.stderr.take().unwrap()));
+        Window { child, lines, errors }
+    }
+
+    /// The last frame line once one satisfies `f` (and two more frames were shown after it).
+    fn wait_for(&self, what: &str, f: impl Fn(&str) -> bool) -> String {
+        let start = Instant::now();
+        loop {
+            {
+                let lines = self.lines.lock().unwrap();
+                let frames: Vec<&String> = lines.iter().filter(|l| l.starts_with("frame ")).collect();
+                if let Some(k) = frames.iter().position(|l| f(l)) {
+                    if frames.len() >= k + 3 && frames[k..].iter().all(|l| f(l)) {
+                        return frames.last().unwrap().to_string();
+                    }
+                }
+            }
+            assert!(
+                start.elapsed() < Duration::from_secs(90),
+                "waited for {what}: {:?}\nstderr: {:?}",
+                self.lines.lock().unwrap().iter().rev().take(3).collect::<Vec<_>>(),
+                self.errors.lock().unwrap()
+            );
+            std::thread::sleep(Duration::from_millis(50));
+        }
+    }
+
+    fn wait_stderr(&self, f: impl Fn(&str) -> bool) -> String {
+        let start = Instant::now();
+        loop {
+            if let Some(l) = self.errors.lock().unwrap().iter().find(|l| f(l)) {
+                return l.clone();
+            }
+            assert!(start.elapsed() < Duration::from_secs(90), "stderr: {:?}", self.errors.lock().unwrap());
+            std::thread::sleep(Duration::from_millis(50));
+        }
+    }
+
+    fn exit_code(&mut self) -> i32 {
+        let start = Instant::now();
+        loop {
+            if let Some(status) = self.child.try_wait().unwrap() {
+                return status.code().unwrap_or(-1);
+            }
+            assert!(start.elapsed() < Duration::from_secs(60), "the window did not close");
+            std::thread::sleep(Duration::from_millis(50));
+        }
+    }
+}
+
+impl Drop for Window {
+    fn drop(&mut self) {
+        self.child.kill().ok();
+        self.child.wait().ok();
+    }
+}
+
+/// A field of a frame line (`viewer=…`).
+fn field(line: &str, name: &str) -> String {
+    let key = format!("{name}=");
+    line.split(' ').find_map(|w| w.strip_prefix(&key)).unwrap_or_else(|| panic!("no {name} in {line}")).to_string()
+}
+
+/// `render`'s two eyes for the same options, stacked as the window shows them (left on top).
+fn rendered(dir: &Path, args: &[&str]) -> (image::RgbImage, PathBuf) {
+    let out = dir.join(format!("render-{}", args.join("_").replace(['/', ','], "-")));
+    let o = twister().arg("render").args(SIZE).args(args).arg("--out").arg(&out).output().unwrap();
+    assert!(o.status.success(), "render {args:?}: {}", String::from_utf8_lossy(&o.stderr));
+    let eye = |e: &str| image::open(out.join(format!("{e}.png"))).unwrap().to_rgb8();
+    let (left, right) = (eye("left"), eye("right"));
+    let mut both = image::RgbImage::new(128, 64);
+    image::imageops::replace(&mut both, &left, 0, 0);
+    image::imageops::replace(&mut both, &right, 0, 32);
+    (both, out)
+}
+
+fn assert_same(shown: &image::RgbImage, want: &image::RgbImage, what: &str) {
+    let differ = shown.pixels().zip(want.pixels()).filter(|(a, b)| a != b).count();
+    if differ > 0 {
+        let keep = std::env::temp_dir().join(format!("twister-view-failed-{}.png", what.replace(' ', "_")));
+        shown.save(&keep).ok();
+        eprintln!("the window's pixels: {}", keep.display());
+    }
+    assert_eq!(differ, 0, "{what}: {differ} of {} pixels differ from render's", want.len() / 3);
+}
+
+#[test]
+fn the_window_shows_what_render_draws_moves_with_the_keys_and_saves_render_s_files() {
+    let Some((_one, x)) = Xvfb::start("keys") else { return };
+    let dir = tmp("keys");
+    let saved = dir.join("saved");
+    let mut w = Window::open(&x, &["--out", saved.to_str().unwrap()]);
+    w.wait_for("the first frames", |_| true);
+    let (first, _) = rendered(&dir, &[]);
+    assert_same(&x.grab(&dir, 128, 64), &first, "the first frame");
+    // Hold W: the viewer walks forward (−z) and stops where the key is let go.
+    let id = String::from_utf8(
+        Command::new("xdotool").env("DISPLAY", &x.display).args(["search", "--name", "twister view"]).output().unwrap().stdout,
+    )
+    .unwrap();
+    x.xdotool(&["windowfocus", "--sync", id.lines().next().unwrap()]);
+    x.xdotool(&["keydown", "w"]);
+    std::thread::sleep(Duration::from_millis(400));
+    x.xdotool(&["keyup", "w"]);
+    std::thread::sleep(Duration::from_millis(300));
+    let line = w.wait_for("the viewer moved", |l| field(l, "viewer") != "0,0,0");
+    let viewer = field(&line, "viewer");
+    let z: f32 = viewer.split(',').nth(2).unwrap().parse().unwrap();
+    assert!(z < -0.1 && viewer.starts_with("0,0,"), "W walks forward: {viewer}");
+    let moved = w.wait_for("the viewer stopped", |l| field(l, "viewer") == viewer);
+    let (want, render_out) = rendered(&dir, &["--viewer", &viewer]);
+    assert_same(&x.grab(&dir, 128, 64), &want, &format!("after W ({moved})"));
+    // F12: render's files for the window's settings, byte for byte.
+    x.xdotool(&["key", "F12"]);
+    w.wait_stderr(|l| l.starts_with("saved into"));
+    for eye in ["left.png", "right.png"] {
+        let (a, b) = (std::fs::read(saved.join(eye)).unwrap(), std::fs::read(render_out.join(eye)).unwrap());
+        assert!(a == b, "{eye}: the saved file is not render's");
+    }
+    // M: the next method (vertex), drawn as render draws it.
+    x.xdotool(&["key", "m"]);
+    w.wait_for("vertex", |l| field(l, "method") == "vertex");
+    let (vertex, _) = rendered(&dir, &["--viewer", &viewer, "--method", "vertex"]);
+    assert_same(&x.grab(&dir, 128, 64), &vertex, "vertex");
+    assert!(vertex != want, "the methods differ on this frame");
+    x.xdotool(&["key", "Escape"]);
+    assert_eq!(w.exit_code(), 0, "Escape closes the window: {:?}", w.errors.lock().unwrap());
+}
+
+#[test]
+fn head_input_lines_move_the_head_and_a_bad_line_stops_the_window() {
+    let Some((_one, x)) = Xvfb::start("head-input") else { return };
+    let dir = tmp("head");
+    let input = dir.join("head.csv");
+    std::fs::create_dir_all(&*dir).unwrap();
+    std::fs::write(&input, "0,0.2,0,-0.1,15,0\n8,0.2,0,-0.1,15,0\n9,oops\n").unwrap();
+    let mut w = Window::open(&x, &["--head-input", input.to_str().unwrap()]);
+    let line = w.wait_for("the head", |l| l.contains(" head="));
+    assert_eq!(field(&line, "head"), "0.2,0,-0.1,15");
+    let (want, _) = rendered(&dir, &["--head", "0.2,0,-0.1,15"]);
+    assert_same(&x.grab(&dir, 128, 64), &want, "the head input's head");
+    let (still, _) = rendered(&dir, &[]);
+    assert!(want != still, "the head moved the frame");
+    // Line 3 is not six numbers: one line naming it, exit non-zero.
+    let error = w.wait_stderr(|l| l.starts_with("error:"));
+    assert!(error.contains("head.csv line 3"), "{error}");
+    assert_ne!(w.exit_code(), 0);
+}
+
+#[test]
+fn view_refuses_bad_options_and_a_missing_window_system_in_one_line() {
+    let dir = tmp("bad");
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (vec!["--frames".into(), "1..2".into()], "--frames"),
+        (vec!["--speed".into(), "0".into()], "--speed"),
+        (vec!["--head-input".into(), dir.join("missing.csv").display().to_string()], "missing.csv"),
+        (vec!["--panorama".into(), "cave".into()], "--cave"),
+        (vec![], "DISPLAY and WAYLAND_DISPLAY are unset"),
+    ];
+    for (args, says) in cases {
+        let o = twister()
+            .arg("view")
+            .args(SIZE)
+            .args(&args)
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{args:?} succeeded");
+        assert_eq!(err.lines().count(), 1, "{args:?}: one line: {err}");
+        assert!(err.contains(says) && !err.contains("panicked"), "{args:?}: {err}");
+    }
+}
