@@ -39,12 +39,17 @@ impl Xvfb {
         static ONE: Mutex<()> = Mutex::new(());
         let guard = ONE.lock().unwrap_or_else(|e| e.into_inner());
         if !(have("Xvfb") && have("xdotool") && have("ffmpeg")) {
-            assert!(std::env::var("CI").is_err(), "{test}: Xvfb, xdotool and ffmpeg are needed under CI (scripts/test.sh installs them)");
+            assert!(
+                std::env::var("CI").is_err(),
+                "{test}: Xvfb, xdotool and ffmpeg are needed under CI (scripts/test.sh installs them)"
+            );
             eprintln!("{test}: not run (no Xvfb, xdotool or ffmpeg: scripts/test.sh installs them)");
             return None;
         }
         let base = 200 + (std::process::id() % 400) * 8 + test.len() as u32 % 8;
-        let n = (base..base + 64).find(|n| !Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() && !Path::new(&format!("/tmp/.X{n}-lock")).exists())?;
+        let n = (base..base + 64).find(|n| {
+            !Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() && !Path::new(&format!("/tmp/.X{n}-lock")).exists()
+        })?;
         let display = format!(":{n}");
         let child = Command::new("Xvfb")
             .args([&display, "-screen", "0", "640x480x24", "-nolisten", "tcp"])
@@ -215,7 +220,12 @@ fn the_window_shows_what_render_draws_moves_with_the_keys_and_saves_render_s_fil
     assert_same(&x.grab(&dir, 128, 64), &first, "the first frame");
     // Hold W: the viewer walks forward (−z) and stops where the key is let go.
     let id = String::from_utf8(
-        Command::new("xdotool").env("DISPLAY", &x.display).args(["search", "--name", "twister view"]).output().unwrap().stdout,
+        Command::new("xdotool")
+            .env("DISPLAY", &x.display)
+            .args(["search", "--name", "twister view"])
+            .output()
+            .unwrap()
+            .stdout,
     )
     .unwrap();
     x.xdotool(&["windowfocus", "--sync", id.lines().next().unwrap()]);
