@@ -13,6 +13,9 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use common::twister;
+use twister::core::display::{DisplayMode, DisplayView, Look};
+use twister::cpu::display::display;
+use twister::Projection;
 
 const SIZE: [&str; 4] = ["--width", "128", "--height", "32"];
 
@@ -255,6 +258,98 @@ fn the_window_shows_what_render_draws_moves_with_the_keys_and_saves_render_s_fil
     assert!(vertex != want, "the methods differ on this frame");
     x.xdotool(&["key", "Escape"]);
     assert_eq!(w.exit_code(), 0, "Escape closes the window: {:?}", w.errors.lock().unwrap());
+}
+
+/// The display twin (`cpu::display`) of an image of `layers` stacked layers (render's eyes: 2;
+/// a heatmap: 1): what the window must show in `mode`.
+fn displayed(img: &image::RgbImage, layers: u32, mode: DisplayMode, look: Look, target: [u32; 2]) -> image::RgbImage {
+    let texels: Vec<u32> =
+        img.pixels().map(|p| p[0] as u32 | (p[1] as u32) << 8 | (p[2] as u32) << 16 | 0xff << 24).collect();
+    let size = [img.width(), img.height() / layers];
+    let view =
+        DisplayView { mode, look, image: size, layers, row_texels: size[0], target, overlay: None, srgb_target: false };
+    let projection = Projection { width: 128, height: 32, ..Projection::default() };
+    let words = display(&view.params(&projection), &projection, &texels, &[], target);
+    image::RgbImage::from_fn(target[0], target[1], |x, y| {
+        let w = words[(y * target[0] + x) as usize];
+        image::Rgb([w as u8, (w >> 8) as u8, (w >> 16) as u8])
+    })
+}
+
+/// At most 0.5 % of the pixels differ (a window pixel on a texel's edge may take its neighbour:
+/// the GPU's arithmetic and the twin's).
+fn assert_close(shown: &image::RgbImage, want: &image::RgbImage, what: &str) {
+    let differ = shown.pixels().zip(want.pixels()).filter(|(a, b)| a != b).count();
+    let uniform = want.pixels().all(|p| p == want.get_pixel(0, 0));
+    assert!(!uniform, "{what}: the expected image is one colour");
+    if differ * 200 > want.len() / 3 {
+        let keep = std::env::temp_dir().join(format!("twister-view-failed-{}.png", what.replace(' ', "_")));
+        shown.save(&keep).ok();
+        panic!(
+            "{what}: {differ} of {} pixels differ from the display twin's (the window's: {})",
+            want.len() / 3,
+            keep.display()
+        );
+    }
+}
+
+#[test]
+fn every_display_shows_render_s_frame_through_the_display_twin_after_a_resize_and_a_drag() {
+    let Some((_one, x)) = Xvfb::start("displays") else { return };
+    let dir = tmp("displays");
+    let mut w = Window::open(&x, &[]);
+    w.wait_for("the first frames", |_| true);
+    let (eyes, _) = rendered(&dir, &[]);
+    let id = String::from_utf8(
+        Command::new("xdotool")
+            .env("DISPLAY", &x.display)
+            .args(["search", "--name", "twister view"])
+            .output()
+            .unwrap()
+            .stdout,
+    )
+    .unwrap();
+    let id = id.lines().next().unwrap().to_string();
+    // A resize: the panoramas fitted into the new size.
+    x.xdotool(&["windowsize", "--sync", &id, "300", "200"]);
+    std::thread::sleep(Duration::from_millis(500));
+    w.wait_for("frames after the resize", |_| true);
+    let target = [300, 200];
+    assert_close(
+        &x.grab(&dir, 300, 200),
+        &displayed(&eyes, 2, DisplayMode::Panorama, Look::default(), target),
+        "resized",
+    );
+    x.xdotool(&["windowfocus", "--sync", &id]);
+    for (mode, show) in [(DisplayMode::Halves, "display halves"), (DisplayMode::LookSideBySide, "look-around")] {
+        x.xdotool(&["key", "v"]);
+        w.wait_for(show, |l| l.contains(&format!("show={show} ")));
+        assert_close(&x.grab(&dir, 300, 200), &displayed(&eyes, 2, mode, Look::default(), target), show);
+    }
+    // A drag turns the gaze: right and up.
+    x.xdotool(&["mousemove", "--window", &id, "100", "120", "mousedown", "1"]);
+    x.xdotool(&["mousemove", "--window", &id, "140", "100"]);
+    x.xdotool(&["mouseup", "1"]);
+    let line = w.wait_for("the drag", |l| !l.contains(" look=0,0 "));
+    let look: Vec<f32> = field(&line, "look").split(',').map(|v| v.parse().unwrap()).collect();
+    assert!(look[0] > 0.05 && look[1] > 0.05, "dragged right and up: {look:?}");
+    let look = Look { yaw: look[0], pitch: look[1], ..Look::default() };
+    assert_close(&x.grab(&dir, 300, 200), &displayed(&eyes, 2, DisplayMode::LookSideBySide, look, target), "dragged");
+    x.xdotool(&["key", "v"]);
+    w.wait_for("anaglyph", |l| l.contains("show=anaglyph "));
+    assert_close(&x.grab(&dir, 300, 200), &displayed(&eyes, 2, DisplayMode::LookAnaglyph, look, target), "anaglyph");
+    // The error heatmap: `error --heatmap`'s image, fitted.
+    x.xdotool(&["key", "v"]);
+    w.wait_for("the heatmap", |l| l.contains("show=error heatmap "));
+    let heatmap = dir.join("heatmap.png");
+    let o = twister().arg("error").args(SIZE).arg("--heatmap").arg(&heatmap).output().unwrap();
+    assert!(o.status.success(), "error: {}", String::from_utf8_lossy(&o.stderr));
+    let map = image::open(&heatmap).unwrap().to_rgb8();
+    let want = displayed(&map, 1, DisplayMode::Panorama, look, target);
+    assert_close(&x.grab(&dir, 300, 200), &want, "heatmap");
+    // The window closed (destroyed: there is no window manager to ask it): exit 0.
+    x.xdotool(&["windowclose", &id]);
+    assert_eq!(w.exit_code(), 0, "{:?}", w.errors.lock().unwrap());
 }
 
 #[test]

@@ -253,7 +253,8 @@ impl ApplicationHandler for App<'_> {
 
     fn window_event(&mut self, el: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
         let result = match event {
-            WindowEvent::CloseRequested => {
+            // Closed by the window manager, or destroyed: the window's work is done.
+            WindowEvent::CloseRequested | WindowEvent::Destroyed => {
                 el.exit();
                 Ok(())
             }

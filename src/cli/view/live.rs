@@ -423,7 +423,8 @@ impl<'a> Live<'a> {
         self.ms_present = ms;
     }
 
-    /// A shown frame in one line (`--trace-frames`): what a script needs to render it again.
+    /// A shown frame in one line (`--trace-frames`): what a script needs to render it again
+    /// (the look-around's gaze in radians, as the display stage takes it).
     fn trace_line(&self) -> String {
         let v = self.viewer();
         let head = self.args.view.head.map_or(String::new(), |(h, yaw)| {
@@ -443,8 +444,8 @@ impl<'a> Live<'a> {
             v.y,
             v.z,
             self.args.view.yaw,
-            self.look.yaw.to_degrees(),
-            self.look.pitch.to_degrees(),
+            self.look.yaw,
+            self.look.pitch,
             self.args.view.method.name(),
             self.settings.projection().panorama,
             self.settings.shading.samples,
