@@ -28,6 +28,10 @@ struct DisplayParams {
     overlay: vec4<f32>, // the overlay's place: x, y, width, height (pixels; width 0: none)
 }
 
+// Whether the pipeline draws the look-around views: the others' pipeline leaves the projection
+// out (on the software driver, a fragment shader that merely holds it ran ten times slower).
+override LOOK: bool = true;
+
 @group(0) @binding(0) var<uniform> params: DisplayParams;
 @group(0) @binding(1) var<storage, read> texels: array<u32>;
 @group(0) @binding(2) var<storage, read> overlay: array<u32>;
@@ -120,7 +124,7 @@ fn srgb_to_linear(c: f32) -> f32 {
 fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
     let xy = position.xy;
     var color = BACKGROUND;
-    if (params.mode >= 2u) {
+    if (LOOK && params.mode >= 2u) {
         color = look(xy);
     } else {
         color = content_texel(xy);

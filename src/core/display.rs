@@ -33,6 +33,13 @@ impl DisplayMode {
         }
     }
 
+    /// The mode of a code ([`DisplayMode::code`]).
+    pub fn from_code(code: u32) -> Option<DisplayMode> {
+        [DisplayMode::Panorama, DisplayMode::Halves, DisplayMode::LookSideBySide, DisplayMode::LookAnaglyph]
+            .into_iter()
+            .find(|m| m.code() == code)
+    }
+
     pub fn is_look(self) -> bool {
         matches!(self, DisplayMode::LookSideBySide | DisplayMode::LookAnaglyph)
     }

@@ -5,7 +5,9 @@
 
 use std::sync::Mutex;
 
+use crate::core::display::DisplayMode;
 use crate::core::frame::EyeImage;
+use crate::core::projection::PanoramaKind;
 use crate::encoding::types::DisplayParams;
 use crate::gpu::device::Gpu;
 use crate::gpu::stages::GpuStage;
@@ -44,7 +46,8 @@ pub struct DisplayStage {
     params: wgpu::Buffer,
     /// Bound where there is no overlay.
     no_overlay: wgpu::Buffer,
-    pipelines: Mutex<Vec<(wgpu::TextureFormat, wgpu::RenderPipeline)>>,
+    /// By target format and the panoramas compiled in (0: no look-around).
+    pipelines: Mutex<Vec<((wgpu::TextureFormat, u32), wgpu::RenderPipeline)>>,
 }
 
 impl DisplayStage {
@@ -57,19 +60,23 @@ impl DisplayStage {
         }
     }
 
-    fn pipeline(&self, gpu: &Gpu, format: wgpu::TextureFormat) -> wgpu::RenderPipeline {
+    /// The pipeline for a target format and the panoramas a look-around draws (`PANORAMAS`'
+    /// bits; 0: the modes without the projection).
+    fn pipeline(&self, gpu: &Gpu, format: wgpu::TextureFormat, panoramas: u32) -> wgpu::RenderPipeline {
         let mut pipelines = self.pipelines.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some((_, p)) = pipelines.iter().find(|(f, _)| *f == format) {
+        if let Some((_, p)) = pipelines.iter().find(|(key, _)| *key == (format, panoramas)) {
             return p.clone();
         }
         let module = self.stage.module(gpu, None);
+        let constants = [("LOOK", (panoramas != 0) as u32 as f64), ("PANORAMAS", panoramas.max(1) as f64)];
+        let options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
         let pipeline = gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("display"),
             layout: Some(self.stage.draw_layout()),
             vertex: wgpu::VertexState {
                 module,
                 entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
+                compilation_options: options.clone(),
                 buffers: &[],
             },
             primitive: Default::default(),
@@ -78,13 +85,13 @@ impl DisplayStage {
             fragment: Some(wgpu::FragmentState {
                 module,
                 entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
+                compilation_options: options,
                 targets: &[Some(format.into())],
             }),
             multiview_mask: None,
             cache: gpu.pipeline_cache(),
         });
-        pipelines.push((format, pipeline.clone()));
+        pipelines.push(((format, panoramas), pipeline.clone()));
         pipeline
     }
 
@@ -99,7 +106,12 @@ impl DisplayStage {
         frame: &ShownFrame,
         overlay: Option<&wgpu::Buffer>,
     ) {
-        let pipeline = self.pipeline(gpu, target.format);
+        let look = DisplayMode::from_code(params.mode).is_some_and(|m| m.is_look());
+        let panoramas = match PanoramaKind::from_code(params.projection.panorama) {
+            Some(kind) if look => crate::gpu::draw::panorama_bits(kind),
+            _ => 0,
+        };
+        let pipeline = self.pipeline(gpu, target.format, panoramas);
         gpu.queue.write_buffer(&self.params, 0, bytemuck::bytes_of(params));
         let overlay = overlay.unwrap_or(&self.no_overlay);
         let bind_group = self.stage.bind_group(gpu, None, 0, &[&self.params, &frame.texels, overlay]);
