@@ -18,6 +18,10 @@ use twister::cpu::display::display;
 use twister::Projection;
 
 const SIZE: [&str; 4] = ["--width", "128", "--height", "32"];
+/// The cylinder the windows draw (SIZE).
+fn cylinder() -> Projection {
+    Projection { width: 128, height: 32, ..Projection::default() }
+}
 
 fn tmp(name: &str) -> common::TempDir {
     common::TempDir::new(format!("twister-view-{}-{name}", std::process::id()))
@@ -192,13 +196,16 @@ fn field(line: &str, name: &str) -> String {
 /// `render`'s two eyes for the same options, stacked as the window shows them (left on top).
 fn rendered(dir: &Path, args: &[&str]) -> (image::RgbImage, PathBuf) {
     let out = dir.join(format!("render-{}", args.join("_").replace(['/', ','], "-")));
-    let o = twister().arg("render").args(SIZE).args(args).arg("--out").arg(&out).output().unwrap();
+    // Another panorama: the width alone (its own aspect, as the window's P key keeps it).
+    let size = if args.contains(&"--panorama") { &SIZE[..2] } else { &SIZE[..] };
+    let o =
+        twister().arg("render").args(size).args(args).args(["--layout", "eyes", "--out"]).arg(&out).output().unwrap();
     assert!(o.status.success(), "render {args:?}: {}", String::from_utf8_lossy(&o.stderr));
     let eye = |e: &str| image::open(out.join(format!("{e}.png"))).unwrap().to_rgb8();
     let (left, right) = (eye("left"), eye("right"));
-    let mut both = image::RgbImage::new(128, 64);
+    let mut both = image::RgbImage::new(left.width(), 2 * left.height());
     image::imageops::replace(&mut both, &left, 0, 0);
-    image::imageops::replace(&mut both, &right, 0, 32);
+    image::imageops::replace(&mut both, &right, 0, left.height() as i64);
     (both, out)
 }
 
@@ -256,19 +263,41 @@ fn the_window_shows_what_render_draws_moves_with_the_keys_and_saves_render_s_fil
     let (vertex, _) = rendered(&dir, &["--viewer", &viewer, "--method", "vertex"]);
     assert_same(&x.grab(&dir, 128, 64), &vertex, "vertex");
     assert!(vertex != want, "the methods differ on this frame");
+    // N: 8 samples (beyond lavapipe's 4: a larger image box-filtered, then shown).
+    x.xdotool(&["key", "n"]);
+    w.wait_for("8 samples", |l| field(l, "samples") == "8");
+    let (eight, _) = rendered(&dir, &["--viewer", &viewer, "--method", "vertex", "--samples", "8"]);
+    assert_same(&x.grab(&dir, 128, 64), &eight, "8 samples");
+    // P: the full sphere at the width asked for (128 × 64 per eye), fitted into the window.
+    x.xdotool(&["key", "p"]);
+    w.wait_for("the sphere", |l| field(l, "panorama") == "Equirect");
+    let sphere_args = ["--viewer", viewer.as_str(), "--method", "vertex", "--samples", "8", "--panorama", "equirect"];
+    let (sphere, _) = rendered(&dir, &sphere_args);
+    let projection = Projection { height: 64, ..Projection::equirect(128) };
+    assert_close(
+        &x.grab(&dir, 128, 64),
+        &displayed(&sphere, 2, DisplayMode::Panorama, Look::default(), [128, 64], projection),
+        "the sphere",
+    );
     x.xdotool(&["key", "Escape"]);
     assert_eq!(w.exit_code(), 0, "Escape closes the window: {:?}", w.errors.lock().unwrap());
 }
 
 /// The display twin (`cpu::display`) of an image of `layers` stacked layers (render's eyes: 2;
 /// a heatmap: 1): what the window must show in `mode`.
-fn displayed(img: &image::RgbImage, layers: u32, mode: DisplayMode, look: Look, target: [u32; 2]) -> image::RgbImage {
+fn displayed(
+    img: &image::RgbImage,
+    layers: u32,
+    mode: DisplayMode,
+    look: Look,
+    target: [u32; 2],
+    projection: Projection,
+) -> image::RgbImage {
     let texels: Vec<u32> =
         img.pixels().map(|p| p[0] as u32 | (p[1] as u32) << 8 | (p[2] as u32) << 16 | 0xff << 24).collect();
     let size = [img.width(), img.height() / layers];
     let view =
         DisplayView { mode, look, image: size, layers, row_texels: size[0], target, overlay: None, srgb_target: false };
-    let projection = Projection { width: 128, height: 32, ..Projection::default() };
     let words = display(&view.params(&projection), &projection, &texels, &[], target);
     image::RgbImage::from_fn(target[0], target[1], |x, y| {
         let w = words[(y * target[0] + x) as usize];
@@ -285,6 +314,7 @@ fn assert_close(shown: &image::RgbImage, want: &image::RgbImage, what: &str) {
     if differ * 200 > want.len() / 3 {
         let keep = std::env::temp_dir().join(format!("twister-view-failed-{}.png", what.replace(' ', "_")));
         shown.save(&keep).ok();
+        want.save(keep.with_extension("want.png")).ok();
         panic!(
             "{what}: {differ} of {} pixels differ from the display twin's (the window's: {})",
             want.len() / 3,
@@ -317,14 +347,14 @@ fn every_display_shows_render_s_frame_through_the_display_twin_after_a_resize_an
     let target = [300, 200];
     assert_close(
         &x.grab(&dir, 300, 200),
-        &displayed(&eyes, 2, DisplayMode::Panorama, Look::default(), target),
+        &displayed(&eyes, 2, DisplayMode::Panorama, Look::default(), target, cylinder()),
         "resized",
     );
     x.xdotool(&["windowfocus", "--sync", &id]);
     for (mode, show) in [(DisplayMode::Halves, "display halves"), (DisplayMode::LookSideBySide, "look-around")] {
         x.xdotool(&["key", "v"]);
         w.wait_for(show, |l| l.contains(&format!("show={show} ")));
-        assert_close(&x.grab(&dir, 300, 200), &displayed(&eyes, 2, mode, Look::default(), target), show);
+        assert_close(&x.grab(&dir, 300, 200), &displayed(&eyes, 2, mode, Look::default(), target, cylinder()), show);
     }
     // A drag turns the gaze: right and up.
     x.xdotool(&["mousemove", "--window", &id, "100", "120", "mousedown", "1"]);
@@ -334,10 +364,18 @@ fn every_display_shows_render_s_frame_through_the_display_twin_after_a_resize_an
     let look: Vec<f32> = field(&line, "look").split(',').map(|v| v.parse().unwrap()).collect();
     assert!(look[0] > 0.05 && look[1] > 0.05, "dragged right and up: {look:?}");
     let look = Look { yaw: look[0], pitch: look[1], ..Look::default() };
-    assert_close(&x.grab(&dir, 300, 200), &displayed(&eyes, 2, DisplayMode::LookSideBySide, look, target), "dragged");
+    assert_close(
+        &x.grab(&dir, 300, 200),
+        &displayed(&eyes, 2, DisplayMode::LookSideBySide, look, target, cylinder()),
+        "dragged",
+    );
     x.xdotool(&["key", "v"]);
     w.wait_for("anaglyph", |l| l.contains("show=anaglyph "));
-    assert_close(&x.grab(&dir, 300, 200), &displayed(&eyes, 2, DisplayMode::LookAnaglyph, look, target), "anaglyph");
+    assert_close(
+        &x.grab(&dir, 300, 200),
+        &displayed(&eyes, 2, DisplayMode::LookAnaglyph, look, target, cylinder()),
+        "anaglyph",
+    );
     // The error heatmap: `error --heatmap`'s image, fitted.
     x.xdotool(&["key", "v"]);
     w.wait_for("the heatmap", |l| l.contains("show=error heatmap "));
@@ -345,7 +383,7 @@ fn every_display_shows_render_s_frame_through_the_display_twin_after_a_resize_an
     let o = twister().arg("error").args(SIZE).arg("--heatmap").arg(&heatmap).output().unwrap();
     assert!(o.status.success(), "error: {}", String::from_utf8_lossy(&o.stderr));
     let map = image::open(&heatmap).unwrap().to_rgb8();
-    let want = displayed(&map, 1, DisplayMode::Panorama, look, target);
+    let want = displayed(&map, 1, DisplayMode::Panorama, look, target, cylinder());
     assert_close(&x.grab(&dir, 300, 200), &want, "heatmap");
     // The window closed (destroyed: there is no window manager to ask it): exit 0.
     x.xdotool(&["windowclose", &id]);
@@ -370,6 +408,13 @@ fn head_input_lines_move_the_head_and_a_bad_line_stops_the_window() {
     let error = w.wait_stderr(|l| l.starts_with("error:"));
     assert!(error.contains("head.csv line 3"), "{error}");
     assert_ne!(w.exit_code(), 0);
+    // A monitor the window system lacks: one line, before any window.
+    let o = twister().args(["view", "--monitor", "5"]).args(SIZE).env("DISPLAY", &x.display).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.lines().count() == 1 && err.contains("--monitor") && err.contains("has 1 monitor,"),
+        "{err}"
+    );
 }
 
 #[test]

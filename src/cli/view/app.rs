@@ -94,9 +94,11 @@ impl<'a> App<'a> {
         match self.args.monitor {
             Some(n) => {
                 let monitor = monitors.get(n).cloned().ok_or_else(|| {
+                    let count = monitors.len();
+                    let s = if count == 1 { "" } else { "s" };
                     Error::option(
                         "--monitor",
-                        format!("{n}: this window system has {} monitors (0 the first)", monitors.len()),
+                        format!("{n}: this window system has {count} monitor{s}, numbered from 0"),
                     )
                 })?;
                 attributes = attributes.with_fullscreen(Some(Fullscreen::Borderless(Some(monitor))));

@@ -215,9 +215,15 @@ impl<'a> Live<'a> {
                 let at = PANORAMAS.iter().position(|&p| p == now).unwrap_or(0);
                 for k in 1..=PANORAMAS.len() {
                     let mut args = self.args.clone();
-                    args.view.panorama = Some(PANORAMAS[(at + k) % PANORAMAS.len()]);
-                    // Each panorama's own default size (a cylinder's size is not a sphere's).
-                    (args.view.width, args.view.height, args.view.preset) = (None, None, None);
+                    let next = PANORAMAS[(at + k) % PANORAMAS.len()];
+                    args.view.panorama = Some(next);
+                    // The width asked for (or the preset's), each panorama its own aspect (the
+                    // cubemap's width a multiple of 3); the cylinder its height asked for.
+                    let given = &self.opts.render.view;
+                    let width = given.width.or(given.preset.map(|p| p.width()));
+                    args.view.width = width.map(|w| if next == PanoramaKind::Cubemap { (w / 3 * 3).max(3) } else { w });
+                    args.view.height = if next == PanoramaKind::Cylinder { given.height } else { None };
+                    args.view.preset = None;
                     if args.view.panorama != Some(PanoramaKind::Cylinder) {
                         args.view.head = None;
                     }
