@@ -418,6 +418,100 @@ fn head_input_lines_move_the_head_and_a_bad_line_stops_the_window() {
 }
 
 #[test]
+fn space_plays_the_animation_and_f12_saves_the_posed_frame_as_render_frames_does() {
+    if !common::assets_present() {
+        return;
+    }
+    let Some((_one, x)) = Xvfb::start("animation") else { return };
+    let dir = tmp("animation");
+    let scene = common::asset("gltf/CesiumMan/glTF-Binary/CesiumMan.glb");
+    let scene = scene.to_str().unwrap();
+    let saved = dir.join("saved");
+    let mut w = Window::open(&x, &[scene, "--fit", "2", "--method", "vertex", "--out", saved.to_str().unwrap()]);
+    w.wait_for("the first frames", |_| true);
+    let id = String::from_utf8(
+        Command::new("xdotool")
+            .env("DISPLAY", &x.display)
+            .args(["search", "--name", "twister view"])
+            .output()
+            .unwrap()
+            .stdout,
+    )
+    .unwrap();
+    x.xdotool(&["windowfocus", "--sync", id.lines().next().unwrap()]);
+    x.xdotool(&["key", "space"]);
+    w.wait_for("the animation to play", |l| field(l, "anim_frame") != "0");
+    x.xdotool(&["key", "space"]);
+    // Paused: the same posed frame from then on.
+    let start = Instant::now();
+    let frame = loop {
+        let last = w.wait_for("a frame", |_| true);
+        let k = field(&last, "anim_frame");
+        std::thread::sleep(Duration::from_millis(600));
+        if field(&w.wait_for("a frame", |_| true), "anim_frame") == k {
+            break k;
+        }
+        assert!(start.elapsed() < Duration::from_secs(60), "the animation did not pause");
+    };
+    assert_ne!(frame, "0");
+    let out = dir.join("render");
+    let o = twister()
+        .args(["render", scene, "--fit", "2", "--method", "vertex", "--layout", "eyes", "--frames", &frame, "--out"])
+        .arg(&out)
+        .args(SIZE)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let k: u32 = frame.parse().unwrap();
+    let eye = |e: &str| image::open(out.join(format!("frame_{k:06}_{e}.png"))).unwrap().to_rgb8();
+    let mut both = image::RgbImage::new(128, 64);
+    image::imageops::replace(&mut both, &eye("left"), 0, 0);
+    image::imageops::replace(&mut both, &eye("right"), 0, 32);
+    assert_same(&x.grab(&dir, 128, 64), &both, &format!("posed frame {k}"));
+    x.xdotool(&["key", "F12"]);
+    w.wait_stderr(|l| l.starts_with("saved into"));
+    for e in ["left", "right"] {
+        let name = format!("frame_{k:06}_{e}.png");
+        assert!(std::fs::read(saved.join(&name)).unwrap() == std::fs::read(out.join(&name)).unwrap(), "{name}");
+    }
+    x.xdotool(&["key", "Escape"]);
+    assert_eq!(w.exit_code(), 0);
+}
+
+#[test]
+fn with_visual_field_lod_the_detail_follows_the_dragged_gaze_as_render_gaze_draws_it() {
+    let Some((_one, x)) = Xvfb::start("lod-gaze") else { return };
+    let dir = tmp("lod");
+    let mut w = Window::open(&x, &["--lod", "visual-field"]);
+    let first = w.wait_for("the first frames", |_| true);
+    let id = String::from_utf8(
+        Command::new("xdotool")
+            .env("DISPLAY", &x.display)
+            .args(["search", "--name", "twister view"])
+            .output()
+            .unwrap()
+            .stdout,
+    )
+    .unwrap();
+    let id = id.lines().next().unwrap().to_string();
+    // Five drags across the window: about half a turn to the right and down.
+    for _ in 0..5 {
+        x.xdotool(&["mousemove", "--window", &id, "10", "20", "mousedown", "1"]);
+        x.xdotool(&["mousemove", "--window", &id, "120", "40"]);
+        x.xdotool(&["mouseup", "1"]);
+    }
+    let line = w.wait_for("the gaze turned", |l| field(l, "gaze") != field(&first, "gaze"));
+    let gaze = field(&line, "gaze");
+    let line = w.wait_for("the gaze stopped", |l| field(l, "gaze") == gaze);
+    assert_ne!(field(&line, "triangles"), field(&first, "triangles"), "the selection follows the gaze");
+    let (want, _) = rendered(&dir, &["--lod", "visual-field", "--gaze", &gaze]);
+    assert_same(&x.grab(&dir, 128, 64), &want, &format!("gaze {gaze}"));
+    x.xdotool(&["windowfocus", "--sync", &id]);
+    x.xdotool(&["key", "Escape"]);
+    assert_eq!(w.exit_code(), 0);
+}
+
+#[test]
 fn view_refuses_bad_options_and_a_missing_window_system_in_one_line() {
     let dir = tmp("bad");
     let cases: Vec<(Vec<String>, &str)> = vec![

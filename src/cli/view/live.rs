@@ -442,10 +442,13 @@ impl<'a> Live<'a> {
             .and_then(|s| s.split_whitespace().nth(1).and_then(|p| p.parse::<u64>().ok()))
             .map_or("-".to_string(), |pages| format!("{:.1}", pages as f64 * 4096.0 / (1 << 20) as f64));
         format!(
-            "frame {} fps={:.2} ms_render={:.1} rss_mib={rss} viewer={},{},{} yaw={}{head} look={},{} method={} panorama={:?} samples={} show={} anim_frame={}",
+            "frame {} fps={:.2} ms_render={:.1} rss_mib={rss} triangles={} gaze={},{} viewer={},{},{} yaw={}{head} look={},{} method={} panorama={:?} samples={} show={} anim_frame={}",
             self.frames,
             self.fps,
             self.stats.ms_total,
+            self.stats.triangles_out,
+            -self.look.yaw.to_degrees(),
+            self.look.pitch.to_degrees(),
             v.x,
             v.y,
             v.z,
