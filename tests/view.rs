@@ -103,6 +103,8 @@ impl Drop for Xvfb {
 /// A running `twister view` and the lines it has written (`--trace-frames`, and stderr).
 struct Window {
     child: Child,
+    /// The window's standard input (`--head-input -`).
+    stdin: Option<std::process::ChildStdin>,
     lines: Arc<Mutex<Vec<String>>>,
     errors: Arc<Mutex<Vec<String>>>,
 }
@@ -115,6 +117,7 @@ impl Window {
             .args(args)
             .env("DISPLAY", &x.display)
             .env_remove("WAYLAND_DISPLAY")
+            .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
             .spawn()
@@ -131,7 +134,8 @@ impl Window {
         };
         let lines = collect(Box::new(child.stdout.take().unwrap()));
         let errors = collect(Box::new(child.stderr.take().unwrap()));
-        Window { child, lines, errors }
+        let stdin = child.stdin.take();
+        Window { child, stdin, lines, errors }
     }
 
     /// The last frame line once one satisfies `f` (and two more frames were shown after it).
@@ -509,6 +513,44 @@ fn with_visual_field_lod_the_detail_follows_the_dragged_gaze_as_render_gaze_draw
     x.xdotool(&["windowfocus", "--sync", &id]);
     x.xdotool(&["key", "Escape"]);
     assert_eq!(w.exit_code(), 0);
+}
+
+#[test]
+fn the_display_halves_fill_the_monitor_named() {
+    let Some((_one, x)) = Xvfb::start("monitor") else { return };
+    let dir = tmp("monitor");
+    let mut w = Window::open(&x, &["--monitor", "0", "--show", "halves"]);
+    w.wait_for("the first frames", |_| true);
+    std::thread::sleep(Duration::from_millis(300));
+    let (eyes, _) = rendered(&dir, &[]);
+    let whole = displayed(&eyes, 2, DisplayMode::Halves, Look::default(), [640, 480], cylinder());
+    assert_close(&x.grab(&dir, 640, 480), &whole, "halves on monitor 0");
+    w.child.kill().ok();
+    w.exit_code();
+}
+
+#[test]
+fn head_input_from_standard_input_moves_the_head_as_lines_arrive() {
+    use std::io::Write;
+    let Some((_one, x)) = Xvfb::start("stdin") else { return };
+    let dir = tmp("stdin");
+    let mut w = Window::open(&x, &["--head-input", "-"]);
+    let first = w.wait_for("the first frames", |_| true);
+    assert!(!first.contains(" head="), "no head before a line: {first}");
+    let mut stdin = w.stdin.take().unwrap();
+    writeln!(stdin, "0,-0.1,0.05,0.2,-20,0").unwrap();
+    stdin.flush().unwrap();
+    let line = w.wait_for("the piped head", |l| l.contains(" head="));
+    assert_eq!(field(&line, "head"), "-0.1,0.05,0.2,-20");
+    let (want, _) = rendered(&dir, &["--head", "-0.1,0.05,0.2,-20"]);
+    assert_same(&x.grab(&dir, 128, 64), &want, "the piped head");
+    // The tracker ends: the window goes on with the last head.
+    drop(stdin);
+    std::thread::sleep(Duration::from_millis(300));
+    w.wait_for("frames after the input ended", |l| l.contains(" head=-0.1,0.05,0.2,-20 "));
+    assert!(w.child.try_wait().unwrap().is_none(), "the window closed when its input ended");
+    w.child.kill().ok();
+    w.exit_code();
 }
 
 #[test]

@@ -101,7 +101,12 @@ impl<'a> App<'a> {
                         format!("{n}: this window system has {count} monitor{s}, numbered from 0"),
                     )
                 })?;
-                attributes = attributes.with_fullscreen(Some(Fullscreen::Borderless(Some(monitor))));
+                // The monitor's place and size as well: without a window manager to make it
+                // fullscreen, the window still covers the monitor.
+                attributes = attributes
+                    .with_position(monitor.position())
+                    .with_inner_size(monitor.size())
+                    .with_fullscreen(Some(Fullscreen::Borderless(Some(monitor))));
             }
             None => {
                 let screen = el.primary_monitor().or_else(|| monitors.first().cloned()).map(|m| m.size());
