@@ -87,6 +87,16 @@ impl Xvfb {
         image::imageops::crop_imm(&image::open(&shot).unwrap().to_rgb8(), 0, 0, w, h).to_image()
     }
 
+    /// The window's X id (the first window named "twister view").
+    fn window_id(&self) -> String {
+        let o = Command::new("xdotool")
+            .env("DISPLAY", &self.display)
+            .args(["search", "--name", "twister view"])
+            .output()
+            .unwrap();
+        String::from_utf8(o.stdout).unwrap().lines().next().expect("a twister view window").to_string()
+    }
+
     fn xdotool(&self, args: &[&str]) {
         let o = Command::new("xdotool").env("DISPLAY", &self.display).args(args).output().unwrap();
         assert!(o.status.success(), "xdotool {args:?}: {}", String::from_utf8_lossy(&o.stderr));
@@ -111,7 +121,12 @@ struct Window {
 
 impl Window {
     fn open(x: &Xvfb, args: &[&str]) -> Window {
+        Window::open_with(x, args, &[])
+    }
+
+    fn open_with(x: &Xvfb, args: &[&str], envs: &[(&str, &str)]) -> Window {
         let mut child = twister()
+            .envs(envs.iter().copied())
             .args(["view", "--overlay", "off", "--trace-frames"])
             .args(SIZE)
             .args(args)
@@ -233,16 +248,8 @@ fn the_window_shows_what_render_draws_moves_with_the_keys_and_saves_render_s_fil
     let (first, _) = rendered(&dir, &[]);
     assert_same(&x.grab(&dir, 128, 64), &first, "the first frame");
     // Hold W: the viewer walks forward (−z) and stops where the key is let go.
-    let id = String::from_utf8(
-        Command::new("xdotool")
-            .env("DISPLAY", &x.display)
-            .args(["search", "--name", "twister view"])
-            .output()
-            .unwrap()
-            .stdout,
-    )
-    .unwrap();
-    x.xdotool(&["windowfocus", "--sync", id.lines().next().unwrap()]);
+    let id = x.window_id();
+    x.xdotool(&["windowfocus", "--sync", &id]);
     x.xdotool(&["keydown", "w"]);
     std::thread::sleep(Duration::from_millis(400));
     x.xdotool(&["keyup", "w"]);
@@ -334,16 +341,7 @@ fn every_display_shows_render_s_frame_through_the_display_twin_after_a_resize_an
     let mut w = Window::open(&x, &[]);
     w.wait_for("the first frames", |_| true);
     let (eyes, _) = rendered(&dir, &[]);
-    let id = String::from_utf8(
-        Command::new("xdotool")
-            .env("DISPLAY", &x.display)
-            .args(["search", "--name", "twister view"])
-            .output()
-            .unwrap()
-            .stdout,
-    )
-    .unwrap();
-    let id = id.lines().next().unwrap().to_string();
+    let id = x.window_id();
     // A resize: the panoramas fitted into the new size.
     x.xdotool(&["windowsize", "--sync", &id, "300", "200"]);
     std::thread::sleep(Duration::from_millis(500));
@@ -433,16 +431,8 @@ fn space_plays_the_animation_and_f12_saves_the_posed_frame_as_render_frames_does
     let saved = dir.join("saved");
     let mut w = Window::open(&x, &[scene, "--fit", "2", "--method", "vertex", "--out", saved.to_str().unwrap()]);
     w.wait_for("the first frames", |_| true);
-    let id = String::from_utf8(
-        Command::new("xdotool")
-            .env("DISPLAY", &x.display)
-            .args(["search", "--name", "twister view"])
-            .output()
-            .unwrap()
-            .stdout,
-    )
-    .unwrap();
-    x.xdotool(&["windowfocus", "--sync", id.lines().next().unwrap()]);
+    let id = x.window_id();
+    x.xdotool(&["windowfocus", "--sync", &id]);
     x.xdotool(&["key", "space"]);
     w.wait_for("the animation to play", |l| field(l, "anim_frame") != "0");
     x.xdotool(&["key", "space"]);
@@ -488,16 +478,7 @@ fn with_visual_field_lod_the_detail_follows_the_dragged_gaze_as_render_gaze_draw
     let dir = tmp("lod");
     let mut w = Window::open(&x, &["--lod", "visual-field"]);
     let first = w.wait_for("the first frames", |_| true);
-    let id = String::from_utf8(
-        Command::new("xdotool")
-            .env("DISPLAY", &x.display)
-            .args(["search", "--name", "twister view"])
-            .output()
-            .unwrap()
-            .stdout,
-    )
-    .unwrap();
-    let id = id.lines().next().unwrap().to_string();
+    let id = x.window_id();
     // Five drags across the window: about half a turn to the right and down.
     for _ in 0..5 {
         x.xdotool(&["mousemove", "--window", &id, "10", "20", "mousedown", "1"]);
@@ -551,6 +532,42 @@ fn head_input_from_standard_input_moves_the_head_as_lines_arrive() {
     assert!(w.child.try_wait().unwrap().is_none(), "the window closed when its input ended");
     w.child.kill().ok();
     w.exit_code();
+}
+
+#[test]
+fn a_lost_device_is_opened_again_and_the_window_goes_on_as_it_was() {
+    let Some((_one, x)) = Xvfb::start("lost-device") else { return };
+    let dir = tmp("lost");
+    let mut w = Window::open_with(&x, &[], &[("TWISTER_VIEW_TEST_KEYS", "1")]);
+    w.wait_for("the first frames", |_| true);
+    let id = x.window_id();
+    x.xdotool(&["windowfocus", "--sync", &id]);
+    x.xdotool(&["key", "v"]);
+    w.wait_for("the halves", |l| l.contains("show=display halves "));
+    // F9 (the test hook) destroys the device.
+    x.xdotool(&["key", "F9"]);
+    let warning = w.wait_stderr(|l| l.contains("device was lost"));
+    assert!(warning.starts_with("warning:"), "{warning}");
+    let lost_at = w.lines.lock().unwrap().len();
+    let start = Instant::now();
+    while w.lines.lock().unwrap().len() < lost_at + 5 {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "no frames after the device was lost: {:?}",
+            w.errors.lock().unwrap()
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    w.wait_for("the halves again", |l| l.contains("show=display halves "));
+    let (eyes, _) = rendered(&dir, &[]);
+    assert_close(
+        &x.grab(&dir, 128, 64),
+        &displayed(&eyes, 2, DisplayMode::Halves, Look::default(), [128, 64], cylinder()),
+        "after the loss",
+    );
+    x.xdotool(&["windowfocus", "--sync", &id]);
+    x.xdotool(&["key", "Escape"]);
+    assert_eq!(w.exit_code(), 0, "{:?}", w.errors.lock().unwrap());
 }
 
 #[test]

@@ -14,7 +14,7 @@ use winit::keyboard::{KeyCode, PhysicalKey};
 use winit::window::{Fullscreen, Window, WindowId};
 
 use super::head_input::HeadInput;
-use super::live::{Action, Held, Live};
+use super::live::{Action, Held, Live, Resume};
 use super::{OnOff, ViewCmdArgs};
 use twister::error::{Error, Result};
 use twister::gpu::display::DisplayTarget;
@@ -114,6 +114,13 @@ impl<'a> App<'a> {
             }
         }
         let window = Arc::new(el.create_window(attributes).map_err(no_window_system)?);
+        let head = self.head.take();
+        self.attach(el, window, Resume::Start(head))
+    }
+
+    /// A device and surface for `window`, and the live state on them: from the options, or
+    /// resumed where a lost device left it.
+    fn attach(&mut self, el: &ActiveEventLoop, window: Arc<Window>, resume: Resume) -> Result<Shown<'a>> {
         let (gpu, surface) = Gpu::for_window(Box::new(el.owned_display_handle()), window.clone())?;
         let lost = Arc::new(AtomicBool::new(false));
         let flag = lost.clone();
@@ -144,7 +151,7 @@ impl<'a> App<'a> {
         };
         surface.configure(&gpu.device, &config);
         let renderer = Renderer::new(gpu)?;
-        let live = Live::new(self.args, renderer, self.head.take())?;
+        let live = Live::new(self.args, renderer, resume)?;
         Ok(Shown { window, surface, config, live, lost })
     }
 
@@ -188,13 +195,17 @@ impl<'a> App<'a> {
     }
 
     fn fail(&mut self, el: &ActiveEventLoop, e: Error) {
-        // A lost device: opened again with the options as the window has them.
-        if let Some(shown) = self.shown.as_mut().filter(|s| s.lost.load(Ordering::Relaxed)) {
+        // A lost device: opened again, on the same window, with the state the window had. (A
+        // poll runs the device's callbacks: the lost one may not have run yet.)
+        if let Some(s) = &self.shown {
+            let _ = s.live.gpu().device.poll(wgpu::PollType::Poll);
+        }
+        let lost = self.shown.as_ref().is_some_and(|s| s.lost.load(Ordering::Relaxed));
+        if let Some(mut shown) = self.shown.take_if(|_| lost) {
             eprintln!("warning: the GPU device was lost ({e}); opening it again");
-            let window = shown.window.clone();
-            self.shown = None;
-            drop(window);
-            match self.open(el) {
+            let (window, resume) = (shown.window.clone(), shown.live.resume());
+            drop(shown);
+            match self.attach(el, window, resume) {
                 Ok(s) => {
                     self.shown = Some(s);
                     return;
@@ -225,6 +236,14 @@ impl<'a> App<'a> {
             KeyCode::KeyO => Action::ToggleOverlay,
             KeyCode::Space => Action::TogglePlay,
             KeyCode::F12 | KeyCode::Enter => Action::Save,
+            // Test hook (TWISTER_VIEW_TEST_KEYS=1): F9 destroys the device, as a driver reset
+            // would lose it.
+            KeyCode::F9 if std::env::var("TWISTER_VIEW_TEST_KEYS").is_ok_and(|v| v == "1") => {
+                if let Some(s) = &self.shown {
+                    s.live.gpu().device.destroy();
+                }
+                return Ok(());
+            }
             KeyCode::F11 => {
                 if let Some(s) = &self.shown {
                     let full = s.window.fullscreen().is_none().then_some(Fullscreen::Borderless(None));

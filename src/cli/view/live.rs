@@ -68,6 +68,23 @@ impl Meter {
     }
 }
 
+/// How the live state starts: from the options (with the head input), or where a lost device
+/// left it.
+pub enum Resume {
+    Start(Option<HeadInput>),
+    Lost(Box<Kept>),
+}
+
+/// The state a lost device's window goes on with.
+pub struct Kept {
+    args: RenderArgs,
+    look: Look,
+    show: Show,
+    overlay_on: bool,
+    anim_frame: u64,
+    head: Option<HeadInput>,
+}
+
 pub struct Live<'a> {
     pub opts: &'a ViewCmdArgs,
     /// The options a saved frame is rendered with (`render`'s), as the window has them now.
@@ -102,8 +119,14 @@ pub struct Live<'a> {
 }
 
 impl<'a> Live<'a> {
-    pub fn new(opts: &'a ViewCmdArgs, renderer: Renderer, head: Option<HeadInput>) -> Result<Live<'a>> {
-        let mut args = opts.render.clone();
+    pub fn new(opts: &'a ViewCmdArgs, renderer: Renderer, resume: Resume) -> Result<Live<'a>> {
+        let (head, state) = match resume {
+            Resume::Start(head) => (head, None),
+            Resume::Lost(state) => {
+                (state.head, Some((state.args, state.look, state.show, state.overlay_on, state.anim_frame)))
+            }
+        };
+        let mut args = state.as_ref().map_or_else(|| opts.render.clone(), |s| s.0.clone());
         let settings = render_settings(&args)?;
         let prepared = prepare_for(&renderer, &args, settings)?;
         // A file camera's place becomes the viewer the keys move (the same frame).
@@ -112,7 +135,7 @@ impl<'a> Live<'a> {
         args.view.yaw = placed.view.yaw_deg;
         let clip = crate::sequence::animation_clip(&args, &prepared.scene)?;
         let now = Instant::now();
-        Live {
+        let mut live = Live {
             opts,
             settings: render_settings(&args)?,
             args,
@@ -139,7 +162,26 @@ impl<'a> Live<'a> {
             saves: Vec::new(),
             lod: None,
         }
-        .with_lod()
+        .with_lod()?;
+        if let Some((_, look, show, overlay_on, anim_frame)) = state {
+            (live.look, live.show, live.overlay_on, live.anim_frame) = (look, show, overlay_on, anim_frame);
+            live.anim_clock = anim_frame as f64 / live.args.fps as f64;
+            live.pose()?;
+        }
+        Ok(live)
+    }
+
+    /// What a device lost takes to the next: the options, the gaze, the display, the pose, the
+    /// head input.
+    pub fn resume(&mut self) -> Resume {
+        Resume::Lost(Box::new(Kept {
+            args: self.args.clone(),
+            look: self.look,
+            show: self.show,
+            overlay_on: self.overlay_on,
+            anim_frame: self.anim_frame,
+            head: self.head.take(),
+        }))
     }
 
     /// With `--lod visual-field`, what the gaze's selection is made from.
