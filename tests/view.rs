@@ -176,6 +176,20 @@ impl Window {
         }
     }
 
+    /// The last frame line once `name`'s value has stayed the same for 0.6 s (and frames went on).
+    fn wait_stable(&self, name: &str) -> String {
+        let start = Instant::now();
+        loop {
+            let before = self.wait_for("a frame", |_| true);
+            std::thread::sleep(Duration::from_millis(600));
+            let after = self.wait_for("a frame", |_| true);
+            if field(&before, name) == field(&after, name) && before.split(' ').nth(1) != after.split(' ').nth(1) {
+                return after;
+            }
+            assert!(start.elapsed() < Duration::from_secs(90), "{name} did not settle: {after}");
+        }
+    }
+
     fn wait_stderr(&self, f: impl Fn(&str) -> bool) -> String {
         let start = Instant::now();
         loop {
@@ -254,11 +268,11 @@ fn the_window_shows_what_render_draws_moves_with_the_keys_and_saves_render_s_fil
     std::thread::sleep(Duration::from_millis(400));
     x.xdotool(&["keyup", "w"]);
     std::thread::sleep(Duration::from_millis(300));
-    let line = w.wait_for("the viewer moved", |l| field(l, "viewer") != "0,0,0");
-    let viewer = field(&line, "viewer");
+    w.wait_for("the viewer moved", |l| field(l, "viewer") != "0,0,0");
+    let moved = w.wait_stable("viewer");
+    let viewer = field(&moved, "viewer");
     let z: f32 = viewer.split(',').nth(2).unwrap().parse().unwrap();
     assert!(z < -0.1 && viewer.starts_with("0,0,"), "W walks forward: {viewer}");
-    let moved = w.wait_for("the viewer stopped", |l| field(l, "viewer") == viewer);
     let (want, render_out) = rendered(&dir, &["--viewer", &viewer]);
     assert_same(&x.grab(&dir, 128, 64), &want, &format!("after W ({moved})"));
     // F12: render's files for the window's settings, byte for byte.
@@ -362,7 +376,8 @@ fn every_display_shows_render_s_frame_through_the_display_twin_after_a_resize_an
     x.xdotool(&["mousemove", "--window", &id, "100", "120", "mousedown", "1"]);
     x.xdotool(&["mousemove", "--window", &id, "140", "100"]);
     x.xdotool(&["mouseup", "1"]);
-    let line = w.wait_for("the drag", |l| !l.contains(" look=0,0 "));
+    w.wait_for("the drag", |l| !l.contains(" look=0,0 "));
+    let line = w.wait_stable("look");
     let look: Vec<f32> = field(&line, "look").split(',').map(|v| v.parse().unwrap()).collect();
     assert!(look[0] > 0.05 && look[1] > 0.05, "dragged right and up: {look:?}");
     let look = Look { yaw: look[0], pitch: look[1], ..Look::default() };
@@ -485,9 +500,9 @@ fn with_visual_field_lod_the_detail_follows_the_dragged_gaze_as_render_gaze_draw
         x.xdotool(&["mousemove", "--window", &id, "120", "40"]);
         x.xdotool(&["mouseup", "1"]);
     }
-    let line = w.wait_for("the gaze turned", |l| field(l, "gaze") != field(&first, "gaze"));
+    w.wait_for("the gaze turned", |l| field(l, "gaze") != field(&first, "gaze"));
+    let line = w.wait_stable("gaze");
     let gaze = field(&line, "gaze");
-    let line = w.wait_for("the gaze stopped", |l| field(l, "gaze") == gaze);
     assert_ne!(field(&line, "triangles"), field(&first, "triangles"), "the selection follows the gaze");
     let (want, _) = rendered(&dir, &["--lod", "visual-field", "--gaze", &gaze]);
     assert_same(&x.grab(&dir, 128, 64), &want, &format!("gaze {gaze}"));
