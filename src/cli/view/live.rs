@@ -163,6 +163,10 @@ impl<'a> Live<'a> {
             lod: None,
         }
         .with_lod()?;
+        // A clip asked for is shown posed from its first frame (as `render --frames 0` poses it).
+        if live.args.animation.is_some() {
+            live.pose()?;
+        }
         if let Some((_, look, show, overlay_on, anim_frame)) = state {
             (live.look, live.show, live.overlay_on, live.anim_frame) = (look, show, overlay_on, anim_frame);
             live.anim_clock = anim_frame as f64 / live.args.fps as f64;
@@ -372,7 +376,8 @@ impl<'a> Live<'a> {
     /// (the window goes on drawing); an animated scene's posed frame as `render --frames K`.
     fn save(&mut self) {
         let mut args = self.args.clone();
-        let posed = self.prepared.scene.rig.is_some() && self.anim_frame > 0;
+        // `--animation` belongs to a sequence for `render`: frame K of it, even frame 0.
+        let posed = self.prepared.scene.rig.is_some() && (self.anim_frame > 0 || args.animation.is_some());
         if posed {
             args.frames = Some((self.anim_frame as u32, self.anim_frame as u32));
         }
