@@ -168,6 +168,9 @@ fn scene_too_big_for_the_memory_budget_is_drawn_in_chunks_without_loss() {
         (Projection { width: 960, height: 180, ..Projection::default() }, 2.0, false, 1),
         (Projection { width: 256, height: 256, ..Projection::default() }, 2.5, true, 1),
         (Projection { width: 256, height: 256, ..Projection::default() }, 2.5, true, 4),
+        // The full sphere: pieces drawn in rows, whose row items share the index buffer with
+        // the triangles of the pieces written in place.
+        (Projection::equirect(256), 2.5, true, 1),
     ] {
         let roomy = RenderSettings::new(projection)
             .with_method(Method::Adaptive(Split::Length))

@@ -45,6 +45,8 @@
 @group(0) @binding(15) var<storage, read_write> piece_work: array<PieceWork>;
 @group(0) @binding(16) var<storage, read_write> lattice_work: array<vec4<u32>>;
 // The bands of the pieces whose rows `lattice_rows` measures, (piece << 5) | band, in the
-// output's index buffer (`out_indices`, written only later by `lattice_triangles`): a piece of
-// R rows has at least R + 1 nodes, so where the output fits, so do they.
+// output's index buffer (`out_indices`) from its back (`row_item_slot`): a piece of R rows has
+// at least R + 1 nodes, so where the output fits, so do they, and the triangles written in
+// place before `lattice_rows_plan` (from the front) reach them only where the output, counted
+// with them, overflows.
 @group(0) @binding(17) var<storage, read_write> row_items: array<u32>;

@@ -54,6 +54,13 @@ fn row_item_room() -> u32 {
     return 3u * params.triangle_capacity;
 }
 
+// Where row item i lies: the output's index buffer from its back, so that the triangles of
+// pieces written in place (from its front) meet them only when the output overflows
+// (`SubdivideCounters::output_units` counts both).
+fn row_item_slot(i: u32) -> u32 {
+    return row_item_room() - 1u - i;
+}
+
 // The row items `lattice` appended, within their room.
 fn row_item_count() -> u32 {
     return min(atomicLoad(&counters.row_items), row_item_room());

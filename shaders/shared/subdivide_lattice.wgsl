@@ -336,11 +336,10 @@ fn candidate_drawn(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> bool {
     return !(same(a, b) || same(b, c) || same(c, a) || off_screen_vertically(a, b, c));
 }
 
-// The u range (both eyes) of the piece's triangle on the cylinder, from its corners
-// (`piece_u_range` in subdivide.rs): its azimuths span those of its corners (its footprint is
-// convex and misses the axis), and α(r) grows with r, so |α| is largest at the footprint's
-// nearest or farthest point from the axis.
-fn piece_u_range(q: array<Node, 3>, theta_c: f32) -> vec2<f32> {
+// The footprint of the piece's triangle (`Footprint` in src/cpu/subdivide/): its corners'
+// azimuths unwrapped towards theta_c (its footprint is convex and misses the axis, so they span
+// its points'), its nearest and farthest distance from the axis: (θ min, θ max, r min, r max).
+fn footprint(q: array<Node, 3>, theta_c: f32) -> vec4<f32> {
     var theta_min = 1e30;
     var theta_max = -1e30;
     var r_min = 1e30;
@@ -356,6 +355,18 @@ fn piece_u_range(q: array<Node, 3>, theta_c: f32) -> vec2<f32> {
         let t = clamp(-dot(a, ab) / max(dot(ab, ab), 1e-30), 0.0, 1.0);
         r_min = min(r_min, length(a + t * ab));
     }
+    return vec4<f32>(theta_min, theta_max, r_min, r_max);
+}
+
+// The u range (both eyes) of the piece's triangle on the cylinder, from its corners
+// (`piece_u_range` in subdivide.rs): α(r) grows with r, so |α| is largest at the footprint's
+// nearest or farthest point from the axis.
+fn piece_u_range(q: array<Node, 3>, theta_c: f32) -> vec2<f32> {
+    let f = footprint(q, theta_c);
+    let theta_min = f.x;
+    let theta_max = f.y;
+    let r_min = f.z;
+    let r_max = f.w;
     let proj = params.projection;
     if (proj.head_on != 0.0) {
         // A tracked head: u = θ − γ, moved by the eye's offset seen from the point and by the
@@ -475,6 +486,27 @@ fn interior_counts(tri: ptr<function, InputTriangle>, part: ptr<function, PartPl
 
 // The azimuths a piece is drawn at: its own, and a turn away where its nodes' u range (both
 // eyes) reaches ±π. Conservative by SEAM_MARGIN: an extra copy is clipped by the rasterizer.
+// A bound on the u range (both eyes) of the nodes of the piece's triangle on the sphere
+// (`sphere_u_bound` in src/cpu/subdivide/): u = θ − s·asin(e/r), |e/r| clamped to 1, and with
+// parallel rays |e| ≤ d_e, so u lies within asin(min(d_e / r_min, 1)) (π/2 for converging rays)
+// of the footprint's azimuths.
+fn sphere_u_bound(q: array<Node, 3>, theta_c: f32) -> vec2<f32> {
+    let f = footprint(q, theta_c);
+    let proj = params.projection;
+    var reach = 0.5 * PI;
+    if (proj.convergence <= 0.0) {
+        reach = asin(min(proj.eye_radius / max(f.z, 1e-30), 1.0));
+    }
+    return vec2<f32>(f.x - reach, f.y + reach);
+}
+
+// Whether a bound on a piece's u range keeps it clear of the seam by SEAM_BOUND_SLACK beyond
+// SEAM_MARGIN: then its nodes' own range needs no copy either.
+fn clear_of_seam(bound: vec2<f32>) -> bool {
+    let margin = SEAM_MARGIN + SEAM_BOUND_SLACK;
+    return bound.y <= PI - margin && bound.x >= -PI + margin;
+}
+
 struct SeamCopies {
     refs: array<f32, 3>,
     copies: u32,
@@ -487,7 +519,12 @@ fn seam_copies(shape: PieceShape, part: ptr<function, PartPlan>, piece_state: pt
     // for each slot (lavapipe stops an invocation after 65,535 loop iterations in all).
     var row = vec2<u32>(0u, 0u);
     if (is_sphere(params.projection)) {
-        for (var k = 0u; k < shape.node_count; k++) {
+        // Every node projected, unless the corners' bound keeps the piece clear of the seam.
+        let bound = sphere_u_bound((*piece_state).corner, theta_c);
+        if (clear_of_seam(bound)) {
+            u_range = bound;
+        }
+        for (var k = 0u; k < shape.node_count && !clear_of_seam(bound); k++) {
             let p = piece_node(k, shape.m, &row, part, piece_state).position;
             let theta = theta_c + wrap_angle(azimuth(p) - theta_c);
             for (var s = 0u; s < 2u; s++) {

@@ -15,11 +15,6 @@
 #import subdivide_dispatch
 #import subdivide_in_place
 
-// Whether the frame measures rows (the sphere, an adaptive rule: `Passes::rows`).
-fn measures_rows() -> bool {
-    return is_adaptive() && is_sphere(params.projection);
-}
-
 // Node slots or candidate triangles one item of a piece drawn `copies` times covers.
 fn chunk_of(copies: u32) -> u32 {
     return LATTICE_CHUNK / copies;
@@ -32,13 +27,13 @@ fn work_capacity() -> u32 {
 
 // The piece at `index` (its shape in `piece_state`, its seam copies): its nodes allocated; a
 // piece of one item's worth (at most LATTICE_CHUNK / copies nodes and candidates: every `vertex`
-// piece, most small ones) written here, as its items would be — except in frames that measure
-// rows, whose row items lie in the output's index buffer until `lattice_rows_plan` —; a larger
-// one's work written and
+// piece, most small ones) written here where `in_place` (by `lattice`; `lattice_rows_plan`'s
+// invocations are one in a piece's rows, and lavapipe ran its writes in place at that density
+// slower than the work items), as its items would be; a larger one's work written and
 // its work items appended: node items from the front of `lattice_work`, triangle items from its
 // back, each triangle item with the walk (strip, quad, rows) at its first candidate. Counted
 // always, written only where they fit.
-fn plan_work(index: u32, shape: PieceShape, seam: SeamCopies, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
+fn plan_work(index: u32, shape: PieceShape, seam: SeamCopies, in_place: bool, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
     let copies = seam.copies;
     var work: PieceWork;
     work.shape = (*piece_state).strip_base;
@@ -54,7 +49,7 @@ fn plan_work(index: u32, shape: PieceShape, seam: SeamCopies, tri: ptr<function,
     }
     work.first_node = atomicAdd(&counters.nodes, copies * shape.node_count);
     let chunk = chunk_of(copies);
-    if (shape.node_count <= chunk && shape.candidates <= chunk && !measures_rows()) {
+    if (in_place && shape.node_count <= chunk && shape.candidates <= chunk) {
         write_in_place(index, work, tri, part, piece_state);
         return;
     }
@@ -102,7 +97,7 @@ fn plan_pending(index: u32, shape: PieceShape, piece_state: ptr<function, PieceS
     let base = atomicAdd(&counters.row_items, r);
     for (var b = 0u; b < r; b++) {
         if (base + b < row_item_room()) {
-            row_items[base + b] = (index << 5u) | b; // b < r ≤ PIECE_DIVISIONS = 32
+            row_items[row_item_slot(base + b)] = (index << 5u) | b; // b < r ≤ PIECE_DIVISIONS = 32
         }
     }
 }

@@ -29,8 +29,9 @@ fn lattice_rows(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     if (local >= row_item_count()) {
         return;
     }
-    let index = row_items[local] >> 5u;
-    let b = row_items[local] & 31u;
+    let item = row_items[row_item_slot(local)];
+    let index = item >> 5u;
+    let b = item & 31u;
     let work = piece_work[index];
     load_triangle(pieces[index].triangle, &tri);
     load_work(index, work, &part, &piece_state);

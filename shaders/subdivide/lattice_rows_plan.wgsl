@@ -26,10 +26,10 @@ fn lattice_rows_plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
     var part: PartPlan;
     var piece_state: PieceState;
     let local = invocation_index(gid, groups);
-    if (local >= row_item_count() || (row_items[local] & 31u) != 0u) {
+    if (local >= row_item_count() || (row_items[row_item_slot(local)] & 31u) != 0u) {
         return;
     }
-    let index = row_items[local] >> 5u;
+    let index = row_items[row_item_slot(local)] >> 5u;
     let work = piece_work[index];
     load_triangle(pieces[index].triangle, &tri);
     load_work(index, work, &part, &piece_state);
@@ -42,5 +42,5 @@ fn lattice_rows_plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
         shape.candidates = rows.x;
         shape.node_count = rows.y;
     }
-    plan_work(index, shape, seam_copies(shape, &part, &piece_state), &tri, &part, &piece_state);
+    plan_work(index, shape, seam_copies(shape, &part, &piece_state), false, &tri, &part, &piece_state);
 }

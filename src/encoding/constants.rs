@@ -49,6 +49,10 @@ pub const TRACE_PENDING: u32 = crate::core::settings::MAX_REFLECT + 2 + MAX_SHAD
 pub const TRACE_COUNT_SLOTS: u32 = 4096;
 /// Seam copies are made for triangles reaching within this many radians of ±π.
 pub const SEAM_MARGIN: f32 = 1e-5;
+/// On the sphere, a piece whose bound from its corners (`sphere_u_bound`) keeps this many
+/// radians more than `SEAM_MARGIN` from ±π is known to need no seam copy without projecting its
+/// nodes (the bound's rounding is ~10⁻⁶ rad).
+pub const SEAM_BOUND_SLACK: f32 = 1e-3;
 /// The most divisions of a piece's edge: `fixed:N` above it is pre-split into a macro-lattice of
 /// K = ceil(N / this) pieces (N = 64: 4 pieces of 32²), and `adaptive` takes N_max as at most
 /// this, so that one `lattice` invocation never makes more than this² triangles (lavapipe cut
@@ -147,6 +151,7 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("MAX_STRETCH", F32(MAX_STRETCH)),
         ("ERROR_SPLIT_LENGTH", F32(ERROR_SPLIT_LENGTH)),
         ("SEAM_MARGIN", F32(SEAM_MARGIN)),
+        ("SEAM_BOUND_SLACK", F32(SEAM_BOUND_SLACK)),
         ("TRACE_STACK", U32(TRACE_STACK)),
         ("TRACE_PENDING", U32(TRACE_PENDING)),
         ("MAX_SHADOWED_LIGHTS", U32(MAX_SHADOWED_LIGHTS)),

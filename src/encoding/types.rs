@@ -207,9 +207,10 @@ impl SubdivideCounters {
     pub const RUN_BYTES: u64 = 48;
 
     /// What the output buffers must hold, in their unit (a triangle's indices and a node each):
-    /// the larger of the triangle and node counts.
+    /// the larger of the node count and the triangle count with the row items (which lie in the
+    /// index buffer from its back while pieces written in place fill it from the front).
     pub fn output_units(&self) -> u32 {
-        self.triangles.max(self.nodes)
+        self.triangles.saturating_add(self.row_items.div_ceil(3)).max(self.nodes)
     }
 
     /// What the piece buffers must hold: the piece records, and as many part records (a part

@@ -23,9 +23,7 @@ use crate::gpu::frame_plan::SubdivisionBuffers;
 use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
 use crate::gpu::timestamps::{self as stamp, Timestamps};
-use crate::shader::{
-    StandIn, CAVE_OFF, CUBEMAP_OFF, FISHEYE_OFF, HEAD_OFF, IN_PLACE_OFF, ROWS_OFF, SPHERE_OFF, SUBDIVIDE,
-};
+use crate::shader::{StandIn, CAVE_OFF, CUBEMAP_OFF, FISHEYE_OFF, HEAD_OFF, ROWS_OFF, SPHERE_OFF, SUBDIVIDE};
 
 pub(crate) const COUNTERS_SIZE: u64 = std::mem::size_of::<SubdivideCounters>() as u64;
 // The frame's timestamps are read back as u64s right after the counters.
@@ -81,9 +79,9 @@ impl SubdivideStage {
                 (0, _) => &[ROWS_OFF, SPHERE_OFF, FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
                 (1, _) => &[ROWS_OFF, SPHERE_OFF, FISHEYE_OFF, CUBEMAP_OFF, CAVE_OFF],
                 (2, false) => &[ROWS_OFF, FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
-                (2, true) => &[IN_PLACE_OFF, FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
+                (2, true) => &[FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
                 (_, false) => &[ROWS_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
-                (_, true) => &[IN_PLACE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
+                (_, true) => &[HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
             };
             // The entry points this frame's schedules dispatch (every schedule's are the usual
             // frame's).

@@ -489,7 +489,6 @@ pub const SHARED: &[(&str, &str)] = &[
     ("subdivide_rows_off", include_str!("../../shaders/shared/subdivide_rows_off.wgsl")),
     ("subdivide_work", include_str!("../../shaders/shared/subdivide_work.wgsl")),
     ("subdivide_in_place", include_str!("../../shaders/shared/subdivide_in_place.wgsl")),
-    ("subdivide_in_place_off", include_str!("../../shaders/shared/subdivide_in_place_off.wgsl")),
     ("surface_bindings", include_str!("../../shaders/shared/surface_bindings.wgsl")),
     ("texture", include_str!("../../shaders/shared/texture.wgsl")),
     ("brdf", include_str!("../../shaders/shared/brdf.wgsl")),
@@ -505,13 +504,10 @@ pub const SHARED: &[(&str, &str)] = &[
 pub type StandIn = (&'static str, &'static str);
 
 /// Every stand-in (the naga test validates each file composed with each one).
-pub const STAND_INS: &[StandIn] = &[ROWS_OFF, SPHERE_OFF, IN_PLACE_OFF, FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF];
+pub const STAND_INS: &[StandIn] = &[ROWS_OFF, SPHERE_OFF, FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF];
 
 /// `subdivide_rows` left out: the `lattice` pipeline of the frames that never draw rows.
 pub const ROWS_OFF: StandIn = ("subdivide_rows", "subdivide_rows_off");
-
-/// `subdivide_in_place` left out: the subdivide stage's pipelines for frames that measure rows.
-pub const IN_PLACE_OFF: StandIn = ("subdivide_in_place", "subdivide_in_place_off");
 
 /// `projection_sphere` left out: the subdivide stage's pipelines for the cylinder.
 pub const SPHERE_OFF: StandIn = ("projection_sphere", "projection_sphere_off");

@@ -103,7 +103,7 @@
 use glam::{Vec2, Vec3, Vec4};
 use std::f32::consts::{PI, TAU};
 
-use crate::core::projection::{azimuth, wrap_angle, PanoramaKind, Projection};
+use crate::core::projection::{PanoramaKind, Projection};
 use crate::core::scene::{pack_tangent, SceneVertex};
 use crate::core::settings::SplitRule;
 use crate::encoding::constants::{SEAM_MARGIN, STRIP_BASE_ERROR, STRIP_MIN_DIVISIONS};
@@ -118,6 +118,7 @@ pub mod passes;
 mod piece;
 mod quad;
 mod rows;
+mod seam;
 mod work;
 
 pub use axis::{
@@ -274,40 +275,6 @@ impl<'a> Subdivider<'a> {
                 }
             }
         }
-    }
-
-    /// The u range (both eyes, unwrapped towards `theta_c`) of a piece's triangle on the
-    /// cylinder, from its corners alone: the triangle's footprint is convex and misses the axis,
-    /// so its azimuths span those of its corners, and α(r) (eq. 3) grows with r, so |α| is
-    /// largest at the footprint's nearest or farthest point from the axis (the nearest: a corner
-    /// or the foot of the perpendicular on an edge). It holds every node of the piece, so seam
-    /// copies are made where the nodes need them (and, rarely, one more, which the rasterizer
-    /// clips). `piece_u_range` in the WGSL.
-    fn piece_u_range(&self, q: &[Node; 3], theta_c: f32) -> (f32, f32) {
-        let (mut theta_min, mut theta_max) = (f32::INFINITY, f32::NEG_INFINITY);
-        let (mut r_min, mut r_max) = (f32::INFINITY, 0.0f32);
-        for e in 0..3 {
-            let a = Vec2::new(q[e].position.x, q[e].position.z);
-            let b = Vec2::new(q[(e + 1) % 3].position.x, q[(e + 1) % 3].position.z);
-            let theta = theta_c + wrap_angle(azimuth(q[e].position) - theta_c);
-            theta_min = theta_min.min(theta);
-            theta_max = theta_max.max(theta);
-            r_max = r_max.max(a.length());
-            let ab = b - a;
-            let t = (-a.dot(ab) / ab.dot(ab).max(1e-30)).clamp(0.0, 1.0);
-            r_min = r_min.min((a + t * ab).length());
-        }
-        let proj = &self.projection;
-        if let Some(head) = &proj.head {
-            // A tracked head: u = θ − γ, moved by the eye's offset seen from the point and by
-            // the eye's distance from the display's axis seen from the screen (`core::head`).
-            let reach = Vec2::new(head.offset[0], head.offset[2]).length() + proj.eye_radius;
-            let bound =
-                (proj.eye_radius / r_min.max(1e-30)).min(1.0).asin() + (reach / proj.screen_radius).min(1.0).asin();
-            return (theta_min - head.turn - bound, theta_max - head.turn + bound);
-        }
-        let alpha = proj.eye_shift(r_min).abs().max(proj.eye_shift(r_max).abs());
-        (theta_min - alpha, theta_max + alpha)
     }
 
     /// The base edge of a sliver piece drawn as a strip ([`strip_triangles`]): on the cylinder,

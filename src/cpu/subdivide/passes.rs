@@ -25,7 +25,7 @@ use crate::encoding::constants::{BANDS, PIECES_FROM_COUNTER, QUAD_HEAD, QUAD_TAI
 use crate::encoding::recording::{Command, Recording};
 use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine};
 use crate::encoding::subdivide::{
-    defers_parts, plan_cuts_split, Passes, DISPATCH_LATTICE, DISPATCH_LATTICE_NODES, DISPATCH_LATTICE_ROWS,
+    defers_parts, plan_cuts_split, DISPATCH_LATTICE, DISPATCH_LATTICE_NODES, DISPATCH_LATTICE_ROWS,
     DISPATCH_LATTICE_TRIANGLES, DISPATCH_PLAN_CUTS, DISPATCH_PLAN_PARTS, DISPATCH_WORDS,
 };
 use crate::encoding::types::{DrawIndexedIndirectArgs, DrawVertex, Piece, SubdivideCounters, SubdivideParams};
@@ -91,6 +91,13 @@ pub struct CpuSubdivision<'s> {
 type PendingRows = (Triangle, PieceGeometry, Vec<(u32, u32)>);
 
 /// A part's corner from a piece record.
+/// Where row item `i` lies in its room (`row_item_slot` in the WGSL): from the back, as on the
+/// GPU, where the room is the output's index buffer, filled from the front by the triangles of
+/// pieces written in place.
+fn row_item_slot(params: &SubdivideParams, i: u32) -> usize {
+    (3 * params.triangle_capacity - 1 - i) as usize
+}
+
 fn record_corner(piece: &Piece, i: usize) -> Node {
     let c = piece.corner[i];
     Node { position: Vec3::new(c[0], c[1], c[2]), bary: Vec3::new(c[3], piece.bary1[i], piece.bary2[i]) }
@@ -348,7 +355,7 @@ impl<'s> CpuSubdivision<'s> {
         if piece.count2_level & QUAD_HEAD != 0 {
             let last = record_corner(&self.pieces[index as usize + 1], 0);
             if let Some(plan) = sub.quad_lattice(&tri, &[corners[0], corners[1], corners[2], last], [n0, n1]) {
-                self.plan_work(sub, index, plan);
+                self.plan_work(sub, index, plan, true);
             }
             return;
         }
@@ -359,7 +366,7 @@ impl<'s> CpuSubdivision<'s> {
         match sub.unmeasured_shape(&g) {
             Some(shape) => {
                 let plan = sub.shaped_plan(&tri, &g, &shape);
-                self.plan_work(sub, index, plan);
+                self.plan_work(sub, index, plan, true);
             }
             None => {
                 // A row item per band, counted always, written where they fit (`plan_pending`).
@@ -368,7 +375,7 @@ impl<'s> CpuSubdivision<'s> {
                     let slot = self.counters.row_items;
                     self.counters.row_items += 1;
                     if slot < 3 * params.triangle_capacity {
-                        self.row_items[slot as usize] = index << 5 | b;
+                        self.row_items[row_item_slot(params, slot)] = index << 5 | b;
                     }
                 }
                 self.pending_rows.insert(index, (tri, g, vec![(0, 0); r as usize]));
@@ -390,7 +397,7 @@ impl<'s> CpuSubdivision<'s> {
         if local >= self.row_item_count(sub.params) {
             return;
         }
-        let item = self.row_items[local as usize];
+        let item = self.row_items[row_item_slot(sub.params, local)];
         let (index, b) = (item >> 5, item & 31);
         if let Some((_, g, measures)) = self.pending_rows.get_mut(&index) {
             measures[b as usize] = sub.row_measure(g, b);
@@ -400,19 +407,24 @@ impl<'s> CpuSubdivision<'s> {
     /// Band 0's row item of a piece whose rows were measured: rows or the lattice, planned as
     /// `lattice` plans the others.
     fn lattice_rows_plan(&mut self, sub: &Subdivider, local: u32) {
-        if local >= self.row_item_count(sub.params) || self.row_items[local as usize] & 31 != 0 {
+        if local >= self.row_item_count(sub.params) {
             return;
         }
-        let index = self.row_items[local as usize] >> 5;
+        let item = self.row_items[row_item_slot(sub.params, local)];
+        if item & 31 != 0 {
+            return;
+        }
+        let index = item >> 5;
         if let Some((tri, g, measures)) = self.pending_rows.remove(&index) {
             let plan = sub.shaped_plan(&tri, &g, &sub.rows_or_lattice(&g, &measures));
-            self.plan_work(sub, index, plan);
+            self.plan_work(sub, index, plan, false);
         }
     }
 
-    /// A planned piece's work: its nodes allocated; a piece of one item's worth written here,
-    /// as its items would be; a larger one's work items appended (`plan_work`).
-    fn plan_work(&mut self, sub: &Subdivider, index: u32, plan: PiecePlan) {
+    /// A planned piece's work: its nodes allocated; a piece of one item's worth written here
+    /// (`in_place`: by `lattice`, not by `lattice_rows_plan`, whose invocations are one in a
+    /// piece's rows), as its items would be; a larger one's work items appended (`plan_work`).
+    fn plan_work(&mut self, sub: &Subdivider, index: u32, plan: PiecePlan, in_place: bool) {
         let params = sub.params;
         let first_node = self.counters.nodes;
         self.counters.nodes += plan.copies * plan.node_count;
@@ -423,9 +435,7 @@ impl<'s> CpuSubdivision<'s> {
         let work = Rc::new((first_node, plan));
         let plan = &work.1;
         let chunk = chunk_of(plan.copies);
-        // Not in frames that measure rows: their row items lie in the output's index buffer.
-        let rows = Passes::of(sub.projection.panorama, params.method).rows;
-        if plan.node_count <= chunk && plan.candidates.len() as u32 <= chunk && !rows {
+        if in_place && plan.node_count <= chunk && plan.candidates.len() as u32 <= chunk {
             if first_node + plan.copies * plan.node_count <= params.triangle_capacity {
                 self.write_nodes(&work, 0);
                 self.write_triangles(sub, &work, 0);

@@ -6,6 +6,7 @@
 
 use super::edges::Limits;
 use super::lattice::{lattice_node, lattice_slots, strip_node, strip_slots, weighted};
+use super::seam::clear_of_seam;
 use super::{
     band_cell, boundary_edge, edge_point, macro_cell, slot_node, snap, strip_node_count, Node, PartSplit, PiecePlan,
     Rows, Subdivider, Triangle,
@@ -241,7 +242,10 @@ impl Subdivider<'_> {
         let q = &g.q;
         let nodes = shape.nodes(g);
         let theta_c = azimuth((q[0].position + q[1].position + q[2].position) / 3.0);
-        let u_range = if self.projection.panorama.is_sphere() {
+        let bound = self.sphere_u_bound(q, theta_c);
+        let u_range = if self.projection.panorama.is_sphere() && clear_of_seam(bound) {
+            bound // every node within it: none projected
+        } else if self.projection.panorama.is_sphere() {
             let (mut u_min, mut u_max) = (f32::INFINITY, f32::NEG_INFINITY);
             for n in &nodes {
                 let theta = theta_c + wrap_angle(azimuth(n.position) - theta_c);

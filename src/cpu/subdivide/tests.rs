@@ -3,7 +3,7 @@
 use super::lattice::quad_strip_node;
 use super::lattice::strip_node;
 use super::*;
-use crate::core::projection::{Eye, Vertical};
+use crate::core::projection::{azimuth, wrap_angle, Eye, Vertical};
 use crate::core::settings::{Method, RenderSettings, Split, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV};
 use crate::encoding::constants::PIECE_DIVISIONS;
 use std::collections::HashMap;
