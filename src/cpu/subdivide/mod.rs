@@ -95,7 +95,8 @@
 //! is part of a triangle not containing the axis). A piece whose nodes' u range (both eyes)
 //! crosses ±π is also emitted with `theta_ref ∓ 2π` (its nodes again, and its triangles indexing
 //! them), so it appears at both edges of the panorama. On the cylinder that range is bounded from
-//! the piece's corners alone (`piece_u_range`); on the sphere every node is projected.
+//! the piece's corners alone (`piece_u_range`); on the sphere from its corners too where that
+//! bound keeps it clear of the seam (`sphere_u_bound`), else from every node projected.
 //!
 //! The GPU appends pieces and triangles with atomic counters, so its order differs from this
 //! twin's; tests compare the two as sets.
