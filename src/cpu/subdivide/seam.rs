@@ -108,12 +108,12 @@ mod tests {
                     params_for(&projection, Method::Adaptive(Split::Error), DEFAULT_EDGE_PX, DEFAULT_MAX_DIV, 1);
                 let sub = Subdivider::new(&params);
                 for _ in 0..400 {
-                    let scale = 10f32.powf(rng.gen_range(-1.5..1.5));
+                    let scale = 10f32.powf(rng.random_range(-1.5..1.5));
                     let centre =
-                        Vec3::new(rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0));
+                        Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
                     let q = [0; 3].map(|_| {
                         let p = (centre
-                            + Vec3::new(rng.gen_range(-0.5..0.5), rng.gen_range(-0.5..0.5), rng.gen_range(-0.5..0.5)))
+                            + Vec3::new(rng.random_range(-0.5..0.5), rng.random_range(-0.5..0.5), rng.random_range(-0.5..0.5)))
                             * scale;
                         Node { position: p, bary: Vec3::ZERO }
                     });
@@ -139,7 +139,7 @@ mod tests {
                         let w = match k {
                             0..=2 => Vec3::from([0, 1, 2].map(|i| (i == k) as u32 as f32)),
                             _ => {
-                                let (a, b): (f32, f32) = (rng.gen(), rng.gen());
+                                let (a, b): (f32, f32) = (rng.random(), rng.random());
                                 let (a, b) = if a + b > 1.0 { (1.0 - a, 1.0 - b) } else { (a, b) };
                                 Vec3::new(1.0 - a - b, a, b)
                             }
