@@ -15,10 +15,10 @@
 // Workgroup counts of the `lattice` dispatch (0–2), written by `lattice_args` from the piece
 // counter, of the `plan_cuts` dispatch (3–5), written by `plan_cuts_args`, of the `plan_parts`
 // dispatch (6–8), written by `plan_parts_args`, of `lattice_nodes` (9–11) and
-// `lattice_triangles` (12–14), written by `lattice_work_args`, and of `lattice_rows` and
-// `lattice_rows_plan` (15–17), written by `lattice_rows_args` (`DISPATCH_*` in
+// `lattice_triangles` (12–14), written by `lattice_work_args`, and of `lattice_rows` (15–17)
+// and `lattice_rows_plan` (18–20), written by `lattice_rows_args` (`DISPATCH_*` in
 // src/encoding/subdivide.rs: their byte offsets).
-@group(0) @binding(7) var<storage, read_write> lattice_dispatch: array<u32, 18>;
+@group(0) @binding(7) var<storage, read_write> lattice_dispatch: array<u32, 21>;
 // Per object: the factor its L is multiplied by (the visual-field level of detail relaxes the
 // subdivision away from the gaze; 1 without it). CPU twin: `Subdivider::edge_px`.
 @group(0) @binding(8) var<storage, read> object_edge_scale: array<f32>;
@@ -36,7 +36,9 @@
 // loads rather than atomic ones.
 @group(0) @binding(13) var<storage, read> edge_marks_read: array<u32>;
 // The parts `plan_cuts` cut (records as pieces', their counts unset), planned by `plan_parts`
-// (room for as many as `pieces`: each part makes at least one piece).
+// (room for as many as `pieces`: each part makes at least one piece). Free after `plan_parts`:
+// then `lattice` lists in it (in each record's `triangle`) the pieces whose rows
+// `lattice_rows` measures, for `lattice_rows_plan`.
 @group(0) @binding(14) var<storage, read_write> parts: array<Piece>;
 // What `lattice` planned for each piece (at the piece's index), and its work items: vec4(piece,
 // first node slot or candidate, the walk at that candidate (two u16 pairs)), for

@@ -61,6 +61,11 @@ fn row_item_slot(i: u32) -> u32 {
     return row_item_room() - 1u - i;
 }
 
+// The pieces `lattice` listed for `lattice_rows_plan` (in `parts`), within its room.
+fn pending_count() -> u32 {
+    return min(atomicLoad(&counters.pending), params.piece_capacity);
+}
+
 // The row items `lattice` appended, within their room.
 fn row_item_count() -> u32 {
     return min(atomicLoad(&counters.row_items), row_item_room());

@@ -51,10 +51,12 @@ struct Counters {
     node_items: atomic<u32>,    // work items `lattice` appended for `lattice_nodes` (front of `lattice_work`)
     triangle_items: atomic<u32>, // ... and for `lattice_triangles` (its back)
     row_items: atomic<u32>,     // bands of pieces whose rows `lattice_rows` measures (`row_items`)
+    pending: atomic<u32>,       // those pieces, listed for `lattice_rows_plan` (in `parts`)
     // The frame's cuts around the axis (`AxisCuts` in axis.rs): bit 0 the quadrant cuts and the
     // square, bit k the diamond c_k; bits 0–31 and 32–63. Kept across the chunks of a frame.
     cuts_low: atomic<u32>,
     cuts_high: atomic<u32>,
+    _pad: u32, // the timestamps read back after the counters start at a multiple of 8 bytes
 }
 
 struct DrawIndexedIndirectArgs {

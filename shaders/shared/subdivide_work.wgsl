@@ -27,13 +27,11 @@ fn work_capacity() -> u32 {
 
 // The piece at `index` (its shape in `piece_state`, its seam copies): its nodes allocated; a
 // piece of one item's worth (at most LATTICE_CHUNK / copies nodes and candidates: every `vertex`
-// piece, most small ones) written here where `in_place` (by `lattice`; `lattice_rows_plan`'s
-// invocations are one in a piece's rows, and lavapipe ran its writes in place at that density
-// slower than the work items), as its items would be; a larger one's work written and
+// piece, most small ones) written here, as its items would be; a larger one's work written and
 // its work items appended: node items from the front of `lattice_work`, triangle items from its
 // back, each triangle item with the walk (strip, quad, rows) at its first candidate. Counted
 // always, written only where they fit.
-fn plan_work(index: u32, shape: PieceShape, seam: SeamCopies, in_place: bool, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
+fn plan_work(index: u32, shape: PieceShape, seam: SeamCopies, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
     let copies = seam.copies;
     var work: PieceWork;
     work.shape = (*piece_state).strip_base;
@@ -49,7 +47,7 @@ fn plan_work(index: u32, shape: PieceShape, seam: SeamCopies, in_place: bool, tr
     }
     work.first_node = atomicAdd(&counters.nodes, copies * shape.node_count);
     let chunk = chunk_of(copies);
-    if (in_place && shape.node_count <= chunk && shape.candidates <= chunk) {
+    if (shape.node_count <= chunk && shape.candidates <= chunk) {
         write_in_place(index, work, tri, part, piece_state);
         return;
     }
@@ -83,7 +81,8 @@ fn plan_work(index: u32, shape: PieceShape, seam: SeamCopies, in_place: bool, tr
 }
 
 // A piece whose rows `lattice_rows` measures: its plan so far (counts, rows' base and sides, the
-// lattice's figures), and a row item per band (`row_items`), counted always, written where they fit.
+// lattice's figures), a row item per band (`row_items`), and its index in the list
+// `lattice_rows_plan` runs over (`parts`), counted always, written where they fit.
 fn plan_pending(index: u32, shape: PieceShape, piece_state: ptr<function, PieceState>) {
     var work: PieceWork;
     work.shape = ROWS_PENDING;
@@ -99,6 +98,10 @@ fn plan_pending(index: u32, shape: PieceShape, piece_state: ptr<function, PieceS
         if (base + b < row_item_room()) {
             row_items[row_item_slot(base + b)] = (index << 5u) | b; // b < r ≤ PIECE_DIVISIONS = 32
         }
+    }
+    let slot = atomicAdd(&counters.pending, 1u);
+    if (slot < params.piece_capacity) {
+        parts[slot].triangle = index;
     }
 }
 

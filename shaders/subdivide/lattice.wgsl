@@ -54,5 +54,5 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         plan_pending(index, shape, &piece_state); // planned by `lattice_rows_plan`
         return;
     }
-    plan_work(index, shape, seam_copies(shape, &part, &piece_state), true, &tri, &part, &piece_state);
+    plan_work(index, shape, seam_copies(shape, &part, &piece_state), &tri, &part, &piece_state);
 }

@@ -1,6 +1,6 @@
 // The `lattice_rows_args` setup pass of the `subdivide` stage (one thread; the sphere, adaptive
-// rules): the indirect dispatch of `lattice_rows` and `lattice_rows_plan`, one invocation per row
-// item `lattice` appended. CPU twin: `CpuSubdivision::lattice_rows_args`.
+// rules): the indirect dispatches of `lattice_rows`, one invocation per row item `lattice`
+// appended, and of `lattice_rows_plan`, one per piece it listed. CPU twin: `CpuSubdivision::lattice_rows_args`.
 
 #import constants
 #import subdivide_types
@@ -10,4 +10,5 @@
 @compute @workgroup_size(1)
 fn lattice_rows_args() {
     set_dispatch(15u, row_item_count());
+    set_dispatch(18u, pending_count());
 }

@@ -1,8 +1,10 @@
 // The `lattice_rows_plan` pass of the `subdivide` stage (the sphere, adaptive rules), after
-// `lattice_rows`: over the row items, band 0's invocation of each piece whose rows were measured gets
-// its rows' widths from the measures (`rows_from_measures`), is drawn in rows where they make
-// fewer candidate triangles than its lattice, and is planned as `lattice` plans the others: its
-// seam copies, its nodes' room, its work items. CPU twin: `CpuSubdivision::lattice_rows_plan`.
+// `lattice_rows`: one invocation per piece `lattice` listed (in `parts`) whose rows were measured:
+// its rows' widths from the measures (`rows_from_measures`), drawn in rows where they make fewer
+// candidate triangles than its lattice, and planned as `lattice` plans the others: its seam
+// copies, its nodes' room, written in place or as work items. (One invocation per row item, band
+// 0's doing the work, left most SIMD lanes idle on lavapipe.) CPU twin:
+// `CpuSubdivision::lattice_rows_plan`.
 
 #import projection
 #import constants
@@ -26,10 +28,10 @@ fn lattice_rows_plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
     var part: PartPlan;
     var piece_state: PieceState;
     let local = invocation_index(gid, groups);
-    if (local >= row_item_count() || (row_items[row_item_slot(local)] & 31u) != 0u) {
+    if (local >= pending_count()) {
         return;
     }
-    let index = row_items[row_item_slot(local)] >> 5u;
+    let index = parts[local].triangle;
     let work = piece_work[index];
     load_triangle(pieces[index].triangle, &tri);
     load_work(index, work, &part, &piece_state);
@@ -42,5 +44,5 @@ fn lattice_rows_plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
         shape.candidates = rows.x;
         shape.node_count = rows.y;
     }
-    plan_work(index, shape, seam_copies(shape, &part, &piece_state), false, &tri, &part, &piece_state);
+    plan_work(index, shape, seam_copies(shape, &part, &piece_state), &tri, &part, &piece_state);
 }

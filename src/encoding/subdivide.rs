@@ -156,8 +156,11 @@ pub fn dispatched(
             Command::DispatchIndirect { entry: "lattice_nodes", .. } => {
                 Some(("lattice_nodes", counters.node_items.min(params.triangle_capacity) as u64))
             }
-            Command::DispatchIndirect { entry: entry @ ("lattice_rows" | "lattice_rows_plan"), .. } => {
-                Some((entry, counters.row_items.min(3 * params.triangle_capacity) as u64))
+            Command::DispatchIndirect { entry: "lattice_rows", .. } => {
+                Some(("lattice_rows", counters.row_items.min(3 * params.triangle_capacity) as u64))
+            }
+            Command::DispatchIndirect { entry: "lattice_rows_plan", .. } => {
+                Some(("lattice_rows_plan", counters.pending.min(params.piece_capacity) as u64))
             }
             Command::DispatchIndirect { entry: "lattice_triangles", .. } => {
                 Some(("lattice_triangles", counters.triangle_items.min(params.triangle_capacity) as u64))
@@ -178,8 +181,9 @@ pub const DISPATCH_PLAN_PARTS: u64 = 24;
 pub const DISPATCH_LATTICE_NODES: u64 = 36;
 pub const DISPATCH_LATTICE_TRIANGLES: u64 = 48;
 pub const DISPATCH_LATTICE_ROWS: u64 = 60;
+pub const DISPATCH_LATTICE_ROWS_PLAN: u64 = 72;
 /// Words of `lattice_dispatch`.
-pub const DISPATCH_WORDS: usize = 18;
+pub const DISPATCH_WORDS: usize = 21;
 
 /// Timestamp query indices of the one-submission schedule's passes (each pass's begin; its end
 /// is the next index): `plan` (with the cuts), `plan_cuts`, `lattice`.
@@ -256,7 +260,7 @@ fn lattice_work(r: &mut Recording, passes: Passes) {
     if passes.rows {
         r.dispatch("lattice_rows_args", 1);
         r.dispatch_indirect("lattice_rows", "lattice_dispatch", DISPATCH_LATTICE_ROWS);
-        r.dispatch_indirect("lattice_rows_plan", "lattice_dispatch", DISPATCH_LATTICE_ROWS);
+        r.dispatch_indirect("lattice_rows_plan", "lattice_dispatch", DISPATCH_LATTICE_ROWS_PLAN);
     }
     r.dispatch("lattice_work_args", 1);
     r.dispatch_indirect("lattice_nodes", "lattice_dispatch", DISPATCH_LATTICE_NODES);

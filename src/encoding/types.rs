@@ -196,15 +196,19 @@ pub struct SubdivideCounters {
     pub triangle_items: u32,
     /// Bands of pieces whose rows `lattice_rows` measures (`row_items`).
     pub row_items: u32,
+    /// Those pieces, listed for `lattice_rows_plan` (in `parts`, free after `plan_parts`).
+    pub pending: u32,
     /// The frame's cuts around the axis (`AxisCuts`), bits 0–31 and 32–63.
     pub cuts_low: u32,
     pub cuts_high: u32,
+    /// The timestamps read back after the counters start at a multiple of 8 bytes.
+    pub _pad: u32,
 }
 
 impl SubdivideCounters {
     /// Bytes of the counters that each `plan` or `lattice` run starts from zero; the cuts after
     /// them are set once per frame by `active_cuts`.
-    pub const RUN_BYTES: u64 = 48;
+    pub const RUN_BYTES: u64 = 52;
 
     /// What the output buffers must hold, in their unit (a triangle's indices and a node each):
     /// the larger of the node count and the triangle count with the row items (which lie in the
@@ -525,7 +529,7 @@ pub const LAYOUTS: &[StructLayout] = &[
         view, projection, axis_clearance, triangle_count, first_triangle, method, fixed_n, edge_px, max_div,
         piece_capacity, triangle_capacity, first_piece, piece_count, measure_edges, vertical_limit, max_error_px, _pad1, _pad2
     }),
-    layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, nodes, cut_wide, max_pieces, max_output, parts, node_items, triangle_items, row_items, cuts_low, cuts_high }),
+    layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, nodes, cut_wide, max_pieces, max_output, parts, node_items, triangle_items, row_items, pending, cuts_low, cuts_high, _pad }),
     layout!("Piece" => Piece { triangle, cell, counts01, count2_level, corner, bary1, bary2 }),
     layout!("PieceWork" => PieceWork { shape, m, node_count, candidates, copies, first_node, counts, strip_n, refs, row_w, _pad }),
     layout!("DrawIndexedIndirectArgs" => DrawIndexedIndirectArgs { index_count, instance_count, first_index, base_vertex, first_instance }),

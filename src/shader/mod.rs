@@ -210,8 +210,8 @@ const CUTTING: &[&str] = &[
     "parts",
 ];
 
-/// What `lattice` and `lattice_rows_plan` read and write: they plan pieces, append row items
-/// and work items, and write small pieces' output in place.
+/// What `lattice` reads and writes: it plans pieces, appends row items (and lists their pieces
+/// in `parts`) and work items, and writes small pieces' output in place.
 const PIECE_PLANNING: &[&str] = &[
     "params",
     "vertices",
@@ -224,6 +224,23 @@ const PIECE_PLANNING: &[&str] = &[
     "row_items",
     "out_nodes",
     "out_indices",
+    "parts",
+];
+
+/// What `lattice_rows_plan` reads and writes: `lattice`'s, but the row items (it runs over the
+/// pieces listed in `parts`).
+const ROWS_PLANNING: &[&str] = &[
+    "params",
+    "vertices",
+    "indices",
+    "pieces",
+    "counters",
+    "object_edge_scale",
+    "piece_work",
+    "lattice_work",
+    "out_nodes",
+    "out_indices",
+    "parts",
 ];
 
 pub const SUBDIVIDE: Stage = Stage {
@@ -274,7 +291,7 @@ pub const SUBDIVIDE: Stage = Stage {
             &["params", "vertices", "indices", "pieces", "counters", "object_edge_scale", "piece_work", "row_items"],
             include_str!("../../shaders/subdivide/lattice_rows.wgsl"),
         ),
-        pass("lattice_rows_plan", PIECE_PLANNING, include_str!("../../shaders/subdivide/lattice_rows_plan.wgsl")),
+        pass("lattice_rows_plan", ROWS_PLANNING, include_str!("../../shaders/subdivide/lattice_rows_plan.wgsl")),
         pass(
             "lattice_work_args",
             &["params", "counters", "lattice_dispatch"],

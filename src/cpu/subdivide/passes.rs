@@ -26,7 +26,7 @@ use crate::encoding::recording::{Command, Recording};
 use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine};
 use crate::encoding::subdivide::{
     defers_parts, plan_cuts_split, DISPATCH_LATTICE, DISPATCH_LATTICE_NODES, DISPATCH_LATTICE_ROWS,
-    DISPATCH_LATTICE_TRIANGLES, DISPATCH_PLAN_CUTS, DISPATCH_PLAN_PARTS, DISPATCH_WORDS,
+    DISPATCH_LATTICE_ROWS_PLAN, DISPATCH_LATTICE_TRIANGLES, DISPATCH_PLAN_CUTS, DISPATCH_PLAN_PARTS, DISPATCH_WORDS,
 };
 use crate::encoding::types::{DrawIndexedIndirectArgs, DrawVertex, Piece, SubdivideCounters, SubdivideParams};
 use crate::error::Result;
@@ -355,7 +355,7 @@ impl<'s> CpuSubdivision<'s> {
         if piece.count2_level & QUAD_HEAD != 0 {
             let last = record_corner(&self.pieces[index as usize + 1], 0);
             if let Some(plan) = sub.quad_lattice(&tri, &[corners[0], corners[1], corners[2], last], [n0, n1]) {
-                self.plan_work(sub, index, plan, true);
+                self.plan_work(sub, index, plan);
             }
             return;
         }
@@ -366,7 +366,7 @@ impl<'s> CpuSubdivision<'s> {
         match sub.unmeasured_shape(&g) {
             Some(shape) => {
                 let plan = sub.shaped_plan(&tri, &g, &shape);
-                self.plan_work(sub, index, plan, true);
+                self.plan_work(sub, index, plan);
             }
             None => {
                 // A row item per band, counted always, written where they fit (`plan_pending`).
@@ -379,6 +379,12 @@ impl<'s> CpuSubdivision<'s> {
                     }
                 }
                 self.pending_rows.insert(index, (tri, g, vec![(0, 0); r as usize]));
+                // Listed for `lattice_rows_plan` in `parts` (free after `plan_parts`).
+                let slot = self.counters.pending;
+                self.counters.pending += 1;
+                if slot < params.piece_capacity {
+                    self.parts[slot as usize].triangle = index;
+                }
             }
         }
     }
@@ -388,8 +394,14 @@ impl<'s> CpuSubdivision<'s> {
         self.counters.row_items.min(3 * params.triangle_capacity)
     }
 
+    /// The pieces `lattice` listed for `lattice_rows_plan`, within their room.
+    fn pending_count(&self, params: &SubdivideParams) -> u32 {
+        self.counters.pending.min(params.piece_capacity)
+    }
+
     fn lattice_rows_args(&mut self, sub: &Subdivider) {
         self.set_dispatch(DISPATCH_LATTICE_ROWS, self.row_item_count(sub.params));
+        self.set_dispatch(DISPATCH_LATTICE_ROWS_PLAN, self.pending_count(sub.params));
     }
 
     /// A row item: band b of a piece whose rows are to be measured, measured.
@@ -404,27 +416,22 @@ impl<'s> CpuSubdivision<'s> {
         }
     }
 
-    /// Band 0's row item of a piece whose rows were measured: rows or the lattice, planned as
-    /// `lattice` plans the others.
+    /// A listed piece whose rows were measured: rows or the lattice, planned as `lattice` plans
+    /// the others.
     fn lattice_rows_plan(&mut self, sub: &Subdivider, local: u32) {
-        if local >= self.row_item_count(sub.params) {
+        if local >= self.pending_count(sub.params) {
             return;
         }
-        let item = self.row_items[row_item_slot(sub.params, local)];
-        if item & 31 != 0 {
-            return;
-        }
-        let index = item >> 5;
+        let index = self.parts[local as usize].triangle;
         if let Some((tri, g, measures)) = self.pending_rows.remove(&index) {
             let plan = sub.shaped_plan(&tri, &g, &sub.rows_or_lattice(&g, &measures));
-            self.plan_work(sub, index, plan, false);
+            self.plan_work(sub, index, plan);
         }
     }
 
-    /// A planned piece's work: its nodes allocated; a piece of one item's worth written here
-    /// (`in_place`: by `lattice`, not by `lattice_rows_plan`, whose invocations are one in a
-    /// piece's rows), as its items would be; a larger one's work items appended (`plan_work`).
-    fn plan_work(&mut self, sub: &Subdivider, index: u32, plan: PiecePlan, in_place: bool) {
+    /// A planned piece's work: its nodes allocated; a piece of one item's worth written here,
+    /// as its items would be; a larger one's work items appended (`plan_work`).
+    fn plan_work(&mut self, sub: &Subdivider, index: u32, plan: PiecePlan) {
         let params = sub.params;
         let first_node = self.counters.nodes;
         self.counters.nodes += plan.copies * plan.node_count;
@@ -435,7 +442,7 @@ impl<'s> CpuSubdivision<'s> {
         let work = Rc::new((first_node, plan));
         let plan = &work.1;
         let chunk = chunk_of(plan.copies);
-        if in_place && plan.node_count <= chunk && plan.candidates.len() as u32 <= chunk {
+        if plan.node_count <= chunk && plan.candidates.len() as u32 <= chunk {
             if first_node + plan.copies * plan.node_count <= params.triangle_capacity {
                 self.write_nodes(&work, 0);
                 self.write_triangles(sub, &work, 0);

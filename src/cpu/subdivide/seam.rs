@@ -109,11 +109,18 @@ mod tests {
                 let sub = Subdivider::new(&params);
                 for _ in 0..400 {
                     let scale = 10f32.powf(rng.random_range(-1.5..1.5));
-                    let centre =
-                        Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+                    let centre = Vec3::new(
+                        rng.random_range(-1.0..1.0),
+                        rng.random_range(-1.0..1.0),
+                        rng.random_range(-1.0..1.0),
+                    );
                     let q = [0; 3].map(|_| {
                         let p = (centre
-                            + Vec3::new(rng.random_range(-0.5..0.5), rng.random_range(-0.5..0.5), rng.random_range(-0.5..0.5)))
+                            + Vec3::new(
+                                rng.random_range(-0.5..0.5),
+                                rng.random_range(-0.5..0.5),
+                                rng.random_range(-0.5..0.5),
+                            ))
                             * scale;
                         Node { position: p, bary: Vec3::ZERO }
                     });
