@@ -210,38 +210,33 @@ const CUTTING: &[&str] = &[
     "parts",
 ];
 
-/// What `lattice` reads and writes: it plans pieces, appends row items (and lists their pieces
-/// in `parts`) and work items, and writes small pieces' output in place.
-const PIECE_PLANNING: &[&str] = &[
-    "params",
-    "vertices",
-    "indices",
-    "pieces",
-    "counters",
-    "object_edge_scale",
-    "piece_work",
-    "lattice_work",
-    "row_items",
-    "out_nodes",
-    "out_indices",
-    "parts",
-];
+/// The bindings of the passes that plan pieces (`lattice`, `lattice_rows_plan`): they plan pieces,
+/// list those whose rows are measured (in `parts`) and append work items, and write small pieces'
+/// output in place; `$extra`: a pass's own.
+macro_rules! piece_planning {
+    ($($extra:literal),*) => {
+        &[
+            "params",
+            "vertices",
+            "indices",
+            "pieces",
+            "counters",
+            "object_edge_scale",
+            "piece_work",
+            "lattice_work",
+            "out_nodes",
+            "out_indices",
+            "parts",
+            $($extra),*
+        ]
+    };
+}
 
-/// What `lattice_rows_plan` reads and writes: `lattice`'s, but the row items (it runs over the
-/// pieces listed in `parts`).
-const ROWS_PLANNING: &[&str] = &[
-    "params",
-    "vertices",
-    "indices",
-    "pieces",
-    "counters",
-    "object_edge_scale",
-    "piece_work",
-    "lattice_work",
-    "out_nodes",
-    "out_indices",
-    "parts",
-];
+/// `lattice`'s: it also appends the row items.
+const PIECE_PLANNING: &[&str] = piece_planning!("row_items");
+
+/// `lattice_rows_plan`'s: it runs over the pieces listed in `parts`.
+const ROWS_PLANNING: &[&str] = piece_planning!();
 
 pub const SUBDIVIDE: Stage = Stage {
     name: "subdivide",
