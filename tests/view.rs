@@ -416,12 +416,11 @@ fn head_input_lines_move_the_head_and_a_bad_line_stops_the_window() {
     // Good lines only: the window goes on with them (its first frame may take seconds on a busy
     // machine, so a bad line in the same file could close it before the screen is grabbed).
     std::fs::write(&input, "0,0.2,0,-0.1,15,0\n8,0.2,0,-0.1,15,0\n").unwrap();
-    let mut w = Window::open(&x, &["--head-input", input.to_str().unwrap()]);
+    let w = Window::open(&x, &["--head-input", input.to_str().unwrap()]);
     let line = w.wait_for("the head", |l| l.contains(" head="));
     assert_eq!(field(&line, "head"), "0.2,0,-0.1,15");
     let grabbed = x.grab(&dir, 128, 64);
-    w.child.kill().ok();
-    w.exit_code();
+    drop(w); // killed and waited for
     let (want, _) = rendered(&dir, &["--head", "0.2,0,-0.1,15"]);
     assert_same(&grabbed, &want, "the head input's head");
     let (still, _) = rendered(&dir, &[]);
@@ -522,14 +521,13 @@ fn with_visual_field_lod_the_detail_follows_the_dragged_gaze_as_render_gaze_draw
 fn the_display_halves_fill_the_monitor_named() {
     let Some((_one, x)) = Xvfb::start("monitor") else { return };
     let dir = tmp("monitor");
-    let mut w = Window::open(&x, &["--monitor", "0", "--show", "halves"]);
+    let w = Window::open(&x, &["--monitor", "0", "--show", "halves"]);
     w.wait_for("the first frames", |_| true);
     std::thread::sleep(Duration::from_millis(300));
     let (eyes, _) = rendered(&dir, &[]);
     let whole = displayed(&eyes, 2, DisplayMode::Halves, Look::default(), [640, 480], cylinder());
     assert_close(&x.grab(&dir, 640, 480), &whole, "halves on monitor 0");
-    w.child.kill().ok();
-    w.exit_code();
+    drop(w); // killed and waited for
 }
 
 #[test]
@@ -552,8 +550,7 @@ fn head_input_from_standard_input_moves_the_head_as_lines_arrive() {
     std::thread::sleep(Duration::from_millis(300));
     w.wait_for("frames after the input ended", |l| l.contains(" head=-0.1,0.05,0.2,-20 "));
     assert!(w.child.try_wait().unwrap().is_none(), "the window closed when its input ended");
-    w.child.kill().ok();
-    w.exit_code();
+    drop(w); // killed and waited for
 }
 
 #[test]

@@ -484,8 +484,6 @@ fn interior_counts(tri: ptr<function, InputTriangle>, part: ptr<function, PartPl
     }
 }
 
-// The azimuths a piece is drawn at: its own, and a turn away where its nodes' u range (both
-// eyes) reaches ±π. Conservative by SEAM_MARGIN: an extra copy is clipped by the rasterizer.
 // A bound on the u range (both eyes) of the nodes of the piece's triangle on the sphere
 // (`sphere_u_bound` in src/cpu/subdivide/): u = θ − s·asin(e/r), |e/r| clamped to 1, and with
 // parallel rays |e| ≤ d_e, so u lies within asin(min(d_e / r_min, 1)) (π/2 for converging rays)
@@ -507,6 +505,8 @@ fn clear_of_seam(bound: vec2<f32>) -> bool {
     return bound.y <= PI - margin && bound.x >= -PI + margin;
 }
 
+// The azimuths a piece is drawn at: its own, and a turn away where its nodes' u range (both
+// eyes) reaches ±π. Conservative by SEAM_MARGIN: an extra copy is clipped by the rasterizer.
 struct SeamCopies {
     refs: array<f32, 3>,
     copies: u32,
@@ -521,10 +521,11 @@ fn seam_copies(shape: PieceShape, part: ptr<function, PartPlan>, piece_state: pt
     if (is_sphere(params.projection)) {
         // Every node projected, unless the corners' bound keeps the piece clear of the seam.
         let bound = sphere_u_bound((*piece_state).corner, theta_c);
-        if (clear_of_seam(bound)) {
+        let clear = clear_of_seam(bound);
+        if (clear) {
             u_range = bound;
         }
-        for (var k = 0u; k < shape.node_count && !clear_of_seam(bound); k++) {
+        for (var k = 0u; k < shape.node_count && !clear; k++) {
             let p = piece_node(k, shape.m, &row, part, piece_state).position;
             let theta = theta_c + wrap_angle(azimuth(p) - theta_c);
             for (var s = 0u; s < 2u; s++) {

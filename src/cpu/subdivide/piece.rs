@@ -242,10 +242,10 @@ impl Subdivider<'_> {
         let q = &g.q;
         let nodes = shape.nodes(g);
         let theta_c = azimuth((q[0].position + q[1].position + q[2].position) / 3.0);
-        let bound = self.sphere_u_bound(q, theta_c);
-        let u_range = if self.projection.panorama.is_sphere() && clear_of_seam(bound) {
+        let sphere_bound = self.projection.panorama.is_sphere().then(|| self.sphere_u_bound(q, theta_c));
+        let u_range = if let Some(bound) = sphere_bound.filter(|&b| clear_of_seam(b)) {
             bound // every node within it: none projected
-        } else if self.projection.panorama.is_sphere() {
+        } else if sphere_bound.is_some() {
             let (mut u_min, mut u_max) = (f32::INFINITY, f32::NEG_INFINITY);
             for n in &nodes {
                 let theta = theta_c + wrap_angle(azimuth(n.position) - theta_c);
