@@ -17,7 +17,7 @@ struct RasterParams {
     // error is still measured against the true projection.
     shift_px: vec2<f32>,
     error_angle: u32,  // 1: the error target holds arcminutes (fragment.wgsl)
-    _pad0: u32,
+    w_by_radius: u32,  // 1: clip w = r (the error split's azimuth spacing; see clip_w)
     _pad1: u32,
     _pad2: u32,
 }
@@ -53,7 +53,7 @@ fn vs_main(in: VertexIn, eye_in: EyeIn) -> VertexOut {
     let theta = theta0 + TAU * floor((in.theta_ref - theta0) / TAU + 0.5);
     let uvd = project_with_azimuth(params.projection, in.position, theta, params.eye_sign);
     var out: VertexOut;
-    out.clip = frame_clip(params.projection, uvd);
+    out.clip = frame_clip(params.projection, uvd) * clip_w(params.projection, in.position, params.w_by_radius);
     out.clip.x += 2.0 * params.shift_px.x / params.projection.width * out.clip.w;
     out.clip.y -= 2.0 * params.shift_px.y / params.projection.height * out.clip.w;
     out.clip = tile_clip(params.projection, out.clip);

@@ -98,6 +98,14 @@ fn precise_atan2(y: f32, x: f32) -> f32 {
     return select(a, -a, y < 0.0);
 }
 
+// sin(x) for 0 ≤ x ≤ π, from the odd series on [0, π/2] (`precise_sin` in
+// src/cpu/subdivide/spacing.rs; truncation error below 6e-8).
+fn precise_sin(x: f32) -> f32 {
+    let y = min(x, PI - x);
+    let y2 = y * y;
+    return y * (1.0 + y2 * (-1.0 / 6.0 + y2 * (1.0 / 120.0 + y2 * (-1.0 / 5040.0 + y2 * (1.0 / 362880.0 + y2 * (-1.0 / 39916800.0))))));
+}
+
 // acos(c) for c in [0, 1].
 fn precise_acos(c: f32) -> f32 {
     return precise_atan2(sqrt(max((1.0 - c) * (1.0 + c), 0.0)), c);
@@ -215,6 +223,18 @@ fn frame_xy(proj: Projection, xy: vec2<f32>) -> vec2<f32> {
 // y is kept within GUARD_BAND_PX of the image (constants.rs says why).
 fn to_clip(proj: Projection, uvd: vec3<f32>) -> vec4<f32> {
     return tile_clip(proj, frame_clip(proj, uvd));
+}
+
+// What the raster stage multiplies a vertex's clip position by (`raster_vertex` in
+// src/cpu/raster.rs): under the error split (`by_radius` 1) r, the vertex's distance from the
+// vertical axis, so that attributes are interpolated as P/r is, linearly on the screen: between
+// two nodes the drawn point's azimuth then follows the screen, as the subdivision's azimuth
+// spacing assumes (src/cpu/subdivide/spacing.rs). The cubemap's faces keep their own w.
+fn clip_w(proj: Projection, p: vec3<f32>, by_radius: u32) -> f32 {
+    if (by_radius == 0u || is_cubemap(proj)) {
+        return 1.0;
+    }
+    return max(horizontal_radius(p), AZIMUTH_MIN_RADIUS);
 }
 
 // The clip position on the whole frame (`to_clip` before the tile's).

@@ -15,6 +15,46 @@ fn same(a: vec3<f32>, b: vec3<f32>) -> bool {
     return all(a == b);
 }
 
+// ---- the spacing of nodes along a segment (src/cpu/subdivide/spacing.rs says why) ----
+
+// The azimuth segment lo–hi sweeps where its points are spaced by azimuth (the error split, both
+// ends at least AZIMUTH_MIN_RADIUS from the axis, the sweep within (AZIMUTH_MIN_TURN,
+// AZIMUTH_MAX_TURN)); else 0 (`Spacing::turn`).
+fn spacing_turn(lo: vec3<f32>, hi: vec3<f32>) -> f32 {
+    let rl = horizontal_radius(lo);
+    let rh = horizontal_radius(hi);
+    if (params.method != METHOD_ERROR || rl < AZIMUTH_MIN_RADIUS || rh < AZIMUTH_MIN_RADIUS) {
+        return 0.0;
+    }
+    let el = vec2<f32>(lo.x, lo.z) / rl;
+    let eh = vec2<f32>(hi.x, hi.z) / rh;
+    let turn = precise_atan2(abs(el.x * eh.y - el.y * eh.x), dot(el, eh));
+    return select(0.0, turn, turn > AZIMUTH_MIN_TURN && turn < AZIMUTH_MAX_TURN);
+}
+
+// The 3-D parameter of the point at fraction t of the way from lo to hi (`Spacing::param`): t,
+// or under the error split the point at azimuth fraction t of the sweep.
+fn spacing_param(lo: vec3<f32>, hi: vec3<f32>, t: f32) -> f32 {
+    let rl = horizontal_radius(lo);
+    let rh = horizontal_radius(hi);
+    if (params.method != METHOD_ERROR || rl < AZIMUTH_MIN_RADIUS || rh < AZIMUTH_MIN_RADIUS) {
+        return t;
+    }
+    let d = spacing_turn(lo, hi);
+    var blend = t;
+    if (d > 0.0) {
+        let a = precise_sin(t * d);
+        blend = a / (a + precise_sin((1.0 - t) * d));
+    }
+    return (blend / rh) / ((1.0 - blend) / rl + blend / rh);
+}
+
+// The node at fraction t of the way from a to b (`Spacing::mix`).
+fn spacing_mix(a: Node, b: Node, t: f32) -> Node {
+    let s = spacing_param(a.position, b.position, t);
+    return Node(a.position + (b.position - a.position) * s, a.bary + (b.bary - a.bary) * s);
+}
+
 // The point j/n of the way from a to b, from the canonically ordered pair; the ends are exact.
 fn edge_point(a: Node, b: Node, j: u32, n: u32) -> Node {
     var lo = a;
@@ -31,8 +71,7 @@ fn edge_point(a: Node, b: Node, j: u32, n: u32) -> Node {
     if (jj == n) {
         return hi;
     }
-    let t = f32(jj) / f32(n);
-    return Node(lo.position + (hi.position - lo.position) * t, lo.bary + (hi.bary - lo.bary) * t);
+    return spacing_mix(lo, hi, f32(jj) / f32(n));
 }
 
 // Image position in pixels (x not wrapped) of a viewer-frame point for one eye sign.
@@ -53,6 +92,7 @@ struct EdgeProfile {
     length_px: f32,
     bend_px: f32,
     ring: bool,
+    residual_px: f32,  // the drawing's residual against the azimuth steps (`EdgeProfile`)
 }
 
 fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
@@ -76,7 +116,7 @@ fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
         var q1 = vec2<f32>(0.0, 0.0);
         for (var k = 0u; k <= segments; k++) {
             let t = f32(k) / f32(segments);
-            let p = lo + (hi - lo) * t;
+            let p = lo + (hi - lo) * spacing_param(lo, hi, t);
             nearest = min(nearest, horizontal_radius(p));
             let raw = pixel(p, eye_sign);
             var q = raw;
@@ -102,7 +142,29 @@ fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
     let shows_ring = params.projection.vertical_exact == 0u || is_sphere(params.projection);
     let ring = shows_ring && nearest < 2.0 * params.projection.eye_radius;
     let stretch = select(MAX_STRETCH, 1.0, ring);
-    return EdgeProfile(max(length_px, f32(segments) * longest / stretch), bend, ring);
+    let turn = spacing_turn(lo, hi);
+    let residual = AZIMUTH_CHORD_RESIDUAL * turn * turn * f32(segments) * longest;
+    return EdgeProfile(max(length_px, f32(segments) * longest / stretch), bend, ring, residual);
+}
+
+// Parts that keep the drawing's residual within AZIMUTH_RESIDUAL_ERROR·τ (`parts_for_residual`).
+// The fewest n with n³ ≥ x: pow's guess corrected by products, which round as the twin's do.
+fn parts_for_residual(p: EdgeProfile, max_error_px: f32) -> f32 {
+    let x = p.residual_px / (AZIMUTH_RESIDUAL_ERROR * max_error_px);
+    if (x <= 1.0) {
+        return 1.0;
+    }
+    let n = ceil(pow(x, 1.0 / 3.0));
+    if ((n - 1.0) * (n - 1.0) * (n - 1.0) >= x) {
+        return n - 1.0;
+    }
+    return select(n, n + 1.0, n * n * n < x);
+}
+
+// Whether the edge drawn in one part is within `share`·τ of its bend and the residual's share of
+// its azimuth steps, away from the eye circle (`EdgeProfile::straight`).
+fn profile_straight(p: EdgeProfile, share: f32, max_error_px: f32) -> bool {
+    return !p.ring && parts_for_bend(p.bend_px, 2u, share * max_error_px) <= 1.0 && parts_for_residual(p, max_error_px) <= 1.0;
 }
 
 // Parts for a chord error of at most τ (`parts_for_bend`).
@@ -128,7 +190,7 @@ fn edge_divisions(a: vec3<f32>, b: vec3<f32>, tri: ptr<function, InputTriangle>)
         let p = edge_profile(a, b, segments);
         let by_bend = parts_for_bend(p.bend_px, segments, (*tri).max_error_px);
         if (round == 0u) {
-            let whole = select(p.length_px <= (*tri).edge_px && !p.ring && by_bend <= 1.0,
+            let whole = select(p.length_px <= (*tri).edge_px && profile_straight(p, 1.0, (*tri).max_error_px),
                                p.length_px <= 0.5 * (*tri).edge_px, by_length);
             if (whole) {
                 return 1u;
@@ -137,7 +199,7 @@ fn edge_divisions(a: vec3<f32>, b: vec3<f32>, tri: ptr<function, InputTriangle>)
             n = ceil(p.length_px / (*tri).edge_px);
         } else {
             let longest = select(ERROR_SPLIT_LENGTH * (*tri).edge_px, (*tri).edge_px, p.ring);
-            n = max(by_bend, ceil(p.length_px / longest));
+            n = max(max(by_bend, ceil(p.length_px / longest)), parts_for_residual(p, (*tri).max_error_px));
         }
     }
     if (n >= f32(MAX_EDGE_DIVISIONS) || !(n == n)) {
@@ -233,7 +295,8 @@ fn diagonal_fits(whole: EdgeProfile, parts: u32, tri: ptr<function, InputTriangl
         return 2.0 * whole.length_px <= w * (*tri).edge_px;
     }
     return whole.bend_px <= w * (2.0 * ROW_DIAGONAL_ERROR * (*tri).max_error_px)
-        && whole.length_px <= w * (ERROR_SPLIT_LENGTH * (*tri).edge_px);
+        && whole.length_px <= w * (ERROR_SPLIT_LENGTH * (*tri).edge_px)
+        && whole.residual_px <= w * w * w * (AZIMUTH_RESIDUAL_ERROR * (*tri).max_error_px);
 }
 
 // Where macro node (a, b, c)/K lies, as (kind, i, j): kind 0 = triangle corner i; kind 1 = fine

@@ -62,7 +62,7 @@ fn macro_node(abc: vec3<u32>, loc: vec3<u32>, part: ptr<function, PartPlan>) -> 
     if (loc.x == ON_EDGE) {
         return edge_point(corner(loc.y, part), corner((loc.y + 1u) % 3u, part), loc.z, (*part).n[loc.y]);
     }
-    return weighted((*part).corner, vec3<f32>(abc) / f32((*part).k));
+    return spaced_interior((*part).corner, abc, (*part).k);
 }
 
 // The node's fine index along original edge oe from its start, or −1 if it is not on that edge.
@@ -133,8 +133,19 @@ fn weighted(q: array<Node, 3>, w: vec3<f32>) -> Node {
     );
 }
 
+// The interior lattice point (i, j, l)/m of a triangle of nodes (`Spacing::interior`): the
+// barycentric blend, or under the error split the point j/(i + j) of the way along the row between
+// the points l/m of the way from q0 and from q1 towards q2, each spaced by azimuth.
+fn spaced_interior(q: array<Node, 3>, c: vec3<u32>, m: u32) -> Node {
+    if (params.method != METHOD_ERROR) {
+        return weighted(q, vec3<f32>(c) / f32(m));
+    }
+    let up = f32(c.z) / f32(m);
+    return spacing_mix(spacing_mix(q[0], q[2], up), spacing_mix(q[1], q[2], up), f32(c.y) / f32(c.x + c.y));
+}
+
 fn interior_node(i: u32, j: u32, l: u32, m: u32, piece_state: ptr<function, PieceState>) -> Node {
-    return weighted((*piece_state).corner, vec3<f32>(f32(i), f32(j), f32(l)) / f32(m));
+    return spaced_interior((*piece_state).corner, vec3<u32>(i, j, l), m);
 }
 
 
@@ -260,7 +271,7 @@ fn strip_base_of(tri: ptr<function, InputTriangle>, piece_state: ptr<function, P
     }
     if (base < 3u) {
         let p = edge_profile((*piece_state).corner[base].position, (*piece_state).corner[(base + 1u) % 3u].position, 2u);
-        if (p.ring || parts_for_bend(p.bend_px, 2u, STRIP_BASE_ERROR * (*tri).max_error_px) > 1.0) {
+        if (!profile_straight(p, STRIP_BASE_ERROR, (*tri).max_error_px)) {
             return 3u;
         }
     }

@@ -34,7 +34,7 @@ fn plan_quad(shown: u32, tri: ptr<function, InputTriangle>, piece_state: ptr<fun
         let a = edge_point(c0, c1, walk.x, rails.x).position;
         let b = edge_point(c3, c2, walk.y, rails.y).position;
         let q = edge_profile(a, b, 2u);
-        if (q.ring || parts_for_bend(q.bend_px, 2u, QUAD_RUNG_ERROR * (*tri).max_error_px) > 1.0) {
+        if (!profile_straight(q, QUAD_RUNG_ERROR, (*tri).max_error_px)) {
             return false;
         }
         if (quad_advances_on_a(walk, rails)) {

@@ -17,7 +17,7 @@ pub const DEFAULT_EDGE_PX: f32 = 32.0;
 /// Default N_max, as in the paper.
 pub const DEFAULT_MAX_DIV: u32 = 7;
 /// Default τ of the error split, pixels: see the README for the error it gives.
-pub const DEFAULT_MAX_ERROR_PX: f32 = 0.5;
+pub const DEFAULT_MAX_ERROR_PX: f32 = 0.4;
 /// `--reflect-max`: seed 000's Reflect_max.
 pub const DEFAULT_REFLECT_MAX: u32 = 3;
 /// The deepest `--reflect-max` (the ray tracer's stack of pending rays is this deep + 1).

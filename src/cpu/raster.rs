@@ -3,14 +3,14 @@
 //!
 //! `raster_vertex` projects a subdivided vertex for one eye (seed 002 eq. 1–4) exactly as the
 //! vertex shader does. `rasterize` samples pixel centres with a depth test: clip-space
-//! near-plane clipping, perspective-correct attributes (with w = 1, as in the raster stage,
-//! that is linear on the screen), depth interpolated linearly on the screen as GPUs do, and an
+//! near-plane clipping, perspective-correct attributes (with the raster stage's w: 1, linear on
+//! the screen, or under the error split r, see `clip_w`), depth interpolated linearly on the screen as GPUs do, and an
 //! optional column scissor. Coverage on exact edges may differ from a GPU's tie-breaking rule,
 //! so tests compare images with a small tolerance on edge pixels.
 
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::core::projection::{azimuth, Eye, PanoramaKind, Projection};
+use crate::core::projection::{azimuth, horizontal_radius, Eye, PanoramaKind, Projection};
 use crate::core::scene::unpack_tangent;
 use crate::core::texture::MaterialTable;
 use crate::cpu::fragment::{
@@ -31,11 +31,22 @@ pub fn raster_vertex(params: &RasterParams, v: &DrawVertex) -> Vec4 {
     let eye = if params.eye_sign > 0.0 { Eye::Right } else { Eye::Left };
     let q = projection.project_with_azimuth(p, theta, eye);
     let depth = (q.depth / (q.depth + 1.0)).min(crate::encoding::constants::MAX_DEPTH);
-    let clip = frame_clip(&projection, q.u, q.v, depth, params.projection.face as usize);
+    let clip = frame_clip(&projection, q.u, q.v, depth, params.projection.face as usize)
+        * clip_w(&projection, p, params.w_by_radius);
     // The test hook's shift, in pixels of the frame; then the tile's part of it.
     let (w, h) = (projection.width as f32, projection.height as f32);
     let shifted = clip + Vec4::new(2.0 * params.shift_px[0] / w, -2.0 * params.shift_px[1] / h, 0.0, 0.0) * clip.w;
     projection.tile_clip(shifted)
+}
+
+/// What a vertex's clip position is multiplied by (`clip_w` in projection.wgsl): r, its distance
+/// from the vertical axis, where the frame draws with w = r (`RasterParams::w_by_radius`, the error
+/// split's azimuth spacing: `cpu::subdivide::spacing`), except on the cubemap; else 1.
+fn clip_w(projection: &Projection, p: Vec3, w_by_radius: u32) -> f32 {
+    if w_by_radius == 0 || projection.panorama == PanoramaKind::Cubemap {
+        return 1.0;
+    }
+    horizontal_radius(p).max(crate::encoding::constants::AZIMUTH_MIN_RADIUS)
 }
 
 /// The clip position on the whole frame of screen point (u, v) at depth `depth` (0..1)
@@ -194,7 +205,7 @@ pub fn rasterize_within(
     }
 }
 
-/// The near plane z ≥ 0 (w = 1 triangles never cross it).
+/// The near plane z ≥ 0 (the raster stage's triangles, z = depth·w with w > 0, never cross it).
 pub(crate) const NEAR_PLANE: Vec4 = Vec4::new(0.0, 0.0, 1.0, 0.0);
 
 /// A triangle clipped against the near plane z ≥ 0 in clip space: none, one or two triangles.

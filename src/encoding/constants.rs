@@ -118,6 +118,19 @@ pub const COARSE_BINS: u32 = 960;
 /// ... and one overflow bin.
 pub const BINS: u32 = FINE_BINS + COARSE_BINS + 1;
 
+/// Under the error split, nodes are spaced by equal steps of azimuth (`cpu::subdivide::spacing`)
+/// along a segment whose ends lie at least this far from the axis (metres; w = r draws them)...
+pub const AZIMUTH_MIN_RADIUS: f32 = 1e-6;
+/// ... and whose azimuth sweep lies between these (radians: below, equal parts of P/r, which is the
+/// same; above, near half a turn, the steps crowd where the segment passes the axis).
+pub const AZIMUTH_MIN_TURN: f32 = 1e-4;
+pub const AZIMUTH_MAX_TURN: f32 = 3.0;
+/// The drawn point between two nodes δ of azimuth apart is off its step of azimuth by at most
+/// this × δ³ radians (the chord of the unit circle against its arc: (2/(9√3))·(δ/2)³); the
+/// error split keeps that within `AZIMUTH_RESIDUAL_ERROR`·τ on screen.
+pub const AZIMUTH_CHORD_RESIDUAL: f32 = 0.016_04;
+pub const AZIMUTH_RESIDUAL_ERROR: f32 = 0.25;
+
 /// A constant's value as WGSL writes it.
 #[derive(Clone, Copy, Debug)]
 pub enum Value {
@@ -149,6 +162,11 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("BAND_RATIO", F32(BAND_RATIO)),
         ("SNAP", F32(SNAP)),
         ("MAX_STRETCH", F32(MAX_STRETCH)),
+        ("AZIMUTH_MIN_RADIUS", F32(AZIMUTH_MIN_RADIUS)),
+        ("AZIMUTH_MIN_TURN", F32(AZIMUTH_MIN_TURN)),
+        ("AZIMUTH_MAX_TURN", F32(AZIMUTH_MAX_TURN)),
+        ("AZIMUTH_CHORD_RESIDUAL", F32(AZIMUTH_CHORD_RESIDUAL)),
+        ("AZIMUTH_RESIDUAL_ERROR", F32(AZIMUTH_RESIDUAL_ERROR)),
         ("ERROR_SPLIT_LENGTH", F32(ERROR_SPLIT_LENGTH)),
         ("SEAM_MARGIN", F32(SEAM_MARGIN)),
         ("SEAM_BOUND_SLACK", F32(SEAM_BOUND_SLACK)),

@@ -3,6 +3,7 @@
 
 use crate::core::projection::Eye;
 use crate::core::settings::RenderSettings;
+use crate::cpu::subdivide::spacing::Spacing;
 use crate::encoding::types::{RasterParams, TraceParams};
 
 /// The raster stage's parameters: the left eye's, then the right's (its `array<RasterParams, 2>`).
@@ -13,6 +14,7 @@ pub fn raster_params(settings: &RenderSettings) -> [RasterParams; 2] {
         ambient: settings.shading.ambient,
         shift_px: settings.measure.shift_px,
         error_angle: settings.measure.error_angle as u32,
+        w_by_radius: (Spacing::of(settings.subdivision.method.split_rule().0 as u32) == Spacing::Azimuth) as u32,
         ..Default::default()
     })
 }

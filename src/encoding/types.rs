@@ -277,7 +277,10 @@ pub struct RasterParams {
     /// 1: the error target holds the display-position error as an angle (arcminutes) rather
     /// than in pixels.
     pub error_angle: u32,
-    pub _pad0: u32,
+    /// 1: draw with clip w = r, the vertex's distance from the vertical axis (perspective-correct
+    /// attributes; the error split's azimuth spacing, `cpu::subdivide::spacing`), except on the
+    /// cubemap, whose faces have their own w.
+    pub w_by_radius: u32,
     pub _pad1: u32,
     pub _pad2: u32,
 }
@@ -533,7 +536,7 @@ pub const LAYOUTS: &[StructLayout] = &[
     layout!("Piece" => Piece { triangle, cell, counts01, count2_level, corner, bary1, bary2 }),
     layout!("PieceWork" => PieceWork { shape, m, node_count, candidates, copies, first_node, counts, strip_n, refs, row_w, _pad }),
     layout!("DrawIndexedIndirectArgs" => DrawIndexedIndirectArgs { index_count, instance_count, first_index, base_vertex, first_instance }),
-    layout!("RasterParams" => RasterParams { projection, eye_sign, ambient, shift_px, error_angle, _pad0, _pad1, _pad2 }),
+    layout!("RasterParams" => RasterParams { projection, eye_sign, ambient, shift_px, error_angle, w_by_radius, _pad1, _pad2 }),
     layout!("DisplayParams" => DisplayParams { projection, mode, width, height, row_texels, layers, srgb_target, _pad0, _pad1, area, look, overlay }),
     layout!("SlitParams" => SlitParams { view, projection, eye_sign, ambient, near, error_angle }),
     layout!("SlitCamera" => SlitCamera { origin_sx, right_cx, up_cy, forward_sy }),

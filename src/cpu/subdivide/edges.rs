@@ -5,22 +5,23 @@
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
+use super::spacing::Spacing;
 use super::{snap_to_cut_planes, Node, PartSplit, Subdivider, Triangle};
 use crate::core::projection::{azimuth, horizontal_radius, Eye, PanoramaKind, Vertical};
 use crate::core::scene::{unpack_tangent, SceneVertex};
 use crate::core::settings::SplitRule;
 use crate::encoding::constants::{
-    EDGE_SAMPLES, ERROR_SPLIT_LENGTH, MAX_EDGE_DIVISIONS, MAX_MACRO_LEVEL, MAX_STRETCH, PIECE_DIVISIONS,
-    ROW_DIAGONAL_ERROR,
+    AZIMUTH_CHORD_RESIDUAL, AZIMUTH_RESIDUAL_ERROR, EDGE_SAMPLES, ERROR_SPLIT_LENGTH, MAX_EDGE_DIVISIONS,
+    MAX_MACRO_LEVEL, MAX_STRETCH, PIECE_DIVISIONS, ROW_DIAGONAL_ERROR,
 };
 
 pub(super) fn lex_less(a: Vec3, b: Vec3) -> bool {
     a.x < b.x || (a.x == b.x && (a.y < b.y || (a.y == b.y && a.z < b.z)))
 }
 
-/// The point j/n of the way from `a` to `b`, computed from the canonically ordered pair so that
-/// both triangles sharing the edge get the same bits; the ends are exact.
-pub(super) fn edge_point(a: Node, b: Node, j: u32, n: u32) -> Node {
+/// The point j/n of the way from `a` to `b` (spaced by `spacing`), computed from the canonically
+/// ordered pair so that both triangles sharing the edge get the same bits; the ends are exact.
+pub(super) fn edge_point(a: Node, b: Node, j: u32, n: u32, spacing: Spacing) -> Node {
     let (lo, hi, jj) = if lex_less(b.position, a.position) { (b, a, n - j) } else { (a, b, j) };
     if jj == 0 {
         return lo;
@@ -28,8 +29,7 @@ pub(super) fn edge_point(a: Node, b: Node, j: u32, n: u32) -> Node {
     if jj == n {
         return hi;
     }
-    let t = jj as f32 / n as f32;
-    Node { position: lo.position + (hi.position - lo.position) * t, bary: lo.bary + (hi.bary - lo.bary) * t }
+    spacing.mix(lo, hi, jj as f32 / n as f32)
 }
 
 /// What [`Subdivider::edge_profile`] measures of an edge.
@@ -38,6 +38,39 @@ pub struct EdgeProfile {
     pub length_px: f32,
     pub bend_px: f32,
     pub ring: bool,
+    /// Under azimuth spacing, how far the drawing between the ends strays from the point of
+    /// its step of azimuth (`AZIMUTH_CHORD_RESIDUAL`·D³ radians, D the sweep, × the fastest
+    /// pixels per radian sampled); n parts leave 1/n³ of it. 0 otherwise.
+    pub residual_px: f32,
+}
+
+impl EdgeProfile {
+    /// Parts that keep the drawing's residual within `AZIMUTH_RESIDUAL_ERROR`·τ: the fewest n
+    /// with n³ at least residual / that (the cube root's guess corrected by products, which
+    /// round alike on the GPU, whose `pow` does not).
+    pub(super) fn parts_for_residual(&self, max_error_px: f32) -> f32 {
+        let x = self.residual_px / (AZIMUTH_RESIDUAL_ERROR * max_error_px);
+        if x <= 1.0 {
+            return 1.0;
+        }
+        let n = x.cbrt().ceil();
+        if (n - 1.0) * (n - 1.0) * (n - 1.0) >= x {
+            n - 1.0
+        } else if n * n * n < x {
+            n + 1.0
+        } else {
+            n
+        }
+    }
+
+    /// Whether the edge drawn in one part strays at most `share`·τ from its bend and within
+    /// the residual's share from its step of azimuth, away from the eye circle (the quick
+    /// profile's test of an edge, a strip's base or a quad's rung).
+    pub(super) fn straight(&self, share: f32, max_error_px: f32) -> bool {
+        !self.ring
+            && parts_for_bend(self.bend_px, 2, share * max_error_px) <= 1.0
+            && self.parts_for_residual(max_error_px) <= 1.0
+    }
 }
 
 /// A triangle's L and τ (see [`Subdivider::limits`]).
@@ -55,6 +88,11 @@ pub(super) fn parts_for_bend(bend_px: f32, segments: u32, max_error_px: f32) -> 
 }
 
 impl Subdivider<'_> {
+    /// How the frame spaces nodes along a segment: by azimuth under the error split.
+    pub(super) fn spacing(&self) -> Spacing {
+        Spacing::of(self.params.method)
+    }
+
     /// L and τ for a triangle of `object`: the level of detail scales L by its factor s, and τ by
     /// s² (an edge's error grows as the square of its parts' length).
     pub(super) fn limits(&self, object: u32) -> Limits {
@@ -93,8 +131,14 @@ impl Subdivider<'_> {
     ///   across and along the curve (the drawn point j/n of the way is not where the point j/n
     ///   of the way along the 3-D edge projects).
     /// - `ring`: the edge comes within 2·d_e of the axis where the panorama shows the eye circle.
+    /// - `residual_px`: see [`EdgeProfile`].
+    ///
+    /// The points are spaced as the frame spaces nodes ([`Spacing`]), so that under the error
+    /// split the second differences measure the image's curvature against azimuth, which is
+    /// what its drawing with w = r leaves (`cpu::subdivide::spacing`).
     pub fn edge_profile(&self, a: Vec3, b: Vec3, segments: u32) -> EdgeProfile {
         let (lo, hi) = if lex_less(b, a) { (b, a) } else { (a, b) };
+        let spacing = self.spacing();
         let clamp_v = 1.5 * self.projection.height as f32;
         let width = self.projection.turn_px(); // a full turn in pixels: x wraps at it
         let (mut length, mut longest, mut nearest, mut bend) = (0.0f32, 0.0f32, f32::INFINITY, 0.0f32);
@@ -105,7 +149,7 @@ impl Subdivider<'_> {
             let (mut q0, mut q1) = (Vec2::ZERO, Vec2::ZERO);
             for k in 0..=segments {
                 let t = k as f32 / segments as f32;
-                let p = lo + (hi - lo) * t;
+                let p = lo + (hi - lo) * spacing.param(lo, hi, t);
                 nearest = nearest.min(horizontal_radius(p));
                 let raw = self.pixel(p, eye_sign);
                 let mut q = raw;
@@ -131,7 +175,10 @@ impl Subdivider<'_> {
         let shows_ring = self.projection.vertical == Vertical::Paper || self.projection.panorama.is_sphere();
         let ring = shows_ring && nearest < 2.0 * self.projection.eye_radius;
         let stretch = if ring { 1.0 } else { MAX_STRETCH };
-        EdgeProfile { length_px: length.max(segments as f32 * longest / stretch), bend_px: bend, ring }
+        // The fastest pixels per radian of azimuth: the longest segment over its step, D/S.
+        let residual_px =
+            spacing.turn(lo, hi).map_or(0.0, |d| AZIMUTH_CHORD_RESIDUAL * d * d * segments as f32 * longest);
+        EdgeProfile { length_px: length.max(segments as f32 * longest / stretch), bend_px: bend, ring, residual_px }
     }
 
     /// Divisions of an edge (not capped by N_max: the pre-split handles that), `edge_px` L and
@@ -156,12 +203,13 @@ impl Subdivider<'_> {
             }
             _ => {
                 let quick = self.edge_profile(a, b, 2);
-                if quick.length_px <= edge_px && !quick.ring && parts_for_bend(quick.bend_px, 2, max_error_px) <= 1.0 {
+                if quick.length_px <= edge_px && quick.straight(1.0, max_error_px) {
                     return 1;
                 }
                 let p = self.edge_profile(a, b, EDGE_SAMPLES);
                 let longest = if p.ring { edge_px } else { ERROR_SPLIT_LENGTH * edge_px };
-                parts_for_bend(p.bend_px, EDGE_SAMPLES, max_error_px).max((p.length_px / longest).ceil())
+                let n = parts_for_bend(p.bend_px, EDGE_SAMPLES, max_error_px).max((p.length_px / longest).ceil());
+                n.max(p.parts_for_residual(max_error_px))
             }
         };
         if n.is_finite() {
@@ -186,6 +234,7 @@ impl Subdivider<'_> {
         } else {
             whole.bend_px <= w * (2.0 * ROW_DIAGONAL_ERROR * limits.max_error_px)
                 && whole.length_px <= w * (ERROR_SPLIT_LENGTH * limits.edge_px)
+                && whole.residual_px <= w * w * w * (AZIMUTH_RESIDUAL_ERROR * limits.max_error_px)
         }
     }
 

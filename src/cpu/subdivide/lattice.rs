@@ -7,6 +7,7 @@
 
 use glam::Vec3;
 
+use super::spacing::Spacing;
 use super::{edge_point, Node};
 
 /// The point with weights `w` of a triangle of nodes (position and barycentric weights alike).
@@ -67,9 +68,10 @@ pub fn lattice_triangles(
     counts: [u32; 3],
     q: &[Node; 3],
     node_on_edge: &dyn Fn(usize, u32) -> Node,
+    spacing: Spacing,
 ) -> Vec<([u32; 3], [Node; 3])> {
     let m = counts[0].max(counts[1]).max(counts[2]);
-    with_nodes(lattice_slots(m), |k| lattice_node(counts, q, node_on_edge, m, slot_node(k, m)))
+    with_nodes(lattice_slots(m), |k| lattice_node(counts, q, node_on_edge, m, slot_node(k, m), spacing))
         .into_iter()
         .filter(|(_, t)| !collapsed(t))
         .collect()
@@ -156,11 +158,11 @@ pub fn quad_strip_node_count(rails: [u32; 2]) -> u32 {
 
 /// Node `slot` of a quad's strip ([`quad_strip_node_count`]): the rails' own nodes, computed
 /// from each side's canonically ordered ends as every piece does ([`edge_point`]).
-pub(super) fn quad_strip_node(corners: &[Node; 4], rails: [u32; 2], slot: u32) -> Node {
+pub(super) fn quad_strip_node(corners: &[Node; 4], rails: [u32; 2], slot: u32, spacing: Spacing) -> Node {
     if slot <= rails[0] {
-        edge_point(corners[0], corners[1], slot, rails[0])
+        edge_point(corners[0], corners[1], slot, rails[0], spacing)
     } else {
-        edge_point(corners[3], corners[2], slot - rails[0] - 1, rails[1])
+        edge_point(corners[3], corners[2], slot - rails[0] - 1, rails[1], spacing)
     }
 }
 
@@ -225,11 +227,12 @@ pub(super) fn lattice_node(
     node_on_edge: &dyn Fn(usize, u32) -> Node,
     m: u32,
     c: [u32; 3],
+    spacing: Spacing,
 ) -> Node {
     if let Some((e, idx)) = boundary_edge(c) {
         node_on_edge(e, snap(idx, counts[e], m))
     } else {
-        weighted(q, Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32) / m as f32)
+        spacing.interior(q, c, m)
     }
 }
 

@@ -120,6 +120,7 @@ mod piece;
 mod quad;
 mod rows;
 mod seam;
+pub mod spacing;
 mod work;
 
 pub use axis::{
@@ -127,7 +128,7 @@ pub use axis::{
     snap_to_cut_planes, triangle_cuts, AxisCuts,
 };
 pub use edges::EdgeProfile;
-use edges::{edge_point, lex_less, parts_for_bend, Limits};
+use edges::{edge_point, lex_less, Limits};
 pub use frame_cuts::FrameCuts;
 pub use lattice::{
     boundary_edge, lattice_triangles, macro_cell, node_slot, quad_strip_node_count, quad_strip_triangles, slot_node,
@@ -293,7 +294,7 @@ impl<'a> Subdivider<'a> {
         }
         let base = counts.iter().position(|&n| n == 1)?;
         let p = self.edge_profile(q[base].position, q[(base + 1) % 3].position, 2);
-        (!p.ring && parts_for_bend(p.bend_px, 2, STRIP_BASE_ERROR * limits.max_error_px) <= 1.0).then_some(base)
+        p.straight(STRIP_BASE_ERROR, limits.max_error_px).then_some(base)
     }
 
     /// Longest chord, in pixels, of a triangle's edges with an end on the screen rows.

@@ -5,14 +5,14 @@
 //! `lattice_rows_plan`).
 
 use super::edges::Limits;
-use super::lattice::{lattice_node, lattice_slots, strip_node, strip_slots, weighted};
+use super::lattice::{lattice_node, lattice_slots, strip_node, strip_slots};
 use super::seam::clear_of_seam;
+use super::spacing::Spacing;
 use super::{
     band_cell, boundary_edge, edge_point, macro_cell, slot_node, snap, strip_node_count, Node, PartSplit, PiecePlan,
     Rows, Subdivider, Triangle,
 };
 use crate::core::projection::{azimuth, wrap_angle, Eye};
-use glam::Vec3;
 
 /// Where a macro node lies. Original edge e runs from corner e to corner e + 1.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -66,6 +66,7 @@ pub(super) struct PieceGeometry {
     pub q: [Node; 3],
     edges: [PieceEdge; 3],
     pub limits: Limits,
+    pub spacing: Spacing,
 }
 
 impl PieceGeometry {
@@ -80,9 +81,9 @@ impl PieceGeometry {
         match pe.original {
             Some(oe) => {
                 let j = if pe.to >= pe.from { pe.from + m } else { pe.from - m };
-                edge_point(self.part[oe], self.part[(oe + 1) % 3], j, self.n[oe])
+                edge_point(self.part[oe], self.part[(oe + 1) % 3], j, self.n[oe], self.spacing)
             }
-            None => edge_point(self.q[e], self.q[(e + 1) % 3], m, pe.count),
+            None => edge_point(self.q[e], self.q[(e + 1) % 3], m, pe.count, self.spacing),
         }
     }
 }
@@ -108,13 +109,13 @@ impl Shape {
     fn nodes(&self, g: &PieceGeometry) -> Vec<Node> {
         let (counts, on_edge) = (g.counts(), |e: usize, m: u32| g.node_on_edge(e, m));
         match self {
-            Shape::Lattice(m) => {
-                (0..(m + 1) * (m + 2) / 2).map(|k| lattice_node(counts, &g.q, &on_edge, *m, slot_node(k, *m))).collect()
-            }
+            Shape::Lattice(m) => (0..(m + 1) * (m + 2) / 2)
+                .map(|k| lattice_node(counts, &g.q, &on_edge, *m, slot_node(k, *m), g.spacing))
+                .collect(),
             Shape::Strip(base) => {
                 (0..strip_node_count(counts, *base)).map(|k| strip_node(counts, *base, &on_edge, k)).collect()
             }
-            Shape::Rows(rows) => rows.nodes(&on_edge),
+            Shape::Rows(rows) => rows.nodes(&on_edge, g.spacing),
         }
     }
 }
@@ -132,11 +133,8 @@ impl Subdivider<'_> {
     fn macro_node(&self, part: &[Node; 3], n: [u32; 3], k: u32, loc: Location) -> Node {
         match loc {
             Location::Corner(i) => part[i],
-            Location::OnEdge(e, j) => edge_point(part[e], part[(e + 1) % 3], j, n[e]),
-            Location::Interior([a, b, c]) => {
-                let w = Vec3::new(a as f32, b as f32, c as f32) / k as f32;
-                weighted(part, w)
-            }
+            Location::OnEdge(e, j) => edge_point(part[e], part[(e + 1) % 3], j, n[e], self.spacing()),
+            Location::Interior(abc) => self.spacing().interior(part, abc, k),
         }
     }
 
@@ -178,7 +176,7 @@ impl Subdivider<'_> {
                     ..Default::default()
                 })
         });
-        Some(PieceGeometry { part: *part, n, k, q, edges, limits })
+        Some(PieceGeometry { part: *part, n, k, q, edges, limits, spacing: self.spacing() })
     }
 
     /// `lattice`: piece `cell` of a part planned — its shape, its nodes once per seam copy, its

@@ -7,7 +7,7 @@
 use glam::Vec3;
 
 use super::lattice::{quad_strip_node, quad_strip_node_count, quad_strip_rungs, quad_strip_slots};
-use super::{parts_for_bend, Node, PiecePlan, Subdivider, Triangle};
+use super::{Node, PiecePlan, Subdivider, Triangle};
 use crate::core::projection::azimuth;
 use crate::core::settings::SplitRule;
 use crate::encoding::constants::{PIECE_DIVISIONS, QUAD_MIN_DIVISIONS, QUAD_RUNG_ERROR};
@@ -45,11 +45,11 @@ impl Subdivider<'_> {
         }
         let straight = |[a, b]: [u32; 2]| {
             let q = self.edge_profile(
-                quad_strip_node(&corners, rails, a).position,
-                quad_strip_node(&corners, rails, b).position,
+                quad_strip_node(&corners, rails, a, self.spacing()).position,
+                quad_strip_node(&corners, rails, b, self.spacing()).position,
                 2,
             );
-            !q.ring && parts_for_bend(q.bend_px, 2, QUAD_RUNG_ERROR * limits.max_error_px) <= 1.0
+            q.straight(QUAD_RUNG_ERROR, limits.max_error_px)
         };
         quad_strip_rungs(rails).all(straight).then_some((corners, rails))
     }
@@ -57,7 +57,8 @@ impl Subdivider<'_> {
     /// `lattice` for a band's quad drawn as a strip between its rails ([`quad_strip_triangles`]):
     /// its plan.
     pub(super) fn quad_lattice(&self, tri: &Triangle, corners: &[Node; 4], rails: [u32; 2]) -> Option<PiecePlan> {
-        let nodes: Vec<Node> = (0..quad_strip_node_count(rails)).map(|k| quad_strip_node(corners, rails, k)).collect();
+        let nodes: Vec<Node> =
+            (0..quad_strip_node_count(rails)).map(|k| quad_strip_node(corners, rails, k, self.spacing())).collect();
         let c = corners.map(|n| n.position);
         let theta_c = azimuth((c[0] + c[1] + c[2] + c[3]) / 4.0);
         // The quad's u range: that of its fan's two triangles, which cover it.

@@ -11,6 +11,7 @@
 
 use super::edges::Limits;
 use super::lattice::{collapsed, with_nodes};
+use super::spacing::Spacing;
 use super::{edge_point, Node, Subdivider};
 use crate::core::settings::SplitRule;
 use crate::encoding::constants::PIECE_DIVISIONS;
@@ -162,21 +163,21 @@ impl Rows {
 
     /// Node a of row k: on the base row the base edge's own nodes, else the point a/w of the
     /// way between the row's ends ([`edge_point`], exact at the ends).
-    pub fn row_node(&self, k: u32, a: u32, node_on_edge: &dyn Fn(usize, u32) -> Node) -> Node {
+    pub fn row_node(&self, k: u32, a: u32, node_on_edge: &dyn Fn(usize, u32) -> Node, spacing: Spacing) -> Node {
         if k == 0 {
             return node_on_edge(self.base, a);
         }
         let [left, right] = Self::row_ends(self.base, self.sides, k, node_on_edge);
-        edge_point(left, right, a, self.widths[k as usize].max(1))
+        edge_point(left, right, a, self.widths[k as usize].max(1), spacing)
     }
 
     /// Every node, row by row (the output's slot order).
-    pub fn nodes(&self, node_on_edge: &dyn Fn(usize, u32) -> Node) -> Vec<Node> {
+    pub fn nodes(&self, node_on_edge: &dyn Fn(usize, u32) -> Node, spacing: Spacing) -> Vec<Node> {
         self.widths
             .iter()
             .zip(0..)
             .flat_map(|(&w, k)| (0..=w).map(move |a| (k, a)))
-            .map(|(k, a)| self.row_node(k, a, node_on_edge))
+            .map(|(k, a)| self.row_node(k, a, node_on_edge, spacing))
             .collect()
     }
 
@@ -184,8 +185,8 @@ impl Rows {
     /// ([`rows_advance_lower`]), making (A_i, A_i+1, B_j) or (A_i, B_j+1, B_j), the piece's
     /// winding. Where a side did not advance between the rows, a triangle at that end has two
     /// coincident corners and is dropped. Each triangle as its corners' slots and nodes.
-    pub fn triangles(&self, node_on_edge: &dyn Fn(usize, u32) -> Node) -> Vec<([u32; 3], [Node; 3])> {
-        let nodes = self.nodes(node_on_edge);
+    pub fn triangles(&self, node_on_edge: &dyn Fn(usize, u32) -> Node, spacing: Spacing) -> Vec<([u32; 3], [Node; 3])> {
+        let nodes = self.nodes(node_on_edge, spacing);
         with_nodes(self.slots(), |k| nodes[k as usize]).into_iter().filter(|(_, t)| !collapsed(t)).collect()
     }
 

@@ -2,6 +2,7 @@
 
 use super::lattice::quad_strip_node;
 use super::lattice::strip_node;
+use super::spacing::Spacing;
 use super::*;
 use crate::core::projection::{azimuth, wrap_angle, Eye, Vertical};
 use crate::core::settings::{Method, RenderSettings, Split, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV};
@@ -235,14 +236,21 @@ const TILED: [Node; 3] = [
     Node { position: Vec3::new(0.4, 1.1, -3.2), bary: Vec3::Z },
 ];
 
-/// The piece's triangles (the lattice, or the strip on `strip` base) tile it exactly: positive
-/// area, the piece's winding, every inner edge shared by two triangles, every boundary segment
-/// (the edges' own nodes) used once; each triangle's slots name its nodes.
+/// The piece's triangles (the lattice, or the strip on `strip` base) tile it exactly, with nodes
+/// spaced evenly and by azimuth: positive area, the piece's winding, every inner edge shared by
+/// two triangles, every boundary segment (the edges' own nodes) used once; each triangle's slots
+/// name its nodes.
 fn check_tiling(counts: [u32; 3], tiling: impl Into<Tiling>) -> usize {
     let tiling = tiling.into();
+    let even = check_spaced_tiling(counts, &tiling, Spacing::Even);
+    assert_eq!(check_spaced_tiling(counts, &tiling, Spacing::Azimuth), even, "{counts:?}");
+    even
+}
+
+fn check_spaced_tiling(counts: [u32; 3], tiling: &Tiling, spacing: Spacing) -> usize {
     let q = TILED;
-    let node_on_edge = |e: usize, m: u32| edge_point(q[e], q[(e + 1) % 3], m, counts[e]);
-    let rows = match &tiling {
+    let node_on_edge = |e: usize, m: u32| edge_point(q[e], q[(e + 1) % 3], m, counts[e], spacing);
+    let rows = match tiling {
         Tiling::Rows(widths) => {
             let (base, _) = Rows::base_of(counts);
             let sides = [counts[(base + 2) % 3], counts[(base + 1) % 3]];
@@ -250,13 +258,13 @@ fn check_tiling(counts: [u32; 3], tiling: impl Into<Tiling>) -> usize {
         }
         _ => None,
     };
-    let triangles = match (&tiling, &rows) {
+    let triangles = match (tiling, &rows) {
         (Tiling::Strip(base), _) => strip_triangles(counts, *base, &node_on_edge),
-        (_, Some(rows)) => rows.triangles(&node_on_edge),
-        _ => lattice_triangles(counts, &q, &node_on_edge),
+        (_, Some(rows)) => rows.triangles(&node_on_edge, spacing),
+        _ => lattice_triangles(counts, &q, &node_on_edge, spacing),
     };
     if let Some(rows) = &rows {
-        let nodes = rows.nodes(&node_on_edge);
+        let nodes = rows.nodes(&node_on_edge, spacing);
         assert_eq!(nodes.len() as u32, rows.node_count());
         assert!(triangles.len() as u32 <= rows.candidates());
         for (slots, t) in &triangles {
@@ -264,7 +272,7 @@ fn check_tiling(counts: [u32; 3], tiling: impl Into<Tiling>) -> usize {
         }
     }
     let strip = match tiling {
-        Tiling::Strip(base) => Some(base),
+        Tiling::Strip(base) => Some(*base),
         _ => None,
     };
     if let Some(base) = strip {
@@ -404,57 +412,58 @@ fn a_band_quads_strip_tiles_it_with_fewer_triangles_than_its_fan() {
         area([c[0].position, c[1].position, c[2].position]) + area([c[0].position, c[2].position, c[3].position]);
     let key = |p: Vec3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
     let pair = |u: Vec3, v: Vec3| if key(u) < key(v) { (key(u), key(v)) } else { (key(v), key(u)) };
-    for n1 in 1..=9 {
-        for n2 in 1..=9 {
-            let rails = [n1, n2];
-            let node = |k: u32| quad_strip_node(&c, rails, k);
-            let triangles = quad_strip_triangles(rails, &node);
-            assert_eq!(triangles.len() as u32, n1 + n2, "{rails:?}");
-            let nodes: Vec<Node> = (0..quad_strip_node_count(rails)).map(node).collect();
-            let mut edges: HashMap<_, u32> = HashMap::new();
-            let mut total = 0.0;
-            for (slots, t) in &triangles {
-                assert_eq!(slots.map(|k| nodes[k as usize]), *t, "{rails:?}: slots {slots:?}");
-                let p = t.map(|n| n.position);
-                assert!((p[1] - p[0]).cross(p[2] - p[0]).dot(normal) > 0.0, "{rails:?}: {p:?} turned over");
-                total += area(p);
-                for e in 0..3 {
-                    *edges.entry(pair(p[e], p[(e + 1) % 3])).or_default() += 1;
-                }
+    let both = [Spacing::Even, Spacing::Azimuth];
+    for (n1, n2, spacing) in (1..=9).flat_map(|n1| (1..=9).flat_map(move |n2| both.map(|s| (n1, n2, s)))) {
+        let rails = [n1, n2];
+        let node = |k: u32| quad_strip_node(&c, rails, k, spacing);
+        let triangles = quad_strip_triangles(rails, &node);
+        assert_eq!(triangles.len() as u32, n1 + n2, "{rails:?}");
+        let nodes: Vec<Node> = (0..quad_strip_node_count(rails)).map(node).collect();
+        let mut edges: HashMap<_, u32> = HashMap::new();
+        let mut total = 0.0;
+        for (slots, t) in &triangles {
+            assert_eq!(slots.map(|k| nodes[k as usize]), *t, "{rails:?}: slots {slots:?}");
+            let p = t.map(|n| n.position);
+            assert!((p[1] - p[0]).cross(p[2] - p[0]).dot(normal) > 0.0, "{rails:?}: {p:?} turned over");
+            total += area(p);
+            for e in 0..3 {
+                *edges.entry(pair(p[e], p[(e + 1) % 3])).or_default() += 1;
             }
-            assert!((total - whole).abs() < 1e-4 * whole, "{rails:?}: area {total} vs {whole}");
-            // The boundary: each rail's own consecutive nodes (as a neighbour sharing that side
-            // makes them) and the two rungs, each used once; every other edge twice.
-            let side = |a: Node, b: Node, n: u32| {
-                (0..n).map(move |j| pair(edge_point(a, b, j, n).position, edge_point(a, b, j + 1, n).position))
-            };
-            let boundary: Vec<_> = side(c[0], c[1], n1)
-                .chain(side(c[1], c[2], 1))
-                .chain(side(c[2], c[3], n2))
-                .chain(side(c[3], c[0], 1))
-                .collect();
-            for (edge, n) in &edges {
-                assert_eq!(*n, if boundary.contains(edge) { 1 } else { 2 }, "{rails:?}: edge used {n} times");
+        }
+        assert!((total - whole).abs() < 1e-4 * whole, "{rails:?}: area {total} vs {whole}");
+        // The boundary: each rail's own consecutive nodes (as a neighbour sharing that side
+        // makes them) and the two rungs, each used once; every other edge twice.
+        let side = |a: Node, b: Node, n: u32| {
+            (0..n).map(move |j| {
+                pair(edge_point(a, b, j, n, spacing).position, edge_point(a, b, j + 1, n, spacing).position)
+            })
+        };
+        let boundary: Vec<_> = side(c[0], c[1], n1)
+            .chain(side(c[1], c[2], 1))
+            .chain(side(c[2], c[3], n2))
+            .chain(side(c[3], c[0], 1))
+            .collect();
+        for (edge, n) in &edges {
+            assert_eq!(*n, if boundary.contains(edge) { 1 } else { 2 }, "{rails:?}: edge used {n} times");
+        }
+        assert!(boundary.iter().all(|b| edges.contains_key(b)), "{rails:?}: a boundary segment is missing");
+        // The fan: two slivers along the diagonal (in as many parts as the longer rail),
+        // each drawn as a strip where it is one.
+        let diagonal = n1.max(n2);
+        let part = |counts: [u32; 3]| match counts.iter().position(|&n| n == 1) {
+            Some(base) if counts.iter().max() >= Some(&STRIP_MIN_DIVISIONS) => {
+                counts[(base + 1) % 3] + counts[(base + 2) % 3] - 1
             }
-            assert!(boundary.iter().all(|b| edges.contains_key(b)), "{rails:?}: a boundary segment is missing");
-            // The fan: two slivers along the diagonal (in as many parts as the longer rail),
-            // each drawn as a strip where it is one.
-            let diagonal = n1.max(n2);
-            let part = |counts: [u32; 3]| match counts.iter().position(|&n| n == 1) {
-                Some(base) if counts.iter().max() >= Some(&STRIP_MIN_DIVISIONS) => {
-                    counts[(base + 1) % 3] + counts[(base + 2) % 3] - 1
-                }
-                _ => {
-                    let q = [c[0], c[1], c[2]];
-                    let on_edge = |e: usize, m: u32| edge_point(q[e], q[(e + 1) % 3], m, counts[e]);
-                    lattice_triangles(counts, &q, &on_edge).len() as u32
-                }
-            };
-            let fan = part([n1, 1, diagonal]) + part([diagonal, n2, 1]);
-            assert!(n1 + n2 <= fan, "{rails:?}: quad strip {} vs fan {fan}", n1 + n2);
-            if n1.max(n2) >= 3 {
-                assert!(n1 + n2 < fan, "{rails:?}: quad strip {} vs fan {fan}", n1 + n2);
+            _ => {
+                let q = [c[0], c[1], c[2]];
+                let on_edge = |e: usize, m: u32| edge_point(q[e], q[(e + 1) % 3], m, counts[e], spacing);
+                lattice_triangles(counts, &q, &on_edge, spacing).len() as u32
             }
+        };
+        let fan = part([n1, 1, diagonal]) + part([diagonal, n2, 1]);
+        assert!(n1 + n2 <= fan, "{rails:?}: quad strip {} vs fan {fan}", n1 + n2);
+        if n1.max(n2) >= 3 {
+            assert!(n1 + n2 < fan, "{rails:?}: quad strip {} vs fan {fan}", n1 + n2);
         }
     }
 }
