@@ -17,36 +17,45 @@ fn same(a: vec3<f32>, b: vec3<f32>) -> bool {
 
 // ---- the spacing of nodes along a segment (src/cpu/subdivide/spacing.rs says why) ----
 
-// The azimuth segment lo–hi sweeps where its points are spaced by azimuth (the error split, both
-// ends at least AZIMUTH_MIN_RADIUS from the axis, the sweep within (AZIMUTH_MIN_TURN,
-// AZIMUTH_MAX_TURN)); else 0 (`Spacing::turn`).
-fn spacing_turn(lo: vec3<f32>, hi: vec3<f32>) -> f32 {
+// What spacing the points of segment lo–hi takes (`Spacer` in src/cpu/subdivide/spacing.rs):
+// `by_radius` under the error split with both ends at least AZIMUTH_MIN_RADIUS from the axis
+// (their distances rl, rh), and the azimuth the segment sweeps where it is within
+// (AZIMUTH_MIN_TURN, AZIMUTH_MAX_TURN), else 0.
+struct Spacer {
+    by_radius: bool,
+    rl: f32,
+    rh: f32,
+    turn: f32,
+}
+
+fn spacer(lo: vec3<f32>, hi: vec3<f32>) -> Spacer {
     let rl = horizontal_radius(lo);
     let rh = horizontal_radius(hi);
     if (params.method != METHOD_ERROR || rl < AZIMUTH_MIN_RADIUS || rh < AZIMUTH_MIN_RADIUS) {
-        return 0.0;
+        return Spacer(false, rl, rh, 0.0);
     }
     let el = vec2<f32>(lo.x, lo.z) / rl;
     let eh = vec2<f32>(hi.x, hi.z) / rh;
     let turn = precise_atan2(abs(el.x * eh.y - el.y * eh.x), dot(el, eh));
-    return select(0.0, turn, turn > AZIMUTH_MIN_TURN && turn < AZIMUTH_MAX_TURN);
+    return Spacer(true, rl, rh, select(0.0, turn, turn > AZIMUTH_MIN_TURN && turn < AZIMUTH_MAX_TURN));
 }
 
-// The 3-D parameter of the point at fraction t of the way from lo to hi (`Spacing::param`): t,
-// or under the error split the point at azimuth fraction t of the sweep.
-fn spacing_param(lo: vec3<f32>, hi: vec3<f32>, t: f32) -> f32 {
-    let rl = horizontal_radius(lo);
-    let rh = horizontal_radius(hi);
-    if (params.method != METHOD_ERROR || rl < AZIMUTH_MIN_RADIUS || rh < AZIMUTH_MIN_RADIUS) {
+// The 3-D parameter of the point at fraction t of the segment (`Spacer::param`): t, or under the
+// error split the point at azimuth fraction t of the sweep.
+fn spaced(sp: Spacer, t: f32) -> f32 {
+    if (!sp.by_radius) {
         return t;
     }
-    let d = spacing_turn(lo, hi);
     var blend = t;
-    if (d > 0.0) {
-        let a = precise_sin(t * d);
-        blend = a / (a + precise_sin((1.0 - t) * d));
+    if (sp.turn > 0.0) {
+        let a = precise_sin(t * sp.turn);
+        blend = a / (a + precise_sin((1.0 - t) * sp.turn));
     }
-    return (blend / rh) / ((1.0 - blend) / rl + blend / rh);
+    return (blend / sp.rh) / ((1.0 - blend) / sp.rl + blend / sp.rh);
+}
+
+fn spacing_param(lo: vec3<f32>, hi: vec3<f32>, t: f32) -> f32 {
+    return spaced(spacer(lo, hi), t);
 }
 
 // The node at fraction t of the way from a to b (`Spacing::mix`).
@@ -108,6 +117,7 @@ fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
     var longest = 0.0;
     var nearest = 1e30;
     var bend = 0.0;
+    let sp = spacer(lo, hi);
     for (var s = 0u; s < 2u; s++) {
         let eye_sign = select(-1.0, 1.0, s == 1u);
         var total = 0.0;
@@ -116,7 +126,7 @@ fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
         var q1 = vec2<f32>(0.0, 0.0);
         for (var k = 0u; k <= segments; k++) {
             let t = f32(k) / f32(segments);
-            let p = lo + (hi - lo) * spacing_param(lo, hi, t);
+            let p = lo + (hi - lo) * spaced(sp, t);
             nearest = min(nearest, horizontal_radius(p));
             let raw = pixel(p, eye_sign);
             var q = raw;
@@ -142,8 +152,7 @@ fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
     let shows_ring = params.projection.vertical_exact == 0u || is_sphere(params.projection);
     let ring = shows_ring && nearest < 2.0 * params.projection.eye_radius;
     let stretch = select(MAX_STRETCH, 1.0, ring);
-    let turn = spacing_turn(lo, hi);
-    let residual = AZIMUTH_CHORD_RESIDUAL * turn * turn * f32(segments) * longest;
+    let residual = AZIMUTH_CHORD_RESIDUAL * sp.turn * sp.turn * f32(segments) * longest;
     return EdgeProfile(max(length_px, f32(segments) * longest / stretch), bend, ring, residual);
 }
 

@@ -138,7 +138,7 @@ impl Subdivider<'_> {
     /// what its drawing with w = r leaves (`cpu::subdivide::spacing`).
     pub fn edge_profile(&self, a: Vec3, b: Vec3, segments: u32) -> EdgeProfile {
         let (lo, hi) = if lex_less(b, a) { (b, a) } else { (a, b) };
-        let spacing = self.spacing();
+        let spacer = self.spacing().spacer(lo, hi);
         let clamp_v = 1.5 * self.projection.height as f32;
         let width = self.projection.turn_px(); // a full turn in pixels: x wraps at it
         let (mut length, mut longest, mut nearest, mut bend) = (0.0f32, 0.0f32, f32::INFINITY, 0.0f32);
@@ -149,7 +149,7 @@ impl Subdivider<'_> {
             let (mut q0, mut q1) = (Vec2::ZERO, Vec2::ZERO);
             for k in 0..=segments {
                 let t = k as f32 / segments as f32;
-                let p = lo + (hi - lo) * spacing.param(lo, hi, t);
+                let p = lo + (hi - lo) * spacer.param(t);
                 nearest = nearest.min(horizontal_radius(p));
                 let raw = self.pixel(p, eye_sign);
                 let mut q = raw;
@@ -176,8 +176,7 @@ impl Subdivider<'_> {
         let ring = shows_ring && nearest < 2.0 * self.projection.eye_radius;
         let stretch = if ring { 1.0 } else { MAX_STRETCH };
         // The fastest pixels per radian of azimuth: the longest segment over its step, D/S.
-        let residual_px =
-            spacing.turn(lo, hi).map_or(0.0, |d| AZIMUTH_CHORD_RESIDUAL * d * d * segments as f32 * longest);
+        let residual_px = spacer.turn.map_or(0.0, |d| AZIMUTH_CHORD_RESIDUAL * d * d * segments as f32 * longest);
         EdgeProfile { length_px: length.max(segments as f32 * longest / stretch), bend_px: bend, ring, residual_px }
     }
 

@@ -48,45 +48,25 @@ impl Spacing {
         }
     }
 
-    /// The azimuth that segment lo–hi sweeps (0..π), where its points are spaced by azimuth:
-    /// both ends at least `AZIMUTH_MIN_RADIUS` from the axis and the sweep within
-    /// (`AZIMUTH_MIN_TURN`, `AZIMUTH_MAX_TURN`); else None (equal parts of the linear blend of
-    /// P/r, which the drawing with w = r follows between the ends).
-    pub fn turn(self, lo: Vec3, hi: Vec3) -> Option<f32> {
-        if self == Spacing::Even {
-            return None;
-        }
+    /// How segment lo–hi's points are spaced ([`Spacer`]).
+    pub fn spacer(self, lo: Vec3, hi: Vec3) -> Spacer {
         let (rl, rh) = (horizontal_radius(lo), horizontal_radius(hi));
-        if rl < AZIMUTH_MIN_RADIUS || rh < AZIMUTH_MIN_RADIUS {
-            return None;
+        if self == Spacing::Even || rl < AZIMUTH_MIN_RADIUS || rh < AZIMUTH_MIN_RADIUS {
+            return Spacer { by_radius: false, rl, rh, turn: None };
         }
         let (el, eh) = (Vec2::new(lo.x, lo.z) / rl, Vec2::new(hi.x, hi.z) / rh);
         let turn = el.perp_dot(eh).abs().atan2(el.dot(eh));
-        (turn > AZIMUTH_MIN_TURN && turn < AZIMUTH_MAX_TURN).then_some(turn)
+        Spacer { by_radius: true, rl, rh, turn: (turn > AZIMUTH_MIN_TURN && turn < AZIMUTH_MAX_TURN).then_some(turn) }
     }
 
-    /// The 3-D parameter (0 at lo, 1 at hi) of the point at fraction t of the way from lo to hi:
-    /// t itself for `Even`; for `Azimuth` the point of the segment at azimuth fraction t of its
-    /// sweep D: the blend T = sin(tD) / (sin(tD) + sin((1 − t)D)) of the ends' horizontal
-    /// directions points there, and the point of the segment whose P/r is that blend of the
-    /// ends' lies (T/r_hi) / ((1 − T)/r_lo + T/r_hi) of the way (where the sweep is not
-    /// measured, T = t).
+    /// The azimuth that segment lo–hi sweeps where its points are spaced by it ([`Spacer`]).
+    pub fn turn(self, lo: Vec3, hi: Vec3) -> Option<f32> {
+        self.spacer(lo, hi).turn
+    }
+
+    /// The 3-D parameter of the point at fraction t of the way from lo to hi ([`Spacer::param`]).
     pub fn param(self, lo: Vec3, hi: Vec3, t: f32) -> f32 {
-        if self == Spacing::Even {
-            return t;
-        }
-        let (rl, rh) = (horizontal_radius(lo), horizontal_radius(hi));
-        if rl < AZIMUTH_MIN_RADIUS || rh < AZIMUTH_MIN_RADIUS {
-            return t;
-        }
-        let blend = match self.turn(lo, hi) {
-            Some(d) => {
-                let a = precise_sin(t * d);
-                a / (a + precise_sin((1.0 - t) * d))
-            }
-            None => t,
-        };
-        (blend / rh) / ((1.0 - blend) / rl + blend / rh)
+        self.spacer(lo, hi).param(t)
     }
 
     /// The node at fraction t of the way from a to b ([`Spacing::param`] of their positions in
@@ -107,6 +87,41 @@ impl Spacing {
         let up = l as f32 / m as f32;
         let (left, right) = (self.mix(q[0], q[2], up), self.mix(q[1], q[2], up));
         self.mix(left, right, j as f32 / (i + j) as f32)
+    }
+}
+
+/// How a segment's points are spaced (`Spacer` in subdivide_edges.wgsl): `by_radius` under
+/// azimuth spacing with both ends at least `AZIMUTH_MIN_RADIUS` from the axis (at `rl`, `rh`),
+/// and the azimuth the segment sweeps where it is within (`AZIMUTH_MIN_TURN`,
+/// `AZIMUTH_MAX_TURN`) (else None: equal parts of the linear blend of P/r, which the drawing
+/// with w = r follows between the ends).
+#[derive(Clone, Copy, Debug)]
+pub struct Spacer {
+    pub by_radius: bool,
+    pub rl: f32,
+    pub rh: f32,
+    pub turn: Option<f32>,
+}
+
+impl Spacer {
+    /// The 3-D parameter (0 at lo, 1 at hi) of the point at fraction t of the way from lo to hi:
+    /// t itself unless `by_radius`; else the point of the segment at azimuth fraction t of its
+    /// sweep D: the blend T = sin(tD) / (sin(tD) + sin((1 − t)D)) of the ends' horizontal
+    /// directions points there, and the point of the segment whose P/r is that blend of the
+    /// ends' lies (T/r_hi) / ((1 − T)/r_lo + T/r_hi) of the way (where the sweep is not
+    /// measured, T = t).
+    pub fn param(&self, t: f32) -> f32 {
+        if !self.by_radius {
+            return t;
+        }
+        let blend = match self.turn {
+            Some(d) => {
+                let a = precise_sin(t * d);
+                a / (a + precise_sin((1.0 - t) * d))
+            }
+            None => t,
+        };
+        (blend / self.rh) / ((1.0 - blend) / self.rl + blend / self.rh)
     }
 }
 
