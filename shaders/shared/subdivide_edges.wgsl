@@ -6,6 +6,7 @@
 #import constants
 #import subdivide_bindings
 #import subdivide_state
+#import subdivide_spacing
 
 fn lex_less(a: vec3<f32>, b: vec3<f32>) -> bool {
     return a.x < b.x || (a.x == b.x && (a.y < b.y || (a.y == b.y && a.z < b.z)));
@@ -13,55 +14,6 @@ fn lex_less(a: vec3<f32>, b: vec3<f32>) -> bool {
 
 fn same(a: vec3<f32>, b: vec3<f32>) -> bool {
     return all(a == b);
-}
-
-// ---- the spacing of nodes along a segment (src/cpu/subdivide/spacing.rs says why) ----
-
-// What spacing the points of segment lo–hi takes (`Spacer` in src/cpu/subdivide/spacing.rs):
-// `by_radius` under the error split with both ends at least AZIMUTH_MIN_RADIUS from the axis
-// (their distances rl, rh), and the azimuth the segment sweeps where it is within
-// (AZIMUTH_MIN_TURN, AZIMUTH_MAX_TURN), else 0.
-struct Spacer {
-    by_radius: bool,
-    rl: f32,
-    rh: f32,
-    turn: f32,
-}
-
-fn spacer(lo: vec3<f32>, hi: vec3<f32>) -> Spacer {
-    let rl = horizontal_radius(lo);
-    let rh = horizontal_radius(hi);
-    if (params.method != METHOD_ERROR || rl < AZIMUTH_MIN_RADIUS || rh < AZIMUTH_MIN_RADIUS) {
-        return Spacer(false, rl, rh, 0.0);
-    }
-    let el = vec2<f32>(lo.x, lo.z) / rl;
-    let eh = vec2<f32>(hi.x, hi.z) / rh;
-    let turn = precise_atan2(abs(el.x * eh.y - el.y * eh.x), dot(el, eh));
-    return Spacer(true, rl, rh, select(0.0, turn, turn > AZIMUTH_MIN_TURN && turn < AZIMUTH_MAX_TURN));
-}
-
-// The 3-D parameter of the point at fraction t of the segment (`Spacer::param`): t, or under the
-// error split the point at azimuth fraction t of the sweep.
-fn spaced(sp: Spacer, t: f32) -> f32 {
-    if (!sp.by_radius) {
-        return t;
-    }
-    var blend = t;
-    if (sp.turn > 0.0) {
-        let a = precise_sin(t * sp.turn);
-        blend = a / (a + precise_sin((1.0 - t) * sp.turn));
-    }
-    return (blend / sp.rh) / ((1.0 - blend) / sp.rl + blend / sp.rh);
-}
-
-fn spacing_param(lo: vec3<f32>, hi: vec3<f32>, t: f32) -> f32 {
-    return spaced(spacer(lo, hi), t);
-}
-
-// The node at fraction t of the way from a to b (`Spacing::mix`).
-fn spacing_mix(a: Node, b: Node, t: f32) -> Node {
-    let s = spacing_param(a.position, b.position, t);
-    return Node(a.position + (b.position - a.position) * s, a.bary + (b.bary - a.bary) * s);
 }
 
 // The point j/n of the way from a to b, from the canonically ordered pair; the ends are exact.

@@ -125,25 +125,6 @@ fn node_on_edge(e: u32, m: u32, part: ptr<function, PartPlan>, piece_state: ptr<
     return edge_point(a, b, j, n);
 }
 
-// The point with weights w of a triangle of nodes (positions and barycentric weights alike).
-fn weighted(q: array<Node, 3>, w: vec3<f32>) -> Node {
-    return Node(
-        w.x * q[0].position + w.y * q[1].position + w.z * q[2].position,
-        w.x * q[0].bary + w.y * q[1].bary + w.z * q[2].bary,
-    );
-}
-
-// The interior lattice point (i, j, l)/m of a triangle of nodes (`Spacing::interior`): the
-// barycentric blend, or under the error split the point j/(i + j) of the way along the row between
-// the points l/m of the way from q0 and from q1 towards q2, each spaced by azimuth.
-fn spaced_interior(q: array<Node, 3>, c: vec3<u32>, m: u32) -> Node {
-    if (params.method != METHOD_ERROR) {
-        return weighted(q, vec3<f32>(c) / f32(m));
-    }
-    let up = f32(c.z) / f32(m);
-    return spacing_mix(spacing_mix(q[0], q[2], up), spacing_mix(q[1], q[2], up), f32(c.y) / f32(c.x + c.y));
-}
-
 fn interior_node(i: u32, j: u32, l: u32, m: u32, piece_state: ptr<function, PieceState>) -> Node {
     return spaced_interior((*piece_state).corner, vec3<u32>(i, j, l), m);
 }

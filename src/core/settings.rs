@@ -72,6 +72,11 @@ impl SplitRule {
     pub fn is_adaptive(method: u32) -> bool {
         method == SplitRule::Adaptive as u32 || method == SplitRule::AdaptiveError as u32
     }
+    /// Whether `SubdivideParams::method` spaces nodes by azimuth and draws them with w = r (the
+    /// error split: `cpu::subdivide::spacing`).
+    pub fn spaces_by_azimuth(method: u32) -> bool {
+        method == SplitRule::AdaptiveError as u32
+    }
     /// The WGSL constant's name.
     pub fn wgsl_name(self) -> &'static str {
         match self {

@@ -2,8 +2,7 @@
 //! (the subdivide and slit stages' are in [`super::subdivide`] and [`super::slits`]).
 
 use crate::core::projection::Eye;
-use crate::core::settings::RenderSettings;
-use crate::cpu::subdivide::spacing::Spacing;
+use crate::core::settings::{RenderSettings, SplitRule};
 use crate::encoding::types::{RasterParams, TraceParams};
 
 /// The raster stage's parameters: the left eye's, then the right's (its `array<RasterParams, 2>`).
@@ -14,7 +13,7 @@ pub fn raster_params(settings: &RenderSettings) -> [RasterParams; 2] {
         ambient: settings.shading.ambient,
         shift_px: settings.measure.shift_px,
         error_angle: settings.measure.error_angle as u32,
-        w_by_radius: (Spacing::of(settings.subdivision.method.split_rule().0 as u32) == Spacing::Azimuth) as u32,
+        w_by_radius: SplitRule::spaces_by_azimuth(settings.subdivision.method.split_rule().0 as u32) as u32,
         ..Default::default()
     })
 }

@@ -11,7 +11,7 @@
 use std::sync::OnceLock;
 
 use crate::core::projection::PanoramaKind;
-use crate::core::settings::RenderSettings;
+use crate::core::settings::{RenderSettings, SplitRule};
 use crate::encoding::constants::PIECES_FROM_COUNTER;
 use crate::encoding::recording::{Command, Recording};
 use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine, INDICES_SIZE, NODE_SIZE};
@@ -23,7 +23,9 @@ use crate::gpu::frame_plan::SubdivisionBuffers;
 use crate::gpu::scene::GpuScene;
 use crate::gpu::stages::GpuStage;
 use crate::gpu::timestamps::{self as stamp, Timestamps};
-use crate::shader::{StandIn, CAVE_OFF, CUBEMAP_OFF, FISHEYE_OFF, HEAD_OFF, ROWS_OFF, SPHERE_OFF, SUBDIVIDE};
+use crate::shader::{
+    StandIn, CAVE_OFF, CUBEMAP_OFF, FISHEYE_OFF, HEAD_OFF, ROWS_OFF, SPACING_OFF, SPHERE_OFF, SUBDIVIDE,
+};
 
 pub(crate) const COUNTERS_SIZE: u64 = std::mem::size_of::<SubdivideCounters>() as u64;
 // The frame's timestamps are read back as u64s right after the counters.
@@ -49,7 +51,7 @@ impl Variant {
 /// (`subdivide_rows_off`): lavapipe builds a pipeline about twice as long with the code merely in it).
 pub(crate) struct SubdivideStage {
     stage: GpuStage,
-    variants: [OnceLock<Variant>; 8],
+    variants: [OnceLock<Variant>; 16],
 }
 
 impl SubdivideStage {
@@ -71,18 +73,23 @@ impl SubdivideStage {
         };
         let passes = Passes::of(panorama, params.method);
         let rows = passes.rows;
-        self.variants[2 * k + rows as usize].get_or_init(|| {
+        let spacing = SplitRule::spaces_by_azimuth(params.method);
+        self.variants[4 * k + 2 * rows as usize + spacing as usize].get_or_init(|| {
             // Built side by side: the driver's compiling of the large passes (`plan_cuts`,
             // `lattice`) is most of a fresh process's time.
             let constants = [("PANORAMAS", bits)];
-            let stand_ins: &[StandIn] = match (k, rows) {
-                (0, _) => &[ROWS_OFF, SPHERE_OFF, FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
-                (1, _) => &[ROWS_OFF, SPHERE_OFF, FISHEYE_OFF, CUBEMAP_OFF, CAVE_OFF],
-                (2, false) => &[ROWS_OFF, FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
-                (2, true) => &[FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
-                (_, false) => &[ROWS_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
-                (_, true) => &[HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
+            let mut stand_ins: Vec<StandIn> = match (k, rows) {
+                (0, _) => vec![ROWS_OFF, SPHERE_OFF, FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
+                (1, _) => vec![ROWS_OFF, SPHERE_OFF, FISHEYE_OFF, CUBEMAP_OFF, CAVE_OFF],
+                (2, false) => vec![ROWS_OFF, FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
+                (2, true) => vec![FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
+                (_, false) => vec![ROWS_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
+                (_, true) => vec![HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
             };
+            if !spacing {
+                stand_ins.push(SPACING_OFF);
+            }
+            let stand_ins = &stand_ins[..];
             // The entry points this frame's schedules dispatch (every schedule's are the usual
             // frame's).
             let used: Vec<&'static str> = one_submission(1, passes, false).entries().collect();

@@ -490,6 +490,8 @@ pub const SHARED: &[(&str, &str)] = &[
     ("subdivide_types", include_str!("../../shaders/shared/subdivide_types.wgsl")),
     ("subdivide_bindings", include_str!("../../shaders/shared/subdivide_bindings.wgsl")),
     ("subdivide_state", include_str!("../../shaders/shared/subdivide_state.wgsl")),
+    ("subdivide_spacing", include_str!("../../shaders/shared/subdivide_spacing.wgsl")),
+    ("subdivide_spacing_off", include_str!("../../shaders/shared/subdivide_spacing_off.wgsl")),
     ("subdivide_edges", include_str!("../../shaders/shared/subdivide_edges.wgsl")),
     ("subdivide_frame_cuts", include_str!("../../shaders/shared/subdivide_frame_cuts.wgsl")),
     ("subdivide_axis", include_str!("../../shaders/shared/subdivide_axis.wgsl")),
@@ -516,10 +518,14 @@ pub const SHARED: &[(&str, &str)] = &[
 pub type StandIn = (&'static str, &'static str);
 
 /// Every stand-in (the naga test validates each file composed with each one).
-pub const STAND_INS: &[StandIn] = &[ROWS_OFF, SPHERE_OFF, FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF];
+pub const STAND_INS: &[StandIn] = &[ROWS_OFF, SPACING_OFF, SPHERE_OFF, FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF];
 
 /// `subdivide_rows` left out: the `lattice` pipeline of the frames that never draw rows.
 pub const ROWS_OFF: StandIn = ("subdivide_rows", "subdivide_rows_off");
+
+/// `subdivide_spacing` left out: the subdivide stage's pipelines for the split rules that space
+/// nodes evenly (all but the error split: `cpu::subdivide::spacing`).
+pub const SPACING_OFF: StandIn = ("subdivide_spacing", "subdivide_spacing_off");
 
 /// `projection_sphere` left out: the subdivide stage's pipelines for the cylinder.
 pub const SPHERE_OFF: StandIn = ("projection_sphere", "projection_sphere_off");

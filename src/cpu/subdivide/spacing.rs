@@ -41,7 +41,7 @@ pub enum Spacing {
 impl Spacing {
     /// A frame's, from its split rule (`SubdivideParams::method`).
     pub fn of(method: u32) -> Spacing {
-        if method == SplitRule::AdaptiveError as u32 {
+        if SplitRule::spaces_by_azimuth(method) {
             Spacing::Azimuth
         } else {
             Spacing::Even

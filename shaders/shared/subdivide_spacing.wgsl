@@ -1,0 +1,74 @@
+// How nodes are spaced along a segment under the error split, and a lattice's interior points
+// (CPU twin: src/cpu/subdivide/spacing.rs, which says why). The pipelines of the other split rules
+// are composed with the stand-in `subdivide_spacing_off` (equal parts, the barycentric blend).
+
+#import projection
+#import constants
+#import subdivide_bindings
+#import subdivide_state
+
+// What spacing the points of segment lo–hi takes (`Spacer` in src/cpu/subdivide/spacing.rs):
+// `by_radius` under the error split with both ends at least AZIMUTH_MIN_RADIUS from the axis
+// (their distances rl, rh), and the azimuth the segment sweeps where it is within
+// (AZIMUTH_MIN_TURN, AZIMUTH_MAX_TURN), else 0.
+struct Spacer {
+    by_radius: bool,
+    rl: f32,
+    rh: f32,
+    turn: f32,
+}
+
+fn spacer(lo: vec3<f32>, hi: vec3<f32>) -> Spacer {
+    let rl = horizontal_radius(lo);
+    let rh = horizontal_radius(hi);
+    if (params.method != METHOD_ERROR || rl < AZIMUTH_MIN_RADIUS || rh < AZIMUTH_MIN_RADIUS) {
+        return Spacer(false, rl, rh, 0.0);
+    }
+    let el = vec2<f32>(lo.x, lo.z) / rl;
+    let eh = vec2<f32>(hi.x, hi.z) / rh;
+    let turn = precise_atan2(abs(el.x * eh.y - el.y * eh.x), dot(el, eh));
+    return Spacer(true, rl, rh, select(0.0, turn, turn > AZIMUTH_MIN_TURN && turn < AZIMUTH_MAX_TURN));
+}
+
+// The 3-D parameter of the point at fraction t of the segment (`Spacer::param`): t, or under the
+// error split the point at azimuth fraction t of the sweep.
+fn spaced(sp: Spacer, t: f32) -> f32 {
+    if (!sp.by_radius) {
+        return t;
+    }
+    var blend = t;
+    if (sp.turn > 0.0) {
+        let a = precise_sin(t * sp.turn);
+        blend = a / (a + precise_sin((1.0 - t) * sp.turn));
+    }
+    return (blend / sp.rh) / ((1.0 - blend) / sp.rl + blend / sp.rh);
+}
+
+fn spacing_param(lo: vec3<f32>, hi: vec3<f32>, t: f32) -> f32 {
+    return spaced(spacer(lo, hi), t);
+}
+
+// The node at fraction t of the way from a to b (`Spacing::mix`).
+fn spacing_mix(a: Node, b: Node, t: f32) -> Node {
+    let s = spacing_param(a.position, b.position, t);
+    return Node(a.position + (b.position - a.position) * s, a.bary + (b.bary - a.bary) * s);
+}
+
+// The interior lattice point (i, j, l)/m of a triangle of nodes (`Spacing::interior`): the
+// barycentric blend, or under the error split the point j/(i + j) of the way along the row between
+// the points l/m of the way from q0 and from q1 towards q2, each spaced by azimuth.
+fn spaced_interior(q: array<Node, 3>, c: vec3<u32>, m: u32) -> Node {
+    if (params.method != METHOD_ERROR) {
+        return weighted(q, vec3<f32>(c) / f32(m));
+    }
+    let up = f32(c.z) / f32(m);
+    return spacing_mix(spacing_mix(q[0], q[2], up), spacing_mix(q[1], q[2], up), f32(c.y) / f32(c.x + c.y));
+}
+
+// The point with weights w of a triangle of nodes (positions and barycentric weights alike).
+fn weighted(q: array<Node, 3>, w: vec3<f32>) -> Node {
+    return Node(
+        w.x * q[0].position + w.y * q[1].position + w.z * q[2].position,
+        w.x * q[0].bary + w.y * q[1].bary + w.z * q[2].bary,
+    );
+}
