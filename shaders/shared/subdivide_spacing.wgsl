@@ -1,27 +1,19 @@
 // How nodes are spaced along a segment under the error split, and a lattice's interior points
 // (CPU twin: src/cpu/subdivide/spacing.rs, which says why). The pipelines of the other split rules
-// are composed with the stand-in `subdivide_spacing_off` (equal parts, the barycentric blend).
+// are composed with the stand-in `subdivide_spacing_off` (equal parts, the barycentric blend; a
+// cubemap frame under the error split runs this module with `by_azimuth` 0, the same).
 
 #import projection
 #import constants
 #import subdivide_bindings
 #import subdivide_state
 
-// What spacing the points of segment lo–hi takes (`Spacer` in src/cpu/subdivide/spacing.rs):
-// `by_radius` under the error split with both ends at least AZIMUTH_MIN_RADIUS from the axis
-// (their distances rl, rh), and the azimuth the segment sweeps where it is within
-// (AZIMUTH_MIN_TURN, AZIMUTH_MAX_TURN), else 0.
-struct Spacer {
-    by_radius: bool,
-    rl: f32,
-    rh: f32,
-    turn: f32,
-}
-
+// How segment lo–hi's points are spaced (`Spacing::spacer`): by azimuth where the frame spaces
+// nodes so (`SubdivideParams::by_azimuth`: the error split, but on the cubemap).
 fn spacer(lo: vec3<f32>, hi: vec3<f32>) -> Spacer {
     let rl = horizontal_radius(lo);
     let rh = horizontal_radius(hi);
-    if (params.method != METHOD_ERROR || rl < AZIMUTH_MIN_RADIUS || rh < AZIMUTH_MIN_RADIUS) {
+    if (params.by_azimuth == 0u || rl < AZIMUTH_MIN_RADIUS || rh < AZIMUTH_MIN_RADIUS) {
         return Spacer(false, rl, rh, 0.0);
     }
     let el = vec2<f32>(lo.x, lo.z) / rl;
@@ -58,7 +50,7 @@ fn spacing_mix(a: Node, b: Node, t: f32) -> Node {
 // barycentric blend, or under the error split the point j/(i + j) of the way along the row between
 // the points l/m of the way from q0 and from q1 towards q2, each spaced by azimuth.
 fn spaced_interior(q: array<Node, 3>, c: vec3<u32>, m: u32) -> Node {
-    if (params.method != METHOD_ERROR) {
+    if (params.by_azimuth == 0u) {
         return weighted(q, vec3<f32>(c) / f32(m));
     }
     let up = f32(c.z) / f32(m);

@@ -5,13 +5,6 @@
 
 #import subdivide_state
 
-struct Spacer {
-    by_radius: bool,
-    rl: f32,
-    rh: f32,
-    turn: f32,
-}
-
 // Even spacing: nothing measured.
 fn spacer(lo: vec3<f32>, hi: vec3<f32>) -> Spacer {
     return Spacer(false, 0.0, 0.0, 0.0);

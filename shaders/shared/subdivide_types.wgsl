@@ -34,7 +34,7 @@ struct SubdivideParams {
     measure_edges: u32,  // 1: also track the longest visible output edge
     vertical_limit: f32, // |y| > this·r: no pixel row shows the point (`Projection::vertical_limit`)
     max_error_px: f32,   // τ of the error split
-    _pad1: u32,
+    by_azimuth: u32,     // 1: nodes spaced by azimuth, drawn with w = r (`SubdivideParams::by_azimuth`)
     _pad2: u32,
 }
 
@@ -106,6 +106,17 @@ const EDGE_CUT: u32 = 2u;
 // `params.piece_count == PIECES_FROM_COUNTER` (from `constants`): as many pieces as `plan` made
 // (read from the counter), so that plan, lattice and drawing can run in one submission.
 // MAX_EDGE_DIVISIONS, EDGE_SAMPLES, BAND_LIMIT, BAND_RATIO, SNAP, SEAM_MARGIN: from src/shader/constants.rs.
+
+// How a segment's points are spaced (`Spacer` in src/cpu/subdivide/spacing.rs; made by
+// `spacer` in subdivide_spacing.wgsl): `by_radius` under azimuth spacing with both ends at least
+// AZIMUTH_MIN_RADIUS from the axis (their distances rl, rh), and the azimuth the segment sweeps
+// where it is within (AZIMUTH_MIN_TURN, AZIMUTH_MAX_TURN), else 0.
+struct Spacer {
+    by_radius: bool,
+    rl: f32,
+    rh: f32,
+    turn: f32,
+}
 
 struct Node {
     position: vec3<f32>,

@@ -11,7 +11,7 @@
 use std::sync::OnceLock;
 
 use crate::core::projection::PanoramaKind;
-use crate::core::settings::{RenderSettings, SplitRule};
+use crate::core::settings::RenderSettings;
 use crate::encoding::constants::PIECES_FROM_COUNTER;
 use crate::encoding::recording::{Command, Recording};
 use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine, INDICES_SIZE, NODE_SIZE};
@@ -73,7 +73,7 @@ impl SubdivideStage {
         };
         let passes = Passes::of(panorama, params.method);
         let rows = passes.rows;
-        let spacing = SplitRule::spaces_by_azimuth(params.method);
+        let spacing = params.by_azimuth != 0;
         self.variants[4 * k + 2 * rows as usize + spacing as usize].get_or_init(|| {
             // Built side by side: the driver's compiling of the large passes (`plan_cuts`,
             // `lattice`) is most of a fresh process's time.

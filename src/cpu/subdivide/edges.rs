@@ -90,7 +90,7 @@ pub(super) fn parts_for_bend(bend_px: f32, segments: u32, max_error_px: f32) -> 
 impl Subdivider<'_> {
     /// How the frame spaces nodes along a segment: by azimuth under the error split.
     pub(super) fn spacing(&self) -> Spacing {
-        Spacing::of(self.params.method)
+        Spacing::of(self.params)
     }
 
     /// L and τ for a triangle of `object`: the level of detail scales L by its factor s, and τ by
