@@ -11,9 +11,12 @@
 // How segment lo–hi's points are spaced (`Spacing::spacer`): by azimuth where the frame spaces
 // nodes so (`SubdivideParams::by_azimuth`: the error split, but on the cubemap).
 fn spacer(lo: vec3<f32>, hi: vec3<f32>) -> Spacer {
+    if (params.by_azimuth == 0u) {
+        return Spacer(false, 0.0, 0.0, 0.0);
+    }
     let rl = horizontal_radius(lo);
     let rh = horizontal_radius(hi);
-    if (params.by_azimuth == 0u || rl < AZIMUTH_MIN_RADIUS || rh < AZIMUTH_MIN_RADIUS) {
+    if (rl < AZIMUTH_MIN_RADIUS || rh < AZIMUTH_MIN_RADIUS) {
         return Spacer(false, rl, rh, 0.0);
     }
     let el = vec2<f32>(lo.x, lo.z) / rl;
@@ -36,13 +39,9 @@ fn spaced(sp: Spacer, t: f32) -> f32 {
     return (blend / sp.rh) / ((1.0 - blend) / sp.rl + blend / sp.rh);
 }
 
-fn spacing_param(lo: vec3<f32>, hi: vec3<f32>, t: f32) -> f32 {
-    return spaced(spacer(lo, hi), t);
-}
-
 // The node at fraction t of the way from a to b (`Spacing::mix`).
 fn spacing_mix(a: Node, b: Node, t: f32) -> Node {
-    let s = spacing_param(a.position, b.position, t);
+    let s = spaced(spacer(a.position, b.position), t);
     return Node(a.position + (b.position - a.position) * s, a.bary + (b.bary - a.bary) * s);
 }
 
@@ -55,12 +54,4 @@ fn spaced_interior(q: array<Node, 3>, c: vec3<u32>, m: u32) -> Node {
     }
     let up = f32(c.z) / f32(m);
     return spacing_mix(spacing_mix(q[0], q[2], up), spacing_mix(q[1], q[2], up), f32(c.y) / f32(c.x + c.y));
-}
-
-// The point with weights w of a triangle of nodes (positions and barycentric weights alike).
-fn weighted(q: array<Node, 3>, w: vec3<f32>) -> Node {
-    return Node(
-        w.x * q[0].position + w.y * q[1].position + w.z * q[2].position,
-        w.x * q[0].bary + w.y * q[1].bary + w.z * q[2].bary,
-    );
 }

@@ -14,22 +14,10 @@ fn spaced(sp: Spacer, t: f32) -> f32 {
     return t;
 }
 
-fn spacing_param(lo: vec3<f32>, hi: vec3<f32>, t: f32) -> f32 {
-    return t;
-}
-
 fn spacing_mix(a: Node, b: Node, t: f32) -> Node {
     return Node(a.position + (b.position - a.position) * t, a.bary + (b.bary - a.bary) * t);
 }
 
 fn spaced_interior(q: array<Node, 3>, c: vec3<u32>, m: u32) -> Node {
     return weighted(q, vec3<f32>(c) / f32(m));
-}
-
-// The point with weights w of a triangle of nodes (positions and barycentric weights alike).
-fn weighted(q: array<Node, 3>, w: vec3<f32>) -> Node {
-    return Node(
-        w.x * q[0].position + w.y * q[1].position + w.z * q[2].position,
-        w.x * q[0].bary + w.y * q[1].bary + w.z * q[2].bary,
-    );
 }

@@ -122,3 +122,11 @@ struct Node {
     position: vec3<f32>,
     bary: vec3<f32>,   // weights of the input triangle's corners, for the attributes
 }
+
+// The point with weights w of a triangle of nodes (positions and barycentric weights alike).
+fn weighted(q: array<Node, 3>, w: vec3<f32>) -> Node {
+    return Node(
+        w.x * q[0].position + w.y * q[1].position + w.z * q[2].position,
+        w.x * q[0].bary + w.y * q[1].bary + w.z * q[2].bary,
+    );
+}

@@ -183,52 +183,26 @@ const MATERIAL_TABLE: [Binding; 8] = [
     bind(1, 7, "shadow_depths", Storage),
 ];
 
+/// The bindings every pass that plans reads and writes (a triangle's corners, its object's level
+/// of detail, the pieces and counters it appends to), then `$extra`: a pass's own.
+macro_rules! planning {
+    ($($extra:literal),* $(,)?) => {
+        &["params", "vertices", "indices", "pieces", "counters", "object_edge_scale", $($extra),*]
+    };
+}
+
 /// What `plan` reads and writes (it plans parts and appends pieces); `plan_cuts` also appends
 /// parts, and `plan_parts` plans them.
-const PLANNING: &[&str] = &[
-    "params",
-    "vertices",
-    "indices",
-    "pieces",
-    "counters",
-    "object_edge_scale",
-    "cut_list",
-    "triangle_edges",
-    "edge_marks_read",
-];
+const PLANNING: &[&str] = planning!("cut_list", "triangle_edges", "edge_marks_read");
 
-const CUTTING: &[&str] = &[
-    "params",
-    "vertices",
-    "indices",
-    "pieces",
-    "counters",
-    "object_edge_scale",
-    "cut_list",
-    "triangle_edges",
-    "edge_marks_read",
-    "parts",
-];
+const CUTTING: &[&str] = planning!("cut_list", "triangle_edges", "edge_marks_read", "parts");
 
 /// The bindings of the passes that plan pieces (`lattice`, `lattice_rows_plan`): they plan pieces,
 /// list those whose rows are measured (in `parts`) and append work items, and write small pieces'
 /// output in place; `$extra`: a pass's own.
 macro_rules! piece_planning {
     ($($extra:literal),*) => {
-        &[
-            "params",
-            "vertices",
-            "indices",
-            "pieces",
-            "counters",
-            "object_edge_scale",
-            "piece_work",
-            "lattice_work",
-            "out_nodes",
-            "out_indices",
-            "parts",
-            $($extra),*
-        ]
+        planning!("piece_work", "lattice_work", "out_nodes", "out_indices", "parts", $($extra),*)
     };
 }
 

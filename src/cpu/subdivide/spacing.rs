@@ -1,5 +1,4 @@
-//! How nodes are spaced along a segment (CPU twin of `spacing_param` and `spacing_mix` in
-//! `shaders/shared/subdivide_edges.wgsl`), and the clip w the raster stage draws with
+//! How nodes are spaced along a segment (CPU twin of `shaders/shared/subdivide_spacing.wgsl`), and the clip w the raster stage draws with
 //! (`clip_w` in `shaders/shared/projection.wgsl`, twin `cpu::raster::raster_vertex`).
 //!
 //! **Why azimuth.** A triangle is drawn between its projected nodes with its attributes (its
@@ -53,18 +52,16 @@ impl Spacing {
 
     /// How segment lo–hi's points are spaced ([`Spacer`]).
     pub fn spacer(self, lo: Vec3, hi: Vec3) -> Spacer {
+        if self == Spacing::Even {
+            return Spacer { by_radius: false, rl: 0.0, rh: 0.0, turn: None };
+        }
         let (rl, rh) = (horizontal_radius(lo), horizontal_radius(hi));
-        if self == Spacing::Even || rl < AZIMUTH_MIN_RADIUS || rh < AZIMUTH_MIN_RADIUS {
+        if rl < AZIMUTH_MIN_RADIUS || rh < AZIMUTH_MIN_RADIUS {
             return Spacer { by_radius: false, rl, rh, turn: None };
         }
         let (el, eh) = (Vec2::new(lo.x, lo.z) / rl, Vec2::new(hi.x, hi.z) / rh);
         let turn = el.perp_dot(eh).abs().atan2(el.dot(eh));
         Spacer { by_radius: true, rl, rh, turn: (turn > AZIMUTH_MIN_TURN && turn < AZIMUTH_MAX_TURN).then_some(turn) }
-    }
-
-    /// The azimuth that segment lo–hi sweeps where its points are spaced by it ([`Spacer`]).
-    pub fn turn(self, lo: Vec3, hi: Vec3) -> Option<f32> {
-        self.spacer(lo, hi).turn
     }
 
     /// The 3-D parameter of the point at fraction t of the way from lo to hi ([`Spacer::param`]).
@@ -152,7 +149,7 @@ mod tests {
             (Vec3::new(-1.0, 0.3, 2.0), Vec3::new(1.5, -0.4, 1.0)),
         ] {
             for (lo, hi) in [(a, b), (b, a)] {
-                let d = Spacing::Azimuth.turn(lo, hi).expect("a measured sweep");
+                let d = Spacing::Azimuth.spacer(lo, hi).turn.expect("a measured sweep");
                 let sweep = (azimuth(hi) - azimuth(lo) + std::f32::consts::PI).rem_euclid(std::f32::consts::TAU)
                     - std::f32::consts::PI;
                 assert!((sweep.abs() - d).abs() < 1e-4, "sweep {sweep} against {d}");
