@@ -74,10 +74,10 @@ fn atan_reduced(t: f32) -> f32 {
 fn atan_unit(t: f32) -> f32 {
     let tan_pi_12 = 0.267949192431123;
     let sqrt3 = 1.73205080756888;
-    if (t > tan_pi_12) {
-        return PI / 6.0 + atan_reduced((t * sqrt3 - 1.0) / (sqrt3 + t));
-    }
-    return atan_reduced(t);
+    // One copy of the series (lavapipe inlines every call): 0 + x is x.
+    let far = t > tan_pi_12;
+    let reduced = select(t, (t * sqrt3 - 1.0) / (sqrt3 + t), far);
+    return select(0.0, PI / 6.0, far) + atan_reduced(reduced);
 }
 
 fn precise_atan2(y: f32, x: f32) -> f32 {
@@ -86,12 +86,10 @@ fn precise_atan2(y: f32, x: f32) -> f32 {
     if (ax == 0.0 && ay == 0.0) {
         return 0.0;
     }
-    var a: f32;
-    if (ay <= ax) {
-        a = atan_unit(ay / ax);
-    } else {
-        a = PI / 2.0 - atan_unit(ax / ay);
-    }
+    // One copy of atan_unit: min/max is ay/ax where ay ≤ ax, else ax/ay.
+    let steep = ay > ax;
+    let unit = atan_unit(min(ax, ay) / max(ax, ay));
+    var a = select(unit, PI / 2.0 - unit, steep);
     if (x < 0.0) {
         a = PI - a;
     }

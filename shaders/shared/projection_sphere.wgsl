@@ -57,7 +57,8 @@ fn sphere_newton_step(proj: Projection, r: f32, y: f32, a: f32) -> f32 {
 }
 
 // The eye offset f(|φ|)·d_e at which a point is seen: the root of φ = φ(f(φ)·d_e), by four Newton
-// steps written out (no loop: lavapipe limits the loop iterations of an invocation).
+// steps, in a loop: one copy of the step (lavapipe inlines every call site, and this runs at every
+// projection); four of the 65,535 loop iterations lavapipe allows an invocation.
 fn sphere_eye_offset(proj: Projection, r: f32, y: f32) -> f32 {
     let de = proj.eye_radius;
     if (proj.pole_to <= 0.0 || sphere_altitude(proj, r, y, de).x <= proj.pole_from) {
@@ -68,9 +69,8 @@ fn sphere_eye_offset(proj: Projection, r: f32, y: f32) -> f32 {
         return 0.0;
     }
     var a = clamp(centre, proj.pole_from, proj.pole_to);
-    a = sphere_newton_step(proj, r, y, a);
-    a = sphere_newton_step(proj, r, y, a);
-    a = sphere_newton_step(proj, r, y, a);
-    a = sphere_newton_step(proj, r, y, a);
+    for (var step = 0u; step < 4u; step++) {
+        a = sphere_newton_step(proj, r, y, a);
+    }
     return pole_fade(proj, a) * de;
 }

@@ -442,16 +442,6 @@ fn edge_crossings(a: Node, b: Node, clip: ptr<function, ClipState>, cuts: vec2<u
     }
 }
 
-// Plans part (apex, pool[i], pool[i + 1 mod the polygon's count]) unless it is off screen.
-fn plan_apex_part(t: u32, apex: Node, i: u32, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, clip: ptr<function, ClipState>) {
-    (*part).corner[0] = apex;
-    (*part).corner[1] = (*clip).pool[i];
-    (*part).corner[2] = (*clip).pool[(i + 1u) % (*clip).poly_count];
-    if (!off_screen_vertically((*part).corner[0].position, (*part).corner[1].position, (*part).corner[2].position)) {
-        plan_cut_part(t, tri, part);
-    }
-}
-
 // A part `plan_cuts` cut: on the sphere appended for `plan_parts` (a quadrant near a pole has
 // many bands, a triangle beside it several parts: planning them here made the frame's longest
 // threads), on the cylinder planned here (`Passes::parts`).
@@ -488,18 +478,32 @@ fn plan_edge_split(t: u32, tri: ptr<function, InputTriangle>, part: ptr<function
             chain = vec3<u32>(e, at, (*clip).poly_count - at);
         }
     }
+    // The parts: the triangle, or the fan (apex, pool[i], pool[i + 1 mod the polygon's count])
+    // of those not off screen; one call site of `plan_cut_part` (lavapipe inlines each: its time
+    // to build the pipeline grows with every copy).
+    var apex = weighted(corners, vec3<f32>(1.0 / 3.0));
+    var first = 0u;
+    var count = (*clip).poly_count;
     if (crossed == 0u) {
-        (*part).corner = corners;
-        plan_cut_part(t, tri, part);
+        count = 1u;
     } else if (crossed == 1u) {
-        for (var i = 0u; i < chain.z; i++) {
-            plan_apex_part(t, corners[(chain.x + 2u) % 3u], chain.y + i, tri, part, clip);
+        apex = corners[(chain.x + 2u) % 3u];
+        first = chain.y;
+        count = chain.z;
+    }
+    for (var k = 0u; k < count; k++) {
+        if (crossed == 0u) {
+            (*part).corner = corners;
+        } else {
+            let i = first + k;
+            (*part).corner[0] = apex;
+            (*part).corner[1] = (*clip).pool[i];
+            (*part).corner[2] = (*clip).pool[(i + 1u) % (*clip).poly_count];
+            if (off_screen_vertically((*part).corner[0].position, (*part).corner[1].position, (*part).corner[2].position)) {
+                continue;
+            }
         }
-    } else {
-        let centre = weighted(corners, vec3<f32>(1.0 / 3.0));
-        for (var i = 0u; i < (*clip).poly_count; i++) {
-            plan_apex_part(t, centre, i, tri, part, clip);
-        }
+        plan_cut_part(t, tri, part);
     }
 }
 

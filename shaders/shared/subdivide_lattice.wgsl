@@ -109,6 +109,12 @@ fn macro_cell(k: u32, cell: u32) -> Cell {
 
 // The m-th node of piece edge e, from piece corner e towards corner e + 1.
 fn node_on_edge(e: u32, m: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Node {
+    let s = along_edge(e, m, part, piece_state);
+    return edge_point(s.a, s.b, s.j, s.n);
+}
+
+// The same as `edge_point`'s arguments.
+fn along_edge(e: u32, m: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Along {
     let oe = (*piece_state).original[e];
     var a = (*piece_state).corner[e];
     var b = (*piece_state).corner[(e + 1u) % 3u];
@@ -122,7 +128,7 @@ fn node_on_edge(e: u32, m: u32, part: ptr<function, PartPlan>, piece_state: ptr<
         n = (*part).n[o];
         j = select((*piece_state).from_index[e] + m, (*piece_state).from_index[e] - m, (*piece_state).to_index[e] < (*piece_state).from_index[e]);
     }
-    return edge_point(a, b, j, n);
+    return Along(a, b, j, n);
 }
 
 fn interior_node(i: u32, j: u32, l: u32, m: u32, piece_state: ptr<function, PieceState>) -> Node {
@@ -203,7 +209,10 @@ fn visible_edge_px(p: array<vec3<f32>, 3>) -> f32 {
     var longest = 0.0;
     for (var s = 0u; s < 2u; s++) {
         let eye_sign = select(-1.0, 1.0, s == 1u);
-        let q = array<vec2<f32>, 3>(pixel(p[0], eye_sign), pixel(p[1], eye_sign), pixel(p[2], eye_sign));
+        var q: array<vec2<f32>, 3>;
+        for (var c = 0u; c < 3u; c++) {
+            q[c] = pixel(p[c], eye_sign); // one copy of the projection (lavapipe inlines each call)
+        }
         for (var e = 0u; e < 3u; e++) {
             let a = q[e];
             let b = q[(e + 1u) % 3u];
@@ -217,16 +226,6 @@ fn visible_edge_px(p: array<vec3<f32>, 3>) -> f32 {
 }
 
 // ---- the lattice of a piece: its nodes once, its triangles as indices ----
-
-// Node (i, j, l) of the piece's lattice of level m: the regular lattice, whose boundary nodes on
-// an edge with fewer divisions snap to that edge's nearest node (see subdivide.rs).
-fn lattice_node(c: vec3<u32>, m: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Node {
-    let on = boundary_edge(c);
-    if (on.x < 3u) {
-        return node_on_edge(on.x, snap(on.y, (*piece_state).counts[on.x], m), part, piece_state);
-    }
-    return interior_node(c.x, c.y, c.z, m, piece_state);
-}
 
 // Slot of lattice node (i, j, l) among the piece's (m + 1)(m + 2)/2: rows l = 0..m of m + 1 − l
 // nodes, by j (`node_slot` in subdivide.rs).
@@ -261,11 +260,10 @@ fn strip_base_of(tri: ptr<function, InputTriangle>, piece_state: ptr<function, P
 
 // Node `slot` of the strip: edge base + 1's nodes from its corner to the apex, then edge
 // base + 2's after the apex.
-fn strip_node(slot: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Node {
-    if (slot <= (*piece_state).strip_n.x) {
-        return node_on_edge(((*piece_state).strip_base + 1u) % 3u, slot, part, piece_state);
-    }
-    return node_on_edge(((*piece_state).strip_base + 2u) % 3u, slot - (*piece_state).strip_n.x, part, piece_state);
+fn strip_along(slot: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Along {
+    let first = slot <= (*piece_state).strip_n.x;
+    let e = ((*piece_state).strip_base + select(2u, 1u, first)) % 3u;
+    return along_edge(e, select(slot - (*piece_state).strip_n.x, slot, first), part, piece_state);
 }
 
 // The next triangle of the strip's walk at `walk` = (i, j) (left L_i = slot n1 + n2 − i, right
@@ -286,24 +284,32 @@ fn strip_step(walk: ptr<function, vec4<u32>>, piece_state: ptr<function, PieceSt
 
 // ---- a piece's nodes and candidate triangles: the lattice of level m, the strip or the quad ----
 
-// Node k in slot order; `row` is the lattice's running (j, l), advanced here.
+// Node k in slot order; `row` is the lattice's running (j, l), advanced here. Each shape names
+// the node as a point along a segment (`Along`), placed by one call of `edge_point`.
 fn piece_node(k: u32, m: u32, row: ptr<function, vec2<u32>>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Node {
+    var along: Along;
     if ((*piece_state).strip_base == QUAD_STRIP) {
-        return quad_node(k, piece_state);
-    }
-    if ((*piece_state).strip_base < 3u) {
-        return strip_node(k, part, piece_state);
-    }
-    if ((*piece_state).strip_base == ROWS_SHAPE) {
+        along = quad_along(k, piece_state);
+    } else if ((*piece_state).strip_base < 3u) {
+        along = strip_along(k, part, piece_state);
+    } else if ((*piece_state).strip_base == ROWS_SHAPE) {
         // `row` = (node a, row k), advanced along the row, then to the next.
-        let node = row_node((*row).y, (*row).x, part, piece_state);
+        along = row_along((*row).y, (*row).x, part, piece_state);
         *row = select(vec2<u32>((*row).x + 1u, (*row).y), vec2<u32>(0u, (*row).y + 1u), (*row).x + 1u > (*piece_state).row_w[(*row).y]);
-        return node;
+    } else {
+        // Node (i, j, l) of the lattice of level m (`lattice_node`): the regular lattice, whose
+        // boundary nodes on an edge with fewer divisions snap to that edge's nearest node.
+        let j = (*row).x;
+        let l = (*row).y;
+        *row = select(vec2<u32>(j + 1u, l), vec2<u32>(0u, l + 1u), j + 1u > m - l);
+        let c = vec3<u32>(m - j - l, j, l);
+        let on = boundary_edge(c);
+        if (on.x >= 3u) {
+            return interior_node(c.x, c.y, c.z, m, piece_state);
+        }
+        along = along_edge(on.x, snap(on.y, (*piece_state).counts[on.x], m), part, piece_state);
     }
-    let j = (*row).x;
-    let l = (*row).y;
-    *row = select(vec2<u32>(j + 1u, l), vec2<u32>(0u, l + 1u), j + 1u > m - l);
-    return lattice_node(vec3<u32>(m - j - l, j, l), m, part, piece_state);
+    return edge_point(along.a, along.b, along.j, along.n);
 }
 
 // Candidate triangle t's slots (the strip's in walk order, advancing `walk`).

@@ -82,11 +82,11 @@ fn append_quad(t: u32, part: ptr<function, PartPlan>, piece_state: ptr<function,
 const QUAD_STRIP: u32 = 4u; // `strip_base` of a quad
 
 // Node `slot`: rail a (corner 0 → 1, strip_n.x parts), then rail d (corner 3 → 2, strip_n.y).
-fn quad_node(slot: u32, piece_state: ptr<function, PieceState>) -> Node {
+fn quad_along(slot: u32, piece_state: ptr<function, PieceState>) -> Along {
     if (slot <= (*piece_state).strip_n.x) {
-        return edge_point((*piece_state).corner[0], (*piece_state).corner[1], slot, (*piece_state).strip_n.x);
+        return Along((*piece_state).corner[0], (*piece_state).corner[1], slot, (*piece_state).strip_n.x);
     }
-    return edge_point((*piece_state).quad_last, (*piece_state).corner[2], slot - (*piece_state).strip_n.x - 1u, (*piece_state).strip_n.y);
+    return Along((*piece_state).quad_last, (*piece_state).corner[2], slot - (*piece_state).strip_n.x - 1u, (*piece_state).strip_n.y);
 }
 
 // Whether the zigzag at rung (a_i, d_j) = `walk` advances on rail a (`quad_advances_on_a`).

@@ -23,15 +23,15 @@ fn row_end(k: u32, right: bool, part: ptr<function, PartPlan>, piece_state: ptr<
 // The parts across (1 to cap) band b (rows b and b + 1) needs for the zipper's diagonals,
 // estimated from its two whole diagonals (`band_parts`).
 fn band_parts(b: u32, cap: u32, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> u32 {
-    let l0 = row_end(b, false, part, piece_state).position;
-    let r0 = row_end(b, true, part, piece_state).position;
-    let l1 = row_end(b + 1u, false, part, piece_state).position;
-    let r1 = row_end(b + 1u, true, part, piece_state).position;
-    // One call site of the profile (lavapipe inlines each: its time to build the pipeline grows
-    // with every copy).
+    // One call site of row_end and of the profile (lavapipe inlines each: its time to build the
+    // pipeline grows with every copy): the ends l0, r0, l1, r1, then the diagonals l0–r1, r0–l1.
+    var ends: array<vec3<f32>, 4>;
+    for (var c = 0u; c < 4u; c++) {
+        ends[c] = row_end(b + c / 2u, (c & 1u) == 1u, part, piece_state).position;
+    }
     var whole: array<EdgeProfile, 2>;
     for (var d = 0u; d < 2u; d++) {
-        whole[d] = edge_profile(select(l0, r0, d == 1u), select(r1, l1, d == 1u), 2u);
+        whole[d] = edge_profile(ends[d], ends[3u - d], 2u);
     }
     for (var w = 1u; w < cap; w++) {
         if (diagonal_fits(whole[0], w, tri) && diagonal_fits(whole[1], w, tri)) {
@@ -69,9 +69,8 @@ fn row_measures(b: u32, tri: ptr<function, InputTriangle>, part: ptr<function, P
     if (b == 0u) {
         return need;
     }
-    let left = row_end(b, false, part, piece_state).position;
-    let right = row_end(b, true, part, piece_state).position;
-    let own = min(min(edge_divisions(left, right, tri), 2u * params.max_div), PIECE_DIVISIONS);
+    let ends = row_ends(b, part, piece_state);
+    let own = min(min(edge_divisions(ends[0].position, ends[1].position, tri), 2u * params.max_div), PIECE_DIVISIONS);
     return need | (own << 8u);
 }
 
@@ -102,11 +101,21 @@ fn rows_from_measures(piece_state: ptr<function, PieceState>) -> vec2<u32> {
 
 // Node a of row k (`Rows::row_node`): the base edge's own nodes on row 0, else the point a/w of
 // the way between the row's ends.
-fn row_node(k: u32, a: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Node {
+fn row_along(k: u32, a: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Along {
     if (k == 0u) {
-        return node_on_edge((*piece_state).row_base, a, part, piece_state);
+        return along_edge((*piece_state).row_base, a, part, piece_state);
     }
-    return edge_point(row_end(k, false, part, piece_state), row_end(k, true, part, piece_state), a, max((*piece_state).row_w[k], 1u));
+    let ends = row_ends(k, part, piece_state);
+    return Along(ends[0], ends[1], a, max((*piece_state).row_w[k], 1u));
+}
+
+// Row k's left and right ends, from one call site of row_end (see band_parts).
+fn row_ends(k: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> array<Node, 2> {
+    var ends: array<Node, 2>;
+    for (var c = 0u; c < 2u; c++) {
+        ends[c] = row_end(k, c == 1u, part, piece_state);
+    }
+    return ends;
 }
 
 // The next triangle of the rows' zipper (`Rows::triangles`) at `walk` = (i on row k, j on row

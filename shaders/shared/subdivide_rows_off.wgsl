@@ -17,8 +17,8 @@ fn rows_from_measures(piece_state: ptr<function, PieceState>) -> vec2<u32> {
     return vec2<u32>(0xffffffffu, 0u);
 }
 
-fn row_node(k: u32, a: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Node {
-    return Node();
+fn row_along(k: u32, a: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Along {
+    return Along();
 }
 
 fn rows_step(walk: ptr<function, vec4<u32>>, at: ptr<function, array<vec2<u32>, 3>>, piece_state: ptr<function, PieceState>) -> vec3<u32> {

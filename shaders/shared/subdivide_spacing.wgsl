@@ -52,6 +52,19 @@ fn spaced_interior(q: array<Node, 3>, c: vec3<u32>, m: u32) -> Node {
     if (params.by_azimuth == 0u) {
         return weighted(q, vec3<f32>(c) / f32(m));
     }
-    let up = f32(c.z) / f32(m);
-    return spacing_mix(spacing_mix(q[0], q[2], up), spacing_mix(q[1], q[2], up), f32(c.y) / f32(c.x + c.y));
+    // One call of spacing_mix in a loop (lavapipe inlines every call site): the row's ends,
+    // then the point along the row.
+    var mixed: array<Node, 3>;
+    for (var s = 0u; s < 3u; s++) {
+        var a = q[min(s, 1u)];
+        var b = q[2];
+        var t = f32(c.z) / f32(m);
+        if (s == 2u) {
+            a = mixed[0];
+            b = mixed[1];
+            t = f32(c.y) / f32(c.x + c.y);
+        }
+        mixed[s] = spacing_mix(a, b, t);
+    }
+    return mixed[2];
 }

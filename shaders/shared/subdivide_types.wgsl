@@ -123,6 +123,16 @@ struct Node {
     bary: vec3<f32>,   // weights of the input triangle's corners, for the attributes
 }
 
+// A node as `edge_point`'s arguments: node j of the n parts of segment a–b. A piece's node is
+// found as one of these by its shape, then placed by one call of `edge_point` (lavapipe inlines
+// every call site: its time to build a pipeline grows with every copy of the spacing).
+struct Along {
+    a: Node,
+    b: Node,
+    j: u32,
+    n: u32,
+}
+
 // The point with weights w of a triangle of nodes (positions and barycentric weights alike).
 fn weighted(q: array<Node, 3>, w: vec3<f32>) -> Node {
     return Node(
