@@ -144,25 +144,35 @@ fn edge_divisions(a: vec3<f32>, b: vec3<f32>, tri: ptr<function, InputTriangle>)
     if (params.method == METHOD_FIXED) {
         return params.fixed_n;
     }
-    let by_length = params.method == METHOD_ADAPTIVE;
     var n = 0.0;
     for (var round = 0u; round < 2u; round++) {
         let segments = select(2u, EDGE_SAMPLES, round == 1u);
-        let p = edge_profile(a, b, segments);
-        let by_bend = parts_for_bend(p.bend_px, segments, (*tri).max_error_px);
-        if (round == 0u) {
-            let whole = select(p.length_px <= (*tri).edge_px && profile_straight(p, 1.0, (*tri).max_error_px),
-                               p.length_px <= 0.5 * (*tri).edge_px, by_length);
-            if (whole) {
-                return 1u;
-            }
-        } else if (by_length) {
-            n = ceil(p.length_px / (*tri).edge_px);
-        } else {
-            let longest = select(ERROR_SPLIT_LENGTH * (*tri).edge_px, (*tri).edge_px, p.ring);
-            n = max(max(by_bend, ceil(p.length_px / longest)), parts_for_residual(p, (*tri).max_error_px));
+        n = divisions_of(round, edge_profile(a, b, segments), segments, tri);
+        if (n == 1.0) {
+            return 1u; // the quick profile needs no more (or the full one asks for one part)
         }
     }
+    return division_count(n);
+}
+
+// What an adaptive rule reads of round `round` of an edge's profiles (`edge_divisions`): after
+// the quick one, 1 where the edge needs no more, else 0; after the full one, its parts.
+fn divisions_of(round: u32, p: EdgeProfile, segments: u32, tri: ptr<function, InputTriangle>) -> f32 {
+    let by_length = params.method == METHOD_ADAPTIVE;
+    if (round == 0u) {
+        let whole = select(p.length_px <= (*tri).edge_px && profile_straight(p, 1.0, (*tri).max_error_px),
+                           p.length_px <= 0.5 * (*tri).edge_px, by_length);
+        return select(0.0, 1.0, whole);
+    }
+    if (by_length) {
+        return ceil(p.length_px / (*tri).edge_px);
+    }
+    let longest = select(ERROR_SPLIT_LENGTH * (*tri).edge_px, (*tri).edge_px, p.ring);
+    return max(max(parts_for_bend(p.bend_px, segments, (*tri).max_error_px), ceil(p.length_px / longest)), parts_for_residual(p, (*tri).max_error_px));
+}
+
+// A division count from the parts a profile asks for, within 1 and MAX_EDGE_DIVISIONS.
+fn division_count(n: f32) -> u32 {
     if (n >= f32(MAX_EDGE_DIVISIONS) || !(n == n)) {
         return MAX_EDGE_DIVISIONS;
     }

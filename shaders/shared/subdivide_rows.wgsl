@@ -21,18 +21,8 @@ fn row_end(k: u32, right: bool, part: ptr<function, PartPlan>, piece_state: ptr<
 }
 
 // The parts across (1 to cap) band b (rows b and b + 1) needs for the zipper's diagonals,
-// estimated from its two whole diagonals (`band_parts`).
-fn band_parts(b: u32, cap: u32, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> u32 {
-    // One call site of row_end and of the profile (lavapipe inlines each: its time to build the
-    // pipeline grows with every copy): the ends l0, r0, l1, r1, then the diagonals l0–r1, r0–l1.
-    var ends: array<vec3<f32>, 4>;
-    for (var c = 0u; c < 4u; c++) {
-        ends[c] = row_end(b + c / 2u, (c & 1u) == 1u, part, piece_state).position;
-    }
-    var whole: array<EdgeProfile, 2>;
-    for (var d = 0u; d < 2u; d++) {
-        whole[d] = edge_profile(ends[d], ends[3u - d], 2u);
-    }
+// estimated from the profiles of its two whole diagonals (`band_parts`).
+fn band_parts(whole: array<EdgeProfile, 2>, cap: u32, tri: ptr<function, InputTriangle>) -> u32 {
     for (var w = 1u; w < cap; w++) {
         if (diagonal_fits(whole[0], w, tri) && diagonal_fits(whole[1], w, tri)) {
             return w;
@@ -64,14 +54,35 @@ fn row_cap() -> u32 {
 
 // Band b's measures (one `lattice_rows` invocation; `Subdivider::row_measures`): the parts
 // across it its zipper's diagonals need, | the parts row b needs itself << 8 (0 for the base row).
+// One call site of row_end and of the profile (lavapipe inlines each, and side by side
+// invocations then measure together): the ends l0, r0, l1, r1; the diagonals l0–r1 and r0–l1;
+// then row b's own edge l0–r0 as `edge_divisions` measures it (quick, then full).
 fn row_measures(b: u32, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> u32 {
-    let need = band_parts(b, row_cap(), tri, part, piece_state);
+    var ends: array<vec3<f32>, 4>;
+    for (var c = 0u; c < 4u; c++) {
+        ends[c] = row_end(b + c / 2u, (c & 1u) == 1u, part, piece_state).position;
+    }
+    var whole: array<EdgeProfile, 2>;
+    var own = 0.0;
+    let profiles = select(2u, 4u, b > 0u);
+    for (var k = 0u; k < profiles; k++) {
+        let own_edge = k >= 2u;
+        let segments = select(2u, EDGE_SAMPLES, k == 3u);
+        let p = edge_profile(ends[select(k, 0u, own_edge)], ends[select(3u - k, 1u, own_edge)], segments);
+        if (!own_edge) {
+            whole[k] = p;
+        } else {
+            own = divisions_of(k - 2u, p, segments, tri);
+            if (own == 1.0) {
+                break; // the quick profile needs no more
+            }
+        }
+    }
+    let need = band_parts(whole, row_cap(), tri);
     if (b == 0u) {
         return need;
     }
-    let ends = row_ends(b, part, piece_state);
-    let own = min(min(edge_divisions(ends[0].position, ends[1].position, tri), 2u * params.max_div), PIECE_DIVISIONS);
-    return need | (own << 8u);
+    return need | (min(min(division_count(own), 2u * params.max_div), PIECE_DIVISIONS) << 8u);
 }
 
 // The piece's rows from its bands' measures in `row_w` (`lattice_rows_plan`;
