@@ -235,10 +235,46 @@ fn is_adaptive() -> bool {
 
 // Edge counts and macro-lattice level of the current part.
 fn plan_part(tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>) {
+    let c = array<vec3<f32>, 3>((*part).corner[0].position, (*part).corner[1].position, (*part).corner[2].position);
+    let n = edge_counts(c, vec3<bool>(true), tri);
     for (var e = 0u; e < 3u; e++) {
-        (*part).n[e] = edge_divisions((*part).corner[e].position, (*part).corner[(e + 1u) % 3u].position, tri);
+        (*part).n[e] = n[e];
     }
     plan_level(part);
+}
+
+// `edge_divisions` of the edges e (corner e → e + 1) of a triangle that `wanted` names (0 for the
+// others), their rounds interleaved: the quick profiles, then the full ones of the edges that
+// need them, listed, from one call site of the profile, so that side by side invocations
+// measure together (one measuring an edge fully while another waited, three times over).
+fn edge_counts(c: array<vec3<f32>, 3>, wanted: vec3<bool>, tri: ptr<function, InputTriangle>) -> vec3<u32> {
+    var n = vec3<u32>(0u);
+    var list: array<u32, 6>;
+    var count = 0u;
+    for (var e = 0u; e < 3u; e++) {
+        if (wanted[e]) {
+            n[e] = select(params.fixed_n, 1u, params.method == METHOD_VERTEX);
+            list[count] = e;
+            count += 1u;
+        }
+    }
+    if (!is_adaptive()) {
+        return n; // the vertex and fixed rules measure nothing
+    }
+    let quick = count;
+    for (var k = 0u; k < count; k++) {
+        let e = list[k];
+        let full = k >= quick;
+        let segments = select(2u, EDGE_SAMPLES, full);
+        let parts = divisions_of(select(0u, 1u, full), edge_profile(c[e], c[(e + 1u) % 3u], segments), segments, tri);
+        if (full || parts == 1.0) {
+            n[e] = division_count(parts);
+        } else {
+            list[count] = e;
+            count += 1u;
+        }
+    }
+    return n;
 }
 
 // The macro-lattice level of the current part from its edge counts `tri_n`, and whether it is

@@ -469,24 +469,20 @@ fn piece_edges(loc: array<vec3<u32>, 3>, part: ptr<function, PartPlan>, piece_st
 }
 
 // Each piece edge inside the part: its own division.
-// The edges are listed first, so that side by side invocations measure their first, second and
-// third interior edges together whatever their places (one measuring each at most three times).
+// (`edge_counts`: side by side invocations measure their interior edges together whatever their
+// places.)
 fn interior_counts(tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
-    var inside = vec3<u32>(0u);
-    var count = 0u;
+    let inside = vec3<bool>((*piece_state).original[0] < 0, (*piece_state).original[1] < 0, (*piece_state).original[2] < 0);
+    let c = array<vec3<f32>, 3>((*piece_state).corner[0].position, (*piece_state).corner[1].position, (*piece_state).corner[2].position);
+    let n = edge_counts(c, inside, tri);
     for (var e = 0u; e < 3u; e++) {
-        if ((*piece_state).original[e] < 0) {
-            inside[count] = e;
-            count += 1u;
-        }
-    }
-    for (var i = 0u; i < count; i++) {
-        let e = inside[i];
-        if (params.method == METHOD_FIXED) {
-            // fixed:N pieces take N/K on interior edges (the regular N-lattice when K | N).
-            (*piece_state).counts[e] = (params.fixed_n + (*part).k - 1u) / (*part).k;
-        } else {
-            (*piece_state).counts[e] = min(min(edge_divisions((*piece_state).corner[e].position, (*piece_state).corner[(e + 1u) % 3u].position, tri), 2u * params.max_div), PIECE_DIVISIONS);
+        if (inside[e]) {
+            if (params.method == METHOD_FIXED) {
+                // fixed:N pieces take N/K on interior edges (the regular N-lattice when K | N).
+                (*piece_state).counts[e] = (params.fixed_n + (*part).k - 1u) / (*part).k;
+            } else {
+                (*piece_state).counts[e] = min(min(n[e], 2u * params.max_div), PIECE_DIVISIONS);
+            }
         }
     }
 }
