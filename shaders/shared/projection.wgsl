@@ -185,6 +185,29 @@ fn project_with_azimuth(proj: Projection, p: vec3<f32>, theta: f32, eye_sign: f3
     return vec3<f32>(theta + eye_sign * eye_shift(proj, r), screen_height(proj, p.y, r), r);
 }
 
+// Both eyes' (u, v, depth), the left's (eye sign −1) first: one projection where the eyes differ
+// only by the sign of their offset (the sphere; the cylinder without a tracked head), else each
+// eye's. The same values as `project_with_azimuth` per eye (an exact sign flip).
+fn project_both(proj: Projection, p: vec3<f32>, theta: f32) -> array<vec3<f32>, 2> {
+    var out: array<vec3<f32>, 2>;
+    let r = horizontal_radius(p);
+    if (is_cave(proj) || (!is_sphere(proj) && proj.head_on != 0.0)) {
+        for (var s = 0u; s < 2u; s++) {
+            out[s] = project_with_azimuth(proj, p, theta, select(-1.0, 1.0, s == 1u));
+        }
+    } else if (is_sphere(proj)) {
+        let view = sphere_offset_view(proj, r, p.y, sphere_eye_offset(proj, r, p.y));
+        out[0] = vec3<f32>(theta + view.x, view.y, view.z);
+        out[1] = vec3<f32>(theta - view.x, view.y, view.z);
+    } else {
+        let alpha = eye_shift(proj, r);
+        let v = screen_height(proj, p.y, r);
+        out[0] = vec3<f32>(theta - alpha, v, r);
+        out[1] = vec3<f32>(theta + alpha, v, r);
+    }
+    return out;
+}
+
 // Continuous image coordinates (x right, y down) of a screen point, u wrapped into [−π, π)
 // (VR180: |u| > π/2 falls outside the image; the fisheye: its own map).
 fn to_pixel(proj: Projection, u: f32, v: f32) -> vec2<f32> {

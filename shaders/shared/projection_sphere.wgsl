@@ -29,15 +29,21 @@ fn sphere_e(proj: Projection, r: f32, y: f32, d: f32) -> f32 {
 
 // Longitude, latitude and depth |P − E| at a fixed eye offset d.
 fn sphere_at_offset(proj: Projection, r: f32, y: f32, theta: f32, eye_sign: f32, d: f32) -> vec3<f32> {
+    let view = sphere_offset_view(proj, r, y, d);
+    return vec3<f32>(theta - eye_sign * view.x, view.y, view.z);
+}
+
+// What both eyes share at eye offset d: the longitude's shift asin(e/r) (the eye's sign sets its
+// side), the latitude and the depth.
+fn sphere_offset_view(proj: Projection, r: f32, y: f32, d: f32) -> vec3<f32> {
     let e = sphere_e(proj, r, y, d);
     var q = 0.0;
     if (r > 0.0) {
         q = clamp(e / r, -1.0, 1.0);
     }
-    let lon = theta - eye_sign * precise_asin(q);
     let lat = precise_atan2(y, sqrt(max(r * r - e * e, 0.0)));
     let depth = sqrt(max(r * r + y * y + d * d - 2.0 * d * e, 0.0));
-    return vec3<f32>(lon, lat, depth);
+    return vec3<f32>(precise_asin(q), lat, depth);
 }
 
 // The altitude at which a point is seen at eye offset d, and its slope d(altitude)/dd.

@@ -14,6 +14,10 @@ fn sphere_at_offset(proj: Projection, r: f32, y: f32, theta: f32, eye_sign: f32,
     return vec3<f32>(0.0);
 }
 
+fn sphere_offset_view(proj: Projection, r: f32, y: f32, d: f32) -> vec3<f32> {
+    return vec3<f32>(0.0);
+}
+
 fn sphere_eye_offset(proj: Projection, r: f32, y: f32) -> f32 {
     return 0.0;
 }

@@ -35,9 +35,19 @@ fn edge_point(a: Node, b: Node, j: u32, n: u32) -> Node {
     return spacing_mix(lo, hi, f32(jj) / f32(n));
 }
 
-// Image position in pixels (x not wrapped) of a viewer-frame point for one eye sign.
-fn pixel(p: vec3<f32>, eye_sign: f32) -> vec2<f32> {
-    let q = project_with_azimuth(params.projection, p, azimuth(p), eye_sign);
+// Image positions in pixels (x not wrapped) of a viewer-frame point: both eyes' (the left's first),
+// from one projection (`project_both`).
+fn pixels(p: vec3<f32>) -> array<vec2<f32>, 2> {
+    let q = project_both(params.projection, p, azimuth(p));
+    var out: array<vec2<f32>, 2>;
+    for (var s = 0u; s < 2u; s++) {
+        out[s] = pixel_of(q[s]);
+    }
+    return out;
+}
+
+// The image position in pixels of a projected point (u, v, depth).
+fn pixel_of(q: vec3<f32>) -> vec2<f32> {
     if (is_fisheye(params.projection)) {
         return fisheye_pixel(params.projection, q.x, q.y) - 0.5 * vec2<f32>(params.projection.width, params.projection.height);
     }
@@ -70,35 +80,36 @@ fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
     var nearest = 1e30;
     var bend = 0.0;
     let sp = spacer(lo, hi);
-    for (var s = 0u; s < 2u; s++) {
-        let eye_sign = select(-1.0, 1.0, s == 1u);
-        var total = 0.0;
-        var prev = vec2<f32>(0.0, 0.0);
-        var q0 = vec2<f32>(0.0, 0.0);
-        var q1 = vec2<f32>(0.0, 0.0);
-        for (var k = 0u; k <= segments; k++) {
-            let t = f32(k) / f32(segments);
-            let p = lo + (hi - lo) * spaced(sp, t);
-            nearest = min(nearest, horizontal_radius(p));
-            let raw = pixel(p, eye_sign);
+    // Each point projected once for both eyes (`pixels`), each eye's walk kept apart.
+    var total = vec2<f32>(0.0);
+    var prev: array<vec2<f32>, 2>;
+    var q0: array<vec2<f32>, 2>;
+    var q1: array<vec2<f32>, 2>;
+    for (var k = 0u; k <= segments; k++) {
+        let t = f32(k) / f32(segments);
+        let p = lo + (hi - lo) * spaced(sp, t);
+        nearest = min(nearest, horizontal_radius(p));
+        var raws = pixels(p);
+        for (var s = 0u; s < 2u; s++) {
+            let raw = raws[s];
             var q = raw;
             q.y = clamp(q.y, -clamp_v, clamp_v);
-            let dx = (q.x - prev.x) - width * round((q.x - prev.x) / width);
-            if (k > 0u && !(q.y == prev.y && abs(q.y) == clamp_v)) {
-                let segment = length(vec2<f32>(dx, q.y - prev.y));
+            let dx = (q.x - prev[s].x) - width * round((q.x - prev[s].x) / width);
+            if (k > 0u && !(q.y == prev[s].y && abs(q.y) == clamp_v)) {
+                let segment = length(vec2<f32>(dx, q.y - prev[s].y));
                 longest = max(longest, segment);
-                total += segment;
+                total[s] += segment;
             }
-            let unwrapped = vec2<f32>(select(raw.x, q1.x + dx, k > 0u), raw.y);
-            if (k >= 2u && abs(unwrapped.y) < clamp_v && abs(q1.y) < clamp_v && abs(q0.y) < clamp_v) {
-                bend = max(bend, length(unwrapped - 2.0 * q1 + q0));
+            let unwrapped = vec2<f32>(select(raw.x, q1[s].x + dx, k > 0u), raw.y);
+            if (k >= 2u && abs(unwrapped.y) < clamp_v && abs(q1[s].y) < clamp_v && abs(q0[s].y) < clamp_v) {
+                bend = max(bend, length(unwrapped - 2.0 * q1[s] + q0[s]));
             }
-            q0 = q1;
-            q1 = unwrapped;
-            prev = q;
+            q0[s] = q1[s];
+            q1[s] = unwrapped;
+            prev[s] = q;
         }
-        length_px = max(length_px, total);
     }
+    length_px = max(max(length_px, total[0]), total[1]);
     // Near the eye circle, which the paper model and the sphere show on screen (α and the
     // longitude ∝ √(r − d_e)), no stretch is allowed (the exact model puts it at v = ±∞).
     let shows_ring = params.projection.vertical_exact == 0u || is_sphere(params.projection);

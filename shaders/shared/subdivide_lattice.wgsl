@@ -207,15 +207,15 @@ fn visible_edge_px(p: array<vec3<f32>, 3>) -> f32 {
     let half_h = 0.5 * params.projection.height;
     let width = params.projection.turn_px; // a full turn in pixels: x wraps at it
     var longest = 0.0;
+    // Each corner projected once for both eyes, from one call site (lavapipe inlines each call).
+    var both: array<array<vec2<f32>, 2>, 3>;
+    for (var c = 0u; c < 3u; c++) {
+        both[c] = pixels(p[c]);
+    }
     for (var s = 0u; s < 2u; s++) {
-        let eye_sign = select(-1.0, 1.0, s == 1u);
-        var q: array<vec2<f32>, 3>;
-        for (var c = 0u; c < 3u; c++) {
-            q[c] = pixel(p[c], eye_sign); // one copy of the projection (lavapipe inlines each call)
-        }
         for (var e = 0u; e < 3u; e++) {
-            let a = q[e];
-            let b = q[(e + 1u) % 3u];
+            let a = both[e][s];
+            let b = both[(e + 1u) % 3u][s];
             if (abs(a.y) <= half_h || abs(b.y) <= half_h) {
                 let dx = (b.x - a.x) - width * round((b.x - a.x) / width);
                 longest = max(longest, length(vec2<f32>(dx, b.y - a.y)));
@@ -531,9 +531,9 @@ fn seam_copies(shape: PieceShape, part: ptr<function, PartPlan>, piece_state: pt
         for (var k = 0u; k < shape.node_count && !clear; k++) {
             let p = piece_node(k, shape.m, &row, part, piece_state).position;
             let theta = theta_c + wrap_angle(azimuth(p) - theta_c);
+            let q = project_both(params.projection, p, theta);
             for (var s = 0u; s < 2u; s++) {
-                let u = project_with_azimuth(params.projection, p, theta, select(-1.0, 1.0, s == 1u)).x;
-                u_range = vec2<f32>(min(u_range.x, u), max(u_range.y, u));
+                u_range = vec2<f32>(min(u_range.x, q[s].x), max(u_range.y, q[s].x));
             }
         }
     } else if ((*piece_state).strip_base == QUAD_STRIP) {
