@@ -192,8 +192,15 @@ fn project_both(proj: Projection, p: vec3<f32>, theta: f32) -> array<vec3<f32>, 
     var out: array<vec3<f32>, 2>;
     let r = horizontal_radius(p);
     if (is_cave(proj) || (!is_sphere(proj) && proj.head_on != 0.0)) {
+        // `project_with_azimuth`'s cave and tracked-head cases only (a copy of the sphere's or
+        // the cylinder's projection here would double the pipeline's build).
         for (var s = 0u; s < 2u; s++) {
-            out[s] = project_with_azimuth(proj, p, theta, select(-1.0, 1.0, s == 1u));
+            let eye_sign = select(-1.0, 1.0, s == 1u);
+            if (is_cave(proj)) {
+                out[s] = cave_project(proj, p, eye_sign);
+            } else {
+                out[s] = head_project(proj, p, theta, eye_sign);
+            }
         }
     } else if (is_sphere(proj)) {
         let view = sphere_offset_view(proj, r, p.y, sphere_eye_offset(proj, r, p.y));
