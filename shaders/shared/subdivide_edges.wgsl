@@ -145,25 +145,10 @@ fn parts_for_bend(bend_px: f32, segments: u32, max_error_px: f32) -> f32 {
 }
 
 // Divisions of an edge (`Subdivider::edge_divisions`): eq. 5 for METHOD_ADAPTIVE, the error
-// split for METHOD_ERROR. The quick 2-segment profile, then the 8-segment one, from one call site
-// in a loop (lavapipe's compiler inlines every call, and a shader that merely contains more code
-// runs slower).
+// split for METHOD_ERROR; the quick 2-segment profile, then the 8-segment one (`edge_counts` of
+// one edge).
 fn edge_divisions(a: vec3<f32>, b: vec3<f32>, tri: ptr<function, InputTriangle>) -> u32 {
-    if (params.method == METHOD_VERTEX) {
-        return 1u;
-    }
-    if (params.method == METHOD_FIXED) {
-        return params.fixed_n;
-    }
-    var n = 0.0;
-    for (var round = 0u; round < 2u; round++) {
-        let segments = select(2u, EDGE_SAMPLES, round == 1u);
-        n = divisions_of(round, edge_profile(a, b, segments), segments, tri);
-        if (n == 1.0) {
-            return 1u; // the quick profile needs no more (or the full one asks for one part)
-        }
-    }
-    return division_count(n);
+    return edge_counts(array<vec3<f32>, 3>(a, b, a), vec3<bool>(true, false, false), tri).x;
 }
 
 // What an adaptive rule reads of round `round` of an edge's profiles (`edge_divisions`): after
@@ -254,8 +239,8 @@ fn plan_part(tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>) {
     plan_level(part);
 }
 
-// `edge_divisions` of the edges e (corner e → e + 1) of a triangle that `wanted` names (0 for the
-// others), their rounds interleaved: the quick profiles, then the full ones of the edges that
+// The divisions of the edges e (corner e → e + 1) of a triangle that `wanted` names (0 for the
+// others; `Subdivider::edge_divisions` of each), their rounds interleaved: the quick profiles, then the full ones of the edges that
 // need them, listed, from one call site of the profile, so that side by side invocations
 // measure together (one measuring an edge fully while another waited, three times over).
 fn edge_counts(c: array<vec3<f32>, 3>, wanted: vec3<bool>, tri: ptr<function, InputTriangle>) -> vec3<u32> {

@@ -113,7 +113,7 @@ fn node_on_edge(e: u32, m: u32, part: ptr<function, PartPlan>, piece_state: ptr<
     return edge_point(s.a, s.b, s.j, s.n);
 }
 
-// The same as `edge_point`'s arguments.
+// The same node as `edge_point`'s arguments.
 fn along_edge(e: u32, m: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Along {
     let oe = (*piece_state).original[e];
     var a = (*piece_state).corner[e];
@@ -131,9 +131,6 @@ fn along_edge(e: u32, m: u32, part: ptr<function, PartPlan>, piece_state: ptr<fu
     return Along(a, b, j, n);
 }
 
-fn interior_node(i: u32, j: u32, l: u32, m: u32, piece_state: ptr<function, PieceState>) -> Node {
-    return spaced_interior((*piece_state).corner, vec3<u32>(i, j, l), m);
-}
 
 
 // The record of the current part of triangle t: its corners (position, barycentric weights),
@@ -305,7 +302,7 @@ fn piece_node(k: u32, m: u32, row: ptr<function, vec2<u32>>, part: ptr<function,
         let c = vec3<u32>(m - j - l, j, l);
         let on = boundary_edge(c);
         if (on.x >= 3u) {
-            return interior_node(c.x, c.y, c.z, m, piece_state);
+            return spaced_interior((*piece_state).corner, c, m);
         }
         along = along_edge(on.x, snap(on.y, (*piece_state).counts[on.x], m), part, piece_state);
     }
@@ -468,9 +465,8 @@ fn piece_edges(loc: array<vec3<u32>, 3>, part: ptr<function, PartPlan>, piece_st
     }
 }
 
-// Each piece edge inside the part: its own division.
-// (`edge_counts`: side by side invocations measure their interior edges together whatever their
-// places.)
+// Each piece edge inside the part: its own division (measured by `edge_counts`, so that side by
+// side invocations measure their interior edges together whatever their places).
 fn interior_counts(tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
     let inside = vec3<bool>((*piece_state).original[0] < 0, (*piece_state).original[1] < 0, (*piece_state).original[2] < 0);
     let c = array<vec3<f32>, 3>((*piece_state).corner[0].position, (*piece_state).corner[1].position, (*piece_state).corner[2].position);

@@ -116,17 +116,12 @@ fn row_along(k: u32, a: u32, part: ptr<function, PartPlan>, piece_state: ptr<fun
     if (k == 0u) {
         return along_edge((*piece_state).row_base, a, part, piece_state);
     }
-    let ends = row_ends(k, part, piece_state);
-    return Along(ends[0], ends[1], a, max((*piece_state).row_w[k], 1u));
-}
-
-// Row k's left and right ends, from one call site of row_end (see band_parts).
-fn row_ends(k: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> array<Node, 2> {
+    // Its left and right ends from one call site of row_end (see `row_measures`).
     var ends: array<Node, 2>;
     for (var c = 0u; c < 2u; c++) {
         ends[c] = row_end(k, c == 1u, part, piece_state);
     }
-    return ends;
+    return Along(ends[0], ends[1], a, max((*piece_state).row_w[k], 1u));
 }
 
 // The next triangle of the rows' zipper (`Rows::triangles`) at `walk` = (i on row k, j on row
