@@ -185,10 +185,25 @@ fn project_with_azimuth(proj: Projection, p: vec3<f32>, theta: f32, eye_sign: f3
     return vec3<f32>(theta + eye_sign * eye_shift(proj, r), screen_height(proj, p.y, r), r);
 }
 
+// The eye offset at a point's altitude: the sphere's (its pole merge fades it towards the poles),
+// else d_e (`Projection::eye_offset`).
+fn eye_offset(proj: Projection, r: f32, y: f32) -> f32 {
+    if (is_sphere(proj)) {
+        return sphere_eye_offset(proj, r, y);
+    }
+    return proj.eye_radius;
+}
+
 // Both eyes' (u, v, depth), the left's (eye sign −1) first: one projection where the eyes differ
 // only by the sign of their offset (the sphere; the cylinder without a tracked head), else each
 // eye's. The same values as `project_with_azimuth` per eye (an exact sign flip).
 fn project_both(proj: Projection, p: vec3<f32>, theta: f32) -> array<vec3<f32>, 2> {
+    return project_both_at(proj, p, theta, eye_offset(proj, horizontal_radius(p), p.y));
+}
+
+// `project_both` with the point's eye offset (`eye_offset`) given: a caller that reads the
+// offset too computes it once.
+fn project_both_at(proj: Projection, p: vec3<f32>, theta: f32, offset: f32) -> array<vec3<f32>, 2> {
     var out: array<vec3<f32>, 2>;
     let r = horizontal_radius(p);
     if (is_cave(proj) || (!is_sphere(proj) && proj.head_on != 0.0)) {
@@ -203,7 +218,7 @@ fn project_both(proj: Projection, p: vec3<f32>, theta: f32) -> array<vec3<f32>, 
             }
         }
     } else if (is_sphere(proj)) {
-        let view = sphere_offset_view(proj, r, p.y, sphere_eye_offset(proj, r, p.y));
+        let view = sphere_offset_view(proj, r, p.y, offset);
         out[0] = vec3<f32>(theta + view.x, view.y, view.z);
         out[1] = vec3<f32>(theta - view.x, view.y, view.z);
     } else {

@@ -36,9 +36,9 @@ fn edge_point(a: Node, b: Node, j: u32, n: u32) -> Node {
 }
 
 // Image positions in pixels (x not wrapped) of a viewer-frame point: both eyes' (the left's first),
-// from one projection (`project_both`).
-fn pixels(p: vec3<f32>) -> array<vec2<f32>, 2> {
-    let q = project_both(params.projection, p, azimuth(p));
+// from one projection (`project_both_at`, the point's eye offset given).
+fn pixels(p: vec3<f32>, offset: f32) -> array<vec2<f32>, 2> {
+    let q = project_both_at(params.projection, p, azimuth(p), offset);
     var out: array<vec2<f32>, 2>;
     for (var s = 0u; s < 2u; s++) {
         out[s] = pixel_of(q[s]);
@@ -88,8 +88,12 @@ fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
     for (var k = 0u; k <= segments; k++) {
         let t = f32(k) / f32(segments);
         let p = lo + (hi - lo) * spaced(sp, t);
-        nearest = min(nearest, horizontal_radius(p));
-        var raws = pixels(p);
+        // How far inside twice the eye offset at its altitude the point lies (d_e on the
+        // cylinder; the sphere's pole merge fades it, and with it the ring).
+        let r = horizontal_radius(p);
+        let offset = eye_offset(params.projection, r, p.y);
+        nearest = min(nearest, r - 2.0 * offset);
+        var raws = pixels(p, offset);
         for (var s = 0u; s < 2u; s++) {
             let raw = raws[s];
             var q = raw;
@@ -113,7 +117,7 @@ fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
     // Near the eye circle, which the paper model and the sphere show on screen (α and the
     // longitude ∝ √(r − d_e)), no stretch is allowed (the exact model puts it at v = ±∞).
     let shows_ring = params.projection.vertical_exact == 0u || is_sphere(params.projection);
-    let ring = shows_ring && nearest < 2.0 * params.projection.eye_radius;
+    let ring = shows_ring && nearest < 0.0;
     let stretch = select(MAX_STRETCH, 1.0, ring);
     let residual = AZIMUTH_CHORD_RESIDUAL * sp.turn * sp.turn * f32(segments) * longest;
     return EdgeProfile(max(length_px, f32(segments) * longest / stretch), bend, ring, residual);

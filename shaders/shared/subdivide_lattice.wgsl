@@ -207,7 +207,7 @@ fn visible_edge_px(p: array<vec3<f32>, 3>) -> f32 {
     // Each corner projected once for both eyes, from one call site (lavapipe inlines each call).
     var both: array<array<vec2<f32>, 2>, 3>;
     for (var c = 0u; c < 3u; c++) {
-        both[c] = pixels(p[c]);
+        both[c] = pixels(p[c], eye_offset(params.projection, horizontal_radius(p[c]), p[c].y));
     }
     for (var s = 0u; s < 2u; s++) {
         for (var e = 0u; e < 3u; e++) {

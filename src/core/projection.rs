@@ -272,6 +272,17 @@ impl Projection {
         (self.eye_radius / r).clamp(0.0, 1.0).acos() - self.acos_eye_screen()
     }
 
+    /// The eye offset at a point's altitude (height `y`, distance `r` from the axis): the
+    /// sphere's, which its pole merge fades towards the poles
+    /// ([`sphere_eye_offset`](Self::sphere_eye_offset)), else d_e (`eye_offset` in projection.wgsl).
+    pub fn eye_offset(&self, r: f32, y: f32) -> f32 {
+        if self.panorama.is_sphere() {
+            self.sphere_eye_offset(r, y)
+        } else {
+            self.eye_radius
+        }
+    }
+
     /// The screen height of a point at height `y` and distance `r` from the axis.
     pub fn screen_height(&self, y: f32, r: f32) -> f32 {
         match self.vertical {

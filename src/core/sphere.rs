@@ -93,9 +93,9 @@ impl Projection {
     /// of g(a) = A(f(a)·d_e) − a, A the altitude at offset d (see the module doc). The closed forms
     /// where the altitude at full offset is below FROM or at zero offset beyond TO; else
     /// `SPHERE_NEWTON_STEPS` Newton steps from the altitude seen from the centre (g' = A'·d_e·f' − 1
-    /// ≤ −1: g falls steeply, so the steps converge fast), written without a loop so that the
-    /// GPU twin (`sphere_eye_offset` in projection.wgsl) stays within lavapipe's per-invocation
-    /// loop budget.
+    /// ≤ −1: g falls steeply, so the steps converge fast). The GPU twin (`sphere_eye_offset` in
+    /// projection_sphere.wgsl) runs the steps in a loop: one inlined copy of a step in its
+    /// pipelines, four of the 65,535 loop iterations lavapipe allows an invocation.
     pub fn sphere_eye_offset(&self, r: f32, y: f32) -> f32 {
         let de = self.eye_radius;
         let Some((from, to)) = self.pole_merge else {

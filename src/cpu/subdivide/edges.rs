@@ -130,7 +130,10 @@ impl Subdivider<'_> {
     ///   along the edge's parameter t, whose sampled estimate is bend·S²): the chord's error,
     ///   across and along the curve (the drawn point j/n of the way is not where the point j/n
     ///   of the way along the 3-D edge projects).
-    /// - `ring`: the edge comes within 2·d_e of the axis where the panorama shows the eye circle.
+    /// - `ring`: the edge comes within twice the eye offset at its altitude of the axis where the
+    ///   panorama shows the eye circle (d_e; on the sphere the pole merge fades the offset, so
+    ///   an edge near the axis but far above or below the eyes, as a floor under the viewer, is
+    ///   no ring: there the eyes meet and the longitude is the azimuth).
     /// - `residual_px`: see [`EdgeProfile`].
     ///
     /// The points are spaced as the frame spaces nodes ([`Spacing`]), so that under the error
@@ -150,7 +153,10 @@ impl Subdivider<'_> {
             for k in 0..=segments {
                 let t = k as f32 / segments as f32;
                 let p = lo + (hi - lo) * spacer.param(t);
-                nearest = nearest.min(horizontal_radius(p));
+                // How far inside twice the eye offset at its altitude the point lies (d_e on
+                // the cylinder; the sphere's pole merge fades it, and with it the ring).
+                let r = horizontal_radius(p);
+                nearest = nearest.min(r - 2.0 * self.projection.eye_offset(r, p.y));
                 let raw = self.pixel(p, eye_sign);
                 let mut q = raw;
                 q.y = q.y.clamp(-clamp_v, clamp_v);
@@ -173,7 +179,7 @@ impl Subdivider<'_> {
         // Near the eye circle, which the paper model and the sphere show on screen (α and the
         // longitude ∝ √(r − d_e)), no stretch is allowed (the exact model puts it at v = ±∞).
         let shows_ring = self.projection.vertical == Vertical::Paper || self.projection.panorama.is_sphere();
-        let ring = shows_ring && nearest < 2.0 * self.projection.eye_radius;
+        let ring = shows_ring && nearest < 0.0;
         let stretch = if ring { 1.0 } else { MAX_STRETCH };
         // The fastest pixels per radian of azimuth: the longest segment over its step, D/S.
         let residual_px = spacer.turn.map_or(0.0, |d| AZIMUTH_CHORD_RESIDUAL * d * d * segments as f32 * longest);
