@@ -325,6 +325,22 @@ fn piece_triangle_slots(t: u32, m: u32, walk: ptr<function, vec4<u32>>, piece_st
     return vec3<u32>(node_slot(cell.c[0], m), node_slot(cell.c[1], m), node_slot(cell.c[2], m));
 }
 
+// Whether seam copy `theta_ref` of a drawn triangle (corners p) shows in the image: its corners'
+// azimuths unwrapped towards the copy's reference as the raster stage unwraps them, widened by
+// the piece's `reach`, meet the image's columns, within SEAM_MARGIN (`PiecePlan::copy_shows`).
+fn copy_shows(p: array<vec3<f32>, 3>, theta_ref: f32, reach: f32) -> bool {
+    var lo = 1e30;
+    var hi = -1e30;
+    for (var k = 0u; k < 3u; k++) {
+        let theta0 = azimuth(p[k]);
+        let theta = theta0 + TAU * floor((theta_ref - theta0) / TAU + 0.5);
+        lo = min(lo, theta);
+        hi = max(hi, theta);
+    }
+    let half = PI * params.projection.width / params.projection.turn_px;
+    return lo - reach < half + SEAM_MARGIN && hi + reach > -half - SEAM_MARGIN;
+}
+
 // Whether a candidate triangle with these corners is drawn: not collapsed by snapping (two
 // corners the same point), not off screen (`drawn` in src/cpu/subdivide/).
 fn candidate_drawn(a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> bool {
@@ -509,11 +525,16 @@ fn clear_of_seam(bound: vec2<f32>) -> bool {
 struct SeamCopies {
     refs: array<f32, 3>,
     copies: u32,
+    // The largest |u − θ| of the piece's nodes (both eyes) where they were projected (the
+    // sphere near the seam), by which `copy_shows` widens a triangle's azimuths; else 1e30
+    // (every copy of every triangle drawn).
+    reach: f32,
 }
 
 fn seam_copies(shape: PieceShape, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> SeamCopies {
     let theta_c = shape.theta_c;
     var u_range = vec2<f32>(1e30, -1e30);
+    var reach = 1e30;
     // Nodes in slot order: (i, j, l) row by row, kept by a running (j, l) rather than searched
     // for each slot (lavapipe stops an invocation after 65,535 loop iterations in all).
     var row = vec2<u32>(0u, 0u);
@@ -523,6 +544,8 @@ fn seam_copies(shape: PieceShape, part: ptr<function, PartPlan>, piece_state: pt
         let clear = clear_of_seam(bound);
         if (clear) {
             u_range = bound;
+        } else {
+            reach = 0.0;
         }
         for (var k = 0u; k < shape.node_count && !clear; k++) {
             let p = piece_node(k, shape.m, &row, part, piece_state).position;
@@ -530,6 +553,7 @@ fn seam_copies(shape: PieceShape, part: ptr<function, PartPlan>, piece_state: pt
             let q = project_both(params.projection, p, theta);
             for (var s = 0u; s < 2u; s++) {
                 u_range = vec2<f32>(min(u_range.x, q[s].x), max(u_range.y, q[s].x));
+                reach = max(reach, abs(q[s].x - theta));
             }
         }
     } else if ((*piece_state).strip_base == QUAD_STRIP) {
@@ -540,9 +564,10 @@ fn seam_copies(shape: PieceShape, part: ptr<function, PartPlan>, piece_state: pt
     } else {
         u_range = piece_u_range((*piece_state).corner, theta_c);
     }
-    var seam = SeamCopies(array<f32, 3>(theta_c, 0.0, 0.0), 1u);
-    // The fisheye's image has no seam (a copy would draw its piece twice over the original).
-    if (is_fisheye(params.projection)) {
+    var seam = SeamCopies(array<f32, 3>(theta_c, 0.0, 0.0), 1u, reach);
+    // The fisheye's and the cubemap's images have no seam (their maps from (u, v) are periodic
+    // in u: a copy would draw its piece twice over the original).
+    if (params.seamless != 0u) {
         return seam;
     }
     if (u_range.y > PI - SEAM_MARGIN) {

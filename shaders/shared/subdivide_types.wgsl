@@ -35,7 +35,7 @@ struct SubdivideParams {
     vertical_limit: f32, // |y| > this·r: no pixel row shows the point (`Projection::vertical_limit`)
     max_error_px: f32,   // τ of the error split
     by_azimuth: u32,     // 1: nodes spaced by azimuth, drawn with w = r (`SubdivideParams::by_azimuth`)
-    _pad2: u32,
+    seamless: u32,       // 1: the image has no seam: no seam copies (`SubdivideParams::seamless`)
 }
 
 struct Counters {

@@ -41,7 +41,7 @@ fn plan_work(index: u32, shape: PieceShape, seam: SeamCopies, tri: ptr<function,
     work.copies = copies;
     work.counts = (*piece_state).counts[0] | ((*piece_state).counts[1] << 8u) | ((*piece_state).counts[2] << 16u) | ((*piece_state).row_base << 24u);
     work.strip_n = (*piece_state).strip_n.x | ((*piece_state).strip_n.y << 16u);
-    work.refs = vec4<f32>(seam.refs[0], seam.refs[1], seam.refs[2], 0.0);
+    work.refs = vec4<f32>(seam.refs[0], seam.refs[1], seam.refs[2], seam.reach);
     if (work.shape == ROWS_SHAPE) {
         work.row_w = (*piece_state).row_w;
     }
@@ -158,35 +158,48 @@ fn write_nodes(first: u32, work: PieceWork, tri: ptr<function, InputTriangle>, p
 }
 
 // A triangle item: the piece's candidates [item.y, item.y + chunk) from the walk in item.zw,
-// those drawn (their corners read from the nodes written) appended as indices, once per copy.
+// those drawn (their corners read from the nodes written) appended as indices, once per seam copy
+// that shows (`copy_shows`; the piece's reach in refs.w).
 fn write_triangles(item: vec4<u32>, work: PieceWork, piece_state: ptr<function, PieceState>) {
     let first = item.y;
     let end = min(first + chunk_of(work.copies), work.candidates);
     let start = vec4<u32>(item.z & 0xffffu, item.z >> 16u, item.w & 0xffffu, item.w >> 16u);
     var walk = start;
+    // Bit (t − first)·copies + c: copy c of candidate t is drawn (at most LATTICE_CHUNK bits).
     var drawn = vec2<u32>(0u);
     var count = 0u;
     for (var t = first; t < end; t++) {
         let s = piece_triangle_slots(t, work.m, &walk, piece_state) + vec3<u32>(work.first_node);
-        if (candidate_drawn(out_nodes[s.x].position, out_nodes[s.y].position, out_nodes[s.z].position)) {
-            drawn[(t - first) / 32u] |= 1u << ((t - first) % 32u);
-            count += 1u;
+        let p = array<vec3<f32>, 3>(out_nodes[s.x].position, out_nodes[s.y].position, out_nodes[s.z].position);
+        if (candidate_drawn(p[0], p[1], p[2])) {
+            for (var c = 0u; c < work.copies; c++) {
+                if (work.copies == 1u || copy_shows(p, work.refs[c], work.refs.w)) {
+                    let bit = (t - first) * work.copies + c;
+                    drawn[bit / 32u] |= 1u << (bit % 32u);
+                    count += 1u;
+                }
+            }
         }
     }
     if (count == 0u) {
         return;
     }
-    let total = count * work.copies;
-    let first_triangle = atomicAdd(&counters.triangles, total);
-    atomicMax(&counters.max_output, total);
-    if (first_triangle + total > params.triangle_capacity) {
+    let first_triangle = atomicAdd(&counters.triangles, count);
+    atomicMax(&counters.max_output, count);
+    if (first_triangle + count > params.triangle_capacity) {
         return; // counted, never written
     }
     walk = start;
     var slot = 3u * first_triangle;
     for (var t = first; t < end; t++) {
         let local = piece_triangle_slots(t, work.m, &walk, piece_state);
-        if ((drawn[(t - first) / 32u] & (1u << ((t - first) % 32u))) == 0u) {
+        let bits = (t - first) * work.copies;
+        var any = false;
+        for (var c = 0u; c < work.copies; c++) {
+            let bit = bits + c;
+            any = any || (drawn[bit / 32u] & (1u << (bit % 32u))) != 0u;
+        }
+        if (!any) {
             continue;
         }
         let s = local + vec3<u32>(work.first_node);
@@ -195,6 +208,10 @@ fn write_triangles(item: vec4<u32>, work: PieceWork, piece_state: ptr<function, 
             atomicMax(&counters.max_edge_bits, bitcast<u32>(visible_edge_px(ps)));
         }
         for (var c = 0u; c < work.copies; c++) {
+            let bit = bits + c;
+            if ((drawn[bit / 32u] & (1u << (bit % 32u))) == 0u) {
+                continue;
+            }
             let base = c * work.node_count;
             out_indices[slot] = s.x + base;
             out_indices[slot + 1u] = s.y + base;

@@ -168,7 +168,9 @@ pub struct SubdivideParams {
     /// 1: nodes are spaced by azimuth, for the raster stage's drawing with w = r (the error
     /// split, but on the cubemap, whose faces draw with their own w: `cpu::subdivide::spacing`).
     pub by_azimuth: u32,
-    pub _pad2: u32,
+    /// 1: the image has no seam (the fisheye; the cubemap, whose faces map (u, v) periodically
+    /// in u): no seam copies, which would draw their pieces twice over.
+    pub seamless: u32,
 }
 
 /// `Counters` in shaders/shared/subdivide_types.wgsl.
@@ -532,7 +534,7 @@ pub const LAYOUTS: &[StructLayout] = &[
     }),
     layout!("SubdivideParams" => SubdivideParams {
         view, projection, axis_clearance, triangle_count, first_triangle, method, fixed_n, edge_px, max_div,
-        piece_capacity, triangle_capacity, first_piece, piece_count, measure_edges, vertical_limit, max_error_px, by_azimuth, _pad2
+        piece_capacity, triangle_capacity, first_piece, piece_count, measure_edges, vertical_limit, max_error_px, by_azimuth, seamless
     }),
     layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, nodes, cut_wide, max_pieces, max_output, parts, node_items, triangle_items, row_items, pending, cuts_low, cuts_high, _pad }),
     layout!("Piece" => Piece { triangle, cell, counts01, count2_level, corner, bary1, bary2 }),

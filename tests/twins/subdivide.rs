@@ -215,14 +215,16 @@ fn compare_subdivided(gpu: &SubdivideOutput, cpu: &SubdivideOutput) -> Result<()
     // maths, but fused multiply-adds where the twin rounds twice) the edges' and macro edges'
     // counts come out the twin's; a piece's rows measure every row and its diagonals, many more
     // measures, and one in 10⁴–10⁵ flips a row's width or the piece's choice between rows and
-    // the lattice (one piece of 84 triangles in a case of 200 random triangles): there 0.1 %
-    // plus one piece (the largest piece's output) may differ. On hardware an edge's count may
+    // the lattice (one piece of 84 triangles in a case of 200 random triangles; two small ones,
+    // 38 triangles, beside the axis in the cubemap's demo room once its pieces had no seam
+    // copies): there 0.1 % plus two pieces (the largest piece's output) may differ. On hardware
+    // an edge's count may
     // flip, and its part is planned again whole: 1 % plus one part (an H200 re-planned one of a
     // cube's parts, 745 of its 10,069 triangles: the cube's 12 triangles make parts of up to
     // 32² pieces each). Every other triangle is the twin's.
     let software = common::renderer().gpu.info.device_type == wgpu::DeviceType::Cpu;
     let (one_piece, one_part) = (cpu.max_piece_output as usize, cpu.max_part_output as usize);
-    let slack = |n: usize| if software { n / 1000 + one_piece } else { n / 100 + one_part };
+    let slack = |n: usize| if software { n / 1000 + 2 * one_piece } else { n / 100 + one_part };
     // Piece records come from the parts' edges alone: exact on a software adapter.
     let piece_slack = if software { 0 } else { cpu.pieces as usize / 100 };
     if cpu.pieces.abs_diff(gpu.pieces) as usize > piece_slack {

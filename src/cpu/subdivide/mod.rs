@@ -104,7 +104,7 @@
 use glam::{Vec2, Vec3, Vec4};
 use std::f32::consts::{PI, TAU};
 
-use crate::core::projection::{PanoramaKind, Projection};
+use crate::core::projection::Projection;
 use crate::core::scene::{pack_tangent, SceneVertex};
 use crate::core::settings::SplitRule;
 use crate::encoding::constants::{SEAM_MARGIN, STRIP_BASE_ERROR, STRIP_MIN_DIVISIONS};
@@ -238,12 +238,15 @@ impl<'a> Subdivider<'a> {
         candidates: Vec<[u32; 3]>,
         theta_c: f32,
         (u_min, u_max): (f32, f32),
+        reach: f32,
     ) -> PiecePlan {
         let mut refs = vec![theta_c];
         // Conservative by SEAM_MARGIN: a vertex exactly on the seam (θ = π, r = R_T) is a tie
-        // that rounding could break either way; an extra copy is clipped by the rasterizer. The
-        // fisheye's image has no seam (a copy would draw its piece twice over the original).
-        let seam = self.projection.panorama != PanoramaKind::Fisheye;
+        // that rounding could break either way; an extra copy is clipped by the rasterizer (and
+        // its triangles wholly beyond the image are not drawn: `PiecePlan::shown`). The
+        // fisheye's and the cubemap's images have no seam (their maps from (u, v) are periodic
+        // in u: a copy would draw its piece twice over the original).
+        let seam = self.params.seamless == 0;
         if seam && u_max > PI - SEAM_MARGIN {
             refs.push(theta_c - TAU);
         }
@@ -252,7 +255,7 @@ impl<'a> Subdivider<'a> {
         }
         let nodes: Vec<DrawVertex> =
             refs.iter().flat_map(|&theta_ref| nodes.iter().map(move |&n| draw_vertex(tri, n, theta_ref))).collect();
-        PiecePlan { node_count: (nodes.len() / refs.len()) as u32, nodes, copies: refs.len() as u32, candidates }
+        PiecePlan { node_count: (nodes.len() / refs.len()) as u32, nodes, copies: refs.len() as u32, candidates, reach }
     }
 
     /// Appends a piece's nodes and its drawn triangles (indices into them), work item by work
@@ -265,16 +268,14 @@ impl<'a> Subdivider<'a> {
             out.max_output = out.max_output.max(plan.node_range(start).len() as u32 * plan.copies);
         }
         for start in plan.triangle_items() {
-            let drawn = plan.drawn(self, start, |k| plan.nodes[k as usize].position.into());
-            out.max_output = out.max_output.max(drawn.len() as u32 * plan.copies);
-            for local in drawn {
-                if self.params.measure_edges != 0 {
+            let shown = plan.shown(self, start, |k| plan.nodes[k as usize]);
+            out.max_output = out.max_output.max(shown.len() as u32);
+            for (k, &(local, c)) in shown.iter().enumerate() {
+                if self.params.measure_edges != 0 && (k == 0 || shown[k - 1].0 != local) {
                     let p = local.map(|i| plan.nodes[i as usize].position.into());
                     out.max_sub_edge_px = out.max_sub_edge_px.max(self.visible_edge_px(p));
                 }
-                for c in 0..plan.copies {
-                    out.indices.extend(local.map(|i| first + c * plan.node_count + i));
-                }
+                out.indices.extend(local.map(|i| first + c * plan.node_count + i));
             }
         }
     }

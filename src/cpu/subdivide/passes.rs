@@ -520,11 +520,11 @@ impl<'s> CpuSubdivision<'s> {
     fn write_triangles(&mut self, sub: &Subdivider, (first_node, plan): &(u32, PiecePlan), start: u32) {
         let len = sub.params.triangle_capacity;
         let node = |k: u32| Vec3::from(self.out_nodes[(first_node + k) as usize].position);
-        let drawn = plan.drawn(sub, start, node);
-        if drawn.is_empty() {
+        let shown = plan.shown(sub, start, |k| self.out_nodes[(first_node + k) as usize]);
+        if shown.is_empty() {
             return;
         }
-        let total = drawn.len() as u32 * plan.copies;
+        let total = shown.len() as u32;
         let first_triangle = self.counters.triangles;
         self.counters.triangles += total;
         self.counters.max_output = self.counters.max_output.max(total);
@@ -532,18 +532,18 @@ impl<'s> CpuSubdivision<'s> {
             return; // counted, never written
         }
         if sub.params.measure_edges != 0 {
-            for t in &drawn {
-                let edge = sub.visible_edge_px(t.map(node));
-                self.counters.max_edge_bits = f32::from_bits(self.counters.max_edge_bits).max(edge).to_bits();
+            for (k, (t, _)) in shown.iter().enumerate() {
+                if k == 0 || shown[k - 1].0 != *t {
+                    let edge = sub.visible_edge_px(t.map(node));
+                    self.counters.max_edge_bits = f32::from_bits(self.counters.max_edge_bits).max(edge).to_bits();
+                }
             }
         }
         let mut slot = 3 * first_triangle as usize;
-        for t in drawn {
-            for c in 0..plan.copies {
-                for k in t {
-                    self.out_indices[slot] = first_node + c * plan.node_count + k;
-                    slot += 1;
-                }
+        for (t, c) in shown {
+            for k in t {
+                self.out_indices[slot] = first_node + c * plan.node_count + k;
+                slot += 1;
             }
         }
     }

@@ -8,6 +8,7 @@ use super::edges::Limits;
 use super::lattice::{lattice_node, lattice_slots, strip_node, strip_slots};
 use super::seam::clear_of_seam;
 use super::spacing::Spacing;
+use super::work::NO_REACH;
 use super::{
     band_cell, boundary_edge, edge_point, macro_cell, slot_node, snap, strip_node_count, Node, PartSplit, PiecePlan,
     Rows, Subdivider, Triangle,
@@ -241,22 +242,24 @@ impl Subdivider<'_> {
         let nodes = shape.nodes(g);
         let theta_c = azimuth((q[0].position + q[1].position + q[2].position) / 3.0);
         let sphere_bound = self.projection.panorama.is_sphere().then(|| self.sphere_u_bound(q, theta_c));
-        let u_range = if let Some(bound) = sphere_bound.filter(|&b| clear_of_seam(b)) {
-            bound // every node within it: none projected
+        // Where the nodes are projected, the largest |u − θ| too (`PiecePlan::reach`).
+        let (u_range, reach) = if let Some(bound) = sphere_bound.filter(|&b| clear_of_seam(b)) {
+            (bound, NO_REACH) // every node within it: none projected
         } else if sphere_bound.is_some() {
-            let (mut u_min, mut u_max) = (f32::INFINITY, f32::NEG_INFINITY);
+            let (mut u_min, mut u_max, mut reach) = (f32::INFINITY, f32::NEG_INFINITY, 0.0f32);
             for n in &nodes {
                 let theta = theta_c + wrap_angle(azimuth(n.position) - theta_c);
                 for eye in Eye::BOTH {
                     let u = self.projection.project_with_azimuth(n.position, theta, eye).u;
                     u_min = u_min.min(u);
                     u_max = u_max.max(u);
+                    reach = reach.max((u - theta).abs());
                 }
             }
-            (u_min, u_max)
+            ((u_min, u_max), reach)
         } else {
-            self.piece_u_range(q, theta_c)
+            (self.piece_u_range(q, theta_c), NO_REACH)
         };
-        self.piece_plan(tri, &nodes, shape.slots(g.counts()), theta_c, u_range)
+        self.piece_plan(tri, &nodes, shape.slots(g.counts()), theta_c, u_range, reach)
     }
 }

@@ -7,6 +7,7 @@
 use glam::Vec3;
 
 use super::lattice::{quad_strip_node, quad_strip_node_count, quad_strip_rungs, quad_strip_slots};
+use super::work::NO_REACH;
 use super::{Node, PiecePlan, Subdivider, Triangle};
 use crate::core::projection::azimuth;
 use crate::core::settings::SplitRule;
@@ -66,6 +67,6 @@ impl Subdivider<'_> {
         let (ra, rb) = (self.piece_u_range(&a, theta_c), self.piece_u_range(&b, theta_c));
         let candidates = quad_strip_slots(rails);
         (!candidates.is_empty())
-            .then(|| self.piece_plan(tri, &nodes, candidates, theta_c, (ra.0.min(rb.0), ra.1.max(rb.1))))
+            .then(|| self.piece_plan(tri, &nodes, candidates, theta_c, (ra.0.min(rb.0), ra.1.max(rb.1)), NO_REACH))
     }
 }

@@ -4,13 +4,19 @@
 //! for `lattice_nodes`, triangle items of as many candidates for `lattice_triangles`, which draws
 //! those not collapsed by snapping and not off screen, reading their corners from the nodes.
 
+use std::f32::consts::{PI, TAU};
 use std::ops::Range;
 
 use glam::Vec3;
 
 use super::Subdivider;
-use crate::encoding::constants::LATTICE_CHUNK;
+use crate::core::projection::azimuth;
+use crate::encoding::constants::{LATTICE_CHUNK, SEAM_MARGIN};
 use crate::encoding::types::DrawVertex;
+
+/// `PiecePlan::reach` where the nodes were not projected: every copy of every triangle drawn
+/// (1e30 in the WGSL's `seam_copies`).
+pub const NO_REACH: f32 = 1e30;
 
 /// Node slots or candidate triangles one item of a piece drawn `copies` times covers.
 pub fn chunk_of(copies: u32) -> u32 {
@@ -26,6 +32,10 @@ pub struct PiecePlan {
     pub copies: u32,
     /// Every candidate triangle as its corners' slots (the lattice's m², the strip's, the rows').
     pub candidates: Vec<[u32; 3]>,
+    /// The largest |u − θ| of its nodes (both eyes) where they were projected (the sphere near
+    /// the seam), by which [`copy_shows`](Self::copy_shows) widens a triangle's azimuths; else
+    /// 1e30 (every copy of every triangle drawn).
+    pub reach: f32,
 }
 
 impl PiecePlan {
@@ -55,9 +65,41 @@ impl PiecePlan {
         first..(first + self.chunk()).min(self.node_count)
     }
 
+    /// The drawn candidates of the triangle item at `first` with the seam copies of each that
+    /// show ([`copy_shows`](Self::copy_shows)), candidate by candidate, copy by copy, their
+    /// corners read by node slot (copy c's slot k at c·node_count + k) from `node`.
+    pub fn shown(&self, sub: &Subdivider, first: u32, node: impl Fn(u32) -> DrawVertex) -> Vec<([u32; 3], u32)> {
+        let drawn = self.drawn(sub, first, |k| Vec3::from(node(k).position));
+        drawn
+            .into_iter()
+            .flat_map(|t| (0..self.copies).map(move |c| (t, c)))
+            .filter(|&(t, c)| {
+                self.copies == 1 || self.copy_shows(sub, t.map(|k| node(c * self.node_count + k)), self.reach)
+            })
+            .collect()
+    }
+
+    /// Whether a seam copy of a triangle (its corners as drawn: positions and the copy's
+    /// reference azimuth) shows in the image: the corners' azimuths unwrapped towards the copy's
+    /// reference as the raster stage unwraps them, widened by `reach`, meet the image's columns
+    /// within `SEAM_MARGIN` (`copy_shows` in the WGSL). A copy wholly beyond the image's left or
+    /// right edge would only be clipped.
+    fn copy_shows(&self, sub: &Subdivider, corners: [DrawVertex; 3], reach: f32) -> bool {
+        let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+        for v in corners {
+            let theta0 = azimuth(Vec3::from(v.position));
+            let theta = theta0 + TAU * ((v.theta_ref - theta0) / TAU + 0.5).floor();
+            lo = lo.min(theta);
+            hi = hi.max(theta);
+        }
+        let projection = &sub.projection;
+        let half = PI * projection.width as f32 / projection.turn_px();
+        lo - reach < half + SEAM_MARGIN && hi + reach > -half - SEAM_MARGIN
+    }
+
     /// The drawn candidates of the triangle item at `first`, their corners' positions read by
     /// slot (`candidate_drawn` in the WGSL).
-    pub fn drawn(&self, sub: &Subdivider, first: u32, position: impl Fn(u32) -> Vec3) -> Vec<[u32; 3]> {
+    fn drawn(&self, sub: &Subdivider, first: u32, position: impl Fn(u32) -> Vec3) -> Vec<[u32; 3]> {
         let end = (first + self.chunk()).min(self.candidates.len() as u32);
         self.candidates[first as usize..end as usize]
             .iter()
