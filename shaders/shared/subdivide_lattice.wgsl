@@ -503,14 +503,14 @@ fn interior_counts(tri: ptr<function, InputTriangle>, part: ptr<function, PartPl
 // (`sphere_u_bound` in src/cpu/subdivide/): u = θ − s·asin(e/r), |e/r| clamped to 1, and with
 // parallel rays |e| ≤ d_e, so u lies within asin(min(d_e / r_min, 1)) (π/2 for converging rays)
 // of the footprint's azimuths.
-fn sphere_u_bound(q: array<Node, 3>, theta_c: f32) -> vec2<f32> {
+fn sphere_u_bound(q: array<Node, 3>, theta_c: f32) -> vec3<f32> {
     let f = footprint(q, theta_c);
     let proj = params.projection;
     var reach = 0.5 * PI;
     if (proj.convergence <= 0.0) {
         reach = asin(min(proj.eye_radius / max(f.z, 1e-30), 1.0));
     }
-    return vec2<f32>(f.x - reach, f.y + reach);
+    return vec3<f32>(f.x - reach, f.y + reach, reach);
 }
 
 // Whether a bound on a piece's u range keeps it clear of the seam by SEAM_BOUND_SLACK beyond
@@ -526,8 +526,9 @@ struct SeamCopies {
     refs: array<f32, 3>,
     copies: u32,
     // The largest |u − θ| of the piece's nodes (both eyes) where they were projected (the
-    // sphere near the seam), by which `copy_shows` widens a triangle's azimuths; else 1e30
-    // (every copy of every triangle drawn).
+    // sphere near the seam), or its corners' bound's (with SEAM_BOUND_SLACK) where it kept them
+    // clear, by which `copy_shows` widens a triangle's azimuths; else 1e30 (the cylinder: every
+    // copy of every triangle drawn).
     reach: f32,
 }
 
@@ -541,9 +542,10 @@ fn seam_copies(shape: PieceShape, part: ptr<function, PartPlan>, piece_state: pt
     if (is_sphere(params.projection)) {
         // Every node projected, unless the corners' bound keeps the piece clear of the seam.
         let bound = sphere_u_bound((*piece_state).corner, theta_c);
-        let clear = clear_of_seam(bound);
+        let clear = clear_of_seam(bound.xy);
         if (clear) {
-            u_range = bound;
+            u_range = bound.xy;
+            reach = bound.z + SEAM_BOUND_SLACK;
         } else {
             reach = 0.0;
         }
@@ -570,13 +572,26 @@ fn seam_copies(shape: PieceShape, part: ptr<function, PartPlan>, piece_state: pt
     if (params.seamless != 0u) {
         return seam;
     }
+    var shifts = array<f32, 3>(0.0, 0.0, 0.0);
+    var n = 1u;
     if (u_range.y > PI - SEAM_MARGIN) {
-        seam.refs[seam.copies] = theta_c - TAU;
-        seam.copies += 1u;
+        shifts[n] = -TAU;
+        n += 1u;
     }
     if (u_range.x < -PI + SEAM_MARGIN) {
-        seam.refs[seam.copies] = theta_c + TAU;
-        seam.copies += 1u;
+        shifts[n] = TAU;
+        n += 1u;
+    }
+    // VR180: a copy whose u range lies wholly beyond the image's columns (behind the viewer) is
+    // not drawn; a piece with none left draws nothing (`plan_work`).
+    let half = PI * params.projection.width / params.projection.turn_px;
+    seam.copies = 0u;
+    for (var c = 0u; c < n; c++) {
+        let d = shifts[c];
+        if (half >= PI || (u_range.x + d < half + SEAM_MARGIN && u_range.y + d > -half - SEAM_MARGIN)) {
+            seam.refs[seam.copies] = theta_c + d;
+            seam.copies += 1u;
+        }
     }
     return seam;
 }

@@ -33,6 +33,9 @@ fn work_capacity() -> u32 {
 // always, written only where they fit.
 fn plan_work(index: u32, shape: PieceShape, seam: SeamCopies, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
     let copies = seam.copies;
+    if (copies == 0u) {
+        return; // VR180: behind the viewer
+    }
     var work: PieceWork;
     work.shape = (*piece_state).strip_base;
     work.m = shape.m;
@@ -168,12 +171,15 @@ fn write_triangles(item: vec4<u32>, work: PieceWork, piece_state: ptr<function, 
     // Bit (t − first)·copies + c: copy c of candidate t is drawn (at most LATTICE_CHUNK bits).
     var drawn = vec2<u32>(0u);
     var count = 0u;
+    // An image narrower than a turn of longitude (VR180): every triangle is tested, copies or
+    // not (the seamless images' x is no longitude).
+    let narrow = params.seamless == 0u && params.projection.width < params.projection.turn_px;
     for (var t = first; t < end; t++) {
         let s = piece_triangle_slots(t, work.m, &walk, piece_state) + vec3<u32>(work.first_node);
         let p = array<vec3<f32>, 3>(out_nodes[s.x].position, out_nodes[s.y].position, out_nodes[s.z].position);
         if (candidate_drawn(p[0], p[1], p[2])) {
             for (var c = 0u; c < work.copies; c++) {
-                if (work.copies == 1u || copy_shows(p, work.refs[c], work.refs.w)) {
+                if ((work.copies == 1u && !narrow) || copy_shows(p, work.refs[c], work.refs.w)) {
                     let bit = (t - first) * work.copies + c;
                     drawn[bit / 32u] |= 1u << (bit % 32u);
                     count += 1u;

@@ -34,7 +34,8 @@ pub fn subdivide_params(settings: &RenderSettings, first_triangle: u32, triangle
         measure_edges: (settings.measure.edges || settings.measure.error) as u32,
         vertical_limit: projection.vertical_limit(),
         by_azimuth: (SplitRule::spaces_by_azimuth(rule as u32) && projection.panorama != PanoramaKind::Cubemap) as u32,
-        seamless: matches!(projection.panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap) as u32,
+        seamless: matches!(projection.panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap | PanoramaKind::Cave)
+            as u32,
     }
 }
 

@@ -169,7 +169,7 @@ pub struct SubdivideParams {
     /// split, but on the cubemap, whose faces draw with their own w: `cpu::subdivide::spacing`).
     pub by_azimuth: u32,
     /// 1: the image has no seam (the fisheye; the cubemap, whose faces map (u, v) periodically
-    /// in u): no seam copies, which would draw their pieces twice over.
+    /// in u; CAVE walls): no seam copies, which would draw their pieces twice over.
     pub seamless: u32,
 }
 

@@ -103,8 +103,9 @@ fn subdivide_cases() -> Vec<(Scene, RenderSettings)> {
                 .with_method(Method::Vertex),
         ),
         (random_triangle_scene(7, 200), RenderSettings::new(Projection::equirect(256)).with_method(Method::Fixed(3))),
-        // VR180: the sphere's front half (the back's pieces land beyond the image's sides).
-        (builtin::demo(), RenderSettings::new(Projection::vr180(128))),
+        // VR180: the sphere's front half (the back's pieces, beyond the image's sides, are not
+        // drawn; nor the triangles of the pieces reaching round them).
+        (builtin::demo(), RenderSettings::new(Projection::vr180(256))),
         // The cubemap: measured on the sphere at its faces' resolution, nothing culled at the poles.
         (builtin::demo(), RenderSettings::new(Projection::cubemap(96))),
         // A tracked head off the display's centre: its seam copies, its vertical limit.

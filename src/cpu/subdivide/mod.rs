@@ -240,28 +240,40 @@ impl<'a> Subdivider<'a> {
         (u_min, u_max): (f32, f32),
         reach: f32,
     ) -> PiecePlan {
-        let mut refs = vec![theta_c];
         // Conservative by SEAM_MARGIN: a vertex exactly on the seam (θ = π, r = R_T) is a tie
         // that rounding could break either way; an extra copy is clipped by the rasterizer (and
         // its triangles wholly beyond the image are not drawn: `PiecePlan::shown`). The
         // fisheye's and the cubemap's images have no seam (their maps from (u, v) are periodic
         // in u: a copy would draw its piece twice over the original).
         let seam = self.params.seamless == 0;
+        let mut shifts = vec![0.0];
         if seam && u_max > PI - SEAM_MARGIN {
-            refs.push(theta_c - TAU);
+            shifts.push(-TAU);
         }
         if seam && u_min < -PI + SEAM_MARGIN {
-            refs.push(theta_c + TAU);
+            shifts.push(TAU);
         }
+        // VR180: a copy whose u range lies wholly beyond the image's columns (behind the viewer)
+        // is not drawn; a piece with none left draws nothing.
+        let half = PI * self.projection.width as f32 / self.projection.turn_px();
+        let refs: Vec<f32> = shifts
+            .into_iter()
+            .filter(|&d| !seam || half >= PI || (u_min + d < half + SEAM_MARGIN && u_max + d > -half - SEAM_MARGIN))
+            .map(|d| theta_c + d)
+            .collect();
         let nodes: Vec<DrawVertex> =
             refs.iter().flat_map(|&theta_ref| nodes.iter().map(move |&n| draw_vertex(tri, n, theta_ref))).collect();
-        PiecePlan { node_count: (nodes.len() / refs.len()) as u32, nodes, copies: refs.len() as u32, candidates, reach }
+        let node_count = if refs.is_empty() { 0 } else { (nodes.len() / refs.len()) as u32 };
+        PiecePlan { node_count, nodes, copies: refs.len() as u32, candidates, reach }
     }
 
     /// Appends a piece's nodes and its drawn triangles (indices into them), work item by work
     /// item as `lattice_nodes` and `lattice_triangles` do; the largest item's output into
     /// `max_output`.
     fn emit(&self, plan: &PiecePlan, out: &mut SubdivideOutput) {
+        if plan.copies == 0 {
+            return; // VR180: behind the viewer
+        }
         let first = out.nodes.len() as u32;
         out.nodes.extend_from_slice(&plan.nodes);
         for start in plan.node_items() {

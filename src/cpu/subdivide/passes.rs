@@ -432,6 +432,9 @@ impl<'s> CpuSubdivision<'s> {
     /// A planned piece's work: its nodes allocated; a piece of one item's worth written here,
     /// as its items would be; a larger one's work items appended (`plan_work`).
     fn plan_work(&mut self, sub: &Subdivider, index: u32, plan: PiecePlan) {
+        if plan.copies == 0 {
+            return; // VR180: behind the viewer
+        }
         let params = sub.params;
         let first_node = self.counters.nodes;
         self.counters.nodes += plan.copies * plan.node_count;

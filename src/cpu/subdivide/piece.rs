@@ -14,6 +14,7 @@ use super::{
     Rows, Subdivider, Triangle,
 };
 use crate::core::projection::{azimuth, wrap_angle, Eye};
+use crate::encoding::constants::SEAM_BOUND_SLACK;
 
 /// Where a macro node lies. Original edge e runs from corner e to corner e + 1.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -243,8 +244,8 @@ impl Subdivider<'_> {
         let theta_c = azimuth((q[0].position + q[1].position + q[2].position) / 3.0);
         let sphere_bound = self.projection.panorama.is_sphere().then(|| self.sphere_u_bound(q, theta_c));
         // Where the nodes are projected, the largest |u − θ| too (`PiecePlan::reach`).
-        let (u_range, reach) = if let Some(bound) = sphere_bound.filter(|&b| clear_of_seam(b)) {
-            (bound, NO_REACH) // every node within it: none projected
+        let (u_range, reach) = if let Some((bound, reach)) = sphere_bound.filter(|&(b, _)| clear_of_seam(b)) {
+            (bound, reach + SEAM_BOUND_SLACK) // every node within it: none projected
         } else if sphere_bound.is_some() {
             let (mut u_min, mut u_max, mut reach) = (f32::INFINITY, f32::NEG_INFINITY, 0.0f32);
             for n in &nodes {

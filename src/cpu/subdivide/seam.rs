@@ -37,12 +37,13 @@ impl Subdivider<'_> {
     /// its corners (`sphere_u_bound` in the WGSL): u = θ − s·asin(e/r) with |e/r| clamped to 1,
     /// and with parallel rays |e| ≤ d_e, so u lies within asin(min(d_e / r_min, 1)) (π/2 for
     /// converging rays) of the footprint's azimuths.
-    pub(super) fn sphere_u_bound(&self, q: &[Node; 3], theta_c: f32) -> (f32, f32) {
+    /// Also the bound's reach beyond the azimuths: the largest |u − θ| it allows.
+    pub(super) fn sphere_u_bound(&self, q: &[Node; 3], theta_c: f32) -> ((f32, f32), f32) {
         let f = Footprint::of(q, theta_c);
         let proj = &self.projection;
         let reach =
             if proj.convergence.is_some() { PI / 2.0 } else { (proj.eye_radius / f.r_min.max(1e-30)).min(1.0).asin() };
-        (f.theta_min - reach, f.theta_max + reach)
+        ((f.theta_min - reach, f.theta_max + reach), reach)
     }
 }
 
@@ -139,7 +140,7 @@ mod tests {
                         continue;
                     }
                     let theta_c = azimuth(c);
-                    let (lo, hi) = sub.sphere_u_bound(&q, theta_c);
+                    let ((lo, hi), _) = sub.sphere_u_bound(&q, theta_c);
                     let is_clear = clear_of_seam((lo, hi));
                     clear += is_clear as u32;
                     for k in 0..67 {

@@ -33,8 +33,9 @@ pub struct PiecePlan {
     /// Every candidate triangle as its corners' slots (the lattice's m², the strip's, the rows').
     pub candidates: Vec<[u32; 3]>,
     /// The largest |u − θ| of its nodes (both eyes) where they were projected (the sphere near
-    /// the seam), by which [`copy_shows`](Self::copy_shows) widens a triangle's azimuths; else
-    /// 1e30 (every copy of every triangle drawn).
+    /// the seam), or its corners' bound's (with `SEAM_BOUND_SLACK`) where that kept them clear,
+    /// by which [`copy_shows`](Self::copy_shows) widens a triangle's azimuths; else 1e30 (the
+    /// cylinder: every copy of every triangle drawn).
     pub reach: f32,
 }
 
@@ -70,11 +71,15 @@ impl PiecePlan {
     /// corners read by node slot (copy c's slot k at c·node_count + k) from `node`.
     pub fn shown(&self, sub: &Subdivider, first: u32, node: impl Fn(u32) -> DrawVertex) -> Vec<([u32; 3], u32)> {
         let drawn = self.drawn(sub, first, |k| Vec3::from(node(k).position));
+        // An image narrower than a turn of longitude (VR180): every triangle is tested, copies
+        // or not (the seamless images' x is no longitude).
+        let narrow = sub.params.seamless == 0 && (sub.projection.width as f32) < sub.projection.turn_px();
         drawn
             .into_iter()
             .flat_map(|t| (0..self.copies).map(move |c| (t, c)))
             .filter(|&(t, c)| {
-                self.copies == 1 || self.copy_shows(sub, t.map(|k| node(c * self.node_count + k)), self.reach)
+                (self.copies == 1 && !narrow)
+                    || self.copy_shows(sub, t.map(|k| node(c * self.node_count + k)), self.reach)
             })
             .collect()
     }
