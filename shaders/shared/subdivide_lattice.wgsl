@@ -369,10 +369,10 @@ fn footprint(q: array<Node, 3>, theta_c: f32) -> vec4<f32> {
     return vec4<f32>(theta_min, theta_max, r_min, r_max);
 }
 
-// The u range (both eyes) of the piece's triangle on the cylinder, from its corners
-// (`piece_u_range` in subdivide.rs): α(r) grows with r, so |α| is largest at the footprint's
-// nearest or farthest point from the axis.
-fn piece_u_range(q: array<Node, 3>, theta_c: f32) -> vec2<f32> {
+// The u range (both eyes) of the piece's triangle on the cylinder, from its corners, and its
+// reach, the largest |u − θ| (1e30 with a tracked head) (`piece_u_range` in the twin): α(r)
+// grows with r, so |α| is largest at the footprint's nearest or farthest point from the axis.
+fn piece_u_range(q: array<Node, 3>, theta_c: f32) -> vec3<f32> {
     let f = footprint(q, theta_c);
     let theta_min = f.x;
     let theta_max = f.y;
@@ -385,10 +385,10 @@ fn piece_u_range(q: array<Node, 3>, theta_c: f32) -> vec2<f32> {
         let reach = length(proj.head_offset.xz) + proj.eye_radius;
         let bound = precise_asin(min(proj.eye_radius / max(r_min, 1e-30), 1.0))
             + precise_asin(min(reach / proj.screen_radius, 1.0));
-        return vec2<f32>(theta_min - proj.head_turn - bound, theta_max - proj.head_turn + bound);
+        return vec3<f32>(theta_min - proj.head_turn - bound, theta_max - proj.head_turn + bound, 1e30);
     }
     let alpha = max(abs(eye_shift(proj, r_min)), abs(eye_shift(proj, r_max)));
-    return vec2<f32>(theta_min - alpha, theta_max + alpha);
+    return vec3<f32>(theta_min - alpha, theta_max + alpha, alpha);
 }
 
 // ---- what `lattice` does with a piece record: its shape, its seam copies, its output ----
@@ -527,8 +527,8 @@ struct SeamCopies {
     copies: u32,
     // The largest |u − θ| of the piece's nodes (both eyes) where they were projected (the
     // sphere near the seam), or its corners' bound's (with SEAM_BOUND_SLACK) where it kept them
-    // clear, by which `copy_shows` widens a triangle's azimuths; else 1e30 (the cylinder: every
-    // copy of every triangle drawn).
+    // clear; on the cylinder its footprint's largest |α| (with the slack); by which `copy_shows`
+    // widens a triangle's azimuths. 1e30 with a tracked head: every copy of every triangle drawn.
     reach: f32,
 }
 
@@ -562,9 +562,12 @@ fn seam_copies(shape: PieceShape, part: ptr<function, PartPlan>, piece_state: pt
         // The quad's range: that of its fan's two triangles, which cover it.
         let ra = piece_u_range((*piece_state).corner, theta_c);
         let rb = piece_u_range(array<Node, 3>((*piece_state).corner[0], (*piece_state).corner[2], (*piece_state).quad_last), theta_c);
+        reach = max(ra.z, rb.z) + SEAM_BOUND_SLACK;
         u_range = vec2<f32>(min(ra.x, rb.x), max(ra.y, rb.y));
     } else {
-        u_range = piece_u_range((*piece_state).corner, theta_c);
+        let r = piece_u_range((*piece_state).corner, theta_c);
+        u_range = r.xy;
+        reach = r.z + SEAM_BOUND_SLACK;
     }
     var seam = SeamCopies(array<f32, 3>(theta_c, 0.0, 0.0), 1u, reach);
     // The fisheye's and the cubemap's images have no seam (their maps from (u, v) are periodic

@@ -8,7 +8,6 @@ use super::edges::Limits;
 use super::lattice::{lattice_node, lattice_slots, strip_node, strip_slots};
 use super::seam::clear_of_seam;
 use super::spacing::Spacing;
-use super::work::NO_REACH;
 use super::{
     band_cell, boundary_edge, edge_point, macro_cell, slot_node, snap, strip_node_count, Node, PartSplit, PiecePlan,
     Rows, Subdivider, Triangle,
@@ -259,7 +258,8 @@ impl Subdivider<'_> {
             }
             ((u_min, u_max), reach)
         } else {
-            (self.piece_u_range(q, theta_c), NO_REACH)
+            let (range, reach) = self.piece_u_range(q, theta_c);
+            (range, reach + SEAM_BOUND_SLACK)
         };
         self.piece_plan(tri, &nodes, shape.slots(g.counts()), theta_c, u_range, reach)
     }

@@ -7,11 +7,10 @@
 use glam::Vec3;
 
 use super::lattice::{quad_strip_node, quad_strip_node_count, quad_strip_rungs, quad_strip_slots};
-use super::work::NO_REACH;
 use super::{Node, PiecePlan, Subdivider, Triangle};
 use crate::core::projection::azimuth;
 use crate::core::settings::SplitRule;
-use crate::encoding::constants::{PIECE_DIVISIONS, QUAD_MIN_DIVISIONS, QUAD_RUNG_ERROR};
+use crate::encoding::constants::{PIECE_DIVISIONS, QUAD_MIN_DIVISIONS, QUAD_RUNG_ERROR, SEAM_BOUND_SLACK};
 
 impl Subdivider<'_> {
     /// Whether a band's polygon is drawn as one strip between two of its sides (the rails)
@@ -64,9 +63,10 @@ impl Subdivider<'_> {
         let theta_c = azimuth((c[0] + c[1] + c[2] + c[3]) / 4.0);
         // The quad's u range: that of its fan's two triangles, which cover it.
         let (a, b) = ([corners[0], corners[1], corners[2]], [corners[0], corners[2], corners[3]]);
-        let (ra, rb) = (self.piece_u_range(&a, theta_c), self.piece_u_range(&b, theta_c));
+        let ((ra, reach_a), (rb, reach_b)) = (self.piece_u_range(&a, theta_c), self.piece_u_range(&b, theta_c));
+        let reach = reach_a.max(reach_b) + SEAM_BOUND_SLACK;
         let candidates = quad_strip_slots(rails);
         (!candidates.is_empty())
-            .then(|| self.piece_plan(tri, &nodes, candidates, theta_c, (ra.0.min(rb.0), ra.1.max(rb.1)), NO_REACH))
+            .then(|| self.piece_plan(tri, &nodes, candidates, theta_c, (ra.0.min(rb.0), ra.1.max(rb.1)), reach))
     }
 }

@@ -6,6 +6,7 @@
 use glam::Vec2;
 use std::f32::consts::PI;
 
+use super::work::NO_REACH;
 use super::{Node, Subdivider};
 use crate::core::projection::{azimuth, wrap_angle};
 use crate::encoding::constants::{SEAM_BOUND_SLACK, SEAM_MARGIN};
@@ -17,8 +18,9 @@ impl Subdivider<'_> {
     /// largest at the footprint's nearest or farthest point from the axis (the nearest: a corner
     /// or the foot of the perpendicular on an edge). It holds every node of the piece, so seam
     /// copies are made where the nodes need them (and, rarely, one more, which the rasterizer
-    /// clips). `piece_u_range` in the WGSL.
-    pub(super) fn piece_u_range(&self, q: &[Node; 3], theta_c: f32) -> (f32, f32) {
+    /// clips). Also its reach: the largest |u − θ| it allows (the largest |α|; `NO_REACH` with a
+    /// tracked head, whose u is not θ ± α). `piece_u_range` in the WGSL.
+    pub(super) fn piece_u_range(&self, q: &[Node; 3], theta_c: f32) -> ((f32, f32), f32) {
         let Footprint { theta_min, theta_max, r_min, r_max } = Footprint::of(q, theta_c);
         let proj = &self.projection;
         if let Some(head) = &proj.head {
@@ -27,10 +29,10 @@ impl Subdivider<'_> {
             let reach = Vec2::new(head.offset[0], head.offset[2]).length() + proj.eye_radius;
             let bound =
                 (proj.eye_radius / r_min.max(1e-30)).min(1.0).asin() + (reach / proj.screen_radius).min(1.0).asin();
-            return (theta_min - head.turn - bound, theta_max - head.turn + bound);
+            return ((theta_min - head.turn - bound, theta_max - head.turn + bound), NO_REACH);
         }
         let alpha = proj.eye_shift(r_min).abs().max(proj.eye_shift(r_max).abs());
-        (theta_min - alpha, theta_max + alpha)
+        ((theta_min - alpha, theta_max + alpha), alpha)
     }
 
     /// A bound on the u range (both eyes) of the nodes of a piece's triangle on the sphere, from

@@ -14,8 +14,8 @@ use crate::core::projection::azimuth;
 use crate::encoding::constants::{LATTICE_CHUNK, SEAM_MARGIN};
 use crate::encoding::types::DrawVertex;
 
-/// `PiecePlan::reach` where the nodes were not projected: every copy of every triangle drawn
-/// (1e30 in the WGSL's `seam_copies`).
+/// `PiecePlan::reach` before a tracked head, whose u is not θ ± α: every copy of every triangle
+/// drawn (1e30 in the WGSL's `piece_u_range`).
 pub const NO_REACH: f32 = 1e30;
 
 /// Node slots or candidate triangles one item of a piece drawn `copies` times covers.
@@ -33,9 +33,10 @@ pub struct PiecePlan {
     /// Every candidate triangle as its corners' slots (the lattice's m², the strip's, the rows').
     pub candidates: Vec<[u32; 3]>,
     /// The largest |u − θ| of its nodes (both eyes) where they were projected (the sphere near
-    /// the seam), or its corners' bound's (with `SEAM_BOUND_SLACK`) where that kept them clear,
-    /// by which [`copy_shows`](Self::copy_shows) widens a triangle's azimuths; else 1e30 (the
-    /// cylinder: every copy of every triangle drawn).
+    /// the seam), or its corners' bound's (with `SEAM_BOUND_SLACK`) where that kept them clear;
+    /// on the cylinder its footprint's largest |α| (with the slack); by which
+    /// [`copy_shows`](Self::copy_shows) widens a triangle's azimuths. [`NO_REACH`] with a tracked
+    /// head: every copy of every triangle drawn.
     pub reach: f32,
 }
 
