@@ -570,8 +570,9 @@ fn seam_copies(shape: PieceShape, part: ptr<function, PartPlan>, piece_state: pt
         reach = r.z + SEAM_BOUND_SLACK;
     }
     var seam = SeamCopies(array<f32, 3>(theta_c, 0.0, 0.0), 1u, reach);
-    // The fisheye's and the cubemap's images have no seam (their maps from (u, v) are periodic
-    // in u: a copy would draw its piece twice over the original).
+    // The seamless images make none (SubdivideParams::seamless: the fisheye's, the cubemap's
+    // and the CAVE walls' maps from (u, v) are no longitude: a copy would draw its piece twice
+    // over the original).
     if (params.seamless != 0u) {
         return seam;
     }

@@ -243,8 +243,9 @@ impl<'a> Subdivider<'a> {
         // Conservative by SEAM_MARGIN: a vertex exactly on the seam (θ = π, r = R_T) is a tie
         // that rounding could break either way; an extra copy is clipped by the rasterizer (and
         // its triangles wholly beyond the image are not drawn: `PiecePlan::shown`). The
-        // fisheye's and the cubemap's images have no seam (their maps from (u, v) are periodic
-        // in u: a copy would draw its piece twice over the original).
+        // seamless images make none (`SubdivideParams::seamless`: the fisheye's, the cubemap's
+        // and the CAVE walls' maps from (u, v) are no longitude: a copy would draw its piece
+        // twice over the original).
         let seam = self.params.seamless == 0;
         let mut shifts = vec![0.0];
         if seam && u_max > PI - SEAM_MARGIN {
