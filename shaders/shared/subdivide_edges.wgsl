@@ -93,7 +93,7 @@ fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
         let r = horizontal_radius(p);
         let offset = eye_offset(params.projection, r, p.y);
         nearest = min(nearest, r - 2.0 * offset);
-        var raws = pixels(p, offset);
+        let raws = pixels(p, offset);
         for (var s = 0u; s < 2u; s++) {
             let raw = raws[s];
             var q = raw;

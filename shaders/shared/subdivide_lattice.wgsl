@@ -131,8 +131,6 @@ fn along_edge(e: u32, m: u32, part: ptr<function, PartPlan>, piece_state: ptr<fu
     return Along(a, b, j, n);
 }
 
-
-
 // The record of the current part of triangle t: its corners (position, barycentric weights),
 // its edge counts and K (`record` in src/cpu/subdivide/passes.rs).
 fn part_record(t: u32, part: ptr<function, PartPlan>) -> Piece {
@@ -278,7 +276,6 @@ fn strip_step(walk: ptr<function, vec4<u32>>, piece_state: ptr<function, PieceSt
     return vec3<u32>(n1 + n2 - i, j, j + 1u);
 }
 
-
 // ---- a piece's nodes and candidate triangles: the lattice of level m, the strip or the quad ----
 
 // Node k in slot order; `row` is the lattice's running (j, l), advanced here. Each shape names
@@ -325,6 +322,12 @@ fn piece_triangle_slots(t: u32, m: u32, walk: ptr<function, vec4<u32>>, piece_st
     return vec3<u32>(node_slot(cell.c[0], m), node_slot(cell.c[1], m), node_slot(cell.c[2], m));
 }
 
+// Half the image's span in longitude, radians: π on the cylinder and the sphere, π/2 for VR180
+// (`Subdivider::image_half_span`; meaningless for the seamless images, whose x is no longitude).
+fn image_half_span() -> f32 {
+    return PI * params.projection.width / params.projection.turn_px;
+}
+
 // Whether seam copy `theta_ref` of a drawn triangle (corners p) shows in the image: its corners'
 // azimuths unwrapped towards the copy's reference as the raster stage unwraps them, widened by
 // the piece's `reach`, meet the image's columns, within SEAM_MARGIN (`PiecePlan::copy_shows`).
@@ -337,7 +340,7 @@ fn copy_shows(p: array<vec3<f32>, 3>, theta_ref: f32, reach: f32) -> bool {
         lo = min(lo, theta);
         hi = max(hi, theta);
     }
-    let half = PI * params.projection.width / params.projection.turn_px;
+    let half = image_half_span();
     return lo - reach < half + SEAM_MARGIN && hi + reach > -half - SEAM_MARGIN;
 }
 
@@ -588,7 +591,7 @@ fn seam_copies(shape: PieceShape, part: ptr<function, PartPlan>, piece_state: pt
     }
     // VR180: a copy whose u range lies wholly beyond the image's columns (behind the viewer) is
     // not drawn; a piece with none left draws nothing (`plan_work`).
-    let half = PI * params.projection.width / params.projection.turn_px;
+    let half = image_half_span();
     seam.copies = 0u;
     for (var c = 0u; c < n; c++) {
         let d = shifts[c];

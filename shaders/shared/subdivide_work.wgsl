@@ -173,7 +173,7 @@ fn write_triangles(item: vec4<u32>, work: PieceWork, piece_state: ptr<function, 
     var count = 0u;
     // An image narrower than a turn of longitude (VR180): every triangle is tested, copies or
     // not (the seamless images' x is no longitude).
-    let narrow = params.seamless == 0u && params.projection.width < params.projection.turn_px;
+    let narrow = params.seamless == 0u && image_half_span() < PI;
     for (var t = first; t < end; t++) {
         let s = piece_triangle_slots(t, work.m, &walk, piece_state) + vec3<u32>(work.first_node);
         let p = array<vec3<f32>, 3>(out_nodes[s.x].position, out_nodes[s.y].position, out_nodes[s.z].position);

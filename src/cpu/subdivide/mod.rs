@@ -256,7 +256,7 @@ impl<'a> Subdivider<'a> {
         }
         // VR180: a copy whose u range lies wholly beyond the image's columns (behind the viewer)
         // is not drawn; a piece with none left draws nothing.
-        let half = PI * self.projection.width as f32 / self.projection.turn_px();
+        let half = self.image_half_span();
         let refs: Vec<f32> = shifts
             .into_iter()
             .filter(|&d| !seam || half >= PI || (u_min + d < half + SEAM_MARGIN && u_max + d > -half - SEAM_MARGIN))
@@ -282,13 +282,15 @@ impl<'a> Subdivider<'a> {
         }
         for start in plan.triangle_items() {
             let shown = plan.shown(self, start, |k| plan.nodes[k as usize]);
-            out.max_output = out.max_output.max(shown.len() as u32);
-            for (k, &(local, c)) in shown.iter().enumerate() {
-                if self.params.measure_edges != 0 && (k == 0 || shown[k - 1].0 != local) {
+            out.max_output = out.max_output.max(shown.iter().map(|(_, mask)| mask.count_ones()).sum());
+            for (local, mask) in shown {
+                if self.params.measure_edges != 0 {
                     let p = local.map(|i| plan.nodes[i as usize].position.into());
                     out.max_sub_edge_px = out.max_sub_edge_px.max(self.visible_edge_px(p));
                 }
-                out.indices.extend(local.map(|i| first + c * plan.node_count + i));
+                for c in (0..plan.copies).filter(|c| mask & 1 << c != 0) {
+                    out.indices.extend(local.map(|i| first + c * plan.node_count + i));
+                }
             }
         }
     }
@@ -309,6 +311,13 @@ impl<'a> Subdivider<'a> {
         let base = counts.iter().position(|&n| n == 1)?;
         let p = self.edge_profile(q[base].position, q[(base + 1) % 3].position, 2);
         p.straight(STRIP_BASE_ERROR, limits.max_error_px).then_some(base)
+    }
+
+    /// Half the image's span in longitude, radians: π on the cylinder and the sphere, π/2 for
+    /// VR180 (`image_half_span` in the WGSL; meaningless for the seamless images, whose x is no
+    /// longitude).
+    pub(super) fn image_half_span(&self) -> f32 {
+        PI * self.projection.width as f32 / self.projection.turn_px()
     }
 
     /// Longest chord, in pixels, of a triangle's edges with an end on the screen rows.
@@ -350,6 +359,8 @@ pub fn subdivide(params: &SubdivideParams, vertices: &[SceneVertex], indices: &[
     Subdivider::new(params).run(vertices, indices)
 }
 
+#[cfg(test)]
+mod seam_tests;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]

@@ -527,7 +527,7 @@ impl<'s> CpuSubdivision<'s> {
         if shown.is_empty() {
             return;
         }
-        let total = shown.len() as u32;
+        let total = shown.iter().map(|(_, mask)| mask.count_ones()).sum::<u32>();
         let first_triangle = self.counters.triangles;
         self.counters.triangles += total;
         self.counters.max_output = self.counters.max_output.max(total);
@@ -535,18 +535,18 @@ impl<'s> CpuSubdivision<'s> {
             return; // counted, never written
         }
         if sub.params.measure_edges != 0 {
-            for (k, (t, _)) in shown.iter().enumerate() {
-                if k == 0 || shown[k - 1].0 != *t {
-                    let edge = sub.visible_edge_px(t.map(node));
-                    self.counters.max_edge_bits = f32::from_bits(self.counters.max_edge_bits).max(edge).to_bits();
-                }
+            for (t, _) in &shown {
+                let edge = sub.visible_edge_px(t.map(node));
+                self.counters.max_edge_bits = f32::from_bits(self.counters.max_edge_bits).max(edge).to_bits();
             }
         }
         let mut slot = 3 * first_triangle as usize;
-        for (t, c) in shown {
-            for k in t {
-                self.out_indices[slot] = first_node + c * plan.node_count + k;
-                slot += 1;
+        for (t, mask) in shown {
+            for c in (0..plan.copies).filter(|c| mask & 1 << c != 0) {
+                for k in t {
+                    self.out_indices[slot] = first_node + c * plan.node_count + k;
+                    slot += 1;
+                }
             }
         }
     }

@@ -242,7 +242,7 @@ impl Subdivider<'_> {
         let nodes = shape.nodes(g);
         let theta_c = azimuth((q[0].position + q[1].position + q[2].position) / 3.0);
         let sphere_bound = self.projection.panorama.is_sphere().then(|| self.sphere_u_bound(q, theta_c));
-        // Where the nodes are projected, the largest |u − θ| too (`PiecePlan::reach`).
+        // With the range, the reach a copy's triangles are tested with (`PiecePlan::reach`).
         let (u_range, reach) = if let Some((bound, reach)) = sphere_bound.filter(|&(b, _)| clear_of_seam(b)) {
             (bound, reach + SEAM_BOUND_SLACK) // every node within it: none projected
         } else if sphere_bound.is_some() {

@@ -67,21 +67,24 @@ impl PiecePlan {
         first..(first + self.chunk()).min(self.node_count)
     }
 
-    /// The drawn candidates of the triangle item at `first` with the seam copies of each that
-    /// show ([`copy_shows`](Self::copy_shows)), candidate by candidate, copy by copy, their
-    /// corners read by node slot (copy c's slot k at c·node_count + k) from `node`.
+    /// The drawn candidates of the triangle item at `first`, each with the seam copies of it that
+    /// show ([`copy_shows`](Self::copy_shows)) as a mask (bit c: copy c), those with none left
+    /// out; their corners read by node slot (copy c's slot k at c·node_count + k) from `node`.
+    /// The triangles drawn are the masks' bits, candidate by candidate, copy by copy.
     pub fn shown(&self, sub: &Subdivider, first: u32, node: impl Fn(u32) -> DrawVertex) -> Vec<([u32; 3], u32)> {
-        let drawn = self.drawn(sub, first, |k| Vec3::from(node(k).position));
         // An image narrower than a turn of longitude (VR180): every triangle is tested, copies
         // or not (the seamless images' x is no longitude).
-        let narrow = sub.params.seamless == 0 && (sub.projection.width as f32) < sub.projection.turn_px();
-        drawn
+        let narrow = sub.params.seamless == 0 && sub.image_half_span() < PI;
+        self.drawn(sub, first, |k| Vec3::from(node(k).position))
             .into_iter()
-            .flat_map(|t| (0..self.copies).map(move |c| (t, c)))
-            .filter(|&(t, c)| {
-                (self.copies == 1 && !narrow)
-                    || self.copy_shows(sub, t.map(|k| node(c * self.node_count + k)), self.reach)
+            .map(|t| {
+                let shows = |c: u32| {
+                    (self.copies == 1 && !narrow)
+                        || self.copy_shows(sub, t.map(|k| node(c * self.node_count + k)), self.reach)
+                };
+                (t, (0..self.copies).filter(|&c| shows(c)).fold(0, |mask, c| mask | 1 << c))
             })
+            .filter(|&(_, mask)| mask != 0)
             .collect()
     }
 
@@ -98,8 +101,7 @@ impl PiecePlan {
             lo = lo.min(theta);
             hi = hi.max(theta);
         }
-        let projection = &sub.projection;
-        let half = PI * projection.width as f32 / projection.turn_px();
+        let half = sub.image_half_span();
         lo - reach < half + SEAM_MARGIN && hi + reach > -half - SEAM_MARGIN
     }
 
