@@ -221,3 +221,30 @@ fn a_triangle_far_away_is_drawn_by_every_method() {
         );
     }
 }
+
+#[test]
+fn a_frame_that_first_needs_the_cut_passes_is_drawn_with_them() {
+    // The cut passes (`plan_cuts`) are built when a frame first needs them: the first frame of
+    // each panorama asks the GPU beforehand; a later frame that needed them unbuilt is drawn
+    // again once they are. A wide cylinder keeps the demo room's floor beyond its rows (no cuts);
+    // a square one shows it, and the floor near the axis is cut.
+    use twister::core::settings::Method;
+    let scene = builtin::demo();
+    let wide = RenderSettings::new(Projection { width: 960, height: 180, ..Projection::default() });
+    let square = RenderSettings::new(Projection { width: 256, height: 256, ..Projection::default() })
+        .with_method(Method::Adaptive(Split::Length));
+    let cut = |f: &twister::Frame| f.stats.subdivide_invocations.iter().any(|&(e, n)| e == "plan_cuts" && n > 0);
+    let fresh = || twister::Renderer::new(twister::gpu::Gpu::new().expect("GPU")).expect("renderer");
+    let (later, first) = (fresh(), fresh());
+    let upload = |r: &twister::Renderer| twister::GpuScene::upload(&r.gpu, &scene).expect("upload");
+    let (on_later, on_first) = (upload(&later), upload(&first));
+    let before = later.render(&on_later, &wide.with_method(Method::Adaptive(Split::Length))).expect("render");
+    assert!(!cut(&before), "the wide frame should need no cuts");
+    let a = later.render(&on_later, &square).expect("render");
+    let b = first.render(&on_first, &square).expect("render");
+    assert!(cut(&a) && cut(&b), "the square frame should cut the floor");
+    assert_eq!(a.stats.triangles_out, b.stats.triangles_out);
+    for eye in Eye::BOTH {
+        assert!(a.eye(eye).rgba == b.eye(eye).rgba, "{eye:?}: the frame drawn again differs from the first");
+    }
+}

@@ -269,6 +269,38 @@ fn lattice_work(r: &mut Recording, passes: Passes) {
     r.dispatch_indirect("lattice_triangles", "lattice_dispatch", DISPATCH_LATTICE_TRIANGLES);
 }
 
+/// The passes that cut triangles around the axis: `plan_cuts`, and on the sphere `plan_parts`
+/// after it. They are the largest pipelines to build, and many frames never run them (a room on
+/// the cylinder whose floor and ceiling stay beyond the image's rows): the GPU builds them when a
+/// frame first lists a triangle for them (`plan`'s counters, [`cut_probe`]).
+pub const CUT_PASSES: [&str; 2] = ["plan_cuts", "plan_parts"];
+
+/// What tells whether a frame needs [`CUT_PASSES`]: the start of [`one_submission`] up to
+/// `plan` (its counters' `cut_count` and `cut_wide`).
+pub fn cut_probe(triangles: u32) -> Recording {
+    let mut r = active_cuts(triangles);
+    r.dispatch("plan", triangles);
+    r
+}
+
+/// The entry points of `recording` that had work after a run with these counters (see
+/// [`dispatched`]) but are not `built`: a run that left them out must run again.
+pub fn missed(
+    recording: &Recording,
+    params: &SubdivideParams,
+    counters: &SubdivideCounters,
+    panorama: PanoramaKind,
+    built: impl Fn(&str) -> bool,
+) -> Vec<&'static str> {
+    let mut missed: Vec<&'static str> = dispatched(recording, params, counters, panorama)
+        .into_iter()
+        .filter(|&(entry, n)| n > 0 && !built(entry))
+        .map(|(entry, _)| entry)
+        .collect();
+    missed.dedup();
+    missed
+}
+
 /// The start of a chunked schedule: the counters and the edge marks cleared, then
 /// `active_cuts` and `ring_cuts` over all of the scene's `triangles`.
 pub fn active_cuts(triangles: u32) -> Recording {

@@ -15,7 +15,7 @@ use crate::core::settings::RenderSettings;
 use crate::encoding::constants::PIECES_FROM_COUNTER;
 use crate::encoding::recording::{Command, Recording};
 use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine, INDICES_SIZE, NODE_SIZE};
-use crate::encoding::subdivide::{one_submission, Passes, SubdivideOutput};
+use crate::encoding::subdivide::{cut_probe, missed, one_submission, Passes, SubdivideOutput, CUT_PASSES};
 use crate::encoding::types::{DrawVertex, SubdivideCounters, SubdivideParams};
 use crate::error::Result;
 use crate::gpu::device::Gpu;
@@ -31,17 +31,67 @@ pub(crate) const COUNTERS_SIZE: u64 = std::mem::size_of::<SubdivideCounters>() a
 // The frame's timestamps are read back as u64s right after the counters.
 const _: () = assert!(COUNTERS_SIZE % 8 == 0);
 
-/// The stage's pipelines for one panorama, one per entry point.
+/// The stage's pipelines for one panorama, one per entry point: those every frame runs, built
+/// with the variant, and the cut passes ([`CUT_PASSES`]), built when a frame first needs them.
 struct Variant {
     pipelines: Vec<(&'static str, wgpu::ComputePipeline)>,
+    cut_passes: OnceLock<Vec<(&'static str, wgpu::ComputePipeline)>>,
+    build: Build,
 }
 
 impl Variant {
-    /// The pipeline of an entry point a recording names.
-    fn pipeline(&self, entry: &str) -> &wgpu::ComputePipeline {
-        let found = self.pipelines.iter().find(|(name, _)| *name == entry);
-        &found.unwrap_or_else(|| panic!("the subdivide stage has no entry point {entry}")).1
+    /// The pipeline of an entry point a recording names, if built.
+    fn pipeline(&self, entry: &str) -> Option<&wgpu::ComputePipeline> {
+        lookup(&self.pipelines, entry).or_else(|| self.cut_passes.get().and_then(|cuts| lookup(cuts, entry)))
     }
+
+    /// The cut passes, built now if they are not yet.
+    fn build_cut_passes(&self, gpu: &Gpu, stage: &GpuStage, passes: Passes) {
+        self.cut_passes.get_or_init(|| {
+            let used = one_submission(1, passes, false).entries().filter(|e| CUT_PASSES.contains(e)).collect();
+            std::thread::scope(|scope| join(self.build.spawn(scope, gpu, stage, used)))
+        });
+    }
+}
+
+/// The entry points whose pipelines a [`cut_probe`] runs.
+const PROBED: [&str; 3] = ["active_cuts", "ring_cuts", "plan"];
+
+/// Asks the GPU whether a frame needs the cut passes, given the pipelines of [`PROBED`].
+type Probe<'a> = dyn for<'p> Fn(Pipelines<'p>) -> bool + 'a;
+
+/// The pipeline of an entry point, where built.
+type Pipelines<'p> = &'p dyn Fn(&str) -> Option<&'p wgpu::ComputePipeline>;
+
+/// How a variant's pipelines are built: its constants and stand-ins.
+struct Build {
+    constants: [(&'static str, f64); 1],
+    stand_ins: Vec<StandIn>,
+}
+
+type Built = Vec<(&'static str, wgpu::ComputePipeline)>;
+type Building<'scope> = Vec<(&'static str, std::thread::ScopedJoinHandle<'scope, wgpu::ComputePipeline>)>;
+
+impl Build {
+    /// Starts building the pipelines of `entries`, each on a thread of `scope`.
+    fn spawn<'scope, 'env>(
+        &'env self,
+        scope: &'scope std::thread::Scope<'scope, 'env>,
+        gpu: &'env Gpu,
+        stage: &'env GpuStage,
+        entries: Vec<&'static str>,
+    ) -> Building<'scope> {
+        let build = move |e| move || stage.compute_standing_in(gpu, e, &self.constants, &self.stand_ins);
+        entries.into_iter().map(|e| (e, scope.spawn(build(e)))).collect()
+    }
+}
+
+fn join(building: Building) -> Built {
+    building.into_iter().map(|(e, b)| (e, b.join().expect("a pipeline build panicked"))).collect()
+}
+
+fn lookup<'a>(built: &'a Built, entry: &str) -> Option<&'a wgpu::ComputePipeline> {
+    built.iter().find(|(name, _)| *name == entry).map(|(_, p)| p)
 }
 
 /// The `subdivide` stage: its layouts, and its pipelines built for each panorama and kind of
@@ -63,7 +113,11 @@ impl SubdivideStage {
     /// The pipelines for a panorama (the cylinder with or without a tracked head, the sphere
     /// and VR180, the fisheye) and a frame's split rule (`params.method`): rows on the sphere
     /// under the adaptive rules only. Each leaves out the other panoramas' projection code.
-    fn variant(&self, gpu: &Gpu, panorama: PanoramaKind, params: &SubdivideParams) -> &Variant {
+    /// Built side by side (the driver's compiling of the large passes, `plan_cuts` and `lattice`,
+    /// is most of a fresh process's time). With a `probe` (a frame's first use of the variant)
+    /// the cut passes ([`CUT_PASSES`]) are built only if it says the frame needs them: it runs
+    /// as soon as `plan`'s pipelines are built, the others still building.
+    fn variant(&self, gpu: &Gpu, panorama: PanoramaKind, params: &SubdivideParams, probe: Option<&Probe>) -> &Variant {
         let head = params.projection.head_on != 0.0;
         let (k, bits) = match panorama {
             PanoramaKind::Fisheye => (3, 6.0),
@@ -75,9 +129,6 @@ impl SubdivideStage {
         let rows = passes.rows;
         let spacing = params.by_azimuth != 0;
         self.variants[4 * k + 2 * rows as usize + spacing as usize].get_or_init(|| {
-            // Built side by side: the driver's compiling of the large passes (`plan_cuts`,
-            // `lattice`) is most of a fresh process's time.
-            let constants = [("PANORAMAS", bits)];
             let mut stand_ins: Vec<StandIn> = match (k, rows) {
                 (0, _) => vec![ROWS_OFF, SPHERE_OFF, FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
                 (1, _) => vec![ROWS_OFF, SPHERE_OFF, FISHEYE_OFF, CUBEMAP_OFF, CAVE_OFF],
@@ -89,23 +140,29 @@ impl SubdivideStage {
             if !spacing {
                 stand_ins.push(SPACING_OFF);
             }
-            let stand_ins = &stand_ins[..];
+            let build = Build { constants: [("PANORAMAS", bits)], stand_ins };
+            let stage = &self.stage;
             // The entry points this frame's schedules dispatch (every schedule's are the usual
-            // frame's).
+            // frame's): `plan`'s, the cut passes, the others.
             let used: Vec<&'static str> = one_submission(1, passes, false).entries().collect();
-            let pipelines = std::thread::scope(|scope| {
-                let builds: Vec<_> = SUBDIVIDE
-                    .entry_points
-                    .iter()
-                    .filter(|e| used.contains(&e.name))
-                    .map(|e| {
-                        let build = move || self.stage.compute_standing_in(gpu, e.name, &constants, stand_ins);
-                        (e.name, scope.spawn(build))
-                    })
-                    .collect();
-                builds.into_iter().map(|(name, b)| (name, b.join().expect("a pipeline build panicked"))).collect()
+            let (cuts, others): (Vec<_>, Vec<_>) = used.into_iter().partition(|e| CUT_PASSES.contains(e));
+            let (probed, others): (Vec<_>, Vec<_>) = others.into_iter().partition(|e| PROBED.contains(e));
+            let (pipelines, cut_passes) = std::thread::scope(|scope| {
+                let probed = build.spawn(scope, gpu, stage, probed);
+                let others = build.spawn(scope, gpu, stage, others);
+                let mut pipelines = join(probed);
+                let cuts = match probe {
+                    Some(probe) if !probe(&|entry| lookup(&pipelines, entry)) => None,
+                    _ => Some(build.spawn(scope, gpu, stage, cuts)),
+                };
+                pipelines.extend(join(others));
+                (pipelines, cuts.map(join))
             });
-            Variant { pipelines }
+            let variant = Variant { pipelines, cut_passes: OnceLock::new(), build };
+            if let Some(built) = cut_passes {
+                variant.cut_passes.set(built).ok();
+            }
+            variant
         })
     }
 
@@ -115,17 +172,18 @@ impl SubdivideStage {
         self.stage.bind_group(gpu, Some(entry), 0, &buffers)
     }
 
-    /// Replays `recording` into `enc` for a frame's buffers (each named as it is bound).
-    fn replay(
+    /// Replays `recording` into `enc` for a frame's buffers (each named as it is bound) with
+    /// `pipelines`; an entry point without one is left out (the cut passes before a frame needs
+    /// them: see [`SubdivideStage::encode`]).
+    fn replay<'p>(
         &self,
         gpu: &Gpu,
         enc: &mut wgpu::CommandEncoder,
         recording: &Recording,
         frame: &FrameBuffers,
-        (panorama, params): (PanoramaKind, &SubdivideParams),
+        pipelines: Pipelines<'p>,
         timestamps: Option<&Timestamps>,
     ) {
-        let variant = self.variant(gpu, panorama, params);
         let mut pass: Option<wgpu::ComputePass<'static>> = None;
         for command in &recording.commands {
             match *command {
@@ -140,14 +198,16 @@ impl SubdivideStage {
                 }
                 Command::Dispatch { entry, invocations } => {
                     let pass = pass.as_mut().expect("a recording dispatches inside a pass");
-                    pass.set_pipeline(variant.pipeline(entry));
+                    let Some(pipeline) = pipelines(entry) else { continue };
+                    pass.set_pipeline(pipeline);
                     pass.set_bind_group(0, &self.bind_group(gpu, entry, frame), &[]);
                     let (x, y) = gpu.workgroups(invocations, 64);
                     pass.dispatch_workgroups(x, y, 1);
                 }
                 Command::DispatchIndirect { entry, args, offset } => {
                     let pass = pass.as_mut().expect("a recording dispatches inside a pass");
-                    pass.set_pipeline(variant.pipeline(entry));
+                    let Some(pipeline) = pipelines(entry) else { continue };
+                    pass.set_pipeline(pipeline);
                     pass.set_bind_group(0, &self.bind_group(gpu, entry, frame), &[]);
                     pass.dispatch_workgroups_indirect(frame.named(args), offset);
                 }
@@ -157,6 +217,9 @@ impl SubdivideStage {
 
     /// Encodes the one-submission schedule ([`one_submission`]; each pass timed where the
     /// adapter has timestamps). `params` covers every triangle, its pieces counted on the GPU.
+    /// On the variant's first frame, a [`cut_probe`] submitted first tells whether the cut
+    /// passes are built; where they are not, the frame leaves them out, and
+    /// [`SubdivideStage::missed_cuts`] says whether it must be drawn again.
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -171,13 +234,45 @@ impl SubdivideStage {
     ) {
         let params = SubdivideParams { first_piece: 0, piece_count: PIECES_FROM_COUNTER, ..*params };
         gpu.queue.write_buffer(uniform, 0, bytemuck::bytes_of(&params));
-        let recording =
-            one_submission(params.triangle_count, Passes::of(panorama, params.method), timestamps.is_some());
-        self.replay(gpu, enc, &recording, &FrameBuffers { uniform, scene, b }, (panorama, &params), timestamps);
+        let frame = FrameBuffers { uniform, scene, b };
+        let passes = Passes::of(panorama, params.method);
+        let recording = one_submission(params.triangle_count, passes, timestamps.is_some());
+        let probe = |pipelines: Pipelines| {
+            let mut enc = gpu.device.create_command_encoder(&Default::default());
+            self.replay(gpu, &mut enc, &cut_probe(params.triangle_count), &frame, pipelines, None);
+            gpu.queue.submit([enc.finish()]);
+            // Unread counters: build them.
+            gpu.download(&b.counters, COUNTERS_SIZE).map_or(true, |bytes| {
+                let cut = |e: &str| !CUT_PASSES.contains(&e);
+                !missed(&recording, &params, bytemuck::from_bytes(&bytes), panorama, cut).is_empty()
+            })
+        };
+        let variant = self.variant(gpu, panorama, &params, Some(&probe));
+        self.replay(gpu, enc, &recording, &frame, &|e| variant.pipeline(e), timestamps);
+    }
+
+    /// After a frame [`SubdivideStage::encode`]d with these `params`: whether it left out cut
+    /// passes that its `counters` say it needed. They are built then, and the frame must be
+    /// drawn again.
+    pub fn missed_cuts(
+        &self,
+        gpu: &Gpu,
+        panorama: PanoramaKind,
+        params: &SubdivideParams,
+        counters: &SubdivideCounters,
+    ) -> bool {
+        let variant = self.variant(gpu, panorama, params, None);
+        let passes = Passes::of(panorama, params.method);
+        let recording = one_submission(params.triangle_count, passes, false);
+        if missed(&recording, params, counters, panorama, |e| variant.pipeline(e).is_some()).is_empty() {
+            return false;
+        }
+        variant.build_cut_passes(gpu, &self.stage, passes);
+        true
     }
 
     /// Replays `recording` with `params` as the uniform for a frame's buffers, submitted; the
-    /// counters afterwards.
+    /// counters afterwards. Every pipeline it names is built first.
     pub fn submit(
         &self,
         gpu: &Gpu,
@@ -186,9 +281,11 @@ impl SubdivideStage {
         params: &SubdivideParams,
         panorama: PanoramaKind,
     ) -> Result<SubdivideCounters> {
+        let variant = self.variant(gpu, panorama, params, None);
+        variant.build_cut_passes(gpu, &self.stage, Passes::of(panorama, params.method));
         gpu.queue.write_buffer(frame.uniform, 0, bytemuck::bytes_of(params));
         let mut enc = gpu.device.create_command_encoder(&Default::default());
-        self.replay(gpu, &mut enc, recording, frame, (panorama, params), None);
+        self.replay(gpu, &mut enc, recording, frame, &|e| variant.pipeline(e), None);
         gpu.queue.submit([enc.finish()]);
         let bytes = gpu.download(&frame.b.counters, COUNTERS_SIZE)?;
         Ok(*bytemuck::from_bytes(&bytes))

@@ -80,9 +80,14 @@ impl Method for SubdividedMethod {
             params.piece_capacity = capacity.pieces;
             params.triangle_capacity = capacity.triangles;
             let t = Instant::now();
-            if let Some((counters, times)) =
-                self.render_one_submission(gpu, res, scene, settings, targets, b, params)?
-            {
+            let mut done = self.render_one_submission(gpu, res, scene, settings, targets, b, params)?;
+            if let Some((counters, _)) = &done {
+                // A frame that needed the cut passes before they were built: again, with them.
+                if self.subdivide.missed_cuts(gpu, p.panorama, &params, counters) {
+                    done = self.render_one_submission(gpu, res, scene, settings, targets, b, params)?;
+                }
+            }
+            if let Some((counters, times)) = done {
                 stats.ms_frame = t.elapsed().as_secs_f64() * 1e3;
                 match times {
                     Some(times) => {

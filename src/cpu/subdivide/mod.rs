@@ -360,6 +360,8 @@ pub fn subdivide(params: &SubdivideParams, vertices: &[SceneVertex], indices: &[
 }
 
 #[cfg(test)]
+mod schedule_tests;
+#[cfg(test)]
 mod seam_tests;
 #[cfg(test)]
 mod tests;
