@@ -145,7 +145,13 @@ impl SubdividedMethod {
         let timestamps = res.timestamps.as_ref();
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         let panorama = settings.projection().panorama;
-        self.subdivide.encode(gpu, &mut enc, &res.subdivide_params, scene, b, &params, panorama, timestamps);
+        std::thread::scope(|scope| {
+            // The raster's pipelines built beside the subdivision's (building them is most of a
+            // fresh process's time on a CPU driver; a built one is only looked up).
+            let raster = scope.spawn(|| self.raster_pipelines(gpu, scene, settings));
+            self.subdivide.encode(gpu, &mut enc, &res.subdivide_params, scene, b, &params, panorama, timestamps);
+            raster.join().expect("building the raster's pipelines panicked");
+        });
         self.encode_raster(
             gpu,
             &mut enc,
@@ -180,6 +186,25 @@ impl SubdividedMethod {
         Ok(Some((counters, times)))
     }
 
+    /// The raster's passes of a frame: its samples (every output at the pixels' centres, then
+    /// or only the multisampled colour) and the eyes each draws ([`Layers::passes`]).
+    fn raster_passes(gpu: &Gpu, settings: &RenderSettings) -> Vec<(Samples, Layers)> {
+        Samples::passes(settings)
+            .into_iter()
+            .flat_map(|samples| samples.layers(gpu.eyes_per_draw).iter().map(move |&layers| (samples, layers)))
+            .collect()
+    }
+
+    /// Builds the pipelines a frame's raster uses, where not built yet.
+    fn raster_pipelines(&self, gpu: &Gpu, scene: &GpuScene, settings: &RenderSettings) {
+        for (samples, layers) in Self::raster_passes(gpu, settings) {
+            self.raster.get(gpu, scene, settings, layers, samples);
+            if scene.shows_environment(settings) {
+                self.raster.background(gpu, settings, layers, samples);
+            }
+        }
+    }
+
     /// Encodes the raster of both eyes (clearing the targets first if `clear`): one multiview
     /// pass, or a pass per eye ([`Layers::passes`]); with a query set, writes timestamps at the
     /// start of the first pass and the end of the last.
@@ -199,11 +224,7 @@ impl SubdividedMethod {
         let materials = self.raster.material_bind_group(gpu, scene);
         // One draw, or the cubemap's six: each face's parameters, and its square as the scissor.
         let draws = face_draws(gpu, &self.raster.stage, &res.raster_params, settings);
-        // Every output at the pixels' centres, then (or only) the multisampled colour.
-        let passes: Vec<(Samples, Layers)> = Samples::passes(settings)
-            .into_iter()
-            .flat_map(|samples| samples.layers(gpu.eyes_per_draw).iter().map(move |&layers| (samples, layers)))
-            .collect();
+        let passes = Self::raster_passes(gpu, settings);
         for (k, &(samples, layers)) in passes.iter().enumerate() {
             let pipeline = self.raster.get(gpu, scene, settings, layers, samples);
             let writes = stamp::first_and_last(timestamps, k, passes.len());
