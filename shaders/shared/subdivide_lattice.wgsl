@@ -330,7 +330,8 @@ fn image_half_span() -> f32 {
 
 // Whether seam copy `theta_ref` of a drawn triangle (corners p) shows in the image: its corners'
 // azimuths unwrapped towards the copy's reference as the raster stage unwraps them, widened by
-// the piece's `reach`, meet the image's columns, within SEAM_MARGIN (`PiecePlan::copy_shows`).
+// the piece's `reach`, reach more than SEAM_MARGIN into the image's columns (one reaching less
+// far covers no sample; `PiecePlan::copy_shows`).
 fn copy_shows(p: array<vec3<f32>, 3>, theta_ref: f32, reach: f32) -> bool {
     var lo = 1e30;
     var hi = -1e30;
@@ -341,7 +342,7 @@ fn copy_shows(p: array<vec3<f32>, 3>, theta_ref: f32, reach: f32) -> bool {
         hi = max(hi, theta);
     }
     let half = image_half_span();
-    return lo - reach < half + SEAM_MARGIN && hi + reach > -half - SEAM_MARGIN;
+    return lo - reach < half - SEAM_MARGIN && hi + reach > -half + SEAM_MARGIN;
 }
 
 // Whether a candidate triangle with these corners is drawn: not collapsed by snapping (two

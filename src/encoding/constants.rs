@@ -47,7 +47,8 @@ pub const TRACE_PENDING: u32 = crate::core::settings::MAX_REFLECT + 2 + MAX_SHAD
 /// The ray tracer counts rays and triangle tests per workgroup into this many slots (two 32-bit
 /// counters each, summed on the host in 64 bits, so that no slot overflows).
 pub const TRACE_COUNT_SLOTS: u32 = 4096;
-/// Seam copies are made for triangles reaching within this many radians of ±π.
+/// Seam copies are made for triangles reaching within this many radians of ±π; a copy's
+/// triangle is drawn where it reaches more than this into the image.
 pub const SEAM_MARGIN: f32 = 1e-5;
 /// On the sphere, a piece whose bound from its corners (`sphere_u_bound`) keeps this many
 /// radians more than `SEAM_MARGIN` from ±π is known to need no seam copy without projecting its

@@ -27,6 +27,24 @@ fn seam_triangle_gets_a_copy_on_the_other_side() {
     assert!(refs.iter().filter(|r| r.abs() > PI).all(|r| (r.abs() - PI).abs() < 0.2 + TAU - PI), "{refs:?}");
 }
 
+#[test]
+fn a_copy_that_only_touches_the_image_edge_is_not_drawn() {
+    // The sphere in mono (no eye offset: the parts' reach, measured at their nodes, is 0; as
+    // where the pole merge fades the offset), the same triangle cut at the seam: each part's copy
+    // a turn away only touches the image's other edge, where it covers no sample.
+    let tri = [[-0.5, 0.0, 3.0], [0.5, 0.0, 3.0], [0.0, 0.5, 3.0]];
+    let mono = Projection { eye_radius: 0.0, ..Projection::equirect(256) };
+    let params = subdivide_params(&RenderSettings::new(mono).with_method(Method::Vertex), 0, 1);
+    let v: Vec<SceneVertex> =
+        tri.iter().map(|&p| SceneVertex { position: p, normal: [0.0, 0.0, -1.0], ..Default::default() }).collect();
+    let out = Subdivider::new(&params).run_with_cuts(&v, &[0, 1, 2], &FrameCuts::every_edge(1, &v, &[0, 1, 2]));
+    assert_eq!(out.vertices.len(), 6, "two parts, drawn once each");
+    for t in out.vertices.chunks(3) {
+        let (lo, hi) = drawn_columns(&mono, t);
+        assert!(hi > 0.0 && lo < mono.width as f32, "a part drawn beyond the image: columns {lo}..{hi}");
+    }
+}
+
 /// Columns (both eyes) a triangle as drawn covers: its corners projected for its copy (θ unwrapped
 /// towards its reference azimuth, as the raster stage does), in pixels from the image's left edge.
 fn drawn_columns(projection: &Projection, t: &[DrawVertex]) -> (f32, f32) {

@@ -90,9 +90,10 @@ impl PiecePlan {
 
     /// Whether a seam copy of a triangle (its corners as drawn: positions and the copy's
     /// reference azimuth) shows in the image: the corners' azimuths unwrapped towards the copy's
-    /// reference as the raster stage unwraps them, widened by `reach`, meet the image's columns
-    /// within `SEAM_MARGIN` (`copy_shows` in the WGSL). A copy wholly beyond the image's left or
-    /// right edge would only be clipped.
+    /// reference as the raster stage unwraps them, widened by `reach`, reach more than
+    /// `SEAM_MARGIN` into the image's columns (`copy_shows` in the WGSL). A copy wholly beyond
+    /// the image's left or right edge would only be clipped, and one that reaches less far in
+    /// (a part cut at the seam, touching the edge) covers no sample: the nearest lies 1/16 px in.
     fn copy_shows(&self, sub: &Subdivider, corners: [DrawVertex; 3], reach: f32) -> bool {
         let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
         for v in corners {
@@ -102,7 +103,7 @@ impl PiecePlan {
             hi = hi.max(theta);
         }
         let half = sub.image_half_span();
-        lo - reach < half + SEAM_MARGIN && hi + reach > -half - SEAM_MARGIN
+        lo - reach < half - SEAM_MARGIN && hi + reach > -half + SEAM_MARGIN
     }
 
     /// The drawn candidates of the triangle item at `first`, their corners' positions read by
