@@ -376,6 +376,8 @@ fn footprint(q: array<Node, 3>, theta_c: f32) -> vec4<f32> {
 // The u range (both eyes) of the piece's triangle on the cylinder, from its corners, and its
 // reach, the largest |u − θ| (1e30 with a tracked head) (`piece_u_range` in the twin): α(r)
 // grows with r, so |α| is largest at the footprint's nearest or farthest point from the axis.
+// Each inverse sine and α from one call site, in a loop (lavapipe inlines every call: each
+// copy of an arc function is an arctangent's worth of code to build).
 fn piece_u_range(q: array<Node, 3>, theta_c: f32) -> vec3<f32> {
     let f = footprint(q, theta_c);
     let theta_min = f.x;
@@ -387,11 +389,17 @@ fn piece_u_range(q: array<Node, 3>, theta_c: f32) -> vec3<f32> {
         // A tracked head: u = θ − γ, moved by the eye's offset seen from the point and by the
         // eye's distance from the display's axis seen from the screen (`core::head`).
         let reach = length(proj.head_offset.xz) + proj.eye_radius;
-        let bound = precise_asin(min(proj.eye_radius / max(r_min, 1e-30), 1.0))
-            + precise_asin(min(reach / proj.screen_radius, 1.0));
+        let ratios = vec2<f32>(proj.eye_radius / max(r_min, 1e-30), reach / proj.screen_radius);
+        var bound = 0.0;
+        for (var k = 0u; k < 2u; k++) {
+            bound += precise_asin(min(ratios[k], 1.0));
+        }
         return vec3<f32>(theta_min - proj.head_turn - bound, theta_max - proj.head_turn + bound, 1e30);
     }
-    let alpha = max(abs(eye_shift(proj, r_min)), abs(eye_shift(proj, r_max)));
+    var alpha = 0.0;
+    for (var k = 0u; k < 2u; k++) {
+        alpha = max(alpha, abs(eye_shift(proj, select(r_min, r_max, k == 1u))));
+    }
     return vec3<f32>(theta_min - alpha, theta_max + alpha, alpha);
 }
 
@@ -562,16 +570,21 @@ fn seam_copies(shape: PieceShape, part: ptr<function, PartPlan>, piece_state: pt
                 reach = max(reach, abs(q[s].x - theta));
             }
         }
-    } else if ((*piece_state).strip_base == QUAD_STRIP) {
-        // The quad's range: that of its fan's two triangles, which cover it.
-        let ra = piece_u_range((*piece_state).corner, theta_c);
-        let rb = piece_u_range(array<Node, 3>((*piece_state).corner[0], (*piece_state).corner[2], (*piece_state).quad_last), theta_c);
-        reach = max(ra.z, rb.z) + SEAM_BOUND_SLACK;
-        u_range = vec2<f32>(min(ra.x, rb.x), max(ra.y, rb.y));
     } else {
-        let r = piece_u_range((*piece_state).corner, theta_c);
-        u_range = r.xy;
-        reach = r.z + SEAM_BOUND_SLACK;
+        // The cylinder: from the corners; a band quad's range is that of its fan's two
+        // triangles, which cover it (one call site of piece_u_range).
+        let triangles = select(1u, 2u, (*piece_state).strip_base == QUAD_STRIP);
+        reach = 0.0;
+        for (var k = 0u; k < triangles; k++) {
+            var q = (*piece_state).corner;
+            if (k == 1u) {
+                q = array<Node, 3>((*piece_state).corner[0], (*piece_state).corner[2], (*piece_state).quad_last);
+            }
+            let r = piece_u_range(q, theta_c);
+            u_range = vec2<f32>(min(u_range.x, r.x), max(u_range.y, r.y));
+            reach = max(reach, r.z);
+        }
+        reach += SEAM_BOUND_SLACK;
     }
     var seam = SeamCopies(array<f32, 3>(theta_c, 0.0, 0.0), 1u, reach);
     // The seamless images make none (SubdivideParams::seamless: the fisheye's, the cubemap's
