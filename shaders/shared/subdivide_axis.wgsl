@@ -84,11 +84,16 @@ fn clip_polygon(cut: Cut, clip: ptr<function, ClipState>) {
             n = push_clipped(at, n, cur, clip);
         }
         if ((d0 >= 0.0) != (d1 >= 0.0) && d0 != 0.0 && d1 != 0.0) {
+            // From the canonically ordered edge (one call site of cut_crossing).
+            var lo = cur;
+            var hi = next;
+            var d = vec2<f32>(d0, d1);
             if (lex_less(next.position, cur.position)) {
-                n = push_clipped(at, n, cut_crossing(cut.kind, next, cur, d1, d0), clip);
-            } else {
-                n = push_clipped(at, n, cut_crossing(cut.kind, cur, next, d0, d1), clip);
+                lo = next;
+                hi = cur;
+                d = d.yx;
             }
+            n = push_clipped(at, n, cut_crossing(cut.kind, lo, hi, d.x, d.y), clip);
         }
     }
     if (n > 1u && same((*clip).pool[at + n - 1u].position, (*clip).pool[at].position)) {
@@ -101,7 +106,8 @@ fn clip_polygon(cut: Cut, clip: ptr<function, ClipState>) {
     (*clip).poly_count = n;
 }
 
-// Clips the input triangle to quadrant q (signs of x and z as in `QUADRANTS` of axis.rs).
+// Clips the input triangle to quadrant q (signs of x and z as in `QUADRANTS` of axis.rs), beyond
+// the first diamond.
 fn quadrant_polygon(s: vec2<f32>, tri: ptr<function, InputTriangle>, clip: ptr<function, ClipState>) {
     (*clip).poly_at = 0u;
     (*clip).quadrant_at = 0u;
@@ -120,11 +126,17 @@ fn quadrant_polygon(s: vec2<f32>, tri: ptr<function, InputTriangle>, clip: ptr<f
         (*clip).poly_count = 0u;
         return;
     }
-    if (all(dx >= vec3<f32>(0.0)) && all(dz >= vec3<f32>(0.0))) {
-        return;
+    // x = 0 and z = 0 (unless it lies wholly inside the quadrant), then what lies beyond the
+    // first diamond (`rest` in axis.rs), from one call site of clip_polygon (lavapipe inlines
+    // every call).
+    let inside = all(dx >= vec3<f32>(0.0)) && all(dz >= vec3<f32>(0.0));
+    for (var k = select(0u, 2u, inside); k < 3u; k++) {
+        var cut = Cut(select(CUT_X, CUT_Z, k == 1u), s, 0.0, 1.0);
+        if (k == 2u) {
+            cut = Cut(CUT_CHORD, s, params.axis_clearance, 1.0);
+        }
+        clip_polygon(cut, clip);
     }
-    clip_polygon(Cut(CUT_X, s, 0.0, 1.0), clip);
-    clip_polygon(Cut(CUT_Z, s, 0.0, 1.0), clip);
 }
 
 // c_k = ρ·√2^k, exactly as the twin (`band_bound` in axis.rs): ρ or ρ·√2, times 2^(k/2).
@@ -304,13 +316,12 @@ fn plan_quadrant(t: u32, q: u32, tri: ptr<function, InputTriangle>, part: ptr<fu
     let signs = QUADRANT_SIGNS;
     {
         let s = signs[q];
+        // What lies in the quadrant beyond the first diamond (`rest` in axis.rs); each band is
+        // cut from it, and the rest beyond the next diamond from the same polygon.
         quadrant_polygon(s, tri, clip);
         if ((*clip).poly_count == 0u) {
             return;
         }
-        // What lies beyond the current diamond (`rest` in axis.rs); each band is cut from it,
-        // and the rest beyond the next diamond from the same polygon.
-        clip_polygon(Cut(CUT_CHORD, s, params.axis_clearance, 1.0), clip);
         (*clip).quadrant_at = (*clip).poly_at;
         (*clip).quadrant_count = (*clip).poly_count;
         // Start at the band of the nearest corner: the bands below are empty, and cutting them
@@ -341,13 +352,20 @@ fn plan_quadrant(t: u32, q: u32, tri: ptr<function, InputTriangle>, part: ptr<fu
                 if (test.y) {
                     (*clip).quadrant_count = 0u;
                 } else {
-                    clip_polygon(within, clip);
-                    let band_at = (*clip).poly_at;
-                    let band_count = (*clip).poly_count;
-                    (*clip).keep_at = band_at;
-                    (*clip).poly_at = (*clip).quadrant_at;
-                    (*clip).poly_count = (*clip).quadrant_count;
-                    clip_polygon(Cut(CUT_CHORD, s, c, 1.0), clip);
+                    // The band within the diamond, then the rest beyond it, from one call site
+                    // of clip_polygon.
+                    var band_at = 0u;
+                    var band_count = 0u;
+                    for (var side = 0u; side < 2u; side++) {
+                        clip_polygon(Cut(CUT_CHORD, s, c, select(-1.0, 1.0, side == 1u)), clip);
+                        if (side == 0u) {
+                            band_at = (*clip).poly_at;
+                            band_count = (*clip).poly_count;
+                            (*clip).keep_at = band_at;
+                            (*clip).poly_at = (*clip).quadrant_at;
+                            (*clip).poly_count = (*clip).quadrant_count;
+                        }
+                    }
                     (*clip).quadrant_at = (*clip).poly_at;
                     (*clip).quadrant_count = (*clip).poly_count;
                     (*clip).poly_at = band_at;
@@ -386,12 +404,15 @@ fn clip_segment(cut: Cut, clip: ptr<function, ClipState>) {
     let dp = cut_distance(cut, (*clip).seg_p.position);
     let dq = cut_distance(cut, (*clip).seg_q.position);
     if ((dp >= 0.0) != (dq >= 0.0) && dp != 0.0 && dq != 0.0) {
-        var x: Node;
+        var lo = (*clip).seg_p;
+        var hi = (*clip).seg_q;
+        var d = vec2<f32>(dp, dq);
         if (lex_less((*clip).seg_q.position, (*clip).seg_p.position)) {
-            x = cut_crossing(cut.kind, (*clip).seg_q, (*clip).seg_p, dq, dp);
-        } else {
-            x = cut_crossing(cut.kind, (*clip).seg_p, (*clip).seg_q, dp, dq);
+            lo = (*clip).seg_q;
+            hi = (*clip).seg_p;
+            d = d.yx;
         }
+        let x = cut_crossing(cut.kind, lo, hi, d.x, d.y);
         add_crossing(x, clip);
         if (dp >= 0.0) {
             (*clip).seg_q = x;
@@ -413,16 +434,22 @@ fn edge_crossings(a: Node, b: Node, clip: ptr<function, ClipState>, cuts: vec2<u
         (*clip).seg_p = a;
         (*clip).seg_q = b;
         (*clip).seg_live = true;
-        clip_segment(Cut(CUT_X, s, 0.0, 1.0), clip);
-        clip_segment(Cut(CUT_Z, s, 0.0, 1.0), clip);
-        clip_segment(Cut(CUT_CHORD, s, params.axis_clearance, 1.0), clip);
+        // x = 0, z = 0, the first diamond, then each band's, from one call site of clip_segment.
+        var step = 0u;
         var k = 0u;
         loop {
-            k = next_cut(k, cuts);
-            if (!(*clip).seg_live || k >= MAX_DIAMONDS) {
-                break;
+            var cut = Cut(select(CUT_X, CUT_Z, step == 1u), s, 0.0, 1.0);
+            if (step == 2u) {
+                cut = Cut(CUT_CHORD, s, params.axis_clearance, 1.0);
+            } else if (step > 2u) {
+                k = next_cut(k, cuts);
+                if (!(*clip).seg_live || k >= MAX_DIAMONDS) {
+                    break;
+                }
+                cut = Cut(CUT_CHORD, s, band_bound(k), 1.0);
             }
-            clip_segment(Cut(CUT_CHORD, s, band_bound(k), 1.0), clip);
+            clip_segment(cut, clip);
+            step += 1u;
         }
     }
     // In order along the edge (insertion sort; a few points).
