@@ -53,30 +53,39 @@ fn sphere_altitude(proj: Projection, r: f32, y: f32, d: f32) -> vec2<f32> {
     return vec2<f32>(precise_atan2(abs(y), h), abs(y) * e.x * e.y / (h * (h * h + y * y)));
 }
 
-// One Newton step on g(a) = altitude(f(a)·d_e) − a (`sphere_eye_offset` in projection.rs).
-fn sphere_newton_step(proj: Projection, r: f32, y: f32, a: f32) -> f32 {
-    let k = 0.5 * PI / (proj.pole_to - proj.pole_from);
-    let altitude = sphere_altitude(proj, r, y, pole_fade(proj, a) * proj.eye_radius);
-    let g = altitude.x - a;
-    let dg = altitude.y * proj.eye_radius * (-k * sin(k * (a - proj.pole_from))) - 1.0;
-    return clamp(a - g / dg, proj.pole_from, proj.pole_to);
-}
-
 // The eye offset f(|φ|)·d_e at which a point is seen: the root of φ = φ(f(φ)·d_e), by four Newton
-// steps, in a loop: one copy of the step (lavapipe inlines every call site, and this runs at every
-// projection); four of the 65,535 loop iterations lavapipe allows an invocation.
+// steps on g(a) = altitude(f(a)·d_e) − a (`sphere_eye_offset` in projection.rs). One loop, one
+// call site of the altitude (lavapipe inlines every call site, and this runs at every
+// projection): step 0 the altitude at the full offset (below the merge: d_e), step 1 at none
+// (beyond it: 0; else Newton's start), steps 2–5 the Newton steps; six of the 65,535 loop
+// iterations lavapipe allows an invocation.
 fn sphere_eye_offset(proj: Projection, r: f32, y: f32) -> f32 {
     let de = proj.eye_radius;
-    if (proj.pole_to <= 0.0 || sphere_altitude(proj, r, y, de).x <= proj.pole_from) {
+    if (proj.pole_to <= 0.0) {
         return de;
     }
-    let centre = sphere_altitude(proj, r, y, 0.0).x;
-    if (centre >= proj.pole_to) {
-        return 0.0;
-    }
-    var a = clamp(centre, proj.pole_from, proj.pole_to);
-    for (var step = 0u; step < 4u; step++) {
-        a = sphere_newton_step(proj, r, y, a);
+    let k = 0.5 * PI / (proj.pole_to - proj.pole_from);
+    var a = 0.0;
+    for (var step = 0u; step < 6u; step++) {
+        var d = pole_fade(proj, a) * de;
+        if (step < 2u) {
+            d = select(de, 0.0, step == 1u);
+        }
+        let altitude = sphere_altitude(proj, r, y, d);
+        if (step == 0u) {
+            if (altitude.x <= proj.pole_from) {
+                return de;
+            }
+        } else if (step == 1u) {
+            if (altitude.x >= proj.pole_to) {
+                return 0.0;
+            }
+            a = clamp(altitude.x, proj.pole_from, proj.pole_to);
+        } else {
+            let g = altitude.x - a;
+            let dg = altitude.y * de * (-k * sin(k * (a - proj.pole_from))) - 1.0;
+            a = clamp(a - g / dg, proj.pole_from, proj.pole_to);
+        }
     }
     return pole_fade(proj, a) * de;
 }
