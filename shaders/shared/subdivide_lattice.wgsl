@@ -282,18 +282,14 @@ fn strip_step(walk: ptr<function, vec4<u32>>, piece_state: ptr<function, PieceSt
 // the node as a point along a segment (`Along`), placed by one call of `edge_point`.
 fn piece_node(k: u32, m: u32, row: ptr<function, vec2<u32>>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Node {
     var along: Along;
-    // Rows: `row` = (node a, row k), advanced along the row, then to the next; a node off the
-    // base row takes three steps (`row_along`).
-    let rows = (*piece_state).strip_base == ROWS_SHAPE;
-    let at = *row;
-    var steps = 1u;
     if ((*piece_state).strip_base == QUAD_STRIP) {
         along = quad_along(k, piece_state);
     } else if ((*piece_state).strip_base < 3u) {
         along = strip_along(k, part, piece_state);
-    } else if (rows) {
-        steps = select(3u, 1u, at.y == 0u);
-        *row = select(vec2<u32>(at.x + 1u, at.y), vec2<u32>(0u, at.y + 1u), at.x + 1u > (*piece_state).row_w[at.y]);
+    } else if ((*piece_state).strip_base == ROWS_SHAPE) {
+        // `row` = (node a, row k), advanced along the row, then to the next.
+        along = row_along((*row).y, (*row).x, part, piece_state);
+        *row = select(vec2<u32>((*row).x + 1u, (*row).y), vec2<u32>(0u, (*row).y + 1u), (*row).x + 1u > (*piece_state).row_w[(*row).y]);
     } else {
         // Node (i, j, l) of the lattice of level m (`lattice_node`): the regular lattice, whose
         // boundary nodes on an edge with fewer divisions snap to that edge's nearest node.
@@ -307,19 +303,7 @@ fn piece_node(k: u32, m: u32, row: ptr<function, vec2<u32>>, part: ptr<function,
         }
         along = along_edge(on.x, snap(on.y, (*piece_state).counts[on.x], m), part, piece_state);
     }
-    // One call site of edge_point (lavapipe inlines every call).
-    var ends: array<Node, 2>;
-    var node: Node;
-    for (var s = 0u; s < steps; s++) {
-        if (rows) {
-            along = row_along(at.y, at.x, s, &ends, part, piece_state);
-        }
-        node = edge_point(along.a, along.b, along.j, along.n);
-        if (s < 2u) {
-            ends[s] = node;
-        }
-    }
-    return node;
+    return edge_point(along.a, along.b, along.j, along.n);
 }
 
 // Candidate triangle t's slots (the strip's in walk order, advancing `walk`).

@@ -110,19 +110,18 @@ fn rows_from_measures(piece_state: ptr<function, PieceState>) -> vec2<u32> {
     return vec2<u32>(candidates, nodes);
 }
 
-// Node a of row k (`Rows::row_node`), as step s of the points `piece_node` finds from its one call
-// site of edge_point: on row 0 the base edge's own node (one step); else the row's left and right
-// ends (steps 0 and 1, the sides' nodes at the row's fraction), then the point a/w of the way
-// between them (step 2, from `ends`, the first two steps' nodes).
-fn row_along(k: u32, a: u32, s: u32, ends: ptr<function, array<Node, 2>>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Along {
+// Node a of row k (`Rows::row_node`): the base edge's own nodes on row 0, else the point a/w of
+// the way between the row's ends.
+fn row_along(k: u32, a: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Along {
     if (k == 0u) {
         return along_edge((*piece_state).row_base, a, part, piece_state);
     }
-    if (s < 2u) {
-        let at = row_end_index(k, s == 1u, (*piece_state).row_base, (*piece_state).strip_n);
-        return along_edge(at.x, at.y, part, piece_state);
+    // Its left and right ends from one call site of row_end (see `row_measures`).
+    var ends: array<Node, 2>;
+    for (var c = 0u; c < 2u; c++) {
+        ends[c] = row_end(k, c == 1u, part, piece_state);
     }
-    return Along((*ends)[0], (*ends)[1], a, max((*piece_state).row_w[k], 1u));
+    return Along(ends[0], ends[1], a, max((*piece_state).row_w[k], 1u));
 }
 
 // The next triangle of the rows' zipper (`Rows::triangles`) at `walk` = (i on row k, j on row

@@ -17,7 +17,7 @@ fn rows_from_measures(piece_state: ptr<function, PieceState>) -> vec2<u32> {
     return vec2<u32>(0xffffffffu, 0u);
 }
 
-fn row_along(k: u32, a: u32, s: u32, ends: ptr<function, array<Node, 2>>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Along {
+fn row_along(k: u32, a: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Along {
     return Along();
 }
 

@@ -162,9 +162,7 @@ fn write_nodes(first: u32, work: PieceWork, tri: ptr<function, InputTriangle>, p
 
 // A triangle item: the piece's candidates [item.y, item.y + chunk) from the walk in item.zw,
 // those drawn (their corners read from the nodes written) appended as indices, once per seam copy
-// that shows (`copy_shows`; the piece's reach in refs.w). Two rounds over the candidates from one
-// call site of the walk (lavapipe inlines every call): the first finds those drawn, the second,
-// after their room is taken, writes them.
+// that shows (`copy_shows`; the piece's reach in refs.w).
 fn write_triangles(item: vec4<u32>, work: PieceWork, piece_state: ptr<function, PieceState>) {
     let first = item.y;
     let end = min(first + chunk_of(work.copies), work.candidates);
@@ -176,37 +174,32 @@ fn write_triangles(item: vec4<u32>, work: PieceWork, piece_state: ptr<function, 
     // An image narrower than a turn of longitude (VR180): every triangle is tested, copies or
     // not (the seamless images' x is no longitude).
     let narrow = params.seamless == 0u && image_half_span() < PI;
-    let n = end - first;
-    var slot = 0u;
-    for (var i = 0u; i < 2u * n; i++) {
-        if (i == n) {
-            if (count == 0u) {
-                return;
-            }
-            let first_triangle = atomicAdd(&counters.triangles, count);
-            atomicMax(&counters.max_output, count);
-            if (first_triangle + count > params.triangle_capacity) {
-                return; // counted, never written
-            }
-            slot = 3u * first_triangle;
-            walk = start;
-        }
-        let t = first + i % n;
+    for (var t = first; t < end; t++) {
         let s = piece_triangle_slots(t, work.m, &walk, piece_state) + vec3<u32>(work.first_node);
-        let bits = (t - first) * work.copies;
-        if (i < n) {
-            let p = array<vec3<f32>, 3>(out_nodes[s.x].position, out_nodes[s.y].position, out_nodes[s.z].position);
-            if (candidate_drawn(p[0], p[1], p[2])) {
-                for (var c = 0u; c < work.copies; c++) {
-                    if ((work.copies == 1u && !narrow) || copy_shows(p, work.refs[c], work.refs.w)) {
-                        let bit = bits + c;
-                        drawn[bit / 32u] |= 1u << (bit % 32u);
-                        count += 1u;
-                    }
+        let p = array<vec3<f32>, 3>(out_nodes[s.x].position, out_nodes[s.y].position, out_nodes[s.z].position);
+        if (candidate_drawn(p[0], p[1], p[2])) {
+            for (var c = 0u; c < work.copies; c++) {
+                if ((work.copies == 1u && !narrow) || copy_shows(p, work.refs[c], work.refs.w)) {
+                    let bit = (t - first) * work.copies + c;
+                    drawn[bit / 32u] |= 1u << (bit % 32u);
+                    count += 1u;
                 }
             }
-            continue;
         }
+    }
+    if (count == 0u) {
+        return;
+    }
+    let first_triangle = atomicAdd(&counters.triangles, count);
+    atomicMax(&counters.max_output, count);
+    if (first_triangle + count > params.triangle_capacity) {
+        return; // counted, never written
+    }
+    walk = start;
+    var slot = 3u * first_triangle;
+    for (var t = first; t < end; t++) {
+        let local = piece_triangle_slots(t, work.m, &walk, piece_state);
+        let bits = (t - first) * work.copies;
         var any = false;
         for (var c = 0u; c < work.copies; c++) {
             let bit = bits + c;
@@ -215,6 +208,7 @@ fn write_triangles(item: vec4<u32>, work: PieceWork, piece_state: ptr<function, 
         if (!any) {
             continue;
         }
+        let s = local + vec3<u32>(work.first_node);
         if (params.measure_edges != 0u) {
             let ps = array<vec3<f32>, 3>(out_nodes[s.x].position, out_nodes[s.y].position, out_nodes[s.z].position);
             atomicMax(&counters.max_edge_bits, bitcast<u32>(visible_edge_px(ps)));
