@@ -48,8 +48,8 @@ impl Variant {
     /// The cut passes, built now if they are not yet.
     fn build_cut_passes(&self, gpu: &Gpu, stage: &GpuStage, passes: Passes) {
         self.cut_passes.get_or_init(|| {
-            let used = one_submission(1, passes, false).entries().filter(|e| CUT_PASSES.contains(e)).collect();
-            std::thread::scope(|scope| join(self.build.spawn(scope, gpu, stage, used)))
+            let used: Vec<_> = one_submission(1, passes, false).entries().filter(|e| CUT_PASSES.contains(e)).collect();
+            Builder::new(&self.build, gpu, stage).run(build_threads(), &used, |_| {})
         });
     }
 }
@@ -70,24 +70,123 @@ struct Build {
 }
 
 type Built = Vec<(&'static str, wgpu::ComputePipeline)>;
-type Building<'scope> = Vec<(&'static str, std::thread::ScopedJoinHandle<'scope, wgpu::ComputePipeline>)>;
 
-impl Build {
-    /// Starts building the pipelines of `entries`, each on a thread of `scope`.
-    fn spawn<'scope, 'env>(
-        &'env self,
-        scope: &'scope std::thread::Scope<'scope, 'env>,
-        gpu: &'env Gpu,
-        stage: &'env GpuStage,
-        entries: Vec<&'static str>,
-    ) -> Building<'scope> {
-        let build = move |e| move || stage.compute_standing_in(gpu, e, &self.constants, &self.stand_ins);
-        entries.into_iter().map(|e| (e, scope.spawn(build(e)))).collect()
+/// The passes by how long lavapipe takes to build them, longest first (`examples/shader_sizes`);
+/// the others (small) after them.
+const LONGEST_FIRST: [&str; 7] =
+    ["lattice", "plan_cuts", "lattice_rows_plan", "lattice_triangles", "lattice_nodes", "lattice_rows", "plan_parts"];
+
+/// What a variant's build threads share: the entry points still to build (the next at the end),
+/// whether more may come, and those built.
+struct Queue {
+    pending: Vec<&'static str>,
+    closed: bool,
+    built: Built,
+    /// A build thread panicked (its pipeline will never come).
+    failed: bool,
+}
+
+/// Pipelines built on as many threads as the CPU has cores, the longest first: the driver builds
+/// each on one thread, so the longest (`lattice`) is the floor of a variant's build, and a thread
+/// per pipeline made it share the cores with all the others until the end.
+struct Builder<'b> {
+    build: &'b Build,
+    gpu: &'b Gpu,
+    stage: &'b GpuStage,
+    queue: std::sync::Mutex<Queue>,
+    changed: std::sync::Condvar,
+}
+
+impl<'b> Builder<'b> {
+    fn new(build: &'b Build, gpu: &'b Gpu, stage: &'b GpuStage) -> Builder<'b> {
+        let queue = Queue { pending: Vec::new(), closed: false, built: Vec::new(), failed: false };
+        Builder { build, gpu, stage, queue: std::sync::Mutex::new(queue), changed: std::sync::Condvar::new() }
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, Queue> {
+        self.queue.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Queues `entries` before those waiting, longest first (in the order given where neither is
+    /// among [`LONGEST_FIRST`]).
+    fn push(&self, entries: &[&'static str]) {
+        let rank = |e: &str| LONGEST_FIRST.iter().position(|l| *l == e).unwrap_or(LONGEST_FIRST.len());
+        let mut first: Vec<&'static str> = entries.to_vec();
+        first.sort_by_key(|e| rank(e)); // stable
+        let mut queue = self.lock();
+        queue.pending.extend(first.into_iter().rev());
+        self.changed.notify_all();
+    }
+
+    /// One build thread: the next entry point until none is left and none may come.
+    fn work(&self) {
+        loop {
+            let entry = {
+                let mut queue = self.lock();
+                loop {
+                    if let Some(e) = queue.pending.pop() {
+                        break e;
+                    }
+                    if queue.closed {
+                        return;
+                    }
+                    queue = self.changed.wait(queue).unwrap_or_else(|e| e.into_inner());
+                }
+            };
+            // Whoever waits hears of a panic here rather than waiting for ever.
+            let failed = Failed(self);
+            let b = self.build;
+            let pipeline = self.stage.compute_standing_in(self.gpu, entry, &b.constants, &b.stand_ins);
+            std::mem::forget(failed);
+            self.lock().built.push((entry, pipeline));
+            self.changed.notify_all();
+        }
+    }
+
+    /// Waits until `entries` are built; their pipelines (handles: the threads go on meanwhile).
+    fn wait_for(&self, entries: &[&str]) -> Built {
+        let mut queue = self.lock();
+        while !entries.iter().all(|e| queue.built.iter().any(|(b, _)| b == e)) {
+            assert!(!queue.failed, "a pipeline build panicked");
+            queue = self.changed.wait(queue).unwrap_or_else(|e| e.into_inner());
+        }
+        queue.built.iter().filter(|(b, _)| entries.contains(b)).cloned().collect()
+    }
+
+    /// No more entry points: the threads end once the queue is empty.
+    fn close(&self) {
+        self.lock().closed = true;
+        self.changed.notify_all();
+    }
+
+    /// Builds `entries` on `threads` threads (and any queued while they run, until closed by
+    /// `during`, which runs beside them); all that was built.
+    fn run(self, threads: usize, entries: &[&'static str], during: impl FnOnce(&Builder)) -> Built {
+        self.push(entries);
+        std::thread::scope(|scope| {
+            for _ in 0..threads {
+                scope.spawn(|| self.work());
+            }
+            during(&self);
+            self.close();
+        });
+        self.queue.into_inner().unwrap_or_else(|e| e.into_inner()).built
     }
 }
 
-fn join(building: Building) -> Built {
-    building.into_iter().map(|(e, b)| (e, b.join().expect("a pipeline build panicked"))).collect()
+/// Marks the queue failed when dropped (a build thread unwinding).
+struct Failed<'a, 'b>(&'a Builder<'b>);
+
+impl Drop for Failed<'_, '_> {
+    fn drop(&mut self) {
+        self.0.lock().failed = true;
+        self.0.changed.notify_all();
+    }
+}
+
+/// Threads for a variant's build: the CPU's cores.
+fn build_threads() -> usize {
+    std::thread::available_parallelism().map_or(2, |n| n.get())
 }
 
 fn lookup<'a>(built: &'a Built, entry: &str) -> Option<&'a wgpu::ComputePipeline> {
@@ -113,10 +212,11 @@ impl SubdivideStage {
     /// The pipelines for a panorama (the cylinder with or without a tracked head, the sphere
     /// and VR180, the fisheye) and a frame's split rule (`params.method`): rows on the sphere
     /// under the adaptive rules only. Each leaves out the other panoramas' projection code.
-    /// Built side by side (the driver's compiling of the large passes, `plan_cuts` and `lattice`,
-    /// is most of a fresh process's time). With a `probe` (a frame's first use of the variant)
-    /// the cut passes ([`CUT_PASSES`]) are built only if it says the frame needs them: it runs
-    /// as soon as `plan`'s pipelines are built, the others still building.
+    /// Built side by side on as many threads as the CPU has cores, the longest first
+    /// ([`Builder`]: the driver's compiling of the large passes, `plan_cuts` and `lattice`, is
+    /// most of a fresh process's time). With a `probe` (a frame's first use of the variant) the
+    /// cut passes ([`CUT_PASSES`]) are built only if it says the frame needs them: it runs as
+    /// soon as `plan`'s pipelines are built, the others still building.
     fn variant(&self, gpu: &Gpu, panorama: PanoramaKind, params: &SubdivideParams, probe: Option<&Probe>) -> &Variant {
         let head = params.projection.head_on != 0.0;
         let (k, bits) = match panorama {
@@ -146,21 +246,25 @@ impl SubdivideStage {
             // frame's): `plan`'s, the cut passes, the others.
             let used: Vec<&'static str> = one_submission(1, passes, false).entries().collect();
             let (cuts, others): (Vec<_>, Vec<_>) = used.into_iter().partition(|e| CUT_PASSES.contains(e));
+            // `plan`'s first (the probe waits for them), then the others, longest first.
             let (probed, others): (Vec<_>, Vec<_>) = others.into_iter().partition(|e| PROBED.contains(e));
-            let (pipelines, cut_passes) = std::thread::scope(|scope| {
-                let probed = build.spawn(scope, gpu, stage, probed);
-                let others = build.spawn(scope, gpu, stage, others);
-                let mut pipelines = join(probed);
-                let cuts = match probe {
-                    Some(probe) if !probe(&|entry| lookup(&pipelines, entry)) => None,
-                    _ => Some(build.spawn(scope, gpu, stage, cuts)),
+            let all = [probed.as_slice(), others.as_slice()].concat();
+            let built = Builder::new(&build, gpu, stage).run(build_threads(), &all, |b| {
+                let needed = match probe {
+                    Some(probe) => {
+                        let built = b.wait_for(&probed);
+                        probe(&|entry| lookup(&built, entry))
+                    }
+                    None => true,
                 };
-                pipelines.extend(join(others));
-                (pipelines, cuts.map(join))
+                if needed {
+                    b.push(&cuts);
+                }
             });
+            let (cut_passes, pipelines): (Built, Built) = built.into_iter().partition(|(e, _)| CUT_PASSES.contains(e));
             let variant = Variant { pipelines, cut_passes: OnceLock::new(), build };
-            if let Some(built) = cut_passes {
-                variant.cut_passes.set(built).ok();
+            if !cut_passes.is_empty() || cuts.is_empty() {
+                variant.cut_passes.set(cut_passes).ok();
             }
             variant
         })
