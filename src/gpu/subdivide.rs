@@ -249,21 +249,19 @@ impl SubdivideStage {
             // `plan`'s first (the probe waits for them), then the others, longest first.
             let (probed, others): (Vec<_>, Vec<_>) = others.into_iter().partition(|e| PROBED.contains(e));
             let all = [probed.as_slice(), others.as_slice()].concat();
+            let mut needed = true;
             let built = Builder::new(&build, gpu, stage).run(build_threads(), &all, |b| {
-                let needed = match probe {
-                    Some(probe) => {
-                        let built = b.wait_for(&probed);
-                        probe(&|entry| lookup(&built, entry))
-                    }
-                    None => true,
-                };
+                if let Some(probe) = probe {
+                    let built = b.wait_for(&probed);
+                    needed = probe(&|entry| lookup(&built, entry));
+                }
                 if needed {
                     b.push(&cuts);
                 }
             });
             let (cut_passes, pipelines): (Built, Built) = built.into_iter().partition(|(e, _)| CUT_PASSES.contains(e));
             let variant = Variant { pipelines, cut_passes: OnceLock::new(), build };
-            if !cut_passes.is_empty() || cuts.is_empty() {
+            if needed {
                 variant.cut_passes.set(cut_passes).ok();
             }
             variant
@@ -366,6 +364,9 @@ impl SubdivideStage {
         counters: &SubdivideCounters,
     ) -> bool {
         let variant = self.variant(gpu, panorama, params, None);
+        if variant.cut_passes.get().is_some() {
+            return false; // every frame once they are built
+        }
         let passes = Passes::of(panorama, params.method);
         let recording = one_submission(params.triangle_count, passes, false);
         if missed(&recording, params, counters, panorama, |e| variant.pipeline(e).is_some()).is_empty() {
