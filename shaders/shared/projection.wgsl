@@ -58,6 +58,12 @@ struct Projection {
 // the cylinder's subdivision three times slower.
 override PANORAMAS: u32 = 31u;
 
+// Whether the sphere's rays may converge (`Projection::convergence` > 0). On lavapipe every lane
+// runs the code behind a uniform's test whether or not one needs it (the converging eye model's
+// root and divisions at every projection of the sphere): the subdivide stage's pipelines for
+// parallel rays are built with it false, compiling that code out.
+override CONVERGING: bool = true;
+
 fn is_sphere(proj: Projection) -> bool {
     return (PANORAMAS & 2u) != 0u && ((PANORAMAS & 1u) == 0u || proj.panorama != PANORAMA_CYLINDER);
 }

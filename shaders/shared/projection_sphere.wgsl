@@ -7,7 +7,7 @@
 
 // e and de/dd: the eye ray's distance from P's vertical line along `side`, for eye offset d ≥ 0.
 fn sphere_e_slope(proj: Projection, r: f32, y: f32, d: f32) -> vec2<f32> {
-    if (proj.convergence <= 0.0) {
+    if (!CONVERGING || proj.convergence <= 0.0) {
         return vec2<f32>(d, 1.0);
     }
     let d2 = d * d;

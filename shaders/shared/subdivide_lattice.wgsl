@@ -519,7 +519,7 @@ fn sphere_u_bound(q: array<Node, 3>, theta_c: f32) -> vec3<f32> {
     let f = footprint(q, theta_c);
     let proj = params.projection;
     var reach = 0.5 * PI;
-    if (proj.convergence <= 0.0) {
+    if (!CONVERGING || proj.convergence <= 0.0) {
         reach = asin(min(proj.eye_radius / max(f.z, 1e-30), 1.0));
     }
     return vec3<f32>(f.x - reach, f.y + reach, reach);

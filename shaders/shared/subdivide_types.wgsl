@@ -38,6 +38,11 @@ struct SubdivideParams {
     seamless: u32,       // 1: the image has no seam: no seam copies (`SubdivideParams::seamless`)
 }
 
+// Whether the pipeline may measure the longest visible output edge (`measure_edges`): built
+// false for the frames that do not (a render's), whose lanes would otherwise all run it on
+// lavapipe (CONVERGING in projection.wgsl).
+override MEASURE_EDGES: bool = true;
+
 struct Counters {
     pieces: atomic<u32>,
     triangles: atomic<u32>,

@@ -209,7 +209,7 @@ fn write_triangles(item: vec4<u32>, work: PieceWork, piece_state: ptr<function, 
             continue;
         }
         let s = local + vec3<u32>(work.first_node);
-        if (params.measure_edges != 0u) {
+        if (MEASURE_EDGES && params.measure_edges != 0u) {
             let ps = array<vec3<f32>, 3>(out_nodes[s.x].position, out_nodes[s.y].position, out_nodes[s.z].position);
             atomicMax(&counters.max_edge_bits, bitcast<u32>(visible_edge_px(ps)));
         }

@@ -65,7 +65,7 @@ type Pipelines<'p> = &'p dyn Fn(&str) -> Option<&'p wgpu::ComputePipeline>;
 
 /// How a variant's pipelines are built: its constants and stand-ins.
 struct Build {
-    constants: [(&'static str, f64); 1],
+    constants: [(&'static str, f64); 3],
     stand_ins: Vec<StandIn>,
 }
 
@@ -200,18 +200,22 @@ fn lookup<'a>(built: &'a Built, entry: &str) -> Option<&'a wgpu::ComputePipeline
 /// (`subdivide_rows_off`): lavapipe builds a pipeline about twice as long with the code merely in it).
 pub(crate) struct SubdivideStage {
     stage: GpuStage,
-    variants: [OnceLock<Variant>; 16],
+    variants: [OnceLock<Variant>; 64],
 }
 
 impl SubdivideStage {
     /// The stage; each panorama's pipelines are built when a frame first needs them.
     pub fn new(gpu: &Gpu) -> SubdivideStage {
-        SubdivideStage { stage: GpuStage::new(gpu, &SUBDIVIDE), variants: Default::default() }
+        SubdivideStage { stage: GpuStage::new(gpu, &SUBDIVIDE), variants: std::array::from_fn(|_| OnceLock::new()) }
     }
 
     /// The pipelines for a panorama (the cylinder with or without a tracked head, the sphere
     /// and VR180, the fisheye) and a frame's split rule (`params.method`): rows on the sphere
-    /// under the adaptive rules only. Each leaves out the other panoramas' projection code.
+    /// under the adaptive rules only. Each leaves out the other panoramas' projection code, and
+    /// where the frame has parallel rays or measures no edges, the converging eye model and the
+    /// edge measure (`CONVERGING`, `MEASURE_EDGES`): lavapipe's lanes run the code behind a
+    /// uniform's test whether or not one takes it (the two cost a render's sphere frame about a
+    /// tenth of its subdivision).
     /// Built side by side on as many threads as the CPU has cores, the longest first
     /// ([`Builder`]: the driver's compiling of the large passes, `plan_cuts` and `lattice`, is
     /// most of a fresh process's time). With a `probe` (a frame's first use of the variant) the
@@ -228,7 +232,12 @@ impl SubdivideStage {
         let passes = Passes::of(panorama, params.method);
         let rows = passes.rows;
         let spacing = params.by_azimuth != 0;
-        self.variants[4 * k + 2 * rows as usize + spacing as usize].get_or_init(|| {
+        // Code behind a uniform's test costs lavapipe's SIMD lanes its time whether or not any
+        // lane runs it: the frames that never run it get pipelines without it.
+        let converging = params.projection.convergence > 0.0;
+        let measuring = params.measure_edges != 0;
+        let index = 32 * converging as usize + 16 * measuring as usize + 4 * k + 2 * rows as usize + spacing as usize;
+        self.variants[index].get_or_init(|| {
             let mut stand_ins: Vec<StandIn> = match (k, rows) {
                 (0, _) => vec![ROWS_OFF, SPHERE_OFF, FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
                 (1, _) => vec![ROWS_OFF, SPHERE_OFF, FISHEYE_OFF, CUBEMAP_OFF, CAVE_OFF],
@@ -240,7 +249,9 @@ impl SubdivideStage {
             if !spacing {
                 stand_ins.push(SPACING_OFF);
             }
-            let build = Build { constants: [("PANORAMAS", bits)], stand_ins };
+            let flag = |on: bool| if on { 1.0 } else { 0.0 };
+            let constants = [("PANORAMAS", bits), ("CONVERGING", flag(converging)), ("MEASURE_EDGES", flag(measuring))];
+            let build = Build { constants, stand_ins };
             let stage = &self.stage;
             // The entry points this frame's schedules dispatch (every schedule's are the usual
             // frame's): `plan`'s, the cut passes, the others.

@@ -102,6 +102,13 @@ fn subdivide_cases() -> Vec<(Scene, RenderSettings)> {
             RenderSettings::new(Projection { convergence: Some(2.0), pole_merge: None, ..Projection::equirect(192) })
                 .with_method(Method::Vertex),
         ),
+        // Converging rays under the error split, measured: the pipelines keep the converging
+        // eye model and the edge measure, which those of a render's frame leave out.
+        (
+            builtin::demo(),
+            RenderSettings::new(Projection { convergence: Some(2.0), ..Projection::equirect(192) })
+                .with_measure_edges(true),
+        ),
         (random_triangle_scene(7, 200), RenderSettings::new(Projection::equirect(256)).with_method(Method::Fixed(3))),
         // VR180: the sphere's front half (the back's pieces, beyond the image's sides, are not
         // drawn; nor the triangles of the pieces reaching round them).
