@@ -53,12 +53,13 @@ fn sphere_altitude(proj: Projection, r: f32, y: f32, d: f32) -> vec2<f32> {
     return vec2<f32>(precise_atan2(abs(y), h), abs(y) * e.x * e.y / (h * (h * h + y * y)));
 }
 
-// The eye offset f(|φ|)·d_e at which a point is seen: the root of φ = φ(f(φ)·d_e), by four Newton
-// steps on g(a) = altitude(f(a)·d_e) − a (`sphere_eye_offset` in projection.rs). One loop, one
-// call site of the altitude (lavapipe inlines every call site, and this runs at every
-// projection): step 0 the altitude at the full offset (below the merge: d_e), step 1 at none
-// (beyond it: 0; else Newton's start), steps 2–5 the Newton steps; six of the 65,535 loop
-// iterations lavapipe allows an invocation.
+// The eye offset f(|φ|)·d_e at which a point is seen: the root of φ = φ(f(φ)·d_e), by Newton
+// steps on g(a) = altitude(f(a)·d_e) − a from the altitude at full offset (below the merge: d_e),
+// at most SPHERE_NEWTON_STEPS, until one moves a by at most SPHERE_NEWTON_TOLERANCE
+// (`sphere_eye_offset` in sphere.rs). One loop, one call site of the altitude (lavapipe inlines
+// every call site, and this runs at every projection): step 0 the altitude at the full offset,
+// then the Newton steps. The loop ends for a group of lanes once all of theirs have converged
+// (most often after two steps): lavapipe runs every step's code for every lane of the group.
 fn sphere_eye_offset(proj: Projection, r: f32, y: f32) -> f32 {
     let de = proj.eye_radius;
     if (proj.pole_to <= 0.0) {
@@ -66,25 +67,26 @@ fn sphere_eye_offset(proj: Projection, r: f32, y: f32) -> f32 {
     }
     let k = 0.5 * PI / (proj.pole_to - proj.pole_from);
     var a = 0.0;
-    for (var step = 0u; step < 6u; step++) {
-        var d = pole_fade(proj, a) * de;
-        if (step < 2u) {
-            d = select(de, 0.0, step == 1u);
+    for (var step = 0u; step <= SPHERE_NEWTON_STEPS; step++) {
+        var d = de;
+        if (step > 0u) {
+            d = pole_fade(proj, a) * de;
         }
         let altitude = sphere_altitude(proj, r, y, d);
         if (step == 0u) {
             if (altitude.x <= proj.pole_from) {
                 return de;
             }
-        } else if (step == 1u) {
-            if (altitude.x >= proj.pole_to) {
-                return 0.0;
-            }
             a = clamp(altitude.x, proj.pole_from, proj.pole_to);
         } else {
             let g = altitude.x - a;
             let dg = altitude.y * de * (-k * sin(k * (a - proj.pole_from))) - 1.0;
-            a = clamp(a - g / dg, proj.pole_from, proj.pole_to);
+            let next = clamp(a - g / dg, proj.pole_from, proj.pole_to);
+            let converged = abs(next - a) <= SPHERE_NEWTON_TOLERANCE;
+            a = next;
+            if (converged) {
+                break;
+            }
         }
     }
     return pole_fade(proj, a) * de;

@@ -28,6 +28,12 @@ use glam::Vec3;
 
 use crate::core::projection::{horizontal_radius, Eye, Projection};
 
+/// The most Newton steps the pole merge's eye offset takes ([`Projection::sphere_eye_offset`]).
+pub const SPHERE_NEWTON_STEPS: u32 = 4;
+/// A Newton step that moves the altitude by at most this many radians ends the pole merge's
+/// steps: the next would move it by about its square (10⁻¹⁰ rad, far below a pixel).
+pub const SPHERE_NEWTON_TOLERANCE: f32 = 1e-5;
+
 impl Projection {
     /// The sphere's pole merge: the factor on the eye offset for a ray of altitude `a` radians
     /// (≥ 0). `pole_fade` in projection.wgsl.
@@ -90,33 +96,38 @@ impl Projection {
     }
 
     /// The eye offset d = f(|φ|)·d_e at which a point is seen, the same for both eyes: the root
-    /// of g(a) = A(f(a)·d_e) − a, A the altitude at offset d (see the module doc). The closed forms
-    /// where the altitude at full offset is below FROM or at zero offset beyond TO; else
-    /// `SPHERE_NEWTON_STEPS` Newton steps from the altitude seen from the centre (g' = A'·d_e·f' − 1
-    /// ≤ −1: g falls steeply, so the steps converge fast). The GPU twin (`sphere_eye_offset` in
-    /// projection_sphere.wgsl) runs the steps in a loop: one inlined copy of a step in its
-    /// pipelines, four of the 65,535 loop iterations lavapipe allows an invocation.
+    /// of g(a) = A(f(a)·d_e) − a, A the altitude at offset d (see the module doc). The closed
+    /// form d_e where the altitude at full offset is below FROM; else Newton steps from that
+    /// altitude (clamped to [FROM, TO]; the root lies between it and the altitude seen from the
+    /// centre, A growing with d), at most [`SPHERE_NEWTON_STEPS`], until one moves a by at most
+    /// [`SPHERE_NEWTON_TOLERANCE`] (g' = A'·d_e·f' − 1 ≤ −1: g falls steeply, and the steps
+    /// converge fast: the next would move a by about the square of the last). A point seen
+    /// beyond TO from the centre ends at TO, whose fade is 0. The GPU twin (`sphere_eye_offset`
+    /// in projection_sphere.wgsl) runs the same steps in a loop, which ends for a group of
+    /// lanes once every lane's steps have converged (two steps, most often, on lavapipe).
     pub fn sphere_eye_offset(&self, r: f32, y: f32) -> f32 {
         let de = self.eye_radius;
         let Some((from, to)) = self.pole_merge else {
             return de;
         };
         let (from, to) = (from.to_radians(), to.to_radians());
-        if self.sphere_altitude(r, y, de).0 <= from {
+        let full = self.sphere_altitude(r, y, de).0;
+        if full <= from {
             return de;
         }
-        let centre = self.sphere_altitude(r, y, 0.0).0;
-        if centre >= to {
-            return 0.0;
-        }
         let k = std::f32::consts::FRAC_PI_2 / (to - from);
-        let step = |a: f32| {
+        let mut a = full.clamp(from, to);
+        for _ in 0..SPHERE_NEWTON_STEPS {
             let (altitude, slope) = self.sphere_altitude(r, y, self.pole_fade(a) * de);
             let g = altitude - a;
             let dg = slope * de * (-k * (k * (a - from)).sin()) - 1.0;
-            (a - g / dg).clamp(from, to)
-        };
-        let a = step(step(step(step(centre.clamp(from, to)))));
+            let next = (a - g / dg).clamp(from, to);
+            let converged = (next - a).abs() <= SPHERE_NEWTON_TOLERANCE;
+            a = next;
+            if converged {
+                break;
+            }
+        }
         self.pole_fade(a) * de
     }
 

@@ -6,6 +6,7 @@ use crate::core::light::{LightKind, Tonemap};
 use crate::core::material::{AlphaMode, Filter, Mipmap, Wrap, NO_TEXTURE};
 use crate::core::projection::PanoramaKind;
 use crate::core::settings::SplitRule;
+use crate::core::sphere::{SPHERE_NEWTON_STEPS, SPHERE_NEWTON_TOLERANCE};
 use crate::core::visual_field::{CENTRAL_RADIUS, FIELD_DOWN, FIELD_SIDEWAYS, FIELD_UP};
 
 /// Largest edge count the adaptive method asks for (edges longer than this many L are capped).
@@ -181,6 +182,8 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("FIELD_DOWN", F32(FIELD_DOWN)),
         ("PIECES_FROM_COUNTER", U32(PIECES_FROM_COUNTER)),
         ("LATTICE_CHUNK", U32(LATTICE_CHUNK)),
+        ("SPHERE_NEWTON_STEPS", U32(SPHERE_NEWTON_STEPS)),
+        ("SPHERE_NEWTON_TOLERANCE", F32(SPHERE_NEWTON_TOLERANCE)),
         ("MAX_DEPTH", F32(MAX_DEPTH)),
         ("GUARD_BAND_PX", F32(GUARD_BAND_PX)),
         ("FINE_BINS", U32(FINE_BINS)),
