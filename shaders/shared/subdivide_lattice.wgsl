@@ -230,24 +230,26 @@ fn node_slot(c: vec3<u32>, m: u32) -> u32 {
 
 // ---- the strip of a sliver piece (`strip_triangles` in subdivide.rs) ----
 
+const LATTICE_SHAPE: u32 = 3u; // `strip_base` of a piece drawn as the regular lattice (0–2: a strip's base)
+
 // On the cylinder, under the error split, the base edge (one part, chord error within
 // STRIP_BASE_ERROR·τ by the quick profile, away from the eye circle) of a piece with another edge
-// in STRIP_MIN_DIVISIONS or more parts; 3: the regular lattice (`strip_base` in subdivide.rs).
+// in STRIP_MIN_DIVISIONS or more parts; LATTICE_SHAPE: the regular lattice (`strip_base` in subdivide.rs).
 fn strip_base_of(tri: ptr<function, InputTriangle>, piece_state: ptr<function, PieceState>) -> u32 {
     let m = max(max((*piece_state).counts[0], (*piece_state).counts[1]), (*piece_state).counts[2]);
     if (params.method != METHOD_ERROR || is_sphere(params.projection) || m < STRIP_MIN_DIVISIONS) {
-        return 3u;
+        return LATTICE_SHAPE;
     }
-    var base = 3u;
+    var base = LATTICE_SHAPE;
     for (var e = 0u; e < 3u; e++) {
-        if (base == 3u && (*piece_state).counts[e] == 1u) {
+        if (base == LATTICE_SHAPE && (*piece_state).counts[e] == 1u) {
             base = e;
         }
     }
-    if (base < 3u) {
+    if (base < LATTICE_SHAPE) {
         let p = edge_profile((*piece_state).corner[base].position, (*piece_state).corner[(base + 1u) % 3u].position, 2u);
         if (!profile_straight(p, STRIP_BASE_ERROR, (*tri).max_error_px)) {
-            return 3u;
+            return LATTICE_SHAPE;
         }
     }
     return base;

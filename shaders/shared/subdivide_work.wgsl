@@ -66,7 +66,7 @@ fn plan_work(index: u32, shape: PieceShape, seam: SeamCopies, tri: ptr<function,
     let triangle_items = (shape.candidates + chunk - 1u) / chunk;
     let back = atomicAdd(&counters.triangle_items, triangle_items);
     // The lattice's candidates are found from their index; the others' by walking.
-    let walked = work.shape != 3u;
+    let walked = work.shape != LATTICE_SHAPE;
     var walk = vec4<u32>(0u);
     for (var t = 0u; t < shape.candidates; t++) {
         if (t % chunk == 0u) {
@@ -148,16 +148,30 @@ fn node_row_at(k: u32, m: u32, piece_state: ptr<function, PieceState>) -> vec2<u
 }
 
 // A node item: the piece's nodes in slots [first, first + chunk), written once per seam copy.
+// A piece that is one lattice triangle (most of a scene's pieces) has its corners for nodes
+// (slot k is corner k, the bits `piece_node` gives them): they come from a loop of their own, and
+// the general loop runs no step for it. A group of lavapipe's lanes runs a loop's body as often
+// as its busiest lane (and once when none is), every branch of the body for every lane: a group
+// of single triangles runs `piece_node` once rather than three times.
 fn write_nodes(first: u32, work: PieceWork, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
     let end = min(first + chunk_of(work.copies), work.node_count);
-    var row = node_row_at(first, work.m, piece_state);
-    for (var k = first; k < end; k++) {
-        let node = piece_node(k, work.m, &row, part, piece_state);
-        for (var c = 0u; c < work.copies; c++) {
-            out_nodes[work.first_node + c * work.node_count + k] = draw_vertex(node, work.refs[c], tri);
-        }
+    let corners_only = work.shape == LATTICE_SHAPE && work.m == 1u;
+    var k = first;
+    for (; k < select(first, end, corners_only); k++) {
+        write_node((*piece_state).corner[k], k, work, tri);
+    }
+    var row = node_row_at(k, work.m, piece_state);
+    for (; k < end; k++) {
+        write_node(piece_node(k, work.m, &row, part, piece_state), k, work, tri);
     }
     atomicMax(&counters.max_output, (end - first) * work.copies);
+}
+
+// Node slot k of a piece, once per seam copy.
+fn write_node(node: Node, k: u32, work: PieceWork, tri: ptr<function, InputTriangle>) {
+    for (var c = 0u; c < work.copies; c++) {
+        out_nodes[work.first_node + c * work.node_count + k] = draw_vertex(node, work.refs[c], tri);
+    }
 }
 
 // A triangle item: the piece's candidates [item.y, item.y + chunk) from the walk in item.zw,

@@ -38,7 +38,7 @@ fn lattice_rows_plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
     let rows = rows_from_measures(&piece_state);
     let c = piece_state.corner;
     var shape = PieceShape(work.m, work.candidates, work.node_count, azimuth((c[0].position + c[1].position + c[2].position) / 3.0));
-    piece_state.strip_base = 3u;
+    piece_state.strip_base = LATTICE_SHAPE;
     if (rows.x < shape.candidates) {
         piece_state.strip_base = ROWS_SHAPE;
         shape.candidates = rows.x;
