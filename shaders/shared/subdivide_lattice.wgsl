@@ -232,6 +232,13 @@ fn node_slot(c: vec3<u32>, m: u32) -> u32 {
 
 const LATTICE_SHAPE: u32 = 3u; // `strip_base` of a piece drawn as the regular lattice (0–2: a strip's base)
 
+// Whether a piece may be a sliver's strip or a band quad: on the cylinder only (`strip_base_of`,
+// `plan_quad`). The sphere's pipelines compile their code out of the tests below, which lavapipe's
+// lanes would otherwise all run whatever their piece's shape.
+fn cylinder_shapes() -> bool {
+    return !is_sphere(params.projection);
+}
+
 // On the cylinder, under the error split, the base edge (one part, chord error within
 // STRIP_BASE_ERROR·τ by the quick profile, away from the eye circle) of a piece with another edge
 // in STRIP_MIN_DIVISIONS or more parts; LATTICE_SHAPE: the regular lattice (`strip_base` in subdivide.rs).
@@ -284,9 +291,9 @@ fn strip_step(walk: ptr<function, vec4<u32>>, piece_state: ptr<function, PieceSt
 // the node as a point along a segment (`Along`), placed by one call of `edge_point`.
 fn piece_node(k: u32, m: u32, row: ptr<function, vec2<u32>>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Node {
     var along: Along;
-    if ((*piece_state).strip_base == QUAD_STRIP) {
+    if (cylinder_shapes() && (*piece_state).strip_base == QUAD_STRIP) {
         along = quad_along(k, piece_state);
-    } else if ((*piece_state).strip_base < 3u) {
+    } else if (cylinder_shapes() && (*piece_state).strip_base < LATTICE_SHAPE) {
         along = strip_along(k, part, piece_state);
     } else if ((*piece_state).strip_base == ROWS_SHAPE) {
         // `row` = (node a, row k), advanced along the row, then to the next.
@@ -310,14 +317,14 @@ fn piece_node(k: u32, m: u32, row: ptr<function, vec2<u32>>, part: ptr<function,
 
 // Candidate triangle t's slots (the strip's in walk order, advancing `walk`).
 fn piece_triangle_slots(t: u32, m: u32, walk: ptr<function, vec4<u32>>, piece_state: ptr<function, PieceState>) -> vec3<u32> {
-    if ((*piece_state).strip_base == QUAD_STRIP) {
+    if (cylinder_shapes() && (*piece_state).strip_base == QUAD_STRIP) {
         return quad_step(walk, piece_state);
     }
     if ((*piece_state).strip_base == ROWS_SHAPE) {
         var at: array<vec2<u32>, 3>;
         return rows_step(walk, &at, piece_state);
     }
-    if ((*piece_state).strip_base < 3u) {
+    if (cylinder_shapes() && (*piece_state).strip_base < LATTICE_SHAPE) {
         return strip_step(walk, piece_state);
     }
     let cell = macro_cell(m, t);

@@ -113,7 +113,7 @@ fn plan_pending(index: u32, shape: PieceShape, piece_state: ptr<function, PieceS
 fn load_work(index: u32, work: PieceWork, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
     let piece = pieces[index];
     record_corners(piece, part);
-    if ((piece.count2_level & QUAD_HEAD) != 0u) {
+    if (cylinder_shapes() && (piece.count2_level & QUAD_HEAD) != 0u) {
         quad_shape(piece, pieces[index + 1u], part, piece_state);
         return;
     }

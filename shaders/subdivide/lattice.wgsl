@@ -36,13 +36,13 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     }
     let index = params.first_piece + local;
     let piece = pieces[index];
-    if ((piece.count2_level & QUAD_TAIL) != 0u) {
+    if (cylinder_shapes() && (piece.count2_level & QUAD_TAIL) != 0u) {
         return; // drawn by the quad's first record
     }
     load_triangle(piece.triangle, &tri);
     record_corners(piece, &part);
     var shape: PieceShape;
-    if ((piece.count2_level & QUAD_HEAD) != 0u) {
+    if (cylinder_shapes() && (piece.count2_level & QUAD_HEAD) != 0u) {
         shape = quad_shape(piece, pieces[index + 1u], &part, &piece_state);
     } else {
         shape = lattice_shape(piece, &tri, &part, &piece_state);
