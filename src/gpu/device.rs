@@ -274,10 +274,20 @@ impl Gpu {
 
     /// A uniform buffer for a `T`, written with `queue.write_buffer` before each use.
     pub fn uniform_buffer<T: bytemuck::Pod>(&self, label: &str) -> wgpu::Buffer {
+        self.params_buffer::<T>(label, wgpu::BufferUsages::UNIFORM)
+    }
+
+    /// A read-only storage buffer for a `T`, written likewise: parameters that lavapipe must not
+    /// inline (the `subdivide` stage's, subdivide_bindings.wgsl).
+    pub fn storage_params_buffer<T: bytemuck::Pod>(&self, label: &str) -> wgpu::Buffer {
+        self.params_buffer::<T>(label, wgpu::BufferUsages::STORAGE)
+    }
+
+    fn params_buffer<T: bytemuck::Pod>(&self, label: &str, usage: wgpu::BufferUsages) -> wgpu::Buffer {
         self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
             size: std::mem::size_of::<T>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: usage | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         })
     }

@@ -115,7 +115,7 @@ impl Renderer {
                 buffers: None,
                 targets: None,
                 timestamps: Timestamps::new(&gpu),
-                subdivide_params: gpu.uniform_buffer::<SubdivideParams>("subdivide params"),
+                subdivide_params: gpu.storage_params_buffer::<SubdivideParams>("subdivide params"),
                 raster_params: gpu.device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("raster params"),
                     size: crate::gpu::frame::raster_params_stride(&gpu) * crate::core::cubemap::CUBE_FACES.len() as u64,

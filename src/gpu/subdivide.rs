@@ -338,7 +338,7 @@ impl SubdivideStage {
         &self,
         gpu: &Gpu,
         enc: &mut wgpu::CommandEncoder,
-        uniform: &wgpu::Buffer,
+        params_buffer: &wgpu::Buffer,
         scene: &GpuScene,
         b: &SubdivisionBuffers,
         params: &SubdivideParams,
@@ -346,8 +346,8 @@ impl SubdivideStage {
         timestamps: Option<&Timestamps>,
     ) {
         let params = SubdivideParams { first_piece: 0, piece_count: PIECES_FROM_COUNTER, ..*params };
-        gpu.queue.write_buffer(uniform, 0, bytemuck::bytes_of(&params));
-        let frame = FrameBuffers { uniform, scene, b };
+        gpu.queue.write_buffer(params_buffer, 0, bytemuck::bytes_of(&params));
+        let frame = FrameBuffers { params: params_buffer, scene, b };
         let passes = Passes::of(panorama, params.method);
         let recording = one_submission(params.triangle_count, passes, timestamps.is_some());
         let probe = |pipelines: Pipelines| {
@@ -387,7 +387,7 @@ impl SubdivideStage {
         true
     }
 
-    /// Replays `recording` with `params` as the uniform for a frame's buffers, submitted; the
+    /// Replays `recording` with `params` as the parameters of a frame's buffers, submitted; the
     /// counters afterwards. Every pipeline it names is built first.
     pub fn submit(
         &self,
@@ -399,7 +399,7 @@ impl SubdivideStage {
     ) -> Result<SubdivideCounters> {
         let variant = self.variant(gpu, panorama, params, None);
         variant.build_cut_passes(gpu, &self.stage, Passes::of(panorama, params.method));
-        gpu.queue.write_buffer(frame.uniform, 0, bytemuck::bytes_of(params));
+        gpu.queue.write_buffer(frame.params, 0, bytemuck::bytes_of(params));
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         self.replay(gpu, &mut enc, recording, frame, &|e| variant.pipeline(e), None);
         gpu.queue.submit([enc.finish()]);
@@ -423,7 +423,7 @@ impl SubdivideStage {
                 gpu,
                 scene,
                 panorama: settings.projection().panorama,
-                uniform: gpu.uniform_buffer::<SubdivideParams>("subdivide params"),
+                params: gpu.storage_params_buffer::<SubdivideParams>("subdivide params"),
                 cache: None,
                 nodes: Vec::new(),
                 indices: Vec::new(),
@@ -441,7 +441,7 @@ struct Readback<'a> {
     gpu: &'a Gpu,
     scene: &'a GpuScene,
     panorama: PanoramaKind,
-    uniform: wgpu::Buffer,
+    params: wgpu::Buffer,
     cache: Option<SubdivisionBuffers>,
     nodes: Vec<DrawVertex>,
     indices: Vec<u32>,
@@ -454,7 +454,7 @@ impl SubdivisionEngine for Readback<'_> {
 
     fn replay(&mut self, recording: &Recording, params: &SubdivideParams) -> Result<SubdivideCounters> {
         let b = self.cache.as_ref().expect("ensured before a replay");
-        let frame = FrameBuffers { uniform: &self.uniform, scene: self.scene, b };
+        let frame = FrameBuffers { params: &self.params, scene: self.scene, b };
         self.stage.submit(self.gpu, recording, &frame, params, self.panorama)
     }
 
@@ -469,9 +469,9 @@ impl SubdivisionEngine for Readback<'_> {
     }
 }
 
-/// The buffers a subdivision's recording names: the uniform, the scene's, the frame's.
+/// The buffers a subdivision's recording names: the parameters, the scene's, the frame's.
 pub(crate) struct FrameBuffers<'f> {
-    pub uniform: &'f wgpu::Buffer,
+    pub params: &'f wgpu::Buffer,
     pub scene: &'f GpuScene,
     pub b: &'f SubdivisionBuffers,
 }
@@ -481,7 +481,7 @@ impl FrameBuffers<'_> {
     fn named(&self, name: &str) -> &wgpu::Buffer {
         let (scene, b) = (self.scene, self.b);
         match name {
-            "params" => self.uniform,
+            "params" => self.params,
             "vertices" => &scene.vertices,
             "indices" => &scene.indices,
             "pieces" => &b.pieces,

@@ -337,7 +337,7 @@ impl SubdivisionEngine for ChunkDraw<'_> {
     fn replay(&mut self, recording: &Recording, params: &SubdivideParams) -> Result<SubdivideCounters> {
         let t = Instant::now();
         let b = self.res.buffers.as_ref().expect("ensured before a replay");
-        let frame = FrameBuffers { uniform: &self.res.subdivide_params, scene: self.scene, b };
+        let frame = FrameBuffers { params: &self.res.subdivide_params, scene: self.scene, b };
         let counters = self.method.subdivide.submit(self.gpu, recording, &frame, params, self.panorama)?;
         self.clock.subdivide += t.elapsed().as_secs_f64() * 1e3;
         Ok(counters)

@@ -289,7 +289,7 @@ pub const SUBDIVIDE: Stage = Stage {
         pass("finalize", &["params", "counters", "draw_args"], include_str!("../../shaders/subdivide/finalize.wgsl")),
     ],
     bindings: &[
-        bind(0, 0, "params", Uniform),
+        bind(0, 0, "params", Storage),
         bind(0, 1, "vertices", Storage),
         bind(0, 2, "indices", Storage),
         bind(0, 3, "pieces", StorageReadWrite),
