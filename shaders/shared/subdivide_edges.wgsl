@@ -158,7 +158,7 @@ fn edge_divisions(a: vec3<f32>, b: vec3<f32>, tri: ptr<function, InputTriangle>)
 // What an adaptive rule reads of round `round` of an edge's profiles (`edge_divisions`): after
 // the quick one, 1 where the edge needs no more, else 0; after the full one, its parts.
 fn divisions_of(round: u32, p: EdgeProfile, segments: u32, tri: ptr<function, InputTriangle>) -> f32 {
-    let by_length = params.method == METHOD_ADAPTIVE;
+    let by_length = split_rule() == METHOD_ADAPTIVE;
     if (round == 0u) {
         let whole = select(p.length_px <= (*tri).edge_px && profile_straight(p, 1.0, (*tri).max_error_px),
                            p.length_px <= 0.5 * (*tri).edge_px, by_length);
@@ -230,7 +230,7 @@ fn load_triangle(t: u32, tri: ptr<function, InputTriangle>) {
 
 // Whether the method is one of the adaptive rules (eq. 5 or the error split).
 fn is_adaptive() -> bool {
-    return params.method == METHOD_ADAPTIVE || params.method == METHOD_ERROR;
+    return split_rule() == METHOD_ADAPTIVE || split_rule() == METHOD_ERROR;
 }
 
 // Edge counts and macro-lattice level of the current part.
@@ -253,7 +253,7 @@ fn edge_counts(c: array<vec3<f32>, 3>, wanted: vec3<bool>, tri: ptr<function, In
     var count = 0u;
     for (var e = 0u; e < 3u; e++) {
         if (wanted[e]) {
-            n[e] = select(params.fixed_n, 1u, params.method == METHOD_VERTEX);
+            n[e] = select(params.fixed_n, 1u, split_rule() == METHOD_VERTEX);
             list[count] = e;
             count += 1u;
         }
@@ -285,7 +285,7 @@ fn plan_level(part: ptr<function, PartPlan>) {
     if (is_adaptive()) {
         let step = min(params.max_div, PIECE_DIVISIONS);
         (*part).k = min((m + step - 1u) / step, MAX_MACRO_LEVEL);
-    } else if (params.method == METHOD_FIXED) {
+    } else if (split_rule() == METHOD_FIXED) {
         (*part).k = (m + PIECE_DIVISIONS - 1u) / PIECE_DIVISIONS;
     }
     (*part).bands = is_adaptive() && (*part).k >= 3u && (*part).n[band_base((*part).n)] <= band_rows();
@@ -298,7 +298,7 @@ fn plan_level(part: ptr<function, PartPlan>) {
 // products, not quotients, which round alike on both sides).
 fn diagonal_fits(whole: EdgeProfile, parts: u32, tri: ptr<function, InputTriangle>) -> bool {
     let w = f32(parts);
-    if (params.method == METHOD_ADAPTIVE) {
+    if (split_rule() == METHOD_ADAPTIVE) {
         return 2.0 * whole.length_px <= w * (*tri).edge_px;
     }
     return whole.bend_px <= w * (2.0 * ROW_DIAGONAL_ERROR * (*tri).max_error_px)

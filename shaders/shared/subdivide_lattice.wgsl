@@ -244,7 +244,7 @@ fn cylinder_shapes() -> bool {
 // in STRIP_MIN_DIVISIONS or more parts; LATTICE_SHAPE: the regular lattice (`strip_base` in subdivide.rs).
 fn strip_base_of(tri: ptr<function, InputTriangle>, piece_state: ptr<function, PieceState>) -> u32 {
     let m = max(max((*piece_state).counts[0], (*piece_state).counts[1]), (*piece_state).counts[2]);
-    if (params.method != METHOD_ERROR || is_sphere(params.projection) || m < STRIP_MIN_DIVISIONS) {
+    if (split_rule() != METHOD_ERROR || is_sphere(params.projection) || m < STRIP_MIN_DIVISIONS) {
         return LATTICE_SHAPE;
     }
     var base = LATTICE_SHAPE;
@@ -510,7 +510,7 @@ fn interior_counts(tri: ptr<function, InputTriangle>, part: ptr<function, PartPl
     let n = edge_counts(c, inside, tri);
     for (var e = 0u; e < 3u; e++) {
         if (inside[e]) {
-            if (params.method == METHOD_FIXED) {
+            if (split_rule() == METHOD_FIXED) {
                 // fixed:N pieces take N/K on interior edges (the regular N-lattice when K | N).
                 (*piece_state).counts[e] = (params.fixed_n + (*part).k - 1u) / (*part).k;
             } else {

@@ -7,7 +7,7 @@
 #import subdivide_edges
 
 fn plan_quad(shown: u32, tri: ptr<function, InputTriangle>, piece_state: ptr<function, PieceState>, clip: ptr<function, ClipState>) -> bool {
-    if (params.method != METHOD_ERROR || is_sphere(params.projection) || (*clip).poly_count != 4u || shown != 6u) {
+    if (split_rule() != METHOD_ERROR || is_sphere(params.projection) || (*clip).poly_count != 4u || shown != 6u) {
         return false;
     }
     var turn = 2u;

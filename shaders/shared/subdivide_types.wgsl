@@ -43,6 +43,16 @@ struct SubdivideParams {
 // lavapipe (CONVERGING in projection.wgsl).
 override MEASURE_EDGES: bool = true;
 
+// The split rule the pipeline is built for (a `SubdivideParams::method` value), or ANY_SPLIT_RULE:
+// the parameters' own, read as the pass runs. A variant per rule compiles the others' tests out,
+// which lavapipe's lanes would otherwise all run (CONVERGING in projection.wgsl).
+const ANY_SPLIT_RULE: u32 = 0xffffffffu;
+override SPLIT_RULE: u32 = ANY_SPLIT_RULE;
+
+fn split_rule() -> u32 {
+    return select(params.method, SPLIT_RULE, SPLIT_RULE != ANY_SPLIT_RULE);
+}
+
 struct Counters {
     pieces: atomic<u32>,
     triangles: atomic<u32>,

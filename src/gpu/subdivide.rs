@@ -65,7 +65,7 @@ type Pipelines<'p> = &'p dyn Fn(&str) -> Option<&'p wgpu::ComputePipeline>;
 
 /// How a variant's pipelines are built: its constants and stand-ins.
 struct Build {
-    constants: [(&'static str, f64); 3],
+    constants: [(&'static str, f64); 4],
     stand_ins: Vec<StandIn>,
 }
 
@@ -200,7 +200,7 @@ fn lookup<'a>(built: &'a Built, entry: &str) -> Option<&'a wgpu::ComputePipeline
 /// (`subdivide_rows_off`): lavapipe builds a pipeline about twice as long with the code merely in it).
 pub(crate) struct SubdivideStage {
     stage: GpuStage,
-    variants: [OnceLock<Variant>; 64],
+    variants: [OnceLock<Variant>; 256],
 }
 
 impl SubdivideStage {
@@ -236,7 +236,13 @@ impl SubdivideStage {
         // lane runs it: the frames that never run it get pipelines without it.
         let converging = params.projection.convergence > 0.0;
         let measuring = params.measure_edges != 0;
-        let index = 32 * converging as usize + 16 * measuring as usize + 4 * k + 2 * rows as usize + spacing as usize;
+        let rule = params.method.min(3);
+        let index = 64 * rule as usize
+            + 32 * converging as usize
+            + 16 * measuring as usize
+            + 4 * k
+            + 2 * rows as usize
+            + spacing as usize;
         self.variants[index].get_or_init(|| {
             let mut stand_ins: Vec<StandIn> = match (k, rows) {
                 (0, _) => vec![ROWS_OFF, SPHERE_OFF, FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
@@ -250,7 +256,12 @@ impl SubdivideStage {
                 stand_ins.push(SPACING_OFF);
             }
             let flag = |on: bool| if on { 1.0 } else { 0.0 };
-            let constants = [("PANORAMAS", bits), ("CONVERGING", flag(converging)), ("MEASURE_EDGES", flag(measuring))];
+            let constants = [
+                ("PANORAMAS", bits),
+                ("CONVERGING", flag(converging)),
+                ("MEASURE_EDGES", flag(measuring)),
+                ("SPLIT_RULE", rule as f64),
+            ];
             let build = Build { constants, stand_ins };
             let stage = &self.stage;
             // The entry points this frame's schedules dispatch (every schedule's are the usual
