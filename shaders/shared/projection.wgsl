@@ -63,6 +63,8 @@ override PANORAMAS: u32 = 31u;
 // root and divisions at every projection of the sphere): the subdivide stage's pipelines for
 // parallel rays are built with it false, compiling that code out.
 override CONVERGING: bool = true;
+// Likewise whether the cylinder's exact vertical model may be drawn (`Vertical::Exact`).
+override VERTICAL_EXACT: bool = true;
 
 fn is_sphere(proj: Projection) -> bool {
     return (PANORAMAS & 2u) != 0u && ((PANORAMAS & 1u) == 0u || proj.panorama != PANORAMA_CYLINDER);
@@ -139,7 +141,7 @@ fn eye_shift(proj: Projection, r: f32) -> f32 {
 }
 
 fn screen_height(proj: Projection, y: f32, r: f32) -> f32 {
-    if (proj.vertical_exact != 0u) {
+    if (VERTICAL_EXACT && proj.vertical_exact != 0u) {
         let de = proj.eye_radius;
         let t_screen = sqrt(proj.screen_radius * proj.screen_radius - de * de);
         let t_point = sqrt(max(r * r - de * de, 1e-12));

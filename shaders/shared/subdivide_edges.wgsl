@@ -116,7 +116,7 @@ fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
     length_px = max(max(length_px, total[0]), total[1]);
     // Near the eye circle, which the paper model and the sphere show on screen (α and the
     // longitude ∝ √(r − d_e)), no stretch is allowed (the exact model puts it at v = ±∞).
-    let shows_ring = params.projection.vertical_exact == 0u || is_sphere(params.projection);
+    let shows_ring = !VERTICAL_EXACT || params.projection.vertical_exact == 0u || is_sphere(params.projection);
     let ring = shows_ring && nearest < 0.0;
     let stretch = select(MAX_STRETCH, 1.0, ring);
     let residual = AZIMUTH_CHORD_RESIDUAL * sp.turn * sp.turn * f32(segments) * longest;

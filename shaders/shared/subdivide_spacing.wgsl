@@ -1,19 +1,17 @@
 // How nodes are spaced along a segment under the error split, and a lattice's interior points
-// (CPU twin: src/cpu/subdivide/spacing.rs, which says why). The pipelines of the other split rules
-// are composed with the stand-in `subdivide_spacing_off` (equal parts, the barycentric blend; a
-// cubemap frame under the error split runs this module with `by_azimuth` 0, the same).
+// (CPU twin: src/cpu/subdivide/spacing.rs, which says why). Composed only into the pipelines of
+// the frames that space nodes by azimuth (`SubdivideParams::by_azimuth`: the error split, but on
+// the cubemap); the others' are composed with the stand-in `subdivide_spacing_off` (equal parts,
+// the barycentric blend). So the parameter is not tested here: lavapipe's lanes would run both
+// ways.
 
 #import projection
 #import constants
 #import subdivide_bindings
 #import subdivide_state
 
-// How segment lo–hi's points are spaced (`Spacing::spacer`): by azimuth where the frame spaces
-// nodes so (`SubdivideParams::by_azimuth`: the error split, but on the cubemap).
+// How segment lo–hi's points are spaced (`Spacing::spacer`): by azimuth.
 fn spacer(lo: vec3<f32>, hi: vec3<f32>) -> Spacer {
-    if (params.by_azimuth == 0u) {
-        return Spacer(false, 0.0, 0.0, 0.0);
-    }
     let rl = horizontal_radius(lo);
     let rh = horizontal_radius(hi);
     if (rl < AZIMUTH_MIN_RADIUS || rh < AZIMUTH_MIN_RADIUS) {
@@ -45,13 +43,10 @@ fn spacing_mix(a: Node, b: Node, t: f32) -> Node {
     return Node(a.position + (b.position - a.position) * s, a.bary + (b.bary - a.bary) * s);
 }
 
-// The interior lattice point (i, j, l)/m of a triangle of nodes (`Spacing::interior`): the
-// barycentric blend, or under the error split the point j/(i + j) of the way along the row between
-// the points l/m of the way from q0 and from q1 towards q2, each spaced by azimuth.
+// The interior lattice point (i, j, l)/m of a triangle of nodes (`Spacing::interior`): the point
+// j/(i + j) of the way along the row between the points l/m of the way from q0 and from q1
+// towards q2, each spaced by azimuth.
 fn spaced_interior(q: array<Node, 3>, c: vec3<u32>, m: u32) -> Node {
-    if (params.by_azimuth == 0u) {
-        return weighted(q, vec3<f32>(c) / f32(m));
-    }
     // One call of spacing_mix in a loop (lavapipe inlines every call site): the row's ends,
     // then the point along the row.
     var mixed: array<Node, 3>;

@@ -65,7 +65,7 @@ type Pipelines<'p> = &'p dyn Fn(&str) -> Option<&'p wgpu::ComputePipeline>;
 
 /// How a variant's pipelines are built: its constants and stand-ins.
 struct Build {
-    constants: [(&'static str, f64); 4],
+    constants: [(&'static str, f64); 5],
     stand_ins: Vec<StandIn>,
 }
 
@@ -200,7 +200,7 @@ fn lookup<'a>(built: &'a Built, entry: &str) -> Option<&'a wgpu::ComputePipeline
 /// (`subdivide_rows_off`): lavapipe builds a pipeline about twice as long with the code merely in it).
 pub(crate) struct SubdivideStage {
     stage: GpuStage,
-    variants: [OnceLock<Variant>; 256],
+    variants: [OnceLock<Variant>; 512],
 }
 
 impl SubdivideStage {
@@ -236,8 +236,10 @@ impl SubdivideStage {
         // lane runs it: the frames that never run it get pipelines without it.
         let converging = params.projection.convergence > 0.0;
         let measuring = params.measure_edges != 0;
+        let exact = params.projection.vertical_exact != 0;
         let rule = params.method.min(3);
-        let index = 64 * rule as usize
+        let index = 256 * exact as usize
+            + 64 * rule as usize
             + 32 * converging as usize
             + 16 * measuring as usize
             + 4 * k
@@ -261,6 +263,7 @@ impl SubdivideStage {
                 ("CONVERGING", flag(converging)),
                 ("MEASURE_EDGES", flag(measuring)),
                 ("SPLIT_RULE", rule as f64),
+                ("VERTICAL_EXACT", flag(exact)),
             ];
             let build = Build { constants, stand_ins };
             let stage = &self.stage;
