@@ -212,10 +212,12 @@ impl SubdivideStage {
     /// The pipelines for a panorama (the cylinder with or without a tracked head, the sphere
     /// and VR180, the fisheye) and a frame's split rule (`params.method`): rows on the sphere
     /// under the adaptive rules only. Each leaves out the other panoramas' projection code, and
-    /// where the frame has parallel rays or measures no edges, the converging eye model and the
-    /// edge measure (`CONVERGING`, `MEASURE_EDGES`): lavapipe's lanes run the code behind a
-    /// uniform's test whether or not one takes it (the two cost a render's sphere frame about a
-    /// tenth of its subdivision).
+    /// through its overrides the code of what the frame is not: the other split rules
+    /// (`SPLIT_RULE`), the converging eye model where its rays are parallel (`CONVERGING`), the
+    /// edge measure where it measures none (`MEASURE_EDGES`), the cylinder's other vertical
+    /// model (`VERTICAL_EXACT`). lavapipe's lanes run the code behind a test of the parameters
+    /// whether or not one takes it (docs/results.md, *What lavapipe runs*: together about a
+    /// quarter of Sponza's sphere subdivision).
     /// Built side by side on as many threads as the CPU has cores, the longest first
     /// ([`Builder`]: the driver's compiling of the large passes, `plan_cuts` and `lattice`, is
     /// most of a fresh process's time). With a `probe` (a frame's first use of the variant) the
@@ -232,8 +234,8 @@ impl SubdivideStage {
         let passes = Passes::of(panorama, params.method);
         let rows = passes.rows;
         let spacing = params.by_azimuth != 0;
-        // Code behind a uniform's test costs lavapipe's SIMD lanes its time whether or not any
-        // lane runs it: the frames that never run it get pipelines without it.
+        // Code behind a test of the parameters costs lavapipe's SIMD lanes its time whether or
+        // not any lane runs it: the frames that never run it get pipelines without it.
         let converging = params.projection.convergence > 0.0;
         let measuring = params.measure_edges != 0;
         let exact = params.projection.vertical_exact != 0;
