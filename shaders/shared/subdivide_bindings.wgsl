@@ -6,7 +6,7 @@
 // uniforms that branches test, and where that shrinks a pass it optimises and compiles it again
 // each time the pass is bound, every frame (a `lattice_triangles` with no work to do took 6 ms of
 // each frame of a 100-triangle model). What is worth compiling per frame kind is compiled once,
-// as a variant's overrides (PANORAMAS, CONVERGING, MEASURE_EDGES).
+// as a variant's overrides (`SubdivideStage::variant` in src/gpu/subdivide.rs).
 @group(0) @binding(0) var<storage, read> params: SubdivideParams;
 @group(0) @binding(1) var<storage, read> vertices: array<SceneVertex>;
 @group(0) @binding(2) var<storage, read> indices: array<u32>;

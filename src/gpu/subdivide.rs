@@ -193,6 +193,10 @@ fn lookup<'a>(built: &'a Built, entry: &str) -> Option<&'a wgpu::ComputePipeline
     built.iter().find(|(name, _)| *name == entry).map(|(_, p)| p)
 }
 
+/// Slots for the stage's variants: 4 panorama kinds × spaced or not × 4 split rules × converging
+/// or not × measuring or not × the vertical model (see [`SubdivideStage::variant`]).
+const VARIANTS: usize = 4 * 2 * 4 * 2 * 2 * 2;
+
 /// The `subdivide` stage: its layouts, and its pipelines built for each panorama and kind of
 /// split rule when first needed (the WGSL `override PANORAMAS` compiles the other panorama's
 /// projection's branches out; the cylinder's passes are composed without the sphere's projection
@@ -200,7 +204,7 @@ fn lookup<'a>(built: &'a Built, entry: &str) -> Option<&'a wgpu::ComputePipeline
 /// (`subdivide_rows_off`): lavapipe builds a pipeline about twice as long with the code merely in it).
 pub(crate) struct SubdivideStage {
     stage: GpuStage,
-    variants: [OnceLock<Variant>; 512],
+    variants: [OnceLock<Variant>; VARIANTS],
 }
 
 impl SubdivideStage {
@@ -240,13 +244,17 @@ impl SubdivideStage {
         let measuring = params.measure_edges != 0;
         let exact = params.projection.vertical_exact != 0;
         let rule = params.method.min(3);
-        let index = 256 * exact as usize
-            + 64 * rule as usize
-            + 32 * converging as usize
-            + 16 * measuring as usize
-            + 4 * k
-            + 2 * rows as usize
-            + spacing as usize;
+        // The variant's slot: what it is built for, as the digits of a mixed-radix number (the
+        // panorama kind and the split rule also say whether it draws rows).
+        let digits = [
+            (k, 4),
+            (spacing as usize, 2),
+            (rule as usize, 4),
+            (converging as usize, 2),
+            (measuring as usize, 2),
+            (exact as usize, 2),
+        ];
+        let index = digits.iter().rev().fold(0, |i, &(digit, radix)| i * radix + digit);
         self.variants[index].get_or_init(|| {
             let mut stand_ins: Vec<StandIn> = match (k, rows) {
                 (0, _) => vec![ROWS_OFF, SPHERE_OFF, FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
