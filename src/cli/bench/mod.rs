@@ -368,7 +368,8 @@ pub struct SpeedArgs {
     /// Place file scenes DIST metres ahead, filling the screen height (built-in ones are placed already).
     #[arg(long, value_name = "DIST")]
     pub fit: Option<f32>,
-    /// Timed frames per point (after one warm-up); the median is reported.
+    /// Timed frames per point (after one warm-up), the methods taking turns frame by frame; the
+    /// median is reported.
     #[arg(long, default_value_t = 5)]
     pub reps: usize,
     #[command(flatten)]
@@ -417,7 +418,7 @@ pub fn bench_speed(args: &SpeedArgs) -> Result<()> {
     let rows = speed::speed(&renderer, &scenes, &args.methods, args.reps, |what| eprintln!("timing {what} ..."))?;
     let timing = rows.first().map_or("-".to_string(), |r| r.timing.clone());
     println!(
-        "adapter: {adapter}; {}x{} per eye, both eyes; median of {} frames after a warm-up; timing: {timing}\n",
+        "adapter: {adapter}; {}x{} per eye, both eyes; median of {} frames after a warm-up, the methods in turn; timing: {timing}\n",
         base.view.projection.width, base.view.projection.height, args.reps
     );
     print!("{}", speed::speed_table(&rows));

@@ -76,6 +76,26 @@ pub fn time_frames(
     (0..reps).map(|_| renderer.render(scene, settings).map(|f| f.stats)).collect()
 }
 
+/// Renders a scene once with each of `settings` (the warm-up), then `reps` rounds of one frame
+/// with each in turn, and returns each settings' frames' stats.
+pub fn time_interleaved(
+    renderer: &Renderer,
+    scene: &GpuScene,
+    settings: &[RenderSettings],
+    reps: usize,
+) -> Result<Vec<Vec<FrameStats>>> {
+    for s in settings {
+        renderer.render(scene, s)?;
+    }
+    let mut frames: Vec<Vec<FrameStats>> = settings.iter().map(|_| Vec::with_capacity(reps)).collect();
+    for _ in 0..reps {
+        for (s, out) in settings.iter().zip(&mut frames) {
+            out.push(renderer.render(scene, s)?.stats);
+        }
+    }
+    Ok(frames)
+}
+
 /// A scene of the `speed` benchmark, uploaded, with its settings (viewer, level of detail).
 pub struct SpeedScene {
     pub spec: String,
@@ -83,7 +103,9 @@ pub struct SpeedScene {
     pub settings: RenderSettings,
 }
 
-/// The `speed` benchmark: every scene with every method.
+/// The `speed` benchmark: every scene with every method. A scene's methods are timed in turn,
+/// frame by frame (after a warm-up frame of each), so that a change in the machine's load while
+/// a scene is timed weighs on every method alike and their ratios compare like with like.
 pub fn speed(
     renderer: &Renderer,
     scenes: &[SpeedScene],
@@ -93,11 +115,12 @@ pub fn speed(
 ) -> Result<Vec<SpeedRow>> {
     let mut rows = Vec::new();
     for SpeedScene { spec, gpu_scene, settings: base } in scenes {
+        let names: Vec<String> = methods.iter().map(|m| m.name()).collect();
+        progress(&format!("{spec} {}", names.join(", ")));
+        let settings: Vec<RenderSettings> = methods.iter().map(|&m| base.with_method(m)).collect();
+        let timed = time_interleaved(renderer, gpu_scene, &settings, reps)?;
         let mut first_ms = None;
-        for &method in methods {
-            progress(&format!("{spec} {}", method.name()));
-            let settings = base.with_method(method);
-            let frames = time_frames(renderer, gpu_scene, &settings, reps)?;
+        for ((&method, settings), frames) in methods.iter().zip(&settings).zip(timed) {
             // The longest visible edge costs extra work: measured in one more, untimed frame.
             let edges = renderer.render(gpu_scene, &settings.with_measure_edges(true))?.stats;
             let ms_frame = median(frames.iter().map(|s| s.ms_frame).collect());
