@@ -248,3 +248,47 @@ fn a_frame_that_first_needs_the_cut_passes_is_drawn_with_them() {
         assert!(a.eye(eye).rgba == b.eye(eye).rgba, "{eye:?}: the frame drawn again differs from the first");
     }
 }
+
+/// Writes `texels` (both eyes, rows of `w` texels of `bytes` bytes) into a two-layer target.
+fn fill_eyes(gpu: &twister::gpu::Gpu, texture: &wgpu::Texture, texels: &[u8], bytes: u32) {
+    let (w, h) = (texture.width(), texture.height());
+    gpu.queue.write_texture(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        texels,
+        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(bytes * w), rows_per_image: Some(h) },
+        wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 2 },
+    );
+}
+
+#[test]
+fn targets_read_back_each_eyes_rows_unpadded_through_the_kept_buffer() {
+    let gpu = &common::renderer().gpu;
+    // Rows of 37 texels (148 bytes, padded to 256 in the copy); a second, larger size after.
+    for (w, h) in [(37u32, 5u32), (70, 9)] {
+        let targets = twister::gpu::targets::Targets::new(gpu, w, h, false, false, 1);
+        let n = (w * h) as usize;
+        // Every texel of both eyes distinct: eye k, row y, column x.
+        let word = |k: usize, i: usize| (k * 1_000_000 + i * 7 + 3) as u32;
+        let words: Vec<u32> = (0..2).flat_map(|k| (0..n).map(move |i| word(k, i))).collect();
+        fill_eyes(gpu, &targets.object, bytemuck::cast_slice(&words), 4);
+        let colors: Vec<u8> = (0..2 * n * 4).map(|i| (i * 13 % 251) as u8).collect();
+        fill_eyes(gpu, &targets.color, &colors, 4);
+        // Colour, objects, colour again: the narrow targets share one kept buffer.
+        for _ in 0..2 {
+            let eyes = targets.read_colors(gpu).unwrap();
+            for (k, eye) in eyes.iter().enumerate() {
+                assert_eq!((eye.width, eye.height), (w, h));
+                assert_eq!(eye.rgba, colors[k * n * 4..(k + 1) * n * 4], "{w}×{h}: eye {k}'s colour");
+            }
+            let objects = targets.read_objects(gpu).unwrap();
+            for (k, eye) in objects.iter().enumerate() {
+                assert_eq!(*eye, (0..n).map(|i| word(k, i)).collect::<Vec<_>>(), "{w}×{h}: eye {k}'s objects");
+            }
+        }
+    }
+}

@@ -208,6 +208,12 @@ impl Gpu {
 
     /// Reads a whole buffer (which must have MAP_READ usage) back to the CPU.
     pub fn read_buffer(&self, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
+        self.read_mapped(buffer, |bytes| bytes.to_vec())
+    }
+
+    /// Maps a whole buffer (which must have MAP_READ usage) once the GPU is done with it and
+    /// hands its bytes to `read`, which takes what it needs before the buffer is unmapped.
+    pub fn read_mapped<R>(&self, buffer: &wgpu::Buffer, read: impl FnOnce(&[u8]) -> R) -> Result<R> {
         let mapped = Arc::new(Mutex::new(None));
         let slot = mapped.clone();
         buffer.map_async(wgpu::MapMode::Read, .., move |r| {
@@ -232,7 +238,10 @@ impl Gpu {
         if let Err(e) = status {
             return Err(Error::Gpu(format!("reading back a buffer: {e}")));
         }
-        let data = buffer.get_mapped_range(..).map_err(|e| Error::Gpu(format!("reading back a buffer: {e}")))?.to_vec();
+        let data = {
+            let mapped = buffer.get_mapped_range(..).map_err(|e| Error::Gpu(format!("reading back a buffer: {e}")))?;
+            read(&mapped)
+        };
         buffer.unmap();
         Ok(data)
     }

@@ -114,6 +114,11 @@ pub struct Targets {
     /// The multisampled colour (`--samples` N > 1).
     pub multisampled: Option<Multisampled>,
     error_target: ErrorTarget,
+    /// The mappable buffer the narrow targets (at most 4 bytes a texel: colour, distance,
+    /// object) are read back through, kept from frame to frame: a fresh one each frame cost
+    /// lavapipe 64 MB of new pages at 4096×2048 (the wider targets, read only when measuring,
+    /// take a buffer of their own).
+    readback: std::sync::Mutex<Option<wgpu::Buffer>>,
 }
 
 impl Targets {
@@ -157,6 +162,7 @@ impl Targets {
                 }),
             }),
             error_target: gpu.error_target,
+            readback: Default::default(),
         }
     }
 
@@ -287,52 +293,67 @@ impl Targets {
 
     /// Reads both eyes' colour targets back.
     pub fn read_colors(&self, gpu: &Gpu) -> Result<[EyeImage; 2]> {
-        let (w, h) = (self.width, self.height);
-        let (buffer, stride) = copy_eyes_to_buffer(gpu, &self.color, wgpu::BufferUsages::COPY_SRC);
-        let [left, right] = unpad_eyes(&gpu.download(&buffer, buffer.size())?, w, h, stride);
-        let image = |texels: Vec<u32>| EyeImage { width: w, height: h, rgba: bytemuck::cast_slice(&texels).to_vec() };
-        Ok([image(left), image(right)])
+        let (width, height) = (self.width, self.height);
+        Ok(self.read_eyes::<u8>(gpu, &self.color)?.map(|rgba| EyeImage { width, height, rgba }))
     }
 
     /// Reads both eyes' linear colours back from an HDR colour target (RGB).
     pub fn read_hdr(&self, gpu: &Gpu) -> Result<[Vec<[f32; 3]>; 2]> {
         let texture = self.hdr_color.as_ref().expect("made for the linear colour (shading.hdr)");
-        let (buffer, stride) = copy_eyes_to_buffer(gpu, texture, wgpu::BufferUsages::COPY_SRC);
-        let words = unpad_eyes(&gpu.download(&buffer, buffer.size())?, 4 * self.width, self.height, stride);
-        Ok(words.map(|v| v.chunks_exact(4).map(|p| [0, 1, 2].map(|k| f32::from_bits(p[k]))).collect()))
+        Ok(self.read_eyes::<[f32; 4]>(gpu, texture)?.map(|v| v.into_iter().map(|p| [p[0], p[1], p[2]]).collect()))
     }
 
     /// Reads both eyes' distances back (metres; +∞ where no surface is drawn).
     pub fn read_distances(&self, gpu: &Gpu) -> Result<[Vec<f32>; 2]> {
-        let (buffer, stride) = copy_eyes_to_buffer(gpu, &self.distance, wgpu::BufferUsages::COPY_SRC);
-        let words = unpad_eyes(&gpu.download(&buffer, buffer.size())?, self.width, self.height, stride);
-        Ok(words.map(|v| v.into_iter().map(f32::from_bits).collect()))
+        self.read_eyes::<f32>(gpu, &self.distance)
     }
 
     /// Reads both eyes' surface points back (NaN where no surface is drawn).
     pub fn read_positions(&self, gpu: &Gpu) -> Result<[Vec<[f32; 3]>; 2]> {
         let texture = self.position.as_ref().expect("made with positions");
-        let (buffer, stride) = copy_eyes_to_buffer(gpu, texture, wgpu::BufferUsages::COPY_SRC);
-        let words = unpad_eyes(&gpu.download(&buffer, buffer.size())?, 4 * self.width, self.height, stride);
-        Ok(words.map(|v| {
-            v.chunks_exact(4)
-                .map(
-                    |p| {
-                        if f32::from_bits(p[3]) > 0.0 {
-                            [0, 1, 2].map(|k| f32::from_bits(p[k]))
-                        } else {
-                            [f32::NAN; 3]
-                        }
-                    },
-                )
-                .collect()
-        }))
+        Ok(self
+            .read_eyes::<[f32; 4]>(gpu, texture)?
+            .map(|v| v.into_iter().map(|p| if p[3] > 0.0 { [p[0], p[1], p[2]] } else { [f32::NAN; 3] }).collect()))
     }
 
     /// Reads both eyes' object ids back.
     pub fn read_objects(&self, gpu: &Gpu) -> Result<[Vec<u32>; 2]> {
-        let (buffer, stride) = copy_eyes_to_buffer(gpu, &self.object, wgpu::BufferUsages::COPY_SRC);
-        Ok(unpad_eyes(&gpu.download(&buffer, buffer.size())?, self.width, self.height, stride))
+        self.read_eyes::<u32>(gpu, &self.object)
+    }
+
+    /// Both eyes' texels of one of the targets read back, each eye's rows unpadded, as `T`s (a
+    /// texel's bytes a whole number of them): one copy into a mappable buffer (kept for the
+    /// narrow targets, see `readback`), then one pass from its mapping into each eye's own
+    /// vector, allocated once at its size.
+    fn read_eyes<T: bytemuck::Pod>(&self, gpu: &Gpu, texture: &wgpu::Texture) -> Result<[Vec<T>; 2]> {
+        let h = texture.height() as usize;
+        let texel = texture.format().block_copy_size(None).expect("a colour format");
+        let row = texel as usize * texture.width() as usize / std::mem::size_of::<T>();
+        let (size, padded) = eyes_buffer_size(texture);
+        let mut kept = self.readback.lock().unwrap_or_else(|e| e.into_inner());
+        let fresh;
+        let buffer = if texel <= 4 {
+            if kept.as_ref().is_none_or(|b| b.size() < size) {
+                *kept = Some(readback_buffer(gpu, size));
+            }
+            kept.as_ref().expect("made")
+        } else {
+            fresh = readback_buffer(gpu, size);
+            &fresh
+        };
+        copy_eyes_into(gpu, texture, buffer, padded);
+        let stride = padded as usize / std::mem::size_of::<T>();
+        gpu.read_mapped(buffer, |bytes| {
+            let data: &[T] = bytemuck::cast_slice(&bytes[..size as usize]);
+            std::array::from_fn(|k| {
+                let eye = &data[k * stride * h..][..stride * h];
+                let mut out = Vec::with_capacity(row * h);
+                for y in 0..h {
+                    out.extend_from_slice(&eye[y * stride..][..row]);
+                }
+                out
+            })
+        })
     }
 }
 
@@ -407,15 +428,40 @@ fn begin<'e>(
 /// Copies both layers (eyes) of a target into one buffer (rows padded to 256 bytes, eyes one
 /// after the other). Returns the buffer and the padded row length in 4-byte words.
 pub fn copy_eyes_to_buffer(gpu: &Gpu, texture: &wgpu::Texture, usage: wgpu::BufferUsages) -> (wgpu::Buffer, u32) {
-    let (w, h) = (texture.width(), texture.height());
-    let texel = texture.format().block_copy_size(None).expect("a colour format");
-    let padded = (texel * w).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let (size, padded) = eyes_buffer_size(texture);
     let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("eye texels"),
-        size: 2 * (padded as u64 * h as u64),
+        size,
         usage: usage | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
+    copy_eyes_into(gpu, texture, &buffer, padded);
+    (buffer, padded / 4)
+}
+
+/// The bytes both eyes of a two-layer texture take in a buffer, and a row's (padded to
+/// `COPY_BYTES_PER_ROW_ALIGNMENT`).
+fn eyes_buffer_size(texture: &wgpu::Texture) -> (u64, u32) {
+    let texel = texture.format().block_copy_size(None).expect("a colour format");
+    let padded =
+        (texel * texture.width()).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    (2 * padded as u64 * texture.height() as u64, padded)
+}
+
+/// A buffer of `size` bytes that a copy fills and the CPU maps.
+fn readback_buffer(gpu: &Gpu, size: u64) -> wgpu::Buffer {
+    gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("eye texels read back"),
+        size,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+/// Copies both eyes (layers) of `texture` into `buffer`, eye k at k × the eye's bytes, rows of
+/// `padded` bytes, and submits the copy.
+fn copy_eyes_into(gpu: &Gpu, texture: &wgpu::Texture, buffer: &wgpu::Buffer, padded: u32) {
+    let (w, h) = (texture.width(), texture.height());
     let mut enc = gpu.device.create_command_encoder(&Default::default());
     for k in 0..2u32 {
         enc.copy_texture_to_buffer(
@@ -426,7 +472,7 @@ pub fn copy_eyes_to_buffer(gpu: &Gpu, texture: &wgpu::Texture, usage: wgpu::Buff
                 aspect: wgpu::TextureAspect::All,
             },
             wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
+                buffer,
                 layout: wgpu::TexelCopyBufferLayout {
                     offset: k as u64 * (padded as u64 * h as u64),
                     bytes_per_row: Some(padded),
@@ -437,7 +483,6 @@ pub fn copy_eyes_to_buffer(gpu: &Gpu, texture: &wgpu::Texture, usage: wgpu::Buff
         );
     }
     gpu.queue.submit([enc.finish()]);
-    (buffer, padded / 4)
 }
 
 /// Unpads the texels of both eyes from a buffer made by [`copy_eyes_to_buffer`] (`w`: words per row).
