@@ -6,7 +6,7 @@ use crate::encoding::types::{ErrorStats, ReduceParams, Totals};
 use crate::error::Result;
 use crate::gpu::device::Gpu;
 use crate::gpu::stages::GpuStage;
-use crate::gpu::targets::{copy_eyes_to_buffer, unpad_eyes, Targets};
+use crate::gpu::targets::{copy_eyes_to_buffer, Targets};
 use crate::shader::REDUCE_ERROR;
 
 /// Invocations per workgroup of `accumulate` (`WG` in the WGSL).
@@ -85,7 +85,6 @@ impl ReduceStage {
         gpu.queue.submit([enc.finish()]);
         let stats: ErrorStats =
             *bytemuck::from_bytes(&gpu.download(&result, std::mem::size_of::<ErrorStats>() as u64)?);
-        let per_eye = unpad_eyes(&gpu.download(&errors, errors.size())?, w, h, stride);
-        Ok((stats, per_eye.map(|v| v.into_iter().map(f32::from_bits).collect())))
+        Ok((stats, targets.read_errors(gpu)?))
     }
 }

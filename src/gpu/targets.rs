@@ -316,6 +316,12 @@ impl Targets {
             .map(|v| v.into_iter().map(|p| if p[3] > 0.0 { [p[0], p[1], p[2]] } else { [f32::NAN; 3] }).collect()))
     }
 
+    /// Reads both eyes' display-position errors back (the error target's words as f32 bits:
+    /// see [`crate::shader::ErrorTarget`]).
+    pub fn read_errors(&self, gpu: &Gpu) -> Result<[Vec<f32>; 2]> {
+        self.read_eyes::<f32>(gpu, &self.error)
+    }
+
     /// Reads both eyes' object ids back.
     pub fn read_objects(&self, gpu: &Gpu) -> Result<[Vec<u32>; 2]> {
         self.read_eyes::<u32>(gpu, &self.object)
@@ -483,13 +489,4 @@ fn copy_eyes_into(gpu: &Gpu, texture: &wgpu::Texture, buffer: &wgpu::Buffer, pad
         );
     }
     gpu.queue.submit([enc.finish()]);
-}
-
-/// Unpads the texels of both eyes from a buffer made by [`copy_eyes_to_buffer`] (`w`: words per row).
-pub fn unpad_eyes(data: &[u8], w: u32, h: u32, stride: u32) -> [Vec<u32>; 2] {
-    let words: &[u32] = bytemuck::cast_slice(data);
-    std::array::from_fn(|k| {
-        let base = k * (stride * h) as usize;
-        (0..h as usize).flat_map(|y| words[base + y * stride as usize..][..w as usize].iter().copied()).collect()
-    })
 }
