@@ -490,3 +490,13 @@ fn copy_eyes_into(gpu: &Gpu, texture: &wgpu::Texture, buffer: &wgpu::Buffer, pad
     }
     gpu.queue.submit([enc.finish()]);
 }
+
+/// Unpads the texels of both eyes from a buffer made by [`copy_eyes_to_buffer`] and downloaded
+/// (`w`: words per row; the targets' own read-backs unpad from the mapping: `Targets::read_eyes`).
+pub fn unpad_eyes(data: &[u8], w: u32, h: u32, stride: u32) -> [Vec<u32>; 2] {
+    let words: &[u32] = bytemuck::cast_slice(data);
+    std::array::from_fn(|k| {
+        let base = k * (stride * h) as usize;
+        (0..h as usize).flat_map(|y| words[base + y * stride as usize..][..w as usize].iter().copied()).collect()
+    })
+}
