@@ -95,46 +95,56 @@ pub struct Matched {
 }
 
 impl Runner<'_> {
-    /// Times a method (median of reps after a warm-up) and measures its error (one more frame).
-    #[allow(clippy::too_many_arguments)]
-    fn point(
+    /// Times the methods of one scene (after a warm-up frame of each, `reps` rounds of one frame
+    /// per method in turn: see `bench::speed::time_interleaved`; the median of each) and
+    /// measures each one's error (one more frame). `methods`: each with its figure parameter.
+    fn points(
         &self,
         label: &str,
         gpu_scene: &GpuScene,
         viewer: Vec3,
-        method: Method,
-        parameter: u32,
+        methods: &[(Method, u32)],
         time: bool,
         vertical: Vertical,
-    ) -> Result<Point> {
-        self.progress.set_message(format!("{label} {}", method.name()));
+    ) -> Result<Vec<Point>> {
+        let names: Vec<String> = methods.iter().map(|(m, _)| m.name()).collect();
+        self.progress.set_message(format!("{label} {}", names.join(", ")));
         let projection = Projection { vertical, ..self.cfg.projection };
-        let settings = RenderSettings::new(projection).with_viewer(viewer).with_method(method);
-        let (ms_frame, timing) = if time {
-            let frames = crate::bench::speed::time_frames(self.renderer, gpu_scene, &settings, self.cfg.reps)?;
-            match frames.iter().map(|f| f.ms_gpu).collect::<Option<Vec<f64>>>() {
-                Some(gpu) => (median(gpu), "gpu-timestamps"),
-                None => (median(frames.iter().map(|f| f.ms_frame).collect()), "wall"),
-            }
+        let settings: Vec<RenderSettings> =
+            methods.iter().map(|&(m, _)| RenderSettings::new(projection).with_viewer(viewer).with_method(m)).collect();
+        let timed = if time {
+            crate::bench::speed::time_interleaved(self.renderer, gpu_scene, &settings, self.cfg.reps)?
         } else {
-            (f64::NAN, "-")
+            vec![Vec::new(); settings.len()]
         };
-        let frame = self.renderer.render(gpu_scene, &settings.with_measure_error(true))?;
-        let e = frame.measurement.expect("measured").stats;
-        self.progress.inc(1);
-        Ok(Point {
-            scene: label.to_string(),
-            method: method.name(),
-            parameter,
-            mean_px: e.mean,
-            std_px: e.std_dev,
-            p99_px: e.p99,
-            max_px: e.max,
-            pixels: e.count,
-            ms_frame,
-            triangles_out: frame.stats.triangles_out,
-            timing: timing.to_string(),
-        })
+        let mut out = Vec::with_capacity(methods.len());
+        for ((&(method, parameter), settings), frames) in methods.iter().zip(&settings).zip(timed) {
+            let (ms_frame, timing) = if !time {
+                (f64::NAN, "-")
+            } else {
+                match frames.iter().map(|f| f.ms_gpu).collect::<Option<Vec<f64>>>() {
+                    Some(gpu) => (median(gpu), "gpu-timestamps"),
+                    None => (median(frames.iter().map(|f| f.ms_frame).collect()), "wall"),
+                }
+            };
+            let frame = self.renderer.render(gpu_scene, &settings.with_measure_error(true))?;
+            let e = frame.measurement.expect("measured").stats;
+            self.progress.inc(1);
+            out.push(Point {
+                scene: label.to_string(),
+                method: method.name(),
+                parameter,
+                mean_px: e.mean,
+                std_px: e.std_dev,
+                p99_px: e.p99,
+                max_px: e.max,
+                pixels: e.count,
+                ms_frame,
+                triangles_out: frame.stats.triangles_out,
+                timing: timing.to_string(),
+            });
+        }
+        Ok(out)
     }
 
     pub fn fig8(&self) -> Result<Vec<Point>> {
@@ -142,17 +152,16 @@ impl Runner<'_> {
         for d in [1, 3, 5] {
             let scene = load_scene(&format!("builtin:triangle@{d}"), &self.cfg.projection)?;
             let gpu_scene = GpuScene::upload(&self.renderer.gpu, &scene)?;
-            for n in self.cfg.fig8_divisions() {
-                out.push(self.point(
-                    &format!("triangle@{d}"),
-                    &gpu_scene,
-                    Vec3::ZERO,
-                    Method::Fixed(n),
-                    n,
-                    false,
-                    Vertical::Paper,
-                )?);
-            }
+            let methods: Vec<(Method, u32)> =
+                self.cfg.fig8_divisions().into_iter().map(|n| (Method::Fixed(n), n)).collect();
+            out.extend(self.points(
+                &format!("triangle@{d}"),
+                &gpu_scene,
+                Vec3::ZERO,
+                &methods,
+                false,
+                Vertical::Paper,
+            )?);
         }
         Ok(out)
     }
@@ -161,10 +170,13 @@ impl Runner<'_> {
         let mut out = Vec::new();
         for case in cases {
             let gpu_scene = GpuScene::upload(&self.renderer.gpu, &case.scene)?;
-            for method in self.cfg.fig10_methods() {
-                let parameter = if let Method::Fixed(n) = method { n } else { 0 };
-                out.push(self.point(&case.label, &gpu_scene, case.viewer, method, parameter, true, Vertical::Paper)?);
-            }
+            let methods: Vec<(Method, u32)> = self
+                .cfg
+                .fig10_methods()
+                .into_iter()
+                .map(|m| (m, if let Method::Fixed(n) = m { n } else { 0 }))
+                .collect();
+            out.extend(self.points(&case.label, &gpu_scene, case.viewer, &methods, true, Vertical::Paper)?);
         }
         Ok(out)
     }
@@ -174,23 +186,13 @@ impl Runner<'_> {
         for case in cases {
             let gpu_scene = GpuScene::upload(&self.renderer.gpu, &case.scene)?;
             // Slits converge to the exact vertical model: every fig12 error is measured in it.
-            let mut adaptive = Vec::new();
-            for split in [Split::Length, Split::Error] {
-                let method = Method::Adaptive(split);
-                adaptive.push(self.point(&case.label, &gpu_scene, case.viewer, method, 0, true, Vertical::Exact)?);
-            }
-            let mut slits = Vec::new();
-            for w in self.cfg.slit_widths() {
-                slits.push(self.point(
-                    &case.label,
-                    &gpu_scene,
-                    case.viewer,
-                    Method::Slit(w),
-                    w,
-                    true,
-                    Vertical::Exact,
-                )?);
-            }
+            // Both adaptive rules and every slit width timed in turn.
+            let mut methods: Vec<(Method, u32)> =
+                [Split::Length, Split::Error].into_iter().map(|split| (Method::Adaptive(split), 0)).collect();
+            methods.extend(self.cfg.slit_widths().into_iter().map(|w| (Method::Slit(w), w)));
+            let mut points = self.points(&case.label, &gpu_scene, case.viewer, &methods, true, Vertical::Exact)?;
+            let slits = points.split_off(2);
+            let adaptive = points;
             for a in &adaptive {
                 matched.push(match_width(&case.label, &a.method, a.ms_frame, &slits));
             }

@@ -112,7 +112,7 @@ pub fn run(runner: &Runner, which: Figure, adapter: &str) -> Result<String> {
         if want(Figure::Fig10) || want(Figure::Fig12) { cases(cfg)? } else { (Vec::new(), Vec::new()) };
     let steps = (if want(Figure::Fig8) { 3 * cfg.fig8_divisions().len() } else { 0 })
         + (if want(Figure::Fig10) { cases.len() * cfg.fig10_methods().len() } else { 0 })
-        + (if want(Figure::Fig12) { cases.len() * (1 + cfg.slit_widths().len()) } else { 0 })
+        + (if want(Figure::Fig12) { cases.len() * (2 + cfg.slit_widths().len()) } else { 0 })
         + (if want(Figure::Lod) { runner.lod_steps() } else { 0 })
         + (if want(Figure::TraceLod) { runner.trace_lod_steps() } else { 0 });
     runner.progress.set_length(steps as u64);
@@ -125,7 +125,7 @@ pub fn run(runner: &Runner, which: Figure, adapter: &str) -> Result<String> {
     } else {
         format!(
         "# twister: the paper's evaluations (seed 002 §4)\n\nAdapter: {adapter}. Image {}x{} per eye, both eyes, R_T = {} m, d_e = {} m, \
-         paper vertical model. Times: median of {} frames after a warm-up{}. Errors: one more frame with the error pass.\n\n",
+         paper vertical model. Times: median of {} frames after a warm-up, a scene's methods in turn{}. Errors: one more frame with the error pass.\n\n",
         cfg.projection.width,
         cfg.projection.height,
         cfg.projection.screen_radius,

@@ -65,17 +65,6 @@ pub fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
-/// Renders a scene `reps` times after one warm-up and returns each frame's stats.
-pub fn time_frames(
-    renderer: &Renderer,
-    scene: &GpuScene,
-    settings: &RenderSettings,
-    reps: usize,
-) -> Result<Vec<FrameStats>> {
-    renderer.render(scene, settings)?;
-    (0..reps).map(|_| renderer.render(scene, settings).map(|f| f.stats)).collect()
-}
-
 /// Renders a scene once with each of `settings` (the warm-up), then `reps` rounds of one frame
 /// with each in turn, and returns each settings' frames' stats.
 pub fn time_interleaved(
