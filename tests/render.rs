@@ -268,7 +268,7 @@ fn fill_eyes(gpu: &twister::gpu::Gpu, texture: &wgpu::Texture, texels: &[u8], by
 #[test]
 fn targets_read_back_each_eyes_rows_unpadded_through_the_kept_buffer() {
     let gpu = &common::renderer().gpu;
-    // Rows of 37 texels (148 bytes, padded to 256 in the copy); a second, larger size after.
+    // Rows of 37 texels (148 bytes, padded to 256 in the copy), then a second size.
     for (w, h) in [(37u32, 5u32), (70, 9)] {
         let targets = twister::gpu::targets::Targets::new(gpu, w, h, false, false, 1);
         let n = (w * h) as usize;

@@ -115,7 +115,7 @@ pub struct Targets {
     pub multisampled: Option<Multisampled>,
     error_target: ErrorTarget,
     /// The mappable buffer the narrow targets (at most 4 bytes a texel: colour, distance,
-    /// object) are read back through, kept from frame to frame: a fresh one each frame cost
+    /// object, error) are read back through, kept from frame to frame: a fresh one each frame cost
     /// lavapipe 64 MB of new pages at 4096×2048 (the wider targets, read only when measuring,
     /// take a buffer of their own).
     readback: std::sync::Mutex<Option<wgpu::Buffer>>,
@@ -349,17 +349,7 @@ impl Targets {
         };
         copy_eyes_into(gpu, texture, buffer, padded);
         let stride = padded as usize / std::mem::size_of::<T>();
-        gpu.read_mapped(buffer, |bytes| {
-            let data: &[T] = bytemuck::cast_slice(&bytes[..size as usize]);
-            std::array::from_fn(|k| {
-                let eye = &data[k * stride * h..][..stride * h];
-                let mut out = Vec::with_capacity(row * h);
-                for y in 0..h {
-                    out.extend_from_slice(&eye[y * stride..][..row]);
-                }
-                out
-            })
-        })
+        gpu.read_mapped(buffer, |bytes| unpad(bytemuck::cast_slice(&bytes[..size as usize]), row, h, stride))
     }
 }
 
@@ -494,9 +484,18 @@ fn copy_eyes_into(gpu: &Gpu, texture: &wgpu::Texture, buffer: &wgpu::Buffer, pad
 /// Unpads the texels of both eyes from a buffer made by [`copy_eyes_to_buffer`] and downloaded
 /// (`w`: words per row; the targets' own read-backs unpad from the mapping: `Targets::read_eyes`).
 pub fn unpad_eyes(data: &[u8], w: u32, h: u32, stride: u32) -> [Vec<u32>; 2] {
-    let words: &[u32] = bytemuck::cast_slice(data);
+    unpad(bytemuck::cast_slice(data), w as usize, h as usize, stride as usize)
+}
+
+/// Both eyes' `row` values of each of `h` rows from `data` (eye after eye, rows `stride` values
+/// apart), each eye's vector allocated once at its size.
+fn unpad<T: bytemuck::Pod>(data: &[T], row: usize, h: usize, stride: usize) -> [Vec<T>; 2] {
     std::array::from_fn(|k| {
-        let base = k * (stride * h) as usize;
-        (0..h as usize).flat_map(|y| words[base + y * stride as usize..][..w as usize].iter().copied()).collect()
+        let eye = &data[k * stride * h..][..stride * h];
+        let mut out = Vec::with_capacity(row * h);
+        for y in 0..h {
+            out.extend_from_slice(&eye[y * stride..][..row]);
+        }
+        out
     })
 }
