@@ -41,10 +41,11 @@ run() {
         [ -f "$icd" ] && export VK_DRIVER_FILES=$icd
         nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.mem,temperature.gpu --format=csv
     fi
-    tar -C .dev -xJf .dev/bin.tar.xz
+    local bin=/tmp/twister-gpu-check
+    rm -rf "$bin" && mkdir -p "$bin" && tar -C "$bin" -xJf .dev/bin.tar.xz
     # The test binaries name the binary and the sources by the paths they were built at.
     mkdir -p target/release
-    cp .dev/bin/twister target/release/twister
+    cp "$bin/bin/twister" target/release/twister
     if [ ! -e /work/main ]; then mkdir -p /work && ln -s "$PWD" /work/main; fi
     export TWISTER_ASSETS=$PWD/.dev/assets NODEVICE_SELECT=1 TWISTER_ASSET_SKIPS=/tmp/asset-skips
     local T=target/release/twister S=$TWISTER_ASSETS/sponza-dabrovic/sponza.obj
@@ -73,7 +74,7 @@ run() {
     timeout 180 $T bench startup --reps 3 --json "$out/startup.json" 2>&1 | tail -12
     for t in "${TESTS[@]}"; do
         step "tests: $t"
-        timeout 240 ".dev/bin/$t" --test-threads 8 2>&1 | grep -E "^test .*(FAILED|ok)$|^test result|panicked|assert" | grep -v " ok$" | head -30
+        timeout 240 "$bin/bin/$t" --test-threads 8 2>&1 | grep -E "^test .*(FAILED|ok)$|^test result|panicked|assert" | grep -v " ok$" | head -30
     done
     [ -d /tmp/asset-skips ] && echo "asset tests not run: $(ls /tmp/asset-skips | tr '\n' ' ')"
     step "done"
