@@ -75,12 +75,19 @@ fn cube_direction(proj: Projection, xy: vec2<f32>) -> vec2<f32> {
     return vec2<f32>(precise_atan2(d.x, -d.z), precise_atan2(d.y, sqrt(d.x * d.x + d.z * d.z)));
 }
 
+// A face's w for D·n (`horizon_w` in core/cubemap.rs): a direction on the face's horizon plane
+// (the cuts around the axis put nodes on x = 0 and z = 0) drawn just in front of it, at
+// CUBE_MIN_W (an H200 drew no triangle with a vertex at w = 0).
+fn horizon_w(w: f32) -> f32 {
+    return select(w, CUBE_MIN_W, abs(w) < CUBE_MIN_W);
+}
+
 // The clip position on the whole grid of the ray of longitude u, latitude v at depth z for the
 // draw of face `proj.face` (`Projection::cube_clip`): w = D·n; the draw's scissor keeps the face.
 fn cube_clip(proj: Projection, u: f32, v: f32, z: f32) -> vec4<f32> {
     let d = lon_lat_direction(u, v);
     let face = cube_face_axes(proj.face);
-    let w = dot(d, face.normal);
+    let w = horizon_w(dot(d, face.normal));
     return vec4<f32>(((2.0 * face.cell.x + 1.0) / 3.0 - 1.0) * w + dot(d, face.right) / 3.0,
                      (0.5 - face.cell.y) * w + 0.5 * dot(d, face.up), z * w, w);
 }

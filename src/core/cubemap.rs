@@ -72,6 +72,24 @@ pub fn cube_face_of(d: Vec3) -> usize {
     }
 }
 
+/// The smallest |w| a vertex of a face's draw keeps: a direction on (or within this of) the
+/// face's horizon plane, D·n = 0, is drawn at w = `CUBE_MIN_W`: in the same direction on the face,
+/// 10⁴ face widths out. The cuts around the axis put nodes exactly on the planes x = 0 and
+/// z = 0, the side faces' horizons; an H200 drew no triangle with such a vertex (w = z = −0: the
+/// floor beyond a wall's foot, a quarter of a face, showed the background under `vertex`), where
+/// lavapipe clipped it. Moved there, each edge to it still leaves in its direction, and the
+/// triangle's image within the face moves by under 10⁻⁴ of a face.
+pub const CUBE_MIN_W: f32 = 1e-5;
+
+/// A face's w for D·n (`cube_clip`; `horizon_w` in projection_cubemap.wgsl).
+pub fn horizon_w(w: f32) -> f32 {
+    if w.abs() < CUBE_MIN_W {
+        CUBE_MIN_W
+    } else {
+        w
+    }
+}
+
 impl Projection {
     /// The stereo cubemap: one eye's 3×2 grid of faces `width`/3 pixels square, parallel rays,
     /// Blender's pole merge.
@@ -143,10 +161,11 @@ impl Projection {
     /// (0..1) for the draw of face `f`: w = D·n, so that the rasterizer's perspective divide is
     /// the face's gnomonic map and its clipping keeps what lies in front of the face; the draw's
     /// scissor (the face's square) keeps the face. Linear in D: the great circle between two
-    /// directions is the straight line between their images on every face.
+    /// directions is the straight line between their images on every face. A direction on the
+    /// face's horizon plane is moved just in front of it ([`horizon_w`]).
     pub fn cube_clip(&self, d: Vec3, z: f32, f: usize) -> Vec4 {
         let face = &CUBE_FACES[f];
-        let w = d.dot(face.normal);
+        let w = horizon_w(d.dot(face.normal));
         let [col, row] = face.cell.map(|c| c as f32);
         // Pixel x = F·(col + (1 + X/w)/2) over a width of 3F; pixel y = F·(row + (1 − Y/w)/2)
         // over a height of 2F; NDC x = 2x/W − 1, NDC y = 1 − 2y/H.
@@ -209,6 +228,7 @@ impl Projection {
 mod tests {
     use super::*;
     use crate::core::projection::{Eye, Panorama};
+    use glam::Vec2;
     use rand::{Rng, SeedableRng};
 
     /// A face pixel's direction from the layout's definition (Spherical Video V2's `cbmp` layout
@@ -263,6 +283,33 @@ mod tests {
             }
         }
         assert!(faces.iter().all(|&n| n > 300), "every face compared: {faces:?}");
+    }
+
+    /// A direction on a face's horizon plane (D·n = 0: the cuts around the axis put nodes on
+    /// x = 0 and z = 0) is drawn in front of the face (w > 0, z > 0: no rasterizer's clipping
+    /// meets a vertex at w = 0), out on the face in the direction a point just in front of the
+    /// plane lies: an edge to it leaves a vertex inside the face the same way.
+    #[test]
+    fn a_direction_on_a_faces_horizon_is_drawn_in_front_of_it_in_its_direction() {
+        let proj = Projection::cubemap(300);
+        let offset = |c: Vec4, f: usize| {
+            let face = &CUBE_FACES[f];
+            let centre = proj.cube_clip(face.normal, 0.5, f);
+            (Vec2::new(c.x, c.y) / c.w - Vec2::new(centre.x, centre.y) / centre.w).normalize()
+        };
+        for f in 0..6 {
+            let n = CUBE_FACES[f].normal;
+            for d in [Vec3::new(0.0, -1.7, -9.5e-6), Vec3::new(0.3, -1.0, 0.0), Vec3::new(0.0, 0.2, -1.0), Vec3::X] {
+                let on_plane = d - d.dot(n) * n;
+                if on_plane.length() < 1e-3 {
+                    continue;
+                }
+                let c = proj.cube_clip(on_plane, 0.5, f);
+                assert!(c.w >= CUBE_MIN_W && c.z > 0.0, "face {f}, {on_plane}: {c}");
+                let in_front = proj.cube_clip(on_plane + 1e-3 * on_plane.length() * n, 0.5, f);
+                assert!(offset(c, f).dot(offset(in_front, f)) > 1.0 - 1e-6, "face {f}, {on_plane}: {c} vs {in_front}");
+            }
+        }
     }
 
     /// The clip positions of the face draws are the face's map after the divide, and points
