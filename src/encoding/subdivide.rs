@@ -122,15 +122,12 @@ impl SubdivideOutput {
     }
 }
 
-/// Invocations of `plan_cuts` per listed triangle: one per quadrant on the sphere (whose bands
-/// reach 10⁻⁵ m from the axis: one quadrant's keep an invocation within lavapipe's loop budget),
-/// one per triangle on the cylinder (`plan_cuts_split` in the WGSL).
-pub fn plan_cuts_split(panorama: PanoramaKind) -> u32 {
-    if panorama.is_sphere() {
-        4
-    } else {
-        1
-    }
+/// Invocations of `plan_cuts` per listed triangle: one per quadrant (`plan_cuts_split` in the
+/// WGSL). On the sphere a quadrant's bands reach 10⁻⁵ m from the axis (one quadrant's keep an
+/// invocation within lavapipe's loop budget); on the cylinder, a triangle around the axis planned
+/// whole in one invocation was the frame's longest thread on a GPU.
+pub fn plan_cuts_split(_panorama: PanoramaKind) -> u32 {
+    4
 }
 
 /// The invocations each dispatch of `recording` ran, read from the counters after it (the
