@@ -307,7 +307,9 @@ fn cave_walls_show_the_room_whole_and_spheres_where_the_eyes_lines_meet_them() {
                 );
             }
             let e = &frame.measurement.as_ref().unwrap().stats;
-            assert!(e.count > 0 && e.mean < 1e-3 && e.max < 1e-2, "wall {k} {}: {e:?}", method.name());
+            // Zero up to the interpolation's rounding: a hardware GPU interpolates the surface
+            // point less exactly than lavapipe (an H200: mean 1.1e-3 px, max 2.5e-3 px).
+            assert!(e.count > 0 && e.mean < 5e-3 && e.max < 1e-2, "wall {k} {}: {e:?}", method.name());
         }
     }
     // Spheres before the front wall, seen through it from both eyes.

@@ -256,5 +256,12 @@ fn compare_subdivided(gpu: &SubdivideOutput, cpu: &SubdivideOutput) -> Result<()
     if let Some(i) = gpu.indices.iter().find(|&&i| i as usize >= gpu.nodes.len()) {
         return Err(format!("GPU index {i} beyond its {} nodes", gpu.nodes.len()));
     }
-    same_triangle_sets(&cpu.vertices, &gpu.vertices, slack(cpu.vertices.len() / 3))
+    // Within a centimetre of the vertical axis (the square cut around it, ρ ≤ 1 mm, and its
+    // bands), where the sphere's measure of sub-millimetre edges under the pole is as
+    // ill-conditioned as the azimuth there, a hardware GPU's last bits change the square's
+    // lattice: an H200 drew 377 of the cubemap demo room's triangles there otherwise (the nodes
+    // 0.3 mm from the nadir; the sphere culls them beyond its first row's centre, the cubemap's
+    // down face draws them, 0.04° across). On a software adapter they must match too.
+    let free_radius = if software { 0.0 } else { 1e-2 };
+    same_triangle_sets(&cpu.vertices, &gpu.vertices, slack(cpu.vertices.len() / 3), free_radius)
 }
