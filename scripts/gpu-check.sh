@@ -74,7 +74,8 @@ run() {
     timeout 180 $T bench startup --reps 3 --json "$out/startup.json" 2>&1 | tail -12
     for t in "${TESTS[@]}"; do
         step "tests: $t"
-        timeout 240 "$bin/bin/$t" --test-threads 8 2>&1 | grep -E "^test .*(FAILED|ok)$|^test result|panicked|assert" | grep -v " ok$" | head -30
+        timeout 240 "$bin/bin/$t" --test-threads 8 >"/tmp/$t.log" 2>&1
+        grep -E -A4 "^test .* FAILED$|^test result|panicked at" "/tmp/$t.log" | grep -v "^stack backtrace\|^note: \|^--$" | head -40
     done
     [ -d /tmp/asset-skips ] && echo "asset tests not run: $(ls /tmp/asset-skips | tr '\n' ' ')"
     step "done"
