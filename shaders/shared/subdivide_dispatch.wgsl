@@ -1,6 +1,6 @@
 // The `subdivide` stage's dispatch helpers: an invocation's index in a dispatch spread over two
-// dimensions, and the triangles `plan` listed for `plan_cuts` (CPU twin: `listed_cuts` and
-// `plan_cuts_split` in src/cpu/subdivide/passes.rs).
+// dimensions, and the triangles `plan` listed for `plan_cuts` (CPU twin: `listed_cuts` in
+// src/cpu/subdivide/passes.rs).
 
 #import constants
 #import projection
@@ -71,10 +71,4 @@ fn row_item_count() -> u32 {
     return min(atomicLoad(&counters.row_items), row_item_room());
 }
 
-// Invocations of `plan_cuts` per listed triangle: one per quadrant (on the sphere its bands reach
-// 10⁻⁵ m from the axis: one quadrant's keep an invocation within lavapipe's loop budget, which
-// stops any invocation after 65,535 loop iterations; on the cylinder a triangle around the axis
-// planned whole made the frame's longest thread on a GPU: Sponza's plan_cuts 4.8 ms on an H200).
-fn plan_cuts_split() -> u32 {
-    return 4u;
-}
+

@@ -1,5 +1,5 @@
-// The `plan_cuts` pass of the `subdivide` stage: one invocation per listed triangle (on the sphere
-// per triangle and quadrant). A triangle not cut by all cuts is fanned at the crossings of its
+// The `plan_cuts` pass of the `subdivide` stage: one invocation per listed triangle and quadrant
+// (`PLAN_CUTS_SPLIT`). A triangle not cut by all cuts is fanned at the crossings of its
 // edges that cut triangles have (`plan_edge_split`); one cut by all, its parts around the
 // vertical axis under the frame's cuts (quadrants minus a small square around the axis, bands
 // between the active diamonds, fan-triangulated; a band's quad whose two opposite sides are in
@@ -30,7 +30,7 @@ fn plan_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     var clip: ClipState;
     var cuts: vec2<u32>;
     let local = invocation_index(gid, groups);
-    let split = plan_cuts_split();
+    let split = PLAN_CUTS_SPLIT;
     let listed = listed_cuts();
     if (local / split >= min(listed.x + listed.y, arrayLength(&cut_list))) {
         return;
@@ -44,14 +44,8 @@ fn plan_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
             plan_edge_split(t, &tri, &part, &clip, cuts);
         }
     } else {
-        // Its quadrant (one invocation per quadrant where `split` is 4), or all four; one call
-        // site of `plan_quadrant` (lavapipe inlines each: its time to build the pipeline grows
-        // with every copy, whether a constant condition leaves it out later or not).
-        let first = select(0u, local % 4u, split == 4u);
-        let end = select(4u, first + 1u, split == 4u);
-        for (var q = first; q < end; q++) {
-            plan_quadrant(t, q, &tri, &part, &piece_state, &clip, cuts);
-        }
+        // Its quadrant.
+        plan_quadrant(t, local % split, &tri, &part, &piece_state, &clip, cuts);
     }
     atomicMax(&counters.max_pieces, part.appended);
 }

@@ -9,5 +9,5 @@
 @compute @workgroup_size(1)
 fn plan_cuts_args() {
     let listed = listed_cuts();
-    set_dispatch(3u, plan_cuts_split() * min(listed.x + listed.y, arrayLength(&cut_list)));
+    set_dispatch(3u, PLAN_CUTS_SPLIT * min(listed.x + listed.y, arrayLength(&cut_list)));
 }

@@ -297,8 +297,8 @@ mod tests {
             let centre = proj.cube_clip(face.normal, 0.5, f);
             (Vec2::new(c.x, c.y) / c.w - Vec2::new(centre.x, centre.y) / centre.w).normalize()
         };
-        for f in 0..6 {
-            let n = CUBE_FACES[f].normal;
+        for (f, face) in CUBE_FACES.iter().enumerate() {
+            let n = face.normal;
             for d in [Vec3::new(0.0, -1.7, -9.5e-6), Vec3::new(0.3, -1.0, 0.0), Vec3::new(0.0, 0.2, -1.0), Vec3::X] {
                 let on_plane = d - d.dot(n) * n;
                 if on_plane.length() < 1e-3 {

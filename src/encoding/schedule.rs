@@ -174,14 +174,8 @@ impl RunTotals {
     }
 
     /// The work of one replay: its invocations and its largest outputs of one invocation.
-    pub fn count(
-        &mut self,
-        recording: &Recording,
-        params: &SubdivideParams,
-        after: &SubdivideCounters,
-        settings: &RenderSettings,
-    ) {
-        for (entry, n) in dispatched(recording, params, after, settings.projection().panorama) {
+    pub fn count(&mut self, recording: &Recording, params: &SubdivideParams, after: &SubdivideCounters) {
+        for (entry, n) in dispatched(recording, params, after) {
             match self.invocations.iter_mut().find(|(e, _)| *e == entry) {
                 Some((_, total)) => *total += n,
                 None => self.invocations.push((entry, n)),
@@ -204,11 +198,10 @@ fn replay_counted<E: SubdivisionEngine>(
     engine: &mut E,
     recording: &Recording,
     params: &SubdivideParams,
-    settings: &RenderSettings,
     totals: &mut RunTotals,
 ) -> Result<SubdivideCounters> {
     let counters = engine.replay(recording, params)?;
-    totals.count(recording, params, &counters, settings);
+    totals.count(recording, params, &counters);
     Ok(counters)
 }
 
@@ -251,7 +244,7 @@ pub fn run_one_submission<E: SubdivisionEngine>(
     (params.first_piece, params.piece_count) = (0, PIECES_FROM_COUNTER);
     let recording = one_submission(triangles, Passes::of_settings(settings), false);
     let mut totals = RunTotals::default();
-    let counters = replay_counted(engine, &recording, &params, settings, &mut totals)?;
+    let counters = replay_counted(engine, &recording, &params, &mut totals)?;
     if counters.overflowed(capacity.pieces, capacity.triangles) {
         let wanted = Capacities {
             pieces: capacity.pieces.max(counters.piece_records()),
@@ -280,7 +273,7 @@ pub fn run_chunked<E: SubdivisionEngine>(
     let n = triangles;
     let mut totals = RunTotals::default();
     engine.ensure(*want);
-    replay_counted(engine, &active_cuts(n), &subdivide_params(settings, 0, n), settings, &mut totals)?;
+    replay_counted(engine, &active_cuts(n), &subdivide_params(settings, 0, n), &mut totals)?;
     let (mut first, mut chunk) = (0u32, chunk.max(1));
     while first < n || totals.chunks == 0 {
         let count = chunk.min(n - first);
@@ -288,13 +281,8 @@ pub fn run_chunked<E: SubdivisionEngine>(
         let mut params = subdivide_params(settings, first, count);
         params.piece_capacity = capacity.pieces.min(budget.pieces);
         params.triangle_capacity = capacity.triangles;
-        let planned = replay_counted(
-            engine,
-            &pass_run("plan", count, Passes::of_settings(settings)),
-            &params,
-            settings,
-            &mut totals,
-        )?;
+        let planned =
+            replay_counted(engine, &pass_run("plan", count, Passes::of_settings(settings)), &params, &mut totals)?;
         if planned.piece_records() > params.piece_capacity {
             match on_overflow(planned.piece_records(), budget.pieces, count) {
                 Overflow::Grow(p) => want.pieces = p,
@@ -332,13 +320,7 @@ fn lattice_ranges<E: SubdivisionEngine>(
         let capacity = engine.ensure(*want);
         (params.first_piece, params.piece_count) = (first, count);
         params.triangle_capacity = capacity.triangles.min(budget.triangles);
-        let done = replay_counted(
-            engine,
-            &pass_run("lattice", count, Passes::of_settings(settings)),
-            params,
-            settings,
-            totals,
-        )?;
+        let done = replay_counted(engine, &pass_run("lattice", count, Passes::of_settings(settings)), params, totals)?;
         if done.output_units() > params.triangle_capacity {
             match on_overflow(done.output_units(), budget.triangles, count) {
                 Overflow::Grow(t) => want.triangles = t,

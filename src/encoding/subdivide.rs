@@ -3,7 +3,7 @@
 
 use crate::core::projection::{PanoramaKind, Projection};
 use crate::core::settings::{RenderSettings, SplitRule};
-use crate::encoding::constants::{AXIS_CLEARANCE_MAX, AXIS_CLEARANCE_MIN};
+use crate::encoding::constants::{AXIS_CLEARANCE_MAX, AXIS_CLEARANCE_MIN, PLAN_CUTS_SPLIT};
 use crate::encoding::recording::{Command, Recording};
 use crate::encoding::types::{DrawVertex, SubdivideCounters, SubdivideParams};
 
@@ -122,14 +122,6 @@ impl SubdivideOutput {
     }
 }
 
-/// Invocations of `plan_cuts` per listed triangle: one per quadrant (`plan_cuts_split` in the
-/// WGSL). On the sphere a quadrant's bands reach 10⁻⁵ m from the axis (one quadrant's keep an
-/// invocation within lavapipe's loop budget); on the cylinder, a triangle around the axis planned
-/// whole in one invocation was the frame's longest thread on a GPU.
-pub fn plan_cuts_split(_panorama: PanoramaKind) -> u32 {
-    4
-}
-
 /// The invocations each dispatch of `recording` ran, read from the counters after it (the
 /// indirect ones: `plan_cuts` over the listed triangles, `lattice` over the pieces counted): the
 /// balance of the subdivision's work, with `max_pieces` and `max_output`.
@@ -137,7 +129,6 @@ pub fn dispatched(
     recording: &Recording,
     params: &SubdivideParams,
     counters: &SubdivideCounters,
-    panorama: PanoramaKind,
 ) -> Vec<(&'static str, u64)> {
     let listed = counters.cut_count as u64 + counters.cut_wide as u64;
     let pieces = counters.pieces.min(params.piece_capacity) as u64;
@@ -147,7 +138,7 @@ pub fn dispatched(
         .filter_map(|c| match *c {
             Command::Dispatch { entry, invocations } => Some((entry, invocations as u64)),
             Command::DispatchIndirect { entry: "plan_cuts", .. } => {
-                Some(("plan_cuts", plan_cuts_split(panorama) as u64 * listed))
+                Some(("plan_cuts", PLAN_CUTS_SPLIT as u64 * listed))
             }
             Command::DispatchIndirect { entry: "plan_parts", .. } => {
                 Some(("plan_parts", counters.parts.min(params.piece_capacity) as u64))
@@ -286,10 +277,9 @@ pub fn missed(
     recording: &Recording,
     params: &SubdivideParams,
     counters: &SubdivideCounters,
-    panorama: PanoramaKind,
     built: impl Fn(&str) -> bool,
 ) -> Vec<&'static str> {
-    let mut missed: Vec<&'static str> = dispatched(recording, params, counters, panorama)
+    let mut missed: Vec<&'static str> = dispatched(recording, params, counters)
         .into_iter()
         .filter(|&(entry, n)| n > 0 && !built(entry))
         .map(|(entry, _)| entry)

@@ -381,7 +381,7 @@ impl SubdivideStage {
             // Unread counters: build them.
             gpu.download(&b.counters, COUNTERS_SIZE).map_or(true, |bytes| {
                 let cut = |e: &str| !CUT_PASSES.contains(&e);
-                !missed(&recording, &params, bytemuck::from_bytes(&bytes), panorama, cut).is_empty()
+                !missed(&recording, &params, bytemuck::from_bytes(&bytes), cut).is_empty()
             })
         };
         let variant = self.variant(gpu, panorama, &params, Some(&probe));
@@ -404,7 +404,7 @@ impl SubdivideStage {
         }
         let passes = Passes::of(panorama, params.method);
         let recording = one_submission(params.triangle_count, passes, false);
-        if missed(&recording, params, counters, panorama, |e| variant.pipeline(e).is_some()).is_empty() {
+        if missed(&recording, params, counters, |e| variant.pipeline(e).is_some()).is_empty() {
             return false;
         }
         variant.build_cut_passes(gpu, &self.stage, passes);

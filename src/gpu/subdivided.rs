@@ -100,12 +100,8 @@ impl Method for SubdividedMethod {
                     None => stats.timing = Timing::WallOneSubmission,
                 }
                 stats.pieces = counters.pieces as u64;
-                stats.subdivide_invocations = dispatched(
-                    &one_submission(n, Passes::of(p.panorama, params.method), false),
-                    &params,
-                    &counters,
-                    p.panorama,
-                );
+                stats.subdivide_invocations =
+                    dispatched(&one_submission(n, Passes::of(p.panorama, params.method), false), &params, &counters);
                 stats.max_pieces_per_invocation = counters.max_pieces;
                 stats.max_output_per_invocation = counters.max_output;
                 stats.triangles_out = counters.triangles as u64;

@@ -21,12 +21,12 @@ use super::{
 };
 use crate::core::scene::SceneVertex;
 use crate::core::settings::RenderSettings;
-use crate::encoding::constants::{BANDS, PIECES_FROM_COUNTER, QUAD_HEAD, QUAD_TAIL};
+use crate::encoding::constants::{BANDS, PIECES_FROM_COUNTER, PLAN_CUTS_SPLIT, QUAD_HEAD, QUAD_TAIL};
 use crate::encoding::recording::{Command, Recording};
 use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine};
 use crate::encoding::subdivide::{
-    defers_parts, plan_cuts_split, DISPATCH_LATTICE, DISPATCH_LATTICE_NODES, DISPATCH_LATTICE_ROWS,
-    DISPATCH_LATTICE_ROWS_PLAN, DISPATCH_LATTICE_TRIANGLES, DISPATCH_PLAN_CUTS, DISPATCH_PLAN_PARTS, DISPATCH_WORDS,
+    defers_parts, DISPATCH_LATTICE, DISPATCH_LATTICE_NODES, DISPATCH_LATTICE_ROWS, DISPATCH_LATTICE_ROWS_PLAN,
+    DISPATCH_LATTICE_TRIANGLES, DISPATCH_PLAN_CUTS, DISPATCH_PLAN_PARTS, DISPATCH_WORDS,
 };
 use crate::encoding::types::{DrawIndexedIndirectArgs, DrawVertex, Piece, SubdivideCounters, SubdivideParams};
 use crate::error::Result;
@@ -163,7 +163,7 @@ impl<'s> CpuSubdivision<'s> {
             "active_cuts" => all.for_each(|i| self.active_cuts(sub, i)),
             "ring_cuts" => all.for_each(|i| self.ring_cuts(sub, i)),
             "plan" => all.for_each(|i| self.plan(sub, i)),
-            "plan_cuts_args" => self.plan_cuts_args(sub),
+            "plan_cuts_args" => self.plan_cuts_args(),
             "plan_cuts" => all.for_each(|i| self.plan_cuts(sub, i)),
             "plan_parts_args" => self.plan_parts_args(sub),
             "plan_parts" => all.for_each(|i| self.plan_parts(sub, i)),
@@ -270,16 +270,16 @@ impl<'s> CpuSubdivision<'s> {
         (self.counters.cut_count.min(len), self.counters.cut_wide.min(len))
     }
 
-    fn plan_cuts_args(&mut self, sub: &Subdivider) {
+    fn plan_cuts_args(&mut self) {
         let (narrow, wide) = self.listed_cuts();
         let listed = (narrow + wide).min(self.cut_list.len() as u32);
-        self.set_dispatch(DISPATCH_PLAN_CUTS, plan_cuts_split(sub.projection.panorama) * listed);
+        self.set_dispatch(DISPATCH_PLAN_CUTS, PLAN_CUTS_SPLIT * listed);
     }
 
     /// A listed triangle: a narrow one cut at its marked edges' crossings, a wide one's parts
-    /// in one quadrant (the sphere) or all four.
+    /// in one quadrant (`PLAN_CUTS_SPLIT` invocations a triangle).
     fn plan_cuts(&mut self, sub: &Subdivider, local: u32) {
-        let split = plan_cuts_split(sub.projection.panorama);
+        let split = PLAN_CUTS_SPLIT;
         let (narrow, wide) = self.listed_cuts();
         let len = self.cut_list.len() as u32;
         let i = local / split;
@@ -298,11 +298,8 @@ impl<'s> CpuSubdivision<'s> {
                 }
             }
         } else {
-            let quadrants = if split == 4 { (local % 4) as usize..(local % 4) as usize + 1 } else { 0..4 };
-            for q in quadrants {
-                for poly in quadrant_polygons(tri.position, rho, cuts, q) {
-                    self.plan_polygon(sub, &tri, t, &poly);
-                }
+            for poly in quadrant_polygons(tri.position, rho, cuts, (local % split) as usize) {
+                self.plan_polygon(sub, &tri, t, &poly);
             }
         }
         let appended = self.counters.pieces + self.counters.parts - before;

@@ -29,11 +29,10 @@ fn the_cut_probe_lists_the_triangles_the_frame_cuts() {
         let probed = engine.replay(&cut_probe(n), &params).expect("probe");
         let done = engine.replay(&frame, &params).expect("frame");
         assert_eq!((probed.cut_count, probed.cut_wide), (done.cut_count, done.cut_wide), "{projection:?}");
-        let panorama = projection.panorama;
-        let ran_cuts = dispatched(&frame, &params, &done, panorama).iter().any(|&(e, k)| e == "plan_cuts" && k > 0);
-        let needs = !missed(&frame, &params, &probed, panorama, |e| !CUT_PASSES.contains(&e)).is_empty();
+        let ran_cuts = dispatched(&frame, &params, &done).iter().any(|&(e, k)| e == "plan_cuts" && k > 0);
+        let needs = !missed(&frame, &params, &probed, |e| !CUT_PASSES.contains(&e)).is_empty();
         assert_eq!((needs, ran_cuts), (cuts, cuts), "{projection:?}");
         // Without the cut passes, the frame misses them exactly when it cuts.
-        assert_eq!(missed(&frame, &params, &done, panorama, |e| !CUT_PASSES.contains(&e)).is_empty(), !cuts);
+        assert_eq!(missed(&frame, &params, &done, |e| !CUT_PASSES.contains(&e)).is_empty(), !cuts);
     }
 }
