@@ -53,7 +53,7 @@ fn vs_main(in: VertexIn, eye_in: EyeIn) -> VertexOut {
     let theta = theta0 + TAU * floor((in.theta_ref - theta0) / TAU + 0.5);
     let uvd = project_with_azimuth(params.projection, in.position, theta, params.eye_sign);
     var out: VertexOut;
-    out.clip = frame_clip(params.projection, uvd) * clip_w(params.projection, in.position, params.w_by_radius);
+    out.clip = frame_clip(params.projection, uvd) * clip_w(params.projection, in.position, uvd.z, params.w_by_radius);
     out.clip.x += 2.0 * params.shift_px.x / params.projection.width * out.clip.w;
     out.clip.y -= 2.0 * params.shift_px.y / params.projection.height * out.clip.w;
     out.clip = tile_clip(params.projection, out.clip);

@@ -7,6 +7,7 @@ mod common;
 use glam::Vec3;
 use twister::core::builtin;
 use twister::core::projection::PanoramaKind;
+use twister::core::scene::SceneVertex;
 use twister::core::settings::{Method, Split};
 use twister::{Eye, Projection, RenderSettings, Scene};
 
@@ -280,6 +281,56 @@ fn the_cubemap_fills_its_faces_with_spheres_where_the_layout_puts_them() {
         let squeeze = if straddles { f32::NAN } else { 1.0 };
         Some((f * (cell.0 + 0.5 * (1.0 + a)), f * (cell.1 + 0.5 * (1.0 - b)), squeeze))
     });
+}
+
+/// The cubemap's faces draw as pinholes from the eye points (w the distance along the ray): a
+/// ceiling and a floor wholly inside the pole merge's cones (seen from the centre beyond 75°,
+/// where the eye offset has faded to 0 and every ray comes from the centre) are drawn exactly
+/// by `vertex` (the error pass, against the projection, reads zero; with the faces' own w it
+/// read 0.04 px), and the error split leaves their edges whole (4 triangles stay 4). A wall beside the viewer, where the eye offset is d_e, still
+/// needs the split.
+#[test]
+fn the_cubemap_draws_what_the_pole_merge_sees_from_the_centre_exactly() {
+    // 0.5 m squares 8 m above and below, beside the axis (0.6 to 1.1 m along x and z: their
+    // farthest corner 1.56 m from it, seen at 79° from the centre, beyond the merge's 75°; not
+    // around the axis, so no cuts around it), their corners at different distances.
+    let quad = |y: f32| -> Vec<SceneVertex> {
+        [[0.6, 0.6], [1.1, 0.6], [1.1, 1.1], [0.6, 1.1]]
+            .iter()
+            .map(|&[x, z]| SceneVertex {
+                position: [x, y, z],
+                normal: [0.0, -y.signum(), 0.0],
+                color: [0.8; 4],
+                ..Default::default()
+            })
+            .collect()
+    };
+    let mut caps = Scene::new("caps");
+    caps.add_mesh("ceiling", &quad(8.0), &[0, 1, 2, 0, 2, 3]);
+    caps.add_mesh("floor", &quad(-8.0), &[0, 2, 1, 0, 3, 2]);
+    let cube = Projection::cubemap(3 * 512);
+    let settings = RenderSettings::new(cube).with_measure_error(true);
+    let frame = common::render(&caps, &settings.with_method(Method::Vertex));
+    let e = &frame.measurement.as_ref().unwrap().stats;
+    assert!(e.count > 500 && e.mean < 5e-3 && e.max < 2e-2, "vertex: {e:?}");
+    let frame = common::render(&caps, &settings.with_method(Method::Adaptive(Split::Error)));
+    assert_eq!(frame.stats.triangles_out, 4, "the error split cut what the centre sees");
+    let e = &frame.measurement.as_ref().unwrap().stats;
+    assert!(e.mean < 5e-3 && e.max < 2e-2, "adaptive: {e:?}");
+    // A wall 1 m ahead, 2 m wide: the eye offset bends it, the split cuts it.
+    let mut wall = Scene::new("wall");
+    let v: Vec<SceneVertex> = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]
+        .iter()
+        .map(|&[x, y]| SceneVertex {
+            position: [x, y, -1.0],
+            normal: [0.0, 0.0, 1.0],
+            color: [0.8; 4],
+            ..Default::default()
+        })
+        .collect();
+    wall.add_mesh("wall", &v, &[0, 1, 2, 0, 2, 3]);
+    let frame = common::render(&wall, &settings.with_method(Method::Adaptive(Split::Error)));
+    assert!(frame.stats.triangles_out > 2, "the wall beside the viewer was not cut");
 }
 
 /// CAVE walls (`--panorama cave`): the closed demo room leaves no wall's pixel to the

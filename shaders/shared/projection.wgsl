@@ -280,9 +280,13 @@ fn to_clip(proj: Projection, uvd: vec3<f32>) -> vec4<f32> {
 // src/cpu/raster.rs): under the error split (`by_radius` 1) r, the vertex's distance from the
 // vertical axis, so that attributes are interpolated as P/r is, linearly on the screen: between
 // two nodes the drawn point's azimuth then follows the screen, as the subdivision's azimuth
-// spacing assumes (src/cpu/subdivide/spacing.rs). The cubemap's faces keep their own w.
-fn clip_w(proj: Projection, p: vec3<f32>, by_radius: u32) -> f32 {
-    if (by_radius == 0u || is_cubemap(proj)) {
+// spacing assumes (src/cpu/subdivide/spacing.rs). On the cubemap `depth`, the distance along the
+// ray from the eye point: each face draws as a pinhole from the eye points.
+fn clip_w(proj: Projection, p: vec3<f32>, depth: f32, by_radius: u32) -> f32 {
+    if (is_cubemap(proj)) {
+        return max(depth, CUBE_MIN_DISTANCE);
+    }
+    if (by_radius == 0u) {
         return 1.0;
     }
     return max(horizontal_radius(p), AZIMUTH_MIN_RADIUS);

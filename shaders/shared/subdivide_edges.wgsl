@@ -59,6 +59,21 @@ fn pixel_of(q: vec3<f32>) -> vec2<f32> {
 // it (heights clamped, segments beyond the clamp at both ends counting 0, stretch-adjusted), the
 // largest second difference of the sampled points (x unwrapped, triples beyond the clamp
 // skipped) by which the error split splits it, and whether it comes near the eye circle.
+// Whether every ray to the segment ab comes from the centre (`Projection::seen_from_centre`): no
+// eye offset, or both ends in one of the pole merge's cones beyond its end.
+fn seen_from_centre(a: vec3<f32>, b: vec3<f32>) -> bool {
+    let proj = params.projection;
+    if (proj.eye_radius == 0.0) {
+        return true;
+    }
+    if (proj.pole_to <= 0.0) {
+        return false;
+    }
+    let merged_a = a.y != 0.0 && atan2(abs(a.y), horizontal_radius(a)) >= proj.pole_to;
+    let merged_b = b.y != 0.0 && atan2(abs(b.y), horizontal_radius(b)) >= proj.pole_to;
+    return merged_a && merged_b && (a.y > 0.0) == (b.y > 0.0);
+}
+
 struct EdgeProfile {
     length_px: f32,
     bend_px: f32,
@@ -72,6 +87,12 @@ fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
     if (lex_less(b, a)) {
         lo = b;
         hi = a;
+    }
+    // Drawn by pinholes whose every ray to it comes from the centre: exact, its length the angle
+    // it spans (`Subdivider::edge_profile`).
+    if (params.pinhole_faces != 0u && seen_from_centre(lo, hi)) {
+        let angle = atan2(length(cross(lo, hi)), dot(lo, hi));
+        return EdgeProfile(angle * params.projection.turn_px / TAU, 0.0, false, 0.0);
     }
     let clamp_v = 1.5 * params.projection.height;
     let width = params.projection.turn_px; // a full turn in pixels: x wraps at it

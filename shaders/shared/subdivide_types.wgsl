@@ -36,6 +36,8 @@ struct SubdivideParams {
     max_error_px: f32,   // τ of the error split
     by_azimuth: u32,     // 1: nodes spaced by azimuth, drawn with w = r (`SubdivideParams::by_azimuth`)
     seamless: u32,       // 1: the image has no seam: no seam copies (`SubdivideParams::seamless`)
+    pinhole_faces: u32,  // 1: drawn as pinholes (the cubemap): `SubdivideParams::pinhole_faces`
+    _pad: array<u32, 3>,
 }
 
 // Whether the pipeline may measure the longest visible output edge (`measure_edges`): built

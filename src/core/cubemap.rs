@@ -20,8 +20,11 @@
 //! of the scene are curved on a face wherever the eyes' offset matters (near things), and the
 //! adaptive subdivision splits them; what a triangle covers beyond a face's edge is drawn on the
 //! neighbouring face (the raster stage draws the subdivided triangles once per face, clipped to
-//! it). The subdivision measures edges on the sphere at the faces' resolution
-//! ([`Projection::measured`]).
+//! it). Each face draws as a pinhole from the eye points (the clip position scaled by the
+//! distance along the ray: `clip_w` in cpu/raster.rs), exact where the rays come from the
+//! centre. The subdivision measures edges on the sphere at the faces' resolution
+//! ([`Projection::measured`]), except those whose rays all come from the centre
+//! (`Projection::seen_from_centre`: split for length only).
 //!
 //! The WGSL twin is `shaders/shared/projection_cubemap.wgsl`.
 
@@ -80,6 +83,10 @@ pub fn cube_face_of(d: Vec3) -> usize {
 /// lavapipe clipped it. Moved there, each edge to it still leaves in its direction, and the
 /// triangle's image within the face moves by under 10⁻⁴ of a face.
 pub const CUBE_MIN_W: f32 = 1e-5;
+
+/// The smallest distance along its ray a vertex's clip position is scaled by (`clip_w` in
+/// cpu/raster.rs): a face draws as a pinhole, w = D·n times that distance.
+pub const CUBE_MIN_DISTANCE: f32 = 1e-6;
 
 /// A face's w for D·n (`cube_clip`; `horizon_w` in projection_cubemap.wgsl).
 pub fn horizon_w(w: f32) -> f32 {
@@ -158,7 +165,8 @@ impl Projection {
     }
 
     /// The clip-space position on the whole grid of direction `d` (any length) at depth `z`
-    /// (0..1) for the draw of face `f`: w = D·n, so that the rasterizer's perspective divide is
+    /// (0..1) for the draw of face `f` (the raster stage scales it by the distance along the
+    /// ray: a pinhole): w = D·n, so that the rasterizer's perspective divide is
     /// the face's gnomonic map and its clipping keeps what lies in front of the face; the draw's
     /// scissor (the face's square) keeps the face. Linear in D: the great circle between two
     /// directions is the straight line between their images on every face. A direction on the

@@ -131,6 +131,23 @@ impl Projection {
         self.pole_fade(a) * de
     }
 
+    /// Whether every ray to the segment ab comes from the centre: no eye offset at all (a mono
+    /// camera), or both ends in one of the pole merge's cones beyond TO (seen from the centre at
+    /// an altitude of at least TO, on the same side: the cone is convex, so the segment lies in
+    /// it), where the offset has faded to 0. A pinhole at the centre (the cubemap's faces drawn
+    /// with w the distance along the ray) draws such a segment exactly.
+    pub fn seen_from_centre(&self, a: Vec3, b: Vec3) -> bool {
+        if self.eye_radius == 0.0 {
+            return true;
+        }
+        let Some((_, to)) = self.pole_merge else {
+            return false;
+        };
+        let to = to.to_radians();
+        let merged = |p: Vec3| p.y != 0.0 && p.y.abs().atan2(horizontal_radius(p)) >= to;
+        merged(a) && merged(b) && (a.y > 0.0) == (b.y > 0.0)
+    }
+
     /// Whether an eye's ray reaches `p` on the sphere: r > |e| (a point on the axis only where the
     /// offset has faded to 0).
     pub(super) fn sphere_sees(&self, p: Vec3) -> bool {

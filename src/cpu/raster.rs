@@ -32,18 +32,24 @@ pub fn raster_vertex(params: &RasterParams, v: &DrawVertex) -> Vec4 {
     let q = projection.project_with_azimuth(p, theta, eye);
     let depth = (q.depth / (q.depth + 1.0)).min(crate::encoding::constants::MAX_DEPTH);
     let clip = frame_clip(&projection, q.u, q.v, depth, params.projection.face as usize)
-        * clip_w(&projection, p, params.w_by_radius);
+        * clip_w(&projection, p, q.depth, params.w_by_radius);
     // The test hook's shift, in pixels of the frame; then the tile's part of it.
     let (w, h) = (projection.width as f32, projection.height as f32);
     let shifted = clip + Vec4::new(2.0 * params.shift_px[0] / w, -2.0 * params.shift_px[1] / h, 0.0, 0.0) * clip.w;
     projection.tile_clip(shifted)
 }
 
-/// What a vertex's clip position is multiplied by (`clip_w` in projection.wgsl): r, its distance
-/// from the vertical axis, where the frame draws with w = r (`RasterParams::w_by_radius`, the error
-/// split's azimuth spacing: `cpu::subdivide::spacing`), except on the cubemap; else 1.
-fn clip_w(projection: &Projection, p: Vec3, w_by_radius: u32) -> f32 {
-    if w_by_radius == 0 || projection.panorama == PanoramaKind::Cubemap {
+/// What a vertex's clip position is multiplied by (`clip_w` in projection.wgsl): on the cubemap
+/// `depth`, its distance along its ray from its eye point, so that each face draws as a pinhole
+/// from the eye points (exact where they are the centre: `Projection::seen_from_centre`);
+/// elsewhere r, its distance from the vertical axis, where the frame draws with w = r
+/// (`RasterParams::w_by_radius`, the error split's azimuth spacing: `cpu::subdivide::spacing`);
+/// else 1.
+fn clip_w(projection: &Projection, p: Vec3, depth: f32, w_by_radius: u32) -> f32 {
+    if projection.panorama == PanoramaKind::Cubemap {
+        return depth.max(crate::core::cubemap::CUBE_MIN_DISTANCE);
+    }
+    if w_by_radius == 0 {
         return 1.0;
     }
     horizontal_radius(p).max(crate::encoding::constants::AZIMUTH_MIN_RADIUS)

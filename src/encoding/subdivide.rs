@@ -36,6 +36,8 @@ pub fn subdivide_params(settings: &RenderSettings, first_triangle: u32, triangle
         by_azimuth: (SplitRule::spaces_by_azimuth(rule as u32) && projection.panorama != PanoramaKind::Cubemap) as u32,
         seamless: matches!(projection.panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap | PanoramaKind::Cave)
             as u32,
+        pinhole_faces: (projection.panorama == PanoramaKind::Cubemap) as u32,
+        _pad: [0; 3],
     }
 }
 

@@ -133,7 +133,7 @@ impl From<&Projection> for ProjectionUniform {
     }
 }
 
-/// `SubdivideParams` in shaders/shared/subdivide_types.wgsl. 208 bytes.
+/// `SubdivideParams` in shaders/shared/subdivide_types.wgsl. 224 bytes.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct SubdivideParams {
@@ -171,6 +171,11 @@ pub struct SubdivideParams {
     /// 1: the image has no seam (the fisheye; the cubemap, whose faces map (u, v) periodically
     /// in u; CAVE walls): no seam copies, which would draw their pieces twice over.
     pub seamless: u32,
+    /// 1: the image is drawn as pinholes (the cubemap's faces, w the distance along the ray):
+    /// where every ray to an edge comes from the centre it is drawn exactly, and split for its
+    /// length alone (`Projection::seen_from_centre`).
+    pub pinhole_faces: u32,
+    pub _pad: [u32; 3],
 }
 
 /// `Counters` in shaders/shared/subdivide_types.wgsl.
@@ -534,7 +539,7 @@ pub const LAYOUTS: &[StructLayout] = &[
     }),
     layout!("SubdivideParams" => SubdivideParams {
         view, projection, axis_clearance, triangle_count, first_triangle, method, fixed_n, edge_px, max_div,
-        piece_capacity, triangle_capacity, first_piece, piece_count, measure_edges, vertical_limit, max_error_px, by_azimuth, seamless
+        piece_capacity, triangle_capacity, first_piece, piece_count, measure_edges, vertical_limit, max_error_px, by_azimuth, seamless, pinhole_faces, _pad
     }),
     layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, nodes, cut_wide, max_pieces, max_output, parts, node_items, triangle_items, row_items, pending, cuts_low, cuts_high, _pad }),
     layout!("Piece" => Piece { triangle, cell, counts01, count2_level, corner, bary1, bary2 }),

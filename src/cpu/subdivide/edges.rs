@@ -141,6 +141,17 @@ impl Subdivider<'_> {
     /// what its drawing with w = r leaves (`cpu::subdivide::spacing`).
     pub fn edge_profile(&self, a: Vec3, b: Vec3, segments: u32) -> EdgeProfile {
         let (lo, hi) = if lex_less(b, a) { (b, a) } else { (a, b) };
+        // Drawn by pinholes whose every ray to it comes from the centre: exact, its length the
+        // angle it spans (the cubemap's faces magnify it up to 2× at their sides' middles).
+        if self.params.pinhole_faces != 0 && self.projection.seen_from_centre(lo, hi) {
+            let angle = lo.cross(hi).length().atan2(lo.dot(hi));
+            return EdgeProfile {
+                length_px: angle * self.projection.pixels_per_radian(),
+                bend_px: 0.0,
+                ring: false,
+                residual_px: 0.0,
+            };
+        }
         let spacer = self.spacing().spacer(lo, hi);
         let clamp_v = 1.5 * self.projection.height as f32;
         let width = self.projection.turn_px(); // a full turn in pixels: x wraps at it

@@ -20,9 +20,9 @@
 //! residual of the chord is bounded apart (`EdgeProfile::residual_px`).
 //!
 //! The paper's methods (`vertex`, `fixed:N`, eq. 5) keep equal parts and the linear drawing, and
-//! so does the cubemap, whose faces draw with their own w (a face is a pinhole: the drawn point
-//! is the ray's own, however the nodes lie; spaced by azimuth, its demo room's p99 rose from 0.44
-//! to 0.84 px).
+//! so does the cubemap, whose faces draw as pinholes (w the distance along the ray: the drawn
+//! point is the ray's own, however the nodes lie; spaced by azimuth, its demo room's p99 rose
+//! from 0.44 to 0.84 px, when its faces drew with w = D·n).
 
 use glam::{Vec2, Vec3};
 
