@@ -1,8 +1,9 @@
 //! The error split (`adaptive`, `--split error`) against the error pass, an oracle that does not
 //! share its estimate: on random triangles near and far, around the vertical axis and across the
-//! seam, on the cylinder (both vertical models) and the sphere, the measured display-position
-//! error's p99 stays within τ + 0.5 px for τ = 0.25, 0.5 and 1 px, where drawing the vertices
-//! alone is far off (so the scenes do bend). (Geometry through the eye circle itself, within
+//! seam, on the cylinder (both vertical models), the sphere and the cubemap, the measured
+//! display-position error's p99 stays within τ + 0.5 px for τ = 0.25, 0.5 and 1 px, where drawing
+//! the vertices alone is far off (so the scenes do bend; on the cubemap, whose faces are
+//! pinholes and bend only with the eye points, the near triangles). (Geometry through the eye circle itself, within
 //! d_e of the axis at eye height, is outside this promise for every rule: see the README.)
 
 mod common;
@@ -71,13 +72,16 @@ fn the_error_split_keeps_the_measured_error_within_its_tolerance() {
         ("cylinder, paper", Projection { width: 640, height: 160, ..Projection::default() }),
         ("cylinder, exact", Projection { width: 640, height: 160, vertical: Vertical::Exact, ..Projection::default() }),
         ("sphere", Projection::equirect(512)),
+        ("cubemap", Projection::cubemap(3 * 192)),
     ];
     for (k, kind) in ["near", "far", "axis", "seam"].iter().enumerate() {
         let scene = scene(kind, 40 + k as u64);
         for (name, projection) in panoramas {
             let base = RenderSettings::new(projection);
             let (vertex, _) = p99(&scene, &base.with_method(Method::Vertex));
-            assert!(vertex > 3.0, "{kind} on the {name}: vertices alone are off by only {vertex} px (p99)");
+            if name != "cubemap" || *kind == "near" {
+                assert!(vertex > 3.0, "{kind} on the {name}: vertices alone are off by only {vertex} px (p99)");
+            }
             for tau in [0.25f32, 0.5, 1.0] {
                 let settings = base.with_method(Method::Adaptive(Split::Error)).with_max_error_px(tau);
                 let (p, count) = p99(&scene, &settings);

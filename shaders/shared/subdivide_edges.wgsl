@@ -54,11 +54,6 @@ fn pixel_of(q: vec3<f32>) -> vec2<f32> {
     return vec2<f32>(q.x * params.projection.turn_px / TAU, q.y * params.projection.pixels_per_v);
 }
 
-// What the split rules read of the straight edge ab (`Subdivider::edge_profile`): sampled at
-// `segments` segments, both eyes, in canonical order: the projected length by which eq. 5 splits
-// it (heights clamped, segments beyond the clamp at both ends counting 0, stretch-adjusted), the
-// largest second difference of the sampled points (x unwrapped, triples beyond the clamp
-// skipped) by which the error split splits it, and whether it comes near the eye circle.
 // Whether every ray to the segment ab comes from the centre (`Projection::seen_from_centre`): no
 // eye offset, or both ends in one of the pole merge's cones beyond its end.
 fn seen_from_centre(a: vec3<f32>, b: vec3<f32>) -> bool {
@@ -74,6 +69,11 @@ fn seen_from_centre(a: vec3<f32>, b: vec3<f32>) -> bool {
     return merged_a && merged_b && (a.y > 0.0) == (b.y > 0.0);
 }
 
+// What the split rules read of the straight edge ab (`Subdivider::edge_profile`): sampled at
+// `segments` segments, both eyes, in canonical order: the projected length by which eq. 5 splits
+// it (heights clamped, segments beyond the clamp at both ends counting 0, stretch-adjusted), the
+// largest second difference of the sampled points (x unwrapped, triples beyond the clamp
+// skipped) by which the error split splits it, and whether it comes near the eye circle.
 struct EdgeProfile {
     length_px: f32,
     bend_px: f32,
@@ -88,11 +88,15 @@ fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
         lo = b;
         hi = a;
     }
-    // Drawn by pinholes whose every ray to it comes from the centre: exact, its length the angle
-    // it spans (`Subdivider::edge_profile`).
-    if (params.pinhole_faces != 0u && seen_from_centre(lo, hi)) {
-        let angle = atan2(length(cross(lo, hi)), dot(lo, hi));
-        return EdgeProfile(angle * params.projection.turn_px / TAU, 0.0, false, 0.0);
+    // Drawn by pinholes (`Subdivider::edge_profile`): whose every ray to it comes from the
+    // centre, exact; its length the angle it spans.
+    let pinhole = PINHOLE_FACES && params.pinhole_faces != 0u;
+    var angle_px = 0.0;
+    if (pinhole) {
+        angle_px = atan2(length(cross(lo, hi)), dot(lo, hi)) * params.projection.turn_px / TAU;
+        if (seen_from_centre(lo, hi)) {
+            return EdgeProfile(angle_px, 0.0, false, 0.0);
+        }
     }
     let clamp_v = 1.5 * params.projection.height;
     let width = params.projection.turn_px; // a full turn in pixels: x wraps at it
@@ -106,6 +110,12 @@ fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
     var prev: array<vec2<f32>, 2>;
     var q0: array<vec2<f32>, 2>;
     var q1: array<vec2<f32>, 2>;
+    // The pinholes' eye points (`pinhole_profile` in edges.rs): the last two, and the distance
+    // along the ray at the last.
+    var e0: array<vec3<f32>, 2>;
+    var e1: array<vec3<f32>, 2>;
+    var depth1 = vec2<f32>(1.0);
+    var eye_bend = 0.0;
     for (var k = 0u; k <= segments; k++) {
         let t = f32(k) / f32(segments);
         let p = lo + (hi - lo) * spaced(sp, t);
@@ -114,9 +124,19 @@ fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
         let r = horizontal_radius(p);
         let offset = eye_offset(params.projection, r, p.y);
         nearest = min(nearest, r - 2.0 * offset);
-        let raws = pixels(p, offset);
+        let projected = project_both_at(params.projection, p, azimuth(p), offset);
         for (var s = 0u; s < 2u; s++) {
-            let raw = raws[s];
+            let raw = pixel_of(projected[s]);
+            if (pinhole) {
+                // The eye point E = s·d·(cos λ, 0, sin λ) (core/sphere.rs).
+                let e = select(-offset, offset, s == 1u) * vec3<f32>(cos(projected[s].x), 0.0, sin(projected[s].x));
+                if (k >= 2u) {
+                    eye_bend = max(eye_bend, length(e - 2.0 * e1[s] + e0[s]) / depth1[s]);
+                }
+                e0[s] = e1[s];
+                e1[s] = e;
+                depth1[s] = projected[s].z;
+            }
             var q = raw;
             q.y = clamp(q.y, -clamp_v, clamp_v);
             let dx = (q.x - prev[s].x) - width * round((q.x - prev[s].x) / width);
@@ -139,6 +159,9 @@ fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
     // longitude ∝ √(r − d_e)), no stretch is allowed (the exact model puts it at v = ±∞).
     let shows_ring = !VERTICAL_EXACT || params.projection.vertical_exact == 0u || is_sphere(params.projection);
     let ring = shows_ring && nearest < 0.0;
+    if (pinhole) {
+        return EdgeProfile(angle_px, eye_bend * params.projection.turn_px / TAU, ring, 0.0);
+    }
     let stretch = select(MAX_STRETCH, 1.0, ring);
     let residual = AZIMUTH_CHORD_RESIDUAL * sp.turn * sp.turn * f32(segments) * longest;
     return EdgeProfile(max(length_px, f32(segments) * longest / stretch), bend, ring, residual);

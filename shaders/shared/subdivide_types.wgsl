@@ -45,6 +45,11 @@ struct SubdivideParams {
 // lavapipe (CONVERGING in projection.wgsl).
 override MEASURE_EDGES: bool = true;
 
+// Whether the pipeline may draw pinholes (`SubdivideParams::pinhole_faces`, the cubemap): built
+// false for the other frames, whose lanes would otherwise all run the eye points' measure on
+// lavapipe (Sponza's sphere subdivision +5 % with it merely there).
+override PINHOLE_FACES: bool = true;
+
 // The split rule the pipeline is built for (a `SubdivideParams::method` value), or ANY_SPLIT_RULE:
 // the parameters' own, read as the pass runs. A variant per rule compiles the others' tests out,
 // which lavapipe's lanes would otherwise all run (CONVERGING in projection.wgsl).

@@ -22,9 +22,9 @@
 //! neighbouring face (the raster stage draws the subdivided triangles once per face, clipped to
 //! it). Each face draws as a pinhole from the eye points (the clip position scaled by the
 //! distance along the ray: `clip_w` in cpu/raster.rs), exact where the rays come from the
-//! centre. The subdivision measures edges on the sphere at the faces' resolution
-//! ([`Projection::measured`]), except those whose rays all come from the centre
-//! (`Projection::seen_from_centre`: split for length only).
+//! centre. The subdivision splits an edge for how far its eye point turns away from the chord
+//! between its nodes' (`pinhole_profile` in cpu/subdivide/edges.rs), in pixels of the sphere at
+//! the faces' resolution ([`Projection::measured`]).
 //!
 //! The WGSL twin is `shaders/shared/projection_cubemap.wgsl`.
 

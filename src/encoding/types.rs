@@ -171,9 +171,9 @@ pub struct SubdivideParams {
     /// 1: the image has no seam (the fisheye; the cubemap, whose faces map (u, v) periodically
     /// in u; CAVE walls): no seam copies, which would draw their pieces twice over.
     pub seamless: u32,
-    /// 1: the image is drawn as pinholes (the cubemap's faces, w the distance along the ray):
-    /// where every ray to an edge comes from the centre it is drawn exactly, and split for its
-    /// length alone (`Projection::seen_from_centre`).
+    /// 1: the image is drawn as pinholes from the eye points (the cubemap's faces, w the distance
+    /// along the ray): an edge is split for how far its eye point turns from the chord, and for
+    /// its length (the angle it spans) — `Subdivider::pinhole_profile`.
     pub pinhole_faces: u32,
     pub _pad: [u32; 3],
 }

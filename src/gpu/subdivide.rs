@@ -65,7 +65,7 @@ type Pipelines<'p> = &'p dyn Fn(&str) -> Option<&'p wgpu::ComputePipeline>;
 
 /// How a variant's pipelines are built: its constants and stand-ins.
 struct Build {
-    constants: [(&'static str, f64); 5],
+    constants: [(&'static str, f64); 6],
     stand_ins: Vec<StandIn>,
 }
 
@@ -194,8 +194,9 @@ fn lookup<'a>(built: &'a Built, entry: &str) -> Option<&'a wgpu::ComputePipeline
 }
 
 /// Slots for the stage's variants: 4 panorama kinds × spaced or not × 4 split rules × converging
-/// or not × measuring or not × the vertical model (see [`SubdivideStage::variant`]).
-const VARIANTS: usize = 4 * 2 * 4 * 2 * 2 * 2;
+/// or not × measuring or not × the vertical model × pinholes or not (see
+/// [`SubdivideStage::variant`]).
+const VARIANTS: usize = 4 * 2 * 4 * 2 * 2 * 2 * 2;
 
 /// The `subdivide` stage: its layouts, and its pipelines built for each panorama and kind of
 /// split rule when first needed (the WGSL `override PANORAMAS` compiles the other panorama's
@@ -219,7 +220,8 @@ impl SubdivideStage {
     /// through its overrides the code of what the frame is not: the other split rules
     /// (`SPLIT_RULE`), the converging eye model where its rays are parallel (`CONVERGING`), the
     /// edge measure where it measures none (`MEASURE_EDGES`), the cylinder's other vertical
-    /// model (`VERTICAL_EXACT`). lavapipe's lanes run the code behind a test of the parameters
+    /// model (`VERTICAL_EXACT`), the pinholes' measure where the image has none
+    /// (`PINHOLE_FACES`). lavapipe's lanes run the code behind a test of the parameters
     /// whether or not one takes it (docs/results.md, *What lavapipe runs*: together about a
     /// quarter of Sponza's sphere subdivision).
     /// Built side by side on as many threads as the CPU has cores, the longest first
@@ -243,6 +245,7 @@ impl SubdivideStage {
         let converging = params.projection.convergence > 0.0;
         let measuring = params.measure_edges != 0;
         let exact = params.projection.vertical_exact != 0;
+        let pinhole = params.pinhole_faces != 0;
         let rule = params.method.min(3);
         // The variant's slot: what it is built for, as the digits of a mixed-radix number (the
         // panorama kind and the split rule also say whether it draws rows).
@@ -253,6 +256,7 @@ impl SubdivideStage {
             (converging as usize, 2),
             (measuring as usize, 2),
             (exact as usize, 2),
+            (pinhole as usize, 2),
         ];
         let index = digits.iter().rev().fold(0, |i, &(digit, radix)| i * radix + digit);
         self.variants[index].get_or_init(|| {
@@ -274,6 +278,7 @@ impl SubdivideStage {
                 ("MEASURE_EDGES", flag(measuring)),
                 ("SPLIT_RULE", rule as f64),
                 ("VERTICAL_EXACT", flag(exact)),
+                ("PINHOLE_FACES", flag(pinhole)),
             ];
             let build = Build { constants, stand_ins };
             let stage = &self.stage;

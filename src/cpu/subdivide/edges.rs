@@ -141,16 +141,8 @@ impl Subdivider<'_> {
     /// what its drawing with w = r leaves (`cpu::subdivide::spacing`).
     pub fn edge_profile(&self, a: Vec3, b: Vec3, segments: u32) -> EdgeProfile {
         let (lo, hi) = if lex_less(b, a) { (b, a) } else { (a, b) };
-        // Drawn by pinholes whose every ray to it comes from the centre: exact, its length the
-        // angle it spans (the cubemap's faces magnify it up to 2× at their sides' middles).
-        if self.params.pinhole_faces != 0 && self.projection.seen_from_centre(lo, hi) {
-            let angle = lo.cross(hi).length().atan2(lo.dot(hi));
-            return EdgeProfile {
-                length_px: angle * self.projection.pixels_per_radian(),
-                bend_px: 0.0,
-                ring: false,
-                residual_px: 0.0,
-            };
+        if self.params.pinhole_faces != 0 {
+            return self.pinhole_profile(lo, hi, segments);
         }
         let spacer = self.spacing().spacer(lo, hi);
         let clamp_v = 1.5 * self.projection.height as f32;
@@ -195,6 +187,43 @@ impl Subdivider<'_> {
         // The fastest pixels per radian of azimuth: the longest segment over its step, D/S.
         let residual_px = spacer.turn.map_or(0.0, |d| AZIMUTH_CHORD_RESIDUAL * d * d * segments as f32 * longest);
         EdgeProfile { length_px: length.max(segments as f32 * longest / stretch), bend_px: bend, ring, residual_px }
+    }
+
+    /// `edge_profile` where the image is drawn by pinholes from the eye points (the cubemap's
+    /// faces, w the distance along the ray: `SubdivideParams::pinhole_faces`). Between two nodes
+    /// the face draws the points of the edge as seen from the eye point that moves linearly from
+    /// one node's to the other's; the point is seen from its own eye point E = s·d·(cos λ, 0,
+    /// sin λ), which turns with its azimuth. So the drawing is wrong by how far E leaves that
+    /// chord, over the distance along the ray: `bend_px` is the largest second difference
+    /// |E(k+1) − 2E(k) + E(k−1)| / |P(k) − E(k)| in pixels (both eyes), measured as the error
+    /// split reads a bend (the chord's error over n parts about bend·(S/n)²/8). An edge whose
+    /// every ray comes from the centre (`Projection::seen_from_centre`) is drawn exactly. The
+    /// length is the angle the edge spans (a face magnifies it up to 2× at its sides' middles);
+    /// the ring as `edge_profile`'s.
+    fn pinhole_profile(&self, lo: Vec3, hi: Vec3, segments: u32) -> EdgeProfile {
+        let ppr = self.projection.pixels_per_radian();
+        let length_px = lo.cross(hi).length().atan2(lo.dot(hi)) * ppr;
+        if self.projection.seen_from_centre(lo, hi) {
+            return EdgeProfile { length_px, bend_px: 0.0, ring: false, residual_px: 0.0 };
+        }
+        let spacer = self.spacing().spacer(lo, hi);
+        let (mut nearest, mut bend) = (f32::INFINITY, 0.0f32);
+        let (mut e0, mut e1, mut depth1) = ([Vec3::ZERO; 2], [Vec3::ZERO; 2], [1.0f32; 2]);
+        for k in 0..=segments {
+            let p = lo + (hi - lo) * spacer.param(k as f32 / segments as f32);
+            let r = horizontal_radius(p);
+            let offset = self.projection.eye_offset(r, p.y);
+            nearest = nearest.min(r - 2.0 * offset);
+            for (s, eye) in [Eye::Left, Eye::Right].into_iter().enumerate() {
+                let q = self.projection.project_with_azimuth(p, azimuth(p), eye);
+                let e = eye.sign() * offset * Vec3::new(q.u.cos(), 0.0, q.u.sin());
+                if k >= 2 {
+                    bend = bend.max((e - 2.0 * e1[s] + e0[s]).length() / depth1[s]);
+                }
+                (e0[s], e1[s], depth1[s]) = (e1[s], e, q.depth);
+            }
+        }
+        EdgeProfile { length_px, bend_px: bend * ppr, ring: nearest < 0.0, residual_px: 0.0 }
     }
 
     /// Divisions of an edge (not capped by N_max: the pre-split handles that), `edge_px` L and
