@@ -4,7 +4,10 @@
 # binaries are built here and travel with the working tree.
 #
 #   scripts/gpu-check.sh pack      here: release twister and test binaries, the assets they read,
-#                                  into .dev/ (ignored; name .dev and .gl in the call's carry)
+#                                  into .dev/ (ignored; name .dev and .gl in the call's carry;
+#                                  .gl/ holds the debs of libvulkan1 and glvnd — libegl1 libglvnd0
+#                                  libopengl0 libgl1 libglx0 libgles2 —, without which the GPU's
+#                                  Vulkan driver does not load there)
 #   scripts/gpu-check.sh run DIR   there: benchmarks and tests, the log and JSON written into DIR
 #
 # REPS (default 30) sets `bench speed --reps`; SMOKE=1 shrinks everything for a trial run here.
