@@ -67,6 +67,7 @@ run() {
     speed rooms_sphere builtin:demo builtin:box-room --panorama equirect
     speed sponza_cylinder "$S" --viewer 0,1.7,0
     speed small_cylinder "$B" builtin:sphere100 --fit 3
+    speed rooms_cubemap builtin:demo builtin:box-room --panorama cubemap
     speed sponza_sphere_last "$S" --viewer 0,1.7,0 --panorama equirect
     step "error on the sphere (adaptive)"
     for sc in "$S --viewer 0,1.7,0" builtin:demo builtin:box-room; do
