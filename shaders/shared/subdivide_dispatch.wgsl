@@ -70,5 +70,3 @@ fn pending_count() -> u32 {
 fn row_item_count() -> u32 {
     return min(atomicLoad(&counters.row_items), row_item_room());
 }
-
-

@@ -89,7 +89,7 @@ pub const CUBE_MIN_W: f32 = 1e-5;
 pub const CUBE_MIN_DISTANCE: f32 = 1e-6;
 
 /// A face's w for D·n (`cube_clip`; `horizon_w` in projection_cubemap.wgsl).
-pub fn horizon_w(w: f32) -> f32 {
+fn horizon_w(w: f32) -> f32 {
     if w.abs() < CUBE_MIN_W {
         CUBE_MIN_W
     } else {
@@ -170,7 +170,7 @@ impl Projection {
     /// the face's gnomonic map and its clipping keeps what lies in front of the face; the draw's
     /// scissor (the face's square) keeps the face. Linear in D: the great circle between two
     /// directions is the straight line between their images on every face. A direction on the
-    /// face's horizon plane is moved just in front of it ([`horizon_w`]).
+    /// face's horizon plane is moved just in front of it (`horizon_w`).
     pub fn cube_clip(&self, d: Vec3, z: f32, f: usize) -> Vec4 {
         let face = &CUBE_FACES[f];
         let w = horizon_w(d.dot(face.normal));
