@@ -242,7 +242,7 @@ fn the_subdivisions_recordings_name_its_entry_points_and_bindings() {
     use twister::shader::SUBDIVIDE;
     let entries: Vec<&str> = SUBDIVIDE.entry_points.iter().map(|e| e.name).collect();
     let bound = |name: &str| SUBDIVIDE.bindings.iter().any(|b| b.name == name);
-    let all = Passes { parts: true, rows: true };
+    let all = Passes { rows: true };
     let usual = one_submission(1000, all, true);
     // The usual frame of the sphere under an adaptive rule dispatches every entry point, in the
     // order the passes depend on.
@@ -254,13 +254,12 @@ fn the_subdivisions_recordings_name_its_entry_points_and_bindings() {
         &["lattice_work_args", "lattice_nodes", "lattice_triangles", "finalize"],
     ];
     assert_eq!(order, expected.concat());
-    // The cylinder's leaves out `plan_parts` (its `plan_cuts` plans its few bands itself), and
-    // the frames without rows their passes.
-    let cylinder: Vec<&str> = one_submission(7, Passes { parts: false, rows: false }, false).entries().collect();
-    let optional = ["plan_parts_args", "plan_parts", "lattice_rows_args", "lattice_rows", "lattice_rows_plan"];
+    // The frames without rows (the cylinder's, `vertex`'s) leave out their passes.
+    let cylinder: Vec<&str> = one_submission(7, Passes { rows: false }, false).entries().collect();
+    let optional = ["lattice_rows_args", "lattice_rows", "lattice_rows_plan"];
     let always: Vec<&str> = order.iter().copied().filter(|e| !optional.contains(e)).collect();
     assert_eq!(cylinder, always);
-    let some = [Passes { parts: false, rows: false }, Passes { parts: true, rows: false }, all];
+    let some = [Passes { rows: false }, all];
     let runs = some.map(|p| [one_submission(7, p, false), pass_run("plan", 7, p), pass_run("lattice", 7, p)]);
     for recording in [usual, active_cuts(7)].into_iter().chain(runs.into_iter().flatten()) {
         let mut in_pass = false;

@@ -7,7 +7,6 @@
 #import subdivide_state
 #import subdivide_edges
 #import subdivide_frame_cuts
-#import subdivide_quad
 
 // ---- the parts around the vertical axis (src/cpu/subdivide/axis.rs) ----
 
@@ -310,9 +309,9 @@ fn single_part(full: bool, marks: vec3<u32>, tri: ptr<function, InputTriangle>, 
     return false;
 }
 
-// Plans every part of the current triangle in quadrant q (`polygons` in axis.rs: band by band
-// outwards, along each fan) and appends its pieces.
-fn plan_quadrant(t: u32, q: u32, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>, clip: ptr<function, ClipState>, cuts: vec2<u32>) {
+// Appends every part of the current triangle in quadrant q for `plan_parts` (`polygons` in
+// axis.rs: band by band outwards, along each fan).
+fn plan_quadrant(t: u32, q: u32, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, clip: ptr<function, ClipState>, cuts: vec2<u32>) {
     let signs = QUADRANT_SIGNS;
     {
         let s = signs[q];
@@ -373,7 +372,7 @@ fn plan_quadrant(t: u32, q: u32, tri: ptr<function, InputTriangle>, part: ptr<fu
                     (*clip).keep_at = (*clip).quadrant_at;
                 }
             }
-            plan_band(t, tri, part, piece_state, clip);
+            plan_band(t, part, clip);
         }
     }
 }
@@ -469,19 +468,7 @@ fn edge_crossings(a: Node, b: Node, clip: ptr<function, ClipState>, cuts: vec2<u
     }
 }
 
-// A part `plan_cuts` cut: on the sphere appended for `plan_parts` (a quadrant near a pole has
-// many bands, a triangle beside it several parts: planning them here made the frame's longest
-// threads), on the cylinder planned here (`Passes::parts`).
-fn plan_cut_part(t: u32, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>) {
-    if (is_sphere(params.projection)) {
-        append_part(t, part);
-    } else {
-        plan_part(tri, part);
-        append_pieces(t, part);
-    }
-}
-
-// Plans the parts of triangle t, which is not cut by all cuts, at the crossings of its edges that
+// Appends for `plan_parts` the parts of triangle t, which is not cut by all cuts, at the crossings of its edges that
 // cut triangles have (`edge_split_parts` in axis.rs): its boundary (corner e, then edge e's
 // crossings) in the pool; with crossings on one edge the fan from the opposite corner, on more
 // the fan from the centroid, on none the triangle.
@@ -506,8 +493,7 @@ fn plan_edge_split(t: u32, tri: ptr<function, InputTriangle>, part: ptr<function
         }
     }
     // The parts: the triangle, or the fan (apex, pool[i], pool[i + 1 mod the polygon's count])
-    // of those not off screen; one call site of `plan_cut_part` (lavapipe inlines each: its time
-    // to build the pipeline grows with every copy).
+    // of those not off screen, appended for `plan_parts`.
     var apex = weighted(corners, vec3<f32>(1.0 / 3.0));
     var first = 0u;
     var count = (*clip).poly_count;
@@ -530,75 +516,20 @@ fn plan_edge_split(t: u32, tri: ptr<function, InputTriangle>, part: ptr<function
                 continue;
             }
         }
-        plan_cut_part(t, tri, part);
+        append_part(t, part);
     }
 }
 
-// The edges of the polygon in `poly` and its fan: side e (corner e → e + 1, the last back to
-// corner 0) for e < poly_count, then diagonal d (corner 0 → d + 2) at poly_count + d. The ends of
-// edge e, as corner indices.
-fn polygon_edge_ends(e: u32, clip: ptr<function, ClipState>) -> vec2<u32> {
-    if (e < (*clip).poly_count) {
-        return vec2<u32>(e, (e + 1u) % (*clip).poly_count);
-    }
-    return vec2<u32>(0u, e - (*clip).poly_count + 2u);
-}
-
-// The edges of fan part i (corners 0, i, i + 1): 0 → i, i → i + 1, i + 1 → 0.
-fn fan_edges(i: u32, clip: ptr<function, ClipState>) -> vec3<u32> {
-    let first = select((*clip).poly_count + i - 2u, 0u, i == 1u);
-    let last = select((*clip).poly_count + i - 1u, (*clip).poly_count - 1u, i + 2u == (*clip).poly_count);
-    return vec3<u32>(first, i, last);
-}
-
-// Whether the band polygon in `poly` (both fan parts `shown`, edge counts in `poly_n`) is drawn as one strip between two of its sides (the rails)
-// rather than as the two parts of its fan (`quad_strip` in subdivide.rs); then `strip_n` holds
-// the rails' counts and `quad_turn` the polygon corner that becomes the quad's corner 0 (rails
-// 0 → 1 and 3 → 2).
-
-// The band polygon in `poly` (of triangle `t`): on the sphere, its fan's parts appended for
-// `plan_parts` (a quadrant near a pole has many bands: planning them all here made the longest
-// threads of the frame); on the cylinder (a few bands) planned here: one strip between its rails
-// where it is a band quad, else its fan's parts. Parts wholly beyond the image's rows left out.
-fn plan_band(t: u32, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>, clip: ptr<function, ClipState>) {
-    // The fan's parts shown, and their edges, each counted once (a diagonal is two parts').
-    var shown = 0u;
-    var needed = 0u;
+// The band polygon in `poly` (of triangle `t`): its fan's parts appended for `plan_parts` (a
+// quadrant near a pole or beside a floor has many bands: planning them all here made the longest
+// threads of the frame). Parts wholly beyond the image's rows left out.
+fn plan_band(t: u32, part: ptr<function, PartPlan>, clip: ptr<function, ClipState>) {
     for (var i = 1u; i + 1u < (*clip).poly_count; i++) {
-        if (!off_screen_vertically(poly_node(0, clip).position, poly_node(i, clip).position, poly_node(i + 1u, clip).position)) {
-            shown |= 1u << i;
-            let e = fan_edges(i, clip);
-            needed |= (1u << e.x) | (1u << e.y) | (1u << e.z);
-        }
-    }
-    let sphere = is_sphere(params.projection);
-    if (!sphere) {
-        for (var e = 0u; e + 3u < 2u * (*clip).poly_count; e++) {
-            if ((needed & (1u << e)) != 0u) {
-                let ends = polygon_edge_ends(e, clip);
-                (*clip).poly_n[e] = edge_divisions(poly_node(ends.x, clip).position, poly_node(ends.y, clip).position, tri);
-            }
-        }
-        if (plan_quad(shown, tri, piece_state, clip)) {
-            append_quad(t, part, piece_state, clip);
-            return;
-        }
-    }
-    for (var i = 1u; i + 1u < (*clip).poly_count; i++) {
-        if ((shown & (1u << i)) != 0u) {
-            (*part).corner[0] = poly_node(0, clip);
-            (*part).corner[1] = poly_node(i, clip);
-            (*part).corner[2] = poly_node(i + 1u, clip);
-            if (sphere) {
-                append_part(t, part); // `plan_cut_part`: the counts are left to `plan_parts`
-            } else {
-                let e = fan_edges(i, clip);
-                (*part).n[0] = (*clip).poly_n[e.x];
-                (*part).n[1] = (*clip).poly_n[e.y];
-                (*part).n[2] = (*clip).poly_n[e.z];
-                plan_level(part);
-                append_pieces(t, part);
-            }
+        (*part).corner[0] = poly_node(0, clip);
+        (*part).corner[1] = poly_node(i, clip);
+        (*part).corner[2] = poly_node(i + 1u, clip);
+        if (!off_screen_vertically((*part).corner[0].position, (*part).corner[1].position, (*part).corner[2].position)) {
+            append_part(t, part); // its counts are left to `plan_parts`
         }
     }
 }

@@ -6,7 +6,6 @@
 #import subdivide_bindings
 #import subdivide_state
 #import subdivide_edges
-#import subdivide_quad
 
 const CORNER: u32 = 0u;
 const ON_EDGE: u32 = 1u;
@@ -232,8 +231,7 @@ fn node_slot(c: vec3<u32>, m: u32) -> u32 {
 
 const LATTICE_SHAPE: u32 = 3u; // `strip_base` of a piece drawn as the regular lattice (0–2: a strip's base)
 
-// Whether a piece may be a sliver's strip or a band quad: on the cylinder only (`strip_base_of`,
-// `plan_quad`). The sphere's pipelines compile their code out of the tests below, which lavapipe's
+// Whether a piece may be a sliver's strip: on the cylinder only (`strip_base_of`). The sphere's pipelines compile their code out of the tests below, which lavapipe's
 // lanes would otherwise all run whatever their piece's shape.
 fn cylinder_shapes() -> bool {
     return !is_sphere(params.projection);
@@ -285,15 +283,13 @@ fn strip_step(walk: ptr<function, vec4<u32>>, piece_state: ptr<function, PieceSt
     return vec3<u32>(n1 + n2 - i, j, j + 1u);
 }
 
-// ---- a piece's nodes and candidate triangles: the lattice of level m, the strip or the quad ----
+// ---- a piece's nodes and candidate triangles: the lattice of level m, the strip or the rows ----
 
 // Node k in slot order; `row` is the lattice's running (j, l), advanced here. Each shape names
 // the node as a point along a segment (`Along`), placed by one call of `edge_point`.
 fn piece_node(k: u32, m: u32, row: ptr<function, vec2<u32>>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Node {
     var along: Along;
-    if (cylinder_shapes() && (*piece_state).strip_base == QUAD_STRIP) {
-        along = quad_along(k, piece_state);
-    } else if (cylinder_shapes() && (*piece_state).strip_base < LATTICE_SHAPE) {
+    if (cylinder_shapes() && (*piece_state).strip_base < LATTICE_SHAPE) {
         along = strip_along(k, part, piece_state);
     } else if ((*piece_state).strip_base == ROWS_SHAPE) {
         // `row` = (node a, row k), advanced along the row, then to the next.
@@ -317,9 +313,6 @@ fn piece_node(k: u32, m: u32, row: ptr<function, vec2<u32>>, part: ptr<function,
 
 // Candidate triangle t's slots (the strip's in walk order, advancing `walk`).
 fn piece_triangle_slots(t: u32, m: u32, walk: ptr<function, vec4<u32>>, piece_state: ptr<function, PieceState>) -> vec3<u32> {
-    if (cylinder_shapes() && (*piece_state).strip_base == QUAD_STRIP) {
-        return quad_step(walk, piece_state);
-    }
     if ((*piece_state).strip_base == ROWS_SHAPE) {
         var at: array<vec2<u32>, 3>;
         return rows_step(walk, &at, piece_state);
@@ -421,17 +414,6 @@ struct PieceShape {
     candidates: u32,
     node_count: u32,
     theta_c: f32,
-}
-
-// A band quad: corners 0–2 in `piece`, corner 3 in the next record (`tail`); its rails' counts.
-fn quad_shape(piece: Piece, tail: Piece, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> PieceShape {
-    (*piece_state).corner = (*part).corner;
-    (*piece_state).quad_last = Node(tail.corner[0].xyz, vec3<f32>(tail.corner[0].w, tail.bary1[0], tail.bary2[0]));
-    (*piece_state).strip_base = QUAD_STRIP;
-    (*piece_state).strip_n = vec2<u32>(piece.counts01 & 0xffffu, piece.counts01 >> 16u);
-    let candidates = (*piece_state).strip_n.x + (*piece_state).strip_n.y;
-    let theta_c = azimuth(((*piece_state).corner[0].position + (*piece_state).corner[1].position + (*piece_state).corner[2].position + (*piece_state).quad_last.position) / 4.0);
-    return PieceShape(max((*piece_state).strip_n.x, (*piece_state).strip_n.y), candidates, candidates + 2u, theta_c);
 }
 
 // A piece of the pre-split: its part's counts and K from its record, its corners (its macro
@@ -580,20 +562,10 @@ fn seam_copies(shape: PieceShape, part: ptr<function, PartPlan>, piece_state: pt
             }
         }
     } else {
-        // The cylinder: from the corners; a band quad's range is that of its fan's two
-        // triangles, which cover it (one call site of piece_u_range).
-        let triangles = select(1u, 2u, (*piece_state).strip_base == QUAD_STRIP);
-        reach = 0.0;
-        for (var k = 0u; k < triangles; k++) {
-            var q = (*piece_state).corner;
-            if (k == 1u) {
-                q = array<Node, 3>((*piece_state).corner[0], (*piece_state).corner[2], (*piece_state).quad_last);
-            }
-            let r = piece_u_range(q, theta_c);
-            u_range = vec2<f32>(min(u_range.x, r.x), max(u_range.y, r.y));
-            reach = max(reach, r.z);
-        }
-        reach += SEAM_BOUND_SLACK;
+        // The cylinder: from the corners.
+        let r = piece_u_range((*piece_state).corner, theta_c);
+        u_range = r.xy;
+        reach = r.z + SEAM_BOUND_SLACK;
     }
     var seam = SeamCopies(array<f32, 3>(theta_c, 0.0, 0.0), 1u, reach);
     // The seamless images make none (SubdivideParams::seamless: the fisheye's, the cubemap's

@@ -36,12 +36,10 @@ struct PieceState {
     original: array<i32, 3>, // original edge under piece edge e, or −1
     from_index: array<u32, 3>,    // fine index on that original edge at corner e
     to_index: array<u32, 3>,  // and at corner e + 1
-    strip_base: u32,         // a sliver's base edge (see `strip_base_of`); 3: the lattice; QUAD_STRIP; ROWS_SHAPE
-    strip_n: vec2<u32>,      // its long edges' counts: edge base + 1, edge base + 2; a quad's rails; rows' sides (left, right)
+    strip_base: u32,         // a sliver's base edge (see `strip_base_of`); 3: the lattice; ROWS_SHAPE
+    strip_n: vec2<u32>,      // its long edges' counts: edge base + 1, edge base + 2; rows' sides (left, right)
     row_base: u32,           // rows: the base edge
     row_w: array<u32, 33>,   // rows: each row's parts, from the base to the apex (`Rows::widths`)
-    quad_last: Node,         // a band quad's corner 3 (its corners 0–2 in `corner`)
-    quad_turn: u32,          // `plan_quad`: the polygon's corner that is the quad's corner 0
 }
 
 // A polygon while it is clipped (at most 7 corners), and a quadrant's polygon kept while its
@@ -55,7 +53,6 @@ struct ClipState {
     quadrant_at: u32,      // the quadrant's rest's slot
     quadrant_count: u32,
     keep_at: u32,          // a third slot a clip must not write (a band kept meanwhile)
-    poly_n: array<u32, 11>, // edge counts of a band's polygon and its fan (`polygon_edge_ends`)
     // The segment of an edge being clipped (`edge_crossings`), the edge's ends, and where its
     // crossings start in the pool.
     seg_p: Node,

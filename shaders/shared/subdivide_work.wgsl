@@ -8,7 +8,6 @@
 #import subdivide_bindings
 #import subdivide_state
 #import subdivide_edges
-#import subdivide_quad
 #import subdivide_lattice
 #import subdivide_bands
 #import subdivide_rows
@@ -29,7 +28,7 @@ fn work_capacity() -> u32 {
 // piece of one item's worth (at most LATTICE_CHUNK / copies nodes and candidates: every `vertex`
 // piece, most small ones) written here, as its items would be; a larger one's work written and
 // its work items appended: node items from the front of `lattice_work`, triangle items from its
-// back, each triangle item with the walk (strip, quad, rows) at its first candidate. Counted
+// back, each triangle item with the walk (strip, rows) at its first candidate. Counted
 // always, written only where they fit.
 fn plan_work(index: u32, shape: PieceShape, seam: SeamCopies, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
     let copies = seam.copies;
@@ -109,14 +108,10 @@ fn plan_pending(index: u32, shape: PieceShape, piece_state: ptr<function, PieceS
 }
 
 // A work item's piece reloaded as `lattice` left it: its part, corners, edges and counts, its
-// shape (and a quad's rails, rows' widths) from its work.
+// shape (and rows' widths) from its work.
 fn load_work(index: u32, work: PieceWork, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
     let piece = pieces[index];
     record_corners(piece, part);
-    if (cylinder_shapes() && (piece.count2_level & QUAD_HEAD) != 0u) {
-        quad_shape(piece, pieces[index + 1u], part, piece_state);
-        return;
-    }
     piece_edges(piece_corners(piece, part, piece_state), part, piece_state);
     for (var e = 0u; e < 3u; e++) {
         (*piece_state).counts[e] = (work.counts >> (8u * e)) & 0xffu;

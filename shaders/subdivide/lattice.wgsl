@@ -1,8 +1,7 @@
 // The `lattice` pass of the `subdivide` stage: one invocation per piece record. The part's
 // corners from the record; the piece's shape: the regular lattice of level m = max(counts),
 // boundary nodes snapped to each edge's nodes, or a sliver's strip along its long edges (the
-// error split on the cylinder), a band quad's strip between its rails (corner 3 read from the
-// next record), or rows (the sphere: their measures are left to `lattice_rows`, the choice to
+// error split on the cylinder), or rows (the sphere: their measures are left to `lattice_rows`, the choice to
 // `lattice_rows_plan`); its seam copies (again a turn away where its nodes' u range crosses ±π).
 // A piece of one work item's worth it writes itself; for a larger one it writes its plan
 // (`piece_work`), its nodes' room and its work items (`plan_work`), which `lattice_nodes` and
@@ -18,7 +17,6 @@
 #import subdivide_edges
 #import subdivide_frame_cuts
 #import subdivide_axis
-#import subdivide_quad
 #import subdivide_lattice
 #import subdivide_bands
 #import subdivide_rows
@@ -36,17 +34,9 @@ fn lattice(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
     }
     let index = params.first_piece + local;
     let piece = pieces[index];
-    if (cylinder_shapes() && (piece.count2_level & QUAD_TAIL) != 0u) {
-        return; // drawn by the quad's first record
-    }
     load_triangle(piece.triangle, &tri);
     record_corners(piece, &part);
-    var shape: PieceShape;
-    if (cylinder_shapes() && (piece.count2_level & QUAD_HEAD) != 0u) {
-        shape = quad_shape(piece, pieces[index + 1u], &part, &piece_state);
-    } else {
-        shape = lattice_shape(piece, &tri, &part, &piece_state);
-    }
+    let shape = lattice_shape(piece, &tri, &part, &piece_state);
     if (shape.candidates == 0u) {
         return;
     }

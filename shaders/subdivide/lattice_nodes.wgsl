@@ -12,7 +12,6 @@
 #import subdivide_edges
 #import subdivide_frame_cuts
 #import subdivide_axis
-#import subdivide_quad
 #import subdivide_lattice
 #import subdivide_bands
 #import subdivide_rows

@@ -2,10 +2,10 @@
 // (`PLAN_CUTS_SPLIT`). A triangle not cut by all cuts is fanned at the crossings of its
 // edges that cut triangles have (`plan_edge_split`); one cut by all, its parts around the
 // vertical axis under the frame's cuts (quadrants minus a small square around the axis, bands
-// between the active diamonds, fan-triangulated; a band's quad whose two opposite sides are in
-// one part each, one piece drawn as a strip between the other two), each planned as in `plan` —
-// except the sphere's bands' parts, appended to `parts` for `plan_parts` (a quadrant near a pole
-// has many bands). CPU twin: `CpuSubdivision::plan_cuts`.
+// between the active diamonds, fan-triangulated), each appended to `parts` for `plan_parts`,
+// which plans it as `plan` plans a triangle (a quadrant near a pole or beside a floor has many
+// bands: planning them here made the frame's longest threads). CPU twin:
+// `CpuSubdivision::plan_cuts`.
 
 #import projection
 #import constants
@@ -16,7 +16,6 @@
 #import subdivide_edges
 #import subdivide_frame_cuts
 #import subdivide_axis
-#import subdivide_quad
 #import subdivide_lattice
 #import subdivide_bands
 #import subdivide_rows
@@ -26,7 +25,6 @@
 fn plan_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     var tri: InputTriangle;
     var part: PartPlan;
-    var piece_state: PieceState;
     var clip: ClipState;
     var cuts: vec2<u32>;
     let local = invocation_index(gid, groups);
@@ -45,7 +43,7 @@ fn plan_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
         }
     } else {
         // Its quadrant.
-        plan_quadrant(t, local % split, &tri, &part, &piece_state, &clip, cuts);
+        plan_quadrant(t, local % split, &tri, &part, &clip, cuts);
     }
     atomicMax(&counters.max_pieces, part.appended);
 }

@@ -74,18 +74,7 @@ pub const STRIP_MIN_DIVISIONS: u32 = 3;
 /// edge or shorter, are then drawn straight with little error (with the whole τ, random slivers
 /// across the seam reached p99 1.7 px at τ = 1 px, against 1.3 with the lattice).
 pub const STRIP_BASE_ERROR: f32 = 0.25;
-/// Under the error split, on the cylinder, a band's polygon with four corners whose two opposite
-/// sides are in one part each (the rungs) and whose longer other side (a rail) is in at least
-/// this many is drawn as one strip between its rails (`quad_strip_triangles` in
-/// src/cpu/subdivide/) instead of the two parts of its fan; below it the two make as many.
-pub const QUAD_MIN_DIVISIONS: u32 = 2;
-/// ... and whose zigzag's every rung has a chord error within this share of τ.
-pub const QUAD_RUNG_ERROR: f32 = 1.0;
-/// `Piece::count2_level` flags: the first record of a band's quad drawn as a strip (corners 0–2,
-/// the rails' counts in `counts01`) and the second (corner 3 only; its invocation draws nothing).
-pub const QUAD_HEAD: u32 = 1 << 31;
-pub const QUAD_TAIL: u32 = 1 << 30;
-/// ... and a piece of a thin part split in bands (`PartSplit` and `band_cell` in
+/// `Piece::count2_level` flag: a piece of a thin part split in bands (`PartSplit` and `band_cell` in
 /// src/cpu/subdivide/; `cell` is the piece's index among the bands' halves).
 pub const BANDS: u32 = 1 << 29;
 /// Under an adaptive rule a piece drawn in rows (`Rows` in src/cpu/subdivide/) gives each band
@@ -157,10 +146,6 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("ROW_DIAGONAL_ERROR", F32(ROW_DIAGONAL_ERROR)),
         ("STRIP_MIN_DIVISIONS", U32(STRIP_MIN_DIVISIONS)),
         ("STRIP_BASE_ERROR", F32(STRIP_BASE_ERROR)),
-        ("QUAD_MIN_DIVISIONS", U32(QUAD_MIN_DIVISIONS)),
-        ("QUAD_RUNG_ERROR", F32(QUAD_RUNG_ERROR)),
-        ("QUAD_HEAD", U32(QUAD_HEAD)),
-        ("QUAD_TAIL", U32(QUAD_TAIL)),
         ("MAX_MACRO_LEVEL", U32(MAX_MACRO_LEVEL)),
         ("AXIS_CLEARANCE_MIN", F32(AXIS_CLEARANCE_MIN)),
         ("AXIS_CLEARANCE_MAX", F32(AXIS_CLEARANCE_MAX)),

@@ -85,9 +85,6 @@ pub struct SubdivideOutput {
     pub rows: u32,
     /// Pieces that are halves of a long thin part's bands (`band_cell`; likewise).
     pub bands: u32,
-    /// Band quads drawn as one strip between their rails (the twin's count, for tests; 0 from
-    /// the GPU).
-    pub quads: u32,
     /// Triangles that ask for no cuts cut at edges they share with ones that do (the twin's
     /// count, for tests; 0 from the GPU).
     pub edge_splits: u32,
@@ -198,7 +195,7 @@ pub fn one_submission(triangles: u32, passes: Passes, timed: bool) -> Recording 
     r.pass("plan", stamp(PLAN_TIMESTAMP));
     r.dispatch("active_cuts", triangles).dispatch("ring_cuts", triangles).dispatch("plan", triangles);
     r.pass("plan_cuts", stamp(PLAN_CUTS_TIMESTAMP));
-    cut_and_plan_parts(&mut r, passes);
+    cut_and_plan_parts(&mut r);
     r.pass("lattice", stamp(LATTICE_TIMESTAMP));
     r.dispatch("lattice_args", 1).dispatch_indirect("lattice", "lattice_dispatch", DISPATCH_LATTICE);
     lattice_work(&mut r, passes);
@@ -206,27 +203,17 @@ pub fn one_submission(triangles: u32, passes: Passes, timed: bool) -> Recording 
     r
 }
 
-/// `plan_cuts` over the triangles `plan` listed, then on the sphere `plan_parts` over the parts
-/// it left (each after its one-thread setup pass).
-fn cut_and_plan_parts(r: &mut Recording, passes: Passes) {
+/// `plan_cuts` over the triangles `plan` listed, then `plan_parts` over the parts it cut (each
+/// after its one-thread setup pass): a quadrant near a pole or beside a floor has many bands,
+/// which one invocation planned in turn made the frame's longest threads.
+fn cut_and_plan_parts(r: &mut Recording) {
     r.dispatch("plan_cuts_args", 1).dispatch_indirect("plan_cuts", "lattice_dispatch", DISPATCH_PLAN_CUTS);
-    if passes.parts {
-        r.dispatch("plan_parts_args", 1).dispatch_indirect("plan_parts", "lattice_dispatch", DISPATCH_PLAN_PARTS);
-    }
-}
-
-/// Whether `plan_cuts` leaves the parts it cuts to `plan_parts`: on the sphere (a quadrant
-/// near a pole has many bands, which one invocation planned in turn); on the cylinder, with a
-/// few, it plans them itself (`plan_cut_part` in the WGSL).
-pub fn defers_parts(panorama: PanoramaKind) -> bool {
-    panorama.is_sphere()
+    r.dispatch("plan_parts_args", 1).dispatch_indirect("plan_parts", "lattice_dispatch", DISPATCH_PLAN_PARTS);
 }
 
 /// The passes a frame's schedules dispatch besides those every frame has.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Passes {
-    /// `plan_parts`: `plan_cuts` leaves the parts it cuts to it ([`defers_parts`]).
-    pub parts: bool,
     /// `lattice_rows` and `lattice_rows_plan`: pieces may be drawn in rows (the sphere, under an
     /// adaptive rule).
     pub rows: bool,
@@ -235,8 +222,7 @@ pub struct Passes {
 impl Passes {
     /// A frame's: its panorama and its split rule (`SubdivideParams::method`).
     pub fn of(panorama: PanoramaKind, method: u32) -> Passes {
-        let sphere = panorama.is_sphere();
-        Passes { parts: defers_parts(panorama), rows: sphere && SplitRule::is_adaptive(method) }
+        Passes { rows: panorama.is_sphere() && SplitRule::is_adaptive(method) }
     }
 
     /// The passes of a frame drawn with `settings`.
@@ -259,8 +245,7 @@ fn lattice_work(r: &mut Recording, passes: Passes) {
     r.dispatch_indirect("lattice_triangles", "lattice_dispatch", DISPATCH_LATTICE_TRIANGLES);
 }
 
-/// The passes that cut triangles around the axis: `plan_cuts`, and on the sphere `plan_parts`
-/// after it. They are the largest pipelines to build, and many frames never run them (a room on
+/// The passes that cut triangles around the axis: `plan_cuts`, and `plan_parts` after it. They are the largest pipelines to build, and many frames never run them (a room on
 /// the cylinder whose floor and ceiling stay beyond the image's rows): the GPU builds them when a
 /// frame first lists a triangle for them (`plan`'s counters, [`cut_probe`]).
 pub const CUT_PASSES: [&str; 2] = ["plan_cuts", "plan_parts"];
@@ -307,7 +292,7 @@ pub fn pass_run(entry: &'static str, count: u32, passes: Passes) -> Recording {
     r.clear("counters", Some(SubdivideCounters::RUN_BYTES));
     r.pass(entry, None).dispatch(entry, count);
     if entry == "plan" {
-        cut_and_plan_parts(&mut r, passes);
+        cut_and_plan_parts(&mut r);
     } else {
         lattice_work(&mut r, passes);
     }

@@ -388,8 +388,8 @@ pub struct Piece {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct PieceWork {
-    /// How it is drawn: a sliver's strip (its base edge 0–2), the lattice (3), a band quad's
-    /// strip (`QUAD_STRIP`), rows (`ROWS_SHAPE`), or `ROWS_PENDING` while its rows are measured.
+    /// How it is drawn: a sliver's strip (its base edge 0–2), the lattice (3), rows
+    /// (`ROWS_SHAPE`), or `ROWS_PENDING` while its rows are measured.
     pub shape: u32,
     /// Its lattice level (the largest edge count).
     pub m: u32,
@@ -402,7 +402,7 @@ pub struct PieceWork {
     pub first_node: u32,
     /// The piece's edge counts, 8 bits each; rows: the base edge in bits 24–31.
     pub counts: u32,
-    /// A strip's, a quad's rails' or rows' sides' counts: x | y << 16.
+    /// A strip's or rows' sides' counts: x | y << 16.
     pub strip_n: u32,
     /// Each copy's reference azimuth (`theta_ref`; x, y, z).
     pub refs: [f32; 4],

@@ -191,11 +191,22 @@ macro_rules! planning {
     };
 }
 
-/// What `plan` reads and writes (it plans parts and appends pieces); `plan_cuts` also appends
-/// parts, and `plan_parts` plans them.
+/// What `plan` reads and writes (it plans parts and appends pieces).
 const PLANNING: &[&str] = planning!("cut_list", "triangle_edges", "edge_marks_read");
 
-const CUTTING: &[&str] = planning!("cut_list", "triangle_edges", "edge_marks_read", "parts");
+/// What `plan_cuts` reads and writes: it cuts the triangles `plan` listed into parts, which it
+/// appends (for `plan_parts`, which plans them) rather than pieces.
+const CUTTING: &[&str] = &[
+    "params",
+    "vertices",
+    "indices",
+    "counters",
+    "object_edge_scale",
+    "cut_list",
+    "triangle_edges",
+    "edge_marks_read",
+    "parts",
+];
 
 /// The bindings of the passes that plan pieces (`lattice`, `lattice_rows_plan`): they plan pieces,
 /// list those whose rows are measured (in `parts`) and append work items, and write small pieces'
@@ -470,7 +481,6 @@ pub const SHARED: &[(&str, &str)] = &[
     ("subdivide_frame_cuts", include_str!("../../shaders/shared/subdivide_frame_cuts.wgsl")),
     ("subdivide_axis", include_str!("../../shaders/shared/subdivide_axis.wgsl")),
     ("subdivide_dispatch", include_str!("../../shaders/shared/subdivide_dispatch.wgsl")),
-    ("subdivide_quad", include_str!("../../shaders/shared/subdivide_quad.wgsl")),
     ("subdivide_lattice", include_str!("../../shaders/shared/subdivide_lattice.wgsl")),
     ("subdivide_bands", include_str!("../../shaders/shared/subdivide_bands.wgsl")),
     ("subdivide_rows", include_str!("../../shaders/shared/subdivide_rows.wgsl")),

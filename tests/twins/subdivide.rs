@@ -152,7 +152,7 @@ impl Twin for Subdivide {
     type Output = Vec<twister::cpu::subdivide::SubdivideOutput>;
     fn cases() -> Vec<(String, Self::Case)> {
         let cases = subdivide_cases();
-        let (mut cut_frames, mut strip_frames, mut quad_frames, mut edge_split_frames) = (0, 0, 0, 0);
+        let (mut cut_frames, mut strip_frames, mut edge_split_frames) = (0, 0, 0);
         let (mut row_frames, mut band_frames) = (0, 0);
         let cases: Vec<_> = cases
             .into_iter()
@@ -164,7 +164,6 @@ impl Twin for Subdivide {
                 assert!(cpu.vertices.len() / 3 > scene.triangle_count(), "{name}: exercises splits and seam copies");
                 cut_frames += (cpu.cuts != 0) as usize;
                 strip_frames += (cpu.strips > 0) as usize;
-                quad_frames += (cpu.quads > 0) as usize;
                 edge_split_frames += (cpu.edge_splits > 0) as usize;
                 row_frames += (cpu.rows > 0) as usize;
                 band_frames += (cpu.bands > 0) as usize;
@@ -175,8 +174,6 @@ impl Twin for Subdivide {
         assert!(cut_frames >= 8 && cut_frames < cases.len(), "{cut_frames} of {} cases cut", cases.len());
         // Slivers drawn as strips (the error split on the cylinder).
         assert!(strip_frames >= 3, "only {strip_frames} cases draw strips");
-        // Band quads drawn as one strip between their rails (the same, around the axis).
-        assert!(quad_frames >= 2, "only {quad_frames} cases draw band quads as strips");
         // Triangles that ask for no cuts, cut only at the edges they share with ones that do.
         assert!(edge_split_frames >= 3, "only {edge_split_frames} cases cut triangles at shared edges alone");
         // Pieces drawn in rows, and long thin parts cut in bands (adaptive rules).

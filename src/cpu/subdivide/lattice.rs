@@ -8,7 +8,7 @@
 use glam::Vec3;
 
 use super::spacing::Spacing;
-use super::{edge_point, Node};
+use super::Node;
 
 /// The point with weights `w` of a triangle of nodes (position and barycentric weights alike).
 pub(super) fn weighted(q: &[Node; 3], w: Vec3) -> Node {
@@ -148,75 +148,6 @@ pub fn strip_slots(counts: [u32; 3], base: usize) -> Vec<[u32; 3]> {
 /// (i + 1)/n2 is at most the right's (j + 1)/n1, or the right edge is done.
 fn strip_advances_left(i: u32, j: u32, n1: u32, n2: u32) -> bool {
     i < n2 && (j == n1 || (i + 1) * n1 <= (j + 1) * n2)
-}
-
-/// Nodes of a band's quad drawn as a strip ([`quad_strip_triangles`]) with rails in `rails`
-/// parts: rail a (corner 0 → 1, n1 + 1 nodes), then rail d (corner 3 → 2, n2 + 1 nodes).
-pub fn quad_strip_node_count(rails: [u32; 2]) -> u32 {
-    rails[0] + rails[1] + 2
-}
-
-/// Node `slot` of a quad's strip ([`quad_strip_node_count`]): the rails' own nodes, computed
-/// from each side's canonically ordered ends as every piece does ([`edge_point`]).
-pub(super) fn quad_strip_node(corners: &[Node; 4], rails: [u32; 2], slot: u32, spacing: Spacing) -> Node {
-    if slot <= rails[0] {
-        edge_point(corners[0], corners[1], slot, rails[0], spacing)
-    } else {
-        edge_point(corners[3], corners[2], slot - rails[0] - 1, rails[1], spacing)
-    }
-}
-
-/// The strip of a band's quad (corners 0, 1, 2, 3 in the triangle's winding; sides 1 → 2 and
-/// 3 → 0 in one part each, the rungs): rails a (0 → 1, n1 parts) and d (3 → 2, n2 parts) joined
-/// by a zigzag from rung 3–0 to rung 1–2; each step advances along the rail whose next node lies at
-/// the smaller fraction of the way (rail a first on a tie), making one triangle, n1 + n2 in all.
-/// The fan of the quad's polygon would make two slivers along its long diagonal, each a strip of
-/// about n1 + n_diagonal triangles, more than the quad's strip. Same corner order (winding) as the quad. Each triangle as its corners' slots and
-/// nodes.
-pub fn quad_strip_triangles(rails: [u32; 2], node: &dyn Fn(u32) -> Node) -> Vec<([u32; 3], [Node; 3])> {
-    with_nodes(quad_strip_slots(rails), node)
-}
-
-/// The quad strip's n1 + n2 triangles ([`quad_strip_triangles`]) as their corners' slots, in
-/// walk order.
-pub fn quad_strip_slots(rails: [u32; 2]) -> Vec<[u32; 3]> {
-    let [n1, _] = rails;
-    let (a, d) = (|i: u32| i, |j: u32| n1 + 1 + j);
-    let (mut i, mut j) = (0, 0);
-    (0..rails[0] + rails[1])
-        .map(|_| {
-            if quad_advances_on_a(i, j, rails) {
-                i += 1;
-                [a(i - 1), a(i), d(j)]
-            } else {
-                j += 1;
-                [a(i), d(j), d(j - 1)]
-            }
-        })
-        .collect()
-}
-
-/// Whether the quad strip's zigzag at rung (a_i, d_j) advances on rail a: its next node's
-/// fraction (i + 1)/n1 is at most rail d's (j + 1)/n2, or rail d is done.
-pub(super) fn quad_advances_on_a(i: u32, j: u32, [n1, n2]: [u32; 2]) -> bool {
-    i < n1 && (j == n2 || (i + 1) * n2 <= (j + 1) * n1)
-}
-
-/// The rungs of a quad strip's zigzag, in slots: (a_i, d_j) from (corner 0, corner 3) to
-/// (corner 1, corner 2), the sides of its triangles that cross between the rails.
-pub(super) fn quad_strip_rungs(rails: [u32; 2]) -> impl Iterator<Item = [u32; 2]> {
-    let (mut i, mut j) = (0, 0);
-    (0..=rails[0] + rails[1]).map(move |step| {
-        let rung = [i, rails[0] + 1 + j];
-        if step < rails[0] + rails[1] {
-            if quad_advances_on_a(i, j, rails) {
-                i += 1;
-            } else {
-                j += 1;
-            }
-        }
-        rung
-    })
 }
 
 /// Lattice node (i, j, l), i + j + l = m (weights of q0, q1, q2), of a piece with corners `q`

@@ -62,13 +62,6 @@
 //! not into K² macro cells but into bands of N_max of its rows, two pieces per band
 //! ([`band_cell`], [`PartSplit`]); the pieces' corners lie on the part's edges' fine nodes.
 //!
-//! **Band quads (likewise).** A band of a floor or wall between two diamonds is often a polygon
-//! of four corners whose fan makes two slivers along its long diagonal. When two opposite sides
-//! are in one part each, the quad is drawn as one strip between the other two (its rails) instead
-//! ([`quad_strip_triangles`]): n1 + n2 triangles, no diagonal. The rails' nodes are their own, the
-//! diagonal was inside the polygon, so neighbours still meet without cracks; every rung of the
-//! zigzag must be within τ of straight, like any edge drawn.
-//!
 //! **The vertical axis.** No eye sees a point with r ≤ d_e, and a triangle around the axis covers
 //! every azimuth. Triangles that reach near the axis, or are large next to their distance from it,
 //! switch on cuts for the whole frame (`active_cuts`, a pass over the scene before `plan`) and are
@@ -117,7 +110,6 @@ mod frame_cuts;
 mod lattice;
 pub mod passes;
 mod piece;
-mod quad;
 mod rows;
 mod seam;
 pub mod spacing;
@@ -131,8 +123,7 @@ pub use edges::EdgeProfile;
 use edges::{edge_point, lex_less, Limits};
 pub use frame_cuts::FrameCuts;
 pub use lattice::{
-    boundary_edge, lattice_triangles, macro_cell, node_slot, quad_strip_node_count, quad_strip_triangles, slot_node,
-    snap, strip_node_count, strip_triangles,
+    boundary_edge, lattice_triangles, macro_cell, node_slot, slot_node, snap, strip_node_count, strip_triangles,
 };
 use piece::{PieceGeometry, Shape};
 pub use rows::{band_cell, PartSplit, Rows};
@@ -191,16 +182,6 @@ impl<'a> Subdivider<'a> {
         for t in first..first + self.params.triangle_count as usize {
             let tri = self.load(vertices, indices, t);
             for poly in self.triangle_polygons(&tri, t, frame, &mut out.edge_splits) {
-                if let Some((corners, rails)) = self.quad_strip(&tri, &poly) {
-                    out.pieces += 2; // the GPU's two records of a quad
-                    if let Some(plan) = self.quad_lattice(&tri, &corners, rails) {
-                        out.quads += 1;
-                        out.max_part_output = out.max_part_output.max(plan.output());
-                        out.max_piece_output = out.max_piece_output.max(plan.output());
-                        self.emit(&plan, &mut out);
-                    }
-                    continue;
-                }
                 for part in fan(&poly) {
                     // A part (a band of a floor under the viewer) wholly beyond the image's rows
                     // makes no pieces; likewise a piece in `lattice`.

@@ -21,11 +21,11 @@ use super::{
 };
 use crate::core::scene::SceneVertex;
 use crate::core::settings::RenderSettings;
-use crate::encoding::constants::{BANDS, PIECES_FROM_COUNTER, PLAN_CUTS_SPLIT, QUAD_HEAD, QUAD_TAIL};
+use crate::encoding::constants::{BANDS, PIECES_FROM_COUNTER, PLAN_CUTS_SPLIT};
 use crate::encoding::recording::{Command, Recording};
 use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine};
 use crate::encoding::subdivide::{
-    defers_parts, DISPATCH_LATTICE, DISPATCH_LATTICE_NODES, DISPATCH_LATTICE_ROWS, DISPATCH_LATTICE_ROWS_PLAN,
+    DISPATCH_LATTICE, DISPATCH_LATTICE_NODES, DISPATCH_LATTICE_ROWS, DISPATCH_LATTICE_ROWS_PLAN,
     DISPATCH_LATTICE_TRIANGLES, DISPATCH_PLAN_CUTS, DISPATCH_PLAN_PARTS, DISPATCH_WORDS,
 };
 use crate::encoding::types::{DrawIndexedIndirectArgs, DrawVertex, Piece, SubdivideCounters, SubdivideParams};
@@ -294,12 +294,12 @@ impl<'s> CpuSubdivision<'s> {
             if local % split == 0 {
                 let shared = [0, 1, 2].map(|e| self.frame.is_cut_edge(t as usize, e));
                 for part in edge_split_parts(tri.position, shared, rho, cuts) {
-                    self.plan_polygon(sub, &tri, t, &part);
+                    self.plan_polygon(sub, t, &part);
                 }
             }
         } else {
             for poly in quadrant_polygons(tri.position, rho, cuts, (local % split) as usize) {
-                self.plan_polygon(sub, &tri, t, &poly);
+                self.plan_polygon(sub, t, &poly);
             }
         }
         let appended = self.counters.pieces + self.counters.parts - before;
@@ -333,7 +333,7 @@ impl<'s> CpuSubdivision<'s> {
         }
     }
 
-    /// One piece record: its lattice (or a band quad's strip, from its two records) planned, its
+    /// One piece record: its lattice planned, its
     /// nodes allocated, its work items appended (`plan_work`) — or, where its rows are to be
     /// measured, left to `lattice_rows` and `lattice_rows_plan`.
     fn lattice(&mut self, sub: &Subdivider, local: u32) {
@@ -343,19 +343,9 @@ impl<'s> CpuSubdivision<'s> {
         }
         let index = params.first_piece + local;
         let piece = self.pieces[index as usize];
-        if piece.count2_level & QUAD_TAIL != 0 {
-            return; // drawn by the quad's first record
-        }
         let tri = sub.load(self.scene.0, self.scene.1, piece.triangle as usize);
         let corners = [0, 1, 2].map(|i| record_corner(&piece, i));
         let (n0, n1) = (piece.counts01 & 0xffff, piece.counts01 >> 16);
-        if piece.count2_level & QUAD_HEAD != 0 {
-            let last = record_corner(&self.pieces[index as usize + 1], 0);
-            if let Some(plan) = sub.quad_lattice(&tri, &[corners[0], corners[1], corners[2], last], [n0, n1]) {
-                self.plan_work(sub, index, plan);
-            }
-            return;
-        }
         let n = [n0, n1, piece.count2_level & 0xffff];
         let k = (piece.count2_level >> 16) & 0x1fff;
         let bands = piece.count2_level & BANDS != 0;
@@ -558,22 +548,11 @@ impl<'s> CpuSubdivision<'s> {
 
     // ---- what the passes share ----
 
-    /// A polygon `plan_cuts` cut from triangle t: a band quad's two records, or its fan's parts
-    /// on screen, planned, or on the sphere appended for `plan_parts` (`plan_cut_part`).
-    fn plan_polygon(&mut self, sub: &Subdivider, tri: &Triangle, t: u32, poly: &[Node]) {
-        let deferred = defers_parts(sub.projection.panorama);
-        if let Some((c, rails)) = sub.quad_strip(tri, poly) {
-            let head = record(t, rails[0] | rails[1] << 16, QUAD_HEAD, [c[0], c[1], c[2]]);
-            let tail = record(t, head.counts01, QUAD_TAIL, [c[3], c[1], c[2]]);
-            self.append(sub.params, &[head, tail]);
-            return;
-        }
+    /// A polygon `plan_cuts` cut from triangle t: its fan's parts on screen appended for
+    /// `plan_parts` (`plan_cut_part`).
+    fn plan_polygon(&mut self, sub: &Subdivider, t: u32, poly: &[Node]) {
         for part in fan(poly) {
             if sub.off_screen_vertically(part.map(|n| n.position)) {
-                continue;
-            }
-            if !deferred {
-                self.plan_part(sub, tri, t, part);
                 continue;
             }
             let slot = self.counters.parts;
