@@ -268,14 +268,6 @@ fn frame_xy(proj: Projection, xy: vec2<f32>) -> vec2<f32> {
     return xy + proj.tile.xy;
 }
 
-// Clip-space position of a projected point. u is NOT wrapped: the pre-pass places seam copies
-// at u ± 2π and the rasterizer clips them (and VR180's |u| > π/2). w = 1, so attributes interpolate linearly on the
-// screen as in the paper; depth r maps monotonically into (0, 1) as r / (r + 1).
-// y is kept within GUARD_BAND_PX of the image (constants.rs says why).
-fn to_clip(proj: Projection, uvd: vec3<f32>) -> vec4<f32> {
-    return tile_clip(proj, frame_clip(proj, uvd));
-}
-
 // What the raster stage multiplies a vertex's clip position by (`raster_vertex` in
 // src/cpu/raster.rs): under the error split (`by_radius` 1) r, the vertex's distance from the
 // vertical axis, so that attributes are interpolated as P/r is, linearly on the screen: between
@@ -292,7 +284,11 @@ fn clip_w(proj: Projection, p: vec3<f32>, depth: f32, by_radius: u32) -> f32 {
     return max(horizontal_radius(p), AZIMUTH_MIN_RADIUS);
 }
 
-// The clip position on the whole frame (`to_clip` before the tile's).
+// The clip position of a projected point on the whole frame (`tile_clip` then gives the tile's).
+// u is NOT wrapped: the pre-pass places seam copies at u ± 2π and the rasterizer clips them (and
+// VR180's |u| > π/2). w = 1 (`clip_w` scales it), so attributes interpolate linearly on the
+// screen as in the paper; depth r maps monotonically into (0, 1) as r / (r + 1). y is kept
+// within GUARD_BAND_PX of the image (constants.rs says why).
 fn frame_clip(proj: Projection, uvd: vec3<f32>) -> vec4<f32> {
     let z = min(uvd.z / (uvd.z + 1.0), MAX_DEPTH);
     if (is_fisheye(proj)) {

@@ -192,14 +192,7 @@ fn parts_for_bend(bend_px: f32, segments: u32, max_error_px: f32) -> f32 {
     return ceil(f32(segments) * sqrt(bend_px / (8.0 * max_error_px)));
 }
 
-// Divisions of an edge (`Subdivider::edge_divisions`): eq. 5 for METHOD_ADAPTIVE, the error
-// split for METHOD_ERROR; the quick 2-segment profile, then the 8-segment one (`edge_counts` of
-// one edge).
-fn edge_divisions(a: vec3<f32>, b: vec3<f32>, tri: ptr<function, InputTriangle>) -> u32 {
-    return edge_counts(array<vec3<f32>, 3>(a, b, a), vec3<bool>(true, false, false), tri).x;
-}
-
-// What an adaptive rule reads of round `round` of an edge's profiles (`edge_divisions`): after
+// What an adaptive rule reads of round `round` of an edge's profiles (`Subdivider::edge_divisions`): after
 // the quick one, 1 where the edge needs no more, else 0; after the full one, its parts.
 fn divisions_of(round: u32, p: EdgeProfile, segments: u32, tri: ptr<function, InputTriangle>) -> f32 {
     let by_length = split_rule() == METHOD_ADAPTIVE;
