@@ -117,7 +117,8 @@ pub struct FrameStats {
     pub ms_gpu: Option<f64>,
     /// The subdivision's time, where it was measured apart (see `timing`).
     pub ms_subdivide: Option<f64>,
-    /// The subdivision's three passes (`plan` with `active_cuts`, `plan_cuts`, `lattice`), where
+    /// The subdivision's three passes (`plan` with `active_cuts` and `ring_cuts`; `plan_cuts`
+    /// with `plan_parts`; `lattice` with the rows' and the work items' passes), where
     /// timestamps measured them (their sum is within the gaps between passes of `ms_subdivide`).
     pub ms_subdivide_passes: Option<[f64; 3]>,
     /// The two eyes' raster time, where it was measured apart (see `timing`).
