@@ -103,10 +103,10 @@ struct Piece {
 }
 
 // What `lattice` planned for a piece (at the piece's index), which its work items read: its
-// shape (`strip_base`: a sliver's strip base 0–2, the lattice 3, QUAD_STRIP, ROWS_SHAPE, or
+// shape (`strip_base`: a sliver's strip base 0–2, the lattice 3, ROWS_SHAPE, or
 // ROWS_PENDING while `lattice_rows` measures its rows), level m, nodes, candidate triangles, seam
 // copies (0: nothing drawn) and their reference azimuths, its first output node, its edge counts
-// (8 bits each; rows' base in bits 24–31), a strip's, quad's or rows' sides' counts
+// (8 bits each; rows' base in bits 24–31), a strip's or rows' sides' counts
 // (x | y << 16), rows' widths (while pending: each band's measures, `row_measures`).
 struct PieceWork {
     shape: u32,

@@ -65,7 +65,7 @@ impl EdgeProfile {
 
     /// Whether the edge drawn in one part strays at most `share`·τ from its bend and within
     /// the residual's share from its step of azimuth, away from the eye circle (the quick
-    /// profile's test of an edge, a strip's base or a quad's rung).
+    /// profile's test of an edge or a strip's base).
     pub(super) fn straight(&self, share: f32, max_error_px: f32) -> bool {
         !self.ring
             && parts_for_bend(self.bend_px, 2, share * max_error_px) <= 1.0
