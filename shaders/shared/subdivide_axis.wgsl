@@ -468,10 +468,10 @@ fn edge_crossings(a: Node, b: Node, clip: ptr<function, ClipState>, cuts: vec2<u
     }
 }
 
-// Appends for `plan_parts` the parts of triangle t, which is not cut by all cuts, at the crossings of its edges that
-// cut triangles have (`edge_split_parts` in axis.rs): its boundary (corner e, then edge e's
-// crossings) in the pool; with crossings on one edge the fan from the opposite corner, on more
-// the fan from the centroid, on none the triangle.
+// Appends for `plan_parts` the parts of triangle t, which is not cut by all cuts, at the
+// crossings of its edges that cut triangles have (`edge_split_parts` in axis.rs): its boundary
+// (corner e, then edge e's crossings) in the pool; with crossings on one edge the fan from the
+// opposite corner, on more the fan from the centroid, on none the triangle.
 fn plan_edge_split(t: u32, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, clip: ptr<function, ClipState>, cuts: vec2<u32>) {
     let corners = array<Node, 3>(Node((*tri).position[0], vec3<f32>(1.0, 0.0, 0.0)),
                                  Node((*tri).position[1], vec3<f32>(0.0, 1.0, 0.0)),

@@ -192,8 +192,9 @@ fn parts_for_bend(bend_px: f32, segments: u32, max_error_px: f32) -> f32 {
     return ceil(f32(segments) * sqrt(bend_px / (8.0 * max_error_px)));
 }
 
-// What an adaptive rule reads of round `round` of an edge's profiles (`Subdivider::edge_divisions`): after
-// the quick one, 1 where the edge needs no more, else 0; after the full one, its parts.
+// What an adaptive rule reads of round `round` of an edge's profiles
+// (`Subdivider::edge_divisions`): after the quick one, 1 where the edge needs no more, else 0;
+// after the full one, its parts.
 fn divisions_of(round: u32, p: EdgeProfile, segments: u32, tri: ptr<function, InputTriangle>) -> f32 {
     let by_length = split_rule() == METHOD_ADAPTIVE;
     if (round == 0u) {

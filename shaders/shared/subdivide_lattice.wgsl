@@ -231,8 +231,9 @@ fn node_slot(c: vec3<u32>, m: u32) -> u32 {
 
 const LATTICE_SHAPE: u32 = 3u; // `strip_base` of a piece drawn as the regular lattice (0–2: a strip's base)
 
-// Whether a piece may be a sliver's strip: on the cylinder only (`strip_base_of`). The sphere's pipelines compile their code out of the tests below, which lavapipe's
-// lanes would otherwise all run whatever their piece's shape.
+// Whether a piece may be a sliver's strip: on the cylinder only (`strip_base_of`). The sphere's
+// pipelines compile their code out of the tests below, which lavapipe's lanes would otherwise all
+// run whatever their piece's shape.
 fn cylinder_shapes() -> bool {
     return !is_sphere(params.projection);
 }

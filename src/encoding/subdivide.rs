@@ -245,9 +245,10 @@ fn lattice_work(r: &mut Recording, passes: Passes) {
     r.dispatch_indirect("lattice_triangles", "lattice_dispatch", DISPATCH_LATTICE_TRIANGLES);
 }
 
-/// The passes that cut triangles around the axis: `plan_cuts`, and `plan_parts` after it. They are the largest pipelines to build, and many frames never run them (a room on
-/// the cylinder whose floor and ceiling stay beyond the image's rows): the GPU builds them when a
-/// frame first lists a triangle for them (`plan`'s counters, [`cut_probe`]).
+/// The passes that cut triangles around the axis: `plan_cuts`, and `plan_parts` after it. They
+/// are the largest pipelines to build, and many frames never run them (a room on the cylinder
+/// whose floor and ceiling stay beyond the image's rows): the GPU builds them when a frame first
+/// lists a triangle for them (`plan`'s counters, [`cut_probe`]).
 pub const CUT_PASSES: [&str; 2] = ["plan_cuts", "plan_parts"];
 
 /// What tells whether a frame needs [`CUT_PASSES`]: the start of [`one_submission`] up to

@@ -333,9 +333,9 @@ impl<'s> CpuSubdivision<'s> {
         }
     }
 
-    /// One piece record: its lattice planned, its
-    /// nodes allocated, its work items appended (`plan_work`) — or, where its rows are to be
-    /// measured, left to `lattice_rows` and `lattice_rows_plan`.
+    /// One piece record: its lattice planned, its nodes allocated, its work items appended
+    /// (`plan_work`) — or, where its rows are to be measured, left to `lattice_rows` and
+    /// `lattice_rows_plan`.
     fn lattice(&mut self, sub: &Subdivider, local: u32) {
         let params = sub.params;
         if local >= self.pieces_planned(params) {
@@ -549,7 +549,7 @@ impl<'s> CpuSubdivision<'s> {
     // ---- what the passes share ----
 
     /// A polygon `plan_cuts` cut from triangle t: its fan's parts on screen appended for
-    /// `plan_parts` (`plan_cut_part`).
+    /// `plan_parts` (`plan_band` and `plan_edge_split` in the WGSL).
     fn plan_polygon(&mut self, sub: &Subdivider, t: u32, poly: &[Node]) {
         for part in fan(poly) {
             if sub.off_screen_vertically(part.map(|n| n.position)) {
