@@ -286,22 +286,43 @@ fn strip_step(walk: ptr<function, vec4<u32>>, piece_state: ptr<function, PieceSt
 
 // ---- a piece's nodes and candidate triangles: the lattice of level m, the strip or the rows ----
 
-// Node k in slot order; `row` is the lattice's running (j, l), advanced here. Each shape names
-// the node as a point along a segment (`Along`), placed by one call of `edge_point`.
-fn piece_node(k: u32, m: u32, row: ptr<function, vec2<u32>>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Node {
+// The running state `piece_node` keeps, at node slot k: the lattice's (j, l, 0, 0); the rows'
+// (node, row, step, the row's first slot) (`rows_along`).
+fn node_row_at(k: u32, m: u32, piece_state: ptr<function, PieceState>) -> vec4<u32> {
+    var rest = k;
+    var row = 0u;
+    if ((*piece_state).strip_base == ROWS_SHAPE) {
+        while (rest > (*piece_state).row_w[row]) {
+            rest -= (*piece_state).row_w[row] + 1u;
+            row += 1u;
+        }
+        return vec4<u32>(rest, row, select(ROW_LEFT_END, ROW_BASE, row == 0u), k - rest);
+    }
+    while (rest > m - row) {
+        rest -= m + 1u - row;
+        row += 1u;
+    }
+    return vec4<u32>(rest, row, 0u, 0u);
+}
+
+// The next node of a piece: the strip's and the lattice's node k in slot order (`row` the
+// lattice's running (j, l, 0, 0)); the rows' in their step order (`rows_along`: the node in slot
+// `rows_slot(row)`). Each shape names the node as a point along a segment (`Along`), placed by
+// one call of `edge_point`; `row` is advanced here.
+fn piece_node(k: u32, m: u32, row: ptr<function, vec4<u32>>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Node {
     var along: Along;
+    var end_kept = 2u;
     if (cylinder_shapes() && (*piece_state).strip_base < LATTICE_SHAPE) {
         along = strip_along(k, part, piece_state);
     } else if ((*piece_state).strip_base == ROWS_SHAPE) {
-        // `row` = (node a, row k), advanced along the row, then to the next.
-        along = row_along((*row).y, (*row).x, part, piece_state);
-        *row = select(vec2<u32>((*row).x + 1u, (*row).y), vec2<u32>(0u, (*row).y + 1u), (*row).x + 1u > (*piece_state).row_w[(*row).y]);
+        end_kept = row_end_kept(*row);
+        along = rows_along(row, part, piece_state);
     } else {
         // Node (i, j, l) of the lattice of level m (`lattice_node`): the regular lattice, whose
         // boundary nodes on an edge with fewer divisions snap to that edge's nearest node.
         let j = (*row).x;
         let l = (*row).y;
-        *row = select(vec2<u32>(j + 1u, l), vec2<u32>(0u, l + 1u), j + 1u > m - l);
+        *row = select(vec4<u32>(j + 1u, l, 0u, 0u), vec4<u32>(0u, l + 1u, 0u, 0u), j + 1u > m - l);
         let c = vec3<u32>(m - j - l, j, l);
         let on = boundary_edge(c);
         if (on.x >= 3u) {
@@ -309,7 +330,9 @@ fn piece_node(k: u32, m: u32, row: ptr<function, vec2<u32>>, part: ptr<function,
         }
         along = along_edge(on.x, snap(on.y, (*piece_state).counts[on.x], m), part, piece_state);
     }
-    return edge_point(along.a, along.b, along.j, along.n);
+    let node = edge_point(along.a, along.b, along.j, along.n);
+    keep_row_end(end_kept, node, piece_state);
+    return node;
 }
 
 // Candidate triangle t's slots (the strip's in walk order, advancing `walk`).
@@ -542,7 +565,7 @@ fn seam_copies(shape: PieceShape, part: ptr<function, PartPlan>, piece_state: pt
     var reach = 1e30;
     // Nodes in slot order: (i, j, l) row by row, kept by a running (j, l) rather than searched
     // for each slot (lavapipe stops an invocation after 65,535 loop iterations in all).
-    var row = vec2<u32>(0u, 0u);
+    var row = node_row_at(0u, shape.m, piece_state);
     if (is_sphere(params.projection)) {
         // Every node projected, unless the corners' bound keeps the piece clear of the seam.
         let bound = sphere_u_bound((*piece_state).corner, theta_c);

@@ -110,18 +110,68 @@ fn rows_from_measures(piece_state: ptr<function, PieceState>) -> vec2<u32> {
     return vec2<u32>(candidates, nodes);
 }
 
-// Node a of row k (`Rows::row_node`): the base edge's own nodes on row 0, else the point a/w of
-// the way between the row's ends.
-fn row_along(k: u32, a: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Along {
-    if (k == 0u) {
-        return along_edge((*piece_state).row_base, a, part, piece_state);
+// The rows' nodes in step order (`Rows::row_node`), one `edge_point` a step: the base row's
+// nodes (the base edge's own) in turn; each other row's left end (its node 0), its right end
+// (node w), kept in `row_ends`, then its nodes between, the point a/w of the way between the
+// ends (placing the ends once a row, not twice a node). `row` = (node a, row k, step, the row's
+// first slot): `ROW_BASE`, `ROW_LEFT_END`, `ROW_RIGHT_END` or `ROW_BETWEEN`; entered at a node
+// a > 0 of a row (a work item's first slot), the ends are placed and the nodes from a on follow.
+// Returns the step's node as a segment's point and advances `row`.
+fn rows_along(row: ptr<function, vec4<u32>>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Along {
+    let a = (*row).x;
+    let k = (*row).y;
+    let step = (*row).z;
+    let start = (*row).w;
+    let w = (*piece_state).row_w[k];
+    // One along_edge: the base row's node a, or an end of row k (`row_end`).
+    var edge = vec2<u32>((*piece_state).row_base, a);
+    if (step != ROW_BASE) {
+        edge = row_end_index(k, step == ROW_RIGHT_END, (*piece_state).row_base, (*piece_state).strip_n);
     }
-    // Its left and right ends from one call site of row_end (see `row_measures`).
-    var ends: array<Node, 2>;
+    var along = along_edge(edge.x, edge.y, part, piece_state);
+    if (step == ROW_BETWEEN) {
+        along = Along((*piece_state).row_ends[0], (*piece_state).row_ends[1], a, max(w, 1u));
+    }
+    var next = vec4<u32>(a + 1u, k, step, start);
+    if (step == ROW_LEFT_END) {
+        next = vec4<u32>(max(a, 1u), k, ROW_RIGHT_END, start);
+    } else if (step == ROW_RIGHT_END) {
+        next = vec4<u32>(a, k, ROW_BETWEEN, start);
+    }
+    // The row is done after its last node: the apex's only one, the right end where no node lies
+    // between, the base's node w, the last between (a = w − 1).
+    let done = (step == ROW_LEFT_END && w == 0u) || (step == ROW_RIGHT_END && a >= w)
+        || (step == ROW_BASE && a >= w) || (step == ROW_BETWEEN && a + 2u > w);
+    if (done) {
+        next = vec4<u32>(0u, k + 1u, ROW_LEFT_END, start + w + 1u);
+    }
+    *row = next;
+    return along;
+}
+
+// The slot of the node the next step of `rows_along` places.
+fn rows_slot(row: vec4<u32>, piece_state: ptr<function, PieceState>) -> u32 {
+    let w = (*piece_state).row_w[row.y];
+    return row.w + select(select(row.x, w, row.z == ROW_RIGHT_END), 0u, row.z == ROW_LEFT_END);
+}
+
+// The lowest slot a step from `row` on places: the rows' nodes are written until it reaches the
+// work item's end.
+fn rows_bound(row: vec4<u32>) -> u32 {
+    return row.w + select(row.x, 0u, row.z == ROW_LEFT_END);
+}
+
+// Which end of its row the node of a step from `row` is (0 left, 1 right; 2 none).
+fn row_end_kept(row: vec4<u32>) -> u32 {
+    return select(select(2u, 1u, row.z == ROW_RIGHT_END), 0u, row.z == ROW_LEFT_END);
+}
+
+// Keeps a row's end (`end`: 0 left, 1 right; 2 none) for the nodes between.
+fn keep_row_end(end: u32, node: Node, piece_state: ptr<function, PieceState>) {
     for (var c = 0u; c < 2u; c++) {
-        ends[c] = row_end(k, c == 1u, part, piece_state);
+        let keep = end == c;
+        (*piece_state).row_ends[c] = Node(select((*piece_state).row_ends[c].position, node.position, keep), select((*piece_state).row_ends[c].bary, node.bary, keep));
     }
-    return Along(ends[0], ends[1], a, max((*piece_state).row_w[k], 1u));
 }
 
 // The next triangle of the rows' zipper (`Rows::triangles`) at `walk` = (i on row k, j on row

@@ -17,8 +17,23 @@ fn rows_from_measures(piece_state: ptr<function, PieceState>) -> vec2<u32> {
     return vec2<u32>(0xffffffffu, 0u);
 }
 
-fn row_along(k: u32, a: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Along {
+fn rows_along(row: ptr<function, vec4<u32>>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Along {
     return Along();
+}
+
+fn rows_slot(row: vec4<u32>, piece_state: ptr<function, PieceState>) -> u32 {
+    return 0u;
+}
+
+fn rows_bound(row: vec4<u32>) -> u32 {
+    return 0u;
+}
+
+fn row_end_kept(row: vec4<u32>) -> u32 {
+    return 2u;
+}
+
+fn keep_row_end(end: u32, node: Node, piece_state: ptr<function, PieceState>) {
 }
 
 fn rows_step(walk: ptr<function, vec4<u32>>, at: ptr<function, array<vec2<u32>, 3>>, piece_state: ptr<function, PieceState>) -> vec3<u32> {

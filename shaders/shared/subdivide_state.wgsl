@@ -40,6 +40,7 @@ struct PieceState {
     strip_n: vec2<u32>,      // its long edges' counts: edge base + 1, edge base + 2; rows' sides (left, right)
     row_base: u32,           // rows: the base edge
     row_w: array<u32, 33>,   // rows: each row's parts, from the base to the apex (`Rows::widths`)
+    row_ends: array<Node, 2>, // rows: the current row's ends (left, right), placed first (`rows_along`)
 }
 
 // A polygon while it is clipped (at most 7 corners), and a quadrant's polygon kept while its

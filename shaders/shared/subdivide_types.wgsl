@@ -122,6 +122,13 @@ struct PieceWork {
     _pad: array<u32, 3>,
 }
 
+// The steps of a piece's rows' nodes (`rows_along`): the base row's nodes, a row's left end, its
+// right end, its nodes between.
+const ROW_BASE: u32 = 3u;
+const ROW_LEFT_END: u32 = 0u;
+const ROW_RIGHT_END: u32 = 1u;
+const ROW_BETWEEN: u32 = 2u;
+
 const EDGE_ASKING: u32 = 1u;
 const EDGE_CUT: u32 = 2u;
 

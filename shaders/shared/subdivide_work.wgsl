@@ -124,40 +124,33 @@ fn load_work(index: u32, work: PieceWork, part: ptr<function, PartPlan>, piece_s
     }
 }
 
-// The running state `piece_node` keeps, at node slot k: the lattice's (j, l), rows' (node, row).
-fn node_row_at(k: u32, m: u32, piece_state: ptr<function, PieceState>) -> vec2<u32> {
-    var rest = k;
-    var row = 0u;
-    if ((*piece_state).strip_base == ROWS_SHAPE) {
-        while (rest > (*piece_state).row_w[row]) {
-            rest -= (*piece_state).row_w[row] + 1u;
-            row += 1u;
-        }
-        return vec2<u32>(rest, row);
-    }
-    while (rest > m - row) {
-        rest -= m + 1u - row;
-        row += 1u;
-    }
-    return vec2<u32>(rest, row);
-}
-
 // A node item: the piece's nodes in slots [first, first + chunk), written once per seam copy.
 // A piece that is one lattice triangle (most of a scene's pieces) has its corners for nodes
 // (slot k is corner k, the bits `piece_node` gives them): they come from a loop of their own, and
 // the general loop runs no step for it. A group of lavapipe's lanes runs a loop's body as often
 // as its busiest lane (and once when none is), every branch of the body for every lane: a group
-// of single triangles runs `piece_node` once rather than three times.
+// of single triangles runs `piece_node` once rather than three times. Rows are stepped through
+// in their own order (`rows_along`: each row's ends first, which its other nodes lie between),
+// until no step is left that writes a slot of the item's (`rows_bound`); an end outside the
+// item is placed and not written.
 fn write_nodes(first: u32, work: PieceWork, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
     let end = min(first + chunk_of(work.copies), work.node_count);
     let corners_only = work.shape == LATTICE_SHAPE && work.m == 1u;
+    let rows = work.shape == ROWS_SHAPE;
     var k = first;
     for (; k < select(first, end, corners_only); k++) {
         write_node((*piece_state).corner[k], k, work, tri);
     }
     var row = node_row_at(k, work.m, piece_state);
-    for (; k < end; k++) {
-        write_node(piece_node(k, work.m, &row, part, piece_state), k, work, tri);
+    var next = k;
+    while (next < end) {
+        let slot = select(k, rows_slot(row, piece_state), rows);
+        let node = piece_node(k, work.m, &row, part, piece_state);
+        if (slot >= first && slot < end) {
+            write_node(node, slot, work, tri);
+        }
+        k += 1u;
+        next = select(k, rows_bound(row), rows);
     }
     atomicMax(&counters.max_output, (end - first) * work.copies);
 }
