@@ -99,6 +99,31 @@ fn bench_speed_honours_scale_viewer_and_lod() {
     };
     let plain = run(&[]);
     assert_eq!(plain["triangles_in"], 100);
+    // Where timestamps time the frame: the subdivision's passes in three groups, or with
+    // --pass-times each pass the frame dispatched apart (its one-thread setup pass and `finalize`
+    // with a neighbour), in schedule order; each from the end of the one before, together the
+    // subdivision's time.
+    let each = run(&["--pass-times"]);
+    for row in [&plain, &each] {
+        if row["timing"] != "gpu-timestamps" {
+            assert!(row["ms_subdivide_passes"].is_null(), "{row}");
+            continue;
+        }
+        let timed = row["ms_subdivide_passes"].as_array().unwrap();
+        let names: Vec<&str> = timed.iter().map(|p| p[0].as_str().unwrap()).collect();
+        let dispatched: Vec<&str> = row["subdivide_invocations"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| p[0].as_str().unwrap())
+            .filter(|e| !e.ends_with("_args") && *e != "finalize")
+            .collect();
+        let groups = ["plan", "plan_cuts", "lattice"];
+        assert_eq!(names, if row == &each { dispatched.as_slice() } else { groups.as_slice() }, "{row}");
+        let ms: Vec<f64> = timed.iter().map(|p| p[1].as_f64().unwrap()).collect();
+        let total = row["ms_subdivide"].as_f64().unwrap();
+        assert!(ms.iter().all(|&t| t >= 0.0) && (ms.iter().sum::<f64>() - total).abs() <= 1e-6 * total.max(1.0), "{row}");
+    }
     // The columns that show what the subdivision multiplies.
     let out = plain["triangles_out"].as_u64().unwrap();
     assert_eq!(plain["vertices_out"].as_u64().unwrap(), 3 * out);

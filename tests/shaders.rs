@@ -238,12 +238,14 @@ fn shared_modules_declare_no_entry_points_and_only_binding_modules_declare_bindi
 #[test]
 fn the_subdivisions_recordings_name_its_entry_points_and_bindings() {
     use twister::encoding::recording::Command;
-    use twister::encoding::subdivide::{active_cuts, one_submission, pass_run, Passes};
+    use twister::encoding::subdivide::{
+        active_cuts, one_submission, pass_run, timed_passes, PassTiming, Passes, TIMED_PASSES,
+    };
     use twister::shader::SUBDIVIDE;
     let entries: Vec<&str> = SUBDIVIDE.entry_points.iter().map(|e| e.name).collect();
     let bound = |name: &str| SUBDIVIDE.bindings.iter().any(|b| b.name == name);
     let all = Passes { rows: true };
-    let usual = one_submission(1000, all, true);
+    let usual = one_submission(1000, all, PassTiming::EachPass);
     // The usual frame of the sphere under an adaptive rule dispatches every entry point, in the
     // order the passes depend on.
     let order: Vec<&str> = usual.entries().collect();
@@ -255,12 +257,32 @@ fn the_subdivisions_recordings_name_its_entry_points_and_bindings() {
     ];
     assert_eq!(order, expected.concat());
     // The frames without rows (the cylinder's, `vertex`'s) leave out their passes.
-    let cylinder: Vec<&str> = one_submission(7, Passes { rows: false }, false).entries().collect();
+    let cylinder: Vec<&str> = one_submission(7, Passes { rows: false }, PassTiming::Untimed).entries().collect();
     let optional = ["lattice_rows_args", "lattice_rows", "lattice_rows_plan"];
     let always: Vec<&str> = order.iter().copied().filter(|e| !optional.contains(e)).collect();
     assert_eq!(cylinder, always);
+    // Timed: each main entry point's pass apart (its setup pass and `finalize` with a neighbour),
+    // or the three groups; each pass at the next pair of queries, within the query set.
     let some = [Passes { rows: false }, all];
-    let runs = some.map(|p| [one_submission(7, p, false), pass_run("plan", 7, p), pass_run("lattice", 7, p)]);
+    for p in some {
+        let main: Vec<&str> = one_submission(7, p, PassTiming::Untimed)
+            .entries()
+            .filter(|e| !e.ends_with("_args") && *e != "finalize")
+            .collect();
+        for (timing, labels) in [(PassTiming::EachPass, main), (PassTiming::Grouped, vec!["plan", "plan_cuts", "lattice"])] {
+            let timed = timed_passes(&one_submission(7, p, timing));
+            assert_eq!(timed.iter().map(|t| t.0).collect::<Vec<_>>(), labels, "{timing:?}");
+            assert!(timed.iter().enumerate().all(|(k, t)| t.1 == 2 * k as u32), "{timed:?}");
+            assert!(timed.len() as u32 <= TIMED_PASSES);
+        }
+        assert!(timed_passes(&one_submission(7, p, PassTiming::Untimed)).is_empty());
+    }
+    let runs = some.map(|p| {
+        [PassTiming::Untimed, PassTiming::Grouped, PassTiming::EachPass]
+            .map(|timing| one_submission(7, p, timing))
+            .into_iter()
+            .chain([pass_run("plan", 7, p), pass_run("lattice", 7, p)])
+    });
     for recording in [usual, active_cuts(7)].into_iter().chain(runs.into_iter().flatten()) {
         let mut in_pass = false;
         for command in &recording.commands {

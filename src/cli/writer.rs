@@ -282,6 +282,8 @@ pub struct FrameRecord<'a> {
     pub ms_frame: f64,
     pub ms_gpu: Option<f64>,
     pub ms_subdivide: Option<f64>,
+    /// Each of the subdivision's passes, where timestamps timed them (`FrameStats`).
+    pub ms_subdivide_passes: Option<Vec<(&'static str, f64)>>,
     pub ms_raster: Option<f64>,
     pub ms_readback: f64,
     pub ms_write: f64,
@@ -342,6 +344,7 @@ impl<'a> FrameRecord<'a> {
             ms_frame: s.ms_frame,
             ms_gpu: s.ms_gpu,
             ms_subdivide: s.ms_subdivide,
+            ms_subdivide_passes: s.ms_subdivide_passes.clone(),
             ms_raster: s.ms_raster,
             ms_readback: s.ms_readback,
             ms_write: 0.0,

@@ -117,10 +117,10 @@ pub struct FrameStats {
     pub ms_gpu: Option<f64>,
     /// The subdivision's time, where it was measured apart (see `timing`).
     pub ms_subdivide: Option<f64>,
-    /// The subdivision's three passes (`plan` with `active_cuts` and `ring_cuts`; `plan_cuts`
-    /// with `plan_parts`; `lattice` with the rows' and the work items' passes), where
-    /// timestamps measured them (their sum is within the gaps between passes of `ms_subdivide`).
-    pub ms_subdivide_passes: Option<[f64; 3]>,
+    /// Each of the subdivision's passes, by its main entry point, in schedule order (a setup
+    /// pass counted with the pass it sets up, `finalize` with the last), where timestamps
+    /// measured them (their sum is within the gaps between passes of `ms_subdivide`).
+    pub ms_subdivide_passes: Option<Vec<(&'static str, f64)>>,
     /// The two eyes' raster time, where it was measured apart (see `timing`).
     pub ms_raster: Option<f64>,
     /// Wall time of reading the colour targets back.

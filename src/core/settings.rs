@@ -229,6 +229,11 @@ pub struct MeasureSettings {
     pub error_angle: bool,
     /// Also read back each pixel's distance from its eye point along its ray (`Frame::depth`).
     pub depth: bool,
+    /// Time each of the subdivision's passes apart (`FrameStats::ms_subdivide_passes` by entry
+    /// point, where the adapter has timestamps) rather than in three groups: a pass boundary and
+    /// a pair of timestamps each, which cost the software driver ~0.3–0.5 ms apiece (benchmarks:
+    /// `bench speed --pass-times`).
+    pub pass_times: bool,
     /// Also read back the surface point each pixel shows (`Frame::positions`), for the
     /// display-position error against the ray tracer (`error --against trace`).
     pub positions: bool,
@@ -419,6 +424,7 @@ builders! {
     with_shadow_map_size: u32 => shading.shadow_map_size,
     with_environment_yaw_deg: f32 => shading.environment_yaw_deg,
     with_measure_edges: bool => measure.edges,
+    with_pass_times: bool => measure.pass_times,
     with_measure_error: bool => measure.error,
     with_error_angle: bool => measure.error_angle,
     with_depth: bool => measure.depth,

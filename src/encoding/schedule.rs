@@ -18,7 +18,7 @@ use crate::core::settings::RenderSettings;
 use crate::encoding::constants::PIECES_FROM_COUNTER;
 use crate::encoding::recording::Recording;
 use crate::encoding::subdivide::{
-    active_cuts, dispatched, one_submission, pass_run, subdivide_params, AxisCuts, Passes, SubdivideOutput,
+    active_cuts, dispatched, one_submission, pass_run, subdivide_params, AxisCuts, PassTiming, Passes, SubdivideOutput,
 };
 use crate::encoding::types::{DrawVertex, Piece, PieceWork, SubdivideCounters, SubdivideParams};
 use crate::error::{Error, Result};
@@ -242,7 +242,7 @@ pub fn run_one_submission<E: SubdivisionEngine>(
     let mut params = subdivide_params(settings, 0, triangles);
     (params.piece_capacity, params.triangle_capacity) = (capacity.pieces, capacity.triangles);
     (params.first_piece, params.piece_count) = (0, PIECES_FROM_COUNTER);
-    let recording = one_submission(triangles, Passes::of_settings(settings), false);
+    let recording = one_submission(triangles, Passes::of_settings(settings), PassTiming::Untimed);
     let mut totals = RunTotals::default();
     let counters = replay_counted(engine, &recording, &params, &mut totals)?;
     if counters.overflowed(capacity.pieces, capacity.triangles) {

@@ -174,40 +174,93 @@ pub const DISPATCH_LATTICE_ROWS_PLAN: u64 = 72;
 /// Words of `lattice_dispatch`.
 pub const DISPATCH_WORDS: usize = 21;
 
-/// Timestamp query indices of the one-submission schedule's passes (each pass's begin; its end
-/// is the next index): `plan` (with the cuts), `plan_cuts`, `lattice`.
-pub const PLAN_TIMESTAMP: u32 = 0;
-pub const PLAN_CUTS_TIMESTAMP: u32 = 2;
-pub const LATTICE_TIMESTAMP: u32 = 4;
+/// The most passes of the one-submission schedule ([`one_submission`]), each timed (where it is)
+/// by a pair of timestamp queries: its begin at 2i, its end at 2i + 1.
+pub const TIMED_PASSES: u32 = 10;
+
+/// How the one-submission schedule's passes are timed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PassTiming {
+    /// Three compute passes, none timed.
+    Untimed,
+    /// Three compute passes, each timed: `plan` (`active_cuts`, `ring_cuts`, `plan`),
+    /// `plan_cuts` (with `plan_parts`), `lattice` (with the rows' and the work items' passes).
+    Grouped,
+    /// A timed compute pass for each main entry point (its setup pass with it, `finalize` with
+    /// the last). Each pass boundary and pair of timestamps costs lavapipe ~0.3–0.5 ms (its
+    /// timestamps wait for the work before them), which weighs most on small frames.
+    EachPass,
+}
+
+impl PassTiming {
+    /// With timestamps (`timed`): each pass apart where `each_pass`, else the three groups.
+    pub fn of(timed: bool, each_pass: bool) -> PassTiming {
+        match (timed, each_pass) {
+            (false, _) => PassTiming::Untimed,
+            (true, false) => PassTiming::Grouped,
+            (true, true) => PassTiming::EachPass,
+        }
+    }
+}
+
+/// Starts a compute pass before `entry` where `timing` has one there (every main entry point's
+/// under `EachPass`; else those that start the three groups, named by the group), timed at the
+/// next pair of queries unless `Untimed`.
+fn pass(r: &mut Recording, entry: &'static str, timing: PassTiming) {
+    let group = match entry {
+        "active_cuts" => Some("plan"),
+        "plan_cuts" | "lattice" => Some(entry),
+        _ => None,
+    };
+    let label = if timing == PassTiming::EachPass { Some(entry) } else { group };
+    if let Some(label) = label {
+        let index = 2 * timed_passes(r).len() as u32;
+        r.pass(label, (timing != PassTiming::Untimed).then_some(index));
+    }
+}
+
+/// The timed passes of a recording, in order: (label, the index of its begin query; its end's
+/// is the next).
+pub fn timed_passes(r: &Recording) -> Vec<(&'static str, u32)> {
+    r.commands
+        .iter()
+        .filter_map(|c| match *c {
+            Command::Pass { label, timestamp: Some(index) } => Some((label, index)),
+            _ => None,
+        })
+        .collect()
+}
 
 /// The usual frame's schedule, in one submission over `triangles` input triangles: the counters
 /// and the edge marks cleared; `active_cuts`, `ring_cuts` and `plan` over every triangle;
 /// `plan_cuts_args`, then `plan_cuts` over the triangles `plan` listed, `plan_parts_args`, then
-/// `plan_parts` over the parts it cut (the "plan_cuts" pass); `lattice_args`, then `lattice` over
-/// the pieces counted on the GPU, `lattice_work_args`, then `lattice_nodes` and
-/// `lattice_triangles` over the work items `lattice` appended, and `finalize` (the draw's
-/// arguments).
-/// `timed`: each pass writes its timestamps.
-pub fn one_submission(triangles: u32, passes: Passes, timed: bool) -> Recording {
-    let stamp = |index: u32| timed.then_some(index);
+/// `plan_parts` over the parts it cut; `lattice_args`, then `lattice` over the pieces counted on
+/// the GPU, the rows' passes where the frame has them, `lattice_work_args`, then `lattice_nodes`
+/// and `lattice_triangles` over the work items `lattice` appended, and `finalize` (the draw's
+/// arguments). In compute passes as `timing` says.
+pub fn one_submission(triangles: u32, passes: Passes, timing: PassTiming) -> Recording {
     let mut r = Recording::default();
     r.clear("counters", None).clear("cut_edges", None);
-    r.pass("plan", stamp(PLAN_TIMESTAMP));
-    r.dispatch("active_cuts", triangles).dispatch("ring_cuts", triangles).dispatch("plan", triangles);
-    r.pass("plan_cuts", stamp(PLAN_CUTS_TIMESTAMP));
-    cut_and_plan_parts(&mut r);
-    r.pass("lattice", stamp(LATTICE_TIMESTAMP));
+    for entry in ["active_cuts", "ring_cuts", "plan"] {
+        pass(&mut r, entry, timing);
+        r.dispatch(entry, triangles);
+    }
+    cut_and_plan_parts(&mut r, timing);
+    pass(&mut r, "lattice", timing);
     r.dispatch("lattice_args", 1).dispatch_indirect("lattice", "lattice_dispatch", DISPATCH_LATTICE);
-    lattice_work(&mut r, passes);
+    lattice_work(&mut r, passes, timing);
     r.dispatch("finalize", 1);
+    debug_assert!(timed_passes(&r).len() as u32 <= TIMED_PASSES);
     r
 }
 
 /// `plan_cuts` over the triangles `plan` listed, then `plan_parts` over the parts it cut (each
 /// after its one-thread setup pass): a quadrant near a pole or beside a floor has many bands,
 /// which one invocation planned in turn made the frame's longest threads.
-fn cut_and_plan_parts(r: &mut Recording) {
+fn cut_and_plan_parts(r: &mut Recording, timing: PassTiming) {
+    pass(r, "plan_cuts", timing);
     r.dispatch("plan_cuts_args", 1).dispatch_indirect("plan_cuts", "lattice_dispatch", DISPATCH_PLAN_CUTS);
+    pass(r, "plan_parts", timing);
     r.dispatch("plan_parts_args", 1).dispatch_indirect("plan_parts", "lattice_dispatch", DISPATCH_PLAN_PARTS);
 }
 
@@ -234,14 +287,18 @@ impl Passes {
 /// What follows `lattice`: where pieces may be drawn in rows, `lattice_rows` over the bands it
 /// listed and `lattice_rows_plan`; then its work items, `lattice_nodes`, then `lattice_triangles`
 /// (which reads the nodes), each after the setup pass that counts them.
-fn lattice_work(r: &mut Recording, passes: Passes) {
+fn lattice_work(r: &mut Recording, passes: Passes, timing: PassTiming) {
     if passes.rows {
+        pass(r, "lattice_rows", timing);
         r.dispatch("lattice_rows_args", 1);
         r.dispatch_indirect("lattice_rows", "lattice_dispatch", DISPATCH_LATTICE_ROWS);
+        pass(r, "lattice_rows_plan", timing);
         r.dispatch_indirect("lattice_rows_plan", "lattice_dispatch", DISPATCH_LATTICE_ROWS_PLAN);
     }
+    pass(r, "lattice_nodes", timing);
     r.dispatch("lattice_work_args", 1);
     r.dispatch_indirect("lattice_nodes", "lattice_dispatch", DISPATCH_LATTICE_NODES);
+    pass(r, "lattice_triangles", timing);
     r.dispatch_indirect("lattice_triangles", "lattice_dispatch", DISPATCH_LATTICE_TRIANGLES);
 }
 
@@ -293,9 +350,9 @@ pub fn pass_run(entry: &'static str, count: u32, passes: Passes) -> Recording {
     r.clear("counters", Some(SubdivideCounters::RUN_BYTES));
     r.pass(entry, None).dispatch(entry, count);
     if entry == "plan" {
-        cut_and_plan_parts(&mut r);
+        cut_and_plan_parts(&mut r, PassTiming::Untimed);
     } else {
-        lattice_work(&mut r, passes);
+        lattice_work(&mut r, passes, PassTiming::Untimed);
     }
     r.dispatch("finalize", 1);
     r

@@ -15,7 +15,7 @@ use crate::core::settings::RenderSettings;
 use crate::encoding::constants::PIECES_FROM_COUNTER;
 use crate::encoding::recording::{Command, Recording};
 use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine, INDICES_SIZE, NODE_SIZE};
-use crate::encoding::subdivide::{cut_probe, missed, one_submission, Passes, SubdivideOutput, CUT_PASSES};
+use crate::encoding::subdivide::{cut_probe, missed, one_submission, PassTiming, Passes, SubdivideOutput, CUT_PASSES};
 use crate::encoding::types::{DrawVertex, SubdivideCounters, SubdivideParams};
 use crate::error::Result;
 use crate::gpu::device::Gpu;
@@ -48,7 +48,7 @@ impl Variant {
     /// The cut passes, built now if they are not yet.
     fn build_cut_passes(&self, gpu: &Gpu, stage: &GpuStage, passes: Passes) {
         self.cut_passes.get_or_init(|| {
-            let used: Vec<_> = one_submission(1, passes, false).entries().filter(|e| CUT_PASSES.contains(e)).collect();
+            let used: Vec<_> = one_submission(1, passes, PassTiming::Untimed).entries().filter(|e| CUT_PASSES.contains(e)).collect();
             Builder::new(&self.build, gpu, stage).run(build_threads(), &used, |_| {})
         });
     }
@@ -284,7 +284,7 @@ impl SubdivideStage {
             let stage = &self.stage;
             // The entry points this frame's schedules dispatch (every schedule's are the usual
             // frame's): `plan`'s, the cut passes, the others.
-            let used: Vec<&'static str> = one_submission(1, passes, false).entries().collect();
+            let used: Vec<&'static str> = one_submission(1, passes, PassTiming::Untimed).entries().collect();
             let (cuts, others): (Vec<_>, Vec<_>) = used.into_iter().partition(|e| CUT_PASSES.contains(e));
             // `plan`'s first (the probe waits for them), then the others, longest first.
             let (probed, others): (Vec<_>, Vec<_>) = others.into_iter().partition(|e| PROBED.contains(e));
@@ -373,12 +373,13 @@ impl SubdivideStage {
         params: &SubdivideParams,
         panorama: PanoramaKind,
         timestamps: Option<&Timestamps>,
+        each_pass: bool,
     ) {
         let params = SubdivideParams { first_piece: 0, piece_count: PIECES_FROM_COUNTER, ..*params };
         gpu.queue.write_buffer(params_buffer, 0, bytemuck::bytes_of(&params));
         let frame = FrameBuffers { params: params_buffer, scene, b };
         let passes = Passes::of(panorama, params.method);
-        let recording = one_submission(params.triangle_count, passes, timestamps.is_some());
+        let recording = one_submission(params.triangle_count, passes, PassTiming::of(timestamps.is_some(), each_pass));
         let probe = |pipelines: Pipelines| {
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             self.replay(gpu, &mut enc, &cut_probe(params.triangle_count), &frame, pipelines, None);
@@ -408,7 +409,7 @@ impl SubdivideStage {
             return false; // every frame once they are built
         }
         let passes = Passes::of(panorama, params.method);
-        let recording = one_submission(params.triangle_count, passes, false);
+        let recording = one_submission(params.triangle_count, passes, PassTiming::Untimed);
         if missed(&recording, params, counters, |e| variant.pipeline(e).is_some()).is_empty() {
             return false;
         }

@@ -12,7 +12,7 @@ use crate::core::settings::RenderSettings;
 use crate::encoding::params::raster_params;
 use crate::encoding::recording::Recording;
 use crate::encoding::schedule::{run_chunked, Capacities, FramePlan, SubdivisionEngine};
-use crate::encoding::subdivide::{dispatched, one_submission, subdivide_params, Passes};
+use crate::encoding::subdivide::{dispatched, one_submission, subdivide_params, timed_passes, PassTiming, Passes};
 use crate::encoding::types::{ProjectionUniform, RasterParams, SubdivideCounters, SubdivideParams};
 use crate::error::Result;
 use crate::gpu::device::Gpu;
@@ -27,8 +27,8 @@ use crate::gpu::timestamps as stamp;
 /// GPU times (ms) of a one-submission frame, from its timestamps.
 struct GpuTimes {
     subdivide: f64,
-    /// The subdivision's passes: `plan` (with `active_cuts`), `plan_cuts`, `lattice`.
-    passes: [f64; 3],
+    /// Each of the subdivision's passes, in schedule order (`encoding::subdivide::timed_passes`).
+    passes: Vec<(&'static str, f64)>,
     raster: f64,
     frame: f64,
 }
@@ -101,7 +101,7 @@ impl Method for SubdividedMethod {
                 }
                 stats.pieces = counters.pieces as u64;
                 stats.subdivide_invocations =
-                    dispatched(&one_submission(n, Passes::of(p.panorama, params.method), false), &params, &counters);
+                    dispatched(&one_submission(n, Passes::of(p.panorama, params.method), PassTiming::Untimed), &params, &counters);
                 stats.max_pieces_per_invocation = counters.max_pieces;
                 stats.max_output_per_invocation = counters.max_output;
                 stats.triangles_out = counters.triangles as u64;
@@ -141,11 +141,16 @@ impl SubdividedMethod {
         let timestamps = res.timestamps.as_ref();
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         let panorama = settings.projection().panorama;
+        // The subdivision's timed passes, and the raster's pair of queries after them.
+        let timing = PassTiming::of(true, settings.measure.pass_times);
+        let timed = timed_passes(&one_submission(params.triangle_count, Passes::of(panorama, params.method), timing));
+        let raster_query = 2 * timed.len() as u32;
         std::thread::scope(|scope| {
             // The raster's pipelines built beside the subdivision's (building them is most of a
             // fresh process's time on a CPU driver; a built one is only looked up).
             let raster = scope.spawn(|| self.raster_pipelines(gpu, scene, settings));
-            self.subdivide.encode(gpu, &mut enc, &res.subdivide_params, scene, b, &params, panorama, timestamps);
+            let each_pass = settings.measure.pass_times;
+            self.subdivide.encode(gpu, &mut enc, &res.subdivide_params, scene, b, &params, panorama, timestamps, each_pass);
             raster.join().expect("building the raster's pipelines panicked");
         });
         self.encode_raster(
@@ -157,11 +162,11 @@ impl SubdividedMethod {
             b,
             settings,
             true,
-            timestamps.map(|t| (&t.set, stamp::RASTER, stamp::RASTER + 1)),
+            timestamps.map(|t| (&t.set, raster_query, raster_query + 1)),
         );
         enc.copy_buffer_to_buffer(&b.counters, 0, &res.staging, 0, COUNTERS_SIZE);
         if let Some(t) = timestamps {
-            t.resolve(&mut enc, &res.staging, COUNTERS_SIZE, stamp::COUNT);
+            t.resolve(&mut enc, &res.staging, COUNTERS_SIZE, raster_query + 2);
         }
         gpu.queue.submit([enc.finish()]);
         let bytes = gpu.read_buffer(&res.staging)?;
@@ -172,11 +177,21 @@ impl SubdividedMethod {
         let times = timestamps.map(|t| {
             let ticks: &[u64] = bytemuck::cast_slice(&bytes[COUNTERS_SIZE as usize..]);
             let span = |first: u32| t.ms(ticks[first as usize], ticks[first as usize + 1]);
+            // Each subdivision pass from the end of the one before (the first from its begin):
+            // lavapipe writes a pass's begin late at times, after work that is the pass's own.
+            let mut pass_from = ticks[0];
+            let passes = timed
+                .iter()
+                .map(|&(label, first)| {
+                    let end = ticks[first as usize + 1];
+                    (label, t.ms(std::mem::replace(&mut pass_from, end), end))
+                })
+                .collect();
             GpuTimes {
-                subdivide: t.ms(ticks[0], ticks[stamp::LATTICE as usize + 1]),
-                passes: [span(stamp::PLAN), span(stamp::PLAN_CUTS), span(stamp::LATTICE)],
-                raster: span(stamp::RASTER),
-                frame: t.ms(ticks[0], ticks[stamp::RASTER as usize + 1]),
+                subdivide: t.ms(ticks[0], ticks[raster_query as usize - 1]),
+                passes,
+                raster: span(raster_query),
+                frame: t.ms(ticks[0], ticks[raster_query as usize + 1]),
             }
         });
         Ok(Some((counters, times)))

@@ -1,7 +1,8 @@
 //! GPU timestamps of a frame's passes, where the adapter has timestamp queries: one query set
-//! of eight (begin/end of the subdivision's three passes — `plan`, `plan_cuts`, `lattice` — and
-//! of the raster) with its resolve buffer, made once; and the timed submission of the one-pass
-//! frames (slit, trace).
+//! (begin/end of each of the subdivision's passes — `active_cuts` … `lattice_triangles`, see
+//! `encoding::subdivide::one_submission` — and of the raster, whose pair follows the last
+//! pass's) with its resolve buffer, made once; and the timed submission of the one-pass frames
+//! (slit, trace).
 
 use std::time::Instant;
 
@@ -9,12 +10,8 @@ use crate::core::frame::{FrameStats, Timing};
 use crate::error::Result;
 use crate::gpu::device::Gpu;
 
-pub const COUNT: u32 = 8;
-/// Query indices: the begin of each subdivision pass (its end is the next index) and of the raster.
-pub const PLAN: u32 = crate::encoding::subdivide::PLAN_TIMESTAMP;
-pub const PLAN_CUTS: u32 = crate::encoding::subdivide::PLAN_CUTS_TIMESTAMP;
-pub const LATTICE: u32 = crate::encoding::subdivide::LATTICE_TIMESTAMP;
-pub const RASTER: u32 = 6;
+/// Queries: a pair per timed pass of the subdivision, and the raster's.
+pub const COUNT: u32 = 2 * crate::encoding::subdivide::TIMED_PASSES + 2;
 
 pub struct Timestamps {
     pub set: wgpu::QuerySet,

@@ -372,6 +372,11 @@ pub struct SpeedArgs {
     /// median is reported.
     #[arg(long, default_value_t = 5)]
     pub reps: usize,
+    /// Time each of the subdivision's passes apart (the balance table's ms, the JSON's
+    /// `ms_subdivide_passes`), where the adapter has timestamps. Each pass boundary and its
+    /// timestamps cost the software driver ~0.3–0.5 ms: compare frame times and ratios without it.
+    #[arg(long)]
+    pub pass_times: bool,
     #[command(flatten)]
     pub view: ViewArgs,
     /// Also write the rows as JSON to this file.
@@ -412,7 +417,7 @@ pub fn bench_speed(args: &SpeedArgs) -> Result<()> {
         scenes.push(speed::SpeedScene {
             spec: spec.clone(),
             gpu_scene: prepared.gpu_scene,
-            settings: prepared.settings,
+            settings: prepared.settings.with_pass_times(args.pass_times),
         });
     }
     let rows = speed::speed(&renderer, &scenes, &args.methods, args.reps, |what| eprintln!("timing {what} ..."))?;
@@ -423,7 +428,7 @@ pub fn bench_speed(args: &SpeedArgs) -> Result<()> {
     );
     print!("{}", speed::speed_table(&rows));
     println!("\nthe subdivision's balance:\n");
-    print!("{}", speed::balance_table(&rows));
+    print!("{}", speed::balance_table(&rows, args.pass_times));
     if let Some(path) = &args.json {
         let json = serde_json::json!({ "adapter": adapter, "width": base.view.projection.width, "height": base.view.projection.height, "rows": rows });
         twister::output::write_text(path, &serde_json::to_string_pretty(&json).unwrap())?;

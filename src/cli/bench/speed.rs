@@ -33,8 +33,9 @@ pub struct SpeedRow {
     pub ms_gpu: Option<f64>,
     /// Median times of the subdivision and the raster, where they were measured apart.
     pub ms_subdivide: Option<f64>,
-    /// Median times of the subdivision's passes (`plan`, `plan_cuts`, `lattice`), where timed.
-    pub ms_subdivide_passes: Option<[f64; 3]>,
+    /// Median times of each of the subdivision's passes, by its main entry point, in schedule
+    /// order (`FrameStats::ms_subdivide_passes`), where timed.
+    pub ms_subdivide_passes: Option<Vec<(&'static str, f64)>>,
     pub ms_raster: Option<f64>,
     pub ms_readback: f64,
     /// ms_frame / ms_frame of the first method on the same scene.
@@ -133,13 +134,7 @@ pub fn speed(
                 timing: last.timing.to_string(),
                 ms_gpu: measured(|s| s.ms_gpu),
                 ms_subdivide: measured(|s| s.ms_subdivide),
-                ms_subdivide_passes: (|| {
-                    let pass = |i: usize| {
-                        let v: Option<Vec<f64>> = frames.iter().map(|s| s.ms_subdivide_passes.map(|p| p[i])).collect();
-                        v.map(median)
-                    };
-                    Some([pass(0)?, pass(1)?, pass(2)?])
-                })(),
+                ms_subdivide_passes: median_passes(&frames),
                 ms_raster: measured(|s| s.ms_raster),
                 ms_readback: median(frames.iter().map(|s| s.ms_readback).collect()),
                 ratio: ms_frame / first,
@@ -156,14 +151,55 @@ pub fn speed(
     Ok(rows)
 }
 
+/// The median of each pass's time over the frames, where every frame timed the same passes.
+fn median_passes(frames: &[FrameStats]) -> Option<Vec<(&'static str, f64)>> {
+    let first = frames.first()?.ms_subdivide_passes.as_ref()?;
+    let mut times: Vec<Vec<f64>> = vec![Vec::with_capacity(frames.len()); first.len()];
+    for f in frames {
+        let passes = f.ms_subdivide_passes.as_ref().filter(|p| p.len() == first.len())?;
+        for (k, ((label, ms), (first_label, _))) in passes.iter().zip(first).enumerate() {
+            if label != first_label {
+                return None;
+            }
+            times[k].push(*ms);
+        }
+    }
+    Some(first.iter().zip(times).map(|(&(label, _), v)| (label, median(v))).collect())
+}
+
+/// The subdivision's time in three groups (`plan` with `active_cuts` and `ring_cuts`;
+/// `plan_cuts` with `plan_parts`; `lattice` with the rows' and the work items' passes).
+fn pass_groups(passes: &[(&'static str, f64)]) -> [f64; 3] {
+    let mut groups = [0.0; 3];
+    for &(label, ms) in passes {
+        let group = match label {
+            "active_cuts" | "ring_cuts" | "plan" => 0,
+            "plan_cuts" | "plan_parts" => 1,
+            _ => 2,
+        };
+        groups[group] += ms;
+    }
+    groups
+}
+
 /// A Markdown table of the subdivision's balance: per scene and projection method, each
-/// pass's invocations, the largest output of one invocation, and its share of the frame.
-pub fn balance_table(rows: &[SpeedRow]) -> String {
-    let mut s = String::from(
-        "| scene | method | invocations per pass | max pieces / invocation | max nodes or triangles / invocation | subdivision's share |\n|---|---|---|---|---|---|\n",
-    );
+/// pass's invocations (with `each_pass`, where each pass was timed apart, its time: a setup
+/// pass's with the pass it sets up), the largest output of one invocation, and its share of the
+/// frame.
+pub fn balance_table(rows: &[SpeedRow], each_pass: bool) -> String {
+    let mut s = String::from(if each_pass {
+        "| scene | method | invocations per pass (ms) | max pieces / invocation | max nodes or triangles / invocation | subdivision's share |\n|---|---|---|---|---|---|\n"
+    } else {
+        "| scene | method | invocations per pass | max pieces / invocation | max nodes or triangles / invocation | subdivision's share |\n|---|---|---|---|---|---|\n"
+    });
     for r in rows.iter().filter(|r| !r.subdivide_invocations.is_empty()) {
-        let passes: Vec<String> = r.subdivide_invocations.iter().map(|(p, n)| format!("{p} {n}")).collect();
+        let times = r.ms_subdivide_passes.iter().flatten().filter(|_| each_pass);
+        let ms = |entry: &str| times.clone().find(|(label, _)| *label == entry).map(|p| p.1);
+        let passes: Vec<String> = r
+            .subdivide_invocations
+            .iter()
+            .map(|&(p, n)| ms(p).map_or(format!("{p} {n}"), |t| format!("{p} {n} ({t:.1})")))
+            .collect();
         s += &format!(
             "| {} | {} | {} | {} | {} | {} |\n",
             r.scene,
@@ -192,7 +228,7 @@ pub fn speed_table(rows: &[SpeedRow]) -> String {
             r.out_per_in,
             r.vertices_out,
             r.ms_frame,
-            match (r.ms_subdivide, r.ms_subdivide_passes) {
+            match (r.ms_subdivide, r.ms_subdivide_passes.as_deref().map(pass_groups)) {
                 (Some(t), Some([plan, cuts, lattice])) => format!("{t:.1} ({plan:.1} / {cuts:.1} / {lattice:.1})"),
                 (Some(t), None) => format!("{t:.1}"),
                 _ => "—".into(),

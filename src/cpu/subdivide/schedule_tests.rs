@@ -6,7 +6,7 @@ use crate::core::projection::Projection;
 use crate::core::settings::{Method, RenderSettings, Split};
 use crate::encoding::constants::PIECES_FROM_COUNTER;
 use crate::encoding::schedule::{Capacities, SubdivisionEngine};
-use crate::encoding::subdivide::{cut_probe, dispatched, missed, one_submission, subdivide_params, Passes, CUT_PASSES};
+use crate::encoding::subdivide::{cut_probe, dispatched, missed, one_submission, subdivide_params, PassTiming, Passes, CUT_PASSES};
 
 #[test]
 fn the_cut_probe_lists_the_triangles_the_frame_cuts() {
@@ -25,7 +25,7 @@ fn the_cut_probe_lists_the_triangles_the_frame_cuts() {
         let mut params = subdivide_params(&settings, 0, n);
         (params.piece_capacity, params.triangle_capacity) = (capacity.pieces, capacity.triangles);
         (params.first_piece, params.piece_count) = (0, PIECES_FROM_COUNTER);
-        let frame = one_submission(n, Passes::of_settings(&settings), false);
+        let frame = one_submission(n, Passes::of_settings(&settings), PassTiming::Untimed);
         let probed = engine.replay(&cut_probe(n), &params).expect("probe");
         let done = engine.replay(&frame, &params).expect("frame");
         assert_eq!((probed.cut_count, probed.cut_wide), (done.cut_count, done.cut_wide), "{projection:?}");
