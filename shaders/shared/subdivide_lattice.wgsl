@@ -54,16 +54,6 @@ fn edge_location(e: u32, j: u32, part: ptr<function, PartPlan>) -> vec3<u32> {
     return vec3<u32>(ON_EDGE, e, j);
 }
 
-fn macro_node(abc: vec3<u32>, loc: vec3<u32>, part: ptr<function, PartPlan>) -> Node {
-    if (loc.x == CORNER) {
-        return corner(loc.y, part);
-    }
-    if (loc.x == ON_EDGE) {
-        return edge_point(corner(loc.y, part), corner((loc.y + 1u) % 3u, part), loc.z, (*part).n[loc.y]);
-    }
-    return spaced_interior((*part).corner, abc, (*part).k);
-}
-
 // The node's fine index along original edge oe from its start, or −1 if it is not on that edge.
 fn index_on(oe: u32, loc: vec3<u32>, part: ptr<function, PartPlan>) -> i32 {
     if (loc.x == CORNER && loc.y == oe) {
@@ -452,13 +442,47 @@ fn piece_corners(piece: Piece, part: ptr<function, PartPlan>, piece_state: ptr<f
     if ((piece.count2_level & BANDS) != 0u) {
         loc = band_cell(piece.cell, part);
     }
+    // Each corner (`macro_node` in src/cpu/subdivide/piece.rs) a part's corner as it is, then
+    // the nodes on an edge, then the interior ones, each placed in a loop over the corners that
+    // are one. A group of lavapipe's lanes runs every branch for every lane, and a loop's body as
+    // often as its busiest lane needs (once when none does); most pieces are a whole part, whose
+    // corners are the part's own: a group of them places one edge point and one interior node
+    // (four spaced points), where each corner placing both took twelve.
+    var on_edge = vec3<u32>(0u);
+    var edge_count = 0u;
+    var inside = vec3<u32>(0u);
+    var inside_count = 0u;
     for (var i = 0u; i < 3u; i++) {
         if ((piece.count2_level & BANDS) == 0u) {
             loc[i] = macro_location(cell.c[i], part);
         }
-        (*piece_state).corner[i] = macro_node(cell.c[i], loc[i], part);
+        (*piece_state).corner[i] = corner(loc[i].y, part);
+        if (loc[i].x == ON_EDGE) {
+            on_edge[edge_count] = i;
+            edge_count += 1u;
+        } else if (loc[i].x != CORNER) {
+            inside[inside_count] = i;
+            inside_count += 1u;
+        }
+    }
+    for (var j = 0u; j < edge_count; j++) {
+        let at = loc[on_edge[j]];
+        let node = edge_point(corner(at.y, part), corner((at.y + 1u) % 3u, part), at.z, (*part).n[at.y]);
+        set_corner(on_edge[j], node, piece_state);
+    }
+    for (var j = 0u; j < inside_count; j++) {
+        set_corner(inside[j], spaced_interior((*part).corner, cell.c[inside[j]], (*part).k), piece_state);
     }
     return loc;
+}
+
+// Sets the piece's corner i (a lane's own i: each slot written where it is the one).
+fn set_corner(i: u32, node: Node, piece_state: ptr<function, PieceState>) {
+    for (var c = 0u; c < 3u; c++) {
+        if (c == i) {
+            (*piece_state).corner[c] = node;
+        }
+    }
 }
 
 // A piece of the pre-split: its corners, each edge's count, lattice or strip, or rows to be
