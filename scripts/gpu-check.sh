@@ -69,6 +69,9 @@ run() {
     speed small_cylinder "$B" builtin:sphere100 --fit 3
     speed rooms_cubemap builtin:demo builtin:box-room --panorama cubemap
     speed sponza_sphere_last "$S" --viewer 0,1.7,0 --panorama equirect
+    # Each subdivision pass timed apart (the balance table's ms): which pass holds the share.
+    reps=$((reps / 3 + 1)) speed passes_sponza_sphere "$S" --viewer 0,1.7,0 --panorama equirect --pass-times
+    reps=$((reps / 3 + 1)) speed passes_sponza_cylinder "$S" --viewer 0,1.7,0 --pass-times
     # The box room's raster was slow on the H200 for what it draws (vertex's 68 flat triangles
     # 15-19 ms on the sphere, the demo room's 4,156 5.1 ms): the same pair on the cylinder, at a
     # quarter of the pixels, and without the pole merge, to see what it follows.
