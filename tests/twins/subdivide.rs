@@ -131,6 +131,10 @@ fn subdivide_cases() -> Vec<(Scene, RenderSettings)> {
         // Rows (the sphere, adaptive rules): random triangles, the box room (long thin parts in
         // bands), eq. 5, a viewer off the axis.
         (random_triangle_scene(9, 200), RenderSettings::new(Projection::equirect(320))),
+        // Rows pieces larger than a node item, near the seam (two copies: items of 32 nodes):
+        // seed 9's items start at rows' right ends, seed 12's between a row's nodes
+        // (`rows_along` places the row's ends first and writes only the item's slots).
+        (random_triangle_scene(12, 200), RenderSettings::new(Projection::equirect(256))),
         (
             builtin::builtin_scene("builtin:box-room", &projection).unwrap(),
             RenderSettings::new(Projection::equirect(256)),
