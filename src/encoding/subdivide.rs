@@ -187,8 +187,8 @@ pub enum PassTiming {
     /// `plan_cuts` (with `plan_parts`), `lattice` (with the rows' and the work items' passes).
     Grouped,
     /// A timed compute pass for each main entry point (its setup pass with it, `finalize` with
-    /// the last). Each pass boundary and pair of timestamps costs lavapipe ~0.3–0.5 ms (its
-    /// timestamps wait for the work before them), which weighs most on small frames.
+    /// the last). Each pass boundary and pair of timestamps costs lavapipe ~0.3–0.5 ms, which
+    /// weighs most on small frames.
     EachPass,
 }
 
