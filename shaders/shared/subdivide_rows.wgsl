@@ -31,15 +31,15 @@ fn band_parts(whole: array<EdgeProfile, 2>, cap: u32, tri: ptr<function, InputTr
     return cap;
 }
 
-// Whether the piece may be drawn in rows — on the sphere, under an adaptive rule, two rows or
-// more (at most PIECE_DIVISIONS) — and then its rows' base and sides in `row_base` and `strip_n`
-// (`Subdivider::rows_base`).
+// Whether the piece may be drawn in rows — on the sphere, under an adaptive rule, three rows or
+// more (at most PIECE_DIVISIONS; two rows never draw fewer than the lattice of level 2) — and
+// then its rows' base and sides in `row_base` and `strip_n` (`Subdivider::rows_base`).
 fn rows_possible(piece_state: ptr<function, PieceState>) -> bool {
     let counts = (*piece_state).counts;
     let base = band_base(counts);
     let sides = vec2<u32>(counts[(base + 2u) % 3u], counts[(base + 1u) % 3u]);
     let r = max(sides.x, sides.y);
-    if (!is_adaptive() || !is_sphere(params.projection) || r < 2u || r > PIECE_DIVISIONS) {
+    if (!is_adaptive() || !is_sphere(params.projection) || r < 3u || r > PIECE_DIVISIONS) {
         return false;
     }
     (*piece_state).row_base = base;

@@ -203,8 +203,8 @@ impl Subdivider<'_> {
 
     /// A piece's shape where it needs no rows measured: a sliver's strip on the cylinder
     /// ([`Subdivider::strip_base`]), or the regular lattice of level m = max(counts) where rows
-    /// cannot be drawn; None: its rows are to be measured (the sphere, an adaptive rule, two rows
-    /// or more).
+    /// cannot be drawn; None: its rows are to be measured (the sphere, an adaptive rule, three
+    /// rows or more).
     pub(super) fn unmeasured_shape(&self, g: &PieceGeometry) -> Option<Shape> {
         let counts = g.counts();
         if let Some(base) = self.strip_base(counts, &g.q, g.limits) {

@@ -217,14 +217,16 @@ impl Rows {
 }
 
 impl Subdivider<'_> {
-    /// Where a piece may be drawn in rows — on the sphere, under an adaptive rule, with two rows
-    /// or more — its base edge and its sides' counts (left, right); None elsewhere
-    /// (`rows_possible` in the WGSL).
+    /// Where a piece may be drawn in rows — on the sphere, under an adaptive rule, with three
+    /// rows or more — its base edge and its sides' counts (left, right); None elsewhere
+    /// (`rows_possible` in the WGSL). Two rows are never fewer triangles than the lattice of
+    /// level 2 draws: with an edge of one part, its snapped middle collapses a corner triangle
+    /// and three are drawn, the fewest two rows make (with two such edges, two).
     pub(super) fn rows_base(&self, counts: [u32; 3]) -> Option<(usize, [u32; 2])> {
         let (base, r) = Rows::base_of(counts);
         let possible = SplitRule::is_adaptive(self.params.method)
             && self.projection.panorama.is_sphere()
-            && (2..=PIECE_DIVISIONS).contains(&r);
+            && (3..=PIECE_DIVISIONS).contains(&r);
         possible.then(|| (base, sides_of(counts, base)))
     }
 
