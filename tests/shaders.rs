@@ -239,7 +239,7 @@ fn shared_modules_declare_no_entry_points_and_only_binding_modules_declare_bindi
 fn the_subdivisions_recordings_name_its_entry_points_and_bindings() {
     use twister::encoding::recording::Command;
     use twister::encoding::subdivide::{
-        active_cuts, one_submission, pass_run, timed_passes, PassTiming, Passes, TIMED_PASSES,
+        active_cuts, one_submission, pass_run, timed_passes, PassTiming, Passes, PASS_GROUPS, TIMED_PASSES,
     };
     use twister::shader::SUBDIVIDE;
     let entries: Vec<&str> = SUBDIVIDE.entry_points.iter().map(|e| e.name).collect();
@@ -269,7 +269,7 @@ fn the_subdivisions_recordings_name_its_entry_points_and_bindings() {
             .entries()
             .filter(|e| !e.ends_with("_args") && *e != "finalize")
             .collect();
-        for (timing, labels) in [(PassTiming::EachPass, main), (PassTiming::Grouped, vec!["plan", "plan_cuts", "lattice"])] {
+        for (timing, labels) in [(PassTiming::EachPass, main), (PassTiming::Grouped, PASS_GROUPS.to_vec())] {
             let timed = timed_passes(&one_submission(7, p, timing));
             assert_eq!(timed.iter().map(|t| t.0).collect::<Vec<_>>(), labels, "{timing:?}");
             assert!(timed.iter().enumerate().all(|(k, t)| t.1 == 2 * k as u32), "{timed:?}");

@@ -203,17 +203,28 @@ impl PassTiming {
     }
 }
 
-/// Starts a compute pass before `entry` where `timing` has one there (every main entry point's
-/// under `EachPass`; else those that start the three groups, named by the group), timed at the
-/// next pair of queries unless `Untimed`.
+/// The three groups `Grouped` times the passes in, in schedule order.
+pub const PASS_GROUPS: [&str; 3] = ["plan", "plan_cuts", "lattice"];
+
+/// The group of `PASS_GROUPS` a main entry point's pass falls in (a group's own name gives it).
+pub fn pass_group(entry: &str) -> &'static str {
+    match entry {
+        "active_cuts" | "ring_cuts" | "plan" => PASS_GROUPS[0],
+        "plan_cuts" | "plan_parts" => PASS_GROUPS[1],
+        _ => PASS_GROUPS[2],
+    }
+}
+
+/// Starts a compute pass before `entry` where `timing` has one there: every main entry point's
+/// under `EachPass`, else where its group (the pass's name) differs from the current pass's;
+/// timed at the next pair of queries unless `Untimed`.
 fn pass(r: &mut Recording, entry: &'static str, timing: PassTiming) {
-    let group = match entry {
-        "active_cuts" => Some("plan"),
-        "plan_cuts" | "lattice" => Some(entry),
+    let label = if timing == PassTiming::EachPass { entry } else { pass_group(entry) };
+    let current = r.commands.iter().rev().find_map(|c| match *c {
+        Command::Pass { label, .. } => Some(label),
         _ => None,
-    };
-    let label = if timing == PassTiming::EachPass { Some(entry) } else { group };
-    if let Some(label) = label {
+    });
+    if current != Some(label) {
         let index = 2 * timed_passes(r).len() as u32;
         r.pass(label, (timing != PassTiming::Untimed).then_some(index));
     }

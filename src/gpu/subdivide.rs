@@ -15,7 +15,9 @@ use crate::core::settings::RenderSettings;
 use crate::encoding::constants::PIECES_FROM_COUNTER;
 use crate::encoding::recording::{Command, Recording};
 use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine, INDICES_SIZE, NODE_SIZE};
-use crate::encoding::subdivide::{cut_probe, missed, one_submission, PassTiming, Passes, SubdivideOutput, CUT_PASSES};
+use crate::encoding::subdivide::{
+    cut_probe, missed, one_submission, timed_passes, PassTiming, Passes, SubdivideOutput, CUT_PASSES,
+};
 use crate::encoding::types::{DrawVertex, SubdivideCounters, SubdivideParams};
 use crate::error::Result;
 use crate::gpu::device::Gpu;
@@ -48,7 +50,8 @@ impl Variant {
     /// The cut passes, built now if they are not yet.
     fn build_cut_passes(&self, gpu: &Gpu, stage: &GpuStage, passes: Passes) {
         self.cut_passes.get_or_init(|| {
-            let used: Vec<_> = one_submission(1, passes, PassTiming::Untimed).entries().filter(|e| CUT_PASSES.contains(e)).collect();
+            let used: Vec<_> =
+                one_submission(1, passes, PassTiming::Untimed).entries().filter(|e| CUT_PASSES.contains(e)).collect();
             Builder::new(&self.build, gpu, stage).run(build_threads(), &used, |_| {})
         });
     }
@@ -357,8 +360,9 @@ impl SubdivideStage {
         }
     }
 
-    /// Encodes the one-submission schedule ([`one_submission`]; each pass timed where the
-    /// adapter has timestamps). `params` covers every triangle, its pieces counted on the GPU.
+    /// Encodes the one-submission schedule ([`one_submission`], its passes timed as `timing`
+    /// says, with `timestamps`) and returns its timed passes ([`timed_passes`]). `params` covers
+    /// every triangle, its pieces counted on the GPU.
     /// On the variant's first frame, a [`cut_probe`] submitted first tells whether the cut
     /// passes are built; where they are not, the frame leaves them out, and
     /// [`SubdivideStage::missed_cuts`] says whether it must be drawn again.
@@ -373,13 +377,13 @@ impl SubdivideStage {
         params: &SubdivideParams,
         panorama: PanoramaKind,
         timestamps: Option<&Timestamps>,
-        each_pass: bool,
-    ) {
+        timing: PassTiming,
+    ) -> Vec<(&'static str, u32)> {
         let params = SubdivideParams { first_piece: 0, piece_count: PIECES_FROM_COUNTER, ..*params };
         gpu.queue.write_buffer(params_buffer, 0, bytemuck::bytes_of(&params));
         let frame = FrameBuffers { params: params_buffer, scene, b };
         let passes = Passes::of(panorama, params.method);
-        let recording = one_submission(params.triangle_count, passes, PassTiming::of(timestamps.is_some(), each_pass));
+        let recording = one_submission(params.triangle_count, passes, timing);
         let probe = |pipelines: Pipelines| {
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             self.replay(gpu, &mut enc, &cut_probe(params.triangle_count), &frame, pipelines, None);
@@ -392,6 +396,7 @@ impl SubdivideStage {
         };
         let variant = self.variant(gpu, panorama, &params, Some(&probe));
         self.replay(gpu, enc, &recording, &frame, &|e| variant.pipeline(e), timestamps);
+        timed_passes(&recording)
     }
 
     /// After a frame [`SubdivideStage::encode`]d with these `params`: whether it left out cut

@@ -12,7 +12,7 @@ use crate::core::settings::RenderSettings;
 use crate::encoding::params::raster_params;
 use crate::encoding::recording::Recording;
 use crate::encoding::schedule::{run_chunked, Capacities, FramePlan, SubdivisionEngine};
-use crate::encoding::subdivide::{dispatched, one_submission, subdivide_params, timed_passes, PassTiming, Passes};
+use crate::encoding::subdivide::{dispatched, one_submission, subdivide_params, PassTiming, Passes};
 use crate::encoding::types::{ProjectionUniform, RasterParams, SubdivideCounters, SubdivideParams};
 use crate::error::Result;
 use crate::gpu::device::Gpu;
@@ -100,8 +100,11 @@ impl Method for SubdividedMethod {
                     None => stats.timing = Timing::WallOneSubmission,
                 }
                 stats.pieces = counters.pieces as u64;
-                stats.subdivide_invocations =
-                    dispatched(&one_submission(n, Passes::of(p.panorama, params.method), PassTiming::Untimed), &params, &counters);
+                stats.subdivide_invocations = dispatched(
+                    &one_submission(n, Passes::of(p.panorama, params.method), PassTiming::Untimed),
+                    &params,
+                    &counters,
+                );
                 stats.max_pieces_per_invocation = counters.max_pieces;
                 stats.max_output_per_invocation = counters.max_output;
                 stats.triangles_out = counters.triangles as u64;
@@ -141,18 +144,27 @@ impl SubdividedMethod {
         let timestamps = res.timestamps.as_ref();
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         let panorama = settings.projection().panorama;
-        // The subdivision's timed passes, and the raster's pair of queries after them.
-        let timing = PassTiming::of(true, settings.measure.pass_times);
-        let timed = timed_passes(&one_submission(params.triangle_count, Passes::of(panorama, params.method), timing));
-        let raster_query = 2 * timed.len() as u32;
-        std::thread::scope(|scope| {
+        let timing = PassTiming::of(timestamps.is_some(), settings.measure.pass_times);
+        let timed = std::thread::scope(|scope| {
             // The raster's pipelines built beside the subdivision's (building them is most of a
             // fresh process's time on a CPU driver; a built one is only looked up).
             let raster = scope.spawn(|| self.raster_pipelines(gpu, scene, settings));
-            let each_pass = settings.measure.pass_times;
-            self.subdivide.encode(gpu, &mut enc, &res.subdivide_params, scene, b, &params, panorama, timestamps, each_pass);
+            let timed = self.subdivide.encode(
+                gpu,
+                &mut enc,
+                &res.subdivide_params,
+                scene,
+                b,
+                &params,
+                panorama,
+                timestamps,
+                timing,
+            );
             raster.join().expect("building the raster's pipelines panicked");
+            timed
         });
+        // The raster's pair of queries after the subdivision's timed passes.
+        let raster_query = 2 * timed.len() as u32;
         self.encode_raster(
             gpu,
             &mut enc,

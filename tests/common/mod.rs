@@ -439,3 +439,20 @@ pub fn cave(k: usize, pixels: u32, head: glam::Vec3, yaw: f32) -> twister::Proje
         ..twister::Projection::default()
     }
 }
+
+/// The subdivision's pass times a `render --stats` record or a `bench speed` row carries
+/// (`ms_subdivide_passes`): where timestamps timed its frame, checked to be each from the end of
+/// the one before (none negative, together `ms_subdivide`) and their names returned in order;
+/// elsewhere checked absent, and None.
+pub fn subdivide_pass_names(row: &serde_json::Value) -> Option<Vec<String>> {
+    if row["timing"] != "gpu-timestamps" {
+        assert!(row["ms_subdivide_passes"].is_null(), "{row}");
+        return None;
+    }
+    let timed = row["ms_subdivide_passes"].as_array().unwrap();
+    let ms: Vec<f64> = timed.iter().map(|p| p[1].as_f64().unwrap()).collect();
+    let total = row["ms_subdivide"].as_f64().unwrap();
+    assert!(ms.iter().all(|&t| t >= 0.0), "{row}");
+    assert!((ms.iter().sum::<f64>() - total).abs() <= 1e-6 * total.max(1.0), "{row}");
+    Some(timed.iter().map(|p| p[0].as_str().unwrap().to_string()).collect())
+}

@@ -8,6 +8,7 @@
 //! against the first method, in the same run.
 
 use twister::core::settings::Method;
+use twister::encoding::subdivide::{pass_group, PASS_GROUPS};
 use twister::error::Result;
 use twister::{FrameStats, GpuScene, RenderSettings, Renderer};
 
@@ -167,17 +168,12 @@ fn median_passes(frames: &[FrameStats]) -> Option<Vec<(&'static str, f64)>> {
     Some(first.iter().zip(times).map(|(&(label, _), v)| (label, median(v))).collect())
 }
 
-/// The subdivision's time in three groups (`plan` with `active_cuts` and `ring_cuts`;
-/// `plan_cuts` with `plan_parts`; `lattice` with the rows' and the work items' passes).
+/// The subdivision's time in its three groups (`encoding::subdivide::PASS_GROUPS`), from the
+/// passes timed apart or in the groups.
 fn pass_groups(passes: &[(&'static str, f64)]) -> [f64; 3] {
     let mut groups = [0.0; 3];
     for &(label, ms) in passes {
-        let group = match label {
-            "active_cuts" | "ring_cuts" | "plan" => 0,
-            "plan_cuts" | "plan_parts" => 1,
-            _ => 2,
-        };
-        groups[group] += ms;
+        groups[PASS_GROUPS.iter().position(|&g| g == pass_group(label)).expect("a group")] += ms;
     }
     groups
 }

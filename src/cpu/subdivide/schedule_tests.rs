@@ -6,7 +6,9 @@ use crate::core::projection::Projection;
 use crate::core::settings::{Method, RenderSettings, Split};
 use crate::encoding::constants::PIECES_FROM_COUNTER;
 use crate::encoding::schedule::{Capacities, SubdivisionEngine};
-use crate::encoding::subdivide::{cut_probe, dispatched, missed, one_submission, subdivide_params, PassTiming, Passes, CUT_PASSES};
+use crate::encoding::subdivide::{
+    cut_probe, dispatched, missed, one_submission, subdivide_params, PassTiming, Passes, CUT_PASSES,
+};
 
 #[test]
 fn the_cut_probe_lists_the_triangles_the_frame_cuts() {
