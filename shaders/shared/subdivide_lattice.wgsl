@@ -444,10 +444,10 @@ fn piece_corners(piece: Piece, part: ptr<function, PartPlan>, piece_state: ptr<f
     }
     // Each corner (`macro_node` in src/cpu/subdivide/piece.rs) a part's corner as it is, then
     // the nodes on an edge, then the interior ones, each placed in a loop over the corners that
-    // are one. A group of lavapipe's lanes runs every branch for every lane, and a loop's body as
-    // often as its busiest lane needs (once when none does); most pieces are a whole part, whose
-    // corners are the part's own: a group of them places one edge point and one interior node
-    // (four spaced points), where each corner placing both took twelve.
+    // are one. A group of lavapipe's lanes runs a branch for every lane when any of them takes
+    // it, and a loop's body as often as its busiest lane needs (once when none does); most pieces
+    // are a whole part, whose corners are the part's own: a group of them places one edge point
+    // and one interior node (four spaced points), where each corner placing both took twelve.
     var on_edge = vec3<u32>(0u);
     var edge_count = 0u;
     var inside = vec3<u32>(0u);

@@ -128,8 +128,8 @@ fn load_work(index: u32, work: PieceWork, part: ptr<function, PartPlan>, piece_s
 // A piece that is one lattice triangle (most of a scene's pieces) has its corners for nodes
 // (slot k is corner k, the bits `piece_node` gives them): they come from a loop of their own, and
 // the general loop runs no step for it. A group of lavapipe's lanes runs a loop's body as often
-// as its busiest lane (and once when none is), every branch of the body for every lane: a group
-// of single triangles runs `piece_node` once rather than three times. Rows are stepped through
+// as its busiest lane (and once when none is), a branch of the body for every lane when any
+// takes it: a group of single triangles runs `piece_node` once rather than three times. Rows are stepped through
 // in their own order (`rows_along`: each row's ends first, which its other nodes lie between),
 // until no step is left that writes a slot of the item's (`rows_bound`); an end outside the
 // item is placed and not written.

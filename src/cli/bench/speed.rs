@@ -183,11 +183,10 @@ fn pass_groups(passes: &[(&'static str, f64)]) -> [f64; 3] {
 /// pass's with the pass it sets up), the largest output of one invocation, and its share of the
 /// frame.
 pub fn balance_table(rows: &[SpeedRow], each_pass: bool) -> String {
-    let mut s = String::from(if each_pass {
-        "| scene | method | invocations per pass (ms) | max pieces / invocation | max nodes or triangles / invocation | subdivision's share |\n|---|---|---|---|---|---|\n"
-    } else {
-        "| scene | method | invocations per pass | max pieces / invocation | max nodes or triangles / invocation | subdivision's share |\n|---|---|---|---|---|---|\n"
-    });
+    let mut s = format!(
+        "| scene | method | invocations per pass{} | max pieces / invocation | max nodes or triangles / invocation | subdivision's share |\n|---|---|---|---|---|---|\n",
+        if each_pass { " (ms)" } else { "" }
+    );
     for r in rows.iter().filter(|r| !r.subdivide_invocations.is_empty()) {
         let times = r.ms_subdivide_passes.iter().flatten().filter(|_| each_pass);
         let ms = |entry: &str| times.clone().find(|(label, _)| *label == entry).map(|p| p.1);
