@@ -682,10 +682,13 @@ fn both_eyes_in_one_multiview_draw_match_a_pass_per_eye() {
     // The raster stage can draw both eyes from one multiview draw (`TWISTER_MULTIVIEW=on`; the
     // default on hardware GPUs) or a pass per eye (`off`; the default on software adapters).
     // Both must draw the same: colours and distances (the error pass's fragment path, which
-    // reads the eye's parameters). Lavapipe's multiview has a race (a few pixels near triangle
-    // edges differ from run to run when the machine is busy, measured up to 0.6 %), so up to
-    // 2 % of the pixels may differ here; mixing the eyes' parameters up would change nearly
-    // every pixel (the eyes are apart by the disparity, and every distance changes).
+    // reads the eye's parameters). Lavapipe's multiview mixes the views up at some pixels near
+    // triangle edges, differently from run to run (a pixel of the left image showing exactly the
+    // right eye's distance there: a vertex shaded for one view drawn in the other), measured up
+    // to 0.6 % of the pixels, and 2.0–2.8 % on AlphaBlendModeTest once the subdivision skipped
+    // its back faces (0 with its default, a pass per eye); so up to 5 % may differ on lavapipe
+    // and 2 % elsewhere. Mixing the eyes' parameters up in twister would change nearly every
+    // pixel (the eyes are apart by the disparity, and every distance changes).
     let duck = common::asset("gltf/Duck/glTF-Binary/Duck.glb");
     let alpha = common::asset("gltf/AlphaBlendModeTest/glTF-Binary/AlphaBlendModeTest.glb");
     let cases: Vec<(String, Vec<&str>)> = vec![
@@ -737,9 +740,10 @@ fn both_eyes_in_one_multiview_draw_match_a_pass_per_eye() {
         }
         let differing = |a: &[[f32; 4]], b: &[[f32; 4]]| a.iter().zip(b).filter(|(p, q)| p != q).count();
         let names = ["left.png", "right.png", "left_depth.exr", "right_depth.exr"];
+        let share = if adapter.contains("llvmpipe") { 20 } else { 50 };
         for (f, (a, b)) in names.iter().zip(both.iter().zip(&per_eye)) {
             let bad = differing(a, b);
-            assert!(bad * 50 <= a.len(), "{scene} {extra:?}: {f}: {bad} of {} pixels differ", a.len());
+            assert!(bad * share <= a.len(), "{scene} {extra:?}: {f}: {bad} of {} pixels differ", a.len());
         }
         // The two eyes differ (each view drew its own eye) by far more than that.
         let apart = differing(&both[2], &both[3]);

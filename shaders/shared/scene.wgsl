@@ -9,7 +9,7 @@ struct SceneVertex {
     color: vec4<f32>,
     uv: vec2<f32>,
     tangent: u32,   // glTF's TANGENT, packed (`pack_tangent`); 0: none
-    _pad1: f32,
+    flags: u32,     // SINGLE_SIDED: its material draws no back faces (`Scene::mark_sides`)
 }
 
 // A tangent and its bitangent sign (unit xyz, w = ±1) in 32 bits: octahedral coordinates in 15

@@ -226,6 +226,18 @@ fn off_screen_vertically(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> bool {
     return all(y > k * r) || all(y < -k * r) || around_dome_antipode(p0, p1, p2);
 }
 
+// Whether input triangle t is single-sided and every eye sees its back, so that it is drawn
+// nowhere (`Subdivider::faces_away`): with n its front's normal (counter-clockwise corners) and
+// p0 a corner in the viewer frame, n·(E − p0) < 0 for every eye point E, all within d_e of the
+// viewer in the horizontal plane (the CAVE's and a tracked head's eyes are not: never there).
+fn faces_away(t: u32, p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> bool {
+    if ((vertices[indices[3u * t]].flags & SINGLE_SIDED) == 0u || is_cave(params.projection) || params.projection.head_on != 0.0) {
+        return false;
+    }
+    let n = cross(p1 - p0, p2 - p0);
+    return dot(n, p0) > params.projection.eye_radius * length(n.xz) + BACK_FACE_MARGIN * length(n) * length(p0);
+}
+
 // Whether a triangle lies wholly in the cone around the point opposite the fisheye's axis
 // (`Projection::around_dome_antipode`): there the image folds onto a ring.
 fn around_dome_antipode(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> bool {

@@ -1,4 +1,5 @@
-// The `plan` pass of the `subdivide` stage: one invocation per input triangle. A triangle that is
+// The `plan` pass of the `subdivide` stage: one invocation per input triangle. A triangle above
+// or below the image, or single-sided and seen from behind by every eye, makes nothing. One that is
 // its own single part (no cuts this frame; neither asks nor has an edge of one that does, nor an
 // edge of a cut one; or inside one quadrant and one band) is planned here: its edge counts N
 // (eq. 5 or the error split), the macro-lattice level K = ceil(M / N_max) and K² piece records.
@@ -32,7 +33,8 @@ fn plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     let t = params.first_triangle + local;
     cuts = vec2<u32>(atomicLoad(&counters.cuts_low), atomicLoad(&counters.cuts_high));
     load_triangle(t, &tri);
-    if (off_screen_vertically(tri.position[0], tri.position[1], tri.position[2])) {
+    if (off_screen_vertically(tri.position[0], tri.position[1], tri.position[2])
+        || faces_away(t, tri.position[0], tri.position[1], tri.position[2])) {
         return; // no pieces
     }
     // Cut by all of the frame's cuts (decided only when there are any; the marks first).

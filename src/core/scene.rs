@@ -23,8 +23,13 @@ pub struct SceneVertex {
     /// The glTF tangent (xyz, bitangent sign w), packed by [`pack_tangent`]; 0: none (the
     /// normal map's frame then comes from the texture coordinates' derivatives).
     pub tangent: u32,
-    pub _pad1: f32,
+    /// [`SINGLE_SIDED`]: the vertex's material draws no back faces ([`Scene::mark_sides`]).
+    pub flags: u32,
 }
+
+/// `SceneVertex::flags`: the material is single-sided (glTF's `doubleSided: false`), so a
+/// triangle every eye sees from behind is drawn nowhere and the subdivision skips it.
+pub const SINGLE_SIDED: u32 = 1;
 
 /// Where the packed tangent's sign and presence bits are.
 const TANGENT_NEGATIVE: u32 = 1 << 30;
@@ -171,6 +176,18 @@ impl Scene {
             self.vertices[i as usize].object = object;
         }
         self.objects.push(Object { name, first_triangle, triangle_count });
+    }
+
+    /// Sets each vertex's [`SINGLE_SIDED`] flag from its material as the drawing stages look it
+    /// up (index 0 the default material, an index past the last the last one): set, the
+    /// subdivision skips the triangles every eye sees from behind, which are drawn nowhere.
+    pub fn mark_sides(&mut self) {
+        let single: Vec<bool> =
+            std::iter::once(false).chain(self.materials.iter().map(|m| m.double_sided == 0)).collect();
+        for v in &mut self.vertices {
+            let one_sided = single[(v.material as usize).min(single.len() - 1)];
+            v.flags = if one_sided { v.flags | SINGLE_SIDED } else { v.flags & !SINGLE_SIDED };
+        }
     }
 
     /// Checks what the GPU stages rely on: whole triangles, indices in range, finite values.

@@ -36,6 +36,9 @@ pub const BAND_RATIO: f32 = std::f32::consts::SQRT_2;
 /// Signed distances within this fraction of their terms' magnitude count as on the clip line,
 /// so that the CPU and the GPU (whose rounding differs in the last bits) take the same side.
 pub const SNAP: f32 = 1e-6;
+/// A single-sided triangle is skipped when every eye sees its back by more than this fraction
+/// of |n|·|P| (n its normal, P a corner), so that the CPU and the GPU agree.
+pub const BACK_FACE_MARGIN: f32 = 1e-4;
 /// An edge is split by the larger of its projected length and `EDGE_SAMPLES` × its longest
 /// sampled segment / this (1 within 2·d_e of the axis in the paper model): equal parts stay short enough where the
 /// projection stretches an edge unevenly, e.g. v ∝ 1/r (see `Subdivider::edge_profile`).
@@ -155,6 +158,8 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("PLAN_CUTS_SPLIT", U32(PLAN_CUTS_SPLIT)),
         ("BAND_RATIO", F32(BAND_RATIO)),
         ("SNAP", F32(SNAP)),
+        ("BACK_FACE_MARGIN", F32(BACK_FACE_MARGIN)),
+        ("SINGLE_SIDED", U32(crate::core::scene::SINGLE_SIDED)),
         ("MAX_STRETCH", F32(MAX_STRETCH)),
         ("AZIMUTH_MIN_RADIUS", F32(AZIMUTH_MIN_RADIUS)),
         ("CUBE_MIN_W", F32(CUBE_MIN_W)),

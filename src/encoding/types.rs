@@ -531,7 +531,7 @@ pub const NO_SKIN: u32 = u32::MAX;
 
 /// Every struct the stages bind (as a uniform or in a storage buffer), by its WGSL name.
 pub const LAYOUTS: &[StructLayout] = &[
-    layout!("SceneVertex" => SceneVertex { position, material, normal, object, color, uv, tangent, _pad1 }),
+    layout!("SceneVertex" => SceneVertex { position, material, normal, object, color, uv, tangent, flags }),
     layout!("DrawVertex" => DrawVertex { position, theta_ref, normal, material, color, uv, object, tangent }),
     layout!("Projection" => ProjectionUniform {
         screen_radius, eye_radius, width, height, acos_eye_screen, vertical_exact, pixels_per_v, panorama,

@@ -456,3 +456,49 @@ pub fn subdivide_pass_names(row: &serde_json::Value) -> Option<Vec<String>> {
     assert!((ms.iter().sum::<f64>() - total).abs() <= 1e-6 * total.max(1.0), "{row}");
     Some(timed.iter().map(|p| p[0].as_str().unwrap().to_string()).collect())
 }
+
+/// Random triangles: a mix of small ones anywhere, big ones around the viewer, and ones near the
+/// axis, each its own object and material index (past the scene's materials: the default).
+pub fn random_triangles(seed: u64, n: usize) -> Scene {
+    use glam::Vec3;
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+    let mut scene = Scene::new("random");
+    for k in 0..n {
+        // Mix of small triangles anywhere, big ones around the viewer, and ones near the axis.
+        let scale = [0.3f32, 6.0, 1.0][k % 3];
+        let center = match k % 3 {
+            2 => Vec3::new(rng.random_range(-0.05..0.05), rng.random_range(-2.0..2.0), rng.random_range(-0.05..0.05)),
+            _ => Vec3::new(rng.random_range(-8.0..8.0), rng.random_range(-3.0..3.0), rng.random_range(-8.0..8.0)),
+        };
+        let v: Vec<twister::core::scene::SceneVertex> = (0..3)
+            .map(|i| twister::core::scene::SceneVertex {
+                position: (center
+                    + scale
+                        * Vec3::new(
+                            rng.random_range(-1.0..1.0),
+                            rng.random_range(-1.0..1.0),
+                            rng.random_range(-1.0..1.0),
+                        ))
+                .into(),
+                normal: [rng.random_range(-1.0..1.0), 1.0, 0.0],
+                color: [rng.random(), rng.random(), rng.random(), 1.0],
+                uv: [i as f32, rng.random()],
+                material: k as u32,
+                ..Default::default()
+            })
+            .collect();
+        scene.add_mesh("t", &v, &[0, 1, 2]);
+    }
+    scene
+}
+
+/// The same triangles, every one single-sided: those every eye sees from behind are skipped.
+pub fn single_sided(mut scene: Scene) -> Scene {
+    scene.materials.push(twister::core::material::Material { double_sided: 0, ..Default::default() });
+    for v in &mut scene.vertices {
+        v.material = 1;
+    }
+    scene.mark_sides();
+    scene
+}

@@ -3,7 +3,6 @@
 //! random triangles, built-in rooms and spheres, both panoramas and every split rule.
 
 use glam::Vec3;
-use rand::{Rng, SeedableRng};
 use twister::core::builtin;
 use twister::core::settings::{Method, Split};
 use twister::cpu::subdivide::passes::run_scheduled;
@@ -15,39 +14,6 @@ use twister::{GpuScene, Projection, RenderSettings, Renderer, Scene, Vertical};
 use super::{common, same_triangle_sets, Twin};
 
 pub struct Subdivide;
-
-/// A mix of small triangles anywhere, big ones around the viewer, and ones near the axis.
-fn random_triangle_scene(seed: u64, n: usize) -> Scene {
-    let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
-    let mut scene = Scene::new("random");
-    for k in 0..n {
-        // Mix of small triangles anywhere, big ones around the viewer, and ones near the axis.
-        let scale = [0.3f32, 6.0, 1.0][k % 3];
-        let center = match k % 3 {
-            2 => Vec3::new(rng.random_range(-0.05..0.05), rng.random_range(-2.0..2.0), rng.random_range(-0.05..0.05)),
-            _ => Vec3::new(rng.random_range(-8.0..8.0), rng.random_range(-3.0..3.0), rng.random_range(-8.0..8.0)),
-        };
-        let v: Vec<twister::core::scene::SceneVertex> = (0..3)
-            .map(|i| twister::core::scene::SceneVertex {
-                position: (center
-                    + scale
-                        * Vec3::new(
-                            rng.random_range(-1.0..1.0),
-                            rng.random_range(-1.0..1.0),
-                            rng.random_range(-1.0..1.0),
-                        ))
-                .into(),
-                normal: [rng.random_range(-1.0..1.0), 1.0, 0.0],
-                color: [rng.random(), rng.random(), rng.random(), 1.0],
-                uv: [i as f32, rng.random()],
-                material: k as u32,
-                ..Default::default()
-            })
-            .collect();
-        scene.add_mesh("t", &v, &[0, 1, 2]);
-    }
-    scene
-}
 
 /// The subdivide twin's scenes and settings: random triangles with every split rule, rooms and
 /// spheres around the viewer, tall images, both vertical models, the full sphere.
@@ -64,11 +30,14 @@ fn subdivide_cases() -> Vec<(Scene, RenderSettings)> {
     let small = RenderSettings::new(Projection { width: 64, height: 96, ..tall_projection });
     let tall_exact = RenderSettings::new(Projection { vertical: Vertical::Exact, ..tall_projection });
     vec![
-        (random_triangle_scene(3, 600), base.with_method(Method::Vertex)),
-        (random_triangle_scene(4, 300), base),
+        (common::random_triangles(3, 600), base.with_method(Method::Vertex)),
+        (common::random_triangles(4, 300), base),
+        // Single-sided triangles, half of them seen from behind (skipped by `plan`).
+        (common::single_sided(common::random_triangles(13, 300)), base),
+        (common::single_sided(common::random_triangles(14, 200)), RenderSettings::new(Projection::equirect(256))),
         // glTF tangents, interpolated and packed again.
-        (common::with_tangents(random_triangle_scene(8, 200)), moved),
-        (random_triangle_scene(5, 200), base.with_method(Method::Fixed(5))),
+        (common::with_tangents(common::random_triangles(8, 200)), moved),
+        (common::random_triangles(5, 200), base.with_method(Method::Fixed(5))),
         (builtin::demo(), base),
         (builtin::demo(), moved.with_projection(tall_projection).with_method(Method::Vertex)),
         (builtin::demo(), moved.with_method(Method::Adaptive(Split::Length)).with_edge_px(12.0).with_max_div(4)),
@@ -79,7 +48,7 @@ fn subdivide_cases() -> Vec<(Scene, RenderSettings)> {
         (builtin::sphere_scene(1024, Vec3::ZERO, 2.5, "sphere around the viewer"), base.with_max_error_px(0.2)),
         // fixed:N beyond 32 divisions: pre-split into pieces (one invocation used to stop short).
         (builtin::builtin_scene("builtin:triangle@3", &projection).unwrap(), base.with_method(Method::Fixed(64))),
-        (random_triangle_scene(6, 12), base.with_method(Method::Fixed(45))),
+        (common::random_triangles(6, 12), base.with_method(Method::Fixed(45))),
         // Surround scenes: quadrant and band cuts, the square around the axis, tall images,
         // both vertical models, a part beyond 32 × N_max divisions (K capped).
         (box_room.clone(), base),
@@ -109,7 +78,10 @@ fn subdivide_cases() -> Vec<(Scene, RenderSettings)> {
             RenderSettings::new(Projection { convergence: Some(2.0), ..Projection::equirect(192) })
                 .with_measure_edges(true),
         ),
-        (random_triangle_scene(7, 200), RenderSettings::new(Projection::equirect(256)).with_method(Method::Fixed(3))),
+        (
+            common::random_triangles(7, 200),
+            RenderSettings::new(Projection::equirect(256)).with_method(Method::Fixed(3)),
+        ),
         // VR180: the sphere's front half (the back's pieces, beyond the image's sides, are not
         // drawn; nor the triangles of the pieces reaching round them).
         (builtin::demo(), RenderSettings::new(Projection::vr180(256))),
@@ -130,11 +102,11 @@ fn subdivide_cases() -> Vec<(Scene, RenderSettings)> {
         (builtin::demo(), RenderSettings::new(Projection { fov: 240.0, dome_tilt: 20.0, ..Projection::fisheye(128) })),
         // Rows (the sphere, adaptive rules): random triangles, the box room (long thin parts in
         // bands), eq. 5, a viewer off the axis.
-        (random_triangle_scene(9, 200), RenderSettings::new(Projection::equirect(320))),
+        (common::random_triangles(9, 200), RenderSettings::new(Projection::equirect(320))),
         // Rows pieces larger than a node item, near the seam (two copies: items of 32 nodes):
         // seed 9's items start at rows' right ends, seed 12's between a row's nodes
         // (`rows_along` places the row's ends first and writes only the item's slots).
-        (random_triangle_scene(12, 200), RenderSettings::new(Projection::equirect(256))),
+        (common::random_triangles(12, 200), RenderSettings::new(Projection::equirect(256))),
         (
             builtin::builtin_scene("builtin:box-room", &projection).unwrap(),
             RenderSettings::new(Projection::equirect(256)),

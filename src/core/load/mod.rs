@@ -45,6 +45,7 @@ pub fn load_scene(spec: &str, projection: &Projection) -> Result<Scene> {
         }
     };
     scene.validate()?;
+    scene.mark_sides();
     // Tangents for normal maps where the file gives none (a moving scene keeps the
     // derivatives' frame: its rig poses only the file's tangents).
     if scene.rig.is_none() {

@@ -8,11 +8,11 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 use super::spacing::Spacing;
 use super::{snap_to_cut_planes, Node, PartSplit, Subdivider, Triangle};
 use crate::core::projection::{azimuth, horizontal_radius, Eye, PanoramaKind, Vertical};
-use crate::core::scene::{unpack_tangent, SceneVertex};
+use crate::core::scene::{unpack_tangent, SceneVertex, SINGLE_SIDED};
 use crate::core::settings::SplitRule;
 use crate::encoding::constants::{
-    AZIMUTH_CHORD_RESIDUAL, AZIMUTH_RESIDUAL_ERROR, EDGE_SAMPLES, ERROR_SPLIT_LENGTH, MAX_EDGE_DIVISIONS,
-    MAX_MACRO_LEVEL, MAX_STRETCH, PIECE_DIVISIONS, ROW_DIAGONAL_ERROR,
+    AZIMUTH_CHORD_RESIDUAL, AZIMUTH_RESIDUAL_ERROR, BACK_FACE_MARGIN, EDGE_SAMPLES, ERROR_SPLIT_LENGTH,
+    MAX_EDGE_DIVISIONS, MAX_MACRO_LEVEL, MAX_STRETCH, PIECE_DIVISIONS, ROW_DIAGONAL_ERROR,
 };
 
 pub(super) fn lex_less(a: Vec3, b: Vec3) -> bool {
@@ -335,6 +335,25 @@ impl Subdivider<'_> {
         let above = p.iter().all(|q| q.y > k * horizontal_radius(*q));
         let below = p.iter().all(|q| q.y < -k * horizontal_radius(*q));
         above || below || self.projection.around_dome_antipode(p)
+    }
+
+    /// Whether input triangle `t` (corners `p` in the viewer frame) is single-sided and every
+    /// eye sees its back, so that no stage draws it (the raster culls it, or the fragment stage
+    /// discards it: both by its winding on the screen) and the subdivision skips it. With n its
+    /// front's normal (counter-clockwise corners), n·(E − p₀) < 0 for every eye point E, which
+    /// lie within d_e of the viewer in the horizontal plane on the cylinder and the sphere's
+    /// panoramas; by a margin (`BACK_FACE_MARGIN`) so that the GPU agrees. The CAVE's and a
+    /// tracked head's eyes are elsewhere: never there. `faces_away` in the WGSL.
+    pub fn faces_away(&self, vertices: &[SceneVertex], indices: &[u32], t: usize, p: [Vec3; 3]) -> bool {
+        let proj = &self.projection;
+        if vertices[indices[3 * t] as usize].flags & SINGLE_SIDED == 0
+            || proj.panorama == PanoramaKind::Cave
+            || proj.head.is_some()
+        {
+            return false;
+        }
+        let n = (p[1] - p[0]).cross(p[2] - p[0]);
+        n.dot(p[0]) > proj.eye_radius * Vec2::new(n.x, n.z).length() + BACK_FACE_MARGIN * n.length() * p[0].length()
     }
 
     /// `plan`: the macro-lattice level K of a part (K² pieces) and its edge counts.

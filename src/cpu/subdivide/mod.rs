@@ -181,6 +181,9 @@ impl<'a> Subdivider<'a> {
         let first = self.params.first_triangle as usize;
         for t in first..first + self.params.triangle_count as usize {
             let tri = self.load(vertices, indices, t);
+            if self.faces_away(vertices, indices, t, tri.position) {
+                continue; // drawn nowhere
+            }
             for poly in self.triangle_polygons(&tri, t, frame, &mut out.edge_splits) {
                 for part in fan(&poly) {
                     // A part (a band of a floor under the viewer) wholly beyond the image's rows

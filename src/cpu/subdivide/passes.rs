@@ -233,7 +233,7 @@ impl<'s> CpuSubdivision<'s> {
         }
         let t = (params.first_triangle + local) as usize;
         let tri = sub.load(self.scene.0, self.scene.1, t);
-        if sub.off_screen_vertically(tri.position) {
+        if sub.off_screen_vertically(tri.position) || sub.faces_away(self.scene.0, self.scene.1, t, tri.position) {
             return;
         }
         let cuts = self.counters.cuts();
