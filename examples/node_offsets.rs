@@ -19,19 +19,26 @@
 //! - `local`: what a piece could compute for itself with every copy of a node agreeing: a node
 //!   no other piece has takes half its largest incident e; a node on an edge two pieces share,
 //!   half the largest e of its shared edges (the same edges in both pieces); a corner (an input
-//!   vertex, or a position three or more pieces share) none.
+//!   vertex, or a position three or more pieces share) none;
+//! - `lines`: one offset per straight line the pieces' boundaries lie on (an input edge, a cut
+//!   line, a macro line: half the largest e of its segments, as an edge's profile could give
+//!   it), taken by every node inside the line (its ends and the input corners none); a node on no
+//!   such line, half the largest e of its piece's edges.
 //!
 //! `cargo run --release --example node_offsets -- SCENE X,Y,Z 'TAU:RULE;TAU:RULE…'`, e.g.
-//! `… -- builtin:demo 0,0,0 '0.4:none;0.7:local'`.
+//! `… -- builtin:demo 0,0,0 '0.4:none;0.7:lines'`.
 
 use std::collections::{HashMap, HashSet};
 
-use glam::{DVec2, Vec3};
+use glam::{DVec2, DVec3, Vec3};
 use twister::core::load::load_scene;
 use twister::core::projection::{azimuth, horizontal_radius, Eye, Projection};
 use twister::core::settings::{Method, RenderSettings, Split};
 use twister::cpu::subdivide::subdivide;
 use twister::encoding::subdivide::subdivide_params;
+use twister::encoding::types::DrawVertex;
+
+type Error = Box<dyn std::error::Error>;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Rule {
@@ -39,9 +46,8 @@ enum Rule {
     Max,
     NoCorners,
     Local,
+    Lines,
 }
-
-type Error = Box<dyn std::error::Error>;
 
 fn parse_configs(arg: &str) -> Result<Vec<(f32, Rule)>, Error> {
     arg.split(';')
@@ -52,124 +58,267 @@ fn parse_configs(arg: &str) -> Result<Vec<(f32, Rule)>, Error> {
                 "max" => Rule::Max,
                 "nocorners" => Rule::NoCorners,
                 "local" => Rule::Local,
-                _ => return Err(format!("'{r}': the rules are none, max, nocorners, local").into()),
+                "lines" => Rule::Lines,
+                _ => return Err(format!("'{r}': the rules are none, max, nocorners, local, lines").into()),
             };
             Ok((t.parse::<f32>().map_err(|e| format!("τ '{t}': {e}"))?, rule))
         })
         .collect()
 }
 
-fn main() -> Result<(), Error> {
-    let args: Vec<String> = std::env::args().collect();
-    if args.len() != 4 {
-        return Err("usage: node_offsets SCENE X,Y,Z 'TAU:RULE;…' (RULE: none, max, nocorners, local)".into());
-    }
-    let v: Vec<f32> = args[2].split(',').map(str::parse).collect::<Result<_, _>>()?;
-    let [x, y, z] = v[..] else { return Err("the viewer is X,Y,Z".into()) };
-    let projection = Projection::equirect(4096);
-    let scene = load_scene(&args[1], &projection)?;
-    let base = RenderSettings::new(projection)
-        .with_method(Method::Adaptive(Split::Error))
-        .with_viewer(Vec3::new(x, y, z));
-    let view = base.view();
-    let corner_key = |p: Vec3| [(p.x * 1e4).round() as i64, (p.y * 1e4).round() as i64, (p.z * 1e4).round() as i64];
-    let corners: HashSet<[i64; 3]> =
-        scene.vertices.iter().map(|v| corner_key(view.transform_point3(Vec3::from(v.position)))).collect();
-    let (w_px, h_px) = (projection.width as f64, projection.height as f64);
-    let (ppr, ppv) = (projection.pixels_per_radian() as f64, projection.pixels_per_v() as f64);
-    // Image position of a point, its azimuth unwrapped towards `theta_ref` as the vertex stage does.
-    let pixel = |p: Vec3, theta_ref: f32| -> DVec2 {
+/// The right eye's image of the sphere, as the vertex stage places points.
+struct Image {
+    projection: Projection,
+    size: DVec2,
+}
+
+impl Image {
+    /// Image position of a point, its azimuth unwrapped towards `theta_ref`.
+    fn pixel(&self, p: Vec3, theta_ref: f32) -> DVec2 {
         let turn = std::f32::consts::TAU;
         let th0 = azimuth(p);
-        let q = projection.project_with_azimuth(p, th0 + turn * ((theta_ref - th0) / turn + 0.5).floor(), Eye::Right);
-        DVec2::new(q.u as f64 * ppr + 0.5 * w_px, 0.5 * h_px - q.v as f64 * ppv)
-    };
-    for (tau, rule) in parse_configs(&args[3])? {
-        let settings = base.with_max_error_px(tau);
-        let params = subdivide_params(&settings, 0, scene.triangle_count() as u32);
-        let out = subdivide(&params, &scene.vertices, &scene.indices);
-        let n = out.nodes.len();
-        let pos: Vec<Vec3> = out.nodes.iter().map(|v| Vec3::from(v.position)).collect();
-        let q: Vec<DVec2> = (0..n).map(|i| pixel(pos[i], out.nodes[i].theta_ref)).collect();
-        let w: Vec<f64> = pos.iter().map(|&p| (horizontal_radius(p) as f64).max(1e-4)).collect();
-        let tris: Vec<[usize; 3]> =
-            out.indices.chunks(3).map(|t| [t[0] as usize, t[1] as usize, t[2] as usize]).collect();
-        // Nodes by position (a seam copy, a turn away, apart): every piece has its own copies.
+        let q = self.projection.project_with_azimuth(p, th0 + turn * ((theta_ref - th0) / turn + 0.5).floor(), Eye::Right);
+        DVec2::new(
+            q.u as f64 * self.projection.pixels_per_radian() as f64 + 0.5 * self.size.x,
+            0.5 * self.size.y - q.v as f64 * self.projection.pixels_per_v() as f64,
+        )
+    }
+}
+
+/// The twin's output with what the rules read: positions, image points, clip w = r, triangles,
+/// nodes grouped by position (every piece has its own copies; a seam copy is its own group), and
+/// every triangle edge's midpoint error.
+struct Mesh<'a> {
+    nodes: &'a [DrawVertex],
+    pos: Vec<Vec3>,
+    q: Vec<DVec2>,
+    w: Vec<f64>,
+    tris: Vec<[usize; 3]>,
+    group: Vec<usize>,
+    copies: Vec<u32>,
+    /// (a, b, e(a, b)) for every triangle edge.
+    edges: Vec<(usize, usize, DVec2)>,
+}
+
+impl<'a> Mesh<'a> {
+    fn new(image: &Image, nodes: &'a [DrawVertex], indices: &[u32]) -> Self {
+        let pos: Vec<Vec3> = nodes.iter().map(|v| Vec3::from(v.position)).collect();
+        let q = pos.iter().zip(nodes).map(|(&p, v)| image.pixel(p, v.theta_ref)).collect();
+        let w = pos.iter().map(|&p| (horizontal_radius(p) as f64).max(1e-4)).collect();
+        let tris: Vec<[usize; 3]> = indices.chunks(3).map(|t| [t[0] as usize, t[1] as usize, t[2] as usize]).collect();
         let mut groups = HashMap::new();
-        let group: Vec<usize> = (0..n)
-            .map(|i| {
-                let key = (pos[i].to_array().map(f32::to_bits), (out.nodes[i].theta_ref / 3.0).round() as i32);
+        let group: Vec<usize> = pos
+            .iter()
+            .zip(nodes)
+            .map(|(p, v)| {
                 let next = groups.len();
-                *groups.entry(key).or_insert(next)
+                *groups.entry((p.to_array().map(f32::to_bits), (v.theta_ref / 3.0).round() as i32)).or_insert(next)
             })
             .collect();
         let mut copies = vec![0u32; groups.len()];
         for &g in &group {
             copies[g] += 1;
         }
-        // An edge two pieces share appears with two different pairs of node copies.
-        let edge = |a: usize, b: usize| (group[a].min(group[b]), group[a].max(group[b]));
-        let mut pairs: HashMap<(usize, usize), HashSet<(usize, usize)>> = HashMap::new();
-        for t in &tris {
-            for e in 0..3 {
-                let (a, b) = (t[e], t[(e + 1) % 3]);
-                pairs.entry(edge(a, b)).or_default().insert((a.min(b), a.max(b)));
-            }
-        }
-        let (mut widest, mut local) = (vec![DVec2::ZERO; groups.len()], vec![DVec2::ZERO; n]);
-        for t in &tris {
-            for e in 0..3 {
-                let (a, b) = (t[e], t[(e + 1) % 3]);
-                let mid = (pos[a].as_dvec3() / w[a] + pos[b].as_dvec3() / w[b]) / (1.0 / w[a] + 1.0 / w[b]);
-                let err = pixel(mid.as_vec3(), out.nodes[a].theta_ref) - 0.5 * (q[a] + q[b]);
-                let shared = pairs[&edge(a, b)].len() >= 2;
-                for k in [a, b] {
-                    if err.length() > widest[group[k]].length() {
-                        widest[group[k]] = err;
-                    }
-                    if (copies[group[k]] == 1 || shared) && err.length() > local[k].length() {
-                        local[k] = err;
-                    }
-                }
-            }
-        }
-        let offset: Vec<DVec2> = (0..n)
-            .map(|i| {
-                let corner = corners.contains(&corner_key(pos[i]));
-                0.5 * match rule {
-                    Rule::None => DVec2::ZERO,
-                    Rule::Max => widest[group[i]],
-                    Rule::NoCorners if corner => DVec2::ZERO,
-                    Rule::NoCorners => widest[group[i]],
-                    Rule::Local if corner || copies[group[i]] >= 3 => DVec2::ZERO,
-                    Rule::Local => local[i],
-                }
-            })
+        let mut mesh = Mesh { nodes, pos, q, w, tris, group, copies, edges: Vec::new() };
+        mesh.edges = mesh
+            .tris
+            .iter()
+            .flat_map(|t| (0..3).map(move |e| (t[e], t[(e + 1) % 3])))
+            .map(|(a, b)| (a, b, mesh.midpoint_error(image, a, b)))
             .collect();
-        let mut errors = Vec::new();
-        for t in &tris {
-            let d = t.map(|i| q[i] + offset[i]);
-            let area2 = (d[1] - d[0]).perp_dot(d[2] - d[0]);
-            if area2.abs() < 1e-12 {
-                continue;
+        mesh
+    }
+
+    /// e(a, b): the point the drawing (w = r) puts at the screen midpoint of a–b, projected,
+    /// against that midpoint.
+    fn midpoint_error(&self, image: &Image, a: usize, b: usize) -> DVec2 {
+        let (wa, wb) = (self.w[a], self.w[b]);
+        let mid = (self.pos[a].as_dvec3() / wa + self.pos[b].as_dvec3() / wb) / (1.0 / wa + 1.0 / wb);
+        image.pixel(mid.as_vec3(), self.nodes[a].theta_ref) - 0.5 * (self.q[a] + self.q[b])
+    }
+
+    /// An edge by its positions (the same in every piece that has it).
+    fn geometric(&self, a: usize, b: usize) -> (usize, usize) {
+        (self.group[a].min(self.group[b]), self.group[a].max(self.group[b]))
+    }
+
+    /// Whether each edge lies on its piece's boundary (its pair of node copies in one triangle).
+    fn boundary(&self) -> Vec<bool> {
+        let mut count: HashMap<(usize, usize), u32> = HashMap::new();
+        for &(a, b, _) in &self.edges {
+            *count.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+        self.edges.iter().map(|&(a, b, _)| count[&(a.min(b), a.max(b))] == 1).collect()
+    }
+
+    /// Each node's piece (triangles connected by node copies).
+    fn pieces(&self) -> Vec<usize> {
+        fn root(parent: &mut [usize], mut x: usize) -> usize {
+            while parent[x] != x {
+                parent[x] = parent[parent[x]];
+                x = parent[x];
             }
-            let lo = d[0].min(d[1]).min(d[2]).floor().max(DVec2::ZERO);
-            let hi = d[0].max(d[1]).max(d[2]).ceil().min(DVec2::new(w_px, h_px));
-            for py in lo.y as i64..hi.y as i64 {
-                for px in lo.x as i64..hi.x as i64 {
-                    let c = DVec2::new(px as f64 + 0.5, py as f64 + 0.5);
-                    let b0 = (d[1] - c).perp_dot(d[2] - c) / area2;
-                    let b1 = (d[2] - c).perp_dot(d[0] - c) / area2;
-                    let b2 = 1.0 - b0 - b1;
-                    if b0 < 0.0 || b1 < 0.0 || b2 < 0.0 {
-                        continue;
-                    }
-                    let bw = [b0 / w[t[0]], b1 / w[t[1]], b2 / w[t[2]]];
-                    let p = (0..3).map(|k| pos[t[k]].as_dvec3() * bw[k]).sum::<glam::DVec3>() / (bw[0] + bw[1] + bw[2]);
-                    errors.push((pixel(p.as_vec3(), out.nodes[t[0]].theta_ref) - c).length());
+            x
+        }
+        let mut parent: Vec<usize> = (0..self.pos.len()).collect();
+        for t in &self.tris {
+            let r0 = root(&mut parent, t[0]);
+            for &k in &t[1..] {
+                let r = root(&mut parent, k);
+                parent[r] = r0;
+            }
+        }
+        (0..self.pos.len()).map(|i| root(&mut parent, i)).collect()
+    }
+
+    /// The straight line through a and b (direction up to sign, its point nearest the origin),
+    /// quantised, and the copy's turn.
+    fn line(&self, a: usize, b: usize) -> ([i64; 3], [i64; 3], i32) {
+        let (pa, pb) = (self.pos[a].as_dvec3(), self.pos[b].as_dvec3());
+        let mut d = (pb - pa).normalize();
+        if d.x < -1e-9 || (d.x.abs() <= 1e-9 && (d.y < -1e-9 || (d.y.abs() <= 1e-9 && d.z < 0.0))) {
+            d = -d;
+        }
+        let foot = pa - d * pa.dot(d);
+        let quantise = |v: DVec3| [v.x, v.y, v.z].map(|x| (x * 2e3).round() as i64);
+        (quantise(d), quantise(foot), (self.nodes[a].theta_ref / 3.0).round() as i32)
+    }
+}
+
+/// Keeps the larger of two error vectors.
+fn widen(slot: &mut DVec2, e: DVec2) {
+    if e.length() > slot.length() {
+        *slot = e;
+    }
+}
+
+/// Each node's offset under `rule` (half the chosen error; `corner`: an input triangle's corner).
+fn offsets(mesh: &Mesh, rule: Rule, corner: &[bool]) -> Vec<DVec2> {
+    let n = mesh.pos.len();
+    let mut chosen = vec![DVec2::ZERO; n];
+    match rule {
+        Rule::None => {}
+        Rule::Max | Rule::NoCorners => {
+            let mut widest = vec![DVec2::ZERO; mesh.copies.len()];
+            for &(a, b, e) in &mesh.edges {
+                widen(&mut widest[mesh.group[a]], e);
+                widen(&mut widest[mesh.group[b]], e);
+            }
+            for i in 0..n {
+                if rule == Rule::Max || !corner[i] {
+                    chosen[i] = widest[mesh.group[i]];
                 }
             }
         }
+        Rule::Local => {
+            // A geometric edge two pieces share comes with two different pairs of node copies.
+            let mut pairs: HashMap<(usize, usize), HashSet<(usize, usize)>> = HashMap::new();
+            for &(a, b, _) in &mesh.edges {
+                pairs.entry(mesh.geometric(a, b)).or_default().insert((a.min(b), a.max(b)));
+            }
+            for &(a, b, e) in &mesh.edges {
+                let shared = pairs[&mesh.geometric(a, b)].len() >= 2;
+                for k in [a, b] {
+                    if mesh.copies[mesh.group[k]] == 1 || shared {
+                        widen(&mut chosen[k], e);
+                    }
+                }
+            }
+            for i in 0..n {
+                if corner[i] || mesh.copies[mesh.group[i]] >= 3 {
+                    chosen[i] = DVec2::ZERO;
+                }
+            }
+        }
+        Rule::Lines => {
+            let boundary = mesh.boundary();
+            let piece = mesh.pieces();
+            let (mut line_max, mut degree) = (HashMap::new(), HashMap::new());
+            let (mut piece_max, mut on_lines) = (HashMap::new(), vec![Vec::new(); n]);
+            let mut counted = HashSet::new();
+            for (&(a, b, e), &on_boundary) in mesh.edges.iter().zip(&boundary) {
+                widen(piece_max.entry(piece[a]).or_default(), e);
+                if on_boundary {
+                    let line = mesh.line(a, b);
+                    widen(line_max.entry(line).or_default(), e);
+                    if counted.insert(mesh.geometric(a, b)) {
+                        *degree.entry((line, mesh.group[a])).or_insert(0u32) += 1;
+                        *degree.entry((line, mesh.group[b])).or_insert(0u32) += 1;
+                    }
+                    on_lines[a].push(line);
+                    on_lines[b].push(line);
+                }
+            }
+            for i in 0..n {
+                if corner[i] {
+                    continue;
+                }
+                if on_lines[i].is_empty() {
+                    chosen[i] = piece_max.get(&piece[i]).copied().unwrap_or_default();
+                }
+                for line in &on_lines[i] {
+                    if degree[&(*line, mesh.group[i])] >= 2 {
+                        let e = line_max[line];
+                        widen(&mut chosen[i], e);
+                    }
+                }
+            }
+        }
+    }
+    chosen.iter().map(|&e| 0.5 * e).collect()
+}
+
+/// The error of every pixel centre each triangle covers, drawn at the offset positions.
+fn pixel_errors(image: &Image, mesh: &Mesh, offset: &[DVec2]) -> Vec<f64> {
+    let mut errors = Vec::new();
+    for t in &mesh.tris {
+        let d = t.map(|i| mesh.q[i] + offset[i]);
+        let area2 = (d[1] - d[0]).perp_dot(d[2] - d[0]);
+        if area2.abs() < 1e-12 {
+            continue;
+        }
+        let lo = d[0].min(d[1]).min(d[2]).floor().max(DVec2::ZERO);
+        let hi = d[0].max(d[1]).max(d[2]).ceil().min(image.size);
+        for py in lo.y as i64..hi.y as i64 {
+            for px in lo.x as i64..hi.x as i64 {
+                let c = DVec2::new(px as f64 + 0.5, py as f64 + 0.5);
+                let b0 = (d[1] - c).perp_dot(d[2] - c) / area2;
+                let b1 = (d[2] - c).perp_dot(d[0] - c) / area2;
+                let b = [b0, b1, 1.0 - b0 - b1];
+                if b.iter().any(|&x| x < 0.0) {
+                    continue;
+                }
+                let bw: [f64; 3] = std::array::from_fn(|k| b[k] / mesh.w[t[k]]);
+                let p = (0..3).map(|k| mesh.pos[t[k]].as_dvec3() * bw[k]).sum::<DVec3>() / (bw[0] + bw[1] + bw[2]);
+                errors.push((image.pixel(p.as_vec3(), mesh.nodes[t[0]].theta_ref) - c).length());
+            }
+        }
+    }
+    errors
+}
+
+fn main() -> Result<(), Error> {
+    let args: Vec<String> = std::env::args().collect();
+    if args.len() != 4 {
+        return Err("usage: node_offsets SCENE X,Y,Z 'TAU:RULE;…' (RULE: none, max, nocorners, local, lines)".into());
+    }
+    let v: Vec<f32> = args[2].split(',').map(str::parse).collect::<Result<_, _>>()?;
+    let [x, y, z] = v[..] else { return Err("the viewer is X,Y,Z".into()) };
+    let projection = Projection::equirect(4096);
+    let image = Image { projection, size: DVec2::new(projection.width as f64, projection.height as f64) };
+    let scene = load_scene(&args[1], &projection)?;
+    let base =
+        RenderSettings::new(projection).with_method(Method::Adaptive(Split::Error)).with_viewer(Vec3::new(x, y, z));
+    let view = base.view();
+    let key = |p: Vec3| [p.x, p.y, p.z].map(|c| (c * 1e4).round() as i64);
+    let corners: HashSet<[i64; 3]> =
+        scene.vertices.iter().map(|v| key(view.transform_point3(Vec3::from(v.position)))).collect();
+    for (tau, rule) in parse_configs(&args[3])? {
+        let params = subdivide_params(&base.with_max_error_px(tau), 0, scene.triangle_count() as u32);
+        let out = subdivide(&params, &scene.vertices, &scene.indices);
+        let mesh = Mesh::new(&image, &out.nodes, &out.indices);
+        let corner: Vec<bool> = mesh.pos.iter().map(|&p| corners.contains(&key(p))).collect();
+        let mut errors = pixel_errors(&image, &mesh, &offsets(&mesh, rule, &corner));
         if errors.is_empty() {
             println!("τ {tau} {rule:?}: no pixel covered");
             continue;
@@ -179,7 +328,7 @@ fn main() -> Result<(), Error> {
         let mean = errors.iter().sum::<f64>() / errors.len() as f64;
         println!(
             "τ {tau} {rule:?}: {} triangles; {} pixels: mean {mean:.3} px, p50 {:.3}, p90 {:.3}, p99 {:.3}, max {:.3}",
-            tris.len(),
+            mesh.tris.len(),
             errors.len(),
             at(0.5),
             at(0.9),
