@@ -23,7 +23,13 @@
 //! - `lines`: one offset per straight line the pieces' boundaries lie on (an input edge, a cut
 //!   line, a macro line: half the largest e of its segments, as an edge's profile could give
 //!   it), taken by every node inside the line (its ends and the input corners none); a node on no
-//!   such line, half the largest e of its piece's edges.
+//!   such line, half the largest e of its piece's edges;
+//! - `profile`: as `lines`, but a line's error estimated as an edge's profile would give it,
+//!   −b·(8/n)²/8 for its n parts, b the largest second difference of its image sampled at 8
+//!   equal steps of azimuth between its ends (per line, so the same in every piece); a node on
+//!   no line, half the largest of its piece's lines' errors;
+//! - `profile-edges`: as `profile` on the lines, but a node on no line as `lines` (half the
+//!   largest e its piece's edges measure).
 //!
 //! `cargo run --release --example node_offsets -- SCENE X,Y,Z 'TAU:RULE;TAU:RULE…'`, e.g.
 //! `… -- builtin:demo 0,0,0 '0.4:none;0.7:lines'`.
@@ -34,6 +40,7 @@ use glam::{DVec2, DVec3, Vec3};
 use twister::core::load::load_scene;
 use twister::core::projection::{azimuth, horizontal_radius, Eye, Projection};
 use twister::core::settings::{Method, RenderSettings, Split};
+use twister::cpu::subdivide::spacing::Spacing;
 use twister::cpu::subdivide::subdivide;
 use twister::encoding::subdivide::subdivide_params;
 use twister::encoding::types::DrawVertex;
@@ -47,6 +54,8 @@ enum Rule {
     NoCorners,
     Local,
     Lines,
+    Profile,
+    ProfileEdges,
 }
 
 fn parse_configs(arg: &str) -> Result<Vec<(f32, Rule)>, Error> {
@@ -59,7 +68,9 @@ fn parse_configs(arg: &str) -> Result<Vec<(f32, Rule)>, Error> {
                 "nocorners" => Rule::NoCorners,
                 "local" => Rule::Local,
                 "lines" => Rule::Lines,
-                _ => return Err(format!("'{r}': the rules are none, max, nocorners, local, lines").into()),
+                "profile" => Rule::Profile,
+                "profile-edges" => Rule::ProfileEdges,
+                _ => return Err(format!("'{r}': the rules are none, max, nocorners, local, lines, profile, profile-edges").into()),
             };
             Ok((t.parse::<f32>().map_err(|e| format!("τ '{t}': {e}"))?, rule))
         })
@@ -193,7 +204,7 @@ fn widen(slot: &mut DVec2, e: DVec2) {
 }
 
 /// Each node's offset under `rule` (half the chosen error; `corner`: an input triangle's corner).
-fn offsets(mesh: &Mesh, rule: Rule, corner: &[bool]) -> Vec<DVec2> {
+fn offsets(image: &Image, mesh: &Mesh, rule: Rule, corner: &[bool]) -> Vec<DVec2> {
     let n = mesh.pos.len();
     let mut chosen = vec![DVec2::ZERO; n];
     match rule {
@@ -230,7 +241,7 @@ fn offsets(mesh: &Mesh, rule: Rule, corner: &[bool]) -> Vec<DVec2> {
                 }
             }
         }
-        Rule::Lines => {
+        Rule::Lines | Rule::Profile | Rule::ProfileEdges => {
             let boundary = mesh.boundary();
             let piece = mesh.pieces();
             let (mut line_max, mut degree) = (HashMap::new(), HashMap::new());
@@ -247,6 +258,17 @@ fn offsets(mesh: &Mesh, rule: Rule, corner: &[bool]) -> Vec<DVec2> {
                     }
                     on_lines[a].push(line);
                     on_lines[b].push(line);
+                }
+            }
+            if rule != Rule::Lines {
+                profile_errors(image, mesh, &degree, &mut line_max);
+            }
+            if rule == Rule::Profile {
+                piece_max.clear();
+                for (&(a, b, _), &on_boundary) in mesh.edges.iter().zip(&boundary) {
+                    if on_boundary {
+                        widen(piece_max.entry(piece[a]).or_default(), line_max[&mesh.line(a, b)]);
+                    }
                 }
             }
             for i in 0..n {
@@ -266,6 +288,45 @@ fn offsets(mesh: &Mesh, rule: Rule, corner: &[bool]) -> Vec<DVec2> {
         }
     }
     chosen.iter().map(|&e| 0.5 * e).collect()
+}
+
+type Line = ([i64; 3], [i64; 3], i32);
+
+/// Replaces each line's largest part error by what its profile would estimate: its ends (the
+/// positions only one of its segments reaches), its parts (segments), and the largest second
+/// difference of its image at 8 equal steps of azimuth between the ends, scaled to a part:
+/// −b·(8/n)²/8. A line whose ends are not two keeps its measured error.
+fn profile_errors(image: &Image, mesh: &Mesh, degree: &HashMap<(Line, usize), u32>, line_max: &mut HashMap<Line, DVec2>) {
+    let mut node_of = HashMap::new();
+    for (i, &g) in mesh.group.iter().enumerate() {
+        node_of.entry(g).or_insert(i);
+    }
+    let mut ends: HashMap<Line, Vec<usize>> = HashMap::new();
+    let mut parts: HashMap<Line, u32> = HashMap::new();
+    for (&(line, g), &d) in degree {
+        *parts.entry(line).or_default() += d;
+        if d == 1 {
+            ends.entry(line).or_default().push(node_of[&g]);
+        }
+    }
+    for (line, e) in line_max.iter_mut() {
+        let Some(&[a, b]) = ends.get(line).map(Vec::as_slice) else { continue };
+        let n = (parts[line] / 2).max(1) as f64;
+        let (pa, pb) = (mesh.pos[a], mesh.pos[b]);
+        let (lo, hi) = if (pa.x, pa.y, pa.z) < (pb.x, pb.y, pb.z) { (pa, pb) } else { (pb, pa) };
+        let theta_ref = mesh.nodes[a].theta_ref;
+        let samples: Vec<DVec2> = (0..=8)
+            .map(|k| {
+                let t = Spacing::Azimuth.param(lo, hi, k as f32 / 8.0);
+                image.pixel(lo + (hi - lo) * t, theta_ref)
+            })
+            .collect();
+        let mut bend = DVec2::ZERO;
+        for k in 1..8 {
+            widen(&mut bend, samples[k + 1] - 2.0 * samples[k] + samples[k - 1]);
+        }
+        *e = -bend * (8.0 / n) * (8.0 / n) / 8.0;
+    }
 }
 
 /// The error of every pixel centre each triangle covers, drawn at the offset positions.
@@ -300,7 +361,7 @@ fn pixel_errors(image: &Image, mesh: &Mesh, offset: &[DVec2]) -> Vec<f64> {
 fn main() -> Result<(), Error> {
     let args: Vec<String> = std::env::args().collect();
     if args.len() != 4 {
-        return Err("usage: node_offsets SCENE X,Y,Z 'TAU:RULE;…' (RULE: none, max, nocorners, local, lines)".into());
+        return Err("usage: node_offsets SCENE X,Y,Z 'TAU:RULE;…' (RULE: none, max, nocorners, local, lines, profile, profile-edges)".into());
     }
     let v: Vec<f32> = args[2].split(',').map(str::parse).collect::<Result<_, _>>()?;
     let [x, y, z] = v[..] else { return Err("the viewer is X,Y,Z".into()) };
@@ -318,7 +379,7 @@ fn main() -> Result<(), Error> {
         let out = subdivide(&params, &scene.vertices, &scene.indices);
         let mesh = Mesh::new(&image, &out.nodes, &out.indices);
         let corner: Vec<bool> = mesh.pos.iter().map(|&p| corners.contains(&key(p))).collect();
-        let mut errors = pixel_errors(&image, &mesh, &offsets(&mesh, rule, &corner));
+        let mut errors = pixel_errors(&image, &mesh, &offsets(&image, &mesh, rule, &corner));
         if errors.is_empty() {
             println!("τ {tau} {rule:?}: no pixel covered");
             continue;
