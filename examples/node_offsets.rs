@@ -29,7 +29,11 @@
 //!   equal steps of azimuth between its ends (per line, so the same in every piece); a node on
 //!   no line, half the largest of its piece's lines' errors;
 //! - `profile-edges`: as `profile` on the lines, but a node on no line as `lines` (half the
-//!   largest e its piece's edges measure).
+//!   largest e its piece's edges measure);
+//! - `profile-local`: from the lines' profiles alone, but locally: a segment's error from the
+//!   profile's second differences at the two samples around its middle (the larger), −d·(8/n)²/8;
+//!   a node inside a line half the larger of its two segments', a node on no line half the
+//!   largest of its piece's boundary segments'. No projection beyond the profiles'.
 //!
 //! `cargo run --release --example node_offsets -- SCENE X,Y,Z 'TAU:RULE;TAU:RULE…'`, e.g.
 //! `… -- builtin:demo 0,0,0 '0.4:none;0.7:lines'`.
@@ -56,6 +60,7 @@ enum Rule {
     Lines,
     Profile,
     ProfileEdges,
+    ProfileLocal,
 }
 
 fn parse_configs(arg: &str) -> Result<Vec<(f32, Rule)>, Error> {
@@ -70,7 +75,8 @@ fn parse_configs(arg: &str) -> Result<Vec<(f32, Rule)>, Error> {
                 "lines" => Rule::Lines,
                 "profile" => Rule::Profile,
                 "profile-edges" => Rule::ProfileEdges,
-                _ => return Err(format!("'{r}': the rules are none, max, nocorners, local, lines, profile, profile-edges").into()),
+                "profile-local" => Rule::ProfileLocal,
+                _ => return Err(format!("'{r}': the rules are none, max, nocorners, local, lines, profile, profile-edges, profile-local").into()),
             };
             Ok((t.parse::<f32>().map_err(|e| format!("τ '{t}': {e}"))?, rule))
         })
@@ -241,6 +247,7 @@ fn offsets(image: &Image, mesh: &Mesh, rule: Rule, corner: &[bool]) -> Vec<DVec2
                 }
             }
         }
+        Rule::ProfileLocal => return profile_local(image, mesh, corner),
         Rule::Lines | Rule::Profile | Rule::ProfileEdges => {
             let boundary = mesh.boundary();
             let piece = mesh.pieces();
@@ -329,6 +336,99 @@ fn profile_errors(image: &Image, mesh: &Mesh, degree: &HashMap<(Line, usize), u3
     }
 }
 
+/// A line's profile: its canonical ends, its parts, and its image's second differences at the
+/// 7 inner samples of 8 equal steps of azimuth (with each sample's 3-D parameter).
+struct LineProfile {
+    lo: Vec3,
+    hi: Vec3,
+    parts: f64,
+    samples: [(f64, DVec2); 7],
+}
+
+impl LineProfile {
+    /// The estimated error of the part between 3-D points a and b of the line.
+    fn part_error(&self, a: Vec3, b: Vec3) -> DVec2 {
+        let axis = (self.hi - self.lo).as_dvec3();
+        let t = ((a + b) * 0.5 - self.lo).as_dvec3().dot(axis) / axis.length_squared();
+        let k = self.samples.iter().position(|&(s, _)| s >= t).unwrap_or(7);
+        let mut d = DVec2::ZERO;
+        for j in [k.saturating_sub(1), k.min(6)] {
+            widen(&mut d, self.samples[j].1);
+        }
+        -d * (8.0 / self.parts) * (8.0 / self.parts) / 8.0
+    }
+}
+
+/// The `profile-local` rule's offsets.
+fn profile_local(image: &Image, mesh: &Mesh, corner: &[bool]) -> Vec<DVec2> {
+    let n = mesh.pos.len();
+    let boundary = mesh.boundary();
+    let piece = mesh.pieces();
+    // Lines: their segments (each geometric segment once) and each position's degree on them.
+    let (mut degree, mut segments, mut counted) = (HashMap::new(), HashMap::new(), HashSet::new());
+    for (&(a, b, _), &on_boundary) in mesh.edges.iter().zip(&boundary) {
+        if on_boundary && counted.insert(mesh.geometric(a, b)) {
+            let line = mesh.line(a, b);
+            *degree.entry((line, mesh.group[a])).or_insert(0u32) += 1;
+            *degree.entry((line, mesh.group[b])).or_insert(0u32) += 1;
+            *segments.entry(line).or_insert(0u32) += 1;
+        }
+    }
+    let mut ends: HashMap<Line, Vec<usize>> = HashMap::new();
+    let mut first = HashMap::new();
+    for (i, &g) in mesh.group.iter().enumerate() {
+        first.entry(g).or_insert(i);
+    }
+    for (&(line, g), &d) in &degree {
+        if d == 1 {
+            ends.entry(line).or_default().push(first[&g]);
+        }
+    }
+    let profiles: HashMap<Line, LineProfile> = ends
+        .iter()
+        .filter_map(|(&line, e)| {
+            let &[a, b] = e.as_slice() else { return None };
+            let (pa, pb) = (mesh.pos[a], mesh.pos[b]);
+            let (lo, hi) = if (pa.x, pa.y, pa.z) < (pb.x, pb.y, pb.z) { (pa, pb) } else { (pb, pa) };
+            let at: Vec<(f64, DVec2)> = (0..=8)
+                .map(|k| {
+                    let t = Spacing::Azimuth.param(lo, hi, k as f32 / 8.0);
+                    (t as f64, image.pixel(lo + (hi - lo) * t, mesh.nodes[a].theta_ref))
+                })
+                .collect();
+            let samples = std::array::from_fn(|k| (at[k + 1].0, at[k + 2].1 - 2.0 * at[k + 1].1 + at[k].1));
+            Some((line, LineProfile { lo, hi, parts: segments[&line] as f64, samples }))
+        })
+        .collect();
+    let (mut chosen, mut piece_max) = (vec![DVec2::ZERO; n], HashMap::new());
+    let mut on_line = vec![false; n];
+    for (&(a, b, measured), &on_boundary) in mesh.edges.iter().zip(&boundary) {
+        if !on_boundary {
+            continue;
+        }
+        let line = mesh.line(a, b);
+        let e = profiles.get(&line).map_or(measured, |p| p.part_error(mesh.pos[a], mesh.pos[b]));
+        widen(piece_max.entry(piece[a]).or_default(), e);
+        for k in [a, b] {
+            on_line[k] = true;
+            if degree[&(line, mesh.group[k])] >= 2 {
+                widen(&mut chosen[k], e);
+            }
+        }
+    }
+    (0..n)
+        .map(|i| {
+            if corner[i] {
+                DVec2::ZERO
+            } else if on_line[i] {
+                0.5 * chosen[i]
+            } else {
+                0.5 * piece_max.get(&piece[i]).copied().unwrap_or_default()
+            }
+        })
+        .collect()
+}
+
 /// The error of every pixel centre each triangle covers, drawn at the offset positions.
 fn pixel_errors(image: &Image, mesh: &Mesh, offset: &[DVec2]) -> Vec<f64> {
     let mut errors = Vec::new();
@@ -361,7 +461,7 @@ fn pixel_errors(image: &Image, mesh: &Mesh, offset: &[DVec2]) -> Vec<f64> {
 fn main() -> Result<(), Error> {
     let args: Vec<String> = std::env::args().collect();
     if args.len() != 4 {
-        return Err("usage: node_offsets SCENE X,Y,Z 'TAU:RULE;…' (RULE: none, max, nocorners, local, lines, profile, profile-edges)".into());
+        return Err("usage: node_offsets SCENE X,Y,Z 'TAU:RULE;…' (RULE: none, max, nocorners, local, lines, profile, profile-edges, profile-local)".into());
     }
     let v: Vec<f32> = args[2].split(',').map(str::parse).collect::<Result<_, _>>()?;
     let [x, y, z] = v[..] else { return Err("the viewer is X,Y,Z".into()) };
