@@ -51,6 +51,10 @@ use twister::encoding::types::DrawVertex;
 
 type Error = Box<dyn std::error::Error>;
 
+/// A straight line of the scene, quantised: its direction up to sign, its point nearest the
+/// origin, and the seam copy's turn.
+type Line = ([i64; 3], [i64; 3], i32);
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Rule {
     None,
@@ -190,7 +194,7 @@ impl<'a> Mesh<'a> {
 
     /// The straight line through a and b (direction up to sign, its point nearest the origin),
     /// quantised, and the copy's turn.
-    fn line(&self, a: usize, b: usize) -> ([i64; 3], [i64; 3], i32) {
+    fn line(&self, a: usize, b: usize) -> Line {
         let (pa, pb) = (self.pos[a].as_dvec3(), self.pos[b].as_dvec3());
         let mut d = (pb - pa).normalize();
         if d.x < -1e-9 || (d.x.abs() <= 1e-9 && (d.y < -1e-9 || (d.y.abs() <= 1e-9 && d.z < 0.0))) {
@@ -296,8 +300,6 @@ fn offsets(image: &Image, mesh: &Mesh, rule: Rule, corner: &[bool]) -> Vec<DVec2
     }
     chosen.iter().map(|&e| 0.5 * e).collect()
 }
-
-type Line = ([i64; 3], [i64; 3], i32);
 
 /// Replaces each line's largest part error by what its profile would estimate: its ends (the
 /// positions only one of its segments reaches), its parts (segments), and the largest second
