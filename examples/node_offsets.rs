@@ -82,7 +82,11 @@ fn parse_configs(arg: &str) -> Result<Vec<(f32, Rule)>, Error> {
                 "profile-local" => Rule::ProfileLocal,
                 _ => return Err(format!("'{r}': the rules are none, max, nocorners, local, lines, profile, profile-edges, profile-local").into()),
             };
-            Ok((t.parse::<f32>().map_err(|e| format!("τ '{t}': {e}"))?, rule))
+            let tau = t.parse::<f32>().map_err(|e| format!("τ '{t}': {e}"))?;
+            if !(tau.is_finite() && tau >= 0.01) {
+                return Err(format!("τ '{t}': want a number of pixels ≥ 0.01").into());
+            }
+            Ok((tau, rule))
         })
         .collect()
 }
