@@ -4,7 +4,8 @@
 //! The subdivision puts every node at its projection, so a drawn triangle's error rises from 0
 //! at its nodes to about τ between them (docs/results.md, *What the raster pays for*). Drawing
 //! each node half that bowl towards the curve would keep the largest error with fewer parts. This
-//! example runs the twin (`cpu::subdivide`, sphere 4096×2048, the error split at each τ given),
+//! example runs the twin (`cpu::subdivide`, the sphere at 4096×2048 or, with `cylinder`, the
+//! TWISTER display's 3168×600; the error split at each τ given),
 //! gives each node a screen offset by one of the rules below, rasterises every output triangle
 //! of the right eye at the offset positions (every covered pixel centre, no depth test, the
 //! surface point interpolated with w = r as the raster stage does) and prints the display-position
@@ -35,7 +36,7 @@
 //!   a node inside a line half the larger of its two segments', a node on no line half the
 //!   largest of its piece's boundary segments'. No projection beyond the profiles'.
 //!
-//! `cargo run --release --example node_offsets -- SCENE X,Y,Z 'TAU:RULE;TAU:RULE…'`, e.g.
+//! `cargo run --release --example node_offsets -- SCENE X,Y,Z 'TAU:RULE;TAU:RULE…' [cylinder]`, e.g.
 //! `… -- builtin:demo 0,0,0 '0.4:none;0.7:lines'`.
 
 use std::collections::{HashMap, HashSet};
@@ -466,12 +467,12 @@ fn pixel_errors(image: &Image, mesh: &Mesh, offset: &[DVec2]) -> Vec<f64> {
 
 fn main() -> Result<(), Error> {
     let args: Vec<String> = std::env::args().collect();
-    if args.len() != 4 {
-        return Err("usage: node_offsets SCENE X,Y,Z 'TAU:RULE;…' (RULE: none, max, nocorners, local, lines, profile, profile-edges, profile-local)".into());
+    if args.len() != 4 && !(args.len() == 5 && args[4] == "cylinder") {
+        return Err("usage: node_offsets SCENE X,Y,Z 'TAU:RULE;…' [cylinder] (RULE: none, max, nocorners, local, lines, profile, profile-edges, profile-local)".into());
     }
     let v: Vec<f32> = args[2].split(',').map(str::parse).collect::<Result<_, _>>()?;
     let [x, y, z] = v[..] else { return Err("the viewer is X,Y,Z".into()) };
-    let projection = Projection::equirect(4096);
+    let projection = if args.len() == 5 { Projection::default() } else { Projection::equirect(4096) };
     let image = Image { projection, size: DVec2::new(projection.width as f64, projection.height as f64) };
     let scene = load_scene(&args[1], &projection)?;
     let base =
