@@ -40,6 +40,9 @@ struct VertexIn {
     @location(5) uv: vec2<f32>,
     @location(6) object: u32,
     @location(7) tangent: u32,
+    // Where the node is drawn off its projection, image pixels (x right, y down): left eye's
+    // (x, y), right eye's (x, y).
+    @location(8) offsets: vec4<f32>,
 }
 
 
@@ -54,8 +57,10 @@ fn vs_main(in: VertexIn, eye_in: EyeIn) -> VertexOut {
     let uvd = project_with_azimuth(params.projection, in.position, theta, params.eye_sign);
     var out: VertexOut;
     out.clip = frame_clip(params.projection, uvd) * clip_w(params.projection, in.position, uvd.z, params.w_by_radius);
-    out.clip.x += 2.0 * params.shift_px.x / params.projection.width * out.clip.w;
-    out.clip.y -= 2.0 * params.shift_px.y / params.projection.height * out.clip.w;
+    // The node's offset for this eye and the test hook's shift, in pixels of the frame.
+    let shift = params.shift_px + select(in.offsets.xy, in.offsets.zw, eye == 1u);
+    out.clip.x += 2.0 * shift.x / params.projection.width * out.clip.w;
+    out.clip.y -= 2.0 * shift.y / params.projection.height * out.clip.w;
     out.clip = tile_clip(params.projection, out.clip);
     out.view_position = in.position;
     out.normal = in.normal;

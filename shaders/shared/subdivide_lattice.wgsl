@@ -184,6 +184,7 @@ fn draw_vertex(n: Node, theta_ref: f32, tri: ptr<function, InputTriangle>) -> Dr
         b.x * (*tri).uv[0] + b.y * (*tri).uv[1] + b.z * (*tri).uv[2],
         (*tri).object,
         pack_tangent(b.x * (*tri).tangent[0] + b.y * (*tri).tangent[1] + b.z * (*tri).tangent[2]),
+        vec4<f32>(0.0),
     );
 }
 

@@ -15,6 +15,7 @@ struct DrawVertex {
     uv: vec2<f32>,
     object: u32,
     tangent: u32,   // the interpolated glTF tangent, viewer frame, packed (`pack_tangent`); 0: none
+    offsets: vec4<f32>, // drawn off the projection, image pixels (x right, y down): left (x, y), right (x, y)
 }
 
 struct SubdivideParams {

@@ -33,9 +33,12 @@ pub fn raster_vertex(params: &RasterParams, v: &DrawVertex) -> Vec4 {
     let depth = (q.depth / (q.depth + 1.0)).min(crate::encoding::constants::MAX_DEPTH);
     let clip = frame_clip(&projection, q.u, q.v, depth, params.projection.face as usize)
         * clip_w(&projection, p, q.depth, params.w_by_radius);
-    // The test hook's shift, in pixels of the frame; then the tile's part of it.
+    // The node's offset for this eye and the test hook's shift, in pixels of the frame; then the
+    // tile's part of it.
     let (w, h) = (projection.width as f32, projection.height as f32);
-    let shifted = clip + Vec4::new(2.0 * params.shift_px[0] / w, -2.0 * params.shift_px[1] / h, 0.0, 0.0) * clip.w;
+    let k = if eye == Eye::Right { 2 } else { 0 };
+    let (sx, sy) = (params.shift_px[0] + v.offsets[k], params.shift_px[1] + v.offsets[k + 1]);
+    let shifted = clip + Vec4::new(2.0 * sx / w, -2.0 * sy / h, 0.0, 0.0) * clip.w;
     projection.tile_clip(shifted)
 }
 

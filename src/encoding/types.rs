@@ -16,7 +16,7 @@ pub use crate::core::shadow::GpuShadowMap;
 
 /// A vertex of a prepared triangle (`DrawVertex` in shaders/shared/subdivide_types.wgsl, read by raster.wgsl),
 /// in the viewer frame. `theta_ref` is the azimuth the vertex stage unwraps θ around; seam
-/// copies carry it shifted by ±2π. 64 bytes; also the vertex-buffer layout of the raster stage.
+/// copies carry it shifted by ±2π. 80 bytes; also the vertex-buffer layout of the raster stage.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct DrawVertex {
@@ -29,6 +29,9 @@ pub struct DrawVertex {
     pub object: u32,
     /// The interpolated glTF tangent in the viewer frame, packed (`core::scene::pack_tangent`; 0: none).
     pub tangent: u32,
+    /// Where the raster stage draws the node off its projection, in image pixels (x right, y
+    /// down): the left eye's (x, y), then the right eye's. Zero: at its projection.
+    pub offsets: [f32; 4],
 }
 
 /// `Projection` in shaders/shared/projection.wgsl. 144 bytes.
@@ -532,7 +535,7 @@ pub const NO_SKIN: u32 = u32::MAX;
 /// Every struct the stages bind (as a uniform or in a storage buffer), by its WGSL name.
 pub const LAYOUTS: &[StructLayout] = &[
     layout!("SceneVertex" => SceneVertex { position, material, normal, object, color, uv, tangent, flags }),
-    layout!("DrawVertex" => DrawVertex { position, theta_ref, normal, material, color, uv, object, tangent }),
+    layout!("DrawVertex" => DrawVertex { position, theta_ref, normal, material, color, uv, object, tangent, offsets }),
     layout!("Projection" => ProjectionUniform {
         screen_radius, eye_radius, width, height, acos_eye_screen, vertical_exact, pixels_per_v, panorama,
         convergence, pole_from, pole_to, turn_px, fov, dome_tilt, head_on, head_turn, head_offset, face, wall_corner, wall_on, wall_right, _pad1, wall_up, _pad2, tile

@@ -341,6 +341,7 @@ fn vertex_layout(kind: DrawStage) -> (usize, Vec<wgpu::VertexAttribute>) {
                 attribute(Float32x2, offset_of!(DrawVertex, uv), 5),
                 attribute(Uint32, offset_of!(DrawVertex, object), 6),
                 attribute(Uint32, offset_of!(DrawVertex, tangent), 7),
+                attribute(Float32x4, offset_of!(DrawVertex, offsets), 8),
             ],
         ),
         DrawStage::Slit => (

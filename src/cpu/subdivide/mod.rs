@@ -334,6 +334,7 @@ fn draw_vertex(tri: &Triangle, n: Node, theta_ref: f32) -> DrawVertex {
         uv: (b.x * tri.uv[0] + b.y * tri.uv[1] + b.z * tri.uv[2]).into(),
         object: tri.object,
         tangent: pack_tangent(b.x * tri.tangent[0] + b.y * tri.tangent[1] + b.z * tri.tangent[2]),
+        offsets: [0.0; 4],
     }
 }
 
