@@ -66,6 +66,7 @@ enum Rule {
     Profile,
     ProfileEdges,
     ProfileLocal,
+    Twin,
 }
 
 fn parse_configs(arg: &str) -> Result<Vec<(f32, Rule)>, Error> {
@@ -81,6 +82,7 @@ fn parse_configs(arg: &str) -> Result<Vec<(f32, Rule)>, Error> {
                 "profile" => Rule::Profile,
                 "profile-edges" => Rule::ProfileEdges,
                 "profile-local" => Rule::ProfileLocal,
+                "twin" => Rule::Twin,
                 _ => return Err(format!("'{r}': the rules are none, max, nocorners, local, lines, profile, profile-edges, profile-local").into()),
             };
             let tau = t.parse::<f32>().map_err(|e| format!("τ '{t}': {e}"))?;
@@ -257,6 +259,10 @@ fn offsets(image: &Image, mesh: &Mesh, rule: Rule, corner: &[bool]) -> Vec<DVec2
             }
         }
         Rule::ProfileLocal => return profile_local(image, mesh, corner),
+        // The twin's own (`TWISTER_NODE_OFFSETS` set): the right eye's.
+        Rule::Twin => {
+            return mesh.nodes.iter().map(|v| DVec2::new(v.offsets[2] as f64, v.offsets[3] as f64)).collect();
+        }
         Rule::Lines | Rule::Profile | Rule::ProfileEdges => {
             let boundary = mesh.boundary();
             let piece = mesh.pieces();

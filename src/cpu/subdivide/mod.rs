@@ -108,6 +108,7 @@ mod axis;
 mod edges;
 mod frame_cuts;
 mod lattice;
+mod offsets;
 pub mod passes;
 mod piece;
 mod rows;
@@ -220,6 +221,7 @@ impl<'a> Subdivider<'a> {
         tri: &Triangle,
         nodes: &[Node],
         candidates: Vec<[u32; 3]>,
+        offsets: &[[f32; 4]],
         theta_c: f32,
         (u_min, u_max): (f32, f32),
         reach: f32,
@@ -247,7 +249,11 @@ impl<'a> Subdivider<'a> {
             .map(|d| theta_c + d)
             .collect();
         let nodes: Vec<DrawVertex> =
-            refs.iter().flat_map(|&theta_ref| nodes.iter().map(move |&n| draw_vertex(tri, n, theta_ref))).collect();
+            refs.iter()
+                .flat_map(|&theta_ref| {
+                    nodes.iter().zip(offsets).map(move |(&n, &o)| DrawVertex { offsets: o, ..draw_vertex(tri, n, theta_ref) })
+                })
+                .collect();
         let node_count = if refs.is_empty() { 0 } else { (nodes.len() / refs.len()) as u32 };
         PiecePlan { node_count, nodes, copies: refs.len() as u32, candidates, reach }
     }

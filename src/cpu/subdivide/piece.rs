@@ -4,6 +4,8 @@
 //! regular lattice — and its plan (`lattice_shape`, and for rows `lattice_rows` and
 //! `lattice_rows_plan`).
 
+use glam::Vec3;
+
 use super::edges::Limits;
 use super::lattice::{lattice_node, lattice_slots, strip_node, strip_slots};
 use super::seam::clear_of_seam;
@@ -66,6 +68,8 @@ pub(super) struct PieceGeometry {
     pub k: u32,
     pub q: [Node; 3],
     edges: [PieceEdge; 3],
+    /// Where each corner lies in its part.
+    pub loc: [Location; 3],
     pub limits: Limits,
     pub spacing: Spacing,
 }
@@ -73,6 +77,23 @@ pub(super) struct PieceGeometry {
 impl PieceGeometry {
     pub fn counts(&self) -> [u32; 3] {
         self.edges.map(|e| e.count)
+    }
+
+    /// The straight line piece edge e lies on, as its nodes are placed: the part's original
+    /// edge (its ends and parts) where it lies on one, else its own ends and parts.
+    pub fn edge_line(&self, e: usize) -> (Vec3, Vec3, u32) {
+        match self.edges[e].original {
+            Some(oe) => (self.part[oe].position, self.part[(oe + 1) % 3].position, self.n[oe]),
+            None => (self.q[e].position, self.q[(e + 1) % 3].position, self.edges[e].count),
+        }
+    }
+
+    /// The part's original edge and its parts where corner c lies inside one.
+    pub fn corner_line(&self, c: usize) -> Option<(Vec3, Vec3, u32)> {
+        match self.loc[c] {
+            Location::OnEdge(oe, _) => Some((self.part[oe].position, self.part[(oe + 1) % 3].position, self.n[oe])),
+            _ => None,
+        }
     }
 
     /// The m-th node of piece edge e from corner e towards corner e + 1: on an original edge,
@@ -177,7 +198,7 @@ impl Subdivider<'_> {
                     ..Default::default()
                 })
         });
-        Some(PieceGeometry { part: *part, n, k, q, edges, limits, spacing: self.spacing() })
+        Some(PieceGeometry { part: *part, n, k, q, edges, loc, limits, spacing: self.spacing() })
     }
 
     /// `lattice`: piece `cell` of a part planned — its shape, its nodes once per seam copy, its
@@ -261,6 +282,8 @@ impl Subdivider<'_> {
             let (range, reach) = self.piece_u_range(q, theta_c);
             (range, reach + SEAM_BOUND_SLACK)
         };
-        self.piece_plan(tri, &nodes, shape.slots(g.counts()), theta_c, u_range, reach)
+        let slots = shape.slots(g.counts());
+        let offsets = self.node_offsets(g, &nodes, &slots);
+        self.piece_plan(tri, &nodes, slots, &offsets, theta_c, u_range, reach)
     }
 }

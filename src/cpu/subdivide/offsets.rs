@@ -1,0 +1,140 @@
+//! Nodes drawn off their projections (prototype, twin only; docs/results.md, *Nodes drawn off
+//! their projections*).
+//!
+//! A drawn triangle's error rises from 0 at its nodes (which lie on the projection) to about τ
+//! between them. Each node is drawn half that bowl towards the curve, so that the error swings
+//! both ways and the split can take larger parts for the same largest error:
+//! - a node inside an edge of its piece takes half that edge's part error as its profile
+//!   estimates it: −b·(S/n)²/8 for n parts, b the largest second difference (a vector, per eye)
+//!   of the edge's image at S = 8 equal steps of azimuth. The edge is the part's original edge
+//!   (an input edge's sub-segment or a cut line) where the piece's edge lies on one, else the
+//!   piece's own edge (a macro line), both profiled from their canonically ordered ends: every
+//!   piece with the node computes the same bits;
+//! - a corner of the piece none;
+//! - a node inside the piece half the largest error its piece's boundary segments measure (the
+//!   drawing's point at each segment's screen midpoint against its projection).
+
+use std::collections::HashMap;
+
+use glam::{Vec2, Vec3};
+
+use super::piece::PieceGeometry;
+use super::spacing::Spacing;
+use super::{lex_less, Node, Subdivider};
+use crate::core::projection::horizontal_radius;
+use crate::encoding::constants::{AZIMUTH_MIN_RADIUS, EDGE_SAMPLES};
+
+/// Keeps the longer of two error vectors.
+fn widen(slot: &mut Vec2, e: Vec2) {
+    if e.length() > slot.length() {
+        *slot = e;
+    }
+}
+
+impl Subdivider<'_> {
+    /// Whether the frame draws nodes off their projections: the sphere's panoramas under the
+    /// error split (prototype: with `TWISTER_NODE_OFFSETS` set).
+    pub(super) fn draws_offsets(&self) -> bool {
+        self.projection.panorama.is_sphere()
+            && self.spacing() == Spacing::Azimuth
+            && std::env::var_os("TWISTER_NODE_OFFSETS").is_some()
+    }
+
+    /// The x difference b − a in pixels, across the seam the short way.
+    fn unwrapped(&self, a: Vec2, b: Vec2) -> Vec2 {
+        let width = self.projection.turn_px();
+        let dx = b.x - a.x;
+        Vec2::new(dx - width * (dx / width).round(), b.y - a.y)
+    }
+
+    /// Both eyes' largest second difference of segment lo–hi's image at `EDGE_SAMPLES` steps of
+    /// the frame's spacing (y up), in the canonical order of its ends.
+    fn bend_vectors(&self, a: Vec3, b: Vec3) -> [Vec2; 2] {
+        let (lo, hi) = if lex_less(b, a) { (b, a) } else { (a, b) };
+        let spacer = self.spacing().spacer(lo, hi);
+        let mut out = [Vec2::ZERO; 2];
+        for (s, eye_sign) in [-1.0f32, 1.0].into_iter().enumerate() {
+            let points: Vec<Vec2> = (0..=EDGE_SAMPLES)
+                .map(|k| self.pixel(lo + (hi - lo) * spacer.param(k as f32 / EDGE_SAMPLES as f32), eye_sign))
+                .collect();
+            for k in 1..EDGE_SAMPLES as usize {
+                let second = self.unwrapped(points[k], points[k + 1]) - self.unwrapped(points[k - 1], points[k]);
+                widen(&mut out[s], second);
+            }
+        }
+        out
+    }
+
+    /// Both eyes' error of the drawing (w = r) at the screen midpoint of segment a–b (y up).
+    fn midpoint_errors(&self, a: Vec3, b: Vec3) -> [Vec2; 2] {
+        let (wa, wb) = (horizontal_radius(a).max(AZIMUTH_MIN_RADIUS), horizontal_radius(b).max(AZIMUTH_MIN_RADIUS));
+        let mid = (a / wa + b / wb) / (1.0 / wa + 1.0 / wb);
+        [-1.0f32, 1.0].map(|eye_sign| {
+            let (pa, pb, pm) = (self.pixel(a, eye_sign), self.pixel(b, eye_sign), self.pixel(mid, eye_sign));
+            self.unwrapped(pa, pm) - 0.5 * self.unwrapped(pa, pb)
+        })
+    }
+
+    /// Half the part error of line lo–hi drawn in `parts` parts, per eye (y up), from its profile.
+    fn line_offsets(&self, lo: Vec3, hi: Vec3, parts: u32) -> [Vec2; 2] {
+        let n = parts as f32;
+        self.bend_vectors(lo, hi).map(|b| -0.5 * b * (EDGE_SAMPLES as f32 / n).powi(2) / 8.0)
+    }
+
+    /// Each node's offsets [left x, y, right x, y] (image pixels, y down) for a shaped piece:
+    /// its nodes in slot order and its candidate triangles' slots.
+    pub(super) fn node_offsets(&self, g: &PieceGeometry, nodes: &[Node], slots: &[[u32; 3]]) -> Vec<[f32; 4]> {
+        let mut out = vec![[0.0; 4]; nodes.len()];
+        if !self.draws_offsets() || nodes.len() <= 3 {
+            return out;
+        }
+        let key = |p: Vec3| p.to_array().map(f32::to_bits);
+        // The nodes inside the piece's edges, and each edge's offset.
+        let mut on_edge = HashMap::new();
+        let mut edge_offsets = [[Vec2::ZERO; 2]; 3];
+        for e in 0..3 {
+            let (lo, hi, parts) = g.edge_line(e);
+            if g.counts()[e] < 2 || parts < 2 {
+                continue;
+            }
+            edge_offsets[e] = self.line_offsets(lo, hi, parts);
+            for m in 1..g.counts()[e] {
+                on_edge.insert(key(g.node_on_edge(e, m).position), e);
+            }
+        }
+        // The piece's boundary segments (a pair of slots in one candidate only) and their errors.
+        let mut pairs: HashMap<(u32, u32), u32> = HashMap::new();
+        for t in slots {
+            for e in 0..3 {
+                let (a, b) = (t[e], t[(e + 1) % 3]);
+                *pairs.entry((a.min(b), a.max(b))).or_default() += 1;
+            }
+        }
+        let mut inside = [Vec2::ZERO; 2];
+        for (&(a, b), _) in pairs.iter().filter(|(_, &c)| c == 1) {
+            let errors = self.midpoint_errors(nodes[a as usize].position, nodes[b as usize].position);
+            for s in 0..2 {
+                widen(&mut inside[s], 0.5 * errors[s]);
+            }
+        }
+        // A corner inside an original edge of the part takes that edge's offset (a piece beside
+        // it may have the node inside its edge); the part's corners and corners inside the part
+        // none.
+        let corners = g.q.map(|c| key(c.position));
+        let corner_offsets: [[Vec2; 2]; 3] = std::array::from_fn(|c| {
+            g.corner_line(c).map_or([Vec2::ZERO; 2], |(lo, hi, parts)| self.line_offsets(lo, hi, parts))
+        });
+        for (k, node) in nodes.iter().enumerate() {
+            let p = key(node.position);
+            let o = if let Some(c) = corners.iter().position(|&q| q == p) {
+                corner_offsets[c]
+            } else if let Some(&e) = on_edge.get(&p) {
+                edge_offsets[e]
+            } else {
+                inside
+            };
+            out[k] = [o[0].x, -o[0].y, o[1].x, -o[1].y];
+        }
+        out
+    }
+}
