@@ -261,6 +261,20 @@ fn offsets(image: &Image, mesh: &Mesh, rule: Rule, corner: &[bool]) -> Vec<DVec2
         Rule::ProfileLocal => return profile_local(image, mesh, corner),
         // The twin's own (`TWISTER_NODE_OFFSETS` set): the right eye's.
         Rule::Twin => {
+            let mut first = HashMap::new();
+            let mut apart = 0;
+            for (i, v) in mesh.nodes.iter().enumerate() {
+                let f = *first.entry(mesh.group[i]).or_insert(v.offsets);
+                if f != v.offsets {
+                    apart += 1;
+                    if apart <= 6 && std::env::var_os("SHOW").is_some() {
+                        println!("  {:?} r {:.4}: {:?} against {:?}", v.position, horizontal_radius(mesh.pos[i]), f, v.offsets);
+                    }
+                }
+            }
+            if apart > 0 {
+                println!("{apart} node copies drawn apart from their first copy");
+            }
             return mesh.nodes.iter().map(|v| DVec2::new(v.offsets[2] as f64, v.offsets[3] as f64)).collect();
         }
         Rule::Lines | Rule::Profile | Rule::ProfileEdges => {

@@ -85,10 +85,26 @@ impl Subdivider<'_> {
     /// its nodes in slot order and its candidate triangles' slots.
     pub(super) fn node_offsets(&self, g: &PieceGeometry, nodes: &[Node], slots: &[[u32; 3]]) -> Vec<[f32; 4]> {
         let mut out = vec![[0.0; 4]; nodes.len()];
-        if !self.draws_offsets() || nodes.len() <= 3 {
+        if !self.draws_offsets() {
             return out;
         }
         let key = |p: Vec3| p.to_array().map(f32::to_bits);
+        // A corner inside an original edge of the part takes that edge's offset (a piece beside
+        // it may have the node inside its edge); the part's corners and corners inside the part
+        // none.
+        let corners = g.q.map(|c| key(c.position));
+        let corner_offsets: [[Vec2; 2]; 3] = std::array::from_fn(|c| {
+            g.corner_line(c).map_or([Vec2::ZERO; 2], |(lo, hi, parts)| self.line_offsets(lo, hi, parts))
+        });
+        let flat = |o: [Vec2; 2]| [o[0].x, -o[0].y, o[1].x, -o[1].y];
+        if nodes.len() <= 3 {
+            for (k, node) in nodes.iter().enumerate() {
+                if let Some(c) = corners.iter().position(|&q| q == key(node.position)) {
+                    out[k] = flat(corner_offsets[c]);
+                }
+            }
+            return out;
+        }
         // The nodes inside the piece's edges, and each edge's offset.
         let mut on_edge = HashMap::new();
         let mut edge_offsets = [[Vec2::ZERO; 2]; 3];
@@ -117,13 +133,6 @@ impl Subdivider<'_> {
                 widen(&mut inside[s], 0.5 * errors[s]);
             }
         }
-        // A corner inside an original edge of the part takes that edge's offset (a piece beside
-        // it may have the node inside its edge); the part's corners and corners inside the part
-        // none.
-        let corners = g.q.map(|c| key(c.position));
-        let corner_offsets: [[Vec2; 2]; 3] = std::array::from_fn(|c| {
-            g.corner_line(c).map_or([Vec2::ZERO; 2], |(lo, hi, parts)| self.line_offsets(lo, hi, parts))
-        });
         for (k, node) in nodes.iter().enumerate() {
             let p = key(node.position);
             let o = if let Some(c) = corners.iter().position(|&q| q == p) {
@@ -133,8 +142,53 @@ impl Subdivider<'_> {
             } else {
                 inside
             };
-            out[k] = [o[0].x, -o[0].y, o[1].x, -o[1].y];
+            out[k] = flat(o);
         }
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::collections::HashMap;
+
+    use glam::Vec3;
+
+    use crate::core::builtin;
+    use crate::core::projection::Projection;
+    use crate::core::settings::{Method, RenderSettings, Split};
+    use crate::cpu::subdivide::subdivide;
+    use crate::encoding::subdivide::subdivide_params;
+
+    /// Every copy of a node position (each piece has its own) is drawn at the same place: the
+    /// offsets agree bit for bit, so the drawing stays watertight.
+    #[test]
+    fn every_copy_of_a_node_takes_the_same_offset() {
+        std::env::set_var("TWISTER_NODE_OFFSETS", "1");
+        for (name, scene, viewer) in [
+            ("demo", builtin::demo(), Vec3::ZERO),
+            ("box room", builtin::builtin_scene("builtin:box-room", &Projection::equirect(512)).unwrap(), Vec3::ZERO),
+            ("demo off centre", builtin::demo(), Vec3::new(0.4, 0.3, -0.2)),
+        ] {
+            for width in [512, 2048] {
+                let settings = RenderSettings::new(Projection::equirect(width))
+                    .with_method(Method::Adaptive(Split::Error))
+                    .with_viewer(viewer)
+                    .with_max_error_px(0.7);
+                let params = subdivide_params(&settings, 0, scene.triangle_count() as u32);
+                let out = subdivide(&params, &scene.vertices, &scene.indices);
+                let mut seen: HashMap<([u32; 3], i32), [f32; 4]> = HashMap::new();
+                let mut offset_nodes = 0;
+                for v in &out.nodes {
+                    let key = (v.position.map(f32::to_bits), (v.theta_ref / 3.0).round() as i32);
+                    if v.offsets != [0.0; 4] {
+                        offset_nodes += 1;
+                    }
+                    let first = *seen.entry(key).or_insert(v.offsets);
+                    assert_eq!(first, v.offsets, "{name} at {width}: node {:?} drawn at two places", v.position);
+                }
+                assert!(offset_nodes * 10 > out.nodes.len(), "{name} at {width}: {offset_nodes} of {} nodes offset", out.nodes.len());
+            }
+        }
     }
 }
