@@ -303,10 +303,15 @@ fn node_row_at(k: u32, m: u32, piece_state: ptr<function, PieceState>) -> vec4<u
 fn piece_node(k: u32, m: u32, row: ptr<function, vec4<u32>>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> Node {
     var along: Along;
     var end_kept = 2u;
+    (*piece_state).node_edge = 3u;
     if (cylinder_shapes() && (*piece_state).strip_base < LATTICE_SHAPE) {
         along = strip_along(k, part, piece_state);
     } else if ((*piece_state).strip_base == ROWS_SHAPE) {
         end_kept = row_end_kept(*row);
+        // The base row's nodes lie on the base edge, the rows' ends on the sides.
+        let base = (*piece_state).row_base;
+        let step = (*row).z;
+        (*piece_state).node_edge = select(select(select(3u, (base + 1u) % 3u, step == ROW_RIGHT_END), (base + 2u) % 3u, step == ROW_LEFT_END), base, step == ROW_BASE);
         along = rows_along(row, part, piece_state);
     } else {
         // Node (i, j, l) of the lattice of level m (`lattice_node`): the regular lattice, whose
@@ -319,6 +324,7 @@ fn piece_node(k: u32, m: u32, row: ptr<function, vec4<u32>>, part: ptr<function,
         if (on.x >= 3u) {
             return spaced_interior((*piece_state).corner, c, m);
         }
+        (*piece_state).node_edge = on.x;
         along = along_edge(on.x, snap(on.y, (*piece_state).counts[on.x], m), part, piece_state);
     }
     let node = edge_point(along.a, along.b, along.j, along.n);
@@ -458,6 +464,7 @@ fn piece_corners(piece: Piece, part: ptr<function, PartPlan>, piece_state: ptr<f
             loc[i] = macro_location(cell.c[i], part);
         }
         (*piece_state).corner[i] = corner(loc[i].y, part);
+        (*piece_state).corner_line[i] = select(-1, i32(loc[i].y), loc[i].x == ON_EDGE);
         if (loc[i].x == ON_EDGE) {
             on_edge[edge_count] = i;
             edge_count += 1u;

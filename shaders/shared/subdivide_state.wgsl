@@ -41,6 +41,8 @@ struct PieceState {
     row_base: u32,           // rows: the base edge
     row_w: array<u32, 33>,   // rows: each row's parts, from the base to the apex (`Rows::widths`)
     row_ends: array<Node, 2>, // rows: the current row's ends (left, right), placed first (`rows_along`)
+    corner_line: array<i32, 3>, // the original edge corner c lies inside, or −1 (`piece_offsets`)
+    node_edge: u32,          // the piece edge the last node `piece_node` placed lies on; 3: inside
 }
 
 // A polygon while it is clipped (at most 7 corners), and a quadrant's polygon kept while its

@@ -38,7 +38,8 @@ struct SubdivideParams {
     by_azimuth: u32,     // 1: nodes spaced by azimuth, drawn with w = r (`SubdivideParams::by_azimuth`)
     seamless: u32,       // 1: the image has no seam: no seam copies (`SubdivideParams::seamless`)
     pinhole_faces: u32,  // 1: drawn as pinholes (the cubemap): `SubdivideParams::pinhole_faces`
-    _pad: array<u32, 3>,
+    node_offsets: u32, // 1: nodes drawn off their projections (`SubdivideParams::node_offsets`)
+    _pad: array<u32, 2>,
 }
 
 // Whether the pipeline may measure the longest visible output edge (`measure_edges`): built
@@ -121,6 +122,9 @@ struct PieceWork {
     refs: vec4<f32>,
     row_w: array<u32, 33>,
     _pad: array<u32, 3>,
+    // Where its nodes are drawn off their projections (image pixels, y down, left xy, right xy):
+    // inside edge 0, 1, 2; at corner 0, 1, 2; inside (`piece_offsets`).
+    offsets: array<vec4<f32>, 7>,
 }
 
 // The steps of a piece's rows' nodes (`rows_along`): the base row's nodes, a row's left end, its

@@ -47,6 +47,7 @@ fn plan_work(index: u32, shape: PieceShape, seam: SeamCopies, tri: ptr<function,
     if (work.shape == ROWS_SHAPE) {
         work.row_w = (*piece_state).row_w;
     }
+    work.offsets = piece_offsets(shape.node_count, part, piece_state);
     work.first_node = atomicAdd(&counters.nodes, copies * shape.node_count);
     let chunk = chunk_of(copies);
     if (shape.node_count <= chunk && shape.candidates <= chunk) {
@@ -139,7 +140,7 @@ fn write_nodes(first: u32, work: PieceWork, tri: ptr<function, InputTriangle>, p
     let rows = work.shape == ROWS_SHAPE;
     var k = first;
     for (; k < select(first, end, corners_only); k++) {
-        write_node((*piece_state).corner[k], k, work, tri);
+        write_node((*piece_state).corner[k], k, work.offsets[3u + k], work, tri);
     }
     var row = node_row_at(k, work.m, piece_state);
     var next = k;
@@ -147,7 +148,7 @@ fn write_nodes(first: u32, work: PieceWork, tri: ptr<function, InputTriangle>, p
         let slot = select(k, rows_slot(row, piece_state), rows);
         let node = piece_node(k, work.m, &row, part, piece_state);
         if (slot >= first && slot < end) {
-            write_node(node, slot, work, tri);
+            write_node(node, slot, node_offset(node, work, piece_state), work, tri);
         }
         k += 1u;
         next = select(k, rows_bound(row), rows);
@@ -155,11 +156,126 @@ fn write_nodes(first: u32, work: PieceWork, tri: ptr<function, InputTriangle>, p
     atomicMax(&counters.max_output, (end - first) * work.copies);
 }
 
-// Node slot k of a piece, once per seam copy.
-fn write_node(node: Node, k: u32, work: PieceWork, tri: ptr<function, InputTriangle>) {
+// Node slot k of a piece, once per seam copy, drawn `offsets` off its projection.
+fn write_node(node: Node, k: u32, offsets: vec4<f32>, work: PieceWork, tri: ptr<function, InputTriangle>) {
     for (var c = 0u; c < work.copies; c++) {
-        out_nodes[work.first_node + c * work.node_count + k] = draw_vertex(node, work.refs[c], tri);
+        var v = draw_vertex(node, work.refs[c], tri);
+        v.offsets = offsets;
+        out_nodes[work.first_node + c * work.node_count + k] = v;
     }
+}
+
+// ---- Nodes drawn off their projections (`cpu::subdivide::offsets`, which says why) ----
+
+// b − a in pixels, x across the seam the short way.
+fn unwrapped_px(a: vec2<f32>, b: vec2<f32>) -> vec2<f32> {
+    let width = params.projection.turn_px;
+    let dx = b.x - a.x;
+    return vec2<f32>(dx - width * round(dx / width), b.y - a.y);
+}
+
+// Keeps the longer of two error vectors.
+fn widened(slot: vec2<f32>, e: vec2<f32>) -> vec2<f32> {
+    return select(slot, e, length(e) > length(slot));
+}
+
+// Half the part error of line a–b drawn in `parts` parts, both eyes (image pixels, y down: left
+// x, y, right x, y), from the largest second differences of its image at EDGE_SAMPLES steps of
+// the frame's spacing (`line_offsets`).
+fn line_offsets(a: vec3<f32>, b: vec3<f32>, parts: u32) -> vec4<f32> {
+    var lo = a;
+    var hi = b;
+    if (lex_less(b, a)) {
+        lo = b;
+        hi = a;
+    }
+    let sp = spacer(lo, hi);
+    var q0: array<vec2<f32>, 2>;
+    var q1: array<vec2<f32>, 2>;
+    var bend: array<vec2<f32>, 2>;
+    for (var k = 0u; k <= EDGE_SAMPLES; k++) {
+        let p = lo + (hi - lo) * spaced(sp, f32(k) / f32(EDGE_SAMPLES));
+        let q = pixels(p, eye_offset(params.projection, horizontal_radius(p), p.y));
+        for (var s = 0u; s < 2u; s++) {
+            if (k >= 2u) {
+                bend[s] = widened(bend[s], unwrapped_px(q1[s], q[s]) - unwrapped_px(q0[s], q1[s]));
+            }
+            q0[s] = q1[s];
+            q1[s] = q[s];
+        }
+    }
+    let step = f32(EDGE_SAMPLES) / f32(parts);
+    let o0 = -0.5 * bend[0] * (step * step) / 8.0;
+    let o1 = -0.5 * bend[1] * (step * step) / 8.0;
+    return vec4<f32>(o0.x, -o0.y, o1.x, -o1.y);
+}
+
+// Where a piece's nodes are drawn off their projections (`PieceWork::offsets`): inside each
+// edge, half its line's part error (the part's original edge where it lies on one); at each
+// corner inside an original edge, that edge's; inside, half the largest error its boundary
+// segments measure (the drawing's screen midpoint against its projection). Zero where the frame
+// draws none.
+fn piece_offsets(node_count: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> array<vec4<f32>, 7> {
+    var out: array<vec4<f32>, 7>;
+    if (params.node_offsets == 0u) {
+        return out;
+    }
+    for (var i = 0u; i < 6u; i++) {
+        var a = vec3<f32>(0.0);
+        var b = vec3<f32>(0.0);
+        var parts = 0u;
+        if (i < 3u) {
+            if ((*piece_state).counts[i] >= 2u && node_count > 3u) {
+                let s = along_edge(i, 0u, part, piece_state);
+                a = s.a.position;
+                b = s.b.position;
+                parts = s.n;
+            }
+        } else if ((*piece_state).corner_line[i - 3u] >= 0) {
+            let oe = u32((*piece_state).corner_line[i - 3u]);
+            a = corner(oe, part).position;
+            b = corner((oe + 1u) % 3u, part).position;
+            parts = (*part).n[oe];
+        }
+        if (parts >= 2u) {
+            out[i] = line_offsets(a, b, parts);
+        }
+    }
+    if (node_count <= 3u) {
+        return out;
+    }
+    var inside: array<vec2<f32>, 2>;
+    for (var e = 0u; e < 3u; e++) {
+        for (var m = 0u; m < (*piece_state).counts[e]; m++) {
+            let pa = node_on_edge(e, m, part, piece_state).position;
+            let pb = node_on_edge(e, m + 1u, part, piece_state).position;
+            let wa = max(horizontal_radius(pa), AZIMUTH_MIN_RADIUS);
+            let wb = max(horizontal_radius(pb), AZIMUTH_MIN_RADIUS);
+            let ends = array<vec3<f32>, 3>(pa, pb, (pa / wa + pb / wb) / (1.0 / wa + 1.0 / wb));
+            var q: array<array<vec2<f32>, 2>, 3>;
+            for (var i = 0u; i < 3u; i++) {
+                q[i] = pixels(ends[i], eye_offset(params.projection, horizontal_radius(ends[i]), ends[i].y));
+            }
+            for (var s = 0u; s < 2u; s++) {
+                let err = unwrapped_px(q[0][s], q[2][s]) - 0.5 * unwrapped_px(q[0][s], q[1][s]);
+                inside[s] = widened(inside[s], 0.5 * err);
+            }
+        }
+    }
+    out[6] = vec4<f32>(inside[0].x, -inside[0].y, inside[1].x, -inside[1].y);
+    return out;
+}
+
+// Where a node just placed by `piece_node` is drawn off its projection: a corner's, an edge's
+// (`node_edge`), or the inside's.
+fn node_offset(node: Node, work: PieceWork, piece_state: ptr<function, PieceState>) -> vec4<f32> {
+    for (var c = 0u; c < 3u; c++) {
+        if (same(node.position, (*piece_state).corner[c].position)) {
+            return work.offsets[3u + c];
+        }
+    }
+    let e = (*piece_state).node_edge;
+    return select(work.offsets[6], work.offsets[min(e, 2u)], e < 3u);
 }
 
 // A triangle item: the piece's candidates [item.y, item.y + chunk) from the walk in item.zw,

@@ -37,7 +37,11 @@ pub fn subdivide_params(settings: &RenderSettings, first_triangle: u32, triangle
         seamless: matches!(projection.panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap | PanoramaKind::Cave)
             as u32,
         pinhole_faces: (projection.panorama == PanoramaKind::Cubemap) as u32,
-        _pad: [0; 3],
+        // Prototype: the sphere's panoramas under the error split, with TWISTER_NODE_OFFSETS set.
+        node_offsets: (projection.panorama.is_sphere()
+            && rule == SplitRule::AdaptiveError
+            && std::env::var_os("TWISTER_NODE_OFFSETS").is_some()) as u32,
+        _pad: [0; 2],
     }
 }
 

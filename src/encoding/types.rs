@@ -178,7 +178,9 @@ pub struct SubdivideParams {
     /// along the ray): an edge is split for how far its eye point turns from the chord, and for
     /// its length (the angle it spans) — `Subdivider::pinhole_profile`.
     pub pinhole_faces: u32,
-    pub _pad: [u32; 3],
+    /// 1: nodes are drawn off their projections (`DrawVertex::offsets`; `cpu::subdivide::offsets`).
+    pub node_offsets: u32,
+    pub _pad: [u32; 2],
 }
 
 /// `Counters` in shaders/shared/subdivide_types.wgsl.
@@ -413,6 +415,9 @@ pub struct PieceWork {
     /// band's measures (`row_measures`).
     pub row_w: [u32; 33],
     pub _pad: [u32; 3],
+    /// Where its nodes are drawn off their projections (`cpu::subdivide::offsets`; image pixels,
+    /// y down, left (x, y) and right (x, y)): inside edge 0, 1, 2; at corner 0, 1, 2; inside.
+    pub offsets: [[f32; 4]; 7],
 }
 
 impl Default for PieceWork {
@@ -542,11 +547,11 @@ pub const LAYOUTS: &[StructLayout] = &[
     }),
     layout!("SubdivideParams" => SubdivideParams {
         view, projection, axis_clearance, triangle_count, first_triangle, method, fixed_n, edge_px, max_div,
-        piece_capacity, triangle_capacity, first_piece, piece_count, measure_edges, vertical_limit, max_error_px, by_azimuth, seamless, pinhole_faces, _pad
+        piece_capacity, triangle_capacity, first_piece, piece_count, measure_edges, vertical_limit, max_error_px, by_azimuth, seamless, pinhole_faces, node_offsets, _pad
     }),
     layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, nodes, cut_wide, max_pieces, max_output, parts, node_items, triangle_items, row_items, pending, cuts_low, cuts_high, _pad }),
     layout!("Piece" => Piece { triangle, cell, counts01, count2_level, corner, bary1, bary2 }),
-    layout!("PieceWork" => PieceWork { shape, m, node_count, candidates, copies, first_node, counts, strip_n, refs, row_w, _pad }),
+    layout!("PieceWork" => PieceWork { shape, m, node_count, candidates, copies, first_node, counts, strip_n, refs, row_w, _pad, offsets }),
     layout!("DrawIndexedIndirectArgs" => DrawIndexedIndirectArgs { index_count, instance_count, first_index, base_vertex, first_instance }),
     layout!("RasterParams" => RasterParams { projection, eye_sign, ambient, shift_px, error_angle, w_by_radius, _pad1, _pad2 }),
     layout!("DisplayParams" => DisplayParams { projection, mode, width, height, row_texels, layers, srgb_target, _pad0, _pad1, area, look, overlay }),

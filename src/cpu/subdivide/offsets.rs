@@ -19,7 +19,6 @@ use std::collections::HashMap;
 use glam::{Vec2, Vec3};
 
 use super::piece::PieceGeometry;
-use super::spacing::Spacing;
 use super::{lex_less, Node, Subdivider};
 use crate::core::projection::horizontal_radius;
 use crate::encoding::constants::{AZIMUTH_MIN_RADIUS, EDGE_SAMPLES};
@@ -32,12 +31,9 @@ fn widen(slot: &mut Vec2, e: Vec2) {
 }
 
 impl Subdivider<'_> {
-    /// Whether the frame draws nodes off their projections: the sphere's panoramas under the
-    /// error split (prototype: with `TWISTER_NODE_OFFSETS` set).
+    /// Whether the frame draws nodes off their projections (`SubdivideParams::node_offsets`).
     pub(super) fn draws_offsets(&self) -> bool {
-        self.projection.panorama.is_sphere()
-            && self.spacing() == Spacing::Azimuth
-            && std::env::var_os("TWISTER_NODE_OFFSETS").is_some()
+        self.params.node_offsets != 0
     }
 
     /// The x difference b − a in pixels, across the seam the short way.
@@ -164,7 +160,6 @@ mod tests {
     /// offsets agree bit for bit, so the drawing stays watertight.
     #[test]
     fn every_copy_of_a_node_takes_the_same_offset() {
-        std::env::set_var("TWISTER_NODE_OFFSETS", "1");
         for (name, scene, viewer) in [
             ("demo", builtin::demo(), Vec3::ZERO),
             ("box room", builtin::builtin_scene("builtin:box-room", &Projection::equirect(512)).unwrap(), Vec3::ZERO),
@@ -175,7 +170,8 @@ mod tests {
                     .with_method(Method::Adaptive(Split::Error))
                     .with_viewer(viewer)
                     .with_max_error_px(0.7);
-                let params = subdivide_params(&settings, 0, scene.triangle_count() as u32);
+                let mut params = subdivide_params(&settings, 0, scene.triangle_count() as u32);
+                params.node_offsets = 1;
                 let out = subdivide(&params, &scene.vertices, &scene.indices);
                 let mut seen: HashMap<([u32; 3], i32), [f32; 4]> = HashMap::new();
                 let mut offset_nodes = 0;
