@@ -224,6 +224,7 @@ fn piece_offsets(node_count: u32, part: ptr<function, PartPlan>, piece_state: pt
         var a = vec3<f32>(0.0);
         var b = vec3<f32>(0.0);
         var parts = 0u;
+        var reuse = 6u;
         if (i < 3u) {
             if ((*piece_state).counts[i] >= 2u && node_count > 3u) {
                 let s = along_edge(i, 0u, part, piece_state);
@@ -232,29 +233,45 @@ fn piece_offsets(node_count: u32, part: ptr<function, PartPlan>, piece_state: pt
                 parts = s.n;
             }
         } else if ((*piece_state).corner_line[i - 3u] >= 0) {
-            let oe = u32((*piece_state).corner_line[i - 3u]);
-            a = corner(oe, part).position;
-            b = corner((oe + 1u) % 3u, part).position;
-            parts = (*part).n[oe];
+            let oe = (*piece_state).corner_line[i - 3u];
+            a = corner(u32(oe), part).position;
+            b = corner((u32(oe) + 1u) % 3u, part).position;
+            parts = (*part).n[u32(oe)];
+            // The same line as an edge's already measured: its offsets.
+            for (var e = 0u; e < 3u; e++) {
+                if ((*piece_state).original[e] == oe && (*piece_state).counts[e] >= 2u && node_count > 3u) {
+                    reuse = e;
+                }
+            }
         }
-        if (parts >= 2u) {
+        if (reuse < 3u) {
+            out[i] = out[reuse];
+        } else if (parts >= 2u) {
             out[i] = line_offsets(a, b, parts);
         }
     }
     if (node_count <= 3u) {
         return out;
     }
+    // Sampled: each edge's first, middle and last segments (`sampled_segments`).
     var inside: array<vec2<f32>, 2>;
     for (var e = 0u; e < 3u; e++) {
-        for (var m = 0u; m < (*piece_state).counts[e]; m++) {
+        let count = (*piece_state).counts[e];
+        let last = max(count, 1u) - 1u;
+        let picks = vec3<u32>(0u, last / 2u, last);
+        for (var i = 0u; i < select(0u, 3u, count > 0u); i++) {
+            if (i > 0u && picks[i] == picks[i - 1u]) {
+                continue;
+            }
+            let m = picks[i];
             let pa = node_on_edge(e, m, part, piece_state).position;
             let pb = node_on_edge(e, m + 1u, part, piece_state).position;
             let wa = max(horizontal_radius(pa), AZIMUTH_MIN_RADIUS);
             let wb = max(horizontal_radius(pb), AZIMUTH_MIN_RADIUS);
             let ends = array<vec3<f32>, 3>(pa, pb, (pa / wa + pb / wb) / (1.0 / wa + 1.0 / wb));
             var q: array<array<vec2<f32>, 2>, 3>;
-            for (var i = 0u; i < 3u; i++) {
-                q[i] = pixels(ends[i], eye_offset(params.projection, horizontal_radius(ends[i]), ends[i].y));
+            for (var j = 0u; j < 3u; j++) {
+                q[j] = pixels(ends[j], eye_offset(params.projection, horizontal_radius(ends[j]), ends[j].y));
             }
             for (var s = 0u; s < 2u; s++) {
                 let err = unwrapped_px(q[0][s], q[2][s]) - 0.5 * unwrapped_px(q[0][s], q[1][s]);

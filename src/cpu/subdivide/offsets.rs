@@ -23,6 +23,14 @@ use super::{lex_less, Node, Subdivider};
 use crate::core::projection::horizontal_radius;
 use crate::encoding::constants::{AZIMUTH_MIN_RADIUS, EDGE_SAMPLES};
 
+/// The segments of an edge of `count` parts whose errors the inside's offset reads: the first,
+/// the middle and the last (each once).
+fn sampled_segments(count: u32) -> impl Iterator<Item = u32> {
+    let last = count.saturating_sub(1);
+    let picks = [0, last / 2, last];
+    (0..3).filter(move |&i| count > 0 && (i == 0 || picks[i] != picks[i - 1])).map(move |i| picks[i])
+}
+
 /// Keeps the longer of two error vectors.
 fn widen(slot: &mut Vec2, e: Vec2) {
     if e.length() > slot.length() {
@@ -114,19 +122,16 @@ impl Subdivider<'_> {
                 on_edge.insert(key(g.node_on_edge(e, m).position), e);
             }
         }
-        // The piece's boundary segments (a pair of slots in one candidate only) and their errors.
-        let mut pairs: HashMap<(u32, u32), u32> = HashMap::new();
-        for t in slots {
-            for e in 0..3 {
-                let (a, b) = (t[e], t[(e + 1) % 3]);
-                *pairs.entry((a.min(b), a.max(b))).or_default() += 1;
-            }
-        }
+        // Half the largest error of the piece's boundary segments, sampled: on each edge its
+        // first, middle and last segments (`sampled_segments`).
+        let _ = slots;
         let mut inside = [Vec2::ZERO; 2];
-        for (&(a, b), _) in pairs.iter().filter(|(_, &c)| c == 1) {
-            let errors = self.midpoint_errors(nodes[a as usize].position, nodes[b as usize].position);
-            for s in 0..2 {
-                widen(&mut inside[s], 0.5 * errors[s]);
+        for e in 0..3 {
+            for m in sampled_segments(g.counts()[e]) {
+                let errors = self.midpoint_errors(g.node_on_edge(e, m).position, g.node_on_edge(e, m + 1).position);
+                for s in 0..2 {
+                    widen(&mut inside[s], 0.5 * errors[s]);
+                }
             }
         }
         for (k, node) in nodes.iter().enumerate() {
