@@ -49,7 +49,7 @@
 // first node slot or candidate, the walk at that candidate (two u16 pairs)), for
 // `lattice_nodes` from the front and for `lattice_triangles` from the back (room for as many as
 // the output's nodes: each item has at least one node's worth, see `work_items` in lattice.rs).
-@group(0) @binding(15) var<storage, read_write> piece_work: array<PieceWork>;
+@group(0) @binding(15) var<storage, read_write> piece_work: array<StoredWork>;
 @group(0) @binding(16) var<storage, read_write> lattice_work: array<vec4<u32>>;
 // The bands of the pieces whose rows `lattice_rows` measures, (piece << 5) | band, in the
 // output's index buffer (`out_indices`) from its back (`row_item_slot`): a piece of R rows has

@@ -10,7 +10,7 @@
 
 fn write_in_place(index: u32, work: PieceWork, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
     if (work.first_node + work.copies * work.node_count <= params.triangle_capacity) {
-        write_nodes(0u, work, tri, part, piece_state);
+        write_nodes(0u, index, work, tri, part, piece_state);
         write_triangles(vec4<u32>(index, 0u, 0u, 0u), work, piece_state);
     }
 }

@@ -122,8 +122,13 @@ struct PieceWork {
     refs: vec4<f32>,
     row_w: array<u32, 33>,
     _pad: array<u32, 3>,
-    // Where its nodes are drawn off their projections (image pixels, y down, left xy, right xy):
-    // inside edge 0, 1, 2; at corner 0, 1, 2; inside (`piece_offsets`).
+}
+
+// A piece's work as `piece_work` stores it, with where its nodes are drawn off their
+// projections (image pixels, y down, left xy, right xy): inside edge 0, 1, 2; at corner 0, 1, 2;
+// inside (`piece_offsets`). Apart from `PieceWork`, which the passes copy by value.
+struct StoredWork {
+    work: PieceWork,
     offsets: array<vec4<f32>, 7>,
 }
 

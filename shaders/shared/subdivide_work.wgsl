@@ -47,14 +47,16 @@ fn plan_work(index: u32, shape: PieceShape, seam: SeamCopies, tri: ptr<function,
     if (work.shape == ROWS_SHAPE) {
         work.row_w = (*piece_state).row_w;
     }
-    work.offsets = piece_offsets(shape.node_count, part, piece_state);
+    if (params.node_offsets != 0u) {
+        piece_work[index].offsets = piece_offsets(shape.node_count, part, piece_state);
+    }
     work.first_node = atomicAdd(&counters.nodes, copies * shape.node_count);
     let chunk = chunk_of(copies);
     if (shape.node_count <= chunk && shape.candidates <= chunk) {
         write_in_place(index, work, tri, part, piece_state);
         return;
     }
-    piece_work[index] = work;
+    piece_work[index].work = work;
     let len = work_capacity();
     let node_items = (shape.node_count + chunk - 1u) / chunk;
     let at = atomicAdd(&counters.node_items, node_items);
@@ -94,7 +96,7 @@ fn plan_pending(index: u32, shape: PieceShape, piece_state: ptr<function, PieceS
     work.candidates = shape.candidates;
     work.counts = (*piece_state).counts[0] | ((*piece_state).counts[1] << 8u) | ((*piece_state).counts[2] << 16u) | ((*piece_state).row_base << 24u);
     work.strip_n = (*piece_state).strip_n.x | ((*piece_state).strip_n.y << 16u);
-    piece_work[index] = work;
+    piece_work[index].work = work;
     let r = max((*piece_state).strip_n.x, (*piece_state).strip_n.y);
     let base = atomicAdd(&counters.row_items, r);
     for (var b = 0u; b < r; b++) {
@@ -134,13 +136,13 @@ fn load_work(index: u32, work: PieceWork, part: ptr<function, PartPlan>, piece_s
 // in their own order (`rows_along`: each row's ends first, which its other nodes lie between),
 // until no step is left that writes a slot of the item's (`rows_bound`); an end outside the
 // item is placed and not written.
-fn write_nodes(first: u32, work: PieceWork, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
+fn write_nodes(first: u32, index: u32, work: PieceWork, tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
     let end = min(first + chunk_of(work.copies), work.node_count);
     let corners_only = work.shape == LATTICE_SHAPE && work.m == 1u;
     let rows = work.shape == ROWS_SHAPE;
     var k = first;
     for (; k < select(first, end, corners_only); k++) {
-        write_node((*piece_state).corner[k], k, work.offsets[3u + k], work, tri);
+        write_node((*piece_state).corner[k], k, corner_offset(index, k), work, tri);
     }
     var row = node_row_at(k, work.m, piece_state);
     var next = k;
@@ -148,7 +150,7 @@ fn write_nodes(first: u32, work: PieceWork, tri: ptr<function, InputTriangle>, p
         let slot = select(k, rows_slot(row, piece_state), rows);
         let node = piece_node(k, work.m, &row, part, piece_state);
         if (slot >= first && slot < end) {
-            write_node(node, slot, node_offset(node, work, piece_state), work, tri);
+            write_node(node, slot, node_offset(node, index, piece_state), work, tri);
         }
         k += 1u;
         next = select(k, rows_bound(row), rows);
@@ -283,16 +285,30 @@ fn piece_offsets(node_count: u32, part: ptr<function, PartPlan>, piece_state: pt
     return out;
 }
 
-// Where a node just placed by `piece_node` is drawn off its projection: a corner's, an edge's
-// (`node_edge`), or the inside's.
-fn node_offset(node: Node, work: PieceWork, piece_state: ptr<function, PieceState>) -> vec4<f32> {
+// Where piece `index`'s corner c is drawn off its projection.
+fn corner_offset(index: u32, c: u32) -> vec4<f32> {
+    if (params.node_offsets == 0u) {
+        return vec4<f32>(0.0);
+    }
+    return piece_work[index].offsets[3u + c];
+}
+
+// Where a node of piece `index` just placed by `piece_node` is drawn off its projection: a
+// corner's, an edge's (`node_edge`), or the inside's.
+fn node_offset(node: Node, index: u32, piece_state: ptr<function, PieceState>) -> vec4<f32> {
+    if (params.node_offsets == 0u) {
+        return vec4<f32>(0.0);
+    }
+    var i = min((*piece_state).node_edge, 3u) * 2u; // an edge's slot (0–2), or 6 inside
+    if (i < 6u) {
+        i = (*piece_state).node_edge;
+    }
     for (var c = 0u; c < 3u; c++) {
         if (same(node.position, (*piece_state).corner[c].position)) {
-            return work.offsets[3u + c];
+            i = 3u + c;
         }
     }
-    let e = (*piece_state).node_edge;
-    return select(work.offsets[6], work.offsets[min(e, 2u)], e < 3u);
+    return piece_work[index].offsets[i];
 }
 
 // A triangle item: the piece's candidates [item.y, item.y + chunk) from the walk in item.zw,

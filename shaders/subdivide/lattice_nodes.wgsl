@@ -28,8 +28,8 @@ fn lattice_nodes(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_wor
         return;
     }
     let item = lattice_work[local];
-    let work = piece_work[item.x];
+    let work = piece_work[item.x].work;
     load_triangle(pieces[item.x].triangle, &tri);
     load_work(item.x, work, &part, &piece_state);
-    write_nodes(item.y, work, &tri, &part, &piece_state);
+    write_nodes(item.y, item.x, work, &tri, &part, &piece_state);
 }

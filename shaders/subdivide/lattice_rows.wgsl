@@ -31,8 +31,8 @@ fn lattice_rows(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     let item = row_items[row_item_slot(local)];
     let index = item >> 5u;
     let b = item & 31u;
-    let work = piece_work[index];
+    let work = piece_work[index].work;
     load_triangle(pieces[index].triangle, &tri);
     load_work(index, work, &part, &piece_state);
-    piece_work[index].row_w[b] = row_measures(b, &tri, &part, &piece_state);
+    piece_work[index].work.row_w[b] = row_measures(b, &tri, &part, &piece_state);
 }

@@ -31,7 +31,7 @@ fn lattice_rows_plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
         return;
     }
     let index = parts[local].triangle;
-    let work = piece_work[index];
+    let work = piece_work[index].work;
     load_triangle(pieces[index].triangle, &tri);
     load_work(index, work, &part, &piece_state);
     let rows = rows_from_measures(&piece_state);

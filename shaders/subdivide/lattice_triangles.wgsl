@@ -28,7 +28,7 @@ fn lattice_triangles(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
         return;
     }
     let item = lattice_work[work_capacity() - 1u - local];
-    let work = piece_work[item.x];
+    let work = piece_work[item.x].work;
     load_work(item.x, work, &part, &piece_state);
     write_triangles(item, work, &piece_state);
 }

@@ -20,7 +20,7 @@ use crate::encoding::recording::Recording;
 use crate::encoding::subdivide::{
     active_cuts, dispatched, one_submission, pass_run, subdivide_params, AxisCuts, PassTiming, Passes, SubdivideOutput,
 };
-use crate::encoding::types::{DrawVertex, Piece, PieceWork, SubdivideCounters, SubdivideParams};
+use crate::encoding::types::{DrawVertex, Piece, StoredWork, SubdivideCounters, SubdivideParams};
 use crate::error::{Error, Result};
 
 /// Bytes of one piece record (`pieces`) or part record (`parts`).
@@ -29,7 +29,7 @@ pub const RECORD_SIZE: u64 = std::mem::size_of::<Piece>() as u64;
 /// many as `pieces`) and its work (`piece_work`).
 pub const PIECE_SIZE: u64 = 2 * RECORD_SIZE + WORK_SIZE;
 /// Bytes of a piece's work (`piece_work`).
-pub const WORK_SIZE: u64 = std::mem::size_of::<PieceWork>() as u64;
+pub const WORK_SIZE: u64 = std::mem::size_of::<StoredWork>() as u64;
 /// Bytes of one work item (`lattice_work`: room for one per output unit).
 pub const ITEM_SIZE: u64 = 16;
 /// Bytes of one output node.

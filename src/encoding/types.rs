@@ -415,8 +415,16 @@ pub struct PieceWork {
     /// band's measures (`row_measures`).
     pub row_w: [u32; 33],
     pub _pad: [u32; 3],
-    /// Where its nodes are drawn off their projections (`cpu::subdivide::offsets`; image pixels,
-    /// y down, left (x, y) and right (x, y)): inside edge 0, 1, 2; at corner 0, 1, 2; inside.
+}
+
+/// `StoredWork` in shaders/shared/subdivide_types.wgsl: a piece's work as `piece_work` stores it,
+/// with where its nodes are drawn off their projections (`cpu::subdivide::offsets`; image
+/// pixels, y down, left (x, y) and right (x, y)): inside edge 0, 1, 2; at corner 0, 1, 2; inside.
+/// Apart from `PieceWork`, which the passes copy by value.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct StoredWork {
+    pub work: PieceWork,
     pub offsets: [[f32; 4]; 7],
 }
 
@@ -551,7 +559,8 @@ pub const LAYOUTS: &[StructLayout] = &[
     }),
     layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, nodes, cut_wide, max_pieces, max_output, parts, node_items, triangle_items, row_items, pending, cuts_low, cuts_high, _pad }),
     layout!("Piece" => Piece { triangle, cell, counts01, count2_level, corner, bary1, bary2 }),
-    layout!("PieceWork" => PieceWork { shape, m, node_count, candidates, copies, first_node, counts, strip_n, refs, row_w, _pad, offsets }),
+    layout!("PieceWork" => PieceWork { shape, m, node_count, candidates, copies, first_node, counts, strip_n, refs, row_w, _pad }),
+    layout!("StoredWork" => StoredWork { work, offsets }),
     layout!("DrawIndexedIndirectArgs" => DrawIndexedIndirectArgs { index_count, instance_count, first_index, base_vertex, first_instance }),
     layout!("RasterParams" => RasterParams { projection, eye_sign, ambient, shift_px, error_angle, w_by_radius, _pad1, _pad2 }),
     layout!("DisplayParams" => DisplayParams { projection, mode, width, height, row_texels, layers, srgb_target, _pad0, _pad1, area, look, overlay }),
