@@ -79,6 +79,9 @@ struct EdgeProfile {
     bend_px: f32,
     ring: bool,
     residual_px: f32,  // the drawing's residual against the azimuth steps (`EdgeProfile`)
+    // Each eye's largest second difference (the left's xy, the right's zw; y up): where nodes
+    // are drawn off their projections, a line's offset (`line_offsets`).
+    bend_vec: vec4<f32>,
 }
 
 fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
@@ -95,7 +98,7 @@ fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
     if (pinhole) {
         angle_px = atan2(length(cross(lo, hi)), dot(lo, hi)) * params.projection.turn_px / TAU;
         if (seen_from_centre(lo, hi)) {
-            return EdgeProfile(angle_px, 0.0, false, 0.0);
+            return EdgeProfile(angle_px, 0.0, false, 0.0, vec4<f32>(0.0));
         }
     }
     let clamp_v = 1.5 * params.projection.height;
@@ -104,6 +107,7 @@ fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
     var longest = 0.0;
     var nearest = 1e30;
     var bend = 0.0;
+    var bend_vec: array<vec2<f32>, 2>;
     let sp = spacer(lo, hi);
     // Each point projected once for both eyes (`pixels`), each eye's walk kept apart.
     var total = vec2<f32>(0.0);
@@ -147,7 +151,9 @@ fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
             }
             let unwrapped = vec2<f32>(select(raw.x, q1[s].x + dx, k > 0u), raw.y);
             if (k >= 2u && abs(unwrapped.y) < clamp_v && abs(q1[s].y) < clamp_v && abs(q0[s].y) < clamp_v) {
-                bend = max(bend, length(unwrapped - 2.0 * q1[s] + q0[s]));
+                let second = unwrapped - 2.0 * q1[s] + q0[s];
+                bend = max(bend, length(second));
+                bend_vec[s] = select(bend_vec[s], second, length(second) > length(bend_vec[s]));
             }
             q0[s] = q1[s];
             q1[s] = unwrapped;
@@ -160,11 +166,11 @@ fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
     let shows_ring = !VERTICAL_EXACT || params.projection.vertical_exact == 0u || is_sphere(params.projection);
     let ring = shows_ring && nearest < 0.0;
     if (pinhole) {
-        return EdgeProfile(angle_px, eye_bend * params.projection.turn_px / TAU, ring, 0.0);
+        return EdgeProfile(angle_px, eye_bend * params.projection.turn_px / TAU, ring, 0.0, vec4<f32>(0.0));
     }
     let stretch = select(MAX_STRETCH, 1.0, ring);
     let residual = AZIMUTH_CHORD_RESIDUAL * sp.turn * sp.turn * f32(segments) * longest;
-    return EdgeProfile(max(length_px, f32(segments) * longest / stretch), bend, ring, residual);
+    return EdgeProfile(max(length_px, f32(segments) * longest / stretch), bend, ring, residual, vec4<f32>(bend_vec[0], bend_vec[1]));
 }
 
 // Parts that keep the drawing's residual within AZIMUTH_RESIDUAL_ERROR·τ (`parts_for_residual`).
@@ -286,10 +292,12 @@ fn is_adaptive() -> bool {
 // Edge counts and macro-lattice level of the current part.
 fn plan_part(tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>) {
     let c = array<vec3<f32>, 3>((*part).corner[0].position, (*part).corner[1].position, (*part).corner[2].position);
-    let n = edge_counts(c, vec3<bool>(true), tri);
+    var bends: array<vec4<f32>, 3>;
+    let n = edge_counts(c, vec3<bool>(true), tri, &bends);
     for (var e = 0u; e < 3u; e++) {
         (*part).n[e] = n[e];
     }
+    (*part).bend = bends;
     plan_level(part);
 }
 
@@ -297,7 +305,7 @@ fn plan_part(tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>) {
 // others; `Subdivider::edge_divisions` of each), their rounds interleaved: the quick profiles, then the full ones of the edges that
 // need them, listed, from one call site of the profile, so that side by side invocations
 // measure together (one measuring an edge fully while another waited, three times over).
-fn edge_counts(c: array<vec3<f32>, 3>, wanted: vec3<bool>, tri: ptr<function, InputTriangle>) -> vec3<u32> {
+fn edge_counts(c: array<vec3<f32>, 3>, wanted: vec3<bool>, tri: ptr<function, InputTriangle>, bends: ptr<function, array<vec4<f32>, 3>>) -> vec3<u32> {
     var n = vec3<u32>(0u);
     var list: array<u32, 6>;
     var count = 0u;
@@ -316,9 +324,11 @@ fn edge_counts(c: array<vec3<f32>, 3>, wanted: vec3<bool>, tri: ptr<function, In
         let e = list[k];
         let full = k >= quick;
         let segments = select(2u, EDGE_SAMPLES, full);
-        let parts = divisions_of(select(0u, 1u, full), edge_profile(c[e], c[(e + 1u) % 3u], segments), segments, tri);
+        let profile = edge_profile(c[e], c[(e + 1u) % 3u], segments);
+        let parts = divisions_of(select(0u, 1u, full), profile, segments, tri);
         if (full || parts == 1.0) {
             n[e] = division_count(parts);
+            (*bends)[e] = select(vec4<f32>(0.0), profile.bend_vec, full);
         } else {
             list[count] = e;
             count += 1u;

@@ -127,6 +127,7 @@ fn part_record(t: u32, part: ptr<function, PartPlan>) -> Piece {
     record.triangle = t;
     record.counts01 = (*part).n[0] | ((*part).n[1] << 16u);
     record.count2_level = (*part).n[2] | ((*part).k << 16u) | select(0u, BANDS, (*part).bands);
+    record.bend = (*part).bend;
     for (var i = 0u; i < 3u; i++) {
         record.corner[i] = vec4<f32>((*part).corner[i].position, (*part).corner[i].bary.x);
         record.bary1[i] = (*part).corner[i].bary.y;
@@ -166,6 +167,7 @@ fn append_part(t: u32, part: ptr<function, PartPlan>) {
 
 // A part's corners from its record (`record_corner` in src/cpu/subdivide/passes.rs).
 fn record_corners(record: Piece, part: ptr<function, PartPlan>) {
+    (*part).bend = record.bend;
     for (var i = 0u; i < 3u; i++) {
         (*part).corner[i] = Node(record.corner[i].xyz, vec3<f32>(record.corner[i].w, record.bary1[i], record.bary2[i]));
     }
@@ -545,7 +547,9 @@ fn piece_edges(loc: array<vec3<u32>, 3>, part: ptr<function, PartPlan>, piece_st
 fn interior_counts(tri: ptr<function, InputTriangle>, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) {
     let inside = vec3<bool>((*piece_state).original[0] < 0, (*piece_state).original[1] < 0, (*piece_state).original[2] < 0);
     let c = array<vec3<f32>, 3>((*piece_state).corner[0].position, (*piece_state).corner[1].position, (*piece_state).corner[2].position);
-    let n = edge_counts(c, inside, tri);
+    var bends: array<vec4<f32>, 3>;
+    let n = edge_counts(c, inside, tri, &bends);
+    (*piece_state).bend = bends;
     for (var e = 0u; e < 3u; e++) {
         if (inside[e]) {
             if (split_rule() == METHOD_FIXED) {

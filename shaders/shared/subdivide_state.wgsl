@@ -27,6 +27,7 @@ struct PartPlan {
     k: u32,             // macro-lattice level
     bands: bool,        // a long thin part cut in bands (`PartSplit::bands`), not K² cells
     appended: u32,      // piece records the invocation appended so far (`max_pieces`)
+    bend: array<vec4<f32>, 3>, // each edge's profile's bend vectors (`EdgeProfile::bend_vec`; 0 if not fully measured)
 }
 
 // The piece being subdivided (`lattice`).
@@ -43,6 +44,7 @@ struct PieceState {
     row_ends: array<Node, 2>, // rows: the current row's ends (left, right), placed first (`rows_along`)
     corner_line: array<i32, 3>, // the original edge corner c lies inside, or −1 (`piece_offsets`)
     node_edge: u32,          // the piece edge the last node `piece_node` placed lies on; 3: inside
+    bend: array<vec4<f32>, 3>, // each edge inside the part: its profile's bend vectors (`interior_counts`)
 }
 
 // A polygon while it is clipped (at most 7 corners), and a quadrant's polygon kept while its

@@ -102,6 +102,7 @@ struct Piece {
     corner: array<vec4<f32>, 3>, // position, barycentric weight of the triangle's corner 0
     bary1: vec4<f32>,   // weights of corners 1 and 2 at the part's corners 0, 1, 2
     bary2: vec4<f32>,
+    bend: array<vec4<f32>, 3>, // each edge's profile's bend vectors (`EdgeProfile::bend_vec`)
 }
 
 // What `lattice` planned for a piece (at the piece's index), which its work items read: its

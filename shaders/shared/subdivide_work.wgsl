@@ -97,6 +97,13 @@ fn plan_pending(index: u32, shape: PieceShape, piece_state: ptr<function, PieceS
     work.counts = (*piece_state).counts[0] | ((*piece_state).counts[1] << 8u) | ((*piece_state).counts[2] << 16u) | ((*piece_state).row_base << 24u);
     work.strip_n = (*piece_state).strip_n.x | ((*piece_state).strip_n.y << 16u);
     piece_work[index].work = work;
+    if (params.node_offsets != 0u) {
+        // Its edges' bend vectors, for `lattice_rows_plan` (which does not measure them again),
+        // kept where its offsets will be (`load_bends`).
+        for (var e = 0u; e < 3u; e++) {
+            piece_work[index].offsets[e] = (*piece_state).bend[e];
+        }
+    }
     let r = max((*piece_state).strip_n.x, (*piece_state).strip_n.y);
     let base = atomicAdd(&counters.row_items, r);
     for (var b = 0u; b < r; b++) {
@@ -181,34 +188,13 @@ fn widened(slot: vec2<f32>, e: vec2<f32>) -> vec2<f32> {
     return select(slot, e, length(e) > length(slot));
 }
 
-// Half the part error of line a–b drawn in `parts` parts, both eyes (image pixels, y down: left
-// x, y, right x, y), from the largest second differences of its image at EDGE_SAMPLES steps of
-// the frame's spacing (`line_offsets`).
-fn line_offsets(a: vec3<f32>, b: vec3<f32>, parts: u32) -> vec4<f32> {
-    var lo = a;
-    var hi = b;
-    if (lex_less(b, a)) {
-        lo = b;
-        hi = a;
-    }
-    let sp = spacer(lo, hi);
-    var q0: array<vec2<f32>, 2>;
-    var q1: array<vec2<f32>, 2>;
-    var bend: array<vec2<f32>, 2>;
-    for (var k = 0u; k <= EDGE_SAMPLES; k++) {
-        let p = lo + (hi - lo) * spaced(sp, f32(k) / f32(EDGE_SAMPLES));
-        let q = pixels(p, eye_offset(params.projection, horizontal_radius(p), p.y));
-        for (var s = 0u; s < 2u; s++) {
-            if (k >= 2u) {
-                bend[s] = widened(bend[s], unwrapped_px(q1[s], q[s]) - unwrapped_px(q0[s], q1[s]));
-            }
-            q0[s] = q1[s];
-            q1[s] = q[s];
-        }
-    }
+// Half the part error of a line drawn in `parts` parts, both eyes (image pixels, y down: left
+// x, y, right x, y), from its profile's bend vectors (`EdgeProfile::bend_vec`, y up: the
+// largest second differences at EDGE_SAMPLES steps) (`line_offsets`).
+fn line_offsets(bend: vec4<f32>, parts: u32) -> vec4<f32> {
     let step = f32(EDGE_SAMPLES) / f32(parts);
-    let o0 = -0.5 * bend[0] * (step * step) / 8.0;
-    let o1 = -0.5 * bend[1] * (step * step) / 8.0;
+    let o0 = -0.5 * bend.xy * (step * step) / 8.0;
+    let o1 = -0.5 * bend.zw * (step * step) / 8.0;
     return vec4<f32>(o0.x, -o0.y, o1.x, -o1.y);
 }
 
@@ -223,33 +209,21 @@ fn piece_offsets(node_count: u32, part: ptr<function, PartPlan>, piece_state: pt
         return out;
     }
     for (var i = 0u; i < 6u; i++) {
-        var a = vec3<f32>(0.0);
-        var b = vec3<f32>(0.0);
+        var bend = vec4<f32>(0.0);
         var parts = 0u;
-        var reuse = 6u;
         if (i < 3u) {
             if ((*piece_state).counts[i] >= 2u && node_count > 3u) {
-                let s = along_edge(i, 0u, part, piece_state);
-                a = s.a.position;
-                b = s.b.position;
-                parts = s.n;
+                let oe = (*piece_state).original[i];
+                bend = select((*piece_state).bend[i], (*part).bend[max(oe, 0)], oe >= 0);
+                parts = select((*piece_state).counts[i], (*part).n[max(oe, 0)], oe >= 0);
             }
         } else if ((*piece_state).corner_line[i - 3u] >= 0) {
-            let oe = (*piece_state).corner_line[i - 3u];
-            a = corner(u32(oe), part).position;
-            b = corner((u32(oe) + 1u) % 3u, part).position;
-            parts = (*part).n[u32(oe)];
-            // The same line as an edge's already measured: its offsets.
-            for (var e = 0u; e < 3u; e++) {
-                if ((*piece_state).original[e] == oe && (*piece_state).counts[e] >= 2u && node_count > 3u) {
-                    reuse = e;
-                }
-            }
+            let oe = u32((*piece_state).corner_line[i - 3u]);
+            bend = (*part).bend[oe];
+            parts = (*part).n[oe];
         }
-        if (reuse < 3u) {
-            out[i] = out[reuse];
-        } else if (parts >= 2u) {
-            out[i] = line_offsets(a, b, parts);
+        if (parts >= 2u) {
+            out[i] = line_offsets(bend, parts);
         }
     }
     if (node_count <= 3u) {
@@ -283,6 +257,15 @@ fn piece_offsets(node_count: u32, part: ptr<function, PartPlan>, piece_state: pt
     }
     out[6] = vec4<f32>(inside[0].x, -inside[0].y, inside[1].x, -inside[1].y);
     return out;
+}
+
+// A pending piece's edges' bend vectors, kept by `plan_pending`.
+fn load_bends(index: u32, piece_state: ptr<function, PieceState>) {
+    if (params.node_offsets != 0u) {
+        for (var e = 0u; e < 3u; e++) {
+            (*piece_state).bend[e] = piece_work[index].offsets[e];
+        }
+    }
 }
 
 // Where piece `index`'s corner c is drawn off its projection.

@@ -34,6 +34,7 @@ fn lattice_rows_plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num
     let work = piece_work[index].work;
     load_triangle(pieces[index].triangle, &tri);
     load_work(index, work, &part, &piece_state);
+    load_bends(index, &piece_state);
     let rows = rows_from_measures(&piece_state);
     let c = piece_state.corner;
     var shape = PieceShape(work.m, work.candidates, work.node_count, azimuth((c[0].position + c[1].position + c[2].position) / 3.0));

@@ -386,6 +386,9 @@ pub struct Piece {
     /// part's corners 0, 1, 2).
     pub bary1: [f32; 4],
     pub bary2: [f32; 4],
+    /// Each edge's profile's bend vectors (`EdgeProfile::bend_vec`: left x, y, right x, y; 0
+    /// where not fully measured), for the nodes drawn off their projections.
+    pub bend: [[f32; 4]; 3],
 }
 
 /// `PieceWork` in shaders/shared/subdivide_types.wgsl: what `lattice` planned for a piece (at
@@ -558,7 +561,7 @@ pub const LAYOUTS: &[StructLayout] = &[
         piece_capacity, triangle_capacity, first_piece, piece_count, measure_edges, vertical_limit, max_error_px, by_azimuth, seamless, pinhole_faces, node_offsets, _pad
     }),
     layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, nodes, cut_wide, max_pieces, max_output, parts, node_items, triangle_items, row_items, pending, cuts_low, cuts_high, _pad }),
-    layout!("Piece" => Piece { triangle, cell, counts01, count2_level, corner, bary1, bary2 }),
+    layout!("Piece" => Piece { triangle, cell, counts01, count2_level, corner, bary1, bary2, bend }),
     layout!("PieceWork" => PieceWork { shape, m, node_count, candidates, copies, first_node, counts, strip_n, refs, row_w, _pad }),
     layout!("StoredWork" => StoredWork { work, offsets }),
     layout!("DrawIndexedIndirectArgs" => DrawIndexedIndirectArgs { index_count, instance_count, first_index, base_vertex, first_instance }),

@@ -42,6 +42,9 @@ pub struct EdgeProfile {
     /// its step of azimuth (`AZIMUTH_CHORD_RESIDUAL`·D³ radians, D the sweep, × the fastest
     /// pixels per radian sampled); n parts leave 1/n³ of it. 0 otherwise.
     pub residual_px: f32,
+    /// Each eye's largest second difference (left, right; y up): where nodes are drawn off
+    /// their projections, the line's offset (`cpu::subdivide::offsets`).
+    pub bend_vec: [Vec2; 2],
 }
 
 impl EdgeProfile {
@@ -148,7 +151,8 @@ impl Subdivider<'_> {
         let clamp_v = 1.5 * self.projection.height as f32;
         let width = self.projection.turn_px(); // a full turn in pixels: x wraps at it
         let (mut length, mut longest, mut nearest, mut bend) = (0.0f32, 0.0f32, f32::INFINITY, 0.0f32);
-        for eye_sign in [-1.0f32, 1.0] {
+        let mut bend_vec = [Vec2::ZERO; 2];
+        for (s, eye_sign) in [-1.0f32, 1.0].into_iter().enumerate() {
             let mut total = 0.0;
             let mut prev = Vec2::ZERO;
             // The last two points, x unwrapped, y unclamped.
@@ -171,7 +175,11 @@ impl Subdivider<'_> {
                 }
                 let unwrapped = Vec2::new(if k > 0 { q1.x + dx } else { raw.x }, raw.y);
                 if k >= 2 && unwrapped.y.abs() < clamp_v && q1.y.abs() < clamp_v && q0.y.abs() < clamp_v {
-                    bend = bend.max((unwrapped - 2.0 * q1 + q0).length());
+                    let second = unwrapped - 2.0 * q1 + q0;
+                    bend = bend.max(second.length());
+                    if second.length() > bend_vec[s].length() {
+                        bend_vec[s] = second;
+                    }
                 }
                 q0 = q1;
                 q1 = unwrapped;
@@ -186,7 +194,7 @@ impl Subdivider<'_> {
         let stretch = if ring { 1.0 } else { MAX_STRETCH };
         // The fastest pixels per radian of azimuth: the longest segment over its step, D/S.
         let residual_px = spacer.turn.map_or(0.0, |d| AZIMUTH_CHORD_RESIDUAL * d * d * segments as f32 * longest);
-        EdgeProfile { length_px: length.max(segments as f32 * longest / stretch), bend_px: bend, ring, residual_px }
+        EdgeProfile { length_px: length.max(segments as f32 * longest / stretch), bend_px: bend, ring, residual_px, bend_vec }
     }
 
     /// `edge_profile` where the image is drawn by pinholes from the eye points (the cubemap's
@@ -204,7 +212,7 @@ impl Subdivider<'_> {
         let ppr = self.projection.pixels_per_radian();
         let length_px = lo.cross(hi).length().atan2(lo.dot(hi)) * ppr;
         if self.projection.seen_from_centre(lo, hi) {
-            return EdgeProfile { length_px, bend_px: 0.0, ring: false, residual_px: 0.0 };
+            return EdgeProfile { length_px, bend_px: 0.0, ring: false, residual_px: 0.0, bend_vec: [Vec2::ZERO; 2] };
         }
         let spacer = self.spacing().spacer(lo, hi);
         let (mut nearest, mut bend) = (f32::INFINITY, 0.0f32);
@@ -223,7 +231,7 @@ impl Subdivider<'_> {
                 (e0[s], e1[s], depth1[s]) = (e1[s], e, q.depth);
             }
         }
-        EdgeProfile { length_px, bend_px: bend * ppr, ring: nearest < 0.0, residual_px: 0.0 }
+        EdgeProfile { length_px, bend_px: bend * ppr, ring: nearest < 0.0, residual_px: 0.0, bend_vec: [Vec2::ZERO; 2] }
     }
 
     /// Divisions of an edge (not capped by N_max: the pre-split handles that), `edge_px` L and

@@ -19,7 +19,7 @@ use std::collections::HashMap;
 use glam::{Vec2, Vec3};
 
 use super::piece::PieceGeometry;
-use super::{lex_less, Node, Subdivider};
+use super::{Node, Subdivider};
 use crate::core::projection::horizontal_radius;
 use crate::encoding::constants::{AZIMUTH_MIN_RADIUS, EDGE_SAMPLES};
 
@@ -51,24 +51,6 @@ impl Subdivider<'_> {
         Vec2::new(dx - width * (dx / width).round(), b.y - a.y)
     }
 
-    /// Both eyes' largest second difference of segment lo–hi's image at `EDGE_SAMPLES` steps of
-    /// the frame's spacing (y up), in the canonical order of its ends.
-    fn bend_vectors(&self, a: Vec3, b: Vec3) -> [Vec2; 2] {
-        let (lo, hi) = if lex_less(b, a) { (b, a) } else { (a, b) };
-        let spacer = self.spacing().spacer(lo, hi);
-        let mut out = [Vec2::ZERO; 2];
-        for (s, eye_sign) in [-1.0f32, 1.0].into_iter().enumerate() {
-            let points: Vec<Vec2> = (0..=EDGE_SAMPLES)
-                .map(|k| self.pixel(lo + (hi - lo) * spacer.param(k as f32 / EDGE_SAMPLES as f32), eye_sign))
-                .collect();
-            for k in 1..EDGE_SAMPLES as usize {
-                let second = self.unwrapped(points[k], points[k + 1]) - self.unwrapped(points[k - 1], points[k]);
-                widen(&mut out[s], second);
-            }
-        }
-        out
-    }
-
     /// Both eyes' error of the drawing (w = r) at the screen midpoint of segment a–b (y up).
     fn midpoint_errors(&self, a: Vec3, b: Vec3) -> [Vec2; 2] {
         let (wa, wb) = (horizontal_radius(a).max(AZIMUTH_MIN_RADIUS), horizontal_radius(b).max(AZIMUTH_MIN_RADIUS));
@@ -81,8 +63,8 @@ impl Subdivider<'_> {
 
     /// Half the part error of line lo–hi drawn in `parts` parts, per eye (y up), from its profile.
     fn line_offsets(&self, lo: Vec3, hi: Vec3, parts: u32) -> [Vec2; 2] {
-        let n = parts as f32;
-        self.bend_vectors(lo, hi).map(|b| -0.5 * b * (EDGE_SAMPLES as f32 / n).powi(2) / 8.0)
+        let step = EDGE_SAMPLES as f32 / parts as f32;
+        self.edge_profile(lo, hi, EDGE_SAMPLES).bend_vec.map(|b| -0.5 * b * (step * step) / 8.0)
     }
 
     /// Each node's offsets [left x, y, right x, y] (image pixels, y down) for a shaped piece:
