@@ -229,17 +229,12 @@ fn piece_offsets(node_count: u32, part: ptr<function, PartPlan>, piece_state: pt
     if (node_count <= 3u) {
         return out;
     }
-    // Sampled: each edge's first, middle and last segments (`sampled_segments`).
+    // Sampled: each edge's middle segment (`sampled_segments`).
     var inside: array<vec2<f32>, 2>;
     for (var e = 0u; e < 3u; e++) {
         let count = (*piece_state).counts[e];
-        let last = max(count, 1u) - 1u;
-        let picks = vec3<u32>(0u, last / 2u, last);
-        for (var i = 0u; i < select(0u, 3u, count > 0u); i++) {
-            if (i > 0u && picks[i] == picks[i - 1u]) {
-                continue;
-            }
-            let m = picks[i];
+        if (count > 0u) {
+            let m = (count - 1u) / 2u;
             let pa = node_on_edge(e, m, part, piece_state).position;
             let pb = node_on_edge(e, m + 1u, part, piece_state).position;
             let wa = max(horizontal_radius(pa), AZIMUTH_MIN_RADIUS);

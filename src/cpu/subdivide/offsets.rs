@@ -23,12 +23,10 @@ use super::{Node, Subdivider};
 use crate::core::projection::horizontal_radius;
 use crate::encoding::constants::{AZIMUTH_MIN_RADIUS, EDGE_SAMPLES};
 
-/// The segments of an edge of `count` parts whose errors the inside's offset reads: the first,
-/// the middle and the last (each once).
+/// The segment of an edge of `count` parts whose error the inside's offset reads: its middle
+/// one (none without parts).
 fn sampled_segments(count: u32) -> impl Iterator<Item = u32> {
-    let last = count.saturating_sub(1);
-    let picks = [0, last / 2, last];
-    (0..3).filter(move |&i| count > 0 && (i == 0 || picks[i] != picks[i - 1])).map(move |i| picks[i])
+    (count > 0).then_some((count - 1) / 2).into_iter()
 }
 
 /// Keeps the longer of two error vectors.
@@ -104,8 +102,8 @@ impl Subdivider<'_> {
                 on_edge.insert(key(g.node_on_edge(e, m).position), e);
             }
         }
-        // Half the largest error of the piece's boundary segments, sampled: on each edge its
-        // first, middle and last segments (`sampled_segments`).
+        // Half the largest error of the piece's boundary segments, sampled: each edge's middle
+        // segment (`sampled_segments`).
         let _ = slots;
         let mut inside = [Vec2::ZERO; 2];
         for e in 0..3 {
