@@ -83,7 +83,10 @@ fn parse_configs(arg: &str) -> Result<Vec<(f32, Rule)>, Error> {
                 "profile-edges" => Rule::ProfileEdges,
                 "profile-local" => Rule::ProfileLocal,
                 "twin" => Rule::Twin,
-                _ => return Err(format!("'{r}': the rules are none, max, nocorners, local, lines, profile, profile-edges, profile-local").into()),
+                _ => return Err(format!(
+                    "'{r}': the rules are none, max, nocorners, local, lines, profile, profile-edges, profile-local"
+                )
+                .into()),
             };
             let tau = t.parse::<f32>().map_err(|e| format!("τ '{t}': {e}"))?;
             if !(tau.is_finite() && tau >= 0.01) {
@@ -105,7 +108,8 @@ impl Image {
     fn pixel(&self, p: Vec3, theta_ref: f32) -> DVec2 {
         let turn = std::f32::consts::TAU;
         let th0 = azimuth(p);
-        let q = self.projection.project_with_azimuth(p, th0 + turn * ((theta_ref - th0) / turn + 0.5).floor(), Eye::Right);
+        let q =
+            self.projection.project_with_azimuth(p, th0 + turn * ((theta_ref - th0) / turn + 0.5).floor(), Eye::Right);
         DVec2::new(
             q.u as f64 * self.projection.pixels_per_radian() as f64 + 0.5 * self.size.x,
             0.5 * self.size.y - q.v as f64 * self.projection.pixels_per_v() as f64,
@@ -259,7 +263,7 @@ fn offsets(image: &Image, mesh: &Mesh, rule: Rule, corner: &[bool]) -> Vec<DVec2
             }
         }
         Rule::ProfileLocal => return profile_local(image, mesh, corner),
-        // The twin's own (`TWISTER_NODE_OFFSETS` set): the right eye's.
+        // The twin's own (drawn by default where the frame draws offsets): the right eye's.
         Rule::Twin => {
             let mut first = HashMap::new();
             let mut apart = 0;
@@ -268,7 +272,13 @@ fn offsets(image: &Image, mesh: &Mesh, rule: Rule, corner: &[bool]) -> Vec<DVec2
                 if f != v.offsets {
                     apart += 1;
                     if apart <= 6 && std::env::var_os("SHOW").is_some() {
-                        println!("  {:?} r {:.4}: {:?} against {:?}", v.position, horizontal_radius(mesh.pos[i]), f, v.offsets);
+                        println!(
+                            "  {:?} r {:.4}: {:?} against {:?}",
+                            v.position,
+                            horizontal_radius(mesh.pos[i]),
+                            f,
+                            v.offsets
+                        );
                     }
                 }
             }
@@ -330,7 +340,12 @@ fn offsets(image: &Image, mesh: &Mesh, rule: Rule, corner: &[bool]) -> Vec<DVec2
 /// positions only one of its segments reaches), its parts (segments), and the largest second
 /// difference of its image at 8 equal steps of azimuth between the ends, scaled to a part:
 /// −b·(8/n)²/8. A line whose ends are not two keeps its measured error.
-fn profile_errors(image: &Image, mesh: &Mesh, degree: &HashMap<(Line, usize), u32>, line_max: &mut HashMap<Line, DVec2>) {
+fn profile_errors(
+    image: &Image,
+    mesh: &Mesh,
+    degree: &HashMap<(Line, usize), u32>,
+    line_max: &mut HashMap<Line, DVec2>,
+) {
     let mut node_of = HashMap::new();
     for (i, &g) in mesh.group.iter().enumerate() {
         node_of.entry(g).or_insert(i);

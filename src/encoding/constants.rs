@@ -130,6 +130,11 @@ pub const AZIMUTH_MAX_TURN: f32 = 3.0;
 /// error split keeps that within `AZIMUTH_RESIDUAL_ERROR`·τ on screen.
 pub const AZIMUTH_CHORD_RESIDUAL: f32 = 0.016_04;
 pub const AZIMUTH_RESIDUAL_ERROR: f32 = 0.25;
+/// Where nodes are drawn off their projections (the error split on the equirectangular
+/// panoramas: `cpu::subdivide::offsets`), the split's tolerance is this × τ: a triangle's error
+/// then swings both ways, and its largest and mean are about what τ gives without offsets
+/// (docs/results.md, *Nodes drawn off their projections*).
+pub const OFFSET_SPLIT_FACTOR: f32 = 1.75;
 
 /// A constant's value as WGSL writes it.
 #[derive(Clone, Copy, Debug)]

@@ -3,7 +3,7 @@
 
 use crate::core::projection::{PanoramaKind, Projection};
 use crate::core::settings::{RenderSettings, SplitRule};
-use crate::encoding::constants::{AXIS_CLEARANCE_MAX, AXIS_CLEARANCE_MIN, PLAN_CUTS_SPLIT};
+use crate::encoding::constants::{AXIS_CLEARANCE_MAX, AXIS_CLEARANCE_MIN, OFFSET_SPLIT_FACTOR, PLAN_CUTS_SPLIT};
 use crate::encoding::recording::{Command, Recording};
 use crate::encoding::types::{DrawVertex, SubdivideCounters, SubdivideParams};
 
@@ -16,6 +16,10 @@ pub fn subdivide_params(settings: &RenderSettings, first_triangle: u32, triangle
     let measured = projection.measured();
     let sub = &settings.subdivision;
     let (rule, fixed_n) = sub.method.split_rule();
+    // The error split on the equirectangular panoramas draws nodes off their projections
+    // (`cpu::subdivide::offsets`), which halves each triangle's largest error: it splits at
+    // OFFSET_SPLIT_FACTOR·τ for about the error τ gives without them.
+    let node_offsets = projection.panorama.is_equirectangular() && rule == SplitRule::AdaptiveError;
     SubdivideParams {
         view: settings.view().to_cols_array_2d(),
         projection: (&measured).into(),
@@ -25,7 +29,7 @@ pub fn subdivide_params(settings: &RenderSettings, first_triangle: u32, triangle
         method: rule as u32,
         fixed_n,
         edge_px: sub.edge_px,
-        max_error_px: sub.max_error_px,
+        max_error_px: sub.max_error_px * if node_offsets { OFFSET_SPLIT_FACTOR } else { 1.0 },
         max_div: sub.max_div.max(1),
         piece_capacity: 0,
         triangle_capacity: 0,
@@ -37,10 +41,7 @@ pub fn subdivide_params(settings: &RenderSettings, first_triangle: u32, triangle
         seamless: matches!(projection.panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap | PanoramaKind::Cave)
             as u32,
         pinhole_faces: (projection.panorama == PanoramaKind::Cubemap) as u32,
-        // Prototype: the sphere's panoramas under the error split, with TWISTER_NODE_OFFSETS set.
-        node_offsets: (projection.panorama.is_sphere()
-            && rule == SplitRule::AdaptiveError
-            && std::env::var_os("TWISTER_NODE_OFFSETS").is_some()) as u32,
+        node_offsets: node_offsets as u32,
         _pad: [0; 2],
     }
 }

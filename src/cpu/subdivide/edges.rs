@@ -194,7 +194,13 @@ impl Subdivider<'_> {
         let stretch = if ring { 1.0 } else { MAX_STRETCH };
         // The fastest pixels per radian of azimuth: the longest segment over its step, D/S.
         let residual_px = spacer.turn.map_or(0.0, |d| AZIMUTH_CHORD_RESIDUAL * d * d * segments as f32 * longest);
-        EdgeProfile { length_px: length.max(segments as f32 * longest / stretch), bend_px: bend, ring, residual_px, bend_vec }
+        EdgeProfile {
+            length_px: length.max(segments as f32 * longest / stretch),
+            bend_px: bend,
+            ring,
+            residual_px,
+            bend_vec,
+        }
     }
 
     /// `edge_profile` where the image is drawn by pinholes from the eye points (the cubemap's

@@ -248,12 +248,15 @@ impl<'a> Subdivider<'a> {
             .filter(|&d| !seam || half >= PI || (u_min + d < half + SEAM_MARGIN && u_max + d > -half - SEAM_MARGIN))
             .map(|d| theta_c + d)
             .collect();
-        let nodes: Vec<DrawVertex> =
-            refs.iter()
-                .flat_map(|&theta_ref| {
-                    nodes.iter().zip(offsets).map(move |(&n, &o)| DrawVertex { offsets: o, ..draw_vertex(tri, n, theta_ref) })
-                })
-                .collect();
+        let nodes: Vec<DrawVertex> = refs
+            .iter()
+            .flat_map(|&theta_ref| {
+                nodes
+                    .iter()
+                    .zip(offsets)
+                    .map(move |(&n, &o)| DrawVertex { offsets: o, ..draw_vertex(tri, n, theta_ref) })
+            })
+            .collect();
         let node_count = if refs.is_empty() { 0 } else { (nodes.len() / refs.len()) as u32 };
         PiecePlan { node_count, nodes, copies: refs.len() as u32, candidates, reach }
     }

@@ -168,7 +168,11 @@ mod tests {
                     let first = *seen.entry(key).or_insert(v.offsets);
                     assert_eq!(first, v.offsets, "{name} at {width}: node {:?} drawn at two places", v.position);
                 }
-                assert!(offset_nodes * 10 > out.nodes.len(), "{name} at {width}: {offset_nodes} of {} nodes offset", out.nodes.len());
+                assert!(
+                    offset_nodes * 10 > out.nodes.len(),
+                    "{name} at {width}: {offset_nodes} of {} nodes offset",
+                    out.nodes.len()
+                );
             }
         }
     }
