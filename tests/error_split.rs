@@ -1,7 +1,9 @@
 //! The error split (`adaptive`, `--split error`) against the error pass, an oracle that does not
 //! share its estimate: on random triangles near and far, around the vertical axis and across the
 //! seam, on the cylinder (both vertical models), the sphere and the cubemap, the measured
-//! display-position error's p99 stays within τ + 0.5 px for τ = 0.25, 0.5 and 1 px, where drawing
+//! display-position error's p99 stays within the split's tolerance + 0.5 px for τ = 0.25, 0.5 and
+//! 1 px (the tolerance is τ, but on the sphere, which draws nodes off their projections and
+//! splits at `OFFSET_SPLIT_FACTOR`·τ), where drawing
 //! the vertices alone is far off (so the scenes do bend; on the cubemap, whose faces are
 //! pinholes and bend only with the eye points, the near triangles). (Geometry through the eye circle itself, within
 //! d_e of the axis at eye height, is outside this promise for every rule: see the README.)
@@ -12,6 +14,7 @@ use glam::Vec3;
 use rand::{Rng, SeedableRng};
 use twister::core::scene::{Scene, SceneVertex};
 use twister::core::settings::{Method, Split};
+use twister::encoding::constants::OFFSET_SPLIT_FACTOR;
 use twister::{Projection, RenderSettings, Vertical};
 
 /// 40 random triangles of one kind, each an object of its own.
@@ -86,7 +89,8 @@ fn the_error_split_keeps_the_measured_error_within_its_tolerance() {
                 let settings = base.with_method(Method::Adaptive(Split::Error)).with_max_error_px(tau);
                 let (p, count) = p99(&scene, &settings);
                 assert!(count > 2_000, "{kind} on the {name}: only {count} pixels measured");
-                assert!(p <= tau + 0.5, "{kind} on the {name}, τ = {tau} px: p99 {p} px");
+                let split = if name == "sphere" { OFFSET_SPLIT_FACTOR * tau } else { tau };
+                assert!(p <= split + 0.5, "{kind} on the {name}, τ = {tau} px (split at {split}): p99 {p} px");
             }
         }
     }
