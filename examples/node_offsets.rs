@@ -1,5 +1,5 @@
-//! What drawing each node off its projection would buy the error split (a feasibility
-//! measure with the CPU twin; nothing in the renderer does this yet).
+//! What drawing each node off its projection buys the error split, measured with the CPU twin:
+//! the rules tried before the renderer drew them (`twin`: the renderer's own, `cpu::subdivide::offsets`).
 //!
 //! The subdivision puts every node at its projection, so a drawn triangle's error rises from 0
 //! at its nodes to about τ between them (docs/results.md, *What the raster pays for*). Drawing
@@ -31,6 +31,7 @@
 //!   no line, half the largest of its piece's lines' errors;
 //! - `profile-edges`: as `profile` on the lines, but a node on no line as `lines` (half the
 //!   largest e its piece's edges measure);
+//! - `twin`: the offsets the twin draws (τ here is the split's: `--max-error-px` τ/1.75);
 //! - `profile-local`: from the lines' profiles alone, but locally: a segment's error from the
 //!   profile's second differences at the two samples around its middle (the larger), −d·(8/n)²/8;
 //!   a node inside a line half the larger of its two segments', a node on no line half the
@@ -47,6 +48,7 @@ use twister::core::projection::{azimuth, horizontal_radius, Eye, Projection};
 use twister::core::settings::{Method, RenderSettings, Split};
 use twister::cpu::subdivide::spacing::Spacing;
 use twister::cpu::subdivide::subdivide;
+use twister::encoding::constants::OFFSET_SPLIT_FACTOR;
 use twister::encoding::subdivide::subdivide_params;
 use twister::encoding::types::DrawVertex;
 
@@ -84,7 +86,7 @@ fn parse_configs(arg: &str) -> Result<Vec<(f32, Rule)>, Error> {
                 "profile-local" => Rule::ProfileLocal,
                 "twin" => Rule::Twin,
                 _ => return Err(format!(
-                    "'{r}': the rules are none, max, nocorners, local, lines, profile, profile-edges, profile-local"
+                    "'{r}': the rules are none, max, nocorners, local, lines, profile, profile-edges, profile-local, twin"
                 )
                 .into()),
             };
@@ -503,7 +505,7 @@ fn pixel_errors(image: &Image, mesh: &Mesh, offset: &[DVec2]) -> Vec<f64> {
 fn main() -> Result<(), Error> {
     let args: Vec<String> = std::env::args().collect();
     if args.len() != 4 && !(args.len() == 5 && args[4] == "cylinder") {
-        return Err("usage: node_offsets SCENE X,Y,Z 'TAU:RULE;…' [cylinder] (RULE: none, max, nocorners, local, lines, profile, profile-edges, profile-local)".into());
+        return Err("usage: node_offsets SCENE X,Y,Z 'TAU:RULE;…' [cylinder] (RULE: none, max, nocorners, local, lines, profile, profile-edges, profile-local, twin)".into());
     }
     let v: Vec<f32> = args[2].split(',').map(str::parse).collect::<Result<_, _>>()?;
     let [x, y, z] = v[..] else { return Err("the viewer is X,Y,Z".into()) };
@@ -517,7 +519,10 @@ fn main() -> Result<(), Error> {
     let corners: HashSet<[i64; 3]> =
         scene.vertices.iter().map(|v| key(view.transform_point3(Vec3::from(v.position)))).collect();
     for (tau, rule) in parse_configs(&args[3])? {
-        let params = subdivide_params(&base.with_max_error_px(tau), 0, scene.triangle_count() as u32);
+        // τ is the split's tolerance: the renderer splits the sphere at OFFSET_SPLIT_FACTOR × the
+        // τ it is given.
+        let params =
+            subdivide_params(&base.with_max_error_px(tau / OFFSET_SPLIT_FACTOR), 0, scene.triangle_count() as u32);
         let out = subdivide(&params, &scene.vertices, &scene.indices);
         let mesh = Mesh::new(&image, &out.nodes, &out.indices);
         let corner: Vec<bool> = mesh.pos.iter().map(|&p| corners.contains(&key(p))).collect();

@@ -216,6 +216,7 @@ impl<'a> Subdivider<'a> {
     /// A piece's plan: its nodes once per seam copy, every node unwrapped towards the piece's
     /// reference azimuth `theta_c`, again a turn away where the nodes' u range (both eyes)
     /// reaches ±π; its candidate triangles (`plan_work` in the WGSL).
+    #[allow(clippy::too_many_arguments)] // the piece as `shaped_plan` measured it
     fn piece_plan(
         &self,
         tri: &Triangle,

@@ -92,12 +92,12 @@ impl Subdivider<'_> {
         // The nodes inside the piece's edges, and each edge's offset.
         let mut on_edge = HashMap::new();
         let mut edge_offsets = [[Vec2::ZERO; 2]; 3];
-        for e in 0..3 {
+        for (e, offset) in edge_offsets.iter_mut().enumerate() {
             let (lo, hi, parts) = g.edge_line(e);
             if g.counts()[e] < 2 || parts < 2 {
                 continue;
             }
-            edge_offsets[e] = self.line_offsets(lo, hi, parts);
+            *offset = self.line_offsets(lo, hi, parts);
             for m in 1..g.counts()[e] {
                 on_edge.insert(key(g.node_on_edge(e, m).position), e);
             }
