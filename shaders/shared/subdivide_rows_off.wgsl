@@ -39,3 +39,20 @@ fn keep_row_end(end: u32, node: Node, piece_state: ptr<function, PieceState>) {
 fn rows_step(walk: ptr<function, vec4<u32>>, at: ptr<function, array<vec2<u32>, 3>>, piece_state: ptr<function, PieceState>) -> vec3<u32> {
     return vec3<u32>(0u);
 }
+
+// No nodes drawn off their projections (the frames without rows draw none).
+fn keep_bends(index: u32, piece_state: ptr<function, PieceState>) {}
+
+fn load_bends(index: u32, piece_state: ptr<function, PieceState>) {}
+
+fn piece_offsets(node_count: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> array<vec4<f32>, 7> {
+    return array<vec4<f32>, 7>();
+}
+
+fn corner_offset(index: u32, c: u32) -> vec4<f32> {
+    return vec4<f32>(0.0);
+}
+
+fn node_offset(node: Node, index: u32, piece_state: ptr<function, PieceState>) -> vec4<f32> {
+    return vec4<f32>(0.0);
+}

@@ -97,13 +97,7 @@ fn plan_pending(index: u32, shape: PieceShape, piece_state: ptr<function, PieceS
     work.counts = (*piece_state).counts[0] | ((*piece_state).counts[1] << 8u) | ((*piece_state).counts[2] << 16u) | ((*piece_state).row_base << 24u);
     work.strip_n = (*piece_state).strip_n.x | ((*piece_state).strip_n.y << 16u);
     piece_work[index].work = work;
-    if (params.node_offsets != 0u) {
-        // Its edges' bend vectors, for `lattice_rows_plan` (which does not measure them again),
-        // kept where its offsets will be (`load_bends`).
-        for (var e = 0u; e < 3u; e++) {
-            piece_work[index].offsets[e] = (*piece_state).bend[e];
-        }
-    }
+    keep_bends(index, piece_state);
     let r = max((*piece_state).strip_n.x, (*piece_state).strip_n.y);
     let base = atomicAdd(&counters.row_items, r);
     for (var b = 0u; b < r; b++) {
@@ -172,121 +166,6 @@ fn write_node(node: Node, k: u32, offsets: vec4<f32>, work: PieceWork, tri: ptr<
         v.offsets = offsets;
         out_nodes[work.first_node + c * work.node_count + k] = v;
     }
-}
-
-// ---- Nodes drawn off their projections (`cpu::subdivide::offsets`, which says why) ----
-
-// b − a in pixels, x across the seam the short way.
-fn unwrapped_px(a: vec2<f32>, b: vec2<f32>) -> vec2<f32> {
-    let width = params.projection.turn_px;
-    let dx = b.x - a.x;
-    return vec2<f32>(dx - width * round(dx / width), b.y - a.y);
-}
-
-// Keeps the longer of two error vectors.
-fn widened(slot: vec2<f32>, e: vec2<f32>) -> vec2<f32> {
-    return select(slot, e, length(e) > length(slot));
-}
-
-// Half the part error of a line drawn in `parts` parts, both eyes (image pixels, y down: left
-// x, y, right x, y), from its profile's bend vectors (`EdgeProfile::bend_vec`, y up: the
-// largest second differences at EDGE_SAMPLES steps) (`line_offsets`).
-fn line_offsets(bend: vec4<f32>, parts: u32) -> vec4<f32> {
-    let step = f32(EDGE_SAMPLES) / f32(parts);
-    let o0 = -0.5 * bend.xy * (step * step) / 8.0;
-    let o1 = -0.5 * bend.zw * (step * step) / 8.0;
-    return vec4<f32>(o0.x, -o0.y, o1.x, -o1.y);
-}
-
-// Where a piece's nodes are drawn off their projections (`PieceWork::offsets`): inside each
-// edge, half its line's part error (the part's original edge where it lies on one); at each
-// corner inside an original edge, that edge's; inside, half the largest error its boundary
-// segments measure (the drawing's screen midpoint against its projection). Zero where the frame
-// draws none.
-fn piece_offsets(node_count: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> array<vec4<f32>, 7> {
-    var out: array<vec4<f32>, 7>;
-    if (params.node_offsets == 0u) {
-        return out;
-    }
-    for (var i = 0u; i < 6u; i++) {
-        var bend = vec4<f32>(0.0);
-        var parts = 0u;
-        if (i < 3u) {
-            if ((*piece_state).counts[i] >= 2u && node_count > 3u) {
-                let oe = (*piece_state).original[i];
-                bend = select((*piece_state).bend[i], (*part).bend[max(oe, 0)], oe >= 0);
-                parts = select((*piece_state).counts[i], (*part).n[max(oe, 0)], oe >= 0);
-            }
-        } else if ((*piece_state).corner_line[i - 3u] >= 0) {
-            let oe = u32((*piece_state).corner_line[i - 3u]);
-            bend = (*part).bend[oe];
-            parts = (*part).n[oe];
-        }
-        if (parts >= 2u) {
-            out[i] = line_offsets(bend, parts);
-        }
-    }
-    if (node_count <= 3u) {
-        return out;
-    }
-    // Sampled: each edge's middle segment (`sampled_segments`).
-    var inside: array<vec2<f32>, 2>;
-    for (var e = 0u; e < 3u; e++) {
-        let count = (*piece_state).counts[e];
-        if (count > 0u) {
-            let m = (count - 1u) / 2u;
-            let pa = node_on_edge(e, m, part, piece_state).position;
-            let pb = node_on_edge(e, m + 1u, part, piece_state).position;
-            let wa = max(horizontal_radius(pa), AZIMUTH_MIN_RADIUS);
-            let wb = max(horizontal_radius(pb), AZIMUTH_MIN_RADIUS);
-            let ends = array<vec3<f32>, 3>(pa, pb, (pa / wa + pb / wb) / (1.0 / wa + 1.0 / wb));
-            var q: array<array<vec2<f32>, 2>, 3>;
-            for (var j = 0u; j < 3u; j++) {
-                q[j] = pixels(ends[j], eye_offset(params.projection, horizontal_radius(ends[j]), ends[j].y));
-            }
-            for (var s = 0u; s < 2u; s++) {
-                let err = unwrapped_px(q[0][s], q[2][s]) - 0.5 * unwrapped_px(q[0][s], q[1][s]);
-                inside[s] = widened(inside[s], 0.5 * err);
-            }
-        }
-    }
-    out[6] = vec4<f32>(inside[0].x, -inside[0].y, inside[1].x, -inside[1].y);
-    return out;
-}
-
-// A pending piece's edges' bend vectors, kept by `plan_pending`.
-fn load_bends(index: u32, piece_state: ptr<function, PieceState>) {
-    if (params.node_offsets != 0u) {
-        for (var e = 0u; e < 3u; e++) {
-            (*piece_state).bend[e] = piece_work[index].offsets[e];
-        }
-    }
-}
-
-// Where piece `index`'s corner c is drawn off its projection.
-fn corner_offset(index: u32, c: u32) -> vec4<f32> {
-    if (params.node_offsets == 0u) {
-        return vec4<f32>(0.0);
-    }
-    return piece_work[index].offsets[3u + c];
-}
-
-// Where a node of piece `index` just placed by `piece_node` is drawn off its projection: a
-// corner's, an edge's (`node_edge`), or the inside's.
-fn node_offset(node: Node, index: u32, piece_state: ptr<function, PieceState>) -> vec4<f32> {
-    if (params.node_offsets == 0u) {
-        return vec4<f32>(0.0);
-    }
-    var i = min((*piece_state).node_edge, 3u) * 2u; // an edge's slot (0–2), or 6 inside
-    if (i < 6u) {
-        i = (*piece_state).node_edge;
-    }
-    for (var c = 0u; c < 3u; c++) {
-        if (same(node.position, (*piece_state).corner[c].position)) {
-            i = 3u + c;
-        }
-    }
-    return piece_work[index].offsets[i];
 }
 
 // A triangle item: the piece's candidates [item.y, item.y + chunk) from the walk in item.zw,
