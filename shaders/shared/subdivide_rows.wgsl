@@ -235,16 +235,13 @@ fn line_offsets(bend: vec4<f32>, parts: u32) -> vec4<f32> {
     return vec4<f32>(o0.x, -o0.y, o1.x, -o1.y);
 }
 
-// Where a piece's nodes are drawn off their projections (`PieceWork::offsets`): inside each
+// Where a piece's nodes are drawn off their projections (`StoredWork::offsets`): inside each
 // edge, half its line's part error (the part's original edge where it lies on one); at each
 // corner inside an original edge, that edge's; inside, half the largest error its boundary
-// segments measure (the drawing's screen midpoint against its projection). Zero where the frame
-// draws none.
+// segments measure (the drawing's screen midpoint against its projection). Called where the
+// frame draws offsets (`plan_work`).
 fn piece_offsets(node_count: u32, part: ptr<function, PartPlan>, piece_state: ptr<function, PieceState>) -> array<vec4<f32>, 7> {
     var out: array<vec4<f32>, 7>;
-    if (params.node_offsets == 0u) {
-        return out;
-    }
     for (var i = 0u; i < 6u; i++) {
         var bend = vec4<f32>(0.0);
         var parts = 0u;
@@ -266,7 +263,7 @@ fn piece_offsets(node_count: u32, part: ptr<function, PartPlan>, piece_state: pt
     if (node_count <= 3u) {
         return out;
     }
-    // Sampled: each edge's middle segment (`sampled_segments`).
+    // Sampled: each edge's middle segment.
     var inside: array<vec2<f32>, 2>;
     for (var e = 0u; e < 3u; e++) {
         let count = (*piece_state).counts[e];
@@ -324,10 +321,7 @@ fn node_offset(node: Node, index: u32, piece_state: ptr<function, PieceState>) -
     if (params.node_offsets == 0u) {
         return vec4<f32>(0.0);
     }
-    var i = min((*piece_state).node_edge, 3u) * 2u; // an edge's slot (0–2), or 6 inside
-    if (i < 6u) {
-        i = (*piece_state).node_edge;
-    }
+    var i = select(6u, (*piece_state).node_edge, (*piece_state).node_edge < 3u); // an edge's slot, or the inside's
     for (var c = 0u; c < 3u; c++) {
         if (same(node.position, (*piece_state).corner[c].position)) {
             i = 3u + c;

@@ -1,5 +1,5 @@
-//! Nodes drawn off their projections (prototype, twin only; docs/results.md, *Nodes drawn off
-//! their projections*).
+//! Nodes drawn off their projections (CPU twin of `piece_offsets` and `node_offset` in
+//! shaders/shared/subdivide_rows.wgsl; docs/method.md, *Nodes drawn off their projections*).
 //!
 //! A drawn triangle's error rises from 0 at its nodes (which lie on the projection) to about τ
 //! between them. Each node is drawn half that bowl towards the curve, so that the error swings
@@ -22,12 +22,6 @@ use super::piece::PieceGeometry;
 use super::{Node, Subdivider};
 use crate::core::projection::horizontal_radius;
 use crate::encoding::constants::{AZIMUTH_MIN_RADIUS, EDGE_SAMPLES};
-
-/// The segment of an edge of `count` parts whose error the inside's offset reads: its middle
-/// one (none without parts).
-fn sampled_segments(count: u32) -> impl Iterator<Item = u32> {
-    (count > 0).then_some((count - 1) / 2).into_iter()
-}
 
 /// Keeps the longer of two error vectors.
 fn widen(slot: &mut Vec2, e: Vec2) {
@@ -65,9 +59,9 @@ impl Subdivider<'_> {
         self.edge_profile(lo, hi, EDGE_SAMPLES).bend_vec.map(|b| -0.5 * b * (step * step) / 8.0)
     }
 
-    /// Each node's offsets [left x, y, right x, y] (image pixels, y down) for a shaped piece:
-    /// its nodes in slot order and its candidate triangles' slots.
-    pub(super) fn node_offsets(&self, g: &PieceGeometry, nodes: &[Node], slots: &[[u32; 3]]) -> Vec<[f32; 4]> {
+    /// Each node's offsets [left x, y, right x, y] (image pixels, y down) for a shaped piece's
+    /// nodes in slot order.
+    pub(super) fn node_offsets(&self, g: &PieceGeometry, nodes: &[Node]) -> Vec<[f32; 4]> {
         let mut out = vec![[0.0; 4]; nodes.len()];
         if !self.draws_offsets() {
             return out;
@@ -103,15 +97,13 @@ impl Subdivider<'_> {
             }
         }
         // Half the largest error of the piece's boundary segments, sampled: each edge's middle
-        // segment (`sampled_segments`).
-        let _ = slots;
+        // segment.
         let mut inside = [Vec2::ZERO; 2];
-        for e in 0..3 {
-            for m in sampled_segments(g.counts()[e]) {
-                let errors = self.midpoint_errors(g.node_on_edge(e, m).position, g.node_on_edge(e, m + 1).position);
-                for s in 0..2 {
-                    widen(&mut inside[s], 0.5 * errors[s]);
-                }
+        for (e, count) in g.counts().into_iter().enumerate().filter(|&(_, c)| c > 0) {
+            let m = (count - 1) / 2;
+            let errors = self.midpoint_errors(g.node_on_edge(e, m).position, g.node_on_edge(e, m + 1).position);
+            for (slot, error) in inside.iter_mut().zip(errors) {
+                widen(slot, 0.5 * error);
             }
         }
         for (k, node) in nodes.iter().enumerate() {

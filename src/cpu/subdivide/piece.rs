@@ -69,7 +69,7 @@ pub(super) struct PieceGeometry {
     pub q: [Node; 3],
     edges: [PieceEdge; 3],
     /// Where each corner lies in its part.
-    pub loc: [Location; 3],
+    loc: [Location; 3],
     pub limits: Limits,
     pub spacing: Spacing,
 }
@@ -282,8 +282,7 @@ impl Subdivider<'_> {
             let (range, reach) = self.piece_u_range(q, theta_c);
             (range, reach + SEAM_BOUND_SLACK)
         };
-        let slots = shape.slots(g.counts());
-        let offsets = self.node_offsets(g, &nodes, &slots);
-        self.piece_plan(tri, &nodes, slots, &offsets, theta_c, u_range, reach)
+        let offsets = self.node_offsets(g, &nodes);
+        self.piece_plan(tri, &nodes, shape.slots(g.counts()), &offsets, theta_c, u_range, reach)
     }
 }
