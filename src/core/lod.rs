@@ -1,7 +1,9 @@
 //! Visual-field level of detail for polygon scenes (seed 001 §2.3, eq. 1–2).
 //!
 //! Each scene object (a glTF mesh instance, an OBJ object/group) gets a polygon budget from where
-//! its centre falls in the visual field of the gaze (`visual_field`):
+//! it falls in the visual field of the gaze (`visual_field`): the most central point of its
+//! bounding sphere ([`nearest_to_gaze`]; an object around the viewer, a room, is central at full
+//! detail whatever the gaze, so the level of detail never opens or empties it):
 //!
 //! ```text
 //! central field:     P_m = P1 · (1 − D/D∞)
@@ -10,8 +12,8 @@
 //! ```
 //!
 //! P1 is the object's own triangle count, P2' = `p2`·P1, P3 = `p3`·P1, D the distance from the
-//! eye point to the object's centre. The result is kept within [P3, P1] (an object beyond D∞
-//! would otherwise get a negative count).
+//! eye point to the object's centre (0 for an object around the viewer). The result is kept
+//! within [P3, P1] (an object beyond D∞ would otherwise get a negative count).
 //!
 //! Simplified meshes come from meshoptimizer's quadric-error simplifier (the Garland–Heckbert QEM
 //! the paper used): a chain of levels, each about `LEVEL_RATIO` (0.7) of the triangles of the one before, built once
@@ -24,7 +26,7 @@
 //! field, at most `MAX_EDGE_RELAXATION`·L — and outside the visual field its edges are not split
 //! at all (the vertex method), since no one looks there.
 
-use glam::Mat4;
+use glam::{Mat4, Quat, Vec3};
 
 use crate::core::scene::object_spheres;
 use crate::core::scene::{Object, Scene};
@@ -180,11 +182,17 @@ impl LodChain {
     pub fn select(&self, scene: &Scene, view: Mat4, gaze: &Gaze, params: &LodParams) -> LodSelection {
         let spheres = object_spheres(scene);
         let mut out = LodSelection { indices: Vec::new(), objects: Vec::new(), chosen: Vec::new() };
-        for ((object, chain), (centre, _)) in scene.objects.iter().zip(&self.levels).zip(spheres) {
+        for ((object, chain), (centre, radius)) in scene.objects.iter().zip(&self.levels).zip(spheres) {
             let c = view.transform_point3(centre);
-            let at = if c.length() > 1e-9 { gaze.position(c) } else { gaze.position(gaze.forward) };
-            let (field, level) = (at.field(), at.level());
-            let budget = params.budget(object.triangle_count, field, level, c.length());
+            let (field, level, distance) = match nearest_to_gaze(gaze, c, radius) {
+                // Around the viewer (a room): every gaze sees it, and it must stay closed.
+                None => (Field::Central, 1.0, 0.0),
+                Some(d) => {
+                    let at = gaze.position(d);
+                    (at.field(), at.level(), c.length())
+                }
+            };
+            let budget = params.budget(object.triangle_count, field, level, distance);
             // The coarsest level that still has at least P_m triangles.
             let k = chain.iter().rposition(|l| (l.len() / 3) as f32 >= budget).unwrap_or(0);
             let first = (out.indices.len() / 3) as u32;
@@ -199,6 +207,28 @@ impl LodChain {
         }
         out
     }
+}
+
+/// The direction of an object's bounding sphere (centre `c` in the viewer frame, `radius`)
+/// nearest the gaze: its centre's direction turned towards the gaze by the sphere's angular
+/// radius, or the gaze itself where the sphere reaches across it. None where the sphere holds
+/// the viewer: the object surrounds the viewer (a room) and lies in every gaze's central field.
+/// So an object's field is the most central one of any point of it, not of its centre (a room
+/// whose centre is behind the gaze is not "outside").
+pub fn nearest_to_gaze(gaze: &Gaze, c: Vec3, radius: f32) -> Option<Vec3> {
+    let distance = c.length();
+    if !(distance > radius) {
+        return None;
+    }
+    let d = c / distance;
+    let reach = (radius / distance).asin();
+    let apart = d.dot(gaze.forward).clamp(-1.0, 1.0).acos();
+    if apart <= reach {
+        return Some(gaze.forward);
+    }
+    // Turn d towards the gaze in the plane of both (any plane holding d where they are opposite).
+    let axis = d.cross(gaze.forward).try_normalize().unwrap_or_else(|| d.any_orthonormal_vector());
+    Some(Quat::from_axis_angle(axis, reach) * d)
 }
 
 impl LodSelection {
@@ -296,6 +326,44 @@ mod tests {
         assert!((p.budget(1000, Field::Peripheral, 0.5, 50.0) - 325.0).abs() < 1e-3);
         assert_eq!(p.budget(1000, Field::Outside, 0.0, 1.0), 50.0);
         assert_eq!(p.budget(1000, Field::Central, 1.0, 500.0), 50.0, "beyond D∞: kept at P3");
+    }
+
+    proptest::proptest! {
+        // A fixed list of cases (PROPTEST_RNG_SEED changes it).
+        #![proptest_config(proptest::test_runner::Config {
+            rng_seed: match proptest::test_runner::Config::default().rng_seed {
+                proptest::test_runner::RngSeed::Random => proptest::test_runner::RngSeed::Fixed(58),
+                fixed => fixed,
+            },
+            ..proptest::test_runner::Config::with_cases(64)
+        })]
+
+        /// A closed room around the viewer (its centre anywhere within it, often behind the
+        /// gaze) is drawn whole at full detail, whatever the gaze; an object that reaches across
+        /// the gaze is central.
+        #[test]
+        fn a_room_around_the_viewer_is_central_at_any_gaze(
+            yaw in -180.0f32..180.0,
+            pitch in -89.0f32..89.0,
+            offset in proptest::array::uniform3(-0.9f32..0.9),
+            size in 1.0f32..30.0,
+        ) {
+            let mut scene = Scene::new("room");
+            let room = crate::core::shapes::ClosedMesh::grid_box(4).placed(Vec3::from(offset) * size, size);
+            room.add_to(&mut scene, [1.0; 4]);
+            // A long wall 2 m in front of the gaze, its centre 40° to the side of it.
+            let gaze = Gaze::new(yaw, pitch);
+            let side = gaze.forward.cross(gaze.up);
+            let wall = sphere_scene(400, 2.0 * gaze.forward + 2.0 * 40f32.to_radians().tan() * side, 1.8, "wall");
+            scene.add_mesh("wall", &wall.vertices, &wall.indices);
+            let chain = LodChain::build(&scene, 0.05);
+            let sel = chain.select(&scene, Mat4::IDENTITY, &gaze, &LodParams::default());
+            for (o, chosen) in sel.chosen.iter().enumerate() {
+                proptest::prop_assert_eq!(chosen.field, Field::Central, "object {}", o);
+                proptest::prop_assert_eq!(chosen.edge_scale, 1.0);
+            }
+            proptest::prop_assert_eq!(sel.chosen[0].triangles, scene.objects[0].triangle_count);
+        }
     }
 
     #[test]
