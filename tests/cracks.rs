@@ -329,8 +329,9 @@ fn surround_scenes_let_no_sample_see_the_background() {
             }
             // The fisheye bends a room's walls and floor far more than the sphere (the floor
             // around a tilted dome's antipode reaches across the image): drawn with straight
-            // edges between unsplit corners (`vertex`, `fixed:7` here) they leave the
-            // background showing, as the paper's point is; the adaptive rules close it.
+            // edges between unsplit corners (`vertex`, `fixed:7` here) they would leave the
+            // background showing, so it refuses those methods (tests/search.rs); the adaptive
+            // rules close it.
             if panorama == PanoramaKind::Fisheye && !matches!(method, Method::Adaptive(_)) {
                 continue;
             }

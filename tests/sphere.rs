@@ -593,7 +593,7 @@ fn sphere_images_carry_photo_sphere_metadata_in_png_and_jpeg_and_players_names()
     assert!(decoder.read_info().unwrap().info().utf8_text.is_empty());
     // Nor is the fisheye (GPano has no fisheye type); its combined layouts carry `_fisheye`.
     let o = common::twister()
-        .args(["render", "builtin:demo", "--panorama", "fisheye", "--width", "64", "--method", "vertex"])
+        .args(["render", "builtin:demo", "--panorama", "fisheye", "--width", "64"])
         .args(["--layout", "side-by-side", "--out"])
         .arg(&out)
         .output()
@@ -606,7 +606,7 @@ fn sphere_images_carry_photo_sphere_metadata_in_png_and_jpeg_and_players_names()
     let opaque = image::open(&file).unwrap().to_rgba8();
     // --alpha: the circle's outside transparent, its inside as before.
     let o = common::twister()
-        .args(["render", "builtin:demo", "--panorama", "fisheye", "--width", "64", "--method", "vertex"])
+        .args(["render", "builtin:demo", "--panorama", "fisheye", "--width", "64"])
         .args(["--layout", "side-by-side", "--alpha", "--out"])
         .arg(&out)
         .output()

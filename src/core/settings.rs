@@ -509,6 +509,19 @@ impl RenderSettings {
                 ));
             }
         }
+        if matches!(s.method, Method::Vertex | Method::Fixed(_))
+            && self.view.projection.panorama == PanoramaKind::Fisheye
+        {
+            return Err(Error::setting(
+                "subdivision.method",
+                format!(
+                    "{}: the fisheye bends an edge beyond its rim round the circle, and an edge split without \
+                     measuring it is drawn as chords that cut into the circle (holes in a closed room): use adaptive \
+                     or adaptive:length",
+                    s.method.name()
+                ),
+            ));
+        }
         if s.method == Method::Trace
             && self.view.projection.panorama == PanoramaKind::Cylinder
             && self.view.projection.vertical == Vertical::Paper
