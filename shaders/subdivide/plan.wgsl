@@ -42,7 +42,9 @@ fn plan(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     var full = false;
     if (any(cuts != vec2<u32>(0u))) {
         marks = edge_marks(t);
-        full = cut_triangle(marks) || asks_for_cuts(diamond_range(tri.position));
+        // Whether it asks for cuts was decided once, by `active_cuts` (its marks): deciding
+        // again in this pipeline could round otherwise and leave its neighbours uncut.
+        full = cut_triangle(marks);
     }
     if (single_part(full, marks, &tri, cuts)) {
         part.corner[0] = Node(tri.position[0], vec3<f32>(1.0, 0.0, 0.0));

@@ -93,8 +93,10 @@ impl Subdivider<'_> {
             return Vec::new();
         }
         let rho = self.params.axis_clearance;
-        let limit = band_limit(self.params.method, self.projection.screen_radius);
-        if frame.axis == 0 || triangle_cuts(tri.position, rho, limit) != 0 || frame.is_cut_triangle(t) {
+        // Whether it asks for cuts was decided once, by `active_cuts`, which marked its edges:
+        // deciding again here could differ in the last bit (the GPU's passes are compiled apart)
+        // and leave its neighbours uncut where it is cut.
+        if frame.axis == 0 || frame.is_cut_triangle(t) {
             return polygons(tri.position, rho, frame.axis);
         }
         let shared = [0, 1, 2].map(|e| frame.is_cut_edge(t, e));
@@ -105,6 +107,19 @@ impl Subdivider<'_> {
         };
         *edge_splits += (parts.len() > 1) as u32;
         parts.into_iter().map(|part| part.to_vec()).collect()
+    }
+
+    /// [`FrameCuts::every_edge`] with the edges of the triangles that ask for cuts marked as
+    /// `active_cuts` marks them (tests of triangles whose neighbours, not given, are cut).
+    pub fn every_edge_cuts(&self, axis: AxisCuts, vertices: &[SceneVertex], indices: &[u32]) -> FrameCuts {
+        let limit = band_limit(self.params.method, self.projection.screen_radius);
+        let mut frame = FrameCuts::every_edge(axis, vertices, indices);
+        for t in 0..indices.len() / 3 {
+            if triangle_cuts(self.positions(vertices, indices, t), self.params.axis_clearance, limit) != 0 {
+                frame.mark(t, true);
+            }
+        }
+        frame
     }
 
     /// `active_cuts` and `ring_cuts`: the cuts around the axis the frame makes, the edges of the

@@ -32,15 +32,17 @@ use crate::encoding::types::{DrawIndexedIndirectArgs, DrawVertex, Piece, Subdivi
 use crate::error::Result;
 
 /// Runs the whole stage on the CPU with `schedule` within `budget`, as the GPU's read-back
-/// does (`gpu::subdivide::SubdivideStage::readback`): the twin side of the twin test.
+/// does (`gpu::subdivide::SubdivideStage::readback`), each object's L scaled by `edge_scale` (the
+/// level of detail's; empty: 1): the twin side of the twin test.
 pub fn run_scheduled(
     settings: &RenderSettings,
     vertices: &[SceneVertex],
     indices: &[u32],
+    edge_scale: &[f32],
     schedule: Schedule,
     budget: Capacities,
 ) -> Result<SubdivideOutput> {
-    let mut engine = CpuSubdivision::new(vertices, indices, &[]);
+    let mut engine = CpuSubdivision::new(vertices, indices, edge_scale);
     let totals = run_schedule(&mut engine, settings, (indices.len() / 3) as u32, schedule, budget)?;
     let max_part_output = engine.part_output.values().copied().max().unwrap_or(0);
     let max_piece_output = engine.max_piece_output;
@@ -238,8 +240,8 @@ impl<'s> CpuSubdivision<'s> {
         }
         let cuts = self.counters.cuts();
         let rho = params.axis_clearance;
-        let limit = band_limit(params.method, sub.projection.screen_radius);
-        let full = cuts != 0 && (self.frame.is_cut_triangle(t) || triangle_cuts(tri.position, rho, limit) != 0);
+        // Whether it asks for cuts was decided once, by `active_cuts` (its marks).
+        let full = cuts != 0 && self.frame.is_cut_triangle(t);
         let marked = cuts != 0 && (0..3).any(|e| self.frame.is_cut_edge(t, e));
         let single = if full { one_part(tri.position, rho, cuts) } else { !marked };
         if single {

@@ -37,7 +37,8 @@ fn a_copy_that_only_touches_the_image_edge_is_not_drawn() {
     let params = subdivide_params(&RenderSettings::new(mono).with_method(Method::Vertex), 0, 1);
     let v: Vec<SceneVertex> =
         tri.iter().map(|&p| SceneVertex { position: p, normal: [0.0, 0.0, -1.0], ..Default::default() }).collect();
-    let out = Subdivider::new(&params).run_with_cuts(&v, &[0, 1, 2], &FrameCuts::every_edge(1, &v, &[0, 1, 2]));
+    let sd = Subdivider::new(&params);
+    let out = sd.run_with_cuts(&v, &[0, 1, 2], &sd.every_edge_cuts(1, &v, &[0, 1, 2]));
     assert_eq!(out.vertices.len(), 6, "two parts, drawn once each");
     for t in out.vertices.chunks(3) {
         let (lo, hi) = drawn_columns(&mono, t);

@@ -45,7 +45,8 @@ pub(super) fn run_method(tri: [[f32; 3]; 3], method: Method) -> (Projection, Vec
 pub(super) fn run_method_with_cuts(tri: [[f32; 3]; 3], method: Method, cuts: AxisCuts) -> Vec<DrawVertex> {
     let params = params_for(&Projection::default(), method, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV, 1);
     let v: Vec<SceneVertex> = tri.iter().map(|&p| vertex(p)).collect();
-    Subdivider::new(&params).run_with_cuts(&v, &[0, 1, 2], &FrameCuts::every_edge(cuts, &v, &[0, 1, 2])).vertices
+    let sd = Subdivider::new(&params);
+    sd.run_with_cuts(&v, &[0, 1, 2], &sd.every_edge_cuts(cuts, &v, &[0, 1, 2])).vertices
 }
 
 fn area3(t: &[DrawVertex]) -> f32 {
@@ -591,7 +592,8 @@ fn the_passes_replaying_every_schedule_make_the_twins_triangles() {
             for budget in [roomy, tiny] {
                 let what =
                     format!("{} {:?}, {schedule:?}, budget {budget:?}", scene.name, settings.projection().panorama);
-                let out = run_scheduled(&settings, &scene.vertices, &scene.indices, schedule, budget).expect(&what);
+                let out =
+                    run_scheduled(&settings, &scene.vertices, &scene.indices, &[], schedule, budget).expect(&what);
                 assert_eq!((out.pieces, out.cuts), (direct.pieces, direct.cuts), "{what}");
                 assert_eq!(out.max_output, direct.max_output, "{what}: the largest output of one lattice invocation");
                 assert!(out.max_pieces >= 1 && out.max_output >= 1, "{what}: the balance counters");
