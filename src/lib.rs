@@ -22,6 +22,7 @@ pub mod encoding;
 pub mod error;
 pub mod gpu;
 pub mod output;
+pub mod search;
 pub mod shader;
 pub mod video;
 

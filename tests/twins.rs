@@ -16,9 +16,6 @@ mod slit;
 mod subdivide;
 #[path = "twins/trace.rs"]
 mod trace;
-#[path = "twins/triangles.rs"]
-mod triangles;
-use triangles::same_triangle_sets;
 
 use glam::Vec3;
 use rand::{Rng, SeedableRng};

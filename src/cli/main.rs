@@ -78,6 +78,7 @@ fn main() -> ExitCode {
         Command::Bench(BenchCommand::TraceLod(args)) => bench::bench_figures(args, Figure::TraceLod),
         Command::Bench(BenchCommand::All(args)) => bench::bench_figures(args, Figure::All),
         Command::Bench(BenchCommand::Startup(args)) => bench::bench_startup(args),
+        Command::Bench(BenchCommand::Search(args)) => bench::search::bench_search(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -27,6 +27,7 @@ pub mod sampling;
 pub mod scene;
 pub mod settings;
 pub mod shadow;
+pub mod shapes;
 pub mod shared_edges;
 pub mod sphere;
 pub mod texture;

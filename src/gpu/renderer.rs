@@ -438,6 +438,12 @@ impl Renderer {
         settings: &RenderSettings,
         schedule: Schedule,
     ) -> Result<SubdivideOutput> {
+        if settings.projection().panorama == crate::core::projection::PanoramaKind::Cave {
+            return Err(Error::setting(
+                "view.projection.wall",
+                "a CAVE wall is drawn as one perspective per eye, without subdivision: there is none to read back",
+            ));
+        }
         self.subdivided().subdivide.readback(&self.gpu, scene, settings, schedule)
     }
 }

@@ -8,10 +8,12 @@ use twister::core::settings::{Method, Split};
 use twister::cpu::subdivide::passes::run_scheduled;
 use twister::cpu::subdivide::subdivide;
 use twister::encoding::schedule::{Capacities, Schedule};
-use twister::encoding::subdivide::{subdivide_params, SubdivideOutput};
+use twister::encoding::subdivide::subdivide_params;
 use twister::{GpuScene, Projection, RenderSettings, Renderer, Scene, Vertical};
 
-use super::{common, same_triangle_sets, Twin};
+use twister::search::twin::compare_subdivided;
+
+use super::{common, Twin};
 
 pub struct Subdivide;
 
@@ -168,13 +170,14 @@ impl Twin for Subdivide {
     fn cpu((scene, settings): &Self::Case) -> Self::Output {
         let budget = Capacities::budget(settings.subdivision.memory_mb, common::renderer().gpu.max_binding());
         subdivide_schedules(scene)
-            .map(|schedule| run_scheduled(settings, &scene.vertices, &scene.indices, schedule, budget).unwrap())
+            .map(|schedule| run_scheduled(settings, &scene.vertices, &scene.indices, &[], schedule, budget).unwrap())
             .into()
     }
     fn compare(gpu: &Self::Output, cpu: &Self::Output) -> Result<(), String> {
         let schedules = ["one submission", "chunked"];
         for ((g, c), schedule) in gpu.iter().zip(cpu).zip(schedules) {
-            compare_subdivided(g, c).map_err(|e| format!("{schedule} schedule: {e}"))?;
+            let software = common::renderer().gpu.info.device_type == wgpu::DeviceType::Cpu;
+            compare_subdivided(g, c, software).map_err(|e| format!("{schedule} schedule: {e}"))?;
         }
         Ok(())
     }
@@ -184,59 +187,4 @@ impl Twin for Subdivide {
 /// chunked one over three ranges or more where the scene has the triangles.
 fn subdivide_schedules(scene: &Scene) -> [Schedule; 2] {
     [Schedule::OneSubmission, Schedule::Chunked { triangles_per_chunk: (scene.triangle_count() as u32 / 3).max(1) }]
-}
-
-/// One GPU output of the subdivide stage against the twin's.
-fn compare_subdivided(gpu: &SubdivideOutput, cpu: &SubdivideOutput) -> Result<(), String> {
-    if cpu.cuts != gpu.cuts {
-        return Err(format!("cuts around the axis: CPU {:#x}, GPU {:#x}", cpu.cuts, gpu.cuts));
-    }
-    // A measure that sits on a ceil boundary flips a division count with the last bit of its
-    // inputs. A hardware GPU's sin, atan2 and acos differ from the CPU's in the last bits (seen
-    // on an H100: 36 of 53,697 nodes in a case of random triangles): there at most 1 % of the
-    // pieces, nodes and triangles may differ. On a software adapter (lavapipe: correctly rounded
-    // maths, but fused multiply-adds where the twin rounds twice) the edges' and macro edges'
-    // counts come out the twin's; a piece's rows measure every row and its diagonals, many more
-    // measures, and one in 10⁴–10⁵ flips a row's width or the piece's choice between rows and
-    // the lattice (one piece of 84 triangles in a case of 200 random triangles; two small ones,
-    // 38 triangles, beside the axis in the cubemap's demo room once its pieces had no seam
-    // copies): there 0.1 % plus two pieces (the largest piece's output) may differ. On hardware
-    // an edge's count may
-    // flip, and its part is planned again whole: 1 % plus one part (an H200 re-planned one of a
-    // cube's parts, 745 of its 10,069 triangles: the cube's 12 triangles make parts of up to
-    // 32² pieces each). Every other triangle is the twin's.
-    let software = common::renderer().gpu.info.device_type == wgpu::DeviceType::Cpu;
-    let (one_piece, one_part) = (cpu.max_piece_output as usize, cpu.max_part_output as usize);
-    let slack = |n: usize| if software { n / 1000 + 2 * one_piece } else { n / 100 + one_part };
-    // Piece records come from the parts' edges alone: exact on a software adapter.
-    let piece_slack = if software { 0 } else { cpu.pieces as usize / 100 };
-    if cpu.pieces.abs_diff(gpu.pieces) as usize > piece_slack {
-        return Err(format!("pieces: CPU {}, GPU {}", cpu.pieces, gpu.pieces));
-    }
-    // The balance counters: the largest output of one invocation (a piece one division more or
-    // less moves them by a few): within 10 %.
-    for (what, c, g) in [("max pieces", cpu.max_pieces, gpu.max_pieces), ("max output", cpu.max_output, gpu.max_output)]
-    {
-        if c.abs_diff(g) > c / 10 || (c == 0) != (g == 0) {
-            return Err(format!("{what} per invocation: CPU {c}, GPU {g}"));
-        }
-    }
-    if (cpu.max_sub_edge_px - gpu.max_sub_edge_px).abs() >= 1e-2 * (1.0 + cpu.max_sub_edge_px) {
-        return Err(format!("max edge: CPU {}, GPU {}", cpu.max_sub_edge_px, gpu.max_sub_edge_px));
-    }
-    // The indexed output: as many shared nodes, every index within them.
-    if cpu.nodes.len().abs_diff(gpu.nodes.len()) > slack(cpu.nodes.len()) {
-        return Err(format!("nodes: CPU {}, GPU {}", cpu.nodes.len(), gpu.nodes.len()));
-    }
-    if let Some(i) = gpu.indices.iter().find(|&&i| i as usize >= gpu.nodes.len()) {
-        return Err(format!("GPU index {i} beyond its {} nodes", gpu.nodes.len()));
-    }
-    // Within a centimetre of the vertical axis (the square cut around it, ρ ≤ 1 mm, and its
-    // bands), where the sphere's measure of sub-millimetre edges under the pole is as
-    // ill-conditioned as the azimuth there, a hardware GPU's last bits change the square's
-    // lattice: an H200 drew 377 of the cubemap demo room's triangles there otherwise (the nodes
-    // 0.3 mm from the nadir; the sphere culls them beyond its first row's centre, the cubemap's
-    // down face draws them, 0.04° across). On a software adapter they must match too.
-    let free_radius = if software { 0.0 } else { 1e-2 };
-    same_triangle_sets(&cpu.vertices, &gpu.vertices, slack(cpu.vertices.len() / 3), free_radius)
 }

@@ -4,6 +4,7 @@
 
 pub mod figures;
 pub mod lod;
+pub mod search;
 pub mod speed;
 pub mod startup;
 pub mod trace_lod;
@@ -298,6 +299,10 @@ pub enum BenchCommand {
     /// Whole-process time of `twister render` commands in fresh processes: cold (Mesa's and
     /// twister's caches emptied), warm, and warm without twister's pipeline cache.
     Startup(StartupArgs),
+    /// The random search for cracks, holes and lost geometry: random closed rooms and objects,
+    /// viewers, panoramas, methods, sizes, eye models, heads and levels of detail, checked on the
+    /// CPU twin and through the renderer; failures written as reproductions.
+    Search(search::SearchArgs),
 }
 
 #[derive(Args)]

@@ -310,7 +310,7 @@ impl Subdivider<'_> {
     }
 
     /// The corners of input triangle t in the viewer frame, snapped to the cut planes.
-    pub(super) fn positions(&self, vertices: &[SceneVertex], indices: &[u32], t: usize) -> [Vec3; 3] {
+    pub fn positions(&self, vertices: &[SceneVertex], indices: &[u32], t: usize) -> [Vec3; 3] {
         let view = Mat4::from_cols_array_2d(&self.params.view);
         [0, 1, 2].map(|k| {
             snap_to_cut_planes(view.transform_point3(Vec3::from(vertices[indices[3 * t + k] as usize].position)))

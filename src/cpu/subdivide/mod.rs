@@ -165,6 +165,16 @@ impl<'a> Subdivider<'a> {
         Subdivider { params, projection: (&params.projection).into(), edge_scale: &[] }
     }
 
+    /// The projection the stage's parameters describe.
+    pub fn projection(&self) -> &Projection {
+        &self.projection
+    }
+
+    /// ρ: the half-diagonal of the square around the axis that the cuts remove.
+    pub fn axis_clearance(&self) -> f32 {
+        self.params.axis_clearance
+    }
+
     /// The same with a per-object factor on L (see `edge_scale`).
     pub fn with_edge_scale(params: &'a SubdivideParams, edge_scale: &'a [f32]) -> Self {
         Subdivider { edge_scale, ..Subdivider::new(params) }
@@ -310,7 +320,7 @@ impl<'a> Subdivider<'a> {
     /// Half the image's span in longitude, radians: π on the cylinder and the sphere, π/2 for
     /// VR180 (`image_half_span` in the WGSL; meaningless for the seamless images, whose x is no
     /// longitude).
-    pub(super) fn image_half_span(&self) -> f32 {
+    pub fn image_half_span(&self) -> f32 {
         PI * self.projection.width as f32 / self.projection.turn_px()
     }
 
@@ -360,5 +370,3 @@ mod schedule_tests;
 mod seam_tests;
 #[cfg(test)]
 mod tests;
-#[cfg(test)]
-mod watertight_tests;
