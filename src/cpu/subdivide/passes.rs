@@ -351,6 +351,12 @@ impl<'s> CpuSubdivision<'s> {
         let n = [n0, n1, piece.count2_level & 0xffff];
         let k = (piece.count2_level >> 16) & 0x1fff;
         let bands = piece.count2_level & BANDS != 0;
+        if k == 0 && !bands {
+            // A slot never written: its part's records overflowed the buffer (`append`), and
+            // the frame is drawn again once it has grown. No piece (the GPU's output from such
+            // slots is discarded with the frame's).
+            return;
+        }
         let Some(g) = sub.piece_geometry(&tri, &corners, PartSplit { n, k, bands }, piece.cell) else { return };
         match sub.unmeasured_shape(&g) {
             Some(shape) => {

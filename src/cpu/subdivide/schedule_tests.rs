@@ -38,3 +38,29 @@ fn the_cut_probe_lists_the_triangles_the_frame_cuts() {
         assert_eq!(missed(&frame, &params, &done, |e| !CUT_PASSES.contains(&e)).is_empty(), !cuts);
     }
 }
+
+#[test]
+fn a_frame_whose_piece_records_overflow_replays_to_the_direct_run() {
+    // Fine splits (L = 4 px, N_max = 1) of a room around the viewer on the fisheye make more
+    // piece records than the first guess holds: the slots counted but never written are no
+    // pieces, and the frame drawn again with grown buffers gives the direct run's triangles.
+    use crate::core::scene::Scene;
+    use crate::core::shapes::ClosedMesh;
+    use crate::encoding::schedule::Schedule;
+    let mut scene = Scene::new("room");
+    ClosedMesh::grid_box(3).placed(glam::Vec3::new(0.3, 0.2, -0.4), 2.0).add_to(&mut scene, [1.0; 4]);
+    let projection = Projection { fov: 250.0, dome_tilt: 6.0, ..Projection::fisheye(96) };
+    let settings = RenderSettings::new(projection)
+        .with_method(Method::Adaptive(Split::Error))
+        .with_edge_px(2.0)
+        .with_max_error_px(0.1)
+        .with_max_div(1);
+    let n = scene.triangle_count() as u32;
+    let direct = super::subdivide(&subdivide_params(&settings, 0, n), &scene.vertices, &scene.indices);
+    assert!(direct.pieces > Capacities::guess(n).pieces, "{} pieces: no overflow", direct.pieces);
+    let budget = Capacities::budget(256, 128 << 20);
+    let passes =
+        super::passes::run_scheduled(&settings, &scene.vertices, &scene.indices, &[], Schedule::OneSubmission, budget)
+            .expect("replayed");
+    assert_eq!(passes.vertices.len(), direct.vertices.len());
+}
