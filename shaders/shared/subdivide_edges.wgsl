@@ -227,7 +227,10 @@ fn division_count(n: f32) -> u32 {
 // src/cpu/subdivide/ for why testing the corners suffices).
 fn off_screen_vertically(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> bool {
     let k = params.vertical_limit;
-    let r = vec3<f32>(horizontal_radius(p0), horizontal_radius(p1), horizontal_radius(p2));
+    // A tracked head's eyes are fixed, d_e beside its axis: a point r from that axis may lie
+    // r + d_e from an eye, where it rises less steeply.
+    let pad = select(0.0, params.projection.eye_radius, params.projection.head_on != 0.0);
+    let r = vec3<f32>(horizontal_radius(p0), horizontal_radius(p1), horizontal_radius(p2)) + vec3<f32>(pad);
     let y = vec3<f32>(p0.y, p1.y, p2.y);
     return all(y > k * r) || all(y < -k * r) || around_dome_antipode(p0, p1, p2);
 }

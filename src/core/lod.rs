@@ -18,7 +18,7 @@
 //! Simplified meshes come from meshoptimizer's quadric-error simplifier (the Garland–Heckbert QEM
 //! the paper used): a chain of levels, each about `LEVEL_RATIO` (0.7) of the triangles of the one before, built once
 //! per object down to P3 and cached (a closed mesh's chain stops before a level that would open
-//! it or fold it onto itself). A frame draws, for each object, the coarsest level that still
+//! it). A frame draws, for each object, the coarsest level that still
 //! has at least P_m triangles. The levels reuse the object's vertices, so UVs, normals and colours
 //! stay as they were at the vertices the simplifier keeps.
 //!
@@ -167,8 +167,8 @@ impl LodChain {
                         Some(&mut error),
                     );
                     // Stop where the simplifier can no longer make real progress, or where it
-                    // would open a closed mesh or fold it onto itself (an edge used other than
-                    // twice: a crack or a fin the original did not have).
+                    // would open a closed mesh (an edge used an odd number of times: a crack or
+                    // a fin the original did not have).
                     if next.is_empty()
                         || next.len() / 3 > count * 9 / 10
                         || (closed && !is_closed(&scene.vertices, &next))
@@ -216,17 +216,18 @@ impl LodChain {
     }
 }
 
-/// Whether every edge of a triangle list (by its end points' positions) is used by exactly
-/// two of its triangles, once in each direction.
+/// Whether a triangle list is watertight: every edge (by its end points' positions) used by an
+/// even number of its triangles (no crack; a fold, an edge used four times, covers as well).
 fn is_closed(vertices: &[crate::core::scene::SceneVertex], indices: &[u32]) -> bool {
     let key = |i: u32| vertices[i as usize].position.map(f32::to_bits);
-    let mut directed: std::collections::HashMap<([u32; 3], [u32; 3]), u32> = std::collections::HashMap::new();
+    let mut uses: std::collections::HashMap<([u32; 3], [u32; 3]), u32> = std::collections::HashMap::new();
     for t in indices.chunks_exact(3) {
         for e in 0..3 {
-            *directed.entry((key(t[e]), key(t[(e + 1) % 3]))).or_default() += 1;
+            let (a, b) = (key(t[e]), key(t[(e + 1) % 3]));
+            *uses.entry(if a < b { (a, b) } else { (b, a) }).or_default() += 1;
         }
     }
-    directed.iter().all(|(&(a, b), &n)| n == 1 && directed.get(&(b, a)) == Some(&1))
+    uses.values().all(|n| n % 2 == 0)
 }
 
 /// The direction of an object's bounding sphere (centre `c` in the viewer frame, `radius`)
@@ -386,8 +387,8 @@ mod tests {
         }
     }
 
-    /// The chain of a closed mesh keeps it closed at every level (no crack, no fin), and still
-    /// simplifies it.
+    /// The chain of a closed mesh keeps it closed at every level (no edge used an odd number of
+    /// times), and still simplifies it.
     #[test]
     fn every_level_of_a_closed_mesh_is_closed() {
         use crate::core::shapes::ClosedMesh;

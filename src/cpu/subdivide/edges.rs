@@ -346,8 +346,12 @@ impl Subdivider<'_> {
     /// beyond mean the whole triangle is.
     pub fn off_screen_vertically(&self, p: [Vec3; 3]) -> bool {
         let k = self.vertical_limit();
-        let above = p.iter().all(|q| q.y > k * horizontal_radius(*q));
-        let below = p.iter().all(|q| q.y < -k * horizontal_radius(*q));
+        // A tracked head's eyes are fixed, d_e beside its axis: a point r from that axis may lie
+        // r + d_e from an eye, where it rises less steeply (the cylinder's eyes, on their circle,
+        // see it along a tangent, from at most r away).
+        let pad = if self.projection.head.is_some() { self.projection.eye_radius } else { 0.0 };
+        let above = p.iter().all(|q| q.y > k * (horizontal_radius(*q) + pad));
+        let below = p.iter().all(|q| q.y < -k * (horizontal_radius(*q) + pad));
         above || below || self.projection.around_dome_antipode(p)
     }
 
