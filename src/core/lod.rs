@@ -17,8 +17,7 @@
 //!
 //! Simplified meshes come from meshoptimizer's quadric-error simplifier (the Garland–Heckbert QEM
 //! the paper used): a chain of levels, each about `LEVEL_RATIO` (0.7) of the triangles of the one before, built once
-//! per object down to P3 and cached (a closed mesh's chain stops before a level that would open
-//! it). A frame draws, for each object, the coarsest level that still
+//! per object down to P3 and cached. A frame draws, for each object, the coarsest level that still
 //! has at least P_m triangles. The levels reuse the object's vertices, so UVs, normals and colours
 //! stay as they were at the vertices the simplifier keeps.
 //!
@@ -147,7 +146,6 @@ impl LodChain {
                 } else {
                     ((o.triangle_count as f32 * min_share).ceil() as usize).max(1)
                 };
-                let closed = is_closed(&scene.vertices, &original);
                 let mut chain = vec![original];
                 let mut errors = vec![0.0f32];
                 loop {
@@ -166,13 +164,8 @@ impl LodChain {
                         meshopt::SimplifyOptions::Sparse,
                         Some(&mut error),
                     );
-                    // Stop where the simplifier can no longer make real progress, or where it
-                    // would open a closed mesh (an edge used an odd number of times: a crack or
-                    // a fin the original did not have).
-                    if next.is_empty()
-                        || next.len() / 3 > count * 9 / 10
-                        || (closed && !is_closed(&scene.vertices, &next))
-                    {
+                    // Stop where the simplifier can no longer make real progress.
+                    if next.is_empty() || next.len() / 3 > count * 9 / 10 {
                         break;
                     }
                     chain.push(next);
@@ -214,20 +207,6 @@ impl LodChain {
         }
         out
     }
-}
-
-/// Whether a triangle list is watertight: every edge (by its end points' positions) used by an
-/// even number of its triangles (no crack; a fold, an edge used four times, covers as well).
-fn is_closed(vertices: &[crate::core::scene::SceneVertex], indices: &[u32]) -> bool {
-    let key = |i: u32| vertices[i as usize].position.map(f32::to_bits);
-    let mut uses: std::collections::HashMap<([u32; 3], [u32; 3]), u32> = std::collections::HashMap::new();
-    for t in indices.chunks_exact(3) {
-        for e in 0..3 {
-            let (a, b) = (key(t[e]), key(t[(e + 1) % 3]));
-            *uses.entry(if a < b { (a, b) } else { (b, a) }).or_default() += 1;
-        }
-    }
-    uses.values().all(|n| n % 2 == 0)
 }
 
 /// The direction of an object's bounding sphere (centre `c` in the viewer frame, `radius`)
@@ -384,29 +363,6 @@ mod tests {
                 proptest::prop_assert_eq!(chosen.edge_scale, 1.0);
             }
             proptest::prop_assert_eq!(sel.chosen[0].triangles, scene.objects[0].triangle_count);
-        }
-    }
-
-    /// The chain of a closed mesh keeps it closed at every level (no edge used an odd number of
-    /// times), and still simplifies it.
-    #[test]
-    fn every_level_of_a_closed_mesh_is_closed() {
-        use crate::core::shapes::ClosedMesh;
-        // The search's shapes (small tori fold onto themselves when simplified far) and larger ones.
-        let small = (6..=12).flat_map(|n| (4..=8).map(move |m| ClosedMesh::torus(n, m)));
-        let meshes =
-            [ClosedMesh::icosphere(2), ClosedMesh::icosphere(3), ClosedMesh::grid_box(3), ClosedMesh::grid_box(8)];
-        for mesh in meshes.into_iter().chain(small) {
-            let mut scene = Scene::new("closed");
-            mesh.add_to(&mut scene, [1.0; 4]);
-            let chain = LodChain::build(&scene, 0.05);
-            let levels = &chain.levels[0];
-            if mesh.indices.len() >= 3 * 500 {
-                assert!(levels[0].len() > 2 * levels.last().unwrap().len(), "{}: not simplified", mesh.name);
-            }
-            for (k, level) in levels.iter().enumerate() {
-                assert!(is_closed(&scene.vertices, level), "{}: level {k} open", mesh.name);
-            }
         }
     }
 
