@@ -381,76 +381,87 @@ pub fn case_strategy(
         head,
         gaze,
     )
-        .prop_map(
-            |(
-                (panorama, family),
-                (fixed_pick, fixed_n, edge_px, tau, max_div),
-                (room_grid, room_half, room_at),
-                objects,
-                (viewer, yaw_deg, width, tall),
-                (screen_radius, eye_radius, exact, convergence, pole_merge),
-                (fov, tilt),
-                (head_at, head_yaw, cave_half, cave_wall),
-                gaze,
-            )| {
-                let method = match family {
-                    SearchMethod::Vertex => Method::Vertex,
-                    SearchMethod::Fixed => {
-                        Method::Fixed(if fixed_pick < 100 { 13 + fixed_pick as u32 % 20 } else { fixed_n })
-                    }
-                    SearchMethod::Adaptive => Method::Adaptive(Split::Error),
-                    SearchMethod::AdaptiveLength => Method::Adaptive(Split::Length),
-                };
-                // A tracked head within 60 % of the screen's radius (the cylinder) or of the
-                // CAVE's half size; the room holds it, the eyes and the CAVE with 0.5 m to spare.
-                let (head, reach) = match panorama {
-                    SearchPanorama::CylinderHead => {
-                        let r = 0.6 * screen_radius;
-                        (Some(([head_at[0] * r, 0.3 * head_at[1], head_at[2] * r], head_yaw)), r + 0.3)
-                    }
-                    SearchPanorama::Cave => {
-                        let r = 0.6 * cave_half;
-                        (Some((head_at.map(|c| c * r), head_yaw)), cave_half * 3f32.sqrt())
-                    }
-                    _ => (None, 0.2),
-                };
-                let room_half = room_half.map(|h| h.max(reach + 0.5 + 2.0 * eye_radius));
-                let room_offset = [0, 1, 2].map(|i| room_at[i] * (room_half[i] - reach - 0.5).max(0.0));
-                let fov = if tilt.abs() > 0.0 { fov.min(330.0) } else { fov };
-                let sphere = panorama.kind().is_sphere();
-                SearchCase {
-                    panorama,
-                    method,
-                    edge_px,
-                    max_error_px: tau,
-                    max_div,
-                    room_grid,
-                    room_half,
-                    room_offset,
-                    objects,
-                    viewer,
-                    yaw_deg,
-                    width: if panorama == SearchPanorama::Cubemap { (width / 3).max(16) * 3 } else { width },
-                    height: ((width as f32 * (0.1 + 0.5 * tall)) as u32).max(16),
-                    screen_radius,
-                    eye_radius,
-                    vertical: if exact || panorama == SearchPanorama::CylinderHead {
-                        Vertical::Exact
-                    } else {
-                        Vertical::Paper
-                    },
-                    convergence: convergence.filter(|_| sphere),
-                    pole_merge,
-                    fov,
-                    dome_tilt: tilt,
-                    head,
-                    cave_half,
-                    cave_wall,
-                    gaze,
-                }
-            },
-        )
+        .prop_map(assemble)
         .boxed()
+}
+
+/// What the strategy draws for one case, before it is assembled ([`assemble`]).
+type Draw = (
+    (SearchPanorama, SearchMethod),
+    (usize, u32, f32, f32, u32),
+    (u32, [f32; 3], [f32; 3]),
+    Vec<ObjectSpec>,
+    ([f32; 3], f32, u32, f32),
+    (f32, f32, bool, Option<f32>, bool),
+    (f32, f32),
+    ([f32; 3], f32, f32, usize),
+    Option<(f32, f32)>,
+);
+
+/// A case from what the strategy drew: the method, a head and a room that holds the eyes, the
+/// head and the CAVE, the sizes each panorama takes.
+fn assemble(
+    (
+        (panorama, family),
+        (fixed_pick, fixed_n, edge_px, tau, max_div),
+        (room_grid, room_half, room_at),
+        objects,
+        (viewer, yaw_deg, width, tall),
+        (screen_radius, eye_radius, exact, convergence, pole_merge),
+        (fov, tilt),
+        (head_at, head_yaw, cave_half, cave_wall),
+        gaze,
+    ): Draw,
+) -> SearchCase {
+    let method = match family {
+        SearchMethod::Vertex => Method::Vertex,
+        SearchMethod::Fixed => Method::Fixed(if fixed_pick < 100 { 13 + fixed_pick as u32 % 20 } else { fixed_n }),
+        SearchMethod::Adaptive => Method::Adaptive(Split::Error),
+        SearchMethod::AdaptiveLength => Method::Adaptive(Split::Length),
+    };
+    // A tracked head within 60 % of the screen's radius (the cylinder) or of the
+    // CAVE's half size; the room holds it, the eyes and the CAVE with 0.5 m to spare.
+    let (head, reach) = match panorama {
+        SearchPanorama::CylinderHead => {
+            let r = 0.6 * screen_radius;
+            (Some(([head_at[0] * r, 0.3 * head_at[1], head_at[2] * r], head_yaw)), r + 0.3)
+        }
+        SearchPanorama::Cave => {
+            let r = 0.6 * cave_half;
+            (Some((head_at.map(|c| c * r), head_yaw)), cave_half * 3f32.sqrt())
+        }
+        _ => (None, 0.2),
+    };
+    let room_half = room_half.map(|h| h.max(reach + 0.5 + 2.0 * eye_radius));
+    let room_offset = [0, 1, 2].map(|i| room_at[i] * (room_half[i] - reach - 0.5).max(0.0));
+    let fov = if tilt.abs() > 0.0 { fov.min(330.0) } else { fov };
+    let sphere = panorama.kind().is_sphere();
+    SearchCase {
+        panorama,
+        method,
+        edge_px,
+        max_error_px: tau,
+        max_div,
+        room_grid,
+        room_half,
+        room_offset,
+        objects,
+        viewer,
+        yaw_deg,
+        width: if panorama == SearchPanorama::Cubemap { (width / 3).max(16) * 3 } else { width },
+        height: ((width as f32 * (0.1 + 0.5 * tall)) as u32).max(16),
+        screen_radius,
+        eye_radius,
+        vertical: if exact || panorama == SearchPanorama::CylinderHead { Vertical::Exact } else { Vertical::Paper },
+        convergence: convergence.filter(|_| sphere),
+        pole_merge,
+        fov,
+        dome_tilt: tilt,
+        head,
+        cave_half,
+        cave_wall,
+        gaze,
+    }
 }
 
 /// The property tests' configuration: `default_cases` cases (`PROPTEST_CASES` where set) from

@@ -102,51 +102,9 @@ pub fn bench_search(args: &SearchArgs) -> Result<()> {
             row.0 += 1;
             if let Err(failure) = search::check(renderer.as_ref(), &case) {
                 *row.1.entry(failure.check).or_default() += 1;
-                failures += 1;
-                progress.suspend(|| {
-                    eprintln!(
-                        "{}",
-                        format!(
-                            "case {i} of the {}: {}: {} ({}); shrinking",
-                            panorama.name(),
-                            failure.check.name(),
-                            failure.message,
-                            case.describe()
-                        )
-                    )
-                });
-                // A panic met while shrinking is a failure of its own, written apart.
-                let panicked = std::cell::RefCell::new(None);
-                let small = search::shrink(tree, args.shrink_steps, |c| {
-                    let result = search::check(renderer.as_ref(), c);
-                    if let Err(f) = &result {
-                        if f.check == Check::Panic && failure.check != Check::Panic && panicked.borrow().is_none() {
-                            *panicked.borrow_mut() = Some((c.clone(), f.clone()));
-                        }
-                    }
-                    result.is_err_and(|f| f.check == failure.check)
-                });
-                if let Some((case, f)) = panicked.into_inner() {
-                    failures += 1;
-                    let dir = args.out.join(format!("failure-{:03}-{}-{i}-panic", failures, panorama.name()));
-                    write_reproduction(&dir, &case, &f)?;
-                    progress.suspend(|| eprintln!("{}: panic: {} ({})", dir.display(), f.message, case.describe()));
-                }
-                let failure = search::check(renderer.as_ref(), &small).err().unwrap_or(failure);
-                let dir = args.out.join(format!("failure-{:03}-{}-{i}", failures, panorama.name()));
-                write_reproduction(&dir, &small, &failure)?;
-                progress.suspend(|| {
-                    eprintln!(
-                        "{}",
-                        format!(
-                            "{}: {}: {} ({})",
-                            dir.display(),
-                            failure.check.name(),
-                            failure.message,
-                            small.describe()
-                        )
-                    )
-                });
+                let say = |line: String| progress.suspend(|| eprintln!("{line}"));
+                let at = Found { out: &args.out, panorama, index: i };
+                failures += report_failure(renderer.as_ref(), tree, failure, args.shrink_steps, &at, failures, say)?;
             }
             progress.set_message(format!("{} failures", failures));
             progress.inc(1);
@@ -163,6 +121,57 @@ pub fn bench_search(args: &SearchArgs) -> Result<()> {
         ));
     }
     Ok(())
+}
+
+/// Where a failing case was found: the output folder, its panorama and its index.
+struct Found<'a> {
+    out: &'a Path,
+    panorama: SearchPanorama,
+    index: usize,
+}
+
+/// A failing case said, shrunk (while the same check fails) and written; a panic met while
+/// shrinking written apart. The failures written (numbered after `before`).
+fn report_failure(
+    renderer: Option<&Renderer>,
+    tree: Box<dyn proptest::strategy::ValueTree<Value = SearchCase>>,
+    failure: Failure,
+    steps: usize,
+    at: &Found,
+    before: usize,
+    say: impl Fn(String),
+) -> Result<usize> {
+    let case = tree.current();
+    let (name, i) = (at.panorama.name(), at.index);
+    say(format!(
+        "case {i} of the {name}: {}: {} ({}); shrinking",
+        failure.check.name(),
+        failure.message,
+        case.describe()
+    ));
+    let panicked = std::cell::RefCell::new(None);
+    let small = search::shrink(tree, steps, |c| {
+        let result = search::check(renderer, c);
+        if let Err(f) = &result {
+            if f.check == Check::Panic && failure.check != Check::Panic && panicked.borrow().is_none() {
+                *panicked.borrow_mut() = Some((c.clone(), f.clone()));
+            }
+        }
+        result.is_err_and(|f| f.check == failure.check)
+    });
+    let mut written = 0;
+    if let Some((case, f)) = panicked.into_inner() {
+        written += 1;
+        let dir = at.out.join(format!("failure-{:03}-{name}-{i}-panic", before + written));
+        write_reproduction(&dir, &case, &f)?;
+        say(format!("{}: panic: {} ({})", dir.display(), f.message, case.describe()));
+    }
+    let failure = search::check(renderer, &small).err().unwrap_or(failure);
+    written += 1;
+    let dir = at.out.join(format!("failure-{:03}-{name}-{i}", before + written));
+    write_reproduction(&dir, &small, &failure)?;
+    say(format!("{}: {}: {} ({})", dir.display(), failure.check.name(), failure.message, small.describe()));
+    Ok(written)
 }
 
 /// The table of cases and failures per panorama and method, with the command and the time.
