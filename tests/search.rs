@@ -65,7 +65,7 @@ proptest! {
         gaze in (-180.0f32..180.0, -80.0f32..80.0),
     ) {
         let case = search::SearchCase { gaze: Some(gaze), ..case };
-        if let Err(f) = search::check_gpu(common::renderer(), &case) {
+        if let Err(f) = search::check_gpu(common::renderer(), &case, &search::drawn_scene(&case)) {
             prop_assert!(false, "{}: {}: {}", case.describe(), f.check.name(), f.message);
         }
     }

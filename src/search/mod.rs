@@ -253,8 +253,8 @@ impl SearchCase {
             SearchPanorama::CylinderHead => {
                 Projection { width: self.width, height: self.height, head: self.head_at(), ..base }
             }
-            SearchPanorama::Equirect => Projection { ..Projection::equirect(self.width).with_eyes(&base) },
-            SearchPanorama::Vr180 => Projection { ..Projection::vr180(self.width).with_eyes(&base) },
+            SearchPanorama::Equirect => Projection::equirect(self.width).with_eyes(&base),
+            SearchPanorama::Vr180 => Projection::vr180(self.width).with_eyes(&base),
             SearchPanorama::Fisheye => Projection {
                 fov: self.fov,
                 dome_tilt: self.dome_tilt,
@@ -509,7 +509,10 @@ pub struct Failure {
 
 /// The case's scene, the scene as its frame draws it (its level-of-detail selection applied),
 /// its settings and the selection.
-pub fn drawn_scene(case: &SearchCase) -> (Scene, Scene, RenderSettings, Option<LodSelection>) {
+pub type Drawn = (Scene, Scene, RenderSettings, Option<LodSelection>);
+
+/// A case's [`Drawn`] (its level-of-detail chain built once for all its checks).
+pub fn drawn_scene(case: &SearchCase) -> Drawn {
     let scene = case.scene();
     let settings = case.settings();
     let lod = case.lod(&scene, &settings);
@@ -519,17 +522,16 @@ pub fn drawn_scene(case: &SearchCase) -> (Scene, Scene, RenderSettings, Option<L
 
 /// The CPU's promises: the settings are valid and the twin's subdivision is watertight and
 /// whole.
-pub fn check_cpu(case: &SearchCase) -> Result<(), Failure> {
-    let (_, scene, settings, lod) = drawn_scene(case);
+pub fn check_cpu(case: &SearchCase, (_, scene, settings, lod): &Drawn) -> Result<(), Failure> {
     settings.validate().map_err(|e| Failure { check: Check::Settings, message: e.to_string() })?;
     if case.panorama == SearchPanorama::Cave {
         return Ok(()); // drawn without subdivision: its promise is the GPU's (no background)
     }
-    let scales = lod.map(|sel| sel.edge_scales()).unwrap_or_default();
+    let scales = lod.as_ref().map(|sel| sel.edge_scales()).unwrap_or_default();
     let topology = topology::Topology {
         vertices: &scene.vertices,
         indices: &scene.indices,
-        params: subdivide_params(&settings, 0, scene.triangle_count() as u32),
+        params: subdivide_params(settings, 0, scene.triangle_count() as u32),
         edge_scale: &scales,
     };
     topology
@@ -540,14 +542,17 @@ pub fn check_cpu(case: &SearchCase) -> Result<(), Failure> {
 
 /// The GPU's promises: no background pixel in either eye (inside the fisheye's circle), and the
 /// GPU's subdivision equal to the twin's (the usual frame's schedule).
-pub fn check_gpu(renderer: &Renderer, case: &SearchCase) -> Result<(), Failure> {
-    let (original, scene, settings, lod) = drawn_scene(case);
+pub fn check_gpu(
+    renderer: &Renderer,
+    case: &SearchCase,
+    (original, scene, settings, lod): &Drawn,
+) -> Result<(), Failure> {
     let fail = |check| move |e: crate::error::Error| Failure { check, message: e.to_string() };
-    let mut gs = GpuScene::upload(&renderer.gpu, &original).map_err(fail(Check::Background))?;
-    if let Some(sel) = &lod {
+    let mut gs = GpuScene::upload(&renderer.gpu, original).map_err(fail(Check::Background))?;
+    if let Some(sel) = lod {
         gs = gs.with_lod(&renderer.gpu, sel);
     }
-    let frame = renderer.render(&gs, &settings).map_err(fail(Check::Background))?;
+    let frame = renderer.render(&gs, settings).map_err(fail(Check::Background))?;
     let projection = settings.projection();
     for (eye, image) in [("left", &frame.left), ("right", &frame.right)] {
         let mut seen = Vec::new();
@@ -573,11 +578,11 @@ pub fn check_gpu(renderer: &Renderer, case: &SearchCase) -> Result<(), Failure> 
     }
     // A CAVE wall is drawn without subdivision (one perspective per eye): nothing to compare.
     if case.panorama != SearchPanorama::Cave {
-        let scales = lod.map(|sel| sel.edge_scales()).unwrap_or_default();
-        let gpu = renderer.subdivide_readback(&gs, &settings, Schedule::OneSubmission).map_err(fail(Check::Twin))?;
+        let scales = lod.as_ref().map(|sel| sel.edge_scales()).unwrap_or_default();
+        let gpu = renderer.subdivide_readback(&gs, settings, Schedule::OneSubmission).map_err(fail(Check::Twin))?;
         let budget = Capacities::budget(settings.subdivision.memory_mb, renderer.gpu.max_binding());
         let cpu = crate::cpu::subdivide::passes::run_scheduled(
-            &settings,
+            settings,
             &scene.vertices,
             &scene.indices,
             &scales,
@@ -595,8 +600,9 @@ pub fn check_gpu(renderer: &Renderer, case: &SearchCase) -> Result<(), Failure> 
 /// failure of its own.
 pub fn check(renderer: Option<&Renderer>, case: &SearchCase) -> Result<(), Failure> {
     let run = || {
-        check_cpu(case)?;
-        renderer.map_or(Ok(()), |r| check_gpu(r, case))
+        let drawn = drawn_scene(case);
+        check_cpu(case, &drawn)?;
+        renderer.map_or(Ok(()), |r| check_gpu(r, case, &drawn))
     };
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)).unwrap_or_else(|panic| {
         let message = panic

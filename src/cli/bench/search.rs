@@ -14,6 +14,9 @@ use twister::{Error, Renderer, Result};
 
 use crate::scene::open_renderer;
 
+/// Cases run and failures by check, per panorama and method family.
+type Table = BTreeMap<(SearchPanorama, SearchMethod), (usize, BTreeMap<Check, usize>)>;
+
 #[derive(Args)]
 pub struct SearchArgs {
     /// Cases per panorama.
@@ -80,7 +83,7 @@ pub fn bench_search(args: &SearchArgs) -> Result<()> {
     }
     std::fs::create_dir_all(&args.out).map_err(|e| Error::output(&args.out, e))?;
     let renderer = if args.cpu_only { None } else { Some(open_renderer()?.0) };
-    let mut table: BTreeMap<(SearchPanorama, SearchMethod), (usize, BTreeMap<Check, usize>)> = BTreeMap::new();
+    let mut table: Table = BTreeMap::new();
     let mut failures = 0;
     let total = args.cases * panoramas.len();
     let progress = indicatif::ProgressBar::new(total as u64).with_style(
@@ -175,12 +178,7 @@ fn report_failure(
 }
 
 /// The table of cases and failures per panorama and method, with the command and the time.
-fn table_text(
-    table: &BTreeMap<(SearchPanorama, SearchMethod), (usize, BTreeMap<Check, usize>)>,
-    args: &SearchArgs,
-    seconds: f64,
-    renderer: Option<&Renderer>,
-) -> String {
+fn table_text(table: &Table, args: &SearchArgs, seconds: f64, renderer: Option<&Renderer>) -> String {
     let mut s = String::new();
     let adapter = renderer.map_or("none (--cpu-only)".to_string(), |r| r.gpu.info.name.clone());
     let _ = writeln!(
