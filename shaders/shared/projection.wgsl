@@ -296,7 +296,7 @@ fn frame_clip(proj: Projection, uvd: vec3<f32>) -> vec4<f32> {
         return vec4<f32>(2.0 * xy.x / proj.width - 1.0, 1.0 - 2.0 * xy.y / proj.height, z, 1.0);
     }
     if (is_cubemap(proj)) {
-        return cube_clip(proj, uvd.x, uvd.y, z);
+        return cube_clip(proj, uvd.x, uvd.y, uvd.z);
     }
     let x = uvd.x * proj.turn_px / (PI * proj.width);
     let y_limit = 1.0 + GUARD_BAND_PX / (0.5 * proj.height);

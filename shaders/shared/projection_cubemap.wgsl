@@ -82,14 +82,26 @@ fn horizon_w(w: f32) -> f32 {
     return select(w, CUBE_MIN_W, abs(w) < CUBE_MIN_W);
 }
 
-// The clip position on the whole grid of the ray of longitude u, latitude v at depth z for the
-// draw of face `proj.face` (`Projection::cube_clip`): w = D·n; the draw's scissor keeps the face.
-fn cube_clip(proj: Projection, u: f32, v: f32, z: f32) -> vec4<f32> {
-    let d = lon_lat_direction(u, v);
+// The direction a vertex seen at (u, v) is drawn in (`Projection::cube_ray`): within half a
+// pixel of a pole (1/F radians), the pole itself, so that the nodes around the axis meet there.
+fn cube_ray(proj: Projection, u: f32, v: f32) -> vec3<f32> {
+    if (abs(v) > 0.5 * PI - 3.0 / proj.width) {
+        return vec3<f32>(0.0, sign(v), 0.0);
+    }
+    return lon_lat_direction(u, v);
+}
+
+// The clip position on the whole grid of the ray of longitude u, latitude v of a point at
+// `distance` from its eye for the draw of face `proj.face`, before `clip_w` scales it by that
+// distance (`Projection::cube_clip`): w = D·n; z = w − ν/distance, linear in the point after the
+// scaling (ν = CUBE_NEAR·R_T, the near plane); the draw's scissor keeps the face.
+fn cube_clip(proj: Projection, u: f32, v: f32, distance: f32) -> vec4<f32> {
+    let d = cube_ray(proj, u, v);
     let face = cube_face_axes(proj.face);
     let w = horizon_w(dot(d, face.normal));
+    let near = CUBE_NEAR * proj.screen_radius / max(distance, CUBE_MIN_DISTANCE);
     return vec4<f32>(((2.0 * face.cell.x + 1.0) / 3.0 - 1.0) * w + dot(d, face.right) / 3.0,
-                     (0.5 - face.cell.y) * w + 0.5 * dot(d, face.up), z * w, w);
+                     (0.5 - face.cell.y) * w + 0.5 * dot(d, face.up), min(w - near, MAX_DEPTH * w), w);
 }
 
 // Where the ray of (u, v) shows on the face of image position xy, and how far in front of that

@@ -250,11 +250,10 @@ fn faces_away(t: u32, p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> bool {
 // Whether a triangle lies wholly in the cone around the point opposite the fisheye's axis
 // (`Projection::around_dome_antipode`): there the image folds onto a ring.
 fn around_dome_antipode(p0: vec3<f32>, p1: vec3<f32>, p2: vec3<f32>) -> bool {
-    let beta = min(180.0 - 0.5 * params.projection.fov - 10.0, 90.0);
-    if (!is_fisheye(params.projection) || beta <= 0.0) {
+    let c = params.antipode_cos;
+    if (c > 1.0) {
         return false;
     }
-    let c = cos(radians(beta));
     let t = radians(params.projection.dome_tilt);
     let axis = vec3<f32>(0.0, cos(t), sin(t));
     return dot(p0, axis) < -c * length(p0) && dot(p1, axis) < -c * length(p1) && dot(p2, axis) < -c * length(p2);

@@ -39,7 +39,8 @@ struct SubdivideParams {
     seamless: u32,       // 1: the image has no seam: no seam copies (`SubdivideParams::seamless`)
     pinhole_faces: u32,  // 1: drawn as pinholes (the cubemap): `SubdivideParams::pinhole_faces`
     node_offsets: u32, // 1: nodes drawn off their projections (`SubdivideParams::node_offsets`)
-    _pad: array<u32, 2>,
+    antipode_cos: f32, // cos β of the fisheye's dropped cone, 2: none (`SubdivideParams::antipode_cos`)
+    _pad: u32,
 }
 
 // Whether the pipeline may measure the longest visible output edge (`measure_edges`): built

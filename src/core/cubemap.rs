@@ -64,6 +64,21 @@ pub fn direction(lon: f32, lat: f32) -> Vec3 {
     Vec3::new(lat.cos() * lon.sin(), lat.sin(), -lat.cos() * lon.cos())
 }
 
+impl Projection {
+    /// The direction a vertex seen at (`lon`, `lat`) is drawn in on the cubemap: within half a
+    /// pixel of a pole (1/F radians, F the face's side), the pole itself, so that every vertex
+    /// there is one point on the up or down face: the nodes around the axis (the square the cuts
+    /// remove, whose images ring the pole at longitudes that differ from triangle to triangle)
+    /// meet, and a pixel centred on the pole (an odd F) is covered. As the sphere puts what lies
+    /// beyond its first row's centre on the image's edge. `cube_ray` in projection_cubemap.wgsl.
+    pub fn cube_ray(&self, lon: f32, lat: f32) -> Vec3 {
+        if lat.abs() > std::f32::consts::FRAC_PI_2 - 3.0 / self.width as f32 {
+            return Vec3::new(0.0, lat.signum(), 0.0);
+        }
+        direction(lon, lat)
+    }
+}
+
 /// The face a direction falls on: the one whose normal it is closest to (ties to the earlier
 /// face). `cube_face_of` in projection_cubemap.wgsl.
 pub fn cube_face_of(d: Vec3) -> usize {
@@ -87,6 +102,16 @@ pub const CUBE_MIN_W: f32 = 1e-5;
 /// The smallest distance along its ray a vertex's clip position is scaled by (`clip_w` in
 /// cpu/raster.rs): a face draws as a pinhole, w = D·n times that distance.
 pub const CUBE_MIN_DISTANCE: f32 = 1e-6;
+
+/// The near plane of a face's draw, as a fraction of R_T: clip z = w − ν with ν =
+/// `CUBE_NEAR`·R_T (a few millimetres at the usual R_T), so that z = 0 is the plane w = ν, linear
+/// in the point like w itself. The rasterizer's clipping at z = 0 then cuts an edge that crosses
+/// the face's horizon plane where its w is ν, in front of the face: the depth r/(r + 1) that the
+/// other panoramas use is not linear, and clipped an edge from a point in front of the face to
+/// one behind it where w had already turned negative (a wall across the eyes' height, drawn on
+/// the down face, left holes at the face's edges). Depth after the divide, 1 − ν/w, orders
+/// points along a pixel's ray as their distance does.
+pub const CUBE_NEAR: f32 = 5e-3;
 
 /// A face's w for D·n (`cube_clip`; `horizon_w` in projection_cubemap.wgsl).
 fn horizon_w(w: f32) -> f32 {
@@ -164,23 +189,26 @@ impl Projection {
         (face.normal + a * face.right + b * face.up).normalize()
     }
 
-    /// The clip-space position on the whole grid of direction `d` (any length) at depth `z`
-    /// (0..1) for the draw of face `f` (the raster stage scales it by the distance along the
-    /// ray: a pinhole): w = D·n, so that the rasterizer's perspective divide is
-    /// the face's gnomonic map and its clipping keeps what lies in front of the face; the draw's
-    /// scissor (the face's square) keeps the face. Linear in D: the great circle between two
-    /// directions is the straight line between their images on every face. A direction on the
-    /// face's horizon plane is moved just in front of it (`horizon_w`).
-    pub fn cube_clip(&self, d: Vec3, z: f32, f: usize) -> Vec4 {
+    /// The clip-space position on the whole grid of direction `d` (unit length) of a point at
+    /// `distance` along it from its eye for the draw of face `f`, before the raster stage scales
+    /// it by that distance (a pinhole, `clip_w`): w = D·n, so that the rasterizer's perspective
+    /// divide is the face's gnomonic map and its clipping keeps what lies in front of the face;
+    /// the draw's scissor (the face's square) keeps the face. Linear in D: the great circle
+    /// between two directions is the straight line between their images on every face. A
+    /// direction on the face's horizon plane is moved just in front of it (`horizon_w`); z is
+    /// w − ν/distance (after the scaling w·distance − ν, see [`CUBE_NEAR`]; the raster stage
+    /// keeps it at most `MAX_DEPTH`·w).
+    pub fn cube_clip(&self, d: Vec3, distance: f32, f: usize) -> Vec4 {
         let face = &CUBE_FACES[f];
         let w = horizon_w(d.dot(face.normal));
+        let near = CUBE_NEAR * self.screen_radius / distance.max(CUBE_MIN_DISTANCE);
         let [col, row] = face.cell.map(|c| c as f32);
         // Pixel x = F·(col + (1 + X/w)/2) over a width of 3F; pixel y = F·(row + (1 − Y/w)/2)
         // over a height of 2F; NDC x = 2x/W − 1, NDC y = 1 − 2y/H.
         Vec4::new(
             ((2.0 * col + 1.0) / 3.0 - 1.0) * w + d.dot(face.right) / 3.0,
             (0.5 - row) * w + 0.5 * d.dot(face.up),
-            z * w,
+            w - near,
             w,
         )
     }
@@ -294,9 +322,9 @@ mod tests {
     }
 
     /// A direction on a face's horizon plane (D·n = 0: the cuts around the axis put nodes on
-    /// x = 0 and z = 0) is drawn in front of the face (w > 0, z > 0: no rasterizer's clipping
-    /// meets a vertex at w = 0), out on the face in the direction a point just in front of the
-    /// plane lies: an edge to it leaves a vertex inside the face the same way.
+    /// x = 0 and z = 0) is drawn with w > 0 (no rasterizer's clipping meets a vertex at w = 0)
+    /// behind the near plane (z < 0), out on the face in the direction a point just in front of
+    /// the plane lies: an edge to it leaves a vertex inside the face the same way.
     #[test]
     fn a_direction_on_a_faces_horizon_is_drawn_in_front_of_it_in_its_direction() {
         let proj = Projection::cubemap(300);
@@ -313,11 +341,44 @@ mod tests {
                     continue;
                 }
                 let c = proj.cube_clip(on_plane, 0.5, f);
-                assert!(c.w >= CUBE_MIN_W && c.z > 0.0, "face {f}, {on_plane}: {c}");
+                assert!(c.w >= CUBE_MIN_W && c.z < 0.0, "face {f}, {on_plane}: {c}");
                 let in_front = proj.cube_clip(on_plane + 1e-3 * on_plane.length() * n, 0.5, f);
                 assert!(offset(c, f).dot(offset(in_front, f)) > 1.0 - 1e-6, "face {f}, {on_plane}: {c} vs {in_front}");
             }
         }
+    }
+
+    /// An edge from a point in front of a face to one behind it (a wall across the eyes'
+    /// height, drawn on the down face) is clipped where the rasterizer clips it (z = 0, the
+    /// raster stage's clip position scaled by the distance) at a point of the 3-D edge in front
+    /// of the face, drawn where that point belongs: z is linear in the point. (With the depth
+    /// r/(r + 1) as z, the clip fell where w had turned negative, and the face showed holes.)
+    #[test]
+    fn an_edge_across_a_faces_horizon_is_clipped_in_front_of_the_face_where_it_belongs() {
+        let proj = Projection { eye_radius: 0.0, ..Projection::cubemap(300) };
+        let near = CUBE_NEAR * proj.screen_radius;
+        let clip = |p: Vec3, f: usize| proj.cube_clip(p.normalize(), p.length(), f) * p.length();
+        let mut rng = rand::rngs::StdRng::seed_from_u64(7);
+        let mut checked = 0;
+        for _ in 0..2000 {
+            let mut point = || Vec3::new(rng.random_range(-5.0..5.0), rng.random_range(-5.0..5.0), rng.random_range(-5.0..5.0));
+            let (a, b) = (point(), point());
+            for f in 0..6 {
+                let (ca, cb) = (clip(a, f), clip(b, f));
+                if !(ca.z > 0.0 && cb.z < 0.0 && cb.w < 0.0) {
+                    continue;
+                }
+                let t = ca.z / (ca.z - cb.z);
+                let c = ca + (cb - ca) * t;
+                assert!((c.w - near).abs() < 1e-3 * near, "face {f}, {a} → {b}: clipped at w = {}", c.w);
+                let p = a + (b - a) * t;
+                let want = proj.cube_clip(p.normalize(), p.length(), f);
+                let (got, want) = (Vec2::new(c.x, c.y) / c.w, Vec2::new(want.x, want.y) / want.w);
+                assert!((got - want).length() < 1e-3 * (1.0 + want.length()), "face {f}, {a} → {b}: {got} vs {want}");
+                checked += 1;
+            }
+        }
+        assert!(checked > 500, "{checked} edges across a horizon");
     }
 
     /// The clip positions of the face draws are the face's map after the divide, and points

@@ -38,7 +38,7 @@ impl Projection {
                     format!("must be degrees between -90 and 90, got {}", self.dome_tilt),
                 ));
             }
-            if self.dome_tilt != 0.0 && self.dome_antipode_cone().is_none() {
+            if self.dome_tilt != 0.0 && self.dome_antipode_cone(0.0).is_none() {
                 return Err(Error::setting(
                     "view.projection.dome_tilt",
                     format!(
@@ -90,25 +90,47 @@ impl Projection {
         (d.x.atan2(-d.z), d.y.atan2((d.x * d.x + d.z * d.z).sqrt()))
     }
 
+    /// How far, in pixels, a drawn edge beyond the fisheye's rim may dip towards the image's
+    /// centre from the circle its ends lie on (0 on the other panoramas): a chord of length c on
+    /// a circle of radius R dips c²/8R. The length rule's parts are at most L long (the
+    /// lattice's diagonals up to about 1.5·L); the error split (`error_split`) bounds each part's
+    /// deviation from its curve by τ (4τ, for the zipper's diagonals and the second
+    /// differences' sampling). The dropped cone keeps this much more margin beyond the rim
+    /// ([`Projection::dome_antipode_cone`]), so that what is dropped leaves no chord inside the
+    /// circle.
+    pub fn chord_dip_px(&self, error_split: bool, edge_px: f32, max_error_px: f32) -> f32 {
+        if self.panorama != crate::core::projection::PanoramaKind::Fisheye {
+            return 0.0;
+        }
+        if error_split {
+            4.0 * max_error_px
+        } else {
+            (1.5 * edge_px).powi(2) / (8.0 * 0.5 * self.width as f32)
+        }
+    }
+
+    /// The largest dip [`Projection::chord_dip_px`] a tilted dome's cone leaves room for (the
+    /// cone must stay: its antipode is off the vertical axis), in pixels.
+    pub fn max_chord_dip_px(&self) -> f32 {
+        (180.0 - 0.5 * self.fov - 10.0).max(0.0).to_radians() * self.fisheye_pixels_per_radian()
+    }
+
     /// The cone around the point opposite the dome's axis whose triangles the subdivision drops:
     /// beyond the field of view, and where the image folds onto a ring (ρ = π·k) around that point,
     /// whose small triangles would be drawn as chords across the whole image. Its half-angle β
-    /// reaches to 10° beyond the field of view's edge (a margin for the eye rays' offset from the
-    /// centre), at most 90° (so that it is convex); None where it would vanish (FOV ≥ 340°: the
+    /// reaches to 10° (a margin for the eye rays' offset from the centre) plus `dip_px` (how far
+    /// the drawn edges' chords may dip towards the centre, `encoding::subdivide::chord_dip_px`,
+    /// in radians at k pixels per radian) beyond the field of view's edge: the edges between what
+    /// is dropped and what is drawn lie in the cone, and their chords stay outside the circle. At
+    /// most 90° (so that it is convex); None where it would vanish (FOV ≥ 340° with no dip: the
     /// antipode is then on the rim; with no tilt it lies on the vertical axis, which the axis
     /// cuts keep whole triangles away from).
     /// Returns cos β: a point p lies in the cone when p·A < −cos β·|p|. Convex (β < 90°): a
     /// triangle whose corners all lie in it lies in it.
-    pub fn dome_antipode_cone(&self) -> Option<f32> {
-        let beta = (180.0 - 0.5 * self.fov - 10.0).min(90.0);
+    pub fn dome_antipode_cone(&self, dip_px: f32) -> Option<f32> {
+        let margin = 10.0 + (dip_px / self.fisheye_pixels_per_radian()).to_degrees();
+        let beta = (180.0 - 0.5 * self.fov - margin).min(90.0);
         (self.panorama == crate::core::projection::PanoramaKind::Fisheye && beta > 0.0).then(|| beta.to_radians().cos())
-    }
-
-    /// Whether a triangle lies wholly in the cone of [`Projection::dome_antipode_cone`].
-    pub fn around_dome_antipode(&self, p: [Vec3; 3]) -> bool {
-        let Some(c) = self.dome_antipode_cone() else { return false };
-        let axis = self.dome_basis()[0];
-        p.iter().all(|q| q.dot(axis) < -c * q.length())
     }
 
     /// Whether image position (x, y) lies inside the fisheye's FOV circle (radius W/2); every

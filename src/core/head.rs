@@ -34,7 +34,11 @@ impl Head {
     /// them).
     pub fn relative(position: Vec3, yaw_deg: f32, viewer: Vec3, viewer_yaw_deg: f32) -> Head {
         let offset = Mat3::from_rotation_y(-viewer_yaw_deg.to_radians()) * (position - viewer);
-        Head { offset: offset.to_array(), turn: (yaw_deg - viewer_yaw_deg).to_radians() }
+        // Within ±π: a turn a whole turn off (a head at −179° before a viewer at 173°: −352°)
+        // would draw every piece a whole image width off its place, where one seam copy each
+        // way no longer reaches the image's other side (the search: background in the first
+        // columns).
+        Head { offset: offset.to_array(), turn: crate::core::projection::wrap_angle((yaw_deg - viewer_yaw_deg).to_radians()) }
     }
 
     /// Head frame → display frame, rotation part.

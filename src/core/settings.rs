@@ -522,6 +522,27 @@ impl RenderSettings {
                 ),
             ));
         }
+        let projection = &self.view.projection;
+        if let Method::Adaptive(split) = s.method {
+            let error_split = split == Split::Error;
+            let dip = projection.chord_dip_px(error_split, s.edge_px, s.max_error_px);
+            if projection.dome_tilt != 0.0 && dip > 0.0 && projection.dome_antipode_cone(dip).is_none() {
+                let room = projection.max_chord_dip_px();
+                let (field, most) = if error_split {
+                    ("subdivision.max_error_px", format!("{:.2} px", room / 4.0))
+                } else {
+                    ("subdivision.edge_px", format!("{:.1} px", (8.0 * 0.5 * projection.width as f32 * room).sqrt() / 1.5))
+                };
+                return Err(Error::setting(
+                    field,
+                    format!(
+                        "a {}° fisheye tilted {}° at {} px takes at most {most}: beyond that, its chords beyond the rim dip \
+                         into the circle, and the point opposite its axis leaves no room to drop them",
+                        projection.fov, projection.dome_tilt, projection.width
+                    ),
+                ));
+            }
+        }
         if s.method == Method::Trace
             && self.view.projection.panorama == PanoramaKind::Cylinder
             && self.view.projection.vertical == Vertical::Paper

@@ -16,7 +16,7 @@ use crate::core::texture::MaterialTable;
 use crate::cpu::fragment::{
     background_color, pixel_distance, pixel_error, shade_surface, shows_environment, surface_color, Surface,
 };
-use crate::encoding::constants::GUARD_BAND_PX;
+use crate::encoding::constants::{GUARD_BAND_PX, MAX_DEPTH};
 use crate::encoding::types::{DrawVertex, RasterParams};
 
 /// Clip-space position of a subdivided vertex (`vs_main` in raster.wgsl), at most
@@ -30,8 +30,7 @@ pub fn raster_vertex(params: &RasterParams, v: &DrawVertex) -> Vec4 {
     let theta = theta0 + std::f32::consts::TAU * ((v.theta_ref - theta0) / std::f32::consts::TAU + 0.5).floor();
     let eye = if params.eye_sign > 0.0 { Eye::Right } else { Eye::Left };
     let q = projection.project_with_azimuth(p, theta, eye);
-    let depth = (q.depth / (q.depth + 1.0)).min(crate::encoding::constants::MAX_DEPTH);
-    let clip = frame_clip(&projection, q.u, q.v, depth, params.projection.face as usize)
+    let clip = frame_clip(&projection, q.u, q.v, q.depth, params.projection.face as usize)
         * clip_w(&projection, p, q.depth, params.w_by_radius);
     // The node's offset for this eye and the test hook's shift, in pixels of the frame; then the
     // tile's part of it.
@@ -58,12 +57,15 @@ fn clip_w(projection: &Projection, p: Vec3, depth: f32, w_by_radius: u32) -> f32
     horizontal_radius(p).max(crate::encoding::constants::AZIMUTH_MIN_RADIUS)
 }
 
-/// The clip position on the whole frame of screen point (u, v) at depth `depth` (0..1)
-/// (`frame_clip` in projection.wgsl; the cubemap: for the draw of face `face`).
-fn frame_clip(projection: &Projection, u: f32, v: f32, depth: f32, face: usize) -> Vec4 {
+/// The clip position on the whole frame of screen point (u, v) at `distance` from its eye,
+/// depth r/(r + 1) (`frame_clip` in projection.wgsl; the cubemap: for the draw of face `face`,
+/// its own depth, `Projection::cube_clip`).
+fn frame_clip(projection: &Projection, u: f32, v: f32, distance: f32, face: usize) -> Vec4 {
     if projection.panorama == PanoramaKind::Cubemap {
-        return projection.cube_clip(crate::core::cubemap::direction(u, v), depth, face);
+        let c = projection.cube_clip(projection.cube_ray(u, v), distance, face);
+        return Vec4::new(c.x, c.y, c.z.min(MAX_DEPTH * c.w), c.w);
     }
+    let depth = (distance / (distance + 1.0)).min(MAX_DEPTH);
     if projection.panorama == PanoramaKind::Fisheye {
         let [x, y] = projection.fisheye_pixel(u, v);
         let (w, h) = (projection.width as f32, projection.height as f32);
@@ -214,7 +216,8 @@ pub fn rasterize_within(
     }
 }
 
-/// The near plane z ≥ 0 (the raster stage's triangles, z = depth·w with w > 0, never cross it).
+/// The near plane z ≥ 0 (the raster stage's triangles, z = depth·w with w > 0, cross it only
+/// on the cubemap, where z is linear in the point: `Projection::cube_clip`).
 pub(crate) const NEAR_PLANE: Vec4 = Vec4::new(0.0, 0.0, 1.0, 0.0);
 
 /// A triangle clipped against the near plane z ≥ 0 in clip space: none, one or two triangles.

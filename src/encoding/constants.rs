@@ -2,7 +2,7 @@
 //! `constants` (composed by `#import constants`) is generated from this list by [`wgsl`], so
 //! the two sides cannot drift apart.
 
-use crate::core::cubemap::{CUBE_MIN_DISTANCE, CUBE_MIN_W};
+use crate::core::cubemap::{CUBE_MIN_DISTANCE, CUBE_MIN_W, CUBE_NEAR};
 use crate::core::light::{LightKind, Tonemap};
 use crate::core::material::{AlphaMode, Filter, Mipmap, Wrap, NO_TEXTURE};
 use crate::core::projection::PanoramaKind;
@@ -169,6 +169,7 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("AZIMUTH_MIN_RADIUS", F32(AZIMUTH_MIN_RADIUS)),
         ("CUBE_MIN_W", F32(CUBE_MIN_W)),
         ("CUBE_MIN_DISTANCE", F32(CUBE_MIN_DISTANCE)),
+        ("CUBE_NEAR", F32(CUBE_NEAR)),
         ("AZIMUTH_MIN_TURN", F32(AZIMUTH_MIN_TURN)),
         ("AZIMUTH_MAX_TURN", F32(AZIMUTH_MAX_TURN)),
         ("AZIMUTH_CHORD_RESIDUAL", F32(AZIMUTH_CHORD_RESIDUAL)),

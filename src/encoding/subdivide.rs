@@ -42,7 +42,10 @@ pub fn subdivide_params(settings: &RenderSettings, first_triangle: u32, triangle
             as u32,
         pinhole_faces: (projection.panorama == PanoramaKind::Cubemap) as u32,
         node_offsets: node_offsets as u32,
-        _pad: [0; 2],
+        antipode_cos: projection
+            .dome_antipode_cone(projection.chord_dip_px(rule == SplitRule::AdaptiveError, sub.edge_px, sub.max_error_px))
+            .unwrap_or(2.0),
+        _pad: 0,
     }
 }
 
@@ -54,11 +57,13 @@ pub fn subdivide_params(settings: &RenderSettings, first_triangle: u32, triangle
 /// not smaller, so that the thin parts beside the square keep distinct lattice nodes in f32.
 ///
 /// The sphere with pole merge sees every point near the axis (at the poles the eyes meet at the
-/// centre): there ρ is `AXIS_CLEARANCE_MIN` metres, so the hole the square leaves at a pole (the
-/// colatitudes below ρ/h for a surface h above or below the eyes) is smaller than half a pixel
-/// row unless h < 2ρ·H/π (1.3 cm at 4096×2048).
+/// centre), and so does the sphere with converging rays (a ray crosses the axis where it meets
+/// the convergence sphere, so the points within d_e of the axis show): there ρ is
+/// `AXIS_CLEARANCE_MIN` metres, so the hole the square leaves at a pole (the colatitudes below
+/// ρ/h for a surface h above or below the eyes) is smaller than half a pixel row unless
+/// h < 2ρ·H/π (1.3 cm at 4096×2048); the sphere's and the cubemap's pole then close it.
 pub fn axis_clearance(projection: &Projection) -> f32 {
-    if projection.panorama.is_sphere() && projection.pole_merge.is_some() {
+    if projection.panorama.is_sphere() && (projection.pole_merge.is_some() || projection.convergence.is_some()) {
         return AXIS_CLEARANCE_MIN;
     }
     let rt = projection.screen_radius;

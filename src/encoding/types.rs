@@ -122,7 +122,7 @@ impl From<&Projection> for ProjectionUniform {
             fov: p.fov,
             dome_tilt: p.dome_tilt,
             head_on: p.head.is_some() as u32 as f32,
-            head_turn: p.head.map_or(0.0, |h| h.turn),
+            head_turn: p.head.map_or(0.0, |h| crate::core::projection::wrap_angle(h.turn)),
             head_offset: p.head.map_or([0.0; 3], |h| h.offset),
             face: 0,
             wall_corner: p.wall.map_or([0.0; 3], |w| w.corner),
@@ -180,7 +180,11 @@ pub struct SubdivideParams {
     pub pinhole_faces: u32,
     /// 1: nodes are drawn off their projections (`DrawVertex::offsets`; `cpu::subdivide::offsets`).
     pub node_offsets: u32,
-    pub _pad: [u32; 2],
+    /// The fisheye: cos β of the cone around the point opposite the dome's axis whose triangles
+    /// are dropped (`Projection::dome_antipode_cone`, its margin following the chords' dip); 2
+    /// where none is (no point lies in it).
+    pub antipode_cos: f32,
+    pub _pad: u32,
 }
 
 /// `Counters` in shaders/shared/subdivide_types.wgsl.
@@ -558,7 +562,7 @@ pub const LAYOUTS: &[StructLayout] = &[
     }),
     layout!("SubdivideParams" => SubdivideParams {
         view, projection, axis_clearance, triangle_count, first_triangle, method, fixed_n, edge_px, max_div,
-        piece_capacity, triangle_capacity, first_piece, piece_count, measure_edges, vertical_limit, max_error_px, by_azimuth, seamless, pinhole_faces, node_offsets, _pad
+        piece_capacity, triangle_capacity, first_piece, piece_count, measure_edges, vertical_limit, max_error_px, by_azimuth, seamless, pinhole_faces, node_offsets, antipode_cos, _pad
     }),
     layout!("Counters" => SubdivideCounters { pieces, triangles, max_edge_bits, cut_count, nodes, cut_wide, max_pieces, max_output, parts, node_items, triangle_items, row_items, pending, cuts_low, cuts_high, _pad }),
     layout!("Piece" => Piece { triangle, cell, counts01, count2_level, corner, bary1, bary2, bend }),

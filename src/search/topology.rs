@@ -105,7 +105,6 @@ impl Topology<'_> {
             })
         };
         let on_square = |p: Vec3| (p.x.abs() + p.z.abs() - rho).abs() <= tol + 1e-3 * rho;
-        let beyond_side = |p: Vec3| beyond_image_side(sd, p);
 
         let mut edges: HashMap<(Key, Key), u32> = HashMap::new();
         for t in originals {
@@ -140,7 +139,7 @@ impl Topology<'_> {
                 || (*n == 1
                     && ((on_square(a) && on_square(b))
                         || sd.off_screen_vertically([a, b, a])
-                        || (beyond_side(a) && beyond_side(b) && beyond_side(0.5 * (a + b)))));
+                        || edge_beyond_image_side(sd, a, b)));
             if !allowed {
                 return Err(format!("edge {a} – {b} used by {n} triangles (crack or T-junction)"));
             }
@@ -194,8 +193,9 @@ impl Topology<'_> {
             // Clearly outside the square and clearly on screen (margins for the sub-triangles
             // culled whole: those lie wholly beyond the image, and so does such a point then).
             let off_screen = p.y.abs() > 0.99 * k * r
-                || sd.projection().around_dome_antipode([p; 3])
+                || sd.around_dome_antipode([p; 3])
                 || beyond_image_side(sd, p)
+                || drawn_beyond_image_side(sd, corner, a, b)
                 || (sd.projection().panorama == PanoramaKind::Cave && !sd.projection().cave_sees(p));
             if p.x.abs() + p.z.abs() < rho * 1.01 + 2.0 * tol || off_screen {
                 continue;
@@ -248,6 +248,42 @@ fn beyond_image_side(sd: &Subdivider, p: Vec3) -> bool {
     [Eye::Left, Eye::Right].into_iter().all(|eye| {
         let u = sd.projection().project_with_azimuth(p, azimuth(p), eye).u;
         wrap_angle(u).abs() >= half - 1.01 * SEAM_MARGIN
+    })
+}
+
+/// Whether the point at (a, b) of a triangle (corners `corner`) drawn straight between its
+/// corners' projections lies within `SEAM_MARGIN` of the image's side or beyond it in every
+/// eye: `vertex` draws the triangle so, and drops it when its corners lie beyond (the true
+/// image of its middle may reach a pixel in).
+fn drawn_beyond_image_side(sd: &Subdivider, corner: [Vec3; 3], a: f32, b: f32) -> bool {
+    if matches!(sd.projection().panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap | PanoramaKind::Cave) {
+        return false;
+    }
+    let limit = sd.image_half_span() - 1.01 * SEAM_MARGIN;
+    [Eye::Left, Eye::Right].into_iter().all(|eye| {
+        let u = corner.map(|p| sd.projection().project_with_azimuth(p, azimuth(p), eye).u);
+        let u0 = wrap_angle(u[0]);
+        let x = u0 + a * wrap_angle(u[1] - u0) + b * wrap_angle(u[2] - u0);
+        x.abs() >= limit
+    })
+}
+
+/// Whether an output edge is drawn wholly within `SEAM_MARGIN` of the image's left or right
+/// side or beyond it, in every eye: it is drawn straight between its ends' projections (x
+/// unwrapped from one end to the other, as the raster stage unwraps a triangle), so both ends
+/// beyond the same side put all of it there, whatever the curve between them would show (the
+/// vertex method draws a wall's sliver beyond VR180's side that the true projection of its
+/// middle brings a pixel inside). Never on the images whose x is no longitude.
+fn edge_beyond_image_side(sd: &Subdivider, a: Vec3, b: Vec3) -> bool {
+    if matches!(sd.projection().panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap | PanoramaKind::Cave) {
+        return false;
+    }
+    let limit = sd.image_half_span() - 1.01 * SEAM_MARGIN;
+    [Eye::Left, Eye::Right].into_iter().all(|eye| {
+        let u = |p: Vec3| sd.projection().project_with_azimuth(p, azimuth(p), eye).u;
+        let ua = wrap_angle(u(a));
+        let ub = ua + wrap_angle(u(b) - ua);
+        (ua >= limit && ub >= limit) || (ua <= -limit && ub <= -limit)
     })
 }
 

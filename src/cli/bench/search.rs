@@ -103,7 +103,13 @@ pub fn bench_search(args: &SearchArgs) -> Result<()> {
             let case = tree.current();
             let row = table.entry((panorama, SearchMethod::of(case.method))).or_default();
             row.0 += 1;
-            if let Err(failure) = search::check(renderer.as_ref(), &case) {
+            let case_started = std::time::Instant::now();
+            let checked = search::check(renderer.as_ref(), &case);
+            let seconds = case_started.elapsed().as_secs_f64();
+            if seconds > SLOW_CASE_S {
+                progress.suspend(|| eprintln!("case {i} of the {} took {seconds:.0} s ({})", panorama.name(), case.describe()));
+            }
+            if let Err(failure) = checked {
                 *row.1.entry(failure.check).or_default() += 1;
                 let say = |line: String| progress.suspend(|| eprintln!("{line}"));
                 let at = Found { out: &args.out, panorama, index: i };
@@ -125,6 +131,10 @@ pub fn bench_search(args: &SearchArgs) -> Result<()> {
     }
     Ok(())
 }
+
+/// A case that takes longer than this is named on the way (a slow case is worth knowing: the
+/// search is meant to run thousands in well under an hour).
+const SLOW_CASE_S: f64 = 10.0;
 
 /// Where a failing case was found: the output folder, its panorama and its index.
 struct Found<'a> {

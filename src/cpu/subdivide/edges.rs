@@ -352,7 +352,18 @@ impl Subdivider<'_> {
         let pad = if self.projection.head.is_some() { self.projection.eye_radius } else { 0.0 };
         let above = p.iter().all(|q| q.y > k * (horizontal_radius(*q) + pad));
         let below = p.iter().all(|q| q.y < -k * (horizontal_radius(*q) + pad));
-        above || below || self.projection.around_dome_antipode(p)
+        above || below || self.around_dome_antipode(p)
+    }
+
+    /// Whether a triangle lies wholly in the fisheye's dropped cone around the point opposite
+    /// the dome's axis (`SubdivideParams::antipode_cos`; `around_dome_antipode` in the WGSL).
+    pub fn around_dome_antipode(&self, p: [Vec3; 3]) -> bool {
+        let c = self.params.antipode_cos;
+        if c > 1.0 {
+            return false;
+        }
+        let axis = self.projection.dome_basis()[0];
+        p.iter().all(|q| q.dot(axis) < -c * q.length())
     }
 
     /// Whether input triangle `t` (corners `p` in the viewer frame) is single-sided and every
