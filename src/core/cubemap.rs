@@ -361,7 +361,8 @@ mod tests {
         let mut rng = rand::rngs::StdRng::seed_from_u64(7);
         let mut checked = 0;
         for _ in 0..2000 {
-            let mut point = || Vec3::new(rng.random_range(-5.0..5.0), rng.random_range(-5.0..5.0), rng.random_range(-5.0..5.0));
+            let mut point =
+                || Vec3::new(rng.random_range(-5.0..5.0), rng.random_range(-5.0..5.0), rng.random_range(-5.0..5.0));
             let (a, b) = (point(), point());
             for f in 0..6 {
                 let (ca, cb) = (clip(a, f), clip(b, f));

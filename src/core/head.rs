@@ -38,7 +38,10 @@ impl Head {
         // would draw every piece a whole image width off its place, where one seam copy each
         // way no longer reaches the image's other side (the search: background in the first
         // columns).
-        Head { offset: offset.to_array(), turn: crate::core::projection::wrap_angle((yaw_deg - viewer_yaw_deg).to_radians()) }
+        Head {
+            offset: offset.to_array(),
+            turn: crate::core::projection::wrap_angle((yaw_deg - viewer_yaw_deg).to_radians()),
+        }
     }
 
     /// Head frame → display frame, rotation part.

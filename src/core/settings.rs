@@ -531,7 +531,10 @@ impl RenderSettings {
                 let (field, most) = if error_split {
                     ("subdivision.max_error_px", format!("{:.2} px", room / 4.0))
                 } else {
-                    ("subdivision.edge_px", format!("{:.1} px", (8.0 * 0.5 * projection.width as f32 * room).sqrt() / 1.5))
+                    (
+                        "subdivision.edge_px",
+                        format!("{:.1} px", (8.0 * 0.5 * projection.width as f32 * room).sqrt() / 1.5),
+                    )
                 };
                 return Err(Error::setting(
                     field,

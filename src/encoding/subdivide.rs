@@ -43,7 +43,11 @@ pub fn subdivide_params(settings: &RenderSettings, first_triangle: u32, triangle
         pinhole_faces: (projection.panorama == PanoramaKind::Cubemap) as u32,
         node_offsets: node_offsets as u32,
         antipode_cos: projection
-            .dome_antipode_cone(projection.chord_dip_px(rule == SplitRule::AdaptiveError, sub.edge_px, sub.max_error_px))
+            .dome_antipode_cone(projection.chord_dip_px(
+                rule == SplitRule::AdaptiveError,
+                sub.edge_px,
+                sub.max_error_px,
+            ))
             .unwrap_or(2.0),
         _pad: 0,
     }

@@ -477,7 +477,12 @@ fn assemble(
 /// into up to `MAX_EDGE_DIVISIONS` parts (a box through the eyes made 8.6 million triangles). An
 /// object whose bounding sphere comes closer is shrunk about its centre, or left out when too
 /// little of it would remain.
-fn clear_of_the_eyes(objects: Vec<ObjectSpec>, room_offset: [f32; 3], room_half: [f32; 3], clearance: f32) -> Vec<ObjectSpec> {
+fn clear_of_the_eyes(
+    objects: Vec<ObjectSpec>,
+    room_offset: [f32; 3],
+    room_half: [f32; 3],
+    clearance: f32,
+) -> Vec<ObjectSpec> {
     let min_half = room_half[0].min(room_half[1]).min(room_half[2]);
     objects
         .into_iter()

@@ -237,18 +237,28 @@ fn same_offsets(vertices: &[DrawVertex]) -> Result<(), String> {
     Ok(())
 }
 
+/// How far from the image's centre column, in longitude, a point's u lies beyond its left or
+/// right side, within `SEAM_MARGIN` of it: a triangle there covers no sample (the nearest lies
+/// 1/16 px in) and `lattice_triangles` draws no copy of it. None on the images whose x is no
+/// longitude.
+fn side_limit(sd: &Subdivider) -> Option<f32> {
+    let seamless =
+        matches!(sd.projection().panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap | PanoramaKind::Cave);
+    (!seamless).then(|| sd.image_half_span() - 1.01 * SEAM_MARGIN)
+}
+
+/// Whether `beyond(u, limit)` holds in both eyes, u the eye's longitude of each point of `p`.
+fn beyond_in_both_eyes<const N: usize>(sd: &Subdivider, p: [Vec3; N], beyond: impl Fn([f32; N], f32) -> bool) -> bool {
+    let Some(limit) = side_limit(sd) else { return false };
+    [Eye::Left, Eye::Right]
+        .into_iter()
+        .all(|eye| beyond(p.map(|q| sd.projection().project_with_azimuth(q, azimuth(q), eye).u), limit))
+}
+
 /// Whether a point lies within `SEAM_MARGIN` of the image's left or right side, or beyond them
-/// (VR180's back), in every eye: a triangle there covers no sample (the nearest lies 1/16 px in)
-/// and `lattice_triangles` draws no copy of it. Never on the images whose x is no longitude.
+/// (VR180's back), in every eye ([`side_limit`]).
 fn beyond_image_side(sd: &Subdivider, p: Vec3) -> bool {
-    if matches!(sd.projection().panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap | PanoramaKind::Cave) {
-        return false;
-    }
-    let half = sd.image_half_span();
-    [Eye::Left, Eye::Right].into_iter().all(|eye| {
-        let u = sd.projection().project_with_azimuth(p, azimuth(p), eye).u;
-        wrap_angle(u).abs() >= half - 1.01 * SEAM_MARGIN
-    })
+    beyond_in_both_eyes(sd, [p], |[u], limit| wrap_angle(u).abs() >= limit)
 }
 
 /// Whether the point at (a, b) of a triangle (corners `corner`) drawn straight between its
@@ -256,15 +266,9 @@ fn beyond_image_side(sd: &Subdivider, p: Vec3) -> bool {
 /// eye: `vertex` draws the triangle so, and drops it when its corners lie beyond (the true
 /// image of its middle may reach a pixel in).
 fn drawn_beyond_image_side(sd: &Subdivider, corner: [Vec3; 3], a: f32, b: f32) -> bool {
-    if matches!(sd.projection().panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap | PanoramaKind::Cave) {
-        return false;
-    }
-    let limit = sd.image_half_span() - 1.01 * SEAM_MARGIN;
-    [Eye::Left, Eye::Right].into_iter().all(|eye| {
-        let u = corner.map(|p| sd.projection().project_with_azimuth(p, azimuth(p), eye).u);
+    beyond_in_both_eyes(sd, corner, |u, limit| {
         let u0 = wrap_angle(u[0]);
-        let x = u0 + a * wrap_angle(u[1] - u0) + b * wrap_angle(u[2] - u0);
-        x.abs() >= limit
+        (u0 + a * wrap_angle(u[1] - u0) + b * wrap_angle(u[2] - u0)).abs() >= limit
     })
 }
 
@@ -273,16 +277,11 @@ fn drawn_beyond_image_side(sd: &Subdivider, corner: [Vec3; 3], a: f32, b: f32) -
 /// unwrapped from one end to the other, as the raster stage unwraps a triangle), so both ends
 /// beyond the same side put all of it there, whatever the curve between them would show (the
 /// vertex method draws a wall's sliver beyond VR180's side that the true projection of its
-/// middle brings a pixel inside). Never on the images whose x is no longitude.
+/// middle brings a pixel inside).
 fn edge_beyond_image_side(sd: &Subdivider, a: Vec3, b: Vec3) -> bool {
-    if matches!(sd.projection().panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap | PanoramaKind::Cave) {
-        return false;
-    }
-    let limit = sd.image_half_span() - 1.01 * SEAM_MARGIN;
-    [Eye::Left, Eye::Right].into_iter().all(|eye| {
-        let u = |p: Vec3| sd.projection().project_with_azimuth(p, azimuth(p), eye).u;
-        let ua = wrap_angle(u(a));
-        let ub = ua + wrap_angle(u(b) - ua);
+    beyond_in_both_eyes(sd, [a, b], |[ua, ub], limit| {
+        let ua = wrap_angle(ua);
+        let ub = ua + wrap_angle(ub - ua);
         (ua >= limit && ub >= limit) || (ua <= -limit && ub <= -limit)
     })
 }

@@ -107,7 +107,9 @@ pub fn bench_search(args: &SearchArgs) -> Result<()> {
             let checked = search::check(renderer.as_ref(), &case);
             let seconds = case_started.elapsed().as_secs_f64();
             if seconds > SLOW_CASE_S {
-                progress.suspend(|| eprintln!("case {i} of the {} took {seconds:.0} s ({})", panorama.name(), case.describe()));
+                progress.suspend(|| {
+                    eprintln!("case {i} of the {} took {seconds:.0} s ({})", panorama.name(), case.describe())
+                });
             }
             if let Err(failure) = checked {
                 *row.1.entry(failure.check).or_default() += 1;
