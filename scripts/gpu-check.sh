@@ -20,7 +20,7 @@ pack() {
     set -e
     cargo build --release -q
     local out
-    out=$(cargo test --release --no-run "${TESTS[@]/#/--test=}" 2>&1)
+    out=$(cargo test -p twister --release --no-run "${TESTS[@]/#/--test=}" 2>&1)
     rm -rf .dev && mkdir -p .dev/bin .dev/assets/gltf
     cp target/release/twister .dev/bin/
     for t in "${TESTS[@]}"; do

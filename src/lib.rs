@@ -11,7 +11,8 @@
 //! - [`gpu`]: the wgpu device, stage pipelines, targets, the frame plan and the renderer;
 //! - [`output`]: image layouts and all-or-nothing file writing.
 //!
-//! The command line, benchmarks, plots and reports live in the `twister` binary (`src/cli/`).
+//! The command line, benchmarks, plots and reports live in the `twister` binary, the workspace's
+//! `cli/` crate; the library depends on no command-line, window or plotting crate.
 
 // Comparisons written `!(x > y)` are deliberate: they put NaN on the rejecting side.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]

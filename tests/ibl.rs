@@ -233,57 +233,6 @@ fn hdr_frames_hold_the_linear_colour_and_tone_map_to_the_ordinary_frame() {
             .count();
         assert!(off * 1000 <= hdr[k].len(), "{eye:?}: {off} of {} pixels tone map elsewhere", hdr[k].len());
     }
-
-    let dir = common::TempDir::new(format!("twister-hdr-{}", std::process::id()));
-    let run = |extra: &[&str]| {
-        std::process::Command::new(env!("CARGO_BIN_EXE_twister"))
-            .args(["render", "builtin:demo", "--width", "128", "--height", "32", "--hdr", "--out"])
-            .arg(&dir)
-            .args(extra)
-            .env("NODEVICE_SELECT", "1")
-            .output()
-            .unwrap()
-    };
-    let o = run(&[]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    // One frame draws both: the display images are the bytes they are without --hdr.
-    let plain = common::TempDir::new(format!("twister-hdr-plain-{}", std::process::id()));
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_twister"))
-        .args(["render", "builtin:demo", "--width", "128", "--height", "32", "--out"])
-        .arg(&*plain)
-        .env("NODEVICE_SELECT", "1")
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    for name in ["left.png", "right.png"] {
-        let read = |d: &std::path::Path| std::fs::read(d.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
-        assert!(read(&dir) == read(&plain), "{name} differs with --hdr");
-    }
-    for name in ["left_hdr.exr", "right_hdr.exr"] {
-        use exr::prelude::*;
-        let image = read_first_rgba_layer_from_file(
-            dir.join(name),
-            |r, _| (r.width(), vec![0f32; r.width() * r.height()]),
-            |(w, v), p, (r, _g, _b, _a): (f32, f32, f32, f32)| v[p.y() * *w + p.x()] = r,
-        )
-        .unwrap_or_else(|e| panic!("{name}: {e}"));
-        let size = image.layer_data.size;
-        assert_eq!((size.width(), size.height()), (128, 32), "{name}");
-        assert!(image.layer_data.channel_data.pixels.1.iter().all(|r| r.is_finite() && *r >= 0.0), "{name}");
-    }
-    for method in ["slit:4", "trace"] {
-        let o = run(&["--method", method, "--vertical", "exact"]);
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert!(!o.status.success() && err.starts_with("error: --hdr: ") && err.trim().lines().count() == 1, "{err}");
-    }
-    // An environment with the headlight look would do nothing: refused.
-    let o = run(&["--environment", "neutral", "--lighting", "headlight"]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(
-        !o.status.success() && err.starts_with("error: --environment: ") && err.trim().lines().count() == 1,
-        "{err}"
-    );
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// Khronos MetalRoughSpheresNoTextures in the red-sky, green-ground environment with a sun: each
@@ -394,8 +343,7 @@ fn the_environment_turns_by_its_yaw() {
 }
 
 /// The preparation is cached on disk: read back, it is exactly what preparing gives; a damaged
-/// or truncated cache file is prepared again and replaced by a whole one; `--environment` in the
-/// command line fills the folder `TWISTER_CACHE_DIR` names.
+/// or truncated cache file is prepared again and replaced by a whole one.
 #[test]
 fn the_prepared_environment_is_cached_and_a_damaged_cache_is_replaced() {
     if !common::assets_present() {
@@ -423,20 +371,5 @@ fn the_prepared_environment_is_cached_and_a_damaged_cache_is_replaced() {
     }
     // No temporary files are left behind.
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
-    // The command line caches where TWISTER_CACHE_DIR says (the studio of a glTF scene too).
-    let cli_dir = dir.join("cli");
-    let out = dir.join("out");
-    let status = std::process::Command::new(env!("CARGO_BIN_EXE_twister"))
-        .env("TWISTER_CACHE_DIR", &cli_dir)
-        .args(["render", "--width", "64", "--height", "32", "--environment"])
-        .arg(common::asset("environments/venice_sunset_1k.hdr"))
-        .arg("--lighting")
-        .arg("pbr")
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(status.status.success(), "{}", String::from_utf8_lossy(&status.stderr));
-    assert!(cli_dir.join(cache_file(&cli_dir, &env).file_name().unwrap()).exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -168,35 +168,3 @@ fn a_tilted_fisheye_refuses_chords_longer_than_its_rim_margin() {
         settings.with_projection(dome(0.0)).validate().expect("untilted, the axis cuts keep the antipode clear");
     }
 }
-
-/// `twister bench search`: a short run writes its table (cases per panorama and method) and
-/// exits 0; bad options are one line naming the option, exit 1, no table.
-#[test]
-fn bench_search_runs_cases_and_refuses_bad_options() {
-    let dir = std::env::temp_dir().join(format!("twister-search-test-{}", std::process::id()));
-    let o = common::twister()
-        .args(["bench", "search", "--cases", "2", "--panoramas", "cylinder,equirect", "--cpu-only", "--out"])
-        .arg(&dir)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let table = std::fs::read_to_string(dir.join("table.md")).unwrap();
-    for row in ["| cylinder | 2 | 0 |", "| equirect | 2 | 0 |"] {
-        assert!(table.contains(row), "{table}");
-    }
-    let _ = std::fs::remove_dir_all(&dir);
-    for (args, option) in [
-        (vec!["--cases", "0"], "--cases"),
-        (vec!["--panoramas", "dome"], "--panoramas"),
-        (vec!["--methods", "slit:4"], "--methods"),
-        (vec!["--panoramas", "fisheye", "--methods", "vertex"], "--methods"),
-        (vec!["--max-width", "4"], "--max-width"),
-    ] {
-        let o =
-            common::twister().args(["bench", "search", "--cpu-only", "--out"]).arg(&dir).args(&args).output().unwrap();
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
-        assert!(err.trim().lines().count() == 1 && err.contains(option), "{args:?}: {err}");
-        assert!(!dir.join("table.md").exists(), "{args:?}: a table written");
-    }
-}

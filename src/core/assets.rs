@@ -20,12 +20,11 @@ pub fn root() -> PathBuf {
     std::env::var_os(ASSETS_VAR).map_or_else(|| PathBuf::from(DEFAULT_ASSETS), PathBuf::from)
 }
 
-/// For a test that needs the assets: whether they are here. Where they are not, the test is
+/// For a test that needs the assets: whether they are here (at `root`, usually [`root`]). Where they are not, the test is
 /// recorded as not run (one line on stderr, one file under [`SKIPPED_VAR`]) and the caller
 /// returns; under CI (`CI=true`) they must be here, so a missing folder panics, naming it —
 /// CI can never turn green without them.
-pub fn present_for_test(test: &str) -> bool {
-    let root = root();
+pub fn present_for_test(root: &std::path::Path, test: &str) -> bool {
     if root.is_dir() {
         return true;
     }

@@ -101,7 +101,7 @@ pub struct GpuLight {
 }
 
 /// How surfaces are lit (`--lighting`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum LightingMode {
     /// The scene's own lights with the glTF BRDF where it has some, else the headlight.
@@ -114,8 +114,14 @@ pub enum LightingMode {
     Pbr,
 }
 
+crate::choices!(LightingMode {
+    Auto => ("auto", "The scene's own lights with the glTF BRDF where it has some, else the headlight"),
+    Headlight => ("headlight", "A light at the viewer, Lambert on the base colour (the paper's look)"),
+    Pbr => ("pbr", "The glTF metallic-roughness BRDF with the scene's lights"),
+});
+
 /// The tone mapping of the linear colour (`--tonemap`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Tonemap {
     /// Khronos PBR Neutral: colours below 0.76 untouched, highlights compressed towards white.
@@ -127,9 +133,14 @@ pub enum Tonemap {
     None,
     /// No tone mapping and no clamp: the linear colour × 2^EV, for a float colour target
     /// (`--hdr`; not a `--tonemap` value).
-    #[value(skip)]
     Linear,
 }
+
+crate::choices!(Tonemap {
+    PbrNeutral => ("pbr-neutral", "Khronos PBR Neutral: highlights compressed towards white"),
+    Aces => ("aces", "The ACES filmic curve"),
+    None => ("none", "Clamp to 0..1"),
+});
 
 impl Tonemap {
     /// `TONEMAP_*` in the WGSL `constants` module.

@@ -7,6 +7,7 @@ pub mod assets;
 pub mod builtin;
 pub mod bvh;
 pub mod cave;
+pub mod choice;
 pub mod color;
 pub mod compare;
 pub mod cubemap;

@@ -5,7 +5,7 @@
 //! `core::cubemap`, `core::cave`.
 
 /// The panoramas twister renders (`--panorama`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum PanoramaKind {
     /// The TWISTER display's cylinder: concentric mosaics, seed 002 eq. 1–4.
@@ -27,6 +27,15 @@ pub enum PanoramaKind {
     /// on a rectangle in the scene (`core::cave`).
     Cave,
 }
+
+crate::choices!(PanoramaKind {
+    Cylinder => ("cylinder", "The TWISTER display's cylinder: concentric mosaics, one image per eye"),
+    Equirect => ("equirect", "The full sphere, equirectangular: 360° × 180° per eye"),
+    Vr180 => ("vr180", "The sphere's front half: 180° × 180° per eye"),
+    Fisheye => ("fisheye", "A dome master: an equidistant fisheye image, W × W"),
+    Cubemap => ("cubemap", "A stereo cubemap: six 90° faces per eye in a 3×2 grid"),
+    Cave => ("cave", "CAVE walls: an off-axis perspective image per wall and eye"),
+});
 
 impl PanoramaKind {
     pub const ALL: [PanoramaKind; 6] = [

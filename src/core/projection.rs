@@ -37,7 +37,7 @@ pub use crate::core::panorama::PanoramaKind;
 use crate::error::{Error, Result};
 
 /// The vertical model: how the screen height `v` of a point is computed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Vertical {
     /// `v = R_T·y/r`, the paper's design (seed 002 eq. 4).
@@ -47,6 +47,11 @@ pub enum Vertical {
     /// the tangent, sees. The slit renderer converges to this model.
     Exact,
 }
+
+crate::choices!(Vertical {
+    Paper => ("paper", "v = R_T·y/r, the paper's vertical model"),
+    Exact => ("exact", "What a pinhole on the eye circle sees (the slit renderer's limit)"),
+});
 
 /// One of the viewer's two eyes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]

@@ -43,7 +43,7 @@ pub enum Method {
 }
 
 /// What decides an adaptive edge's divisions (`--split`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Split {
     /// Its projected error (τ = --max-error-px): N = ceil(S·√(b / 8τ)), b the largest second
     /// difference of the projected edge sampled at S = 8 segments (`Subdivider::edge_profile`);
@@ -53,6 +53,11 @@ pub enum Split {
     /// Its projected length (L = --edge-px), N = ceil(l/L): the paper's eq. 5.
     Length,
 }
+
+crate::choices!(Split {
+    Error => ("error", "Each edge's divisions from its projected error (τ)"),
+    Length => ("length", "Each edge's divisions from its projected length (L, the paper's eq. 5)"),
+});
 
 /// The subdivision rule as the `subdivide` stage reads it (`SubdivideParams::method`); the WGSL
 /// constants `METHOD_VERTEX`, `METHOD_FIXED`, `METHOD_ADAPTIVE` are generated from it.

@@ -13,6 +13,15 @@ pub struct Timeline {
     pub rows: Vec<(f32, Vec<f32>)>,
 }
 
+/// A CSV file's records, as fields: comma-separated, each trimmed and unquoted; blank lines
+/// and lines that start with `#` skipped. A timeline's fields are numbers, so a field never
+/// holds a comma, a quote or a line break.
+fn records(text: &str) -> impl Iterator<Item = impl Iterator<Item = &str>> {
+    text.lines()
+        .filter(|line| !line.trim().is_empty() && !line.starts_with('#'))
+        .map(|line| line.split(',').map(|field| field.trim().trim_matches('"').trim()))
+}
+
 impl Timeline {
     /// Reads `path` for `setting` (named in errors): rows of a time and `min..=max` further
     /// numbers (all rows as many), `#` comments, a header row of names skipped; `check` says
@@ -26,21 +35,20 @@ impl Timeline {
         check: impl Fn(&[f32]) -> Option<String>,
     ) -> Result<Timeline> {
         let bad = |m: String| Error::setting(setting, format!("{}: {m}", path.display()));
-        let size = std::fs::metadata(path).map_err(|e| bad(e.to_string()))?.len();
-        if size > 64 << 20 {
+        // Read at most 64 MiB and one byte: an endless file (a pipe, a device) ends there too.
+        const LIMIT: u64 = 64 << 20;
+        let mut text = String::new();
+        std::io::Read::read_to_string(
+            &mut std::io::Read::take(std::fs::File::open(path).map_err(|e| bad(e.to_string()))?, LIMIT + 1),
+            &mut text,
+        )
+        .map_err(|e| bad(e.to_string()))?;
+        if text.len() as u64 > LIMIT {
             return Err(bad("larger than 64 MiB".into()));
         }
-        let mut reader = csv::ReaderBuilder::new()
-            .has_headers(false)
-            .flexible(true)
-            .trim(csv::Trim::All)
-            .comment(Some(b'#'))
-            .from_path(path)
-            .map_err(|e| bad(e.to_string()))?;
         let mut rows: Vec<(f32, Vec<f32>)> = Vec::new();
-        for (k, record) in reader.records().enumerate() {
-            let record = record.map_err(|e| bad(format!("row {}: {e}", k + 1)))?;
-            let numbers: Vec<Option<f32>> = record.iter().map(|f| f.parse::<f32>().ok()).collect();
+        for (k, record) in records(&text).enumerate() {
+            let numbers: Vec<Option<f32>> = record.map(|f| f.parse::<f32>().ok()).collect();
             if k == 0 && numbers.iter().all(Option::is_none) {
                 continue; // a header
             }
@@ -80,5 +88,54 @@ impl Timeline {
         let (a, b) = (&r[i - 1], &r[i]);
         let s = (t - a.0) / (b.0 - a.0);
         a.1.iter().zip(&b.1).map(|(x, y)| x + (y - x) * s).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn read(name: &str, text: &[u8]) -> Result<Timeline> {
+        let path = std::env::temp_dir().join(format!("twister-timeline-{}-{name}.csv", std::process::id()));
+        std::fs::write(&path, text).unwrap();
+        let read = Timeline::read(&path, "gaze_path", (2, 2), "time,yaw,pitch", |_| None);
+        std::fs::remove_file(&path).unwrap();
+        read
+    }
+
+    #[test]
+    fn rows_are_read_past_a_header_comments_blank_lines_spaces_and_quotes() {
+        let t = read("good", b"time,yaw,pitch\n# a comment\n\n0, 10, \"5\"\r\n 2 ,30,-5\n").unwrap();
+        assert_eq!(t.rows, vec![(0.0, vec![10.0, 5.0]), (2.0, vec![30.0, -5.0])]);
+        assert_eq!(t.at(1.0), vec![20.0, 0.0]);
+        assert_eq!((t.at(-1.0), t.at(9.0)), (vec![10.0, 5.0], vec![30.0, -5.0]));
+    }
+
+    #[test]
+    fn bad_rows_and_files_are_one_error_naming_the_setting_the_file_and_the_row() {
+        for (name, text, needle) in [
+            ("short", &b"0,1\n"[..], "row 1: expected time,yaw,pitch: the same count"),
+            ("nan", b"0,1,2\n1,NaN,2\n", "row 2: expected time,yaw,pitch: finite numbers"),
+            ("word", b"0,1,2\n1,up,2\n", "row 2: expected time,yaw,pitch: finite numbers"),
+            ("order", b"1,1,2\n1,1,2\n", "row 2: expected time,yaw,pitch: times increasing"),
+            ("empty", b"# nothing\n", "no rows"),
+            ("binary", b"\xff\xfe\x00", "valid UTF-8"),
+        ] {
+            let e = read(name, text).unwrap_err().to_string();
+            assert!(
+                e.starts_with("gaze_path: ") && e.contains("twister-timeline") && e.contains(needle),
+                "{name}: {e}"
+            );
+            assert_eq!(e.lines().count(), 1, "{name}: {e}");
+        }
+        let missing = Timeline::read(Path::new("/nonexistent/gaze.csv"), "gaze_path", (2, 2), "", |_| None);
+        assert!(missing.unwrap_err().to_string().contains("/nonexistent/gaze.csv"));
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn an_endless_file_stops_at_the_size_limit() {
+        let e = Timeline::read(Path::new("/dev/zero"), "gaze_path", (2, 2), "", |_| None).unwrap_err().to_string();
+        assert!(e.contains("/dev/zero") && e.contains("larger than 64 MiB"), "{e}");
     }
 }

@@ -26,7 +26,7 @@ use crate::error::{Error, Result};
 mod stream;
 pub use stream::{stream_exr, stream_image};
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Layout {
     #[default]
@@ -36,10 +36,22 @@ pub enum Layout {
     Twister,
     /// The cubemap's twelve faces in one strip, the left eye's six then the right eye's, each
     /// eye's in the grid's order (right, left, up, down, front, back): Meta's 360 photo format.
-    #[value(name = "12x1")]
     #[serde(rename = "12x1")]
     Strip12,
 }
+
+crate::choices!(Layout {
+    Eyes => ("eyes", "One image per eye"),
+    TopBottom => ("top-bottom", "One image, the left eye above the right"),
+    SideBySide => ("side-by-side", "One image, the left eye beside the right"),
+    Twister => ("twister", "Four images: each eye's front and back halves"),
+    Strip12 => ("12x1", "The cubemap's twelve faces in one strip (Meta's 360 photo format)"),
+});
+
+crate::choices!(ImageFormat {
+    Png => ("png", "PNG"),
+    Jpg => ("jpg", "JPEG at the chosen quality"),
+});
 
 impl Layout {
     /// The layout a panorama is written in by default: the eyes apart for the cylinder (the
@@ -57,7 +69,7 @@ impl Layout {
 }
 
 /// The image file format (`--format`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ImageFormat {
     #[default]

@@ -7,11 +7,16 @@ use twister::gpu::Gpu;
 use twister::{EyeImage, Frame};
 use twister::{GpuScene, RenderSettings, Renderer, Scene};
 
-/// The `twister` binary, with Mesa's device-select layer quiet.
-pub fn twister() -> std::process::Command {
-    let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_twister"));
-    c.env("NODEVICE_SELECT", "1");
-    c
+pub mod gltf_files;
+
+/// The assets folder: `TWISTER_ASSETS` where that is set, else `../shared/assets` beside the
+/// workspace (cargo runs each member's tests in that member's folder, so not the working
+/// directory's).
+pub fn assets_root() -> std::path::PathBuf {
+    use twister::core::assets::{ASSETS_VAR, DEFAULT_ASSETS};
+    let here = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let workspace = here.ancestors().find(|d| d.join("shaders").is_dir()).unwrap_or(here);
+    std::env::var_os(ASSETS_VAR).map_or_else(|| workspace.join(DEFAULT_ASSETS), std::path::PathBuf::from)
 }
 
 /// A PNG file's width and height.
@@ -54,7 +59,7 @@ pub fn is_background(px: [u8; 4], bg: [f32; 3]) -> bool {
 /// A file or folder of the third-party assets (`TWISTER_ASSETS`, default `../shared/assets`).
 /// Call [`assets_present`] first: where the folder is here, a missing file fails the test, naming it.
 pub fn asset(relative: &str) -> std::path::PathBuf {
-    let path = twister::core::assets::root().join(relative);
+    let path = assets_root().join(relative);
     assert!(path.exists(), "test asset {} is missing (see the assets' README)", path.display());
     path
 }
@@ -63,7 +68,7 @@ pub fn asset(relative: &str) -> std::path::PathBuf {
 /// not run (the test script counts it) and should return. Under CI a missing folder fails it.
 pub fn assets_present() -> bool {
     let thread = std::thread::current();
-    twister::core::assets::present_for_test(thread.name().unwrap_or("a test"))
+    twister::core::assets::present_for_test(&assets_root(), thread.name().unwrap_or("a test"))
 }
 
 /// Standard base64 (for data: URIs in generated glTF files).

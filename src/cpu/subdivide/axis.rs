@@ -61,7 +61,7 @@
 
 use glam::Vec3;
 
-use super::lattice::weighted;
+use super::spacing::weighted;
 use super::Node;
 use crate::encoding::constants::{BAND_LIMIT, BAND_RATIO, MAX_DIAMONDS, SNAP, WIDE_RATIO};
 pub use crate::encoding::subdivide::{axis_clearance, AxisCuts};

@@ -5,18 +5,8 @@
 //! snapped to each edge's own nodes, and a sliver's strip. Shared by the twin's `plan` and
 //! `lattice` and by the tests; the WGSL has the same functions under the same names.
 
-use glam::Vec3;
-
 use super::spacing::Spacing;
 use super::Node;
-
-/// The point with weights `w` of a triangle of nodes (position and barycentric weights alike).
-pub(super) fn weighted(q: &[Node; 3], w: Vec3) -> Node {
-    Node {
-        position: w.x * q[0].position + w.y * q[1].position + w.z * q[2].position,
-        bary: w.x * q[0].bary + w.y * q[1].bary + w.z * q[2].bary,
-    }
-}
 
 /// The boundary edge a node (a, b, c) of a lattice lies on, with its index along that edge from
 /// the edge's start: edge 0 (corner 0 → 1) where c = 0, index b; edge 1 (1 → 2) where a = 0,

@@ -31,6 +31,14 @@ use crate::core::projection::horizontal_radius;
 use crate::encoding::constants::{AZIMUTH_MAX_TURN, AZIMUTH_MIN_RADIUS, AZIMUTH_MIN_TURN};
 use crate::encoding::types::SubdivideParams;
 
+/// The point with weights `w` of a triangle of nodes (position and barycentric weights alike).
+pub(super) fn weighted(q: &[Node; 3], w: Vec3) -> Node {
+    Node {
+        position: w.x * q[0].position + w.y * q[1].position + w.z * q[2].position,
+        bary: w.x * q[0].bary + w.y * q[1].bary + w.z * q[2].bary,
+    }
+}
+
 /// How a frame spaces nodes along a segment and draws between them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Spacing {
@@ -82,7 +90,7 @@ impl Spacing {
     /// (rows parallel to q0–q1, spaced by azimuth along and across).
     pub fn interior(self, q: &[Node; 3], [i, j, l]: [u32; 3], m: u32) -> Node {
         if self == Spacing::Even {
-            return super::lattice::weighted(q, Vec3::new(i as f32, j as f32, l as f32) / m as f32);
+            return weighted(q, Vec3::new(i as f32, j as f32, l as f32) / m as f32);
         }
         let up = l as f32 / m as f32;
         let (left, right) = (self.mix(q[0], q[2], up), self.mix(q[1], q[2], up));

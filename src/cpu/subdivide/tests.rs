@@ -485,7 +485,10 @@ mod real_mesh_tests {
     /// one leaves on a shared edge are compared.
     #[test]
     fn shared_edges_get_bit_identical_nodes_on_a_real_mesh() {
-        if !crate::core::assets::present_for_test("shared_edges_get_bit_identical_nodes_on_a_real_mesh") {
+        if !crate::core::assets::present_for_test(
+            &crate::core::assets::root(),
+            "shared_edges_get_bit_identical_nodes_on_a_real_mesh",
+        ) {
             return;
         }
         let path = crate::core::assets::root().join("cow/cow.obj");

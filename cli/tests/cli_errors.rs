@@ -5,7 +5,6 @@
 mod common;
 
 use std::path::Path;
-use std::process::Command;
 
 use common::twister;
 
@@ -152,7 +151,7 @@ fn a_plain_run_without_a_desktop_session_prints_no_driver_noise() {
     // No NODEVICE_SELECT and no XDG_RUNTIME_DIR, as on a fresh server: the program quiets
     // Mesa's device-select layer itself.
     let out = tmp("quiet");
-    let o = Command::new(env!("CARGO_BIN_EXE_twister"))
+    let o = common::twister()
         .env_remove("NODEVICE_SELECT")
         .env_remove("XDG_RUNTIME_DIR")
         .args(["render", "--width", "64", "--height", "16", "--out", out.to_str().unwrap()])
@@ -288,4 +287,29 @@ fn a_damaged_or_unwritable_pipeline_cache_is_never_an_error() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let left: Vec<_> = std::fs::read_dir(&work).unwrap().flatten().map(|e| e.file_name()).collect();
     assert!(left.is_empty(), "the working folder got {left:?}");
+}
+
+/// Bad sample counts and anisotropies: one error line naming the option, nothing written.
+#[test]
+fn bad_sample_counts_are_one_clear_line() {
+    for (args, says) in [
+        (&["--samples", "3"][..], "must be 1, 2, 4, 8, 16 or 32"),
+        (&["--samples", "99999999999"][..], "--samples"),
+        (&["--anisotropy", "0"][..], "must be 1 to 16"),
+        (&["--anisotropy", "17"][..], "must be 1 to 16"),
+        (&["--anisotropy", "-1"][..], "--anisotropy"),
+    ] {
+        let dir = common::TempDir::new(format!("twister-samples-{}", std::process::id()));
+        let o = common::twister()
+            .args(["render", "builtin:triangle@3", "--width", "64", "--height", "16", "--out"])
+            .arg(&*dir)
+            .args(args)
+            .output()
+            .expect("runs");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{args:?} succeeded");
+        assert!(err.contains(args[0]) && err.contains(says), "{args:?}: {err}");
+        assert_eq!(err.lines().filter(|l| l.starts_with("error")).count(), 1, "{args:?}: one error line: {err}");
+        assert!(std::fs::read_dir(&*dir).map_or(true, |mut d| d.next().is_none()), "{args:?} wrote output");
+    }
 }

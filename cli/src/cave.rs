@@ -7,7 +7,9 @@ use twister::core::projection::PanoramaKind;
 use twister::error::{Error, Result};
 use twister::{Projection, RenderSettings};
 
-use crate::args::{ViewArgs, Viewer};
+use crate::args::{RenderArgs, ViewArgs, Viewer};
+use glam::Vec3;
+use twister::core::timeline::Timeline;
 
 /// `settings` drawing CAVE wall `wall` (a projection of `ViewArgs::cave_walls`): its size and
 /// rectangle, the rest as `settings` have them (placed with the scene).
@@ -18,16 +20,6 @@ pub fn on_wall(settings: RenderSettings, wall: &Projection) -> RenderSettings {
         wall: wall.wall,
         ..*settings.projection()
     })
-}
-
-/// A CAVE wall's error with the wall named.
-pub(crate) fn name_wall(error: Error, wall: &str) -> Error {
-    match error {
-        Error::Setting { setting: "view.projection.wall", message } => {
-            Error::Setting { setting: "view.projection.wall", message: format!("wall {wall:?}: {message}") }
-        }
-        other => other,
-    }
 }
 
 impl ViewArgs {
@@ -63,9 +55,29 @@ impl ViewArgs {
                 let wall = w.in_display(self.scale, settings.view.viewer, settings.view.yaw_deg);
                 let projection =
                     Projection { width: w.pixels[0], height: w.pixels[1], wall: Some(wall), ..*settings.projection() };
-                projection.validate().map_err(|e| crate::flags::for_user(name_wall(e, &w.name)))?;
+                projection.validate().map_err(|e| crate::flags::for_user(crate::flags::name_wall(e, &w.name)))?;
                 Ok((w.name.clone(), projection))
             })
             .collect()
     }
+}
+
+/// The rows of a `--head-path` file, checked.
+pub fn read_head_timeline(path: &std::path::Path) -> Result<Timeline> {
+    Timeline::read(path, "head_path", (3, 4), "time,x,y,z[,yaw]", |v| {
+        let max = twister::core::scene::MAX_COORDINATE;
+        (v[..3].iter().any(|c| c.abs() > max)).then(|| format!("coordinates within ±{max:e}"))
+    })
+}
+
+/// The head where a CAVE sequence's `--head-path` starts (at its frame range's first time), for
+/// the base settings (each frame then puts the path's head); None unless the CAVE is drawn with
+/// a head path and no `--head`.
+pub fn cave_head_start(args: &RenderArgs) -> Result<Option<(Vec3, Option<f32>)>> {
+    let (Some(path), None, Some(PanoramaKind::Cave)) = (&args.head_path, args.view.head, args.view.panorama) else {
+        return Ok(None);
+    };
+    let first = args.frames.map_or(0, |(a, _)| a);
+    let v = read_head_timeline(path)?.at(first as f32 / args.fps);
+    Ok(Some((Vec3::new(v[0], v[1], v[2]), v.get(3).copied())))
 }

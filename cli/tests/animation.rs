@@ -265,7 +265,7 @@ fn the_slurm_example_shards_a_sequence() {
     let small = ["--fit", "2.5", "--width", "128", "--height", "48", "--fps", "8"];
     for task in 0..3 {
         let out = Command::new("bash")
-            .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/farm/slurm_array.sh"))
+            .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/../examples/farm/slurm_array.sh"))
             .args([scene.to_str().unwrap(), "0", "5", root.join("array").to_str().unwrap()])
             .args(small)
             .env("PATH", &path)

@@ -20,8 +20,8 @@ use std::path::Path;
 use glam::{Mat4, Vec3};
 use serde::Serialize;
 
+use crate::bench::runner::{write_csv, write_png, Runner};
 use crate::bench::speed::median;
-use crate::bench::{write_csv, write_png, Runner};
 use crate::plot::{draw_panels, Chart, Series, PALETTE};
 use twister::core::bvh::SceneBvh;
 use twister::core::load::load_obj;

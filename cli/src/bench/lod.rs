@@ -19,8 +19,8 @@ use twister::error::{Error, Result};
 use glam::{Mat4, Vec3};
 use serde::Serialize;
 
+use crate::bench::runner::{write_csv, write_png, Runner};
 use crate::bench::speed::median;
-use crate::bench::{write_csv, write_png, Runner};
 use crate::plot::{draw_panels, Chart, Series, PALETTE};
 use twister::core::builtin::sphere_scene;
 use twister::core::load::load_obj;

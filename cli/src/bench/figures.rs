@@ -23,8 +23,8 @@ use twister::error::Result;
 use glam::Vec3;
 use serde::Serialize;
 
+use crate::bench::runner::{FigureConfig, Runner};
 use crate::bench::speed::median;
-use crate::bench::{FigureConfig, Runner};
 use crate::plot::{draw_panels, Chart, Series, PALETTE};
 use twister::core::load::load_scene;
 use twister::core::projection::{Projection, Vertical};

@@ -3,6 +3,7 @@
 
 use std::path::PathBuf;
 
+use crate::choice::choice;
 use clap::Args;
 use glam::Vec3;
 use twister::core::environment::PreparedEnvironment;
@@ -28,7 +29,7 @@ pub struct ViewArgs {
     /// mono with --eye-radius 0), cubemap (six 90° faces per eye in YouTube's 3×2 grid: right,
     /// left, up / down, front, back) or cave (CAVE walls: --cave, --head). [default: cylinder;
     /// equirect with --preset]
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<PanoramaKind>())]
     pub panorama: Option<PanoramaKind>,
     /// Image width per eye in pixels (the full 360°; vr180: 180°; fisheye: --fov; cubemap: three
     /// faces) [default: 3168; equirect, vr180 and fisheye 4096; cubemap 3072].
@@ -67,7 +68,7 @@ pub struct ViewArgs {
     pub eye_radius: f32,
     /// Vertical model: paper (v = R_T·y/r) or exact (pinhole on the eye circle) [default: paper;
     /// exact when `trace` draws the cylinder, since the paper's model has no ray per pixel].
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<Vertical>())]
     pub vertical: Option<Vertical>,
     /// Viewer: a position x,y,z in scene units, or camera[:N] for the file's N-th camera (default 0;
     /// its position and yaw, plus --yaw).
@@ -109,7 +110,7 @@ pub struct ViewArgs {
     pub anisotropy: Option<u32>,
     /// What splits an adaptive edge: error (its projected error, --max-error-px) or length (its
     /// projected length, --edge-px: the paper's eq. 5) [default: error].
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<Split>())]
     pub split: Option<Split>,
     /// τ: the display-position error the error split allows an edge, pixels.
     #[arg(long, default_value_t = DEFAULT_MAX_ERROR_PX)]
@@ -128,7 +129,7 @@ pub struct ViewArgs {
     /// How surfaces are lit: auto (the glTF BRDF under the scene's KHR_lights_punctual lights
     /// where it has some, else the headlight), headlight, or pbr (the BRDF even without lights:
     /// emission and ambient only). The ray tracer's --light replaces the scene's lights.
-    #[arg(long, value_enum, default_value_t = LightingMode::Auto)]
+    #[arg(long, value_parser = choice::<LightingMode>(), default_value = "auto")]
     pub lighting: LightingMode,
     /// Image-based lighting: an equirectangular radiance map (.hdr or .exr; the centre column
     /// looks along −z), also shown as the background; `neutral`, the built-in grey studio (light
@@ -157,7 +158,7 @@ pub struct ViewArgs {
     #[arg(long, default_value_t = 0.0, value_name = "EV")]
     pub exposure: f32,
     /// Tone mapping of the BRDF's colour: pbr-neutral (Khronos PBR Neutral), aces, or none (clamp).
-    #[arg(long, value_enum, default_value_t = Tonemap::PbrNeutral)]
+    #[arg(long, value_parser = choice::<Tonemap>(), default_value = "pbr-neutral")]
     pub tonemap: Tonemap,
     /// N_max: the largest lattice step of one piece; larger polygons are pre-split.
     #[arg(long, default_value_t = DEFAULT_MAX_DIV)]
@@ -390,7 +391,7 @@ impl ViewArgs {
             None => projection,
         };
         projection.validate().map_err(|e| match walls.first() {
-            Some(wall) => crate::cave::name_wall(e, &wall.name),
+            Some(wall) => crate::flags::name_wall(e, &wall.name),
             None => e,
         })?;
         if !self.yaw.is_finite() {
@@ -540,10 +541,10 @@ pub struct RenderArgs {
     /// vr180's stereo_180_LR.png), twister (four W/2×H images, the cylinder), 12x1 (the
     /// cubemap's twelve faces in one strip, left eye's first: stereo_cubemap_12x1.png)
     /// [default: eyes; top-bottom for equirect and cubemap; side-by-side for vr180].
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<Layout>())]
     pub layout: Option<Layout>,
     /// Image format: png or jpg (full-sphere images carry GPano XMP metadata in both).
-    #[arg(long, value_enum, default_value_t = ImageFormat::Png)]
+    #[arg(long, value_parser = choice::<ImageFormat>(), default_value = "png")]
     pub format: ImageFormat,
     /// JPEG quality, 1–100 (with --format jpg).
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=100))]

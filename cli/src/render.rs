@@ -15,7 +15,7 @@ pub const DEFAULT_SAMPLES: u32 = 4;
 /// statistics, the linear colour) and the background, checked as a whole; then only read.
 pub fn render_settings(args: &RenderArgs) -> Result<twister::RenderSettings> {
     // A CAVE sequence's head path: the base settings see the head where it starts.
-    let view = match crate::sequence::cave_head_start(args)? {
+    let view = match crate::cave::cave_head_start(args)? {
         Some(head) => &crate::args::ViewArgs { head: Some(head), ..args.view.clone() },
         None => &args.view,
     };

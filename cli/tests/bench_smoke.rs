@@ -4,10 +4,9 @@
 use std::path::Path;
 
 mod common;
-use std::process::Command;
 
 fn run_quick(out: &Path, assets: &Path) {
-    let o = Command::new(env!("CARGO_BIN_EXE_twister"))
+    let o = common::twister()
         .env("NODEVICE_SELECT", "1")
         // One timed frame per point: this checks the outputs, not the speed.
         .args(["bench", "all", "--quick", "--reps", "1", "--out"])
@@ -143,7 +142,7 @@ fn check_trace_lod(out: &std::path::Path, report: &str) {
 #[test]
 fn absent_assets_are_skipped_with_a_clear_line() {
     let out = common::TempDir::new(format!("twister-bench-noassets-{}", std::process::id()));
-    let o = Command::new(env!("CARGO_BIN_EXE_twister"))
+    let o = common::twister()
         .env("NODEVICE_SELECT", "1")
         .args(["bench", "fig10", "--quick", "--reps", "1", "--assets", "/nonexistent/assets", "--out"])
         .arg(&out)
@@ -157,4 +156,36 @@ fn absent_assets_are_skipped_with_a_clear_line() {
     );
     assert!(report.contains("Sponza skipped"), "{report}");
     let _ = std::fs::remove_dir_all(&out);
+}
+
+/// `twister bench search`: a short run writes its table (cases per panorama and method) and
+/// exits 0; bad options are one line naming the option, exit 1, no table.
+#[test]
+fn bench_search_runs_cases_and_refuses_bad_options() {
+    let dir = std::env::temp_dir().join(format!("twister-search-test-{}", std::process::id()));
+    let o = common::twister()
+        .args(["bench", "search", "--cases", "2", "--panoramas", "cylinder,equirect", "--cpu-only", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let table = std::fs::read_to_string(dir.join("table.md")).unwrap();
+    for row in ["| cylinder | 2 | 0 |", "| equirect | 2 | 0 |"] {
+        assert!(table.contains(row), "{table}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    for (args, option) in [
+        (vec!["--cases", "0"], "--cases"),
+        (vec!["--panoramas", "dome"], "--panoramas"),
+        (vec!["--methods", "slit:4"], "--methods"),
+        (vec!["--panoramas", "fisheye", "--methods", "vertex"], "--methods"),
+        (vec!["--max-width", "4"], "--max-width"),
+    ] {
+        let o =
+            common::twister().args(["bench", "search", "--cpu-only", "--out"]).arg(&dir).args(&args).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        assert!(err.trim().lines().count() == 1 && err.contains(option), "{args:?}: {err}");
+        assert!(!dir.join("table.md").exists(), "{args:?}: a table written");
+    }
 }

@@ -58,18 +58,28 @@ pub fn for_user(error: Error) -> Error {
     }
 }
 
+/// A CAVE wall's error with the wall named.
+pub fn name_wall(error: Error, wall: &str) -> Error {
+    match error {
+        Error::Setting { setting: "view.projection.wall", message } => {
+            Error::Setting { setting: "view.projection.wall", message: format!("wall {wall:?}: {message}") }
+        }
+        other => other,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// The library's source files (everything under src/ but the command line), with their text.
+    /// The library's source files (the workspace root's src/), with their text.
     fn library_sources() -> Vec<(String, String)> {
         let mut files = Vec::new();
-        let mut stack = vec![std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src")];
+        let mut stack = vec![std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../src")];
         while let Some(dir) = stack.pop() {
             for entry in std::fs::read_dir(&dir).unwrap() {
                 let path = entry.unwrap().path();
-                if path.is_dir() && !path.ends_with("cli") {
+                if path.is_dir() {
                     stack.push(path);
                 } else if path.extension().is_some_and(|e| e == "rs") {
                     files.push((path.display().to_string(), std::fs::read_to_string(&path).unwrap()));
@@ -112,7 +122,7 @@ mod tests {
         }
         assert!(named.len() >= 20, "found only {named:?}");
         for (name, file) in &named {
-            assert!(flag_of(name).is_some(), "{file}: setting {name} has no option in cli/flags.rs");
+            assert!(flag_of(name).is_some(), "{file}: setting {name} has no option in cli/src/flags.rs");
         }
         let error = for_user(Error::setting("subdivision.edge_px", "must be ≥ 0.25"));
         assert_eq!(error.to_string(), "--edge-px: must be ≥ 0.25");

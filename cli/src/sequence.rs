@@ -408,27 +408,7 @@ fn read_head_path(args: &RenderArgs, settings: &twister::RenderSettings) -> Resu
     if let Some(why) = why {
         return Err(Error::option("--head-path", why));
     }
-    Ok(Some(read_head_timeline(path)?))
-}
-
-/// The rows of a `--head-path` file, checked.
-fn read_head_timeline(path: &std::path::Path) -> Result<Timeline> {
-    Timeline::read(path, "head_path", (3, 4), "time,x,y,z[,yaw]", |v| {
-        let max = twister::core::scene::MAX_COORDINATE;
-        (v[..3].iter().any(|c| c.abs() > max)).then(|| format!("coordinates within ±{max:e}"))
-    })
-}
-
-/// The head where a CAVE sequence's `--head-path` starts (at its frame range's first time), for
-/// the base settings (each frame then puts the path's head); None unless the CAVE is drawn with
-/// a head path and no `--head`.
-pub fn cave_head_start(args: &RenderArgs) -> Result<Option<(Vec3, Option<f32>)>> {
-    let (Some(path), None, Some(PanoramaKind::Cave)) = (&args.head_path, args.view.head, args.view.panorama) else {
-        return Ok(None);
-    };
-    let first = args.frames.map_or(0, |(a, _)| a);
-    let v = read_head_timeline(path)?.at(first as f32 / args.fps);
-    Ok(Some((Vec3::new(v[0], v[1], v[2]), v.get(3).copied())))
+    Ok(Some(crate::cave::read_head_timeline(path)?))
 }
 
 /// The animation a sequence plays: `--animation` by name or index, else the file's first.

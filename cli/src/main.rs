@@ -6,6 +6,7 @@
 mod args;
 mod bench;
 mod cave;
+mod choice;
 mod flags;
 mod heatmap;
 mod info;
