@@ -2,7 +2,7 @@
 # The project's test command (README quick start, and what CI runs).
 # Installs Mesa's software Vulkan driver (lavapipe) when no Vulkan driver is present, ffmpeg
 # (for `render --video`) and Xvfb with xdotool (for `view`'s window) when they are missing, then
-# runs the whole test suite. Extra arguments go
+# runs the whole test suite: cargo's, then the Python package's (pytest). Extra arguments go
 # to `cargo test`.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -51,6 +51,19 @@ rm -rf "$skips"
 export TWISTER_ASSET_SKIPS="$skips"
 status=0
 cargo test "$@" || status=$?
+
+# The Python package (python/): installed into a virtual environment under target/ as users
+# install it (`pip install ./python`; here with cargo's dev profile, which shares the build
+# above), then its tests (pytest), which compare it with the binary just built.
+venv=target/python-venv
+if [ ! -x "$venv/bin/python" ]; then
+    python3 -m venv "$venv"
+fi
+pip=("$venv/bin/python" -m pip -q --disable-pip-version-check)
+"${pip[@]}" install numpy pytest matplotlib
+MATURIN_PEP517_ARGS="--profile dev" "${pip[@]}" install --force-reinstall --no-deps ./python
+"$venv/bin/python" -m pytest -q -p no:cacheprovider python/tests || status=$?
+
 if [ -d "$skips" ]; then
     n=$(find "$skips" -type f | wc -l)
     echo "asset tests not run: $n (${TWISTER_ASSETS:-../shared/assets} not found; set TWISTER_ASSETS)"

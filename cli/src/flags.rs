@@ -6,6 +6,7 @@ use twister::Error;
 
 /// Each setting the library names in its errors, and the option that sets it.
 pub const FLAGS: &[(&str, &str)] = &[
+    ("adapter", "TWISTER_ADAPTER"),
     ("view.projection.screen_radius", "--screen-radius"),
     ("view.projection.eye_radius", "--eye-radius"),
     ("view.projection.convergence", "--convergence"),

@@ -3,23 +3,9 @@
 // Comparisons written `!(x > y)` are deliberate: they put NaN on the rejecting side.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-mod args;
-mod bench;
-mod cave;
-mod choice;
-mod flags;
-mod heatmap;
-mod info;
-mod measure;
-mod plot;
-mod render;
-mod scene;
-mod sequence;
-mod tiled;
-mod view;
-mod writer;
-
 use std::process::ExitCode;
+
+use twister_cli::{args, bench, flags, info, measure, render, sequence, view};
 
 use clap::{Parser, Subcommand};
 

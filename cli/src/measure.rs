@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use clap::Args;
 
 use crate::args::ViewArgs;
-use crate::scene::{lod_stats, open_renderer, prepare};
+use crate::scene::{lod_stats, open_renderer, prepare_loaded};
 use twister::core::settings::Method;
 use twister::error::{Error, Result};
 use twister::output::write_images;
@@ -38,7 +38,25 @@ pub struct ErrorArgs {
     pub against: Option<Method>,
 }
 
-pub fn measure(args: &ErrorArgs) -> Result<()> {
+/// One view's measurement: its settings, the `--json` object and each eye's per-pixel error.
+pub struct Measured {
+    pub wall: Option<String>,
+    pub settings: twister::RenderSettings,
+    pub json: serde_json::Value,
+    /// Display-position error per pixel, left and right eye (−1: background or unseen).
+    pub error: [Vec<f32>; 2],
+    pub error_stats: twister::encoding::types::ErrorStats,
+    pub frame_stats: twister::FrameStats,
+}
+
+/// Measures each view (one, or a CAVE's walls) of what `args` ask for; `loaded`: the scene
+/// already loaded from `args.scene`.
+pub fn measure_views(
+    renderer: &twister::Renderer,
+    adapter: &str,
+    args: &ErrorArgs,
+    loaded: Option<&twister::Scene>,
+) -> Result<Vec<Measured>> {
     if let Some(max) = args.heatmap_max.filter(|m| !(m.is_finite() && *m > 0.0)) {
         return Err(Error::option("--heatmap-max", format!("must be a positive number of pixels, got {max}")));
     }
@@ -51,35 +69,24 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
         .with_measure_error(true)
         .with_depth(args.against.is_some())
         .with_positions(args.against == Some(Method::Trace));
-    // One view, or a CAVE's walls, each measured (its heatmap named by the wall).
+    // One view, or a CAVE's walls, each measured.
     let walls = args.view.cave_walls(&settings)?;
     let views: Vec<(Option<String>, Option<twister::Projection>)> = if walls.is_empty() {
         vec![(None, None)]
     } else {
         walls.into_iter().map(|(name, p)| (Some(name), Some(p))).collect()
     };
-    let heatmap = |wall: &Option<String>| {
-        args.heatmap.as_ref().map(|path| match wall {
-            Some(wall) => {
-                path.with_file_name(format!("{wall}_{}", path.file_name().unwrap_or_default().to_string_lossy()))
-            }
-            None => path.clone(),
-        })
-    };
-    let heatmaps: Vec<std::path::PathBuf> = views.iter().filter_map(|(wall, _)| heatmap(wall)).collect();
-    twister::output::check_outputs(&heatmaps.iter().map(|p| p.as_path()).collect::<Vec<_>>())?;
-    let (renderer, adapter) = open_renderer()?;
     let methods: Vec<Method> = std::iter::once(settings.subdivision.method).chain(args.against).collect();
-    let prepared = prepare(&renderer, &args.scene, args.fit, &args.view, settings, false, &methods)?;
+    let prepared = prepare_loaded(renderer, &args.scene, loaded, args.fit, &args.view, settings, false, &methods)?;
     let gpu_scene = &prepared.gpu_scene;
-    for (wall, projection) in &views {
+    let mut measured = Vec::new();
+    for (wall, projection) in views {
         let settings = match projection {
-            Some(wall) => crate::cave::on_wall(prepared.settings, wall),
+            Some(wall) => crate::cave::on_wall(prepared.settings, &wall),
             None => prepared.settings,
         };
         let frame = renderer.render(gpu_scene, &settings)?;
-        let measured = frame.measurement.as_ref().expect("rendered with the error pass");
-        let e = &measured.stats;
+        let e = &frame.measurement.as_ref().expect("rendered with the error pass").stats;
         let s = &frame.stats;
         let mut json = serde_json::json!({
             "scene": args.scene,
@@ -102,7 +109,7 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
             "ms_total": s.ms_total,
             "adapter": adapter,
         });
-        if let Some(wall) = wall {
+        if let Some(wall) = &wall {
             json["wall"] = serde_json::json!(wall);
         }
         // On the sphere, pixels shrink towards the poles: the error is also measured as an angle
@@ -115,18 +122,53 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
             let reference = renderer.render(gpu_scene, &settings.with_method(method))?;
             add_comparison(&mut json, method, &twister::core::compare::compare(&frame, &reference)?);
         }
-        if let Some(path) = heatmap(wall) {
-            let max = args.heatmap_max.unwrap_or_else(|| crate::heatmap::nice_max(e.p99));
-            write_heatmap(&path, &measured.error, settings.projection(), max)?;
+        let measurement = frame.measurement.expect("rendered with the error pass");
+        measured.push(Measured {
+            wall,
+            settings,
+            json,
+            error: measurement.error,
+            error_stats: measurement.stats,
+            frame_stats: frame.stats,
+        });
+    }
+    Ok(measured)
+}
+
+pub fn measure(args: &ErrorArgs) -> Result<()> {
+    let heatmap = |wall: &Option<String>| {
+        args.heatmap.as_ref().map(|path| match wall {
+            Some(wall) => {
+                path.with_file_name(format!("{wall}_{}", path.file_name().unwrap_or_default().to_string_lossy()))
+            }
+            None => path.clone(),
+        })
+    };
+    // The heatmaps' files are checked before anything is drawn (a CAVE's named by wall).
+    let walls = match args.view.panorama {
+        Some(twister::core::projection::PanoramaKind::Cave) => {
+            args.view.cave_walls(&args.view.settings(&[args.view.method])?)?
+        }
+        _ => Vec::new(),
+    };
+    let names: Vec<Option<String>> =
+        if walls.is_empty() { vec![None] } else { walls.into_iter().map(|(name, _)| Some(name)).collect() };
+    let heatmaps: Vec<std::path::PathBuf> = names.iter().filter_map(heatmap).collect();
+    twister::output::check_outputs(&heatmaps.iter().map(|p| p.as_path()).collect::<Vec<_>>())?;
+    let (renderer, adapter) = open_renderer()?;
+    for m in measure_views(&renderer, &adapter, args, None)? {
+        if let Some(path) = heatmap(&m.wall) {
+            let max = args.heatmap_max.unwrap_or_else(|| crate::heatmap::nice_max(m.error_stats.p99));
+            write_heatmap(&path, &m.error, m.settings.projection(), max)?;
         }
         if args.json {
-            println!("{}", serde_json::to_string(&json).unwrap());
+            println!("{}", serde_json::to_string(&m.json).unwrap());
         } else {
-            let scene = match wall {
+            let scene = match &m.wall {
                 Some(wall) => format!("{} wall {wall}", args.scene),
                 None => args.scene.clone(),
             };
-            print_summary(&scene, &settings, &json, e, s);
+            print_summary(&scene, &m.settings, &m.json, &m.error_stats, &m.frame_stats);
         }
     }
     Ok(())

@@ -34,7 +34,15 @@ pub fn render_settings(args: &RenderArgs) -> Result<twister::RenderSettings> {
     Ok(settings)
 }
 
-pub fn render(args: &RenderArgs) -> Result<()> {
+/// What a still draws: its settings, checked, and each view's projection (a CAVE's walls; one
+/// view otherwise) with the writer of its files.
+pub struct Still {
+    pub settings: twister::RenderSettings,
+    pub views: Vec<(Option<twister::Projection>, FrameWriter)>,
+}
+
+/// The still that `args` ask for, every option checked before anything is drawn.
+pub fn still(args: &RenderArgs) -> Result<Still> {
     for (given, option) in [
         (args.resume, "--resume"),
         (args.shard.is_some(), "--shard"),
@@ -58,59 +66,94 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     }
     // One view, or a CAVE's walls: each its projection and its writer (files named by wall).
     let walls = args.view.cave_walls(&settings)?;
-    let views: Vec<(Option<twister::Projection>, FrameWriter)> = if walls.is_empty() {
+    let views = if walls.is_empty() {
         vec![(None, writer)]
     } else {
         walls.into_iter().map(|(name, p)| (Some(p), writer.for_wall(Some(name)))).collect()
     };
-    // Every output is checked before anything is rendered, and all are written together.
-    let image_paths: Vec<std::path::PathBuf> = views.iter().flat_map(|(_, w)| w.paths(None)).collect();
-    let mut all_paths: Vec<&std::path::Path> = image_paths.iter().map(|p| p.as_path()).collect();
-    all_paths.extend(args.stats.as_deref());
-    check_outputs(&all_paths)?;
-    let (renderer, adapter) = open_renderer()?;
-    let method = [settings.subdivision.method];
-    let prepared = prepare(&renderer, &args.scene, args.fit, &args.view, settings, args.lod_overlay, &method)?;
-    let views: Vec<(twister::RenderSettings, FrameWriter)> = views
-        .into_iter()
-        .map(|(wall, writer)| {
-            let settings = match wall {
-                Some(wall) => crate::cave::on_wall(prepared.settings, &wall),
-                None => prepared.settings,
-            };
-            (settings, writer)
-        })
-        .collect();
-    // Larger than the adapter draws at once (or --max-tile): in tiles, streamed (`tiled`).
-    let all: Vec<twister::RenderSettings> = views.iter().map(|(s, _)| *s).collect();
-    if crate::tiled::any_tiled(&renderer, &all, args.max_tile) {
-        for path in crate::tiled::render_streamed(args, &renderer, &prepared, &views, &adapter)? {
-            println!("{}", path.display());
-        }
-        return Ok(());
-    }
-    let mut files = Vec::new();
-    let mut records = Vec::new();
-    for (settings, writer) in &views {
-        let settings = *settings;
+    Ok(Still { settings, views })
+}
+
+/// One view of a still, drawn: its settings (placed with the scene, on its wall), the frame, its
+/// writer and, with `--stats`, its record.
+pub struct Drawn {
+    pub settings: twister::RenderSettings,
+    pub frame: twister::Frame,
+    pub writer: FrameWriter,
+    pub record: Option<serde_json::Value>,
+}
+
+/// Draws each view of `still` from the prepared scene (the frame writer's record when `stats`).
+pub fn draw(
+    renderer: &twister::Renderer,
+    adapter: &str,
+    args: &RenderArgs,
+    prepared: &crate::scene::Prepared,
+    still: Still,
+    stats: bool,
+) -> Result<Vec<Drawn>> {
+    let mut drawn = Vec::new();
+    for (wall, writer) in still.views {
+        let settings = match wall {
+            Some(wall) => crate::cave::on_wall(prepared.settings, &wall),
+            None => prepared.settings,
+        };
         let mut frame = renderer.render(&prepared.gpu_scene, &settings)?;
         if let (true, Some(gaze)) = (args.lod_overlay, &prepared.gaze) {
             for img in [&mut frame.left, &mut frame.right] {
                 twister::core::lod::draw_field_boundaries(img, settings.projection(), gaze);
             }
         }
+        let record = stats.then(|| {
+            let record =
+                FrameRecord::new(&args.scene, &settings, &frame, &writer, adapter, lod_stats(&prepared.selection));
+            serde_json::to_value(&record).expect("JSON of plain values")
+        });
+        drawn.push(Drawn { settings, frame, writer, record });
+    }
+    Ok(drawn)
+}
+
+pub fn render(args: &RenderArgs) -> Result<()> {
+    let still = still(args)?;
+    // Every output is checked before anything is rendered, and all are written together.
+    let image_paths: Vec<std::path::PathBuf> = still.views.iter().flat_map(|(_, w)| w.paths(None)).collect();
+    let mut all_paths: Vec<&std::path::Path> = image_paths.iter().map(|p| p.as_path()).collect();
+    all_paths.extend(args.stats.as_deref());
+    check_outputs(&all_paths)?;
+    let (renderer, adapter) = open_renderer()?;
+    let method = [still.settings.subdivision.method];
+    let prepared = prepare(&renderer, &args.scene, args.fit, &args.view, still.settings, args.lod_overlay, &method)?;
+    // Larger than the adapter draws at once (or --max-tile): in tiles, streamed (`tiled`).
+    let placed: Vec<(twister::RenderSettings, FrameWriter)> = still
+        .views
+        .iter()
+        .map(|(wall, writer)| {
+            let settings = match wall {
+                Some(wall) => crate::cave::on_wall(prepared.settings, wall),
+                None => prepared.settings,
+            };
+            (settings, writer.clone())
+        })
+        .collect();
+    let all: Vec<twister::RenderSettings> = placed.iter().map(|(s, _)| *s).collect();
+    if crate::tiled::any_tiled(&renderer, &all, args.max_tile) {
+        for path in crate::tiled::render_streamed(args, &renderer, &prepared, &placed, &adapter)? {
+            println!("{}", path.display());
+        }
+        return Ok(());
+    }
+    let mut files = Vec::new();
+    let mut records = Vec::new();
+    for drawn in draw(&renderer, &adapter, args, &prepared, still, args.stats.is_some())? {
         let t = std::time::Instant::now();
-        files.extend(writer.files(&frame, None)?);
+        files.extend(drawn.writer.files(&drawn.frame, None)?);
         // Encoding: the writing itself is a rename.
         let ms_write = t.elapsed().as_secs_f64() * 1e3;
-        if args.stats.is_some() {
-            let lod = lod_stats(&prepared.selection);
-            let record = FrameRecord {
-                ms_write,
-                ms_total: frame.stats.ms_total + ms_write,
-                ..FrameRecord::new(&args.scene, &settings, &frame, writer, &adapter, lod)
-            };
-            records.push(serde_json::to_value(&record).expect("JSON of plain values"));
+        if let Some(mut record) = drawn.record {
+            record["ms_write"] = ms_write.into();
+            record["ms_total"] = (drawn.frame.stats.ms_total + ms_write).into();
+            records.push(record);
         }
     }
     let written = files.len();

@@ -15,9 +15,13 @@ use twister::error::{Error, Result};
 use twister::gpu::Gpu;
 use twister::{GpuScene, RenderSettings, Renderer, Scene};
 
-/// The GPU and its renderer, with the adapter's description for reports.
+/// The environment variable that chooses an adapter by a part of its name.
+pub const ADAPTER_VAR: &str = "TWISTER_ADAPTER";
+
+/// The GPU and its renderer, with the adapter's description for reports: the adapter whose name
+/// contains `TWISTER_ADAPTER` where that is set, else the default one.
 pub fn open_renderer() -> Result<(Renderer, String)> {
-    let gpu = Gpu::new()?;
+    let gpu = Gpu::with_adapter(std::env::var(ADAPTER_VAR).ok().filter(|v| !v.is_empty()).as_deref())?;
     let adapter = gpu.adapter_description();
     Ok((Renderer::new(gpu)?, adapter))
 }
@@ -29,14 +33,19 @@ pub fn warn(spec: &str, warning: &str) {
 
 /// Loads and places a scene: `--scale`, then `--fit`; a `camera[:N]` viewer takes that
 /// camera's place and yaw (the camera moved with the scene): the settings returned say so.
-/// Prints the loader's warnings.
+/// Prints the loader's warnings. `loaded`: the file already loaded (a caller that keeps
+/// scenes, as the Python package does), placed as a copy.
 pub fn place(
     spec: &str,
+    loaded: Option<&Scene>,
     fit: Option<f32>,
     view: &ViewArgs,
     settings: RenderSettings,
 ) -> Result<(Scene, RenderSettings)> {
-    let mut scene = load_scene(spec, settings.projection())?;
+    let mut scene = match loaded {
+        Some(scene) => scene.clone(),
+        None => load_scene(spec, settings.projection())?,
+    };
     for w in &scene.warnings {
         warn(spec, w);
     }
@@ -95,6 +104,21 @@ pub fn prepare(
     overlay: bool,
     methods: &[Method],
 ) -> Result<Prepared> {
+    prepare_loaded(renderer, spec, None, fit, view, settings, overlay, methods)
+}
+
+/// [`prepare`] of a scene already loaded from `spec` (see [`place`]).
+#[allow(clippy::too_many_arguments)]
+pub fn prepare_loaded(
+    renderer: &Renderer,
+    spec: &str,
+    loaded: Option<&Scene>,
+    fit: Option<f32>,
+    view: &ViewArgs,
+    settings: RenderSettings,
+    overlay: bool,
+    methods: &[Method],
+) -> Result<Prepared> {
     view.check_light(methods)?;
     let mut lod = view.lod()?;
     // The ray tracer's level of detail: each object's chain down to P3 of its triangles.
@@ -112,7 +136,7 @@ pub fn prepare(
         trace_min_share = Some(params.p3);
         lod = None;
     }
-    let (mut scene, settings) = place(spec, fit, view, settings)?;
+    let (mut scene, settings) = place(spec, loaded, fit, view, settings)?;
     settings.validate()?;
     if let Some([azimuth, elevation, lux]) = view.sun {
         scene.lights.push(twister::core::light::Light::sun(azimuth, elevation, lux));

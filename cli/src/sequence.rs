@@ -17,7 +17,7 @@ use glam::Vec3;
 
 use crate::args::{RenderArgs, ShardMode, Viewer};
 use crate::render::render_settings;
-use crate::scene::{open_renderer, prepare, Prepared};
+use crate::scene::{open_renderer, prepare_loaded, Prepared};
 use crate::writer::{frame_name, FrameRecord, FrameWriter};
 use twister::core::lod::{LodChain, LodParams, LodSelection};
 use twister::core::projection::PanoramaKind;
@@ -57,8 +57,8 @@ struct Drawn {
 
 /// With a gaze path, each frame selects its level of detail from the whole scene: the path,
 /// the parameters, the scene's chains and the whole scene uploaded.
-struct Tracked<'a> {
-    path: &'a GazePath,
+struct Tracked {
+    path: GazePath,
     params: LodParams,
     chain: LodChain,
     whole: twister::GpuScene,
@@ -78,7 +78,7 @@ struct Sequence<'a> {
     /// `--head-path`: the tracked head over time.
     head_path: Option<Timeline>,
     camera: Option<usize>,
-    tracked: Option<Tracked<'a>>,
+    tracked: Option<Tracked>,
     /// A CAVE's walls (their projections; `ViewArgs::cave_walls`), or none: one view.
     walls: Vec<twister::Projection>,
     /// Each view's writer (a frame drawn in tiles is written as it is drawn).
@@ -185,8 +185,45 @@ impl Sequence<'_> {
     }
 }
 
-/// Renders the sequence `args.frames` asks for.
-pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32)) -> Result<()> {
+/// What opening a sequence gives: the settings, its views' writers, and the sequence that
+/// draws its frames.
+pub struct Opened<'a> {
+    pub settings: twister::RenderSettings,
+    pub writer: FrameWriter,
+    pub writers: Vec<FrameWriter>,
+    pub stereo: StereoMode,
+    sequence: Sequence<'a>,
+}
+
+impl Opened<'_> {
+    /// Draws frame `frame`: each view's (a CAVE's walls, or the one panorama) settings and frame;
+    /// frames drawn in tiles (already written) are left out.
+    pub fn draw(&mut self, frame: u32) -> Result<Vec<(twister::RenderSettings, twister::Frame)>> {
+        Ok(self
+            .sequence
+            .draw(frame)?
+            .into_iter()
+            .filter(|d| d.written.is_none())
+            .map(|d| (d.settings, d.rendered))
+            .collect())
+    }
+}
+
+/// A sequence's options, checked, with its paths read: what opens it, before any device.
+pub struct Checked {
+    settings: twister::RenderSettings,
+    writer: FrameWriter,
+    writers: Vec<FrameWriter>,
+    stereo: StereoMode,
+    walls: Vec<twister::Projection>,
+    gaze_path: Option<GazePath>,
+    lod: Option<(LodParams, twister::core::visual_field::Gaze)>,
+    viewer_path: Option<Timeline>,
+    head_path: Option<Timeline>,
+}
+
+/// Checks a sequence's options and reads its paths.
+pub fn check_sequence(args: &RenderArgs) -> Result<Checked> {
     if let Some(side) = args.max_tile.filter(|&s| s < 16) {
         return Err(Error::option("--max-tile", format!("must be at least 16 pixels, got {side}")));
     }
@@ -205,10 +242,6 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32)) -> Result<(
         walls.iter().map(|(name, _)| writer.for_wall(Some(name.clone()))).collect()
     };
     let walls: Vec<twister::Projection> = walls.into_iter().map(|(_, p)| p).collect();
-    let frames = match args.shard {
-        Some(shard) => shard_frames(first, last, shard, args.shard_mode),
-        None => (first..=last).collect(),
-    };
     let gaze_path = args.gaze_path.as_deref().map(GazePath::read).transpose()?;
     let lod = args.view.lod()?;
     let viewer_path = read_viewer_path(args)?;
@@ -216,12 +249,23 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32)) -> Result<(
     if gaze_path.is_some() && lod.is_none() {
         return Err(Error::option("--gaze-path", "steers the level of detail: use it with --lod visual-field"));
     }
-    let (renderer, adapter) = open_renderer()?;
+    Ok(Checked { settings, writer, writers, stereo, walls, gaze_path, lod, viewer_path, head_path })
+}
+
+/// Places and uploads the scene of a checked sequence (`loaded`: already loaded from
+/// `args.scene`): what draws its frames.
+pub fn open_sequence<'a>(
+    args: &'a RenderArgs,
+    checked: Checked,
+    renderer: &'a twister::Renderer,
+    loaded: Option<&twister::Scene>,
+) -> Result<Opened<'a>> {
+    let Checked { settings, writer, writers, stereo, walls, gaze_path, lod, viewer_path, head_path } = checked;
     let base_yaw = settings.view.yaw_deg;
     let method = [settings.subdivision.method];
-    let prepared = prepare(&renderer, &args.scene, args.fit, &args.view, settings, false, &method)?;
+    let prepared = prepare_loaded(renderer, &args.scene, loaded, args.fit, &args.view, settings, false, &method)?;
     let clip = animation_clip(args, &prepared.scene)?;
-    let tracked = match (&gaze_path, &lod) {
+    let tracked = match (gaze_path, &lod) {
         (Some(path), Some((params, _))) => Some(Tracked {
             path,
             params: *params,
@@ -235,9 +279,9 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32)) -> Result<(
         Viewer::At(_) => None,
     };
     let base = prepared.settings;
-    let mut sequence = Sequence {
+    let sequence = Sequence {
         args,
-        renderer: &renderer,
+        renderer,
         prepared,
         base,
         base_yaw,
@@ -249,6 +293,18 @@ pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32)) -> Result<(
         walls,
         writers: writers.clone(),
     };
+    Ok(Opened { settings, writer, writers, stereo, sequence })
+}
+
+/// Renders the sequence `args.frames` asks for.
+pub fn render_sequence(args: &RenderArgs, (first, last): (u32, u32)) -> Result<()> {
+    let frames = match args.shard {
+        Some(shard) => shard_frames(first, last, shard, args.shard_mode),
+        None => (first..=last).collect(),
+    };
+    let checked = check_sequence(args)?;
+    let (renderer, adapter) = open_renderer()?;
+    let Opened { settings, writer, writers, stereo, mut sequence } = open_sequence(args, checked, &renderer, None)?;
     let complete = |f: u32| writers.iter().all(|w| w.paths(Some(f)).iter().all(|p| p.exists()));
     let todo: Vec<u32> = frames.into_iter().filter(|&f| !(args.resume && complete(f))).collect();
     let stats = open_stats(args)?;

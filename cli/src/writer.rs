@@ -84,6 +84,11 @@ impl FrameWriter {
         self.layout
     }
 
+    /// The CAVE wall this writer's files are named by, if any.
+    pub fn wall(&self) -> Option<&str> {
+        self.wall.as_deref()
+    }
+
     /// The writer of a CAVE's wall: the same files, each name prefixed by the wall's.
     pub fn for_wall(&self, wall: Option<String>) -> FrameWriter {
         FrameWriter { wall, ..self.clone() }

@@ -90,6 +90,27 @@ impl Gpu {
         Ok((gpu, surface))
     }
 
+    /// Opens the adapter whose name contains `name` (any case), or the default one where `name`
+    /// is None; an error listing the adapters there are where none matches.
+    pub fn with_adapter(name: Option<&str>) -> Result<Gpu> {
+        let Some(name) = name else { return Gpu::new() };
+        quiet_device_select_layer();
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
+        let names: Vec<String> =
+            adapters.iter().map(|a| a.get_info()).map(|i| format!("{} ({:?})", i.name, i.backend)).collect();
+        let wanted = name.to_lowercase();
+        let Some(k) = names.iter().position(|n| n.to_lowercase().contains(&wanted)) else {
+            let there = if names.is_empty() { "none".to_string() } else { names.join(", ") };
+            return Err(Error::setting(
+                "adapter",
+                format!("no adapter's name contains {name:?}; the adapters: {there}"),
+            ));
+        };
+        let adapter = adapters.into_iter().nth(k).expect("the position found");
+        pollster::block_on(Self::from_adapter(adapter))
+    }
+
     async fn new_async(instance: wgpu::Instance, surface: Option<&wgpu::Surface<'static>>) -> Result<Gpu> {
         let adapter = instance
             .request_adapter(&wgpu::RequestAdapterOptions {
@@ -99,6 +120,10 @@ impl Gpu {
             })
             .await
             .map_err(|e| Error::NoGpu(format!("{NO_ADAPTER_HELP} ({e})")))?;
+        Self::from_adapter(adapter).await
+    }
+
+    async fn from_adapter(adapter: wgpu::Adapter) -> Result<Gpu> {
         let info = adapter.get_info();
         let float_renderable = adapter
             .get_texture_format_features(wgpu::TextureFormat::R32Float)

@@ -18,6 +18,7 @@ use crate::args::ViewArgs;
 use crate::scene::open_renderer;
 use twister::core::settings::Method;
 use twister::error::{Error, Result};
+use twister::gpu::Renderer;
 
 use figures::{cases, plot_fig10, plot_fig12, plot_fig8, table};
 pub use runner::{write_csv, write_png, FigureConfig, Runner};
@@ -341,24 +342,35 @@ pub fn bench_figures(args: &FigureArgs, which: Figure) -> Result<()> {
     Ok(())
 }
 
-pub fn bench_speed(args: &SpeedArgs) -> Result<()> {
+/// `bench speed`'s rows on an open renderer: each scene placed as `render` places it, each
+/// method timed in turn; `progress` hears what is being timed.
+pub fn speed_rows(renderer: &Renderer, args: &SpeedArgs, progress: impl FnMut(&str)) -> Result<Vec<speed::SpeedRow>> {
     if !(1..=MAX_REPS).contains(&args.reps) {
         return Err(Error::option("--reps", format!("must be between 1 and {MAX_REPS}, got {}", args.reps)));
     }
     let base = args.view.settings(&args.methods)?;
-    let (renderer, adapter) = open_renderer()?;
     // Every scene as `render` would draw it: --scale, --fit (file scenes), --viewer camera:N, --lod.
     let mut scenes = Vec::new();
     for spec in &args.scenes {
         let fit = args.fit.filter(|_| !spec.starts_with("builtin:"));
-        let prepared = crate::scene::prepare(&renderer, spec, fit, &args.view, base, false, &args.methods)?;
+        let prepared = crate::scene::prepare(renderer, spec, fit, &args.view, base, false, &args.methods)?;
         scenes.push(speed::SpeedScene {
             spec: spec.clone(),
             gpu_scene: prepared.gpu_scene,
             settings: prepared.settings.with_pass_times(args.pass_times),
         });
     }
-    let rows = speed::speed(&renderer, &scenes, &args.methods, args.reps, |what| eprintln!("timing {what} ..."))?;
+    speed::speed(renderer, &scenes, &args.methods, args.reps, progress)
+}
+
+pub fn bench_speed(args: &SpeedArgs) -> Result<()> {
+    // The options are checked before the device is opened.
+    if !(1..=MAX_REPS).contains(&args.reps) {
+        return Err(Error::option("--reps", format!("must be between 1 and {MAX_REPS}, got {}", args.reps)));
+    }
+    let base = args.view.settings(&args.methods)?;
+    let (renderer, adapter) = open_renderer()?;
+    let rows = speed_rows(&renderer, args, |what| eprintln!("timing {what} ..."))?;
     let timing = rows.first().map_or("-".to_string(), |r| r.timing.clone());
     println!(
         "adapter: {adapter}; {}x{} per eye, both eyes; median of {} frames after a warm-up, the methods in turn; timing: {timing}\n",
