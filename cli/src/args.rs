@@ -29,162 +29,162 @@ pub struct ViewArgs {
     /// mono with --eye-radius 0), cubemap (six 90° faces per eye in YouTube's 3×2 grid: right,
     /// left, up / down, front, back) or cave (CAVE walls: --cave, --head). [default: cylinder;
     /// equirect with --preset]
-    #[arg(long, value_parser = choice::<PanoramaKind>())]
+    #[arg(help_heading = "Panorama", long, value_parser = choice::<PanoramaKind>())]
     pub panorama: Option<PanoramaKind>,
     /// Image width per eye in pixels (the full 360°; vr180: 180°; fisheye: --fov; cubemap: three
     /// faces) [default: 3168; equirect, vr180 and fisheye 4096; cubemap 3072].
-    #[arg(long)]
+    #[arg(help_heading = "Panorama", long)]
     pub width: Option<u32>,
     /// Image height per eye in pixels [default: 600; equirect: width/2; vr180, fisheye: width;
     /// cubemap: 2·width/3].
-    #[arg(long)]
+    #[arg(help_heading = "Panorama", long)]
     pub height: Option<u32>,
     /// Size preset of the full sphere (implies --panorama equirect): vr4k (4096×4096 top-bottom:
     /// 4096×2048 per eye), vr6k (6144×6144), vr8k (8192×8192), vr16k (16384×16384: drawn in
     /// tiles where the adapter's textures are smaller, written as rows arrive).
-    #[arg(long, value_enum, conflicts_with_all = ["width", "height"])]
+    #[arg(help_heading = "Panorama", long, value_enum, conflicts_with_all = ["width", "height"])]
     pub preset: Option<Preset>,
     /// equirect: parallel (every eye ray tangent to the eye circle, Google ODS, Cycles
     /// "parallel"), or DIST: the rays converge on the sphere of DIST metres (Cycles "off-axis")
     /// [default: parallel].
-    #[arg(long, value_parser = parse_convergence)]
+    #[arg(help_heading = "Panorama", long, value_parser = parse_convergence)]
     pub convergence: Option<Convergence>,
     /// equirect: FROM,TO degrees of altitude over which the eye offset fades to 0 towards the
     /// poles (Blender's pole merge), or off [default: 60,75].
-    #[arg(long, value_parser = parse_pole_merge)]
+    #[arg(help_heading = "Panorama", long, value_parser = parse_pole_merge)]
     pub pole_merge: Option<PoleMerge>,
     /// fisheye: the field of view inscribed in the square image, degrees, 0 < FOV ≤ 360
     /// [default: 180].
-    #[arg(long, allow_hyphen_values = true)]
+    #[arg(help_heading = "Panorama", long, allow_hyphen_values = true)]
     pub fov: Option<f32>,
     /// fisheye: the dome's front raised by DEG degrees (a tilted dome), -90..90 [default: 0].
-    #[arg(long, value_name = "DEG", allow_hyphen_values = true)]
+    #[arg(help_heading = "Panorama", long, value_name = "DEG", allow_hyphen_values = true)]
     pub dome_tilt: Option<f32>,
     /// R_T: radius of the display cylinder, metres.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(help_heading = "Eyes and display", long, default_value_t = 1.0)]
     pub screen_radius: f32,
     /// d_e: radius of the circle the eyes move on, metres.
-    #[arg(long, default_value_t = 0.032)]
+    #[arg(help_heading = "Eyes and display", long, default_value_t = 0.032)]
     pub eye_radius: f32,
     /// Vertical model: paper (v = R_T·y/r) or exact (pinhole on the eye circle) [default: paper;
     /// exact when `trace` draws the cylinder, since the paper's model has no ray per pixel].
-    #[arg(long, value_parser = choice::<Vertical>())]
+    #[arg(help_heading = "Eyes and display", long, value_parser = choice::<Vertical>())]
     pub vertical: Option<Vertical>,
     /// Viewer: a position x,y,z in scene units, or camera[:N] for the file's N-th camera (default 0;
     /// its position and yaw, plus --yaw).
-    #[arg(long, value_parser = parse_viewer, default_value = "0,0,0", allow_hyphen_values = true)]
+    #[arg(help_heading = "Scene and placement", long, value_parser = parse_viewer, default_value = "0,0,0", allow_hyphen_values = true)]
     pub viewer: Viewer,
     /// Turn of the view about the vertical axis, degrees; positive turns left.
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(help_heading = "Scene and placement", long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub yaw: f32,
     /// cylinder and cave: a tracked head at X,Y,Z (scene units, the point midway between the
     /// eyes) facing YAW degrees (as --yaw; default --yaw), away from the display's centre
     /// (--viewer): each point is drawn where the line from an eye meets the screen (the cylinder:
     /// the exact model) or the CAVE's wall.
-    #[arg(long, value_parser = parse_head, value_name = "X,Y,Z[,YAW]", allow_hyphen_values = true)]
+    #[arg(help_heading = "Eyes and display", long, value_parser = parse_head, value_name = "X,Y,Z[,YAW]", allow_hyphen_values = true)]
     pub head: Option<(Vec3, Option<f32>)>,
     /// cave: the CAVE's walls, a JSON file {"walls": [{"name", "lower_left", "lower_right",
     /// "upper_left", "pixels": [W, H]}]}: each a rectangle in the scene (scene units, seen from
     /// the room: lower right to the right of lower left), drawn per eye as `NAME_left.png`,
     /// `NAME_right.png`.
-    #[arg(long, value_name = "FILE.json")]
+    #[arg(help_heading = "Panorama", long, value_name = "FILE.json")]
     pub cave: Option<PathBuf>,
     /// Metres per scene unit: the scene (and --viewer, given in scene units) is scaled by it.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(help_heading = "Scene and placement", long, default_value_t = 1.0)]
     pub scale: f32,
     /// Subdivision: adaptive (each edge split as --split says), adaptive:length (the paper's
     /// eq. 5, N = ceil(l/L) per edge), fixed:N (every edge N), vertex (none).
-    #[arg(long, value_parser = Method::parse, default_value = "adaptive")]
+    #[arg(help_heading = "Quality", long, value_parser = Method::parse, default_value = "adaptive")]
     pub method: Method,
     /// Samples per pixel of the colour image: 1, 2, 4, 8, 16 or 32 (multisampling, averaged in
     /// linear light after tone mapping; the projection methods and slit:W; counts the adapter
     /// lacks are made up by a larger image; trace: a ray through each sample position). Depth,
     /// --hdr and the error pass stay one sample at each pixel's centre.
     /// [default: 4 for render; 1 for bench and error, the paper's geometry]
-    #[arg(long)]
+    #[arg(help_heading = "Quality", long)]
     pub samples: Option<u32>,
     /// Anisotropic texture filtering: the most probes a texture sample takes along its
     /// footprint's longer axis, 1 to 16 (1: isotropic, trilinear from the longest axis).
     /// [default: 16 for render; 1 for bench and error]
-    #[arg(long)]
+    #[arg(help_heading = "Quality", long)]
     pub anisotropy: Option<u32>,
     /// What splits an adaptive edge: error (its projected error, --max-error-px) or length (its
     /// projected length, --edge-px: the paper's eq. 5) [default: error].
-    #[arg(long, value_parser = choice::<Split>())]
+    #[arg(help_heading = "Quality", long, value_parser = choice::<Split>())]
     pub split: Option<Split>,
     /// τ: the display-position error the error split allows an edge, pixels.
-    #[arg(long, default_value_t = DEFAULT_MAX_ERROR_PX)]
+    #[arg(help_heading = "Quality", long, default_value_t = DEFAULT_MAX_ERROR_PX)]
     pub max_error_px: f32,
     /// L: the longest projected edge `adaptive:length` leaves, pixels (the error split keeps
     /// edges under 8·L, and under L near the eye circle).
-    #[arg(long, default_value_t = DEFAULT_EDGE_PX)]
+    #[arg(help_heading = "Quality", long, default_value_t = DEFAULT_EDGE_PX)]
     pub edge_px: f32,
     /// `--method trace`: bounces of mirror and refraction rays (seed 000's Reflect_max), 0 to 8.
-    #[arg(long, default_value_t = DEFAULT_REFLECT_MAX)]
+    #[arg(help_heading = "Lighting", long, default_value_t = DEFAULT_REFLECT_MAX)]
     pub reflect_max: u32,
     /// `--method trace`: a point light at X,Y,Z (scene coordinates) casting hard shadows, instead
     /// of the headlight at the viewer.
-    #[arg(long, value_parser = parse_vec3, value_name = "X,Y,Z")]
+    #[arg(help_heading = "Lighting", long, value_parser = parse_vec3, value_name = "X,Y,Z")]
     pub light: Option<Vec3>,
     /// How surfaces are lit: auto (the glTF BRDF under the scene's KHR_lights_punctual lights
     /// where it has some, else the headlight), headlight, or pbr (the BRDF even without lights:
     /// emission and ambient only). The ray tracer's --light replaces the scene's lights.
-    #[arg(long, value_parser = choice::<LightingMode>(), default_value = "auto")]
+    #[arg(help_heading = "Lighting", long, value_parser = choice::<LightingMode>(), default_value = "auto")]
     pub lighting: LightingMode,
     /// Image-based lighting: an equirectangular radiance map (.hdr or .exr; the centre column
     /// looks along −z), also shown as the background; `neutral`, the built-in grey studio (light
     /// only); or `none`. Default: `neutral` for a glTF scene or `--lighting pbr` without
     /// the scene's own lights, else none.
-    #[arg(long, value_name = "FILE|neutral|none")]
+    #[arg(help_heading = "Lighting", long, value_name = "FILE|neutral|none")]
     pub environment: Option<String>,
     /// Turns the environment about the vertical axis, degrees: what the map shows at azimuth θ
     /// appears at θ + DEG (to put its sun where the scene wants it).
-    #[arg(long, default_value_t = 0.0, value_name = "DEG", allow_hyphen_values = true)]
+    #[arg(help_heading = "Lighting", long, default_value_t = 0.0, value_name = "DEG", allow_hyphen_values = true)]
     pub environment_yaw: f32,
     /// Adds a sun: a directional light shining from azimuth AZ (degrees from −z towards +x, the
     /// panorama's u) and elevation EL above the horizon, of LUX lux [default: 3]; it casts
     /// shadows like the scene's own lights.
-    #[arg(long, value_parser = parse_sun, value_name = "AZ,EL[,LUX]", allow_hyphen_values = true)]
+    #[arg(help_heading = "Lighting", long, value_parser = parse_sun, value_name = "AZ,EL[,LUX]", allow_hyphen_values = true)]
     pub sun: Option<[f32; 3]>,
     /// The scene's lights cast no shadows (the drawing methods' shadow maps for directional and
     /// spot lights, the ray tracer's shadow rays).
-    #[arg(long)]
+    #[arg(help_heading = "Lighting", long)]
     pub no_shadows: bool,
     /// The side of a shadow map in texels (a multiple of 64; the first four lights get maps,
     /// fitted to the scene's bounding box; a point light a cube of six faces of half the side).
-    #[arg(long, default_value_t = twister::core::shadow::DEFAULT_SHADOW_MAP_SIZE, value_name = "N")]
+    #[arg(help_heading = "Lighting", long, default_value_t = twister::core::shadow::DEFAULT_SHADOW_MAP_SIZE, value_name = "N")]
     pub shadow_map_size: u32,
     /// Exposure in stops: the BRDF's linear colour is scaled by 2^EV before tone mapping.
-    #[arg(long, default_value_t = 0.0, value_name = "EV")]
+    #[arg(help_heading = "Lighting", long, default_value_t = 0.0, value_name = "EV")]
     pub exposure: f32,
     /// Tone mapping of the BRDF's colour: pbr-neutral (Khronos PBR Neutral), aces, or none (clamp).
-    #[arg(long, value_parser = choice::<Tonemap>(), default_value = "pbr-neutral")]
+    #[arg(help_heading = "Lighting", long, value_parser = choice::<Tonemap>(), default_value = "pbr-neutral")]
     pub tonemap: Tonemap,
     /// N_max: the largest lattice step of one piece; larger polygons are pre-split.
-    #[arg(long, default_value_t = DEFAULT_MAX_DIV)]
+    #[arg(help_heading = "Quality", long, default_value_t = DEFAULT_MAX_DIV)]
     pub max_div: u32,
     /// Memory budget of the subdivision buffers, MiB; scenes that need more run in chunks.
-    #[arg(long, default_value_t = DEFAULT_MEMORY_MB)]
+    #[arg(help_heading = "Quality", long, default_value_t = DEFAULT_MEMORY_MB)]
     pub memory_mb: u32,
     /// Level of detail: off, or visual-field (seeds 001/000: polygon budgets and subdivision by
     /// where each object falls in the visual field of --gaze).
-    #[arg(long, value_enum, default_value_t = LodMode::Off)]
+    #[arg(help_heading = "Quality", long, value_enum, default_value_t = LodMode::Off)]
     pub lod: LodMode,
     /// Gaze direction YAW,PITCH in degrees from straight ahead (yaw positive left, pitch up)
     /// [default: 0,0] (needs --lod visual-field)
-    #[arg(long, value_parser = parse_gaze, allow_hyphen_values = true)]
+    #[arg(help_heading = "Quality", long, value_parser = parse_gaze, allow_hyphen_values = true)]
     pub gaze: Option<Gaze>,
     /// P2'/P1: the peripheral field's smallest share of an object's triangles [default: 0.3]
     /// (needs --lod visual-field).
-    #[arg(long)]
+    #[arg(help_heading = "Quality", long)]
     pub lod_p2: Option<f32>,
     /// P3/P1: the share of an object's triangles outside the visual field [default: 0.05]
     /// (needs --lod visual-field).
-    #[arg(long)]
+    #[arg(help_heading = "Quality", long)]
     pub lod_p3: Option<f32>,
     /// D∞, metres: the budgets fall linearly with distance, kept at least P3 (eq. 2)
     /// [default: 100] (needs --lod visual-field).
-    #[arg(long)]
+    #[arg(help_heading = "Quality", long)]
     pub lod_dinf: Option<f32>,
 }
 
@@ -529,10 +529,10 @@ pub struct RenderArgs {
     #[arg(default_value = "builtin:demo")]
     pub scene: String,
     /// Move and scale the scene so that it stands DIST metres ahead, filling the screen height.
-    #[arg(long, value_name = "DIST")]
+    #[arg(help_heading = "Scene and placement", long, value_name = "DIST")]
     pub fit: Option<f32>,
     /// Output folder.
-    #[arg(long, default_value = "out")]
+    #[arg(help_heading = "Scene and placement", long, default_value = "out")]
     pub out: PathBuf,
     #[command(flatten)]
     pub view: ViewArgs,
@@ -541,82 +541,82 @@ pub struct RenderArgs {
     /// vr180's stereo_180_LR.png), twister (four W/2×H images, the cylinder), 12x1 (the
     /// cubemap's twelve faces in one strip, left eye's first: stereo_cubemap_12x1.png)
     /// [default: eyes; top-bottom for equirect and cubemap; side-by-side for vr180].
-    #[arg(long, value_parser = choice::<Layout>())]
+    #[arg(help_heading = "Output", long, value_parser = choice::<Layout>())]
     pub layout: Option<Layout>,
     /// Image format: png or jpg (full-sphere images carry GPano XMP metadata in both).
-    #[arg(long, value_parser = choice::<ImageFormat>(), default_value = "png")]
+    #[arg(help_heading = "Output", long, value_parser = choice::<ImageFormat>(), default_value = "png")]
     pub format: ImageFormat,
     /// JPEG quality, 1–100 (with --format jpg).
-    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=100))]
+    #[arg(help_heading = "Output", long, value_parser = clap::value_parser!(u8).range(1..=100))]
     pub quality: Option<u8>,
     /// Also write each eye's distance from its eye point along the ray, metres, as 32-bit float
     /// OpenEXR (channel Z, +inf where no surface): left_depth.exr/right_depth.exr, depth_TB.exr
     /// or depth_LR.exr, following the layout.
-    #[arg(long)]
+    #[arg(help_heading = "Output", long)]
     pub depth: bool,
     /// Also write each eye's linear colour (× 2^EV, before tone mapping, not clamped) as 32-bit
     /// float OpenEXR (channels R, G, B): left_hdr.exr, right_hdr.exr. Drawn into a float colour
     /// target beside the display colour, in the same frame; the projection methods only.
-    #[arg(long)]
+    #[arg(help_heading = "Output", long)]
     pub hdr: bool,
     /// fisheye: outside the circle transparent (alpha 0) instead of the background colour; PNG.
-    #[arg(long)]
+    #[arg(help_heading = "Output", long)]
     pub alpha: bool,
     /// The largest tile a frame is drawn in, pixels a side (at least 16): a frame larger than
     /// this, than the adapter draws at once, or than 512 MiB of colour is drawn in tiles and its
     /// images (and --depth, --hdr) are written as rows arrive, in bounded memory [default: the
     /// adapter's].
-    #[arg(long, value_name = "PIXELS")]
+    #[arg(help_heading = "Output", long, value_name = "PIXELS")]
     pub max_tile: Option<u32>,
     /// Background colour R,G,B, each 0–255.
-    #[arg(long, value_parser = parse_rgb, default_value = "26,26,31")]
+    #[arg(help_heading = "Output", long, value_parser = parse_rgb, default_value = "26,26,31")]
     pub background: [f32; 3],
     /// Write render statistics as JSON to this file.
-    #[arg(long)]
+    #[arg(help_heading = "Output", long)]
     pub stats: Option<PathBuf>,
     /// With --lod visual-field: tint each object by its level and draw the central-field
     /// (white) and visual-field (orange) boundaries.
-    #[arg(long)]
+    #[arg(help_heading = "Output", long)]
     pub lod_overlay: bool,
     /// Render frames A to B (inclusive) of the animation timeline (frame k at k / FPS seconds)
     /// into numbered files: frame_000123_TB.png (top-bottom), frame_000123_left.png … (see
     /// *Sequences* in the README); `N` alone renders frame N.
-    #[arg(long, value_parser = parse_frames, value_name = "A..B")]
+    #[arg(help_heading = "Animation and farm", long, value_parser = parse_frames, value_name = "A..B")]
     pub frames: Option<(u32, u32)>,
     /// Frames per second of the sequence's timeline.
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(help_heading = "Animation and farm", long, default_value_t = 30.0)]
     pub fps: f32,
     /// The animation a sequence plays, by name or index [default: the file's first].
-    #[arg(long, value_name = "NAME|INDEX")]
+    #[arg(help_heading = "Animation and farm", long, value_name = "NAME|INDEX")]
     pub animation: Option<String>,
     /// Skip the frames whose files all exist (a sequence resumed after a stop).
-    #[arg(long)]
+    #[arg(help_heading = "Animation and farm", long)]
     pub resume: bool,
     /// Render only this shard's frames: I/N, frames whose index from A is ≡ I (mod N), or the
     /// I-th of N contiguous blocks with --shard-mode blocks (a job array's task id).
-    #[arg(long, value_parser = parse_shard, value_name = "I/N")]
+    #[arg(help_heading = "Animation and farm", long, value_parser = parse_shard, value_name = "I/N")]
     pub shard: Option<(u32, u32)>,
     /// With --frames: also encode the sequence as an MP4 video (H.264 by the system's ffmpeg)
     /// with Google's spherical video metadata (st3d stereo mode; sv3d equirectangular on the
     /// sphere); needs a one-image layout (top-bottom or side-by-side). After --shard runs, run
     /// once more with --resume --video to encode.
-    #[arg(long, value_name = "FILE.mp4")]
+    #[arg(help_heading = "Animation and farm", long, value_name = "FILE.mp4")]
     pub video: Option<PathBuf>,
     /// With --frames and --lod visual-field: the gaze over time, a CSV of time,yaw,pitch rows
     /// (seconds, degrees as --gaze): each frame's level of detail follows the tracked viewer.
-    #[arg(long, value_name = "FILE.csv")]
+    #[arg(help_heading = "Animation and farm", long, value_name = "FILE.csv")]
     pub gaze_path: Option<PathBuf>,
     /// With --frames: the viewer over time, a CSV of time,x,y,z[,yaw] rows (seconds; the place
     /// in scene units as --viewer; degrees added to --yaw), blended linearly between rows.
-    #[arg(long, value_name = "FILE.csv")]
+    #[arg(help_heading = "Animation and farm", long, value_name = "FILE.csv")]
     pub viewer_path: Option<PathBuf>,
     /// With --frames, the cylinder: the tracked head over time, a CSV of time,x,y,z[,yaw] rows
     /// (seconds; the head in scene units as --head; its yaw in degrees, default --yaw), blended
     /// linearly between rows.
-    #[arg(long, value_name = "FILE.csv")]
+    #[arg(help_heading = "Animation and farm", long, value_name = "FILE.csv")]
     pub head_path: Option<PathBuf>,
     /// How --shard splits the frames.
-    #[arg(long, value_enum, default_value_t = ShardMode::Interleave)]
+    #[arg(help_heading = "Animation and farm", long, value_enum, default_value_t = ShardMode::Interleave)]
     pub shard_mode: ShardMode,
 }
 

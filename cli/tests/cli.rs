@@ -531,3 +531,30 @@ fn both_eyes_in_one_multiview_draw_match_a_pass_per_eye() {
         assert!(apart * 2 > covered, "{scene} {extra:?}: left and right differ on only {apart} of {covered} distances");
     }
 }
+
+/// `render --help` groups its options under headings, `-h` is the short form, and no module
+/// path or internal name of the library leaks into either.
+#[test]
+fn render_help_is_grouped_and_speaks_no_module_paths() {
+    let long = twister().args(["render", "--help"]).output().unwrap();
+    let short = twister().args(["render", "-h"]).output().unwrap();
+    let (long, short) = (String::from_utf8_lossy(&long.stdout), String::from_utf8_lossy(&short.stdout));
+    let headings = [
+        "Scene and placement:",
+        "Panorama:",
+        "Eyes and display:",
+        "Quality:",
+        "Lighting:",
+        "Output:",
+        "Animation and farm:",
+    ];
+    for text in [&long, &short] {
+        let positions: Vec<usize> = headings.iter().map(|h| text.find(&format!("\n{h}\n")).expect(h)).collect();
+        assert!(positions.windows(2).all(|w| w[0] < w[1]), "headings out of order");
+        assert!(!text.contains("::") && !text.contains("core_") && !text.contains("encoding"), "{text}");
+    }
+    assert!(short.lines().count() * 3 < long.lines().count() * 2, "-h is not shorter than --help");
+    // Every option sits under a heading: the untitled "Options:" group holds only help.
+    let options = long.split("\nOptions:\n").nth(1).unwrap().split("\n\n").next().unwrap();
+    assert!(options.trim_start().starts_with("-h, --help") && options.matches("--").count() == 1, "{options}");
+}
