@@ -7,7 +7,6 @@ the per-pixel mean |Δ|, overall and per object (which part differs, by how much
 
 import json
 import math
-import os
 import pathlib
 import sys
 import tempfile
@@ -160,9 +159,8 @@ def main():
         }
     result["per_object"] = cols
     print(json.dumps(result, indent=2), flush=True)
-    # Blender as a module, after a Cycles render and a twister device in one process, was seen
-    # to hang on its way out (the leak detector's teardown): end the process here.
-    os._exit(0)
+    # Blender as a module hangs on its way out while any Python class is still registered.
+    twister_blender.unregister()
 
 
 if __name__ == "__main__":
