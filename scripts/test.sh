@@ -32,6 +32,11 @@ fi
 if [[ "$(ldconfig -p 2>/dev/null || true)" != *libxkbcommon-x11.so.0* ]]; then
     missing+=(libxkbcommon-x11-0)
 fi
+# The Python package's and the Blender add-on's tests run in virtual environments.
+if ! python3 -c "import ensurepip, venv" >/dev/null 2>&1; then
+    echo "No Python venv module found: installing it (the Python package's tests)..."
+    missing+=(python3-venv)
+fi
 if [ ${#missing[@]} -gt 0 ]; then
     sudo=""
     if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
