@@ -178,7 +178,8 @@ def test_the_images_agree_with_cycles_spherical_stereo_to_a_pixel(tmp_path, pano
         assert differ < 0.03 * compared, f"{eye}: {differ} of {compared} pixels differ"
 
 
-def test_an_animation_renders_its_frames_headless(tmp_path):
+@pytest.mark.parametrize("via", ["package", "command"])
+def test_an_animation_renders_its_frames_headless(tmp_path, monkeypatch, via):
     build_scene()
     scene = bpy.context.scene
     scene.frame_start, scene.frame_end = 1, 3
@@ -189,8 +190,14 @@ def test_an_animation_renders_its_frames_headless(tmp_path):
     cube.keyframe_insert("location", frame=3)
     t = scene.twister
     t.width, t.samples, t.layout, t.output_dir = 64, "1", "eyes", str(tmp_path / "seq")
-    if run.command() is None:
-        pytest.skip("the twister command is needed for sequences: set TWISTER_BIN")
+    if via == "command":
+        if run.command() is None:
+            pytest.skip("the twister command is needed here: set TWISTER_BIN")
+        monkeypatch.setattr(run, "package", lambda: None)
+    elif run.package() is None:
+        pytest.skip("the twister package is needed here")
     assert operator("render_animation") == {"FINISHED"}
     names = sorted(os.listdir(tmp_path / "seq"))
     assert names == [f"frame_{k:06d}_{e}.png" for k in range(3) for e in ("left", "right")], names
+    first, last = (load(tmp_path / "seq" / f"frame_{k:06d}_left.png") for k in (0, 2))
+    assert not np.array_equal(first, last), "the box moves"

@@ -81,6 +81,7 @@ class TWISTER_OT_render_animation(bpy.types.Operator):
     bl_label = "Render animation with twister"
 
     _process = None
+    _frames = None
     _timer = None
     _tmp = None
 
@@ -89,55 +90,82 @@ class TWISTER_OT_render_animation(bpy.types.Operator):
         try:
             path, settings, out, warnings, tmp = prepare(context, animation=True)
             fps = scene.render.fps / scene.render.fps_base
-            frames = list(range(scene.frame_start, scene.frame_end + 1))
-            cmd = run.sequence_command(path, out, settings, [f - scene.frame_start for f in frames], fps, props.preferences(context))
+            frames = range(scene.frame_end - scene.frame_start + 1)
+            if run.package() is not None:
+                # The package: one frame a step, each saved whole as it finishes.
+                self._frames = iter(run.renderer().render_frames(path, frames=frames, fps=fps, **settings))
+            else:
+                cmd = run.sequence_command(path, out, settings, list(frames), fps, props.preferences(context))
+                self._process = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         except (ValueError, RuntimeError) as e:
             self.report({"ERROR"}, str(e))
             return {"CANCELLED"}
         for w in warnings:
             self.report({"WARNING"}, w)
-        self._tmp = tmp
-        self._total = len(frames)
-        self._process = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        self._tmp, self._out, self._total, self._done = tmp, out, len(frames), 0
         if bpy.app.background:
-            return self._wait(context)
+            while True:
+                state = self._step()
+                if state is not None:
+                    return self._finish(state)
         wm = context.window_manager
         wm.progress_begin(0, self._total)
-        self._timer = wm.event_timer_add(0.25, window=context.window)
+        self._timer = wm.event_timer_add(0.1, window=context.window)
         wm.modal_handler_add(self)
         return {"RUNNING_MODAL"}
 
-    def _wait(self, context):
-        _, err = self._process.communicate()
-        return self._finish(context, err)
-
-    def _finish(self, context, err):
-        self._tmp.cleanup()
+    def _step(self):
+        """Advances the sequence: None while frames remain, else the error line ("" when done)."""
+        if self._frames is not None:
+            try:
+                frame = next(self._frames)
+            except StopIteration:
+                return ""
+            except (ValueError, OSError, RuntimeError) as e:
+                return str(e) or type(e).__name__
+            for f in frame.values() if isinstance(frame, dict) else [frame]:
+                f.save(self._out)
+            self._done += 1
+            return None
+        if self._process.poll() is None:
+            if bpy.app.background:
+                self._process.wait()
+            return None
+        err = self._process.stderr.read()
         if self._process.returncode != 0:
-            self.report({"ERROR"}, (err.strip().splitlines() or ["twister stopped"])[-1].removeprefix("error: "))
+            return (err.strip().splitlines() or ["twister stopped"])[-1].removeprefix("error: ")
+        self._done = self._total
+        return ""
+
+    def _finish(self, error):
+        self._tmp.cleanup()
+        if error:
+            self.report({"ERROR"}, error)
             return {"CANCELLED"}
-        self.report({"INFO"}, f"twister: {self._total} frames in {bpy.path.abspath(context.scene.twister.output_dir)}")
+        self.report({"INFO"}, f"twister: {self._total} frames in {self._out}")
         return {"FINISHED"}
 
     def modal(self, context, event):
         wm = context.window_manager
         if event.type == "ESC":
             # Frames are written whole (each by a rename): stopping leaves none half-written.
-            self._process.terminate()
-            self._process.wait()
+            if self._process is not None:
+                self._process.terminate()
+                self._process.wait()
             self._tmp.cleanup()
             wm.event_timer_remove(self._timer)
             wm.progress_end()
             self.report({"WARNING"}, "twister: stopped; the frames already written are whole")
             return {"CANCELLED"}
         if event.type == "TIMER":
-            out = bpy.path.abspath(context.scene.twister.output_dir)
-            done = len([f for f in os.listdir(out) if f.startswith("frame_")]) if os.path.isdir(out) else 0
-            wm.progress_update(min(done, self._total))
-            if self._process.poll() is not None:
+            state = self._step()
+            if self._process is not None and os.path.isdir(self._out):
+                self._done = len([f for f in os.listdir(self._out) if f.startswith("frame_")]) // 2
+            wm.progress_update(min(self._done, self._total))
+            if state is not None:
                 wm.event_timer_remove(self._timer)
                 wm.progress_end()
-                return self._finish(context, self._process.stderr.read())
+                return self._finish(state)
         return {"PASS_THROUGH"}
 
 

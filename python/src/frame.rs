@@ -34,6 +34,9 @@ pub struct Frame {
     argv: Vec<String>,
     /// The settings it was drawn with, placed with the scene.
     settings: twister::RenderSettings,
+    /// A sequence's frame number (`render_frames`): its files are named as `--frames` names them.
+    #[pyo3(get)]
+    frame: Option<u32>,
 }
 
 /// A flat vector as a numpy array of `shape`, without copying.
@@ -50,6 +53,7 @@ impl Frame {
         argv: Vec<String>,
         wall: Option<String>,
         stats: serde_json::Value,
+        number: Option<u32>,
     ) -> PyResult<Frame> {
         let (w, h) = (frame.left.width as usize, frame.left.height as usize);
         let pair = |[l, r]: [Vec<f32>; 2], c: usize| -> PyResult<(Py<PyAny>, Py<PyAny>)> {
@@ -69,6 +73,7 @@ impl Frame {
             frame_stats: frame.stats,
             argv,
             settings,
+            frame: number,
         })
     }
 
@@ -112,7 +117,8 @@ impl Frame {
 
     /// Writes the files `twister render --out DIR` writes for this frame with the same settings
     /// (its images in `layout` and `format`, the sphere's metadata, depth and linear colour
-    /// when drawn), all or nothing; returns their paths.
+    /// when drawn; a sequence's frame named as `--frames` names it), all or nothing; returns
+    /// their paths.
     #[pyo3(signature = (dir, layout=None, format=None, quality=None))]
     fn save(
         &self,
@@ -132,10 +138,11 @@ impl Frame {
         }
         let args = parse::<RenderCmd>(&argv)?.args;
         let frame = self.rebuild(py)?;
-        let (settings, wall) = (self.settings, self.wall.clone());
+        let (settings, wall, number) = (self.settings, self.wall.clone(), self.frame);
         without_gil(py, move || {
-            let writer = twister_cli::writer::FrameWriter::new(&args, &settings, false)?.for_wall(wall);
-            let files = writer.files(&frame, None)?;
+            // A sequence's frames are deflated fast, as `--frames` writes them.
+            let writer = twister_cli::writer::FrameWriter::new(&args, &settings, number.is_some())?.for_wall(wall);
+            let files = writer.files(&frame, number)?;
             twister::output::check_outputs(&files.iter().map(|f| f.path.as_path()).collect::<Vec<_>>())?;
             twister::output::write_all(&files)?;
             Ok(files.into_iter().map(|f| f.path).collect())

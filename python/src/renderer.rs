@@ -159,7 +159,7 @@ impl Renderer {
             .map(|d| {
                 let wall = d.writer.wall().map(str::to_string);
                 let stats = d.record.unwrap_or_default();
-                Frame::new(py, d.frame, d.settings, argv.clone(), wall, stats)
+                Frame::new(py, d.frame, d.settings, argv.clone(), wall, stats, None)
             })
             .collect()
     }
@@ -207,7 +207,7 @@ impl Renderer {
                 let mut stats = serde_json::to_value(&record).unwrap_or_default();
                 stats["frame"] = frame.into();
                 let wall = writer.wall().map(str::to_string);
-                Frame::new(py, rendered, settings, argv.clone(), wall, stats)
+                Frame::new(py, rendered, settings, argv.clone(), wall, stats, Some(frame))
             })
             .collect()
     }

@@ -137,4 +137,9 @@ def test_render_frames_yields_the_sequences_frames(renderer, cli, tmp_path):
     assert len(frames) == 3 and not np.array_equal(frames[0].left, frames[2].left)
     for k, frame in enumerate(frames):
         assert np.array_equal(read_png(tmp_path / "cli" / f"frame_{k:06d}_left.png"), frame.left), k
-        assert frame.stats["frame"] == k
+        assert frame.stats["frame"] == k and frame.frame == k
+        # Saved, a frame's files are named and written as the sequence's.
+        for p in frame.save(tmp_path / "py"):
+            name = pathlib.Path(p).name
+            assert name.startswith(f"frame_{k:06d}_"), name
+            assert pathlib.Path(p).read_bytes() == (tmp_path / "cli" / name).read_bytes(), name

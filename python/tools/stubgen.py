@@ -73,6 +73,7 @@ def stub() -> str:
         "    depth: Optional[Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]]",
         "    hdr: Optional[Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]]",
         "    wall: Optional[str]",
+        "    frame: Optional[int]",
         "    width: int",
         "    height: int",
         "    stats: Dict[str, Any]",

@@ -26,6 +26,7 @@ class Frame:
     depth: Optional[Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]]
     hdr: Optional[Tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]]
     wall: Optional[str]
+    frame: Optional[int]
     width: int
     height: int
     stats: Dict[str, Any]
