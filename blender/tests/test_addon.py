@@ -201,3 +201,17 @@ def test_an_animation_renders_its_frames_headless(tmp_path, monkeypatch, via):
     assert names == [f"frame_{k:06d}_{e}.png" for k in range(3) for e in ("left", "right")], names
     first, last = (load(tmp_path / "seq" / f"frame_{k:06d}_left.png") for k in (0, 2))
     assert not np.array_equal(first, last), "the box moves"
+
+
+def test_an_animation_can_be_a_video_too(tmp_path):
+    if run.command() is None:
+        pytest.skip("the twister command is needed for video: set TWISTER_BIN")
+    build_scene()
+    scene = bpy.context.scene
+    scene.frame_start, scene.frame_end = 1, 2
+    t = scene.twister
+    t.width, t.samples, t.output_dir, t.video = 64, "1", str(tmp_path / "video"), True
+    assert operator("render_animation") == {"FINISHED"}
+    mp4 = tmp_path / "video" / "twister.mp4"
+    assert mp4.stat().st_size > 0 and b"ftyp" in mp4.read_bytes()[:64]
+    assert b"sv3d" in mp4.read_bytes() or b"st3d" in mp4.read_bytes(), "spherical metadata"

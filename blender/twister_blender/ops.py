@@ -91,7 +91,10 @@ class TWISTER_OT_render_animation(bpy.types.Operator):
             path, settings, out, warnings, tmp = prepare(context, animation=True)
             fps = scene.render.fps / scene.render.fps_base
             frames = range(scene.frame_end - scene.frame_start + 1)
-            if run.package() is not None:
+            if scene.twister.video:
+                # The video is the command line's (ffmpeg, spherical metadata).
+                settings = dict(settings, video=os.path.join(out, "twister.mp4"))
+            if run.package() is not None and not scene.twister.video:
                 # The package: one frame a step, each saved whole as it finishes.
                 self._frames = iter(run.renderer().render_frames(path, frames=frames, fps=fps, **settings))
             else:
@@ -184,7 +187,7 @@ class TWISTER_PT_settings(bpy.types.Panel):
         sub = col.column()
         sub.enabled = not t.eyes_from_camera
         sub.prop(t, "eye_radius")
-        for name in ("output_dir", "format", "depth"):
+        for name in ("output_dir", "format", "depth", "video"):
             col.prop(t, name)
         row = col.row()
         row.operator("twister.render", icon="RENDER_STILL")

@@ -37,6 +37,9 @@ class TwisterSettings(bpy.types.PropertyGroup):
     output_dir: bpy.props.StringProperty(name="Output folder", subtype="DIR_PATH", default="//twister/")
     format: bpy.props.EnumProperty(name="Format", items=_items(s.FORMATS), default="png")
     depth: bpy.props.BoolProperty(name="Depth", description="Also write each eye's distance as EXR", default=False)
+    video: bpy.props.BoolProperty(
+        name="Video", description="Animation: also encode twister.mp4 with spherical metadata (ffmpeg; the twister command)", default=False
+    )
 
     def values(self) -> dict:
         return {
