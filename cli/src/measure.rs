@@ -49,14 +49,15 @@ pub struct Measured {
     pub frame_stats: twister::FrameStats,
 }
 
-/// Measures each view (one, or a CAVE's walls) of what `args` ask for; `loaded`: the scene
-/// already loaded from `args.scene`.
-pub fn measure_views(
-    renderer: &twister::Renderer,
-    adapter: &str,
-    args: &ErrorArgs,
-    loaded: Option<&twister::Scene>,
-) -> Result<Vec<Measured>> {
+/// What `error` measures, checked before anything is drawn: the settings and each view (one,
+/// or a CAVE's walls: each its name and projection).
+pub struct MeasurePlan {
+    pub settings: twister::RenderSettings,
+    pub views: Vec<(Option<String>, Option<twister::Projection>)>,
+}
+
+/// The measurement `args` ask for, every option checked.
+pub fn plan_measure(args: &ErrorArgs) -> Result<MeasurePlan> {
     if let Some(max) = args.heatmap_max.filter(|m| !(m.is_finite() && *m > 0.0)) {
         return Err(Error::option("--heatmap-max", format!("must be a positive number of pixels, got {max}")));
     }
@@ -69,13 +70,24 @@ pub fn measure_views(
         .with_measure_error(true)
         .with_depth(args.against.is_some())
         .with_positions(args.against == Some(Method::Trace));
-    // One view, or a CAVE's walls, each measured.
     let walls = args.view.cave_walls(&settings)?;
-    let views: Vec<(Option<String>, Option<twister::Projection>)> = if walls.is_empty() {
+    let views = if walls.is_empty() {
         vec![(None, None)]
     } else {
         walls.into_iter().map(|(name, p)| (Some(name), Some(p))).collect()
     };
+    Ok(MeasurePlan { settings, views })
+}
+
+/// Measures each view of `plan`; `loaded`: the scene already loaded from `args.scene`.
+pub fn measure_views(
+    renderer: &twister::Renderer,
+    adapter: &str,
+    args: &ErrorArgs,
+    plan: MeasurePlan,
+    loaded: Option<&twister::Scene>,
+) -> Result<Vec<Measured>> {
+    let MeasurePlan { settings, views } = plan;
     let methods: Vec<Method> = std::iter::once(settings.subdivision.method).chain(args.against).collect();
     let prepared = prepare_loaded(renderer, &args.scene, loaded, args.fit, &args.view, settings, false, &methods)?;
     let gpu_scene = &prepared.gpu_scene;
@@ -144,19 +156,12 @@ pub fn measure(args: &ErrorArgs) -> Result<()> {
             None => path.clone(),
         })
     };
+    let plan = plan_measure(args)?;
     // The heatmaps' files are checked before anything is drawn (a CAVE's named by wall).
-    let walls = match args.view.panorama {
-        Some(twister::core::projection::PanoramaKind::Cave) => {
-            args.view.cave_walls(&args.view.settings(&[args.view.method])?)?
-        }
-        _ => Vec::new(),
-    };
-    let names: Vec<Option<String>> =
-        if walls.is_empty() { vec![None] } else { walls.into_iter().map(|(name, _)| Some(name)).collect() };
-    let heatmaps: Vec<std::path::PathBuf> = names.iter().filter_map(heatmap).collect();
+    let heatmaps: Vec<std::path::PathBuf> = plan.views.iter().filter_map(|(wall, _)| heatmap(wall)).collect();
     twister::output::check_outputs(&heatmaps.iter().map(|p| p.as_path()).collect::<Vec<_>>())?;
     let (renderer, adapter) = open_renderer()?;
-    for m in measure_views(&renderer, &adapter, args, None)? {
+    for m in measure_views(&renderer, &adapter, args, plan, None)? {
         if let Some(path) = heatmap(&m.wall) {
             let max = args.heatmap_max.unwrap_or_else(|| crate::heatmap::nice_max(m.error_stats.p99));
             write_heatmap(&path, &m.error, m.settings.projection(), max)?;

@@ -74,6 +74,20 @@ pub fn still(args: &RenderArgs) -> Result<Still> {
     Ok(Still { settings, views })
 }
 
+impl Still {
+    /// Each view's settings placed with the scene (`placed`: the settings `prepare` returned; a
+    /// CAVE's walls each on its wall), with its writer.
+    pub fn placed(self, placed: twister::RenderSettings) -> Vec<(twister::RenderSettings, FrameWriter)> {
+        self.views
+            .into_iter()
+            .map(|(wall, writer)| match wall {
+                Some(wall) => (crate::cave::on_wall(placed, &wall), writer),
+                None => (placed, writer),
+            })
+            .collect()
+    }
+}
+
 /// One view of a still, drawn: its settings (placed with the scene, on its wall), the frame, its
 /// writer and, with `--stats`, its record.
 pub struct Drawn {
@@ -83,21 +97,18 @@ pub struct Drawn {
     pub record: Option<serde_json::Value>,
 }
 
-/// Draws each view of `still` from the prepared scene (the frame writer's record when `stats`).
+/// Draws each placed view ([`Still::placed`]) from the prepared scene (the frame writer's
+/// record when `stats`).
 pub fn draw(
     renderer: &twister::Renderer,
     adapter: &str,
     args: &RenderArgs,
     prepared: &crate::scene::Prepared,
-    still: Still,
+    views: Vec<(twister::RenderSettings, FrameWriter)>,
     stats: bool,
 ) -> Result<Vec<Drawn>> {
     let mut drawn = Vec::new();
-    for (wall, writer) in still.views {
-        let settings = match wall {
-            Some(wall) => crate::cave::on_wall(prepared.settings, &wall),
-            None => prepared.settings,
-        };
+    for (settings, writer) in views {
         let mut frame = renderer.render(&prepared.gpu_scene, &settings)?;
         if let (true, Some(gaze)) = (args.lod_overlay, &prepared.gaze) {
             for img in [&mut frame.left, &mut frame.right] {
@@ -124,28 +135,18 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     let (renderer, adapter) = open_renderer()?;
     let method = [still.settings.subdivision.method];
     let prepared = prepare(&renderer, &args.scene, args.fit, &args.view, still.settings, args.lod_overlay, &method)?;
+    let views = still.placed(prepared.settings);
     // Larger than the adapter draws at once (or --max-tile): in tiles, streamed (`tiled`).
-    let placed: Vec<(twister::RenderSettings, FrameWriter)> = still
-        .views
-        .iter()
-        .map(|(wall, writer)| {
-            let settings = match wall {
-                Some(wall) => crate::cave::on_wall(prepared.settings, wall),
-                None => prepared.settings,
-            };
-            (settings, writer.clone())
-        })
-        .collect();
-    let all: Vec<twister::RenderSettings> = placed.iter().map(|(s, _)| *s).collect();
+    let all: Vec<twister::RenderSettings> = views.iter().map(|(s, _)| *s).collect();
     if crate::tiled::any_tiled(&renderer, &all, args.max_tile) {
-        for path in crate::tiled::render_streamed(args, &renderer, &prepared, &placed, &adapter)? {
+        for path in crate::tiled::render_streamed(args, &renderer, &prepared, &views, &adapter)? {
             println!("{}", path.display());
         }
         return Ok(());
     }
     let mut files = Vec::new();
     let mut records = Vec::new();
-    for drawn in draw(&renderer, &adapter, args, &prepared, still, args.stats.is_some())? {
+    for drawn in draw(&renderer, &adapter, args, &prepared, views, args.stats.is_some())? {
         let t = std::time::Instant::now();
         files.extend(drawn.writer.files(&drawn.frame, None)?);
         // Encoding: the writing itself is a rename.

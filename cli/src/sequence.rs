@@ -100,11 +100,7 @@ impl Sequence<'_> {
             selected = Some(selection);
         }
         let ms_pose = t.elapsed().as_secs_f64() * 1e3;
-        let views: Vec<twister::RenderSettings> = if self.walls.is_empty() {
-            vec![settings]
-        } else {
-            self.walls.iter().map(|wall| crate::cave::on_wall(settings, wall)).collect()
-        };
+        let views = self.views(settings);
         let mut drawn = Vec::with_capacity(views.len());
         for (view, settings) in views.into_iter().enumerate() {
             let selected = selected.clone();
@@ -127,6 +123,15 @@ impl Sequence<'_> {
             drawn.push(Drawn { frame, view, time, ms_pose, rendered, settings, selected, written: None });
         }
         Ok(drawn)
+    }
+
+    /// Each view's settings of a frame drawn with `settings`: a CAVE's walls, or the one panorama.
+    fn views(&self, settings: twister::RenderSettings) -> Vec<twister::RenderSettings> {
+        if self.walls.is_empty() {
+            vec![settings]
+        } else {
+            self.walls.iter().map(|wall| crate::cave::on_wall(settings, wall)).collect()
+        }
     }
 
     /// Poses an animated scene at `time`.
@@ -196,6 +201,13 @@ pub struct Opened<'a> {
 }
 
 impl Opened<'_> {
+    /// Whether a view is larger than the adapter draws at once (`--frames` draws it in tiles,
+    /// written as they are drawn).
+    pub fn any_tiled(&self) -> bool {
+        let s = &self.sequence;
+        crate::tiled::any_tiled(s.renderer, &s.views(s.base), s.args.max_tile)
+    }
+
     /// Draws frame `frame`: each view's (a CAVE's walls, or the one panorama) settings and frame;
     /// frames drawn in tiles (already written) are left out.
     pub fn draw(&mut self, frame: u32) -> Result<Vec<(twister::RenderSettings, twister::Frame)>> {

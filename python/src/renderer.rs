@@ -147,10 +147,12 @@ impl Renderer {
                 args.lod_overlay,
                 &method,
             )?;
-            if r.tiles(&prepared.settings, args.max_tile).is_some() {
+            let views = still.placed(prepared.settings);
+            let all: Vec<twister::RenderSettings> = views.iter().map(|(s, _)| *s).collect();
+            if twister_cli::tiled::any_tiled(r, &all, args.max_tile) {
                 return Err(beyond_the_adapter());
             }
-            let drawn = twister_cli::render::draw(r, &adapter, &args, &prepared, still, true)?;
+            let drawn = twister_cli::render::draw(r, &adapter, &args, &prepared, views, true)?;
             state.renders += drawn.len() as u64;
             Ok(drawn)
         })?;
@@ -183,10 +185,10 @@ impl Renderer {
             let mut state = self.lock();
             let checked = twister_cli::sequence::check_sequence(&args)?;
             let mut opened = twister_cli::sequence::open_sequence(&args, checked, &state.renderer, loaded.as_deref())?;
-            let views = opened.draw(frame)?;
-            if views.len() != opened.writers.len() {
+            if opened.any_tiled() {
                 return Err(beyond_the_adapter());
             }
+            let views = opened.draw(frame)?;
             let writers = opened.writers.clone();
             drop(opened);
             state.renders += views.len() as u64;
@@ -228,7 +230,9 @@ impl Renderer {
         let adapter = self.adapter.clone();
         let measured = without_gil(py, || {
             let mut state = self.lock();
-            let measured = twister_cli::measure::measure_views(&state.renderer, &adapter, &args, loaded.as_deref())?;
+            let plan = twister_cli::measure::plan_measure(&args)?;
+            let measured =
+                twister_cli::measure::measure_views(&state.renderer, &adapter, &args, plan, loaded.as_deref())?;
             state.renders += measured.len() as u64;
             Ok(measured)
         })?;

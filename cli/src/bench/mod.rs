@@ -345,10 +345,7 @@ pub fn bench_figures(args: &FigureArgs, which: Figure) -> Result<()> {
 /// `bench speed`'s rows on an open renderer: each scene placed as `render` places it, each
 /// method timed in turn; `progress` hears what is being timed.
 pub fn speed_rows(renderer: &Renderer, args: &SpeedArgs, progress: impl FnMut(&str)) -> Result<Vec<speed::SpeedRow>> {
-    if !(1..=MAX_REPS).contains(&args.reps) {
-        return Err(Error::option("--reps", format!("must be between 1 and {MAX_REPS}, got {}", args.reps)));
-    }
-    let base = args.view.settings(&args.methods)?;
+    let base = speed_settings(args)?;
     // Every scene as `render` would draw it: --scale, --fit (file scenes), --viewer camera:N, --lod.
     let mut scenes = Vec::new();
     for spec in &args.scenes {
@@ -363,12 +360,17 @@ pub fn speed_rows(renderer: &Renderer, args: &SpeedArgs, progress: impl FnMut(&s
     speed::speed(renderer, &scenes, &args.methods, args.reps, progress)
 }
 
-pub fn bench_speed(args: &SpeedArgs) -> Result<()> {
-    // The options are checked before the device is opened.
+/// `bench speed`'s options checked: the base settings of every point.
+fn speed_settings(args: &SpeedArgs) -> Result<twister::RenderSettings> {
     if !(1..=MAX_REPS).contains(&args.reps) {
         return Err(Error::option("--reps", format!("must be between 1 and {MAX_REPS}, got {}", args.reps)));
     }
-    let base = args.view.settings(&args.methods)?;
+    args.view.settings(&args.methods)
+}
+
+pub fn bench_speed(args: &SpeedArgs) -> Result<()> {
+    // The options are checked before the device is opened.
+    let base = speed_settings(args)?;
     let (renderer, adapter) = open_renderer()?;
     let rows = speed_rows(&renderer, args, |what| eprintln!("timing {what} ..."))?;
     let timing = rows.first().map_or("-".to_string(), |r| r.timing.clone());
