@@ -75,10 +75,12 @@ pub fn uv_sphere(center: Vec3, radius: f32, slices: u32, stacks: u32, color: [f3
     let mut idx = Vec::new();
     for i in 0..=stacks {
         let polar = PI * i as f32 / stacks as f32;
+        // The poles exactly on the axis (sin π is not 0 in f32): one point, a closed mesh.
+        let ring = if i == 0 || i == stacks { 0.0 } else { polar.sin() };
         for j in 0..=slices {
             // The last column repeats the first's positions bit for bit (a closed mesh).
             let az = TAU * (j % slices) as f32 / slices as f32;
-            let n = Vec3::new(polar.sin() * az.cos(), polar.cos(), polar.sin() * az.sin());
+            let n = Vec3::new(ring * az.cos(), polar.cos(), ring * az.sin());
             v.push(vertex(center + radius * n, n, color));
         }
     }

@@ -16,7 +16,8 @@
 //! within [P3, P1] (an object beyond D∞ would otherwise get a negative count).
 //!
 //! Simplified meshes come from meshoptimizer's quadric-error simplifier (the Garland–Heckbert QEM
-//! the paper used): a chain of levels, each about `LEVEL_RATIO` (0.7) of the triangles of the one before, built once
+//! the paper used), on the object's welded surface so that a closed object stays closed at every
+//! level (`core::simplify`): a chain of levels, each about `LEVEL_RATIO` (0.7) of the triangles of the one before, built once
 //! per object down to P3 and cached. A frame draws, for each object, the coarsest level that still
 //! has at least P_m triangles. The levels reuse the object's vertices, so UVs, normals and colours
 //! stay as they were at the vertices the simplifier keeps.
@@ -29,12 +30,11 @@
 use glam::{Mat4, Quat, Vec3};
 
 use crate::core::scene::object_spheres;
+use crate::core::simplify::{simplify_chain, Welding};
 use crate::core::scene::{Object, Scene};
 use crate::core::visual_field::{Field, Gaze};
 
-/// Each simplified level aims at this share of the triangles of the level before: close enough
-/// that the coarsest level meeting a budget is at most ~1.4× the budget.
-pub const LEVEL_RATIO: f32 = 0.7;
+pub use crate::core::simplify::LEVEL_RATIO;
 /// The most the peripheral field relaxes L (at the field's boundary).
 pub const MAX_EDGE_RELAXATION: f32 = 4.0;
 /// Objects with fewer triangles keep only their original: there is little to save, and the
@@ -132,46 +132,19 @@ pub struct LodSelection {
 impl LodChain {
     /// Simplifies every object down to `min_share` of its triangles, each level `LEVEL_RATIO` of the last.
     pub fn build(scene: &Scene, min_share: f32) -> LodChain {
-        let bytes: &[u8] = bytemuck::cast_slice(&scene.vertices);
-        let stride = std::mem::size_of::<crate::core::scene::SceneVertex>();
-        let adapter = meshopt::VertexDataAdapter::new(bytes, stride, 0).expect("vertex layout");
+        let welding = Welding::of(&scene.vertices);
         let (levels, errors) = scene
             .objects
             .iter()
             .map(|o| {
                 let first = 3 * o.first_triangle as usize;
-                let original = scene.indices[first..first + 3 * o.triangle_count as usize].to_vec();
+                let original = &scene.indices[first..first + 3 * o.triangle_count as usize];
                 let floor = if o.triangle_count < MIN_CHAIN_TRIANGLES {
                     o.triangle_count as usize
                 } else {
                     ((o.triangle_count as f32 * min_share).ceil() as usize).max(1)
                 };
-                let mut chain = vec![original];
-                let mut errors = vec![0.0f32];
-                loop {
-                    let last = chain.last().unwrap();
-                    let count = last.len() / 3;
-                    if count <= floor {
-                        break;
-                    }
-                    let target = ((count as f32 * LEVEL_RATIO) as usize).max(floor);
-                    let mut error = 0.0f32;
-                    let next = meshopt::simplify(
-                        last,
-                        &adapter,
-                        3 * target,
-                        1.0,
-                        meshopt::SimplifyOptions::Sparse,
-                        Some(&mut error),
-                    );
-                    // Stop where the simplifier can no longer make real progress.
-                    if next.is_empty() || next.len() / 3 > count * 9 / 10 {
-                        break;
-                    }
-                    chain.push(next);
-                    errors.push(errors.last().unwrap() + error);
-                }
-                (chain, errors)
+                simplify_chain(&scene.vertices, &welding, original, floor)
             })
             .unzip();
         LodChain { levels, errors }

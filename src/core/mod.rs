@@ -30,6 +30,7 @@ pub mod settings;
 pub mod shadow;
 pub mod shapes;
 pub mod shared_edges;
+pub mod simplify;
 pub mod sphere;
 pub mod texture;
 pub mod timeline;
