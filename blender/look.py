@@ -3,7 +3,8 @@ parts) under an HDR world, both renders linear (no tone mapping), equirect 256 �
 Cycles at 128 samples. Prints the mean linear colour of the objects' pixels on each side and
 the per-pixel mean |Δ|, overall and per object (which part differs, by how much).
 
-    python blender/look.py [OUT_DIR]   (a Python with bpy 4.5 and twister's package)"""
+    python blender/look.py [OUT_DIR [TURN_DEG]]   (a Python with bpy 4.5 and twister's package;
+    TURN_DEG turns the world's map about Z with a Mapping node)"""
 
 import json
 import math
@@ -70,9 +71,10 @@ def pbr(name, metallic, roughness, texture=None, colour=(0.8, 0.8, 0.8)):
     return mat
 
 
-def build(env_path):
+def build(env_path, turn_deg=0.0):
     bpy.ops.wm.read_factory_settings(use_empty=True)
-    twister_blender.register()
+    if not hasattr(bpy.types.Scene, "twister"):
+        twister_blender.register()
     objects = [
         ("metal", (0.0, 2.0, 0.0), pbr("metal", 1.0, 0.3, checker("gold", (0.9, 0.7, 0.3), (0.6, 0.6, 0.6)))),
         ("plastic", (-1.6, 1.4, -0.2), pbr("plastic", 0.0, 0.6, checker("red", (0.7, 0.1, 0.1), (0.9, 0.9, 0.9)))),
@@ -89,6 +91,12 @@ def build(env_path):
     env = world.node_tree.nodes.new("ShaderNodeTexEnvironment")
     env.image = bpy.data.images.load(env_path)
     world.node_tree.links.new(env.outputs["Color"], world.node_tree.nodes["Background"].inputs["Color"])
+    if turn_deg:
+        coords = world.node_tree.nodes.new("ShaderNodeTexCoord")
+        mapping = world.node_tree.nodes.new("ShaderNodeMapping")
+        mapping.inputs["Rotation"].default_value[2] = math.radians(turn_deg)
+        world.node_tree.links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
+        world.node_tree.links.new(mapping.outputs["Vector"], env.inputs["Vector"])
     scene = bpy.context.scene
     scene.world = world
     data = bpy.data.cameras.new("pano")
@@ -121,12 +129,14 @@ def cycles_left(out):
     return px
 
 
-def main():
-    out = sys.argv[1] if len(sys.argv) > 1 else tempfile.mkdtemp()
+def measure(out, turn_deg=0.0):
+    """Renders the look scene both ways (the world turned `turn_deg` about Z by a Mapping node)
+    and returns the comparison: means, mean |Δ| over the mean, per object and for the
+    background."""
     env_path = f"{out}/sky.hdr"
     pathlib.Path(out).mkdir(parents=True, exist_ok=True)
     write_hdr(env_path)
-    names = build(env_path)
+    build(env_path, turn_deg)
     scene = bpy.context.scene
     t = scene.twister
     t.width, t.samples = W, "16"
@@ -147,18 +157,27 @@ def main():
     result["mean_abs_diff_over_mean"] = float(np.abs(a - b).mean() / b.mean())
     bg = ~seen
     result["background_ratio"] = float(ours[bg].mean() / theirs[bg].mean())
+    result["background_mean_abs_diff_over_mean"] = float(np.abs(ours[bg] - theirs[bg]).mean() / theirs[bg].mean())
+    np.save(f"{out}/twister.npy", ours)
+    np.save(f"{out}/cycles.npy", theirs)
     # Per object: by azimuth (the objects stand apart), the columns each covers.
-    cols = {"metal": (0, 0.0), "plastic": (0, 0.0), "rough": (0, 0.0)}
+    per_object = {}
     az = ((np.arange(W) + 0.5) / W - 0.5) * 360
     for name, centre in [("metal", 0.0), ("plastic", 48.8), ("rough", -54.8)]:
         m = seen & (np.abs(az - centre) < 20)[None, :]
-        cols[name] = {
+        per_object[name] = {
             "pixels": int(m.sum()),
             "ratio": float(ours[m].mean() / theirs[m].mean()),
             "mean_abs_diff_over_mean": float(np.abs(ours[m] - theirs[m]).mean() / theirs[m].mean()),
         }
-    result["per_object"] = cols
-    print(json.dumps(result, indent=2), flush=True)
+    result["per_object"] = per_object
+    return result
+
+
+def main():
+    out = sys.argv[1] if len(sys.argv) > 1 else tempfile.mkdtemp()
+    turn = float(sys.argv[2]) if len(sys.argv) > 2 else 0.0
+    print(json.dumps(measure(out, turn), indent=2), flush=True)
     # Blender as a module hangs on its way out while any Python class is still registered.
     twister_blender.unregister()
 

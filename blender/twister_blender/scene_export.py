@@ -56,6 +56,10 @@ def bpy_vector(v):
     return Vector(v)
 
 
+# Where twister draws a Blender world map's azimuth 0 (degrees): see `world_settings`.
+BLENDER_MAP_YAW = 90.0
+
+
 def world_settings(scene: bpy.types.Scene) -> Tuple[Optional[Dict[str, object]], List[str]]:
     """The world's Environment Texture (image path, strength, rotation about Z), or None."""
     world = scene.world
@@ -70,7 +74,12 @@ def world_settings(scene: bpy.types.Scene) -> Tuple[Optional[Dict[str, object]],
     if not os.path.isfile(path) or not path.lower().endswith((".hdr", ".exr")):
         return None, [f"the world's environment image {texture.image.name!r} is not an .hdr or .exr file on disk: not carried over"]
     mapping = next((n for n in nodes if n.type == "MAPPING"), None)
-    yaw = math.degrees(mapping.inputs["Rotation"].default_value[2]) if mapping is not None else 0.0
+    # Blender's equirectangular image has its centre towards −X; twister's towards −z, Blender's
+    # +Y: the same map turned a quarter turn. A mapping's turn about Z turns the lookup, so what
+    # the map shows turns the other way, which in twister's azimuth (clockwise seen from above)
+    # is the same sign.
+    turn = math.degrees(mapping.inputs["Rotation"].default_value[2]) if mapping is not None else 0.0
+    yaw = BLENDER_MAP_YAW + turn
     strength = background.inputs["Strength"].default_value
     return {"image": path, "strength": strength, "yaw_deg": yaw}, []
 
