@@ -12,6 +12,76 @@ use twister::core::settings::{Method, Split};
 use twister::EyeImage;
 use twister::{Projection, RenderSettings, Scene};
 
+mod real_mesh {
+    use super::*;
+    use std::collections::{BTreeSet, HashMap};
+    use twister::cpu::subdivide::Subdivider;
+    use twister::encoding::subdivide::subdivide_params;
+    use twister::encoding::types::{DrawVertex, SubdivideParams};
+
+    /// Seed 002 §2.3's crack-freeness, literally: on a real mesh, the two triangles sharing an
+    /// edge put bit-identical nodes on it. Each triangle is subdivided alone; the nodes each
+    /// one leaves on a shared edge are compared.
+    #[test]
+    fn shared_edges_get_bit_identical_nodes_on_a_real_mesh() {
+        if !common::assets_present() {
+            return;
+        }
+        let path = common::asset("cow/cow.obj");
+        let projection = Projection { width: 1600, height: 300, ..Projection::default() };
+        let mut scene = twister::core::load::load_obj(&path).unwrap();
+        scene.fit(3.0, &projection).unwrap();
+        let key = |p: Vec3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+        // Edges by their two corner positions (unordered), with the triangles that have them.
+        let mut edges: HashMap<([u32; 3], [u32; 3]), Vec<usize>> = HashMap::new();
+        for t in 0..scene.triangle_count() {
+            for e in 0..3 {
+                let a = Vec3::from(scene.vertices[scene.indices[3 * t + e] as usize].position);
+                let b = Vec3::from(scene.vertices[scene.indices[3 * t + (e + 1) % 3] as usize].position);
+                let (ka, kb) = (key(a), key(b));
+                edges.entry(if ka < kb { (ka, kb) } else { (kb, ka) }).or_default().push(t);
+            }
+        }
+        let settings = RenderSettings::new(projection)
+            .with_method(Method::Adaptive(Split::Length))
+            .with_edge_px(6.0)
+            .with_max_div(4)
+            .with_measure_edges(true);
+        let params = subdivide_params(&settings, 0, 1);
+        let cuts = Subdivider::new(&params).active_cuts(&scene.vertices, &scene.indices);
+        let outputs: Vec<Vec<DrawVertex>> = (0..scene.triangle_count())
+            .map(|t| {
+                let one = SubdivideParams { first_triangle: t as u32, ..params };
+                Subdivider::new(&one).run_with_cuts(&scene.vertices, &scene.indices, &cuts).vertices
+            })
+            .collect();
+        let (mut compared, mut split) = (0, 0);
+        for ((ka, kb), tris) in edges.iter().filter(|(_, t)| t.len() == 2) {
+            let (a, b) = (
+                Vec3::new(f32::from_bits(ka[0]), f32::from_bits(ka[1]), f32::from_bits(ka[2])),
+                Vec3::new(f32::from_bits(kb[0]), f32::from_bits(kb[1]), f32::from_bits(kb[2])),
+            );
+            let on_edge = |v: &DrawVertex| {
+                let p = Vec3::from(v.position);
+                (p - a).cross(b - a).length() <= 1e-5 * (b - a).length_squared()
+                    && (p - a).dot(b - a) >= 0.0
+                    && (p - b).dot(a - b) >= 0.0
+            };
+            let nodes = |t: usize| -> BTreeSet<[u32; 3]> {
+                outputs[t].iter().filter(|v| on_edge(v)).map(|v| key(Vec3::from(v.position))).collect()
+            };
+            let (n0, n1) = (nodes(tris[0]), nodes(tris[1]));
+            if n0.is_empty() || n1.is_empty() {
+                continue; // culled off screen on one side
+            }
+            assert_eq!(n0, n1, "edge {a} – {b}: the two triangles put different nodes on it");
+            compared += 1;
+            split += (n0.len() > 2) as usize;
+        }
+        assert!(compared > 1000 && split > 100, "{compared} shared edges compared, {split} of them split");
+    }
+}
+
 const BG: [f32; 3] = [1.0, 0.0, 1.0];
 
 fn holes(img: &EyeImage) -> Vec<(u32, u32)> {

@@ -59,7 +59,6 @@ mod tests {
     use super::*;
     use crate::core::light::Tonemap;
     use crate::core::panorama::PanoramaKind;
-    use crate::output::Layout;
 
     #[test]
     fn names_round_trip_in_kebab_and_snake_case_and_match_the_json_spelling() {
@@ -70,8 +69,6 @@ mod tests {
         }
         assert_eq!(PanoramaKind::CHOICES.len(), PanoramaKind::ALL.len());
         assert_eq!(Tonemap::from_name("pbr_neutral"), Some(Tonemap::PbrNeutral));
-        assert_eq!(Layout::from_name("Top-Bottom"), Some(Layout::TopBottom));
-        assert_eq!(serde_json::to_value(Layout::Strip12).unwrap(), Layout::Strip12.name());
         // The linear tone map belongs to HDR frames and is no user's choice.
         assert_eq!(Tonemap::from_name("linear"), None);
         assert!(!Tonemap::CHOICES.contains(&Tonemap::Linear));

@@ -6,7 +6,6 @@
 //! so every panorama is previewed as it is drawn.
 
 use crate::core::projection::{PanoramaKind, Projection};
-use crate::encoding::types::DisplayParams;
 
 /// How the frame is shown.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -112,25 +111,6 @@ impl DisplayView {
             DisplayMode::Halves => [0.0, 0.0, self.target[0] as f32, self.target[1] as f32],
             m if m.is_look() => [0.0, 0.0, self.target[0] as f32, self.target[1] as f32],
             _ => fit_area([w, h * self.layers], self.target),
-        }
-    }
-
-    /// The stage's parameters for a frame of projection `p`.
-    pub fn params(&self, p: &Projection) -> DisplayParams {
-        let overlay = self.overlay.map_or([0.0; 4], |r| r.map(|v| v as f32));
-        DisplayParams {
-            projection: p.into(),
-            mode: self.mode.code(),
-            width: self.image[0],
-            height: self.image[1],
-            row_texels: self.row_texels,
-            layers: self.layers,
-            srgb_target: self.srgb_target as u32,
-            _pad0: 0,
-            _pad1: 0,
-            area: self.area(),
-            look: [self.look.yaw, self.look.pitch, (self.look.fov_deg.to_radians() / 2.0).tan(), look_far(p)],
-            overlay,
         }
     }
 }

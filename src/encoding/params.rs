@@ -3,7 +3,9 @@
 
 use crate::core::projection::Eye;
 use crate::core::settings::{RenderSettings, SplitRule};
-use crate::encoding::types::{RasterParams, TraceParams};
+use crate::core::display::{look_far, DisplayView};
+use crate::core::projection::Projection;
+use crate::encoding::types::{DisplayParams, RasterParams, TraceParams};
 
 /// The raster stage's parameters: the left eye's, then the right's (its `array<RasterParams, 2>`).
 pub fn raster_params(settings: &RenderSettings) -> [RasterParams; 2] {
@@ -38,5 +40,25 @@ pub fn trace_params(settings: &RenderSettings, row_texels: u32) -> TraceParams {
         original_root: 0,
         original_level: -1.0,
         samples: settings.shading.samples,
+    }
+}
+
+/// The display stage's parameters for a frame of projection `p` shown as `view` (the live
+/// window's `display` stage; twin `cpu::display`).
+pub fn display_params(view: &DisplayView, p: &Projection) -> DisplayParams {
+    let overlay = view.overlay.map_or([0.0; 4], |r| r.map(|v| v as f32));
+    DisplayParams {
+        projection: p.into(),
+        mode: view.mode.code(),
+        width: view.image[0],
+        height: view.image[1],
+        row_texels: view.row_texels,
+        layers: view.layers,
+        srgb_target: view.srgb_target as u32,
+        _pad0: 0,
+        _pad1: 0,
+        area: view.area(),
+        look: [view.look.yaw, view.look.pitch, (view.look.fov_deg.to_radians() / 2.0).tan(), look_far(p)],
+        overlay,
     }
 }

@@ -87,19 +87,23 @@ pub(crate) trait Method {
     ) -> Result<Frame>;
 }
 
-/// The end of every frame: the read-back of its targets and, with the error pass, the
-/// `reduce_error` stage (built when first needed). A frame the live window shows keeps its
-/// colour on the GPU instead (`show`): copied into a storage buffer for the display stage.
+/// The stages at the end of every frame, kept by the renderer: the `reduce_error` stage (built
+/// when first needed).
 #[derive(Default)]
-pub(crate) struct FrameEnd {
+pub(crate) struct EndStages {
     reduce: std::sync::OnceLock<ReduceStage>,
-    /// Set while a shown frame is drawn (the renderer's frame lock is held meanwhile).
-    pub show: std::sync::atomic::AtomicBool,
-    /// The last shown frame's colour.
-    pub shown: std::sync::Mutex<Option<ShownFrame>>,
 }
 
-impl FrameEnd {
+/// One frame's end: the read-back of its targets and, with the error pass, the reduction. A
+/// frame the live window shows (`show`) keeps its colour on the GPU instead, copied into a
+/// storage buffer for the display stage (`shown`).
+pub(crate) struct FrameEnd<'a> {
+    pub stages: &'a EndStages,
+    pub show: bool,
+    pub shown: std::cell::OnceCell<ShownFrame>,
+}
+
+impl FrameEnd<'_> {
     /// Reads the targets back and reduces the error: the end of every render.
     pub fn finish(
         &self,
@@ -110,12 +114,12 @@ impl FrameEnd {
         start: Instant,
     ) -> Result<Frame> {
         let t = Instant::now();
-        let [left, right] = if self.show.load(std::sync::atomic::Ordering::Relaxed) {
+        let [left, right] = if self.show {
             let (texels, row_texels) =
                 copy_eyes_to_buffer(gpu, &targets.color, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
             let (width, height) = (targets.width, targets.height);
             let shown = ShownFrame { texels, width, height, row_texels, layers: 2 };
-            *self.shown.lock().unwrap_or_else(|e| e.into_inner()) = Some(shown);
+            let _ = self.shown.set(shown);
             [0, 1].map(|_| EyeImage { width, height, rgba: Vec::new() })
         } else {
             targets.read_colors(gpu)?
@@ -126,7 +130,7 @@ impl FrameEnd {
         let positions = if settings.measure.positions { Some(targets.read_positions(gpu)?) } else { None };
         let measurement = if settings.measure.error {
             let object = targets.read_objects(gpu)?;
-            let reduce = self.reduce.get_or_init(|| ReduceStage::new(gpu));
+            let reduce = self.stages.reduce.get_or_init(|| ReduceStage::new(gpu));
             let (stats, error) = reduce.reduce(gpu, targets, settings.measure.reduce_per_eye)?;
             Some(Measurement { error, object, stats })
         } else {

@@ -20,7 +20,7 @@ use crate::encoding::types::{SlitParams, SubdivideParams, TraceParams};
 use crate::error::{Error, Result};
 use crate::gpu::device::Gpu;
 use crate::gpu::display::{DisplayStage, ShownFrame};
-use crate::gpu::frame::{FrameEnd, FrameResources, Method, STAGING_SIZE};
+use crate::gpu::frame::{EndStages, FrameEnd, FrameResources, Method, STAGING_SIZE};
 use crate::gpu::project_points::ProjectPointsStage;
 use crate::gpu::scene::GpuScene;
 use crate::gpu::shadow::ShadowStage;
@@ -98,7 +98,7 @@ pub struct Renderer {
     slit: OnceLock<SlitMethod>,
     trace: TraceMethod,
     shadow: OnceLock<ShadowStage>,
-    end: FrameEnd,
+    end: EndStages,
     skin: SkinStage,
     project_points: ProjectPointsStage,
     display: OnceLock<DisplayStage>,
@@ -140,7 +140,7 @@ impl Renderer {
             slit: OnceLock::new(),
             trace: TraceMethod::default(),
             shadow: OnceLock::new(),
-            end: FrameEnd::default(),
+            end: EndStages::default(),
             skin: SkinStage::default(),
             project_points: ProjectPointsStage::default(),
             display: OnceLock::new(),
@@ -160,7 +160,7 @@ impl Renderer {
         let counts = crate::gpu::targets::sample_counts(&self.gpu);
         // The ray tracer traces any count itself (a ray per sample).
         if counts.contains(&n) || settings.subdivision.method == MethodName::Trace {
-            return self.render_direct(scene, settings);
+            return Ok(self.render_direct(scene, settings, false)?.0);
         }
         self.render_larger(scene, settings, &counts)
     }
@@ -297,8 +297,8 @@ impl Renderer {
             .with_hdr(false);
         self.check_size(&larger)?;
         let centre_outputs = settings.measure.outputs() > 1 || settings.shading.hdr;
-        let centre = if centre_outputs { Some(self.render_direct(scene, &settings.with_samples(1))?) } else { None };
-        let drawn = self.render_direct(scene, &larger)?;
+        let centre = if centre_outputs { Some(self.render_direct(scene, &settings.with_samples(1), false)?.0) } else { None };
+        let drawn = self.render_direct(scene, &larger, false)?.0;
         let (left, right) = (drawn.left.box_filtered(kx, ky), drawn.right.box_filtered(kx, ky));
         let mut frame = match centre {
             Some(centre) => Frame { left, right, ..centre },
@@ -313,8 +313,9 @@ impl Renderer {
         Ok(frame)
     }
 
-    /// A frame at the sample count the adapter draws.
-    fn render_direct(&self, scene: &GpuScene, settings: &RenderSettings) -> Result<Frame> {
+    /// A frame at the sample count the adapter draws; shown (`show`): its colour kept on the
+    /// GPU for the live window instead of read back.
+    fn render_direct(&self, scene: &GpuScene, settings: &RenderSettings, show: bool) -> Result<(Frame, Option<ShownFrame>)> {
         let mut resources = self.resources.lock().unwrap_or_else(|e| e.into_inner());
         let shadow_maps = scene.write_lighting(&self.gpu, settings);
         self.gpu.scoped("rendering a frame", || {
@@ -331,7 +332,8 @@ impl Renderer {
                 _ if cave => self.slit.get_or_init(|| SlitMethod::new(&self.gpu)),
                 _ => self.subdivided(),
             };
-            let mut frame = method.draw(&self.gpu, &self.end, &mut resources, scene, settings)?;
+            let end = FrameEnd { stages: &self.end, show, shown: std::cell::OnceCell::new() };
+            let mut frame = method.draw(&self.gpu, &end, &mut resources, scene, settings)?;
             let n = settings.shading.samples;
             frame.stats.samples = n;
             frame.stats.sampling = match crate::gpu::targets::Samples::passes(settings).as_slice() {
@@ -342,7 +344,7 @@ impl Renderer {
                 [_] => format!("multisampled {n} (a pass per eye)"),
                 _ => format!("multisampled {n} (a pass per eye), depth, error and linear colour at the centres"),
             };
-            Ok(frame)
+            Ok((frame, end.shown.into_inner()))
         })
     }
 
@@ -350,7 +352,6 @@ impl Renderer {
     /// colour left on the GPU for the display stage (the images of the returned frame are
     /// empty), or, for a sample count beyond the adapter's (box-filtered on the CPU), uploaded.
     pub fn render_shown(&self, scene: &GpuScene, settings: &RenderSettings) -> Result<(Frame, ShownFrame)> {
-        use std::sync::atomic::Ordering::Relaxed;
         settings.validate()?;
         self.check_size(settings)?;
         let counts = crate::gpu::targets::sample_counts(&self.gpu);
@@ -359,11 +360,7 @@ impl Renderer {
             let shown = ShownFrame::upload(&self.gpu, &[&frame.left, &frame.right]);
             return Ok((frame, shown));
         }
-        self.end.show.store(true, Relaxed);
-        let frame = self.render_direct(scene, settings);
-        self.end.show.store(false, Relaxed);
-        let shown = self.end.shown.lock().unwrap_or_else(|e| e.into_inner()).take();
-        let frame = frame?;
+        let (frame, shown) = self.render_direct(scene, settings, true)?;
         let shown = shown.ok_or_else(|| Error::Gpu("the frame's colour was not kept for the window".into()))?;
         Ok((frame, shown))
     }

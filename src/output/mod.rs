@@ -563,6 +563,14 @@ mod tests {
     use super::*;
 
     #[test]
+    fn layouts_are_named_in_kebab_and_snake_case_as_the_json_spells_them() {
+        use crate::core::choice::Choice;
+        assert_eq!(Layout::from_name("Top-Bottom"), Some(Layout::TopBottom));
+        assert_eq!(Layout::from_name("top_bottom"), Some(Layout::TopBottom));
+        assert_eq!(serde_json::to_value(Layout::Strip12).unwrap(), Layout::Strip12.name());
+    }
+
+    #[test]
     fn layout_names_are_the_names_of_the_layout_images() {
         let eye = EyeImage { width: 6, height: 4, rgba: vec![0; 96] };
         let frame = Frame {

@@ -462,7 +462,7 @@ impl<'a> Live<'a> {
             overlay: self.overlay.as_ref().filter(|_| self.overlay_on).map(|([w, h], _)| [8, 8, *w, *h]),
             srgb_target: srgb,
         };
-        let params = view.params(settings.projection());
+        let params = twister::encoding::params::display_params(&view, settings.projection());
         let overlay = self.overlay.as_ref().filter(|_| self.overlay_on).map(|(_, b)| b);
         self.renderer.display().draw(&self.renderer.gpu, enc, target, &params, &shown, overlay);
         if self.opts.trace_frames {
