@@ -194,12 +194,13 @@ pub fn render_streamed(
             .iter()
             .zip(views)
             .map(|((stats, tiles), (settings, writer))| {
+                let frame = stats_frame(stats);
                 let record = FrameRecord {
                     tiles: Some(tiles.count()),
                     ..FrameRecord::new(
                         &args.scene,
                         settings,
-                        &stats_frame(stats),
+                        &frame,
                         writer,
                         adapter,
                         lod_stats(&prepared.selection),

@@ -12,6 +12,7 @@ use twister::output::{
     depth_images, depth_names, exr_file, gpano_xmp, hdr_exr_file, image_file, layout_images, layout_names,
     transparent_outside, Encoding, ImageFormat, Layout, OutputFile,
 };
+use twister::core::frame::FrameStats;
 use twister::{Frame, RenderSettings};
 
 use crate::args::RenderArgs;
@@ -234,9 +235,9 @@ pub fn frame_name(frame: u32, layout_name: &str) -> String {
     format!("frame_{frame:06}_{}", layout_name.strip_prefix("stereo_").unwrap_or(layout_name))
 }
 
-/// What `--stats` records of a frame: the scene, the method and its parameters, the view, the
-/// counts and times. A sequence's lines also carry the frame, its time, the pose's time and
-/// the files written.
+/// What `--stats` records of a frame: the scene, the method and its parameters, the view, and
+/// the frame's own [`FrameStats`] (counts and times, flattened into the record). A sequence's
+/// lines also carry the frame, its time, the pose's time and the files written.
 #[derive(Serialize)]
 pub struct FrameRecord<'a> {
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -254,22 +255,10 @@ pub struct FrameRecord<'a> {
     pub edge_px: f32,
     pub max_error_px: f32,
     pub max_div: u32,
-    pub triangles_in: u64,
-    pub triangles_out: u64,
+    #[serde(flatten)]
+    pub stats: &'a FrameStats,
+    /// The triangles drawn (the subdivision's output, `triangles_out`).
     pub triangles_drawn: u64,
-    pub pieces: u64,
-    pub rays_traced: Option<u64>,
-    pub triangle_tests: Option<u64>,
-    pub max_sub_edge_px: f32,
-    pub chunks: u32,
-    /// The subdivision's balance: invocations per pass, and the largest output of one
-    /// invocation (`FrameStats`).
-    pub subdivide_invocations: Vec<(&'static str, u64)>,
-    pub max_pieces_per_invocation: u32,
-    pub max_output_per_invocation: u32,
-    /// Samples per pixel of the colour, and how they were drawn (`FrameStats`).
-    pub samples: u32,
-    pub sampling: String,
     pub width: u32,
     pub height: u32,
     pub screen_radius: f32,
@@ -281,19 +270,9 @@ pub struct FrameRecord<'a> {
     pub layout: Layout,
     pub format: ImageFormat,
     pub adapter: &'a str,
-    pub timing: twister::core::frame::Timing,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ms_pose: Option<f64>,
-    pub ms_frame: f64,
-    pub ms_gpu: Option<f64>,
-    pub ms_subdivide: Option<f64>,
-    /// Each of the subdivision's passes, where timestamps timed them (`FrameStats`).
-    pub ms_subdivide_passes: Option<Vec<(&'static str, f64)>>,
-    pub ms_raster: Option<f64>,
-    pub ms_readback: f64,
     pub ms_write: f64,
-    /// The render call's wall time; a still's includes the writing (encoding) too.
-    pub ms_total: f64,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub files: Option<Vec<String>>,
     pub lod: serde_json::Value,
@@ -304,7 +283,7 @@ impl<'a> FrameRecord<'a> {
     pub fn new(
         scene: &'a str,
         settings: &RenderSettings,
-        rendered: &Frame,
+        rendered: &'a Frame,
         writer: &FrameWriter,
         adapter: &'a str,
         lod: serde_json::Value,
@@ -320,19 +299,8 @@ impl<'a> FrameRecord<'a> {
             edge_px: sub.edge_px,
             max_error_px: sub.max_error_px,
             max_div: sub.max_div,
-            triangles_in: s.triangles_in,
-            triangles_out: s.triangles_out,
+            stats: s,
             triangles_drawn: s.triangles_out,
-            pieces: s.pieces,
-            rays_traced: s.rays_traced,
-            triangle_tests: s.triangle_tests,
-            max_sub_edge_px: s.max_sub_edge_px,
-            chunks: s.chunks,
-            subdivide_invocations: s.subdivide_invocations.clone(),
-            max_pieces_per_invocation: s.max_pieces_per_invocation,
-            max_output_per_invocation: s.max_output_per_invocation,
-            samples: s.samples,
-            sampling: s.sampling.clone(),
             width: p.width,
             height: p.height,
             screen_radius: p.screen_radius,
@@ -344,16 +312,8 @@ impl<'a> FrameRecord<'a> {
             layout: writer.layout,
             format: writer.encoding.format,
             adapter,
-            timing: s.timing,
             ms_pose: None,
-            ms_frame: s.ms_frame,
-            ms_gpu: s.ms_gpu,
-            ms_subdivide: s.ms_subdivide,
-            ms_subdivide_passes: s.ms_subdivide_passes.clone(),
-            ms_raster: s.ms_raster,
-            ms_readback: s.ms_readback,
             ms_write: 0.0,
-            ms_total: s.ms_total,
             files: None,
             lod,
         }
