@@ -211,40 +211,46 @@ pub fn with_spherical_metadata(
     }
     if mdat_after {
         // The media data moved: every chunk offset of every track follows it.
-        let moov_end = moov.end + grow;
-        let traks = boxes(&out, moov.start + moov.header, moov_end).ok_or_else(|| bad("a broken moov box"))?;
-        for trak in traks.iter().filter(|b| &b.kind == b"trak") {
-            let stbl = child(&out, trak, b"mdia")
-                .and_then(|m| child(&out, &m, b"minf"))
-                .and_then(|m| child(&out, &m, b"stbl"))
-                .ok_or_else(|| bad("a track without a sample table"))?;
-            for table in boxes(&out, stbl.start + stbl.header, stbl.end).ok_or_else(|| bad("a broken stbl box"))? {
-                let wide = match &table.kind {
-                    b"stco" => false,
-                    b"co64" => true,
-                    _ => continue,
-                };
-                let body = table.start + table.header + 4;
-                let count = u32::from_be_bytes(out[body..body + 4].try_into().expect("4 bytes")) as usize;
-                let step = if wide { 8 } else { 4 };
-                if body + 4 + count * step > table.end {
-                    return Err(bad("a chunk offset table longer than its box"));
-                }
-                for k in 0..count {
-                    let at = body + 4 + k * step;
-                    if wide {
-                        let v = u64::from_be_bytes(out[at..at + 8].try_into().expect("8 bytes")) + grow as u64;
-                        out[at..at + 8].copy_from_slice(&v.to_be_bytes());
-                    } else {
-                        let v = u32::from_be_bytes(out[at..at + 4].try_into().expect("4 bytes")) as u64 + grow as u64;
-                        let v = u32::try_from(v).map_err(|_| bad("a chunk offset beyond 4 GiB"))?;
-                        out[at..at + 4].copy_from_slice(&v.to_be_bytes());
-                    }
+        shift_chunk_offsets(&mut out, moov.start + moov.header, moov.end + grow, grow, &bad)?;
+    }
+    Ok(out)
+}
+
+/// Adds `grow` to every chunk offset (stco, co64) of every track in the moov box's body
+/// `[body, end)` of `out`.
+fn shift_chunk_offsets(out: &mut [u8], body: usize, end: usize, grow: usize, bad: &dyn Fn(&str) -> Error) -> Result<()> {
+    let traks = boxes(out, body, end).ok_or_else(|| bad("a broken moov box"))?;
+    for trak in traks.iter().filter(|b| &b.kind == b"trak") {
+        let stbl = child(out, trak, b"mdia")
+            .and_then(|m| child(out, &m, b"minf"))
+            .and_then(|m| child(out, &m, b"stbl"))
+            .ok_or_else(|| bad("a track without a sample table"))?;
+        for table in boxes(out, stbl.start + stbl.header, stbl.end).ok_or_else(|| bad("a broken stbl box"))? {
+            let wide = match &table.kind {
+                b"stco" => false,
+                b"co64" => true,
+                _ => continue,
+            };
+            let body = table.start + table.header + 4;
+            let count = u32::from_be_bytes(out[body..body + 4].try_into().expect("4 bytes")) as usize;
+            let step = if wide { 8 } else { 4 };
+            if body + 4 + count * step > table.end {
+                return Err(bad("a chunk offset table longer than its box"));
+            }
+            for k in 0..count {
+                let at = body + 4 + k * step;
+                if wide {
+                    let v = u64::from_be_bytes(out[at..at + 8].try_into().expect("8 bytes")) + grow as u64;
+                    out[at..at + 8].copy_from_slice(&v.to_be_bytes());
+                } else {
+                    let v = u32::from_be_bytes(out[at..at + 4].try_into().expect("4 bytes")) as u64 + grow as u64;
+                    let v = u32::try_from(v).map_err(|_| bad("a chunk offset beyond 4 GiB"))?;
+                    out[at..at + 4].copy_from_slice(&v.to_be_bytes());
                 }
             }
         }
     }
-    Ok(out)
+    Ok(())
 }
 
 /// The boxes named by a path from the top (e.g. `["moov", "trak"]`), for tests and checks: each

@@ -318,49 +318,12 @@ impl ViewArgs {
     /// The render settings these options give for a command that draws with `methods` (the
     /// viewer of `camera[:N]` is placed with the scene, by `cli::scene::prepare`).
     pub fn settings(&self, methods: &[Method]) -> Result<RenderSettings> {
-        let panorama = match (self.panorama, self.preset) {
-            (Some(p), Some(_)) if p != PanoramaKind::Equirect => {
-                return Err(Error::option("--preset", "sizes the full sphere: use it with --panorama equirect"))
-            }
-            (Some(p), _) => p,
-            (None, Some(_)) => PanoramaKind::Equirect,
-            (None, None) => PanoramaKind::Cylinder,
-        };
-        if panorama == PanoramaKind::Cylinder {
-            if self.convergence.is_some() {
-                return Err(Error::option("--convergence", "needs --panorama equirect or vr180"));
-            }
-            if self.pole_merge.is_some() {
-                return Err(Error::option("--pole-merge", "needs --panorama equirect or vr180"));
-            }
-        }
+        let panorama = self.panorama_kind()?;
         let walls = self.cave_file(panorama)?;
-        let (width, height) = match (panorama, self.preset) {
-            (PanoramaKind::Cave, _) => (walls[0].pixels[0], walls[0].pixels[1]),
-            (_, Some(preset)) => (preset.width(), preset.width() / 2),
-            (PanoramaKind::Cylinder, None) => (self.width.unwrap_or(3168), self.height.unwrap_or(600)),
-            (PanoramaKind::Equirect, None) => {
-                let width = self.width.unwrap_or(4096);
-                (width, self.height.unwrap_or(width / 2))
-            }
-            (PanoramaKind::Vr180 | PanoramaKind::Fisheye, None) => {
-                let width = self.width.unwrap_or(4096);
-                (width, self.height.unwrap_or(width))
-            }
-            // Faces of 1024: the default sphere's resolution (4096 pixels a turn) at their centres.
-            (PanoramaKind::Cubemap, None) => {
-                let width = self.width.unwrap_or(3072);
-                (width, self.height.unwrap_or(2 * width / 3))
-            }
+        let (width, height) = match (panorama, walls.first()) {
+            (PanoramaKind::Cave, Some(wall)) => (wall.pixels[0], wall.pixels[1]),
+            _ => self.size(panorama),
         };
-        if panorama != PanoramaKind::Fisheye {
-            if self.fov.is_some() {
-                return Err(Error::option("--fov", "needs --panorama fisheye"));
-            }
-            if self.dome_tilt.is_some() {
-                return Err(Error::option("--dome-tilt", "needs --panorama fisheye"));
-            }
-        }
         let projection = Projection {
             screen_radius: self.screen_radius,
             eye_radius: self.eye_radius,
@@ -374,15 +337,7 @@ impl ViewArgs {
             dome_tilt: self.dome_tilt.unwrap_or(0.0),
             wall: None,
             tile: None,
-            head: match (self.head, self.viewer) {
-                (None, _) => None,
-                (Some(_), Viewer::Camera(_)) => {
-                    return Err(Error::option("--head", "needs the display's centre as --viewer x,y,z"))
-                }
-                (Some((at, yaw)), Viewer::At(viewer)) => {
-                    Some(Head::relative(at * self.scale, yaw.unwrap_or(self.yaw), viewer * self.scale, self.yaw))
-                }
-            },
+            head: self.head()?,
         };
         let projection = match walls.first() {
             Some(wall) => {
@@ -426,6 +381,69 @@ impl ViewArgs {
             .with_anisotropy(self.anisotropy.unwrap_or(1));
         settings.validate()?;
         Ok(settings)
+    }
+
+    /// `--panorama` (equirect under `--preset`), and the options that need another panorama
+    /// refused.
+    fn panorama_kind(&self) -> Result<PanoramaKind> {
+        let panorama = match (self.panorama, self.preset) {
+            (Some(p), Some(_)) if p != PanoramaKind::Equirect => {
+                return Err(Error::option("--preset", "sizes the full sphere: use it with --panorama equirect"))
+            }
+            (Some(p), _) => p,
+            (None, Some(_)) => PanoramaKind::Equirect,
+            (None, None) => PanoramaKind::Cylinder,
+        };
+        if panorama == PanoramaKind::Cylinder {
+            if self.convergence.is_some() {
+                return Err(Error::option("--convergence", "needs --panorama equirect or vr180"));
+            }
+            if self.pole_merge.is_some() {
+                return Err(Error::option("--pole-merge", "needs --panorama equirect or vr180"));
+            }
+        }
+        if panorama != PanoramaKind::Fisheye {
+            if self.fov.is_some() {
+                return Err(Error::option("--fov", "needs --panorama fisheye"));
+            }
+            if self.dome_tilt.is_some() {
+                return Err(Error::option("--dome-tilt", "needs --panorama fisheye"));
+            }
+        }
+        Ok(panorama)
+    }
+
+    /// The image's size per eye: `--preset`, else `--width`/`--height` with each panorama's
+    /// defaults (a CAVE's walls give their own).
+    fn size(&self, panorama: PanoramaKind) -> (u32, u32) {
+        match (panorama, self.preset) {
+            (_, Some(preset)) => (preset.width(), preset.width() / 2),
+            (PanoramaKind::Cylinder, None) => (self.width.unwrap_or(3168), self.height.unwrap_or(600)),
+            (PanoramaKind::Equirect, None) => {
+                let width = self.width.unwrap_or(4096);
+                (width, self.height.unwrap_or(width / 2))
+            }
+            (PanoramaKind::Vr180 | PanoramaKind::Fisheye, None) => {
+                let width = self.width.unwrap_or(4096);
+                (width, self.height.unwrap_or(width))
+            }
+            // Faces of 1024: the default sphere's resolution (4096 pixels a turn) at their centres.
+            (PanoramaKind::Cubemap | PanoramaKind::Cave, None) => {
+                let width = self.width.unwrap_or(3072);
+                (width, self.height.unwrap_or(2 * width / 3))
+            }
+        }
+    }
+
+    /// `--head`: the tracked head relative to the display's centre (`--viewer x,y,z`).
+    fn head(&self) -> Result<Option<Head>> {
+        match (self.head, self.viewer) {
+            (None, _) => Ok(None),
+            (Some(_), Viewer::Camera(_)) => Err(Error::option("--head", "needs the display's centre as --viewer x,y,z")),
+            (Some((at, yaw)), Viewer::At(viewer)) => {
+                Ok(Some(Head::relative(at * self.scale, yaw.unwrap_or(self.yaw), viewer * self.scale, self.yaw)))
+            }
+        }
     }
 
     /// `--viewer` in metres (a camera's place: the origin until the scene is prepared, by

@@ -461,6 +461,21 @@ impl RenderSettings {
 
     pub fn validate(&self) -> Result<()> {
         self.view.projection.validate()?;
+        self.validate_view()?;
+        self.validate_subdivision()?;
+        self.validate_method()?;
+        self.validate_shading()?;
+        if self.subdivision.memory_mb < 8 {
+            return Err(Error::setting(
+                "subdivision.memory_mb",
+                format!("must be at least 8, got {}", self.subdivision.memory_mb),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The viewer's place and turn: [`Self::validate`]'s first part.
+    fn validate_view(&self) -> Result<()> {
         let max = crate::core::scene::MAX_COORDINATE;
         if !self.view.viewer.is_finite() || self.view.viewer.abs().max_element() > max {
             return Err(Error::setting("view.viewer", format!("must lie within ±{max:e}, got {}", self.view.viewer)));
@@ -468,6 +483,11 @@ impl RenderSettings {
         if !self.view.yaw_deg.is_finite() {
             return Err(Error::setting("view.yaw_deg", "must be a finite number of degrees"));
         }
+        Ok(())
+    }
+
+    /// The subdivision's numbers (L, τ, N_max): part of [`Self::validate`].
+    fn validate_subdivision(&self) -> Result<()> {
         let s = &self.subdivision;
         if !(s.edge_px.is_finite() && s.edge_px >= 0.25) {
             return Err(Error::setting(
@@ -484,6 +504,13 @@ impl RenderSettings {
         if !(1..=64).contains(&s.max_div) {
             return Err(Error::setting("subdivision.max_div", format!("must be between 1 and 64, got {}", s.max_div)));
         }
+        Ok(())
+    }
+
+    /// The method against the panorama, the vertical model and the outputs: part of
+    /// [`Self::validate`].
+    fn validate_method(&self) -> Result<()> {
+        let s = &self.subdivision;
         if let Method::Slit(w) = s.method {
             if self.view.projection.panorama == PanoramaKind::Cave {
                 return Err(Error::setting(
@@ -527,7 +554,30 @@ impl RenderSettings {
                 ),
             ));
         }
-        let projection = &self.view.projection;
+        self.validate_tilted_dome()?;
+        if s.method == Method::Trace
+            && self.view.projection.panorama == PanoramaKind::Cylinder
+            && self.view.projection.vertical == Vertical::Paper
+        {
+            return Err(Error::setting(
+                "view.projection.vertical",
+                "trace follows each pixel's ray, and the paper's vertical model (v = R_T·y/r) has none \
+                 (the points it shows at a pixel lie on a curve): use the exact model",
+            ));
+        }
+        if self.shading.hdr && matches!(s.method, Method::Slit(_) | Method::Trace) {
+            return Err(Error::setting(
+                "shading.hdr",
+                "the linear colour comes from the projection methods (vertex, fixed, adaptive); slit and trace write display colours",
+            ));
+        }
+        Ok(())
+    }
+
+    /// A tilted fisheye's chords against the room its dropped cone leaves: part of
+    /// [`Self::validate`].
+    fn validate_tilted_dome(&self) -> Result<()> {
+        let (s, projection) = (&self.subdivision, &self.view.projection);
         if let Method::Adaptive(split) = s.method {
             let error_split = split == Split::Error;
             let dip = projection.chord_dip_px(error_split, s.edge_px, s.max_error_px);
@@ -550,26 +600,6 @@ impl RenderSettings {
                     ),
                 ));
             }
-        }
-        if s.method == Method::Trace
-            && self.view.projection.panorama == PanoramaKind::Cylinder
-            && self.view.projection.vertical == Vertical::Paper
-        {
-            return Err(Error::setting(
-                "view.projection.vertical",
-                "trace follows each pixel's ray, and the paper's vertical model (v = R_T·y/r) has none \
-                 (the points it shows at a pixel lie on a curve): use the exact model",
-            ));
-        }
-        if self.shading.hdr && matches!(s.method, Method::Slit(_) | Method::Trace) {
-            return Err(Error::setting(
-                "shading.hdr",
-                "the linear colour comes from the projection methods (vertex, fixed, adaptive); slit and trace write display colours",
-            ));
-        }
-        self.validate_shading()?;
-        if s.memory_mb < 8 {
-            return Err(Error::setting("subdivision.memory_mb", format!("must be at least 8, got {}", s.memory_mb)));
         }
         Ok(())
     }

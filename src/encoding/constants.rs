@@ -145,8 +145,16 @@ pub enum Value {
 
 /// Every shared constant: (WGSL name, value).
 pub fn all() -> Vec<(&'static str, Value)> {
+    let mut out = numbers();
+    out.extend(codes());
+    out.extend(SplitRule::ALL.map(|m| (m.wgsl_name(), Value::U32(m as u32))));
+    out
+}
+
+/// The shared numbers: the subdivision's, the tracer's, the visual field's, the raster's.
+fn numbers() -> Vec<(&'static str, Value)> {
     use Value::{F32, U32};
-    let mut out = vec![
+    vec![
         ("MAX_EDGE_DIVISIONS", U32(MAX_EDGE_DIVISIONS)),
         ("EDGE_SAMPLES", U32(EDGE_SAMPLES)),
         ("PIECE_DIVISIONS", U32(PIECE_DIVISIONS)),
@@ -194,6 +202,15 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("FINE_BINS", U32(FINE_BINS)),
         ("COARSE_BINS", U32(COARSE_BINS)),
         ("BINS", U32(BINS)),
+        ("NORMAL_OFFSET_TEXELS", F32(crate::core::shadow::NORMAL_OFFSET_TEXELS)),
+        ("LIGHT_OFFSET_TEXELS", F32(crate::core::shadow::LIGHT_OFFSET_TEXELS)),
+    ]
+}
+
+/// The codes the settings and the scene's enums are passed as, and the tables' sizes.
+fn codes() -> Vec<(&'static str, Value)> {
+    use Value::U32;
+    vec![
         ("PANORAMA_CYLINDER", U32(PanoramaKind::Cylinder.code())),
         ("PANORAMA_EQUIRECT", U32(PanoramaKind::Equirect.code())),
         ("PANORAMA_VR180", U32(PanoramaKind::Vr180.code())),
@@ -223,15 +240,11 @@ pub fn all() -> Vec<(&'static str, Value)> {
         ("SHADOW_CUBE", U32(crate::core::shadow::SHADOW_CUBE)),
         ("NO_SKIN", U32(crate::encoding::types::NO_SKIN)),
         ("NO_SHADOW_MAP", U32(crate::core::light::NO_SHADOW_MAP)),
-        ("NORMAL_OFFSET_TEXELS", F32(crate::core::shadow::NORMAL_OFFSET_TEXELS)),
-        ("LIGHT_OFFSET_TEXELS", F32(crate::core::shadow::LIGHT_OFFSET_TEXELS)),
         ("TONEMAP_NONE", U32(Tonemap::None.code())),
         ("TONEMAP_PBR_NEUTRAL", U32(Tonemap::PbrNeutral.code())),
         ("TONEMAP_ACES", U32(Tonemap::Aces.code())),
         ("TONEMAP_LINEAR", U32(Tonemap::Linear.code())),
-    ];
-    out.extend(SplitRule::ALL.map(|m| (m.wgsl_name(), U32(m as u32))));
-    out
+    ]
 }
 
 /// The generated WGSL module `constants`.
