@@ -218,7 +218,13 @@ pub fn with_spherical_metadata(
 
 /// Adds `grow` to every chunk offset (stco, co64) of every track in the moov box's body
 /// `[body, end)` of `out`.
-fn shift_chunk_offsets(out: &mut [u8], body: usize, end: usize, grow: usize, bad: &dyn Fn(&str) -> Error) -> Result<()> {
+fn shift_chunk_offsets(
+    out: &mut [u8],
+    body: usize,
+    end: usize,
+    grow: usize,
+    bad: &dyn Fn(&str) -> Error,
+) -> Result<()> {
     let traks = boxes(out, body, end).ok_or_else(|| bad("a broken moov box"))?;
     for trak in traks.iter().filter(|b| &b.kind == b"trak") {
         let stbl = child(out, trak, b"mdia")

@@ -135,7 +135,11 @@ fn trace_refuses_the_paper_model_and_a_scene_without_its_bvh() {
     let gs = gs.with_bvh(&r.gpu, &scene).unwrap();
     let frame = r.render(&gs, &sphere).expect("the sphere traced in the paper's model too");
     let pixels = (frame.left.width * frame.left.height) as u64;
-    assert!(frame.stats.rays_traced.is_some_and(|n| n >= 2 * pixels), "{:?} rays for {pixels} px", frame.stats.rays_traced);
+    assert!(
+        frame.stats.rays_traced.is_some_and(|n| n >= 2 * pixels),
+        "{:?} rays for {pixels} px",
+        frame.stats.rays_traced
+    );
     let bg = sphere.shading.background.map(|c| (c * 255.0).round() as u8);
     let drawn = frame.left.rgba.chunks(4).filter(|p| p[..3] != bg).count();
     assert!(drawn > pixels as usize / 4, "the demo room drawn in {drawn} of {pixels} pixels");

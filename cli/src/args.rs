@@ -439,7 +439,9 @@ impl ViewArgs {
     fn head(&self) -> Result<Option<Head>> {
         match (self.head, self.viewer) {
             (None, _) => Ok(None),
-            (Some(_), Viewer::Camera(_)) => Err(Error::option("--head", "needs the display's centre as --viewer x,y,z")),
+            (Some(_), Viewer::Camera(_)) => {
+                Err(Error::option("--head", "needs the display's centre as --viewer x,y,z"))
+            }
             (Some((at, yaw)), Viewer::At(viewer)) => {
                 Ok(Some(Head::relative(at * self.scale, yaw.unwrap_or(self.yaw), viewer * self.scale, self.yaw)))
             }

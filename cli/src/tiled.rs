@@ -197,14 +197,7 @@ pub fn render_streamed(
                 let frame = stats_frame(stats);
                 let record = FrameRecord {
                     tiles: Some(tiles.count()),
-                    ..FrameRecord::new(
-                        &args.scene,
-                        settings,
-                        &frame,
-                        writer,
-                        adapter,
-                        lod_stats(&prepared.selection),
-                    )
+                    ..FrameRecord::new(&args.scene, settings, &frame, writer, adapter, lod_stats(&prepared.selection))
                 };
                 serde_json::to_value(&record).expect("JSON of plain values")
             })

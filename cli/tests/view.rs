@@ -329,7 +329,8 @@ fn displayed(
     let size = [img.width(), img.height() / layers];
     let view =
         DisplayView { mode, look, image: size, layers, row_texels: size[0], target, overlay: None, srgb_target: false };
-    let words = display(&twister::encoding::params::display_params(&view, &projection), &projection, &texels, &[], target);
+    let words =
+        display(&twister::encoding::params::display_params(&view, &projection), &projection, &texels, &[], target);
     image::RgbImage::from_fn(target[0], target[1], |x, y| {
         let w = words[(y * target[0] + x) as usize];
         image::Rgb([w as u8, (w >> 8) as u8, (w >> 16) as u8])

@@ -30,8 +30,8 @@
 use glam::{Mat4, Quat, Vec3};
 
 use crate::core::scene::object_spheres;
-use crate::core::simplify::{simplify_chain, Welding};
 use crate::core::scene::{Object, Scene};
+use crate::core::simplify::{simplify_chain, Welding};
 use crate::core::visual_field::{Field, Gaze};
 
 pub use crate::core::simplify::LEVEL_RATIO;

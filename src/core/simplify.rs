@@ -74,8 +74,7 @@ pub fn simplify_chain(
     floor: usize,
 ) -> (Vec<Vec<u32>>, Vec<f32>) {
     let bytes: &[u8] = bytemuck::cast_slice(vertices);
-    let adapter =
-        meshopt::VertexDataAdapter::new(bytes, std::mem::size_of::<SceneVertex>(), 0).expect("vertex layout");
+    let adapter = meshopt::VertexDataAdapter::new(bytes, std::mem::size_of::<SceneVertex>(), 0).expect("vertex layout");
     let mut welded = welding.weld(original);
     let closed = is_closed(&welded);
     let corners = Corners::of(original, welding);
@@ -147,7 +146,8 @@ fn unweld(welded: &[u32], corners: &Corners, vertices: &[SceneVertex]) -> Vec<u3
                     return candidates[0];
                 }
                 let score = |v: u32| {
-                    let reach = corners.neighbours.get(&v).map_or(0, |n| n.iter().filter(|r| others.contains(r)).count());
+                    let reach =
+                        corners.neighbours.get(&v).map_or(0, |n| n.iter().filter(|r| others.contains(r)).count());
                     (reach, glam::Vec3::from(vertices[v as usize].normal).dot(normal))
                 };
                 // The best score; on equal scores the first candidate.
@@ -199,7 +199,12 @@ mod tests {
         assert!(!is_closed(&indices), "the sphere's seam splits its vertices");
         let chain = chain_of(&vertices, &indices, indices.len() / 3 / 20);
         assert!(chain.len() >= 6, "{} levels", chain.len());
-        assert!(chain.last().unwrap().len() * 5 < indices.len(), "{} of {}", chain.last().unwrap().len(), indices.len());
+        assert!(
+            chain.last().unwrap().len() * 5 < indices.len(),
+            "{} of {}",
+            chain.last().unwrap().len(),
+            indices.len()
+        );
         for level in &chain {
             assert!(is_closed(&welding.weld(level)));
             // No triangle spans the seam's two UV sides (u near 0 and near 1 in one triangle).

@@ -1,10 +1,10 @@
 //! Uniform builders: the parameters of the raster and trace stages, built from the settings
 //! (the subdivide and slit stages' are in [`super::subdivide`] and [`super::slits`]).
 
-use crate::core::projection::Eye;
-use crate::core::settings::{RenderSettings, SplitRule};
 use crate::core::display::{look_far, DisplayView};
+use crate::core::projection::Eye;
 use crate::core::projection::Projection;
+use crate::core::settings::{RenderSettings, SplitRule};
 use crate::encoding::types::{DisplayParams, RasterParams, TraceParams};
 
 /// The raster stage's parameters: the left eye's, then the right's (its `array<RasterParams, 2>`).

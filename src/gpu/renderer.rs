@@ -297,7 +297,8 @@ impl Renderer {
             .with_hdr(false);
         self.check_size(&larger)?;
         let centre_outputs = settings.measure.outputs() > 1 || settings.shading.hdr;
-        let centre = if centre_outputs { Some(self.render_direct(scene, &settings.with_samples(1), false)?.0) } else { None };
+        let centre =
+            if centre_outputs { Some(self.render_direct(scene, &settings.with_samples(1), false)?.0) } else { None };
         let drawn = self.render_direct(scene, &larger, false)?.0;
         let (left, right) = (drawn.left.box_filtered(kx, ky), drawn.right.box_filtered(kx, ky));
         let mut frame = match centre {
@@ -315,7 +316,12 @@ impl Renderer {
 
     /// A frame at the sample count the adapter draws; shown (`show`): its colour kept on the
     /// GPU for the live window instead of read back.
-    fn render_direct(&self, scene: &GpuScene, settings: &RenderSettings, show: bool) -> Result<(Frame, Option<ShownFrame>)> {
+    fn render_direct(
+        &self,
+        scene: &GpuScene,
+        settings: &RenderSettings,
+        show: bool,
+    ) -> Result<(Frame, Option<ShownFrame>)> {
         let mut resources = self.resources.lock().unwrap_or_else(|e| e.into_inner());
         let shadow_maps = scene.write_lighting(&self.gpu, settings);
         self.gpu.scoped("rendering a frame", || {

@@ -107,7 +107,13 @@ impl Twin for Display {
     }
     fn cpu(c: &Case) -> Vec<u32> {
         let overlay = c.overlay.clone().unwrap_or_default();
-        display(&twister::encoding::params::display_params(&c.view, &c.projection), &c.projection, &c.texels, &overlay, c.view.target)
+        display(
+            &twister::encoding::params::display_params(&c.view, &c.projection),
+            &c.projection,
+            &c.texels,
+            &overlay,
+            c.view.target,
+        )
     }
     fn compare(gpu: &Vec<u32>, cpu: &Vec<u32>) -> Result<(), String> {
         if gpu.len() != cpu.len() {

@@ -66,6 +66,15 @@ fn subdivide_cases() -> Vec<(Scene, RenderSettings)> {
                 .with_max_div(3),
         ),
         (cube, tall_exact.with_viewer(Vec3::new(0.1, -0.8, 0.2)).with_edge_px(12.0)),
+    ]
+    .into_iter()
+    .chain(sphere_cases(&projection))
+    .collect()
+}
+
+/// The full sphere's, VR180's, the cubemap's, a tracked head's and the fisheye's cases.
+fn sphere_cases(projection: &Projection) -> Vec<(Scene, RenderSettings)> {
+    vec![
         // The full sphere: the poles (pole merge on and off), converging rays, the seam (τ small
         // enough at these sizes that the demo room is split, its nodes drawn off their projections).
         (builtin::demo(), RenderSettings::new(Projection::equirect(256)).with_max_error_px(0.25)),

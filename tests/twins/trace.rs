@@ -77,6 +77,147 @@ fn mirror_in_studio() -> Scene {
     scene
 }
 
+/// The tracer's cases on every panorama and view (the demo room).
+fn trace_panorama_cases(cylinder: Projection, sphere: Projection) -> Vec<(String, (Scene, RenderSettings))> {
+    let moved = RenderSettings::new(cylinder)
+        .with_method(Method::Trace)
+        .with_viewer(Vec3::new(0.3, 0.2, -0.4))
+        .with_yaw_deg(35.0);
+    vec![
+        ("demo".into(), (builtin::demo(), RenderSettings::new(cylinder).with_method(Method::Trace))),
+        ("demo, viewer moved and turned".into(), (builtin::demo(), moved)),
+        (
+            "demo on the sphere, converging".into(),
+            (builtin::demo(), RenderSettings::new(sphere).with_method(Method::Trace)),
+        ),
+        (
+            "demo seen by a tracked head".into(),
+            (
+                builtin::demo(),
+                RenderSettings::new(Projection {
+                    head: Some(twister::core::head::Head { offset: [0.3, 0.1, -0.2], turn: 0.35 }),
+                    ..cylinder
+                })
+                .with_method(Method::Trace),
+            ),
+        ),
+        (
+            "demo on a 200° fisheye".into(),
+            (
+                builtin::demo(),
+                RenderSettings::new(Projection { fov: 200.0, ..Projection::fisheye(96) }).with_method(Method::Trace),
+            ),
+        ),
+        (
+            "demo on VR180".into(),
+            (builtin::demo(), RenderSettings::new(Projection::vr180(96)).with_method(Method::Trace)),
+        ),
+        (
+            "demo on a CAVE's floor".into(),
+            (
+                builtin::demo(),
+                RenderSettings::new(common::cave(2, 64, glam::Vec3::new(0.2, 0.1, 0.3), 25.0))
+                    .with_method(Method::Trace),
+            ),
+        ),
+        (
+            "demo on the cubemap".into(),
+            (builtin::demo(), RenderSettings::new(Projection::cubemap(96)).with_method(Method::Trace)),
+        ),
+    ]
+}
+
+/// The tracer's cases of optics, lights, materials, textures and samples.
+fn trace_shading_cases(cylinder: Projection) -> Vec<(String, (Scene, RenderSettings))> {
+    vec![
+        (
+            "demo with a mirror and a glass object".into(),
+            (optics_demo(), RenderSettings::new(cylinder).with_method(Method::Trace)),
+        ),
+        (
+            "demo with a mirror, a glass and a point light".into(),
+            (
+                optics_demo(),
+                RenderSettings::new(cylinder).with_method(Method::Trace).with_light(Some(Vec3::new(0.4, 1.2, -0.8))),
+            ),
+        ),
+        (
+            "demo with a mirror and a glass object, visual-field level of detail".into(),
+            (
+                optics_demo(),
+                RenderSettings::new(cylinder)
+                    .with_method(Method::Trace)
+                    .with_trace_gaze(Some(twister::core::visual_field::Gaze::new(30.0, 5.0))),
+            ),
+        ),
+        (
+            "two dense spheres among the demo's objects, per-ray polygon level (eq. 10)".into(),
+            (
+                lod_spheres(),
+                RenderSettings::new(cylinder)
+                    .with_method(Method::Trace)
+                    .with_light(Some(Vec3::new(0.0, 1.5, 0.0)))
+                    .with_trace_gaze(Some(twister::core::visual_field::Gaze::new(-20.0, 0.0)))
+                    .with_trace_min_share(0.1),
+            ),
+        ),
+        (
+            "a checker floor and a mirror sphere: textures filtered by ray cones, reflected too".into(),
+            (mirror_over_checker(), RenderSettings::new(cylinder).with_method(Method::Trace)),
+        ),
+        (
+            "lit spheres: the glTF BRDF under point, spot and directional lights".into(),
+            (common::lit_spheres(), RenderSettings::new(cylinder).with_method(Method::Trace).with_exposure_ev(0.5)),
+        ),
+        (
+            "a mirror sphere and lit spheres in the studio, shown as the background and in the mirror".into(),
+            (mirror_in_studio(), RenderSettings::new(cylinder).with_method(Method::Trace)),
+        ),
+    ]
+}
+
+/// The tracer's cases of glTF maps, rooms, samples and anisotropy.
+fn trace_material_cases(cylinder: Projection, sphere: Projection) -> Vec<(String, (Scene, RenderSettings))> {
+    vec![
+        (
+            "every glTF map on quads, u mirrored on one, the tangent frame from the triangle".into(),
+            (common::mapped_panels(), RenderSettings::new(cylinder).with_method(Method::Trace)),
+        ),
+        (
+            "every glTF map, the file's tangents".into(),
+            (common::with_tangents(common::mapped_panels()), RenderSettings::new(cylinder).with_method(Method::Trace)),
+        ),
+        (
+            "box room".into(),
+            (
+                builtin::builtin_scene("builtin:box-room", &cylinder).unwrap(),
+                RenderSettings::new(cylinder).with_method(Method::Trace),
+            ),
+        ),
+        (
+            "4 rays per pixel: a mirror and a glass, visual-field level of detail".into(),
+            (
+                optics_demo(),
+                RenderSettings::new(cylinder)
+                    .with_method(Method::Trace)
+                    .with_samples(4)
+                    .with_trace_gaze(Some(twister::core::visual_field::Gaze::new(30.0, 5.0))),
+            ),
+        ),
+        (
+            "a striped floor, anisotropy 16 (the ray cone's ellipse)".into(),
+            (
+                common::striped_floor(),
+                RenderSettings::new(sphere).with_method(Method::Trace).with_ambient(1.0).with_anisotropy(16),
+            ),
+        ),
+        (
+            "8 rays per pixel: the studio as background and in a mirror, on the sphere".into(),
+            (mirror_in_studio(), RenderSettings::new(sphere).with_method(Method::Trace).with_samples(8)),
+        ),
+    ]
+}
+
 impl Twin for Trace {
     type Case = (Scene, RenderSettings);
     /// The images, and the rays traced and triangle tests made.
@@ -84,137 +225,10 @@ impl Twin for Trace {
     fn cases() -> Vec<(String, Self::Case)> {
         let cylinder = Projection { width: 192, height: 48, vertical: Vertical::Exact, ..Projection::default() };
         let sphere = Projection { convergence: Some(2.0), ..Projection::equirect(128) };
-        let moved = RenderSettings::new(cylinder)
-            .with_method(Method::Trace)
-            .with_viewer(Vec3::new(0.3, 0.2, -0.4))
-            .with_yaw_deg(35.0);
-        vec![
-            ("demo".into(), (builtin::demo(), RenderSettings::new(cylinder).with_method(Method::Trace))),
-            ("demo, viewer moved and turned".into(), (builtin::demo(), moved)),
-            (
-                "demo on the sphere, converging".into(),
-                (builtin::demo(), RenderSettings::new(sphere).with_method(Method::Trace)),
-            ),
-            (
-                "demo seen by a tracked head".into(),
-                (
-                    builtin::demo(),
-                    RenderSettings::new(Projection {
-                        head: Some(twister::core::head::Head { offset: [0.3, 0.1, -0.2], turn: 0.35 }),
-                        ..cylinder
-                    })
-                    .with_method(Method::Trace),
-                ),
-            ),
-            (
-                "demo on a 200° fisheye".into(),
-                (
-                    builtin::demo(),
-                    RenderSettings::new(Projection { fov: 200.0, ..Projection::fisheye(96) })
-                        .with_method(Method::Trace),
-                ),
-            ),
-            (
-                "demo on VR180".into(),
-                (builtin::demo(), RenderSettings::new(Projection::vr180(96)).with_method(Method::Trace)),
-            ),
-            (
-                "demo on a CAVE's floor".into(),
-                (
-                    builtin::demo(),
-                    RenderSettings::new(common::cave(2, 64, glam::Vec3::new(0.2, 0.1, 0.3), 25.0))
-                        .with_method(Method::Trace),
-                ),
-            ),
-            (
-                "demo on the cubemap".into(),
-                (builtin::demo(), RenderSettings::new(Projection::cubemap(96)).with_method(Method::Trace)),
-            ),
-            (
-                "demo with a mirror and a glass object".into(),
-                (optics_demo(), RenderSettings::new(cylinder).with_method(Method::Trace)),
-            ),
-            (
-                "demo with a mirror, a glass and a point light".into(),
-                (
-                    optics_demo(),
-                    RenderSettings::new(cylinder)
-                        .with_method(Method::Trace)
-                        .with_light(Some(Vec3::new(0.4, 1.2, -0.8))),
-                ),
-            ),
-            (
-                "demo with a mirror and a glass object, visual-field level of detail".into(),
-                (
-                    optics_demo(),
-                    RenderSettings::new(cylinder)
-                        .with_method(Method::Trace)
-                        .with_trace_gaze(Some(twister::core::visual_field::Gaze::new(30.0, 5.0))),
-                ),
-            ),
-            (
-                "two dense spheres among the demo's objects, per-ray polygon level (eq. 10)".into(),
-                (
-                    lod_spheres(),
-                    RenderSettings::new(cylinder)
-                        .with_method(Method::Trace)
-                        .with_light(Some(Vec3::new(0.0, 1.5, 0.0)))
-                        .with_trace_gaze(Some(twister::core::visual_field::Gaze::new(-20.0, 0.0)))
-                        .with_trace_min_share(0.1),
-                ),
-            ),
-            (
-                "a checker floor and a mirror sphere: textures filtered by ray cones, reflected too".into(),
-                (mirror_over_checker(), RenderSettings::new(cylinder).with_method(Method::Trace)),
-            ),
-            (
-                "lit spheres: the glTF BRDF under point, spot and directional lights".into(),
-                (common::lit_spheres(), RenderSettings::new(cylinder).with_method(Method::Trace).with_exposure_ev(0.5)),
-            ),
-            (
-                "a mirror sphere and lit spheres in the studio, shown as the background and in the mirror".into(),
-                (mirror_in_studio(), RenderSettings::new(cylinder).with_method(Method::Trace)),
-            ),
-            (
-                "every glTF map on quads, u mirrored on one, the tangent frame from the triangle".into(),
-                (common::mapped_panels(), RenderSettings::new(cylinder).with_method(Method::Trace)),
-            ),
-            (
-                "every glTF map, the file's tangents".into(),
-                (
-                    common::with_tangents(common::mapped_panels()),
-                    RenderSettings::new(cylinder).with_method(Method::Trace),
-                ),
-            ),
-            (
-                "box room".into(),
-                (
-                    builtin::builtin_scene("builtin:box-room", &cylinder).unwrap(),
-                    RenderSettings::new(cylinder).with_method(Method::Trace),
-                ),
-            ),
-            (
-                "4 rays per pixel: a mirror and a glass, visual-field level of detail".into(),
-                (
-                    optics_demo(),
-                    RenderSettings::new(cylinder)
-                        .with_method(Method::Trace)
-                        .with_samples(4)
-                        .with_trace_gaze(Some(twister::core::visual_field::Gaze::new(30.0, 5.0))),
-                ),
-            ),
-            (
-                "a striped floor, anisotropy 16 (the ray cone's ellipse)".into(),
-                (
-                    common::striped_floor(),
-                    RenderSettings::new(sphere).with_method(Method::Trace).with_ambient(1.0).with_anisotropy(16),
-                ),
-            ),
-            (
-                "8 rays per pixel: the studio as background and in a mirror, on the sphere".into(),
-                (mirror_in_studio(), RenderSettings::new(sphere).with_method(Method::Trace).with_samples(8)),
-            ),
-        ]
+        let mut cases = trace_panorama_cases(cylinder, sphere);
+        cases.extend(trace_shading_cases(cylinder));
+        cases.extend(trace_material_cases(cylinder, sphere));
+        cases
     }
     fn gpu(r: &Renderer, (scene, settings): &Self::Case) -> Self::Output {
         let gs = GpuScene::upload(&r.gpu, scene)
