@@ -1,7 +1,7 @@
 //! The generic twin test: every stage of the registry (`twister::shader::STAGES`) runs on the
-//! GPU and through its CPU twin on the same cases, and the outputs must agree. A stage is added
-//! by implementing [`Twin`] for it and naming it in `twin_of`; a registered stage without one
-//! fails `every_registered_stage_matches_its_cpu_twin`.
+//! GPU and through its CPU twin on the same cases, and the outputs must agree, one test per
+//! stage. A stage is added by implementing [`Twin`] for it and naming it in `twin_of` and
+//! `twin_tests!`; a registered stage without them fails `every_registered_stage_has_a_twin_test`.
 
 mod common;
 #[path = "twins/display.rs"]
@@ -88,23 +88,51 @@ fn twin_of(stage: &str) -> Option<TwinCheck> {
     })
 }
 
-/// Every stage is checked, and every case that differs is reported (not only the first).
-#[test]
-fn every_registered_stage_matches_its_cpu_twin() {
-    let mut differ = Vec::new();
-    // TWISTER_TWINS=slit,trace checks only those stages (while working on them); all by default.
-    let only = std::env::var("TWISTER_TWINS").ok();
-    let chosen = |name: &str| only.as_deref().is_none_or(|o| o.split(',').any(|s| s == name));
-    for stage in STAGES.iter().filter(|s| chosen(s.name)) {
-        let run = twin_of(stage.name).unwrap_or_else(|| {
-            panic!("stage {} has no twin check: implement Twin for it in tests/twins.rs", stage.name)
-        });
-        match run(stage.name) {
-            Ok(n) => eprintln!("{}: {n} cases agree", stage.name),
-            Err(cases) => differ.extend(cases),
-        }
+/// A stage's twin check as a test: every case that differs is reported (not only the first).
+fn assert_twin(stage: &str) {
+    let run = twin_of(stage).unwrap_or_else(|| panic!("no twin check for stage {stage}"));
+    match run(stage) {
+        Ok(n) => eprintln!("{stage}: {n} cases agree"),
+        Err(differ) => panic!("{} cases differ:\n{}", differ.len(), differ.join("\n")),
     }
-    assert!(differ.is_empty(), "{} cases differ:\n{}", differ.len(), differ.join("\n"));
+}
+
+/// One test per stage (`cargo test --test twins subdivide` runs one).
+macro_rules! twin_tests {
+    ($($test:ident => $stage:literal),* $(,)?) => {
+        $(
+            #[test]
+            fn $test() {
+                assert_twin($stage);
+            }
+        )*
+        /// The stages the tests above check.
+        const TESTED: &[&str] = &[$($stage),*];
+    };
+}
+
+twin_tests! {
+    project_points_matches_its_cpu_twin => "project_points",
+    subdivide_matches_its_cpu_twin => "subdivide",
+    raster_matches_its_cpu_twin => "raster",
+    slit_matches_its_cpu_twin => "slit",
+    trace_matches_its_cpu_twin => "trace",
+    shadow_matches_its_cpu_twin => "shadow",
+    skin_matches_its_cpu_twin => "skin",
+    reduce_error_matches_its_cpu_twin => "reduce_error",
+    display_matches_its_cpu_twin => "display",
+}
+
+/// Every registered stage has a twin check and a test of its own.
+#[test]
+fn every_registered_stage_has_a_twin_test() {
+    for stage in STAGES {
+        assert!(
+            twin_of(stage.name).is_some() && TESTED.contains(&stage.name),
+            "stage {} has no twin test: implement Twin for it in tests/twins.rs and add it to twin_tests!",
+            stage.name
+        );
+    }
 }
 
 // ---- project_points ----
@@ -227,10 +255,22 @@ fn frame_outputs(frame: &Frame) -> EyeOutputs {
     [0, 1].map(|k| (frame.eye(Eye::BOTH[k]).rgba.clone(), m.error[k].clone(), m.object[k].clone(), depth[k].clone()))
 }
 
+/// How far a pixel's display-position error may differ between the GPU and the twin: 0.02 px
+/// (a hardware GPU's interpolation differs from the twin's by ~0.002 px), in the error's unit:
+/// with `error_angle`, the arcminutes 0.02 px spans on the equator.
+fn error_tolerance(settings: &RenderSettings) -> f32 {
+    let p = settings.projection();
+    if settings.measure.error_angle {
+        0.02 * 360.0 * 60.0 / p.width as f32
+    } else {
+        0.02
+    }
+}
+
 /// Only pixels on triangle edges may differ (tie-breaking and rounding at coverage edges): at
-/// most `1/share` of the pixels in colour or object; the error where both drew a surface.
-fn compare_eyes(gpu: &EyeOutputs, cpu: &EyeOutputs, share: usize, error_tolerance: Option<f32>) -> Result<(), String> {
-    let error_tolerance = error_tolerance.unwrap_or(f32::INFINITY);
+/// most `1/share` of the pixels in colour, object, distance or error (beyond `error_tolerance`
+/// where both drew a surface).
+fn compare_eyes(gpu: &EyeOutputs, cpu: &EyeOutputs, share: usize, error_tolerance: f32) -> Result<(), String> {
     for (k, ((gc, ge, go, gd), (cc, ce, co, cd))) in gpu.iter().zip(cpu).enumerate() {
         let total = go.len();
         let distance = gd
@@ -263,10 +303,9 @@ fn compare_eyes(gpu: &EyeOutputs, cpu: &EyeOutputs, share: usize, error_toleranc
     Ok(())
 }
 
-/// A raster case: the scene, its settings, and the tolerance of the per-pixel error (None: not
-/// compared — on the demo room, pixels where overlapping near-axis triangles tie in depth may
-/// show another sub-triangle of the same surface, whose interpolated error differs).
-type RasterCase = (Scene, RenderSettings, Option<f32>);
+/// A raster case: the scene and its settings (every target compared: colour, error, object,
+/// distance).
+type RasterCase = (Scene, RenderSettings);
 
 /// The material table as group 1 holds it for a frame: with the scene's lights, lighting and
 /// shadow maps (drawn by the shadow stage's twin).
@@ -284,24 +323,24 @@ fn raster_geometry_cases() -> Vec<(String, RasterCase)> {
     let mut out = Vec::new();
     for vertical in [Vertical::Paper, Vertical::Exact] {
         let projection = Projection { width: 400, height: 100, vertical, ..Projection::default() };
-        out.push((format!("demo {vertical:?}"), (builtin::demo(), RenderSettings::new(projection), None)));
+        out.push((format!("demo {vertical:?}"), (builtin::demo(), RenderSettings::new(projection))));
         let triangle = builtin::builtin_scene("builtin:triangle@3", &projection).unwrap();
         for method in [Method::Vertex, Method::Adaptive(Split::Length), Method::Adaptive(Split::Error)] {
             let settings = RenderSettings::new(projection).with_method(method);
-            out.push((format!("triangle@3 {} {vertical:?}", method.name()), (triangle.clone(), settings, Some(0.01))));
+            out.push((format!("triangle@3 {} {vertical:?}", method.name()), (triangle.clone(), settings)));
         }
     }
     // The full sphere, with the error in pixels and as an angle (arcminutes).
     let sphere = Projection::equirect(320);
-    out.push(("demo on the sphere".into(), (builtin::demo(), RenderSettings::new(sphere), None)));
-    out.push(("demo on VR180".into(), (builtin::demo(), RenderSettings::new(Projection::vr180(128)), None)));
+    out.push(("demo on the sphere".into(), (builtin::demo(), RenderSettings::new(sphere))));
+    out.push(("demo on VR180".into(), (builtin::demo(), RenderSettings::new(Projection::vr180(128)))));
     let head = twister::core::head::Head { offset: [0.3, 0.1, -0.2], turn: 0.35 };
     let tracked =
         Projection { width: 256, height: 64, vertical: Vertical::Exact, head: Some(head), ..Projection::default() };
-    out.push(("demo seen by a tracked head".into(), (builtin::demo(), RenderSettings::new(tracked), None)));
+    out.push(("demo seen by a tracked head".into(), (builtin::demo(), RenderSettings::new(tracked))));
     let dome = Projection { fov: 240.0, dome_tilt: 20.0, ..Projection::fisheye(128) };
-    out.push(("demo on a tilted 240° fisheye".into(), (builtin::demo(), RenderSettings::new(dome), None)));
-    out.push(("demo on the cubemap".into(), (builtin::demo(), RenderSettings::new(Projection::cubemap(192)), None)));
+    out.push(("demo on a tilted 240° fisheye".into(), (builtin::demo(), RenderSettings::new(dome))));
+    out.push(("demo on the cubemap".into(), (builtin::demo(), RenderSettings::new(Projection::cubemap(192)))));
     // A triangle 2 m ahead reaching ±60° across and 50° up and down.
     let mut triangle = Scene::new("big triangle");
     let corner = |p: [f32; 3]| twister::core::scene::SceneVertex {
@@ -315,13 +354,9 @@ fn raster_geometry_cases() -> Vec<(String, RasterCase)> {
         &[corner([-3.5, -2.4, -2.0]), corner([3.5, -2.4, -2.0]), corner([0.0, 2.4, -2.0])],
         &[0, 1, 2],
     );
-    // 0.02 px, in the error's unit: as an angle, the arcminutes a pixel spans on the equator (a
-    // hardware GPU's interpolation differs from the twin's by ~0.002 px, 0.17′, there).
-    let arcmin_per_px = 360.0 * 60.0 / sphere.width as f32;
     for angle in [false, true] {
         let settings = RenderSettings::new(sphere).with_method(Method::Vertex).with_error_angle(angle);
-        let tolerance = if angle { 0.02 * arcmin_per_px } else { 0.02 };
-        out.push((format!("triangle@3 on the sphere, angle {angle}"), (triangle.clone(), settings, Some(tolerance))));
+        out.push((format!("triangle@3 on the sphere, angle {angle}"), (triangle.clone(), settings)));
     }
     // Eyes 5 cm under a ceiling in the exact vertical model: needles reaching from the
     // ceiling's image to points inside the eye circle, millions of pixels above it, drawn
@@ -329,7 +364,7 @@ fn raster_geometry_cases() -> Vec<(String, RasterCase)> {
     let cube = builtin::closed_box("cube", Vec3::splat(-1.0), Vec3::splat(1.0));
     let exact = Projection { width: 192, height: 192, vertical: Vertical::Exact, ..Projection::default() };
     let settings = RenderSettings::new(exact).with_viewer(Vec3::new(0.0, 0.95, 0.0)).with_method(Method::Fixed(7));
-    out.push(("cube, eyes under the ceiling, exact".into(), (cube, settings, None)));
+    out.push(("cube, eyes under the ceiling, exact".into(), (cube, settings)));
     out
 }
 
@@ -350,15 +385,12 @@ fn raster_sample_cases() -> Vec<(String, RasterCase)> {
     }
     let screen = common::ball_over_floor(twister::core::light::LightKind::Spot, true);
     vec![
-        ("demo, 4 samples".into(), (builtin::demo(), settings, None)),
-        ("demo with two BLEND objects, 4 samples".into(), (blended, settings, None)),
-        (
-            "ball and MASK screen, 4 samples: alpha to coverage".into(),
-            (screen, settings.with_shadow_map_size(512), None),
-        ),
+        ("demo, 4 samples".into(), (builtin::demo(), settings)),
+        ("demo with two BLEND objects, 4 samples".into(), (blended, settings)),
+        ("ball and MASK screen, 4 samples: alpha to coverage".into(), (screen, settings.with_shadow_map_size(512))),
         (
             "demo on the sphere, 4 samples".into(),
-            (builtin::demo(), RenderSettings::new(Projection::equirect(256)).with_samples(4), None),
+            (builtin::demo(), RenderSettings::new(Projection::equirect(256)).with_samples(4)),
         ),
     ]
 }
@@ -375,32 +407,29 @@ fn raster_look_cases() -> Vec<(String, RasterCase)> {
     let settings = RenderSettings::new(Projection { width: 400, height: 100, ..Projection::default() })
         .with_yaw_deg(-25.0)
         .with_viewer(Vec3::new(0.1, 0.2, 0.0));
-    out.push(("lit spheres in the neutral studio".into(), (studio.clone(), settings.with_shadow_map_size(256), None)));
+    out.push(("lit spheres in the neutral studio".into(), (studio.clone(), settings.with_shadow_map_size(256))));
     // The environment as the background too (the triangle drawn first), on the sphere.
     studio.environment = Some(common::studio(true));
     let sphere = RenderSettings::new(Projection::equirect(256)).with_yaw_deg(30.0);
     out.push((
         "lit spheres, the studio as the background, on the sphere".into(),
-        (studio, sphere.with_shadow_map_size(256), None),
+        (studio, sphere.with_shadow_map_size(256)),
     ));
     // Every glTF map (metallic-roughness, normal, occlusion, emissive), u mirrored on the
     // middle quad, under a directional light and the studio.
     let mut panels = common::mapped_panels();
     panels.environment = Some(common::studio(false));
     let settings = RenderSettings::new(Projection { width: 480, height: 120, ..Projection::default() });
-    out.push(("mapped panels".into(), (panels.clone(), settings, None)));
+    out.push(("mapped panels".into(), (panels.clone(), settings)));
     // Anisotropic filtering: a striped floor at grazing angles, 16 probes, on the sphere.
     let floor = RenderSettings::new(Projection::equirect(192)).with_ambient(1.0).with_anisotropy(16);
-    out.push(("striped floor, anisotropy 16".into(), (common::striped_floor(), floor, None)));
-    out.push(("mapped panels with glTF tangents".into(), (common::with_tangents(panels), settings, None)));
+    out.push(("striped floor, anisotropy 16".into(), (common::striped_floor(), floor)));
+    out.push(("mapped panels with glTF tangents".into(), (common::with_tangents(panels), settings)));
     // Shadow maps: a ball and a masked screen over a floor under a spot light.
     let shadows = common::ball_over_floor(twister::core::light::LightKind::Spot, true);
     let settings =
         RenderSettings::new(Projection { width: 400, height: 120, vertical: Vertical::Exact, ..Projection::default() });
-    out.push((
-        "ball and screen, spot light's shadow map".into(),
-        (shadows, settings.with_shadow_map_size(512), Some(0.01)),
-    ));
+    out.push(("ball and screen, spot light's shadow map".into(), (shadows, settings.with_shadow_map_size(512))));
     // The glTF BRDF under point, spot and directional lights, seen from a moved viewer, with
     // each tone mapping.
     let cylinder = Projection { width: 400, height: 100, vertical: Vertical::Exact, ..Projection::default() };
@@ -411,7 +440,7 @@ fn raster_look_cases() -> Vec<(String, RasterCase)> {
             .with_tonemap(tonemap);
         out.push((
             format!("lit spheres, {tonemap:?}"),
-            (common::lit_spheres(), settings.with_exposure_ev(0.5).with_shadow_map_size(256), None),
+            (common::lit_spheres(), settings.with_exposure_ev(0.5).with_shadow_map_size(256)),
         ));
     }
     out
@@ -419,17 +448,18 @@ fn raster_look_cases() -> Vec<(String, RasterCase)> {
 
 impl Twin for Raster {
     type Case = RasterCase;
-    type Output = (EyeOutputs, Option<f32>);
+    /// The images, and how far their errors may differ.
+    type Output = (EyeOutputs, f32);
     fn cases() -> Vec<(String, Self::Case)> {
         let mut out = raster_geometry_cases();
         out.extend(raster_look_cases());
         out.extend(raster_sample_cases());
         out
     }
-    fn gpu(_: &Renderer, (scene, settings, tolerance): &Self::Case) -> Self::Output {
-        (frame_outputs(&measured(scene, settings)), *tolerance)
+    fn gpu(_: &Renderer, (scene, settings): &Self::Case) -> Self::Output {
+        (frame_outputs(&measured(scene, settings)), error_tolerance(settings))
     }
-    fn cpu((scene, settings, tolerance): &Self::Case) -> Self::Output {
+    fn cpu((scene, settings): &Self::Case) -> Self::Output {
         let params = subdivide_params(settings, 0, scene.triangle_count() as u32);
         let tris = subdivide(&params, &scene.vertices, &scene.indices).vertices;
         let table = lit_table(scene, settings);
@@ -444,7 +474,7 @@ impl Twin for Raster {
                 eye.0 = rgba;
             }
         }
-        (eyes, *tolerance)
+        (eyes, error_tolerance(settings))
     }
     fn compare((gpu, tolerance): &Self::Output, (cpu, _): &Self::Output) -> Result<(), String> {
         compare_eyes(gpu, cpu, 100, *tolerance)
@@ -456,8 +486,10 @@ impl Twin for Raster {
 struct ReduceError;
 
 impl Twin for ReduceError {
-    /// Per-pixel errors of both eyes (a real frame's), and the GPU's reduction of them.
-    type Case = ([Vec<f32>; 2], ErrorStats);
+    /// A frame's scene and settings, and its per-pixel errors of both eyes (the raster stage's,
+    /// drawn once here): the GPU's `reduce_error` runs on them when the frame is drawn again in
+    /// `gpu` (the same pixels, checked), the twin on the errors themselves.
+    type Case = (Scene, RenderSettings, [Vec<f32>; 2]);
     type Output = ErrorStats;
     fn cases() -> Vec<(String, Self::Case)> {
         let mut out = Vec::new();
@@ -470,16 +502,17 @@ impl Twin for ReduceError {
             let projection = Projection { width: 480, height: 90, ..Projection::default() };
             let scene = builtin::builtin_scene(scene, &projection).unwrap();
             let settings = RenderSettings::new(projection).with_method(method).with_reduce_per_eye(per_eye);
-            let frame = measured(&scene, &settings);
-            let m = frame.measurement.unwrap();
-            out.push((name.to_string(), (m.error, m.stats)));
+            let errors = measured(&scene, &settings).measurement.unwrap().error;
+            out.push((name.to_string(), (scene, settings, errors)));
         }
         out
     }
-    fn gpu(_: &Renderer, (_, stats): &Self::Case) -> Self::Output {
-        *stats
+    fn gpu(_: &Renderer, (scene, settings, errors): &Self::Case) -> Self::Output {
+        let m = measured(scene, settings).measurement.unwrap();
+        assert!(m.error == *errors, "the frame drew other errors the second time");
+        m.stats
     }
-    fn cpu((errors, _): &Self::Case) -> Self::Output {
+    fn cpu((_, _, errors): &Self::Case) -> Self::Output {
         reduce_error(errors.iter().map(|v| v.as_slice()))
     }
     fn compare(gpu: &Self::Output, cpu: &Self::Output) -> Result<(), String> {

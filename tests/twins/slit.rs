@@ -97,6 +97,6 @@ impl Twin for Slit {
         })
     }
     fn compare(gpu: &Self::Output, cpu: &Self::Output) -> Result<(), String> {
-        compare_eyes(gpu, cpu, 50, Some(0.01))
+        compare_eyes(gpu, cpu, 50, 0.01)
     }
 }

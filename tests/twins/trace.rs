@@ -252,6 +252,6 @@ impl Twin for Trace {
         if !near(*g_rays, *c_rays, 0.002) || !near(*g_tests, *c_tests, 0.01) || *c_rays == 0 {
             return Err(format!("rays {g_rays} vs {c_rays}, triangle tests {g_tests} vs {c_tests}"));
         }
-        compare_eyes(gpu, cpu, 200, Some(0.01))
+        compare_eyes(gpu, cpu, 200, 0.01)
     }
 }
