@@ -12,10 +12,6 @@ use twister::core::color::srgb_to_linear;
 use twister::core::environment::Environment;
 use twister::core::light::Tonemap;
 use twister::core::material::Material;
-use twister::cpu::raster::raster;
-use twister::cpu::subdivide::subdivide;
-use twister::encoding::params::raster_params;
-use twister::encoding::subdivide::subdivide_params;
 use twister::{Eye, Projection, RenderSettings, Scene, Vertical};
 
 /// Spheres of the given (metallic, roughness) and colour on a circle 1.8 m around the viewer,
@@ -86,11 +82,7 @@ fn white_spheres_in_a_uniform_environment_reflect_exactly_what_arrives() {
     scene.environment = Some(Arc::new(Environment::uniform(Vec3::splat(0.5)).prepare()));
     let s = settings(480, 120);
     let gpu = common::render(&scene, &s);
-    let params = subdivide_params(&s, 0, scene.triangle_count() as u32);
-    let tris = subdivide(&params, &scene.vertices, &scene.indices).vertices;
-    let (lights, lighting) = s.lighting(&scene.lights, scene.physically_based, scene.environment.as_deref());
-    let table = scene.material_table(usize::MAX).with_lighting(lights, lighting);
-    let cpu = raster(&raster_params(&s), &tris, &table, s.shading.background);
+    let cpu = twister::cpu::render::render(&scene, &s).eyes;
     for (what, rgba) in [("GPU", &gpu.eye(Eye::Left).rgba), ("CPU twin", &cpu[0].rgba)] {
         let columns = sphere_columns(rgba, 480, 120);
         assert_eq!(columns.len(), looks.len(), "{what}: {columns:?}");

@@ -22,12 +22,7 @@ use rand::{Rng, SeedableRng};
 use twister::core::builtin;
 use twister::core::light::Tonemap;
 use twister::core::settings::{Method, Split};
-use twister::cpu::multisample::raster_multisampled;
-use twister::cpu::raster::raster;
 use twister::cpu::reduce_error::reduce_error;
-use twister::cpu::subdivide::subdivide;
-use twister::encoding::params::raster_params;
-use twister::encoding::subdivide::subdivide_params;
 use twister::encoding::types::ErrorStats;
 use twister::shader::STAGES;
 use twister::{Eye, Frame, Projection, RenderSettings, Renderer, Scene, Vertical};
@@ -307,16 +302,6 @@ fn compare_eyes(gpu: &EyeOutputs, cpu: &EyeOutputs, share: usize, error_toleranc
 /// distance).
 type RasterCase = (Scene, RenderSettings);
 
-/// The material table as group 1 holds it for a frame: with the scene's lights, lighting and
-/// shadow maps (drawn by the shadow stage's twin).
-fn lit_table(scene: &Scene, settings: &RenderSettings) -> twister::core::texture::MaterialTable {
-    let (lights, lighting, maps) =
-        settings.shadowed_lighting(&scene.lights, scene.physically_based, scene.environment.as_deref(), scene.bounds());
-    let table = scene.material_table(usize::MAX);
-    let depths = twister::cpu::shadow::shadow(&scene.vertices, &scene.indices, &table, settings.view(), &maps);
-    table.with_lighting(lights, lighting).with_shadows(maps, depths)
-}
-
 /// The raster twin's geometry cases: the demo and the evaluation triangle with each split rule
 /// in both vertical models, the full sphere, eyes just under a ceiling.
 fn raster_geometry_cases() -> Vec<(String, RasterCase)> {
@@ -460,20 +445,9 @@ impl Twin for Raster {
         (frame_outputs(&measured(scene, settings)), error_tolerance(settings))
     }
     fn cpu((scene, settings): &Self::Case) -> Self::Output {
-        let params = subdivide_params(settings, 0, scene.triangle_count() as u32);
-        let tris = subdivide(&params, &scene.vertices, &scene.indices).vertices;
-        let table = lit_table(scene, settings);
-        let (background, samples) = (settings.shading.background, settings.shading.samples);
-        let mut eyes = raster(&raster_params(settings), &tris, &table, background)
+        let eyes = twister::cpu::render::render(scene, settings)
+            .eyes
             .map(|img| (img.rgba, img.error, img.object, img.distance));
-        // Several samples: the colour is the multisampled pass's, resolved; the rest stays the
-        // one-sample pass's, at the pixels' centres.
-        if samples > 1 {
-            let resolved = raster_multisampled(&raster_params(settings), &tris, &table, background, samples);
-            for (eye, rgba) in eyes.iter_mut().zip(resolved) {
-                eye.0 = rgba;
-            }
-        }
         (eyes, error_tolerance(settings))
     }
     fn compare((gpu, tolerance): &Self::Output, (cpu, _): &Self::Output) -> Result<(), String> {

@@ -13,6 +13,8 @@
 //! | [`fragment`] | `shaders/shared/fragment.wgsl` and `surface.wgsl` (composed into raster, slit and trace) |
 //! | [`reduce_error`] | `shaders/reduce_error.wgsl` |
 //! | [`project_points`] | `shaders/project_points.wgsl` |
+//!
+//! [`render`] runs a whole frame of the projection methods through the twins, in the GPU's order.
 
 pub mod display;
 pub mod fragment;
@@ -20,6 +22,7 @@ pub mod multisample;
 pub mod project_points;
 pub mod raster;
 pub mod reduce_error;
+pub mod render;
 pub mod shadow;
 pub mod skin;
 pub mod slit;

@@ -7,7 +7,7 @@ use twister::cpu::slit::{slit, slit_multisampled};
 use twister::encoding::slits::{slit_params, slits};
 use twister::{Eye, Projection, RenderSettings, Renderer, Scene, Vertical};
 
-use super::{common, compare_eyes, frame_outputs, lit_table, measured, EyeOutputs, Twin};
+use super::{common, compare_eyes, frame_outputs, measured, EyeOutputs, Twin};
 
 pub struct Slit;
 
@@ -83,7 +83,7 @@ impl Twin for Slit {
             Method::Slit(w) => w,
             _ => p.width, // a CAVE wall's one camera per eye
         };
-        let table = lit_table(scene, settings);
+        let table = twister::cpu::render::lit_table(scene, settings);
         let (background, samples) = (settings.shading.background, settings.shading.samples);
         Eye::BOTH.map(|eye| {
             let params = slit_params(p, settings.view(), eye, settings.shading.ambient, settings.measure.error_angle);

@@ -7,7 +7,7 @@ use twister::core::settings::Method;
 use twister::encoding::params::trace_params;
 use twister::{GpuScene, Projection, RenderSettings, Renderer, Scene, Vertical};
 
-use super::{common, compare_eyes, frame_outputs, lit_table, EyeOutputs, Twin};
+use super::{common, compare_eyes, frame_outputs, EyeOutputs, Twin};
 
 pub struct Trace;
 
@@ -242,7 +242,7 @@ impl Twin for Trace {
         let bvh = traced_bvh(scene, settings);
         let p = settings.projection();
         let params = trace_params(settings, p.width);
-        let table = lit_table(scene, settings);
+        let table = twister::cpu::render::lit_table(scene, settings);
         let out = twister::cpu::trace::trace(&params, &scene.vertices, &bvh, &table);
         (out.images.map(|img| (img.rgba, img.error, img.object, img.distance)), out.rays, out.triangle_tests)
     }
