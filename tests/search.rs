@@ -162,6 +162,44 @@ fn a_torus_simplified_outside_the_visual_field_stays_closed() {
     }
 }
 
+/// A ceiling above a tracked head, drawn by `vertex`: its part beside the axis reached from the
+/// eye circle (points drawn thousands of pixels above the image) to the room's corner, and its
+/// fan, straight on screen, left a column of background (the search's seed 1, case 108 of the
+/// cylinder-head, shrunk). Parts now stay within bands for every method.
+#[test]
+fn a_ceiling_above_a_tracked_head_is_drawn_closed_by_vertex() {
+    use twister::core::settings::Method;
+    let case = search::SearchCase {
+        panorama: SearchPanorama::CylinderHead,
+        method: Method::Vertex,
+        edge_px: 4.0,
+        max_error_px: 0.1,
+        max_div: 1,
+        room_grid: 1,
+        room_half: [7.979104, 1.9200716, 1.9200716],
+        room_offset: [0.0; 3],
+        objects: vec![],
+        viewer: [0.0; 3],
+        yaw_deg: 0.0,
+        width: 77,
+        height: 44,
+        screen_radius: 1.8616618,
+        eye_radius: 0.0015371877,
+        vertical: twister::Vertical::Exact,
+        convergence: None,
+        pole_merge: false,
+        fov: 180.0,
+        dome_tilt: 0.0,
+        head: Some(([-1.0266521, -0.017859649, -0.3355328], -130.60023)),
+        cave_half: 1.5,
+        cave_wall: 0,
+        gaze: None,
+    };
+    if let Err(f) = search::check(Some(common::renderer()), &case) {
+        panic!("{}: {}", f.check.name(), f.message);
+    }
+}
+
 /// The fisheye refuses the methods that measure no edge, naming the setting.
 #[test]
 fn the_fisheye_refuses_vertex_and_fixed_with_one_line() {

@@ -29,8 +29,8 @@ fn active_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     if (off_screen_vertically(tri.position[0], tri.position[1], tri.position[2])) {
         return;
     }
-    // Diamonds for the adaptive method only (`band_limit` in axis.rs).
-    let limit = select(0.0, BAND_LIMIT * params.projection.screen_radius, is_adaptive());
+    // Diamonds for every method (`band_limit` in axis.rs).
+    let limit = BAND_LIMIT * params.projection.screen_radius;
     let bits = triangle_cuts(limit, &tri);
     if (bits.x != 0u) {
         atomicOr(&counters.cuts_low, bits.x);

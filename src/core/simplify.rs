@@ -63,6 +63,19 @@ pub fn is_closed(welded: &[u32]) -> bool {
     !edges.is_empty() && edges.iter().all(|(&(a, b), &n)| n == 1 && edges.get(&(b, a)) == Some(&1))
 }
 
+/// Whether a triangle of `indices` has (nearly) no area: its height under 10⁻⁴ of its longest
+/// edge. Its plane is then undefined, and it draws nothing while its neighbours meet it.
+pub fn has_sliver(vertices: &[SceneVertex], indices: &[u32]) -> bool {
+    let at = |i: u32| glam::Vec3::from(vertices[i as usize].position);
+    indices.chunks_exact(3).any(|t| {
+        let (a, b, c) = (at(t[0]), at(t[1]), at(t[2]));
+        let longest = (b - a).length_squared().max((c - b).length_squared()).max((a - c).length_squared());
+        // Twice the area is the longest edge times the height over it.
+        let twice_area = (b - a).cross(c - a).length();
+        twice_area <= 1e-4 * longest
+    })
+}
+
 /// One object's chain of levels, each about [`LEVEL_RATIO`] of the last, down to `floor`
 /// triangles: level 0 is `original`; a closed original's levels are all closed. Returns the
 /// levels (indices into `vertices`) and each level's error (meshoptimizer's, summed along the
@@ -89,8 +102,13 @@ pub fn simplify_chain(
         let mut error = 0.0f32;
         let next =
             meshopt::simplify(&welded, &adapter, 3 * target, 1.0, meshopt::SimplifyOptions::Sparse, Some(&mut error));
-        // Stop where the simplifier can no longer make real progress, or would open the surface.
-        if next.is_empty() || next.len() / 3 > count * 9 / 10 || (closed && !is_closed(&next)) {
+        // Stop where the simplifier can no longer make real progress, would open the surface, or
+        // left a triangle with no area (three corners on a line, a flat face's collapse).
+        if next.is_empty()
+            || next.len() / 3 > count * 9 / 10
+            || (closed && !is_closed(&next))
+            || has_sliver(vertices, &next)
+        {
             break;
         }
         chain.push(unweld(&next, &corners, vertices));
@@ -212,6 +230,21 @@ mod tests {
                 let u: Vec<f32> = t.iter().map(|&i| vertices[i as usize].uv[0]).collect();
                 let spread = u.iter().fold(0f32, |m, &a| m.max(u.iter().fold(0f32, |n, &b| n.max((a - b).abs()))));
                 assert!(spread < 0.5, "a triangle across the seam: u {u:?}");
+            }
+        }
+    }
+
+    /// Grid boxes (flat faces, where collapses can leave three corners on a line): no level has
+    /// a triangle without area, and each is closed.
+    #[test]
+    fn grid_boxes_simplify_without_slivers() {
+        for n in [3, 4, 6] {
+            let mut scene = crate::core::scene::Scene::new("box");
+            ClosedMesh::grid_box(n).placed(Vec3::new(0.4, 0.05, -0.4), 0.21).add_to(&mut scene, [1.0; 4]);
+            let welding = Welding::of(&scene.vertices);
+            for (k, level) in chain_of(&scene.vertices, &scene.indices, 1).iter().enumerate() {
+                assert!(!has_sliver(&scene.vertices, level), "box {n}, level {k}");
+                assert!(is_closed(&welding.weld(level)), "box {n}, level {k}");
             }
         }
     }

@@ -298,14 +298,13 @@ fn single_band(p: [Vec3; 3], (sx, sz): (f32, f32), rho: f32, cuts: AxisCuts) -> 
     p.iter().all(|&q| lower.distance(q) > 0.0 && upper.is_none_or(|u| u.distance(q) > 0.0))
 }
 
-/// Where diamonds stop: `BAND_LIMIT`·R_T for the adaptive method; for `vertex` and `fixed:N`,
-/// whose splits do not follow projected lengths, only the square is cut (0).
-pub fn band_limit(method: u32, screen_radius: f32) -> f32 {
-    if crate::core::settings::SplitRule::is_adaptive(method) {
-        BAND_LIMIT * screen_radius
-    } else {
-        0.0
-    }
+/// Where diamonds stop: `BAND_LIMIT`·R_T for every method. `vertex` and `fixed:N` split no edge
+/// by its projected length, but a part that reaches from the eye circle to far out projects, in
+/// straight lines, as a polygon that is no longer simple (a ceiling's corner above the eyes fanned
+/// over points whose images lie thousands of pixels above the image): within a band, r varies by
+/// at most a factor 2 and the fans stay simple.
+pub fn band_limit(_method: u32, screen_radius: f32) -> f32 {
+    BAND_LIMIT * screen_radius
 }
 
 /// The active diamonds' bounds, innermost first.
