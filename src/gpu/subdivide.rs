@@ -196,10 +196,60 @@ fn lookup<'a>(built: &'a Built, entry: &str) -> Option<&'a wgpu::ComputePipeline
     built.iter().find(|(name, _)| *name == entry).map(|(_, p)| p)
 }
 
-/// Slots for the stage's variants: 4 panorama kinds × spaced or not × 4 split rules × converging
-/// or not × measuring or not × the vertical model × pinholes or not (see
-/// [`SubdivideStage::variant`]).
-const VARIANTS: usize = 4 * 2 * 4 * 2 * 2 * 2 * 2;
+/// The projection code a variant keeps (the others' is left out: see [`SubdivideStage::variant`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum VariantProjection {
+    Cylinder,
+    /// The cylinder seen by a tracked head.
+    Head,
+    /// The sphere and VR180 (with the cubemap's pinholes where `pinhole`).
+    Sphere,
+    Fisheye,
+}
+
+/// What a variant of the stage's pipelines is built for, its key (as draw.rs keys its pipelines
+/// by `DrawKey`): the projection, spacing by azimuth, the split rule, converging rays, the edge
+/// measure, the vertical model and pinhole faces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+struct VariantKey {
+    projection: VariantProjection,
+    spacing: bool,
+    rule: u32,
+    converging: bool,
+    measuring: bool,
+    exact: bool,
+    pinhole: bool,
+}
+
+impl VariantKey {
+    fn of(panorama: PanoramaKind, params: &SubdivideParams) -> VariantKey {
+        let projection = match panorama {
+            PanoramaKind::Fisheye => VariantProjection::Fisheye,
+            p if p.is_sphere() => VariantProjection::Sphere,
+            _ if params.projection.head_on != 0.0 => VariantProjection::Head,
+            _ => VariantProjection::Cylinder,
+        };
+        VariantKey {
+            projection,
+            spacing: params.by_azimuth != 0,
+            rule: params.method.min(3),
+            converging: params.projection.convergence > 0.0,
+            measuring: params.measure_edges != 0,
+            exact: params.projection.vertical_exact != 0,
+            pinhole: params.pinhole_faces != 0,
+        }
+    }
+}
+
+/// A built variant, shared with the frames that use it.
+struct VariantRef(std::sync::Arc<OnceLock<Variant>>);
+
+impl std::ops::Deref for VariantRef {
+    type Target = Variant;
+    fn deref(&self) -> &Variant {
+        self.0.get().expect("a variant is built before it is handed out")
+    }
+}
 
 /// The `subdivide` stage: its layouts, and its pipelines built for each panorama and kind of
 /// split rule when first needed (the WGSL `override PANORAMAS` compiles the other panorama's
@@ -208,13 +258,14 @@ const VARIANTS: usize = 4 * 2 * 4 * 2 * 2 * 2 * 2;
 /// (`subdivide_rows_off`): lavapipe builds a pipeline about twice as long with the code merely in it).
 pub(crate) struct SubdivideStage {
     stage: GpuStage,
-    variants: [OnceLock<Variant>; VARIANTS],
+    /// The variants built so far, by key (each built once, outside the map's lock).
+    variants: std::sync::Mutex<std::collections::HashMap<VariantKey, std::sync::Arc<OnceLock<Variant>>>>,
 }
 
 impl SubdivideStage {
     /// The stage; each panorama's pipelines are built when a frame first needs them.
     pub fn new(gpu: &Gpu) -> SubdivideStage {
-        SubdivideStage { stage: GpuStage::new(gpu, &SUBDIVIDE), variants: std::array::from_fn(|_| OnceLock::new()) }
+        SubdivideStage { stage: GpuStage::new(gpu, &SUBDIVIDE), variants: Default::default() }
     }
 
     /// The pipelines for a panorama (the cylinder with or without a tracked head, the sphere
@@ -232,44 +283,47 @@ impl SubdivideStage {
     /// most of a fresh process's time). With a `probe` (a frame's first use of the variant) the
     /// cut passes ([`CUT_PASSES`]) are built only if it says the frame needs them: it runs as
     /// soon as `plan`'s pipelines are built, the others still building.
-    fn variant(&self, gpu: &Gpu, panorama: PanoramaKind, params: &SubdivideParams, probe: Option<&Probe>) -> &Variant {
-        let head = params.projection.head_on != 0.0;
-        let (k, bits) = match panorama {
-            PanoramaKind::Fisheye => (3, 6.0),
-            p if p.is_sphere() => (2, 2.0),
-            _ if head => (1, 1.0),
-            _ => (0, 1.0),
-        };
-        let passes = Passes::of(panorama, params.method);
+    fn variant(
+        &self,
+        gpu: &Gpu,
+        panorama: PanoramaKind,
+        params: &SubdivideParams,
+        probe: Option<&Probe>,
+    ) -> VariantRef {
+        let key = VariantKey::of(panorama, params);
+        let slot = self.variants.lock().unwrap_or_else(|e| e.into_inner()).entry(key).or_default().clone();
+        slot.get_or_init(|| self.build_variant(gpu, panorama, params.method, key, probe));
+        VariantRef(slot)
+    }
+
+    /// Builds the pipelines of the variant `key` (see [`SubdivideStage::variant`]).
+    fn build_variant(
+        &self,
+        gpu: &Gpu,
+        panorama: PanoramaKind,
+        method: u32,
+        key: VariantKey,
+        probe: Option<&Probe>,
+    ) -> Variant {
+        let passes = Passes::of(panorama, method);
         let rows = passes.rows;
-        let spacing = params.by_azimuth != 0;
+        let VariantKey { projection, spacing, rule, converging, measuring, exact, pinhole } = key;
         // Code behind a test of the parameters costs lavapipe's SIMD lanes its time whether or
         // not any lane runs it: the frames that never run it get pipelines without it.
-        let converging = params.projection.convergence > 0.0;
-        let measuring = params.measure_edges != 0;
-        let exact = params.projection.vertical_exact != 0;
-        let pinhole = params.pinhole_faces != 0;
-        let rule = params.method.min(3);
-        // The variant's slot: what it is built for, as the digits of a mixed-radix number (the
-        // panorama kind and the split rule also say whether it draws rows).
-        let digits = [
-            (k, 4),
-            (spacing as usize, 2),
-            (rule as usize, 4),
-            (converging as usize, 2),
-            (measuring as usize, 2),
-            (exact as usize, 2),
-            (pinhole as usize, 2),
-        ];
-        let index = digits.iter().rev().fold(0, |i, &(digit, radix)| i * radix + digit);
-        self.variants[index].get_or_init(|| {
-            let mut stand_ins: Vec<StandIn> = match (k, rows) {
-                (0, _) => vec![ROWS_OFF, SPHERE_OFF, FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
-                (1, _) => vec![ROWS_OFF, SPHERE_OFF, FISHEYE_OFF, CUBEMAP_OFF, CAVE_OFF],
-                (2, false) => vec![ROWS_OFF, FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
-                (2, true) => vec![FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
-                (_, false) => vec![ROWS_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
-                (_, true) => vec![HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
+        let bits = match projection {
+            VariantProjection::Fisheye => 6.0,
+            VariantProjection::Sphere => 2.0,
+            _ => 1.0,
+        };
+        {
+            use VariantProjection::*;
+            let mut stand_ins: Vec<StandIn> = match (projection, rows) {
+                (Cylinder, _) => vec![ROWS_OFF, SPHERE_OFF, FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
+                (Head, _) => vec![ROWS_OFF, SPHERE_OFF, FISHEYE_OFF, CUBEMAP_OFF, CAVE_OFF],
+                (Sphere, false) => vec![ROWS_OFF, FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
+                (Sphere, true) => vec![FISHEYE_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
+                (Fisheye, false) => vec![ROWS_OFF, HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
+                (Fisheye, true) => vec![HEAD_OFF, CUBEMAP_OFF, CAVE_OFF],
             };
             if !spacing {
                 stand_ins.push(SPACING_OFF);
@@ -308,7 +362,7 @@ impl SubdivideStage {
                 variant.cut_passes.set(cut_passes).ok();
             }
             variant
-        })
+        }
     }
 
     /// The bind group of `entry` (the bindings of `SUBDIVIDE` it uses, by name).
