@@ -243,7 +243,13 @@ fn the_subdivisions_recordings_name_its_entry_points_and_bindings() {
     };
     use twister::shader::SUBDIVIDE;
     let entries: Vec<&str> = SUBDIVIDE.entry_points.iter().map(|e| e.name).collect();
-    let bound = |name: &str| SUBDIVIDE.bindings.iter().any(|b| b.name == name);
+    // A handle is bound when some binding of the stage binds its buffer.
+    let bound = |buffer: twister::encoding::recording::SubdivideBuffer| {
+        SUBDIVIDE
+            .bindings
+            .iter()
+            .any(|b| twister::encoding::recording::SubdivideBuffer::bound_as(b.name) == Some(buffer))
+    };
     let all = Passes { rows: true };
     let usual = one_submission(1000, all, PassTiming::EachPass);
     // The usual frame of the sphere under an adaptive rule dispatches every entry point, in the
@@ -288,15 +294,25 @@ fn the_subdivisions_recordings_name_its_entry_points_and_bindings() {
         for command in &recording.commands {
             match *command {
                 Command::Clear { buffer, .. } => {
-                    assert!(bound(buffer), "clears {buffer}, which SUBDIVIDE does not bind");
+                    assert!(bound(buffer), "clears {buffer:?}, which SUBDIVIDE does not bind");
                     in_pass = false;
                 }
                 Command::Pass { .. } => in_pass = true,
                 Command::Dispatch { entry, .. } => assert!(entries.contains(&entry) && in_pass, "{entry}"),
                 Command::DispatchIndirect { entry, args, .. } => {
-                    assert!(entries.contains(&entry) && in_pass && bound(args), "{entry} from {args}")
+                    assert!(entries.contains(&entry) && in_pass && bound(args), "{entry} from {args:?}")
                 }
             }
         }
+    }
+}
+
+/// Every buffer the subdivide stage binds is a typed handle the engines resolve (the recordings
+/// name buffers only by handle).
+#[test]
+fn every_subdivide_binding_is_a_buffer_handle() {
+    use twister::encoding::recording::SubdivideBuffer;
+    for binding in twister::shader::SUBDIVIDE.bindings {
+        assert!(SubdivideBuffer::bound_as(binding.name).is_some(), "{} has no SubdivideBuffer", binding.name);
     }
 }

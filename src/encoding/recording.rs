@@ -3,13 +3,65 @@
 //! arguments a previous dispatch wrote. An engine replays a recording; the subdivision's two
 //! schedules are recordings (`one_submission`, `active_cuts` and `pass_run` in the subdivide
 //! stage's encoding).
-//! Buffers are named by the WGSL variable they are bound as.
+//! Buffers are [`SubdivideBuffer`] handles (as vello's `BufferProxy`): each engine resolves
+//! every one, by an exhaustive match, to its own storage.
+
+/// The buffers of a subdivision frame, as a recording names them and as the stage's bindings
+/// bind them (several WGSL variables may bind one buffer: [`SubdivideBuffer::bound_as`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SubdivideBuffer {
+    Params,
+    Vertices,
+    Indices,
+    Pieces,
+    Parts,
+    PieceWork,
+    LatticeWork,
+    OutNodes,
+    Counters,
+    DrawArgs,
+    LatticeDispatch,
+    ObjectEdgeScale,
+    CutList,
+    /// The output indices (also bound as `row_items`, the rows' items before the lattice).
+    OutIndices,
+    TriangleEdges,
+    /// The frame's marked edges (also bound read-only as `edge_marks_read`).
+    CutEdges,
+}
+
+impl SubdivideBuffer {
+    /// The buffer a WGSL variable of the subdivide stage binds (`shader::SUBDIVIDE.bindings`);
+    /// None for a name the stage does not bind (`tests/shaders.rs` checks every binding has one).
+    pub fn bound_as(name: &str) -> Option<SubdivideBuffer> {
+        use SubdivideBuffer::*;
+        Some(match name {
+            "params" => Params,
+            "vertices" => Vertices,
+            "indices" => Indices,
+            "pieces" => Pieces,
+            "parts" => Parts,
+            "piece_work" => PieceWork,
+            "lattice_work" => LatticeWork,
+            "out_nodes" => OutNodes,
+            "counters" => Counters,
+            "draw_args" => DrawArgs,
+            "lattice_dispatch" => LatticeDispatch,
+            "object_edge_scale" => ObjectEdgeScale,
+            "cut_list" => CutList,
+            "out_indices" | "row_items" => OutIndices,
+            "triangle_edges" => TriangleEdges,
+            "cut_edges" | "edge_marks_read" => CutEdges,
+            _ => return None,
+        })
+    }
+}
 
 /// One step of a recording.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Command {
     /// Clears a buffer to zero: its first `bytes`, or all of it.
-    Clear { buffer: &'static str, bytes: Option<u64> },
+    Clear { buffer: SubdivideBuffer, bytes: Option<u64> },
     /// Begins a compute pass (ending the one before); `timestamp`: the first of its two query
     /// indices, where the frame is timed.
     Pass { label: &'static str, timestamp: Option<u32> },
@@ -17,7 +69,7 @@ pub enum Command {
     /// where one is not enough) or, for a one-thread setup entry, 1.
     Dispatch { entry: &'static str, invocations: u32 },
     /// Dispatches `entry` with the workgroup counts at `offset` in `args`.
-    DispatchIndirect { entry: &'static str, args: &'static str, offset: u64 },
+    DispatchIndirect { entry: &'static str, args: SubdivideBuffer, offset: u64 },
 }
 
 /// A schedule: commands in order.
@@ -27,7 +79,7 @@ pub struct Recording {
 }
 
 impl Recording {
-    pub fn clear(&mut self, buffer: &'static str, bytes: Option<u64>) -> &mut Self {
+    pub fn clear(&mut self, buffer: SubdivideBuffer, bytes: Option<u64>) -> &mut Self {
         self.commands.push(Command::Clear { buffer, bytes });
         self
     }
@@ -42,7 +94,7 @@ impl Recording {
         self
     }
 
-    pub fn dispatch_indirect(&mut self, entry: &'static str, args: &'static str, offset: u64) -> &mut Self {
+    pub fn dispatch_indirect(&mut self, entry: &'static str, args: SubdivideBuffer, offset: u64) -> &mut Self {
         self.commands.push(Command::DispatchIndirect { entry, args, offset });
         self
     }

@@ -4,7 +4,7 @@
 use crate::core::projection::{PanoramaKind, Projection};
 use crate::core::settings::{RenderSettings, SplitRule};
 use crate::encoding::constants::{AXIS_CLEARANCE_MAX, AXIS_CLEARANCE_MIN, OFFSET_SPLIT_FACTOR, PLAN_CUTS_SPLIT};
-use crate::encoding::recording::{Command, Recording};
+use crate::encoding::recording::{Command, Recording, SubdivideBuffer};
 use crate::encoding::types::{DrawVertex, SubdivideCounters, SubdivideParams};
 
 /// The `subdivide` stage's parameters for a range of input triangles (capacities and piece
@@ -265,14 +265,14 @@ pub fn timed_passes(r: &Recording) -> Vec<(&'static str, u32)> {
 /// arguments). In compute passes as `timing` says.
 pub fn one_submission(triangles: u32, passes: Passes, timing: PassTiming) -> Recording {
     let mut r = Recording::default();
-    r.clear("counters", None).clear("cut_edges", None);
+    r.clear(SubdivideBuffer::Counters, None).clear(SubdivideBuffer::CutEdges, None);
     for entry in ["active_cuts", "ring_cuts", "plan"] {
         pass(&mut r, entry, timing);
         r.dispatch(entry, triangles);
     }
     cut_and_plan_parts(&mut r, timing);
     pass(&mut r, "lattice", timing);
-    r.dispatch("lattice_args", 1).dispatch_indirect("lattice", "lattice_dispatch", DISPATCH_LATTICE);
+    r.dispatch("lattice_args", 1).dispatch_indirect("lattice", SubdivideBuffer::LatticeDispatch, DISPATCH_LATTICE);
     lattice_work(&mut r, passes, timing);
     r.dispatch("finalize", 1);
     debug_assert!(timed_passes(&r).len() as u32 <= TIMED_PASSES);
@@ -284,9 +284,17 @@ pub fn one_submission(triangles: u32, passes: Passes, timing: PassTiming) -> Rec
 /// which one invocation planned in turn made the frame's longest threads.
 fn cut_and_plan_parts(r: &mut Recording, timing: PassTiming) {
     pass(r, "plan_cuts", timing);
-    r.dispatch("plan_cuts_args", 1).dispatch_indirect("plan_cuts", "lattice_dispatch", DISPATCH_PLAN_CUTS);
+    r.dispatch("plan_cuts_args", 1).dispatch_indirect(
+        "plan_cuts",
+        SubdivideBuffer::LatticeDispatch,
+        DISPATCH_PLAN_CUTS,
+    );
     pass(r, "plan_parts", timing);
-    r.dispatch("plan_parts_args", 1).dispatch_indirect("plan_parts", "lattice_dispatch", DISPATCH_PLAN_PARTS);
+    r.dispatch("plan_parts_args", 1).dispatch_indirect(
+        "plan_parts",
+        SubdivideBuffer::LatticeDispatch,
+        DISPATCH_PLAN_PARTS,
+    );
 }
 
 /// The passes a frame's schedules dispatch besides those every frame has.
@@ -316,15 +324,15 @@ fn lattice_work(r: &mut Recording, passes: Passes, timing: PassTiming) {
     if passes.rows {
         pass(r, "lattice_rows", timing);
         r.dispatch("lattice_rows_args", 1);
-        r.dispatch_indirect("lattice_rows", "lattice_dispatch", DISPATCH_LATTICE_ROWS);
+        r.dispatch_indirect("lattice_rows", SubdivideBuffer::LatticeDispatch, DISPATCH_LATTICE_ROWS);
         pass(r, "lattice_rows_plan", timing);
-        r.dispatch_indirect("lattice_rows_plan", "lattice_dispatch", DISPATCH_LATTICE_ROWS_PLAN);
+        r.dispatch_indirect("lattice_rows_plan", SubdivideBuffer::LatticeDispatch, DISPATCH_LATTICE_ROWS_PLAN);
     }
     pass(r, "lattice_nodes", timing);
     r.dispatch("lattice_work_args", 1);
-    r.dispatch_indirect("lattice_nodes", "lattice_dispatch", DISPATCH_LATTICE_NODES);
+    r.dispatch_indirect("lattice_nodes", SubdivideBuffer::LatticeDispatch, DISPATCH_LATTICE_NODES);
     pass(r, "lattice_triangles", timing);
-    r.dispatch_indirect("lattice_triangles", "lattice_dispatch", DISPATCH_LATTICE_TRIANGLES);
+    r.dispatch_indirect("lattice_triangles", SubdivideBuffer::LatticeDispatch, DISPATCH_LATTICE_TRIANGLES);
 }
 
 /// The passes that cut triangles around the axis: `plan_cuts`, and `plan_parts` after it. They
@@ -362,7 +370,7 @@ pub fn missed(
 /// `active_cuts` and `ring_cuts` over all of the scene's `triangles`.
 pub fn active_cuts(triangles: u32) -> Recording {
     let mut r = Recording::default();
-    r.clear("counters", None).clear("cut_edges", None);
+    r.clear(SubdivideBuffer::Counters, None).clear(SubdivideBuffer::CutEdges, None);
     r.pass("cuts", None).dispatch("active_cuts", triangles).dispatch("ring_cuts", triangles);
     r
 }
@@ -372,7 +380,7 @@ pub fn active_cuts(triangles: u32) -> Recording {
 /// frame's cuts kept).
 pub fn pass_run(entry: &'static str, count: u32, passes: Passes) -> Recording {
     let mut r = Recording::default();
-    r.clear("counters", Some(SubdivideCounters::RUN_BYTES));
+    r.clear(SubdivideBuffer::Counters, Some(SubdivideCounters::RUN_BYTES));
     r.pass(entry, None).dispatch(entry, count);
     if entry == "plan" {
         cut_and_plan_parts(&mut r, PassTiming::Untimed);

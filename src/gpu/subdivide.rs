@@ -13,7 +13,7 @@ use std::sync::OnceLock;
 use crate::core::projection::PanoramaKind;
 use crate::core::settings::RenderSettings;
 use crate::encoding::constants::PIECES_FROM_COUNTER;
-use crate::encoding::recording::{Command, Recording};
+use crate::encoding::recording::{Command, Recording, SubdivideBuffer};
 use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine, INDICES_SIZE, NODE_SIZE};
 use crate::encoding::subdivide::{
     cut_probe, missed, one_submission, timed_passes, PassTiming, Passes, SubdivideOutput, CUT_PASSES,
@@ -367,7 +367,13 @@ impl SubdivideStage {
 
     /// The bind group of `entry` (the bindings of `SUBDIVIDE` it uses, by name).
     fn bind_group(&self, gpu: &Gpu, entry: &str, frame: &FrameBuffers) -> wgpu::BindGroup {
-        let buffers: Vec<&wgpu::Buffer> = SUBDIVIDE.bindings.iter().map(|b| frame.named(b.name)).collect();
+        let buffers: Vec<&wgpu::Buffer> = SUBDIVIDE
+            .bindings
+            .iter()
+            .map(|b| {
+                frame.get(SubdivideBuffer::bound_as(b.name).expect("every binding is a handle (tests/shaders.rs)"))
+            })
+            .collect();
         self.stage.bind_group(gpu, Some(entry), 0, &buffers)
     }
 
@@ -388,7 +394,7 @@ impl SubdivideStage {
             match *command {
                 Command::Clear { buffer, bytes } => {
                     drop(pass.take());
-                    enc.clear_buffer(frame.named(buffer), 0, bytes);
+                    enc.clear_buffer(frame.get(buffer), 0, bytes);
                 }
                 Command::Pass { label, timestamp } => {
                     drop(pass.take());
@@ -408,7 +414,7 @@ impl SubdivideStage {
                     let Some(pipeline) = pipelines(entry) else { continue };
                     pass.set_pipeline(pipeline);
                     pass.set_bind_group(0, &self.bind_group(gpu, entry, frame), &[]);
-                    pass.dispatch_workgroups_indirect(frame.named(args), offset);
+                    pass.dispatch_workgroups_indirect(frame.get(args), offset);
                 }
             }
         }
@@ -566,27 +572,27 @@ pub(crate) struct FrameBuffers<'f> {
 }
 
 impl FrameBuffers<'_> {
-    /// The buffer bound as `name` (`SUBDIVIDE.bindings`).
-    fn named(&self, name: &str) -> &wgpu::Buffer {
+    /// The buffer behind a handle.
+    fn get(&self, buffer: SubdivideBuffer) -> &wgpu::Buffer {
+        use SubdivideBuffer::*;
         let (scene, b) = (self.scene, self.b);
-        match name {
-            "params" => self.params,
-            "vertices" => &scene.vertices,
-            "indices" => &scene.indices,
-            "pieces" => &b.pieces,
-            "parts" => &b.parts,
-            "piece_work" => &b.piece_work,
-            "lattice_work" => &b.lattice_work,
-            "out_nodes" => &b.nodes,
-            "counters" => &b.counters,
-            "draw_args" => &b.draw_args,
-            "lattice_dispatch" => &b.lattice_dispatch,
-            "object_edge_scale" => &scene.object_edge_scale,
-            "cut_list" => &b.cut_list,
-            "out_indices" | "row_items" => &b.indices,
-            "triangle_edges" => &scene.triangle_edges,
-            "cut_edges" | "edge_marks_read" => &b.cut_edges,
-            other => panic!("the subdivide stage binds no buffer {other}"),
+        match buffer {
+            Params => self.params,
+            Vertices => &scene.vertices,
+            Indices => &scene.indices,
+            Pieces => &b.pieces,
+            Parts => &b.parts,
+            PieceWork => &b.piece_work,
+            LatticeWork => &b.lattice_work,
+            OutNodes => &b.nodes,
+            Counters => &b.counters,
+            DrawArgs => &b.draw_args,
+            LatticeDispatch => &b.lattice_dispatch,
+            ObjectEdgeScale => &scene.object_edge_scale,
+            CutList => &b.cut_list,
+            OutIndices => &b.indices,
+            TriangleEdges => &scene.triangle_edges,
+            CutEdges => &b.cut_edges,
         }
     }
 }

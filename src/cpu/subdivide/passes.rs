@@ -22,7 +22,7 @@ use super::{
 use crate::core::scene::SceneVertex;
 use crate::core::settings::RenderSettings;
 use crate::encoding::constants::{BANDS, PIECES_FROM_COUNTER, PLAN_CUTS_SPLIT};
-use crate::encoding::recording::{Command, Recording};
+use crate::encoding::recording::{Command, Recording, SubdivideBuffer};
 use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine};
 use crate::encoding::subdivide::{
     DISPATCH_LATTICE, DISPATCH_LATTICE_NODES, DISPATCH_LATTICE_ROWS, DISPATCH_LATTICE_ROWS_PLAN,
@@ -142,18 +142,16 @@ impl<'s> CpuSubdivision<'s> {
         }
     }
 
-    fn clear(&mut self, buffer: &str, bytes: Option<u64>) {
-        match (buffer, bytes) {
-            ("counters", None) => self.counters = SubdivideCounters::default(),
-            ("counters", Some(SubdivideCounters::RUN_BYTES)) => {
-                self.counters = SubdivideCounters {
-                    cuts_low: self.counters.cuts_low,
-                    cuts_high: self.counters.cuts_high,
-                    ..Default::default()
-                }
+    fn clear(&mut self, buffer: SubdivideBuffer, bytes: Option<u64>) {
+        match buffer {
+            // The first `bytes` of the counters, as the GPU's clear does.
+            SubdivideBuffer::Counters => {
+                let all = bytemuck::bytes_of_mut(&mut self.counters);
+                let n = bytes.map_or(all.len(), |n| (n as usize).min(all.len()));
+                all[..n].fill(0);
             }
-            ("cut_edges", None) => self.frame.clear_marks(),
-            other => panic!("the subdivide twin clears no {other:?}"),
+            SubdivideBuffer::CutEdges => self.frame.clear_marks(),
+            other => unreachable!("the subdivide twin keeps no {other:?} to clear (its recordings clear none)"),
         }
     }
 
@@ -617,7 +615,7 @@ impl SubdivisionEngine for CpuSubdivision<'_> {
                 Command::Pass { .. } => {}
                 Command::Dispatch { entry, invocations } => self.dispatch(&sub, entry, invocations),
                 Command::DispatchIndirect { entry, args, offset } => {
-                    assert_eq!(args, "lattice_dispatch", "the subdivide stage's indirect arguments");
+                    assert_eq!(args, SubdivideBuffer::LatticeDispatch, "the subdivide stage's indirect arguments");
                     let at = offset as usize / 4;
                     let groups = &self.lattice_dispatch[at..at + 3];
                     let invocations = groups[0] * groups[1] * groups[2] * 64;
