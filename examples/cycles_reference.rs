@@ -17,8 +17,8 @@
 
 use std::path::Path;
 
-use twister::core::builtin;
 use twister::core::compare::{boundary_agreement, display_palette, palette_labels};
+use twister::core::scenes::builtin;
 use twister::gpu::Gpu;
 use twister::{Eye, GpuScene, Projection, RenderSettings, Renderer, Scene};
 

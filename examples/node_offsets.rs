@@ -43,8 +43,8 @@
 use std::collections::{HashMap, HashSet};
 
 use glam::{DVec2, DVec3, Vec3};
-use twister::core::load::load_scene;
-use twister::core::projection::{azimuth, horizontal_radius, Eye, Projection};
+use twister::core::panoramas::projection::{azimuth, horizontal_radius, Eye, Projection};
+use twister::core::scenes::load::load_scene;
 use twister::core::settings::{Method, RenderSettings, Split};
 use twister::cpu::subdivide::spacing::Spacing;
 use twister::cpu::subdivide::subdivide;

@@ -5,7 +5,7 @@
 //! `cargo run --release --example port_gltf -- ../shared/assets/gltf/Duck/glTF-Binary/Duck.glb out/duck`
 
 use glam::Vec3;
-use twister::core::load::{load_scene, suggested_viewer};
+use twister::core::scenes::load::{load_scene, suggested_viewer};
 use twister::gpu::Gpu;
 use twister::output::{layout_images, write_images, Layout};
 use twister::{GpuScene, RenderSettings, Renderer};
@@ -34,7 +34,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             &frame,
             Layout::Twister,
             twister::output::ImageFormat::Png,
-            twister::core::projection::PanoramaKind::Cylinder,
+            twister::core::panoramas::projection::PanoramaKind::Cylinder,
         ),
     )? {
         println!("{}", path.display());

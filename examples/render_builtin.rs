@@ -2,7 +2,7 @@
 //!
 //! `cargo run --release --example render_builtin -- builtin:demo out/example`
 
-use twister::core::builtin;
+use twister::core::scenes::builtin;
 use twister::gpu::Gpu;
 use twister::output::{layout_images, write_images, Layout};
 use twister::{GpuScene, RenderSettings, Renderer};

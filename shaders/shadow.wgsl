@@ -1,4 +1,4 @@
-// The `shadow` stage (src/core/shadow.rs): the depth of the scene seen from a light (a
+// The `shadow` stage (src/core/shading/shadow.rs): the depth of the scene seen from a light (a
 // directional light's orthographic map, a spot light's perspective one, each of a point light's
 // six cube faces), one map per render pass, before the drawing stages read it (`shadow_visibility`
 // in surface.wgsl). A plain linear projection, so the scene's own triangles are drawn, not

@@ -1,14 +1,14 @@
 // The `trace` stage (compute): ray tracing (seed 000), a primary ray per sample of each pixel
 // (`--samples`; one: the pixel's centre) and eye from its eye point (`pixel_ray` of
 // surface.wgsl: the cylinder's exact vertical model, or the sphere with its convergence and pole merge), the closest hit through the scene's BVH
-// (src/core/bvh.rs), shaded with the rasterizer's materials and headlight (surface.wgsl), or a
+// (src/core/scenes/bvh.rs), shaded with the rasterizer's materials and headlight (surface.wgsl), or a
 // point light with shadow rays; mirror and refraction rays (the material's optics) to
 // `reflect_max` bounces, depth first.
 // Writes the same four outputs as the drawing stages, per eye, into buffers the host copies into
 // the targets: colour (sRGB-encoded RGBA8), display-position error, object id + 1, distance.
 // CPU twin: src/cpu/trace.rs.
 //
-// Traversal: the two-level BVH of src/core/bvh.rs (a top level over the objects, a tree per
+// Traversal: the two-level BVH of src/core/scenes/bvh.rs (a top level over the objects, a tree per
 // level of each object's chain) walked as one binary tree, nearer child first, the farther on a stack of TRACE_STACK entries
 // with its entry distance (skipped when popped if the best hit is nearer; the host refuses
 // deeper trees); at an object leaf the walk goes on at the root of the level the ray's visual
@@ -483,8 +483,8 @@ fn trace(@builtin(global_invocation_id) gid: vec3<u32>) {
 
 // Where sample i of n lies in its pixel (0..1 from the pixel's corner): the standard sample
 // positions of Vulkan and Direct3D for 1, 2, 4, 8 and 16 samples (in 16ths of a pixel; one
-// sample: the centre; `SAMPLES_N`, generated from src/core/sampling.rs), 32 as the 8 pattern in
-// each quarter of the pixel. `sample_position` in src/core/sampling.rs.
+// sample: the centre; `SAMPLES_N`, generated from src/core/shading/sampling.rs), 32 as the 8 pattern in
+// each quarter of the pixel. `sample_position` in src/core/shading/sampling.rs.
 fn sample_position(n: u32, i: u32) -> vec2<f32> {
     // The generated tables (`constants`), copied to be indexed at run time.
     var p2 = SAMPLES_2;

@@ -28,8 +28,8 @@ pub mod shader;
 pub mod video;
 
 pub use crate::core::frame::{EyeImage, Frame, FrameStats};
-pub use crate::core::projection::{Eye, Projection, Vertical};
-pub use crate::core::scene::Scene;
+pub use crate::core::panoramas::projection::{Eye, Projection, Vertical};
+pub use crate::core::scenes::scene::Scene;
 pub use crate::core::settings::RenderSettings;
 pub use error::{Error, Result};
 pub use gpu::{GpuScene, Renderer};

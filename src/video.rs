@@ -17,7 +17,7 @@
 //! bytes added inside it; where `moov` comes before the media data (`faststart`), every chunk
 //! offset (`stco`, `co64`) moves by the bytes added in all.
 
-use crate::core::projection::PanoramaKind;
+use crate::core::panoramas::projection::PanoramaKind;
 use crate::error::{Error, Result};
 
 /// Spherical Video V1's box type: `uuid` with this UUID.

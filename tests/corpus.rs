@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 use rand::{Rng, SeedableRng};
 use serde_json::json;
-use twister::core::load::load_scene;
+use twister::core::scenes::load::load_scene;
 use twister::{GpuScene, Projection, RenderSettings};
 
 fn dir(name: &str) -> common::TempDir {

@@ -8,10 +8,10 @@
 mod common;
 
 use glam::Vec3;
-use twister::core::builtin;
-use twister::core::color::srgb_to_linear;
-use twister::core::material::Material;
-use twister::core::projection::{PanoramaKind, Projection};
+use twister::core::panoramas::projection::{PanoramaKind, Projection};
+use twister::core::scenes::builtin;
+use twister::core::shading::color::srgb_to_linear;
+use twister::core::shading::material::Material;
 use twister::{EyeImage, RenderSettings, Scene};
 
 /// An emissive white sphere of radius 0.66 m, 2 m away at azimuth `azimuth` (radians from −z

@@ -6,8 +6,8 @@
 mod common;
 
 use glam::Vec3;
-use twister::core::builtin;
-use twister::core::projection::Vertical;
+use twister::core::panoramas::projection::Vertical;
+use twister::core::scenes::builtin;
 use twister::core::settings::{Method, Split};
 use twister::EyeImage;
 use twister::{Projection, RenderSettings, Scene};
@@ -29,7 +29,7 @@ mod real_mesh {
         }
         let path = common::asset("cow/cow.obj");
         let projection = Projection { width: 1600, height: 300, ..Projection::default() };
-        let mut scene = twister::core::load::load_obj(&path).unwrap();
+        let mut scene = twister::core::scenes::load::load_obj(&path).unwrap();
         scene.fit(3.0, &projection).unwrap();
         let key = |p: Vec3| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
         // Edges by their two corner positions (unordered), with the triangles that have them.
@@ -172,7 +172,7 @@ fn closed_models_have_no_cracks() {
     }
     let cow = common::asset("cow/cow.obj");
     let p = Projection { width: 480, height: 120, ..Projection::default() };
-    let mut scene = twister::core::load::load_scene(cow.to_str().unwrap(), &p).unwrap();
+    let mut scene = twister::core::scenes::load::load_scene(cow.to_str().unwrap(), &p).unwrap();
     scene.fit(3.0, &p).unwrap();
     check(&scene, "cow", Vec3::ZERO, false);
 }
@@ -184,7 +184,7 @@ fn closed_models_have_no_cracks() {
 /// at wide, square and tall image sizes, in both vertical models.
 #[test]
 fn surround_scenes_show_no_background_for_any_method_size_or_vertical_model() {
-    use twister::core::projection::Vertical;
+    use twister::core::panoramas::projection::Vertical;
     let cube = builtin::closed_box("cube", Vec3::splat(-1.0), Vec3::splat(1.0));
     let scenes: Vec<(&str, Scene, Vec3)> = vec![
         ("box room", builtin::builtin_scene("builtin:box-room", &Projection::default()).unwrap(), Vec3::ZERO),
@@ -243,7 +243,7 @@ fn surround_scenes_show_no_background_for_any_method_size_or_vertical_model() {
 /// The demo room at 1024×1024 (its ceiling and floor reach far towards the axis on screen).
 #[test]
 fn the_demo_room_is_closed_at_1024_square() {
-    use twister::core::projection::Vertical;
+    use twister::core::panoramas::projection::Vertical;
     let r = common::renderer();
     let gs = twister::GpuScene::upload(&r.gpu, &builtin::demo()).unwrap();
     for vertical in [Vertical::Paper, Vertical::Exact] {
@@ -269,16 +269,16 @@ fn the_demo_room_is_closed_at_1024_square() {
 #[test]
 fn triangles_reaching_into_the_eye_circle_are_drawn_whole() {
     use rand::{Rng, SeedableRng};
-    use twister::core::projection::{Panorama, Vertical};
+    use twister::core::panoramas::projection::{Panorama, Vertical};
     let r = common::renderer();
     let mut rng = rand::rngs::StdRng::seed_from_u64(5);
     let mut checked = 0;
     // At the viewer (seen edge-on, a sliver), behind it, and inside the eye circle below it.
     for near in [Vec3::ZERO, Vec3::new(0.0, 0.0, 0.5), Vec3::new(0.01, -0.3, -0.01)] {
         let corners = [near, Vec3::new(-1.0, -1.0, -3.0), Vec3::new(1.2, 0.5, -3.0)];
-        let v: Vec<twister::core::scene::SceneVertex> = corners
+        let v: Vec<twister::core::scenes::scene::SceneVertex> = corners
             .iter()
-            .map(|p| twister::core::scene::SceneVertex {
+            .map(|p| twister::core::scenes::scene::SceneVertex {
                 position: p.to_array(),
                 normal: [0.0, 0.0, 1.0],
                 color: [0.8, 0.8, 0.8, 1.0],
@@ -364,7 +364,7 @@ fn background_seen(
 /// pixel (any background a sample sees changes its pixel).
 #[test]
 fn surround_scenes_let_no_sample_see_the_background() {
-    use twister::core::projection::PanoramaKind;
+    use twister::core::panoramas::projection::PanoramaKind;
     let scenes: Vec<(&str, Scene, Vec3)> = vec![
         ("box room", builtin::builtin_scene("builtin:box-room", &Projection::default()).unwrap(), Vec3::ZERO),
         ("demo room", builtin::demo(), Vec3::ZERO),
@@ -437,7 +437,7 @@ fn surround_scenes_let_no_sample_see_the_background() {
 /// heads moved off the centre and turned; the oracle as above.
 #[test]
 fn a_tracked_head_sees_closed_rooms_whole() {
-    use twister::core::head::Head;
+    use twister::core::panoramas::head::Head;
     let r = common::renderer();
     let rooms = [
         ("box room", builtin::builtin_scene("builtin:box-room", &Projection::default()).unwrap()),

@@ -10,8 +10,8 @@
 
 mod common;
 
-use twister::core::builtin;
 use twister::core::compare::{boundary_agreement, display_palette, palette_labels};
+use twister::core::scenes::builtin;
 use twister::{Eye, Projection, RenderSettings};
 
 fn check(fixture: &str, convergence: Option<f32>, pole_merge: Option<(f32, f32)>) {
@@ -71,7 +71,7 @@ fn vr180_boundaries_agree_with_cycles() {
 /// The fulldome master (issue 34): Cycles' equidistant fisheye (200°, looking up, the front at
 /// the bottom), 256 × 256, mono (Cycles turns its spherical stereo's eye circle with the
 /// camera, so a camera looking up would stand it upright; twister's stays level, as the sphere's:
-/// the stereo is checked against the sphere's rays in `core::fisheye`); pixels outside the circle
+/// the stereo is checked against the sphere's rays in `core::panoramas::fisheye`); pixels outside the circle
 /// are not compared (Cycles leaves them black).
 #[test]
 fn fisheye_boundaries_agree_with_cycles() {
@@ -99,7 +99,7 @@ fn swapped_eyes_do_not_agree_with_cycles() {
 /// well under one sample's (all or nothing).
 #[test]
 fn edge_pixels_agree_with_cycles_box_filtered_renders() {
-    use twister::core::color::srgb_to_linear;
+    use twister::core::shading::color::srgb_to_linear;
     let scene = builtin::demo();
     let projection = Projection { pole_merge: Some((60.0, 75.0)), ..Projection::equirect(512) };
     let palette = display_palette(&scene);

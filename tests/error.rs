@@ -3,7 +3,7 @@
 
 mod common;
 
-use twister::core::builtin;
+use twister::core::scenes::builtin;
 use twister::core::settings::Method;
 use twister::Frame;
 use twister::{Projection, RenderSettings, Vertical};

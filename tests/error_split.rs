@@ -12,7 +12,7 @@ mod common;
 
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
-use twister::core::scene::{Scene, SceneVertex};
+use twister::core::scenes::scene::{Scene, SceneVertex};
 use twister::core::settings::{Method, Split};
 use twister::encoding::constants::OFFSET_SPLIT_FACTOR;
 use twister::{Projection, RenderSettings, Vertical};

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use twister::core::load::load_scene;
+use twister::core::scenes::load::load_scene;
 use twister::Projection;
 
 mod common;
@@ -113,7 +113,7 @@ fn png_bytes(w: u32, h: u32, f: impl Fn(u32, u32) -> [u8; 4]) -> Vec<u8> {
 
 #[test]
 fn gltf_materials_keep_sampler_alpha_sides_texcoord_set_and_texture_transform() {
-    use twister::core::material::{AlphaMode, Filter, Mipmap, Wrap};
+    use twister::core::shading::material::{AlphaMode, Filter, Mipmap, Wrap};
     let dir = tmp("material");
     let uv0: [[f32; 2]; 4] = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]];
     let uv1: [[f32; 2]; 4] = [[0.1, 0.2], [0.3, 0.4], [0.5, 0.6], [0.7, 0.8]];
@@ -186,7 +186,10 @@ fn gltf_materials_keep_sampler_alpha_sides_texcoord_set_and_texture_transform() 
     json["meshes"][0]["primitives"][0].as_object_mut().unwrap().remove("material");
     let s = load_scene(write(&dir, "default.gltf", &json).to_str().unwrap(), &Projection::default()).unwrap();
     let k = s.vertices[0].material as usize - 1;
-    assert_eq!((s.materials[k].double_sided, s.materials[k].texture), (0, twister::core::material::NO_TEXTURE));
+    assert_eq!(
+        (s.materials[k].double_sided, s.materials[k].texture),
+        (0, twister::core::shading::material::NO_TEXTURE)
+    );
 }
 
 #[test]
@@ -206,7 +209,7 @@ fn obj_map_kd_is_relative_to_the_mtl_file_and_a_missing_texture_is_a_warning() {
     assert_eq!(s.textures.len(), 1, "{:?}", s.warnings);
     assert_eq!(&s.textures[0].rgba[12..16], &[200, 200, 9, 255], "texel (1, 1) of the PNG");
     assert_eq!(s.materials[0].texture, 0);
-    assert_eq!(s.materials[1].texture, twister::core::material::NO_TEXTURE);
+    assert_eq!(s.materials[1].texture, twister::core::shading::material::NO_TEXTURE);
     assert!(s.warnings.iter().any(|w| w.contains("lost") && w.contains("missing.png")), "{:?}", s.warnings);
     // OBJ's v runs up from the bottom row; texture space runs down from the top row.
     let top_left = s.vertices.iter().find(|v| v.position == [0.0, 1.0, -3.0]).unwrap();

@@ -7,11 +7,11 @@ mod common;
 use std::sync::Arc;
 
 use glam::Vec3;
-use twister::core::builtin;
-use twister::core::color::srgb_to_linear;
-use twister::core::environment::Environment;
-use twister::core::light::Tonemap;
-use twister::core::material::Material;
+use twister::core::scenes::builtin;
+use twister::core::shading::color::srgb_to_linear;
+use twister::core::shading::environment::Environment;
+use twister::core::shading::light::Tonemap;
+use twister::core::shading::material::Material;
 use twister::{Eye, Projection, RenderSettings, Scene, Vertical};
 
 /// Spheres of the given (metallic, roughness) and colour on a circle 1.8 m around the viewer,
@@ -100,7 +100,7 @@ fn two_tone(sun: f32) -> Environment {
     let sun_dir = Vec3::new(0.0, 0.5, 1.0).normalize();
     let radiance = (0..w * h)
         .map(|i| {
-            let d = twister::core::environment::direction_at((i % w) as f32 + 0.5, (i / w) as f32 + 0.5, w, h);
+            let d = twister::core::shading::environment::direction_at((i % w) as f32 + 0.5, (i / w) as f32 + 0.5, w, h);
             let base = if d.y > 0.0 { Vec3::new(0.6, 0.05, 0.05) } else { Vec3::new(0.05, 0.6, 0.05) };
             base + if d.dot(sun_dir) > 0.995 { Vec3::splat(sun) } else { Vec3::ZERO }
         })
@@ -178,7 +178,7 @@ fn a_given_environment_is_the_background_and_the_studio_is_not() {
     let s = settings(256, 128).with_measure_error(true);
     for (background, what) in [(true, "given"), (false, "studio-like")] {
         scene.environment =
-            Some(Arc::new(twister::core::environment::PreparedEnvironment { background, ..prepared.clone() }));
+            Some(Arc::new(twister::core::shading::environment::PreparedEnvironment { background, ..prepared.clone() }));
         let frame = common::render(&scene, &s);
         let img = frame.eye(Eye::Right);
         let objects = &frame.measurement.as_ref().unwrap().object[1];
@@ -199,7 +199,7 @@ fn a_given_environment_is_the_background_and_the_studio_is_not() {
 /// command line: left_hdr.exr and right_hdr.exr (R, G, B), and slit/trace refused in one line.
 #[test]
 fn hdr_frames_hold_the_linear_colour_and_tone_map_to_the_ordinary_frame() {
-    use twister::core::light::{tonemap, LightingParams};
+    use twister::core::shading::light::{tonemap, LightingParams};
     use twister::cpu::fragment::display_bytes;
     let mut scene = common::lit_spheres();
     scene.environment = Some(common::studio(true));
@@ -239,7 +239,7 @@ fn metal_rough_spheres_mirror_the_environment_by_roughness() {
     let path = common::asset("gltf/MetalRoughSpheresNoTextures/glTF-Binary/MetalRoughSpheresNoTextures.glb");
     let (w, h) = (1024u32, 256u32);
     let projection = Projection { width: w, height: h, vertical: Vertical::Exact, ..Projection::default() };
-    let mut scene = twister::core::load::load_scene(path.to_str().unwrap(), &projection).unwrap();
+    let mut scene = twister::core::scenes::load::load_scene(path.to_str().unwrap(), &projection).unwrap();
     scene.fit(3.0, &projection).unwrap();
     scene.environment = Some(Arc::new(two_tone(40.0).prepare()));
     let frame = common::render(&scene, &settings(w, h).with_measure_error(true));
@@ -295,7 +295,7 @@ fn the_environment_turns_by_its_yaw() {
     let (w, h) = (256u32, 64u32);
     let radiance = (0..w * h)
         .map(|i| {
-            let d = twister::core::environment::direction_at((i % w) as f32 + 0.5, (i / w) as f32 + 0.5, w, h);
+            let d = twister::core::shading::environment::direction_at((i % w) as f32 + 0.5, (i / w) as f32 + 0.5, w, h);
             if d.x > 0.7 {
                 Vec3::new(0.9, 0.9, 0.1)
             } else {
@@ -310,7 +310,7 @@ fn the_environment_turns_by_its_yaw() {
         v.position[2] += 3.6;
     }
     scene.environment =
-        Some(Arc::new(twister::core::environment::PreparedEnvironment { background: true, ..env.prepare() }));
+        Some(Arc::new(twister::core::shading::environment::PreparedEnvironment { background: true, ..env.prepare() }));
     let bright_columns = |frame: &twister::Frame| -> Vec<u32> {
         let img = frame.eye(Eye::Left);
         (0..img.width).filter(|&x| img.pixel(x, img.height / 2)[0] > 150).collect()
@@ -341,7 +341,7 @@ fn the_prepared_environment_is_cached_and_a_damaged_cache_is_replaced() {
     if !common::assets_present() {
         return;
     }
-    use twister::core::environment_cache::cache_file;
+    use twister::core::caches::environment_cache::cache_file;
     let dir = common::TempDir::new(format!("twister-env-cache-{}", std::process::id()));
     let env = Environment::load(&common::asset("environments/venice_sunset_1k.hdr")).unwrap();
     let fresh = env.prepare();

@@ -5,11 +5,11 @@
 mod common;
 
 use glam::Vec3;
-use twister::core::builtin::sphere_scene;
-use twister::core::lod::{LodChain, LodParams, NO_SPLIT};
-use twister::core::projection::Projection;
+use twister::core::detail::lod::{LodChain, LodParams, NO_SPLIT};
+use twister::core::detail::visual_field::{Field, Gaze};
+use twister::core::panoramas::projection::Projection;
+use twister::core::scenes::builtin::sphere_scene;
 use twister::core::settings::Method;
-use twister::core::visual_field::{Field, Gaze};
 use twister::cpu::subdivide::Subdivider;
 use twister::encoding::schedule::Schedule;
 use twister::encoding::subdivide::subdivide_params;
@@ -97,7 +97,7 @@ fn fewer_triangles_and_no_worse_error_in_the_central_field() {
                 .flat_map(|eye| eye.iter().enumerate())
                 .filter(|(i, e)| {
                     let (x, y) = ((*i as u32 % p.width) as f32 + 0.5, (*i as u32 / p.width) as f32 + 0.5);
-                    **e >= 0.0 && twister::core::lod::pixel_field(p, &gaze, x, y) == Field::Central
+                    **e >= 0.0 && twister::core::detail::lod::pixel_field(p, &gaze, x, y) == Field::Central
                 })
                 .map(|(_, e)| *e)
                 .collect();

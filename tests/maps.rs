@@ -5,12 +5,12 @@
 mod common;
 
 use glam::Vec3;
-use twister::core::color::srgb_to_linear;
-use twister::core::light::{Light, LightKind, Tonemap};
-use twister::core::material::{Material, NO_TEXTURE};
-use twister::core::scene::pack_tangent;
+use twister::core::scenes::scene::pack_tangent;
 use twister::core::settings::{Method, Split};
-use twister::core::texture::Texture;
+use twister::core::shading::color::srgb_to_linear;
+use twister::core::shading::light::{Light, LightKind, Tonemap};
+use twister::core::shading::material::{Material, NO_TEXTURE};
+use twister::core::shading::texture::Texture;
 use twister::{Eye, Projection, RenderSettings, Scene, Vertical};
 
 /// A quad ahead whose normal map tilts every normal by 30° towards `tilt` (tangent space: +x
@@ -122,7 +122,7 @@ fn a_khronos_samples_maps_are_read_as_data() {
     }
     let path = common::asset("gltf/NormalTangentMirrorTest/glTF-Binary/NormalTangentMirrorTest.glb");
     let p = Projection::default();
-    let scene = twister::core::load::load_scene(path.to_str().unwrap(), &p).unwrap();
+    let scene = twister::core::scenes::load::load_scene(path.to_str().unwrap(), &p).unwrap();
     let with_maps: Vec<&Material> = scene.materials.iter().filter(|m| m.normal_texture != NO_TEXTURE).collect();
     assert!(!with_maps.is_empty());
     for m in &with_maps {
@@ -157,14 +157,15 @@ fn mtl_bump_textures_become_normal_maps() {
         "mtllib m.mtl\nv 0 0 -2\nv 1 0 -2\nv 0 1 -2\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl bumpy\nf 1/1 2/2 3/3\nusemtl normal\nf 1/1 3/3 2/2\n",
     )
     .unwrap();
-    let scene = twister::core::load::load_scene(dir.join("m.obj").to_str().unwrap(), &Projection::default()).unwrap();
+    let scene =
+        twister::core::scenes::load::load_scene(dir.join("m.obj").to_str().unwrap(), &Projection::default()).unwrap();
     let (bumpy, normal) = (&scene.materials[0], &scene.materials[1]);
     assert!(bumpy.normal_texture != NO_TEXTURE && normal.normal_texture != NO_TEXTURE);
     // Tangents generated for the normal maps: along +u (+x here); on the triangle facing +z,
     // w = +1 (the bitangent up the image, +y, as v runs down it); on the one wound the other way
     // (facing −z, the image seen mirrored), w = −1.
     for v in &scene.vertices {
-        let t = twister::core::scene::unpack_tangent(v.tangent);
+        let t = twister::core::scenes::scene::unpack_tangent(v.tangent);
         let w = if v.normal[2] > 0.0 { 1.0 } else { -1.0 };
         assert!((t - glam::Vec4::new(1.0, 0.0, 0.0, w)).abs().max_element() < 1e-3, "{t} at normal {:?}", v.normal);
     }
@@ -191,7 +192,7 @@ fn generated_tangents_are_the_files_own_on_normal_tangent_mirror_test() {
     }
     let path = common::asset("gltf/NormalTangentMirrorTest/glTF-Binary/NormalTangentMirrorTest.glb");
     let p = Projection { width: 720, height: 240, ..Projection::default() };
-    let mut file = twister::core::load::load_scene(path.to_str().unwrap(), &p).unwrap();
+    let mut file = twister::core::scenes::load::load_scene(path.to_str().unwrap(), &p).unwrap();
     file.fit(2.2, &p).unwrap();
     file.lights.push(Light::sun(20.0, 35.0, 3.0));
     let wants: Vec<bool> =
@@ -202,15 +203,15 @@ fn generated_tangents_are_the_files_own_on_normal_tangent_mirror_test() {
     for v in &mut generated.vertices {
         v.tangent = 0;
     }
-    twister::core::scene::generate_tangents(&mut generated.vertices, &generated.indices, |m| wants[m as usize]);
-    let unpack = twister::core::scene::unpack_tangent;
+    twister::core::scenes::scene::generate_tangents(&mut generated.vertices, &generated.indices, |m| wants[m as usize]);
+    let unpack = twister::core::scenes::scene::unpack_tangent;
     let mut off = 0;
     for (a, b) in file.vertices.iter().zip(&generated.vertices).filter(|(a, _)| a.tangent != 0) {
         let (a, b) = (unpack(a.tangent), unpack(b.tangent));
         off += (a.truncate().dot(b.truncate()) < 0.999 || a.w != b.w) as usize;
     }
     assert!(off * 100 <= supplied, "{off} of {supplied} generated tangents differ from the file's");
-    let settings = RenderSettings::new(p).with_lighting(twister::core::light::LightingMode::Pbr);
+    let settings = RenderSettings::new(p).with_lighting(twister::core::shading::light::LightingMode::Pbr);
     let (a, b) = (common::render(&file, &settings), common::render(&generated, &settings));
     let mut sum = [0.0f64; 3];
     let mut differ = 0;

@@ -5,10 +5,10 @@
 mod common;
 
 use glam::{Vec2, Vec3};
-use twister::core::builtin;
-use twister::core::light::{Light, LightKind, LightingMode, Tonemap};
-use twister::core::load::load_scene;
-use twister::core::material::Material;
+use twister::core::scenes::builtin;
+use twister::core::scenes::load::load_scene;
+use twister::core::shading::light::{Light, LightKind, LightingMode, Tonemap};
+use twister::core::shading::material::Material;
 use twister::cpu::fragment::{brdf, pixel_ray};
 use twister::{Eye, Projection, RenderSettings, Scene, Vertical};
 

@@ -3,8 +3,8 @@
 mod common;
 
 use glam::Vec3;
-use twister::core::builtin::{self, SEAM_SPHERE_RADIUS};
-use twister::core::scene::SceneVertex;
+use twister::core::scenes::builtin::{self, SEAM_SPHERE_RADIUS};
+use twister::core::scenes::scene::SceneVertex;
 use twister::core::settings::{Method, Split};
 use twister::EyeImage;
 use twister::{Eye, Projection, RenderSettings, Scene, Vertical};
@@ -31,7 +31,7 @@ fn centroid(img: &EyeImage, bg: [f32; 3], around_x: f32) -> (f32, f32, usize) {
 #[test]
 fn sphere100_centroid_lies_where_the_oracle_projects_its_centre() {
     let projection = small();
-    let scene = twister::core::builtin::builtin_scene("builtin:sphere100", &projection).unwrap();
+    let scene = twister::core::scenes::builtin::builtin_scene("builtin:sphere100", &projection).unwrap();
     let settings = RenderSettings::new(projection);
     let frame = common::render(&scene, &settings);
     let center = Vec3::new(0.0, 0.0, -3.0);

@@ -6,11 +6,11 @@
 mod common;
 
 use glam::Vec3;
-use twister::core::color::srgb_to_linear;
-use twister::core::material::Material;
-use twister::core::projection::{Eye, PanoramaKind, Projection, Vertical};
-use twister::core::scene::SceneVertex;
+use twister::core::panoramas::projection::{Eye, PanoramaKind, Projection, Vertical};
+use twister::core::scenes::scene::SceneVertex;
 use twister::core::settings::Method;
+use twister::core::shading::color::srgb_to_linear;
+use twister::core::shading::material::Material;
 use twister::{RenderSettings, Scene};
 
 /// An emissive white wall 2 m ahead (black base colour, no lights: its colour is its emission),
@@ -169,7 +169,7 @@ fn samples_beyond_the_adapter_need_an_image_it_can_draw() {
         eprintln!("the adapter draws 16 samples itself: nothing made up to refuse");
         return;
     }
-    if max > twister::core::projection::MAX_IMAGE_SIDE {
+    if max > twister::core::panoramas::projection::MAX_IMAGE_SIDE {
         eprintln!("the adapter's images are larger than a frame may be: no made-up image to refuse");
         return;
     }
@@ -183,15 +183,15 @@ fn samples_beyond_the_adapter_need_an_image_it_can_draw() {
 /// `wall(left)` with its alpha: BLEND with the vertex colours' alpha `alpha`, or MASK (cutoff
 /// 1/2) with a texture of two texels, alpha 0 then 1, filtered linearly across the wall: the
 /// cutoff's line runs down the wall's middle, 2 m right of `left`.
-fn alpha_wall(left: f32, mode: twister::core::material::AlphaMode, alpha: f32) -> Scene {
-    use twister::core::material::{AlphaMode, Filter, Wrap};
+fn alpha_wall(left: f32, mode: twister::core::shading::material::AlphaMode, alpha: f32) -> Scene {
+    use twister::core::shading::material::{AlphaMode, Filter, Wrap};
     let mut scene = wall(left);
     scene.vertices.iter_mut().for_each(|v| v.color[3] = alpha);
     let m = &mut scene.materials[0];
     m.alpha_mode = mode as u32;
     if mode == AlphaMode::Mask {
         m.alpha_cutoff = 0.5;
-        scene.textures.push(twister::core::texture::Texture {
+        scene.textures.push(twister::core::shading::texture::Texture {
             name: "alpha edge".into(),
             width: 2,
             height: 1,
@@ -220,7 +220,7 @@ fn alpha_covers_its_share_of_each_pixel() {
 /// `alpha_covers_its_share_of_each_pixel` drawn by `method` (the ray tracer: a ray per sample,
 /// each with its own alpha test and screen-door threshold).
 fn alpha_coverage(method: Method) {
-    use twister::core::material::AlphaMode;
+    use twister::core::shading::material::AlphaMode;
     let projection = Projection { width: 256, height: 64, vertical: Vertical::Exact, ..Projection::default() };
     let settings = RenderSettings::new(projection).with_method(method).with_ambient(0.0).with_background([0.0; 3]);
     let linear = |image: &twister::EyeImage, x: u32, y: u32| srgb_to_linear(image.pixel(x, y)[0] as f32 / 255.0) as f64;
@@ -307,8 +307,8 @@ fn bright_edges_keep_their_share_when_samples_are_tone_mapped_first() {
     let settings = RenderSettings::new(projection).with_ambient(0.0).with_background([0.0; 3]);
     let larger = Projection { width: 4 * projection.width, height: 4 * projection.height, ..projection };
     let hdr_settings = RenderSettings::new(larger).with_ambient(0.0).with_background([0.0; 3]).with_hdr(true);
-    let lighting =
-        settings.lighting_params(twister::core::light::SceneLighting { lights: 0, physically_based: true }, None);
+    let lighting = settings
+        .lighting_params(twister::core::shading::light::SceneLighting { lights: 0, physically_based: true }, None);
     let (mut first, mut after, mut n) = (0.0f64, 0.0f64, 0);
     for k in 0..6 {
         let left = -0.4 + 0.023 * k as f32;
@@ -331,7 +331,7 @@ fn bright_edges_keep_their_share_when_samples_are_tone_mapped_first() {
                 let block = (0..16).map(|i| hdr[((4 * row + i / 4) * larger.width + 4 * c + i % 4) as usize][0]);
                 block.sum::<f32>() / 16.0
             };
-            let toned = |c: u32| twister::core::light::tonemap(Vec3::splat(mean(c)), &lighting).x as f64;
+            let toned = |c: u32| twister::core::shading::light::tonemap(Vec3::splat(mean(c)), &lighting).x as f64;
             after += (toned(column) / toned(column + 2) - exact).abs();
             n += 1;
         }

@@ -42,7 +42,7 @@ proptest! {
     }
 
     /// The level of detail never opens a closed room around the viewer, whatever the gaze:
-    /// every case here has one (the selection's own promise is `core::lod`'s property test).
+    /// every case here has one (the selection's own promise is `core::detail::lod`'s property test).
     #[test]
     fn the_level_of_detail_keeps_a_room_around_the_viewer_closed_at_any_gaze(
         case in search::case_strategy(&[SearchPanorama::Cylinder, SearchPanorama::Equirect], &[SearchMethod::Adaptive, SearchMethod::Vertex], 160),
@@ -155,7 +155,7 @@ fn a_torus_simplified_outside_the_visual_field_stays_closed() {
     };
     let drawn = search::drawn_scene(&case);
     let torus = &drawn.3.as_ref().expect("a level of detail").chosen[1];
-    assert_eq!(torus.field, twister::core::visual_field::Field::Outside);
+    assert_eq!(torus.field, twister::core::detail::visual_field::Field::Outside);
     assert!(torus.triangles < 96, "the torus is simplified: {torus:?}");
     if let Err(f) = search::check(Some(common::renderer()), &case) {
         panic!("{}: {}", f.check.name(), f.message);

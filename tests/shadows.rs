@@ -6,8 +6,8 @@ mod common;
 
 use common::{ball_over_floor, render};
 use glam::{Vec2, Vec3};
-use twister::core::light::LightKind;
 use twister::core::settings::{Method, Split};
+use twister::core::shading::light::LightKind;
 use twister::cpu::fragment::pixel_ray;
 use twister::{Eye, Projection, RenderSettings, Vertical};
 

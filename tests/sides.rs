@@ -10,9 +10,9 @@ mod common;
 use std::collections::BTreeSet;
 
 use glam::Vec3;
-use twister::core::material::Material;
-use twister::core::scene::{SceneVertex, SINGLE_SIDED};
+use twister::core::scenes::scene::{SceneVertex, SINGLE_SIDED};
 use twister::core::settings::Method;
+use twister::core::shading::material::Material;
 use twister::cpu::raster::raster;
 use twister::cpu::subdivide::subdivide;
 use twister::encoding::params::raster_params;

@@ -5,8 +5,8 @@
 mod common;
 
 use glam::Vec3;
-use twister::core::builtin;
-use twister::core::scene::SceneVertex;
+use twister::core::scenes::builtin;
+use twister::core::scenes::scene::SceneVertex;
 use twister::core::settings::{Method, Split};
 use twister::{Eye, Projection, RenderSettings, Scene};
 
@@ -196,7 +196,7 @@ fn probes_land_where_the_format_puts_them(projection: Projection, want: impl Fn(
 /// the ray's direction turned into the dome's frame (the front raised by the tilt), x = W/2 +
 /// ρ·sin α, y = W/2 + ρ·cos α with ρ = (W/2)·ψ/(FOV/2), ψ its angle from the dome's axis and α its
 /// azimuth about it (0 ahead, at the bottom). A sphere 45° up straight ahead sits at (W/2, 3W/4)
-/// in the 180° dome (`core::fisheye` checks that exactly, mono).
+/// in the 180° dome (`core::panoramas::fisheye` checks that exactly, mono).
 #[test]
 fn the_fisheye_fills_its_circle_with_spheres_where_the_dome_puts_them() {
     let black = [0.0; 3];

@@ -8,11 +8,11 @@ use twister::encoding::params::raster_params;
 use twister::encoding::subdivide::subdivide_params;
 
 use glam::{Vec2, Vec3};
-use twister::core::material::{AlphaMode, Filter, Material, Mipmap, Wrap, NO_TEXTURE};
-use twister::core::projection::{Eye, Projection};
-use twister::core::scene::SceneVertex;
+use twister::core::panoramas::projection::{Eye, Projection};
+use twister::core::scenes::scene::SceneVertex;
 use twister::core::settings::{Method, Split};
-use twister::core::texture::Texture;
+use twister::core::shading::material::{AlphaMode, Filter, Material, Mipmap, Wrap, NO_TEXTURE};
+use twister::core::shading::texture::Texture;
 use twister::cpu::raster::raster;
 use twister::cpu::slit::slit;
 use twister::cpu::subdivide::subdivide;
@@ -313,9 +313,10 @@ fn box_textured_shows_its_logo_colours() {
     // The texture's colours under the paper's headlight (a glTF scene is otherwise lit by the
     // BRDF, and this one has no lights of its own).
     let mut s = settings(1200, 300, Method::Adaptive(Split::Length))
-        .with_lighting(twister::core::light::LightingMode::Headlight);
+        .with_lighting(twister::core::shading::light::LightingMode::Headlight);
     let mut scene =
-        twister::core::load::load_scene(dir.join("BoxTextured.gltf").to_str().unwrap(), &s.view.projection).unwrap();
+        twister::core::scenes::load::load_scene(dir.join("BoxTextured.gltf").to_str().unwrap(), &s.view.projection)
+            .unwrap();
     assert_eq!(scene.textures.len(), 1);
     assert!(scene.materials[0].texture != NO_TEXTURE);
     scene.fit(1.5, &s.view.projection).unwrap();
@@ -357,9 +358,10 @@ fn box_textured_shows_its_logo_colours() {
 /// 0.04 with 16 probes.)
 #[test]
 fn anisotropic_filtering_keeps_the_stripes_that_isotropic_filtering_blurs() {
-    use twister::core::color::srgb_to_linear;
-    use twister::core::projection::pixel_ray;
-    let projection = Projection { vertical: twister::core::projection::Vertical::Exact, ..Projection::equirect(192) };
+    use twister::core::panoramas::projection::pixel_ray;
+    use twister::core::shading::color::srgb_to_linear;
+    let projection =
+        Projection { vertical: twister::core::panoramas::projection::Vertical::Exact, ..Projection::equirect(192) };
     let scene = common::striped_floor();
     // The exact mean over each pixel of the eye's image, where the pixel sees the floor 2 to 10 m
     // away, looking mostly along z (across the stripes).

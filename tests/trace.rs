@@ -8,12 +8,12 @@ mod common;
 use std::cell::Cell;
 
 use glam::{Mat4, Vec2, Vec3};
-use twister::core::builtin;
-use twister::core::builtin::sphere_scene;
-use twister::core::bvh::{BvhLevel, SceneBvh};
-use twister::core::load::load_scene;
-use twister::core::lod::LodChain;
-use twister::core::scene::SceneVertex;
+use twister::core::detail::lod::LodChain;
+use twister::core::scenes::builtin;
+use twister::core::scenes::builtin::sphere_scene;
+use twister::core::scenes::bvh::{BvhLevel, SceneBvh};
+use twister::core::scenes::load::load_scene;
+use twister::core::scenes::scene::SceneVertex;
 use twister::core::settings::Method;
 use twister::cpu::trace::{closest_hit, TracedRay, TracedScene};
 use twister::{Eye, Frame, GpuScene, Projection, RenderSettings, Scene, Vertical};
@@ -147,8 +147,8 @@ fn trace_refuses_the_paper_model_and_a_scene_without_its_bvh() {
 
 // ---- optics: a mirror sphere and a glass sphere against analytic rays ----
 
-use twister::core::color::linear_to_srgb;
-use twister::core::material::Material;
+use twister::core::shading::color::linear_to_srgb;
+use twister::core::shading::material::Material;
 use twister::cpu::fragment::pixel_ray;
 
 /// The room (each wall its colour), a checkerboard of 0.25 m tiles just before the −z wall, and
@@ -171,7 +171,7 @@ fn optics_scene(material: Material) -> Scene {
             let color = TILE_COLOURS[((i + j) % 2) as usize];
             let base = v.len() as u32;
             for (x, y) in [(x0, y0), (x0 + TILE, y0), (x0 + TILE, y0 + TILE), (x0, y0 + TILE)] {
-                v.push(twister::core::scene::SceneVertex {
+                v.push(twister::core::scenes::scene::SceneVertex {
                     position: [x, y, BOARD_Z],
                     normal: [0.0, 0.0, 1.0],
                     color,
@@ -373,7 +373,7 @@ fn a_point_light_casts_the_blockers_hard_shadow_where_geometry_puts_it() {
 
 #[test]
 fn visual_field_lod_leaves_rays_outside_the_field_untraced_and_the_rest_as_without() {
-    use twister::core::visual_field::Gaze;
+    use twister::core::detail::visual_field::Gaze;
     let projection = exact(480, 120);
     let scene = builtin::demo();
     let gaze = Gaze::new(40.0, -10.0);
@@ -426,9 +426,9 @@ fn per_ray_polygon_levels_keep_the_central_field_and_coarsen_the_periphery_withi
     if !common::assets_present() {
         return;
     }
-    use twister::core::bvh::SceneBvh;
-    use twister::core::lod::LodChain;
-    use twister::core::visual_field::{Field, Gaze};
+    use twister::core::detail::lod::LodChain;
+    use twister::core::detail::visual_field::{Field, Gaze};
+    use twister::core::scenes::bvh::SceneBvh;
     let projection = exact(480, 120);
     let ring = cow_ring(&projection);
     let share = 500.0 / 5804.0;

@@ -19,9 +19,9 @@ mod trace;
 
 use glam::Vec3;
 use rand::{Rng, SeedableRng};
-use twister::core::builtin;
-use twister::core::light::Tonemap;
+use twister::core::scenes::builtin;
 use twister::core::settings::{Method, Split};
+use twister::core::shading::light::Tonemap;
 use twister::cpu::reduce_error::reduce_error;
 use twister::encoding::types::ErrorStats;
 use twister::shader::STAGES;
@@ -172,7 +172,7 @@ impl Twin for ProjectPoints {
         // VR180: the same points, half of them behind (outside the image).
         for eye in Eye::BOTH {
             out.push((format!("vr180 {eye:?}"), (Projection::vr180(2048), eye, sphere_points.clone())));
-            let head = twister::core::head::Head { offset: [0.3, 0.1, -0.2], turn: 0.35 };
+            let head = twister::core::panoramas::head::Head { offset: [0.3, 0.1, -0.2], turn: 0.35 };
             let tracked = Projection { vertical: Vertical::Exact, head: Some(head), ..Projection::default() };
             out.push((format!("a tracked head {eye:?}"), (tracked, eye, points.clone())));
             let dome = Projection { fov: 240.0, dome_tilt: 20.0, ..Projection::fisheye(2048) };
@@ -319,7 +319,7 @@ fn raster_geometry_cases() -> Vec<(String, RasterCase)> {
     let sphere = Projection::equirect(320);
     out.push(("demo on the sphere".into(), (builtin::demo(), RenderSettings::new(sphere))));
     out.push(("demo on VR180".into(), (builtin::demo(), RenderSettings::new(Projection::vr180(128)))));
-    let head = twister::core::head::Head { offset: [0.3, 0.1, -0.2], turn: 0.35 };
+    let head = twister::core::panoramas::head::Head { offset: [0.3, 0.1, -0.2], turn: 0.35 };
     let tracked =
         Projection { width: 256, height: 64, vertical: Vertical::Exact, head: Some(head), ..Projection::default() };
     out.push(("demo seen by a tracked head".into(), (builtin::demo(), RenderSettings::new(tracked))));
@@ -328,7 +328,7 @@ fn raster_geometry_cases() -> Vec<(String, RasterCase)> {
     out.push(("demo on the cubemap".into(), (builtin::demo(), RenderSettings::new(Projection::cubemap(192)))));
     // A triangle 2 m ahead reaching ±60° across and 50° up and down.
     let mut triangle = Scene::new("big triangle");
-    let corner = |p: [f32; 3]| twister::core::scene::SceneVertex {
+    let corner = |p: [f32; 3]| twister::core::scenes::scene::SceneVertex {
         position: p,
         normal: [0.0, 0.0, 1.0],
         color: [0.8, 0.7, 0.6, 1.0],
@@ -359,8 +359,8 @@ fn raster_sample_cases() -> Vec<(String, RasterCase)> {
     let projection = Projection { width: 400, height: 100, vertical: Vertical::Exact, ..Projection::default() };
     let settings = RenderSettings::new(projection).with_samples(4);
     let mut blended = builtin::demo();
-    blended.materials.push(twister::core::material::Material {
-        alpha_mode: twister::core::material::AlphaMode::Blend as u32,
+    blended.materials.push(twister::core::shading::material::Material {
+        alpha_mode: twister::core::shading::material::AlphaMode::Blend as u32,
         ..Default::default()
     });
     let blend = blended.materials.len() as u32;
@@ -368,7 +368,7 @@ fn raster_sample_cases() -> Vec<(String, RasterCase)> {
         v.material = blend;
         v.color[3] = if v.object == 1 { 0.5 } else { 0.3 };
     }
-    let screen = common::ball_over_floor(twister::core::light::LightKind::Spot, true);
+    let screen = common::ball_over_floor(twister::core::shading::light::LightKind::Spot, true);
     vec![
         ("demo, 4 samples".into(), (builtin::demo(), settings)),
         ("demo with two BLEND objects, 4 samples".into(), (blended, settings)),
@@ -411,7 +411,7 @@ fn raster_look_cases() -> Vec<(String, RasterCase)> {
     out.push(("striped floor, anisotropy 16".into(), (common::striped_floor(), floor)));
     out.push(("mapped panels with glTF tangents".into(), (common::with_tangents(panels), settings)));
     // Shadow maps: a ball and a masked screen over a floor under a spot light.
-    let shadows = common::ball_over_floor(twister::core::light::LightKind::Spot, true);
+    let shadows = common::ball_over_floor(twister::core::shading::light::LightKind::Spot, true);
     let settings =
         RenderSettings::new(Projection { width: 400, height: 120, vertical: Vertical::Exact, ..Projection::default() });
     out.push(("ball and screen, spot light's shadow map".into(), (shadows, settings.with_shadow_map_size(512))));

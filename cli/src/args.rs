@@ -6,16 +6,16 @@ use std::path::PathBuf;
 use crate::choice::choice;
 use clap::Args;
 use glam::Vec3;
-use twister::core::environment::PreparedEnvironment;
-use twister::core::light::{LightingMode, Tonemap};
+use twister::core::shading::environment::PreparedEnvironment;
+use twister::core::shading::light::{LightingMode, Tonemap};
 
-use twister::core::head::Head;
-use twister::core::lod::LodParams;
-use twister::core::projection::{PanoramaKind, DEFAULT_POLE_MERGE};
+use twister::core::detail::lod::LodParams;
+use twister::core::detail::visual_field::Gaze;
+use twister::core::panoramas::head::Head;
+use twister::core::panoramas::projection::{PanoramaKind, DEFAULT_POLE_MERGE};
 use twister::core::settings::{
     Method, Split, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV, DEFAULT_MAX_ERROR_PX, DEFAULT_MEMORY_MB, DEFAULT_REFLECT_MAX,
 };
-use twister::core::visual_field::Gaze;
 use twister::error::{Error, Result};
 use twister::output::{ImageFormat, Layout};
 use twister::{Projection, RenderSettings, Vertical};
@@ -152,7 +152,7 @@ pub struct ViewArgs {
     pub no_shadows: bool,
     /// The side of a shadow map in texels (a multiple of 64; the first four lights get maps,
     /// fitted to the scene's bounding box; a point light a cube of six faces of half the side).
-    #[arg(help_heading = "Lighting", long, default_value_t = twister::core::shadow::DEFAULT_SHADOW_MAP_SIZE, value_name = "N")]
+    #[arg(help_heading = "Lighting", long, default_value_t = twister::core::shading::shadow::DEFAULT_SHADOW_MAP_SIZE, value_name = "N")]
     pub shadow_map_size: u32,
     /// Exposure in stops: the BRDF's linear colour is scaled by 2^EV before tone mapping.
     #[arg(help_heading = "Lighting", long, default_value_t = 0.0, value_name = "EV")]
@@ -478,7 +478,7 @@ impl ViewArgs {
 
     /// The environment that lights the scene (see `--environment`), prepared.
     pub fn environment(&self, scene: &twister::Scene) -> Result<Option<PreparedEnvironment>> {
-        use twister::core::environment::Environment;
+        use twister::core::shading::environment::Environment;
         if self.lighting == LightingMode::Headlight && self.environment.as_deref().is_some_and(|e| e != "none") {
             return Err(Error::option(
                 "--environment",

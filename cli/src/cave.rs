@@ -1,15 +1,15 @@
 //! The command line's CAVE (`--panorama cave --cave FILE.json`): the walls of the file, each
-//! checked and turned into the projection that draws it (`core::cave` has the maths), and the
+//! checked and turned into the projection that draws it (`core::panoramas::cave` has the maths), and the
 //! settings of one wall's draw.
 
-use twister::core::cave::NamedWall;
-use twister::core::projection::PanoramaKind;
+use twister::core::panoramas::cave::NamedWall;
+use twister::core::panoramas::projection::PanoramaKind;
 use twister::error::{Error, Result};
 use twister::{Projection, RenderSettings};
 
 use crate::args::{RenderArgs, ViewArgs, Viewer};
 use glam::Vec3;
-use twister::core::timeline::Timeline;
+use twister::core::scenes::timeline::Timeline;
 
 /// `settings` drawing CAVE wall `wall` (a projection of `ViewArgs::cave_walls`): its size and
 /// rectangle, the rest as `settings` have them (placed with the scene).
@@ -42,7 +42,7 @@ impl ViewArgs {
         if matches!(self.viewer, Viewer::Camera(_)) {
             return Err(Error::option("--viewer", "a CAVE's walls and head are in the scene: give --viewer x,y,z"));
         }
-        twister::core::cave::read_cave(path).map_err(crate::flags::for_user)
+        twister::core::panoramas::cave::read_cave(path).map_err(crate::flags::for_user)
     }
 
     /// Each wall of `--cave` drawn with `settings` (which draw the first): its name and its
@@ -65,7 +65,7 @@ impl ViewArgs {
 /// The rows of a `--head-path` file, checked.
 pub fn read_head_timeline(path: &std::path::Path) -> Result<Timeline> {
     Timeline::read(path, "head_path", (3, 4), "time,x,y,z[,yaw]", |v| {
-        let max = twister::core::scene::MAX_COORDINATE;
+        let max = twister::core::scenes::scene::MAX_COORDINATE;
         (v[..3].iter().any(|c| c.abs() > max)).then(|| format!("coordinates within ±{max:e}"))
     })
 }

@@ -2,7 +2,7 @@
 
 use clap::Args;
 
-use twister::core::load::{load_scene, suggested_viewer};
+use twister::core::scenes::load::{load_scene, suggested_viewer};
 use twister::error::{Error, Result};
 use twister::Projection;
 

@@ -112,7 +112,7 @@ pub fn draw(
         let mut frame = renderer.render(&prepared.gpu_scene, &settings)?;
         if let (true, Some(gaze)) = (args.lod_overlay, &prepared.gaze) {
             for img in [&mut frame.left, &mut frame.right] {
-                twister::core::lod::draw_field_boundaries(img, settings.projection(), gaze);
+                twister::core::detail::lod::draw_field_boundaries(img, settings.projection(), gaze);
             }
         }
         let record = stats.then(|| {

@@ -5,12 +5,12 @@
 use glam::{Mat4, Vec3};
 
 use crate::args::{ViewArgs, Viewer};
-use twister::core::bvh::SceneBvh;
-use twister::core::load::load_scene;
-use twister::core::lod::{LodChain, LodSelection};
-use twister::core::scene::MAX_COORDINATE;
+use twister::core::detail::lod::{LodChain, LodSelection};
+use twister::core::detail::visual_field::{Field, Gaze};
+use twister::core::scenes::bvh::SceneBvh;
+use twister::core::scenes::load::load_scene;
+use twister::core::scenes::scene::MAX_COORDINATE;
 use twister::core::settings::Method;
-use twister::core::visual_field::{Field, Gaze};
 use twister::error::{Error, Result};
 use twister::gpu::Gpu;
 use twister::{GpuScene, RenderSettings, Renderer, Scene};
@@ -139,12 +139,12 @@ pub fn prepare_loaded(
     let (mut scene, settings) = place(spec, loaded, fit, view, settings)?;
     settings.validate()?;
     if let Some([azimuth, elevation, lux]) = view.sun {
-        scene.lights.push(twister::core::light::Light::sun(azimuth, elevation, lux));
+        scene.lights.push(twister::core::shading::light::Light::sun(azimuth, elevation, lux));
     }
     let selection =
         lod.map(|(params, gaze)| LodChain::build(&scene, params.p3).select(&scene, settings.view(), &gaze, &params));
     if let (Some(sel), true) = (&selection, overlay) {
-        twister::core::lod::tint(&mut scene, sel);
+        twister::core::detail::lod::tint(&mut scene, sel);
     }
     scene.environment = view.environment(&scene)?.map(std::sync::Arc::new);
     let mut gpu_scene = GpuScene::upload(&renderer.gpu, &scene)?;

@@ -1,6 +1,6 @@
 //! `twister render --frames A..B`: a frame sequence of an animated scene (issue 18). The device,
 //! pipelines, scene buffers and targets are made once; each frame poses the scene's rig at
-//! frame / fps seconds (`core::animation`; the vertices by the GPU's skin stage, which reads only
+//! frame / fps seconds (`core::scenes::animation`; the vertices by the GPU's skin stage, which reads only
 //! the frame's matrices and weights), renders and writes its files atomically (all of a frame's
 //! files or none: `output::write_all`).
 //!
@@ -19,11 +19,11 @@ use crate::args::{RenderArgs, ShardMode, Viewer};
 use crate::render::render_settings;
 use crate::scene::{open_renderer, prepare_loaded, Prepared};
 use crate::writer::{frame_name, FrameRecord, FrameWriter};
-use twister::core::lod::{LodChain, LodParams, LodSelection};
-use twister::core::projection::PanoramaKind;
+use twister::core::detail::lod::{LodChain, LodParams, LodSelection};
+use twister::core::detail::visual_field::GazePath;
+use twister::core::panoramas::projection::PanoramaKind;
+use twister::core::scenes::timeline::Timeline;
 use twister::core::settings::Method;
-use twister::core::timeline::Timeline;
-use twister::core::visual_field::GazePath;
 use twister::error::{Error, Result};
 use twister::output::{write_all, Layout};
 use twister::video::StereoMode;
@@ -162,7 +162,7 @@ impl Sequence<'_> {
         let Some(path) = &self.head_path else { return settings };
         let v = path.at(time);
         let scale = self.args.view.scale;
-        let head = twister::core::head::Head::relative(
+        let head = twister::core::panoramas::head::Head::relative(
             Vec3::new(v[0], v[1], v[2]) * scale,
             v.get(3).copied().unwrap_or(self.base_yaw),
             settings.view.viewer,
@@ -229,7 +229,7 @@ pub struct Checked {
     stereo: StereoMode,
     walls: Vec<twister::Projection>,
     gaze_path: Option<GazePath>,
-    lod: Option<(LodParams, twister::core::visual_field::Gaze)>,
+    lod: Option<(LodParams, twister::core::detail::visual_field::Gaze)>,
     viewer_path: Option<Timeline>,
     head_path: Option<Timeline>,
 }
@@ -449,7 +449,7 @@ fn read_viewer_path(args: &RenderArgs) -> Result<Option<Timeline>> {
             Err(Error::option("--viewer-path", "moves the viewer itself: leave out --viewer camera"))
         }
         Some(path) => Ok(Some(Timeline::read(path, "viewer_path", (3, 4), "time,x,y,z[,yaw]", |v| {
-            let max = twister::core::scene::MAX_COORDINATE;
+            let max = twister::core::scenes::scene::MAX_COORDINATE;
             (v[..3].iter().any(|c| c.abs() > max)).then(|| format!("coordinates within ±{max:e}"))
         })?)),
         None => Ok(None),

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 use twister::core::frame::FrameStats;
-use twister::core::projection::PanoramaKind;
+use twister::core::panoramas::projection::PanoramaKind;
 use twister::error::{Error, Result};
 use twister::output::{
     depth_images, depth_names, exr_file, gpano_xmp, hdr_exr_file, image_file, layout_images, layout_names,

@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use glam::{Quat, Vec2, Vec3, Vec4};
-use twister::core::animation::{pose_nodes, Interpolation, Property};
-use twister::core::load::load_scene;
+use twister::core::scenes::animation::{pose_nodes, Interpolation, Property};
+use twister::core::scenes::load::load_scene;
 use twister::{Eye, GpuScene, Projection, RenderSettings, Scene, Vertical};
 
 fn asset_scene(relative: &str) -> Scene {
@@ -294,7 +294,7 @@ fn a_video_carries_the_spherical_metadata() {
     if !common::assets_present() {
         return;
     }
-    use twister::core::projection::PanoramaKind;
+    use twister::core::panoramas::projection::PanoramaKind;
     use twister::video::{find_boxes, find_spherical_v1, with_spherical_metadata, StereoMode};
     let root = common::TempDir::new(format!("twister-video-{}", std::process::id()));
     let video = root.join("cube.mp4");

@@ -338,7 +338,7 @@ fn scale_turns_scene_units_into_metres_which_sets_the_disparity() {
     // Scaling the scene and the viewer together keeps every direction; only the disparity
     // changes, since the eye circle is in metres. Sphere100 (3 m ahead) at --scale 0.2 stands
     // 0.6 m ahead, inside the display cylinder: its disparity changes sign.
-    use twister::core::projection::{Eye, Projection};
+    use twister::core::panoramas::projection::{Eye, Projection};
     let (w, h) = (720u32, 120u32);
     let projection = Projection { width: w, height: h, ..Projection::default() };
     let disparity = |scale: &str| {
@@ -365,7 +365,7 @@ fn scale_turns_scene_units_into_metres_which_sets_the_disparity() {
         let x = |eye| projection.to_pixel(projection.project(glam::Vec3::new(0.0, 0.0, -r), eye).unwrap().u, 0.0)[0];
         x(Eye::Right) - x(Eye::Left)
     };
-    let sphere = twister::core::builtin::builtin_scene("builtin:sphere100", &projection).unwrap();
+    let sphere = twister::core::scenes::builtin::builtin_scene("builtin:sphere100", &projection).unwrap();
     let (lo, hi) = sphere.bounds().unwrap();
     let (centre, front) = (-(lo.z + hi.z) / 2.0, -hi.z);
     let (d1, d02) = (disparity("1"), disparity("0.2"));

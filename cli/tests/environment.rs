@@ -2,7 +2,7 @@
 
 mod common;
 
-use twister::core::environment::Environment;
+use twister::core::shading::environment::Environment;
 
 /// `--hdr` writes each eye's linear colour as an EXR beside display images that are the bytes
 /// they are without it; the methods that cannot draw a linear frame, and an environment that
@@ -67,7 +67,7 @@ fn render_caches_the_prepared_environment_where_twister_cache_dir_says() {
     if !common::assets_present() {
         return;
     }
-    use twister::core::environment_cache::cache_file;
+    use twister::core::caches::environment_cache::cache_file;
     let dir = common::TempDir::new(format!("twister-env-cache-cli-{}", std::process::id()));
     let env = Environment::load(&common::asset("environments/venice_sunset_1k.hdr")).unwrap();
     // The command line caches where TWISTER_CACHE_DIR says (the studio of a glTF scene too).

@@ -5,7 +5,7 @@
 mod common;
 
 use glam::Vec3;
-use twister::core::projection::PanoramaKind;
+use twister::core::panoramas::projection::PanoramaKind;
 use twister::{Eye, Projection};
 
 fn tmp(name: &str) -> common::TempDir {

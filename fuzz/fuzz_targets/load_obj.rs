@@ -3,7 +3,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use twister::core::load::load_scene;
+use twister::core::scenes::load::load_scene;
 use twister::Projection;
 
 fuzz_target!(|data: &[u8]| {

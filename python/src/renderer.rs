@@ -113,7 +113,7 @@ impl Renderer {
             return Ok(Scene { spec, placement, loaded: None });
         }
         let loaded = without_gil(py, || {
-            let loaded = twister::core::load::load_scene(&spec, &twister::Projection::default())?;
+            let loaded = twister::core::scenes::load::load_scene(&spec, &twister::Projection::default())?;
             self.lock().scenes_loaded += 1;
             Ok(loaded)
         })?;

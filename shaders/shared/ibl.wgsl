@@ -1,12 +1,12 @@
 // Image-based lighting from the prepared environment (split sum: prefiltered levels, SH
-// irradiance, the lobe table; src/core/environment.rs). CPU twin: src/cpu/fragment/ibl.rs.
+// irradiance, the lobe table; src/core/shading/environment.rs). CPU twin: src/cpu/fragment/ibl.rs.
 
 #import projection
 #import constants
 #import surface_bindings
 #import brdf
 
-// ---- Image-based lighting (src/core/environment.rs; twins in fragment.rs) ----
+// ---- Image-based lighting (src/core/shading/environment.rs; twins in fragment.rs) ----
 
 // A viewer-frame direction in the environment's frame.
 fn env_direction(d: vec3<f32>) -> vec3<f32> {
@@ -73,7 +73,7 @@ fn env_lut(nv: f32, roughness: f32) -> vec2<f32> {
 }
 
 // The environment's light reflected towards v by a surface with unit normal n (split sum with
-// Fdez-Agüera's multiple-scattering term; see src/core/environment.rs).
+// Fdez-Agüera's multiple-scattering term; see src/core/shading/environment.rs).
 fn ibl_radiance(n: vec3<f32>, v: vec3<f32>, base: vec3<f32>, metallic: f32, roughness: f32) -> vec3<f32> {
     let nv = clamp(dot(n, v), 1e-4, 1.0);
     let ab = env_lut(nv, roughness);

@@ -1,6 +1,6 @@
 // The pixel geometry: a pixel's screen point, its ray from its eye point, the display-position
 // error of seed 002 §4.1 and the distance along a pixel's ray. No bindings. CPU twin:
-// src/cpu/fragment/pixel_error.rs (the ray itself: src/core/projection.rs, `pixel_ray`).
+// src/cpu/fragment/pixel_error.rs (the ray itself: src/core/panoramas/projection.rs, `pixel_ray`).
 
 #import projection
 #import constants

@@ -1,5 +1,5 @@
 // The panoramas' projections, GPU side. Imported by every stage that projects
-// (`#import projection`); the CPU twin is src/core/projection.rs, which derives both.
+// (`#import projection`); the CPU twin is src/core/panoramas/projection.rs, which derives both.
 //
 // The TWISTER cylinder (seed 002, §2.1, eq. 1–4):
 //   r = √(x² + z²), θ = atan2(x, −z), α = acos(d_e/r) − acos(d_e/R_T)
@@ -37,11 +37,11 @@ struct Projection {
     turn_px: f32,          // pixels per full turn of azimuth: the width, 2W for VR180 (its width spans π)
     fov: f32,              // fisheye: the field of view inscribed in the image, degrees
     dome_tilt: f32,        // fisheye: the dome's front raised by this, degrees
-    head_on: f32,          // the cylinder's tracked head (`core::head`): 1 on, 0 off
+    head_on: f32,          // the cylinder's tracked head (`core::panoramas::head`): 1 on, 0 off
     head_turn: f32,        // γ: head frame → display frame turn, radians
     head_offset: vec3<f32>, // O: the head in the display's frame, metres
     face: u32,             // the cubemap: the face this draw projects into (0 elsewhere)
-    wall_corner: vec3<f32>, // the CAVE: its wall in the display's frame (`core::cave`), metres
+    wall_corner: vec3<f32>, // the CAVE: its wall in the display's frame (`core::panoramas::cave`), metres
     wall_on: f32,
     wall_right: vec3<f32>,
     _pad1: f32,

@@ -1,4 +1,4 @@
-// CAVE walls (`core::cave`): per wall and eye, where the line from a tracked head's eye through a
+// CAVE walls (`core::panoramas::cave`): per wall and eye, where the line from a tracked head's eye through a
 // point meets the wall. The frame drawn is the head's (eyes at ±d_e·x); the uniform holds the
 // wall in the display's frame and the head (`head_offset`, `head_turn`), turned into the head's
 // frame here. `projection` calls these; the subdivision (which never draws a CAVE) is composed

@@ -1,4 +1,4 @@
-// The stereo cubemap's image (`core::cubemap`): the sphere's eye rays on six 90° gnomonic faces,
+// The stereo cubemap's image (`core::panoramas::cubemap`): the sphere's eye rays on six 90° gnomonic faces,
 // one eye's image the 3×2 grid of YouTube's layout (right, left, up / down, front, back).
 // `projection` calls these; the subdivision (which measures a cubemap on the sphere) is composed
 // with `projection_cubemap_off` in its place.
@@ -16,7 +16,7 @@ struct CubeFace {
     cell: vec2<f32>,
 }
 
-// `CUBE_FACES` in core/cubemap.rs: right, left, up, down, front, back.
+// `CUBE_FACES` in core/panoramas/cubemap.rs: right, left, up, down, front, back.
 fn cube_face_axes(f: u32) -> CubeFace {
     switch f {
         case 0u: { return CubeFace(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 0.0, 1.0), vec3<f32>(0.0, 1.0, 0.0), vec2<f32>(0.0, 0.0)); }
@@ -75,7 +75,7 @@ fn cube_direction(proj: Projection, xy: vec2<f32>) -> vec2<f32> {
     return vec2<f32>(precise_atan2(d.x, -d.z), precise_atan2(d.y, sqrt(d.x * d.x + d.z * d.z)));
 }
 
-// A face's w for D·n (`horizon_w` in core/cubemap.rs): a direction on the face's horizon plane
+// A face's w for D·n (`horizon_w` in core/panoramas/cubemap.rs): a direction on the face's horizon plane
 // (the cuts around the axis put nodes on x = 0 and z = 0) drawn just in front of it, at
 // CUBE_MIN_W (an H200 drew no triangle with a vertex at w = 0).
 fn horizon_w(w: f32) -> f32 {

@@ -1,4 +1,4 @@
-// The fulldome master's image (`core::fisheye`): the sphere's eye rays in an equidistant
+// The fulldome master's image (`core::panoramas::fisheye`): the sphere's eye rays in an equidistant
 // azimuthal image, the dome's axis at the centre. `projection` calls these; the pipelines of the
 // other panoramas' subdivision are composed with `projection_fisheye_off` in its place.
 

@@ -1,4 +1,4 @@
-// The cylinder seen by a tracked head away from the display's centre (`core::head`): the line
+// The cylinder seen by a tracked head away from the display's centre (`core::panoramas::head`): the line
 // from a fixed eye through a point meets the screen. `projection` calls these; the subdivision's
 // pipelines of frames without a head are composed with `projection_head_off` in its place.
 

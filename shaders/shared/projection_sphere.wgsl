@@ -1,4 +1,4 @@
-// The full sphere's projection at a point (`Projection::sphere_*` in src/core/projection.rs):
+// The full sphere's projection at a point (`Projection::sphere_*` in src/core/panoramas/projection.rs):
 // the eye offset it is seen at (the pole merge, by Newton steps) and its longitude, latitude and
 // depth there; the equations are in `projection`, which calls these. The subdivide stage's
 // cylinder pipelines are composed with `projection_sphere_off` in its place.

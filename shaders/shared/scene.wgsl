@@ -1,4 +1,4 @@
-// The scene's vertices as uploaded (`SceneVertex` in src/core/scene.rs), read by the stages
+// The scene's vertices as uploaded (`SceneVertex` in src/core/scenes/scene.rs), read by the stages
 // that start from the scene (subdivide, trace), and the tangent's packing (also raster, slit).
 
 struct SceneVertex {
@@ -14,7 +14,7 @@ struct SceneVertex {
 
 // A tangent and its bitangent sign (unit xyz, w = ±1) in 32 bits: octahedral coordinates in 15
 // bits each, w < 0 in bit 30, bit 31 set; 0 (none) for a zero direction (`pack_tangent` in
-// src/core/scene.rs).
+// src/core/scenes/scene.rs).
 fn pack_tangent(t: vec4<f32>) -> u32 {
     let sum = abs(t.x) + abs(t.y) + abs(t.z);
     if (!(sum > 0.0)) {

@@ -132,7 +132,7 @@ fn edge_profile(a: vec3<f32>, b: vec3<f32>, segments: u32) -> EdgeProfile {
         for (var s = 0u; s < 2u; s++) {
             let raw = pixel_of(projected[s]);
             if (pinhole) {
-                // The eye point E = s·d·(cos λ, 0, sin λ) (core/sphere.rs).
+                // The eye point E = s·d·(cos λ, 0, sin λ) (core/panoramas/sphere.rs).
                 let e = select(-offset, offset, s == 1u) * vec3<f32>(cos(projected[s].x), 0.0, sin(projected[s].x));
                 if (k >= 2u) {
                     eye_bend = max(eye_bend, length(e - 2.0 * e1[s] + e0[s]) / depth1[s]);

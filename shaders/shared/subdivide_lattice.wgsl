@@ -412,7 +412,7 @@ fn piece_u_range(q: array<Node, 3>, theta_c: f32) -> vec3<f32> {
     let proj = params.projection;
     if (proj.head_on != 0.0) {
         // A tracked head: u = θ − γ, moved by the eye's offset seen from the point and by the
-        // eye's distance from the display's axis seen from the screen (`core::head`).
+        // eye's distance from the display's axis seen from the screen (`core::panoramas::head`).
         let reach = length(proj.head_offset.xz) + proj.eye_radius;
         let ratios = vec2<f32>(proj.eye_radius / max(r_min, 1e-30), reach / proj.screen_radius);
         var bound = 0.0;

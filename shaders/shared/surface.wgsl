@@ -259,7 +259,7 @@ fn pbr_radiance(ambient: f32, v: vec3<f32>, view_position: vec3<f32>, normal: ve
 }
 
 // The share of a light that reaches p (viewer frame; `normal` its interpolated normal, l the unit
-// direction towards the light) by the light's shadow map `map` (src/core/shadow.rs): the point
+// direction towards the light) by the light's shadow map `map` (src/core/shading/shadow.rs): the point
 // offset along the normal (turned towards the light) and towards the light by a few texels'
 // world size, its depth compared with the four nearest texels, the results weighted bilinearly.
 // Points the map does not see are lit. A cube reads the face the light sees p through
@@ -338,7 +338,7 @@ fn shading_normal(normal: vec3<f32>, v: vec3<f32>, maps: SurfaceMaps) -> vec3<f3
 }
 
 // The cube face a light is seen through from p, l the unit direction towards the light: the
-// major axis of −l, +x −x +y −y +z −z as 0..5 (`cube_face` in src/core/shadow.rs).
+// major axis of −l, +x −x +y −y +z −z as 0..5 (`cube_face` in src/core/shading/shadow.rs).
 fn cube_face(l: vec3<f32>) -> u32 {
     let d = -l;
     let a = abs(d);

@@ -2,11 +2,11 @@
 // texels), the lights and the frame's lighting, the environment, the shadow maps; the pipeline
 // constants that compile parts of the look in or out. Bindings only, no functions: the modules
 // texture, brdf, ibl and surface read them. Rust twins of the structs: src/encoding/types.rs
-// (LAYOUTS), src/core/material.rs, src/core/light.rs, src/core/shadow.rs.
+// (LAYOUTS), src/core/shading/material.rs, src/core/shading/light.rs, src/core/shading/shadow.rs.
 
 #import constants
 
-// ---- Materials and textures (layout: src/core/material.rs, packing: src/core/texture.rs) ----
+// ---- Materials and textures (layout: src/core/shading/material.rs, packing: src/core/shading/texture.rs) ----
 
 // false: every material of the scene is untextured, opaque and double-sided, so a fragment's
 // colour is its vertex colour and nothing is discarded; the renderer then compiles the material
@@ -33,7 +33,7 @@ override MAPS: bool = true;
 // tracer, which shadows by rays); the drawing pipelines then leave the look-up out.
 override SHADOW_MAPS: bool = true;
 
-// NO_TEXTURE, WRAP_*, FILTER_*, MIPMAP_*, ALPHA_*: from `constants` (src/core/material.rs).
+// NO_TEXTURE, WRAP_*, FILTER_*, MIPMAP_*, ALPHA_*: from `constants` (src/core/shading/material.rs).
 
 struct Material {
     texture: u32,
@@ -47,7 +47,7 @@ struct Material {
     double_sided: u32,
     first_mip: u32,
     mip_count: u32,
-    mirror: f32,        // the ray tracer's optics (src/core/material.rs)
+    mirror: f32,        // the ray tracer's optics (src/core/shading/material.rs)
     transmission: f32,
     ior: f32,
     metallic: f32,      // glTF metallic-roughness factors
@@ -72,7 +72,7 @@ struct Material {
     emissive_mip_count: u32,
 }
 
-// A punctual light (KHR_lights_punctual, src/core/light.rs), viewer frame: colour × intensity
+// A punctual light (KHR_lights_punctual, src/core/shading/light.rs), viewer frame: colour × intensity
 // (candela; lux for directional lights), range 0 = unlimited, spot cone cosines.
 struct Light {
     position: vec3<f32>,
@@ -82,13 +82,13 @@ struct Light {
     color: vec3<f32>,
     inner_cos: f32,
     outer_cos: f32,
-    shadow_map: u32,    // its shadow map (src/core/shadow.rs), or NO_SHADOW_MAP
+    shadow_map: u32,    // its shadow map (src/core/shading/shadow.rs), or NO_SHADOW_MAP
     _pad1: u32,
     _pad2: u32,
 }
 
 // The frame's lighting (`LightingParams`): lights in use, the glTF BRDF (1) or the headlight
-// (0), 2^EV, the tone mapping; the environment's image-based lighting (src/core/environment.rs):
+// (0), 2^EV, the tone mapping; the environment's image-based lighting (src/core/shading/environment.rs):
 // on or off, where its split-sum table starts, the rotation
 // from the viewer frame to the environment's, the irradiance's SH coefficients and the
 // prefiltered levels (first texel, width, height).
@@ -124,10 +124,10 @@ struct MipLevel {
 @group(1) @binding(3) var<storage, read> lights: array<Light>;
 @group(1) @binding(4) var<uniform> lighting: Lighting;
 // The environment's prefiltered levels (RGB9E5) and split-sum table (two half floats); a single
-// entry when none (src/core/environment.rs).
+// entry when none (src/core/shading/environment.rs).
 @group(1) @binding(5) var<storage, read> environment: array<u32>;
 
-// A light's shadow map (src/core/shadow.rs): viewer frame → the light's clip space, its first
+// A light's shadow map (src/core/shading/shadow.rs): viewer frame → the light's clip space, its first
 // depth, its side in texels, a texel's world size (at unit distance along the axis when
 // perspective), its kind: SHADOW_ORTHOGRAPHIC, SHADOW_PERSPECTIVE, or SHADOW_CUBE (a point
 // light's six faces, +x −x +y −y +z −z, this the first).

@@ -57,8 +57,8 @@ macro_rules! choices {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::core::light::Tonemap;
-    use crate::core::panorama::PanoramaKind;
+    use crate::core::panoramas::panorama::PanoramaKind;
+    use crate::core::shading::light::Tonemap;
 
     #[test]
     fn names_round_trip_in_kebab_and_snake_case_and_match_the_json_spelling() {

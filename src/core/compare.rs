@@ -5,9 +5,9 @@
 //! images from two renderers by where their colour boundaries lie (twister against Blender
 //! Cycles: `examples/cycles_reference.rs`, `tests/cycles.rs`).
 
-use crate::core::color::linear_to_srgb;
 use crate::core::frame::Frame;
-use crate::core::scene::Scene;
+use crate::core::scenes::scene::Scene;
+use crate::core::shading::color::linear_to_srgb;
 use crate::error::{Error, Result};
 use glam::Vec3;
 

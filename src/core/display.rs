@@ -5,7 +5,7 @@
 //! forward map (seed 002 eq. 1–4 on the cylinder; the sphere's, the fisheye's, the cubemap's),
 //! so every panorama is previewed as it is drawn.
 
-use crate::core::projection::{PanoramaKind, Projection};
+use crate::core::panoramas::projection::{PanoramaKind, Projection};
 
 /// How the frame is shown.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -1,7 +1,7 @@
 //! What a render returns: both eyes' images, what the frame cost and drew, and what the
 //! error pass measured.
 
-use crate::core::projection::Eye;
+use crate::core::panoramas::projection::Eye;
 
 /// One eye's image, tightly packed RGBA8 rows, top row first.
 #[derive(Clone, Debug, Default)]
@@ -17,7 +17,8 @@ impl EyeImage {
     /// larger image's samples one pixel's.
     pub fn box_filtered(&self, kx: u32, ky: u32) -> EyeImage {
         let (w, h) = (self.width / kx, self.height / ky);
-        let decode: Vec<f32> = (0..=255).map(|b| crate::core::color::srgb_to_linear(b as f32 / 255.0)).collect();
+        let decode: Vec<f32> =
+            (0..=255).map(|b| crate::core::shading::color::srgb_to_linear(b as f32 / 255.0)).collect();
         let mut rgba = vec![0u8; (4 * w * h) as usize];
         let n = (kx * ky) as f32;
         for y in 0..h {
@@ -34,8 +35,9 @@ impl EyeImage {
                 }
                 let i = 4 * (y * w + x) as usize;
                 for c in 0..3 {
-                    rgba[i + c] =
-                        (crate::core::color::linear_to_srgb(sum[c] / n) * 255.0).round().clamp(0.0, 255.0) as u8;
+                    rgba[i + c] = (crate::core::shading::color::linear_to_srgb(sum[c] / n) * 255.0)
+                        .round()
+                        .clamp(0.0, 255.0) as u8;
                 }
                 rgba[i + 3] = (sum[3] / n * 255.0).round().clamp(0.0, 255.0) as u8;
             }

@@ -2,36 +2,14 @@
 //! [`projection::Panorama`], scenes with their loaders and materials, the visual field and level
 //! of detail (seeds 000/001), render settings and the frames a renderer returns.
 
-pub mod animation;
 pub mod assets;
-pub mod builtin;
-pub mod bvh;
-pub mod cave;
+pub mod caches;
 pub mod choice;
-pub mod color;
 pub mod compare;
-pub mod cubemap;
-pub mod disk_cache;
+pub mod detail;
 pub mod display;
-pub mod environment;
-pub mod environment_cache;
-pub mod fisheye;
 pub mod frame;
-pub mod head;
-pub mod light;
-pub mod load;
-pub mod lod;
-pub mod material;
-pub mod panorama;
-pub mod projection;
-pub mod sampling;
-pub mod scene;
+pub mod panoramas;
+pub mod scenes;
 pub mod settings;
-pub mod shadow;
-pub mod shapes;
-pub mod shared_edges;
-pub mod simplify;
-pub mod sphere;
-pub mod texture;
-pub mod timeline;
-pub mod visual_field;
+pub mod shading;

@@ -5,7 +5,7 @@
 
 use glam::{Mat4, Vec3};
 
-use crate::core::projection::{PanoramaKind, Projection, Vertical};
+use crate::core::panoramas::projection::{PanoramaKind, Projection, Vertical};
 use crate::error::{Error, Result};
 
 /// Default memory budget for the subdivision buffers, MiB.
@@ -176,20 +176,20 @@ pub struct ShadingSettings {
     /// The ray tracer's visual-field level of detail (seed 000, `--lod visual-field` with
     /// `--method trace`): the gaze; each primary ray's level (eq. 8) sets its bounces (eq. 9),
     /// and rays outside the visual field are not traced.
-    pub trace_gaze: Option<crate::core::visual_field::Gaze>,
+    pub trace_gaze: Option<crate::core::detail::visual_field::Gaze>,
     /// With `trace_gaze`: N_min / N_max of eq. 10, the share of an object's triangles that a ray
     /// at level 0 meets (`--lod-p3`); the scene's BVH holds each object's chain down to it.
     pub trace_min_share: f32,
     /// How surfaces are lit (`--lighting`): the glTF BRDF under the scene's lights, or the
     /// headlight.
-    pub lighting: crate::core::light::LightingMode,
+    pub lighting: crate::core::shading::light::LightingMode,
     /// Exposure in stops (`--exposure`): the linear colour is scaled by 2^EV before tone mapping
     /// (the glTF BRDF only).
     pub exposure_ev: f32,
     /// Tone mapping of the lit colour (`--tonemap`; the glTF BRDF only).
-    pub tonemap: crate::core::light::Tonemap,
+    pub tonemap: crate::core::shading::light::Tonemap,
     /// Whether the scene's lights cast shadows (`--no-shadows`: false): by shadow maps in the
-    /// drawing stages (directional and spot lights, `core::shadow`), by rays in the ray tracer.
+    /// drawing stages (directional and spot lights, `core::shading::shadow`), by rays in the ray tracer.
     pub shadows: bool,
     /// The side of a shadow map in texels (`--shadow-map-size`, a multiple of 64).
     pub shadow_map_size: u32,
@@ -202,7 +202,7 @@ pub struct ShadingSettings {
     /// Samples per pixel of the display colour (`--samples`: 1, 2, 4, 8, 16 or 32): each pixel
     /// shows the average of its samples' tone-mapped linear colours (the projection methods and
     /// slits multisample, resolved in linear light; the ray tracer traces a ray through each of
-    /// [`sample_position`](crate::core::sampling::sample_position)). The other outputs (the error
+    /// [`sample_position`](crate::core::shading::sampling::sample_position)). The other outputs (the error
     /// pass's targets, depth, the linear HDR colour) stay one sample at the pixel's centre.
     pub samples: u32,
     /// The most probes a texture sample takes along its footprint's longer axis (`--anisotropy`,
@@ -278,7 +278,7 @@ impl RenderSettings {
     /// Whether a frame lit by the glTF BRDF (`pbr`) of a scene with `lights` has shadow maps:
     /// shadows on, a drawing method (the ray tracer shadows by rays), and a light (the drawing
     /// pipelines' `SHADOW_MAPS`).
-    pub fn uses_shadow_maps(&self, lights: &[crate::core::light::Light], pbr: bool) -> bool {
+    pub fn uses_shadow_maps(&self, lights: &[crate::core::shading::light::Light], pbr: bool) -> bool {
         pbr && self.shading.shadows && self.subdivision.method != Method::Trace && !lights.is_empty()
     }
 
@@ -287,17 +287,20 @@ impl RenderSettings {
     /// (scene frame; the maps are fitted to it).
     pub fn shadowed_lighting(
         &self,
-        lights: &[crate::core::light::Light],
+        lights: &[crate::core::shading::light::Light],
         physically_based: bool,
-        environment: Option<&crate::core::environment::PreparedEnvironment>,
+        environment: Option<&crate::core::shading::environment::PreparedEnvironment>,
         bounds: Option<(Vec3, Vec3)>,
-    ) -> (Vec<crate::core::light::GpuLight>, crate::core::light::LightingParams, Vec<crate::core::shadow::GpuShadowMap>)
-    {
+    ) -> (
+        Vec<crate::core::shading::light::GpuLight>,
+        crate::core::shading::light::LightingParams,
+        Vec<crate::core::shading::shadow::GpuShadowMap>,
+    ) {
         let (mut gpu_lights, params) = self.lighting(lights, physically_based, environment);
         let maps = match bounds {
             Some((min, max)) if self.uses_shadow_maps(lights, params.pbr != 0) => {
-                let corners = crate::core::shadow::box_corners(min, max, self.view());
-                crate::core::shadow::plan_shadow_maps(
+                let corners = crate::core::shading::shadow::box_corners(min, max, self.view());
+                crate::core::shading::shadow::plan_shadow_maps(
                     &mut gpu_lights,
                     lights.len(),
                     &corners,
@@ -314,13 +317,13 @@ impl RenderSettings {
     /// bindings; the CPU twins' `MaterialTable::with_lighting`).
     pub fn lighting(
         &self,
-        lights: &[crate::core::light::Light],
+        lights: &[crate::core::shading::light::Light],
         physically_based: bool,
-        environment: Option<&crate::core::environment::PreparedEnvironment>,
-    ) -> (Vec<crate::core::light::GpuLight>, crate::core::light::LightingParams) {
-        let scene = crate::core::light::SceneLighting { lights: lights.len(), physically_based };
+        environment: Option<&crate::core::shading::environment::PreparedEnvironment>,
+    ) -> (Vec<crate::core::shading::light::GpuLight>, crate::core::shading::light::LightingParams) {
+        let scene = crate::core::shading::light::SceneLighting { lights: lights.len(), physically_based };
         (
-            crate::core::light::gpu_lights(lights, self.view()),
+            crate::core::shading::light::gpu_lights(lights, self.view()),
             self.lighting_params(scene, environment).with_view(self.view(), self.shading.environment_yaw_deg),
         )
     }
@@ -328,15 +331,15 @@ impl RenderSettings {
     /// The frame's lighting for a scene with what it brings (`scene`) and perhaps an environment.
     pub fn lighting_params(
         &self,
-        scene: crate::core::light::SceneLighting,
-        environment: Option<&crate::core::environment::PreparedEnvironment>,
-    ) -> crate::core::light::LightingParams {
+        scene: crate::core::shading::light::SceneLighting,
+        environment: Option<&crate::core::shading::environment::PreparedEnvironment>,
+    ) -> crate::core::shading::light::LightingParams {
         let s = &self.shading;
         let tonemap = s.tonemap;
-        crate::core::light::LightingParams {
+        crate::core::shading::light::LightingParams {
             shadows: s.shadows as u32,
             anisotropy: s.anisotropy,
-            ..crate::core::light::LightingParams::of(s.lighting, scene, environment, s.exposure_ev, tonemap)
+            ..crate::core::shading::light::LightingParams::of(s.lighting, scene, environment, s.exposure_ev, tonemap)
         }
     }
 }
@@ -376,7 +379,7 @@ impl Default for ShadingSettings {
             reflect_max: DEFAULT_REFLECT_MAX,
             light: None,
             trace_gaze: None,
-            trace_min_share: crate::core::lod::LodParams::DEFAULT.p3,
+            trace_min_share: crate::core::detail::lod::LodParams::DEFAULT.p3,
             lighting: Default::default(),
             exposure_ev: 0.0,
             tonemap: Default::default(),
@@ -384,7 +387,7 @@ impl Default for ShadingSettings {
             samples: 1,
             anisotropy: 1,
             shadows: true,
-            shadow_map_size: crate::core::shadow::DEFAULT_SHADOW_MAP_SIZE,
+            shadow_map_size: crate::core::shading::shadow::DEFAULT_SHADOW_MAP_SIZE,
             environment_yaw_deg: 0.0,
         }
     }
@@ -417,11 +420,11 @@ builders! {
     with_ambient: f32 => shading.ambient,
     with_reflect_max: u32 => shading.reflect_max,
     with_light: Option<Vec3> => shading.light,
-    with_trace_gaze: Option<crate::core::visual_field::Gaze> => shading.trace_gaze,
+    with_trace_gaze: Option<crate::core::detail::visual_field::Gaze> => shading.trace_gaze,
     with_trace_min_share: f32 => shading.trace_min_share,
-    with_lighting: crate::core::light::LightingMode => shading.lighting,
+    with_lighting: crate::core::shading::light::LightingMode => shading.lighting,
     with_exposure_ev: f32 => shading.exposure_ev,
-    with_tonemap: crate::core::light::Tonemap => shading.tonemap,
+    with_tonemap: crate::core::shading::light::Tonemap => shading.tonemap,
     with_hdr: bool => shading.hdr,
     with_samples: u32 => shading.samples,
     with_anisotropy: u32 => shading.anisotropy,
@@ -452,7 +455,7 @@ impl RenderSettings {
     pub fn view(&self) -> Mat4 {
         let display =
             Mat4::from_rotation_y(-self.view.yaw_deg.to_radians()) * Mat4::from_translation(-self.view.viewer);
-        // A tracked head: the frame drawn is the head's (`core::head`).
+        // A tracked head: the frame drawn is the head's (`core::panoramas::head`).
         match &self.view.projection.head {
             Some(head) => head.to_head() * display,
             None => display,
@@ -476,7 +479,7 @@ impl RenderSettings {
 
     /// The viewer's place and turn: [`Self::validate`]'s first part.
     fn validate_view(&self) -> Result<()> {
-        let max = crate::core::scene::MAX_COORDINATE;
+        let max = crate::core::scenes::scene::MAX_COORDINATE;
         if !self.view.viewer.is_finite() || self.view.viewer.abs().max_element() > max {
             return Err(Error::setting("view.viewer", format!("must lie within ±{max:e}, got {}", self.view.viewer)));
         }
@@ -635,7 +638,7 @@ impl RenderSettings {
             ));
         }
         if let Some(light) = self.shading.light {
-            let max = crate::core::scene::MAX_COORDINATE;
+            let max = crate::core::scenes::scene::MAX_COORDINATE;
             if !light.is_finite() || light.abs().max_element() > max {
                 return Err(Error::setting("shading.light", format!("must lie within ±{max:e}, got {light}")));
             }

@@ -4,7 +4,7 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::core::projection::{Eye, Projection};
+use crate::core::panoramas::projection::{Eye, Projection};
 use crate::encoding::types::DisplayParams;
 
 const BACKGROUND: [f32; 4] = [0.05, 0.05, 0.06, 1.0];

@@ -9,10 +9,10 @@
 
 use glam::{Vec2, Vec4};
 
-use crate::core::color::{linear_to_srgb, srgb_to_linear};
-use crate::core::projection::{Eye, Projection};
-use crate::core::sampling::sample_position;
-use crate::core::texture::MaterialTable;
+use crate::core::panoramas::projection::{Eye, Projection};
+use crate::core::shading::color::{linear_to_srgb, srgb_to_linear};
+use crate::core::shading::sampling::sample_position;
+use crate::core::shading::texture::MaterialTable;
 use crate::cpu::fragment::{
     background_color, coverage_mask, mask_alpha_width, shade_surface, shows_environment, surface_rgba,
 };

@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 
-use crate::core::projection::{Eye, Projection};
+use crate::core::panoramas::projection::{Eye, Projection};
 
 /// For each viewer-frame point, `[pixel x, pixel y, depth, 1]`, or all zeros where no eye sees it.
 pub fn project_points(projection: &Projection, eye: Eye, points: &[Vec3]) -> Vec<[f32; 4]> {

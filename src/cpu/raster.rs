@@ -10,9 +10,9 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::core::projection::{azimuth, horizontal_radius, Eye, PanoramaKind, Projection};
-use crate::core::scene::unpack_tangent;
-use crate::core::texture::MaterialTable;
+use crate::core::panoramas::projection::{azimuth, horizontal_radius, Eye, PanoramaKind, Projection};
+use crate::core::scenes::scene::unpack_tangent;
+use crate::core::shading::texture::MaterialTable;
 use crate::cpu::fragment::{
     background_color, pixel_distance, pixel_error, shade_surface, shows_environment, surface_color, Surface,
 };
@@ -49,7 +49,7 @@ pub fn raster_vertex(params: &RasterParams, v: &DrawVertex) -> Vec4 {
 /// else 1.
 fn clip_w(projection: &Projection, p: Vec3, depth: f32, w_by_radius: u32) -> f32 {
     if projection.panorama == PanoramaKind::Cubemap {
-        return depth.max(crate::core::cubemap::CUBE_MIN_DISTANCE);
+        return depth.max(crate::core::panoramas::cubemap::CUBE_MIN_DISTANCE);
     }
     if w_by_radius == 0 {
         return 1.0;

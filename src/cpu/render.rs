@@ -5,9 +5,9 @@
 //! the GPU. The oracle a test compares a GPU frame against, without assembling the stages
 //! itself.
 
-use crate::core::scene::Scene;
+use crate::core::scenes::scene::Scene;
 use crate::core::settings::RenderSettings;
-use crate::core::texture::MaterialTable;
+use crate::core::shading::texture::MaterialTable;
 use crate::cpu::multisample::raster_multisampled;
 use crate::cpu::raster::{raster, RasterImage};
 use crate::cpu::shadow::shadow;

@@ -4,9 +4,9 @@
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
-use crate::core::scene::SceneVertex;
-use crate::core::shadow::GpuShadowMap;
-use crate::core::texture::MaterialTable;
+use crate::core::scenes::scene::SceneVertex;
+use crate::core::shading::shadow::GpuShadowMap;
+use crate::core::shading::texture::MaterialTable;
 use crate::cpu::fragment::{surface_color, Surface};
 use crate::cpu::raster::{rasterize, ClipVertex, FragmentIn, FragmentOut, RasterImage};
 

@@ -8,7 +8,7 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
-use crate::core::scene::{pack_tangent, SceneVertex};
+use crate::core::scenes::scene::{pack_tangent, SceneVertex};
 pub use crate::encoding::skin::{SkinData, SkinFrame};
 use crate::encoding::types::NO_SKIN;
 

@@ -4,7 +4,7 @@
 //! **The cylinder.** The panorama is cut into slits of W columns (the last may be narrower).
 //! For slit columns [c0, c1) with centre column c = (c0 + c1)/2 at screen azimuth u_c, and an
 //! eye of sign s (+1 right), the camera's viewing direction is φ = u_c − s·asin(d_e/R_T) and it
-//! stands at s·d_e·right(φ) on the eye circle (the construction of [`crate::core::projection`]):
+//! stands at s·d_e·right(φ) on the eye circle (the construction of [`crate::core::panoramas::projection`]):
 //! its central ray meets the screen cylinder at u_c. In camera coordinates (x_c along right(φ),
 //! y_c up, z_c along the view):
 //!
@@ -33,9 +33,9 @@
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
-use crate::core::projection::{Eye, Projection};
-use crate::core::scene::{object_spheres, unpack_tangent, Scene, SceneVertex};
-use crate::core::texture::MaterialTable;
+use crate::core::panoramas::projection::{Eye, Projection};
+use crate::core::scenes::scene::{object_spheres, unpack_tangent, Scene, SceneVertex};
+use crate::core::shading::texture::MaterialTable;
 use crate::cpu::raster::{fragment, rasterize, ClipVertex, FragmentIn, RasterImage};
 use crate::encoding::slits::{camera_coordinates, sphere_in_slit, Slit};
 use crate::encoding::types::{SlitCamera, SlitParams};

@@ -10,16 +10,16 @@ use std::cell::Cell;
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
-use crate::core::bvh::{BvhNode, SceneBvh, OBJECT_LEAF};
-use crate::core::color::srgb_to_linear;
-use crate::core::light::tonemap;
-use crate::core::light::LightKind;
-use crate::core::material::AlphaMode;
-use crate::core::projection::{Eye, Projection};
-use crate::core::sampling::sample_position;
-use crate::core::scene::{unpack_tangent, SceneVertex};
-use crate::core::texture::MaterialTable;
-use crate::core::visual_field::Gaze;
+use crate::core::detail::visual_field::Gaze;
+use crate::core::panoramas::projection::{Eye, Projection};
+use crate::core::scenes::bvh::{BvhNode, SceneBvh, OBJECT_LEAF};
+use crate::core::scenes::scene::{unpack_tangent, SceneVertex};
+use crate::core::shading::color::srgb_to_linear;
+use crate::core::shading::light::tonemap;
+use crate::core::shading::light::LightKind;
+use crate::core::shading::material::AlphaMode;
+use crate::core::shading::sampling::sample_position;
+use crate::core::shading::texture::MaterialTable;
 use crate::cpu::fragment::{
     display_bytes, env_direction, env_level, env_st, light_at, light_term, pbr_radiance, pixel_error, pixel_ray,
     pixel_spread, shade_linear, shading_normal, surface_color, surface_maps, Surface,
@@ -267,7 +267,7 @@ impl<'a> Tracer<'a> {
         [0, 1, 2].map(|k| &self.vertices[indices[(3 * tri + k) as usize] as usize])
     }
 
-    fn material(&self, tri: u32) -> &'a crate::core::material::Material {
+    fn material(&self, tri: u32) -> &'a crate::core::shading::material::Material {
         let materials = &self.table.materials;
         &materials[(self.corners(tri)[0].material as usize).min(materials.len() - 1)]
     }

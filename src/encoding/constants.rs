@@ -2,13 +2,13 @@
 //! `constants` (composed by `#import constants`) is generated from this list by [`wgsl`], so
 //! the two sides cannot drift apart.
 
-use crate::core::cubemap::{CUBE_MIN_DISTANCE, CUBE_MIN_W, CUBE_NEAR};
-use crate::core::light::{LightKind, Tonemap};
-use crate::core::material::{AlphaMode, Filter, Mipmap, Wrap, NO_TEXTURE};
-use crate::core::projection::PanoramaKind;
+use crate::core::detail::visual_field::{CENTRAL_RADIUS, FIELD_DOWN, FIELD_SIDEWAYS, FIELD_UP};
+use crate::core::panoramas::cubemap::{CUBE_MIN_DISTANCE, CUBE_MIN_W, CUBE_NEAR};
+use crate::core::panoramas::projection::PanoramaKind;
+use crate::core::panoramas::sphere::{SPHERE_NEWTON_STEPS, SPHERE_NEWTON_TOLERANCE};
 use crate::core::settings::SplitRule;
-use crate::core::sphere::{SPHERE_NEWTON_STEPS, SPHERE_NEWTON_TOLERANCE};
-use crate::core::visual_field::{CENTRAL_RADIUS, FIELD_DOWN, FIELD_SIDEWAYS, FIELD_UP};
+use crate::core::shading::light::{LightKind, Tonemap};
+use crate::core::shading::material::{AlphaMode, Filter, Mipmap, Wrap, NO_TEXTURE};
 
 /// Largest edge count the adaptive method asks for (edges longer than this many L are capped).
 pub const MAX_EDGE_DIVISIONS: u32 = 1024;
@@ -172,7 +172,7 @@ fn numbers() -> Vec<(&'static str, Value)> {
         ("BAND_RATIO", F32(BAND_RATIO)),
         ("SNAP", F32(SNAP)),
         ("BACK_FACE_MARGIN", F32(BACK_FACE_MARGIN)),
-        ("SINGLE_SIDED", U32(crate::core::scene::SINGLE_SIDED)),
+        ("SINGLE_SIDED", U32(crate::core::scenes::scene::SINGLE_SIDED)),
         ("MAX_STRETCH", F32(MAX_STRETCH)),
         ("AZIMUTH_MIN_RADIUS", F32(AZIMUTH_MIN_RADIUS)),
         ("CUBE_MIN_W", F32(CUBE_MIN_W)),
@@ -202,8 +202,8 @@ fn numbers() -> Vec<(&'static str, Value)> {
         ("FINE_BINS", U32(FINE_BINS)),
         ("COARSE_BINS", U32(COARSE_BINS)),
         ("BINS", U32(BINS)),
-        ("NORMAL_OFFSET_TEXELS", F32(crate::core::shadow::NORMAL_OFFSET_TEXELS)),
-        ("LIGHT_OFFSET_TEXELS", F32(crate::core::shadow::LIGHT_OFFSET_TEXELS)),
+        ("NORMAL_OFFSET_TEXELS", F32(crate::core::shading::shadow::NORMAL_OFFSET_TEXELS)),
+        ("LIGHT_OFFSET_TEXELS", F32(crate::core::shading::shadow::LIGHT_OFFSET_TEXELS)),
     ]
 }
 
@@ -232,14 +232,14 @@ fn codes() -> Vec<(&'static str, Value)> {
         ("LIGHT_DIRECTIONAL", U32(LightKind::Directional as u32)),
         ("LIGHT_POINT", U32(LightKind::Point as u32)),
         ("LIGHT_SPOT", U32(LightKind::Spot as u32)),
-        ("ENV_LEVELS", U32(crate::core::environment::ENV_LEVELS as u32)),
-        ("LUT_SIZE", U32(crate::core::environment::LUT_SIZE as u32)),
-        ("MAX_SHADOW_MAPS", U32(crate::core::shadow::MAX_SHADOW_MAPS as u32)),
-        ("SHADOW_ORTHOGRAPHIC", U32(crate::core::shadow::SHADOW_ORTHOGRAPHIC)),
-        ("SHADOW_PERSPECTIVE", U32(crate::core::shadow::SHADOW_PERSPECTIVE)),
-        ("SHADOW_CUBE", U32(crate::core::shadow::SHADOW_CUBE)),
+        ("ENV_LEVELS", U32(crate::core::shading::environment::ENV_LEVELS as u32)),
+        ("LUT_SIZE", U32(crate::core::shading::environment::LUT_SIZE as u32)),
+        ("MAX_SHADOW_MAPS", U32(crate::core::shading::shadow::MAX_SHADOW_MAPS as u32)),
+        ("SHADOW_ORTHOGRAPHIC", U32(crate::core::shading::shadow::SHADOW_ORTHOGRAPHIC)),
+        ("SHADOW_PERSPECTIVE", U32(crate::core::shading::shadow::SHADOW_PERSPECTIVE)),
+        ("SHADOW_CUBE", U32(crate::core::shading::shadow::SHADOW_CUBE)),
         ("NO_SKIN", U32(crate::encoding::types::NO_SKIN)),
-        ("NO_SHADOW_MAP", U32(crate::core::light::NO_SHADOW_MAP)),
+        ("NO_SHADOW_MAP", U32(crate::core::shading::light::NO_SHADOW_MAP)),
         ("TONEMAP_NONE", U32(Tonemap::None.code())),
         ("TONEMAP_PBR_NEUTRAL", U32(Tonemap::PbrNeutral.code())),
         ("TONEMAP_ACES", U32(Tonemap::Aces.code())),
@@ -258,7 +258,7 @@ pub fn wgsl() -> String {
         }
     }
     // The standard sample positions (16ths of a pixel), for the ray tracer's samples.
-    for (n, table) in crate::core::sampling::STANDARD_POSITIONS {
+    for (n, table) in crate::core::shading::sampling::STANDARD_POSITIONS {
         let items: Vec<String> = table.iter().map(|[x, y]| format!("vec2<f32>({x:?}, {y:?})")).collect();
         s += &format!("const SAMPLES_{n}: array<vec2<f32>, {n}> = array<vec2<f32>, {n}>({});\n", items.join(", "));
     }

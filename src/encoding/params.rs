@@ -2,8 +2,8 @@
 //! (the subdivide and slit stages' are in [`super::subdivide`] and [`super::slits`]).
 
 use crate::core::display::{look_far, DisplayView};
-use crate::core::projection::Eye;
-use crate::core::projection::Projection;
+use crate::core::panoramas::projection::Eye;
+use crate::core::panoramas::projection::Projection;
 use crate::core::settings::{RenderSettings, SplitRule};
 use crate::encoding::types::{DisplayParams, RasterParams, TraceParams};
 

@@ -4,7 +4,7 @@
 
 use glam::{Mat4, Vec3};
 
-use crate::core::animation::{pose_nodes, world_matrices, Rig};
+use crate::core::scenes::animation::{pose_nodes, world_matrices, Rig};
 use crate::encoding::types::{SkinInstance, SkinSource, NO_SKIN};
 
 /// What the skin stage reads once: a source per posed vertex, the morph offsets (per vertex
@@ -127,7 +127,7 @@ impl SkinFrame {
                     .map(|j| m * Mat4::from_cols_array_2d(j))
                     .collect()
             };
-            for corner in crate::core::shadow::box_corners(lo, hi, Mat4::IDENTITY) {
+            for corner in crate::core::shading::shadow::box_corners(lo, hi, Mat4::IDENTITY) {
                 for mm in &matrices {
                     let p = mm.transform_point3(corner);
                     out = Some(out.map_or((p, p), |(a, b)| (a.min(p), b.max(p))));

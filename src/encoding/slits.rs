@@ -4,7 +4,7 @@
 
 use glam::{Mat4, Vec2, Vec3};
 
-use crate::core::projection::{Eye, PanoramaKind, Projection};
+use crate::core::panoramas::projection::{Eye, PanoramaKind, Projection};
 use crate::encoding::types::{SlitCamera, SlitParams};
 
 /// Distance of the slit cameras' near plane, metres.
@@ -97,7 +97,7 @@ pub fn slits(projection: &Projection, eye: Eye, width: u32) -> Vec<Slit> {
         .collect()
 }
 
-/// A CAVE wall's camera for one eye (`core::cave`): at the eye, looking into the wall along its
+/// A CAVE wall's camera for one eye (`core::panoramas::cave`): at the eye, looking into the wall along its
 /// normal, its right and up the wall's; the wall's image spans the NDC square, so the pinhole's
 /// x_c/z_c maps to the wall's fraction a with NDC 2a − 1 = cx + sx·x_c/z_c, sx = 2δ/|R|, cx =
 /// −2(C − E)·R̂/|R| − 1 (δ the eye's distance to the wall's plane), and likewise up.

@@ -1,7 +1,7 @@
 //! The `subdivide` stage's encoding: its parameters built from the settings, the cuts around the
 //! axis it reports, and its output as both the GPU (read back) and the CPU twin give it.
 
-use crate::core::projection::{PanoramaKind, Projection};
+use crate::core::panoramas::projection::{PanoramaKind, Projection};
 use crate::core::settings::{RenderSettings, SplitRule};
 use crate::encoding::constants::{AXIS_CLEARANCE_MAX, AXIS_CLEARANCE_MIN, OFFSET_SPLIT_FACTOR, PLAN_CUTS_SPLIT};
 use crate::encoding::recording::{Command, Recording, SubdivideBuffer};

@@ -6,13 +6,13 @@ use std::mem::{offset_of, size_of};
 
 use bytemuck::{Pod, Zeroable};
 
-pub use crate::core::bvh::{BvhLevel, BvhNode};
 pub use crate::core::frame::ErrorStats;
-pub use crate::core::light::{GpuLight, LightingParams};
-use crate::core::material::{Material, MipLevel};
-use crate::core::projection::{PanoramaKind, Projection, Vertical};
-use crate::core::scene::SceneVertex;
-pub use crate::core::shadow::GpuShadowMap;
+use crate::core::panoramas::projection::{PanoramaKind, Projection, Vertical};
+pub use crate::core::scenes::bvh::{BvhLevel, BvhNode};
+use crate::core::scenes::scene::SceneVertex;
+pub use crate::core::shading::light::{GpuLight, LightingParams};
+use crate::core::shading::material::{Material, MipLevel};
+pub use crate::core::shading::shadow::GpuShadowMap;
 
 /// A vertex of a prepared triangle (`DrawVertex` in shaders/shared/subdivide_types.wgsl, read by raster.wgsl),
 /// in the viewer frame. `theta_ref` is the azimuth the vertex stage unwraps θ around; seam
@@ -27,7 +27,7 @@ pub struct DrawVertex {
     pub color: [f32; 4],
     pub uv: [f32; 2],
     pub object: u32,
-    /// The interpolated glTF tangent in the viewer frame, packed (`core::scene::pack_tangent`; 0: none).
+    /// The interpolated glTF tangent in the viewer frame, packed (`core::scenes::scene::pack_tangent`; 0: none).
     pub tangent: u32,
     /// Where the raster stage draws the node off its projection, in image pixels (x right, y
     /// down): the left eye's (x, y), then the right eye's. Zero: at its projection.
@@ -58,15 +58,15 @@ pub struct ProjectionUniform {
     /// The fisheye's field of view and dome tilt, degrees (`Projection::fov`, `dome_tilt`).
     pub fov: f32,
     pub dome_tilt: f32,
-    /// The cylinder's tracked head (`core::head`): 1 on, 0 off; its turn γ (radians) and its
+    /// The cylinder's tracked head (`core::panoramas::head`): 1 on, 0 off; its turn γ (radians) and its
     /// position O in the display's frame (metres).
     pub head_on: f32,
     pub head_turn: f32,
     pub head_offset: [f32; 3],
-    /// The cubemap: the face a draw projects into (`core::cubemap::CUBE_FACES`); set per face
+    /// The cubemap: the face a draw projects into (`core::panoramas::cubemap::CUBE_FACES`); set per face
     /// draw by the raster stage, 0 elsewhere.
     pub face: u32,
-    /// The CAVE's wall in the display's frame (`core::cave::CaveWall`): its lower left corner,
+    /// The CAVE's wall in the display's frame (`core::panoramas::cave::CaveWall`): its lower left corner,
     /// right and up edges, metres.
     pub wall_corner: [f32; 3],
     pub wall_on: f32,
@@ -92,8 +92,9 @@ impl From<&ProjectionUniform> for Projection {
             pole_merge: (p.pole_to > 0.0).then(|| (p.pole_from.to_degrees(), p.pole_to.to_degrees())),
             fov: p.fov,
             dome_tilt: p.dome_tilt,
-            head: (p.head_on != 0.0).then_some(crate::core::head::Head { offset: p.head_offset, turn: p.head_turn }),
-            wall: (p.wall_on != 0.0).then_some(crate::core::cave::CaveWall {
+            head: (p.head_on != 0.0)
+                .then_some(crate::core::panoramas::head::Head { offset: p.head_offset, turn: p.head_turn }),
+            wall: (p.wall_on != 0.0).then_some(crate::core::panoramas::cave::CaveWall {
                 corner: p.wall_corner,
                 right: p.wall_right,
                 up: p.wall_up,
@@ -122,7 +123,7 @@ impl From<&Projection> for ProjectionUniform {
             fov: p.fov,
             dome_tilt: p.dome_tilt,
             head_on: p.head.is_some() as u32 as f32,
-            head_turn: p.head.map_or(0.0, |h| crate::core::projection::wrap_angle(h.turn)),
+            head_turn: p.head.map_or(0.0, |h| crate::core::panoramas::projection::wrap_angle(h.turn)),
             head_offset: p.head.map_or([0.0; 3], |h| h.offset),
             face: 0,
             wall_corner: p.wall.map_or([0.0; 3], |w| w.corner),
@@ -491,7 +492,7 @@ pub struct TraceParams {
     /// the visual level above which they do (`SceneBvh::original_level`).
     pub original_root: u32,
     pub original_level: f32,
-    /// Rays per pixel, through `core::sampling::sample_position` (`ShadingSettings::samples`).
+    /// Rays per pixel, through `core::shading::sampling::sample_position` (`ShadingSettings::samples`).
     pub samples: u32,
 }
 

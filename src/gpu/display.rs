@@ -7,7 +7,7 @@ use std::sync::Mutex;
 
 use crate::core::display::DisplayMode;
 use crate::core::frame::EyeImage;
-use crate::core::projection::PanoramaKind;
+use crate::core::panoramas::projection::PanoramaKind;
 use crate::encoding::types::DisplayParams;
 use crate::gpu::device::Gpu;
 use crate::gpu::stages::GpuStage;

@@ -6,7 +6,7 @@ use std::collections::HashMap;
 use std::mem::offset_of;
 use std::sync::{Mutex, OnceLock};
 
-use crate::core::scene::SceneVertex;
+use crate::core::scenes::scene::SceneVertex;
 use crate::core::settings::RenderSettings;
 use crate::encoding::types::DrawVertex;
 use crate::gpu::device::{error_target_format, Gpu};
@@ -315,11 +315,11 @@ fn look_constants(look: Look, lit: Lit) -> Vec<(&'static str, f64)> {
 
 /// `PANORAMAS` for a panorama (projection.wgsl): 1 the cylinder, 2 the sphere and VR180, 6 the
 /// fisheye and 10 the cubemap (the sphere's eye model in their own images), 16 the CAVE.
-pub(crate) fn panorama_bits(panorama: crate::core::projection::PanoramaKind) -> u32 {
+pub(crate) fn panorama_bits(panorama: crate::core::panoramas::projection::PanoramaKind) -> u32 {
     match panorama {
-        crate::core::projection::PanoramaKind::Fisheye => 6,
-        crate::core::projection::PanoramaKind::Cubemap => 10,
-        crate::core::projection::PanoramaKind::Cave => 16,
+        crate::core::panoramas::projection::PanoramaKind::Fisheye => 6,
+        crate::core::panoramas::projection::PanoramaKind::Cubemap => 10,
+        crate::core::panoramas::projection::PanoramaKind::Cave => 16,
         p if p.is_sphere() => 2,
         _ => 1,
     }

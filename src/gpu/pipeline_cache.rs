@@ -2,7 +2,7 @@
 //! adapter has one, loaded when the device opens and saved when it closes if pipelines were
 //! built meanwhile, so that a fresh process does less of the driver's compiling.
 //!
-//! Where: the folder of `core::disk_cache` (`TWISTER_CACHE_DIR`, `off` or empty: none). One
+//! Where: the folder of `core::caches::disk_cache` (`TWISTER_CACHE_DIR`, `off` or empty: none). One
 //! file per adapter class (`wgpu::util::pipeline_cache_key`) and build of the shaders (a hash of
 //! every WGSL source and of twister's version): a newer build's file replaces the older one's. A damaged, foreign or unreadable file is ignored and replaced
 //! (wgpu checks the header and falls back to an empty cache); a cache that cannot be written
@@ -12,7 +12,7 @@ use std::hash::{Hash, Hasher};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use crate::core::disk_cache::{cache_dir, fnv1a, write_whole, FNV_OFFSET};
+use crate::core::caches::disk_cache::{cache_dir, fnv1a, write_whole, FNV_OFFSET};
 
 /// The cache and its file.
 pub struct DiskPipelineCache {

@@ -5,7 +5,7 @@ use std::sync::OnceLock;
 
 use glam::Vec3;
 
-use crate::core::projection::{Eye, Projection};
+use crate::core::panoramas::projection::{Eye, Projection};
 use crate::encoding::types::ProjectParams;
 use crate::error::Result;
 use crate::gpu::device::Gpu;

@@ -11,8 +11,8 @@ use std::sync::{Mutex, OnceLock};
 use glam::Vec3;
 
 use crate::core::frame::{EyeImage, Frame};
-use crate::core::projection::{Eye, Projection};
-use crate::core::scene::Scene;
+use crate::core::panoramas::projection::{Eye, Projection};
+use crate::core::scenes::scene::Scene;
 use crate::core::settings::{Method as MethodName, RenderSettings};
 use crate::encoding::schedule::Schedule;
 use crate::encoding::subdivide::SubdivideOutput;
@@ -118,7 +118,8 @@ impl Renderer {
                 subdivide_params: gpu.storage_params_buffer::<SubdivideParams>("subdivide params"),
                 raster_params: gpu.device.create_buffer(&wgpu::BufferDescriptor {
                     label: Some("raster params"),
-                    size: crate::gpu::frame::raster_params_stride(&gpu) * crate::core::cubemap::CUBE_FACES.len() as u64,
+                    size: crate::gpu::frame::raster_params_stride(&gpu)
+                        * crate::core::panoramas::cubemap::CUBE_FACES.len() as u64,
                     usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
                     mapped_at_creation: false,
                 }),
@@ -189,7 +190,8 @@ impl Renderer {
         let rows_buffer = (self.gpu.limits.max_buffer_size / (2 * padded_row(tile_w) * ky as u64)).max(1);
         let rows_strip = (STRIP_BYTES / (8 * p.width as u64)).max(1);
         let tile_h = (p.height.min(side) as u64).min(rows_buffer).min(rows_strip).max(1) as u32;
-        let face = if p.panorama == crate::core::projection::PanoramaKind::Cubemap { p.width / 3 } else { 0 };
+        let face =
+            if p.panorama == crate::core::panoramas::projection::PanoramaKind::Cubemap { p.width / 3 } else { 0 };
         Some(Tiles { width: p.width, height: p.height, tile_w, tile_h, face })
     }
 
@@ -330,8 +332,8 @@ impl Renderer {
                 shadow.draw_maps(&self.gpu, scene, settings.view(), &shadow_maps)?;
             }
             // A CAVE wall is a perspective: every projection method draws it exactly as one
-            // pinhole camera per eye, the slit stage's (`core::cave`), with no subdivision.
-            let cave = settings.projection().panorama == crate::core::projection::PanoramaKind::Cave;
+            // pinhole camera per eye, the slit stage's (`core::panoramas::cave`), with no subdivision.
+            let cave = settings.projection().panorama == crate::core::panoramas::projection::PanoramaKind::Cave;
             let method: &dyn Method = match settings.subdivision.method {
                 MethodName::Trace => &self.trace,
                 MethodName::Slit(_) => self.slit.get_or_init(|| SlitMethod::new(&self.gpu)),
@@ -441,7 +443,7 @@ impl Renderer {
         settings: &RenderSettings,
         schedule: Schedule,
     ) -> Result<SubdivideOutput> {
-        if settings.projection().panorama == crate::core::projection::PanoramaKind::Cave {
+        if settings.projection().panorama == crate::core::panoramas::projection::PanoramaKind::Cave {
             return Err(Error::setting(
                 "view.projection.wall",
                 "a CAVE wall is drawn as one perspective per eye, without subdivision: there is none to read back",

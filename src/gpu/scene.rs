@@ -5,15 +5,15 @@ use std::sync::Mutex;
 
 use glam::{Mat4, Vec3};
 
-use crate::core::bvh::SceneBvh;
-use crate::core::environment::PreparedEnvironment;
-use crate::core::light::{gpu_lights, Light, LightingParams, SceneLighting};
-use crate::core::lod::LodSelection;
-use crate::core::scene::{object_spheres, Scene};
+use crate::core::detail::lod::LodSelection;
+use crate::core::scenes::bvh::SceneBvh;
+use crate::core::scenes::scene::{object_spheres, Scene};
+use crate::core::scenes::shared_edges::{shared_edges_of, welded_points, SharedEdges};
 use crate::core::settings::RenderSettings;
-use crate::core::shadow::{GpuShadowMap, MAX_SHADOW_MAPS};
-use crate::core::shared_edges::{shared_edges_of, welded_points, SharedEdges};
-use crate::core::texture::MaterialTable;
+use crate::core::shading::environment::PreparedEnvironment;
+use crate::core::shading::light::{gpu_lights, Light, LightingParams, SceneLighting};
+use crate::core::shading::shadow::{GpuShadowMap, MAX_SHADOW_MAPS};
+use crate::core::shading::texture::MaterialTable;
 use crate::encoding::constants::TRACE_STACK;
 use crate::error::{Error, Result};
 use crate::gpu::device::Gpu;
@@ -82,7 +82,7 @@ pub struct GpuScene {
     pub warnings: Vec<String>,
     /// Per object: the factor on L of the adaptive subdivision (1; the level of detail sets it).
     pub object_edge_scale: wgpu::Buffer,
-    /// The triangles' shared edges (`core::shared_edges`): three edge numbers per triangle, and
+    /// The triangles' shared edges (`core::scenes::shared_edges`): three edge numbers per triangle, and
     /// two bits per edge that the subdivision's `active_cuts` and `ring_cuts` set each frame
     /// (`cut_edges`, in the frame's `SubdivisionBuffers`: `cut_edge_words` words).
     pub triangle_edges: wgpu::Buffer,
@@ -199,11 +199,11 @@ impl GpuScene {
         })
     }
 
-    /// Takes a new pose of the same scene (`core::animation::Rig::pose`): its vertices written
+    /// Takes a new pose of the same scene (`core::scenes::animation::Rig::pose`): its vertices written
     /// over the uploaded ones (the only upload), its lights and bounds; the shadow maps are
     /// drawn again.
     pub fn update_pose(&mut self, gpu: &Gpu, scene: &Scene) -> Result<()> {
-        if scene.vertices.len() as u64 * std::mem::size_of::<crate::core::scene::SceneVertex>() as u64
+        if scene.vertices.len() as u64 * std::mem::size_of::<crate::core::scenes::scene::SceneVertex>() as u64
             != self.vertices.size()
         {
             return Err(Error::scene(&scene.name, "a pose must keep the scene's vertices"));

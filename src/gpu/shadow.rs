@@ -1,4 +1,4 @@
-//! The `shadow` stage on the GPU (maths in `core::shadow`, twin `cpu::shadow`): each of a frame's
+//! The `shadow` stage on the GPU (maths in `core::shading::shadow`, twin `cpu::shadow`): each of a frame's
 //! shadow maps drawn from its light (the scene's own triangles, a render pass per map into a
 //! depth texture of its size) and copied into the scene's depth buffer, group 1's binding 7, which the
 //! drawing stages read. The maps are drawn again only when they change (another view or other
@@ -9,8 +9,8 @@ use std::sync::OnceLock;
 
 use glam::Mat4;
 
-use crate::core::scene::SceneVertex;
-use crate::core::shadow::GpuShadowMap;
+use crate::core::scenes::scene::SceneVertex;
+use crate::core::shading::shadow::GpuShadowMap;
 use crate::encoding::types::ShadowParams;
 use crate::error::{Error, Result};
 use crate::gpu::device::Gpu;

@@ -5,7 +5,7 @@
 
 use std::sync::OnceLock;
 
-use crate::core::scene::Scene;
+use crate::core::scenes::scene::Scene;
 use crate::encoding::skin::{SkinData, SkinFrame};
 use crate::encoding::types::SkinParams;
 use crate::error::{Error, Result};

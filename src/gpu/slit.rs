@@ -4,7 +4,7 @@
 use std::time::Instant;
 
 use crate::core::frame::{Frame, FrameStats};
-use crate::core::projection::Eye;
+use crate::core::panoramas::projection::Eye;
 use crate::core::settings::RenderSettings;
 use crate::encoding::slits::{slit_params, slits, sphere_in_slit};
 use crate::encoding::types::SlitCamera;

@@ -10,7 +10,7 @@
 
 use std::sync::OnceLock;
 
-use crate::core::projection::PanoramaKind;
+use crate::core::panoramas::projection::PanoramaKind;
 use crate::core::settings::RenderSettings;
 use crate::encoding::constants::PIECES_FROM_COUNTER;
 use crate::encoding::recording::{Command, Recording, SubdivideBuffer};

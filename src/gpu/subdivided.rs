@@ -7,7 +7,7 @@
 use std::time::Instant;
 
 use crate::core::frame::{Frame, FrameStats, Timing};
-use crate::core::projection::PanoramaKind;
+use crate::core::panoramas::projection::PanoramaKind;
 use crate::core::settings::RenderSettings;
 use crate::encoding::params::raster_params;
 use crate::encoding::recording::Recording;
@@ -306,7 +306,7 @@ impl SubdividedMethod {
 
 /// The raster stage's draws of a frame: its parameters' bind group, and for the cubemap one draw
 /// per face this draw's image holds, each projecting into its face (`face` in the projection
-/// uniform) and kept to the face's square by the scissor (`core::cubemap`: w = D·n clips what
+/// uniform) and kept to the face's square by the scissor (`core::panoramas::cubemap`: w = D·n clips what
 /// lies behind the face).
 fn face_draws(
     gpu: &Gpu,
@@ -319,13 +319,14 @@ fn face_draws(
     let stride = crate::gpu::frame::raster_params_stride(gpu);
     let projection = settings.projection();
     // (face, scissor): the faces a tile holds, each with its square; or the one draw.
-    let faces: Vec<(u32, Option<[u32; 4]>)> = if projection.panorama == crate::core::projection::PanoramaKind::Cubemap {
-        (0..crate::core::cubemap::CUBE_FACES.len())
-            .filter_map(|f| projection.cube_face_scissor(f).map(|rect| (f as u32, Some(rect))))
-            .collect()
-    } else {
-        vec![(0, None)]
-    };
+    let faces: Vec<(u32, Option<[u32; 4]>)> =
+        if projection.panorama == crate::core::panoramas::projection::PanoramaKind::Cubemap {
+            (0..crate::core::panoramas::cubemap::CUBE_FACES.len())
+                .filter_map(|f| projection.cube_face_scissor(f).map(|rect| (f as u32, Some(rect))))
+                .collect()
+        } else {
+            vec![(0, None)]
+        };
     faces
         .into_iter()
         .enumerate()

@@ -3,10 +3,10 @@
 //! layer 1 the right; the render pass that draws one eye into its layer, or both eyes at once
 //! (multiview); and their read-back.
 
-use crate::core::color::srgb_to_linear;
 use crate::core::frame::EyeImage;
-use crate::core::projection::Eye;
+use crate::core::panoramas::projection::Eye;
 use crate::core::settings::RenderSettings;
+use crate::core::shading::color::srgb_to_linear;
 use crate::error::Result;
 use crate::gpu::device::{error_target_format, Gpu};
 use crate::shader::{ErrorTarget, EyesPerDraw};

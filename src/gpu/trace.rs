@@ -5,9 +5,9 @@
 
 use std::time::Instant;
 
-use crate::core::bvh::SceneBvh;
 use crate::core::frame::{Frame, FrameStats};
-use crate::core::projection::{ray_hit_points, Projection};
+use crate::core::panoramas::projection::{ray_hit_points, Projection};
+use crate::core::scenes::bvh::SceneBvh;
 use crate::core::settings::RenderSettings;
 use crate::encoding::constants::TRACE_COUNT_SLOTS;
 use crate::encoding::params::trace_params;

@@ -20,7 +20,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::core::frame::{EyeImage, Frame};
-use crate::core::projection::PanoramaKind;
+use crate::core::panoramas::projection::PanoramaKind;
 use crate::error::{Error, Result};
 
 mod stream;
@@ -105,7 +105,7 @@ impl Default for Encoding {
 
 /// The image with every pixel outside the projection's image (the fisheye's circle) transparent
 /// (RGBA 0, 0, 0, 0): `--alpha`.
-pub fn transparent_outside(img: &EyeImage, projection: &crate::core::projection::Projection) -> EyeImage {
+pub fn transparent_outside(img: &EyeImage, projection: &crate::core::panoramas::projection::Projection) -> EyeImage {
     let mut out = img.clone();
     for (i, px) in out.rgba.chunks_exact_mut(4).enumerate() {
         let (x, y) = ((i as u32 % img.width) as f32 + 0.5, (i as u32 / img.width) as f32 + 0.5);

@@ -3,8 +3,8 @@
 //! no background pixel, and the GPU's subdivision is the twin's ([`super::twin`]).
 
 use super::{topology, twin, SearchCase, SearchPanorama};
-use crate::core::lod::LodSelection;
-use crate::core::scene::Scene;
+use crate::core::detail::lod::LodSelection;
+use crate::core::scenes::scene::Scene;
 use crate::core::settings::RenderSettings;
 use crate::encoding::schedule::{Capacities, Schedule};
 use crate::encoding::subdivide::subdivide_params;

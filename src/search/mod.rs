@@ -8,7 +8,7 @@
 //!   pixel: the room is closed around every eye (inside the fisheye's circle);
 //! - `twin`: the GPU's subdivision is the twin's ([`twin::compare_subdivided`]).
 //!
-//! The property tests (`tests/search.rs`, `cpu::subdivide` and `core::lod` tests) and
+//! The property tests (`tests/search.rs`, `cpu::subdivide` and `core::detail::lod` tests) and
 //! `twister bench search` both draw their cases here.
 
 pub mod checks;
@@ -22,14 +22,14 @@ use proptest::prelude::*;
 use proptest::strategy::{BoxedStrategy, ValueTree};
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 
-use crate::core::cave::NamedWall;
-use crate::core::head::Head;
-use crate::core::lod::{LodChain, LodParams, LodSelection};
-use crate::core::projection::{PanoramaKind, Projection, Vertical, DEFAULT_POLE_MERGE};
-use crate::core::scene::Scene;
+use crate::core::detail::lod::{LodChain, LodParams, LodSelection};
+use crate::core::detail::visual_field::Gaze;
+use crate::core::panoramas::cave::NamedWall;
+use crate::core::panoramas::head::Head;
+use crate::core::panoramas::projection::{PanoramaKind, Projection, Vertical, DEFAULT_POLE_MERGE};
+use crate::core::scenes::scene::Scene;
+use crate::core::scenes::shapes::ClosedMesh;
 use crate::core::settings::{Method, RenderSettings, Split};
-use crate::core::shapes::ClosedMesh;
-use crate::core::visual_field::Gaze;
 
 /// The marker background: no surface of a case has this colour.
 pub const MARKER: [f32; 3] = [1.0, 0.0, 1.0];

@@ -19,8 +19,8 @@ use glam::Vec3;
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
-use crate::core::projection::{azimuth, horizontal_radius, wrap_angle, Eye, PanoramaKind};
-use crate::core::scene::SceneVertex;
+use crate::core::panoramas::projection::{azimuth, horizontal_radius, wrap_angle, Eye, PanoramaKind};
+use crate::core::scenes::scene::SceneVertex;
 use crate::cpu::subdivide::{FrameCuts, Subdivider};
 use crate::encoding::constants::SEAM_MARGIN;
 use crate::encoding::types::{DrawVertex, SubdivideParams};

@@ -6,7 +6,7 @@ use std::collections::HashMap;
 
 use glam::Vec3;
 
-use crate::core::scene::unpack_tangent;
+use crate::core::scenes::scene::unpack_tangent;
 use crate::encoding::subdivide::SubdivideOutput;
 use crate::encoding::types::DrawVertex;
 /// One GPU output of the subdivide stage against the twin's; `software`: the adapter is a CPU

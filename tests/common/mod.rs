@@ -160,9 +160,9 @@ pub fn striped_floor() -> twister::Scene {
 /// A floor quad 1 m below the viewer, white, its corners (x, z, u, v) in order, with a 64×64
 /// texture (`rgba`) filtered linearly between linear mip levels.
 fn textured_floor(name: &str, rgba: Vec<u8>, corners: [[f32; 4]; 4]) -> twister::Scene {
-    use twister::core::material::{Filter, Material, Mipmap};
-    use twister::core::scene::SceneVertex;
-    use twister::core::texture::Texture;
+    use twister::core::scenes::scene::SceneVertex;
+    use twister::core::shading::material::{Filter, Material, Mipmap};
+    use twister::core::shading::texture::Texture;
     let mut scene = twister::Scene::new(format!("{name} floor"));
     scene.textures.push(Texture { name: name.into(), width: 64, height: 64, rgba });
     scene.materials.push(Material {
@@ -196,8 +196,8 @@ pub fn stripe_is_white(x: u32) -> bool {
 /// light with a range, a spot light and a directional light (`KHR_lights_punctual`): the glTF BRDF.
 pub fn lit_spheres() -> twister::Scene {
     use glam::Vec3;
-    use twister::core::light::{Light, LightKind};
-    use twister::core::material::Material;
+    use twister::core::shading::light::{Light, LightKind};
+    use twister::core::shading::material::Material;
     let mut scene = twister::Scene::new("lit spheres");
     scene.materials = vec![
         Material { metallic: 0.0, roughness: 0.5, ..Default::default() },
@@ -213,7 +213,7 @@ pub fn lit_spheres() -> twister::Scene {
     ];
     let colours = [[0.9, 0.9, 0.9, 1.0], [1.0, 0.78, 0.34, 1.0], [0.2, 0.2, 0.2, 1.0]];
     for (k, x) in [-1.3f32, 0.0, 1.3].into_iter().enumerate() {
-        let s = twister::core::builtin::sphere_scene(800, Vec3::new(x, 0.0, -1.6), 0.6, "ball");
+        let s = twister::core::scenes::builtin::sphere_scene(800, Vec3::new(x, 0.0, -1.6), 0.6, "ball");
         let first = scene.vertices.len();
         scene.add_mesh(format!("ball {k}"), &s.vertices, &s.indices);
         for v in &mut scene.vertices[first..] {
@@ -245,7 +245,7 @@ pub fn lit_spheres() -> twister::Scene {
 /// left to right (right to left when `mirrored`) and v top to bottom, material `material`.
 pub fn facing_quad(scene: &mut twister::Scene, azimuth_deg: f32, mirrored: bool, material: u32) {
     use glam::Vec3;
-    use twister::core::scene::SceneVertex;
+    use twister::core::scenes::scene::SceneVertex;
     let a = azimuth_deg.to_radians();
     let centre = Vec3::new(2.0 * a.sin(), 0.0, -2.0 * a.cos());
     let right = Vec3::new(a.cos(), 0.0, a.sin());
@@ -272,9 +272,9 @@ pub fn facing_quad(scene: &mut twister::Scene, azimuth_deg: f32, mirrored: bool,
 /// light from the upper right.
 pub fn mapped_panels() -> twister::Scene {
     use glam::Vec3;
-    use twister::core::light::{Light, LightKind};
-    use twister::core::material::Material;
-    use twister::core::texture::Texture;
+    use twister::core::shading::light::{Light, LightKind};
+    use twister::core::shading::material::Material;
+    use twister::core::shading::texture::Texture;
     let mut scene = twister::Scene::new("mapped panels");
     let image = |name: &str, f: &dyn Fn(u32, u32) -> [u8; 4]| Texture {
         name: name.into(),
@@ -337,15 +337,15 @@ pub fn with_tangents(mut scene: twister::Scene) -> twister::Scene {
         let n = Vec3::from(v.normal).normalize_or(Vec3::Z);
         let side = if n.y.abs() < 0.9 { Vec3::Y } else { Vec3::X };
         let t = Quat::from_axis_angle(n, 0.3 * i as f32) * n.cross(side).normalize();
-        v.tangent = twister::core::scene::pack_tangent(t.extend(if v.object == 0 { 1.0 } else { -1.0 }));
+        v.tangent = twister::core::scenes::scene::pack_tangent(t.extend(if v.object == 0 { 1.0 } else { -1.0 }));
     }
     scene
 }
 
 /// The neutral studio, prepared, shown as the background if `background`.
-pub fn studio(background: bool) -> std::sync::Arc<twister::core::environment::PreparedEnvironment> {
-    let prepared = twister::core::environment::Environment::neutral().prepare();
-    std::sync::Arc::new(twister::core::environment::PreparedEnvironment { background, ..prepared })
+pub fn studio(background: bool) -> std::sync::Arc<twister::core::shading::environment::PreparedEnvironment> {
+    let prepared = twister::core::shading::environment::Environment::neutral().prepare();
+    std::sync::Arc::new(twister::core::shading::environment::PreparedEnvironment { background, ..prepared })
 }
 
 /// A grey rough floor (y = −1.2) with a ball of radius 0.3 at (0.3, −0.6, −2.2) above it, under
@@ -353,12 +353,12 @@ pub fn studio(background: bool) -> std::sync::Arc<twister::core::environment::Pr
 /// (cone 0.5/0.8 rad), or a point light there. With `screen`, also a 1 m square screen at y = −0.3 over x −1.6..−0.6,
 /// z −2.8..−1.8, whose alpha-masked 8×8 texture is a checker of holes (texel (i, j) opaque
 /// where i + j is even; u along +x, v along +z).
-pub fn ball_over_floor(kind: twister::core::light::LightKind, screen: bool) -> twister::Scene {
+pub fn ball_over_floor(kind: twister::core::shading::light::LightKind, screen: bool) -> twister::Scene {
     use glam::Vec3;
-    use twister::core::light::{Light, LightKind};
-    use twister::core::material::{AlphaMode, Filter, Material};
-    use twister::core::scene::SceneVertex;
-    use twister::core::texture::Texture;
+    use twister::core::scenes::scene::SceneVertex;
+    use twister::core::shading::light::{Light, LightKind};
+    use twister::core::shading::material::{AlphaMode, Filter, Material};
+    use twister::core::shading::texture::Texture;
     let mut scene = twister::Scene::new("ball over floor");
     scene.materials.push(Material { metallic: 0.0, roughness: 1.0, ..Default::default() });
     let corner = |x: f32, y: f32, z: f32, material: u32| SceneVertex {
@@ -376,7 +376,7 @@ pub fn ball_over_floor(kind: twister::core::light::LightKind, screen: bool) -> t
         corner(-3.0, -1.2, -5.0, 1),
     ];
     scene.add_mesh("floor", &floor, &[0, 1, 2, 0, 2, 3]);
-    let ball = twister::core::builtin::sphere_scene(800, Vec3::new(0.3, -0.6, -2.2), 0.3, "ball");
+    let ball = twister::core::scenes::builtin::sphere_scene(800, Vec3::new(0.3, -0.6, -2.2), 0.3, "ball");
     scene.add_mesh("ball", &ball.vertices, &ball.indices);
     if screen {
         let rgba = (0..64u32).flat_map(|i| [200, 200, 200, if (i % 8 + i / 8) % 2 == 0 { 255 } else { 0 }]).collect();
@@ -450,9 +450,15 @@ impl Drop for TempDir {
 
 /// The walls of a CAVE, a 3 m cube about the origin (floor at y = −1.5): the front, the left
 /// and the floor, `pixels` square each.
-pub fn cave_walls(pixels: u32) -> Vec<twister::core::cave::NamedWall> {
+pub fn cave_walls(pixels: u32) -> Vec<twister::core::panoramas::cave::NamedWall> {
     let wall = |name: &str, lower_left: [f32; 3], lower_right: [f32; 3], upper_left: [f32; 3]| {
-        twister::core::cave::NamedWall { name: name.into(), lower_left, lower_right, upper_left, pixels: [pixels; 2] }
+        twister::core::panoramas::cave::NamedWall {
+            name: name.into(),
+            lower_left,
+            lower_right,
+            upper_left,
+            pixels: [pixels; 2],
+        }
     };
     vec![
         wall("front", [-1.5, -1.5, -1.5], [1.5, -1.5, -1.5], [-1.5, 1.5, -1.5]),
@@ -466,11 +472,11 @@ pub fn cave_walls(pixels: u32) -> Vec<twister::core::cave::NamedWall> {
 pub fn cave(k: usize, pixels: u32, head: glam::Vec3, yaw: f32) -> twister::Projection {
     let wall = &cave_walls(pixels)[k];
     twister::Projection {
-        panorama: twister::core::projection::PanoramaKind::Cave,
+        panorama: twister::core::panoramas::projection::PanoramaKind::Cave,
         width: pixels,
         height: pixels,
         wall: Some(wall.in_display(1.0, glam::Vec3::ZERO, 0.0)),
-        head: Some(twister::core::head::Head::relative(head, yaw, glam::Vec3::ZERO, 0.0)),
+        head: Some(twister::core::panoramas::head::Head::relative(head, yaw, glam::Vec3::ZERO, 0.0)),
         vertical: twister::Vertical::Exact,
         ..twister::Projection::default()
     }
@@ -507,8 +513,8 @@ pub fn random_triangles(seed: u64, n: usize) -> Scene {
             2 => Vec3::new(rng.random_range(-0.05..0.05), rng.random_range(-2.0..2.0), rng.random_range(-0.05..0.05)),
             _ => Vec3::new(rng.random_range(-8.0..8.0), rng.random_range(-3.0..3.0), rng.random_range(-8.0..8.0)),
         };
-        let v: Vec<twister::core::scene::SceneVertex> = (0..3)
-            .map(|i| twister::core::scene::SceneVertex {
+        let v: Vec<twister::core::scenes::scene::SceneVertex> = (0..3)
+            .map(|i| twister::core::scenes::scene::SceneVertex {
                 position: (center
                     + scale
                         * Vec3::new(
@@ -531,7 +537,7 @@ pub fn random_triangles(seed: u64, n: usize) -> Scene {
 
 /// The same triangles, every one single-sided: those every eye sees from behind are skipped.
 pub fn single_sided(mut scene: Scene) -> Scene {
-    scene.materials.push(twister::core::material::Material { double_sided: 0, ..Default::default() });
+    scene.materials.push(twister::core::shading::material::Material { double_sided: 0, ..Default::default() });
     for v in &mut scene.vertices {
         v.material = 1;
     }

@@ -5,8 +5,8 @@
 //! `render` reads back.
 
 use rand::{Rng, SeedableRng};
-use twister::core::builtin;
 use twister::core::display::{DisplayMode, DisplayView, Look};
+use twister::core::scenes::builtin;
 use twister::cpu::display::display;
 use twister::gpu::display::{DisplayTarget, ShownFrame};
 use twister::gpu::targets::{copy_eyes_to_buffer, unpad_eyes};
@@ -50,7 +50,7 @@ impl Twin for Display {
         let cylinder = Projection { width: 64, height: 24, ..Projection::default() };
         let sphere = Projection { height: 32, ..Projection::equirect(64) };
         let cube = Projection { width: 48, height: 32, ..Projection::equirect(48) };
-        let cube = Projection { panorama: twister::core::projection::PanoramaKind::Cubemap, ..cube };
+        let cube = Projection { panorama: twister::core::panoramas::projection::PanoramaKind::Cubemap, ..cube };
         let fisheye = Projection::fisheye(40);
         use DisplayMode::*;
         vec![

@@ -1,8 +1,8 @@
 //! The shadow stage's twin check (tests/twins.rs): each shadow map's depths drawn on the GPU
 //! against `cpu::shadow` on the same scene and maps.
 
-use twister::core::light::LightKind;
 use twister::core::settings::Method;
+use twister::core::shading::light::LightKind;
 use twister::{GpuScene, Projection, RenderSettings, Renderer, Scene};
 
 use super::{common, Twin};
@@ -10,7 +10,7 @@ use super::{common, Twin};
 pub struct Shadow;
 
 /// The maps a frame of `scene` with `settings` draws.
-fn maps(scene: &Scene, settings: &RenderSettings) -> Vec<twister::core::shadow::GpuShadowMap> {
+fn maps(scene: &Scene, settings: &RenderSettings) -> Vec<twister::core::shading::shadow::GpuShadowMap> {
     settings.shadowed_lighting(&scene.lights, scene.physically_based, scene.environment.as_deref(), scene.bounds()).2
 }
 
@@ -90,6 +90,6 @@ impl Twin for Shadow {
 }
 
 /// Each map's first depth and side.
-fn layout(maps: &[twister::core::shadow::GpuShadowMap]) -> Vec<(usize, usize)> {
+fn layout(maps: &[twister::core::shading::shadow::GpuShadowMap]) -> Vec<(usize, usize)> {
     maps.iter().map(|m| (m.offset as usize, m.size as usize)).collect()
 }

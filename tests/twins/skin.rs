@@ -3,8 +3,8 @@
 //! rest).
 
 use glam::Vec3;
-use twister::core::load::load_scene;
-use twister::core::scene::{unpack_tangent, SceneVertex};
+use twister::core::scenes::load::load_scene;
+use twister::core::scenes::scene::{unpack_tangent, SceneVertex};
 use twister::cpu::skin::{skin, SkinData, SkinFrame};
 use twister::{GpuScene, Projection, Renderer, Scene};
 

@@ -1,7 +1,7 @@
 //! The slit stage's twin check (tests/twins.rs): both eyes of slit mosaics on the GPU against
 //! `cpu::slit`.
 
-use twister::core::builtin;
+use twister::core::scenes::builtin;
 use twister::core::settings::Method;
 use twister::cpu::slit::{slit, slit_multisampled};
 use twister::encoding::slits::{slit_params, slits};
@@ -43,7 +43,7 @@ impl Twin for Slit {
                 RenderSettings::new(projection).with_method(Method::Slit(4)).with_shadow_map_size(256),
             ),
         ));
-        let shadows = common::ball_over_floor(twister::core::light::LightKind::Directional, true);
+        let shadows = common::ball_over_floor(twister::core::shading::light::LightKind::Directional, true);
         let settings = RenderSettings::new(projection).with_method(Method::Slit(4)).with_shadow_map_size(512);
         cases.push(("ball and screen, directional light's shadow map".into(), (shadows, settings)));
         cases.push((
@@ -57,7 +57,7 @@ impl Twin for Slit {
             "demo slit:4, 4 samples".into(),
             (builtin::demo(), RenderSettings::new(projection).with_method(Method::Slit(4)).with_samples(4)),
         ));
-        let screen = common::ball_over_floor(twister::core::light::LightKind::Directional, true);
+        let screen = common::ball_over_floor(twister::core::shading::light::LightKind::Directional, true);
         let settings = RenderSettings::new(projection).with_method(Method::Slit(4)).with_shadow_map_size(512);
         cases.push((
             "ball and MASK screen slit:4, 4 samples: alpha to coverage".into(),

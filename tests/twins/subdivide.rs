@@ -3,7 +3,7 @@
 //! random triangles, built-in rooms and spheres, both panoramas and every split rule.
 
 use glam::Vec3;
-use twister::core::builtin;
+use twister::core::scenes::builtin;
 use twister::core::settings::{Method, Split};
 use twister::cpu::subdivide::passes::run_scheduled;
 use twister::cpu::subdivide::subdivide;
@@ -107,7 +107,7 @@ fn sphere_cases(projection: &Projection) -> Vec<(Scene, RenderSettings)> {
                 width: 256,
                 height: 64,
                 vertical: Vertical::Exact,
-                head: Some(twister::core::head::Head { offset: [-0.5, -0.2, 0.4], turn: -1.0 }),
+                head: Some(twister::core::panoramas::head::Head { offset: [-0.5, -0.2, 0.4], turn: -1.0 }),
                 ..Projection::default()
             }),
         ),

@@ -2,7 +2,7 @@
 //! `cpu::trace`, with the rays traced and the triangle tests made.
 
 use glam::Vec3;
-use twister::core::builtin;
+use twister::core::scenes::builtin;
 use twister::core::settings::Method;
 use twister::encoding::params::trace_params;
 use twister::{GpuScene, Projection, RenderSettings, Renderer, Scene, Vertical};
@@ -15,8 +15,12 @@ pub struct Trace;
 /// index 1.3): the ray tracer's mirror and refraction rays.
 fn optics_demo() -> Scene {
     let mut scene = builtin::demo();
-    scene.materials.push(twister::core::material::Material { mirror: 0.6, ..Default::default() });
-    scene.materials.push(twister::core::material::Material { transmission: 0.8, ior: 1.3, ..Default::default() });
+    scene.materials.push(twister::core::shading::material::Material { mirror: 0.6, ..Default::default() });
+    scene.materials.push(twister::core::shading::material::Material {
+        transmission: 0.8,
+        ior: 1.3,
+        ..Default::default()
+    });
     let base = scene.materials.len() as u32 - 1;
     for v in &mut scene.vertices {
         if v.object == 1 || v.object == 2 {
@@ -43,12 +47,12 @@ fn lod_spheres() -> Scene {
 
 /// The BVH the command line builds: with a visual-field gaze, each object's level-of-detail
 /// chain down to the settings' N_min share.
-fn traced_bvh(scene: &Scene, settings: &RenderSettings) -> twister::core::bvh::SceneBvh {
+fn traced_bvh(scene: &Scene, settings: &RenderSettings) -> twister::core::scenes::bvh::SceneBvh {
     match settings.shading.trace_gaze {
-        None => twister::core::bvh::SceneBvh::of_scene(scene),
+        None => twister::core::scenes::bvh::SceneBvh::of_scene(scene),
         Some(_) => {
-            let chain = twister::core::lod::LodChain::build(scene, settings.shading.trace_min_share);
-            twister::core::bvh::SceneBvh::build(&scene.vertices, &chain.levels)
+            let chain = twister::core::detail::lod::LodChain::build(scene, settings.shading.trace_min_share);
+            twister::core::scenes::bvh::SceneBvh::build(&scene.vertices, &chain.levels)
         }
     }
 }
@@ -56,7 +60,7 @@ fn traced_bvh(scene: &Scene, settings: &RenderSettings) -> twister::core::bvh::S
 /// A checker floor and a mirror sphere on it (the trace twin: textures by ray cones, reflected).
 fn mirror_over_checker() -> Scene {
     let mut scene = common::checker_floor();
-    scene.materials.push(twister::core::material::Material { mirror: 0.7, ..Default::default() });
+    scene.materials.push(twister::core::shading::material::Material { mirror: 0.7, ..Default::default() });
     let s = builtin::sphere_scene(800, Vec3::new(0.0, -0.3, -2.0), 0.5, "mirror");
     let first = scene.vertices.len();
     scene.add_mesh("mirror", &s.vertices, &s.indices);
@@ -68,7 +72,7 @@ fn mirror_over_checker() -> Scene {
 fn mirror_in_studio() -> Scene {
     let mut scene = common::lit_spheres();
     scene.environment = Some(common::studio(true));
-    scene.materials.push(twister::core::material::Material { mirror: 0.8, ..Default::default() });
+    scene.materials.push(twister::core::shading::material::Material { mirror: 0.8, ..Default::default() });
     let s = builtin::sphere_scene(800, Vec3::new(0.0, 0.2, 1.6), 0.5, "mirror");
     let first = scene.vertices.len();
     scene.add_mesh("mirror", &s.vertices, &s.indices);
@@ -95,7 +99,7 @@ fn trace_panorama_cases(cylinder: Projection, sphere: Projection) -> Vec<(String
             (
                 builtin::demo(),
                 RenderSettings::new(Projection {
-                    head: Some(twister::core::head::Head { offset: [0.3, 0.1, -0.2], turn: 0.35 }),
+                    head: Some(twister::core::panoramas::head::Head { offset: [0.3, 0.1, -0.2], turn: 0.35 }),
                     ..cylinder
                 })
                 .with_method(Method::Trace),
@@ -147,7 +151,7 @@ fn trace_shading_cases(cylinder: Projection) -> Vec<(String, (Scene, RenderSetti
                 optics_demo(),
                 RenderSettings::new(cylinder)
                     .with_method(Method::Trace)
-                    .with_trace_gaze(Some(twister::core::visual_field::Gaze::new(30.0, 5.0))),
+                    .with_trace_gaze(Some(twister::core::detail::visual_field::Gaze::new(30.0, 5.0))),
             ),
         ),
         (
@@ -157,7 +161,7 @@ fn trace_shading_cases(cylinder: Projection) -> Vec<(String, (Scene, RenderSetti
                 RenderSettings::new(cylinder)
                     .with_method(Method::Trace)
                     .with_light(Some(Vec3::new(0.0, 1.5, 0.0)))
-                    .with_trace_gaze(Some(twister::core::visual_field::Gaze::new(-20.0, 0.0)))
+                    .with_trace_gaze(Some(twister::core::detail::visual_field::Gaze::new(-20.0, 0.0)))
                     .with_trace_min_share(0.1),
             ),
         ),
@@ -201,7 +205,7 @@ fn trace_material_cases(cylinder: Projection, sphere: Projection) -> Vec<(String
                 RenderSettings::new(cylinder)
                     .with_method(Method::Trace)
                     .with_samples(4)
-                    .with_trace_gaze(Some(twister::core::visual_field::Gaze::new(30.0, 5.0))),
+                    .with_trace_gaze(Some(twister::core::detail::visual_field::Gaze::new(30.0, 5.0))),
             ),
         ),
         (

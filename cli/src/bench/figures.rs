@@ -26,9 +26,9 @@ use serde::Serialize;
 use crate::bench::runner::{FigureConfig, Runner};
 use crate::bench::speed::median;
 use crate::plot::{draw_panels, Chart, Series, PALETTE};
-use twister::core::load::load_scene;
-use twister::core::projection::{Projection, Vertical};
-use twister::core::scene::Scene;
+use twister::core::panoramas::projection::{Projection, Vertical};
+use twister::core::scenes::load::load_scene;
+use twister::core::scenes::scene::Scene;
 use twister::core::settings::{Method, Split};
 use twister::{GpuScene, RenderSettings};
 

@@ -22,11 +22,11 @@ use serde::Serialize;
 use crate::bench::runner::{write_csv, write_png, Runner};
 use crate::bench::speed::median;
 use crate::plot::{draw_panels, Chart, Series, PALETTE};
-use twister::core::builtin::sphere_scene;
-use twister::core::load::load_obj;
-use twister::core::lod::{LodChain, LodParams};
-use twister::core::scene::Scene;
-use twister::core::visual_field::{Field, Gaze};
+use twister::core::detail::lod::{LodChain, LodParams};
+use twister::core::detail::visual_field::{Field, Gaze};
+use twister::core::scenes::builtin::sphere_scene;
+use twister::core::scenes::load::load_obj;
+use twister::core::scenes::scene::Scene;
 use twister::{Frame, GpuScene, RenderSettings};
 
 /// Twelve copies of a model, `height` m tall, `radius` m around the viewer every 30°, at eye
@@ -87,7 +87,7 @@ fn field_errors(frame: &Frame, settings: &RenderSettings, gaze: &Gaze) -> (f32, 
             if e < 0.0 {
                 continue;
             }
-            if twister::core::lod::pixel_field(p, gaze, x, y) == Field::Central {
+            if twister::core::detail::lod::pixel_field(p, gaze, x, y) == Field::Central {
                 central.push(e);
             } else {
                 other.push(e);
@@ -209,10 +209,10 @@ impl Runner<'_> {
                 let gaze = Gaze::new(self.gazes()[0].0, self.gazes()[0].1);
                 let sel = chain.select(scene, settings.view(), &gaze, &params);
                 let mut tinted = scene.clone();
-                twister::core::lod::tint(&mut tinted, &sel);
+                twister::core::detail::lod::tint(&mut tinted, &sel);
                 let shown = GpuScene::upload(&self.renderer.gpu, &tinted)?.with_lod(&self.renderer.gpu, &sel);
                 let mut frame = self.renderer.render(&shown, &settings)?;
-                twister::core::lod::draw_field_boundaries(&mut frame.left, &settings.view.projection, &gaze);
+                twister::core::detail::lod::draw_field_boundaries(&mut frame.left, &settings.view.projection, &gaze);
                 let img = image::RgbaImage::from_raw(frame.left.width, frame.left.height, frame.left.rgba)
                     .ok_or_else(|| Error::output(self.cfg.out.join("lod_overlay.png"), "overlay image size"))?;
                 write_png(&self.cfg.out.join("lod_overlay.png"), img)?;

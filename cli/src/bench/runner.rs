@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
-use twister::core::projection::Projection;
+use twister::core::panoramas::projection::Projection;
 use twister::core::settings::{Method, Split};
 use twister::error::{Error, Result};
 use twister::gpu::Renderer;

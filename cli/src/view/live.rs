@@ -11,10 +11,10 @@ use super::{OnOff, Show, ViewCmdArgs};
 use crate::args::{RenderArgs, Viewer};
 use crate::render::render_settings;
 use crate::scene::{prepare, Prepared};
+use twister::core::detail::visual_field::Gaze;
 use twister::core::display::{DisplayView, Look};
-use twister::core::projection::PanoramaKind;
+use twister::core::panoramas::projection::PanoramaKind;
 use twister::core::settings::{Method, Split};
-use twister::core::visual_field::Gaze;
 use twister::error::{Error, Result};
 use twister::gpu::display::{DisplayTarget, ShownFrame};
 use twister::{EyeImage, RenderSettings, Renderer};
@@ -115,7 +115,7 @@ pub struct Live<'a> {
     overlay_at: Option<Instant>,
     saves: Vec<std::thread::JoinHandle<Result<()>>>,
     /// With `--lod visual-field`: the scene's chains and the whole scene uploaded.
-    lod: Option<(twister::core::lod::LodChain, twister::GpuScene)>,
+    lod: Option<(twister::core::detail::lod::LodChain, twister::GpuScene)>,
 }
 
 impl<'a> Live<'a> {
@@ -191,7 +191,7 @@ impl<'a> Live<'a> {
     /// With `--lod visual-field`, what the gaze's selection is made from.
     fn with_lod(mut self) -> Result<Live<'a>> {
         if let Some((params, _)) = self.args.view.lod()? {
-            let chain = twister::core::lod::LodChain::build(&self.prepared.scene, params.p3);
+            let chain = twister::core::detail::lod::LodChain::build(&self.prepared.scene, params.p3);
             let whole = twister::GpuScene::upload(&self.renderer.gpu, &self.prepared.scene)?;
             self.lod = Some((chain, whole));
         }

@@ -115,7 +115,7 @@ pub fn view(args: &ViewCmdArgs) -> Result<()> {
             return Err(Error::option(option, "belongs to `render`: the window draws one frame at a time"));
         }
     }
-    if r.view.cave.is_some() || r.view.panorama == Some(twister::core::projection::PanoramaKind::Cave) {
+    if r.view.cave.is_some() || r.view.panorama == Some(twister::core::panoramas::projection::PanoramaKind::Cave) {
         return Err(Error::option(
             "--cave",
             "a CAVE's walls are images apart: render them (the window shows one panorama)",

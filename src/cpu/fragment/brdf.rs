@@ -1,10 +1,10 @@
 //! The glTF look's maths, CPU twin of `shaders/shared/brdf.wgsl`: the metallic-roughness BRDF
 //! (glTF 2.0 Appendix B) and the punctual lights' radiance at a point (tone mapping:
-//! `core::light::tonemap`).
+//! `core::shading::light::tonemap`).
 
 use glam::Vec3;
 
-use crate::core::light::{GpuLight, LightKind};
+use crate::core::shading::light::{GpuLight, LightKind};
 
 /// The glTF 2.0 BRDF (`brdf` in surface.wgsl; specification Appendix B): Lambert diffuse of
 /// c_diff = base·(1 − metallic) weighted by 1 − F, plus GGX D · Smith separable Vis · F, with

@@ -1,10 +1,10 @@
 //! Image-based lighting from the prepared environment, CPU twin of `shaders/shared/ibl.wgsl`:
-//! the split sum's prefiltered levels, SH irradiance and lobe table (`core::environment`).
+//! the split sum's prefiltered levels, SH irradiance and lobe table (`core::shading::environment`).
 
 use glam::{Vec2, Vec3};
 
-use crate::core::environment::{ENV_LEVELS, LUT_SIZE};
-use crate::core::texture::MaterialTable;
+use crate::core::shading::environment::{ENV_LEVELS, LUT_SIZE};
+use crate::core::shading::texture::MaterialTable;
 
 /// A viewer-frame direction in the environment's frame (`env_direction`).
 pub fn env_direction(table: &MaterialTable, d: Vec3) -> Vec3 {
@@ -21,7 +21,7 @@ pub fn env_level(table: &MaterialTable, k: usize, st: Vec2) -> Vec3 {
     let texel = |dx: i32, dy: i32| {
         let x = (base.x as i32 + dx).rem_euclid(width as i32) as u32;
         let y = (base.y as i32 + dy).clamp(0, height as i32 - 1) as u32;
-        crate::core::environment::rgb9e5_decode(table.environment[(offset + y * width + x) as usize])
+        crate::core::shading::environment::rgb9e5_decode(table.environment[(offset + y * width + x) as usize])
     };
     let top = texel(0, 0).lerp(texel(1, 0), f.x);
     let bottom = texel(0, 1).lerp(texel(1, 1), f.x);
@@ -45,7 +45,7 @@ pub fn env_radiance(table: &MaterialTable, d: Vec3, roughness: f32) -> Vec3 {
 /// E(n)/π at viewer-frame normal n (`env_irradiance`).
 pub fn env_irradiance(table: &MaterialTable, n: Vec3) -> Vec3 {
     let sh = table.lighting.env_sh.map(|c| Vec3::from_slice(&c[..3]));
-    crate::core::environment::irradiance(&sh, env_direction(table, n))
+    crate::core::shading::environment::irradiance(&sh, env_direction(table, n))
 }
 
 /// The split-sum table (A, B) at n·v and roughness (`env_lut`).
@@ -62,7 +62,7 @@ pub fn env_lut(table: &MaterialTable, nv: f32, roughness: f32) -> Vec2 {
             + (base.y as usize + dy as usize) * LUT_SIZE
             + base.x as usize
             + dx as usize;
-        out += w * crate::core::environment::unpack_half2(table.environment[i]);
+        out += w * crate::core::shading::environment::unpack_half2(table.environment[i]);
     }
     out
 }

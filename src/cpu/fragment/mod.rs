@@ -18,15 +18,15 @@ pub use texture::{sample_levels, sample_texture, wrap_index};
 
 use glam::{Vec2, Vec3, Vec4};
 
-pub use crate::core::color::display_bytes;
-use crate::core::light::{tonemap, GpuLight, NO_SHADOW_MAP};
-use crate::core::material::{AlphaMode, NO_TEXTURE};
-pub use crate::core::projection::pixel_ray;
-use crate::core::projection::{Eye, Projection};
-use crate::core::shadow::{
+pub use crate::core::panoramas::projection::pixel_ray;
+use crate::core::panoramas::projection::{Eye, Projection};
+pub use crate::core::shading::color::display_bytes;
+use crate::core::shading::light::{tonemap, GpuLight, NO_SHADOW_MAP};
+use crate::core::shading::material::{AlphaMode, NO_TEXTURE};
+use crate::core::shading::shadow::{
     cube_face, shadow_coordinates, LIGHT_OFFSET_TEXELS, NORMAL_OFFSET_TEXELS, SHADOW_CUBE, SHADOW_ORTHOGRAPHIC,
 };
-use crate::core::texture::MaterialTable;
+use crate::core::shading::texture::MaterialTable;
 
 /// Linear colour × (ambient + (1 − ambient)·|n·l|), the light at the viewer, two-sided; as
 /// sRGB-encoded RGBA8 (the colour target holds display values).
@@ -119,7 +119,7 @@ pub fn pbr_radiance(
 }
 
 /// The share of a light reaching p by its shadow map (`shadow_visibility` in surface.wgsl; the
-/// offsets and the filter in `core::shadow`).
+/// offsets and the filter in `core::shading::shadow`).
 pub fn shadow_visibility(table: &MaterialTable, first_map: u32, p: Vec3, normal: Vec3, l: Vec3) -> f32 {
     let mut map = first_map;
     if table.shadow_maps[map as usize].projection == SHADOW_CUBE {
@@ -270,7 +270,7 @@ pub fn mapped_normal(n: Vec3, s: &SurfaceMaps) -> Vec3 {
     (t * (k * s.normal.x) - b * (k * s.normal.y) + n * s.normal.z).normalize()
 }
 
-// ---- Image-based lighting (`core::environment`; surface.wgsl's twins) ----
+// ---- Image-based lighting (`core::shading::environment`; surface.wgsl's twins) ----
 
 /// Screen-door threshold of a pixel for BLEND materials (`blend_threshold` in surface.wgsl): a
 /// 4×4 ordered-dither (Bayer) matrix, shifted by a point's offset from the pixel's centre along x
@@ -365,9 +365,9 @@ pub fn surface_rgba(table: &MaterialTable, s: &Surface) -> Option<Vec4> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::core::color::{linear_to_srgb, srgb_to_linear};
-    use crate::core::material::{Filter, Material, Mipmap, Wrap};
-    use crate::core::texture::Texture;
+    use crate::core::shading::color::{linear_to_srgb, srgb_to_linear};
+    use crate::core::shading::material::{Filter, Material, Mipmap, Wrap};
+    use crate::core::shading::texture::Texture;
 
     /// Alpha to coverage against the closed form: over a 4×4 block of pixels (every screen-door
     /// threshold once) a BLEND fragment of alpha a covers a·n·16 samples within one, each pixel

@@ -4,7 +4,7 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::core::projection::{pixel_ray, Eye, PanoramaKind, Projection};
+use crate::core::panoramas::projection::{pixel_ray, Eye, PanoramaKind, Projection};
 
 /// The angle a pixel spans, radians (`pixel_spread` in surface.wgsl): the larger of its width
 /// (2π/turn_px, on the sphere × cos latitude) and its height (on the cylinder 1/(pixels_per_v·R_T),
@@ -47,7 +47,7 @@ pub fn pixel_error(projection: &Projection, eye: Eye, p: Vec3, frag_xy: Vec2, an
         Some(q) if projection.panorama == PanoramaKind::Cubemap => {
             // On the pixel's own face (a point drawn across a face's edge belongs beyond it there).
             let face = projection.cube_face_at(frag_xy.x, frag_xy.y);
-            match projection.cube_pixel_on_face(crate::core::cubemap::direction(q.u, q.v), face) {
+            match projection.cube_pixel_on_face(crate::core::panoramas::cubemap::direction(q.u, q.v), face) {
                 Some([x, y]) => Vec2::new(x - frag_xy.x, y - frag_xy.y).length(),
                 None => 1e9,
             }

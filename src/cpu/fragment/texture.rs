@@ -4,9 +4,9 @@
 
 use glam::{Vec2, Vec4};
 
-use crate::core::color::srgb_to_linear;
-use crate::core::material::{Filter, Material, MipLevel, Mipmap, Wrap};
-use crate::core::texture::MaterialTable;
+use crate::core::shading::color::srgb_to_linear;
+use crate::core::shading::material::{Filter, Material, MipLevel, Mipmap, Wrap};
+use crate::core::shading::texture::MaterialTable;
 
 /// Texel index `i` folded into `0..n` by a wrap mode.
 pub fn wrap_index(i: i32, n: i32, mode: u32) -> i32 {

@@ -12,7 +12,7 @@
 //! that reaches the first diamond, or whose diamond distances span more than `WIDE_RATIO`,
 //! switches on the quadrant cuts and the square, and (adaptive) every diamond that crosses it
 //! ([`triangle_cuts`]); it also marks its three edges (by the scene's shared-edge numbers,
-//! `core::shared_edges`). Such a triangle, and any triangle that has one of those edges (a wall
+//! `core::scenes::shared_edges`). Such a triangle, and any triangle that has one of those edges (a wall
 //! beside a floor), is then cut at the quadrant planes and the active diamonds it crosses
 //! ([`polygons`]); a second pass (`ring_cuts`) marks the edges of the latter too. Any other
 //! triangle is small next to its distance from the axis and needs no cut for itself: it is cut

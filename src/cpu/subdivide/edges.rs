@@ -7,8 +7,8 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use super::spacing::Spacing;
 use super::{snap_to_cut_planes, Node, PartSplit, Subdivider, Triangle};
-use crate::core::projection::{azimuth, horizontal_radius, Eye, PanoramaKind, Vertical};
-use crate::core::scene::{unpack_tangent, SceneVertex, SINGLE_SIDED};
+use crate::core::panoramas::projection::{azimuth, horizontal_radius, Eye, PanoramaKind, Vertical};
+use crate::core::scenes::scene::{unpack_tangent, SceneVertex, SINGLE_SIDED};
 use crate::core::settings::SplitRule;
 use crate::encoding::constants::{
     AZIMUTH_CHORD_RESIDUAL, AZIMUTH_RESIDUAL_ERROR, BACK_FACE_MARGIN, EDGE_SAMPLES, ERROR_SPLIT_LENGTH,

@@ -7,8 +7,8 @@
 use glam::Vec3;
 
 use super::{band_limit, edge_split_parts, polygons, triangle_cuts, AxisCuts, Node, Subdivider, Triangle};
-use crate::core::scene::SceneVertex;
-use crate::core::shared_edges::{shared_edges, SharedEdges};
+use crate::core::scenes::scene::SceneVertex;
+use crate::core::scenes::shared_edges::{shared_edges, SharedEdges};
 
 /// The frame's cuts around the axis (`active_cuts`): which cuts, and which of the scene's
 /// shared edges are a triangle's that asks for cuts, or a cut triangle's (`cut_edges` in the

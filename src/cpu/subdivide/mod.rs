@@ -97,8 +97,8 @@
 use glam::{Vec2, Vec3, Vec4};
 use std::f32::consts::{PI, TAU};
 
-use crate::core::projection::Projection;
-use crate::core::scene::{pack_tangent, SceneVertex};
+use crate::core::panoramas::projection::Projection;
+use crate::core::scenes::scene::{pack_tangent, SceneVertex};
 use crate::core::settings::SplitRule;
 use crate::encoding::constants::{SEAM_MARGIN, STRIP_BASE_ERROR, STRIP_MIN_DIVISIONS};
 pub use crate::encoding::subdivide::{expand, subdivide_params, SubdivideOutput};

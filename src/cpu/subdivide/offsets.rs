@@ -20,7 +20,7 @@ use glam::{Vec2, Vec3};
 
 use super::piece::PieceGeometry;
 use super::{Node, Subdivider};
-use crate::core::projection::horizontal_radius;
+use crate::core::panoramas::projection::horizontal_radius;
 use crate::encoding::constants::{AZIMUTH_MIN_RADIUS, EDGE_SAMPLES};
 
 /// Keeps the longer of two error vectors.
@@ -127,8 +127,8 @@ mod tests {
 
     use glam::Vec3;
 
-    use crate::core::builtin;
-    use crate::core::projection::Projection;
+    use crate::core::panoramas::projection::Projection;
+    use crate::core::scenes::builtin;
     use crate::core::settings::{Method, RenderSettings, Split};
     use crate::cpu::subdivide::subdivide;
     use crate::encoding::subdivide::subdivide_params;

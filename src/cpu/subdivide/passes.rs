@@ -19,7 +19,7 @@ use super::{
     band_limit, chunk_of, edge_split_parts, fan, one_part, quadrant_polygons, triangle_cuts, FrameCuts, Node,
     PartSplit, PieceGeometry, PiecePlan, SubdivideOutput, Subdivider, Triangle,
 };
-use crate::core::scene::SceneVertex;
+use crate::core::scenes::scene::SceneVertex;
 use crate::core::settings::RenderSettings;
 use crate::encoding::constants::{BANDS, PIECES_FROM_COUNTER, PLAN_CUTS_SPLIT};
 use crate::encoding::recording::{Command, Recording, SubdivideBuffer};

@@ -14,7 +14,7 @@ use super::{
     band_cell, boundary_edge, edge_point, macro_cell, slot_node, snap, strip_node_count, Node, PartSplit, PiecePlan,
     Rows, Subdivider, Triangle,
 };
-use crate::core::projection::{azimuth, wrap_angle, Eye};
+use crate::core::panoramas::projection::{azimuth, wrap_angle, Eye};
 use crate::encoding::constants::SEAM_BOUND_SLACK;
 
 /// Where a macro node lies. Original edge e runs from corner e to corner e + 1.

@@ -1,8 +1,8 @@
 //! Tests of the twin running the schedules' recordings: the cut probe tells what the frame cuts.
 
 use super::passes::CpuSubdivision;
-use crate::core::builtin;
-use crate::core::projection::Projection;
+use crate::core::panoramas::projection::Projection;
+use crate::core::scenes::builtin;
 use crate::core::settings::{Method, RenderSettings, Split};
 use crate::encoding::constants::PIECES_FROM_COUNTER;
 use crate::encoding::schedule::{Capacities, SubdivisionEngine};
@@ -44,8 +44,8 @@ fn a_frame_whose_piece_records_overflow_replays_to_the_direct_run() {
     // Fine splits (L = 4 px, N_max = 1) of a room around the viewer on the fisheye make more
     // piece records than the first guess holds: the slots counted but never written are no
     // pieces, and the frame drawn again with grown buffers gives the direct run's triangles.
-    use crate::core::scene::Scene;
-    use crate::core::shapes::ClosedMesh;
+    use crate::core::scenes::scene::Scene;
+    use crate::core::scenes::shapes::ClosedMesh;
     use crate::encoding::schedule::Schedule;
     let mut scene = Scene::new("room");
     ClosedMesh::grid_box(3).placed(glam::Vec3::new(0.3, 0.2, -0.4), 2.0).add_to(&mut scene, [1.0; 4]);

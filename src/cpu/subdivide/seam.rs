@@ -8,7 +8,7 @@ use std::f32::consts::PI;
 
 use super::work::NO_REACH;
 use super::{Node, Subdivider};
-use crate::core::projection::{azimuth, wrap_angle};
+use crate::core::panoramas::projection::{azimuth, wrap_angle};
 use crate::encoding::constants::{SEAM_BOUND_SLACK, SEAM_MARGIN};
 
 impl Subdivider<'_> {
@@ -25,7 +25,7 @@ impl Subdivider<'_> {
         let proj = &self.projection;
         if let Some(head) = &proj.head {
             // A tracked head: u = θ − γ, moved by the eye's offset seen from the point and by
-            // the eye's distance from the display's axis seen from the screen (`core::head`).
+            // the eye's distance from the display's axis seen from the screen (`core::panoramas::head`).
             let reach = Vec2::new(head.offset[0], head.offset[2]).length() + proj.eye_radius;
             let bound =
                 (proj.eye_radius / r_min.max(1e-30)).min(1.0).asin() + (reach / proj.screen_radius).min(1.0).asin();
@@ -89,7 +89,7 @@ pub(super) fn clear_of_seam((u_min, u_max): (f32, f32)) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::core::projection::{Eye, Projection};
+    use crate::core::panoramas::projection::{Eye, Projection};
     use crate::core::settings::{Method, Split, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV};
     use crate::cpu::subdivide::tests::params_for;
     use glam::Vec3;

@@ -5,8 +5,8 @@ use std::collections::HashMap;
 
 use super::tests::{run_method, run_method_with_cuts};
 use super::*;
-use crate::core::builtin;
-use crate::core::projection::{azimuth, Eye, PanoramaKind};
+use crate::core::panoramas::projection::{azimuth, Eye, PanoramaKind};
+use crate::core::scenes::builtin;
 use crate::core::settings::{Method, RenderSettings};
 
 #[test]

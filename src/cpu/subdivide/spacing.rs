@@ -27,7 +27,7 @@
 use glam::{Vec2, Vec3};
 
 use super::Node;
-use crate::core::projection::horizontal_radius;
+use crate::core::panoramas::projection::horizontal_radius;
 use crate::encoding::constants::{AZIMUTH_MAX_TURN, AZIMUTH_MIN_RADIUS, AZIMUTH_MIN_TURN};
 use crate::encoding::types::SubdivideParams;
 
@@ -146,7 +146,7 @@ pub fn precise_sin(x: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::core::projection::azimuth;
+    use crate::core::panoramas::projection::azimuth;
 
     #[test]
     fn azimuth_spacing_takes_equal_steps_of_azimuth_along_the_segment() {

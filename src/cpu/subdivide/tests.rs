@@ -4,8 +4,8 @@
 use super::lattice::strip_node;
 use super::spacing::Spacing;
 use super::*;
-use crate::core::builtin;
-use crate::core::projection::{azimuth, wrap_angle, Eye, Vertical};
+use crate::core::panoramas::projection::{azimuth, wrap_angle, Eye, Vertical};
+use crate::core::scenes::builtin;
 use crate::core::settings::{Method, RenderSettings, Split, DEFAULT_EDGE_PX, DEFAULT_MAX_DIV};
 use crate::encoding::constants::PIECE_DIVISIONS;
 use std::collections::HashMap;
@@ -436,7 +436,7 @@ fn macro_cells_tile_the_lattice() {
 #[test]
 fn subdivided_closed_mesh_stays_closed() {
     let projection = Projection { width: 1200, height: 240, ..Projection::default() };
-    let blob = crate::core::builtin::blob(Vec3::new(0.3, 0.1, -3.0), 1.2);
+    let blob = crate::core::scenes::builtin::blob(Vec3::new(0.3, 0.1, -3.0), 1.2);
     let (v, i) = (blob.vertices, blob.indices);
     for (method, edge_px, max_div) in [
         (Method::Adaptive(Split::Length), 32.0f32, 7),
@@ -485,7 +485,7 @@ fn the_passes_replaying_every_schedule_make_the_twins_triangles() {
 
     let cylinder = Projection { width: 480, height: 120, ..Projection::default() };
     let mut rng = rand::rngs::StdRng::seed_from_u64(11);
-    let mut random = crate::core::scene::Scene::new("random");
+    let mut random = crate::core::scenes::scene::Scene::new("random");
     for k in 0..120 {
         let near_axis = k % 3 == 2;
         let c = if near_axis {

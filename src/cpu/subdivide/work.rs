@@ -10,7 +10,7 @@ use std::ops::Range;
 use glam::Vec3;
 
 use super::Subdivider;
-use crate::core::projection::azimuth;
+use crate::core::panoramas::projection::azimuth;
 use crate::encoding::constants::{LATTICE_CHUNK, SEAM_MARGIN};
 use crate::encoding::types::DrawVertex;
 

@@ -1,4 +1,4 @@
-//! What twister's caches on disk share (the prepared environments, `core::environment_cache`;
+//! What twister's caches on disk share (the prepared environments, `core::caches::environment_cache`;
 //! the driver's pipeline cache, `gpu::pipeline_cache`): the folder, the hash that keys and checks
 //! their files, and the whole-file write. A cache is an optimisation: failing to read or write it
 //! is silent.

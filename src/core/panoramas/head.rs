@@ -24,8 +24,8 @@
 
 use glam::{Mat3, Vec3};
 
-pub use crate::core::projection::Head;
-use crate::core::projection::{azimuth, wrap_angle, Eye, PanoramaKind, Projected, Projection, Vertical};
+pub use crate::core::panoramas::projection::Head;
+use crate::core::panoramas::projection::{azimuth, wrap_angle, Eye, PanoramaKind, Projected, Projection, Vertical};
 use crate::error::{Error, Result};
 
 impl Head {
@@ -40,7 +40,7 @@ impl Head {
         // columns).
         Head {
             offset: offset.to_array(),
-            turn: crate::core::projection::wrap_angle((yaw_deg - viewer_yaw_deg).to_radians()),
+            turn: crate::core::panoramas::projection::wrap_angle((yaw_deg - viewer_yaw_deg).to_radians()),
         }
     }
 
@@ -124,7 +124,7 @@ impl Projection {
 
 #[cfg(test)]
 mod tests {
-    use crate::core::projection::{pixel_ray, Eye, Head, Panorama, Projection, Vertical};
+    use crate::core::panoramas::projection::{pixel_ray, Eye, Head, Panorama, Projection, Vertical};
     use glam::{Vec2, Vec3};
     use rand::{Rng, SeedableRng};
 

@@ -1,4 +1,4 @@
-//! The stereo cubemap (`--panorama cubemap`): the full sphere's eye rays (`core::sphere`, the
+//! The stereo cubemap (`--panorama cubemap`): the full sphere's eye rays (`core::panoramas::sphere`, the
 //! same ODS eye model: a point is first projected to the longitude λ and latitude φ of the eye
 //! ray that reaches it, from that eye's point on the eye circle) drawn on the six faces of a cube,
 //! each face a 90° gnomonic image of those rays' directions:
@@ -30,7 +30,7 @@
 
 use glam::{Vec3, Vec4};
 
-use crate::core::projection::{PanoramaKind, Projection};
+use crate::core::panoramas::projection::{PanoramaKind, Projection};
 use crate::error::{Error, Result};
 
 /// One face of the cube: its name, where it sits in an eye's 3×2 grid, and its camera's axes.
@@ -83,7 +83,7 @@ impl Projection {
 /// face). `cube_face_of` in projection_cubemap.wgsl.
 pub fn cube_face_of(d: Vec3) -> usize {
     // The shadow cubes' order (+x, −x, +y, −y, +z, −z) with the front (−z) before the back.
-    match crate::core::shadow::major_axis_face(d) {
+    match crate::core::shading::shadow::major_axis_face(d) {
         4 => 5,
         5 => 4,
         k => k as usize,
@@ -263,7 +263,7 @@ impl Projection {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::core::projection::{Eye, Panorama};
+    use crate::core::panoramas::projection::{Eye, Panorama};
     use glam::Vec2;
     use rand::{Rng, SeedableRng};
 
@@ -295,7 +295,7 @@ mod tests {
         let s = proj.cube_face_px() as f64;
         let mut faces = [0; 6];
         for _ in 0..3000 {
-            let p = crate::core::projection::tests::random_point(&mut rng);
+            let p = crate::core::panoramas::projection::tests::random_point(&mut rng);
             let dist = p.length();
             for eye in Eye::BOTH {
                 let Some(([x, y], depth)) = proj.project_pixel(p, eye) else { continue };

@@ -1,4 +1,4 @@
-//! The fulldome master (`--panorama fisheye`): the full sphere's eye rays (`core::sphere`, the
+//! The fulldome master (`--panorama fisheye`): the full sphere's eye rays (`core::panoramas::sphere`, the
 //! same ODS eye model, so a point is first projected to the longitude λ and latitude φ of the
 //! eye ray that reaches it) drawn in an equidistant azimuthal image, the planetarium convention:
 //!
@@ -19,7 +19,7 @@
 
 use glam::Vec3;
 
-use crate::core::projection::{PanoramaKind, Projection};
+use crate::core::panoramas::projection::{PanoramaKind, Projection};
 use crate::error::{Error, Result};
 
 impl Projection {
@@ -99,7 +99,7 @@ impl Projection {
     /// ([`Projection::dome_antipode_cone`]), so that what is dropped leaves no chord inside the
     /// circle.
     pub fn chord_dip_px(&self, error_split: bool, edge_px: f32, max_error_px: f32) -> f32 {
-        if self.panorama != crate::core::projection::PanoramaKind::Fisheye {
+        if self.panorama != crate::core::panoramas::projection::PanoramaKind::Fisheye {
             return 0.0;
         }
         if error_split {
@@ -130,13 +130,14 @@ impl Projection {
     pub fn dome_antipode_cone(&self, dip_px: f32) -> Option<f32> {
         let margin = 10.0 + (dip_px / self.fisheye_pixels_per_radian()).to_degrees();
         let beta = (180.0 - 0.5 * self.fov - margin).min(90.0);
-        (self.panorama == crate::core::projection::PanoramaKind::Fisheye && beta > 0.0).then(|| beta.to_radians().cos())
+        (self.panorama == crate::core::panoramas::projection::PanoramaKind::Fisheye && beta > 0.0)
+            .then(|| beta.to_radians().cos())
     }
 
     /// Whether image position (x, y) lies inside the fisheye's FOV circle (radius W/2); every
     /// position of the other panoramas.
     pub fn shows_pixel(&self, x: f32, y: f32) -> bool {
-        if self.panorama != crate::core::projection::PanoramaKind::Fisheye {
+        if self.panorama != crate::core::panoramas::projection::PanoramaKind::Fisheye {
             return true;
         }
         let (dx, dy) = (x - 0.5 * self.width as f32, y - 0.5 * self.height as f32);
@@ -146,7 +147,7 @@ impl Projection {
 
 #[cfg(test)]
 mod tests {
-    use crate::core::projection::{Eye, Panorama, Projection};
+    use crate::core::panoramas::projection::{Eye, Panorama, Projection};
     use glam::Vec3;
     use rand::SeedableRng;
 
@@ -182,7 +183,7 @@ mod tests {
             let proj = Projection { fov, dome_tilt: tilt, ..Projection::fisheye(1024) };
             proj.validate().unwrap();
             for _ in 0..1500 {
-                let p = crate::core::projection::tests::random_point(&mut rng);
+                let p = crate::core::panoramas::projection::tests::random_point(&mut rng);
                 let dist = p.length();
                 for eye in Eye::BOTH {
                     let Some(([x, y], depth)) = proj.project_pixel(p, eye) else { continue };

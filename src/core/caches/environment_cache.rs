@@ -3,7 +3,7 @@
 //! result is kept under a key of what it depends on — the radiance itself and the preparation's
 //! parameters — and read back instead of prepared again.
 //!
-//! Where: the folder of `core::disk_cache` (`TWISTER_CACHE_DIR`, empty or `off` turns it off). A
+//! Where: the folder of `core::caches::disk_cache` (`TWISTER_CACHE_DIR`, empty or `off` turns it off). A
 //! file is written whole (`disk_cache::write_whole`), so a reader never sees half of one; one
 //! that does not read back
 //! exactly (wrong magic, size or checksum: truncated, corrupt, another version) is prepared
@@ -13,8 +13,8 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
-use crate::core::disk_cache::{cache_dir, fnv1a, write_whole, FNV_OFFSET};
-use crate::core::environment::{
+use crate::core::caches::disk_cache::{cache_dir, fnv1a, write_whole, FNV_OFFSET};
+use crate::core::shading::environment::{
     Environment, PreparedEnvironment, ENV_LEVELS, LUT_SAMPLES, LUT_SIZE, MAX_ENV_WIDTH, PREFILTER_SAMPLES,
 };
 

@@ -4,9 +4,9 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3, Vec4};
 
-use crate::core::material::Material;
-use crate::core::projection::Projection;
-use crate::core::texture::{MaterialTable, Texture};
+use crate::core::panoramas::projection::Projection;
+use crate::core::shading::material::Material;
+use crate::core::shading::texture::{MaterialTable, Texture};
 use crate::error::{Error, Result};
 
 /// A scene vertex as the stages read it (`SceneVertex` in shaders/shared/scene.wgsl). 64 bytes.
@@ -101,18 +101,18 @@ pub struct Scene {
     /// Cameras placed in the file (glTF camera nodes), usable as the viewer.
     pub cameras: Vec<Camera>,
     /// Punctual lights placed in the file (glTF `KHR_lights_punctual`).
-    pub lights: Vec<crate::core::light::Light>,
+    pub lights: Vec<crate::core::shading::light::Light>,
     /// Whether the file describes its materials for the glTF BRDF (a glTF file): `--lighting
     /// auto` then lights it so, with the neutral environment where it has no lights.
     pub physically_based: bool,
     /// The environment that lights it (image-based lighting, `--environment`), prepared.
-    pub environment: Option<std::sync::Arc<crate::core::environment::PreparedEnvironment>>,
+    pub environment: Option<std::sync::Arc<crate::core::shading::environment::PreparedEnvironment>>,
     /// Meshes drawn (glTF mesh instances, OBJ objects/groups, built-in shapes: one per object)
     /// and their primitives.
     pub meshes: usize,
     pub primitives: usize,
     /// What moves (glTF animation, skins, morph targets), where the file has any.
-    pub rig: Option<Box<crate::core::animation::Rig>>,
+    pub rig: Option<Box<crate::core::scenes::animation::Rig>>,
 }
 
 /// A camera placed in a scene file: where it stands and which way it looks (yaw only: the
@@ -279,7 +279,7 @@ impl Scene {
         let scale2 = m.transform_vector3(Vec3::X).length_squared();
         for light in &mut self.lights {
             *light = light.transformed(m);
-            if light.kind != crate::core::light::LightKind::Directional {
+            if light.kind != crate::core::shading::light::LightKind::Directional {
                 light.color *= scale2;
             }
         }
@@ -414,7 +414,7 @@ impl bevy_mikktspace::Geometry for MikkTSpace<'_> {
 }
 
 impl Scene {
-    /// Poses the scene's rig (`core::animation`) at time t of clip `clip` (None: the rest pose):
+    /// Poses the scene's rig (`core::scenes::animation`) at time t of clip `clip` (None: the rest pose):
     /// each mesh instance's vertices (morphed, skinned, moved by its node and the placement),
     /// the nodes' lights and cameras. Nothing happens without a rig.
     pub fn pose(&mut self, clip: Option<usize>, t: f32) {
@@ -424,7 +424,7 @@ impl Scene {
     /// The same, the vertices left as they are unless `vertices` (the GPU's skin stage poses
     /// them: `Renderer::pose`).
     pub fn pose_with(&mut self, clip: Option<usize>, t: f32, vertices: bool) {
-        use crate::core::animation::{pose_nodes, pose_vertex, world_matrices};
+        use crate::core::scenes::animation::{pose_nodes, pose_vertex, world_matrices};
         let Some(rig) = self.rig.take() else { return };
         let poses = pose_nodes(&rig.nodes, clip.and_then(|c| rig.clips.get(c)), t);
         let world = world_matrices(&rig.nodes, &poses, &rig.order);
@@ -458,7 +458,7 @@ impl Scene {
         for &(k, node, light) in &rig.lights {
             if let Some(l) = self.lights.get_mut(k) {
                 *l = light.transformed(rig.placement * world[node]);
-                if l.kind != crate::core::light::LightKind::Directional {
+                if l.kind != crate::core::shading::light::LightKind::Directional {
                     l.color *= scale2;
                 }
             }

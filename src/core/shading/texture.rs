@@ -8,8 +8,8 @@
 //! by hand (`sample_texture` in shaders/shared/fragment.wgsl, twin in `src/cpu/fragment.rs`), which also
 //! makes every glTF wrap and filter mode exact per texture.
 
-use crate::core::color::{linear_to_srgb, srgb_to_linear};
-use crate::core::material::{AlphaMode, Material, MipLevel, NO_TEXTURE};
+use crate::core::shading::color::{linear_to_srgb, srgb_to_linear};
+use crate::core::shading::material::{AlphaMode, Material, MipLevel, NO_TEXTURE};
 
 /// A decoded texture image: `width × height` RGBA8 texels, rows top to bottom, colour sRGB-encoded.
 #[derive(Clone, Debug, PartialEq)]
@@ -88,27 +88,34 @@ pub struct MaterialTable {
     pub warnings: Vec<String>,
     /// The frame's lights (viewer frame) and lighting, as group 1 also holds them; empty and
     /// the headlight by default ([`MaterialTable::with_lighting`]).
-    pub lights: Vec<crate::core::light::GpuLight>,
-    pub lighting: crate::core::light::LightingParams,
+    pub lights: Vec<crate::core::shading::light::GpuLight>,
+    pub lighting: crate::core::shading::light::LightingParams,
     /// The environment's prefiltered levels and split-sum table, as group 1's binding 5 holds
     /// them (empty without an environment; [`MaterialTable::with_environment`]).
     pub environment: Vec<u32>,
     /// The frame's shadow maps and their depths, as group 1's bindings 6 and 7 hold them
     /// (empty without; [`MaterialTable::with_shadows`]).
-    pub shadow_maps: Vec<crate::core::shadow::GpuShadowMap>,
+    pub shadow_maps: Vec<crate::core::shading::shadow::GpuShadowMap>,
     pub shadow_depths: Vec<f32>,
 }
 
 impl MaterialTable {
     /// The same table with a frame's lights (viewer frame) and lighting (the CPU twins' group 1).
     /// With an environment's texels (its places and coefficients come with the lighting).
-    pub fn with_environment(mut self, environment: &crate::core::environment::PreparedEnvironment) -> MaterialTable {
+    pub fn with_environment(
+        mut self,
+        environment: &crate::core::shading::environment::PreparedEnvironment,
+    ) -> MaterialTable {
         self.environment = environment.texels.clone();
         self
     }
 
     /// With a frame's shadow maps and their depths (`cpu::shadow`).
-    pub fn with_shadows(mut self, maps: Vec<crate::core::shadow::GpuShadowMap>, depths: Vec<f32>) -> MaterialTable {
+    pub fn with_shadows(
+        mut self,
+        maps: Vec<crate::core::shading::shadow::GpuShadowMap>,
+        depths: Vec<f32>,
+    ) -> MaterialTable {
         self.shadow_maps = maps;
         self.shadow_depths = depths;
         self
@@ -116,8 +123,8 @@ impl MaterialTable {
 
     pub fn with_lighting(
         mut self,
-        lights: Vec<crate::core::light::GpuLight>,
-        lighting: crate::core::light::LightingParams,
+        lights: Vec<crate::core::shading::light::GpuLight>,
+        lighting: crate::core::shading::light::LightingParams,
     ) -> MaterialTable {
         self.lights = lights;
         self.lighting = lighting;

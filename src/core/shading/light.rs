@@ -9,7 +9,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 
-use crate::core::environment::{PreparedEnvironment, ENV_LEVELS};
+use crate::core::shading::environment::{PreparedEnvironment, ENV_LEVELS};
 
 /// `LIGHT_*` in the WGSL `constants` module.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
@@ -79,7 +79,7 @@ impl Light {
     }
 }
 
-/// `GpuLight::shadow_map` of a light without a shadow map (`core::shadow`).
+/// `GpuLight::shadow_map` of a light without a shadow map (`core::shading::shadow`).
 pub const NO_SHADOW_MAP: u32 = u32::MAX;
 
 /// `Light` in shaders/shared/surface.wgsl (viewer frame). 64 bytes.
@@ -94,7 +94,7 @@ pub struct GpuLight {
     pub color: [f32; 3],
     pub inner_cos: f32,
     pub outer_cos: f32,
-    /// Its shadow map's index in the frame's maps (`core::shadow`), or `NO_SHADOW_MAP`.
+    /// Its shadow map's index in the frame's maps (`core::shading::shadow`), or `NO_SHADOW_MAP`.
     pub shadow_map: u32,
     pub _pad1: u32,
     pub _pad2: u32,
@@ -166,7 +166,7 @@ pub struct LightingParams {
     pub exposure: f32,
     /// `TONEMAP_*`.
     pub tonemap: u32,
-    /// 1: image-based lighting from the environment (`core::environment`) replaces the ambient term.
+    /// 1: image-based lighting from the environment (`core::shading::environment`) replaces the ambient term.
     pub environment: u32,
     /// 1: background pixels show the environment (one the user gave).
     pub env_background: u32,

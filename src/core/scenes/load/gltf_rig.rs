@@ -1,4 +1,4 @@
-//! The rig of an animated glTF file (`core::animation`): its nodes' rest transforms and
+//! The rig of an animated glTF file (`core::scenes::animation`): its nodes' rest transforms and
 //! parents, the mesh instances with their vertices in the mesh frame (joints, weights, morph
 //! targets), skins, and the animations' channels. Read only where the file animates, skins or
 //! morphs something; a still file loads as before.
@@ -6,7 +6,7 @@
 use glam::{Mat4, Quat, Vec3, Vec4};
 use gltf::animation::util::ReadOutputs;
 
-use crate::core::animation::{
+use crate::core::scenes::animation::{
     Channel, Clip, Instance, Interpolation, LocalVertex, Property, Rig, RigNode, Sampler, Skin,
 };
 

@@ -1,8 +1,8 @@
 //! The panoramas twister renders (`--panorama`): which image each is, its code in the WGSL
 //! projection uniform and the facts about its image the rest of the pipeline asks (the sphere's
 //! eye model or the cylinder's, the azimuth its width spans, the name players detect). The maps
-//! themselves are `core::projection` (the cylinder), `core::sphere`, `core::fisheye`,
-//! `core::cubemap`, `core::cave`.
+//! themselves are `core::panoramas::projection` (the cylinder), `core::panoramas::sphere`, `core::panoramas::fisheye`,
+//! `core::panoramas::cubemap`, `core::panoramas::cave`.
 
 /// The panoramas twister renders (`--panorama`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Serialize)]
@@ -18,13 +18,13 @@ pub enum PanoramaKind {
     /// model as `Equirect`; longitudes beyond ±90° fall outside the image.
     Vr180,
     /// The fulldome master: the sphere's eye rays drawn in an equidistant azimuthal (fisheye)
-    /// image, W × W, the dome's axis at the centre (`core::fisheye`).
+    /// image, W × W, the dome's axis at the centre (`core::panoramas::fisheye`).
     Fisheye,
     /// The stereo cubemap: the sphere's eye rays on the six 90° faces of a cube, one eye's
-    /// image the 3×2 grid of YouTube's layout (`core::cubemap`).
+    /// image the 3×2 grid of YouTube's layout (`core::panoramas::cubemap`).
     Cubemap,
     /// CAVE walls: per wall and eye, the off-axis perspective image a tracked head's eye sees
-    /// on a rectangle in the scene (`core::cave`).
+    /// on a rectangle in the scene (`core::panoramas::cave`).
     Cave,
 }
 
@@ -59,7 +59,7 @@ impl PanoramaKind {
     }
 
     /// Whether the panorama is (part of) the full sphere's equirectangular ODS: longitude u,
-    /// latitude v, the eye model of `core::sphere`.
+    /// latitude v, the eye model of `core::panoramas::sphere`.
     pub const fn is_sphere(self) -> bool {
         matches!(self, PanoramaKind::Equirect | PanoramaKind::Vr180 | PanoramaKind::Fisheye | PanoramaKind::Cubemap)
     }

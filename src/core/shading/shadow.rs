@@ -21,7 +21,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3, Vec4};
 
-use crate::core::light::{GpuLight, LightKind, NO_SHADOW_MAP};
+use crate::core::shading::light::{GpuLight, LightKind, NO_SHADOW_MAP};
 
 /// Lights of a frame that get shadow maps.
 pub const MAX_SHADOWED_LIGHTS: usize = 4;
@@ -215,7 +215,7 @@ pub fn shadow_coordinates(map: &GpuShadowMap, p: Vec3) -> Option<(f32, f32, f32)
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::core::light::Light;
+    use crate::core::shading::light::Light;
 
     fn light(kind: LightKind, position: Vec3, direction: Vec3) -> GpuLight {
         Light {

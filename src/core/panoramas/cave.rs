@@ -1,7 +1,7 @@
 //! CAVE walls (`--panorama cave --cave FILE.json`, seeds 000 and 001's display): each wall a
 //! rectangle in the scene, and per wall and eye the off-axis perspective image a tracked head's
 //! eye sees on it (`--head X,Y,Z[,YAW]`: the eyes fixed d_e either side of the head along its
-//! right, as `core::head`). The frame drawn is the head's (origin midway between the eyes, the
+//! right, as `core::panoramas::head`). The frame drawn is the head's (origin midway between the eyes, the
 //! eyes at s·d_e·(1, 0, 0)); the wall is given in the display's frame (`--viewer`, `--yaw`) and
 //! turned into the head's with the head ([`Head`]). For a point p, eye E, the wall's corner C
 //! (lower left), its right R and up U (full width and height) and n = (R × U)/|R × U| (towards
@@ -21,8 +21,8 @@ use std::path::Path;
 
 use glam::{Mat3, Vec3};
 
-pub use crate::core::projection::CaveWall;
-use crate::core::projection::{Eye, Head, PanoramaKind, Projection};
+pub use crate::core::panoramas::projection::CaveWall;
+use crate::core::panoramas::projection::{Eye, Head, PanoramaKind, Projection};
 use crate::error::{Error, Result};
 
 /// A wall of a `--cave` file: its name (the outputs' prefix), three corners in scene units and
@@ -79,7 +79,7 @@ pub fn read_cave(path: &Path) -> Result<Vec<NamedWall>> {
             return Err(named("two walls have this name".into()));
         }
         let corners = [wall.lower_left, wall.lower_right, wall.upper_left];
-        let max = crate::core::scene::MAX_COORDINATE;
+        let max = crate::core::scenes::scene::MAX_COORDINATE;
         if corners.iter().flatten().any(|c| !c.is_finite() || c.abs() > max) {
             return Err(named(format!("corners must be finite coordinates within ±{max:e}")));
         }
@@ -96,7 +96,7 @@ pub fn read_cave(path: &Path) -> Result<Vec<NamedWall>> {
                 cos.clamp(-1.0, 1.0).acos().to_degrees()
             )));
         }
-        let side = crate::core::projection::MAX_IMAGE_SIDE;
+        let side = crate::core::panoramas::projection::MAX_IMAGE_SIDE;
         if wall.pixels.iter().any(|&p| !(2..=side).contains(&p)) {
             return Err(named(format!("pixels must be WIDTH,HEIGHT of 2 to {side} each, got {:?}", wall.pixels)));
         }
@@ -172,7 +172,7 @@ impl Projection {
         Ok(())
     }
 
-    /// The head of a CAVE's frame (`core::head`), turning the display's frame into it.
+    /// The head of a CAVE's frame (`core::panoramas::head`), turning the display's frame into it.
     fn cave_head(&self) -> Head {
         self.head.unwrap_or(Head { offset: [0.0; 3], turn: 0.0 })
     }
@@ -224,7 +224,7 @@ impl Projection {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::core::projection::Panorama;
+    use crate::core::panoramas::projection::Panorama;
     use rand::{Rng, SeedableRng};
 
     /// A 3 m cube's front wall and a floor, seen by a head off the centre and turned.
@@ -260,7 +260,7 @@ mod tests {
                 height: named.pixels[1],
                 wall: Some(wall),
                 head: Some(head),
-                vertical: crate::core::projection::Vertical::Exact,
+                vertical: crate::core::panoramas::projection::Vertical::Exact,
                 ..Projection::default()
             };
             proj.validate().unwrap();

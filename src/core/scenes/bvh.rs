@@ -21,7 +21,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3A;
 
-use crate::core::scene::{Scene, SceneVertex};
+use crate::core::scenes::scene::{Scene, SceneVertex};
 
 /// The flag of a top-level leaf's `count` (the rest of `count` is the object's level count).
 pub const OBJECT_LEAF: u32 = 0x8000_0000;
@@ -251,8 +251,8 @@ impl SceneBvh {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::core::builtin::sphere_scene;
-    use crate::core::lod::LodChain;
+    use crate::core::detail::lod::LodChain;
+    use crate::core::scenes::builtin::sphere_scene;
     use glam::Vec3;
 
     fn levels(counts: &[u32]) -> Vec<BvhLevel> {

@@ -17,7 +17,7 @@
 //!
 //! Simplified meshes come from meshoptimizer's quadric-error simplifier (the Garland–Heckbert QEM
 //! the paper used), on the object's welded surface so that a closed object stays closed at every
-//! level (`core::simplify`): a chain of levels, each about `LEVEL_RATIO` (0.7) of the triangles of the one before, built once
+//! level (`core::detail::simplify`): a chain of levels, each about `LEVEL_RATIO` (0.7) of the triangles of the one before, built once
 //! per object down to P3 and cached. A frame draws, for each object, the coarsest level that still
 //! has at least P_m triangles. The levels reuse the object's vertices, so UVs, normals and colours
 //! stay as they were at the vertices the simplifier keeps.
@@ -29,12 +29,12 @@
 
 use glam::{Mat4, Quat, Vec3};
 
-use crate::core::scene::object_spheres;
-use crate::core::scene::{Object, Scene};
-use crate::core::simplify::{simplify_chain, Welding};
-use crate::core::visual_field::{Field, Gaze};
+use crate::core::detail::simplify::{simplify_chain, Welding};
+use crate::core::detail::visual_field::{Field, Gaze};
+use crate::core::scenes::scene::object_spheres;
+use crate::core::scenes::scene::{Object, Scene};
 
-pub use crate::core::simplify::LEVEL_RATIO;
+pub use crate::core::detail::simplify::LEVEL_RATIO;
 /// The most the peripheral field relaxes L (at the field's boundary).
 pub const MAX_EDGE_RELAXATION: f32 = 4.0;
 /// Objects with fewer triangles keep only their original: there is little to save, and the
@@ -238,7 +238,7 @@ pub fn tint(scene: &mut Scene, selection: &LodSelection) {
 /// The visual field of a pixel of a panorama, from the viewer's centre: the pixel's direction is
 /// `Projection::screen_direction` (on the cylinder (sin u, v/R_T, −cos u), the paper's vertical
 /// model; the eyes' offset is left out, this is for looking at).
-pub fn pixel_field(projection: &crate::core::projection::Projection, gaze: &Gaze, x: f32, y: f32) -> Field {
+pub fn pixel_field(projection: &crate::core::panoramas::projection::Projection, gaze: &Gaze, x: f32, y: f32) -> Field {
     let (u, v) = projection.pixel_to_screen(x - 0.5, y - 0.5);
     gaze.position(projection.screen_direction(u, v)).field()
 }
@@ -247,7 +247,7 @@ pub fn pixel_field(projection: &crate::core::projection::Projection, gaze: &Gaze
 /// (orange) on an eye's image: the pixels on the inner side of each boundary.
 pub fn draw_field_boundaries(
     img: &mut crate::core::frame::EyeImage,
-    projection: &crate::core::projection::Projection,
+    projection: &crate::core::panoramas::projection::Projection,
     gaze: &Gaze,
 ) {
     let (w, h) = (img.width, img.height);
@@ -285,7 +285,7 @@ pub fn draw_field_boundaries(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::core::builtin::sphere_scene;
+    use crate::core::scenes::builtin::sphere_scene;
     use glam::Vec3;
 
     #[test]
@@ -322,7 +322,7 @@ mod tests {
             size in 1.0f32..30.0,
         ) {
             let mut scene = Scene::new("room");
-            let room = crate::core::shapes::ClosedMesh::grid_box(4).placed(Vec3::from(offset) * size, size);
+            let room = crate::core::scenes::shapes::ClosedMesh::grid_box(4).placed(Vec3::from(offset) * size, size);
             room.add_to(&mut scene, [1.0; 4]);
             // A long wall 2 m in front of the gaze, its centre 40° to the side of it.
             let gaze = Gaze::new(yaw, pitch);
@@ -351,7 +351,8 @@ mod tests {
         let chain = LodChain::build(&scene, 0.05);
         // A small object, such as a flat quad, has no coarser level.
         let mut quad = Scene::new("quad");
-        let corner = |x: f32, z: f32| crate::core::scene::SceneVertex { position: [x, 0.0, z], ..Default::default() };
+        let corner =
+            |x: f32, z: f32| crate::core::scenes::scene::SceneVertex { position: [x, 0.0, z], ..Default::default() };
         quad.add_mesh(
             "quad",
             &[corner(0.0, 0.0), corner(0.0, 1.0), corner(1.0, 1.0), corner(1.0, 0.0)],

@@ -13,8 +13,8 @@
 
 use std::collections::HashMap;
 
-use crate::core::scene::SceneVertex;
-use crate::core::shared_edges::welded_points;
+use crate::core::scenes::scene::SceneVertex;
+use crate::core::scenes::shared_edges::welded_points;
 
 /// Each simplified level aims at this share of the triangles of the level before: close enough
 /// that the coarsest level meeting a budget is at most ~1.4× the budget.
@@ -186,8 +186,8 @@ fn unweld(welded: &[u32], corners: &Corners, vertices: &[SceneVertex]) -> Vec<u3
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::core::builtin::uv_sphere;
-    use crate::core::shapes::ClosedMesh;
+    use crate::core::scenes::builtin::uv_sphere;
+    use crate::core::scenes::shapes::ClosedMesh;
     use glam::Vec3;
 
     fn chain_of(vertices: &[SceneVertex], indices: &[u32], floor: usize) -> Vec<Vec<u32>> {
@@ -239,7 +239,7 @@ mod tests {
     #[test]
     fn grid_boxes_simplify_without_slivers() {
         for n in [3, 4, 6] {
-            let mut scene = crate::core::scene::Scene::new("box");
+            let mut scene = crate::core::scenes::scene::Scene::new("box");
             ClosedMesh::grid_box(n).placed(Vec3::new(0.4, 0.05, -0.4), 0.21).add_to(&mut scene, [1.0; 4]);
             let welding = Welding::of(&scene.vertices);
             for (k, level) in chain_of(&scene.vertices, &scene.indices, 1).iter().enumerate() {
@@ -254,7 +254,7 @@ mod tests {
     #[test]
     fn small_tori_stay_closed_at_every_level() {
         for (n, m) in [(8, 6), (6, 3), (12, 8), (16, 4), (24, 12)] {
-            let mut scene = crate::core::scene::Scene::new("torus");
+            let mut scene = crate::core::scenes::scene::Scene::new("torus");
             ClosedMesh::torus(n, m).placed(Vec3::new(0.3, -0.2, -2.0), 0.3).add_to(&mut scene, [1.0; 4]);
             let welding = Welding::of(&scene.vertices);
             assert!(is_closed(&welding.weld(&scene.indices)), "torus {n}×{m}");

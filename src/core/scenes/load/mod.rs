@@ -16,9 +16,9 @@ mod obj;
 
 use std::path::Path;
 
-use crate::core::builtin;
-use crate::core::projection::Projection;
-use crate::core::scene::Scene;
+use crate::core::panoramas::projection::Projection;
+use crate::core::scenes::builtin;
+use crate::core::scenes::scene::Scene;
 use crate::error::{Error, Result};
 
 /// Default colour of surfaces without a material (linear; sRGB 0.8, 0.78, 0.74).
@@ -50,9 +50,9 @@ pub fn load_scene(spec: &str, projection: &Projection) -> Result<Scene> {
     // derivatives' frame: its rig poses only the file's tangents).
     if scene.rig.is_none() {
         let wants: Vec<bool> = std::iter::once(false)
-            .chain(scene.materials.iter().map(|m| m.normal_texture != crate::core::material::NO_TEXTURE))
+            .chain(scene.materials.iter().map(|m| m.normal_texture != crate::core::shading::material::NO_TEXTURE))
             .collect();
-        crate::core::scene::generate_tangents(&mut scene.vertices, &scene.indices, |m| {
+        crate::core::scenes::scene::generate_tangents(&mut scene.vertices, &scene.indices, |m| {
             wants.get(m as usize).copied().unwrap_or(false)
         });
     }

@@ -8,7 +8,7 @@
 
 use std::collections::HashMap;
 
-use super::scene::SceneVertex;
+use crate::core::scenes::scene::SceneVertex;
 
 /// The edge numbers of a scene's triangles.
 #[derive(Clone, Debug, Default, PartialEq)]

@@ -4,9 +4,9 @@
 use std::path::{Path, PathBuf};
 
 use super::DEFAULT_COLOR;
-use crate::core::material::Material;
-use crate::core::scene::{compute_normals, Scene, SceneVertex};
-use crate::core::texture::Texture;
+use crate::core::scenes::scene::{compute_normals, Scene, SceneVertex};
+use crate::core::shading::material::Material;
+use crate::core::shading::texture::Texture;
 
 pub(super) fn read_obj(path: &Path) -> std::result::Result<Scene, String> {
     let name = path.display().to_string();

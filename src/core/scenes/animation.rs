@@ -208,7 +208,7 @@ pub struct Rig {
     pub order: Vec<usize>,
     pub instances: Vec<Instance>,
     pub skins: Vec<Skin>,
-    pub lights: Vec<(usize, usize, crate::core::light::Light)>,
+    pub lights: Vec<(usize, usize, crate::core::shading::light::Light)>,
     pub cameras: Vec<(usize, usize)>,
     pub clips: Vec<Clip>,
     /// Where the scene was moved after loading (`--scale`, `--fit`: `Scene::transform`), applied

@@ -26,14 +26,14 @@
 //! Pixels: u ∈ [−π, π) spans the image width with θ = 0 at the centre column; pixels are square,
 //! one pixel = 2π·R_T/W metres of screen; v = 0 is the middle row, +y is up in the image.
 //!
-//! The full sphere's eye model and its forward map are in `core::sphere`; the fisheye's image map
-//! in `core::fisheye`.
+//! The full sphere's eye model and its forward map are in `core::panoramas::sphere`; the fisheye's image map
+//! in `core::panoramas::fisheye`.
 //!
 //! The WGSL twin of this module is `shaders/shared/projection.wgsl`; both must stay in step.
 
 use glam::{Vec2, Vec3};
 
-pub use crate::core::panorama::PanoramaKind;
+pub use crate::core::panoramas::panorama::PanoramaKind;
 use crate::error::{Error, Result};
 
 /// The vertical model: how the screen height `v` of a point is computed.
@@ -102,17 +102,17 @@ pub struct Projection {
     pub fov: f32,
     /// The fisheye: the dome's front raised by this many degrees (its axis tilted back).
     pub dome_tilt: f32,
-    /// The cylinder: a tracked head away from the display's centre (`core::head`); None: the
+    /// The cylinder: a tracked head away from the display's centre (`core::panoramas::head`); None: the
     /// paper's eyes on the circle about the centre.
     pub head: Option<Head>,
-    /// The CAVE: the wall drawn, in the display's frame (`core::cave`); None elsewhere.
+    /// The CAVE: the wall drawn, in the display's frame (`core::panoramas::cave`); None elsewhere.
     pub wall: Option<CaveWall>,
     /// A frame larger than the adapter draws is drawn in tiles: this draw's [x, y, width,
     /// height] in the frame's pixels (the maps stay the frame's); None: the whole frame.
     pub tile: Option<[u32; 4]>,
 }
 
-/// A tracked head before the cylinder (`core::head`, which has its maths): where the head is,
+/// A tracked head before the cylinder (`core::panoramas::head`, which has its maths): where the head is,
 /// seen from the display: its position O in the display's frame (metres;
 /// the display's centre is the origin, its front −z) and the turn γ (radians) that takes the
 /// head's frame into the display's (a direction at azimuth θ about the head lies at θ − γ about
@@ -123,7 +123,7 @@ pub struct Head {
     pub turn: f32,
 }
 
-/// A CAVE wall in the display's frame, metres (`core::cave`, which has its maths): its lower
+/// A CAVE wall in the display's frame, metres (`core::panoramas::cave`, which has its maths): its lower
 /// left corner, and its right and up edges (full width and height).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct CaveWall {

@@ -6,7 +6,7 @@ use std::collections::HashMap;
 
 use glam::Vec3;
 
-use crate::core::scene::{Scene, SceneVertex};
+use crate::core::scenes::scene::{Scene, SceneVertex};
 
 /// A mesh as positions and triangle indices (counter-clockwise seen from outside).
 #[derive(Clone, Debug, PartialEq)]
@@ -156,7 +156,7 @@ impl ClosedMesh {
             .iter()
             .map(|p| SceneVertex { position: p.to_array(), color, ..Default::default() })
             .collect();
-        crate::core::scene::compute_normals(&mut vertices, &self.indices);
+        crate::core::scenes::scene::compute_normals(&mut vertices, &self.indices);
         vertices
     }
 

@@ -5,10 +5,10 @@ use std::path::Path;
 
 use glam::{Mat4, Vec3};
 
-use crate::core::light::{Light, LightKind};
-use crate::core::material::{AlphaMode, Filter, Material, Mipmap, Wrap};
-use crate::core::scene::{compute_normals, pack_tangent, Scene, SceneVertex};
-use crate::core::texture::Texture;
+use crate::core::scenes::scene::{compute_normals, pack_tangent, Scene, SceneVertex};
+use crate::core::shading::light::{Light, LightKind};
+use crate::core::shading::material::{AlphaMode, Filter, Material, Mipmap, Wrap};
+use crate::core::shading::texture::Texture;
 
 /// An image decoded by the glTF importer, as RGBA8 (16-bit channels keep their high byte,
 /// float channels are clamped to 0..1).
@@ -195,7 +195,7 @@ fn gltf_material(material: &gltf::Material) -> GltfMaterial {
 /// textures (`Texture::encode_data`), converted in place where no material uses the image as a
 /// colour (base colour, emission), else as a copy.
 fn data_maps(scene: &mut Scene) {
-    use crate::core::material::NO_TEXTURE;
+    use crate::core::shading::material::NO_TEXTURE;
     let n = scene.textures.len();
     let mut as_colour = vec![false; n];
     let mut as_data = vec![false; n];
@@ -265,7 +265,7 @@ pub const GLTF_EXTENSIONS: &[&str] = &["KHR_texture_transform"];
 
 /// The most triangles a scene may hold (`Scene::validate`'s limit, checked while mesh instances
 /// are added so that a file cannot make memory grow past it).
-const MAX_TRIANGLES: usize = crate::core::scene::MAX_TRIANGLES;
+const MAX_TRIANGLES: usize = crate::core::scenes::scene::MAX_TRIANGLES;
 
 /// A glTF document with its buffers and decoded images.
 type Document = (gltf::Document, Vec<gltf::buffer::Data>, Vec<gltf::image::Data>);
@@ -369,7 +369,7 @@ pub(super) fn read_gltf(path: &Path) -> std::result::Result<Scene, String> {
     }
     let root =
         doc.default_scene().or_else(|| doc.scenes().next()).ok_or_else(|| format!("{name}: the file has no scene"))?;
-    // What moves, where the file animates, skins or morphs (`core::animation`).
+    // What moves, where the file animates, skins or morphs (`core::scenes::animation`).
     let mut rig = super::gltf_rig::needs_rig(&doc).then(|| super::gltf_rig::rig_nodes(&doc, &buffers));
     let mut stack: Vec<(gltf::Node, Mat4, usize, Option<usize>)> =
         root.nodes().map(|n| (n, Mat4::IDENTITY, 0, None)).collect();
@@ -433,7 +433,7 @@ fn add_node_light_and_camera(
     scene: &mut Scene,
     node: &gltf::Node,
     world: Mat4,
-    mut rig: Option<&mut crate::core::animation::Rig>,
+    mut rig: Option<&mut crate::core::scenes::animation::Rig>,
 ) {
     if let Some(light) = node.light() {
         if let Some(rig) = rig.as_mut() {
@@ -447,7 +447,7 @@ fn add_node_light_and_camera(
         }
         // The camera looks along its local −z.
         let forward = world.transform_vector3(-Vec3::Z);
-        scene.cameras.push(crate::core::scene::Camera {
+        scene.cameras.push(crate::core::scenes::scene::Camera {
             name: camera
                 .name()
                 .or(node.name())
@@ -573,7 +573,7 @@ fn add_gltf_primitive(
     (node, world): (&gltf::Node, Mat4),
     label: &str,
     materials: &[GltfMaterial],
-    rig: Option<&mut crate::core::animation::Rig>,
+    rig: Option<&mut crate::core::scenes::animation::Rig>,
 ) -> std::result::Result<(), String> {
     use gltf::mesh::Mode;
     let mode = prim.mode();

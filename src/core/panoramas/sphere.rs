@@ -1,5 +1,5 @@
 //! The full-sphere panorama's eye model and forward map
-//! ([`PanoramaKind::Equirect`](crate::core::projection::PanoramaKind::Equirect), omni-directional stereo as Google's
+//! ([`PanoramaKind::Equirect`](crate::core::panoramas::projection::PanoramaKind::Equirect), omni-directional stereo as Google's
 //! ODS and Blender Cycles' spherical stereo make it). A pixel at longitude λ (column, 0 straight
 //! ahead, positive to the right) and latitude φ (row, +90° at the top) looks along
 //! D = (cos φ sin λ, sin φ, −cos φ cos λ) from the eye point E = s·d·side, side = (cos λ, 0, sin λ)
@@ -26,7 +26,7 @@
 
 use glam::Vec3;
 
-use crate::core::projection::{horizontal_radius, Eye, Projection};
+use crate::core::panoramas::projection::{horizontal_radius, Eye, Projection};
 
 /// The most Newton steps the pole merge's eye offset takes ([`Projection::sphere_eye_offset`]).
 pub const SPHERE_NEWTON_STEPS: u32 = 4;
@@ -172,8 +172,8 @@ impl Projection {
 
 #[cfg(test)]
 mod tests {
-    use crate::core::projection::tests::angle_diff;
-    use crate::core::projection::{Eye, Panorama, PanoramaKind, Projection, DEFAULT_POLE_MERGE};
+    use crate::core::panoramas::projection::tests::angle_diff;
+    use crate::core::panoramas::projection::{Eye, Panorama, PanoramaKind, Projection, DEFAULT_POLE_MERGE};
     use glam::Vec3;
     use rand::{Rng, SeedableRng};
     use std::f64::consts::PI;

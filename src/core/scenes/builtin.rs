@@ -8,13 +8,13 @@
 //! | `builtin:sphere100`, `builtin:sphere1024` | spheres of exactly 100 and 1024 triangles, 3 m ahead, filling the screen height (the paper's Sphere100/Sphere1024) |
 //! | `builtin:triangle@D` | the paper's evaluation-1 triangle: equilateral, facing the viewer, D metres straight ahead, projected side ≈ the image height H |
 
-use crate::core::color::srgb_to_linear;
+use crate::core::shading::color::srgb_to_linear;
 use glam::Vec3;
 use std::f32::consts::{FRAC_1_SQRT_2, PI, TAU};
 
-use crate::core::projection::Projection;
-use crate::core::scene::Scene;
-use crate::core::scene::SceneVertex;
+use crate::core::panoramas::projection::Projection;
+use crate::core::scenes::scene::Scene;
+use crate::core::scenes::scene::SceneVertex;
 use crate::error::{Error, Result};
 
 /// Colour of the seam sphere in `builtin:demo` (tests find it by this hue).
@@ -153,7 +153,7 @@ pub fn blob(center: Vec3, radius: f32) -> Scene {
             vertex(center + radius * d, Vec3::ZERO, [0.6, 0.7, 0.5, 1.0])
         })
         .collect();
-    crate::core::scene::compute_normals(&mut v, &faces);
+    crate::core::scenes::scene::compute_normals(&mut v, &faces);
     let mut s = Scene::new("blob");
     s.add_mesh("blob", &v, &faces);
     s
@@ -306,8 +306,10 @@ mod tests {
         let p = Projection { width: 3168, height: 600, ..Default::default() };
         for d in [1.0, 3.0, 5.0] {
             let s = builtin_scene(&format!("builtin:triangle@{d}"), &p).unwrap();
-            let a = p.project(Vec3::from(s.vertices[0].position), crate::core::projection::Eye::Left).unwrap();
-            let b = p.project(Vec3::from(s.vertices[1].position), crate::core::projection::Eye::Left).unwrap();
+            let a =
+                p.project(Vec3::from(s.vertices[0].position), crate::core::panoramas::projection::Eye::Left).unwrap();
+            let b =
+                p.project(Vec3::from(s.vertices[1].position), crate::core::panoramas::projection::Eye::Left).unwrap();
             let side_px = (b.u - a.u) * p.pixels_per_radian();
             assert!((side_px - 600.0).abs() < 0.12 * 600.0, "side {side_px} px at {d} m");
         }

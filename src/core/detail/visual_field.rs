@@ -46,15 +46,15 @@ impl Default for Gaze {
 }
 
 /// A tracked viewer's gaze over time (`--gaze-path FILE`, the seeds' tracked viewer): rows of
-/// time (s), yaw and pitch (degrees, as `--gaze`), blended linearly (`core::timeline`).
+/// time (s), yaw and pitch (degrees, as `--gaze`), blended linearly (`core::scenes::timeline`).
 #[derive(Clone, Debug, PartialEq)]
-pub struct GazePath(pub crate::core::timeline::Timeline);
+pub struct GazePath(pub crate::core::scenes::timeline::Timeline);
 
 impl GazePath {
     /// Reads a CSV of `time,yaw,pitch` rows; one line naming the file and row otherwise.
     pub fn read(path: &std::path::Path) -> crate::error::Result<GazePath> {
         let check = |v: &[f32]| (v[1].abs() > 89.0).then(|| "pitch within ±89".to_string());
-        crate::core::timeline::Timeline::read(path, "gaze_path", (2, 2), "time,yaw,pitch", check).map(GazePath)
+        crate::core::scenes::timeline::Timeline::read(path, "gaze_path", (2, 2), "time,yaw,pitch", check).map(GazePath)
     }
 
     /// The gaze at time t.
