@@ -266,76 +266,78 @@ fn offsets(image: &Image, mesh: &Mesh, rule: Rule, corner: &[bool]) -> Vec<DVec2
         }
         Rule::ProfileLocal => return profile_local(image, mesh, corner),
         // The twin's own (drawn by default where the frame draws offsets): the right eye's.
-        Rule::Twin => {
-            let mut first = HashMap::new();
-            let mut apart = 0;
-            for (i, v) in mesh.nodes.iter().enumerate() {
-                let f = *first.entry(mesh.group[i]).or_insert(v.offsets);
-                if f != v.offsets {
-                    apart += 1;
-                    if apart <= 6 && std::env::var_os("SHOW").is_some() {
-                        println!(
-                            "  {:?} r {:.4}: {:?} against {:?}",
-                            v.position,
-                            horizontal_radius(mesh.pos[i]),
-                            f,
-                            v.offsets
-                        );
-                    }
-                }
-            }
-            if apart > 0 {
-                println!("{apart} node copies drawn apart from their first copy");
-            }
-            return mesh.nodes.iter().map(|v| DVec2::new(v.offsets[2] as f64, v.offsets[3] as f64)).collect();
-        }
-        Rule::Lines | Rule::Profile | Rule::ProfileEdges => {
-            let boundary = mesh.boundary();
-            let piece = mesh.pieces();
-            let (mut line_max, mut degree) = (HashMap::new(), HashMap::new());
-            let (mut piece_max, mut on_lines) = (HashMap::new(), vec![Vec::new(); n]);
-            let mut counted = HashSet::new();
-            for (&(a, b, e), &on_boundary) in mesh.edges.iter().zip(&boundary) {
-                widen(piece_max.entry(piece[a]).or_default(), e);
-                if on_boundary {
-                    let line = mesh.line(a, b);
-                    widen(line_max.entry(line).or_default(), e);
-                    if counted.insert(mesh.geometric(a, b)) {
-                        *degree.entry((line, mesh.group[a])).or_insert(0u32) += 1;
-                        *degree.entry((line, mesh.group[b])).or_insert(0u32) += 1;
-                    }
-                    on_lines[a].push(line);
-                    on_lines[b].push(line);
-                }
-            }
-            if rule != Rule::Lines {
-                profile_errors(image, mesh, &degree, &mut line_max);
-            }
-            if rule == Rule::Profile {
-                piece_max.clear();
-                for (&(a, b, _), &on_boundary) in mesh.edges.iter().zip(&boundary) {
-                    if on_boundary {
-                        widen(piece_max.entry(piece[a]).or_default(), line_max[&mesh.line(a, b)]);
-                    }
-                }
-            }
-            for i in 0..n {
-                if corner[i] {
-                    continue;
-                }
-                if on_lines[i].is_empty() {
-                    chosen[i] = piece_max.get(&piece[i]).copied().unwrap_or_default();
-                }
-                for line in &on_lines[i] {
-                    if degree[&(*line, mesh.group[i])] >= 2 {
-                        let e = line_max[line];
-                        widen(&mut chosen[i], e);
-                    }
-                }
+        Rule::Twin => return twin_offsets(mesh),
+        Rule::Lines | Rule::Profile | Rule::ProfileEdges => line_offsets(image, mesh, rule, corner, &mut chosen),
+    }
+    chosen.iter().map(|&e| 0.5 * e).collect()
+}
+
+/// The twin's own offsets (the right eye's), and how many node copies it draws apart.
+fn twin_offsets(mesh: &Mesh) -> Vec<DVec2> {
+    let mut first = HashMap::new();
+    let mut apart = 0;
+    for (i, v) in mesh.nodes.iter().enumerate() {
+        let f = *first.entry(mesh.group[i]).or_insert(v.offsets);
+        if f != v.offsets {
+            apart += 1;
+            if apart <= 6 && std::env::var_os("SHOW").is_some() {
+                println!("  {:?} r {:.4}: {:?} against {:?}", v.position, horizontal_radius(mesh.pos[i]), f, v.offsets);
             }
         }
     }
-    chosen.iter().map(|&e| 0.5 * e).collect()
+    if apart > 0 {
+        println!("{apart} node copies drawn apart from their first copy");
+    }
+    mesh.nodes.iter().map(|v| DVec2::new(v.offsets[2] as f64, v.offsets[3] as f64)).collect()
+}
+
+/// The offsets of the rules that go by the pieces' boundary lines (`Lines`, `Profile`,
+/// `ProfileEdges`), into `chosen`.
+fn line_offsets(image: &Image, mesh: &Mesh, rule: Rule, corner: &[bool], chosen: &mut [DVec2]) {
+    let n = mesh.pos.len();
+    let boundary = mesh.boundary();
+    let piece = mesh.pieces();
+    let (mut line_max, mut degree) = (HashMap::new(), HashMap::new());
+    let (mut piece_max, mut on_lines) = (HashMap::new(), vec![Vec::new(); n]);
+    let mut counted = HashSet::new();
+    for (&(a, b, e), &on_boundary) in mesh.edges.iter().zip(&boundary) {
+        widen(piece_max.entry(piece[a]).or_default(), e);
+        if on_boundary {
+            let line = mesh.line(a, b);
+            widen(line_max.entry(line).or_default(), e);
+            if counted.insert(mesh.geometric(a, b)) {
+                *degree.entry((line, mesh.group[a])).or_insert(0u32) += 1;
+                *degree.entry((line, mesh.group[b])).or_insert(0u32) += 1;
+            }
+            on_lines[a].push(line);
+            on_lines[b].push(line);
+        }
+    }
+    if rule != Rule::Lines {
+        profile_errors(image, mesh, &degree, &mut line_max);
+    }
+    if rule == Rule::Profile {
+        piece_max.clear();
+        for (&(a, b, _), &on_boundary) in mesh.edges.iter().zip(&boundary) {
+            if on_boundary {
+                widen(piece_max.entry(piece[a]).or_default(), line_max[&mesh.line(a, b)]);
+            }
+        }
+    }
+    for i in 0..n {
+        if corner[i] {
+            continue;
+        }
+        if on_lines[i].is_empty() {
+            chosen[i] = piece_max.get(&piece[i]).copied().unwrap_or_default();
+        }
+        for line in &on_lines[i] {
+            if degree[&(*line, mesh.group[i])] >= 2 {
+                let e = line_max[line];
+                widen(&mut chosen[i], e);
+            }
+        }
+    }
 }
 
 /// Replaces each line's largest part error by what its profile would estimate: its ends (the

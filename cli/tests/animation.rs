@@ -283,19 +283,44 @@ fn the_slurm_example_shards_a_sequence() {
     std::fs::remove_dir_all(&root).unwrap();
 }
 
+/// The video track's first sample entry, as a box path.
+const VIDEO_ENTRY: [&str; 7] = ["moov", "trak", "mdia", "minf", "stbl", "stsd", "avc1"];
+
+/// ffprobe's first stream of `file`, its frames counted.
+fn probe(file: &Path) -> serde_json::Value {
+    let out = Command::new("ffprobe")
+        .args(["-v", "error", "-count_frames", "-show_streams", "-of", "json"])
+        .arg(file)
+        .output()
+        .expect("ffprobe (scripts/test.sh installs ffmpeg)");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()["streams"][0].clone()
+}
+
+/// `from` copied to `to` by ffmpeg (no re-encoding), with `extra` options.
+fn ffmpeg_copy(from: &Path, to: &Path, extra: &[&str]) {
+    let status = Command::new("ffmpeg")
+        .args(["-y", "-loglevel", "error", "-i"])
+        .arg(from)
+        .args(["-c", "copy"])
+        .args(extra)
+        .arg(to)
+        .status()
+        .unwrap();
+    assert!(status.success());
+}
+
 /// `--video`: the sequence encoded by ffmpeg, with Google's spherical metadata in the video's
 /// sample entry — read back by our own box walk (st3d top-bottom; sv3d → proj → equi) and by
-/// ffprobe (Stereo 3D "top and bottom", Spherical Mapping "equirectangular"), every frame there.
-/// A file with its moov first (faststart) keeps decoding after the boxes are added (its chunk
-/// offsets moved with them). Without ffmpeg on PATH: one line naming the install command.
-/// (scripts/test.sh installs ffmpeg where it is missing.)
+/// ffprobe (Stereo 3D "top and bottom", Spherical Mapping "equirectangular"), every frame there;
+/// then re-tagged as VR180 and as a cubemap (`video_retagged_*`). Without ffmpeg on PATH: one
+/// line naming the install command. (scripts/test.sh installs ffmpeg where it is missing.)
 #[test]
 fn a_video_carries_the_spherical_metadata() {
     if !common::assets_present() {
         return;
     }
-    use twister::core::panoramas::projection::PanoramaKind;
-    use twister::video::{find_boxes, find_spherical_v1, with_spherical_metadata, StereoMode};
+    use twister::video::{find_boxes, find_spherical_v1, StereoMode};
     let root = common::TempDir::new(format!("twister-video-{}", std::process::id()));
     let video = root.join("cube.mp4");
     let scene = common::asset("gltf/AnimatedCube/glTF/AnimatedCube.gltf");
@@ -307,20 +332,10 @@ fn a_video_carries_the_spherical_metadata() {
         .unwrap();
     assert!(made.status.success(), "{}", String::from_utf8_lossy(&made.stderr));
     let mp4 = std::fs::read(&video).unwrap();
-    let entry = ["moov", "trak", "mdia", "minf", "stbl", "stsd", "avc1"];
-    let st3d = find_boxes(&mp4, &[&entry[..], &["st3d"]].concat());
+    let st3d = find_boxes(&mp4, &[&VIDEO_ENTRY[..], &["st3d"]].concat());
     assert_eq!(st3d.len(), 1);
     assert_eq!(st3d[0][4], StereoMode::TopBottom as u8, "st3d: version/flags, then the stereo mode");
-    assert_eq!(find_boxes(&mp4, &[&entry[..], &["sv3d", "proj", "equi"]].concat()).len(), 1);
-    let probe = |file: &Path| -> serde_json::Value {
-        let out = Command::new("ffprobe")
-            .args(["-v", "error", "-count_frames", "-show_streams", "-of", "json"])
-            .arg(file)
-            .output()
-            .expect("ffprobe (scripts/test.sh installs ffmpeg)");
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()["streams"][0].clone()
-    };
+    assert_eq!(find_boxes(&mp4, &[&VIDEO_ENTRY[..], &["sv3d", "proj", "equi"]].concat()).len(), 1);
     let stream = probe(&video);
     assert_eq!(stream["nb_read_frames"], "12");
     assert_eq!((stream["width"].as_u64(), stream["height"].as_u64()), (Some(128), Some(128)), "top-bottom");
@@ -328,34 +343,45 @@ fn a_video_carries_the_spherical_metadata() {
         stream["side_data_list"].as_array().unwrap().iter().map(|d| d.to_string()).collect::<Vec<_>>();
     assert!(side.iter().any(|d| d.contains("top and bottom")), "{side:?}");
     assert!(side.iter().any(|d| d.contains("equirectangular")), "{side:?}");
-    // faststart: moov before mdat, so the chunk offsets must move.
-    let fast = root.join("fast.mp4");
-    let status = Command::new("ffmpeg")
-        .args(["-y", "-loglevel", "error", "-i"])
-        .arg(&video)
-        .args(["-c", "copy", "-movflags", "+faststart"])
-        .arg(&fast)
-        .status()
-        .unwrap();
-    assert!(status.success());
-    // Re-tagged as VR180 side by side: equi's bounds crop a quarter off each side, and the V1
-    // XML gives the same crop in pixels.
     let v1 = find_spherical_v1(&mp4);
     assert_eq!(v1.len(), 1, "the sphere's video carries one V1 box");
     assert!(
         v1[0].contains("<GSpherical:StereoMode>top-bottom<") && v1[0].contains("<GSpherical:FullPanoWidthPixels>128<")
     );
-    let eye = [64, 64];
+    video_retagged_as_vr180(&root, &video);
+    video_retagged_as_a_cubemap(&root, &video);
+    // No ffmpeg: one line.
+    let out = common::twister()
+        .args(["render", scene.to_str().unwrap(), "--frames", "0..1", "--layout", "top-bottom", "--video"])
+        .arg(root.join("none.mp4"))
+        .arg("--out")
+        .arg(root.join("none"))
+        .env("PATH", "/nonexistent")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("ffmpeg") && err.contains("install"), "{err}");
+    std::fs::remove_dir_all(&root).unwrap();
+}
+
+/// The video with its moov first (faststart, so the chunk offsets must move) re-tagged as VR180
+/// side by side: equi's bounds crop a quarter off each side, the V1 XML gives the same crop in
+/// pixels, and every frame still decodes.
+fn video_retagged_as_vr180(root: &Path, video: &Path) {
+    use twister::core::panoramas::projection::PanoramaKind;
+    use twister::video::{find_boxes, find_spherical_v1, with_spherical_metadata, StereoMode};
+    let fast = root.join("fast.mp4");
+    ffmpeg_copy(video, &fast, &["-movflags", "+faststart"]);
     let tagged = with_spherical_metadata(
         &std::fs::read(&fast).unwrap(),
         "fast",
         StereoMode::LeftRight,
         PanoramaKind::Vr180,
-        eye,
+        [64, 64],
     )
     .unwrap();
     std::fs::write(&fast, &tagged).unwrap();
-    let equi = find_boxes(&tagged, &[&entry[..], &["sv3d", "proj", "equi"]].concat());
+    let equi = find_boxes(&tagged, &[&VIDEO_ENTRY[..], &["sv3d", "proj", "equi"]].concat());
     let bounds: Vec<u32> = equi[0][4..20].chunks(4).map(|b| u32::from_be_bytes(b.try_into().unwrap())).collect();
     assert_eq!(bounds, [0, 0, 1 << 30, 1 << 30], "top, bottom, left, right");
     let v1 = find_spherical_v1(&tagged);
@@ -377,43 +403,32 @@ fn a_video_carries_the_spherical_metadata() {
     let mapping = stream["side_data_list"].as_array().unwrap().iter().find(|d| d["bound_left"].is_u64()).unwrap();
     let (l, r) = (mapping["bound_left"].as_u64().unwrap(), mapping["bound_right"].as_u64().unwrap());
     assert!(l + r == 128 && l.abs_diff(64) <= 2, "{side}");
-    // Re-tagged as a stereo cubemap (top-bottom): `cbmp` layout 0 (the 3×2 grid), no padding, and
-    // no V1 box (V1 describes equirectangular images only); ffprobe reads a cubemap.
+}
+
+/// The video re-tagged as a stereo cubemap (top-bottom): `cbmp` layout 0 (the 3×2 grid), no
+/// padding, and no V1 box (V1 describes equirectangular images only); ffprobe reads a cubemap.
+fn video_retagged_as_a_cubemap(root: &Path, video: &Path) {
+    use twister::core::panoramas::projection::PanoramaKind;
+    use twister::video::{find_boxes, find_spherical_v1, with_spherical_metadata, StereoMode};
     let cube = root.join("cube-map.mp4");
-    let status = Command::new("ffmpeg")
-        .args(["-y", "-loglevel", "error", "-i"])
-        .arg(&video)
-        .args(["-c", "copy"])
-        .arg(&cube)
-        .status()
-        .unwrap();
-    assert!(status.success());
+    ffmpeg_copy(video, &cube, &[]);
     let untagged = std::fs::read(&cube).unwrap();
-    assert!(find_boxes(&untagged, &[&entry[..], &["sv3d"]].concat()).is_empty(), "ffmpeg writes no sv3d of its own");
+    assert!(
+        find_boxes(&untagged, &[&VIDEO_ENTRY[..], &["sv3d"]].concat()).is_empty(),
+        "ffmpeg writes no sv3d of its own"
+    );
     let tagged =
         with_spherical_metadata(&untagged, "cube", StereoMode::TopBottom, PanoramaKind::Cubemap, [96, 64]).unwrap();
     std::fs::write(&cube, &tagged).unwrap();
-    let cbmp = find_boxes(&tagged, &[&entry[..], &["sv3d", "proj", "cbmp"]].concat());
+    let cbmp = find_boxes(&tagged, &[&VIDEO_ENTRY[..], &["sv3d", "proj", "cbmp"]].concat());
     assert_eq!(cbmp.len(), 1);
     assert_eq!(&cbmp[0][4..12], &[0; 8], "layout 0, padding 0");
-    assert!(find_boxes(&tagged, &[&entry[..], &["sv3d", "proj", "equi"]].concat()).is_empty());
+    assert!(find_boxes(&tagged, &[&VIDEO_ENTRY[..], &["sv3d", "proj", "equi"]].concat()).is_empty());
     assert!(find_spherical_v1(&tagged).is_empty());
     let stream = probe(&cube);
     assert_eq!(stream["nb_read_frames"], "12", "every frame still decodes");
     let side = stream["side_data_list"].to_string();
     assert!(side.contains("top and bottom") && side.contains("cubemap"), "{side}");
-    // No ffmpeg: one line.
-    let out = common::twister()
-        .args(["render", scene.to_str().unwrap(), "--frames", "0..1", "--layout", "top-bottom", "--video"])
-        .arg(root.join("none.mp4"))
-        .arg("--out")
-        .arg(root.join("none"))
-        .env("PATH", "/nonexistent")
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success() && err.contains("ffmpeg") && err.contains("install"), "{err}");
-    std::fs::remove_dir_all(&root).unwrap();
 }
 
 /// Options of a sequence without `--frames`, an unknown animation, and a still-only option with

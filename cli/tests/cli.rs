@@ -57,7 +57,13 @@ fn render_writes_every_layout_and_stats() {
             assert_eq!(back.get_pixel(x, y), eye.get_pixel((240 + x) % 320, y));
         }
     }
-    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    stats_record_a_one_submission_frame(&stats);
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// The `--stats` JSON of a one-submission frame of `builtin:sphere100` at 320×60.
+fn stats_record_a_one_submission_frame(stats: &Path) {
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(stats).unwrap()).unwrap();
     for key in [
         "scene",
         "triangles_in",
@@ -84,8 +90,13 @@ fn render_writes_every_layout_and_stats() {
     assert_eq!(json["triangles_in"], 100);
     assert_eq!(json["width"], 320);
     assert!(json["triangles_drawn"].as_u64().unwrap() >= 100);
-    // The cubemap: top-bottom by default (stereo_cubemap_TB.png); 12x1 cuts each eye's 3×2 grid
-    // into one strip of twelve faces, the left eye's six first.
+}
+
+/// The cubemap: top-bottom by default (stereo_cubemap_TB.png); 12x1 cuts each eye's 3×2 grid
+/// into one strip of twelve faces, the left eye's six first.
+#[test]
+fn the_cubemap_writes_its_layouts() {
+    let out = tmp("cube-layouts");
     let cube = ["--panorama", "cubemap", "--width", "96"];
     let run = |layout: &str, dir: &Path, extra: &[&str]| {
         let o = twister()

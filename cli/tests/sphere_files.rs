@@ -4,12 +4,25 @@
 
 mod common;
 
+use std::path::Path;
+
 use glam::Vec3;
 use twister::core::panoramas::projection::PanoramaKind;
 use twister::{Eye, Projection};
 
 fn tmp(name: &str) -> common::TempDir {
     common::TempDir::new(format!("twister-sphere-files-{}-{name}", std::process::id()))
+}
+
+/// Runs `render builtin:demo` into `out/dir` with `args`.
+fn run_demo(out: &Path, dir: &str, args: &[&str]) {
+    let o = common::twister().args(["render", "builtin:demo", "--out"]).arg(out.join(dir)).args(args).output().unwrap();
+    assert!(o.status.success(), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
+}
+
+/// An image `out/dir/name`.
+fn read_image(out: &Path, dir: &str, name: &str) -> image::RgbaImage {
+    image::open(out.join(dir).join(name)).unwrap().to_rgba8()
 }
 
 /// Frames beyond the adapter's textures (issue 34): drawn in tiles (forced small here with
@@ -20,12 +33,8 @@ fn tmp(name: &str) -> common::TempDir {
 #[test]
 fn frames_drawn_in_tiles_are_the_frames_drawn_whole() {
     let out = tmp("tiles");
-    let run = |dir: &str, args: &[&str]| {
-        let o =
-            common::twister().args(["render", "builtin:demo", "--out"]).arg(out.join(dir)).args(args).output().unwrap();
-        assert!(o.status.success(), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
-    };
-    let read = |dir: &str, name: &str| image::open(out.join(dir).join(name)).unwrap().to_rgba8();
+    let run = |dir: &str, args: &[&str]| run_demo(&out, dir, args);
+    let read = |dir: &str, name: &str| read_image(&out, dir, name);
     let cases: [(&[&str], &str, f64); 5] = [
         (
             &["--panorama", "equirect", "--width", "128", "--method", "trace", "--samples", "1"],
@@ -53,7 +62,15 @@ fn frames_drawn_in_tiles_are_the_frames_drawn_whole() {
             assert_eq!(xmp_of(&out.join(&tiled).join(name)), xmp_of(&out.join(&whole).join(name)), "the GPano XMP");
         }
     }
-    // JPEG, streamed through its encoder: the same picture, its XMP, and the tiles counted.
+}
+
+/// A frame in tiles as JPEG, streamed through its encoder: the same picture, its XMP, and the
+/// tiles counted in the statistics.
+#[test]
+fn a_jpeg_drawn_in_tiles_is_the_jpeg_drawn_whole() {
+    let out = tmp("tiles-jpeg");
+    let run = |dir: &str, args: &[&str]| run_demo(&out, dir, args);
+    let read = |dir: &str, name: &str| read_image(&out, dir, name);
     let jpeg = ["--panorama", "equirect", "--width", "128", "--format", "jpg"];
     run("jpeg-whole", &jpeg);
     let stats = out.join("stats.json");
@@ -68,8 +85,14 @@ fn frames_drawn_in_tiles_are_the_frames_drawn_whole() {
         .is_some_and(|t| t == "equirectangular"));
     let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
     assert_eq!(json["tiles"], 128u32.div_ceil(48) * 64u32.div_ceil(48), "{json}");
-    // Depth and the linear colour stream too (OpenEXR, row by row): the same values (the ray
-    // tracer's depth exactly; the rasterizer's linear colour but for tie-broken edge pixels).
+}
+
+/// Depth and the linear colour in tiles stream too (OpenEXR, row by row): the same values (the
+/// ray tracer's depth exactly; the rasterizer's linear colour but for tie-broken edge pixels).
+#[test]
+fn depth_and_linear_colour_drawn_in_tiles_are_the_frames_drawn_whole() {
+    let out = tmp("tiles-exr");
+    let run = |dir: &str, args: &[&str]| run_demo(&out, dir, args);
     let depth = ["--panorama", "equirect", "--width", "128", "--method", "trace", "--samples", "1", "--depth"];
     run("depth-whole", &depth);
     run("depth-tiled", &[&depth[..], &["--max-tile", "40"]].concat());
@@ -95,7 +118,15 @@ fn frames_drawn_in_tiles_are_the_frames_drawn_whole() {
     let off = |p: &[f32; 3], q: &[f32; 3]| (0..3).any(|c| (p[c] - q[c]).abs() > 1e-3 * (1.0 + p[c].abs()));
     let differ = a.iter().zip(&b).filter(|(p, q)| off(p, q)).count();
     assert!(a.len() == 128 * 64 && differ * 100 <= a.len(), "the linear colour: {differ} pixels differ");
-    // A sequence's frames in tiles: each frame streamed as it is drawn, the same pixels.
+}
+
+/// A sequence's frames in tiles, each streamed as it is drawn: the same pixels; no spool is
+/// left beside the outputs; misuses are one line and write nothing.
+#[test]
+fn a_sequence_drawn_in_tiles_is_the_sequence_drawn_whole() {
+    let out = tmp("tiles-seq");
+    let run = |dir: &str, args: &[&str]| run_demo(&out, dir, args);
+    let read = |dir: &str, name: &str| read_image(&out, dir, name);
     let seq = ["--panorama", "equirect", "--width", "128", "--method", "trace", "--samples", "1", "--frames", "0..1"];
     run("seq-whole", &seq);
     run("seq-tiled", &[&seq[..], &["--max-tile", "40"]].concat());
@@ -103,7 +134,7 @@ fn frames_drawn_in_tiles_are_the_frames_drawn_whole() {
         assert_eq!(read("seq-whole", f), read("seq-tiled", f), "{f}");
     }
     // No spool is left beside the outputs.
-    let left: Vec<String> = std::fs::read_dir(out.join("jpeg-tiled"))
+    let left: Vec<String> = std::fs::read_dir(out.join("seq-tiled"))
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .collect();
@@ -327,7 +358,13 @@ fn depth_files_hold_the_distance_along_each_pixels_ray() {
             assert!(checked > 300);
         }
     }
-    // Background: +∞.
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// Where a depth file's pixel shows no surface, its distance is +∞.
+#[test]
+fn depth_files_hold_infinity_where_no_surface_is() {
+    let out = tmp("depth-background");
     let o = common::twister()
         .args(["render", "builtin:sphere100", "--panorama", "equirect", "--width", "128", "--depth", "--out"])
         .arg(&out)
