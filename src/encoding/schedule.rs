@@ -205,8 +205,10 @@ fn replay_counted<E: SubdivisionEngine>(
     Ok(counters)
 }
 
-/// Runs `schedule` over the scene's `triangles` to the end, within `budget`: one submission
-/// (grown until it fits, within the budget; then chunks) or chunks of the given size.
+/// Runs `schedule` over the scene's `triangles` to the end, within `budget`, by the usual
+/// frame's policy ([`FramePlan`], which the GPU's frames follow too): one submission with the
+/// first capacities; where a buffer overflows, chunks from there (grown within the budget, or
+/// halved). `Chunked` starts with chunks of the given size.
 pub fn run_schedule<E: SubdivisionEngine>(
     engine: &mut E,
     settings: &RenderSettings,
@@ -214,20 +216,19 @@ pub fn run_schedule<E: SubdivisionEngine>(
     schedule: Schedule,
     budget: Capacities,
 ) -> Result<RunTotals> {
-    let mut want = Capacities::guess(triangles).min(budget);
-    let chunk = match schedule {
-        Schedule::OneSubmission => loop {
-            let capacity = engine.ensure(want).min(budget);
-            match run_one_submission(engine, settings, triangles, capacity)? {
-                Ok(totals) => return Ok(totals),
-                Err(wanted) if wanted.pieces > budget.pieces || wanted.triangles > budget.triangles => {
-                    break triangles.max(1);
-                }
-                Err(wanted) => want = wanted,
-            }
-        },
-        Schedule::Chunked { triangles_per_chunk } => triangles_per_chunk.max(1),
+    let first = FramePlan::first(triangles, None, budget);
+    let (mut plan, chunk) = match schedule {
+        Schedule::OneSubmission => (first, triangles.max(1)),
+        Schedule::Chunked { triangles_per_chunk } => (first.after_overflow(budget), triangles_per_chunk.max(1)),
     };
+    if let FramePlan::OneSubmission(want) = plan {
+        let capacity = engine.ensure(want).min(budget);
+        match run_one_submission(engine, settings, triangles, capacity)? {
+            Ok(totals) => return Ok(totals),
+            Err(_) => plan = plan.after_overflow(budget),
+        }
+    }
+    let FramePlan::Chunked { mut want, budget } = plan else { unreachable!("a one-submission run returned") };
     run_chunked(engine, settings, triangles, &mut want, budget, chunk)
 }
 
