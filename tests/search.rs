@@ -200,6 +200,78 @@ fn a_ceiling_above_a_tracked_head_is_drawn_closed_by_vertex() {
     }
 }
 
+/// Two cases of the previous step's searches left open: a VR180 room holding two grid boxes
+/// simplified by the level of detail (a triangle without area in a level: no longer kept), and a
+/// 310° fisheye whose piece the software adapter's atan2 flipped between rows and the lattice (35
+/// triangles re-triangulated over the same surface: the twin comparison now tells that from lost
+/// geometry).
+#[test]
+fn the_previous_searches_open_cases_pass() {
+    use twister::core::settings::{Method, Split};
+    let boxes = search::SearchCase {
+        panorama: SearchPanorama::Vr180,
+        method: Method::Vertex,
+        edge_px: 4.0,
+        max_error_px: 0.1,
+        max_div: 1,
+        room_grid: 1,
+        room_half: [6.011456, 7.6485767, 1.6449602],
+        room_offset: [-1.4785882, -6.8241053, 0.43931302],
+        objects: vec![
+            search::ObjectSpec {
+                shape: search::ShapeSpec::Box(3),
+                at: [0.48790336, 0.47624892, 0.2986957],
+                size: 0.21805015,
+            },
+            search::ObjectSpec {
+                shape: search::ShapeSpec::Box(3),
+                at: [0.2238109, 0.2565737, -0.36520267],
+                size: 0.2100431,
+            },
+        ],
+        viewer: [-2.6673975, -2.575046, 0.58618623],
+        yaw_deg: 176.1584,
+        width: 122,
+        height: 64,
+        screen_radius: 2.3079693,
+        eye_radius: 0.09248866,
+        vertical: twister::Vertical::Exact,
+        convergence: Some(4.2807336),
+        pole_merge: true,
+        fov: 180.0,
+        dome_tilt: 0.0,
+        head: None,
+        cave_half: 1.5,
+        cave_wall: 0,
+        gaze: Some((111.46967, 0.90213007)),
+    };
+    let dome = search::SearchCase {
+        panorama: SearchPanorama::Fisheye,
+        method: Method::Adaptive(Split::Error),
+        max_error_px: 0.960288,
+        room_half: [1.5, 2.7982497, 1.5],
+        room_offset: [0.0, -1.9985782, 0.3898186],
+        objects: vec![],
+        viewer: [0.0; 3],
+        yaw_deg: 0.0,
+        width: 85,
+        height: 35,
+        screen_radius: 2.086631,
+        eye_radius: 0.08040526,
+        convergence: Some(1.6788898),
+        pole_merge: false,
+        fov: 310.46347,
+        dome_tilt: -26.207405,
+        gaze: None,
+        ..boxes.clone()
+    };
+    for case in [boxes, dome] {
+        if let Err(f) = search::check(Some(common::renderer()), &case) {
+            panic!("{}: {}: {}", case.describe(), f.check.name(), f.message);
+        }
+    }
+}
+
 /// The fisheye refuses the methods that measure no edge, naming the setting.
 #[test]
 fn the_fisheye_refuses_vertex_and_fixed_with_one_line() {
