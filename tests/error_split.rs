@@ -82,8 +82,10 @@ fn the_error_split_keeps_the_measured_error_within_its_tolerance() {
         for (name, projection) in panoramas {
             let base = RenderSettings::new(projection);
             let (vertex, _) = p99(&scene, &base.with_method(Method::Vertex));
+            // The scene is hard: vertices alone are off by more than any tolerance below keeps
+            // (split + 0.5 px, at most 1.5 px).
             if name != "cubemap" || *kind == "near" {
-                assert!(vertex > 3.0, "{kind} on the {name}: vertices alone are off by only {vertex} px (p99)");
+                assert!(vertex > 2.0, "{kind} on the {name}: vertices alone are off by only {vertex} px (p99)");
             }
             for tau in [0.25f32, 0.5, 1.0] {
                 let settings = base.with_method(Method::Adaptive(Split::Error)).with_max_error_px(tau);
