@@ -2,8 +2,8 @@
 //!
 //! The vertical axis (see the module doc of `cpu::subdivide`). Triangles near the axis, or
 //! large next to their distance from it, are cut into **parts**: their polygon in each of the
-//! four quadrants around the axis (cut by the planes x = 0 and z = 0), for the adaptive method
-//! cut further into **bands** by the diamonds |x| + |z| = c_k, c_k = ρ·√2^k ([`band_bound`]),
+//! four quadrants around the axis (cut by the planes x = 0 and z = 0), for every method cut
+//! further into **bands** by the diamonds |x| + |z| = c_k, c_k = ρ·√2^k ([`band_bound`]),
 //! minus the innermost diamond (half-diagonal ρ = [`axis_clearance`]), each fan-triangulated.
 //! The parts are what the pre-split and the lattice subdivide.
 //!
