@@ -89,7 +89,9 @@ pub fn simplify_chain(
     let bytes: &[u8] = bytemuck::cast_slice(vertices);
     let adapter = meshopt::VertexDataAdapter::new(bytes, std::mem::size_of::<SceneVertex>(), 0).expect("vertex layout");
     let mut welded = welding.weld(original);
-    let closed = is_closed(&welded);
+    // A closed object free of slivers stays so at every level (an open or sliver-holding mesh,
+    // a scan such as the cow, is simplified as meshoptimizer gives it).
+    let keep_closed = is_closed(&welded) && !has_sliver(vertices, original);
     let corners = Corners::of(original, welding);
     let mut chain = vec![original.to_vec()];
     let mut errors = vec![0.0f32];
@@ -98,19 +100,25 @@ pub fn simplify_chain(
         if count <= floor {
             break;
         }
-        let target = ((count as f32 * LEVEL_RATIO) as usize).max(floor);
+        // A level that would open the surface (or leave a triangle without area) is tried again
+        // with a gentler step before the chain stops: meshoptimizer's collapses differ with
+        // the target.
         let mut error = 0.0f32;
-        let next =
-            meshopt::simplify(&welded, &adapter, 3 * target, 1.0, meshopt::SimplifyOptions::Sparse, Some(&mut error));
-        // Stop where the simplifier can no longer make real progress, would open the surface, or
-        // left a triangle with no area (three corners on a line, a flat face's collapse).
-        if next.is_empty()
-            || next.len() / 3 > count * 9 / 10
-            || (closed && !is_closed(&next))
-            || has_sliver(vertices, &next)
-        {
-            break;
+        let mut accepted = None;
+        for ratio in [LEVEL_RATIO, 0.8, 0.9] {
+            let target = ((count as f32 * ratio) as usize).max(floor);
+            let next =
+                meshopt::simplify(&welded, &adapter, 3 * target, 1.0, meshopt::SimplifyOptions::Sparse, Some(&mut error));
+            // No real progress: stop.
+            if next.is_empty() || next.len() / 3 > count * 19 / 20 {
+                break;
+            }
+            if !keep_closed || (is_closed(&next) && !has_sliver(vertices, &next)) {
+                accepted = Some(next);
+                break;
+            }
         }
+        let Some(next) = accepted else { break };
         chain.push(unweld(&next, &corners, vertices));
         errors.push(errors.last().unwrap() + error);
         welded = next;
