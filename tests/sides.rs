@@ -97,8 +97,9 @@ fn objects_drawn(out: &SubdivideOutput) -> BTreeSet<u32> {
 /// subdivided and drawn as before. (Such pixels exist: a back face's sub-triangle so thin that
 /// the projection's curvature turns its winding over on the screen passes the raster's test and
 /// draws a pixel or a few of a face seen from behind — on the sphere, near a pole; the skip
-/// removes them; they are few: at most 1 in 200 of the image, where a face that shows, skipped,
-/// would change thousands.)
+/// removes them; they are few: at most 1 in 150 of the image (140 of 25,600 px for `vertex` on the
+/// cylinder, whose parts beside the axis are now cut into bands too), where a face that shows,
+/// skipped, would change thousands.)
 fn only_skipped_pixels_change(
     name: &str,
     width: usize,
@@ -120,7 +121,7 @@ fn only_skipped_pixels_change(
             assert!(near, "{name}: pixel ({x}, {y}) changed, near no skipped triangle");
         }
     }
-    assert!(changed * 200 <= n, "{name}: {changed} of {n} pixels changed");
+    assert!(changed * 150 <= n, "{name}: {changed} of {n} pixels changed");
 }
 
 #[test]
