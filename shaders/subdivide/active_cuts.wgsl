@@ -29,8 +29,10 @@ fn active_cuts(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     if (off_screen_vertically(tri.position[0], tri.position[1], tri.position[2])) {
         return;
     }
-    // Diamonds for every method (`band_limit` in axis.rs).
-    let limit = BAND_LIMIT * params.projection.screen_radius;
+    // Diamonds for the adaptive rules, and on the cylinder for every method (`band_limit` in
+    // axis.rs).
+    let banded = is_adaptive() || !is_sphere(params.projection);
+    let limit = select(0.0, BAND_LIMIT * params.projection.screen_radius, banded);
     let bits = triangle_cuts(limit, &tri);
     if (bits.x != 0u) {
         atomicOr(&counters.cuts_low, bits.x);

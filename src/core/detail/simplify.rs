@@ -107,8 +107,14 @@ pub fn simplify_chain(
         let mut accepted = None;
         for ratio in [LEVEL_RATIO, 0.8, 0.9] {
             let target = ((count as f32 * ratio) as usize).max(floor);
-            let next =
-                meshopt::simplify(&welded, &adapter, 3 * target, 1.0, meshopt::SimplifyOptions::Sparse, Some(&mut error));
+            let next = meshopt::simplify(
+                &welded,
+                &adapter,
+                3 * target,
+                1.0,
+                meshopt::SimplifyOptions::Sparse,
+                Some(&mut error),
+            );
             // No real progress: stop.
             if next.is_empty() || next.len() / 3 > count * 19 / 20 {
                 break;

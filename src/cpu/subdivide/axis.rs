@@ -2,8 +2,8 @@
 //!
 //! The vertical axis (see the module doc of `cpu::subdivide`). Triangles near the axis, or
 //! large next to their distance from it, are cut into **parts**: their polygon in each of the
-//! four quadrants around the axis (cut by the planes x = 0 and z = 0), for every method cut
-//! further into **bands** by the diamonds |x| + |z| = c_k, c_k = ρ·√2^k ([`band_bound`]),
+//! four quadrants around the axis (cut by the planes x = 0 and z = 0), for the adaptive rules
+//! (and every method on the cylinder: [`band_limit`]) cut further into **bands** by the diamonds |x| + |z| = c_k, c_k = ρ·√2^k ([`band_bound`]),
 //! minus the innermost diamond (half-diagonal ρ = [`axis_clearance`]), each fan-triangulated.
 //! The parts are what the pre-split and the lattice subdivide.
 //!
@@ -298,13 +298,19 @@ fn single_band(p: [Vec3; 3], (sx, sz): (f32, f32), rho: f32, cuts: AxisCuts) -> 
     p.iter().all(|&q| lower.distance(q) > 0.0 && upper.is_none_or(|u| u.distance(q) > 0.0))
 }
 
-/// Where diamonds stop: `BAND_LIMIT`·R_T for every method. `vertex` and `fixed:N` split no edge
-/// by its projected length, but a part that reaches from the eye circle to far out projects, in
-/// straight lines, as a polygon that is no longer simple (a ceiling's corner above the eyes fanned
-/// over points whose images lie thousands of pixels above the image): within a band, r varies by
-/// at most a factor 2 and the fans stay simple.
-pub fn band_limit(_method: u32, screen_radius: f32) -> f32 {
-    BAND_LIMIT * screen_radius
+/// Where diamonds stop: `BAND_LIMIT`·R_T for the adaptive rules, and on the cylinder for every
+/// method: `vertex` and `fixed:N` split no edge by its projected length, but the cylinder's
+/// v = R_T·y/√(r² − d_e²) grows without bound towards the eye circle, and a part that reaches
+/// from there to far out projects, in straight lines, as a polygon that is no longer simple (a
+/// ceiling's corner above a tracked head, fanned over points thousands of pixels above the
+/// image); within a band r varies by at most a factor 2 and the fans stay simple. The sphere's
+/// latitude is bounded: there they cut only the square (0).
+pub fn band_limit(method: u32, projection: &crate::core::panoramas::projection::Projection) -> f32 {
+    if crate::core::settings::SplitRule::is_adaptive(method) || !projection.panorama.is_sphere() {
+        BAND_LIMIT * projection.screen_radius
+    } else {
+        0.0
+    }
 }
 
 /// The active diamonds' bounds, innermost first.

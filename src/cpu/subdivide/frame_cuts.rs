@@ -112,7 +112,7 @@ impl Subdivider<'_> {
     /// [`FrameCuts::every_edge`] with the edges of the triangles that ask for cuts marked as
     /// `active_cuts` marks them (tests of triangles whose neighbours, not given, are cut).
     pub fn every_edge_cuts(&self, axis: AxisCuts, vertices: &[SceneVertex], indices: &[u32]) -> FrameCuts {
-        let limit = band_limit(self.params.method, self.projection.screen_radius);
+        let limit = band_limit(self.params.method, &self.projection);
         let mut frame = FrameCuts::every_edge(axis, vertices, indices);
         for t in 0..indices.len() / 3 {
             if triangle_cuts(self.positions(vertices, indices, t), self.params.axis_clearance, limit) != 0 {
@@ -127,7 +127,7 @@ impl Subdivider<'_> {
     /// neighbours across those edges; see `axis.rs`), from every on-screen triangle of the scene:
     /// all of `indices`, whatever range the dispatch plans.
     pub fn active_cuts(&self, vertices: &[SceneVertex], indices: &[u32]) -> FrameCuts {
-        let limit = band_limit(self.params.method, self.projection.screen_radius);
+        let limit = band_limit(self.params.method, &self.projection);
         let mut frame = FrameCuts::unmarked(vertices, indices);
         let on_screen: Vec<(usize, AxisCuts)> = (0..indices.len() / 3)
             .map(|t| (t, self.positions(vertices, indices, t)))

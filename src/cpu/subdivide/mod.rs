@@ -67,7 +67,8 @@
 //! switch on cuts for the whole frame (`active_cuts`, a pass over the scene before `plan`) and are
 //! cut into their parts in the four quadrants around the axis (planes x = 0 and z = 0; the seam
 //! θ = ±π is one of the cuts, so no part crosses it in θ), minus a small square around the axis
-//! whose points no eye sees, and into bands between the diamonds they need; their
+//! whose points no eye sees, and (adaptive, or any method on the cylinder) into bands between the
+//! diamonds they need; their
 //! neighbours are cut only where the edges they share cross those cuts, and every other triangle
 //! is its own single part (see `axis.rs`). The cut points on an edge depend on that edge and the
 //! frame's cuts alone, so neighbours agree; the parts are then split as above, each part's edges

@@ -202,7 +202,7 @@ impl<'s> CpuSubdivision<'s> {
         if sub.off_screen_vertically(p) {
             return;
         }
-        let bits = triangle_cuts(p, params.axis_clearance, band_limit(params.method, sub.projection.screen_radius));
+        let bits = triangle_cuts(p, params.axis_clearance, band_limit(params.method, &sub.projection));
         self.counters.cuts_low |= bits as u32;
         self.counters.cuts_high |= (bits >> 32) as u32;
         if bits != 0 {
