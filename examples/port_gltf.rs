@@ -34,7 +34,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             &frame,
             Layout::Twister,
             twister::output::ImageFormat::Png,
-            twister::core::panoramas::projection::PanoramaKind::Cylinder,
+            settings.projection().panorama,
         ),
     )? {
         println!("{}", path.display());

@@ -17,7 +17,7 @@
 //! bytes added inside it; where `moov` comes before the media data (`faststart`), every chunk
 //! offset (`stco`, `co64`) moves by the bytes added in all.
 
-use crate::core::panoramas::projection::PanoramaKind;
+use crate::core::panoramas::panorama::{ImageMap, PanoramaKind};
 use crate::error::{Error, Result};
 
 /// Spherical Video V1's box type: `uuid` with this UUID.
@@ -98,7 +98,7 @@ pub fn spherical_boxes(stereo: StereoMode, panorama: PanoramaKind) -> Vec<u8> {
     let projection = if panorama.is_equirectangular() {
         let bounds: Vec<u8> = equi_bounds(panorama).iter().flat_map(|b| b.to_be_bytes()).collect();
         full_box(b"equi", &bounds)
-    } else if panorama == PanoramaKind::Cubemap {
+    } else if panorama.model().image_map() == ImageMap::Cubemap {
         full_box(b"cbmp", &[0; 8])
     } else {
         return out;

@@ -269,7 +269,7 @@ fn the_demo_room_is_closed_at_1024_square() {
 #[test]
 fn triangles_reaching_into_the_eye_circle_are_drawn_whole() {
     use rand::{Rng, SeedableRng};
-    use twister::core::panoramas::projection::{Panorama, Vertical};
+    use twister::core::panoramas::projection::{Camera, Vertical};
     let r = common::renderer();
     let mut rng = rand::rngs::StdRng::seed_from_u64(5);
     let mut checked = 0;
@@ -364,7 +364,6 @@ fn background_seen(
 /// pixel (any background a sample sees changes its pixel).
 #[test]
 fn surround_scenes_let_no_sample_see_the_background() {
-    use twister::core::panoramas::projection::PanoramaKind;
     let scenes: Vec<(&str, Scene, Vec3)> = vec![
         ("box room", builtin::builtin_scene("builtin:box-room", &Projection::default()).unwrap(), Vec3::ZERO),
         ("demo room", builtin::demo(), Vec3::ZERO),
@@ -379,21 +378,24 @@ fn surround_scenes_let_no_sample_see_the_background() {
             .map(|m| (m, 4))
             .into_iter()
             .chain([(Method::Adaptive(Split::Error), 2), (Method::Adaptive(Split::Error), 16), (Method::Trace, 4)]);
+        let cylinder = |width, height| Projection { width, height, ..Projection::default() };
         let sizes = [
-            (PanoramaKind::Cylinder, 320, 80),
-            (PanoramaKind::Cylinder, 192, 192),
-            (PanoramaKind::Equirect, 256, 128),
-            (PanoramaKind::Vr180, 128, 128),
-            (PanoramaKind::Fisheye, 128, 128),
-            (PanoramaKind::Cubemap, 192, 128),
-        ];
+            cylinder(320, 80),
+            cylinder(192, 192),
+            Projection::equirect(256),
+            Projection::vr180(128),
+            Projection::fisheye(128),
+            Projection::cubemap(192),
+        ]
+        .map(|p| (p.panorama.name(), p));
         let runs: Vec<_> = runs.flat_map(|run| sizes.map(|size| (run, size))).collect();
-        for ((method, samples), (panorama, width, height)) in runs {
+        for ((method, samples), (panorama, size)) in runs {
+            let (width, height) = (size.width, size.height);
             // One size each for the extra counts (2: the cylinder, 16: the sphere) and the ray
             // tracer (the sphere; the exact vertical model only).
             let extra = samples != 4 || method == Method::Trace;
-            let sphere = panorama == PanoramaKind::Equirect;
-            let vr180 = matches!(panorama, PanoramaKind::Vr180 | PanoramaKind::Fisheye | PanoramaKind::Cubemap);
+            let sphere = panorama == "equirect";
+            let vr180 = matches!(panorama, "vr180" | "fisheye" | "cubemap");
             if extra && (width == 192 || vr180 || (samples == 2 && sphere) || (samples != 2 && !sphere)) {
                 continue;
             }
@@ -402,26 +404,25 @@ fn surround_scenes_let_no_sample_see_the_background() {
             // edges between unsplit corners (`vertex`, `fixed:7` here) they would leave the
             // background showing, so it refuses those methods (tests/search.rs); the adaptive
             // rules close it.
-            if panorama == PanoramaKind::Fisheye && !matches!(method, Method::Adaptive(_)) {
+            if panorama == "fisheye" && !matches!(method, Method::Adaptive(_)) {
                 continue;
             }
             // VR180 is the sphere's front half, whose every method the sphere's size checks:
             // the adaptive rule here, for its own image's edges.
-            if panorama == PanoramaKind::Vr180 && !matches!(method, Method::Adaptive(_)) {
+            if panorama == "vr180" && !matches!(method, Method::Adaptive(_)) {
                 continue;
             }
             {
                 let vertical = if method == Method::Trace { Vertical::Exact } else { Vertical::Paper };
                 // The fisheye at 240°, tilted: the floor's antipode cone inside the circle's reach.
-                let (fov, dome_tilt) = if panorama == PanoramaKind::Fisheye { (240.0, 20.0) } else { (180.0, 0.0) };
-                let projection =
-                    Projection { width, height, panorama, vertical, fov, dome_tilt, ..Projection::default() };
+                let (fov, dome_tilt) = if panorama == "fisheye" { (240.0, 20.0) } else { (180.0, 0.0) };
+                let projection = Projection { vertical, fov, dome_tilt, ..size };
                 let settings =
                     RenderSettings::new(projection).with_viewer(*viewer).with_method(method).with_samples(samples);
                 for (eye, seen) in background_seen(r, &gs, &settings) {
                     assert!(
                         seen.is_empty(),
-                        "{what}, {panorama:?} {width}x{height} {} at {samples} samples {eye:?}: {} pixels see the background, e.g. {:?}",
+                        "{what}, {panorama} {width}x{height} {} at {samples} samples {eye:?}: {} pixels see the background, e.g. {:?}",
                         method.name(),
                         seen.len(),
                         &seen[..seen.len().min(5)]

@@ -5,7 +5,7 @@
 //! forward map (seed 002 eq. 1–4 on the cylinder; the sphere's, the fisheye's, the cubemap's),
 //! so every panorama is previewed as it is drawn.
 
-use crate::core::panoramas::projection::{PanoramaKind, Projection};
+use crate::core::panoramas::projection::Projection;
 
 /// How the frame is shown.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -117,5 +117,5 @@ impl DisplayView {
 
 /// Whether a panorama can be looked around in (a CAVE's walls are perspectives already).
 pub fn can_look(p: &Projection) -> bool {
-    p.panorama != PanoramaKind::Cave
+    !p.model().drawn_as_pinhole()
 }

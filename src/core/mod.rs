@@ -1,5 +1,5 @@
 //! The core: maths and data with no GPU in them. The projection (seed 002 eq. 1–4) as a
-//! [`projection::Panorama`], scenes with their loaders and materials, the visual field and level
+//! [`panoramas::panorama::Panorama`], scenes with their loaders and materials, the visual field and level
 //! of detail (seeds 000/001), render settings and the frames a renderer returns.
 
 pub mod assets;

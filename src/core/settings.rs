@@ -5,7 +5,8 @@
 
 use glam::{Mat4, Vec3};
 
-use crate::core::panoramas::projection::{PanoramaKind, Projection, Vertical};
+use crate::core::panoramas::panorama::EyeModel;
+use crate::core::panoramas::projection::{Projection, Vertical};
 use crate::error::{Error, Result};
 
 /// Default memory budget for the subdivision buffers, MiB.
@@ -515,7 +516,8 @@ impl RenderSettings {
     fn validate_method(&self) -> Result<()> {
         let s = &self.subdivision;
         if let Method::Slit(w) = s.method {
-            if self.view.projection.panorama == PanoramaKind::Cave {
+            let model = self.view.projection.model();
+            if model.drawn_as_pinhole() {
                 return Err(Error::setting(
                     "subdivision.method",
                     format!("slit:{w}: a CAVE wall is one perspective per eye, which every method draws exactly: use vertex, or trace as the reference"),
@@ -528,7 +530,7 @@ impl RenderSettings {
                 ));
             }
             let panorama = self.view.projection.panorama;
-            if matches!(panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap) {
+            if !model.has_slits() {
                 return Err(Error::setting(
                     "subdivision.method",
                     format!(
@@ -545,7 +547,7 @@ impl RenderSettings {
             }
         }
         if matches!(s.method, Method::Vertex | Method::Fixed(_))
-            && self.view.projection.panorama == PanoramaKind::Fisheye
+            && !self.view.projection.model().takes_unmeasured_edges()
         {
             return Err(Error::setting(
                 "subdivision.method",
@@ -559,7 +561,7 @@ impl RenderSettings {
         }
         self.validate_tilted_dome()?;
         if s.method == Method::Trace
-            && self.view.projection.panorama == PanoramaKind::Cylinder
+            && self.view.projection.model().eye_model() == EyeModel::Circle
             && self.view.projection.vertical == Vertical::Paper
         {
             return Err(Error::setting(

@@ -10,7 +10,8 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::core::panoramas::projection::{azimuth, horizontal_radius, Eye, PanoramaKind, Projection};
+use crate::core::panoramas::panorama::ImageMap;
+use crate::core::panoramas::projection::{azimuth, horizontal_radius, Eye, Projection};
 use crate::core::scenes::scene::unpack_tangent;
 use crate::core::shading::texture::MaterialTable;
 use crate::cpu::fragment::{
@@ -48,7 +49,7 @@ pub fn raster_vertex(params: &RasterParams, v: &DrawVertex) -> Vec4 {
 /// (`RasterParams::w_by_radius`, the error split's azimuth spacing: `cpu::subdivide::spacing`);
 /// else 1.
 fn clip_w(projection: &Projection, p: Vec3, depth: f32, w_by_radius: u32) -> f32 {
-    if projection.panorama == PanoramaKind::Cubemap {
+    if projection.model().image_map() == ImageMap::Cubemap {
         return depth.max(crate::core::panoramas::cubemap::CUBE_MIN_DISTANCE);
     }
     if w_by_radius == 0 {
@@ -61,12 +62,12 @@ fn clip_w(projection: &Projection, p: Vec3, depth: f32, w_by_radius: u32) -> f32
 /// depth r/(r + 1) (`frame_clip` in projection.wgsl; the cubemap: for the draw of face `face`,
 /// its own depth, `Projection::cube_clip`).
 fn frame_clip(projection: &Projection, u: f32, v: f32, distance: f32, face: usize) -> Vec4 {
-    if projection.panorama == PanoramaKind::Cubemap {
+    if projection.model().image_map() == ImageMap::Cubemap {
         let c = projection.cube_clip(projection.cube_ray(u, v), distance, face);
         return Vec4::new(c.x, c.y, c.z.min(MAX_DEPTH * c.w), c.w);
     }
     let depth = (distance / (distance + 1.0)).min(MAX_DEPTH);
-    if projection.panorama == PanoramaKind::Fisheye {
+    if projection.model().image_map() == ImageMap::Fisheye {
         let [x, y] = projection.fisheye_pixel(u, v);
         let (w, h) = (projection.width as f32, projection.height as f32);
         return Vec4::new(2.0 * x / w - 1.0, 1.0 - 2.0 * y / h, depth, 1.0);
@@ -382,7 +383,7 @@ pub fn raster(
         }
     }
     // One draw, or the cubemap's six, each face's clipped to its square (the GPU's scissor).
-    let draws: Vec<(Option<usize>, Vec<Vec4>)> = if projection.panorama == PanoramaKind::Cubemap {
+    let draws: Vec<(Option<usize>, Vec<Vec4>)> = if projection.model().image_map() == ImageMap::Cubemap {
         (0..6).map(|f| (Some(f), [&[NEAR_PLANE][..], &projection.cube_face_planes(f)].concat())).collect()
     } else {
         vec![(None, vec![NEAR_PLANE])]

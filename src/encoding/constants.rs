@@ -4,7 +4,7 @@
 
 use crate::core::detail::visual_field::{CENTRAL_RADIUS, FIELD_DOWN, FIELD_SIDEWAYS, FIELD_UP};
 use crate::core::panoramas::cubemap::{CUBE_MIN_DISTANCE, CUBE_MIN_W, CUBE_NEAR};
-use crate::core::panoramas::projection::PanoramaKind;
+use crate::core::panoramas::registry::PANORAMAS;
 use crate::core::panoramas::sphere::{SPHERE_NEWTON_STEPS, SPHERE_NEWTON_TOLERANCE};
 use crate::core::settings::SplitRule;
 use crate::core::shading::light::{LightKind, Tonemap};
@@ -210,13 +210,9 @@ fn numbers() -> Vec<(&'static str, Value)> {
 /// The codes the settings and the scene's enums are passed as, and the tables' sizes.
 fn codes() -> Vec<(&'static str, Value)> {
     use Value::U32;
-    vec![
-        ("PANORAMA_CYLINDER", U32(PanoramaKind::Cylinder.code())),
-        ("PANORAMA_EQUIRECT", U32(PanoramaKind::Equirect.code())),
-        ("PANORAMA_VR180", U32(PanoramaKind::Vr180.code())),
-        ("PANORAMA_FISHEYE", U32(PanoramaKind::Fisheye.code())),
-        ("PANORAMA_CUBEMAP", U32(PanoramaKind::Cubemap.code())),
-        ("PANORAMA_CAVE", U32(PanoramaKind::Cave.code())),
+    // Each panorama's code, from the registry.
+    let panoramas = PANORAMAS.iter().map(|m| (m.wgsl_name(), U32(m.kind().code())));
+    panoramas.chain([
         ("NO_TEXTURE", U32(NO_TEXTURE)),
         ("WRAP_REPEAT", U32(Wrap::Repeat as u32)),
         ("WRAP_CLAMP", U32(Wrap::ClampToEdge as u32)),
@@ -244,7 +240,8 @@ fn codes() -> Vec<(&'static str, Value)> {
         ("TONEMAP_PBR_NEUTRAL", U32(Tonemap::PbrNeutral.code())),
         ("TONEMAP_ACES", U32(Tonemap::Aces.code())),
         ("TONEMAP_LINEAR", U32(Tonemap::Linear.code())),
-    ]
+    ])
+    .collect()
 }
 
 /// The generated WGSL module `constants`.

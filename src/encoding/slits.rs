@@ -4,7 +4,7 @@
 
 use glam::{Mat4, Vec2, Vec3};
 
-use crate::core::panoramas::projection::{Eye, PanoramaKind, Projection};
+use crate::core::panoramas::projection::{Eye, Projection};
 use crate::encoding::types::{SlitCamera, SlitParams};
 
 /// Distance of the slit cameras' near plane, metres.
@@ -46,7 +46,7 @@ fn camera(origin: Vec3, right: Vec3, up: Vec3, forward: Vec3, centre: Vec2, scal
 /// columns on the cylinder, tiles of `width` × `width` pixels on the sphere.
 pub fn slits(projection: &Projection, eye: Eye, width: u32) -> Vec<Slit> {
     let (w_img, h_img) = (projection.width, projection.height);
-    if projection.panorama == PanoramaKind::Cave {
+    if projection.model().drawn_as_pinhole() {
         return vec![Slit {
             first_column: 0,
             end_column: w_img,

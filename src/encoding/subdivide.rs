@@ -1,6 +1,7 @@
 //! The `subdivide` stage's encoding: its parameters built from the settings, the cuts around the
 //! axis it reports, and its output as both the GPU (read back) and the CPU twin give it.
 
+use crate::core::panoramas::panorama::ImageMap;
 use crate::core::panoramas::projection::{PanoramaKind, Projection};
 use crate::core::settings::{RenderSettings, SplitRule};
 use crate::encoding::constants::{AXIS_CLEARANCE_MAX, AXIS_CLEARANCE_MIN, OFFSET_SPLIT_FACTOR, PLAN_CUTS_SPLIT};
@@ -20,6 +21,8 @@ pub fn subdivide_params(settings: &RenderSettings, first_triangle: u32, triangle
     // (`cpu::subdivide::offsets`), which halves each triangle's largest error: it splits at
     // OFFSET_SPLIT_FACTOR·τ for about the error τ gives without them.
     let node_offsets = projection.panorama.is_equirectangular() && rule == SplitRule::AdaptiveError;
+    // The cubemap's faces, each drawn as a pinhole from the eye points (`cpu::raster::clip_w`).
+    let pinhole_faces = projection.model().image_map() == ImageMap::Cubemap;
     SubdivideParams {
         view: settings.view().to_cols_array_2d(),
         projection: (&measured).into(),
@@ -37,10 +40,9 @@ pub fn subdivide_params(settings: &RenderSettings, first_triangle: u32, triangle
         piece_count: 0,
         measure_edges: (settings.measure.edges || settings.measure.error) as u32,
         vertical_limit: projection.vertical_limit(),
-        by_azimuth: (SplitRule::spaces_by_azimuth(rule as u32) && projection.panorama != PanoramaKind::Cubemap) as u32,
-        seamless: matches!(projection.panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap | PanoramaKind::Cave)
-            as u32,
-        pinhole_faces: (projection.panorama == PanoramaKind::Cubemap) as u32,
+        by_azimuth: (SplitRule::spaces_by_azimuth(rule as u32) && !pinhole_faces) as u32,
+        seamless: projection.model().turn_share().is_none() as u32,
+        pinhole_faces: pinhole_faces as u32,
         node_offsets: node_offsets as u32,
         antipode_cos: projection
             .dome_antipode_cone(projection.chord_dip_px(

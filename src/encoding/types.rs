@@ -46,7 +46,7 @@ pub struct ProjectionUniform {
     pub vertical_exact: u32,
     /// Pixels per unit of v (metres of screen, or radians of latitude).
     pub pixels_per_v: f32,
-    /// 0 the cylinder, 1 the sphere, 2 VR180, 3 the fisheye (`PanoramaKind::code`).
+    /// The panorama's code: its index in the registry (`core::panoramas::panorama::PANORAMAS`).
     pub panorama: u32,
     /// The sphere's convergence distance, metres; 0: parallel rays.
     pub convergence: f32,

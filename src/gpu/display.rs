@@ -7,7 +7,7 @@ use std::sync::Mutex;
 
 use crate::core::display::DisplayMode;
 use crate::core::frame::EyeImage;
-use crate::core::panoramas::projection::PanoramaKind;
+use crate::core::panoramas::registry::PANORAMAS;
 use crate::encoding::types::DisplayParams;
 use crate::gpu::device::Gpu;
 use crate::gpu::stages::GpuStage;
@@ -107,8 +107,8 @@ impl DisplayStage {
         overlay: Option<&wgpu::Buffer>,
     ) {
         let look = DisplayMode::from_code(params.mode).is_some_and(|m| m.is_look());
-        let panoramas = match PanoramaKind::from_code(params.projection.panorama) {
-            Some(kind) if look => crate::gpu::draw::panorama_bits(kind),
+        let panoramas = match PANORAMAS.get(params.projection.panorama as usize) {
+            Some(model) if look => model.shader_bits(),
             _ => 0,
         };
         let pipeline = self.pipeline(gpu, target.format, panoramas);

@@ -316,13 +316,7 @@ fn look_constants(look: Look, lit: Lit) -> Vec<(&'static str, f64)> {
 /// `PANORAMAS` for a panorama (projection.wgsl): 1 the cylinder, 2 the sphere and VR180, 6 the
 /// fisheye and 10 the cubemap (the sphere's eye model in their own images), 16 the CAVE.
 pub(crate) fn panorama_bits(panorama: crate::core::panoramas::projection::PanoramaKind) -> u32 {
-    match panorama {
-        crate::core::panoramas::projection::PanoramaKind::Fisheye => 6,
-        crate::core::panoramas::projection::PanoramaKind::Cubemap => 10,
-        crate::core::panoramas::projection::PanoramaKind::Cave => 16,
-        p if p.is_sphere() => 2,
-        _ => 1,
-    }
+    panorama.model().shader_bits()
 }
 
 /// A drawing stage's vertex buffer: its stride and attributes. Raster: the subdivided

@@ -190,8 +190,7 @@ impl Renderer {
         let rows_buffer = (self.gpu.limits.max_buffer_size / (2 * padded_row(tile_w) * ky as u64)).max(1);
         let rows_strip = (STRIP_BYTES / (8 * p.width as u64)).max(1);
         let tile_h = (p.height.min(side) as u64).min(rows_buffer).min(rows_strip).max(1) as u32;
-        let face =
-            if p.panorama == crate::core::panoramas::projection::PanoramaKind::Cubemap { p.width / 3 } else { 0 };
+        let face = p.model().tile_face(p);
         Some(Tiles { width: p.width, height: p.height, tile_w, tile_h, face })
     }
 
@@ -333,7 +332,7 @@ impl Renderer {
             }
             // A CAVE wall is a perspective: every projection method draws it exactly as one
             // pinhole camera per eye, the slit stage's (`core::panoramas::cave`), with no subdivision.
-            let cave = settings.projection().panorama == crate::core::panoramas::projection::PanoramaKind::Cave;
+            let cave = settings.projection().model().drawn_as_pinhole();
             let method: &dyn Method = match settings.subdivision.method {
                 MethodName::Trace => &self.trace,
                 MethodName::Slit(_) => self.slit.get_or_init(|| SlitMethod::new(&self.gpu)),
@@ -443,7 +442,7 @@ impl Renderer {
         settings: &RenderSettings,
         schedule: Schedule,
     ) -> Result<SubdivideOutput> {
-        if settings.projection().panorama == crate::core::panoramas::projection::PanoramaKind::Cave {
+        if settings.projection().model().drawn_as_pinhole() {
             return Err(Error::setting(
                 "view.projection.wall",
                 "a CAVE wall is drawn as one perspective per eye, without subdivision: there is none to read back",

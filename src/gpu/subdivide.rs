@@ -10,6 +10,7 @@
 
 use std::sync::OnceLock;
 
+use crate::core::panoramas::panorama::{EyeModel, ImageMap};
 use crate::core::panoramas::projection::PanoramaKind;
 use crate::core::settings::RenderSettings;
 use crate::encoding::constants::PIECES_FROM_COUNTER;
@@ -223,9 +224,10 @@ struct VariantKey {
 
 impl VariantKey {
     fn of(panorama: PanoramaKind, params: &SubdivideParams) -> VariantKey {
-        let projection = match panorama {
-            PanoramaKind::Fisheye => VariantProjection::Fisheye,
-            p if p.is_sphere() => VariantProjection::Sphere,
+        let model = panorama.model();
+        let projection = match (model.eye_model(), model.image_map()) {
+            (_, ImageMap::Fisheye) => VariantProjection::Fisheye,
+            (EyeModel::Sphere, _) => VariantProjection::Sphere,
             _ if params.projection.head_on != 0.0 => VariantProjection::Head,
             _ => VariantProjection::Cylinder,
         };

@@ -320,7 +320,7 @@ fn face_draws(
     let projection = settings.projection();
     // (face, scissor): the faces a tile holds, each with its square; or the one draw.
     let faces: Vec<(u32, Option<[u32; 4]>)> =
-        if projection.panorama == crate::core::panoramas::projection::PanoramaKind::Cubemap {
+        if projection.model().image_map() == crate::core::panoramas::panorama::ImageMap::Cubemap {
             (0..crate::core::panoramas::cubemap::CUBE_FACES.len())
                 .filter_map(|f| projection.cube_face_scissor(f).map(|rect| (f as u32, Some(rect))))
                 .collect()

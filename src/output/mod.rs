@@ -20,7 +20,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::core::frame::{EyeImage, Frame};
-use crate::core::panoramas::projection::PanoramaKind;
+use crate::core::panoramas::panorama::{EyePacking, PanoramaKind};
 use crate::error::{Error, Result};
 
 mod stream;
@@ -54,16 +54,14 @@ crate::choices!(ImageFormat {
 });
 
 impl Layout {
-    /// The layout a panorama is written in by default: the eyes apart for the cylinder (the
-    /// TWISTER display's inputs), top-bottom for the sphere (what VR players take).
+    /// The layout a panorama is written in by default (its [`EyePacking`]): the eyes apart for
+    /// the cylinder (the TWISTER display's inputs), top-bottom for the sphere (what VR players
+    /// take), side by side for VR180.
     pub fn default_for(panorama: PanoramaKind) -> Layout {
-        match panorama {
-            PanoramaKind::Cylinder => Layout::Eyes,
-            PanoramaKind::Equirect => Layout::TopBottom,
-            PanoramaKind::Vr180 => Layout::SideBySide,
-            PanoramaKind::Fisheye => Layout::Eyes,
-            PanoramaKind::Cubemap => Layout::TopBottom,
-            PanoramaKind::Cave => Layout::Eyes,
+        match panorama.model().eye_packing() {
+            EyePacking::Separate => Layout::Eyes,
+            EyePacking::TopBottom => Layout::TopBottom,
+            EyePacking::SideBySide => Layout::SideBySide,
         }
     }
 }
@@ -584,7 +582,7 @@ mod tests {
         };
         for layout in [Layout::Eyes, Layout::TopBottom, Layout::SideBySide, Layout::Twister, Layout::Strip12] {
             for format in [ImageFormat::Png, ImageFormat::Jpg] {
-                for panorama in PanoramaKind::ALL {
+                for &panorama in PanoramaKind::ALL {
                     let images = layout_images(&frame, layout, format, panorama);
                     let names: Vec<String> = images.into_iter().map(|(n, _)| n).collect();
                     assert_eq!(names, layout_names(layout, format, panorama));
@@ -619,7 +617,7 @@ mod tests {
             positions: None,
             hdr: None,
         };
-        let images = layout_images(&frame, Layout::Strip12, ImageFormat::Png, PanoramaKind::Cubemap);
+        let images = layout_images(&frame, Layout::Strip12, ImageFormat::Png, crate::core::panoramas::projection::Projection::cubemap(48).panorama);
         assert_eq!(images.len(), 1);
         let (name, strip) = &images[0];
         assert_eq!((name.as_str(), strip.width, strip.height), ("stereo_cubemap_12x1.png", 12 * face, face));

@@ -26,6 +26,7 @@ use crate::core::detail::lod::{LodChain, LodParams, LodSelection};
 use crate::core::detail::visual_field::Gaze;
 use crate::core::panoramas::cave::NamedWall;
 use crate::core::panoramas::head::Head;
+use crate::core::choice::Choice;
 use crate::core::panoramas::projection::{PanoramaKind, Projection, Vertical, DEFAULT_POLE_MERGE};
 use crate::core::scenes::scene::Scene;
 use crate::core::scenes::shapes::ClosedMesh;
@@ -73,15 +74,11 @@ impl SearchPanorama {
         SearchPanorama::ALL.into_iter().find(|p| p.name() == s)
     }
 
+    /// The panorama it draws: the one of its name (the cylinder with a tracked head: the
+    /// cylinder).
     pub fn kind(self) -> PanoramaKind {
-        match self {
-            SearchPanorama::Cylinder | SearchPanorama::CylinderHead => PanoramaKind::Cylinder,
-            SearchPanorama::Equirect => PanoramaKind::Equirect,
-            SearchPanorama::Vr180 => PanoramaKind::Vr180,
-            SearchPanorama::Fisheye => PanoramaKind::Fisheye,
-            SearchPanorama::Cubemap => PanoramaKind::Cubemap,
-            SearchPanorama::Cave => PanoramaKind::Cave,
-        }
+        let name = if self == SearchPanorama::CylinderHead { SearchPanorama::Cylinder.name() } else { self.name() };
+        Choice::from_name(name).expect("every searched panorama is one of the library's")
     }
 }
 
@@ -270,7 +267,7 @@ impl SearchCase {
             SearchPanorama::Cave => {
                 let wall = &self.cave_walls()[self.cave_wall];
                 Projection {
-                    panorama: PanoramaKind::Cave,
+                    panorama: SearchPanorama::Cave.kind(),
                     width: self.width,
                     height: self.width,
                     wall: Some(wall.in_display(1.0, Vec3::from(self.viewer), self.yaw_deg)),

@@ -19,7 +19,7 @@ use glam::Vec3;
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
-use crate::core::panoramas::projection::{azimuth, horizontal_radius, wrap_angle, Eye, PanoramaKind};
+use crate::core::panoramas::projection::{azimuth, horizontal_radius, wrap_angle, Eye};
 use crate::core::scenes::scene::SceneVertex;
 use crate::cpu::subdivide::{FrameCuts, Subdivider};
 use crate::encoding::constants::SEAM_MARGIN;
@@ -196,7 +196,7 @@ impl Topology<'_> {
                 || sd.around_dome_antipode([p; 3])
                 || beyond_image_side(sd, p)
                 || drawn_beyond_image_side(sd, corner, a, b)
-                || (sd.projection().panorama == PanoramaKind::Cave && !sd.projection().cave_sees(p));
+                || (sd.projection().model().drawn_as_pinhole() && !sd.projection().cave_sees(p));
             if p.x.abs() + p.z.abs() < rho * 1.01 + 2.0 * tol || off_screen {
                 continue;
             }
@@ -242,8 +242,7 @@ fn same_offsets(vertices: &[DrawVertex]) -> Result<(), String> {
 /// 1/16 px in) and `lattice_triangles` draws no copy of it. None on the images whose x is no
 /// longitude.
 fn side_limit(sd: &Subdivider) -> Option<f32> {
-    let seamless =
-        matches!(sd.projection().panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap | PanoramaKind::Cave);
+    let seamless = sd.projection().model().turn_share().is_none();
     (!seamless).then(|| sd.image_half_span() - 1.01 * SEAM_MARGIN)
 }
 

@@ -49,8 +49,7 @@ impl Twin for Display {
     fn cases() -> Vec<(String, Case)> {
         let cylinder = Projection { width: 64, height: 24, ..Projection::default() };
         let sphere = Projection { height: 32, ..Projection::equirect(64) };
-        let cube = Projection { width: 48, height: 32, ..Projection::equirect(48) };
-        let cube = Projection { panorama: twister::core::panoramas::projection::PanoramaKind::Cubemap, ..cube };
+        let cube = Projection::cubemap(48);
         let fisheye = Projection::fisheye(40);
         use DisplayMode::*;
         vec![

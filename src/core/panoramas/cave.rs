@@ -22,7 +22,8 @@ use std::path::Path;
 use glam::{Mat3, Vec3};
 
 pub use crate::core::panoramas::projection::CaveWall;
-use crate::core::panoramas::projection::{Eye, Head, PanoramaKind, Projection};
+use crate::core::panoramas::panorama::{EyeModel, ImageMap, Panorama, PanoramaKind};
+use crate::core::panoramas::projection::{Eye, Head, Projected, Projection};
 use crate::error::{Error, Result};
 
 /// A wall of a `--cave` file: its name (the outputs' prefix), three corners in scene units and
@@ -123,13 +124,7 @@ pub const MIN_EYE_DISTANCE: f32 = 0.01;
 
 impl Projection {
     /// A CAVE wall's settings: the wall and a tracked head, each eye before the wall's front.
-    pub(crate) fn validate_cave(&self) -> Result<()> {
-        if self.panorama != PanoramaKind::Cave {
-            if self.wall.is_some() {
-                return Err(Error::setting("view.projection.wall", "a wall belongs to the CAVE panorama"));
-            }
-            return Ok(());
-        }
+    fn validate_cave(&self) -> Result<()> {
         let Some(wall) = &self.wall else {
             return Err(Error::setting("view.projection.wall", "the CAVE panorama draws a wall: give it one"));
         };
@@ -221,10 +216,95 @@ impl Projection {
     }
 }
 
+/// CAVE walls: one wall per frame.
+pub struct Cave;
+
+impl Panorama for Cave {
+    fn kind(&self) -> PanoramaKind {
+        PanoramaKind::Cave
+    }
+
+    fn wgsl_name(&self) -> &'static str {
+        "PANORAMA_CAVE"
+    }
+
+    fn shader_bits(&self) -> u32 {
+        16
+    }
+
+    fn eye_model(&self) -> EyeModel {
+        EyeModel::Pinhole
+    }
+
+    fn image_map(&self) -> ImageMap {
+        ImageMap::Plane
+    }
+
+    fn turn_share(&self) -> Option<f32> {
+        None
+    }
+
+    fn default_size(&self, width: u32) -> [u32; 2] {
+        [width, width]
+    }
+
+    fn has_slits(&self) -> bool {
+        false
+    }
+
+    fn drawn_as_pinhole(&self) -> bool {
+        true
+    }
+
+    fn validate(&self, p: &Projection) -> Result<()> {
+        p.validate_cave()
+    }
+
+    fn sees(&self, p: &Projection, q: Vec3) -> bool {
+        p.cave_sees(q)
+    }
+
+    /// Before both eyes' planes (as `sees` in projection.wgsl), then this eye's.
+    fn project(&self, p: &Projection, q: Vec3, eye: Eye) -> Option<Projected> {
+        let seen = (q.is_finite() && p.cave_sees(q)).then(|| p.cave_pixel(q, eye)).flatten();
+        seen.map(|([x, y], depth)| Projected { u: x, v: y, depth })
+    }
+
+    fn project_with_azimuth(&self, p: &Projection, q: Vec3, _theta: f32, eye: Eye) -> Projected {
+        let ([x, y], depth) = p.cave_pixel(q, eye).unwrap_or(([f32::NAN; 2], f32::NAN));
+        Projected { u: x, v: y, depth }
+    }
+
+    /// The CAVE's (u, v) are its image position.
+    fn to_pixel(&self, _p: &Projection, u: f32, v: f32) -> [f32; 2] {
+        [u, v]
+    }
+
+    fn pixel_to_screen(&self, _p: &Projection, column: f32, row: f32) -> (f32, f32) {
+        (column + 0.5, row + 0.5)
+    }
+
+    /// v is the image row itself.
+    fn pixels_per_v(&self, _p: &Projection) -> f32 {
+        1.0
+    }
+
+    /// The wall's point, seen from the head.
+    fn screen_direction(&self, p: &Projection, u: f32, v: f32) -> Vec3 {
+        p.cave_point(u, v).normalize()
+    }
+
+    /// From the eye through the wall's point: the depth is the distance from the eye.
+    fn ray(&self, p: &Projection, eye: Eye, u: f32, v: f32) -> (Vec3, Vec3) {
+        let origin = p.head_eye(eye);
+        (origin, (p.cave_point(u, v) - origin).normalize())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::core::panoramas::projection::Panorama;
+    use crate::core::panoramas::projection::Camera;
     use rand::{Rng, SeedableRng};
 
     /// A 3 m cube's front wall and a floor, seen by a head off the centre and turned.
@@ -255,7 +335,7 @@ mod tests {
             let wall = named.in_display(1.0, viewer, yaw);
             let head = Head::relative(head_at, head_yaw, viewer, yaw);
             let proj = Projection {
-                panorama: PanoramaKind::Cave,
+                panorama: Cave.kind(),
                 width: named.pixels[0],
                 height: named.pixels[1],
                 wall: Some(wall),
@@ -340,7 +420,7 @@ mod tests {
     fn a_wall_facing_away_or_touching_an_eye_is_refused() {
         let front = &walls()[0];
         let cave = |head_at: Vec3, wall: CaveWall| Projection {
-            panorama: PanoramaKind::Cave,
+            panorama: Cave.kind(),
             wall: Some(wall),
             head: Some(Head::relative(head_at, 0.0, Vec3::ZERO, 0.0)),
             ..Projection::default()

@@ -30,7 +30,9 @@
 
 use glam::{Vec3, Vec4};
 
-use crate::core::panoramas::projection::{PanoramaKind, Projection};
+use crate::core::panoramas::equirect::Equirect;
+use crate::core::panoramas::panorama::{EyeModel, EyePacking, ImageMap, Panorama, PanoramaKind};
+use crate::core::panoramas::projection::Projection;
 use crate::error::{Error, Result};
 
 /// One face of the cube: its name, where it sits in an eye's 3×2 grid, and its camera's axes.
@@ -59,10 +61,7 @@ pub const CUBE_FACES: [CubeFace; 6] = [
     face("back", [2, 1], Vec3::Z, Vec3::NEG_X, Vec3::Y),
 ];
 
-/// The unit direction of longitude `lon`, latitude `lat`.
-pub fn direction(lon: f32, lat: f32) -> Vec3 {
-    Vec3::new(lat.cos() * lon.sin(), lat.sin(), -lat.cos() * lon.cos())
-}
+pub use crate::core::panoramas::sphere::direction;
 
 impl Projection {
     /// The direction a vertex seen at (`lon`, `lat`) is drawn in on the cubemap: within half a
@@ -126,12 +125,12 @@ impl Projection {
     /// The stereo cubemap: one eye's 3×2 grid of faces `width`/3 pixels square, parallel rays,
     /// Blender's pole merge.
     pub fn cubemap(width: u32) -> Projection {
-        Projection { panorama: PanoramaKind::Cubemap, width, height: 2 * width / 3, ..Projection::default() }
+        Projection::of(Cubemap.kind(), width)
     }
 
     /// The cubemap's grid: a width of three faces and a height of two.
-    pub(crate) fn validate_cubemap(&self) -> Result<()> {
-        if self.panorama == PanoramaKind::Cubemap && (self.width % 3 != 0 || 3 * self.height != 2 * self.width) {
+    fn validate_cubemap(&self) -> Result<()> {
+        if self.width % 3 != 0 || 3 * self.height != 2 * self.width {
             return Err(Error::setting(
                 "view.projection.width/height",
                 format!(
@@ -247,23 +246,89 @@ impl Projection {
         [col * s, row * s, s]
     }
 
+}
+
+/// The stereo cubemap.
+pub struct Cubemap;
+
+impl Panorama for Cubemap {
+    fn kind(&self) -> PanoramaKind {
+        PanoramaKind::Cubemap
+    }
+
+    fn wgsl_name(&self) -> &'static str {
+        "PANORAMA_CUBEMAP"
+    }
+
+    /// The sphere's eye model in its own image.
+    fn shader_bits(&self) -> u32 {
+        2 | 8
+    }
+
+    fn eye_model(&self) -> EyeModel {
+        EyeModel::Sphere
+    }
+
+    fn image_map(&self) -> ImageMap {
+        ImageMap::Cubemap
+    }
+
+    fn turn_share(&self) -> Option<f32> {
+        None
+    }
+
+    fn player_tag(&self) -> Option<&'static str> {
+        Some("cubemap")
+    }
+
+    fn eye_packing(&self) -> EyePacking {
+        EyePacking::TopBottom
+    }
+
+    fn default_size(&self, width: u32) -> [u32; 2] {
+        [width, 2 * width / 3]
+    }
+
+    fn has_slits(&self) -> bool {
+        false
+    }
+
+    fn validate(&self, p: &Projection) -> Result<()> {
+        p.validate_cubemap()
+    }
+
+    fn to_pixel(&self, p: &Projection, u: f32, v: f32) -> [f32; 2] {
+        p.cube_pixel(u, v)
+    }
+
+    fn pixel_to_screen(&self, p: &Projection, column: f32, row: f32) -> (f32, f32) {
+        let d = p.cube_direction_at(column + 0.5, row + 0.5);
+        (d.x.atan2(-d.z), d.y.atan2((d.x * d.x + d.z * d.z).sqrt()))
+    }
+
+    /// A face's centre: F/2 pixels per radian (its least).
+    fn pixels_per_v(&self, p: &Projection) -> f32 {
+        0.5 * p.cube_face_px()
+    }
+
     /// The equirectangular image the subdivision measures a cubemap's edges on: the sphere with
     /// the faces' angular resolution at their centres (a turn of 4F pixels), the same eye model.
     /// A face magnifies its edges up to twice that (sec²45° at the middle of its sides), where
-    /// `--edge-px` is then met within a factor of two; the other panoramas measure themselves.
-    pub fn measured(&self) -> Projection {
-        if self.panorama != PanoramaKind::Cubemap {
-            return *self;
-        }
-        let f = self.width / 3;
-        Projection { panorama: PanoramaKind::Equirect, width: 4 * f, height: 2 * f, tile: None, ..*self }
+    /// `--edge-px` is then met within a factor of two.
+    fn measured(&self, p: &Projection) -> Projection {
+        let f = p.width / 3;
+        Projection { panorama: Equirect.kind(), width: 4 * f, height: 2 * f, tile: None, ..*p }
+    }
+
+    fn tile_face(&self, p: &Projection) -> u32 {
+        p.width / 3
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::core::panoramas::projection::{Eye, Panorama};
+    use crate::core::panoramas::projection::{Camera, Eye};
     use glam::Vec2;
     use rand::{Rng, SeedableRng};
 

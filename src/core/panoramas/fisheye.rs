@@ -19,13 +19,22 @@
 
 use glam::Vec3;
 
-use crate::core::panoramas::projection::{PanoramaKind, Projection};
+use crate::core::panoramas::panorama::{EyeModel, ImageMap, Panorama, PanoramaKind};
+use crate::core::panoramas::projection::Projection;
 use crate::error::{Error, Result};
 
+/// The fulldome master.
+pub struct Fisheye;
+
 impl Projection {
+    /// The fulldome master: `width` × `width` pixels per eye, the zenith at the centre, 180°.
+    pub fn fisheye(width: u32) -> Projection {
+        Projection::of(Fisheye.kind(), width)
+    }
+
     /// The fisheye's settings: its field of view, its tilt, and a tilted dome's antipode off the rim.
-    pub(crate) fn validate_fisheye(&self) -> Result<()> {
-        if self.panorama == PanoramaKind::Fisheye {
+    fn validate_fisheye(&self) -> Result<()> {
+        {
             if !(self.fov.is_finite() && self.fov > 0.0 && self.fov <= 360.0) {
                 return Err(Error::setting(
                     "view.projection.fov",
@@ -38,7 +47,7 @@ impl Projection {
                     format!("must be degrees between -90 and 90, got {}", self.dome_tilt),
                 ));
             }
-            if self.dome_tilt != 0.0 && self.dome_antipode_cone(0.0).is_none() {
+            if self.dome_tilt != 0.0 && self.fisheye_antipode_cone(0.0).is_none() {
                 return Err(Error::setting(
                     "view.projection.dome_tilt",
                     format!(
@@ -98,10 +107,7 @@ impl Projection {
     /// differences' sampling). The dropped cone keeps this much more margin beyond the rim
     /// ([`Projection::dome_antipode_cone`]), so that what is dropped leaves no chord inside the
     /// circle.
-    pub fn chord_dip_px(&self, error_split: bool, edge_px: f32, max_error_px: f32) -> f32 {
-        if self.panorama != crate::core::panoramas::projection::PanoramaKind::Fisheye {
-            return 0.0;
-        }
+    fn fisheye_chord_dip_px(&self, error_split: bool, edge_px: f32, max_error_px: f32) -> f32 {
         if error_split {
             4.0 * max_error_px
         } else {
@@ -127,27 +133,93 @@ impl Projection {
     /// cuts keep whole triangles away from).
     /// Returns cos β: a point p lies in the cone when p·A < −cos β·|p|. Convex (β < 90°): a
     /// triangle whose corners all lie in it lies in it.
-    pub fn dome_antipode_cone(&self, dip_px: f32) -> Option<f32> {
+    fn fisheye_antipode_cone(&self, dip_px: f32) -> Option<f32> {
         let margin = 10.0 + (dip_px / self.fisheye_pixels_per_radian()).to_degrees();
         let beta = (180.0 - 0.5 * self.fov - margin).min(90.0);
-        (self.panorama == crate::core::panoramas::projection::PanoramaKind::Fisheye && beta > 0.0)
-            .then(|| beta.to_radians().cos())
+        (beta > 0.0).then(|| beta.to_radians().cos())
     }
 
-    /// Whether image position (x, y) lies inside the fisheye's FOV circle (radius W/2); every
-    /// position of the other panoramas.
-    pub fn shows_pixel(&self, x: f32, y: f32) -> bool {
-        if self.panorama != crate::core::panoramas::projection::PanoramaKind::Fisheye {
-            return true;
-        }
+    /// Whether image position (x, y) lies inside the fisheye's FOV circle (radius W/2).
+    fn fisheye_shows_pixel(&self, x: f32, y: f32) -> bool {
         let (dx, dy) = (x - 0.5 * self.width as f32, y - 0.5 * self.height as f32);
         dx * dx + dy * dy <= 0.25 * (self.width as f32) * (self.width as f32)
     }
 }
 
+impl Panorama for Fisheye {
+    fn kind(&self) -> PanoramaKind {
+        PanoramaKind::Fisheye
+    }
+
+    fn wgsl_name(&self) -> &'static str {
+        "PANORAMA_FISHEYE"
+    }
+
+    /// The sphere's eye model in its own image.
+    fn shader_bits(&self) -> u32 {
+        2 | 4
+    }
+
+    fn eye_model(&self) -> EyeModel {
+        EyeModel::Sphere
+    }
+
+    fn image_map(&self) -> ImageMap {
+        ImageMap::Fisheye
+    }
+
+    fn turn_share(&self) -> Option<f32> {
+        None
+    }
+
+    fn player_tag(&self) -> Option<&'static str> {
+        Some("fisheye")
+    }
+
+    fn default_size(&self, width: u32) -> [u32; 2] {
+        [width, width]
+    }
+
+    fn has_slits(&self) -> bool {
+        false
+    }
+
+    fn takes_unmeasured_edges(&self) -> bool {
+        false
+    }
+
+    fn validate(&self, p: &Projection) -> Result<()> {
+        p.validate_fisheye()
+    }
+
+    fn to_pixel(&self, p: &Projection, u: f32, v: f32) -> [f32; 2] {
+        p.fisheye_pixel(u, v)
+    }
+
+    fn pixel_to_screen(&self, p: &Projection, column: f32, row: f32) -> (f32, f32) {
+        p.fisheye_direction_at(column + 0.5, row + 0.5)
+    }
+
+    fn pixels_per_v(&self, p: &Projection) -> f32 {
+        p.fisheye_pixels_per_radian()
+    }
+
+    fn shows_pixel(&self, p: &Projection, x: f32, y: f32) -> bool {
+        p.fisheye_shows_pixel(x, y)
+    }
+
+    fn chord_dip_px(&self, p: &Projection, error_split: bool, edge_px: f32, max_error_px: f32) -> f32 {
+        p.fisheye_chord_dip_px(error_split, edge_px, max_error_px)
+    }
+
+    fn antipode_cone(&self, p: &Projection, dip_px: f32) -> Option<f32> {
+        p.fisheye_antipode_cone(dip_px)
+    }
+}
+
 #[cfg(test)]
 mod tests {
-    use crate::core::panoramas::projection::{Eye, Panorama, Projection};
+    use crate::core::panoramas::projection::{Camera, Eye, Projection};
     use glam::Vec3;
     use rand::SeedableRng;
 

@@ -25,7 +25,8 @@
 use glam::{Mat3, Vec3};
 
 pub use crate::core::panoramas::projection::Head;
-use crate::core::panoramas::projection::{azimuth, wrap_angle, Eye, PanoramaKind, Projected, Projection, Vertical};
+use crate::core::panoramas::panorama::EyeModel;
+use crate::core::panoramas::projection::{azimuth, wrap_angle, Eye, Projected, Projection, Vertical};
 use crate::error::{Error, Result};
 
 impl Head {
@@ -60,7 +61,8 @@ impl Projection {
     pub(crate) fn validate_head(&self) -> Result<()> {
         if let Some(head) = &self.head {
             let [x, y, z] = head.offset;
-            if !matches!(self.panorama, PanoramaKind::Cylinder | PanoramaKind::Cave) {
+            let circle = self.model().eye_model() == EyeModel::Circle;
+            if self.model().eye_model() == EyeModel::Sphere {
                 return Err(Error::setting(
                     "view.projection.head",
                     "a tracked head looks at the cylinder panorama or CAVE walls",
@@ -70,7 +72,7 @@ impl Projection {
                 return Err(Error::setting("view.projection.head", format!("must be finite, got {head:?}")));
             }
             let reach = (x * x + z * z).sqrt() + self.eye_radius;
-            if self.panorama == PanoramaKind::Cylinder && reach >= self.screen_radius {
+            if circle && reach >= self.screen_radius {
                 return Err(Error::setting(
                     "view.projection.head",
                     format!(
@@ -83,7 +85,7 @@ impl Projection {
                 ));
             }
             let _ = y;
-            if self.panorama == PanoramaKind::Cylinder && self.vertical == Vertical::Paper {
+            if circle && self.vertical == Vertical::Paper {
                 return Err(Error::setting(
                     "view.projection.vertical",
                     "a tracked head draws each point where the line from the eye meets the screen: the exact model",
@@ -124,7 +126,7 @@ impl Projection {
 
 #[cfg(test)]
 mod tests {
-    use crate::core::panoramas::projection::{pixel_ray, Eye, Head, Panorama, Projection, Vertical};
+    use crate::core::panoramas::projection::{pixel_ray, Camera, Eye, Head, Projection, Vertical};
     use glam::{Vec2, Vec3};
     use rand::{Rng, SeedableRng};
 

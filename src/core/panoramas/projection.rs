@@ -33,7 +33,7 @@
 
 use glam::{Vec2, Vec3};
 
-pub use crate::core::panoramas::panorama::PanoramaKind;
+pub use crate::core::panoramas::kind::PanoramaKind;
 use crate::error::{Error, Result};
 
 /// The vertical model: how the screen height `v` of a point is computed.
@@ -144,7 +144,7 @@ impl Default for Projection {
             width: 3168,
             height: 600,
             vertical: Vertical::Paper,
-            panorama: PanoramaKind::Cylinder,
+            panorama: Default::default(),
             convergence: None,
             pole_merge: Some(DEFAULT_POLE_MERGE),
             fov: 180.0,
@@ -153,25 +153,6 @@ impl Default for Projection {
             wall: None,
             tile: None,
         }
-    }
-}
-
-impl Projection {
-    /// The full-sphere panorama of `width` × `width`/2 pixels per eye, parallel rays, Blender's
-    /// pole merge.
-    pub fn equirect(width: u32) -> Projection {
-        Projection { panorama: PanoramaKind::Equirect, width, height: width / 2, ..Projection::default() }
-    }
-
-    /// The fulldome master: `width` × `width` pixels per eye, the zenith at the centre, 180°.
-    pub fn fisheye(width: u32) -> Projection {
-        Projection { panorama: PanoramaKind::Fisheye, width, height: width, ..Projection::default() }
-    }
-
-    /// VR180: the sphere's front half, `width` × `width` pixels per eye, parallel rays, Blender's
-    /// pole merge.
-    pub fn vr180(width: u32) -> Projection {
-        Projection { panorama: PanoramaKind::Vr180, width, height: width, ..Projection::default() }
     }
 }
 
@@ -239,9 +220,10 @@ impl Projection {
             }
         }
         self.validate_head()?;
-        self.validate_fisheye()?;
-        self.validate_cubemap()?;
-        self.validate_cave()?;
+        if self.wall.is_some() && !self.model().drawn_as_pinhole() {
+            return Err(Error::setting("view.projection.wall", "a wall belongs to the CAVE panorama"));
+        }
+        self.model().validate(self)?;
         if let Some([x, y, w, h]) = self.tile {
             let inside = w > 0
                 && h > 0
@@ -266,17 +248,6 @@ impl Projection {
         Ok(())
     }
 
-    /// acos(d_e / R_T), the constant term of α.
-    pub fn acos_eye_screen(&self) -> f32 {
-        (self.eye_radius / self.screen_radius).clamp(0.0, 1.0).acos()
-    }
-
-    /// α(r) = acos(d_e/r) − acos(d_e/R_T) (eq. 3). Points with r ≤ d_e are seen by no eye;
-    /// the ratio is clamped so that the result stays finite (the pre-pass culls them).
-    pub fn eye_shift(&self, r: f32) -> f32 {
-        (self.eye_radius / r).clamp(0.0, 1.0).acos() - self.acos_eye_screen()
-    }
-
     /// The eye offset at a point's altitude (height `y`, distance `r` from the axis): the
     /// sphere's, which its pole merge fades towards the poles
     /// ([`sphere_eye_offset`](Self::sphere_eye_offset)), else d_e (`eye_offset` in projection.wgsl).
@@ -288,52 +259,16 @@ impl Projection {
         }
     }
 
-    /// The screen height of a point at height `y` and distance `r` from the axis.
-    pub fn screen_height(&self, y: f32, r: f32) -> f32 {
-        match self.vertical {
-            Vertical::Paper => self.screen_radius * y / r,
-            Vertical::Exact => {
-                let (rt, de) = (self.screen_radius, self.eye_radius);
-                let t_screen = (rt * rt - de * de).sqrt();
-                let t_point = (r * r - de * de).max(1e-12).sqrt();
-                y * t_screen / t_point
-            }
-        }
-    }
-
     /// Projects a viewer-frame point for one eye. `None` when the eye does not see it (the
     /// cylinder: r ≤ d_e; the sphere: r below the eye offset at its altitude) or it is not finite.
     pub fn project(&self, p: Vec3, eye: Eye) -> Option<Projected> {
-        let r = horizontal_radius(p);
-        if !p.is_finite() {
-            return None;
-        }
-        if self.panorama == PanoramaKind::Cave {
-            // Before both eyes' planes (as `sees` in projection.wgsl), then this eye's.
-            let seen = self.cave_sees(p).then(|| self.cave_pixel(p, eye)).flatten();
-            return seen.map(|([x, y], depth)| Projected { u: x, v: y, depth });
-        }
-        let seen = if self.panorama.is_sphere() { self.sphere_sees(p) } else { r > self.eye_radius };
-        seen.then(|| self.project_with_azimuth(p, azimuth(p), eye))
+        self.model().project(self, p, eye)
     }
 
     /// Like [`project`](Self::project) but with θ given (already unwrapped by the caller).
     /// Points no eye sees are drawn with the offset clamped (they stay finite).
     pub fn project_with_azimuth(&self, p: Vec3, theta: f32, eye: Eye) -> Projected {
-        let r = horizontal_radius(p);
-        if self.panorama == PanoramaKind::Cave {
-            let ([x, y], depth) = self.cave_pixel(p, eye).unwrap_or(([f32::NAN; 2], f32::NAN));
-            return Projected { u: x, v: y, depth };
-        }
-        if self.panorama.is_sphere() {
-            let d = self.sphere_eye_offset(r, p.y);
-            let (lon, lat, depth) = self.sphere_at_offset(r, p.y, theta, eye.sign(), d);
-            return Projected { u: lon, v: lat, depth };
-        }
-        if let Some(head) = &self.head {
-            return self.head_project(head, p, theta, eye);
-        }
-        Projected { u: theta + eye.sign() * self.eye_shift(r), v: self.screen_height(p.y, r), depth: r }
+        self.model().project_with_azimuth(self, p, theta, eye)
     }
 
     /// The size of the image this draw makes: the tile's, or the frame's.
@@ -360,33 +295,17 @@ impl Projection {
         )
     }
 
-    /// Pixels per metre of screen (square pixels): W / (2π·R_T). The cylinder only.
-    pub fn pixels_per_metre(&self) -> f32 {
-        self.width as f32 / (std::f32::consts::TAU * self.screen_radius)
-    }
-
     /// Pixels per unit of v: per metre of screen height (the cylinder), per radian of latitude
     /// (the sphere: H/π).
     pub fn pixels_per_v(&self) -> f32 {
-        match self.panorama {
-            PanoramaKind::Fisheye => self.fisheye_pixels_per_radian(),
-            // A face's centre: F/2 pixels per radian (its least).
-            PanoramaKind::Cubemap => 0.5 * self.cube_face_px(),
-            // The CAVE: v is the image row itself.
-            PanoramaKind::Cave => 1.0,
-            p if p.is_sphere() => self.height as f32 / std::f32::consts::PI,
-            _ => self.pixels_per_metre(),
-        }
+        self.model().pixels_per_v(self)
     }
 
     /// Pixels per full turn of azimuth (2π): the width, or twice it for VR180 (whose width
-    /// spans π); the fisheye and the cubemap, whose images have no seam, f32::MAX (x never
-    /// wraps). `turn_px` in projection.wgsl.
+    /// spans π); the images without a seam (the fisheye, the cubemap, the CAVE) f32::MAX (x
+    /// never wraps). `turn_px` in projection.wgsl.
     pub fn turn_px(&self) -> f32 {
-        if matches!(self.panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap | PanoramaKind::Cave) {
-            return f32::MAX;
-        }
-        self.width as f32 / self.panorama.turn_share()
+        self.model().turn_share().map_or(f32::MAX, |share| self.width as f32 / share)
     }
 
     /// Pixels per radian of azimuth: W / 2π (VR180: W / π).
@@ -398,99 +317,62 @@ impl Projection {
     /// `u` is wrapped into [−π, π), azimuth 0 at the image's centre column (VR180: |u| > π/2
     /// falls outside the image).
     pub fn to_pixel(&self, u: f32, v: f32) -> [f32; 2] {
-        if self.panorama == PanoramaKind::Fisheye {
-            return self.fisheye_pixel(u, v);
-        }
-        if self.panorama == PanoramaKind::Cubemap {
-            return self.cube_pixel(u, v);
-        }
-        if self.panorama == PanoramaKind::Cave {
-            return [u, v]; // the CAVE's (u, v) are its image position
-        }
-        let x = wrap_angle(u) / std::f32::consts::TAU * self.turn_px() + 0.5 * self.width as f32;
-        let y = 0.5 * self.height as f32 - v * self.pixels_per_v();
-        [x, y]
+        self.model().to_pixel(self, u, v)
     }
 
     /// The screen point (u, v) at the centre of pixel (column, row); u ∈ [−π, π) (VR180:
     /// [−π/2, π/2)).
     pub fn pixel_to_screen(&self, column: f32, row: f32) -> (f32, f32) {
-        if self.panorama == PanoramaKind::Fisheye {
-            return self.fisheye_direction_at(column + 0.5, row + 0.5);
-        }
-        if self.panorama == PanoramaKind::Cave {
-            return (column + 0.5, row + 0.5);
-        }
-        if self.panorama == PanoramaKind::Cubemap {
-            let d = self.cube_direction_at(column + 0.5, row + 0.5);
-            return (d.x.atan2(-d.z), d.y.atan2((d.x * d.x + d.z * d.z).sqrt()));
-        }
-        let u = (column + 0.5 - 0.5 * self.width as f32) / self.turn_px() * std::f32::consts::TAU;
-        let v = (0.5 * self.height as f32 - (row + 0.5)) / self.pixels_per_v();
-        (u, v)
+        self.model().pixel_to_screen(self, column, row)
     }
 
     /// The tangent of the half vertical angle that `--fit` and the screen-filling built-ins fill:
-    /// the cylinder's half height over R_T (v = R_T·y/r); on the sphere tan 30° (about the
+    /// the cylinder's half height over R_T (v = R_T·y/r); elsewhere tan 30° (about the
     /// cylinder's default view).
     pub fn fill_tan(&self) -> f32 {
-        if self.panorama.is_sphere() || self.panorama == PanoramaKind::Cave {
-            30f32.to_radians().tan()
-        } else {
-            self.half_height_m() / self.screen_radius
-        }
+        self.model().fill_tan(self)
     }
 
     /// The unit direction, seen from the centre, of screen point (u, v): on the cylinder the
     /// screen point (R_T sin u, v, −R_T cos u), on the sphere longitude u, latitude v.
     /// `screen_direction` in fragment.wgsl.
     pub fn screen_direction(&self, u: f32, v: f32) -> Vec3 {
-        if self.panorama == PanoramaKind::Cave {
-            return self.cave_point(u, v).normalize(); // the wall's point, seen from the head
-        }
-        if self.panorama.is_sphere() {
-            return Vec3::new(v.cos() * u.sin(), v.sin(), -v.cos() * u.cos());
-        }
-        if let Some(head) = &self.head {
-            return self.head_screen_point(head, u, v).normalize();
-        }
-        let rt = self.screen_radius;
-        Vec3::new(rt * u.sin(), v, -rt * u.cos()).normalize()
+        self.model().screen_direction(self, u, v)
     }
 
     /// The slope k such that a point with |y| > k·r shows in no pixel row: above the top of the
     /// cylinder's image, or on the sphere beyond the centre of its first (or last) pixel row
-    /// (latitude π/2 − π/2H), which no rasterized sample reaches. The exact model has
-    /// v ≥ v_paper·√(1 − d_e²/R_T²), so k = half height / (R_T·√(1 − d_e²/R_T²)) is safe for both
-    /// vertical models; on the sphere the latitude atan2(y, √(r² − e²)) ≥ atan(y/r), so
-    /// k = 1/tan(π/2H) is safe for every eye offset.
+    /// (its panorama's `vertical_limit`).
     pub fn vertical_limit(&self) -> f32 {
-        if matches!(self.panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap | PanoramaKind::Cave) {
-            return f32::MAX; // the dome shows every altitude its field of view reaches; the cube all
-        }
-        if self.panorama.is_sphere() {
-            return 1.0 / (0.5 * std::f32::consts::PI / self.height as f32).tan();
-        }
-        let (rt, de) = (self.screen_radius, self.eye_radius);
-        if let Some(head) = &self.head {
-            // From an eye, the screen's rows rise at most to its edge's height over its nearest
-            // distance from the eye.
-            let [x, y, z] = head.offset;
-            return (self.half_height_m() + y.abs()) / (rt - (x * x + z * z).sqrt() - de);
-        }
-        self.half_height_m() / (rt * (1.0 - (de / rt) * (de / rt)).sqrt())
+        self.model().vertical_limit(self)
     }
 
-    /// Half the screen height in metres (the cylinder).
-    pub fn half_height_m(&self) -> f32 {
-        0.5 * self.height as f32 / self.pixels_per_metre()
+    /// Whether image position (x, y) shows the panorama (the fisheye: inside its circle).
+    pub fn shows_pixel(&self, x: f32, y: f32) -> bool {
+        self.model().shows_pixel(self, x, y)
+    }
+
+    /// How far a drawn edge may dip inside the image's rim (its panorama's `chord_dip_px`).
+    pub fn chord_dip_px(&self, error_split: bool, edge_px: f32, max_error_px: f32) -> f32 {
+        self.model().chord_dip_px(self, error_split, edge_px, max_error_px)
+    }
+
+    /// The cone about the antipode of the image's axis the subdivision drops
+    /// (its panorama's `antipode_cone`).
+    pub fn dome_antipode_cone(&self, dip_px: f32) -> Option<f32> {
+        self.model().antipode_cone(self, dip_px)
+    }
+
+    /// The image the subdivision measures its edges on (its panorama's `measured`).
+    pub fn measured(&self) -> Projection {
+        self.model().measured(self)
     }
 
     /// The horizontal distance in pixels between two image x coordinates, wrapping around the
     /// full turn (VR180: a turn is twice the width, so no two pixels of its image wrap; the
     /// fisheye and the cubemap: no wrap).
     pub fn wrapped_dx(&self, a: f32, b: f32) -> f32 {
-        if matches!(self.panorama, PanoramaKind::Fisheye | PanoramaKind::Cubemap | PanoramaKind::Cave) {
+        if self.model().turn_share().is_none() {
             return (a - b).abs();
         }
         let w = self.turn_px();
@@ -499,11 +381,26 @@ impl Projection {
     }
 }
 
-/// A panorama as a camera model (pbrt's `Camera`, for two eyes): where an eye's image shows a
+/// The linear image map (the cylinder, the sphere's equirectangular images): x linear in u,
+/// wrapped into [−π, π) about the centre column at `turn_px` pixels a turn; y linear in v.
+pub(crate) fn linear_pixel(p: &Projection, u: f32, v: f32) -> [f32; 2] {
+    let x = wrap_angle(u) / std::f32::consts::TAU * p.turn_px() + 0.5 * p.width as f32;
+    let y = 0.5 * p.height as f32 - v * p.pixels_per_v();
+    [x, y]
+}
+
+/// The inverse of [`linear_pixel`] at the centre of pixel (column, row).
+pub(crate) fn linear_screen(p: &Projection, column: f32, row: f32) -> (f32, f32) {
+    let u = (column + 0.5 - 0.5 * p.width as f32) / p.turn_px() * std::f32::consts::TAU;
+    let v = (0.5 * p.height as f32 - (row + 0.5)) / p.pixels_per_v();
+    (u, v)
+}
+
+/// A frame's panorama as a camera (pbrt's `Camera`, for two eyes): where an eye's image shows a
 /// viewer-frame point, and its inverse, the point at a given depth that a pixel shows. The
 /// rasterizer's stages and their twins use the forward map; the inverse places points from
 /// pixels (tests, ray generation).
-pub trait Panorama {
+pub trait Camera {
     fn kind(&self) -> PanoramaKind;
     /// Image size per eye, pixels.
     fn size(&self) -> [u32; 2];
@@ -515,7 +412,7 @@ pub trait Panorama {
     fn unproject_pixel(&self, pixel: [f32; 2], depth: f32, eye: Eye) -> Vec3;
 }
 
-impl Panorama for Projection {
+impl Camera for Projection {
     fn kind(&self) -> PanoramaKind {
         self.panorama
     }
@@ -528,56 +425,18 @@ impl Panorama for Projection {
         self.project(p, eye).map(|q| (self.to_pixel(q.u, q.v), q.depth))
     }
 
-    /// Inverts eq. 1–4 at depth r (the distance from the axis): u and v from the pixel, then
-    /// θ = u ∓ α(r) and y = v·r/R_T (paper) or y = v·√(r² − d_e²)/√(R_T² − d_e²) (exact).
-    ///
-    /// The sphere: the point at distance `depth` along the pixel's ray ([`Projection::sphere_ray`]).
-    fn unproject_pixel(&self, [x, y]: [f32; 2], r: f32, eye: Eye) -> Vec3 {
+    /// The panorama's inverse (its `unproject`) at the pixel's screen point.
+    fn unproject_pixel(&self, [x, y]: [f32; 2], depth: f32, eye: Eye) -> Vec3 {
         let (u, v) = self.pixel_to_screen(x - 0.5, y - 0.5);
-        if self.panorama.is_sphere() {
-            let (origin, ray) = self.sphere_ray(u, v, eye);
-            return origin + r * ray;
-        }
-        if self.head.is_some() || self.panorama == PanoramaKind::Cave {
-            // The depth is the distance from the eye along the pixel's ray.
-            let (origin, ray) = pixel_ray(self, eye, Vec2::new(x, y));
-            return origin + r * ray;
-        }
-        let theta = u - eye.sign() * self.eye_shift(r);
-        let height = match self.vertical {
-            Vertical::Paper => v * r / self.screen_radius,
-            Vertical::Exact => {
-                let (rt, de) = (self.screen_radius, self.eye_radius);
-                v * (r * r - de * de).max(0.0).sqrt() / (rt * rt - de * de).sqrt()
-            }
-        };
-        Vec3::new(r * theta.sin(), height, -r * theta.cos())
+        self.model().unproject(self, u, v, depth, eye)
     }
 }
 
-/// The ray of the pixel at `frag_xy`: its eye point and unit direction. The sphere: the
-/// pixel's ray ([`Projection::sphere_ray`]). The cylinder: from the eye whose tangent ray meets
-/// the screen at the pixel's column (viewing direction φ = u − s·asin(d_e/R_T), as the slit
-/// cameras) through the pixel's screen point (R_T sin u, v, −R_T cos u) — the exact vertical
-/// model's ray; the paper model has no single ray per pixel and uses the same.
+/// The ray of the pixel at `frag_xy`: its eye point and unit direction (each panorama's
+/// `ray` at the pixel's screen point).
 pub fn pixel_ray(projection: &Projection, eye: Eye, frag_xy: Vec2) -> (Vec3, Vec3) {
     let (u, v) = projection.pixel_to_screen(frag_xy.x - 0.5, frag_xy.y - 0.5);
-    if projection.panorama == PanoramaKind::Cave {
-        let origin = projection.head_eye(eye);
-        return (origin, (projection.cave_point(u, v) - origin).normalize());
-    }
-    if projection.panorama.is_sphere() {
-        return projection.sphere_ray(u, v, eye);
-    }
-    if let Some(head) = &projection.head {
-        let origin = projection.head_eye(eye);
-        return (origin, (projection.head_screen_point(head, u, v) - origin).normalize());
-    }
-    let (rt, de) = (projection.screen_radius, projection.eye_radius);
-    let phi = u - eye.sign() * (de / rt).asin();
-    let origin = eye.sign() * de * Vec3::new(phi.cos(), 0.0, phi.sin());
-    let screen = Vec3::new(rt * u.sin(), v, -rt * u.cos());
-    (origin, (screen - origin).normalize())
+    projection.model().ray(projection, eye, u, v)
 }
 
 /// The points the pixels' rays meet at `distances` (per eye, +∞: none → NaN), viewer frame:

@@ -1,5 +1,5 @@
-//! The full-sphere panorama's eye model and forward map
-//! ([`PanoramaKind::Equirect`](crate::core::panoramas::projection::PanoramaKind::Equirect), omni-directional stereo as Google's
+//! The full sphere's eye model and forward map, shared by the panoramas that draw its rays
+//! (`equirect`, `vr180`, `fisheye`, `cubemap`: omni-directional stereo as Google's
 //! ODS and Blender Cycles' spherical stereo make it). A pixel at longitude λ (column, 0 straight
 //! ahead, positive to the right) and latitude φ (row, +90° at the top) looks along
 //! D = (cos φ sin λ, sin φ, −cos φ cos λ) from the eye point E = s·d·side, side = (cos λ, 0, sin λ)
@@ -26,13 +26,18 @@
 
 use glam::Vec3;
 
-use crate::core::panoramas::projection::{horizontal_radius, Eye, Projection};
+use crate::core::panoramas::projection::{horizontal_radius, Eye, Projected, Projection};
 
 /// The most Newton steps the pole merge's eye offset takes ([`Projection::sphere_eye_offset`]).
 pub const SPHERE_NEWTON_STEPS: u32 = 4;
 /// A Newton step that moves the altitude by at most this many radians ends the pole merge's
 /// steps: the next would move it by about its square (10⁻¹⁰ rad, far below a pixel).
 pub const SPHERE_NEWTON_TOLERANCE: f32 = 1e-5;
+
+/// The unit direction of longitude `lon`, latitude `lat`.
+pub fn direction(lon: f32, lat: f32) -> Vec3 {
+    Vec3::new(lat.cos() * lon.sin(), lat.sin(), -lat.cos() * lon.cos())
+}
 
 impl Projection {
     /// The sphere's pole merge: the factor on the eye offset for a ray of altitude `a` radians
@@ -156,10 +161,19 @@ impl Projection {
         r > e.abs() || (r == 0.0 && e == 0.0 && p.y != 0.0)
     }
 
+    /// Longitude, latitude and depth of `p` for `eye`, the longitude unwrapped about the
+    /// caller's azimuth θ (see the module doc).
+    pub(super) fn sphere_project(&self, p: Vec3, theta: f32, eye: Eye) -> Projected {
+        let r = horizontal_radius(p);
+        let d = self.sphere_eye_offset(r, p.y);
+        let (lon, lat, depth) = self.sphere_at_offset(r, p.y, theta, eye.sign(), d);
+        Projected { u: lon, v: lat, depth }
+    }
+
     /// The eye point and ray direction of the sphere's pixel at longitude `lon`, latitude `lat`
     /// (Cycles' spherical stereo, see the module doc).
     pub fn sphere_ray(&self, lon: f32, lat: f32, eye: Eye) -> (Vec3, Vec3) {
-        let dir = Vec3::new(lat.cos() * lon.sin(), lat.sin(), -lat.cos() * lon.cos());
+        let dir = direction(lon, lat);
         let side = Vec3::new(lon.cos(), 0.0, lon.sin());
         let origin = eye.sign() * self.pole_fade(lat.abs()) * self.eye_radius * side;
         let ray = match self.convergence {
@@ -173,7 +187,7 @@ impl Projection {
 #[cfg(test)]
 mod tests {
     use crate::core::panoramas::projection::tests::angle_diff;
-    use crate::core::panoramas::projection::{Eye, Panorama, PanoramaKind, Projection, DEFAULT_POLE_MERGE};
+    use crate::core::panoramas::projection::{Camera, Eye, Projection, DEFAULT_POLE_MERGE};
     use glam::Vec3;
     use rand::{Rng, SeedableRng};
     use std::f64::consts::PI;
@@ -183,7 +197,7 @@ mod tests {
         let mut rng = rand::rngs::StdRng::seed_from_u64(12);
         for convergence in [None, Some(2.0)] {
             let proj = Projection { convergence, ..Projection::equirect(2048) };
-            assert_eq!((proj.kind(), proj.size()), (PanoramaKind::Equirect, [2048, 1024]));
+            assert_eq!((proj.kind().name(), proj.size()), ("equirect", [2048, 1024]));
             for _ in 0..2000 {
                 let pixel = [rng.random_range(0.0..2048.0f32), rng.random_range(1.0..1023.0f32)];
                 let depth = rng.random_range(0.2..30.0f32);
@@ -336,7 +350,7 @@ mod tests {
     fn vr180_draws_the_spheres_rays_on_the_front_half() {
         let mut rng = rand::rngs::StdRng::seed_from_u64(18);
         let proj = Projection::vr180(2048);
-        assert_eq!((proj.kind(), proj.size()), (PanoramaKind::Vr180, [2048, 2048]));
+        assert_eq!((proj.kind().name(), proj.size()), ("vr180", [2048, 2048]));
         let (w, h) = (2048.0, 2048.0);
         let (mut inside, mut behind) = (0, 0);
         for _ in 0..3000 {

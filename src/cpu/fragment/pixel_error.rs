@@ -4,30 +4,32 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::core::panoramas::projection::{pixel_ray, Eye, PanoramaKind, Projection};
+use crate::core::panoramas::panorama::ImageMap;
+use crate::core::panoramas::projection::{pixel_ray, Eye, Projection};
 
 /// The angle a pixel spans, radians (`pixel_spread` in surface.wgsl): the larger of its width
 /// (2π/turn_px, on the sphere × cos latitude) and its height (on the cylinder 1/(pixels_per_v·R_T),
 /// seen from the eyes about R_T away; on the sphere 1/pixels_per_v). A ray cone grows by this
 /// much per metre.
 pub fn pixel_spread(projection: &Projection, frag_xy: Vec2) -> f32 {
-    if projection.panorama == PanoramaKind::Fisheye {
-        return 1.0 / projection.fisheye_pixels_per_radian();
-    }
-    if projection.panorama == PanoramaKind::Cubemap {
-        return 1.0 / projection.pixels_per_v(); // a face's centre, where its pixels span the most
-    }
-    if projection.panorama == PanoramaKind::Cave {
-        // A pixel's width at the wall's nearest point, seen from the head.
-        let [corner, right, up] = projection.cave_wall();
-        return right.length() / projection.width as f32 / corner.dot(right.cross(up).normalize()).abs();
-    }
-    let (_, v) = projection.pixel_to_screen(frag_xy.x - 0.5, frag_xy.y - 0.5);
-    let across = std::f32::consts::TAU / projection.turn_px();
-    if projection.panorama.is_sphere() {
-        (across * v.cos()).max(1.0 / projection.pixels_per_v())
-    } else {
-        across.max(1.0 / (projection.pixels_per_v() * projection.screen_radius))
+    match projection.model().image_map() {
+        // The fisheye's k pixels per radian; the cubemap's a face's centre, where its pixels
+        // span the most.
+        ImageMap::Fisheye | ImageMap::Cubemap => 1.0 / projection.pixels_per_v(),
+        ImageMap::Plane => {
+            // A pixel's width at the wall's nearest point, seen from the head.
+            let [corner, right, up] = projection.cave_wall();
+            right.length() / projection.width as f32 / corner.dot(right.cross(up).normalize()).abs()
+        }
+        ImageMap::Linear => {
+            let (_, v) = projection.pixel_to_screen(frag_xy.x - 0.5, frag_xy.y - 0.5);
+            let across = std::f32::consts::TAU / projection.turn_px();
+            if projection.panorama.is_sphere() {
+                (across * v.cos()).max(1.0 / projection.pixels_per_v())
+            } else {
+                across.max(1.0 / (projection.pixels_per_v() * projection.screen_radius))
+            }
+        }
     }
 }
 
@@ -44,7 +46,7 @@ pub fn pixel_error(projection: &Projection, eye: Eye, p: Vec3, frag_xy: Vec2, an
             let b = projection.screen_direction(u, v);
             a.cross(b).length().atan2(a.dot(b)).to_degrees() * 60.0
         }
-        Some(q) if projection.panorama == PanoramaKind::Cubemap => {
+        Some(q) if projection.model().image_map() == ImageMap::Cubemap => {
             // On the pixel's own face (a point drawn across a face's edge belongs beyond it there).
             let face = projection.cube_face_at(frag_xy.x, frag_xy.y);
             match projection.cube_pixel_on_face(crate::core::panoramas::cubemap::direction(q.u, q.v), face) {

@@ -7,7 +7,8 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use super::spacing::Spacing;
 use super::{snap_to_cut_planes, Node, PartSplit, Subdivider, Triangle};
-use crate::core::panoramas::projection::{azimuth, horizontal_radius, Eye, PanoramaKind, Vertical};
+use crate::core::panoramas::panorama::{EyeModel, ImageMap};
+use crate::core::panoramas::projection::{azimuth, horizontal_radius, Eye, Vertical};
 use crate::core::scenes::scene::{unpack_tangent, SceneVertex, SINGLE_SIDED};
 use crate::core::settings::SplitRule;
 use crate::encoding::constants::{
@@ -108,7 +109,7 @@ impl Subdivider<'_> {
         let eye = if eye_sign > 0.0 { Eye::Right } else { Eye::Left };
         let q = self.projection.project_with_azimuth(p, azimuth(p), eye);
         let proj = &self.projection;
-        if proj.panorama == PanoramaKind::Fisheye {
+        if proj.model().image_map() == ImageMap::Fisheye {
             // Its own image, centred (no seam: x never wraps).
             let [x, y] = proj.fisheye_pixel(q.u, q.v);
             return Vec2::new(x - 0.5 * proj.width as f32, y - 0.5 * proj.height as f32);
@@ -376,7 +377,7 @@ impl Subdivider<'_> {
     pub fn faces_away(&self, vertices: &[SceneVertex], indices: &[u32], t: usize, p: [Vec3; 3]) -> bool {
         let proj = &self.projection;
         if vertices[indices[3 * t] as usize].flags & SINGLE_SIDED == 0
-            || proj.panorama == PanoramaKind::Cave
+            || proj.model().eye_model() == EyeModel::Pinhole
             || proj.head.is_some()
         {
             return false;

@@ -5,7 +5,7 @@ use std::collections::HashMap;
 
 use super::tests::{run_method, run_method_with_cuts};
 use super::*;
-use crate::core::panoramas::projection::{azimuth, Eye, PanoramaKind};
+use crate::core::panoramas::projection::{azimuth, Eye};
 use crate::core::scenes::builtin;
 use crate::core::settings::{Method, RenderSettings};
 
@@ -98,7 +98,7 @@ fn seam_copies_are_drawn_only_where_they_show() {
             let drawn = out.vertices.len() / 3;
             let (name, kind) = (&scene.name, projection.panorama);
             let lost = shown.values().filter(|&&s| !s).count();
-            if kind == PanoramaKind::Vr180 {
+            if !kind.wraps() {
                 // Pieces whose u range lies behind the viewer are not drawn, nor triangles
                 // wholly beyond the image's sides (some within a piece's bound stay).
                 assert!(beyond * 10 < drawn, "{name} {kind:?}: {beyond} of {drawn} triangles wholly beyond the image");
