@@ -416,23 +416,23 @@ impl ViewArgs {
     /// The image's size per eye: `--preset`, else `--width`/`--height` with each panorama's
     /// defaults (a CAVE's walls give their own).
     fn size(&self, panorama: PanoramaKind) -> (u32, u32) {
-        match (panorama, self.preset) {
-            (_, Some(preset)) => (preset.width(), preset.width() / 2),
-            (PanoramaKind::Cylinder, None) => (self.width.unwrap_or(3168), self.height.unwrap_or(600)),
-            (PanoramaKind::Equirect, None) => {
-                let width = self.width.unwrap_or(4096);
-                (width, self.height.unwrap_or(width / 2))
-            }
-            (PanoramaKind::Vr180 | PanoramaKind::Fisheye, None) => {
-                let width = self.width.unwrap_or(4096);
-                (width, self.height.unwrap_or(width))
-            }
-            // Faces of 1024: the default sphere's resolution (4096 pixels a turn) at their centres.
-            (PanoramaKind::Cubemap | PanoramaKind::Cave, None) => {
-                let width = self.width.unwrap_or(3072);
-                (width, self.height.unwrap_or(2 * width / 3))
-            }
+        if let Some(preset) = self.preset {
+            return (preset.width(), preset.width() / 2);
         }
+        // The paper's 3168 × 600 on the cylinder (600 rows whatever the width); the cubemap's
+        // faces of 1024 (the default sphere's 4096 pixels a turn at their centres); else 4096
+        // pixels wide and the panorama's own height for its width.
+        let width = self.width.unwrap_or(match panorama {
+            PanoramaKind::Cylinder => 3168,
+            PanoramaKind::Cubemap | PanoramaKind::Cave => 3072,
+            _ => 4096,
+        });
+        let height = match panorama {
+            PanoramaKind::Cylinder => 600,
+            PanoramaKind::Cave => 2 * width / 3,
+            _ => panorama.model().default_size(width)[1],
+        };
+        (width, self.height.unwrap_or(height))
     }
 
     /// `--head`: the tracked head relative to the display's centre (`--viewer x,y,z`).
