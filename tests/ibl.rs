@@ -82,7 +82,7 @@ fn white_spheres_in_a_uniform_environment_reflect_exactly_what_arrives() {
     scene.environment = Some(Arc::new(Environment::uniform(Vec3::splat(0.5)).prepare()));
     let s = settings(480, 120);
     let gpu = common::render(&scene, &s);
-    let cpu = twister::cpu::render::render(&scene, &s).eyes;
+    let cpu = twister::cpu::render::render(&scene, &s).expect("the twins' frame").eyes;
     for (what, rgba) in [("GPU", &gpu.eye(Eye::Left).rgba), ("CPU twin", &cpu[0].rgba)] {
         let columns = sphere_columns(rgba, 480, 120);
         assert_eq!(columns.len(), looks.len(), "{what}: {columns:?}");

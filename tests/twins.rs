@@ -6,6 +6,8 @@
 mod common;
 #[path = "twins/display.rs"]
 mod display;
+#[path = "twins/frame.rs"]
+mod frame;
 #[path = "twins/shadow.rs"]
 mod shadow;
 #[path = "twins/skin.rs"]
@@ -446,6 +448,7 @@ impl Twin for Raster {
     }
     fn cpu((scene, settings): &Self::Case) -> Self::Output {
         let eyes = twister::cpu::render::render(scene, settings)
+            .expect("the twins' frame")
             .eyes
             .map(|img| (img.rgba, img.error, img.object, img.distance));
         (eyes, error_tolerance(settings))

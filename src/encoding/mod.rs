@@ -7,10 +7,13 @@
 //! - [`constants`]: constants shared with WGSL (the generated `constants` module);
 //! - [`params`], [`subdivide`], [`slits`], [`skin`]: each stage's parameters and tables built
 //!   from the settings and the scene, and the outputs both engines give;
+//! - [`frame`]: a whole frame's schedule as data, recorded once, run by either engine;
 //! - [`recording`]: a stage's schedule as data (the subdivision's, in [`subdivide`]);
-//! - [`schedule`]: the subdivision's frame schedules, run by either engine.
+//! - [`schedule`]: the subdivision's frame schedules and its one overflow policy, run by either
+//!   engine.
 
 pub mod constants;
+pub mod frame;
 pub mod params;
 pub mod recording;
 pub mod schedule;

@@ -76,8 +76,8 @@ impl Capacities {
 /// How a frame runs on the GPU.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FramePlan {
-    /// Everything in one submission, with these capacities.
-    OneSubmission(Capacities),
+    /// Everything in one submission, with these capacities (within the budget).
+    OneSubmission(Capacities, Capacities),
     /// Triangle ranges and piece ranges, each drawn in turn, starting from the capacities
     /// wanted and growing within the budget.
     Chunked { want: Capacities, budget: Capacities },
@@ -87,13 +87,20 @@ impl FramePlan {
     /// The usual plan: one submission with the cached buffers' capacities (or a guess from the
     /// triangle count), never beyond the budget.
     pub fn first(triangles: u32, cached: Option<Capacities>, budget: Capacities) -> FramePlan {
-        FramePlan::OneSubmission(cached.unwrap_or(Capacities::guess(triangles)).min(budget))
+        FramePlan::OneSubmission(cached.unwrap_or(Capacities::guess(triangles)).min(budget), budget)
     }
 
     /// The plan after a one-submission frame overflowed its buffers.
     pub fn after_overflow(self, budget: Capacities) -> FramePlan {
         match self {
-            FramePlan::OneSubmission(want) | FramePlan::Chunked { want, .. } => FramePlan::Chunked { want, budget },
+            FramePlan::OneSubmission(want, _) | FramePlan::Chunked { want, .. } => FramePlan::Chunked { want, budget },
+        }
+    }
+
+    /// The memory budget the plan stays within.
+    pub fn budget(self) -> Capacities {
+        match self {
+            FramePlan::OneSubmission(_, budget) | FramePlan::Chunked { budget, .. } => budget,
         }
     }
 }
@@ -140,6 +147,16 @@ pub trait SubdivisionEngine {
     /// Takes the output of a finished run (`counters` says how much): draws it, reads it back
     /// or keeps it.
     fn take(&mut self, counters: &SubdivideCounters) -> Result<()>;
+    /// The usual frame's run: replays `recording` and, where no buffer overflowed, takes its
+    /// output; the counters. The GPU does both in one submission (drawing before it reads the
+    /// counters back, and drawing again by chunks where they say a buffer overflowed).
+    fn replay_and_take(&mut self, recording: &Recording, params: &SubdivideParams) -> Result<SubdivideCounters> {
+        let counters = self.replay(recording, params)?;
+        if !counters.overflowed(params.piece_capacity, params.triangle_capacity) {
+            self.take(&counters)?;
+        }
+        Ok(counters)
+    }
 }
 
 /// What a run made, over all its ranges.
@@ -217,11 +234,26 @@ pub fn run_schedule<E: SubdivisionEngine>(
     budget: Capacities,
 ) -> Result<RunTotals> {
     let first = FramePlan::first(triangles, None, budget);
-    let (mut plan, chunk) = match schedule {
+    let (plan, chunk) = match schedule {
         Schedule::OneSubmission => (first, triangles.max(1)),
         Schedule::Chunked { triangles_per_chunk } => (first.after_overflow(budget), triangles_per_chunk.max(1)),
     };
-    if let FramePlan::OneSubmission(want) = plan {
+    run_plan(engine, settings, triangles, plan, chunk)
+}
+
+/// Runs a frame's subdivision by `plan` to the end: the one overflow policy, which the GPU's
+/// frames (`gpu::subdivided`), the GPU's read-back and the CPU twin all follow. One submission
+/// with the plan's capacities; where a buffer overflows, chunks from there (grown within the
+/// budget, or halved), the first of at most `chunk` triangles.
+pub fn run_plan<E: SubdivisionEngine>(
+    engine: &mut E,
+    settings: &RenderSettings,
+    triangles: u32,
+    mut plan: FramePlan,
+    chunk: u32,
+) -> Result<RunTotals> {
+    let budget = plan.budget();
+    if let FramePlan::OneSubmission(want, _) = plan {
         let capacity = engine.ensure(want).min(budget);
         match run_one_submission(engine, settings, triangles, capacity)? {
             Ok(totals) => return Ok(totals),
@@ -229,7 +261,7 @@ pub fn run_schedule<E: SubdivisionEngine>(
         }
     }
     let FramePlan::Chunked { mut want, budget } = plan else { unreachable!("a one-submission run returned") };
-    run_chunked(engine, settings, triangles, &mut want, budget, chunk)
+    run_chunked(engine, settings, triangles, &mut want, budget, chunk.max(1))
 }
 
 /// The one-submission schedule with these capacities: the totals, or (when a buffer overflowed,
@@ -245,7 +277,8 @@ pub fn run_one_submission<E: SubdivisionEngine>(
     (params.first_piece, params.piece_count) = (0, PIECES_FROM_COUNTER);
     let recording = one_submission(triangles, Passes::of_settings(settings), PassTiming::Untimed);
     let mut totals = RunTotals::default();
-    let counters = replay_counted(engine, &recording, &params, &mut totals)?;
+    let counters = engine.replay_and_take(&recording, &params)?;
+    totals.count(&recording, &params, &counters);
     if counters.overflowed(capacity.pieces, capacity.triangles) {
         let wanted = Capacities {
             pieces: capacity.pieces.max(counters.piece_records()),
@@ -253,7 +286,6 @@ pub fn run_one_submission<E: SubdivisionEngine>(
         };
         return Ok(Err(wanted));
     }
-    engine.take(&counters)?;
     totals.pieces = counters.pieces as u64;
     totals.add(&counters);
     Ok(Ok(totals))
@@ -366,11 +398,14 @@ mod tests {
         let budget = Capacities::budget(8, u64::MAX);
         assert_eq!(budget.pieces as u64, 2 * (1 << 20) / PIECE_SIZE);
         match FramePlan::first(10_000_000, None, budget) {
-            FramePlan::OneSubmission(c) => assert_eq!(c, budget),
+            FramePlan::OneSubmission(c, b) => assert_eq!((c, b), (budget, budget)),
             other => panic!("{other:?}"),
         }
         let small = Capacities { pieces: 10, triangles: 20 };
-        assert_eq!(FramePlan::first(5, Some(small), budget), FramePlan::OneSubmission(small));
-        assert_eq!(FramePlan::OneSubmission(small).after_overflow(budget), FramePlan::Chunked { want: small, budget });
+        assert_eq!(FramePlan::first(5, Some(small), budget), FramePlan::OneSubmission(small, budget));
+        assert_eq!(
+            FramePlan::OneSubmission(small, budget).after_overflow(budget),
+            FramePlan::Chunked { want: small, budget }
+        );
     }
 }

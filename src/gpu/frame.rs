@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use crate::core::frame::{EyeImage, Frame, FrameStats, Measurement};
 use crate::core::settings::RenderSettings;
+use crate::encoding::frame::{FrameRecording, FrameStep};
 use crate::error::Result;
 use crate::gpu::device::Gpu;
 use crate::gpu::display::ShownFrame;
@@ -74,7 +75,8 @@ impl FrameResources {
 pub(crate) const STAGING_SIZE: u64 = COUNTERS_SIZE + 8 * stamp::COUNT as u64;
 
 /// A way of drawing a frame (as pbrt's `Integrator`): the projection methods' subdivided
-/// raster, the slit mosaic, the ray tracer. Each draws into the frame's resources and ends with
+/// raster, the slit mosaic, the ray tracer — the GPU's side of a recording's drawing step
+/// (`encoding::frame::FrameStep`). Each draws into the frame's resources and ends with
 /// [`FrameEnd::finish`].
 pub(crate) trait Method {
     fn draw(
@@ -84,6 +86,7 @@ pub(crate) trait Method {
         res: &mut FrameResources,
         scene: &GpuScene,
         settings: &RenderSettings,
+        step: &FrameStep,
     ) -> Result<Frame>;
 }
 
@@ -94,11 +97,12 @@ pub(crate) struct EndStages {
     reduce: std::sync::OnceLock<ReduceStage>,
 }
 
-/// One frame's end: the read-back of its targets and, with the error pass, the reduction. A
-/// frame the live window shows (`show`) keeps its colour on the GPU instead, copied into a
-/// storage buffer for the display stage (`shown`).
+/// One frame's end, its recording's last steps: the read-back of its targets and, with the
+/// error pass, the reduction. A frame the live window shows (`show`) keeps its colour on the GPU
+/// instead, copied into a storage buffer for the display stage (`shown`).
 pub(crate) struct FrameEnd<'a> {
     pub stages: &'a EndStages,
+    pub recording: &'a FrameRecording,
     pub show: bool,
     pub shown: std::cell::OnceCell<ShownFrame>,
 }
@@ -109,7 +113,6 @@ impl FrameEnd<'_> {
         &self,
         gpu: &Gpu,
         targets: &Targets,
-        settings: &RenderSettings,
         mut stats: FrameStats,
         start: Instant,
     ) -> Result<Frame> {
@@ -124,17 +127,28 @@ impl FrameEnd<'_> {
         } else {
             targets.read_colors(gpu)?
         };
-        let hdr = if targets.hdr { Some(targets.read_hdr(gpu)?) } else { None };
+        let steps = &self.recording.steps;
+        let read = steps.iter().find_map(|s| match *s {
+            FrameStep::ReadBack { hdr, depth, positions, error } => Some((hdr, depth, positions, error)),
+            _ => None,
+        });
+        let (hdr, depth, positions, _) = read.unwrap_or_default();
+        let hdr = if hdr && targets.hdr { Some(targets.read_hdr(gpu)?) } else { None };
         stats.ms_readback = t.elapsed().as_secs_f64() * 1e3;
-        let depth = if settings.measure.depth { Some(targets.read_distances(gpu)?) } else { None };
-        let positions = if settings.measure.positions { Some(targets.read_positions(gpu)?) } else { None };
-        let measurement = if settings.measure.error {
-            let object = targets.read_objects(gpu)?;
-            let reduce = self.stages.reduce.get_or_init(|| ReduceStage::new(gpu));
-            let (stats, error) = reduce.reduce(gpu, targets, settings.measure.reduce_per_eye)?;
-            Some(Measurement { error, object, stats })
-        } else {
-            None
+        let depth = if depth { Some(targets.read_distances(gpu)?) } else { None };
+        let positions = if positions { Some(targets.read_positions(gpu)?) } else { None };
+        let reduce = steps.iter().find_map(|s| match *s {
+            FrameStep::ReduceError { per_eye } => Some(per_eye),
+            _ => None,
+        });
+        let measurement = match reduce {
+            Some(per_eye) => {
+                let object = targets.read_objects(gpu)?;
+                let reduce = self.stages.reduce.get_or_init(|| ReduceStage::new(gpu));
+                let (stats, error) = reduce.reduce(gpu, targets, per_eye)?;
+                Some(Measurement { error, object, stats })
+            }
+            None => None,
         };
         stats.ms_total = start.elapsed().as_secs_f64() * 1e3;
         Ok(Frame { left, right, stats, measurement, depth, positions, hdr })

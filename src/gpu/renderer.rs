@@ -14,6 +14,7 @@ use crate::core::frame::{EyeImage, Frame};
 use crate::core::panoramas::projection::{Eye, Projection};
 use crate::core::scenes::scene::Scene;
 use crate::core::settings::{Method as MethodName, RenderSettings};
+use crate::encoding::frame::{record_frame, FrameFacts, FrameRecording, FrameStep};
 use crate::encoding::schedule::Schedule;
 use crate::encoding::subdivide::SubdivideOutput;
 use crate::encoding::types::{SlitParams, SubdivideParams, TraceParams};
@@ -323,24 +324,73 @@ impl Renderer {
         settings: &RenderSettings,
         show: bool,
     ) -> Result<(Frame, Option<ShownFrame>)> {
-        let mut resources = self.resources.lock().unwrap_or_else(|e| e.into_inner());
+        let resources = self.resources.lock().unwrap_or_else(|e| e.into_inner());
         let shadow_maps = scene.write_lighting(&self.gpu, settings);
+        let facts = FrameFacts {
+            triangles: scene.triangle_count,
+            shadow_maps: shadow_maps.len() as u32,
+            cached: resources.buffers.as_ref().map(|b| b.capacity),
+            max_binding: self.gpu.max_binding(),
+        };
+        drop(resources);
+        let recording = record_frame(settings, &facts);
+        self.run_recording(scene, settings, &recording, &shadow_maps, show)
+    }
+
+    /// Records the frame `settings` draw of `scene` as this renderer would now
+    /// ([`record_frame`] with what it holds): what [`Renderer::render_recorded`] runs.
+    pub fn record(&self, scene: &GpuScene, settings: &RenderSettings) -> FrameRecording {
+        let (_, _, maps) =
+            settings.shadowed_lighting(&scene.lights, scene.physically_based, scene.environment.as_deref(), scene.bounds);
+        let resources = self.resources.lock().unwrap_or_else(|e| e.into_inner());
+        let facts = FrameFacts {
+            triangles: scene.triangle_count,
+            shadow_maps: maps.len() as u32,
+            cached: resources.buffers.as_ref().map(|b| b.capacity),
+            max_binding: self.gpu.max_binding(),
+        };
+        record_frame(settings, &facts)
+    }
+
+    /// Draws a recorded frame of `scene` ([`Renderer::record`]; the CPU twins run the same
+    /// recording, `cpu::render::render_recorded`), at a sample count the adapter draws.
+    pub fn render_recorded(&self, scene: &GpuScene, settings: &RenderSettings, recording: &FrameRecording) -> Result<Frame> {
+        settings.validate()?;
+        self.check_size(settings)?;
+        let shadow_maps = scene.write_lighting(&self.gpu, settings);
+        Ok(self.run_recording(scene, settings, recording, &shadow_maps, false)?.0)
+    }
+
+    /// Runs a frame's recording, step by step: the shadow maps, the method's drawing, then its
+    /// end (the read-back and the reduction, `FrameEnd`).
+    fn run_recording(
+        &self,
+        scene: &GpuScene,
+        settings: &RenderSettings,
+        recording: &FrameRecording,
+        shadow_maps: &[crate::core::shading::shadow::GpuShadowMap],
+        show: bool,
+    ) -> Result<(Frame, Option<ShownFrame>)> {
+        let mut resources = self.resources.lock().unwrap_or_else(|e| e.into_inner());
         self.gpu.scoped("rendering a frame", || {
-            if !shadow_maps.is_empty() {
-                let shadow = self.shadow.get_or_init(|| ShadowStage::new(&self.gpu));
-                shadow.draw_maps(&self.gpu, scene, settings.view(), &shadow_maps)?;
+            let end = FrameEnd { stages: &self.end, recording, show, shown: std::cell::OnceCell::new() };
+            let mut drawn = None;
+            for step in &recording.steps {
+                let method: &dyn Method = match step {
+                    FrameStep::Shadow { .. } => {
+                        let shadow = self.shadow.get_or_init(|| ShadowStage::new(&self.gpu));
+                        shadow.draw_maps(&self.gpu, scene, settings.view(), shadow_maps)?;
+                        continue;
+                    }
+                    FrameStep::Subdivided { .. } => self.subdivided(),
+                    FrameStep::Slit { .. } => self.slit.get_or_init(|| SlitMethod::new(&self.gpu)),
+                    FrameStep::Trace => &self.trace,
+                    // The frame's end, run by the drawing step's `FrameEnd::finish`.
+                    FrameStep::ReadBack { .. } | FrameStep::ReduceError { .. } => continue,
+                };
+                drawn = Some(method.draw(&self.gpu, &end, &mut resources, scene, settings, step)?);
             }
-            // A CAVE wall is a perspective: every projection method draws it exactly as one
-            // pinhole camera per eye, the slit stage's (`core::panoramas::cave`), with no subdivision.
-            let cave = settings.projection().model().drawn_as_pinhole();
-            let method: &dyn Method = match settings.subdivision.method {
-                MethodName::Trace => &self.trace,
-                MethodName::Slit(_) => self.slit.get_or_init(|| SlitMethod::new(&self.gpu)),
-                _ if cave => self.slit.get_or_init(|| SlitMethod::new(&self.gpu)),
-                _ => self.subdivided(),
-            };
-            let end = FrameEnd { stages: &self.end, show, shown: std::cell::OnceCell::new() };
-            let mut frame = method.draw(&self.gpu, &end, &mut resources, scene, settings)?;
+            let mut frame = drawn.ok_or_else(|| Error::Gpu("the frame's recording draws nothing".into()))?;
             let n = settings.shading.samples;
             frame.stats.samples = n;
             frame.stats.sampling = match crate::gpu::targets::Samples::passes(settings).as_slice() {

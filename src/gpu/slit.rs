@@ -1,6 +1,7 @@
 //! The slit-mosaic reference renderer on the GPU (`slit` stage, twin `cpu::slit`): one draw per
 //! slit and visible object, per eye, with all slit cameras in one buffer.
 
+use crate::encoding::frame::FrameStep;
 use std::time::Instant;
 
 use crate::core::frame::{Frame, FrameStats};
@@ -35,11 +36,11 @@ impl Method for SlitMethod {
         res: &mut FrameResources,
         scene: &GpuScene,
         settings: &RenderSettings,
+        step: &FrameStep,
     ) -> Result<Frame> {
         // slit:W, or a CAVE wall's one camera per eye (every projection method: a perspective).
-        let width = match settings.subdivision.method {
-            crate::core::settings::Method::Slit(width) => width,
-            _ => settings.projection().width,
+        let FrameStep::Slit { width } = *step else {
+            return Err(crate::error::Error::Gpu(format!("the slit method was given the step {step:?}")));
         };
         let start = Instant::now();
         let projection = settings.projection();
@@ -99,6 +100,6 @@ impl Method for SlitMethod {
         }
         targets.copy_resolved(&mut enc);
         submit_timed_pass(gpu, enc, timestamps, &res.staging, t, &mut stats)?;
-        end.finish(gpu, targets, settings, stats, start)
+        end.finish(gpu, targets, stats, start)
     }
 }

@@ -11,8 +11,9 @@ use crate::core::panoramas::projection::PanoramaKind;
 use crate::core::settings::RenderSettings;
 use crate::encoding::params::raster_params;
 use crate::encoding::recording::Recording;
-use crate::encoding::schedule::{run_chunked, Capacities, FramePlan, SubdivisionEngine};
-use crate::encoding::subdivide::{dispatched, one_submission, subdivide_params, PassTiming, Passes};
+use crate::encoding::frame::FrameStep;
+use crate::encoding::schedule::{run_plan, Capacities, FramePlan, SubdivisionEngine};
+use crate::encoding::subdivide::PassTiming;
 use crate::encoding::types::{ProjectionUniform, RasterParams, SubdivideCounters, SubdivideParams};
 use crate::error::Result;
 use crate::gpu::device::Gpu;
@@ -47,7 +48,8 @@ impl SubdividedMethod {
 }
 
 impl Method for SubdividedMethod {
-    /// The subdivided frame: follows the [`FramePlan`].
+    /// The subdivided frame: its step's plan, followed by the one overflow policy
+    /// ([`run_plan`]) with this frame's engine ([`FrameDraw`]).
     fn draw(
         &self,
         gpu: &Gpu,
@@ -55,40 +57,39 @@ impl Method for SubdividedMethod {
         res: &mut FrameResources,
         scene: &GpuScene,
         settings: &RenderSettings,
+        step: &FrameStep,
     ) -> Result<Frame> {
         let start = Instant::now();
-        let mut stats = FrameStats { triangles_in: scene.triangle_count as u64, ..Default::default() };
+        let FrameStep::Subdivided { plan, chunk } = *step else {
+            return Err(crate::error::Error::Gpu(format!("the subdivided method was given the step {step:?}")));
+        };
         let p = settings.projection();
         let [tile_w, tile_h] = p.image_size();
         res.targets(gpu, tile_w, tile_h, settings.measure.positions, settings.shading.hdr, settings.shading.samples);
-        let budget = Capacities::budget(settings.subdivision.memory_mb, gpu.max_binding());
         let n = scene.triangle_count;
-        let mut plan = FramePlan::first(n, res.buffers.as_ref().map(|b| b.capacity), budget);
-        if let FramePlan::OneSubmission(want) = plan {
+        if let FramePlan::OneSubmission(want, _) = plan {
             SubdivisionBuffers::ensure(&mut res.buffers, gpu, want, scene);
-            let b = res.buffers.as_ref().expect("ensured");
-            if b.cut_list_capacity < n {
-                // More triangles than one binding lists for `plan_cuts`: chunks.
-                plan = plan.after_overflow(budget);
-            }
         }
-        if let FramePlan::OneSubmission(_) = plan {
-            let b = res.buffers.as_ref().expect("ensured");
-            let targets = res.targets.as_ref().expect("made");
-            let mut params = subdivide_params(settings, 0, n);
-            let capacity = b.capacity.min(budget);
-            params.piece_capacity = capacity.pieces;
-            params.triangle_capacity = capacity.triangles;
-            let t = Instant::now();
-            let mut done = self.render_one_submission(gpu, res, scene, settings, targets, b, params)?;
-            if let Some((counters, _)) = &done {
-                // A frame that needed the cut passes before they were built: again, with them.
-                if self.subdivide.missed_cuts(gpu, p.panorama, &params, counters) {
-                    done = self.render_one_submission(gpu, res, scene, settings, targets, b, params)?;
-                }
-            }
-            if let Some((counters, times)) = done {
-                stats.ms_frame = t.elapsed().as_secs_f64() * 1e3;
+        let panorama = p.panorama;
+        let mut engine = FrameDraw { method: self, gpu, res, scene, settings, panorama, clock: FrameClock::default() };
+        let totals = run_plan(&mut engine, settings, n, plan, chunk)?;
+        let clock = engine.clock;
+        let mut stats = FrameStats {
+            triangles_in: n as u64,
+            pieces: totals.pieces,
+            triangles_out: totals.triangles,
+            nodes_out: totals.nodes,
+            chunks: totals.chunks,
+            max_sub_edge_px: totals.max_edge_px,
+            max_pieces_per_invocation: totals.max_pieces,
+            max_output_per_invocation: totals.max_output,
+            subdivide_invocations: totals.invocations,
+            ..Default::default()
+        };
+        match clock.one_submission {
+            // Drawn in one submission: its GPU times where timestamps were written.
+            Some((ms, times)) if !clock.chunked => {
+                stats.ms_frame = ms;
                 match times {
                     Some(times) => {
                         stats.timing = Timing::GpuTimestamps;
@@ -99,49 +100,35 @@ impl Method for SubdividedMethod {
                     }
                     None => stats.timing = Timing::WallOneSubmission,
                 }
-                stats.pieces = counters.pieces as u64;
-                stats.subdivide_invocations = dispatched(
-                    &one_submission(n, Passes::of(p.panorama, params.method), PassTiming::Untimed),
-                    &params,
-                    &counters,
-                );
-                stats.max_pieces_per_invocation = counters.max_pieces;
-                stats.max_output_per_invocation = counters.max_output;
-                stats.triangles_out = counters.triangles as u64;
-                stats.nodes_out = counters.nodes as u64;
-                stats.chunks = 1;
-                stats.max_sub_edge_px = f32::from_bits(counters.max_edge_bits);
-                return end.finish(gpu, targets, settings, stats, start);
             }
-            plan = plan.after_overflow(budget);
+            _ => {
+                stats.ms_subdivide = Some(clock.subdivide);
+                stats.ms_raster = Some(clock.raster);
+                stats.ms_frame = clock.subdivide + clock.raster;
+                stats.timing = Timing::WallPerPass;
+            }
         }
-        let FramePlan::Chunked { mut want, budget } = plan else { unreachable!("a one-submission frame returned") };
-        // Each chunk's pass loads what the eye's earlier chunks drew: no samples shared by the eyes.
-        res.targets.as_mut().expect("made").give_each_eye_its_samples(gpu);
-        self.render_chunked(gpu, res, scene, settings, &mut want, budget, &mut stats)?;
-        stats.ms_frame = stats.ms_subdivide.unwrap_or(0.0) + stats.ms_raster.unwrap_or(0.0);
-        stats.timing = Timing::WallPerPass;
         let targets = res.targets.as_ref().expect("made");
-        end.finish(gpu, targets, settings, stats, start)
+        end.finish(gpu, targets, stats, start)
     }
 }
 
 impl SubdividedMethod {
-    /// The usual frame, in one submission (see [`FramePlan::OneSubmission`]). Returns None if a
-    /// buffer overflowed; else the counters and, with timestamp queries, the GPU times (ms) of
-    /// the subdivision, the raster and the whole frame.
-    #[allow(clippy::too_many_arguments)]
+    /// The usual frame, in one submission (see [`FramePlan::OneSubmission`]): the subdivision,
+    /// the raster (drawn before the counters are read: a frame whose buffers overflowed is drawn
+    /// again by chunks), the counters and timestamps read back. The counters and, with timestamp
+    /// queries, the GPU times (ms) of the subdivision, the raster and the whole frame.
     fn render_one_submission(
         &self,
         gpu: &Gpu,
         res: &FrameResources,
         scene: &GpuScene,
         settings: &RenderSettings,
-        targets: &Targets,
-        b: &SubdivisionBuffers,
         params: SubdivideParams,
-    ) -> Result<Option<(SubdivideCounters, Option<GpuTimes>)>> {
+    ) -> Result<(SubdivideCounters, Option<GpuTimes>)> {
         let timestamps = res.timestamps.as_ref();
+        let targets = res.targets.as_ref().expect("made");
+        let b = res.buffers.as_ref().expect("ensured");
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         let panorama = settings.projection().panorama;
         let timing = PassTiming::of(timestamps.is_some(), settings.measure.pass_times);
@@ -184,7 +171,7 @@ impl SubdividedMethod {
         let bytes = gpu.read_buffer(&res.staging)?;
         let counters: SubdivideCounters = *bytemuck::from_bytes(&bytes[..COUNTERS_SIZE as usize]);
         if counters.overflowed(params.piece_capacity, params.triangle_capacity) {
-            return Ok(None);
+            return Ok((counters, None));
         }
         let times = timestamps.map(|t| {
             let ticks: &[u64] = bytemuck::cast_slice(&bytes[COUNTERS_SIZE as usize..]);
@@ -206,7 +193,7 @@ impl SubdividedMethod {
                 frame: t.ms(ticks[0], ticks[raster_query as usize + 1]),
             }
         });
-        Ok(Some((counters, times)))
+        Ok((counters, times))
     }
 
     /// The raster's passes of a frame: its samples (every output at the pixels' centres, then
@@ -271,37 +258,6 @@ impl SubdividedMethod {
         }
         targets.copy_resolved(enc);
     }
-
-    /// The chunked schedule (see [`FramePlan::Chunked`]; [`run_chunked`]): wall times per pass.
-    #[allow(clippy::too_many_arguments)]
-    fn render_chunked(
-        &self,
-        gpu: &Gpu,
-        res: &mut FrameResources,
-        scene: &GpuScene,
-        settings: &RenderSettings,
-        want: &mut Capacities,
-        budget: Capacities,
-        stats: &mut FrameStats,
-    ) -> Result<()> {
-        let n = scene.triangle_count;
-        let b = SubdivisionBuffers::ensure(&mut res.buffers, gpu, *want, scene);
-        let chunk = n.max(1).min(b.cut_list_capacity);
-        let panorama = settings.projection().panorama;
-        let mut engine = ChunkDraw { method: self, gpu, res, scene, settings, panorama, clock: ChunkClock::default() };
-        let totals = run_chunked(&mut engine, settings, n, want, budget, chunk)?;
-        stats.pieces += totals.pieces;
-        stats.triangles_out += totals.triangles;
-        stats.nodes_out += totals.nodes;
-        stats.chunks += totals.chunks;
-        stats.max_sub_edge_px = stats.max_sub_edge_px.max(totals.max_edge_px);
-        stats.max_pieces_per_invocation = totals.max_pieces;
-        stats.max_output_per_invocation = totals.max_output;
-        stats.subdivide_invocations = totals.invocations;
-        stats.ms_subdivide = Some(engine.clock.subdivide);
-        stats.ms_raster = Some(engine.clock.raster);
-        Ok(())
-    }
 }
 
 /// The raster stage's draws of a frame: its parameters' bind group, and for the cubemap one draw
@@ -341,19 +297,20 @@ fn face_draws(
         .collect()
 }
 
-/// The chunked frame's engine: submits each recording, draws each range's output into the
-/// targets (the first range clears them).
-struct ChunkDraw<'a> {
+/// A subdivided frame's engine: the one-submission frame drawn as it is submitted; a chunked
+/// frame's recordings submitted one by one, each range's output drawn into the targets (the
+/// first range clears them).
+struct FrameDraw<'a> {
     method: &'a SubdividedMethod,
     gpu: &'a Gpu,
     res: &'a mut FrameResources,
     scene: &'a GpuScene,
     settings: &'a RenderSettings,
     panorama: PanoramaKind,
-    clock: ChunkClock,
+    clock: FrameClock,
 }
 
-impl SubdivisionEngine for ChunkDraw<'_> {
+impl SubdivisionEngine for FrameDraw<'_> {
     fn ensure(&mut self, want: Capacities) -> Capacities {
         SubdivisionBuffers::ensure(&mut self.res.buffers, self.gpu, want, self.scene).capacity
     }
@@ -369,6 +326,12 @@ impl SubdivisionEngine for ChunkDraw<'_> {
 
     fn take(&mut self, _: &SubdivideCounters) -> Result<()> {
         let t = Instant::now();
+        if !self.clock.chunked {
+            // Each chunk's pass loads what the eye's earlier chunks drew: no samples shared by
+            // the eyes.
+            self.res.targets.as_mut().expect("made").give_each_eye_its_samples(self.gpu);
+            self.clock.chunked = true;
+        }
         let (gpu, res) = (self.gpu, &*self.res);
         let targets = res.targets.as_ref().expect("made");
         let b = res.buffers.as_ref().expect("ensured");
@@ -380,13 +343,29 @@ impl SubdivisionEngine for ChunkDraw<'_> {
         self.clock.drawn = true;
         Ok(())
     }
+
+    /// The one-submission frame ([`SubdividedMethod::render_one_submission`]), again where it
+    /// needed the cut passes before they were built.
+    fn replay_and_take(&mut self, _: &Recording, params: &SubdivideParams) -> Result<SubdivideCounters> {
+        let t = Instant::now();
+        let (method, gpu, scene, settings) = (self.method, self.gpu, self.scene, self.settings);
+        let mut done = method.render_one_submission(gpu, self.res, scene, settings, *params)?;
+        if method.subdivide.missed_cuts(gpu, self.panorama, params, &done.0) {
+            done = method.render_one_submission(gpu, self.res, scene, settings, *params)?;
+        }
+        self.clock.one_submission = Some((t.elapsed().as_secs_f64() * 1e3, done.1));
+        Ok(done.0)
+    }
 }
 
-/// A chunked frame's wall times (ms) of the subdivision and the raster, and whether a range has
-/// been drawn (the first clears the targets).
+/// A subdivided frame's times (ms): the one submission's (wall, and the GPU's where timed), or a
+/// chunked frame's wall times of the subdivision and the raster; whether a range has been drawn
+/// by chunks (the first clears the targets) and whether the frame went by chunks.
 #[derive(Default)]
-struct ChunkClock {
+struct FrameClock {
+    one_submission: Option<(f64, Option<GpuTimes>)>,
     subdivide: f64,
     raster: f64,
     drawn: bool,
+    chunked: bool,
 }

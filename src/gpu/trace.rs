@@ -33,6 +33,7 @@ impl Method for TraceMethod {
         res: &mut FrameResources,
         scene: &GpuScene,
         settings: &RenderSettings,
+        _: &crate::encoding::frame::FrameStep,
     ) -> Result<Frame> {
         let start = Instant::now();
         let Some(bvh) = &scene.bvh else {
@@ -88,9 +89,9 @@ impl Method for TraceMethod {
         stats.rays_traced = Some(words.iter().step_by(2).map(|&w| w as u64).sum());
         stats.triangle_tests = Some(words.iter().skip(1).step_by(2).map(|&w| w as u64).sum());
         // The surface points are where the pixels' rays meet their hits.
+        // (The recording reads the distances back in their place: `encoding::frame`.)
         let wanted = settings.measure.positions;
-        let inner = settings.with_positions(false).with_depth(settings.measure.depth || wanted);
-        let mut frame = end.finish(gpu, targets, &inner, stats, start)?;
+        let mut frame = end.finish(gpu, targets, stats, start)?;
         if wanted {
             frame.positions = Some(ray_hit_points(p, frame.depth.as_ref().expect("read with the positions")));
             if !settings.measure.depth {

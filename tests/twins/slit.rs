@@ -3,9 +3,7 @@
 
 use twister::core::scenes::builtin;
 use twister::core::settings::Method;
-use twister::cpu::slit::{slit, slit_multisampled};
-use twister::encoding::slits::{slit_params, slits};
-use twister::{Eye, Projection, RenderSettings, Renderer, Scene, Vertical};
+use twister::{Projection, RenderSettings, Renderer, Scene, Vertical};
 
 use super::{common, compare_eyes, frame_outputs, measured, EyeOutputs, Twin};
 
@@ -78,23 +76,8 @@ impl Twin for Slit {
         frame_outputs(&measured(scene, settings))
     }
     fn cpu((scene, settings): &Self::Case) -> Self::Output {
-        let p = settings.projection();
-        let w = match settings.subdivision.method {
-            Method::Slit(w) => w,
-            _ => p.width, // a CAVE wall's one camera per eye
-        };
-        let table = twister::cpu::render::lit_table(scene, settings);
-        let (background, samples) = (settings.shading.background, settings.shading.samples);
-        Eye::BOTH.map(|eye| {
-            let params = slit_params(p, settings.view(), eye, settings.shading.ambient, settings.measure.error_angle);
-            let img = slit(&params, &slits(p, eye, w), scene, &table, background);
-            // Several samples: the multisampled pass's colour, the rest at the pixels' centres.
-            let rgba = match samples {
-                1 => img.rgba,
-                n => slit_multisampled(&params, &slits(p, eye, w), scene, &table, background, n),
-            };
-            (rgba, img.error, img.object, img.distance)
-        })
+        let frame = twister::cpu::render::render(scene, settings).expect("the twins' frame");
+        frame.eyes.map(|img| (img.rgba, img.error, img.object, img.distance))
     }
     fn compare(gpu: &Self::Output, cpu: &Self::Output) -> Result<(), String> {
         compare_eyes(gpu, cpu, 50, 0.01)

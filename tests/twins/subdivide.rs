@@ -121,7 +121,7 @@ fn sphere_cases(projection: &Projection) -> Vec<(Scene, RenderSettings)> {
         // (`rows_along` places the row's ends first and writes only the item's slots).
         (common::random_triangles(12, 200), RenderSettings::new(Projection::equirect(256))),
         (
-            builtin::builtin_scene("builtin:box-room", &projection).unwrap(),
+            builtin::builtin_scene("builtin:box-room", projection).unwrap(),
             RenderSettings::new(Projection::equirect(256)),
         ),
         (

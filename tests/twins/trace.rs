@@ -4,7 +4,6 @@
 use glam::Vec3;
 use twister::core::scenes::builtin;
 use twister::core::settings::Method;
-use twister::encoding::params::trace_params;
 use twister::{GpuScene, Projection, RenderSettings, Renderer, Scene, Vertical};
 
 use super::{common, compare_eyes, frame_outputs, EyeOutputs, Twin};
@@ -43,18 +42,6 @@ fn lod_spheres() -> Scene {
         scene.vertices[first..].iter_mut().for_each(|v| v.material = mirror);
     }
     scene
-}
-
-/// The BVH the command line builds: with a visual-field gaze, each object's level-of-detail
-/// chain down to the settings' N_min share.
-fn traced_bvh(scene: &Scene, settings: &RenderSettings) -> twister::core::scenes::bvh::SceneBvh {
-    match settings.shading.trace_gaze {
-        None => twister::core::scenes::bvh::SceneBvh::of_scene(scene),
-        Some(_) => {
-            let chain = twister::core::detail::lod::LodChain::build(scene, settings.shading.trace_min_share);
-            twister::core::scenes::bvh::SceneBvh::build(&scene.vertices, &chain.levels)
-        }
-    }
 }
 
 /// A checker floor and a mirror sphere on it (the trace twin: textures by ray cones, reflected).
@@ -236,19 +223,16 @@ impl Twin for Trace {
     }
     fn gpu(r: &Renderer, (scene, settings): &Self::Case) -> Self::Output {
         let gs = GpuScene::upload(&r.gpu, scene)
-            .and_then(|g| g.with_built_bvh(&r.gpu, &scene.name, &traced_bvh(scene, settings)))
+            .and_then(|g| g.with_built_bvh(&r.gpu, &scene.name, &twister::cpu::render::traced_bvh(scene, settings)))
             .expect("upload");
         let frame = r.render(&gs, &settings.with_measure_error(true).with_depth(true)).expect("render");
         let (rays, tests) = (frame.stats.rays_traced.expect("counted"), frame.stats.triangle_tests.expect("counted"));
         (frame_outputs(&frame), rays, tests)
     }
     fn cpu((scene, settings): &Self::Case) -> Self::Output {
-        let bvh = traced_bvh(scene, settings);
-        let p = settings.projection();
-        let params = trace_params(settings, p.width);
-        let table = twister::cpu::render::lit_table(scene, settings);
-        let out = twister::cpu::trace::trace(&params, &scene.vertices, &bvh, &table);
-        (out.images.map(|img| (img.rgba, img.error, img.object, img.distance)), out.rays, out.triangle_tests)
+        let frame = twister::cpu::render::render(scene, settings).expect("the twins' frame");
+        let (rays, tests) = frame.traced.expect("traced");
+        (frame.eyes.map(|img| (img.rgba, img.error, img.object, img.distance)), rays, tests)
     }
     fn compare((gpu, g_rays, g_tests): &Self::Output, (cpu, c_rays, c_tests): &Self::Output) -> Result<(), String> {
         // The same traversal: the same counts, but for rays where rounding decides a tie.

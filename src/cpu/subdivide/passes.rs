@@ -23,7 +23,7 @@ use crate::core::scenes::scene::SceneVertex;
 use crate::core::settings::RenderSettings;
 use crate::encoding::constants::{BANDS, PIECES_FROM_COUNTER, PLAN_CUTS_SPLIT};
 use crate::encoding::recording::{Command, Recording, SubdivideBuffer};
-use crate::encoding::schedule::{run_schedule, Capacities, Schedule, SubdivisionEngine};
+use crate::encoding::schedule::{run_plan, run_schedule, Capacities, FramePlan, RunTotals, Schedule, SubdivisionEngine};
 use crate::encoding::subdivide::{
     DISPATCH_LATTICE, DISPATCH_LATTICE_NODES, DISPATCH_LATTICE_ROWS, DISPATCH_LATTICE_ROWS_PLAN,
     DISPATCH_LATTICE_TRIANGLES, DISPATCH_PLAN_CUTS, DISPATCH_PLAN_PARTS, DISPATCH_WORDS,
@@ -47,6 +47,21 @@ pub fn run_scheduled(
     let max_part_output = engine.part_output.values().copied().max().unwrap_or(0);
     let max_piece_output = engine.max_piece_output;
     Ok(SubdivideOutput { max_piece_output, max_part_output, ..totals.output(engine.nodes, engine.taken_indices) })
+}
+
+/// Runs the whole stage on the CPU by a frame's `plan` (a recorded frame's subdivision step,
+/// `encoding::frame`), the first chunk of at most `chunk` triangles where it goes by chunks:
+/// every range's output, and the run's totals.
+pub fn run_planned(
+    settings: &RenderSettings,
+    vertices: &[SceneVertex],
+    indices: &[u32],
+    plan: FramePlan,
+    chunk: u32,
+) -> Result<(SubdivideOutput, RunTotals)> {
+    let mut engine = CpuSubdivision::new(vertices, indices, &[]);
+    let totals = run_plan(&mut engine, settings, (indices.len() / 3) as u32, plan, chunk)?;
+    Ok((totals.output(engine.nodes, engine.taken_indices), totals))
 }
 
 /// The stage's buffers on the CPU, and what [`SubdivisionEngine::take`] kept.

@@ -1,0 +1,73 @@
+//! A whole frame as one recording (`twister::encoding::frame`): the GPU (`Renderer::render_recorded`)
+//! and the CPU twins (`cpu::render::render_recorded`) run the same recording, step by step, and
+//! draw the same frame — the usual one-submission frame (indirect dispatches and draw), one
+//! whose buffers overflow (the one overflow policy, `encoding::schedule::run_plan`, redraws it
+//! by chunks on both), and one by chunks from the start; every target compared, the chunks and
+//! triangles counted alike, the error reduced alike.
+
+use twister::core::scenes::builtin;
+use twister::core::settings::Method;
+use twister::cpu::render::render_recorded;
+use twister::encoding::frame::{FrameRecording, FrameStep};
+use twister::encoding::schedule::{Capacities, FramePlan};
+use twister::{GpuScene, Projection, RenderSettings};
+
+use super::{common, compare_eyes, error_tolerance, frame_outputs};
+
+/// `recording` with its subdivision's plan and first chunk replaced.
+fn with_plan(recording: &FrameRecording, plan: FramePlan, chunk: u32) -> FrameRecording {
+    let steps = recording
+        .steps
+        .iter()
+        .map(|s| match s {
+            FrameStep::Subdivided { .. } => FrameStep::Subdivided { plan, chunk },
+            s => *s,
+        })
+        .collect();
+    FrameRecording { steps }
+}
+
+#[test]
+fn the_gpu_and_the_twins_run_the_same_frame_recording() {
+    let r = common::renderer();
+    let scene = builtin::demo();
+    let gs = GpuScene::upload(&r.gpu, &scene).expect("upload");
+    let projection = Projection { width: 256, height: 64, ..Projection::default() };
+    let settings = RenderSettings::new(projection)
+        .with_method(Method::Adaptive(Default::default()))
+        .with_measure_error(true)
+        .with_depth(true);
+    let usual = r.record(&gs, &settings);
+    assert!(matches!(usual.plan(), Some(FramePlan::OneSubmission(..))), "{usual:?}");
+    assert!(usual.steps.contains(&FrameStep::ReduceError { per_eye: false }), "{usual:?}");
+    // Buffers a few hundred pieces and a few thousand output units large: the one submission
+    // overflows; the chunks halve until they fit.
+    let small = Capacities { pieces: 300, triangles: 2500 };
+    let n = scene.triangle_count() as u32;
+    let cases = [
+        ("one submission", usual.clone(), false),
+        ("one submission overflowed, redrawn by chunks", with_plan(&usual, FramePlan::OneSubmission(small, small), n), true),
+        (
+            "by chunks of 64 triangles from the start",
+            with_plan(&usual, FramePlan::first(n, None, small).after_overflow(small), 64),
+            true,
+        ),
+    ];
+    for (name, recording, chunked) in cases {
+        let gpu = r.render_recorded(&gs, &settings, &recording).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let cpu = render_recorded(&scene, &settings, &recording).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let (chunks, triangles, reduced) = (cpu.chunks, cpu.triangles.len() as u64 / 3, cpu.error_stats);
+        let cpu_eyes = cpu.eyes.map(|img| (img.rgba, img.error, img.object, img.distance));
+        compare_eyes(&frame_outputs(&gpu), &cpu_eyes, 100, error_tolerance(&settings))
+            .unwrap_or_else(|e| panic!("{name}: GPU and twins differ: {e}"));
+        assert_eq!(gpu.stats.chunks, chunks, "{name}: chunks");
+        assert_eq!(chunks > 1, chunked, "{name}: {chunks} chunks");
+        assert_eq!(gpu.stats.triangles_out, triangles, "{name}: triangles");
+        let (g, c) = (gpu.measurement.expect("measured").stats, reduced.expect("reduced"));
+        let near = |a: f32, b: f32| (a - b).abs() <= 0.02 * b.abs() + 1e-3;
+        assert!(
+            g.count.abs_diff(c.count) * 100 <= c.count && near(g.mean, c.mean) && near(g.p90, c.p90),
+            "{name}: error statistics GPU {g:?}, CPU {c:?}"
+        );
+    }
+}
