@@ -14,7 +14,7 @@
 //! | [`reduce_error`] | `shaders/reduce_error.wgsl` |
 //! | [`project_points`] | `shaders/project_points.wgsl` |
 //!
-//! [`render`] runs a whole frame of the projection methods through the twins, in the GPU's order.
+//! [`render`] runs a whole frame's recording (`encoding::frame`) through the twins.
 
 pub mod display;
 pub mod fragment;
