@@ -30,12 +30,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let frame = renderer.render(&gpu_scene, &settings)?;
     for path in write_images(
         out.as_ref(),
-        &layout_images(
-            &frame,
-            Layout::Twister,
-            twister::output::ImageFormat::Png,
-            settings.projection().panorama,
-        ),
+        &layout_images(&frame, Layout::Twister, twister::output::ImageFormat::Png, settings.projection().panorama),
     )? {
         println!("{}", path.display());
     }

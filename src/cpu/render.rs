@@ -73,8 +73,11 @@ pub fn render(scene: &Scene, settings: &RenderSettings) -> Result<CpuFrame> {
     render_recorded(scene, settings, &record(scene, settings))
 }
 
-/// Runs a frame's recording through the CPU twins, step by step.
+/// Runs a frame's recording through the CPU twins, step by step. A recording that cannot draw
+/// the frame the settings record (`FrameRecording::check`) is one error.
 pub fn render_recorded(scene: &Scene, settings: &RenderSettings, recording: &FrameRecording) -> Result<CpuFrame> {
+    settings.validate()?;
+    recording.check(&record(scene, settings))?;
     // The shadow step's maps are drawn with the material table (`lit_table`).
     let table = lit_table(scene, settings);
     let mut frame = None;

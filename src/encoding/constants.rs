@@ -212,36 +212,37 @@ fn codes() -> Vec<(&'static str, Value)> {
     use Value::U32;
     // Each panorama's code, from the registry.
     let panoramas = PANORAMAS.iter().map(|m| (m.wgsl_name(), U32(m.kind().code())));
-    panoramas.chain([
-        ("NO_TEXTURE", U32(NO_TEXTURE)),
-        ("WRAP_REPEAT", U32(Wrap::Repeat as u32)),
-        ("WRAP_CLAMP", U32(Wrap::ClampToEdge as u32)),
-        ("WRAP_MIRROR", U32(Wrap::MirroredRepeat as u32)),
-        ("FILTER_NEAREST", U32(Filter::Nearest as u32)),
-        ("FILTER_LINEAR", U32(Filter::Linear as u32)),
-        ("MIPMAP_NONE", U32(Mipmap::None as u32)),
-        ("MIPMAP_NEAREST", U32(Mipmap::Nearest as u32)),
-        ("MIPMAP_LINEAR", U32(Mipmap::Linear as u32)),
-        ("ALPHA_OPAQUE", U32(AlphaMode::Opaque as u32)),
-        ("ALPHA_MASK", U32(AlphaMode::Mask as u32)),
-        ("ALPHA_BLEND", U32(AlphaMode::Blend as u32)),
-        ("LIGHT_DIRECTIONAL", U32(LightKind::Directional as u32)),
-        ("LIGHT_POINT", U32(LightKind::Point as u32)),
-        ("LIGHT_SPOT", U32(LightKind::Spot as u32)),
-        ("ENV_LEVELS", U32(crate::core::shading::environment::ENV_LEVELS as u32)),
-        ("LUT_SIZE", U32(crate::core::shading::environment::LUT_SIZE as u32)),
-        ("MAX_SHADOW_MAPS", U32(crate::core::shading::shadow::MAX_SHADOW_MAPS as u32)),
-        ("SHADOW_ORTHOGRAPHIC", U32(crate::core::shading::shadow::SHADOW_ORTHOGRAPHIC)),
-        ("SHADOW_PERSPECTIVE", U32(crate::core::shading::shadow::SHADOW_PERSPECTIVE)),
-        ("SHADOW_CUBE", U32(crate::core::shading::shadow::SHADOW_CUBE)),
-        ("NO_SKIN", U32(crate::encoding::types::NO_SKIN)),
-        ("NO_SHADOW_MAP", U32(crate::core::shading::light::NO_SHADOW_MAP)),
-        ("TONEMAP_NONE", U32(Tonemap::None.code())),
-        ("TONEMAP_PBR_NEUTRAL", U32(Tonemap::PbrNeutral.code())),
-        ("TONEMAP_ACES", U32(Tonemap::Aces.code())),
-        ("TONEMAP_LINEAR", U32(Tonemap::Linear.code())),
-    ])
-    .collect()
+    panoramas
+        .chain([
+            ("NO_TEXTURE", U32(NO_TEXTURE)),
+            ("WRAP_REPEAT", U32(Wrap::Repeat as u32)),
+            ("WRAP_CLAMP", U32(Wrap::ClampToEdge as u32)),
+            ("WRAP_MIRROR", U32(Wrap::MirroredRepeat as u32)),
+            ("FILTER_NEAREST", U32(Filter::Nearest as u32)),
+            ("FILTER_LINEAR", U32(Filter::Linear as u32)),
+            ("MIPMAP_NONE", U32(Mipmap::None as u32)),
+            ("MIPMAP_NEAREST", U32(Mipmap::Nearest as u32)),
+            ("MIPMAP_LINEAR", U32(Mipmap::Linear as u32)),
+            ("ALPHA_OPAQUE", U32(AlphaMode::Opaque as u32)),
+            ("ALPHA_MASK", U32(AlphaMode::Mask as u32)),
+            ("ALPHA_BLEND", U32(AlphaMode::Blend as u32)),
+            ("LIGHT_DIRECTIONAL", U32(LightKind::Directional as u32)),
+            ("LIGHT_POINT", U32(LightKind::Point as u32)),
+            ("LIGHT_SPOT", U32(LightKind::Spot as u32)),
+            ("ENV_LEVELS", U32(crate::core::shading::environment::ENV_LEVELS as u32)),
+            ("LUT_SIZE", U32(crate::core::shading::environment::LUT_SIZE as u32)),
+            ("MAX_SHADOW_MAPS", U32(crate::core::shading::shadow::MAX_SHADOW_MAPS as u32)),
+            ("SHADOW_ORTHOGRAPHIC", U32(crate::core::shading::shadow::SHADOW_ORTHOGRAPHIC)),
+            ("SHADOW_PERSPECTIVE", U32(crate::core::shading::shadow::SHADOW_PERSPECTIVE)),
+            ("SHADOW_CUBE", U32(crate::core::shading::shadow::SHADOW_CUBE)),
+            ("NO_SKIN", U32(crate::encoding::types::NO_SKIN)),
+            ("NO_SHADOW_MAP", U32(crate::core::shading::light::NO_SHADOW_MAP)),
+            ("TONEMAP_NONE", U32(Tonemap::None.code())),
+            ("TONEMAP_PBR_NEUTRAL", U32(Tonemap::PbrNeutral.code())),
+            ("TONEMAP_ACES", U32(Tonemap::Aces.code())),
+            ("TONEMAP_LINEAR", U32(Tonemap::Linear.code())),
+        ])
+        .collect()
 }
 
 /// The generated WGSL module `constants`.

@@ -7,6 +7,7 @@
 
 use crate::core::settings::{Method, RenderSettings};
 use crate::encoding::schedule::{Capacities, FramePlan};
+use crate::error::{Error, Result};
 
 /// One step of a frame, named by the stage that runs it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -50,6 +51,25 @@ pub struct FrameFacts {
 }
 
 impl FrameRecording {
+    /// Whether this recording (handed to an engine) can draw the frame `expected` records
+    /// (`record_frame` with the same settings): the same steps in the same order, the same
+    /// slits, its subdivision's plan free (one submission or chunks, any capacities, a first
+    /// chunk of at least one triangle). Else one error naming what differs.
+    pub fn check(&self, expected: &FrameRecording) -> Result<()> {
+        let same = self.steps.len() == expected.steps.len()
+            && self.steps.iter().zip(&expected.steps).all(|(a, b)| match (a, b) {
+                (FrameStep::Subdivided { chunk, .. }, FrameStep::Subdivided { .. }) => *chunk > 0,
+                (a, b) => a == b,
+            });
+        if same {
+            return Ok(());
+        }
+        Err(Error::setting(
+            "recording",
+            format!("{:?} cannot draw this frame, whose settings record {:?}", self.steps, expected.steps),
+        ))
+    }
+
     /// The plan of its subdivision; None for a frame without one.
     pub fn plan(&self) -> Option<FramePlan> {
         self.steps.iter().find_map(|s| match *s {
@@ -107,7 +127,13 @@ mod tests {
         let settings = RenderSettings::new(Projection { width: 64, height: 16, ..Projection::default() });
         let steps = record_frame(&settings.with_measure_error(true), &FACTS).steps;
         assert!(matches!(steps[0], FrameStep::Subdivided { plan: FramePlan::OneSubmission(..), chunk: 1000 }));
-        assert_eq!(steps[1..], [FrameStep::ReadBack { hdr: false, depth: false, positions: false, error: true }, FrameStep::ReduceError { per_eye: false }]);
+        assert_eq!(
+            steps[1..],
+            [
+                FrameStep::ReadBack { hdr: false, depth: false, positions: false, error: true },
+                FrameStep::ReduceError { per_eye: false }
+            ]
+        );
         let lit = FrameFacts { shadow_maps: 2, ..FACTS };
         let slit = record_frame(&settings.with_method(Method::Slit(4)).with_measure_error(false), &lit).steps;
         assert_eq!(slit[..2], [FrameStep::Shadow { maps: 2 }, FrameStep::Slit { width: 4 }]);
@@ -116,11 +142,43 @@ mod tests {
     }
 
     #[test]
+    fn a_recording_for_other_settings_is_refused_by_name() {
+        let settings = RenderSettings::new(Projection { width: 64, height: 16, ..Projection::default() });
+        let expected = record_frame(&settings, &FACTS);
+        let chunked = FrameStep::Subdivided {
+            plan: FramePlan::first(1000, None, Capacities { pieces: 9, triangles: 9 }),
+            chunk: 7,
+        };
+        let other_plan = FrameRecording { steps: [vec![chunked], expected.steps[1..].to_vec()].concat() };
+        assert!(other_plan.check(&expected).is_ok(), "the plan is free");
+        for bad in [
+            FrameRecording { steps: vec![] },
+            FrameRecording { steps: [vec![FrameStep::Slit { width: 0 }], expected.steps[1..].to_vec()].concat() },
+            FrameRecording {
+                steps: [
+                    vec![FrameStep::Subdivided {
+                        plan: FramePlan::first(1, None, Capacities { pieces: 1, triangles: 1 }),
+                        chunk: 0,
+                    }],
+                    expected.steps[1..].to_vec(),
+                ]
+                .concat(),
+            },
+            FrameRecording { steps: [expected.steps.clone(), vec![FrameStep::ReduceError { per_eye: true }]].concat() },
+        ] {
+            let e = bad.check(&expected).expect_err("refused").to_string();
+            assert!(e.starts_with("recording: "), "{e}");
+        }
+    }
+
+    #[test]
     fn more_triangles_than_one_binding_lists_are_subdivided_by_chunks() {
         let settings = RenderSettings::new(Projection { width: 64, height: 16, ..Projection::default() });
         let facts = FrameFacts { triangles: 5000, max_binding: 4 * 3000, ..FACTS };
         let plan = record_frame(&settings, &facts).plan();
         assert!(matches!(plan, Some(FramePlan::Chunked { .. })), "{plan:?}");
-        assert!(record_frame(&settings, &facts).steps.contains(&FrameStep::Subdivided { plan: plan.unwrap(), chunk: 3000 }));
+        assert!(record_frame(&settings, &facts)
+            .steps
+            .contains(&FrameStep::Subdivided { plan: plan.unwrap(), chunk: 3000 }));
     }
 }

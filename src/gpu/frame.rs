@@ -109,13 +109,7 @@ pub(crate) struct FrameEnd<'a> {
 
 impl FrameEnd<'_> {
     /// Reads the targets back and reduces the error: the end of every render.
-    pub fn finish(
-        &self,
-        gpu: &Gpu,
-        targets: &Targets,
-        mut stats: FrameStats,
-        start: Instant,
-    ) -> Result<Frame> {
+    pub fn finish(&self, gpu: &Gpu, targets: &Targets, mut stats: FrameStats, start: Instant) -> Result<Frame> {
         let t = Instant::now();
         let [left, right] = if self.show {
             let (texels, row_texels) =

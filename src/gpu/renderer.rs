@@ -324,28 +324,29 @@ impl Renderer {
         settings: &RenderSettings,
         show: bool,
     ) -> Result<(Frame, Option<ShownFrame>)> {
-        let resources = self.resources.lock().unwrap_or_else(|e| e.into_inner());
         let shadow_maps = scene.write_lighting(&self.gpu, settings);
-        let facts = FrameFacts {
-            triangles: scene.triangle_count,
-            shadow_maps: shadow_maps.len() as u32,
-            cached: resources.buffers.as_ref().map(|b| b.capacity),
-            max_binding: self.gpu.max_binding(),
-        };
-        drop(resources);
-        let recording = record_frame(settings, &facts);
+        let recording = self.record_with(scene, settings, shadow_maps.len());
         self.run_recording(scene, settings, &recording, &shadow_maps, show)
     }
 
     /// Records the frame `settings` draw of `scene` as this renderer would now
     /// ([`record_frame`] with what it holds): what [`Renderer::render_recorded`] runs.
     pub fn record(&self, scene: &GpuScene, settings: &RenderSettings) -> FrameRecording {
-        let (_, _, maps) =
-            settings.shadowed_lighting(&scene.lights, scene.physically_based, scene.environment.as_deref(), scene.bounds);
+        let (_, _, maps) = settings.shadowed_lighting(
+            &scene.lights,
+            scene.physically_based,
+            scene.environment.as_deref(),
+            scene.bounds,
+        );
+        self.record_with(scene, settings, maps.len())
+    }
+
+    /// [`Renderer::record`] with the lights' `shadow_maps` known.
+    fn record_with(&self, scene: &GpuScene, settings: &RenderSettings, shadow_maps: usize) -> FrameRecording {
         let resources = self.resources.lock().unwrap_or_else(|e| e.into_inner());
         let facts = FrameFacts {
             triangles: scene.triangle_count,
-            shadow_maps: maps.len() as u32,
+            shadow_maps: shadow_maps as u32,
             cached: resources.buffers.as_ref().map(|b| b.capacity),
             max_binding: self.gpu.max_binding(),
         };
@@ -353,11 +354,19 @@ impl Renderer {
     }
 
     /// Draws a recorded frame of `scene` ([`Renderer::record`]; the CPU twins run the same
-    /// recording, `cpu::render::render_recorded`), at a sample count the adapter draws.
-    pub fn render_recorded(&self, scene: &GpuScene, settings: &RenderSettings, recording: &FrameRecording) -> Result<Frame> {
+    /// recording, `cpu::render::render_recorded`), at a sample count the adapter draws. A
+    /// recording that cannot draw the frame the settings record (other steps, other slits; its
+    /// subdivision's plan is free) is one error.
+    pub fn render_recorded(
+        &self,
+        scene: &GpuScene,
+        settings: &RenderSettings,
+        recording: &FrameRecording,
+    ) -> Result<Frame> {
         settings.validate()?;
         self.check_size(settings)?;
         let shadow_maps = scene.write_lighting(&self.gpu, settings);
+        recording.check(&self.record_with(scene, settings, shadow_maps.len()))?;
         Ok(self.run_recording(scene, settings, recording, &shadow_maps, false)?.0)
     }
 

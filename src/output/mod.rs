@@ -617,7 +617,12 @@ mod tests {
             positions: None,
             hdr: None,
         };
-        let images = layout_images(&frame, Layout::Strip12, ImageFormat::Png, crate::core::panoramas::projection::Projection::cubemap(48).panorama);
+        let images = layout_images(
+            &frame,
+            Layout::Strip12,
+            ImageFormat::Png,
+            crate::core::panoramas::projection::Projection::cubemap(48).panorama,
+        );
         assert_eq!(images.len(), 1);
         let (name, strip) = &images[0];
         assert_eq!((name.as_str(), strip.width, strip.height), ("stereo_cubemap_12x1.png", 12 * face, face));

@@ -22,11 +22,11 @@ use proptest::prelude::*;
 use proptest::strategy::{BoxedStrategy, ValueTree};
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 
+use crate::core::choice::Choice;
 use crate::core::detail::lod::{LodChain, LodParams, LodSelection};
 use crate::core::detail::visual_field::Gaze;
 use crate::core::panoramas::cave::NamedWall;
 use crate::core::panoramas::head::Head;
-use crate::core::choice::Choice;
 use crate::core::panoramas::projection::{PanoramaKind, Projection, Vertical, DEFAULT_POLE_MERGE};
 use crate::core::scenes::scene::Scene;
 use crate::core::scenes::shapes::ClosedMesh;

@@ -46,7 +46,11 @@ fn the_gpu_and_the_twins_run_the_same_frame_recording() {
     let n = scene.triangle_count() as u32;
     let cases = [
         ("one submission", usual.clone(), false),
-        ("one submission overflowed, redrawn by chunks", with_plan(&usual, FramePlan::OneSubmission(small, small), n), true),
+        (
+            "one submission overflowed, redrawn by chunks",
+            with_plan(&usual, FramePlan::OneSubmission(small, small), n),
+            true,
+        ),
         (
             "by chunks of 64 triangles from the start",
             with_plan(&usual, FramePlan::first(n, None, small).after_overflow(small), 64),
@@ -70,4 +74,42 @@ fn the_gpu_and_the_twins_run_the_same_frame_recording() {
             "{name}: error statistics GPU {g:?}, CPU {c:?}"
         );
     }
+}
+
+/// A recording that cannot draw the frame its settings record — another method's step, slits
+/// of no width, a subdivision whose first chunk holds no triangle — is one error naming the
+/// recording on both engines, nothing drawn.
+#[test]
+fn a_recording_that_cannot_draw_the_frame_is_one_error_on_both_engines() {
+    let r = common::renderer();
+    let scene = builtin::demo();
+    let gs = GpuScene::upload(&r.gpu, &scene).expect("upload");
+    let settings = RenderSettings::new(Projection { width: 64, height: 16, ..Projection::default() });
+    let usual = r.record(&gs, &settings);
+    let slit_settings = settings.with_method(Method::Slit(4));
+    let no_width = with_step(&r.record(&gs, &slit_settings), FrameStep::Slit { width: 0 });
+    let plan = usual.plan().expect("subdivided");
+    let cases = [
+        ("slits for a subdivided frame", settings, with_step(&usual, FrameStep::Slit { width: 4 })),
+        ("slits of no width", slit_settings, no_width),
+        ("a first chunk of no triangles", settings, with_plan(&usual, plan, 0)),
+        ("no steps", settings, FrameRecording { steps: Vec::new() }),
+    ];
+    for (name, settings, recording) in cases {
+        let gpu = r.render_recorded(&gs, &settings, &recording).map(|_| ()).expect_err(name).to_string();
+        let cpu = render_recorded(&scene, &settings, &recording).map(|_| ()).expect_err(name).to_string();
+        assert!(gpu.starts_with("recording: ") && cpu.starts_with("recording: "), "{name}: {gpu} / {cpu}");
+    }
+    // A plan whose budget holds nothing: the memory budget's error, the same on both.
+    let none = Capacities { pieces: 0, triangles: 0 };
+    let starved = with_plan(&usual, FramePlan::OneSubmission(none, none), 8);
+    let gpu = r.render_recorded(&gs, &settings, &starved).map(|_| ()).expect_err("starved").to_string();
+    let cpu = render_recorded(&scene, &settings, &starved).map(|_| ()).expect_err("starved").to_string();
+    assert!(gpu.starts_with("subdivision.memory_mb: ") && gpu == cpu, "{gpu} / {cpu}");
+}
+
+/// `recording` with its drawing step replaced by `step`.
+fn with_step(recording: &FrameRecording, step: FrameStep) -> FrameRecording {
+    let drawing = |s: &FrameStep| matches!(s, FrameStep::Subdivided { .. } | FrameStep::Slit { .. } | FrameStep::Trace);
+    FrameRecording { steps: recording.steps.iter().map(|s| if drawing(s) { step } else { *s }).collect() }
 }

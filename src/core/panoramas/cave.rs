@@ -21,8 +21,8 @@ use std::path::Path;
 
 use glam::{Mat3, Vec3};
 
-pub use crate::core::panoramas::projection::CaveWall;
 use crate::core::panoramas::panorama::{EyeModel, ImageMap, Panorama, PanoramaKind};
+pub use crate::core::panoramas::projection::CaveWall;
 use crate::core::panoramas::projection::{Eye, Head, Projected, Projection};
 use crate::error::{Error, Result};
 

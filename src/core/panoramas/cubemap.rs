@@ -245,7 +245,6 @@ impl Projection {
         let [col, row] = CUBE_FACES[f].cell;
         [col * s, row * s, s]
     }
-
 }
 
 /// The stereo cubemap.

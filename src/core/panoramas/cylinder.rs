@@ -8,7 +8,9 @@
 use glam::Vec3;
 
 use crate::core::panoramas::panorama::{EyeModel, ImageMap, Panorama, PanoramaKind};
-use crate::core::panoramas::projection::{horizontal_radius, linear_pixel, linear_screen, Eye, Projected, Projection, Vertical};
+use crate::core::panoramas::projection::{
+    horizontal_radius, linear_pixel, linear_screen, Eye, Projected, Projection, Vertical,
+};
 
 /// The cylinder.
 pub struct Cylinder;

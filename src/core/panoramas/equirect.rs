@@ -61,5 +61,4 @@ impl Panorama for Equirect {
     fn vertical_limit(&self, p: &Projection) -> f32 {
         sphere_vertical_limit(p)
     }
-
 }

@@ -24,8 +24,8 @@
 
 use glam::{Mat3, Vec3};
 
-pub use crate::core::panoramas::projection::Head;
 use crate::core::panoramas::panorama::EyeModel;
+pub use crate::core::panoramas::projection::Head;
 use crate::core::panoramas::projection::{azimuth, wrap_angle, Eye, Projected, Projection, Vertical};
 use crate::error::{Error, Result};
 

@@ -58,5 +58,4 @@ impl Panorama for Vr180 {
     fn vertical_limit(&self, p: &Projection) -> f32 {
         sphere_vertical_limit(p)
     }
-
 }

@@ -23,7 +23,9 @@ use crate::core::scenes::scene::SceneVertex;
 use crate::core::settings::RenderSettings;
 use crate::encoding::constants::{BANDS, PIECES_FROM_COUNTER, PLAN_CUTS_SPLIT};
 use crate::encoding::recording::{Command, Recording, SubdivideBuffer};
-use crate::encoding::schedule::{run_plan, run_schedule, Capacities, FramePlan, RunTotals, Schedule, SubdivisionEngine};
+use crate::encoding::schedule::{
+    run_plan, run_schedule, Capacities, FramePlan, RunTotals, Schedule, SubdivisionEngine,
+};
 use crate::encoding::subdivide::{
     DISPATCH_LATTICE, DISPATCH_LATTICE_NODES, DISPATCH_LATTICE_ROWS, DISPATCH_LATTICE_ROWS_PLAN,
     DISPATCH_LATTICE_TRIANGLES, DISPATCH_PLAN_CUTS, DISPATCH_PLAN_PARTS, DISPATCH_WORDS,
