@@ -60,14 +60,21 @@ mod tests {
     use crate::core::panoramas::panorama::PanoramaKind;
     use crate::core::shading::light::Tonemap;
 
+    /// Every value of `C` comes back from its name, in kebab and snake case, and the JSON files
+    /// spell it so; each has a line of help.
+    fn round_trips<C: Choice + serde::Serialize + std::fmt::Debug>() {
+        for &value in C::CHOICES {
+            assert_eq!(C::from_name(value.name()), Some(value));
+            assert_eq!(C::from_name(&value.name().replace('-', "_")), Some(value));
+            assert_eq!(serde_json::to_value(value).unwrap(), value.name(), "the JSON files spell it so");
+            assert!(!value.help().is_empty());
+        }
+    }
+
     #[test]
     fn names_round_trip_in_kebab_and_snake_case_and_match_the_json_spelling() {
-        for &kind in PanoramaKind::CHOICES {
-            assert_eq!(PanoramaKind::from_name(kind.name()), Some(kind));
-            assert_eq!(serde_json::to_value(kind).unwrap(), kind.name(), "the JSON files spell it so");
-            assert!(!kind.help().is_empty());
-        }
-        assert_eq!(PanoramaKind::CHOICES.len(), PanoramaKind::ALL.len());
+        round_trips::<PanoramaKind>();
+        round_trips::<Tonemap>();
         assert_eq!(Tonemap::from_name("pbr_neutral"), Some(Tonemap::PbrNeutral));
         // The linear tone map belongs to HDR frames and is no user's choice.
         assert_eq!(Tonemap::from_name("linear"), None);
@@ -76,7 +83,8 @@ mod tests {
 
     #[test]
     fn an_unknown_name_is_an_error_naming_the_setting_and_the_values() {
-        let e = PanoramaKind::parse_for("view.projection.panorama", "dome").unwrap_err().to_string();
+        let parsed: Result<PanoramaKind> = Choice::parse_for("view.projection.panorama", "dome");
+        let e = parsed.unwrap_err().to_string();
         assert_eq!(
             e,
             "view.projection.panorama: \"dome\" is not one of cylinder, equirect, vr180, fisheye, cubemap, cave"

@@ -470,9 +470,10 @@ pub fn cave_walls(pixels: u32) -> Vec<twister::core::panoramas::cave::NamedWall>
 /// CAVE wall `k` of [`cave_walls`] seen by a head at `head` (scene = display frame) facing
 /// `yaw` degrees: its projection.
 pub fn cave(k: usize, pixels: u32, head: glam::Vec3, yaw: f32) -> twister::Projection {
+    use twister::core::panoramas::panorama::Panorama;
     let wall = &cave_walls(pixels)[k];
     twister::Projection {
-        panorama: twister::core::panoramas::projection::PanoramaKind::Cave,
+        panorama: twister::core::panoramas::cave::Cave.kind(),
         width: pixels,
         height: pixels,
         wall: Some(wall.in_display(1.0, glam::Vec3::ZERO, 0.0)),

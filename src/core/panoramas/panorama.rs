@@ -2,8 +2,8 @@
 //! `Camera`): each is a type in its own file — `Cylinder` (cylinder.rs), `Equirect`, `Vr180`,
 //! `Fisheye`, `Cubemap`, `Cave` — with its forward map and inverse, its image's facts, its WGSL
 //! module's code and what the pipeline asks of it. [`PanoramaKind`] is the name a setting chooses
-//! (the command line, a settings file, `core::panoramas::kind`); `PanoramaKind::model` finds its
-//! type in the registry (`core::panoramas::registry`). Adding a panorama: its file, a line in the
+//! (the command line, a settings file, `core::panoramas::kind`); its `model` is its type, from
+//! the registry (`core::panoramas::registry`). Adding a panorama: its file, a line in the
 //! registry and a variant of the kind (docs/ARCHITECTURE.md, *How to add … a panorama*).
 //!
 //! The maps' defaults are the full sphere's eye model (`core::panoramas::sphere`), whose rays

@@ -72,7 +72,7 @@ mod tests {
             assert_eq!((kind.code(), kind.model().wgsl_name()), (code as u32, model.wgsl_name()));
             assert_eq!(PanoramaKind::from_code(code as u32), Some(kind));
         }
-        let all = PanoramaKind::ALL;
+        let all = <PanoramaKind as crate::core::choice::Choice>::CHOICES;
         assert_eq!(all.len(), PANORAMAS.len(), "every kind has a type in the registry");
         assert!(all.iter().enumerate().all(|(i, k)| k.code() == i as u32), "the kinds' order is the registry's");
     }
