@@ -365,6 +365,13 @@ impl Renderer {
     ) -> Result<Frame> {
         settings.validate()?;
         self.check_size(settings)?;
+        let (n, counts) = (settings.shading.samples, crate::gpu::targets::sample_counts(&self.gpu));
+        if !counts.contains(&n) && settings.subdivision.method != MethodName::Trace {
+            return Err(Error::setting(
+                "shading.samples",
+                format!("a recorded frame is drawn at a sample count the adapter has ({counts:?}), not {n}: `render` makes up the others"),
+            ));
+        }
         let shadow_maps = scene.write_lighting(&self.gpu, settings);
         recording.check(&self.record_with(scene, settings, shadow_maps.len()))?;
         Ok(self.run_recording(scene, settings, recording, &shadow_maps, false)?.0)

@@ -100,6 +100,14 @@ fn a_recording_that_cannot_draw_the_frame_is_one_error_on_both_engines() {
         let cpu = render_recorded(&scene, &settings, &recording).map(|_| ()).expect_err(name).to_string();
         assert!(gpu.starts_with("recording: ") && cpu.starts_with("recording: "), "{name}: {gpu} / {cpu}");
     }
+    // A sample count the adapter lacks (`render` makes it up from a larger image; a recorded
+    // frame is drawn as it is): one error naming the setting.
+    let counts = twister::gpu::targets::sample_counts(&r.gpu);
+    if let Some(&n) = [2, 4, 8, 16, 32].iter().find(|n| !counts.contains(n)) {
+        let many = settings.with_samples(n);
+        let e = r.render_recorded(&gs, &many, &r.record(&gs, &many)).map(|_| ()).expect_err("samples").to_string();
+        assert!(e.starts_with("shading.samples: "), "{e}");
+    }
     // A plan whose budget holds nothing: the memory budget's error, the same on both.
     let none = Capacities { pieces: 0, triangles: 0 };
     let starved = with_plan(&usual, FramePlan::OneSubmission(none, none), 8);
