@@ -3,7 +3,9 @@
 //! draw the same frame — the usual one-submission frame (indirect dispatches and draw), one
 //! whose buffers overflow (the one overflow policy, `encoding::schedule::run_plan`, redraws it
 //! by chunks on both), and one by chunks from the start; every target compared, the chunks and
-//! triangles counted alike, the error reduced alike.
+//! triangles counted alike, the error reduced alike. Then every other drawing step (slits, a
+//! CAVE wall's pinholes, the ray tracer) and the shadow step, and recordings that cannot draw
+//! their frame.
 
 use twister::core::scenes::builtin;
 use twister::core::settings::Method;
@@ -120,4 +122,42 @@ fn a_recording_that_cannot_draw_the_frame_is_one_error_on_both_engines() {
 fn with_step(recording: &FrameRecording, step: FrameStep) -> FrameRecording {
     let drawing = |s: &FrameStep| matches!(s, FrameStep::Subdivided { .. } | FrameStep::Slit { .. } | FrameStep::Trace);
     FrameRecording { steps: recording.steps.iter().map(|s| if drawing(s) { step } else { *s }).collect() }
+}
+
+/// Every drawing step, and the shadow step before it, through one recording on both engines:
+/// a spot light's shadow map under the subdivided raster, `slit:4`, a CAVE wall (one pinhole
+/// per eye), the ray tracer; every target compared (as the stages' own twin tests do).
+#[test]
+fn every_drawing_step_runs_the_same_recording_on_both_engines() {
+    use twister::core::shading::light::LightKind;
+    let r = common::renderer();
+    let cylinder = Projection { width: 160, height: 48, vertical: twister::Vertical::Exact, ..Projection::default() };
+    let lit = common::ball_over_floor(LightKind::Spot, true);
+    let cave = common::cave(1, 64, glam::Vec3::new(0.2, 0.1, 0.3), 25.0);
+    let cases = [
+        ("a spot light's shadow map", lit, RenderSettings::new(cylinder).with_shadow_map_size(256), 100),
+        ("slit:4", builtin::demo(), RenderSettings::new(cylinder).with_method(Method::Slit(4)), 50),
+        ("a CAVE wall", builtin::demo(), RenderSettings::new(cave), 50),
+        ("trace", builtin::demo(), RenderSettings::new(cylinder).with_method(Method::Trace), 200),
+    ];
+    for (name, scene, settings, share) in cases {
+        let settings = settings.with_measure_error(true).with_depth(true);
+        let gs = GpuScene::upload(&r.gpu, &scene)
+            .and_then(|g| g.with_built_bvh(&r.gpu, &scene.name, &twister::cpu::render::traced_bvh(&scene, &settings)))
+            .expect("upload");
+        let recording = r.record(&gs, &settings);
+        let drawing = recording.steps.iter().find(|s| !matches!(s, FrameStep::Shadow { .. }));
+        let expected = match name {
+            "a spot light's shadow map" => recording.steps[0] == FrameStep::Shadow { maps: 1 },
+            "slit:4" => drawing == Some(&FrameStep::Slit { width: 4 }),
+            "a CAVE wall" => drawing == Some(&FrameStep::Slit { width: 64 }),
+            _ => drawing == Some(&FrameStep::Trace),
+        };
+        assert!(expected, "{name}: recorded {recording:?}");
+        let gpu = r.render_recorded(&gs, &settings, &recording).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let cpu = render_recorded(&scene, &settings, &recording).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let cpu_eyes = cpu.eyes.map(|img| (img.rgba, img.error, img.object, img.distance));
+        compare_eyes(&frame_outputs(&gpu), &cpu_eyes, share, 0.01)
+            .unwrap_or_else(|e| panic!("{name}: GPU and twins differ: {e}"));
+    }
 }
