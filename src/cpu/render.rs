@@ -25,9 +25,10 @@ use crate::encoding::slits::{slit_params, slits};
 use crate::encoding::types::DrawVertex;
 use crate::error::{Error, Result};
 
-/// The largest storage binding the CPU engine records its frames with: the WebGPU default's
-/// (128 MiB), which every adapter has.
-pub const CPU_MAX_BINDING: u64 = 128 << 20;
+/// The largest storage binding the CPU engine records its frames with: none (its buffers are
+/// bounded by the memory budget alone, which holds any adapter's budget: a GPU's recording
+/// runs on the CPU within it).
+pub const CPU_MAX_BINDING: u64 = u64::MAX;
 
 /// A frame drawn by the CPU twins.
 pub struct CpuFrame {
@@ -55,7 +56,7 @@ pub fn lit_table(scene: &Scene, settings: &RenderSettings) -> MaterialTable {
 }
 
 /// Records the frame `settings` draw of `scene` as the CPU engine holds it (no buffers kept
-/// from an earlier frame; bindings of [`CPU_MAX_BINDING`]).
+/// from an earlier frame; bindings of any size, [`CPU_MAX_BINDING`]).
 pub fn record(scene: &Scene, settings: &RenderSettings) -> FrameRecording {
     let (_, _, maps) =
         settings.shadowed_lighting(&scene.lights, scene.physically_based, scene.environment.as_deref(), scene.bounds());

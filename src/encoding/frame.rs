@@ -53,12 +53,21 @@ pub struct FrameFacts {
 impl FrameRecording {
     /// Whether this recording (handed to an engine) can draw the frame `expected` records
     /// (`record_frame` with the same settings): the same steps in the same order, the same
-    /// slits, its subdivision's plan free (one submission or chunks, any capacities, a first
-    /// chunk of at least one triangle). Else one error naming what differs.
+    /// slits, its subdivision's plan free (one submission or chunks, a first chunk of at least
+    /// one triangle) within the settings' memory budget. Else one error naming what differs.
     pub fn check(&self, expected: &FrameRecording) -> Result<()> {
+        let within = |plan: FramePlan, budget: Capacities| {
+            let fits = |c: Capacities| c.pieces <= budget.pieces && c.triangles <= budget.triangles;
+            let want = match plan {
+                FramePlan::OneSubmission(want, _) | FramePlan::Chunked { want, .. } => want,
+            };
+            fits(plan.budget()) && fits(want)
+        };
         let same = self.steps.len() == expected.steps.len()
             && self.steps.iter().zip(&expected.steps).all(|(a, b)| match (a, b) {
-                (FrameStep::Subdivided { chunk, .. }, FrameStep::Subdivided { .. }) => *chunk > 0,
+                (FrameStep::Subdivided { plan, chunk }, FrameStep::Subdivided { plan: settings, .. }) => {
+                    *chunk > 0 && within(*plan, settings.budget())
+                }
                 (a, b) => a == b,
             });
         if same {
@@ -165,6 +174,17 @@ mod tests {
                 .concat(),
             },
             FrameRecording { steps: [expected.steps.clone(), vec![FrameStep::ReduceError { per_eye: true }]].concat() },
+            // Buffers beyond the settings' memory budget.
+            FrameRecording {
+                steps: [
+                    vec![FrameStep::Subdivided {
+                        plan: FramePlan::first(1000, None, Capacities { pieces: u32::MAX, triangles: u32::MAX }),
+                        chunk: 1000,
+                    }],
+                    expected.steps[1..].to_vec(),
+                ]
+                .concat(),
+            },
         ] {
             let e = bad.check(&expected).expect_err("refused").to_string();
             assert!(e.starts_with("recording: "), "{e}");
