@@ -111,7 +111,7 @@ impl Lit {
             environment: pbr && scene.environment.is_some(),
             maps: pbr && scene.has_maps,
             shadows: scene.shadow_maps(settings),
-            panoramas: panorama_bits(settings.projection().panorama),
+            panoramas: settings.projection().model().shader_bits(),
         }
     }
 }
@@ -311,12 +311,6 @@ fn look_constants(look: Look, lit: Lit) -> Vec<(&'static str, f64)> {
         ("CIRCLE", (lit.panoramas & 4 != 0) as u32 as f64),
         ("PANORAMAS", lit.panoramas as f64),
     ]
-}
-
-/// `PANORAMAS` for a panorama (projection.wgsl): 1 the cylinder, 2 the sphere and VR180, 6 the
-/// fisheye and 10 the cubemap (the sphere's eye model in their own images), 16 the CAVE.
-pub(crate) fn panorama_bits(panorama: crate::core::panoramas::projection::PanoramaKind) -> u32 {
-    panorama.model().shader_bits()
 }
 
 /// A drawing stage's vertex buffer: its stride and attributes. Raster: the subdivided

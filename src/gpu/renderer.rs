@@ -158,13 +158,17 @@ impl Renderer {
     pub fn render(&self, scene: &GpuScene, settings: &RenderSettings) -> Result<Frame> {
         settings.validate()?;
         self.check_size(settings)?;
-        let n = settings.shading.samples;
-        let counts = crate::gpu::targets::sample_counts(&self.gpu);
-        // The ray tracer traces any count itself (a ray per sample).
-        if counts.contains(&n) || settings.subdivision.method == MethodName::Trace {
+        if self.draws_directly(settings) {
             return Ok(self.render_direct(scene, settings, false)?.0);
         }
-        self.render_larger(scene, settings, &counts)
+        self.render_larger(scene, settings, &crate::gpu::targets::sample_counts(&self.gpu))
+    }
+
+    /// Whether the adapter draws a frame's sample count itself (the ray tracer traces any count:
+    /// a ray per sample); else [`Renderer::render_larger`] makes it up.
+    fn draws_directly(&self, settings: &RenderSettings) -> bool {
+        let counts = crate::gpu::targets::sample_counts(&self.gpu);
+        counts.contains(&settings.shading.samples) || settings.subdivision.method == MethodName::Trace
     }
 
     /// How a frame is cut into tiles when it is larger than the adapter draws at once (its
@@ -247,11 +251,11 @@ impl Renderer {
     /// How many times larger (x, y) a frame is drawn for a sample count beyond the adapter's
     /// ([`Renderer::render_larger`]); (1, 1) where the adapter draws it.
     fn larger_factor(&self, settings: &RenderSettings) -> (u32, u32) {
-        let n = settings.shading.samples;
-        let counts = crate::gpu::targets::sample_counts(&self.gpu);
-        if counts.contains(&n) || settings.subdivision.method == MethodName::Trace {
+        if self.draws_directly(settings) {
             return (1, 1);
         }
+        let n = settings.shading.samples;
+        let counts = crate::gpu::targets::sample_counts(&self.gpu);
         let base = counts.iter().copied().filter(|&c| n % c == 0 && c < n).max().unwrap_or(1);
         let cells = n / base;
         (1u32 << cells.ilog2().div_ceil(2), 1u32 << (cells.ilog2() / 2))
@@ -365,8 +369,8 @@ impl Renderer {
     ) -> Result<Frame> {
         settings.validate()?;
         self.check_size(settings)?;
-        let (n, counts) = (settings.shading.samples, crate::gpu::targets::sample_counts(&self.gpu));
-        if !counts.contains(&n) && settings.subdivision.method != MethodName::Trace {
+        if !self.draws_directly(settings) {
+            let (n, counts) = (settings.shading.samples, crate::gpu::targets::sample_counts(&self.gpu));
             return Err(Error::setting(
                 "shading.samples",
                 format!("a recorded frame is drawn at a sample count the adapter has ({counts:?}), not {n}: `render` makes up the others"),
@@ -427,9 +431,8 @@ impl Renderer {
     pub fn render_shown(&self, scene: &GpuScene, settings: &RenderSettings) -> Result<(Frame, ShownFrame)> {
         settings.validate()?;
         self.check_size(settings)?;
-        let counts = crate::gpu::targets::sample_counts(&self.gpu);
-        if !counts.contains(&settings.shading.samples) && settings.subdivision.method != MethodName::Trace {
-            let frame = self.render_larger(scene, settings, &counts)?;
+        if !self.draws_directly(settings) {
+            let frame = self.render_larger(scene, settings, &crate::gpu::targets::sample_counts(&self.gpu))?;
             let shown = ShownFrame::upload(&self.gpu, &[&frame.left, &frame.right]);
             return Ok((frame, shown));
         }

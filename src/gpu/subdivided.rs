@@ -1,6 +1,6 @@
 //! The projection methods (`adaptive`, `fixed:N`, `vertex`): the `subdivide` stage's compute
 //! passes, then the `raster` stage draws the subdivided triangles indirectly for both eyes (one
-//! multiview draw, or a pass per eye). The schedule is a [`FramePlan`]: everything in one
+//! multiview draw, or a pass per eye). The schedule is a `FramePlan`: everything in one
 //! submission, or, where a buffer overflowed, chunks of triangles and pieces drawn one after
 //! another into the same targets.
 
@@ -12,7 +12,7 @@ use crate::core::settings::RenderSettings;
 use crate::encoding::frame::FrameStep;
 use crate::encoding::params::raster_params;
 use crate::encoding::recording::Recording;
-use crate::encoding::schedule::{run_plan, Capacities, FramePlan, SubdivisionEngine};
+use crate::encoding::schedule::{run_plan, Capacities, SubdivisionEngine};
 use crate::encoding::subdivide::PassTiming;
 use crate::encoding::types::{ProjectionUniform, RasterParams, SubdivideCounters, SubdivideParams};
 use crate::error::Result;
@@ -67,9 +67,6 @@ impl Method for SubdividedMethod {
         let [tile_w, tile_h] = p.image_size();
         res.targets(gpu, tile_w, tile_h, settings.measure.positions, settings.shading.hdr, settings.shading.samples);
         let n = scene.triangle_count;
-        if let FramePlan::OneSubmission(want, _) = plan {
-            SubdivisionBuffers::ensure(&mut res.buffers, gpu, want, scene);
-        }
         let panorama = p.panorama;
         let mut engine = FrameDraw { method: self, gpu, res, scene, settings, panorama, clock: FrameClock::default() };
         let totals = run_plan(&mut engine, settings, n, plan, chunk)?;
@@ -114,7 +111,7 @@ impl Method for SubdividedMethod {
 }
 
 impl SubdividedMethod {
-    /// The usual frame, in one submission (see [`FramePlan::OneSubmission`]): the subdivision,
+    /// The usual frame, in one submission (see `FramePlan::OneSubmission`): the subdivision,
     /// the raster (drawn before the counters are read: a frame whose buffers overflowed is drawn
     /// again by chunks), the counters and timestamps read back. The counters and, with timestamp
     /// queries, the GPU times (ms) of the subdivision, the raster and the whole frame.

@@ -248,14 +248,6 @@ impl Panorama for Cave {
         [width, width]
     }
 
-    fn has_slits(&self) -> bool {
-        false
-    }
-
-    fn drawn_as_pinhole(&self) -> bool {
-        true
-    }
-
     fn validate(&self, p: &Projection) -> Result<()> {
         p.validate_cave()
     }

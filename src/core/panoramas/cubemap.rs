@@ -288,10 +288,6 @@ impl Panorama for Cubemap {
         [width, 2 * width / 3]
     }
 
-    fn has_slits(&self) -> bool {
-        false
-    }
-
     fn validate(&self, p: &Projection) -> Result<()> {
         p.validate_cubemap()
     }

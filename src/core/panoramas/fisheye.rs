@@ -180,10 +180,6 @@ impl Panorama for Fisheye {
         [width, width]
     }
 
-    fn has_slits(&self) -> bool {
-        false
-    }
-
     fn takes_unmeasured_edges(&self) -> bool {
         false
     }

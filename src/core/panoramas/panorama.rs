@@ -97,9 +97,10 @@ pub trait Panorama: Sync {
     /// The image size per eye, pixels, of a frame `width` wide (`--width` alone).
     fn default_size(&self, width: u32) -> [u32; 2];
 
-    /// Whether the slit renderer (`slit:W`, the reference) pastes this panorama's slits.
+    /// Whether the slit renderer (`slit:W`, the reference) pastes this panorama's slits: its
+    /// columns (or the sphere's tiles) in the linear image map.
     fn has_slits(&self) -> bool {
-        true
+        self.image_map() == ImageMap::Linear
     }
 
     /// Whether an edge split without measuring it (`vertex`, `fixed:N`) is drawn within the
@@ -108,9 +109,10 @@ pub trait Panorama: Sync {
         true
     }
 
-    /// Whether every method draws it as one pinhole per eye, without subdivision (the CAVE).
+    /// Whether every method draws it as one pinhole per eye, without subdivision: where the
+    /// eyes are pinholes before a plane (the CAVE).
     fn drawn_as_pinhole(&self) -> bool {
-        false
+        self.eye_model() == EyeModel::Pinhole
     }
 
     /// The panorama's own settings (its field of view, its wall, its grid), each error naming
